@@ -1,0 +1,149 @@
+//! Integrators for first-order systems `y' = f(t, y)`.
+//!
+//! One integrator per file behind the small [`Integrator`] trait (the REBOUND layout):
+//! - [`bulirsch_stoer`]: our own adaptive Gragg–Bulirsch–Stoer extrapolation integrator in the style of
+//!   Hairer's ODEX (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9), the method Roig03 §3 used;
+//! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dop853, Dopri5 and Rk4, for cross-checks;
+//! - [`problems`]: canonical test problems with known solutions, shared by tests and benchmarks.
+
+pub mod bulirsch_stoer;
+pub mod ode_solvers_adapter;
+pub mod problems;
+
+use std::fmt;
+
+/// A first-order ODE system `dy/dt = f(t, y)` of fixed dimension.
+pub trait OdeSystem: Sync {
+    /// Number of state components.
+    fn dim(&self) -> usize;
+    /// Writes `f(t, y)` into `dydt` (both of length [`OdeSystem::dim`]).
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
+}
+
+/// Which integrator runs a system (the scene's `[integrator] method`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// Adaptive Bulirsch–Stoer (ours), `"bulirsch-stoer"`.
+    BulirschStoer,
+    /// Dormand–Prince 8(5,3) from `ode_solvers`, `"dop853"`.
+    Dop853,
+    /// Dormand–Prince 5(4) from `ode_solvers`, `"dopri5"`.
+    Dopri5,
+    /// Classical fixed-step Runge–Kutta 4 from `ode_solvers`, `"rk4"` (needs a step).
+    Rk4,
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let s = match self {
+            Method::BulirschStoer => "bulirsch-stoer",
+            Method::Dop853 => "dop853",
+            Method::Dopri5 => "dopri5",
+            Method::Rk4 => "rk4",
+        };
+        f.write_str(s)
+    }
+}
+
+/// Relative and absolute tolerances, one pair per state component.
+///
+/// The error of a step is measured in the scaled RMS norm
+/// `err = sqrt( (1/n) Σ_i (e_i / (atol_i + rtol_i · max(|y_i(t)|, |y_i(t+h)|)))² )`
+/// and a step is accepted when `err ≤ 1`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tolerances {
+    /// Relative tolerance per component (dimensionless, > 0).
+    pub rtol: Vec<f64>,
+    /// Absolute tolerance per component (units of that component, ≥ 0).
+    pub atol: Vec<f64>,
+}
+
+impl Tolerances {
+    /// The same `rtol` and `atol` for all `n` components.
+    pub fn uniform(rtol: f64, atol: f64, n: usize) -> Self {
+        Tolerances { rtol: vec![rtol; n], atol: vec![atol; n] }
+    }
+}
+
+/// Counters every integrator keeps (cumulative over its life).
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize)]
+pub struct Stats {
+    /// Accepted steps.
+    pub steps_accepted: u64,
+    /// Rejected steps (error too large, stability check, non-finite trial values).
+    pub steps_rejected: u64,
+    /// Evaluations of the right-hand side.
+    pub rhs_evaluations: u64,
+    /// Smallest accepted step size (s); `f64::INFINITY` before the first step.
+    pub smallest_step: f64,
+}
+
+/// Why an integration stopped early. The state passed to the integrator is left at the last good
+/// (accepted) point `t`, so the caller can save it.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum IntegrateError {
+    /// The state or its derivative became NaN or infinite and step reduction did not cure it.
+    #[error("non-finite state or derivative at t = {t} s (last good state kept)")]
+    NonFinite {
+        /// Last good time (s).
+        t: f64,
+    },
+    /// The step size fell below the resolvable limit `|h| < 10 ε |t|` (or below `h_min`).
+    #[error("step size underflow at t = {t} s: h = {h:e} s (last good state kept)")]
+    StepUnderflow {
+        /// Last good time (s).
+        t: f64,
+        /// The step that was too small (s).
+        h: f64,
+    },
+    /// More steps than the configured maximum.
+    #[error("more than {max_steps} steps before t = {t} s (last good state kept)")]
+    TooManySteps {
+        /// Last good time (s).
+        t: f64,
+        /// The limit.
+        max_steps: u64,
+    },
+    /// A configuration error (e.g. rk4 without a step, tolerances of the wrong length).
+    #[error("integrator configuration: {0}")]
+    Config(String),
+}
+
+/// An integrator that advances a state to requested times, landing on each exactly.
+pub trait Integrator {
+    /// Advances `y` from `*t` to `t_target` (> `*t`), landing exactly on `t_target`.
+    /// On success `*t == t_target`. On error `*t, y` hold the last accepted point.
+    fn advance(
+        &mut self,
+        system: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_target: f64,
+    ) -> Result<(), IntegrateError>;
+    /// Cumulative statistics.
+    fn stats(&self) -> Stats;
+    /// Which method this is.
+    fn method(&self) -> Method;
+}
+
+/// Builds the integrator for `method`. `step` is the fixed step (s) for `Rk4`, or an optional
+/// initial step for the adaptive methods.
+pub fn make_integrator(
+    method: Method,
+    tolerances: Tolerances,
+    step: Option<f64>,
+) -> Result<Box<dyn Integrator + Send>, IntegrateError> {
+    match method {
+        Method::BulirschStoer => Ok(Box::new(bulirsch_stoer::BulirschStoer::new(tolerances, step)?)),
+        Method::Dop853 | Method::Dopri5 => {
+            Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(method, tolerances, step)?))
+        }
+        Method::Rk4 => match step {
+            Some(h) if h > 0.0 && h.is_finite() => {
+                Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(method, tolerances, step)?))
+            }
+            _ => Err(IntegrateError::Config("rk4 needs a positive finite `step` (s)".into())),
+        },
+    }
+}

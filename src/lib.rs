@@ -1,0 +1,11 @@
+//! rubblepile — dynamics of rubble-pile asteroids.
+//!
+//! The core is the interacting-ellipsoids model of Roig et al. (2003, Icarus 165) ("Roig03"):
+//! rigid triaxial fragments with a Gaussian-overlap contact potential, monopole gravity,
+//! quaternion attitudes constrained by Lagrange multipliers, a Rayleigh point-dissipation function,
+//! integrated by an adaptive Bulirsch–Stoer integrator.
+
+pub mod ellipsoid;
+pub mod geometry;
+pub mod integrate;
+pub mod math;
