@@ -1,15 +1,39 @@
 //! Equations of motion of N interacting ellipsoids (Roig03 Eqs. 28–37) as an [`OdeSystem`].
 //!
-//! API skeleton — bodies being filled in.
+//! State per body, in order: `r` (3, m), `q` (4), `u = m ṙ` (3, kg m/s), `p = M(q) q̇` (4, kg m² s⁻¹),
+//! i.e. 14 numbers; when attitudes are not integrated (all bodies spheres and no dissipation, so nothing
+//! depends on attitude) only `r, u` (6 numbers) and the spins stay constant. With dissipation on, one
+//! more component at the end carries `∫F dt` (J), so `H(t) − H0 − 2∫F dt` is a checkable residual.
+//!
+//! `u̇ = ∂L/∂r + ∂F/∂ṙ`; `ṗ = ∂L/∂q + ∂F/∂q̇ − λ q` with λ fixed by differentiating `q·q̇ = 0` twice:
+//! `qᵀ M⁻¹ ṗ = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` (Roig03 Eq. 35 as corrected in the notes), solved per body as
+//! the 4×4 system of Eq. 36 by LU ([`constrained_momentum_rate`]); [`constrained_momentum_rate_closed_form`]
+//! is the equivalent closed form used as a test oracle.
 
-use crate::ellipsoid::body::{Body, InertiaModel};
+use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
+use crate::ellipsoid::calibration::pair_prefactor;
+use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
+use crate::ellipsoid::gravity::gravity_forces;
+use crate::ellipsoid::potential::{
+    BodyGeometry, contact_gradient, cull_exponent, interaction_radius, is_negligible, overlap,
+};
+use crate::ellipsoid::quaternion::{
+    extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin,
+    rotational_kinetic_gradient, rotation_matrix, to_unit_quaternion,
+    w_matrix,
+};
+use crate::geometry::neighbours::sphere_pairs;
 use crate::integrate::OdeSystem;
-use crate::math::Vec3;
+use crate::math::{Mat4, Vec3, Vec4};
+use rayon::prelude::*;
+
+/// SI gravitational constant (m³ kg⁻¹ s⁻²), the default of `gravity = { G = … }`.
+pub const G_SI: f64 = 6.674e-11;
 
 /// Monopole gravity term (Roig03 Eq. 6).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GravityTerm {
-    /// Gravitational constant G (m³ kg⁻¹ s⁻²); SI default 6.674e-11.
+    /// Gravitational constant G (m³ kg⁻¹ s⁻²); SI default [`G_SI`].
     pub g: f64,
 }
 
@@ -18,6 +42,12 @@ pub struct GravityTerm {
 pub struct ContactTerm {
     /// Pairs whose potential is provably below `cutoff × amplitude` are skipped (dimensionless, default 1e-16).
     pub cutoff: f64,
+}
+
+impl Default for ContactTerm {
+    fn default() -> Self {
+        ContactTerm { cutoff: 1e-16 }
+    }
 }
 
 /// Point dissipation term (Roig03 Eqs. 40–41).
@@ -45,7 +75,7 @@ pub struct ModelConfig {
     pub kappa: f64,
     /// Which moments of inertia the bodies get.
     pub inertia: InertiaModel,
-    /// G used in `U0_ij` (Roig03 Eq. 11) — the gravity term's G, or the SI value when gravity is off.
+    /// G used in `U0_ij` (Roig03 Eq. 11) — the gravity term's G, or [`G_SI`] when gravity is off.
     pub contact_g: f64,
 }
 
@@ -56,9 +86,9 @@ pub struct Diagnostics {
     pub kinetic_translational: f64,
     /// Rotational kinetic energy K_R (J).
     pub kinetic_rotational: f64,
-    /// Contact potential energy U_C (J).
+    /// Contact potential energy U_C (J); 0 when the contact term is off.
     pub potential_contact: f64,
-    /// Gravitational potential energy U_G (J).
+    /// Gravitational potential energy U_G (J); 0 when gravity is off.
     pub potential_gravity: f64,
     /// `2 ∫ F dt` so far (J, ≤ 0).
     pub dissipated: f64,
@@ -83,43 +113,403 @@ impl Diagnostics {
     }
 }
 
+/// Kinematic quantities of one body in one state.
+#[derive(Debug, Clone, Copy)]
+struct Kinematics {
+    r: Vec3,
+    q: Vec4,
+    u: Vec3,
+    p: Vec4,
+    q_dot: Vec4,
+    spin_body: Vec3,
+    spin_world: Vec3,
+    geometry: Option<BodyGeometry>,
+}
+
+/// Contributions of one pair to the generalised forces.
+#[derive(Debug, Clone, Copy)]
+struct PairTerms {
+    i: usize,
+    j: usize,
+    /// Generalised force on `r_i` (N); `r_j` gets its negative.
+    force_i: Vec3,
+    /// Generalised force on `q_i`, `q_j` (J).
+    gq_i: Vec4,
+    gq_j: Vec4,
+    /// `U_C` of the pair (J), counted only when the contact term is on.
+    potential: f64,
+    /// `F_ij` (W).
+    dissipation: f64,
+}
+
 /// The N-ellipsoid system.
 pub struct EllipsoidSystem {
-    _private: (),
+    initial: Vec<Body>,
+    shapes: Vec<Ellipsoid>,
+    moments: Vec<Vec3>,
+    inertia_ext: Vec<Vec4>,
+    radii: Vec<f64>,
+    model: ModelConfig,
+    physics: Physics,
+    rotation: bool,
+    stride: usize,
+    cull_exp: f64,
 }
 
 impl EllipsoidSystem {
     /// Builds the system from bodies (validated by the caller), model constants and physics.
-    pub fn new(_bodies: &[Body], _model: ModelConfig, _physics: Physics) -> Self {
-        todo!()
+    pub fn new(bodies: &[Body], model: ModelConfig, physics: Physics) -> Self {
+        let shapes: Vec<Ellipsoid> = bodies.iter().map(|b| b.shape).collect();
+        let kappa_i = model.inertia.inertia_kappa(model.kappa);
+        let moments: Vec<Vec3> = shapes.iter().map(|s| s.principal_moments(kappa_i)).collect();
+        let rotation = physics.dissipation.is_some() || !shapes.iter().all(|s| s.is_sphere());
+        let cutoff = physics.contact.map_or(ContactTerm::default().cutoff, |c| c.cutoff);
+        EllipsoidSystem {
+            initial: bodies.to_vec(),
+            inertia_ext: moments.iter().map(extended_inertia).collect(),
+            radii: shapes.iter().map(|s| s.equivalent_radius()).collect(),
+            shapes,
+            moments,
+            model,
+            physics,
+            rotation,
+            stride: if rotation { 14 } else { 6 },
+            cull_exp: cull_exponent(cutoff),
+        }
     }
-    /// The packed initial state.
+
+    /// The packed initial state (quaternions normalised, `q̇ ⊥ q`).
     pub fn initial_state(&self) -> Vec<f64> {
-        todo!()
+        let mut y = vec![0.0; self.dim()];
+        for (i, b) in self.initial.iter().enumerate() {
+            let s = &mut y[i * self.stride..(i + 1) * self.stride];
+            let u = b.velocity * b.shape.mass;
+            s[0..3].copy_from_slice(b.position.as_slice());
+            if self.rotation {
+                let q = b.quaternion.normalize();
+                let q_dot = q_dot_from_body_spin(&q, &b.spin_body);
+                let p = mass_matrix(&q, &self.inertia_ext[i]) * q_dot;
+                s[3..7].copy_from_slice(q.as_slice());
+                s[7..10].copy_from_slice(u.as_slice());
+                s[10..14].copy_from_slice(p.as_slice());
+            } else {
+                s[3..6].copy_from_slice(u.as_slice());
+            }
+        }
+        y
     }
+
     /// Whether attitudes are integrated (false for all-sphere scenes without dissipation).
     pub fn rotation_integrated(&self) -> bool {
-        todo!()
+        self.rotation
     }
+
     /// Number of bodies.
     pub fn n_bodies(&self) -> usize {
-        todo!()
+        self.shapes.len()
     }
-    /// The bodies' state at time `t` from the packed state `y`.
-    pub fn bodies_at(&self, _t: f64, _y: &[f64]) -> Vec<Body> {
-        todo!()
+
+    /// The enabled physics.
+    pub fn physics(&self) -> &Physics {
+        &self.physics
     }
+
+    /// The model constants.
+    pub fn model(&self) -> &ModelConfig {
+        &self.model
+    }
+
+    /// Principal moments of inertia of each body (kg m²).
+    pub fn principal_moments(&self) -> &[Vec3] {
+        &self.moments
+    }
+
+    /// Index of the `∫F dt` component in the state, when dissipation is on.
+    pub fn dissipation_index(&self) -> Option<usize> {
+        self.physics.dissipation.map(|_| self.n_bodies() * self.stride)
+    }
+
+    fn kinematics(&self, i: usize, y: &[f64], with_geometry: bool) -> Kinematics {
+        let s = &y[i * self.stride..(i + 1) * self.stride];
+        let r = Vec3::new(s[0], s[1], s[2]);
+        if self.rotation {
+            let q = Vec4::new(s[3], s[4], s[5], s[6]);
+            let u = Vec3::new(s[7], s[8], s[9]);
+            let p = Vec4::new(s[10], s[11], s[12], s[13]);
+            let q_dot = inverse_mass_matrix(&q, &self.inertia_ext[i]) * p;
+            let wq = w_matrix(&q) * q_dot;
+            let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
+            let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
+            let rot = geometry.map_or_else(|| rotation_matrix(&q), |g| g.rot);
+            Kinematics { r, q, u, p, q_dot, spin_body, spin_world: rot.transpose() * spin_body, geometry }
+        } else {
+            let b = &self.initial[i];
+            let q = b.quaternion.normalize();
+            let spin_world = rotation_matrix(&q).transpose() * b.spin_body;
+            Kinematics {
+                r,
+                q,
+                u: Vec3::new(s[3], s[4], s[5]),
+                p: Vec4::zeros(),
+                q_dot: Vec4::zeros(),
+                spin_body: b.spin_body,
+                spin_world,
+                // Spheres: Σ = R² 1 whatever the attitude.
+                geometry: with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &Vec4::w())),
+            }
+        }
+    }
+
+    fn all_kinematics(&self, y: &[f64], with_geometry: bool) -> Vec<Kinematics> {
+        let n = self.n_bodies();
+        if n >= 64 {
+            (0..n).into_par_iter().map(|i| self.kinematics(i, y, with_geometry)).collect()
+        } else {
+            (0..n).map(|i| self.kinematics(i, y, with_geometry)).collect()
+        }
+    }
+
+    fn needs_pairs(&self) -> bool {
+        self.physics.contact.is_some() || self.physics.dissipation.is_some()
+    }
+
+    /// Candidate pairs that are not provably negligible (bounding-sphere search, then the exact bound).
+    fn interacting_pairs(&self, kin: &[Kinematics]) -> Vec<(usize, usize)> {
+        let kappa = self.model.kappa;
+        let centres: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
+        let radii: Vec<f64> = kin
+            .iter()
+            .map(|k| interaction_radius(kappa, k.geometry.as_ref().expect("geometry"), self.cull_exp))
+            .collect();
+        let mut pairs = sphere_pairs(&centres, &radii);
+        pairs.retain(|&(i, j)| {
+            let (gi, gj) = (kin[i].geometry.as_ref().unwrap(), kin[j].geometry.as_ref().unwrap());
+            !is_negligible(kappa, &(kin[i].r - kin[j].r), gi, gj, self.cull_exp)
+        });
+        pairs
+    }
+
+    fn pair_terms(&self, i: usize, j: usize, kin: &[Kinematics], with_forces: bool) -> PairTerms {
+        let kappa = self.model.kappa;
+        let (ki, kj) = (&kin[i], &kin[j]);
+        let (gi, gj) = (ki.geometry.as_ref().unwrap(), kj.geometry.as_ref().unwrap());
+        let prefactor = pair_prefactor(
+            self.model.contact_g,
+            kappa,
+            self.radii[i],
+            self.shapes[i].mass,
+            self.radii[j],
+            self.shapes[j].mass,
+        );
+        let ov = overlap(prefactor, kappa, &(ki.r - kj.r), gi, gj);
+        let mut t = PairTerms {
+            i,
+            j,
+            force_i: Vec3::zeros(),
+            gq_i: Vec4::zeros(),
+            gq_j: Vec4::zeros(),
+            potential: 0.0,
+            dissipation: 0.0,
+        };
+        if self.physics.contact.is_some() {
+            t.potential = ov.potential;
+            if with_forces {
+                let grad = contact_gradient(&ov, kappa, gi, gj);
+                t.force_i -= grad.d_ri;
+                if self.rotation {
+                    t.gq_i -= grad.d_qi;
+                    t.gq_j -= grad.d_qj;
+                }
+            }
+        }
+        if let Some(d) = self.physics.dissipation {
+            let vi = BodyVelocity { velocity: ki.u / self.shapes[i].mass, spin_world: ki.spin_world };
+            let vj = BodyVelocity { velocity: kj.u / self.shapes[j].mass, spin_world: kj.spin_world };
+            let pd = pair_dissipation(d.f0, kappa, &ov, gi, gj, &vi, &vj);
+            t.dissipation = pd.value;
+            if with_forces {
+                t.force_i += pd.d_vi;
+                t.gq_i += spin_force_to_quaternion(&ki.q, gi, &pd.d_wi);
+                t.gq_j += spin_force_to_quaternion(&kj.q, gj, &pd.d_wj);
+            }
+        }
+        t
+    }
+
+    fn all_pair_terms(&self, kin: &[Kinematics], with_forces: bool) -> Vec<PairTerms> {
+        if !self.needs_pairs() {
+            return Vec::new();
+        }
+        let pairs = self.interacting_pairs(kin);
+        if pairs.len() >= 32 {
+            pairs.par_iter().map(|&(i, j)| self.pair_terms(i, j, kin, with_forces)).collect()
+        } else {
+            pairs.iter().map(|&(i, j)| self.pair_terms(i, j, kin, with_forces)).collect()
+        }
+    }
+
+    /// The bodies' state at time `t` from the packed state `y` (`spin_body` from `q̇`; for non-integrated
+    /// attitudes, the free uniform rotation of a sphere about its constant world spin).
+    pub fn bodies_at(&self, t: f64, y: &[f64]) -> Vec<Body> {
+        (0..self.n_bodies())
+            .map(|i| {
+                let k = self.kinematics(i, y, false);
+                let mass = self.shapes[i].mass;
+                let (quaternion, spin_body) = if self.rotation {
+                    (k.q, k.spin_body)
+                } else {
+                    let rotated =
+                        nalgebra::UnitQuaternion::from_scaled_axis(k.spin_world * t) * to_unit_quaternion(&k.q);
+                    let q = from_unit_quaternion(&rotated);
+                    (q, rotation_matrix(&q) * k.spin_world)
+                };
+                Body { shape: self.shapes[i], position: k.r, velocity: k.u / mass, quaternion, spin_body }
+            })
+            .collect()
+    }
+
     /// Diagnostics of the packed state `y`.
-    pub fn diagnostics(&self, _y: &[f64]) -> Diagnostics {
-        todo!()
+    pub fn diagnostics(&self, y: &[f64]) -> Diagnostics {
+        let kin = self.all_kinematics(y, self.needs_pairs());
+        let mut d = Diagnostics::default();
+        for (i, k) in kin.iter().enumerate() {
+            let m = self.shapes[i].mass;
+            let l_spin = rotation_matrix(&k.q).transpose() * self.moments[i].component_mul(&k.spin_body);
+            let l_orb = k.r.cross(&k.u);
+            d.kinetic_translational += 0.5 * k.u.norm_squared() / m;
+            d.kinetic_rotational += 0.5 * k.spin_body.dot(&self.moments[i].component_mul(&k.spin_body));
+            d.momentum += k.u;
+            d.angular_momentum += l_orb + l_spin;
+            d.momentum_scale += k.u.norm();
+            d.angular_momentum_scale += l_orb.norm() + l_spin.norm();
+            if self.rotation {
+                d.quaternion_norm_error = d.quaternion_norm_error.max((k.q.norm() - 1.0).abs());
+            }
+        }
+        if self.rotation {
+            // K_R = ½ pᵀ M⁻¹ p exactly (includes the tiny q·q̇ part the spin form leaves out).
+            d.kinetic_rotational = kin.iter().map(|k| 0.5 * k.p.dot(&k.q_dot)).sum();
+        }
+        if self.physics.contact.is_some() {
+            d.potential_contact = self.all_pair_terms(&kin, false).iter().map(|t| t.potential).sum();
+        }
+        if let Some(gr) = self.physics.gravity {
+            let pos: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
+            let masses: Vec<f64> = self.shapes.iter().map(|s| s.mass).collect();
+            let mut f = vec![Vec3::zeros(); pos.len()];
+            d.potential_gravity = gravity_forces(gr.g, &pos, &masses, &mut f);
+        }
+        if let Some(idx) = self.dissipation_index() {
+            d.dissipated = 2.0 * y[idx];
+        }
+        d.energy_scale = d.kinetic_translational
+            + d.kinetic_rotational
+            + d.potential_contact.abs()
+            + d.potential_gravity.abs();
+        d
     }
+}
+
+/// `∂F/∂q̇ = 2 W₃(q)ᵀ R ∂F/∂ω_w` (the chain rule through `ω_w = Rᵀ 2 W₃ q̇`).
+fn spin_force_to_quaternion(q: &Vec4, g: &BodyGeometry, d_spin_world: &Vec3) -> Vec4 {
+    let b = g.rot * d_spin_world;
+    2.0 * w_matrix(q).transpose() * Vec4::new(b.x, b.y, b.z, 0.0)
+}
+
+/// The right side `c = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` of the differentiated constraint (corrected Roig03 Eq. 35),
+/// with `M⁻¹ p = q̇` and `Ṁ = 4 (W(q̇)ᵀ Ĩ W(q) + W(q)ᵀ Ĩ W(q̇))`.
+pub fn constraint_rhs(q: &Vec4, q_dot: &Vec4, m_inv: &Mat4, inertia_ext: &Vec4) -> f64 {
+    let (w, w_dot) = (w_matrix(q), w_matrix(q_dot));
+    let m_dot_q_dot = 4.0
+        * (w_dot.transpose() * inertia_ext.component_mul(&(w * q_dot))
+            + w.transpose() * inertia_ext.component_mul(&(w_dot * q_dot)));
+    (m_inv * q).dot(&m_dot_q_dot) - q_dot.norm_squared()
+}
+
+/// `ṗ` from Roig03 Eq. 36: three rows of the projector `|q|² 1 − q qᵀ` (the row of the largest `|q_k|`
+/// deleted) applied to `ṗ = g` plus the constraint row `qᵀ M⁻¹ ṗ = c`, solved by LU.
+/// `g = ∂L/∂q + ∂F/∂q̇` (J).
+pub fn constrained_momentum_rate(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Vec4 {
+    let q2 = q.norm_squared();
+    let kmax = q.iamax();
+    let qg = q.dot(g);
+    let mq = m_inv * q;
+    let mut a = Mat4::zeros();
+    let mut b = Vec4::zeros();
+    let mut row = 0;
+    for k in (0..4).filter(|&k| k != kmax) {
+        for l in 0..4 {
+            a[(row, l)] = if l == k { q2 } else { 0.0 } - q[k] * q[l];
+        }
+        b[row] = q2 * g[k] - q[k] * qg;
+        row += 1;
+    }
+    for l in 0..4 {
+        a[(3, l)] = mq[l];
+    }
+    b[3] = c;
+    a.lu().solve(&b).unwrap_or_else(|| Vec4::from_element(f64::NAN))
+}
+
+/// Closed form equivalent to [`constrained_momentum_rate`]: `ṗ = g − λ q`, `λ = (qᵀM⁻¹g − c)/(qᵀM⁻¹q)`.
+pub fn constrained_momentum_rate_closed_form(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Vec4 {
+    let mq = m_inv * q;
+    let lambda = (mq.dot(g) - c) / mq.dot(q);
+    g - lambda * q
 }
 
 impl OdeSystem for EllipsoidSystem {
     fn dim(&self) -> usize {
-        todo!()
+        self.n_bodies() * self.stride + usize::from(self.physics.dissipation.is_some())
     }
-    fn rhs(&self, _t: f64, _y: &[f64], _dydt: &mut [f64]) {
-        todo!()
+
+    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+        let n = self.n_bodies();
+        let kin = self.all_kinematics(y, self.needs_pairs());
+        let mut force = vec![Vec3::zeros(); n];
+        let mut gq = vec![Vec4::zeros(); n];
+        let mut dissipation_rate = 0.0;
+        for t in self.all_pair_terms(&kin, true) {
+            force[t.i] += t.force_i;
+            force[t.j] -= t.force_i;
+            gq[t.i] += t.gq_i;
+            gq[t.j] += t.gq_j;
+            dissipation_rate += t.dissipation;
+        }
+        if let Some(gr) = self.physics.gravity {
+            let pos: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
+            let masses: Vec<f64> = self.shapes.iter().map(|s| s.mass).collect();
+            let mut fg = vec![Vec3::zeros(); n];
+            gravity_forces(gr.g, &pos, &masses, &mut fg);
+            force.iter_mut().zip(&fg).for_each(|(f, g)| *f += g);
+        }
+        let stride = self.stride;
+        let rotation = self.rotation;
+        let body_rate = |(i, out): (usize, &mut [f64])| {
+            let k = &kin[i];
+            let v = k.u / self.shapes[i].mass;
+            out[0..3].copy_from_slice(v.as_slice());
+            if rotation {
+                let ie = &self.inertia_ext[i];
+                let m_inv = inverse_mass_matrix(&k.q, ie);
+                let g = rotational_kinetic_gradient(&k.q, &k.q_dot, ie) + gq[i];
+                let c = constraint_rhs(&k.q, &k.q_dot, &m_inv, ie);
+                let p_dot = constrained_momentum_rate(&k.q, &g, &m_inv, c);
+                out[3..7].copy_from_slice(k.q_dot.as_slice());
+                out[7..10].copy_from_slice(force[i].as_slice());
+                out[10..14].copy_from_slice(p_dot.as_slice());
+            } else {
+                out[3..6].copy_from_slice(force[i].as_slice());
+            }
+        };
+        let (bodies, rest) = dydt.split_at_mut(n * stride);
+        if n >= 64 {
+            bodies.par_chunks_mut(stride).enumerate().for_each(body_rate);
+        } else {
+            bodies.chunks_mut(stride).enumerate().for_each(body_rate);
+        }
+        if let Some(slot) = rest.first_mut() {
+            *slot = dissipation_rate;
+        }
     }
 }

@@ -1,1 +1,3 @@
-//! Neighbour search shared by the engines.
+//! Geometry shared by the engines: neighbour search (and, later, wall primitives).
+
+pub mod neighbours;
