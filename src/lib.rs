@@ -5,7 +5,11 @@
 //! quaternion attitudes constrained by Lagrange multipliers, a Rayleigh point-dissipation function,
 //! integrated by an adaptive Bulirsch–Stoer integrator.
 
+pub mod cli;
 pub mod ellipsoid;
 pub mod geometry;
 pub mod integrate;
+pub mod io;
 pub mod math;
+pub mod run;
+pub mod scene;

@@ -1,3 +1,5 @@
-fn main() {
-    println!("Hello, world!");
+//! `rubblepile`: see [`rubblepile::cli`].
+
+fn main() -> std::process::ExitCode {
+    rubblepile::cli::main()
 }

@@ -32,13 +32,24 @@ fn torque_free_asymmetric_top_matches_euler_equations() {
     let mut rng = Random::new(11);
     let spin = [0.02, 0.05, 0.5];
     let body = rock([3.0, 2.0, 1.0], [0.0; 3], [0.0; 3], rng.unit_quaternion(), spin);
-    let model = ModelConfig { kappa: 10.0, inertia: InertiaModel::Gaussian, contact_g: G_SI };
+    let model = ModelConfig {
+        kappa: 10.0,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
     let sys = EllipsoidSystem::new(&[body], model, Physics::default());
     assert!(sys.rotation_integrated());
     let period = 2.0 * std::f64::consts::PI / Vec3::from(spin).norm();
     let t_end = 60.0 * period;
-    let reference = EulerEquations { moments: sys.principal_moments()[0] };
-    let mut integ = make_integrator(Method::BulirschStoer, Tolerances::uniform(1e-11, 1e-11, sys.dim()), None).unwrap();
+    let reference = EulerEquations {
+        moments: sys.principal_moments()[0],
+    };
+    let mut integ = make_integrator(
+        Method::BulirschStoer,
+        Tolerances::uniform(1e-11, 1e-11, sys.dim()),
+        None,
+    )
+    .unwrap();
     let mut reference_integ = make_integrator(Method::Dop853, Tolerances::uniform(1e-13, 1e-13, 3), None).unwrap();
     let (mut t, mut t_ref) = (0.0, 0.0);
     let mut y = sys.initial_state();
@@ -48,13 +59,19 @@ fn torque_free_asymmetric_top_matches_euler_equations() {
     for k in 1..=120 {
         let target = t_end * k as f64 / 120.0;
         integ.advance(&sys, &mut t, &mut y, target).unwrap();
-        reference_integ.advance(&reference, &mut t_ref, &mut w_ref, target).unwrap();
+        reference_integ
+            .advance(&reference, &mut t_ref, &mut w_ref, target)
+            .unwrap();
         let w = sys.bodies_at(t, &y)[0].spin_body;
         let err = (w - Vec3::from_column_slice(&w_ref)).norm() / Vec3::from(spin).norm();
         worst = worst.max(err);
         worst_q = worst_q.max(sys.diagnostics(&y).quaternion_norm_error);
     }
-    eprintln!("top: {:.0} periods, max relative spin error {worst:e}, max ||q|-1| {worst_q:e}, stats {:?}", t_end / period, integ.stats());
+    eprintln!(
+        "top: {:.0} periods, max relative spin error {worst:e}, max ||q|-1| {worst_q:e}, stats {:?}",
+        t_end / period,
+        integ.stats()
+    );
     assert!(worst <= 1e-8, "body spin differs from Euler's equations by {worst:e}");
     assert!(worst_q <= 1e-9, "||q| - 1| = {worst_q:e}");
 }
@@ -63,10 +80,26 @@ fn torque_free_asymmetric_top_matches_euler_equations() {
 /// faster than the mutual escape speed, so they collide, rebound and separate.
 fn grazing_pair(physics: Physics) -> EllipsoidSystem {
     let mut rng = Random::new(12);
-    let a = rock([1000.0, 700.0, 500.0], [-2500.0, -600.0, 0.0], [1.2, 0.0, 0.0], rng.unit_quaternion(), [2e-4, -1e-4, 8e-4]);
-    let b = rock([900.0, 800.0, 600.0], [2500.0, 600.0, 50.0], [-1.2, 0.0, 0.0], rng.unit_quaternion(), [-3e-4, 5e-4, 1e-4]);
+    let a = rock(
+        [1000.0, 700.0, 500.0],
+        [-2500.0, -600.0, 0.0],
+        [1.2, 0.0, 0.0],
+        rng.unit_quaternion(),
+        [2e-4, -1e-4, 8e-4],
+    );
+    let b = rock(
+        [900.0, 800.0, 600.0],
+        [2500.0, 600.0, 50.0],
+        [-1.2, 0.0, 0.0],
+        rng.unit_quaternion(),
+        [-3e-4, 5e-4, 1e-4],
+    );
     let (ra, rb) = (a.shape.equivalent_radius(), b.shape.equivalent_radius());
-    let (small, large) = if a.shape.mass < b.shape.mass { (&a, &b) } else { (&b, &a) };
+    let (small, large) = if a.shape.mass < b.shape.mass {
+        (&a, &b)
+    } else {
+        (&b, &a)
+    };
     let kappa = calibrate_kappa(
         10.0,
         2.4,
@@ -77,14 +110,22 @@ fn grazing_pair(physics: Physics) -> EllipsoidSystem {
     )
     .unwrap();
     let _ = (ra, rb);
-    let model = ModelConfig { kappa, inertia: InertiaModel::Gaussian, contact_g: G_SI };
+    let model = ModelConfig {
+        kappa,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
     EllipsoidSystem::new(&[a, b], model, physics)
 }
 
 const T_COLLISION: f64 = 4000.0;
 
 fn conservative() -> Physics {
-    Physics { gravity: Some(GravityTerm { g: G_SI }), contact: Some(ContactTerm::default()), dissipation: None }
+    Physics {
+        gravity: Some(GravityTerm { g: G_SI }),
+        contact: Some(ContactTerm::default()),
+        dissipation: None,
+    }
 }
 
 #[test]
@@ -96,25 +137,43 @@ fn grazing_collision_conserves_energy_and_momenta() {
     // it did collide: the spins changed
     let b = sys.bodies_at(T_COLLISION, &y);
     let b0 = sys.bodies_at(0.0, &sys.initial_state());
-    assert!((b[0].spin_body - b0[0].spin_body).norm() > 1e-2 * b0[0].spin_body.norm(), "no spin exchange: no contact?");
+    assert!(
+        (b[0].spin_body - b0[0].spin_body).norm() > 1e-2 * b0[0].spin_body.norm(),
+        "no spin exchange: no contact?"
+    );
     // and rebounded: moving apart at the end
     assert!((b[1].position - b[0].position).dot(&(b[1].velocity - b[0].velocity)) > 0.0);
     assert!(e.energy <= 10.0 * rtol, "energy error {:e}", e.energy);
     assert!(e.momentum <= 10.0 * rtol, "momentum error {:e}", e.momentum);
-    assert!(e.angular_momentum <= 10.0 * rtol, "angular momentum error {:e}", e.angular_momentum);
+    assert!(
+        e.angular_momentum <= 10.0 * rtol,
+        "angular momentum error {:e}",
+        e.angular_momentum
+    );
 }
 
 #[test]
 fn dissipative_collision_balances_energy_and_conserves_momenta() {
-    let physics = Physics { dissipation: Some(DissipationTerm { f0: 1.0 }), ..conservative() };
+    let physics = Physics {
+        dissipation: Some(DissipationTerm { f0: 1.0 }),
+        ..conservative()
+    };
     let sys = grazing_pair(physics);
     let rtol = 1e-10;
     let (_, e, stats) = integrate(&sys, Method::BulirschStoer, rtol, T_COLLISION, 80);
     eprintln!("grazing dissipative: {e:?} {stats:?}");
     assert!(e.energy <= 10.0 * rtol, "energy residual H - H0 - 2∫F: {:e}", e.energy);
     assert!(e.momentum <= 10.0 * rtol, "momentum error {:e}", e.momentum);
-    assert!(e.angular_momentum <= 10.0 * rtol, "angular momentum error {:e}", e.angular_momentum);
-    assert!(e.dissipated_fraction > 0.01, "only {:e} of the kinetic energy dissipated", e.dissipated_fraction);
+    assert!(
+        e.angular_momentum <= 10.0 * rtol,
+        "angular momentum error {:e}",
+        e.angular_momentum
+    );
+    assert!(
+        e.dissipated_fraction > 0.01,
+        "only {:e} of the kinetic energy dissipated",
+        e.dissipated_fraction
+    );
 }
 
 #[test]
@@ -125,10 +184,29 @@ fn common_rigid_motion_dissipates_nothing() {
     let (ra, rb) = (Vec3::new(-700.0, 100.0, 0.0), Vec3::new(800.0, -50.0, 40.0));
     let (qa, qb) = (rng.unit_quaternion(), rng.unit_quaternion());
     let spin_body = |q: &Vec4| rubblepile::ellipsoid::quaternion::rotation_matrix(q) * omega;
-    let a = rock([1000.0, 700.0, 500.0], ra.into(), omega.cross(&ra).into(), qa, spin_body(&qa).into());
-    let b = rock([900.0, 800.0, 600.0], rb.into(), omega.cross(&rb).into(), qb, spin_body(&qb).into());
-    let model = ModelConfig { kappa: 5.0, inertia: InertiaModel::Gaussian, contact_g: G_SI };
-    let physics = Physics { dissipation: Some(DissipationTerm { f0: 1.0 }), ..conservative() };
+    let a = rock(
+        [1000.0, 700.0, 500.0],
+        ra.into(),
+        omega.cross(&ra).into(),
+        qa,
+        spin_body(&qa).into(),
+    );
+    let b = rock(
+        [900.0, 800.0, 600.0],
+        rb.into(),
+        omega.cross(&rb).into(),
+        qb,
+        spin_body(&qb).into(),
+    );
+    let model = ModelConfig {
+        kappa: 5.0,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
+    let physics = Physics {
+        dissipation: Some(DissipationTerm { f0: 1.0 }),
+        ..conservative()
+    };
     let sys = EllipsoidSystem::new(&[a.clone(), b.clone()], model, physics);
     let y = sys.initial_state();
     let mut dy = vec![0.0; sys.dim()];
@@ -142,7 +220,10 @@ fn common_rigid_motion_dissipates_nothing() {
     sys2.rhs(0.0, &sys2.initial_state(), &mut dy);
     let f_scale = dy[sys2.dissipation_index().unwrap()];
     assert!(f_scale < 0.0);
-    assert!(f_rigid.abs() <= 1e-12 * f_scale.abs(), "rigid motion dissipates {f_rigid:e} (scale {f_scale:e})");
+    assert!(
+        f_rigid.abs() <= 1e-12 * f_scale.abs(),
+        "rigid motion dissipates {f_rigid:e} (scale {f_scale:e})"
+    );
 }
 
 #[test]
@@ -159,16 +240,34 @@ fn bulirsch_stoer_and_dop853_agree_on_collision() {
         assert!((a.position - b.position).norm() <= 1e-8 * scale_r, "positions differ");
         assert!((a.velocity - b.velocity).norm() <= 1e-8 * scale_v, "velocities differ");
         assert!((a.spin_body - b.spin_body).norm() <= 1e-8 * scale_w, "spins differ");
-        let dq = (a.quaternion - b.quaternion).norm().min((a.quaternion + b.quaternion).norm());
+        let dq = (a.quaternion - b.quaternion)
+            .norm()
+            .min((a.quaternion + b.quaternion).norm());
         assert!(dq <= 1e-8, "attitudes differ by {dq:e}");
     }
 }
 
 #[test]
 fn spheres_without_dissipation_skip_rotation() {
-    let s1 = rock([500.0; 3], [-600.0, 0.0, 0.0], [0.1, 0.0, 0.0], Vec4::w(), [0.0, 0.0, 1e-3]);
-    let s2 = rock([400.0; 3], [600.0, 0.0, 0.0], [-0.1, 0.0, 0.0], Vec4::w(), [1e-3, 0.0, 0.0]);
-    let model = ModelConfig { kappa: 5.0, inertia: InertiaModel::Gaussian, contact_g: G_SI };
+    let s1 = rock(
+        [500.0; 3],
+        [-600.0, 0.0, 0.0],
+        [0.1, 0.0, 0.0],
+        Vec4::w(),
+        [0.0, 0.0, 1e-3],
+    );
+    let s2 = rock(
+        [400.0; 3],
+        [600.0, 0.0, 0.0],
+        [-0.1, 0.0, 0.0],
+        Vec4::w(),
+        [1e-3, 0.0, 0.0],
+    );
+    let model = ModelConfig {
+        kappa: 5.0,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
     let sys = EllipsoidSystem::new(&[s1.clone(), s2.clone()], model, conservative());
     assert!(!sys.rotation_integrated());
     assert_eq!(sys.dim(), 12);
@@ -178,7 +277,10 @@ fn spheres_without_dissipation_skip_rotation() {
     assert!((b[0].spin_body.norm() - 1e-3).abs() < 1e-15);
     let angle = 2.0 * b[0].quaternion.w.clamp(-1.0, 1.0).acos();
     assert!((angle - 0.1).abs() < 1e-12, "rotated by {angle}");
-    let with_dissipation = Physics { dissipation: Some(DissipationTerm { f0: 1.0 }), ..conservative() };
+    let with_dissipation = Physics {
+        dissipation: Some(DissipationTerm { f0: 1.0 }),
+        ..conservative()
+    };
     let sys2 = EllipsoidSystem::new(&[s1, s2], model, with_dissipation);
     assert!(sys2.rotation_integrated());
     assert_eq!(sys2.dim(), 29);

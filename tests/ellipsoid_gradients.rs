@@ -79,7 +79,10 @@ fn rotation_spin_convention_matches_notes() {
         let spin_world = r.transpose() * spin_body;
         // Ṙᵀ R = [ω_w]×
         let lhs = r_dot.transpose() * r;
-        assert!((lhs - skew(&spin_world)).norm() <= 1e-8 * spin_world.norm(), "ṘᵀR ≠ [ω_w]×");
+        assert!(
+            (lhs - skew(&spin_world)).norm() <= 1e-8 * spin_world.norm(),
+            "ṘᵀR ≠ [ω_w]×"
+        );
         // (ω_b, 0) = 2 W q̇ : the fourth row vanishes
         assert!((w_matrix(&q) * q_dot).w.abs() < 1e-14);
         // R is orthogonal and is the transpose of nalgebra's body→world matrix
@@ -122,11 +125,18 @@ fn contact_gradient_matches_finite_differences_near_and_far() {
             let e_rj = rel_err((-grad.d_ri).as_slice(), &fd_rj, 0.0);
             assert!(e_rj <= 1e-6, "∂U/∂r_j: rel err {e_rj:e}");
             // quaternions
-            let fd_qi = central_difference(pr.q[0].into(), 1e-6, |x| pr.potential(&pr.r, &[Vec4::from(*x), pr.q[1]]));
-            let fd_qj = central_difference(pr.q[1].into(), 1e-6, |x| pr.potential(&pr.r, &[pr.q[0], Vec4::from(*x)]));
+            let fd_qi = central_difference(pr.q[0].into(), 1e-6, |x| {
+                pr.potential(&pr.r, &[Vec4::from(*x), pr.q[1]])
+            });
+            let fd_qj = central_difference(pr.q[1].into(), 1e-6, |x| {
+                pr.potential(&pr.r, &[pr.q[0], Vec4::from(*x)])
+            });
             let e_qi = rel_err(grad.d_qi.as_slice(), &fd_qi, 0.0);
             let e_qj = rel_err(grad.d_qj.as_slice(), &fd_qj, 0.0);
-            assert!(e_qi <= 1e-6 && e_qj <= 1e-6, "∂U/∂q: rel err {e_qi:e}, {e_qj:e} (gap {gap})");
+            assert!(
+                e_qi <= 1e-6 && e_qj <= 1e-6,
+                "∂U/∂q: rel err {e_qi:e}, {e_qj:e} (gap {gap})"
+            );
         }
     }
 }
@@ -161,9 +171,13 @@ fn dissipation_derivatives_match_finite_differences() {
             if pd.value.abs() < 1e-300 {
                 continue;
             }
-            let fd_v = central_difference(v[0].into(), 1e-4, |x| dissipation_of(&pr, f0, &[Vec3::from(*x), v[1]], &q_dot).0);
+            let fd_v = central_difference(v[0].into(), 1e-4, |x| {
+                dissipation_of(&pr, f0, &[Vec3::from(*x), v[1]], &q_dot).0
+            });
             assert!(rel_err(pd.d_vi.as_slice(), &fd_v, 0.0) <= 1e-6, "∂F/∂ṙ_i");
-            let fd_vj = central_difference(v[1].into(), 1e-4, |x| dissipation_of(&pr, f0, &[v[0], Vec3::from(*x)], &q_dot).0);
+            let fd_vj = central_difference(v[1].into(), 1e-4, |x| {
+                dissipation_of(&pr, f0, &[v[0], Vec3::from(*x)], &q_dot).0
+            });
             assert!(rel_err((-pd.d_vi).as_slice(), &fd_vj, 0.0) <= 1e-6, "∂F/∂ṙ_j");
             // ∂F/∂q̇ = 2 W₃ᵀ R ∂F/∂ω_w
             for (k, (g, dw)) in [(&gi, pd.d_wi), (&gj, pd.d_wj)].into_iter().enumerate() {
@@ -190,17 +204,34 @@ fn dissipation_vanishes_for_common_rigid_motion_and_conserves_momenta() {
         let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
         let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj);
         let (v0, omega) = (rng.vec3(3.0), rng.vec3(1e-3));
-        let rigid = |r: Vec3| BodyVelocity { velocity: v0 + omega.cross(&r), spin_world: omega };
+        let rigid = |r: Vec3| BodyVelocity {
+            velocity: v0 + omega.cross(&r),
+            spin_world: omega,
+        };
         let rigid_f = pair_dissipation(1.0, pr.kappa, &ov, &gi, &gj, &rigid(pr.r[0]), &rigid(pr.r[1])).value;
         // reference: the same speeds, but not rigid
-        let vi = BodyVelocity { velocity: v0, spin_world: omega };
-        let vj = BodyVelocity { velocity: -v0, spin_world: -omega };
+        let vi = BodyVelocity {
+            velocity: v0,
+            spin_world: omega,
+        };
+        let vj = BodyVelocity {
+            velocity: -v0,
+            spin_world: -omega,
+        };
         let pd = pair_dissipation(1.0, pr.kappa, &ov, &gi, &gj, &vi, &vj);
-        assert!(rigid_f.abs() <= 1e-12 * pd.value.abs(), "rigid motion dissipates {rigid_f:e} vs {:e}", pd.value);
+        assert!(
+            rigid_f.abs() <= 1e-12 * pd.value.abs(),
+            "rigid motion dissipates {rigid_f:e} vs {:e}",
+            pd.value
+        );
         // linear momentum: forces on i and j cancel by construction; angular momentum: total torque vanishes
         let torque = pr.r[0].cross(&pd.d_vi) - pr.r[1].cross(&pd.d_vi) + pd.d_wi + pd.d_wj;
         let scale = (pr.r[0] - pr.r[1]).norm() * pd.d_vi.norm() + pd.d_wi.norm() + pd.d_wj.norm();
-        assert!(torque.norm() <= 1e-12 * scale, "dissipative torque {:e} of {scale:e}", torque.norm());
+        assert!(
+            torque.norm() <= 1e-12 * scale,
+            "dissipative torque {:e} of {scale:e}",
+            torque.norm()
+        );
         // F ≤ 0 (negative definite)
         assert!(pd.value <= 0.0);
     }
@@ -212,7 +243,11 @@ fn rotational_kinetic_gradient_matches_finite_differences() {
     for _ in 0..50 {
         let q = rng.unit_quaternion();
         let q_dot = rng.vec3(0.1).push(rng.range(-0.1, 0.1));
-        let ie = extended_inertia(&Vec3::new(rng.range(1.0, 3.0), rng.range(1.0, 3.0), rng.range(1.0, 3.0)));
+        let ie = extended_inertia(&Vec3::new(
+            rng.range(1.0, 3.0),
+            rng.range(1.0, 3.0),
+            rng.range(1.0, 3.0),
+        ));
         let analytic = rotational_kinetic_gradient(&q, &q_dot, &ie);
         let fd = central_difference(q.into(), 1e-6, |x| {
             0.5 * q_dot.dot(&(mass_matrix(&Vec4::from(*x), &ie) * q_dot))
@@ -228,7 +263,11 @@ fn eq36_lu_solution_matches_closed_form_and_keeps_constraint() {
     for _ in 0..200 {
         // slightly off-unit q, as during integration
         let q = rng.unit_quaternion() * (1.0 + rng.range(-1e-6, 1e-6));
-        let ie = extended_inertia(&Vec3::new(rng.range(0.5, 3.0), rng.range(0.5, 3.0), rng.range(0.5, 3.0)));
+        let ie = extended_inertia(&Vec3::new(
+            rng.range(0.5, 3.0),
+            rng.range(0.5, 3.0),
+            rng.range(0.5, 3.0),
+        ));
         let m_inv = inverse_mass_matrix(&q, &ie);
         let mut q_dot = rng.vec3(0.3).push(0.0);
         q_dot -= q * q.dot(&q_dot) / q.norm_squared();
@@ -236,7 +275,10 @@ fn eq36_lu_solution_matches_closed_form_and_keeps_constraint() {
         let c = constraint_rhs(&q, &q_dot, &m_inv, &ie);
         let lu = constrained_momentum_rate(&q, &g, &m_inv, c);
         let closed = constrained_momentum_rate_closed_form(&q, &g, &m_inv, c);
-        assert!(rel_err(lu.as_slice(), closed.as_slice(), 1.0) < 1e-12, "{lu} vs {closed}");
+        assert!(
+            rel_err(lu.as_slice(), closed.as_slice(), 1.0) < 1e-12,
+            "{lu} vs {closed}"
+        );
         // the solution satisfies the differentiated constraint: d/dt(q·q̇) = 0
         // q̈ = d/dt(M⁻¹p) = M⁻¹ṗ − M⁻¹ṀM⁻¹p; check numerically with a small step.
         let p = mass_matrix(&q, &ie) * q_dot;
@@ -248,7 +290,10 @@ fn eq36_lu_solution_matches_closed_form_and_keeps_constraint() {
         let pm = p - h * lu;
         let qdm = inverse_mass_matrix(&qm, &ie) * pm;
         let rate = (qp.dot(&qdp) - qm.dot(&qdm)) / (2.0 * h);
-        assert!(rate.abs() < 1e-6 * (q_dot.norm_squared() + g.norm()), "d(q·q̇)/dt = {rate:e}");
+        assert!(
+            rate.abs() < 1e-6 * (q_dot.norm_squared() + g.norm()),
+            "d(q·q̇)/dt = {rate:e}"
+        );
     }
 }
 
@@ -274,7 +319,10 @@ fn two_sphere_potential_minimum_at_contact_with_depth_ratio() {
         assert!((d_min / s - 1.0).abs() <= 1e-6, "minimum at {d_min} vs R_i + R_j = {s}");
         let ratio = u_c(s) / (G * m_i * m_j / s);
         let expected = 1.0 / (2.0 * kappa * lambda(r_i, r_j));
-        assert!((ratio / expected - 1.0).abs() < 1e-12, "depth ratio {ratio} vs {expected}");
+        assert!(
+            (ratio / expected - 1.0).abs() < 1e-12,
+            "depth ratio {ratio} vs {expected}"
+        );
     }
 }
 
@@ -294,7 +342,11 @@ fn culled_pairs_are_below_cutoff_of_amplitude() {
         let reach = interaction_radius(pr.kappa, &gi, cexp) + interaction_radius(pr.kappa, &gj, cexp);
         if is_negligible(pr.kappa, &delta, &gi, &gj, cexp) {
             checked += 1;
-            assert!(ov.potential <= cutoff * ov.amplitude, "culled pair keeps {:e} of amplitude", ov.potential / ov.amplitude);
+            assert!(
+                ov.potential <= cutoff * ov.amplitude,
+                "culled pair keeps {:e} of amplitude",
+                ov.potential / ov.amplitude
+            );
         } else {
             // every kept pair is found by the bounding-sphere search
             assert!(delta.norm() < reach);
@@ -357,7 +409,10 @@ fn gravity_parallel_rows_match_serial_pairs_and_gradient() {
 
 #[test]
 fn uniform_inertia_is_the_uniform_ellipsoid() {
-    let e = Ellipsoid { axes: Vec3::new(3.0, 2.0, 1.0), mass: 7.0 };
+    let e = Ellipsoid {
+        axes: Vec3::new(3.0, 2.0, 1.0),
+        mass: 7.0,
+    };
     let i = e.principal_moments(2.5);
     assert!((i.x - 7.0 / 5.0 * (4.0 + 1.0)).abs() < 1e-14);
     assert!((i.z - 7.0 / 5.0 * (9.0 + 4.0)).abs() < 1e-14);

@@ -90,7 +90,8 @@ pub fn calibrate_kappa(
         v,
         v2_min: x_min.exp() / x_min * g * m_small / (beta * (r_small + r_large)),
     };
-    if !(rhs > x_min.exp() / x_min) {
+    // (written so that a NaN right side is refused too)
+    if rhs.is_nan() || rhs <= x_min.exp() / x_min {
         return Err(unreachable());
     }
     // f(x) = x − ln x − ln(rhs) is convex and increasing for x > 1: Newton from the right converges monotonically.
@@ -105,5 +106,9 @@ pub fn calibrate_kappa(
         }
     }
     let kappa = x / lam;
-    if kappa > 1.5 && kappa.is_finite() { Ok(kappa) } else { Err(unreachable()) }
+    if kappa > 1.5 && kappa.is_finite() {
+        Ok(kappa)
+    } else {
+        Err(unreachable())
+    }
 }

@@ -18,9 +18,8 @@ use crate::ellipsoid::potential::{
     BodyGeometry, contact_gradient, cull_exponent, interaction_radius, is_negligible, overlap,
 };
 use crate::ellipsoid::quaternion::{
-    extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin,
-    rotational_kinetic_gradient, rotation_matrix, to_unit_quaternion,
-    w_matrix,
+    extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin, rotation_matrix,
+    rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
 };
 use crate::geometry::neighbours::sphere_pairs;
 use crate::integrate::OdeSystem;
@@ -241,7 +240,16 @@ impl EllipsoidSystem {
             let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
             let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
             let rot = geometry.map_or_else(|| rotation_matrix(&q), |g| g.rot);
-            Kinematics { r, q, u, p, q_dot, spin_body, spin_world: rot.transpose() * spin_body, geometry }
+            Kinematics {
+                r,
+                q,
+                u,
+                p,
+                q_dot,
+                spin_body,
+                spin_world: rot.transpose() * spin_body,
+                geometry,
+            }
         } else {
             let b = &self.initial[i];
             let q = b.quaternion.normalize();
@@ -263,7 +271,10 @@ impl EllipsoidSystem {
     fn all_kinematics(&self, y: &[f64], with_geometry: bool) -> Vec<Kinematics> {
         let n = self.n_bodies();
         if n >= 64 {
-            (0..n).into_par_iter().map(|i| self.kinematics(i, y, with_geometry)).collect()
+            (0..n)
+                .into_par_iter()
+                .map(|i| self.kinematics(i, y, with_geometry))
+                .collect()
         } else {
             (0..n).map(|i| self.kinematics(i, y, with_geometry)).collect()
         }
@@ -323,8 +334,14 @@ impl EllipsoidSystem {
             }
         }
         if let Some(d) = self.physics.dissipation {
-            let vi = BodyVelocity { velocity: ki.u / self.shapes[i].mass, spin_world: ki.spin_world };
-            let vj = BodyVelocity { velocity: kj.u / self.shapes[j].mass, spin_world: kj.spin_world };
+            let vi = BodyVelocity {
+                velocity: ki.u / self.shapes[i].mass,
+                spin_world: ki.spin_world,
+            };
+            let vj = BodyVelocity {
+                velocity: kj.u / self.shapes[j].mass,
+                spin_world: kj.spin_world,
+            };
             let pd = pair_dissipation(d.f0, kappa, &ov, gi, gj, &vi, &vj);
             t.dissipation = pd.value;
             if with_forces {
@@ -342,9 +359,15 @@ impl EllipsoidSystem {
         }
         let pairs = self.interacting_pairs(kin);
         if pairs.len() >= 32 {
-            pairs.par_iter().map(|&(i, j)| self.pair_terms(i, j, kin, with_forces)).collect()
+            pairs
+                .par_iter()
+                .map(|&(i, j)| self.pair_terms(i, j, kin, with_forces))
+                .collect()
         } else {
-            pairs.iter().map(|&(i, j)| self.pair_terms(i, j, kin, with_forces)).collect()
+            pairs
+                .iter()
+                .map(|&(i, j)| self.pair_terms(i, j, kin, with_forces))
+                .collect()
         }
     }
 
@@ -363,7 +386,13 @@ impl EllipsoidSystem {
                     let q = from_unit_quaternion(&rotated);
                     (q, rotation_matrix(&q) * k.spin_world)
                 };
-                Body { shape: self.shapes[i], position: k.r, velocity: k.u / mass, quaternion, spin_body }
+                Body {
+                    shape: self.shapes[i],
+                    position: k.r,
+                    velocity: k.u / mass,
+                    quaternion,
+                    spin_body,
+                }
             })
             .collect()
     }
@@ -402,10 +431,8 @@ impl EllipsoidSystem {
         if let Some(idx) = self.dissipation_index() {
             d.dissipated = 2.0 * y[idx];
         }
-        d.energy_scale = d.kinetic_translational
-            + d.kinetic_rotational
-            + d.potential_contact.abs()
-            + d.potential_gravity.abs();
+        d.energy_scale =
+            d.kinetic_translational + d.kinetic_rotational + d.potential_contact.abs() + d.potential_gravity.abs();
         d
     }
 }
@@ -436,13 +463,11 @@ pub fn constrained_momentum_rate(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Ve
     let mq = m_inv * q;
     let mut a = Mat4::zeros();
     let mut b = Vec4::zeros();
-    let mut row = 0;
-    for k in (0..4).filter(|&k| k != kmax) {
+    for (row, k) in (0..4).filter(|&k| k != kmax).enumerate() {
         for l in 0..4 {
             a[(row, l)] = if l == k { q2 } else { 0.0 } - q[k] * q[l];
         }
         b[row] = q2 * g[k] - q[k] * qg;
-        row += 1;
     }
     for l in 0..4 {
         a[(3, l)] = mq[l];

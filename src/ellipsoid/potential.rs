@@ -70,7 +70,13 @@ pub fn overlap(prefactor: f64, kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: 
     let y = g_inv * delta;
     let exponent = kappa * delta.dot(&y);
     let amplitude = prefactor / det.sqrt();
-    Overlap { g_inv, y, amplitude, exponent, potential: amplitude * (-exponent).exp() }
+    Overlap {
+        g_inv,
+        y,
+        amplitude,
+        exponent,
+        potential: amplitude * (-exponent).exp(),
+    }
 }
 
 /// Gradients of `U_C` with respect to the positions and quaternions of a pair.

@@ -22,7 +22,7 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
         return pairs;
     }
     let rmax = radii.iter().cloned().fold(0.0_f64, f64::max);
-    if !(rmax > 0.0) || !rmax.is_finite() || n <= 16 {
+    if rmax.is_nan() || rmax <= 0.0 || !rmax.is_finite() || n <= 16 {
         for i in 0..n {
             for j in (i + 1)..n {
                 if (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
@@ -34,7 +34,11 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
     }
     let cell = 2.0 * rmax;
     let key = |p: &Vec3| -> [i64; 3] {
-        [(p.x / cell).floor() as i64, (p.y / cell).floor() as i64, (p.z / cell).floor() as i64]
+        [
+            (p.x / cell).floor() as i64,
+            (p.y / cell).floor() as i64,
+            (p.z / cell).floor() as i64,
+        ]
     };
     let keys: Vec<[i64; 3]> = centres.iter().map(key).collect();
     let mut order: Vec<usize> = (0..n).collect();

@@ -62,7 +62,10 @@ pub struct Tolerances {
 impl Tolerances {
     /// The same `rtol` and `atol` for all `n` components.
     pub fn uniform(rtol: f64, atol: f64, n: usize) -> Self {
-        Tolerances { rtol: vec![rtol; n], atol: vec![atol; n] }
+        Tolerances {
+            rtol: vec![rtol; n],
+            atol: vec![atol; n],
+        }
     }
 }
 
@@ -136,13 +139,13 @@ pub fn make_integrator(
 ) -> Result<Box<dyn Integrator + Send>, IntegrateError> {
     match method {
         Method::BulirschStoer => Ok(Box::new(bulirsch_stoer::BulirschStoer::new(tolerances, step)?)),
-        Method::Dop853 | Method::Dopri5 => {
-            Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(method, tolerances, step)?))
-        }
+        Method::Dop853 | Method::Dopri5 => Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(
+            method, tolerances, step,
+        )?)),
         Method::Rk4 => match step {
-            Some(h) if h > 0.0 && h.is_finite() => {
-                Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(method, tolerances, step)?))
-            }
+            Some(h) if h > 0.0 && h.is_finite() => Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(
+                method, tolerances, step,
+            )?)),
             _ => Err(IntegrateError::Config("rk4 needs a positive finite `step` (s)".into())),
         },
     }

@@ -21,12 +21,21 @@ impl Random {
         lo + (hi - lo) * self.uniform()
     }
     pub fn vec3(&mut self, scale: f64) -> Vec3 {
-        Vec3::new(self.range(-scale, scale), self.range(-scale, scale), self.range(-scale, scale))
+        Vec3::new(
+            self.range(-scale, scale),
+            self.range(-scale, scale),
+            self.range(-scale, scale),
+        )
     }
     /// A random unit quaternion (scalar last).
     pub fn unit_quaternion(&mut self) -> Vec4 {
         loop {
-            let q = Vec4::new(self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0), self.range(-1.0, 1.0));
+            let q = Vec4::new(
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+                self.range(-1.0, 1.0),
+            );
             let n = q.norm();
             if n > 0.2 && n < 1.0 {
                 return q / n;
@@ -44,7 +53,12 @@ impl Random {
 
 /// Relative error of `approx` against `exact`, by vector norm, with a floor on the scale.
 pub fn rel_err(approx: &[f64], exact: &[f64], floor: f64) -> f64 {
-    let diff: f64 = approx.iter().zip(exact).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    let diff: f64 = approx
+        .iter()
+        .zip(exact)
+        .map(|(a, b)| (a - b) * (a - b))
+        .sum::<f64>()
+        .sqrt();
     let scale: f64 = exact.iter().map(|b| b * b).sum::<f64>().sqrt().max(floor);
     diff / scale
 }
@@ -94,10 +108,13 @@ pub fn integrate(
         let target = t_end * k as f64 / samples as f64;
         integ.advance(sys, &mut t, &mut y, target).unwrap();
         let d = sys.diagnostics(&y);
-        e.energy = e.energy.max((d.energy() - d0.energy() - d.dissipated).abs() / d0.energy_scale);
+        e.energy = e
+            .energy
+            .max((d.energy() - d0.energy() - d.dissipated).abs() / d0.energy_scale);
         e.momentum = e.momentum.max((d.momentum - d0.momentum).norm() / d0.momentum_scale);
-        e.angular_momentum =
-            e.angular_momentum.max((d.angular_momentum - d0.angular_momentum).norm() / d0.angular_momentum_scale);
+        e.angular_momentum = e
+            .angular_momentum
+            .max((d.angular_momentum - d0.angular_momentum).norm() / d0.angular_momentum_scale);
         e.quaternion_norm = e.quaternion_norm.max(d.quaternion_norm_error);
         e.dissipated_fraction = -d.dissipated / (d0.kinetic_translational + d0.kinetic_rotational);
     }

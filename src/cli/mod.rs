@@ -1,0 +1,247 @@
+//! The `rubblepile` command line.
+//!
+//! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress]`: runs a scene (the built-in
+//!   default scene without SCENE) and writes its outputs into DIR;
+//! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to;
+//! - `rubblepile bench rhs --bodies N [--repeats R] [--out DIR]`: times one right-hand-side
+//!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
+//!
+//! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
+//! scene, bad arguments, existing output directory) and 1 for a failed run.
+
+pub mod bench;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::run::{RunOptions, run_scene};
+use crate::scene::{LoadedScene, default_scene, load_scene};
+
+/// Dynamics of rubble-pile asteroids: interacting ellipsoids (Roig et al. 2003).
+#[derive(Debug, Parser)]
+#[command(name = "rubblepile", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run a scene and write its outputs (summary.json, timeseries.csv, snapshots/) into DIR.
+    Run(RunArgs),
+    /// Validate a scene file and print what it resolves to (κ, bodies, output times).
+    Check(CheckArgs),
+    /// Benchmarks.
+    #[command(subcommand)]
+    Bench(BenchCommand),
+}
+
+/// `rubblepile run`.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// Scene file (TOML). Without it, the built-in default scene runs.
+    pub scene: Option<PathBuf>,
+    /// Output directory (created if missing; must be empty unless --force).
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Overwrite the outputs of a previous run in DIR.
+    #[arg(long)]
+    pub force: bool,
+    /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
+    #[arg(long)]
+    pub no_progress: bool,
+}
+
+/// `rubblepile check`.
+#[derive(Debug, clap::Args)]
+pub struct CheckArgs {
+    /// Scene file (TOML). Without it, the built-in default scene is checked.
+    pub scene: Option<PathBuf>,
+    /// Print the built-in default scene's TOML instead (a starting point for your own scenes).
+    #[arg(long, conflicts_with = "scene")]
+    pub print_default: bool,
+}
+
+/// `rubblepile bench …`.
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Time one right-hand-side evaluation for a random cloud of ellipsoids (1 thread vs all threads).
+    Rhs(bench::RhsArgs),
+}
+
+/// A CLI failure: the message (one line) and the exit code.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CliError {
+    /// One-line message (printed after `error: `).
+    pub message: String,
+    /// Exit code: 2 bad input, 1 failed run.
+    pub code: u8,
+}
+
+impl CliError {
+    /// Bad input (exit code 2).
+    pub fn usage(message: impl std::fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            code: 2,
+        }
+    }
+    /// A failure while running (exit code 1).
+    pub fn failed(message: impl std::fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            code: 1,
+        }
+    }
+}
+
+fn load(scene: Option<&PathBuf>) -> Result<LoadedScene, CliError> {
+    match scene {
+        Some(path) => load_scene(path),
+        None => default_scene(),
+    }
+    .map_err(CliError::usage)
+}
+
+/// Runs a parsed command line.
+pub fn execute(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Run(args) => {
+            let scene = load(args.scene.as_ref())?;
+            let options = RunOptions {
+                force: args.force,
+                progress: !args.no_progress,
+            };
+            match run_scene(&scene, &args.out, &options) {
+                Ok(summary) => {
+                    println!("{}", summary.one_line());
+                    Ok(())
+                }
+                Err(e) => {
+                    if let crate::run::RunError::Failed { summary, .. } = &e {
+                        println!("{}", summary.one_line());
+                    }
+                    if e.is_usage() {
+                        Err(CliError::usage(e))
+                    } else {
+                        Err(CliError::failed(e))
+                    }
+                }
+            }
+        }
+        Command::Check(args) => {
+            if args.print_default {
+                print!("{}", crate::scene::DEFAULT_SCENE_TOML);
+                return Ok(());
+            }
+            let scene = load(args.scene.as_ref())?;
+            print_check(&scene);
+            Ok(())
+        }
+        Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
+    }
+}
+
+fn print_check(s: &LoadedScene) {
+    let kappa = match s.kappa_source {
+        crate::scene::KappaSource::Given => format!("kappa = {} (given)", s.model.kappa),
+        crate::scene::KappaSource::Calibrated { beta, v } => {
+            format!("kappa = {} (calibrated: beta = {beta}, v = {v} m/s)", s.model.kappa)
+        }
+    };
+    println!("{}: ok", s.name);
+    println!("  {} bodies, t_end = {} s, {kappa}", s.bodies.len(), s.t_end);
+    let p = &s.physics;
+    let mut terms = Vec::new();
+    if let Some(g) = p.gravity {
+        terms.push(format!("gravity (G = {:e})", g.g));
+    }
+    if let Some(c) = p.contact {
+        terms.push(format!("contact (cutoff = {:e})", c.cutoff));
+    }
+    if let Some(d) = p.dissipation {
+        terms.push(format!("dissipation (F0 = {})", d.f0));
+    }
+    if terms.is_empty() {
+        terms.push("none (free motion)".into());
+    }
+    println!("  physics: {}", terms.join(", "));
+    println!(
+        "  integrator: {} (rtol {:e}, atol {:e}{})",
+        s.integrator.method,
+        s.integrator.rtol,
+        s.integrator.atol,
+        s.integrator.step.map(|h| format!(", step {h} s")).unwrap_or_default()
+    );
+    println!(
+        "  output: every {} s, {} snapshots",
+        s.output.every,
+        s.output.times.len()
+    );
+    for (k, b) in s.bodies.iter().enumerate() {
+        println!(
+            "  body[{k}]: axes [{}, {}, {}] m, mass {:e} kg, R_eq {:.4e} m, at [{:e}, {:e}, {:e}] m",
+            b.shape.axes.x,
+            b.shape.axes.y,
+            b.shape.axes.z,
+            b.shape.mass,
+            b.shape.equivalent_radius(),
+            b.position.x,
+            b.position.y,
+            b.position.z
+        );
+    }
+}
+
+/// clap's multi-line argument error as one line, e.g. `the following required arguments were not
+/// provided: --out <DIR> (see `rubblepile run --help`)`.
+fn one_line_clap_error(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let body = text.split("Usage:").next().unwrap_or(&text);
+    let body = body.trim_start().strip_prefix("error:").unwrap_or(body);
+    let body = body.replace("For more information, try '--help'.", "");
+    let mut msg: String = if e.kind() == clap::error::ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        "a subcommand is required".to_string()
+    } else {
+        body.split_whitespace().collect::<Vec<_>>().join(" ")
+    };
+    if let Some(usage) = text.split("Usage:").nth(1) {
+        // `Usage: rubblepile run [OPTIONS] --out <DIR> [SCENE]` -> `rubblepile run --help`
+        let words: Vec<&str> = usage
+            .split_whitespace()
+            .take_while(|w| !w.starts_with('-') && !w.starts_with('[') && !w.starts_with('<'))
+            .collect();
+        if !words.is_empty() {
+            msg.push_str(&format!(" (see `{} --help`)", words.join(" ")));
+        }
+    }
+    msg
+}
+
+/// The binary's entry point: parses `std::env::args`, runs, prints `error: …` on failure.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help / --version: print and exit 0.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            eprintln!("error: {}", one_line_clap_error(&e));
+            return ExitCode::from(2);
+        }
+    };
+    match execute(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            let msg: String = e.message.split_whitespace().collect::<Vec<_>>().join(" ");
+            eprintln!("error: {msg}");
+            ExitCode::from(e.code)
+        }
+    }
+}

@@ -1,0 +1,318 @@
+//! CSV files: snapshots (and `last_good_state.csv`), the time series, and bodies files.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::ellipsoid::body::Body;
+use crate::ellipsoid::equations::Diagnostics;
+use crate::io::fmt_f64;
+
+/// Columns of a snapshot (and of a bodies file): time (s), body index, mass (kg), semi-axes A, B, C
+/// (m), position (m), velocity (m/s), quaternion `(α, β, γ, δ)` (scalar last), body-frame spin (rad/s).
+pub const SNAPSHOT_COLUMNS: [&str; 19] = [
+    "t", "id", "mass", "a", "b", "c", "x", "y", "z", "vx", "vy", "vz", "qa", "qb", "qc", "qd", "wx", "wy", "wz",
+];
+
+/// Columns of `timeseries.csv`: time (s); energies (J): translational and rotational kinetic,
+/// contact and gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
+/// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum
+/// about the origin (kg m²/s); wall-clock seconds since the integration started.
+pub const TIMESERIES_COLUMNS: [&str; 14] = [
+    "t",
+    "kinetic_translational",
+    "kinetic_rotational",
+    "potential_contact",
+    "potential_gravity",
+    "dissipated",
+    "energy_residual",
+    "px",
+    "py",
+    "pz",
+    "lx",
+    "ly",
+    "lz",
+    "wall_seconds",
+];
+
+fn csv_to_io(e: ::csv::Error) -> std::io::Error {
+    match e.into_kind() {
+        ::csv::ErrorKind::Io(e) => e,
+        other => std::io::Error::other(format!("{other:?}")),
+    }
+}
+
+/// The snapshot rows of `bodies` at time `t` (ids are the indices), without the header.
+pub fn snapshot_records(t: f64, bodies: &[Body]) -> Vec<Vec<String>> {
+    bodies
+        .iter()
+        .enumerate()
+        .map(|(id, b)| {
+            let mut row = Vec::with_capacity(SNAPSHOT_COLUMNS.len());
+            row.push(fmt_f64(t));
+            row.push(id.to_string());
+            row.push(fmt_f64(b.shape.mass));
+            row.extend(b.shape.axes.iter().map(|&x| fmt_f64(x)));
+            row.extend(b.position.iter().map(|&x| fmt_f64(x)));
+            row.extend(b.velocity.iter().map(|&x| fmt_f64(x)));
+            row.extend(b.quaternion.iter().map(|&x| fmt_f64(x)));
+            row.extend(b.spin_body.iter().map(|&x| fmt_f64(x)));
+            row
+        })
+        .collect()
+}
+
+/// Writes a snapshot of `bodies` at time `t` to `path` (header + one row per body), lossless.
+pub fn write_snapshot(path: &Path, t: f64, bodies: &[Body]) -> std::io::Result<()> {
+    let file = File::create(path)?;
+    let mut w = ::csv::Writer::from_writer(BufWriter::new(file));
+    w.write_record(SNAPSHOT_COLUMNS).map_err(csv_to_io)?;
+    for row in snapshot_records(t, bodies) {
+        w.write_record(&row).map_err(csv_to_io)?;
+    }
+    let inner = w.into_inner().map_err(|e| e.into_error())?;
+    inner.into_inner().map_err(|e| e.into_error())?.sync_all()
+}
+
+/// One row of `timeseries.csv`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeseriesRow {
+    /// Time (s).
+    pub t: f64,
+    /// The diagnostics at `t`.
+    pub diagnostics: Diagnostics,
+    /// `(H − H0 − (dissipated − dissipated0)) / energy_scale(0)` (signed).
+    pub energy_residual: f64,
+    /// Wall-clock seconds since the integration started.
+    pub wall_seconds: f64,
+}
+
+/// Writes `timeseries.csv` row by row, flushing after each row so a crash loses nothing written.
+pub struct TimeseriesWriter {
+    w: ::csv::Writer<BufWriter<File>>,
+}
+
+impl TimeseriesWriter {
+    /// Creates the file and writes the header.
+    pub fn create(path: &Path) -> std::io::Result<Self> {
+        let mut w = ::csv::Writer::from_writer(BufWriter::new(File::create(path)?));
+        w.write_record(TIMESERIES_COLUMNS).map_err(csv_to_io)?;
+        w.flush()?;
+        Ok(TimeseriesWriter { w })
+    }
+
+    /// Appends a row and flushes it to the OS.
+    pub fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
+        let d = &row.diagnostics;
+        let fields = [
+            row.t,
+            d.kinetic_translational,
+            d.kinetic_rotational,
+            d.potential_contact,
+            d.potential_gravity,
+            d.dissipated,
+            row.energy_residual,
+            d.momentum.x,
+            d.momentum.y,
+            d.momentum.z,
+            d.angular_momentum.x,
+            d.angular_momentum.y,
+            d.angular_momentum.z,
+            row.wall_seconds,
+        ];
+        self.w
+            .write_record(fields.iter().map(|&x| fmt_f64(x)))
+            .map_err(csv_to_io)?;
+        self.w.flush()
+    }
+
+    /// Flushes and syncs the file.
+    pub fn finish(self) -> std::io::Result<()> {
+        let inner = self.w.into_inner().map_err(|e| e.into_error())?;
+        let mut file = inner.into_inner().map_err(|e| e.into_error())?;
+        file.flush()?;
+        file.sync_all()
+    }
+}
+
+/// One body read from a bodies file (values unchecked; the scene validates them).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyRecord {
+    /// Line of the file the body came from (1-based; line 1 is the header).
+    pub line: u64,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Semi-axes `[A, B, C]` (m).
+    pub axes: [f64; 3],
+    /// Position (m).
+    pub position: [f64; 3],
+    /// Velocity (m/s).
+    pub velocity: [f64; 3],
+    /// Quaternion `[α, β, γ, δ]`.
+    pub quaternion: [f64; 4],
+    /// Body-frame spin (rad/s).
+    pub spin_body: [f64; 3],
+}
+
+/// Why a bodies file could not be read. Messages are one line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BodiesFileError {
+    /// The file could not be opened or read.
+    #[error("{0}")]
+    Read(String),
+    /// A bad header or value.
+    #[error("line {line}: {message}")]
+    Format {
+        /// 1-based line.
+        line: u64,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// Reads a bodies file: a CSV with a header naming the columns `mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz`
+/// in any order (plus optional `t` and `id`, ignored); any other column is an error.
+pub fn read_bodies_csv(path: &Path) -> Result<Vec<BodyRecord>, BodiesFileError> {
+    let file = File::open(path).map_err(|e| BodiesFileError::Read(e.to_string()))?;
+    read_bodies(file)
+}
+
+/// [`read_bodies_csv`] from any reader.
+pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, BodiesFileError> {
+    let mut r = ::csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(::csv::Trim::All)
+        .from_reader(reader);
+    let headers = r
+        .headers()
+        .map_err(|e| BodiesFileError::Format {
+            line: 1,
+            message: format!("bad header: {}", one_line_csv(&e)),
+        })?
+        .clone();
+    let required = &SNAPSHOT_COLUMNS[2..];
+    let mut index = [usize::MAX; 17];
+    for (pos, name) in headers.iter().enumerate() {
+        if name == "t" || name == "id" {
+            continue;
+        }
+        match required.iter().position(|&c| c == name) {
+            Some(k) if index[k] == usize::MAX => index[k] = pos,
+            Some(_) => {
+                return Err(BodiesFileError::Format {
+                    line: 1,
+                    message: format!("column `{name}` appears twice"),
+                });
+            }
+            None => {
+                return Err(BodiesFileError::Format {
+                    line: 1,
+                    message: format!("unknown column `{name}`; expected {}", SNAPSHOT_COLUMNS.join(",")),
+                });
+            }
+        }
+    }
+    if let Some(k) = index.iter().position(|&i| i == usize::MAX) {
+        return Err(BodiesFileError::Format {
+            line: 1,
+            message: format!(
+                "missing column `{}`; expected {}",
+                required[k],
+                SNAPSHOT_COLUMNS.join(",")
+            ),
+        });
+    }
+    let mut out = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| BodiesFileError::Format {
+            line: e.position().map(|p| p.line()).unwrap_or(0),
+            message: one_line_csv(&e),
+        })?;
+        let line = rec.position().map(|p| p.line()).unwrap_or(0);
+        let mut v = [0.0; 17];
+        for (k, &pos) in index.iter().enumerate() {
+            let s = rec.get(pos).unwrap_or("");
+            v[k] = s.parse::<f64>().map_err(|_| BodiesFileError::Format {
+                line,
+                message: format!("column `{}`: not a number: {s:?}", required[k]),
+            })?;
+        }
+        out.push(BodyRecord {
+            line,
+            mass: v[0],
+            axes: [v[1], v[2], v[3]],
+            position: [v[4], v[5], v[6]],
+            velocity: [v[7], v[8], v[9]],
+            quaternion: [v[10], v[11], v[12], v[13]],
+            spin_body: [v[14], v[15], v[16]],
+        });
+    }
+    Ok(out)
+}
+
+fn one_line_csv(e: &::csv::Error) -> String {
+    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ellipsoid::body::Ellipsoid;
+    use crate::math::{Vec3, Vec4};
+
+    #[test]
+    fn snapshot_round_trip_is_lossless() {
+        let b = Body {
+            shape: Ellipsoid {
+                axes: Vec3::new(3.1, 2.0 / 3.0, 0.1),
+                mass: 1.0 / 7.0,
+            },
+            position: Vec3::new(-1e-300, 1.0 / 3.0, 12345.678901234567),
+            velocity: Vec3::new(-0.0, 2.0f64.sqrt(), 1e10),
+            quaternion: Vec4::new(0.1, 0.2, 0.3, 0.9).normalize(),
+            spin_body: Vec3::new(1e-5, -3.3, std::f64::consts::PI),
+        };
+        let mut bytes = Vec::new();
+        {
+            let mut w = ::csv::Writer::from_writer(&mut bytes);
+            w.write_record(SNAPSHOT_COLUMNS).unwrap();
+            for row in snapshot_records(1.5, std::slice::from_ref(&b)) {
+                w.write_record(&row).unwrap();
+            }
+        }
+        let recs = read_bodies(bytes.as_slice()).unwrap();
+        assert_eq!(recs.len(), 1);
+        let r = recs[0];
+        assert_eq!(r.line, 2);
+        assert_eq!(r.mass.to_bits(), b.shape.mass.to_bits());
+        for k in 0..3 {
+            assert_eq!(r.axes[k].to_bits(), b.shape.axes[k].to_bits());
+            assert_eq!(r.position[k].to_bits(), b.position[k].to_bits());
+            assert_eq!(r.velocity[k].to_bits(), b.velocity[k].to_bits());
+            assert_eq!(r.spin_body[k].to_bits(), b.spin_body[k].to_bits());
+        }
+        for k in 0..4 {
+            assert_eq!(r.quaternion[k].to_bits(), b.quaternion[k].to_bits());
+        }
+    }
+
+    #[test]
+    fn bad_bodies_files() {
+        let e = read_bodies("mass,a\n1,2\n".as_bytes()).unwrap_err().to_string();
+        assert!(e.contains("missing column `b`"), "{e}");
+        let e = read_bodies("mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz,zz\n".as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown column `zz`"), "{e}");
+        let e = read_bodies(
+            "mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz\n1,1,1,1,0,0,0,0,0,0,0,0,0,1,0,0,x\n".as_bytes(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert_eq!(e, "line 2: column `wz`: not a number: \"x\"");
+        let e = read_bodies("mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz\n1,1,1\n".as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("line 2:"), "{e}");
+    }
+}

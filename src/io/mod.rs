@@ -1,0 +1,41 @@
+//! Output files of a run (and the bodies-file reader).
+//!
+//! - [`csv`] writes `snapshots/<k>.csv`, `last_good_state.csv`, `timeseries.csv`, and the reader for a
+//!   scene's `bodies_file` (which takes the snapshot format);
+//! - [`summary`] writes `summary.json`.
+//!
+//! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific
+//! notation), so a snapshot re-read as a bodies file gives the same `f64`s bit for bit.
+
+pub mod csv;
+pub mod summary;
+
+/// Formats an `f64` losslessly: the shortest decimal that parses back to the same bits (`{:e}`).
+pub fn fmt_f64(x: f64) -> String {
+    format!("{x:e}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fmt_f64_round_trips() {
+        for x in [
+            0.0,
+            -0.0,
+            1.0,
+            0.1,
+            1.0 / 3.0,
+            6.674e-11,
+            1e300,
+            -2.5e-310,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+        ] {
+            let s = fmt_f64(x);
+            let y: f64 = s.parse().unwrap();
+            assert_eq!(x.to_bits(), y.to_bits(), "{x} -> {s}");
+        }
+    }
+}

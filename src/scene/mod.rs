@@ -1,0 +1,1056 @@
+//! Scene files: the TOML a user writes to describe a run, its validation, and its conversion into
+//! the model's types ([`Body`], [`ModelConfig`], [`Physics`]).
+//!
+//! A scene file looks like this (every key is documented on the struct that holds it, starting at
+//! [`SceneFile`]):
+//!
+//! ```toml
+//! [scene]
+//! kind = "ellipsoids"
+//! t_end = 200.0                 # s
+//! seed = 1
+//!
+//! [model]
+//! kappa = 10.0                  # or: calibrate = { beta = 10.0, v = 20.0 }
+//! inertia = "gaussian"          # or "uniform"
+//!
+//! [physics]                     # every term optional: absent = left out
+//! gravity = { G = 6.674e-11 }
+//! contact = {}
+//! dissipation = { F0 = 1.0 }
+//!
+//! [integrator]
+//! method = "bulirsch-stoer"
+//! rtol = 1e-10
+//! atol = 1e-10
+//!
+//! [output]
+//! times = [0.0, 100.0, 200.0]
+//! every = 1.0
+//!
+//! [[body]]
+//! axes = [3.0, 2.0, 1.0]
+//! mass = 1000.0
+//! position = [0.0, 0.0, 0.0]
+//! velocity = [0.0, 0.0, 0.0]
+//! spin_body = [0.01, 0.5, 0.02]
+//! ```
+//!
+//! Bad input never panics: [`parse_scene`] and [`load_scene`] return a [`SceneError`] whose message
+//! is one line naming the file, the field and what was expected, e.g.
+//! `scene.toml: body[3].axes: need A >= B >= C > 0, got [1, 2, 3]`.
+
+pub mod cloud;
+
+use std::path::{Path, PathBuf};
+
+use nalgebra::{Quaternion, UnitQuaternion};
+use serde::{Deserialize, Serialize};
+
+use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
+use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
+use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
+use crate::integrate::Method;
+use crate::math::{Vec3, Vec4};
+
+/// The SI gravitational constant used when a scene gives none (m³ kg⁻¹ s⁻²).
+pub const SI_G: f64 = 6.674e-11;
+
+/// Default contact cutoff (dimensionless): see [`ContactSpec::cutoff`].
+pub const DEFAULT_CONTACT_CUTOFF: f64 = 1e-16;
+
+/// Largest allowed `||q| − 1|` of an input quaternion.
+pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
+
+/// Most time-series rows a scene may ask for (`t_end / every`).
+pub const MAX_TIMESERIES_ROWS: f64 = 1e8;
+
+/// The built-in default scene (`targets/default.toml`), run by `rubblepile run` without a scene file.
+pub const DEFAULT_SCENE_TOML: &str = include_str!("../../targets/default.toml");
+
+/// Name used for the built-in scene in messages.
+pub const DEFAULT_SCENE_NAME: &str = "<built-in default scene>";
+
+// ---------------------------------------------------------------------------------------------
+// The file model (what serde reads). Every struct rejects unknown keys.
+// ---------------------------------------------------------------------------------------------
+
+/// A whole scene file. Tables: `[scene]`, `[model]`, `[physics]`, `[integrator]`, `[output]` and
+/// one `[[body]]` table per body (or `scene.bodies_file` instead of the `[[body]]` tables).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// `[scene]`: what is simulated and for how long. Required.
+    pub scene: SceneSection,
+    /// `[model]`: model constants (κ, moments of inertia). Required.
+    pub model: ModelSection,
+    /// `[physics]`: which force terms are on. Optional; an absent table turns every term off
+    /// (the bodies then move freely).
+    #[serde(default)]
+    pub physics: PhysicsSection,
+    /// `[integrator]`: method and tolerances. Optional; defaults as documented on
+    /// [`IntegratorSection`].
+    #[serde(default)]
+    pub integrator: IntegratorSection,
+    /// `[output]`: snapshot times and time-series cadence. Required.
+    pub output: OutputSection,
+    /// `[[body]]`: the bodies, one table each, numbered `body[0]`, `body[1]`, … in file order.
+    /// Either these tables or `scene.bodies_file`, not both.
+    #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
+    pub bodies: Vec<BodySpec>,
+}
+
+/// `[scene]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSection {
+    /// What is simulated. Required; must be `"ellipsoids"` (the Roig03 interacting-ellipsoids model).
+    pub kind: String,
+    /// End time of the run (s), > 0. Required. The run starts at t = 0.
+    pub t_end: f64,
+    /// Random seed (non-negative integer). Default 0. Recorded in `summary.json`; the ellipsoids
+    /// model itself is deterministic and draws no random numbers.
+    #[serde(default)]
+    pub seed: u64,
+    /// Optional CSV file with the initial bodies, replacing the `[[body]]` tables. The path is
+    /// relative to the scene file's directory. Columns as in the snapshots
+    /// (`t,id,mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz`; `t` and `id` may be present and are
+    /// ignored; `w` is the body-frame spin, rad/s), so a snapshot can be used directly. Quaternions
+    /// from a bodies file are used as written (checked to have unit norm within 1e-6, not
+    /// renormalised) so that a run restarted from a snapshot continues bit-for-bit.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bodies_file: Option<String>,
+}
+
+/// `[model]`: give exactly one of `kappa` or `calibrate`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSection {
+    /// Width parameter κ of the Gaussian mass distribution (Roig03 Eq. 2), dimensionless, > 3/2.
+    /// Larger κ = stiffer, more sharply bounded bodies.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kappa: Option<f64>,
+    /// Compute κ from Roig03 Eq. 14 instead of giving it: `calibrate = { beta = 10.0, v = 20.0 }`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub calibrate: Option<CalibrateSpec>,
+    /// Moments of inertia: `"gaussian"` (Roig03 Eq. 4 with the model's κ, the paper's choice) or
+    /// `"uniform"` (uniform-density ellipsoid, i.e. Eq. 4 with κ = 5/2). Default `"gaussian"`.
+    #[serde(default)]
+    pub inertia: InertiaModel,
+}
+
+/// `model.calibrate`: κ from Roig03 Eq. 14 for the smallest (by mass) and the largest body of the
+/// scene, with their equivalent radii `(A B C)^{1/3}` and the gravity term's G (SI G if gravity is off).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateSpec {
+    /// β of Eq. 14 (dimensionless, > 0): the contact barrier between the two bodies is β times
+    /// their kinetic energy at relative speed `v`. Required.
+    pub beta: f64,
+    /// Relative speed `v` of Eq. 14 (m/s, > 0) the contact must withstand. Required.
+    pub v: f64,
+}
+
+/// `[physics]`: every term is optional; an absent term is not computed at all.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhysicsSection {
+    /// Monopole gravity between centres of mass (Roig03 Eq. 6): `gravity = {}` or `gravity = { G = … }`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<GravitySpec>,
+    /// Gaussian-overlap contact potential (Roig03 Eqs. 7–12): `contact = {}` or `contact = { cutoff = … }`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact: Option<ContactSpec>,
+    /// Point dissipation (Roig03 Eqs. 40–41): `dissipation = { F0 = … }`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dissipation: Option<DissipationSpec>,
+}
+
+/// `physics.gravity`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySpec {
+    /// Gravitational constant `G` (m³ kg⁻¹ s⁻²), > 0. Default 6.674e-11 (SI). Also used in the
+    /// contact amplitude U0 (Roig03 Eq. 11) and in `model.calibrate`.
+    #[serde(default, rename = "G", skip_serializing_if = "Option::is_none")]
+    pub g: Option<f64>,
+}
+
+/// `physics.contact`.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Relative amplitude below which far pairs are skipped (dimensionless, in (0, 1)): a pair whose
+    /// contact potential is provably below `cutoff × U0` is not evaluated. Default 1e-16.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff: Option<f64>,
+}
+
+/// `physics.dissipation`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DissipationSpec {
+    /// Dissipation coefficient `F0` (s m⁻², ≥ 0) of Roig03 Eq. 41. Required. The dissipation is
+    /// weighted by the contact overlap, so it acts only on touching pairs.
+    #[serde(rename = "F0")]
+    pub f0: f64,
+}
+
+/// `[integrator]`. The whole table is optional.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSection {
+    /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
+    /// (adaptive Dormand–Prince) or `"rk4"` (fixed step; needs `step`). Default `"bulirsch-stoer"`.
+    #[serde(default = "default_method")]
+    pub method: Method,
+    /// Relative tolerance per state component (dimensionless, > 0). Default 1e-10.
+    #[serde(default = "default_tolerance")]
+    pub rtol: f64,
+    /// Absolute tolerance per state component (SI units of the component, ≥ 0). Default 1e-10.
+    #[serde(default = "default_tolerance")]
+    pub atol: f64,
+    /// Step (s, > 0): the fixed step for `"rk4"` (required there), an initial step guess for the
+    /// adaptive methods (optional; by default they choose one).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
+}
+
+fn default_method() -> Method {
+    Method::BulirschStoer
+}
+
+fn default_tolerance() -> f64 {
+    1e-10
+}
+
+impl Default for IntegratorSection {
+    fn default() -> Self {
+        IntegratorSection {
+            method: default_method(),
+            rtol: default_tolerance(),
+            atol: default_tolerance(),
+            step: None,
+        }
+    }
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSection {
+    /// Snapshot times (s): strictly increasing, each in `[0, t_end]`. The integrator lands on each
+    /// exactly and writes `snapshots/<k>.csv` for the k-th time. Default `[0, t_end]`; `[]` = no snapshots.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub times: Option<Vec<f64>>,
+    /// Time-series cadence (s, > 0): a row of `timeseries.csv` every `every` seconds from 0 to
+    /// `t_end` inclusive (plus one at each snapshot time). Required. At most 1e8 rows.
+    pub every: f64,
+}
+
+/// `[[body]]`: one ellipsoid and its initial state.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodySpec {
+    /// Semi-axes `[A, B, C]` (m) along the body x, y, z axes, with `A ≥ B ≥ C > 0`. Required.
+    pub axes: [f64; 3],
+    /// Mass (kg, > 0). Give exactly one of `mass` and `density`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mass: Option<f64>,
+    /// Bulk density (kg/m³, > 0); then `mass = density · 4/3 π A B C`. Give exactly one of `mass`
+    /// and `density`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
+    /// Centre-of-mass position `[x, y, z]` (m), world frame. Required.
+    pub position: [f64; 3],
+    /// Centre-of-mass velocity `[vx, vy, vz]` (m/s), world frame. Default `[0, 0, 0]`.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Attitude quaternion `[α, β, γ, δ]` (vector part first, scalar last; Roig03 Eq. 19), whose
+    /// rotation matrix R(q) (Eq. 21) maps world to body coordinates. Must have unit norm within 1e-6;
+    /// it is then normalised. Default `[0, 0, 0, 1]` (body axes = world axes).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quaternion: Option<[f64; 4]>,
+    /// Spin `[ω1, ω2, ω3]` (rad/s) about the body's principal axes (A, B, C). At most one of
+    /// `spin_body` and `spin_world`; default no spin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spin_body: Option<[f64; 3]>,
+    /// Spin `[ωx, ωy, ωz]` (rad/s) in the world frame; converted with `spin_body = R(q) · spin_world`.
+    /// At most one of `spin_body` and `spin_world`; default no spin.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spin_world: Option<[f64; 3]>,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Errors.
+// ---------------------------------------------------------------------------------------------
+
+/// A bad scene. Display is always one line: `<file>: <field>: <what was expected>, got <value>`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file (or its bodies file) could not be read.
+    #[error("{file}: cannot read: {reason}")]
+    Read {
+        /// The file as named by the user.
+        file: String,
+        /// The OS error.
+        reason: String,
+    },
+    /// Malformed TOML, an unknown or missing key, or a value of the wrong type.
+    #[error("{file}: {message}")]
+    Syntax {
+        /// The scene file.
+        file: String,
+        /// One-line description with the location.
+        message: String,
+    },
+    /// A value out of its allowed range.
+    #[error("{file}: {field}: {message}")]
+    Invalid {
+        /// The scene file.
+        file: String,
+        /// Dotted path of the field, e.g. `body[3].axes` or `integrator.rtol`.
+        field: String,
+        /// What was expected and what was given.
+        message: String,
+    },
+    /// `model.calibrate` has no solution (the message starts with `model.calibrate:`).
+    #[error("{file}: {source}")]
+    Calibration {
+        /// The scene file.
+        file: String,
+        /// Why.
+        source: CalibrationError,
+    },
+}
+
+impl SceneError {
+    /// The field the error is about, where there is one (e.g. `body[3].axes`).
+    pub fn field(&self) -> Option<&str> {
+        match self {
+            SceneError::Invalid { field, .. } => Some(field),
+            SceneError::Calibration { .. } => Some("model.calibrate"),
+            _ => None,
+        }
+    }
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Formats a list of numbers as `[1, 2, 3]`.
+fn fmt_list(v: &[f64]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+    format!("[{}]", parts.join(", "))
+}
+
+// ---------------------------------------------------------------------------------------------
+// The resolved scene.
+// ---------------------------------------------------------------------------------------------
+
+/// How κ was obtained.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum KappaSource {
+    /// Given as `model.kappa`.
+    Given,
+    /// From `model.calibrate` (Roig03 Eq. 14).
+    Calibrated {
+        /// β used.
+        beta: f64,
+        /// v used (m/s).
+        v: f64,
+    },
+}
+
+/// Validated integrator settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IntegratorSettings {
+    /// Method.
+    pub method: Method,
+    /// Relative tolerance (> 0).
+    pub rtol: f64,
+    /// Absolute tolerance (≥ 0).
+    pub atol: f64,
+    /// Fixed (rk4) or initial step (s).
+    pub step: Option<f64>,
+}
+
+/// Validated output settings.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputSettings {
+    /// Snapshot times (s), strictly increasing, in `[0, t_end]`.
+    pub times: Vec<f64>,
+    /// Time-series cadence (s, > 0).
+    pub every: f64,
+}
+
+/// A validated scene, ready to run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedScene {
+    /// How the scene is named in messages (the path as given, or [`DEFAULT_SCENE_NAME`]).
+    pub name: String,
+    /// The scene file's text (copied into the output directory as `scene.toml`).
+    pub source: String,
+    /// The scene file's directory (where `bodies_file` is resolved), if it came from a file.
+    pub base_dir: Option<PathBuf>,
+    /// The parsed file, as written.
+    pub file: SceneFile,
+    /// End time (s).
+    pub t_end: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Initial bodies, in file order (their index is the `id` column of the outputs).
+    pub bodies: Vec<Body>,
+    /// Model constants (κ resolved).
+    pub model: ModelConfig,
+    /// How κ was obtained.
+    pub kappa_source: KappaSource,
+    /// Physics terms.
+    pub physics: Physics,
+    /// Integrator settings.
+    pub integrator: IntegratorSettings,
+    /// Output settings.
+    pub output: OutputSettings,
+}
+
+// ---------------------------------------------------------------------------------------------
+// Entry points.
+// ---------------------------------------------------------------------------------------------
+
+/// Reads and validates a scene file. Errors name the file as given by `path`.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+        file: name.clone(),
+        reason: one_line(&e.to_string()),
+    })?;
+    let base = path.parent().map(|p| {
+        if p.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            p.to_path_buf()
+        }
+    });
+    parse_scene(&text, &name, base.as_deref())
+}
+
+/// The built-in default scene ([`DEFAULT_SCENE_TOML`]).
+pub fn default_scene() -> Result<LoadedScene, SceneError> {
+    parse_scene(DEFAULT_SCENE_TOML, DEFAULT_SCENE_NAME, None)
+}
+
+/// Parses and validates scene text. `name` is used in messages; `base_dir` resolves a relative
+/// `bodies_file` (the current directory when `None`).
+pub fn parse_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Result<LoadedScene, SceneError> {
+    let file = parse_toml(text, name)?;
+    let v = Validator { file: name };
+    v.resolve(text, file, base_dir)
+}
+
+/// Parses TOML into a [`SceneFile`] without validating values.
+pub fn parse_toml(text: &str, name: &str) -> Result<SceneFile, SceneError> {
+    let de = toml::Deserializer::parse(text).map_err(|e| SceneError::Syntax {
+        file: name.to_string(),
+        message: format!("{}: {}", location(text, e.span()), one_line(e.message())),
+    })?;
+    serde_path_to_error::deserialize::<_, SceneFile>(de).map_err(|e| {
+        let segments: Vec<serde_path_to_error::Segment> = e.path().iter().cloned().collect();
+        let inner = e.into_inner();
+        SceneError::Syntax {
+            file: name.to_string(),
+            message: describe_toml_error(text, &segments, &inner),
+        }
+    })
+}
+
+/// `line L, column C` of a byte span in `text`.
+fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
+    match span {
+        Some(span) => {
+            let (line, col) = line_col(text, span.start);
+            format!("line {line}, column {col}")
+        }
+        None => "unknown location".to_string(),
+    }
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text.as_bytes()[..offset];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let line_start = before.iter().rposition(|&b| b == b'\n').map(|p| p + 1).unwrap_or(0);
+    let col = String::from_utf8_lossy(&before[line_start..]).chars().count() + 1;
+    (line, col)
+}
+
+fn fmt_path(segments: &[serde_path_to_error::Segment]) -> String {
+    use serde_path_to_error::Segment;
+    let mut s = String::new();
+    for seg in segments {
+        match seg {
+            Segment::Seq { index } => s.push_str(&format!("[{index}]")),
+            Segment::Map { key } | Segment::Enum { variant: key } => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                s.push_str(key);
+            }
+            Segment::Unknown => {
+                if !s.is_empty() {
+                    s.push('.');
+                }
+                s.push('?');
+            }
+        }
+    }
+    s
+}
+
+/// Where a table lives, for "unknown field `x` in …": `[physics]`, `[physics.gravity]`, `body[2]`,
+/// `the top level`.
+fn fmt_table(segments: &[serde_path_to_error::Segment]) -> String {
+    if segments.is_empty() {
+        return "the top level".to_string();
+    }
+    let p = fmt_path(segments);
+    if p.contains('[') { p } else { format!("[{p}]") }
+}
+
+fn describe_toml_error(text: &str, segments: &[serde_path_to_error::Segment], e: &toml::de::Error) -> String {
+    let msg = one_line(e.message());
+    let line = match e.span() {
+        Some(span) => format!(" (line {})", line_col(text, span.start).0),
+        None => String::new(),
+    };
+    if let Some(rest) = msg.strip_prefix("unknown field `") {
+        // The path ends with the unknown key itself; name the table that holds it.
+        if let Some(end) = rest.find('`') {
+            let key = &rest[..end];
+            let expected = rest[end + 1..].trim_start_matches(',').trim();
+            let parent = match segments.last() {
+                Some(serde_path_to_error::Segment::Map { key: k }) if k == key => &segments[..segments.len() - 1],
+                _ => segments,
+            };
+            let expected = if expected.is_empty() {
+                String::new()
+            } else {
+                format!("; {expected}")
+            };
+            return format!("unknown field `{key}` in {}{expected}{line}", fmt_table(parent));
+        }
+    }
+    if let Some(rest) = msg.strip_prefix("missing field `")
+        && let Some(end) = rest.find('`')
+    {
+        let key = &rest[..end];
+        let full = if segments.is_empty() {
+            key.to_string()
+        } else {
+            format!("{}.{key}", fmt_path(segments))
+        };
+        return format!("{full}: missing (required in {}){line}", fmt_table(segments));
+    }
+    if segments.is_empty() {
+        format!("{msg}{line}")
+    } else {
+        format!("{}: {msg}{line}", fmt_path(segments))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Validation.
+// ---------------------------------------------------------------------------------------------
+
+struct Validator<'a> {
+    file: &'a str,
+}
+
+/// A body before conversion, from either a `[[body]]` table or a bodies-file row.
+struct RawBody {
+    /// Field prefix in messages, e.g. `body[2]` or `body[2] (bodies.csv line 4)`.
+    label: String,
+    axes: [f64; 3],
+    mass: Option<f64>,
+    density: Option<f64>,
+    position: [f64; 3],
+    velocity: [f64; 3],
+    quaternion: Option<[f64; 4]>,
+    normalise_quaternion: bool,
+    spin_body: Option<[f64; 3]>,
+    spin_world: Option<[f64; 3]>,
+}
+
+impl Validator<'_> {
+    fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_string(),
+            field: field.into(),
+            message: one_line(&message.into()),
+        }
+    }
+
+    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("must be > 0 and finite, got {x}")))
+        }
+    }
+
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("must be >= 0 and finite, got {x}")))
+        }
+    }
+
+    fn finite_vec(&self, field: &str, v: &[f64]) -> Result<(), SceneError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(())
+        } else {
+            Err(self.invalid(field, format!("non-finite value, got {}", fmt_list(v))))
+        }
+    }
+
+    fn resolve(&self, text: &str, file: SceneFile, base_dir: Option<&Path>) -> Result<LoadedScene, SceneError> {
+        // [scene]
+        if file.scene.kind != "ellipsoids" {
+            return Err(self.invalid(
+                "scene.kind",
+                format!("must be \"ellipsoids\", got {:?}", file.scene.kind),
+            ));
+        }
+        let t_end = self.positive("scene.t_end", file.scene.t_end)?;
+
+        // [model] (κ itself after the bodies, since calibration needs them)
+        let m = &file.model;
+        match (m.kappa, m.calibrate) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got both"));
+            }
+            (None, None) => {
+                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got neither"));
+            }
+            (Some(k), None) => {
+                if !(k.is_finite() && k > 1.5) {
+                    return Err(self.invalid("model.kappa", format!("must be > 1.5 and finite, got {k}")));
+                }
+            }
+            (None, Some(c)) => {
+                self.positive("model.calibrate.beta", c.beta)?;
+                self.positive("model.calibrate.v", c.v)?;
+            }
+        }
+
+        // [physics]
+        let p = &file.physics;
+        let gravity = match p.gravity {
+            Some(g) => Some(GravityTerm {
+                g: self.positive("physics.gravity.G", g.g.unwrap_or(SI_G))?,
+            }),
+            None => None,
+        };
+        let contact = match p.contact {
+            Some(c) => {
+                let cutoff = c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF);
+                if !(cutoff.is_finite() && cutoff > 0.0 && cutoff < 1.0) {
+                    return Err(self.invalid("physics.contact.cutoff", format!("must be in (0, 1), got {cutoff}")));
+                }
+                Some(ContactTerm { cutoff })
+            }
+            None => None,
+        };
+        let dissipation = match p.dissipation {
+            Some(d) => Some(DissipationTerm {
+                f0: self.non_negative("physics.dissipation.F0", d.f0)?,
+            }),
+            None => None,
+        };
+        let physics = Physics {
+            gravity,
+            contact,
+            dissipation,
+        };
+
+        // [integrator]
+        let i = &file.integrator;
+        let rtol = self.positive("integrator.rtol", i.rtol)?;
+        let atol = self.non_negative("integrator.atol", i.atol)?;
+        let step = match i.step {
+            Some(h) => Some(self.positive("integrator.step", h)?),
+            None => None,
+        };
+        if i.method == Method::Rk4 && step.is_none() {
+            return Err(self.invalid("integrator.step", "method \"rk4\" needs a fixed step: step = <s> (> 0)"));
+        }
+        let integrator = IntegratorSettings {
+            method: i.method,
+            rtol,
+            atol,
+            step,
+        };
+
+        // [output]
+        let every = self.positive("output.every", file.output.every)?;
+        if t_end / every > MAX_TIMESERIES_ROWS {
+            return Err(self.invalid(
+                "output.every",
+                format!(
+                    "too small for t_end = {t_end}: would write {:e} rows (at most 1e8), got {every}",
+                    t_end / every
+                ),
+            ));
+        }
+        let times = match &file.output.times {
+            Some(times) => {
+                for (k, &t) in times.iter().enumerate() {
+                    if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+                        return Err(self.invalid(
+                            format!("output.times[{k}]"),
+                            format!("must be in [0, t_end = {t_end}], got {t}"),
+                        ));
+                    }
+                    if k > 0 && t <= times[k - 1] {
+                        return Err(self.invalid(
+                            "output.times",
+                            format!("must be strictly increasing, got {} then {t}", times[k - 1]),
+                        ));
+                    }
+                }
+                times.clone()
+            }
+            None => vec![0.0, t_end],
+        };
+        let output = OutputSettings { times, every };
+
+        // bodies
+        let raw = match (&file.scene.bodies_file, file.bodies.is_empty()) {
+            (Some(_), false) => {
+                return Err(self.invalid(
+                    "scene.bodies_file",
+                    "give either `bodies_file` or [[body]] tables, got both",
+                ));
+            }
+            (None, true) => {
+                return Err(self.invalid("body", "no bodies: give [[body]] tables or scene.bodies_file"));
+            }
+            (None, false) => file
+                .bodies
+                .iter()
+                .enumerate()
+                .map(|(k, b)| RawBody {
+                    label: format!("body[{k}]"),
+                    axes: b.axes,
+                    mass: b.mass,
+                    density: b.density,
+                    position: b.position,
+                    velocity: b.velocity,
+                    quaternion: b.quaternion,
+                    normalise_quaternion: true,
+                    spin_body: b.spin_body,
+                    spin_world: b.spin_world,
+                })
+                .collect::<Vec<_>>(),
+            (Some(rel), true) => self.read_bodies_file(rel, base_dir)?,
+        };
+        let bodies = raw.iter().map(|b| self.body(b)).collect::<Result<Vec<_>, _>>()?;
+
+        // κ
+        let contact_g = gravity.map(|g| g.g).unwrap_or(SI_G);
+        let (kappa, kappa_source) = match (m.kappa, m.calibrate) {
+            (Some(k), _) => (k, KappaSource::Given),
+            (None, Some(c)) => {
+                let small = bodies
+                    .iter()
+                    .min_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
+                    .expect("at least one body (checked above)");
+                let large = bodies
+                    .iter()
+                    .max_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
+                    .expect("at least one body (checked above)");
+                let k = calibrate_kappa(
+                    c.beta,
+                    c.v,
+                    small.shape.equivalent_radius(),
+                    small.shape.mass,
+                    large.shape.equivalent_radius(),
+                    contact_g,
+                )
+                .map_err(|source| SceneError::Calibration {
+                    file: self.file.to_string(),
+                    source,
+                })?;
+                if !(k.is_finite() && k > 1.5) {
+                    return Err(self.invalid("model.calibrate", format!("calibration gave kappa = {k}, need > 1.5")));
+                }
+                (k, KappaSource::Calibrated { beta: c.beta, v: c.v })
+            }
+            (None, None) => unreachable!("checked above"),
+        };
+        let model = ModelConfig {
+            kappa,
+            inertia: m.inertia,
+            contact_g,
+        };
+
+        Ok(LoadedScene {
+            name: self.file.to_string(),
+            source: text.to_string(),
+            base_dir: base_dir.map(Path::to_path_buf),
+            t_end,
+            seed: file.scene.seed,
+            file,
+            bodies,
+            model,
+            kappa_source,
+            physics,
+            integrator,
+            output,
+        })
+    }
+
+    fn read_bodies_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<RawBody>, SceneError> {
+        let path = match base_dir {
+            Some(dir) => dir.join(rel),
+            None => PathBuf::from(rel),
+        };
+        let records = crate::io::csv::read_bodies_csv(&path).map_err(|e| match e {
+            crate::io::csv::BodiesFileError::Read(reason) => self.invalid(
+                "scene.bodies_file",
+                format!("cannot read {}: {}", path.display(), reason),
+            ),
+            crate::io::csv::BodiesFileError::Format { line, message } => self.invalid(
+                "scene.bodies_file",
+                format!("{} line {line}: {message}", path.display()),
+            ),
+        })?;
+        if records.is_empty() {
+            return Err(self.invalid(
+                "scene.bodies_file",
+                format!("{}: no bodies (no data rows)", path.display()),
+            ));
+        }
+        Ok(records
+            .into_iter()
+            .enumerate()
+            .map(|(k, r)| RawBody {
+                label: format!("body[{k}] ({} line {})", rel, r.line),
+                axes: r.axes,
+                mass: Some(r.mass),
+                density: None,
+                position: r.position,
+                velocity: r.velocity,
+                quaternion: Some(r.quaternion),
+                normalise_quaternion: false,
+                spin_body: Some(r.spin_body),
+                spin_world: None,
+            })
+            .collect())
+    }
+
+    fn body(&self, b: &RawBody) -> Result<Body, SceneError> {
+        let f = |name: &str| format!("{}.{name}", b.label);
+        let axes_field = f("axes");
+        self.finite_vec(&axes_field, &b.axes)?;
+        let [a, bb, c] = b.axes;
+        if !(a >= bb && bb >= c && c > 0.0) {
+            return Err(self.invalid(axes_field, format!("need A >= B >= C > 0, got {}", fmt_list(&b.axes))));
+        }
+        let volume = 4.0 / 3.0 * std::f64::consts::PI * a * bb * c;
+        let mass = match (b.mass, b.density) {
+            (Some(m), None) => self.positive(&f("mass"), m)?,
+            (None, Some(rho)) => {
+                let rho = self.positive(&f("density"), rho)?;
+                let m = rho * volume;
+                if !(m.is_finite() && m > 0.0) {
+                    return Err(self.invalid(f("density"), format!("gives a mass of {m} kg, need > 0 and finite")));
+                }
+                m
+            }
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got both"));
+            }
+            (None, None) => {
+                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got neither"));
+            }
+        };
+        self.finite_vec(&f("position"), &b.position)?;
+        self.finite_vec(&f("velocity"), &b.velocity)?;
+
+        let q = match b.quaternion {
+            Some(q) => {
+                let field = f("quaternion");
+                self.finite_vec(&field, &q)?;
+                let v = Vec4::new(q[0], q[1], q[2], q[3]);
+                let norm = v.norm();
+                if (norm - 1.0).abs() > QUATERNION_NORM_TOLERANCE {
+                    return Err(self.invalid(
+                        field,
+                        format!("must have unit norm within 1e-6, got {} (norm {norm})", fmt_list(&q)),
+                    ));
+                }
+                if b.normalise_quaternion { v / norm } else { v }
+            }
+            None => Vec4::new(0.0, 0.0, 0.0, 1.0),
+        };
+
+        let spin_body = match (b.spin_body, b.spin_world) {
+            (Some(_), Some(_)) => {
+                return Err(self.invalid(
+                    b.label.clone(),
+                    "give at most one of `spin_body` or `spin_world`, got both",
+                ));
+            }
+            (Some(w), None) => {
+                self.finite_vec(&f("spin_body"), &w)?;
+                Vec3::new(w[0], w[1], w[2])
+            }
+            (None, Some(w)) => {
+                self.finite_vec(&f("spin_world"), &w)?;
+                world_to_body(&q, &Vec3::new(w[0], w[1], w[2]))
+            }
+            (None, None) => Vec3::zeros(),
+        };
+
+        Ok(Body {
+            shape: Ellipsoid {
+                axes: Vec3::new(a, bb, c),
+                mass,
+            },
+            position: Vec3::new(b.position[0], b.position[1], b.position[2]),
+            velocity: Vec3::new(b.velocity[0], b.velocity[1], b.velocity[2]),
+            quaternion: q,
+            spin_body,
+        })
+    }
+}
+
+/// `R(q) · v`: a world-frame vector in body coordinates (Roig03 Eq. 21; `q = (α, β, γ, δ)`, scalar last).
+///
+/// R(q) is the transpose of nalgebra's rotation matrix of the unit quaternion `δ + α i + β j + γ k`.
+pub fn world_to_body(q: &Vec4, v: &Vec3) -> Vec3 {
+    let uq = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
+    uq.to_rotation_matrix().matrix().transpose() * v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+[scene]
+kind = "ellipsoids"
+t_end = 200.0
+seed = 1
+[model]
+kappa = 10.0
+inertia = "gaussian"
+[physics]
+gravity = { G = 6.674e-11 }
+contact = {}
+dissipation = { F0 = 1.0 }
+[integrator]
+method = "bulirsch-stoer"
+rtol = 1e-10
+atol = 1e-10
+[output]
+times = [0.0, 100.0, 200.0]
+every = 1.0
+[[body]]
+axes = [3.0, 2.0, 1.0]
+mass = 1000.0
+position = [0.0, 0.0, 0.0]
+velocity = [0.0, 0.0, 0.0]
+quaternion = [0.0, 0.0, 0.0, 1.0]
+spin_body = [0.01, 0.5, 0.02]
+[[body]]
+axes = [2, 2, 2]
+density = 3000
+position = [10.0, 0.0, 0.0]
+spin_world = [0.0, 0.0, 0.1]
+quaternion = [0.0, 0.0, 0.7071067811865476, 0.7071067811865476]
+"#;
+
+    #[test]
+    fn good_scene_parses() {
+        let s = parse_scene(GOOD, "scene.toml", None).unwrap();
+        assert_eq!(s.bodies.len(), 2);
+        assert_eq!(s.model.kappa, 10.0);
+        assert_eq!(s.physics.gravity.unwrap().g, 6.674e-11);
+        assert_eq!(s.physics.contact.unwrap().cutoff, 1e-16);
+        assert_eq!(s.output.times, vec![0.0, 100.0, 200.0]);
+        let m = 3000.0 * 4.0 / 3.0 * std::f64::consts::PI * 8.0;
+        assert!((s.bodies[1].shape.mass - m).abs() < 1e-9 * m);
+        // A 90° turn about z: the world z spin stays about the body z axis.
+        let w = s.bodies[1].spin_body;
+        assert!((w - Vec3::new(0.0, 0.0, 0.1)).norm() < 1e-15);
+    }
+
+    #[test]
+    fn spin_world_conversion_matches_eq21() {
+        // 90° about z: body x axis = world y axis. A world-x spin is then about body −y.
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        let q = Vec4::new(0.0, 0.0, h, h);
+        let w = world_to_body(&q, &Vec3::new(1.0, 0.0, 0.0));
+        assert!((w - Vec3::new(0.0, -1.0, 0.0)).norm() < 1e-15, "{w}");
+        // Explicit Roig03 Eq. 21 for a generic quaternion.
+        let q = Vec4::new(0.1, -0.3, 0.5, 0.8).normalize();
+        let (a, b, c, d) = (q[0], q[1], q[2], q[3]);
+        let r = crate::math::Mat3::new(
+            a * a - b * b - c * c + d * d,
+            2.0 * (a * b + c * d),
+            2.0 * (a * c - b * d),
+            2.0 * (a * b - c * d),
+            -a * a + b * b - c * c + d * d,
+            2.0 * (b * c + a * d),
+            2.0 * (a * c + b * d),
+            2.0 * (b * c - a * d),
+            -a * a - b * b + c * c + d * d,
+        );
+        let v = Vec3::new(0.3, -1.2, 2.0);
+        assert!((world_to_body(&q, &v) - r * v).norm() < 1e-14);
+    }
+
+    #[test]
+    fn defaults() {
+        let text = r#"
+[scene]
+kind = "ellipsoids"
+t_end = 5
+[model]
+kappa = 4
+[output]
+every = 1
+[[body]]
+axes = [1, 1, 1]
+mass = 1
+position = [0, 0, 0]
+"#;
+        let s = parse_scene(text, "x.toml", None).unwrap();
+        assert_eq!(s.integrator.method, Method::BulirschStoer);
+        assert_eq!(s.integrator.rtol, 1e-10);
+        assert_eq!(s.output.times, vec![0.0, 5.0]);
+        assert_eq!(s.physics, Physics::default());
+        assert_eq!(s.bodies[0].quaternion, Vec4::new(0.0, 0.0, 0.0, 1.0));
+        assert_eq!(s.model.contact_g, SI_G);
+    }
+
+    #[test]
+    fn unknown_field_message() {
+        let text = GOOD.replace("contact = {}", "contact = {}\nfoo = 1");
+        let e = parse_scene(&text, "scene.toml", None).unwrap_err().to_string();
+        assert!(e.starts_with("scene.toml: unknown field `foo` in [physics]"), "{e}");
+        let text = GOOD.replace("contact = {}", "contact = { cutof = 1e-10 }");
+        let e = parse_scene(&text, "scene.toml", None).unwrap_err().to_string();
+        assert!(e.contains("unknown field `cutof` in [physics.contact]"), "{e}");
+    }
+
+    #[test]
+    fn default_scene_parses_without_calibration_errors_in_toml() {
+        // Only the TOML layer: calibration needs the physics.
+        parse_toml(DEFAULT_SCENE_TOML, DEFAULT_SCENE_NAME).unwrap();
+    }
+}
