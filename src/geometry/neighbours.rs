@@ -6,6 +6,7 @@
 //! independent of thread count, so runs are deterministic.
 
 use crate::math::Vec3;
+use rayon::prelude::*;
 
 /// All pairs `(i, j)`, `i < j`, with `|r_i − r_j| < ρ_i + ρ_j`, sorted.
 ///
@@ -43,21 +44,22 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
     let keys: Vec<[i64; 3]> = centres.iter().map(key).collect();
     let mut order: Vec<usize> = (0..n).collect();
     order.sort_unstable_by(|&a, &b| keys[a].cmp(&keys[b]).then(a.cmp(&b)));
+    // Bodies laid out contiguously in cell order, so the inner loop streams through memory.
     let sorted_keys: Vec<[i64; 3]> = order.iter().map(|&k| keys[k]).collect();
-    let mut row = Vec::new();
-    for i in 0..n {
-        row.clear();
-        let k = keys[i];
+    let sorted_centres: Vec<Vec3> = order.iter().map(|&k| centres[k]).collect();
+    let sorted_radii: Vec<f64> = order.iter().map(|&k| radii[k]).collect();
+    let row_of = |i: usize| -> Vec<usize> {
+        let mut row = Vec::new();
+        let (k, ci, ri) = (keys[i], centres[i], radii[i]);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     let target = [k[0] + dx, k[1] + dy, k[2] + dz];
-                    let start = sorted_keys.partition_point(|c| *c < target);
-                    let mut m = start;
+                    let mut m = sorted_keys.partition_point(|c| *c < target);
                     while m < n && sorted_keys[m] == target {
-                        let j = order[m];
-                        if j > i && (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
-                            row.push(j);
+                        let reach = ri + sorted_radii[m];
+                        if (sorted_centres[m] - ci).norm_squared() < reach * reach && order[m] > i {
+                            row.push(order[m]);
                         }
                         m += 1;
                     }
@@ -65,7 +67,49 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
             }
         }
         row.sort_unstable();
-        pairs.extend(row.iter().map(|&j| (i, j)));
+        row
+    };
+    // Rows are independent; collecting them in index order keeps the output deterministic.
+    let rows: Vec<Vec<usize>> = if n >= 256 {
+        (0..n).into_par_iter().map(row_of).collect()
+    } else {
+        (0..n).map(row_of).collect()
+    };
+    for (i, row) in rows.into_iter().enumerate() {
+        pairs.extend(row.into_iter().map(|j| (i, j)));
     }
     pairs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The grid search must find exactly the pairs of the brute-force search (polydisperse, clustered).
+    #[test]
+    fn grid_search_equals_brute_force() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for n in [17, 300, 1200] {
+            let centres: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(next(), next(), next() * 0.4) * 4.0 * (n as f64).cbrt())
+                .collect();
+            let radii: Vec<f64> = (0..n).map(|_| 0.5 + 4.0 * next() * next()).collect();
+            let mut brute = Vec::new();
+            for i in 0..n {
+                for j in (i + 1)..n {
+                    if (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
+                        brute.push((i, j));
+                    }
+                }
+            }
+            assert!(!brute.is_empty());
+            assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
+        }
+    }
 }

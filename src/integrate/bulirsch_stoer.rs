@@ -85,8 +85,8 @@ pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = 10;
 /// [`BulirschStoer::reset`] after a discontinuity of the state or of the equations.
 ///
 /// Statistics ([`Integrator::stats`]) count every RHS call (including the initial-step guess and
-/// the derivative at the start of each `advance`); `smallest_step` includes steps shortened to
-/// land on an output time. [`BulirschStoer::rejections`] splits the rejected steps by cause.
+/// the derivative at the start of each `advance`); `smallest_step` leaves out steps shortened
+/// only to land on an output time. [`BulirschStoer::rejections`] splits the rejected steps by cause.
 ///
 /// All work arrays are allocated once (at the first call and whenever the dimension changes);
 /// a step allocates nothing.
@@ -726,7 +726,10 @@ impl Integrator for BulirschStoer {
                     }
                     y.copy_from_slice(&self.tab[..n]);
                     self.stats.steps_accepted += 1;
-                    self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
+                    if !(last && h_abs < saved_h) {
+                        // Steps shortened only to land on an output time say nothing about stiffness.
+                        self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
+                    }
                     nonfinite_run = 0;
                     if last {
                         *t = t_target;
