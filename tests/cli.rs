@@ -439,33 +439,48 @@ fn default_scene_checks() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Needs the physics.
+/// `bench rhs` over several sizes writes one CSV row per (N, threads) and the SVG plot, and refuses to
+/// overwrite them without `--force`.
 #[test]
-fn bench_rhs_writes_csv() {
+fn bench_rhs_writes_csv_and_plot() {
     let dir = temp_dir("bench");
-    let out = rubblepile(
-        &dir,
-        &[
-            "bench",
-            "rhs",
-            "--bodies",
-            "8",
-            "--repeats",
-            "3",
-            "--threads",
-            "2",
-            "--out",
-            "bench",
-        ],
-    );
+    let args = [
+        "bench",
+        "rhs",
+        "--bodies",
+        "8,30",
+        "--repeats",
+        "3",
+        "--threads",
+        "2",
+        "--out",
+        "bench",
+    ];
+    let out = rubblepile(&dir, &args);
     assert_ok(&out, "bench");
     let csv = read(&dir.join("bench/bench_rhs.csv"));
     let mut lines = csv.lines();
     assert_eq!(lines.next().unwrap(), "bodies,threads,median_us,min_us,repeats");
     let rows: Vec<&str> = lines.collect();
-    assert_eq!(rows.len(), 2);
+    assert_eq!(rows.len(), 4);
     assert!(rows[0].starts_with("8,1,") && rows[0].ends_with(",3"), "{}", rows[0]);
     assert!(rows[1].starts_with("8,2,"), "{}", rows[1]);
+    assert!(rows[3].starts_with("30,2,"), "{}", rows[3]);
+    let svg = read(&dir.join("bench/bench_rhs.svg"));
+    assert!(
+        svg.contains("<svg") && svg.contains("number of bodies N"),
+        "plot lacks its axis label"
+    );
+    let again = rubblepile(&dir, &args);
+    assert_eq!(again.status.code(), Some(2), "overwrote a benchmark without --force");
+    assert_eq!(
+        read(&dir.join("bench/bench_rhs.csv")),
+        csv,
+        "first benchmark's CSV changed"
+    );
+    let mut forced = args.to_vec();
+    forced.push("--force");
+    assert_ok(&rubblepile(&dir, &forced), "bench --force");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

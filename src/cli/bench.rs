@@ -16,8 +16,9 @@ use crate::scene::{DEFAULT_CONTACT_CUTOFF, SI_G};
 pub struct RhsArgs {
     /// Number of ellipsoids (density 3000 kg/m³, equivalent radii 1–5 km, on a jittered cubic
     /// lattice with spacing 1.9 × the mean radius, random attitudes, spins and velocities).
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
-    pub bodies: u64,
+    /// Several sizes may be given, comma-separated (`--bodies 30,200,2000`), to see how the cost scales.
+    #[arg(long, required = true, value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub bodies: Vec<u64>,
     /// Timed evaluations per thread count (the median and minimum are reported).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub repeats: u64,
@@ -30,9 +31,13 @@ pub struct RhsArgs {
     /// Threads of the parallel run (default: all available).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Option<u64>,
-    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats) into this directory.
+    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats) and the plot `bench_rhs.svg`
+    /// (median µs per RHS against N, one line per thread count) into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
+    /// Overwrite `bench_rhs.csv`/`bench_rhs.svg` of an earlier benchmark in DIR.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Timing of one thread count.
@@ -106,56 +111,125 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
             args.kappa
         )));
     }
-    let n = args.bodies as usize;
     let repeats = args.repeats as usize;
     let all = match args.threads {
         Some(k) => k as usize,
         None => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
     };
-    if let Some(dir) = &args.out {
+    let paths = args
+        .out
+        .as_ref()
+        .map(|dir| (dir.join("bench_rhs.csv"), dir.join("bench_rhs.svg")));
+    if let (Some(dir), Some((csv, svg))) = (&args.out, &paths) {
+        if !args.force && (csv.exists() || svg.exists()) {
+            return Err(CliError::usage(format!(
+                "--out: {} already holds a benchmark; use --force to overwrite it",
+                dir.display()
+            )));
+        }
         std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
     }
-    let system = bench_system(n, args.seed, args.kappa);
     let mut counts = vec![1];
     if all > 1 {
         counts.push(all);
     }
-    println!(
-        "bench rhs: {n} bodies, {repeats} repeats, seed {}, kappa {}",
-        args.seed, args.kappa
-    );
-    let mut results = Vec::new();
-    for &threads in &counts {
-        let r = time_rhs(&system, threads, repeats).map_err(CliError::failed)?;
+    let mut results: Vec<(usize, RhsTiming)> = Vec::new();
+    for &bodies in &args.bodies {
+        let n = bodies as usize;
+        let system = bench_system(n, args.seed, args.kappa);
         println!(
-            "  {:>3} thread{}: median {:.1} us per RHS (min {:.1} us)",
-            r.threads,
-            if r.threads == 1 { " " } else { "s" },
-            r.median_us,
-            r.min_us
+            "bench rhs: {n} bodies, {repeats} repeats, seed {}, kappa {}",
+            args.seed, args.kappa
         );
-        results.push(r);
+        let mut row = Vec::new();
+        for &threads in &counts {
+            let r = time_rhs(&system, threads, repeats).map_err(CliError::failed)?;
+            println!(
+                "  {:>3} thread{}: median {:.1} us per RHS (min {:.1} us)",
+                r.threads,
+                if r.threads == 1 { " " } else { "s" },
+                r.median_us,
+                r.min_us
+            );
+            row.push(r);
+        }
+        if row.len() == 2 {
+            println!(
+                "  speed-up {:.2}x on {} threads (median 1 thread / median {} threads)",
+                row[0].median_us / row[1].median_us,
+                row[1].threads,
+                row[1].threads
+            );
+        }
+        results.extend(row.into_iter().map(|r| (n, r)));
     }
-    if results.len() == 2 {
-        println!(
-            "  speed-up {:.2}x on {} threads (median 1 thread / median {} threads)",
-            results[0].median_us / results[1].median_us,
-            results[1].threads,
-            results[1].threads
-        );
-    }
-    if let Some(dir) = &args.out {
-        let path = dir.join("bench_rhs.csv");
+    if let Some((csv, svg)) = &paths {
         let write = || -> std::io::Result<()> {
-            let mut f = std::io::BufWriter::new(std::fs::File::create(&path)?);
+            let mut f = std::io::BufWriter::new(std::fs::File::create(csv)?);
             writeln!(f, "bodies,threads,median_us,min_us,repeats")?;
-            for r in &results {
+            for (n, r) in &results {
                 writeln!(f, "{n},{},{:e},{:e},{repeats}", r.threads, r.median_us, r.min_us)?;
             }
             f.flush()
         };
-        write().map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
-        println!("  wrote {}", path.display());
+        write().map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
+        plot_rhs(svg, &results, &counts).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
+        println!("  wrote {} and {}", csv.display(), svg.display());
     }
     Ok(())
+}
+
+/// Log–log plot of the median µs per RHS against the number of bodies, one line per thread count.
+fn plot_rhs(path: &std::path::Path, results: &[(usize, RhsTiming)], counts: &[usize]) -> Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let (mut n_lo, mut n_hi) = (f64::INFINITY, 0.0_f64);
+    let (mut t_lo, mut t_hi) = (f64::INFINITY, 0.0_f64);
+    for (n, r) in results {
+        n_lo = n_lo.min(*n as f64);
+        n_hi = n_hi.max(*n as f64);
+        t_lo = t_lo.min(r.median_us);
+        t_hi = t_hi.max(r.median_us);
+    }
+    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption("rubblepile bench rhs: cost of one right-hand side", ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (n_lo * 0.8..n_hi * 1.25).log_scale(),
+            (t_lo * 0.5..t_hi * 2.0).log_scale(),
+        )
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("number of bodies N")
+        .y_desc("median time per RHS (µs)")
+        .draw()
+        .map_err(|e| err(&e))?;
+    for (k, &threads) in counts.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let points: Vec<(f64, f64)> = results
+            .iter()
+            .filter(|(_, r)| r.threads == threads)
+            .map(|(n, r)| (*n as f64, r.median_us))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+            .map_err(|e| err(&e))?
+            .label(format!("{threads} thread{}", if threads == 1 { "" } else { "s" }))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart
+            .draw_series(points.into_iter().map(|p| Circle::new(p, 3, color.filled())))
+            .map_err(|e| err(&e))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))
 }

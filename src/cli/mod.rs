@@ -3,7 +3,7 @@
 //! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress]`: runs a scene (the built-in
 //!   default scene without SCENE) and writes its outputs into DIR;
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to;
-//! - `rubblepile bench rhs --bodies N [--repeats R] [--out DIR]`: times one right-hand-side
+//! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad

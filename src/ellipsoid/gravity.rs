@@ -35,21 +35,21 @@ pub fn gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &mut [
             .par_iter_mut()
             .enumerate()
             .map(|(i, fi)| {
-                let mut f = Vec3::zeros();
-                let mut u = 0.0;
-                for j in 0..n {
-                    if j == i {
-                        continue;
+                // Σ_j m_j d/r³ and Σ_j m_j/r over j ≠ i, in index order (two branch-free ranges).
+                let (mut acc, mut phi) = (Vec3::zeros(), 0.0);
+                let pi = positions[i];
+                for range in [0..i, i + 1..n] {
+                    for (pj, &mj) in positions[range.clone()].iter().zip(&masses[range]) {
+                        let d = pj - pi;
+                        let inv_r = 1.0 / d.norm_squared().sqrt();
+                        let w = mj * inv_r;
+                        phi += w;
+                        acc += d * (w * inv_r * inv_r);
                     }
-                    let d = positions[j] - positions[i];
-                    let r2 = d.norm_squared();
-                    let r = r2.sqrt();
-                    let gm = g * masses[i] * masses[j];
-                    u -= gm / r;
-                    f += d * (gm / (r2 * r));
                 }
-                *fi = f;
-                u
+                let gm = g * masses[i];
+                *fi = acc * gm;
+                -gm * phi
             })
             .collect();
         0.5 * potentials.iter().sum::<f64>()

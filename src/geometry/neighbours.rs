@@ -1,12 +1,61 @@
 //! Neighbour search by bounding spheres on a uniform cell grid.
 //!
 //! Each body has a centre and an interaction radius `ρ`; the candidate pairs are those with
-//! `|r_i − r_j| < ρ_i + ρ_j`. With cell size `2 max ρ` every such pair lies in adjacent cells, so the
-//! cost is O(N + pairs) for bodies of comparable size. The output is sorted `(i, j)` with `i < j`,
-//! independent of thread count, so runs are deterministic.
+//! `|r_i − r_j| < ρ_i + ρ_j`. Bodies with `ρ ≤ ρ_ref = min(ρ_max, 2 × median ρ)` ("regular") are binned in
+//! cells of side `ρ_ref`, sorted by `(z, y, x)` cell index so that a run of cells along x is contiguous;
+//! each body scans the cell runs that its reach `ρ_i + ρ_ref` overlaps. The few larger bodies query the
+//! same grid with their own reach and are paired with each other directly, so a wide size distribution
+//! does not inflate the cells. Cost O(N + pairs) for piles of bounded density. The output is sorted
+//! `(i, j)` with `i < j` and does not depend on the number of threads, so runs are deterministic.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
+
+/// Below this many bodies the plain O(N²) loop is used.
+const BRUTE_FORCE_BELOW: usize = 24;
+/// From this many bodies on, rows are built in parallel.
+const PARALLEL_FROM: usize = 256;
+
+/// Cells of the regular bodies, in `(z, y, x)` order.
+struct Grid {
+    cell: f64,
+    keys: Vec<[i64; 3]>,
+    centres: Vec<Vec3>,
+    radii: Vec<f64>,
+    ids: Vec<usize>,
+}
+
+impl Grid {
+    fn key(&self, p: &Vec3) -> [i64; 3] {
+        [
+            (p.z / self.cell).floor() as i64,
+            (p.y / self.cell).floor() as i64,
+            (p.x / self.cell).floor() as i64,
+        ]
+    }
+
+    /// Calls `visit(id)` for every binned body whose sphere overlaps the sphere (`c`, `r`), given the
+    /// largest binned radius `r_ref`.
+    fn query(&self, c: &Vec3, r: f64, r_ref: f64, mut visit: impl FnMut(usize)) {
+        let reach = r + r_ref;
+        let lo = self.key(&(c - Vec3::from_element(reach)));
+        let hi = self.key(&(c + Vec3::from_element(reach)));
+        for kz in lo[0]..=hi[0] {
+            for ky in lo[1]..=hi[1] {
+                let first = [kz, ky, lo[2]];
+                let last = [kz, ky, hi[2]];
+                let mut m = self.keys.partition_point(|k| *k < first);
+                while m < self.keys.len() && self.keys[m] <= last {
+                    let reach_ij = r + self.radii[m];
+                    if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
+                        visit(self.ids[m]);
+                    }
+                    m += 1;
+                }
+            }
+        }
+    }
+}
 
 /// All pairs `(i, j)`, `i < j`, with `|r_i − r_j| < ρ_i + ρ_j`, sorted.
 ///
@@ -18,65 +67,73 @@ use rayon::prelude::*;
 /// ```
 pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
     let n = centres.len();
-    let mut pairs = Vec::new();
-    if n < 2 {
-        return pairs;
+    let finite =
+        centres.iter().all(|c| c.iter().all(|x| x.is_finite())) && radii.iter().all(|r| r.is_finite() && *r > 0.0);
+    if n < BRUTE_FORCE_BELOW || !finite {
+        return brute_force_pairs(centres, radii);
     }
-    let rmax = radii.iter().cloned().fold(0.0_f64, f64::max);
-    if rmax.is_nan() || rmax <= 0.0 || !rmax.is_finite() || n <= 16 {
-        for i in 0..n {
-            for j in (i + 1)..n {
-                if (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
-                    pairs.push((i, j));
-                }
-            }
-        }
-        return pairs;
-    }
-    let cell = 2.0 * rmax;
-    let key = |p: &Vec3| -> [i64; 3] {
-        [
-            (p.x / cell).floor() as i64,
-            (p.y / cell).floor() as i64,
-            (p.z / cell).floor() as i64,
-        ]
+    let mut sorted = radii.to_vec();
+    sorted.sort_unstable_by(f64::total_cmp);
+    let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
+    let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
+    let mut grid = Grid {
+        cell: r_ref,
+        keys: Vec::new(),
+        centres: Vec::new(),
+        radii: Vec::new(),
+        ids: Vec::new(),
     };
-    let keys: Vec<[i64; 3]> = centres.iter().map(key).collect();
-    let mut order: Vec<usize> = (0..n).collect();
-    order.sort_unstable_by(|&a, &b| keys[a].cmp(&keys[b]).then(a.cmp(&b)));
-    // Bodies laid out contiguously in cell order, so the inner loop streams through memory.
-    let sorted_keys: Vec<[i64; 3]> = order.iter().map(|&k| keys[k]).collect();
-    let sorted_centres: Vec<Vec3> = order.iter().map(|&k| centres[k]).collect();
-    let sorted_radii: Vec<f64> = order.iter().map(|&k| radii[k]).collect();
+    let mut binned: Vec<([i64; 3], usize)> = regular.iter().map(|&i| (grid.key(&centres[i]), i)).collect();
+    binned.sort_unstable();
+    grid.keys = binned.iter().map(|b| b.0).collect();
+    grid.ids = binned.iter().map(|b| b.1).collect();
+    grid.centres = grid.ids.iter().map(|&i| centres[i]).collect();
+    grid.radii = grid.ids.iter().map(|&i| radii[i]).collect();
+
+    // Regular–regular pairs: each body lists its partners of higher index.
     let row_of = |i: usize| -> Vec<usize> {
         let mut row = Vec::new();
-        let (k, ci, ri) = (keys[i], centres[i], radii[i]);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let target = [k[0] + dx, k[1] + dy, k[2] + dz];
-                    let mut m = sorted_keys.partition_point(|c| *c < target);
-                    while m < n && sorted_keys[m] == target {
-                        let reach = ri + sorted_radii[m];
-                        if (sorted_centres[m] - ci).norm_squared() < reach * reach && order[m] > i {
-                            row.push(order[m]);
-                        }
-                        m += 1;
-                    }
+        if radii[i] <= r_ref {
+            grid.query(&centres[i], radii[i], r_ref, |j| {
+                if j > i {
+                    row.push(j)
                 }
-            }
+            });
         }
-        row.sort_unstable();
         row
     };
-    // Rows are independent; collecting them in index order keeps the output deterministic.
-    let rows: Vec<Vec<usize>> = if n >= 256 {
+    let mut rows: Vec<Vec<usize>> = if n >= PARALLEL_FROM {
         (0..n).into_par_iter().map(row_of).collect()
     } else {
         (0..n).map(row_of).collect()
     };
-    for (i, row) in rows.into_iter().enumerate() {
+    // Pairs with a large body: large–regular through the grid, large–large directly.
+    for (a, &l) in large.iter().enumerate() {
+        grid.query(&centres[l], radii[l], r_ref, |j| rows[l.min(j)].push(l.max(j)));
+        for &m in &large[a + 1..] {
+            if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
+                rows[l.min(m)].push(l.max(m));
+            }
+        }
+    }
+    let mut pairs = Vec::with_capacity(rows.iter().map(Vec::len).sum());
+    for (i, mut row) in rows.into_iter().enumerate() {
+        row.sort_unstable();
         pairs.extend(row.into_iter().map(|j| (i, j)));
+    }
+    pairs
+}
+
+/// The O(N²) reference search.
+pub fn brute_force_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
+    let n = centres.len();
+    let mut pairs = Vec::new();
+    for i in 0..n {
+        for j in (i + 1)..n {
+            if (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
+                pairs.push((i, j));
+            }
+        }
     }
     pairs
 }
@@ -99,15 +156,9 @@ mod tests {
             let centres: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(next(), next(), next() * 0.4) * 4.0 * (n as f64).cbrt())
                 .collect();
-            let radii: Vec<f64> = (0..n).map(|_| 0.5 + 4.0 * next() * next()).collect();
-            let mut brute = Vec::new();
-            for i in 0..n {
-                for j in (i + 1)..n {
-                    if (centres[i] - centres[j]).norm() < radii[i] + radii[j] {
-                        brute.push((i, j));
-                    }
-                }
-            }
+            // a wide size distribution: a few bodies far above twice the median radius
+            let radii: Vec<f64> = (0..n).map(|_| 0.5 + 4.0 * next().powi(6) * 8.0).collect();
+            let brute = brute_force_pairs(&centres, &radii);
             assert!(!brute.is_empty());
             assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
         }
