@@ -1,3 +1,4 @@
+#![warn(missing_docs)]
 //! rubblepile — dynamics of rubble-pile asteroids.
 //!
 //! The core is the interacting-ellipsoids model of Roig et al. (2003, Icarus 165) ("Roig03"):
