@@ -6,37 +6,79 @@
 //!   at each snapshot time (written and flushed row by row);
 //! - `snapshots/<k>.csv`: the bodies at the k-th `output.times` entry;
 //! - `summary.json`: counters and conservation errors ([`RunSummary`]);
-//! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format.
+//! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format;
+//! - `checkpoint.json` (only when checkpoints are due, see [`RunOptions`]): the full state the run
+//!   continues from with [`resume_run`] (format in [`crate::io::checkpoint`]).
+//!
+//! # Checkpoints and resume
+//!
+//! Checkpoints are taken at output samples only (after the sample's time-series row and snapshot
+//! are written), when [`RunOptions::checkpoint_every`] wall-clock seconds have passed since the
+//! last checkpoint (or since the process started) or [`RunOptions::checkpoint_every_sim`] simulated
+//! seconds have passed since the last checkpoint's time; never after the last sample. Taking a
+//! checkpoint does not touch the integration, and [`resume_run`] restores the integrator's internal
+//! state exactly ([`crate::integrate::Integrator::restore_state`]), so a run interrupted after a
+//! checkpoint and resumed ends with the same snapshots, time series (the `wall_seconds` column
+//! aside) and summary counters, bit for bit, as an uninterrupted run.
+//!
+//! On resume the scene is re-read from the run's `scene.toml` copy; a relative `scene.bodies_file`
+//! in it is resolved against the *original* scene file's directory, stored (absolute) in the
+//! checkpoint, and the bodies read are checked against a fingerprint stored with it (as is the
+//! scene text), so a moved or edited bodies file gives a clear error instead of a different run.
+//! `timeseries.csv` is truncated to the rows written up to the checkpoint (a process killed later
+//! may have written more); snapshots written after the checkpoint are rewritten identically.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
-use crate::integrate::{IntegrateError, OdeSystem, Tolerances, make_integrator};
-use crate::io::csv::{TimeseriesRow, TimeseriesWriter, write_snapshot};
+use crate::integrate::{IntegrateError, Integrator, OdeSystem, Tolerances, make_integrator};
+use crate::io::checkpoint::{
+    CHECKPOINT_FILE, CHECKPOINT_FORMAT, CHECKPOINT_TMP_FILE, CHECKPOINT_VERSION, Checkpoint, CheckpointError,
+    DriverState, ErrorState, TimeseriesAppender, fnv1a_hex, read_checkpoint, write_checkpoint,
+};
+use crate::io::csv::{TimeseriesRow, TimeseriesWriter, snapshot_records, write_snapshot};
 pub use crate::io::summary::RunSummary;
 use crate::io::summary::{CalibrationSummary, PhysicsSummary, Scales, write_summary};
-use crate::scene::{KappaSource, LoadedScene};
+use crate::scene::{KappaSource, LoadedScene, parse_scene};
 
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
 
+/// Default wall-clock checkpoint cadence (s) of [`RunOptions::default`] and of the command line:
+/// runs shorter than this never write a checkpoint.
+pub const DEFAULT_CHECKPOINT_EVERY: f64 = 600.0;
+
 /// How a run behaves (not what it simulates).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunOptions {
     /// Write into an existing non-empty output directory (removing a previous run's files first).
     pub force: bool,
     /// Show a progress bar on stderr when stderr is a terminal.
     pub progress: bool,
+    /// Checkpoint at the first output sample after this many wall-clock seconds since the last
+    /// checkpoint (or the start of the process); `None` or a value ≤ 0 = never by wall clock.
+    pub checkpoint_every: Option<f64>,
+    /// Checkpoint at the first output sample at least this many simulated seconds after the last
+    /// checkpoint's time (or t = 0); `Some(0.0)` = at every output sample; `None` = never by
+    /// simulated time.
+    pub checkpoint_every_sim: Option<f64>,
+    /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many
+    /// checkpoints (as if the process had been killed then).
+    pub stop_after_checkpoints: Option<u64>,
 }
 
 impl Default for RunOptions {
-    /// `force: false, progress: true`.
+    /// `force: false, progress: true`, checkpoints every [`DEFAULT_CHECKPOINT_EVERY`] wall-clock
+    /// seconds, none by simulated time, no stop.
     fn default() -> Self {
         RunOptions {
             force: false,
             progress: true,
+            checkpoint_every: Some(DEFAULT_CHECKPOINT_EVERY),
+            checkpoint_every_sim: None,
+            stop_after_checkpoints: None,
         }
     }
 }
@@ -79,13 +121,60 @@ pub enum RunError {
         /// The summary written.
         summary: Box<RunSummary>,
     },
+    /// [`resume_run`]: the directory holds no checkpoint.
+    #[error("nothing to resume: {} does not exist (checkpoints are written only when due, see --checkpoint-every)", .dir.join(CHECKPOINT_FILE).display())]
+    NoCheckpoint {
+        /// The run directory.
+        dir: PathBuf,
+    },
+    /// [`resume_run`]: the run already completed.
+    #[error("the run in {} already completed (t = {t} s); nothing to resume", .dir.display())]
+    AlreadyCompleted {
+        /// The run directory.
+        dir: PathBuf,
+        /// Its final time (s).
+        t: f64,
+    },
+    /// [`resume_run`]: the checkpoint or the run directory cannot be used (corrupt checkpoint,
+    /// changed scene or bodies file, truncated time series, …).
+    #[error("cannot resume: {0}")]
+    BadCheckpoint(String),
+    /// The run stopped after a checkpoint as asked by [`RunOptions::stop_after_checkpoints`].
+    #[error("stopped after checkpoint {checkpoints} at t = {t} s (--stop-after-checkpoints); continue with `rubblepile resume {}`", .dir.display())]
+    Stopped {
+        /// The run directory.
+        dir: PathBuf,
+        /// Time of the checkpoint (s).
+        t: f64,
+        /// Checkpoints this process wrote.
+        checkpoints: u64,
+    },
 }
 
 impl RunError {
     /// Whether the error is the caller's (bad arguments) rather than a failed run: the CLI exits
     /// with code 2 for these and 1 otherwise.
     pub fn is_usage(&self) -> bool {
-        matches!(self, RunError::OutputExists { .. } | RunError::NotADirectory { .. })
+        matches!(
+            self,
+            RunError::OutputExists { .. }
+                | RunError::NotADirectory { .. }
+                | RunError::NoCheckpoint { .. }
+                | RunError::AlreadyCompleted { .. }
+                | RunError::BadCheckpoint(_)
+        )
+    }
+
+    /// The command line's exit code for this error: 2 for [`RunError::is_usage`], 3 for
+    /// [`RunError::Stopped`], 1 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        if self.is_usage() {
+            2
+        } else if matches!(self, RunError::Stopped { .. }) {
+            3
+        } else {
+            1
+        }
     }
 }
 
@@ -97,7 +186,14 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 }
 
 /// Files a run writes at the top of its directory (removed by `force`).
-const OUTPUT_FILES: [&str; 4] = ["scene.toml", "summary.json", "timeseries.csv", "last_good_state.csv"];
+const OUTPUT_FILES: [&str; 6] = [
+    "scene.toml",
+    "summary.json",
+    "timeseries.csv",
+    "last_good_state.csv",
+    CHECKPOINT_FILE,
+    CHECKPOINT_TMP_FILE,
+];
 
 /// Checks `dir` is usable and creates it (and `snapshots/`). With `force`, a previous run's files
 /// are removed first (only those: other files are left alone).
@@ -288,6 +384,40 @@ impl ErrorTracker {
         }
     }
 
+    /// The tracker as stored in a checkpoint.
+    fn to_state(&self) -> ErrorState {
+        ErrorState {
+            h0: self.h0,
+            dissipated0: self.dissipated0,
+            p0: [self.p0.x, self.p0.y, self.p0.z],
+            l0: [self.l0.x, self.l0.y, self.l0.z],
+            scales0: self.scales0,
+            scales_max: self.scales_max,
+            energy: self.energy,
+            momentum: self.momentum,
+            angular: self.angular,
+            quaternion: self.quaternion,
+            samples: self.samples,
+        }
+    }
+
+    /// The tracker stored in a checkpoint.
+    fn from_state(s: &ErrorState) -> Self {
+        ErrorTracker {
+            h0: s.h0,
+            dissipated0: s.dissipated0,
+            p0: crate::math::Vec3::new(s.p0[0], s.p0[1], s.p0[2]),
+            l0: crate::math::Vec3::new(s.l0[0], s.l0[1], s.l0[2]),
+            scales0: s.scales0,
+            scales_max: s.scales_max,
+            energy: s.energy,
+            momentum: s.momentum,
+            angular: s.angular,
+            quaternion: s.quaternion,
+            samples: s.samples,
+        }
+    }
+
     /// Absolute signed energy residual `H − H0 − (dissipated − dissipated0)`.
     fn energy_residual(&self, d: &Diagnostics) -> f64 {
         d.energy() - self.h0 - (d.dissipated - self.dissipated0)
@@ -387,7 +517,7 @@ fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
     None
 }
 
-fn progress_bar(enabled: bool, t_end: f64) -> Option<indicatif::ProgressBar> {
+fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::ProgressBar> {
     if !enabled || !std::io::stderr().is_terminal() {
         return None;
     }
@@ -395,9 +525,62 @@ fn progress_bar(enabled: bool, t_end: f64) -> Option<indicatif::ProgressBar> {
     let style = indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg} ETA {eta}")
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
     pb.set_style(style);
-    pb.set_message(format!("t = 0/{t_end} s"));
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.reset_eta();
+    pb.set_message(format!("t = {t}/{t_end} s"));
     pb.enable_steady_tick(Duration::from_millis(250));
     Some(pb)
+}
+
+/// Fingerprint of a scene's initial bodies: FNV-1a of their lossless snapshot rows.
+fn bodies_hash(scene: &LoadedScene) -> String {
+    let mut text = String::new();
+    for row in snapshot_records(0.0, &scene.bodies) {
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    fnv1a_hex(text.as_bytes())
+}
+
+/// `timeseries.csv`, new or continued.
+enum Rows {
+    New(Box<TimeseriesWriter>),
+    Continued(TimeseriesAppender),
+}
+
+impl Rows {
+    fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
+        match self {
+            Rows::New(w) => w.write_row(row),
+            Rows::Continued(w) => w.write_row(row),
+        }
+    }
+
+    fn finish(self) -> std::io::Result<()> {
+        match self {
+            Rows::New(w) => w.finish(),
+            Rows::Continued(w) => w.finish(),
+        }
+    }
+}
+
+/// Where [`drive`] starts: t = 0, or a checkpoint.
+struct Start {
+    t: f64,
+    y: Vec<f64>,
+    tracker: ErrorTracker,
+    next_sample: u64,
+    rows: u64,
+    wall_before: f64,
+    checkpoints: u64,
+    timeseries: Rows,
+}
+
+/// What every checkpoint of a run repeats.
+struct RunIdentity {
+    scene_base_dir: Option<PathBuf>,
+    scene_hash: String,
+    bodies_hash: String,
 }
 
 /// Runs `scene`, writing the outputs into `out_dir` (see the module docs).
@@ -405,15 +588,29 @@ fn progress_bar(enabled: bool, t_end: f64) -> Option<indicatif::ProgressBar> {
 /// Refuses an existing non-empty `out_dir` unless `options.force`. On an integrator error, a
 /// non-finite diagnostic or a broken quaternion constraint (`||q| − 1| > 1e-3`), writes
 /// `last_good_state.csv` and `summary.json` (its `status` names the cause) and returns
-/// [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunSummary::one_line`].
+/// [`RunError::Failed`]. Writes checkpoints as [`RunOptions`] asks (see the module docs). Prints
+/// nothing but the progress bar; see [`RunSummary::one_line`].
 pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError> {
     prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
     std::fs::write(&scene_copy, &scene.source).map_err(io_err(&scene_copy))?;
+    let scene_base_dir = match &scene.base_dir {
+        Some(d) => Some(
+            std::fs::canonicalize(d)
+                .or_else(|_| std::path::absolute(d))
+                .map_err(io_err(d))?,
+        ),
+        None => None,
+    };
+    let identity = RunIdentity {
+        scene_base_dir,
+        scene_hash: fnv1a_hex(scene.source.as_bytes()),
+        bodies_hash: bodies_hash(scene),
+    };
 
     let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
     let settings = scene.integrator;
-    let mut integrator = make_integrator(
+    let integrator = make_integrator(
         settings.method,
         Tolerances::uniform(settings.rtol, settings.atol, system.dim()),
         settings.step,
@@ -421,22 +618,183 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
     .map_err(RunError::Setup)?;
 
     let ts_path = out_dir.join("timeseries.csv");
-    let mut timeseries = TimeseriesWriter::create(&ts_path).map_err(io_err(&ts_path))?;
+    let timeseries = TimeseriesWriter::create(&ts_path).map_err(io_err(&ts_path))?;
+    let y = system.initial_state();
+    let tracker = ErrorTracker::new(&system.diagnostics(&y));
+    let start = Start {
+        t: 0.0,
+        y,
+        tracker,
+        next_sample: 0,
+        rows: 0,
+        wall_before: 0.0,
+        checkpoints: 0,
+        timeseries: Rows::New(Box::new(timeseries)),
+    };
+    drive(scene, out_dir, options, &system, integrator, start, &identity)
+}
+
+/// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
+fn completed_run(dir: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    (v.get("status")?.as_str()? == "completed")
+        .then(|| v.get("final_time").and_then(|t| t.as_f64()).unwrap_or(f64::NAN))
+}
+
+/// Continues the run in `dir` from its `checkpoint.json` (see the module docs), as if it had never
+/// stopped: same snapshots, time-series rows (after truncating those written after the checkpoint)
+/// and summary. `options.force` is ignored; the checkpoint options apply to the continued run.
+///
+/// Errors: [`RunError::AlreadyCompleted`] when `dir/summary.json` says the run completed,
+/// [`RunError::NoCheckpoint`] without a checkpoint, [`RunError::BadCheckpoint`] when the checkpoint
+/// is corrupt or does not match the directory (scene copy, bodies file, time series); otherwise as
+/// [`run_scene`].
+pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError> {
+    if let Some(t) = completed_run(dir) {
+        return Err(RunError::AlreadyCompleted {
+            dir: dir.to_path_buf(),
+            t,
+        });
+    }
+    let ckpt = read_checkpoint(dir).map_err(|e| match e {
+        CheckpointError::Missing(_) => RunError::NoCheckpoint { dir: dir.to_path_buf() },
+        other => RunError::BadCheckpoint(other.to_string()),
+    })?;
+    let bad = |msg: String| RunError::BadCheckpoint(msg);
+    let scene_path = dir.join("scene.toml");
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| bad(format!("{}: {e}", scene_path.display())))?;
+    if fnv1a_hex(text.as_bytes()) != ckpt.scene_hash {
+        return Err(bad(format!(
+            "{} changed since the checkpoint was written",
+            scene_path.display()
+        )));
+    }
+    let scene = parse_scene(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
+        .map_err(|e| bad(e.to_string()))?;
+    let identity = RunIdentity {
+        scene_base_dir: ckpt.scene_base_dir.clone(),
+        scene_hash: ckpt.scene_hash.clone(),
+        bodies_hash: bodies_hash(&scene),
+    };
+    if identity.bodies_hash != ckpt.bodies_hash || scene.bodies.len() != ckpt.n_bodies {
+        let from = match (&scene.file.scene.bodies_file, &ckpt.scene_base_dir) {
+            (Some(f), Some(base)) => format!(" (bodies_file {})", base.join(f).display()),
+            (Some(f), None) => format!(" (bodies_file {f})"),
+            _ => String::new(),
+        };
+        return Err(bad(format!(
+            "the scene's bodies{from} differ from those the run started with"
+        )));
+    }
+
+    let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
+    if ckpt.y.len() != system.dim() {
+        return Err(bad(format!(
+            "the checkpoint's state has {} components, the scene's system {}",
+            ckpt.y.len(),
+            system.dim()
+        )));
+    }
+    let settings = scene.integrator;
+    if ckpt.integrator.method() != settings.method {
+        return Err(bad(format!(
+            "the checkpoint is of a {} run, the scene asks for {}",
+            ckpt.integrator.method(),
+            settings.method
+        )));
+    }
+    let mut integrator = make_integrator(
+        settings.method,
+        Tolerances::uniform(settings.rtol, settings.atol, system.dim()),
+        settings.step,
+    )
+    .map_err(RunError::Setup)?;
+    integrator
+        .restore_state(&ckpt.integrator)
+        .map_err(|e| bad(format!("integrator: {e}")))?;
+
+    // The checkpoint must sit right after one of the run's samples.
+    let d = &ckpt.driver;
+    let schedule = Schedule::new(scene.t_end, scene.output.every, &scene.output.times);
+    let total = schedule.clone().count() as u64;
+    let prev = d
+        .next_sample
+        .checked_sub(1)
+        .and_then(|i| schedule.clone().nth(i as usize));
+    if d.next_sample > total || prev.is_none_or(|p| p.t.to_bits() != ckpt.t.to_bits()) {
+        return Err(bad(format!(
+            "the checkpoint (t = {} s, next sample {}) does not match the scene's output samples",
+            ckpt.t, d.next_sample
+        )));
+    }
+    if d.timeseries_rows != d.next_sample {
+        return Err(bad(format!(
+            "the checkpoint counts {} time-series rows for {} samples",
+            d.timeseries_rows, d.next_sample
+        )));
+    }
+
+    // Stale files of the interrupted process (a failure summary, a half-written checkpoint).
+    for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
+        let p = dir.join(name);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(io_err(&p))?;
+        }
+    }
+    let snaps = dir.join("snapshots");
+    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    let ts_path = dir.join("timeseries.csv");
+    let timeseries =
+        TimeseriesAppender::open_truncated(&ts_path, d.timeseries_rows, d.timeseries_bytes).map_err(bad)?;
+
+    let start = Start {
+        t: ckpt.t,
+        y: ckpt.y.clone(),
+        tracker: ErrorTracker::from_state(&d.errors),
+        next_sample: d.next_sample,
+        rows: d.timeseries_rows,
+        wall_before: d.wall_seconds,
+        checkpoints: d.checkpoints,
+        timeseries: Rows::Continued(timeseries),
+    };
+    drive(&scene, dir, options, &system, integrator, start, &identity)
+}
+
+/// The sampling loop shared by [`run_scene`] and [`resume_run`].
+fn drive(
+    scene: &LoadedScene,
+    out_dir: &Path,
+    options: &RunOptions,
+    system: &EllipsoidSystem,
+    mut integrator: Box<dyn Integrator + Send>,
+    start: Start,
+    identity: &RunIdentity,
+) -> Result<RunSummary, RunError> {
+    let Start {
+        mut t,
+        mut y,
+        mut tracker,
+        next_sample,
+        mut rows,
+        wall_before,
+        mut checkpoints,
+        mut timeseries,
+    } = start;
+    let settings = scene.integrator;
+    let ts_path = out_dir.join("timeseries.csv");
     let snapshot_path = |k: usize| out_dir.join("snapshots").join(format!("{k}.csv"));
 
-    let start = Instant::now();
-    let mut t = 0.0;
-    let mut y = system.initial_state();
-    let d0 = system.diagnostics(&y);
-    let mut tracker = ErrorTracker::new(&d0);
+    let started = Instant::now();
+    let wall = || wall_before + started.elapsed().as_secs_f64();
     let mut last_good = (t, y.clone());
-    let pb = progress_bar(options.progress, scene.t_end);
+    let pb = progress_bar(options.progress, scene.t_end, t);
 
     let summary_of = |status: String, final_time: f64, tracker: &ErrorTracker, stats: crate::integrate::Stats| {
         let scales = tracker.scales();
         RunSummary {
             status,
-            wall_seconds: start.elapsed().as_secs_f64(),
+            wall_seconds: wall(),
             final_time,
             t_end: scene.t_end,
             steps_accepted: stats.steps_accepted,
@@ -500,14 +858,19 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         }
     };
 
-    for sample in Schedule::new(scene.t_end, scene.output.every, &scene.output.times) {
+    let schedule = Schedule::new(scene.t_end, scene.output.every, &scene.output.times);
+    let total = schedule.clone().count() as u64;
+    let mut last_checkpoint_wall = Instant::now();
+    let mut last_checkpoint_t = t;
+    let mut checkpoints_here: u64 = 0;
+    for (index, sample) in (0u64..).zip(schedule).skip(next_sample as usize) {
         if sample.t > t
-            && let Err(e) = integrator.advance(&system, &mut t, &mut y, sample.t)
+            && let Err(e) = integrator.advance(system, &mut t, &mut y, sample.t)
         {
             let cause = format!("integrator error: {e}");
             return Err(fail(cause, t, &y, &tracker, integrator.stats()));
         }
-        let d = if t == 0.0 { d0 } else { system.diagnostics(&y) };
+        let d = system.diagnostics(&y);
         if let Some(cause) = check_state(t, &d) {
             let (tg, yg) = &last_good;
             return Err(fail(cause, *tg, yg, &tracker, integrator.stats()));
@@ -517,9 +880,10 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
             t,
             diagnostics: d,
             energy_residual: tracker.energy_residual(&d) / tracker.energy_scale_for_rows(),
-            wall_seconds: start.elapsed().as_secs_f64(),
+            wall_seconds: wall(),
         };
         timeseries.write_row(&row).map_err(io_err(&ts_path))?;
+        rows += 1;
         if let Some(k) = sample.snapshot {
             let p = snapshot_path(k);
             write_snapshot(&p, t, &system.bodies_at(t, &y)).map_err(io_err(&p))?;
@@ -529,6 +893,61 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         if let Some(pb) = &pb {
             pb.set_position((t / scene.t_end * 1e6) as u64);
             pb.set_message(format!("t = {t:.4}/{} s", scene.t_end));
+        }
+
+        let due_wall = options
+            .checkpoint_every
+            .is_some_and(|s| s > 0.0 && last_checkpoint_wall.elapsed().as_secs_f64() >= s);
+        let due_sim = options
+            .checkpoint_every_sim
+            .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
+        if index + 1 < total && (due_wall || due_sim) {
+            // The rows the checkpoint counts must be on disk before it is.
+            std::fs::OpenOptions::new()
+                .write(true)
+                .open(&ts_path)
+                .and_then(|f| f.sync_all())
+                .map_err(io_err(&ts_path))?;
+            let timeseries_bytes = std::fs::metadata(&ts_path).map_err(io_err(&ts_path))?.len();
+            checkpoints += 1;
+            let wall_seconds = wall();
+            let ckpt = Checkpoint {
+                format: CHECKPOINT_FORMAT.into(),
+                version: CHECKPOINT_VERSION,
+                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
+                scene_base_dir: identity.scene_base_dir.clone(),
+                scene_hash: identity.scene_hash.clone(),
+                bodies_hash: identity.bodies_hash.clone(),
+                n_bodies: system.n_bodies(),
+                t,
+                t_seconds: t,
+                y: y.clone(),
+                integrator: integrator.save_state(),
+                driver: DriverState {
+                    next_sample: index + 1,
+                    timeseries_rows: rows,
+                    timeseries_bytes,
+                    wall_seconds,
+                    wall_seconds_approx: wall_seconds,
+                    checkpoints,
+                    errors: tracker.to_state(),
+                },
+            };
+            let cp = out_dir.join(CHECKPOINT_FILE);
+            write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+            last_checkpoint_wall = Instant::now();
+            last_checkpoint_t = t;
+            checkpoints_here += 1;
+            if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
+                if let Some(pb) = &pb {
+                    pb.abandon();
+                }
+                return Err(RunError::Stopped {
+                    dir: out_dir.to_path_buf(),
+                    t,
+                    checkpoints,
+                });
+            }
         }
     }
     timeseries.finish().map_err(io_err(&ts_path))?;

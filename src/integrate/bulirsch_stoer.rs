@@ -49,7 +49,8 @@
 //!   derivative at an *accepted* point fails at once (no step size can cure it).
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
-use super::{IntegrateError, Integrator, Method, OdeSystem, Stats, Tolerances};
+use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
+use crate::io::checkpoint::{exact_f64, exact_f64_opt, exact_f64_vec};
 
 /// Step-size factor bound parameter (ODEX `fac1`).
 const FAC1: f64 = 0.02;
@@ -144,9 +145,55 @@ pub struct BulirschStoer {
     rejections: Rejections,
 }
 
+/// Everything a [`BulirschStoer`] carries between [`Integrator::advance`] calls
+/// ([`Integrator::save_state`]): the step-size and column control, the per-column proposals and
+/// work of the last attempt, the counters and the settings. The work arrays are not saved: every
+/// call recomputes them before reading them. The tolerances are not saved either: the integrator
+/// the state is restored into must be built with the same ones (only their length is checked).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BulirschStoerState {
+    /// Length of the tolerance vectors (the system's dimension).
+    pub dim: usize,
+    /// Maximum number of columns `km`.
+    pub km: usize,
+    /// Maximum step attempts per `advance`.
+    pub max_steps: u64,
+    /// Smallest allowed step (s).
+    #[serde(with = "exact_f64")]
+    pub h_min: f64,
+    /// Largest allowed step (s).
+    #[serde(with = "exact_f64")]
+    pub h_max: f64,
+    /// Consecutive non-finite rejections retried.
+    pub max_nonfinite_retries: u32,
+    /// The configured initial step (s), if any.
+    #[serde(with = "exact_f64_opt")]
+    pub initial_step: Option<f64>,
+    /// Proposed `|H|` for the next step (s); 0 = not yet known. After landing on an output time
+    /// this is the un-shortened proposal.
+    #[serde(with = "exact_f64")]
+    pub h: f64,
+    /// Target column count `k`.
+    pub k: usize,
+    /// The previous attempt was rejected.
+    pub reject: bool,
+    /// At least one step has been attempted.
+    pub started: bool,
+    /// Optimal step per column of the last attempt (index 0 unused, length `km + 1`).
+    #[serde(with = "exact_f64_vec")]
+    pub hh: Vec<f64>,
+    /// Work per unit step per column of the last attempt (index 0 unused, length `km + 1`).
+    #[serde(with = "exact_f64_vec")]
+    pub w: Vec<f64>,
+    /// Cumulative statistics.
+    pub stats: SavedStats,
+    /// Cumulative rejections by cause.
+    pub rejections: Rejections,
+}
+
 /// Rejected steps of a [`BulirschStoer`] by cause (cumulative); their sum is
 /// [`Stats::steps_rejected`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Rejections {
     /// Error estimate too large (ordinary step-size control, including the convergence monitor).
     pub error: u64,
@@ -782,5 +829,80 @@ impl Integrator for BulirschStoer {
 
     fn method(&self) -> Method {
         Method::BulirschStoer
+    }
+
+    fn save_state(&self) -> IntegratorState {
+        IntegratorState::BulirschStoer(BulirschStoerState {
+            dim: self.tol.rtol.len(),
+            km: self.km,
+            max_steps: self.max_steps,
+            h_min: self.h_min,
+            h_max: self.h_max,
+            max_nonfinite_retries: self.max_nonfinite_retries,
+            initial_step: self.initial_step,
+            h: self.h,
+            k: self.k,
+            reject: self.reject,
+            started: self.started,
+            hh: self.hh.clone(),
+            w: self.w.clone(),
+            stats: self.stats.into(),
+            rejections: self.rejections,
+        })
+    }
+
+    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
+        let s = match state {
+            IntegratorState::BulirschStoer(s) => s,
+            other => {
+                return Err(IntegrateError::Config(format!(
+                    "cannot restore a {} state into bulirsch-stoer",
+                    other.method()
+                )));
+            }
+        };
+        let bad = |what: String| Err(IntegrateError::Config(format!("bulirsch-stoer state: {what}")));
+        if s.dim != self.tol.rtol.len() {
+            return bad(format!(
+                "saved for dimension {}, tolerances have {}",
+                s.dim,
+                self.tol.rtol.len()
+            ));
+        }
+        if !(3..=20).contains(&s.km) {
+            return bad(format!("max columns {} not in 3..=20", s.km));
+        }
+        if !(2..s.km).contains(&s.k) {
+            return bad(format!("column count {} not in 2..{}", s.k, s.km));
+        }
+        if s.hh.len() != s.km + 1 || s.w.len() != s.km + 1 {
+            return bad(format!("per-column arrays must have {} entries", s.km + 1));
+        }
+        if !(s.h.is_finite() && s.h >= 0.0) || s.h_min.is_nan() || s.h_max.is_nan() {
+            return bad(format!(
+                "bad step sizes (h = {}, h_min = {}, h_max = {})",
+                s.h, s.h_min, s.h_max
+            ));
+        }
+        if s.initial_step.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
+            return bad("bad initial step".into());
+        }
+        if s.km != self.km {
+            self.set_max_columns(s.km)?;
+        }
+        self.max_steps = s.max_steps;
+        self.h_min = s.h_min;
+        self.h_max = s.h_max;
+        self.max_nonfinite_retries = s.max_nonfinite_retries;
+        self.initial_step = s.initial_step;
+        self.h = s.h;
+        self.k = s.k;
+        self.reject = s.reject;
+        self.started = s.started;
+        self.hh.copy_from_slice(&s.hh);
+        self.w.copy_from_slice(&s.w);
+        self.stats = s.stats.into();
+        self.rejections = s.rejections;
+        Ok(())
     }
 }

@@ -82,6 +82,65 @@ pub struct Stats {
     pub smallest_step: f64,
 }
 
+/// [`Stats`] as stored in a checkpoint (`smallest_step` as exact bits, so `∞` survives).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SavedStats {
+    /// Accepted steps.
+    pub steps_accepted: u64,
+    /// Rejected steps.
+    pub steps_rejected: u64,
+    /// Evaluations of the right-hand side.
+    pub rhs_evaluations: u64,
+    /// Smallest accepted step size (s), exact.
+    #[serde(with = "crate::io::checkpoint::exact_f64")]
+    pub smallest_step: f64,
+}
+
+impl From<Stats> for SavedStats {
+    fn from(s: Stats) -> Self {
+        SavedStats {
+            steps_accepted: s.steps_accepted,
+            steps_rejected: s.steps_rejected,
+            rhs_evaluations: s.rhs_evaluations,
+            smallest_step: s.smallest_step,
+        }
+    }
+}
+
+impl From<SavedStats> for Stats {
+    fn from(s: SavedStats) -> Self {
+        Stats {
+            steps_accepted: s.steps_accepted,
+            steps_rejected: s.steps_rejected,
+            rhs_evaluations: s.rhs_evaluations,
+            smallest_step: s.smallest_step,
+        }
+    }
+}
+
+/// Everything an integrator carries from one [`Integrator::advance`] call to the next (step-size
+/// and order control, counters, settings), as saved by [`Integrator::save_state`] into a checkpoint.
+/// Serialisable with exact floats: restoring it into a fresh integrator of the same method and
+/// tolerances continues bit for bit like the original.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum IntegratorState {
+    /// State of a [`bulirsch_stoer::BulirschStoer`].
+    BulirschStoer(bulirsch_stoer::BulirschStoerState),
+    /// State of an [`ode_solvers_adapter::OdeSolversAdapter`] (Dop853, Dopri5, Rk4).
+    OdeSolvers(ode_solvers_adapter::OdeSolversState),
+}
+
+impl IntegratorState {
+    /// The method whose state this is.
+    pub fn method(&self) -> Method {
+        match self {
+            IntegratorState::BulirschStoer(_) => Method::BulirschStoer,
+            IntegratorState::OdeSolvers(s) => s.method,
+        }
+    }
+}
+
 /// Why an integration stopped early. The state passed to the integrator is left at the last good
 /// (accepted) point `t`, so the caller can save it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -128,6 +187,15 @@ pub trait Integrator {
     fn stats(&self) -> Stats;
     /// Which method this is.
     fn method(&self) -> Method;
+    /// Everything that influences later calls to [`Integrator::advance`] (see [`IntegratorState`]).
+    /// Taken between `advance` calls; the integrator is not changed.
+    fn save_state(&self) -> IntegratorState;
+    /// Restores a state saved by [`Integrator::save_state`] of an integrator of the same method, built
+    /// with the same tolerances for a system of the same dimension; afterwards `advance` continues
+    /// exactly (bit for bit) as the saved integrator would have. Errors with
+    /// [`IntegrateError::Config`] (leaving `self` unchanged) for another method's state or an
+    /// inconsistent one.
+    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError>;
 }
 
 /// Builds the integrator for `method`. `step` is the fixed step (s) for `Rk4`, or an optional

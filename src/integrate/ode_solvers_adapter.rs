@@ -28,10 +28,14 @@
 //!   `smallest_step` includes steps shortened to land on an output time.
 //! * **Continuation.** Each `advance` starts a new `ode_solvers` run; Dop853/Dopri5 start it with the
 //!   last full step of the previous call (or the automatic guess / the given `step` at first).
+//! * **Checkpoints.** Since every `advance` starts a new `ode_solvers` run, the state carried between
+//!   calls is only the next initial step, the counters and the settings ([`OdeSolversState`]);
+//!   restoring it continues bit for bit.
 //! * **Failure**: on error `t, y` are left at the last accepted state (the start of the call if no
 //!   step was accepted), never at a trial state.
 
-use super::{IntegrateError, Integrator, Method, OdeSystem, Stats, Tolerances};
+use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
+use crate::io::checkpoint::{exact_f64, exact_f64_opt};
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dop853, Dopri5, OutputType, Rk4, System};
 use std::cell::Cell;
@@ -99,6 +103,35 @@ pub struct OdeSolversAdapter {
     max_steps: u64,
     chunk_steps: Option<usize>,
     stats: Stats,
+}
+
+/// Everything an [`OdeSolversAdapter`] carries between [`Integrator::advance`] calls
+/// ([`Integrator::save_state`]). The scalar tolerances are saved only to check that the adapter the
+/// state is restored into was built with the same ones.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct OdeSolversState {
+    /// Dop853, Dopri5 or Rk4.
+    pub method: Method,
+    /// Length of the tolerance vectors (the system's dimension).
+    pub dim: usize,
+    /// Scalar relative tolerance in use.
+    #[serde(with = "exact_f64")]
+    pub rtol: f64,
+    /// Scalar absolute tolerance in use.
+    #[serde(with = "exact_f64")]
+    pub atol: f64,
+    /// Rk4's fixed step or the adaptive methods' configured initial step (s).
+    #[serde(with = "exact_f64_opt")]
+    pub step: Option<f64>,
+    /// The step the next `advance` starts with (adaptive methods; 0 = automatic).
+    #[serde(with = "exact_f64")]
+    pub h_next: f64,
+    /// Maximum steps per `advance`.
+    pub max_steps: u64,
+    /// Steps per `ode_solvers` run (`None` = automatic).
+    pub chunk_steps: Option<usize>,
+    /// Cumulative statistics.
+    pub stats: SavedStats,
 }
 
 impl OdeSolversAdapter {
@@ -490,5 +523,54 @@ impl Integrator for OdeSolversAdapter {
 
     fn method(&self) -> Method {
         self.method
+    }
+
+    fn save_state(&self) -> IntegratorState {
+        IntegratorState::OdeSolvers(OdeSolversState {
+            method: self.method,
+            dim: self.n_tol,
+            rtol: self.rtol,
+            atol: self.atol,
+            step: self.step,
+            h_next: self.h_next,
+            max_steps: self.max_steps,
+            chunk_steps: self.chunk_steps,
+            stats: self.stats.into(),
+        })
+    }
+
+    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
+        let s = match state {
+            IntegratorState::OdeSolvers(s) if s.method == self.method => s,
+            other => {
+                return Err(IntegrateError::Config(format!(
+                    "cannot restore a {} state into {}",
+                    other.method(),
+                    self.method
+                )));
+            }
+        };
+        let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
+        if s.dim != self.n_tol || !same(s.rtol, self.rtol) || !same(s.atol, self.atol) {
+            return Err(IntegrateError::Config(format!(
+                "{} state saved for dimension {} with rtol {:e}, atol {:e}; this integrator has {}, {:e}, {:e}",
+                self.method, s.dim, s.rtol, s.atol, self.n_tol, self.rtol, self.atol
+            )));
+        }
+        if !(s.h_next.is_finite() && s.h_next >= 0.0) || s.step.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
+            return Err(IntegrateError::Config(format!(
+                "{} state: bad step sizes (h_next = {}, step = {:?})",
+                self.method, s.h_next, s.step
+            )));
+        }
+        if self.method == Method::Rk4 && s.step.is_none() {
+            return Err(IntegrateError::Config("rk4 state without a step".into()));
+        }
+        self.step = s.step;
+        self.h_next = s.h_next;
+        self.max_steps = s.max_steps;
+        self.chunk_steps = s.chunk_steps.map(|c| c.max(1));
+        self.stats = s.stats.into();
+        Ok(())
     }
 }

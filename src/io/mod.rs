@@ -2,11 +2,13 @@
 //!
 //! - [`csv`] writes `snapshots/<k>.csv`, `last_good_state.csv`, `timeseries.csv`, and the reader for a
 //!   scene's `bodies_file` (which takes the snapshot format);
-//! - [`summary`] writes `summary.json`.
+//! - [`summary`] writes `summary.json`;
+//! - [`checkpoint`] writes and reads `checkpoint.json` (the state a run resumes from).
 //!
 //! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific
 //! notation), so a snapshot re-read as a bodies file gives the same `f64`s bit for bit.
 
+pub mod checkpoint;
 pub mod csv;
 pub mod summary;
 
