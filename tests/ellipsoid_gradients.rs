@@ -10,12 +10,14 @@ use rubblepile::ellipsoid::equations::{
 };
 use rubblepile::ellipsoid::gravity::gravity_forces;
 use rubblepile::ellipsoid::potential::{
-    BodyGeometry, contact_gradient, cull_exponent, interaction_radius, is_negligible, overlap,
+    BodyGeometry, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
 use rubblepile::ellipsoid::quaternion::*;
 use rubblepile::math::{Vec3, Vec4, skew};
 
 const G: f64 = 6.674e-11;
+/// The default relative cutoff.
+const CUTOFF: f64 = 1e-16;
 
 /// A random pair of ellipsoids at a separation of `gap` × (A_i + A_j) along a random direction.
 struct Pair {
@@ -40,6 +42,13 @@ impl Pair {
             kappa: rng.range(2.0, 12.0),
         }
     }
+    fn kappa_lambda(&self) -> f64 {
+        let rad = self.axes.map(|a| (a.x * a.y * a.z).cbrt());
+        self.kappa * lambda(rad[0], rad[1])
+    }
+    fn taper(&self) -> Taper {
+        Taper::for_pair(CUTOFF, self.kappa_lambda())
+    }
     fn prefactor(&self) -> f64 {
         let rad = self.axes.map(|a| (a.x * a.y * a.z).cbrt());
         pair_prefactor(G, self.kappa, rad[0], self.mass[0], rad[1], self.mass[1])
@@ -47,7 +56,7 @@ impl Pair {
     fn potential(&self, r: &[Vec3; 2], q: &[Vec4; 2]) -> f64 {
         let gi = BodyGeometry::new(&self.axes[0], &q[0]);
         let gj = BodyGeometry::new(&self.axes[1], &q[1]);
-        overlap(self.prefactor(), self.kappa, &(r[0] - r[1]), &gi, &gj).potential
+        overlap(self.prefactor(), self.kappa, &(r[0] - r[1]), &gi, &gj, &self.taper()).potential
     }
 }
 
@@ -103,6 +112,59 @@ fn rotation_spin_convention_matches_notes() {
 }
 
 #[test]
+fn taper_constant_matches_cutoff() {
+    let t = Taper::for_pair(1e-16, 20.0);
+    assert!((t.start - (20.0 + 16.0 * 10f64.ln())).abs() < 1e-12 && (t.end - t.start - 4.0).abs() < 1e-12);
+    // C¹ at both ends and monotone in between
+    let (v0, s0) = t.value_and_slope(t.start);
+    let (v1, s1) = t.value_and_slope(t.end);
+    assert_eq!((v0, s0, v1, s1), (1.0, 0.0, 0.0, 0.0));
+    let mut last = 1.0;
+    for k in 1..100 {
+        let x = t.start + (t.end - t.start) * k as f64 / 100.0;
+        let (v, s) = t.value_and_slope(x);
+        assert!(v < last && s < 0.0);
+        let h = 1e-6;
+        let fd = (t.value_and_slope(x + h).0 - t.value_and_slope(x - h).0) / (2.0 * h);
+        assert!((fd - s).abs() < 1e-8, "T' at {x}: {s} vs {fd}");
+        last = v;
+    }
+}
+
+/// Pairs inside the taper zone (exponent between −ln 1e-16 and that + 4): gradients include the taper's slope.
+#[test]
+fn contact_gradient_matches_finite_differences_in_the_taper() {
+    let mut rng = Random::new(22);
+    let mut checked = 0;
+    for _ in 0..4000 {
+        let gap = rng.range(0.8, 3.0);
+        let pr = Pair::random(&mut rng, gap);
+        let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
+        let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
+        let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj, &pr.taper());
+        let taper = pr.taper();
+        if !(ov.exponent > taper.start + 0.2 && ov.exponent < taper.end - 0.2) {
+            continue;
+        }
+        checked += 1;
+        let grad = contact_gradient(&ov, pr.kappa, &gi, &gj);
+        let h = 1e-5 * pr.axes[0].x;
+        let fd_r = central_difference(pr.r[0].into(), h, |x| pr.potential(&[Vec3::from(*x), pr.r[1]], &pr.q));
+        let e_r = rel_err(grad.d_ri.as_slice(), &fd_r, 0.0);
+        let fd_q = central_difference(pr.q[0].into(), 1e-7, |x| {
+            pr.potential(&pr.r, &[Vec4::from(*x), pr.q[1]])
+        });
+        let e_q = rel_err(grad.d_qi.as_slice(), &fd_q, 0.0);
+        assert!(
+            e_r <= 1e-6 && e_q <= 1e-6,
+            "taper zone x = {}: errors {e_r:e}, {e_q:e}",
+            ov.exponent
+        );
+    }
+    assert!(checked >= 20, "only {checked} pairs in the taper zone");
+}
+
+#[test]
 fn contact_gradient_matches_finite_differences_near_and_far() {
     let mut rng = Random::new(2);
     for &gap in &[0.3, 0.6, 0.9, 1.3, 1.8] {
@@ -110,7 +172,7 @@ fn contact_gradient_matches_finite_differences_near_and_far() {
             let pr = Pair::random(&mut rng, gap);
             let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
             let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
-            let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj);
+            let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj, &pr.taper());
             if ov.potential < 1e-300 {
                 continue;
             }
@@ -145,7 +207,7 @@ fn contact_gradient_matches_finite_differences_near_and_far() {
 fn dissipation_of(pr: &Pair, f0: f64, v: &[Vec3; 2], q_dot: &[Vec4; 2]) -> (f64, BodyVelocity, BodyVelocity) {
     let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
     let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
-    let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj);
+    let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj, &pr.taper());
     let bv = |k: usize, g: &BodyGeometry| BodyVelocity {
         velocity: v[k],
         spin_world: g.rot.transpose() * body_spin(&pr.q[k], &q_dot[k]),
@@ -165,7 +227,7 @@ fn dissipation_derivatives_match_finite_differences() {
             let q_dot = [rng.vec3(1e-3).push(rng.range(-1e-3, 1e-3)), rng.vec3(1e-3).push(0.0)];
             let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
             let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
-            let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj);
+            let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj, &pr.taper());
             let (_, vi, vj) = dissipation_of(&pr, f0, &v, &q_dot);
             let pd = pair_dissipation(f0, pr.kappa, &ov, &gi, &gj, &vi, &vj);
             if pd.value.abs() < 1e-300 {
@@ -202,7 +264,7 @@ fn dissipation_vanishes_for_common_rigid_motion_and_conserves_momenta() {
         let pr = Pair::random(&mut rng, 0.7);
         let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
         let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
-        let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj);
+        let ov = overlap(pr.prefactor(), pr.kappa, &(pr.r[0] - pr.r[1]), &gi, &gj, &pr.taper());
         let (v0, omega) = (rng.vec3(3.0), rng.vec3(1e-3));
         let rigid = |r: Vec3| BodyVelocity {
             velocity: v0 + omega.cross(&r),
@@ -305,7 +367,8 @@ fn two_sphere_potential_minimum_at_contact_with_depth_ratio() {
         let pref = pair_prefactor(G, kappa, r_i, m_i, r_j, m_j);
         let gi = BodyGeometry::new(&Vec3::from_element(r_i), &Vec4::w());
         let gj = BodyGeometry::new(&Vec3::from_element(r_j), &Vec4::w());
-        let u_c = |d: f64| overlap(pref, kappa, &Vec3::new(d, 0.0, 0.0), &gi, &gj).potential;
+        let taper = Taper::for_pair(CUTOFF, kappa * lambda(r_i, r_j));
+        let u_c = |d: f64| overlap(pref, kappa, &Vec3::new(d, 0.0, 0.0), &gi, &gj, &taper).potential;
         let u = |d: f64| u_c(d) - G * m_i * m_j / d;
         // golden-section search for the minimum on [0.5, 1.5] (R_i + R_j)
         let s = r_i + r_j;
@@ -326,30 +389,35 @@ fn two_sphere_potential_minimum_at_contact_with_depth_ratio() {
     }
 }
 
+/// What the far-pair treatment neglects is below `cutoff` of the pair's potential at contact, hence below
+/// `cutoff × amplitude`; culled pairs contribute exactly 0; every kept pair is found by the bounding spheres.
 #[test]
-fn culled_pairs_are_below_cutoff_of_amplitude() {
+fn culled_and_tapered_pairs_neglect_less_than_cutoff() {
     let mut rng = Random::new(7);
-    let cutoff = 1e-16;
-    let cexp = cull_exponent(cutoff);
     let mut checked = 0;
-    for _ in 0..2000 {
-        let gap = rng.range(0.5, 4.0);
+    for _ in 0..3000 {
+        let gap = rng.range(0.5, 5.0);
         let pr = Pair::random(&mut rng, gap);
         let gi = BodyGeometry::new(&pr.axes[0], &pr.q[0]);
         let gj = BodyGeometry::new(&pr.axes[1], &pr.q[1]);
         let delta = pr.r[0] - pr.r[1];
-        let ov = overlap(pr.prefactor(), pr.kappa, &delta, &gi, &gj);
-        let reach = interaction_radius(pr.kappa, &gi, cexp) + interaction_radius(pr.kappa, &gj, cexp);
-        if is_negligible(pr.kappa, &delta, &gi, &gj, cexp) {
+        let taper = pr.taper();
+        let ov = overlap(pr.prefactor(), pr.kappa, &delta, &gi, &gj, &taper);
+        let raw = ov.amplitude * (-ov.exponent).exp();
+        let at_contact = ov.amplitude * (-pr.kappa_lambda()).exp();
+        assert!(
+            raw - ov.potential <= CUTOFF * at_contact,
+            "taper removes {:e} of the contact value",
+            (raw - ov.potential) / at_contact
+        );
+        assert!(raw - ov.potential <= CUTOFF * ov.amplitude);
+        let max_exp = max_cull_exponent(pr.kappa, CUTOFF);
+        let reach = interaction_radius(pr.kappa, &gi, max_exp) + interaction_radius(pr.kappa, &gj, max_exp);
+        if is_negligible(pr.kappa, &delta, &gi, &gj, taper.end) {
             checked += 1;
-            assert!(
-                ov.potential <= cutoff * ov.amplitude,
-                "culled pair keeps {:e} of amplitude",
-                ov.potential / ov.amplitude
-            );
+            assert_eq!(ov.potential, 0.0, "a culled pair still interacts");
         } else {
-            // every kept pair is found by the bounding-sphere search
-            assert!(delta.norm() < reach);
+            assert!(delta.norm() < reach, "a kept pair is outside the bounding spheres");
         }
     }
     assert!(checked > 100, "too few culled pairs sampled ({checked})");

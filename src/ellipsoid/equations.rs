@@ -11,11 +11,11 @@
 //! is the equivalent closed form used as a test oracle.
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
-use crate::ellipsoid::calibration::pair_prefactor;
+use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use crate::ellipsoid::gravity::gravity_forces;
 use crate::ellipsoid::potential::{
-    BodyGeometry, contact_gradient, cull_exponent, interaction_radius, is_negligible, overlap,
+    BodyGeometry, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
 use crate::ellipsoid::quaternion::{
     extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin, rotation_matrix,
@@ -152,6 +152,7 @@ pub struct EllipsoidSystem {
     physics: Physics,
     rotation: bool,
     stride: usize,
+    cutoff: f64,
     cull_exp: f64,
 }
 
@@ -173,7 +174,8 @@ impl EllipsoidSystem {
             physics,
             rotation,
             stride: if rotation { 14 } else { 6 },
-            cull_exp: cull_exponent(cutoff),
+            cutoff,
+            cull_exp: max_cull_exponent(model.kappa, cutoff),
         }
     }
 
@@ -295,9 +297,14 @@ impl EllipsoidSystem {
         let mut pairs = sphere_pairs(&centres, &radii);
         pairs.retain(|&(i, j)| {
             let (gi, gj) = (kin[i].geometry.as_ref().unwrap(), kin[j].geometry.as_ref().unwrap());
-            !is_negligible(kappa, &(kin[i].r - kin[j].r), gi, gj, self.cull_exp)
+            !is_negligible(kappa, &(kin[i].r - kin[j].r), gi, gj, self.pair_taper(i, j).end)
         });
         pairs
+    }
+
+    /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
+    fn pair_taper(&self, i: usize, j: usize) -> Taper {
+        Taper::for_pair(self.cutoff, self.model.kappa * lambda(self.radii[i], self.radii[j]))
     }
 
     fn pair_terms(&self, i: usize, j: usize, kin: &[Kinematics], with_forces: bool) -> PairTerms {
@@ -312,7 +319,7 @@ impl EllipsoidSystem {
             self.radii[j],
             self.shapes[j].mass,
         );
-        let ov = overlap(prefactor, kappa, &(ki.r - kj.r), gi, gj);
+        let ov = overlap(prefactor, kappa, &(ki.r - kj.r), gi, gj, &self.pair_taper(i, j));
         let mut t = PairTerms {
             i,
             j,

@@ -6,6 +6,18 @@
 //!
 //! Gradients: `∂U_C/∂r_i = −2κ U_C G⁻¹Δ`; `∂U_C/∂q_i,k = 2 U_C ⟨D_i R_i S, ∂R_i/∂q_k⟩_F` with
 //! `S = −½ G⁻¹ + κ (G⁻¹Δ)(G⁻¹Δ)ᵀ` (chain rule of `ln U_C` through `G` and `R(q)`).
+//!
+//! Far pairs: with `x = κ Δᵀ G⁻¹ Δ`, the potential is multiplied by a C² taper `T(x)` that is 1 for
+//! `x ≤ x₀ = κλ_ij − ln(cutoff)` and falls to exactly 0 at `x₁ = x₀ + 4` (quintic smoothstep). At contact
+//! `x = κλ_ij` (two spheres at `R_i + R_j`), so everything the taper changes is below `cutoff` of the pair's
+//! potential at contact, i.e. below `cutoff · e^{−κλ}` of its amplitude (the potential at full overlap).
+//! Measuring the cut from the amplitude alone, as first specified, is wrong for stiff pairs: when
+//! `κλ > −ln(cutoff)` (κ = 25 for two unequal spheres with λ = 1.5) the contact itself lies below
+//! `1e-16 × amplitude` and would be cut away (`tests/ellipsoid_gradients.rs` guards this).
+//! The right-hand side stays twice continuously differentiable when a pair enters or leaves the neighbour
+//! list — a hard cut makes the force and torque jump, which an extrapolation integrator cannot step across
+//! (it drove Bulirsch–Stoer to step-size underflow when a non-spinning projectile came within range).
+//! With the taper: `∂U/∂Δ = −2κ U (T − T′) G⁻¹Δ` and `S = −½ T G⁻¹ + κ (T − T′) y yᵀ`, `U = U_raw T`.
 
 use crate::ellipsoid::quaternion::{rotation_matrix, rotation_matrix_derivatives};
 use crate::math::{Mat3, Vec3, Vec4};
@@ -45,6 +57,45 @@ impl BodyGeometry {
     }
 }
 
+/// The far-pair taper: 1 up to exponent `start`, C² quintic fall to 0 at `end`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Taper {
+    /// Exponent `x₀ = −ln(cutoff)` where the taper begins (dimensionless).
+    pub start: f64,
+    /// Exponent `x₁ = x₀ + TAPER_WIDTH` beyond which the pair contributes exactly nothing.
+    pub end: f64,
+}
+
+/// Width of the taper in the exponent `x` (a factor e⁴ ≈ 55 in the potential).
+pub const TAPER_WIDTH: f64 = 4.0;
+
+impl Taper {
+    /// The taper of a pair with `κλ_ij` (Roig03 Eq. 12) for a relative cutoff (e.g. 1e-16): it starts where
+    /// the potential is `cutoff` times its value at contact.
+    pub fn for_pair(cutoff: f64, kappa_lambda: f64) -> Self {
+        let start = kappa_lambda - cutoff.ln();
+        Taper {
+            start,
+            end: start + TAPER_WIDTH,
+        }
+    }
+
+    /// `(T(x), T′(x))`.
+    pub fn value_and_slope(&self, x: f64) -> (f64, f64) {
+        if x <= self.start {
+            (1.0, 0.0)
+        } else if x >= self.end {
+            (0.0, 0.0)
+        } else {
+            let w = self.end - self.start;
+            let t = (x - self.start) / w;
+            let s = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t);
+            let ds = 30.0 * t * t * (1.0 - t) * (1.0 - t) / w;
+            (1.0 - s, -ds)
+        }
+    }
+}
+
 /// The overlap of two Gaussian bodies at separation `Δ = r_i − r_j`.
 #[derive(Debug, Clone, Copy)]
 pub struct Overlap {
@@ -56,13 +107,24 @@ pub struct Overlap {
     pub amplitude: f64,
     /// `κ Δᵀ G⁻¹ Δ` (dimensionless).
     pub exponent: f64,
-    /// `U_C` (J).
+    /// `U_C` (J), tapered: `U_raw · T(x)`.
     pub potential: f64,
+    /// `T(x)`.
+    pub taper: f64,
+    /// `T′(x)`.
+    pub taper_slope: f64,
 }
 
 /// Evaluates the overlap integral of a pair. `prefactor` is `U0_ij m_i m_j (κ/π)^{3/2}` (J m³),
 /// see [`crate::ellipsoid::calibration::pair_prefactor`].
-pub fn overlap(prefactor: f64, kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: &BodyGeometry) -> Overlap {
+pub fn overlap(
+    prefactor: f64,
+    kappa: f64,
+    delta: &Vec3,
+    gi: &BodyGeometry,
+    gj: &BodyGeometry,
+    taper: &Taper,
+) -> Overlap {
     let g = gi.sigma + gj.sigma;
     let det = g.determinant();
     // G is symmetric positive definite for any non-degenerate bodies; the closed-form 3×3 inverse is exact enough.
@@ -70,12 +132,15 @@ pub fn overlap(prefactor: f64, kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: 
     let y = g_inv * delta;
     let exponent = kappa * delta.dot(&y);
     let amplitude = prefactor / det.sqrt();
+    let (t, t_slope) = taper.value_and_slope(exponent);
     Overlap {
         g_inv,
         y,
         amplitude,
         exponent,
-        potential: amplitude * (-exponent).exp(),
+        potential: amplitude * (-exponent).exp() * t,
+        taper: t,
+        taper_slope: t_slope,
     }
 }
 
@@ -102,29 +167,34 @@ fn quaternion_gradient(u: f64, s: &Mat3, body: &BodyGeometry) -> Vec4 {
 
 /// Analytic gradients of the contact potential of a pair (see the module doc).
 pub fn contact_gradient(ov: &Overlap, kappa: f64, gi: &BodyGeometry, gj: &BodyGeometry) -> ContactGradient {
-    let u = ov.potential;
-    let s = -0.5 * ov.g_inv + kappa * ov.y * ov.y.transpose();
+    // The untapered potential from the amplitude and exponent (not U / T: T is 0 beyond the taper).
+    let u_raw = ov.amplitude * (-ov.exponent).exp();
+    let (t, dt) = (ov.taper, ov.taper_slope);
+    let s = -0.5 * t * ov.g_inv + kappa * (t - dt) * ov.y * ov.y.transpose();
     ContactGradient {
-        d_ri: -2.0 * kappa * u * ov.y,
-        d_qi: quaternion_gradient(u, &s, gi),
-        d_qj: quaternion_gradient(u, &s, gj),
+        d_ri: -2.0 * kappa * u_raw * (t - dt) * ov.y,
+        d_qi: quaternion_gradient(u_raw, &s, gi),
+        d_qj: quaternion_gradient(u_raw, &s, gj),
     }
 }
 
-/// `−ln(cutoff)`: pairs with `κ|Δ|²/(λ̄_i + λ̄_j) > −ln(cutoff)` have `U_C < cutoff × amplitude`
-/// (since `Δᵀ G⁻¹ Δ ≥ |Δ|²/λ_max(G)` and `λ_max(G) ≤ λ̄_i + λ̄_j` with `λ̄` = [`BodyGeometry::sigma_bound`]).
-pub fn cull_exponent(cutoff: f64) -> f64 {
-    -cutoff.ln()
+/// The largest taper end over all pairs, `2κ − ln(cutoff) + TAPER_WIDTH` (λ ≤ 2), for the neighbour search.
+pub fn max_cull_exponent(kappa: f64, cutoff: f64) -> f64 {
+    Taper::for_pair(cutoff, 2.0 * kappa).end
 }
 
-/// Whether a pair is provably negligible: `U_C < cutoff · amplitude` (and so is its dissipation weight).
+/// Whether a pair provably contributes nothing: with `cull_exp` its taper's end, pairs with
+/// `κ|Δ|²/(λ̄_i + λ̄_j) > cull_exp` have `x = κ Δᵀ G⁻¹ Δ` beyond it too (since `Δᵀ G⁻¹ Δ ≥ |Δ|²/λ_max(G)` and
+/// `λ_max(G) ≤ λ̄_i + λ̄_j` with `λ̄` = [`BodyGeometry::sigma_bound`]), where the tapered potential and
+/// the dissipation weight are exactly 0.
 pub fn is_negligible(kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: &BodyGeometry, cull_exp: f64) -> bool {
     kappa * delta.norm_squared() > cull_exp * (gi.sigma_bound + gj.sigma_bound)
 }
 
-/// Radius (m) of the sphere around a body outside which no partner (of any size up to its own bound)
-/// can interact: a pair is a candidate only if `|Δ| < ρ_i + ρ_j` with `ρ = sqrt(cull_exp · λ̄ / κ)`,
-/// which contains every pair that [`is_negligible`] keeps because `√(a+b) ≤ √a + √b`.
+/// Radius (m) of the sphere around a body outside which no partner can interact: with `cull_exp` at least
+/// every pair's taper end ([`max_cull_exponent`]), a pair is a candidate only if `|Δ| < ρ_i + ρ_j` with
+/// `ρ = sqrt(cull_exp · λ̄ / κ)`, which contains every pair that [`is_negligible`] keeps because
+/// `√(a+b) ≤ √a + √b`.
 pub fn interaction_radius(kappa: f64, gi: &BodyGeometry, cull_exp: f64) -> f64 {
     (cull_exp * gi.sigma_bound / kappa).sqrt()
 }
