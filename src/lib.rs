@@ -6,11 +6,14 @@
 //! quaternion attitudes constrained by Lagrange multipliers, a Rayleigh point-dissipation function,
 //! integrated by an adaptive Bulirsch–Stoer integrator.
 
+pub mod analysis;
 pub mod cli;
 pub mod ellipsoid;
 pub mod geometry;
+pub mod impact;
 pub mod integrate;
 pub mod io;
 pub mod math;
+pub mod random;
 pub mod run;
 pub mod scene;

@@ -1,22 +1,31 @@
 //! The `rubblepile` command line.
 //!
-//! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress]`: runs a scene (the built-in
-//!   default scene without SCENE) and writes its outputs into DIR;
+//! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress] [--checkpoint-every S]
+//!   [--checkpoint-every-sim S]`: runs a scene (the built-in default scene without SCENE) and writes
+//!   its outputs into DIR, with checkpoints as asked;
+//! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
+//!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::run`]);
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to;
+//! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
+//!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
+//! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
-//! scene, bad arguments, existing output directory) and 1 for a failed run.
+//! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
+//! the hidden testing flag `--stop-after-checkpoints N` stopped a run after its N-th checkpoint.
 
 pub mod bench;
+pub mod impact;
+pub mod target;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::run::{RunOptions, run_scene};
+use crate::run::{DEFAULT_CHECKPOINT_EVERY, RunOptions, resume_run, run_scene};
 use crate::scene::{LoadedScene, default_scene, load_scene};
 
 /// Dynamics of rubble-pile asteroids: interacting ellipsoids (Roig et al. 2003).
@@ -33,8 +42,15 @@ pub struct Cli {
 pub enum Command {
     /// Run a scene and write its outputs (summary.json, timeseries.csv, snapshots/) into DIR.
     Run(RunArgs),
+    /// Continue an interrupted run in DIR from its checkpoint (DIR/checkpoint.json).
+    Resume(ResumeArgs),
     /// Validate a scene file and print what it resolves to (κ, bodies, output times).
     Check(CheckArgs),
+    /// Rubble-pile targets.
+    #[command(subcommand)]
+    Target(target::TargetCommand),
+    /// Run an impact of a projectile (P1, P2, P3 or custom) on a target.
+    Impact(Box<impact::ImpactArgs>),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -54,6 +70,67 @@ pub struct RunArgs {
     /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
     #[arg(long)]
     pub no_progress: bool,
+    /// Checkpoint options.
+    #[command(flatten)]
+    pub checkpoints: CheckpointArgs,
+}
+
+/// `rubblepile resume`.
+#[derive(Debug, clap::Args)]
+pub struct ResumeArgs {
+    /// The run's output directory (holding checkpoint.json and scene.toml).
+    pub dir: PathBuf,
+    /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
+    #[arg(long)]
+    pub no_progress: bool,
+    /// Checkpoint options.
+    #[command(flatten)]
+    pub checkpoints: CheckpointArgs,
+}
+
+/// When `run` and `resume` write `DIR/checkpoint.json` (always at an output sample).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct CheckpointArgs {
+    /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never).
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
+    pub checkpoint_every: f64,
+    /// Also checkpoint at the first output sample SECONDS of simulated time after the last
+    /// checkpoint (0 = at every output sample).
+    #[arg(long, value_name = "SECONDS")]
+    pub checkpoint_every_sim: Option<f64>,
+    /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
+    #[arg(long, value_name = "N", hide = true)]
+    pub stop_after_checkpoints: Option<u64>,
+}
+
+impl CheckpointArgs {
+    /// The run options these arguments ask for.
+    pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
+        let ok = |v: f64| v.is_finite() && v >= 0.0;
+        if !ok(self.checkpoint_every) {
+            return Err(CliError::usage(format!(
+                "--checkpoint-every must be a finite number of seconds >= 0, got {}",
+                self.checkpoint_every
+            )));
+        }
+        if let Some(s) = self.checkpoint_every_sim
+            && !ok(s)
+        {
+            return Err(CliError::usage(format!(
+                "--checkpoint-every-sim must be a finite number of seconds >= 0, got {s}"
+            )));
+        }
+        if self.stop_after_checkpoints == Some(0) {
+            return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
+        }
+        Ok(RunOptions {
+            force: false,
+            progress,
+            checkpoint_every: (self.checkpoint_every > 0.0).then_some(self.checkpoint_every),
+            checkpoint_every_sim: self.checkpoint_every_sim,
+            stop_after_checkpoints: self.stop_after_checkpoints,
+        })
+    }
 }
 
 /// `rubblepile check`.
@@ -78,7 +155,7 @@ pub enum BenchCommand {
 pub struct CliError {
     /// One-line message (printed after `error: `).
     pub message: String,
-    /// Exit code: 2 bad input, 1 failed run.
+    /// Exit code: 2 bad input, 1 failed run, 3 stopped after a checkpoint on request.
     pub code: u8,
 }
 
@@ -111,27 +188,16 @@ fn load(scene: Option<&PathBuf>) -> Result<LoadedScene, CliError> {
 pub fn execute(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Run(args) => {
-            let scene = load(args.scene.as_ref())?;
             let options = RunOptions {
                 force: args.force,
-                progress: !args.no_progress,
+                ..args.checkpoints.options(!args.no_progress)?
             };
-            match run_scene(&scene, &args.out, &options) {
-                Ok(summary) => {
-                    println!("{}", summary.one_line());
-                    Ok(())
-                }
-                Err(e) => {
-                    if let crate::run::RunError::Failed { summary, .. } = &e {
-                        println!("{}", summary.one_line());
-                    }
-                    if e.is_usage() {
-                        Err(CliError::usage(e))
-                    } else {
-                        Err(CliError::failed(e))
-                    }
-                }
-            }
+            let scene = load(args.scene.as_ref())?;
+            report(run_scene(&scene, &args.out, &options))
+        }
+        Command::Resume(args) => {
+            let options = args.checkpoints.options(!args.no_progress)?;
+            report(resume_run(&args.dir, &options))
         }
         Command::Check(args) => {
             if args.print_default {
@@ -142,7 +208,28 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             print_check(&scene);
             Ok(())
         }
+        Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
+        Command::Impact(args) => impact::impact(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
+    }
+}
+
+/// Prints the one-line summary of a finished (or failed) run; maps errors to exit codes.
+pub(crate) fn report(result: Result<crate::run::RunSummary, crate::run::RunError>) -> Result<(), CliError> {
+    match result {
+        Ok(summary) => {
+            println!("{}", summary.one_line());
+            Ok(())
+        }
+        Err(e) => {
+            if let crate::run::RunError::Failed { summary, .. } = &e {
+                println!("{}", summary.one_line());
+            }
+            Err(CliError {
+                message: e.to_string(),
+                code: e.exit_code(),
+            })
+        }
     }
 }
 

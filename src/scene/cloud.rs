@@ -1,10 +1,8 @@
 //! Random clouds of ellipsoids (for benchmarks and stress tests), seeded and reproducible.
 
-use rand_core::{Rng, SeedableRng};
-use rand_pcg::Pcg64;
-
 use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::math::{Vec3, Vec4};
+use crate::math::Vec3;
+use crate::random::{generator, random_quaternion, symmetric, uniform};
 
 /// Parameters of [`random_cloud`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,32 +42,10 @@ impl Default for CloudParams {
     }
 }
 
-fn uniform(rng: &mut Pcg64) -> f64 {
-    (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-}
-
-fn symmetric(rng: &mut Pcg64, half_width: f64) -> f64 {
-    (2.0 * uniform(rng) - 1.0) * half_width
-}
-
-/// A uniformly distributed unit quaternion `(α, β, γ, δ)` (Shoemake's method).
-fn random_quaternion(rng: &mut Pcg64) -> Vec4 {
-    let (u1, u2, u3) = (uniform(rng), uniform(rng), uniform(rng));
-    let tau = std::f64::consts::TAU;
-    let (a, b) = ((1.0 - u1).sqrt(), u1.sqrt());
-    Vec4::new(
-        a * (tau * u2).sin(),
-        a * (tau * u2).cos(),
-        b * (tau * u3).sin(),
-        b * (tau * u3).cos(),
-    )
-    .normalize()
-}
-
 /// `n` ellipsoids on a jittered cubic lattice centred on the origin, with random shapes (equivalent
 /// radius uniform in `[r_min, r_max]`, `A ≥ B ≥ C`), attitudes, spins and velocities.
 pub fn random_cloud(n: usize, seed: u64, p: &CloudParams) -> Vec<Body> {
-    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut rng = generator(seed);
     let side = (n as f64).cbrt().ceil().max(1.0) as usize;
     let spacing = p.spacing_factor * 0.5 * (p.r_min + p.r_max);
     let offset = 0.5 * (side as f64 - 1.0) * spacing;

@@ -1,0 +1,3 @@
+//! Post-processing of states and runs.
+
+pub mod rigid_rotation;
