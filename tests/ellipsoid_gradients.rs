@@ -485,3 +485,16 @@ fn uniform_inertia_is_the_uniform_ellipsoid() {
     assert!((i.x - 7.0 / 5.0 * (4.0 + 1.0)).abs() < 1e-14);
     assert!((i.z - 7.0 / 5.0 * (9.0 + 4.0)).abs() < 1e-14);
 }
+
+/// The cheap form of the pair prefactor equals Eq. 11's `U0` times `m_i m_j (κ/π)^{3/2}`.
+#[test]
+fn pair_prefactor_equals_eq11_form() {
+    use rubblepile::ellipsoid::calibration::contact_amplitude_u0;
+    let mut rng = Random::new(31);
+    for _ in 0..100 {
+        let (ri, rj, k) = (rng.range(1e2, 1e5), rng.range(1e2, 1e5), rng.range(1.6, 40.0));
+        let (mi, mj) = (rng.range(1e10, 1e18), rng.range(1e10, 1e18));
+        let direct = contact_amplitude_u0(G, k, ri, rj) * mi * mj * (k / std::f64::consts::PI).powf(1.5);
+        assert!((pair_prefactor(G, k, ri, mi, rj, mj) / direct - 1.0).abs() < 1e-12);
+    }
+}

@@ -45,8 +45,13 @@ pub fn contact_amplitude_u0(g: f64, kappa: f64, r_i: f64, r_j: f64) -> f64 {
 
 /// The pair prefactor `U0_ij m_i m_j (κ/π)^{3/2}` (J m³) so that
 /// `U_C = prefactor · det(G)^{−1/2} · exp(−κ Δᵀ G⁻¹ Δ)` (the note's cheaper form of Eq. 10).
+///
+/// Evaluated without `powf` (it runs for every interacting pair at every RHS evaluation):
+/// `U0 (κ/π)^{3/2} = ½ G (R_i+R_j)² e^{κλ} / (κ λ^{5/2})`.
 pub fn pair_prefactor(g: f64, kappa: f64, r_i: f64, m_i: f64, r_j: f64, m_j: f64) -> f64 {
-    contact_amplitude_u0(g, kappa, r_i, r_j) * m_i * m_j * (kappa / PI).powf(1.5)
+    let sum = r_i + r_j;
+    let lam = sum * sum / (r_i * r_i + r_j * r_j);
+    0.5 * g * sum * sum * (kappa * lam).exp() / (kappa * lam * lam * lam.sqrt()) * m_i * m_j
 }
 
 /// Solves Roig03 Eq. 14 for κ: `exp(κλ)/(κλ) = β v² (R_k + R_l)/(G m_k)`, where `k` is the smallest

@@ -15,7 +15,7 @@ use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use crate::ellipsoid::gravity::gravity_forces;
 use crate::ellipsoid::potential::{
-    BodyGeometry, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
+    BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
 use crate::ellipsoid::quaternion::{
     extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin, rotation_matrix,
@@ -152,7 +152,8 @@ pub struct EllipsoidSystem {
     physics: Physics,
     rotation: bool,
     stride: usize,
-    cutoff: f64,
+    /// `−ln(cutoff)`, where each pair's taper starts above its contact exponent κλ.
+    neg_ln_cutoff: f64,
     cull_exp: f64,
 }
 
@@ -174,7 +175,7 @@ impl EllipsoidSystem {
             physics,
             rotation,
             stride: if rotation { 14 } else { 6 },
-            cutoff,
+            neg_ln_cutoff: -cutoff.ln(),
             cull_exp: max_cull_exponent(model.kappa, cutoff),
         }
     }
@@ -304,7 +305,8 @@ impl EllipsoidSystem {
 
     /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
     fn pair_taper(&self, i: usize, j: usize) -> Taper {
-        Taper::for_pair(self.cutoff, self.model.kappa * lambda(self.radii[i], self.radii[j]))
+        let start = self.model.kappa * lambda(self.radii[i], self.radii[j]) + self.neg_ln_cutoff;
+        Taper { start, end: start + TAPER_WIDTH }
     }
 
     fn pair_terms(&self, i: usize, j: usize, kin: &[Kinematics], with_forces: bool) -> PairTerms {
@@ -365,7 +367,8 @@ impl EllipsoidSystem {
             return Vec::new();
         }
         let pairs = self.interacting_pairs(kin);
-        if pairs.len() >= 32 {
+        // Below a few hundred pairs the work per pair does not pay for waking the thread pool.
+        if pairs.len() >= 256 {
             pairs
                 .par_iter()
                 .map(|&(i, j)| self.pair_terms(i, j, kin, with_forces))
