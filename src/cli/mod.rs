@@ -9,6 +9,8 @@
 //! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
 //! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
+//! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
+//!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
 //!
@@ -17,6 +19,7 @@
 //! the hidden testing flag `--stop-after-checkpoints N` stopped a run after its N-th checkpoint.
 
 pub mod bench;
+pub mod campaign;
 pub mod impact;
 pub mod target;
 
@@ -51,6 +54,8 @@ pub enum Command {
     Target(target::TargetCommand),
     /// Run an impact of a projectile (P1, P2, P3 or custom) on a target.
     Impact(Box<impact::ImpactArgs>),
+    /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
+    Campaign(campaign::CampaignArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -209,7 +214,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             Ok(())
         }
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
+        Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
+        Command::Campaign(args) => campaign::campaign(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
     }
 }

@@ -12,6 +12,85 @@ use crate::io::csv::write_snapshot;
 pub enum TargetCommand {
     /// Build a target: sizes ∝ D^−2.5, Monte-Carlo placement, rigid rotation, relaxation until rigid.
     Build(BuildArgs),
+    /// Print Roig03 Table 1 for target reports (NAME.json) beside the paper's values, as Markdown.
+    Table(TableArgs),
+}
+
+/// `rubblepile target table`.
+#[derive(Debug, clap::Args)]
+pub struct TableArgs {
+    /// Target reports written by `target build` (NAME.json).
+    #[arg(required = true)]
+    pub reports: Vec<PathBuf>,
+}
+
+/// Roig03 Table 1 by number of fragments: total mass (1e18 kg), effective and apparent radius (km),
+/// effective and apparent density (g/cm³), porosity, major and equivalent radius of the largest and the
+/// smallest fragment (km).
+const TABLE1: [(usize, [f64; 10]); 3] = [
+    (30, [10.03, 92.76, 107.44, 3.00, 1.93, 0.36, 90.51, 64.00, 22.62, 16.00]),
+    (100, [9.99, 92.64, 107.43, 3.00, 1.92, 0.36, 84.85, 60.00, 14.14, 10.00]),
+    (200, [10.05, 92.82, 110.10, 3.00, 1.80, 0.40, 83.43, 59.00, 9.89, 7.00]),
+];
+
+/// Runs `target table`.
+pub fn table(args: &TableArgs) -> Result<(), CliError> {
+    let rows = [
+        "Total mass [10^18 kg]",
+        "Effective radius [km]",
+        "Apparent radius [km]",
+        "Effective density [g cm^-3]",
+        "Apparent density [g cm^-3]",
+        "Porosity",
+        "Major radius of largest fragment [km]",
+        "Equivalent radius of largest fragment [km]",
+        "Major radius of smallest fragment [km]",
+        "Equivalent radius of smallest fragment [km]",
+        "Spin period [h]",
+        "Relaxation time [s]",
+        "kappa",
+    ];
+    let mut header = vec!["quantity".to_string()];
+    let mut columns: Vec<Vec<String>> = Vec::new();
+    for path in &args.reports {
+        let text = std::fs::read_to_string(path).map_err(|e| CliError::usage(format!("{}: {e}", path.display())))?;
+        let r: crate::impact::target::TargetReport =
+            serde_json::from_str(&text).map_err(|e| CliError::usage(format!("{}: {e}", path.display())))?;
+        let ours = [
+            r.total_mass_kg / 1e18,
+            r.effective_radius_m / 1e3,
+            r.apparent_radius_m / 1e3,
+            r.effective_density_kg_m3 / 1e3,
+            r.apparent_density_kg_m3 / 1e3,
+            r.porosity,
+            r.largest_major_radius_m / 1e3,
+            r.largest_equivalent_radius_m / 1e3,
+            r.smallest_major_radius_m / 1e3,
+            r.smallest_equivalent_radius_m / 1e3,
+            r.spin_period_hours,
+            r.relaxation_time_s,
+            r.kappa,
+        ];
+        let stem = path
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        header.push(format!("{stem} (ours)"));
+        columns.push(ours.iter().map(|v| format!("{v:.2}")).collect());
+        if let Some((_, paper)) = TABLE1.iter().find(|(n, _)| *n == r.fragments) {
+            header.push(format!("N{} (Roig03)", r.fragments));
+            let mut col: Vec<String> = paper.iter().map(|v| format!("{v:.2}")).collect();
+            col.push(format!("{:.0}", r.spec.period_hours));
+            col.extend(["–".to_string(), "–".to_string()]);
+            columns.push(col);
+        }
+    }
+    println!("| {} |", header.join(" | "));
+    println!("|{}|", vec!["---"; header.len()].join("|"));
+    for (k, name) in rows.iter().enumerate() {
+        let cells: Vec<&str> = columns.iter().map(|c| c[k].as_str()).collect();
+        println!("| {name} | {} |", cells.join(" | "));
+    }
+    Ok(())
 }
 
 /// `rubblepile target build`.

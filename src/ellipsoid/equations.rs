@@ -306,7 +306,10 @@ impl EllipsoidSystem {
     /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
     fn pair_taper(&self, i: usize, j: usize) -> Taper {
         let start = self.model.kappa * lambda(self.radii[i], self.radii[j]) + self.neg_ln_cutoff;
-        Taper { start, end: start + TAPER_WIDTH }
+        Taper {
+            start,
+            end: start + TAPER_WIDTH,
+        }
     }
 
     fn pair_terms(&self, i: usize, j: usize, kin: &[Kinematics], with_forces: bool) -> PairTerms {

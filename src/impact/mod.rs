@@ -1,7 +1,12 @@
 //! Impact experiments on rubble-pile targets (Roig03 §3, Tables 1–2).
 //!
 //! - [`target`]: the Monte-Carlo rubble-pile builder and its relaxation to a rigidly rotating pile;
-//! - [`projectile`]: the projectiles P1–P3 and the impact geometry.
+//! - [`projectile`]: the projectiles P1–P3 and the impact geometry;
+//! - [`run`]: one impact run (target + projectile → run directory → [`crate::run::run_scene`]);
+//! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
+//!   in parallel, resumable, summarised in `campaign.csv`.
 
+pub mod campaign;
 pub mod projectile;
+pub mod run;
 pub mod target;

@@ -1,0 +1,471 @@
+//! Impact campaigns (`rubblepile campaign`): a small grid runs and is listed in `campaign.csv`; a second
+//! invocation skips every completed run without touching it; a run stopped after its first checkpoint is
+//! resumed (not restarted) and ends bit for bit like an uninterrupted run; bad campaign files give one-line
+//! errors naming the field; `rubblepile impact` still works as a thin wrapper of the library.
+//!
+//! Everything runs on a tiny target (6 fragments, 3 → 1.5 km) built here, hit by 1 km projectiles at a few
+//! tens of m/s, for a few tens of simulated seconds.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::SystemTime;
+
+use rubblepile::impact::campaign::{
+    Action, CAMPAIGN_COLUMNS, CampaignOptions, RunStatus, load_campaign, parse_campaign, run_campaign,
+};
+use rubblepile::impact::run::run_impact;
+use rubblepile::impact::target::{TargetSpec, build_target};
+use rubblepile::io::csv::write_snapshot;
+use rubblepile::run::RunOptions;
+use std::f64::consts::PI;
+
+fn temp_dir(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let n = N.fetch_add(1, Ordering::SeqCst);
+    let nanos = SystemTime::now()
+        .duration_since(SystemTime::UNIX_EPOCH)
+        .map(|d| d.subsec_nanos())
+        .unwrap_or(0);
+    let dir = std::env::temp_dir().join(format!("rubblepile-campaign-{tag}-{}-{n}-{nanos}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// The tiny target's CSV text, built once per test process (6 fragments, 3 → 1.5 km, 6 h period).
+fn tiny_target_csv() -> &'static [u8] {
+    static CSV: OnceLock<Vec<u8>> = OnceLock::new();
+    CSV.get_or_init(|| {
+        let mut spec = TargetSpec::table1(30, 6.0, 1).unwrap();
+        spec.fragments = 6;
+        spec.r_largest = 3e3;
+        spec.r_smallest = 1.5e3;
+        spec.total_mass = {
+            // the expected mass of such a draw, so that a draw within 10 % comes quickly
+            let (a, b) = (spec.r_largest.powf(-2.5), spec.r_smallest.powf(-2.5));
+            let mean_r3 = (0..1000)
+                .map(|k| (a + (k as f64 + 0.5) / 1000.0 * (b - a)).powf(-1.2))
+                .sum::<f64>()
+                / 1000.0;
+            3000.0 * 4.0 / 3.0 * PI * (3e3f64.powi(3) + 1.5e3f64.powi(3) + 4.0 * mean_r3)
+        };
+        spec.mass_tolerance = 0.1;
+        spec.f0 = 1e-3; // damps this small pile to rigid rotation quickly
+        let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
+        let (bodies, _) = build_target(&spec, &mut quiet).unwrap();
+        let dir = temp_dir("target");
+        let path = dir.join("tiny.csv");
+        write_snapshot(&path, 0.0, &bodies).unwrap();
+        let text = std::fs::read(&path).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        text
+    })
+}
+
+/// A campaign directory `dir` with `targets/tiny.csv` and `campaign.toml` (`[campaign]` lines given).
+fn campaign_dir(tag: &str, campaign: &str) -> (PathBuf, PathBuf) {
+    let dir = temp_dir(tag);
+    std::fs::create_dir_all(dir.join("targets")).unwrap();
+    std::fs::write(dir.join("targets/tiny.csv"), tiny_target_csv()).unwrap();
+    let file = dir.join("campaign.toml");
+    std::fs::write(&file, campaign).unwrap();
+    (dir, file)
+}
+
+/// A 2 × 2 grid: projectiles S1 (1 km) and S2 (0.8 km) at 20 m/s, ζ = 0 and 90°, to t = 40 s.
+const GRID: &str = r#"
+[campaign]
+out = "out"
+targets = ["targets/tiny.csv"]
+projectiles = ["S1", "S2"]
+angles = [0, 90.0]
+seeds = [7]
+parallel = 2
+
+[impact]
+t_end = 40.0
+contact_time = 5.0
+every = 5.0
+rtol = 1e-8
+
+[[projectile]]
+id = "S1"
+radius_km = 1.0
+speed_km_s = 0.02
+
+[[projectile]]
+id = "S2"
+radius_km = 0.8
+speed_km_s = 0.02
+"#;
+
+fn quiet() -> CampaignOptions {
+    CampaignOptions {
+        run: RunOptions {
+            progress: false,
+            ..RunOptions::default()
+        },
+        parallel: None,
+        verbose: false,
+    }
+}
+
+fn read_csv(path: &Path) -> Vec<Vec<String>> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+    assert_eq!(header, CAMPAIGN_COLUMNS);
+    r.records()
+        .map(|x| x.unwrap().iter().map(String::from).collect())
+        .collect()
+}
+
+/// Every file under `dir` with its bytes and modification time.
+fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>, SystemTime)> {
+    let mut out = Vec::new();
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_dir() {
+            out.extend(tree(&p));
+        } else {
+            let modified = std::fs::metadata(&p).unwrap().modified().unwrap();
+            out.push((p.clone(), std::fs::read(&p).unwrap(), modified));
+        }
+    }
+    out.sort_by(|a, b| a.0.cmp(&b.0));
+    out
+}
+
+fn bin(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+        .args(args)
+        .output()
+        .expect("run rubblepile")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// (a) the grid runs, `campaign.csv` lists every run completed with finite errors; (b) a second invocation
+/// skips every run and modifies nothing in the run directories; a run directory whose scene no longer matches
+/// the campaign is left alone and recorded as failed while the rest is skipped.
+#[test]
+fn grid_runs_then_everything_is_skipped() {
+    let (dir, file) = campaign_dir("grid", GRID);
+    let campaign = load_campaign(&file).unwrap();
+    assert_eq!(campaign.points.len(), 4);
+    let names: Vec<&str> = campaign.points.iter().map(|p| p.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["tiny_S1_z0_s7", "tiny_S1_z90_s7", "tiny_S2_z0_s7", "tiny_S2_z90_s7"]
+    );
+    assert_eq!(campaign.out, dir.join("out"));
+    assert_eq!(campaign.parallel, 2);
+
+    let report = run_campaign(&campaign, &quiet()).unwrap();
+    assert_eq!(report.completed(), 4, "{}", report.one_line());
+    assert!(report.runs.iter().all(|r| r.action == Action::Start));
+    let worst = report.worst_energy_error().unwrap().0;
+    assert!(worst.is_finite() && worst < 1e-5, "{}", report.one_line());
+
+    let rows = read_csv(&dir.join("out/campaign.csv"));
+    assert_eq!(rows.len(), 4);
+    for (row, name) in rows.iter().zip(&names) {
+        assert_eq!(row[0], *name);
+        assert_eq!(row[1], "tiny");
+        assert_eq!(row[4], "7");
+        assert_eq!(row[6], "completed", "{row:?}");
+        assert_eq!(row[8].parse::<f64>().unwrap(), 40.0);
+        assert!(row[5].parse::<f64>().unwrap() > 0.0, "Q {row:?}");
+        for k in 11..14 {
+            let e: f64 = row[k].parse().unwrap();
+            assert!(e.is_finite() && e >= 0.0, "{} = {e} in {row:?}", CAMPAIGN_COLUMNS[k]);
+        }
+        let summary = std::fs::read_to_string(dir.join("out").join(name).join("summary.json")).unwrap();
+        assert!(summary.contains("\"status\": \"completed\""));
+    }
+    assert_eq!(rows[1][2], "S1");
+    assert_eq!(rows[1][3], "90");
+    assert!(!dir.join("out/campaign.csv.tmp").exists());
+
+    // (b) again: everything skipped, nothing in the run directories touched.
+    let before = tree(&dir.join("out"));
+    let again = run_campaign(&load_campaign(&file).unwrap(), &quiet()).unwrap();
+    assert_eq!(again.skipped(), 4, "{}", again.one_line());
+    assert_eq!(again.completed(), 4);
+    let after = tree(&dir.join("out"));
+    let runs_only = |t: &[(PathBuf, Vec<u8>, SystemTime)]| -> Vec<(PathBuf, Vec<u8>, SystemTime)> {
+        t.iter()
+            .filter(|(p, _, _)| !p.ends_with("campaign.csv"))
+            .cloned()
+            .collect()
+    };
+    assert_eq!(runs_only(&before), runs_only(&after));
+    assert_eq!(read_csv(&dir.join("out/campaign.csv")), rows);
+
+    // A completed run whose scene differs from the campaign's: left alone, recorded as failed.
+    let changed = GRID.replace("t_end = 40.0", "t_end = 40.0\nf0 = 2e-4");
+    std::fs::write(&file, changed).unwrap();
+    let conflict = run_campaign(&load_campaign(&file).unwrap(), &quiet()).unwrap();
+    assert_eq!(conflict.failed(), 4, "{}", conflict.one_line());
+    assert!(matches!(&conflict.runs[0].status, RunStatus::Failed(c) if c.contains("scene.toml differs")));
+    assert_eq!(runs_only(&tree(&dir.join("out"))), runs_only(&before));
+    let rows = read_csv(&dir.join("out/campaign.csv"));
+    assert!(rows[0][6].starts_with("failed: "), "{:?}", rows[0]);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// (c) runs stopped right after their first checkpoint (the hidden `--stop-after-checkpoints`, through the
+/// binary: exit code 3) are resumed by the next invocation, not restarted, and end bit for bit like an
+/// uninterrupted run of the same grid point.
+#[test]
+fn stopped_runs_are_resumed_bit_for_bit() {
+    let grid = GRID
+        .replace("projectiles = [\"S1\", \"S2\"]", "projectiles = [\"S1\"]")
+        .replace("angles = [0, 90.0]", "angles = [45.0]");
+    let (dir, file) = campaign_dir("resume", &grid);
+    let f = file.to_str().unwrap();
+    let out = bin(&[
+        "campaign",
+        f,
+        "--checkpoint-every-sim",
+        "10",
+        "--stop-after-checkpoints",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", stderr(&out));
+    let run = dir.join("out/tiny_S1_z45_s7");
+    assert!(run.join("checkpoint.json").is_file());
+    assert!(!run.join("summary.json").exists());
+    let rows = read_csv(&dir.join("out/campaign.csv"));
+    assert_eq!(rows[0][6], "pending");
+    let initial = tree(&run)
+        .into_iter()
+        .filter(|(p, _, _)| p.ends_with("initial_bodies.csv") || p.ends_with("impact.json"))
+        .collect::<Vec<_>>();
+    assert_eq!(initial.len(), 2);
+
+    let out = bin(&["campaign", f, "--no-progress"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("1 completed (0 skipped, 1 resumed)"), "{stdout}");
+    // not restarted: the set-up files are those of the first invocation
+    for (p, bytes, modified) in &initial {
+        assert_eq!(&std::fs::read(p).unwrap(), bytes);
+        assert_eq!(std::fs::metadata(p).unwrap().modified().unwrap(), *modified);
+    }
+    assert_eq!(read_csv(&dir.join("out/campaign.csv"))[0][6], "completed");
+
+    // The same grid point, uninterrupted.
+    let campaign = load_campaign(&file).unwrap();
+    let whole = dir.join("whole");
+    let options = RunOptions {
+        progress: false,
+        ..RunOptions::default()
+    };
+    let summary = run_impact(&campaign.points[0].config, &whole, &options).unwrap();
+    assert!(summary.completed());
+    let snapshots = |d: &Path| -> Vec<(PathBuf, Vec<u8>)> {
+        tree(&d.join("snapshots"))
+            .into_iter()
+            .map(|(p, bytes, _)| (p.strip_prefix(d).unwrap().to_path_buf(), bytes))
+            .collect()
+    };
+    assert_eq!(snapshots(&run).len(), 2); // t = 0 and t_end = 40 s
+    assert_eq!(snapshots(&run), snapshots(&whole), "snapshots differ");
+    let json = |d: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap()
+    };
+    let (a, b) = (json(&run), json(&whole));
+    for key in [
+        "final_time",
+        "steps_accepted",
+        "steps_rejected",
+        "rhs_evaluations",
+        "energy_error",
+        "angular_momentum_error",
+    ] {
+        assert_eq!(a[key], b[key], "{key}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn campaign_error(text: &str, dir: &Path) -> String {
+    let e = parse_campaign(text, "c.toml", dir).expect_err("a bad campaign");
+    let msg = e.to_string();
+    assert!(!msg.contains('\n'), "not one line: {msg}");
+    assert_eq!(e.exit_code(), 2, "{msg}");
+    msg
+}
+
+/// (d) bad campaign files: one line naming the field, exit code 2, never a panic.
+#[test]
+fn bad_campaign_files_give_one_line_errors() {
+    let (dir, _) = campaign_dir("bad", GRID);
+    let ok = parse_campaign(GRID, "c.toml", &dir);
+    assert!(ok.is_ok(), "{:?}", ok.err());
+    let cases: [(String, &str); 10] = [
+        (
+            GRID.replace("parallel = 2", "parallel = 2\nthreads = 4"),
+            "c.toml: unknown field `threads` in [campaign]",
+        ),
+        (
+            GRID.replace("rtol = 1e-8", "rtol = 1e-8\ntol = 3"),
+            "c.toml: unknown field `tol` in [impact]",
+        ),
+        (
+            GRID.replace("targets = [\"targets/tiny.csv\"]", "targets = []"),
+            "c.toml: campaign.targets: must list at least one",
+        ),
+        (
+            GRID.replace("targets/tiny.csv", "targets/missing.csv"),
+            "c.toml: campaign.targets[0]: ",
+        ),
+        (
+            GRID.replace("angles = [0, 90.0]", "angles = [0, 190.0]"),
+            "c.toml: campaign.angles[1]: expected 0 to 180 degrees, got 190",
+        ),
+        (
+            GRID.replace("angles = [0, 90.0]", "angles = [-5]"),
+            "c.toml: campaign.angles[0]: expected 0 to 180 degrees, got -5",
+        ),
+        (
+            GRID.replace("projectiles = [\"S1\", \"S2\"]", "projectiles = [\"P4\"]"),
+            "c.toml: campaign.projectiles[0]: expected P1, P2, P3 or the id",
+        ),
+        (
+            GRID.replace("t_end = 40.0", "t_end = -1.0"),
+            "c.toml: impact.t_end: must be > 0",
+        ),
+        (GRID.replace("out = \"out\"\n", ""), "c.toml: campaign.out: missing"),
+        (
+            GRID.replace("angles = [0, 90.0]", "angles = \"0\""),
+            "c.toml: campaign.angles: invalid type",
+        ),
+    ];
+    for (text, expected) in &cases {
+        let msg = campaign_error(text, &dir);
+        assert!(msg.starts_with(expected), "expected {expected:?}, got {msg:?}");
+    }
+    // through the binary: `error: …` on one line, exit code 2, nothing run
+    let file = dir.join("bad.toml");
+    std::fs::write(&file, GRID.replace("angles = [0, 90.0]", "angles = [0, 190.0]")).unwrap();
+    let out = bin(&["campaign", file.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = stderr(&out);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: ") && err.contains("campaign.angles[1]"),
+        "{err}"
+    );
+    assert!(!dir.join("out").exists());
+    let out = bin(&["campaign", dir.join("nope.toml").to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("cannot read"), "{}", stderr(&out));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// (e) `rubblepile impact` (now a wrapper of `impact::run`) still runs an impact and names its flags in errors.
+#[test]
+fn impact_command_still_works() {
+    let (dir, _) = campaign_dir("impact", GRID);
+    let target = dir.join("targets/tiny.csv");
+    let out_dir = dir.join("run");
+    let args = |angle: &str| -> Vec<String> {
+        [
+            "impact",
+            "--target",
+            target.to_str().unwrap(),
+            "--projectile-radius-km",
+            "1",
+            "--projectile-speed-km-s",
+            "0.02",
+            "--angle",
+            angle,
+            "--contact-time",
+            "5",
+            "--t-end",
+            "20",
+            "--snapshots",
+            "0,20",
+            "--every",
+            "5",
+            "--out",
+            out_dir.to_str().unwrap(),
+            "--no-progress",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect()
+    };
+    let run = |a: &[String]| bin(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = run(&args("30"));
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let mut lines = stdout.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("Impact of custom (1.00 km, 0.0 km/s) on "),
+        "{stdout}"
+    );
+    assert!(lines.next().unwrap().starts_with("done: t = 20 s"), "{stdout}");
+    for f in [
+        "initial_bodies.csv",
+        "impact.json",
+        "scene.toml",
+        "summary.json",
+        "snapshots/1.csv",
+    ] {
+        assert!(out_dir.join(f).is_file(), "{f}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("impact.json")).unwrap()).unwrap();
+    assert_eq!(json["target"], target.display().to_string());
+    assert_eq!(json["angle_deg"], 30.0);
+    // the run directory's scene is an ordinary scene
+    let scene = std::fs::read_to_string(out_dir.join("scene.toml")).unwrap();
+    assert!(scene.contains("bodies_file = \"initial_bodies.csv\""));
+    assert!(scene.contains("calibrate = { beta = 10.0, v = 20.0 }"));
+    // existing directory without --force; bad angle: one line naming the flag
+    let out = run(&args("30"));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--force"), "{}", stderr(&out));
+    let out = run(&args("200"));
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(
+        stderr(&out).trim(),
+        "error: --angle: expected 0 to 180 degrees, got 200"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The committed Roig03 campaign files parse: 6 targets × 3 projectiles × 3 angles (when the targets have been
+/// built; otherwise the only complaint is a missing target), and the smoke campaign is 2 short runs.
+#[test]
+fn roig2003_campaign_files_are_valid() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (file, runs) in [("campaign.toml", 54), ("smoke_campaign.toml", 2)] {
+        let path = root.join("analysis/roig2003").join(file);
+        match load_campaign(&path) {
+            Ok(c) => {
+                assert_eq!(c.points.len(), runs, "{file}");
+                assert!(c.points.iter().all(|p| p.seed == 1 && p.config.rtol == 1e-9), "{file}");
+                assert!(c.out.file_name().unwrap().to_str().unwrap().starts_with("roig2003"));
+                assert!(c.out.starts_with(root.join("runs")), "{}", c.out.display());
+                if runs == 54 {
+                    assert_eq!(c.points[0].name, "N30_T4_P1_z0_s1");
+                    assert_eq!(c.points[53].name, "N200_T12_P3_z90_s1");
+                    assert!(c.points.iter().all(|p| p.config.t_end == 10_000.0));
+                } else {
+                    assert_eq!(c.points[1].name, "N30_T4_P1_z90_s1");
+                    assert_eq!(c.points[1].config.snapshots, [0.0, 100.0, 150.0]);
+                }
+            }
+            Err(e) => assert!(e.to_string().contains(": campaign.targets["), "{file}: {e}"),
+        }
+    }
+}
