@@ -21,11 +21,11 @@ pub struct ImpactArgs {
     /// Projectile preset P1, P2 or P3 (Roig03 Table 2); or give --projectile-radius-km.
     #[arg(long, default_value = "P2")]
     pub projectile: String,
-    /// Equivalent radius of a custom projectile (km); overrides the preset.
-    #[arg(long)]
+    /// Equivalent radius of a custom projectile (km); overrides the preset. Alias `--projectile-radius` (km).
+    #[arg(long, visible_alias = "projectile-radius")]
     pub projectile_radius_km: Option<f64>,
-    /// Impact speed (km/s).
-    #[arg(long, default_value_t = 5.0)]
+    /// Impact speed (km/s). Alias `--projectile-speed` (km/s).
+    #[arg(long, default_value_t = 5.0, visible_alias = "projectile-speed")]
     pub projectile_speed_km_s: f64,
     /// Angle ζ between the trajectory and the target's spin axis z (degrees, 0–180).
     #[arg(long, default_value_t = 45.0)]
@@ -48,9 +48,9 @@ pub struct ImpactArgs {
     /// β of Roig03 Eq. 14 (κ is calibrated over target + projectile).
     #[arg(long, default_value_t = 10.0)]
     pub beta: f64,
-    /// Snapshot times (s), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "0,100,400,1000,10000")]
-    pub snapshots: Vec<f64>,
+    /// Snapshot times (s), comma-separated [default: 0,100,400,1000,10000, cut at --t-end, plus --t-end].
+    #[arg(long, value_delimiter = ',')]
+    pub snapshots: Option<Vec<f64>>,
     /// Time-series cadence (s).
     #[arg(long, default_value_t = 10.0)]
     pub every: f64,
@@ -99,7 +99,10 @@ impl ImpactArgs {
             rtol: self.rtol,
             f0: self.f0,
             beta: self.beta,
-            snapshots: self.snapshots.clone(),
+            snapshots: self
+                .snapshots
+                .clone()
+                .unwrap_or_else(|| crate::impact::run::default_snapshots(self.t_end)),
             every: self.every,
         };
         cfg.validate().map_err(cli_error)?;
