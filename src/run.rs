@@ -542,27 +542,8 @@ fn bodies_hash(scene: &LoadedScene) -> String {
     fnv1a_hex(text.as_bytes())
 }
 
-/// `timeseries.csv`, new or continued.
-enum Rows {
-    New(Box<TimeseriesWriter>),
-    Continued(TimeseriesAppender),
-}
-
-impl Rows {
-    fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
-        match self {
-            Rows::New(w) => w.write_row(row),
-            Rows::Continued(w) => w.write_row(row),
-        }
-    }
-
-    fn finish(self) -> std::io::Result<()> {
-        match self {
-            Rows::New(w) => w.finish(),
-            Rows::Continued(w) => w.finish(),
-        }
-    }
-}
+/// `timeseries.csv`, new or continued after a checkpoint.
+type Rows = TimeseriesWriter; // new, or reopened by TimeseriesAppender::open_truncated
 
 /// Where [`drive`] starts: t = 0, or a checkpoint.
 struct Start {
@@ -629,7 +610,7 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         rows: 0,
         wall_before: 0.0,
         checkpoints: 0,
-        timeseries: Rows::New(Box::new(timeseries)),
+        timeseries,
     };
     drive(scene, out_dir, options, &system, integrator, start, &identity)
 }
@@ -756,7 +737,7 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
         rows: d.timeseries_rows,
         wall_before: d.wall_seconds,
         checkpoints: d.checkpoints,
-        timeseries: Rows::Continued(timeseries),
+        timeseries,
     };
     drive(&scene, dir, options, &system, integrator, start, &identity)
 }

@@ -23,8 +23,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::integrate::IntegratorState;
-use crate::io::csv::TimeseriesRow;
-use crate::io::fmt_f64;
+use crate::io::csv::TimeseriesWriter;
 
 /// Name of the checkpoint file in a run directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";
@@ -321,17 +320,15 @@ pub fn read_checkpoint(dir: &Path) -> Result<Checkpoint, CheckpointError> {
     Ok(c)
 }
 
-/// Appends rows to an existing `timeseries.csv` in exactly the format of
-/// [`crate::io::csv::TimeseriesWriter`] (used when a run resumes).
-pub struct TimeseriesAppender {
-    file: BufWriter<File>,
-}
+/// Reopens `timeseries.csv` when a run resumes (rows are then written by
+/// [`crate::io::csv::TimeseriesWriter`], so the format cannot drift).
+pub struct TimeseriesAppender;
 
 impl TimeseriesAppender {
     /// Opens `path`, checks that it holds at least `bytes` bytes whose first `rows + 1` lines are the
     /// header and `rows` complete rows, truncates it to `bytes` (dropping rows written after the
     /// checkpoint) and positions for appending. Errors are one line.
-    pub fn open_truncated(path: &Path, rows: u64, bytes: u64) -> Result<Self, String> {
+    pub fn open_truncated(path: &Path, rows: u64, bytes: u64) -> Result<TimeseriesWriter, String> {
         let io = |e: std::io::Error| format!("{}: {e}", path.display());
         let data = std::fs::read(path).map_err(io)?;
         if (data.len() as u64) < bytes {
@@ -352,40 +349,7 @@ impl TimeseriesAppender {
         let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(io)?;
         file.set_len(bytes).map_err(io)?;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(io)?;
-        Ok(TimeseriesAppender {
-            file: BufWriter::new(file),
-        })
-    }
-
-    /// Appends a row and flushes it to the OS.
-    pub fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
-        let d = &row.diagnostics;
-        let fields = [
-            row.t,
-            d.kinetic_translational,
-            d.kinetic_rotational,
-            d.potential_contact,
-            d.potential_gravity,
-            d.dissipated,
-            row.energy_residual,
-            d.momentum.x,
-            d.momentum.y,
-            d.momentum.z,
-            d.angular_momentum.x,
-            d.angular_momentum.y,
-            d.angular_momentum.z,
-            row.wall_seconds,
-        ];
-        let line: Vec<String> = fields.iter().map(|&x| fmt_f64(x)).collect();
-        self.file.write_all(line.join(",").as_bytes())?;
-        self.file.write_all(b"\n")?;
-        self.file.flush()
-    }
-
-    /// Flushes and syncs the file.
-    pub fn finish(self) -> std::io::Result<()> {
-        let file = self.file.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()
+        Ok(TimeseriesWriter::continue_file(file))
     }
 }
 
@@ -393,7 +357,7 @@ impl TimeseriesAppender {
 mod tests {
     use super::*;
     use crate::ellipsoid::equations::Diagnostics;
-    use crate::io::csv::TimeseriesWriter;
+    use crate::io::csv::TimeseriesRow;
     use crate::math::Vec3;
 
     #[test]

@@ -101,6 +101,14 @@ impl TimeseriesWriter {
         Ok(TimeseriesWriter { w })
     }
 
+    /// Continues a file already positioned after its last complete row (no header is written); used when a
+    /// run resumes from a checkpoint.
+    pub fn continue_file(file: File) -> Self {
+        TimeseriesWriter {
+            w: ::csv::Writer::from_writer(BufWriter::new(file)),
+        }
+    }
+
     /// Appends a row and flushes it to the OS.
     pub fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
         let d = &row.diagnostics;
