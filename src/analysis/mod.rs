@@ -1,3 +1,5 @@
 //! Post-processing of states and runs.
 
+pub mod fits;
+pub mod fragments;
 pub mod rigid_rotation;

@@ -1,0 +1,437 @@
+//! Post-impact fragment analysis of Roig03 §4: energy partition (§4.1), ejection velocities and escape
+//! (§4.2, Eq. 43, footnote 6), spins with the `√(5/(2κ))` correction (§4.3) and tumbling (§4.4, Eq. 46).
+//!
+//! Everything is computed from two snapshots of the same bodies (same order and count): the state at
+//! `t = 0` and the state at the analysis time `t_at` (the paper uses `t = 400 s`, ≈ 300 s after the impact).
+//! One body is the projectile: it is analysed and flagged, but excluded from every "target" quantity
+//! (parent-body size, target barycentre, bound mass fraction, fragment kinetic energy, ejection-speed
+//! statistics). It still counts in the binding energy of Eq. 43 (the sum runs over all other bodies) and
+//! in the barycentre of the whole system.
+//!
+//! Conventions (the choices where the paper is not explicit):
+//! * **Parent-body size** (Figs. 4, 8, 9: "normalized to the size of the parent body"): the radius
+//!   `R_eff = (3 V_T / 4π)^{1/3}` of the sphere whose volume `V_T` is the total volume of the target
+//!   fragments, the same "effective radius of the target" that enters `v_esc` (footnote 6). Each fragment's
+//!   size is its equivalent radius `(A B C)^{1/3}` divided by `R_eff`; the voids of the rubble pile are not
+//!   counted.
+//! * **Ejection velocity** (§4.2, Fig. 3 caption "referred to the barycenter of the target"):
+//!   `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]`, with `V_T` the mass-weighted mean velocity of the
+//!   target fragments (projectile excluded) at each time. A rigid translation of everything gives zero.
+//! * **Escape** (Eq. 43): `K_i = ½ m_i |v_i − V_sys|²` (translational only, barycentric frame of the whole
+//!   system at `t_at`), `U_i^bind = −Σ_{j≠i} G m_i m_j / |r_i − r_j|` over all other bodies; the fragment
+//!   escapes iff `K_i ≥ |U_i^bind|`. Reported `binding_energy` is the magnitude `|U_i^bind| ≥ 0`.
+//! * **Bound mass fraction** (Fig. 5: "fraction of target mass that remains bounded"): the mass of the
+//!   non-escaping target fragments over the target mass, projectile excluded from both. It is *not* the
+//!   largest remnant (reported separately as `largest_fragment_fraction`).
+//! * **f_KE** (§4.1, Fig. 2a): the total (translational + rotational) kinetic energy of the target fragments
+//!   at `t_at`, barycentric frame of the whole system, divided by the projectile's kinetic energy at `t = 0`
+//!   relative to the target, `½ m_p |v_p(0) − V_T(0)|²`. The paper's curve is the final fragment energy
+//!   itself, not its increase; the initial value (the target's own spin) is reported alongside.
+//! * **Spin correction** (§4.3): spins "should be roughly multiplied by `√(5/(2κ))`" to account for the
+//!   Gaussian (non-uniform) density of Eq. 4; for κ ≈ 10 this halves spin rates and doubles periods. So
+//!   `ω_corr = ω √(5/(2κ_I))` and `P_corr = P / √(5/(2κ_I))`, with `κ_I` the κ of the inertia model
+//!   ([`InertiaModel::inertia_kappa`]): for [`InertiaModel::Uniform`] `κ_I = 5/2` and the factor is 1.
+//! * **Tumbling** (§4.4, Eq. 46): `I_eff = |L_s|² / (2 K_R)` with `L_s = I ω`, `K_R = ½ ωᵀ I ω` (body frame,
+//!   principal moments of Eq. 4). With the sorted moments `I₁ ≤ I₂ ≤ I₃` the axis-rotation-mode measure is
+//!   the piecewise-linear map
+//!   `s = (I_eff − I₂)/(I₃ − I₂)` for `I_eff ≥ I₂` and `s = (I_eff − I₂)/(I₂ − I₁)` for `I_eff < I₂`,
+//!   clamped to `[−1, 1]`: `+1` pure short-axis rotation (about the axis of `I₃`), `−1` pure long-axis
+//!   rotation (axis of `I₁`), `0` rotation about the intermediate axis. SAM iff `I_eff > I₂`
+//!   (`I₂ < I_eff ≤ I₃`), LAM iff `I_eff < I₂` (`I₁ ≤ I_eff < I₂`), as in §4.4.
+
+use std::path::Path;
+
+use crate::ellipsoid::body::{Body, InertiaModel};
+use crate::impact::run::{ImpactError, read_target};
+use crate::math::Vec3;
+
+/// `|s|` below which the axis-rotation-mode measure counts as the intermediate-axis mode (round-off only).
+pub const MODE_TOLERANCE: f64 = 1e-9;
+
+/// Petit & Farinella (1993) coefficient in `v_esc² = 1.64 G M / R_eff` (Roig03 footnote 6).
+pub const ESCAPE_COEFFICIENT: f64 = 1.64;
+
+/// Axis rotation mode of a fragment (Roig03 §4.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RotationMode {
+    /// Short-axis mode: `I₂ < I_eff ≤ I₃`.
+    Sam,
+    /// Long-axis mode: `I₁ ≤ I_eff < I₂`.
+    Lam,
+    /// Rotation about the intermediate axis (`I_eff = I₂` within [`MODE_TOLERANCE`]), or a degenerate body.
+    Intermediate,
+    /// No spin: `I_eff` is undefined.
+    None,
+}
+
+/// Model parameters the analysis needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FragmentParams {
+    /// The model's κ (Roig03 Eq. 4/5).
+    pub kappa: f64,
+    /// Which moments of inertia the bodies had in the run.
+    pub inertia: InertiaModel,
+    /// Gravitational constant (SI).
+    pub g: f64,
+    /// Index of the projectile among the bodies.
+    pub projectile: usize,
+}
+
+/// Why the analysis could not be done.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FragmentError {
+    /// The two snapshots hold different numbers of bodies.
+    #[error("snapshots differ in size: {initial} bodies at t = 0, {at} at the analysis time")]
+    CountMismatch {
+        /// Bodies at `t = 0`.
+        initial: usize,
+        /// Bodies at `t_at`.
+        at: usize,
+    },
+    /// The projectile index is out of range, or it is the only body.
+    #[error("projectile index {index} invalid for {count} bodies (need at least one target fragment)")]
+    Projectile {
+        /// The index given.
+        index: usize,
+        /// Number of bodies.
+        count: usize,
+    },
+    /// κ or G is not finite and positive.
+    #[error("need finite kappa > 0 and G > 0 (got kappa = {kappa}, G = {g})")]
+    Parameters {
+        /// κ given.
+        kappa: f64,
+        /// G given.
+        g: f64,
+    },
+}
+
+/// Analysis of one body at the analysis time.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FragmentAnalysis {
+    /// Index of the body in the snapshots.
+    pub index: usize,
+    /// Whether this body is the projectile (excluded from target quantities).
+    pub is_projectile: bool,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Equivalent radius `(A B C)^{1/3}` (m).
+    pub equivalent_radius: f64,
+    /// Equivalent radius over the parent-body radius `R_eff` (module docs).
+    pub size: f64,
+    /// Ejection velocity `Δv` in the target's barycentric frame (m/s).
+    pub ejection_velocity: [f64; 3],
+    /// `|Δv|` (m/s).
+    pub ejection_speed: f64,
+    /// Translational kinetic energy in the system's barycentric frame at `t_at` (J).
+    pub kinetic_energy: f64,
+    /// Rotational kinetic energy `½ ωᵀ I ω` at `t_at` (J).
+    pub rotational_energy: f64,
+    /// Binding energy magnitude `|U_bind|` of Eq. 43 (J, ≥ 0).
+    pub binding_energy: f64,
+    /// Whether `kinetic_energy ≥ binding_energy` (Eq. 43).
+    pub escaping: bool,
+    /// Spin rate `|ω|` (rad/s).
+    pub spin_rate: f64,
+    /// Spin period `2π/|ω|` (h); `None` without spin.
+    pub spin_period_h: Option<f64>,
+    /// Spin rate times `√(5/(2κ_I))` (rad/s; §4.3).
+    pub spin_rate_corrected: f64,
+    /// Spin period divided by `√(5/(2κ_I))` (h); `None` without spin.
+    pub spin_period_corrected_h: Option<f64>,
+    /// Principal moments `(I_x, I_y, I_z)` of Eq. 4 with the inertia model's κ (kg m²).
+    pub moments: [f64; 3],
+    /// `I_eff` of Eq. 46 (kg m²); `None` without spin.
+    pub effective_inertia: Option<f64>,
+    /// Axis-rotation-mode measure in `[−1, 1]` (+1 pure SAM, −1 pure LAM, 0 intermediate); `None` without spin.
+    pub rotation_mode_measure: Option<f64>,
+    /// SAM / LAM classification.
+    pub rotation_mode: RotationMode,
+}
+
+/// Per-run aggregates.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FragmentSummary {
+    /// Number of target fragments (projectile excluded).
+    pub n_fragments: usize,
+    /// Target mass `M` (kg).
+    pub target_mass: f64,
+    /// Parent-body radius `R_eff` (m): sphere of the target's total volume.
+    pub target_radius: f64,
+    /// `v_esc = √(1.64 G M / R_eff)` (m/s; footnote 6).
+    pub escape_velocity: f64,
+    /// Projectile speed relative to the target barycentre at `t = 0` (m/s).
+    pub projectile_speed: f64,
+    /// Projectile kinetic energy relative to the target at `t = 0`, `½ m_p v_p²` (J).
+    pub projectile_kinetic_energy: f64,
+    /// Specific impact energy `Q = ½ m_p v_p² / M` (J/kg).
+    pub specific_energy: f64,
+    /// Kinetic energy of the target fragments at `t = 0` (translational + rotational, system frame) (J).
+    pub fragment_kinetic_initial: f64,
+    /// Translational kinetic energy of the target fragments at `t_at` (system frame) (J).
+    pub fragment_kinetic_translational: f64,
+    /// Rotational kinetic energy of the target fragments at `t_at` (J).
+    pub fragment_kinetic_rotational: f64,
+    /// `f_KE`: fragment kinetic energy at `t_at` over the projectile kinetic energy (§4.1).
+    pub f_ke: f64,
+    /// Rotational share of the fragment kinetic energy at `t_at` (0 when it is zero).
+    pub rotational_share: f64,
+    /// Mass fraction of the target in non-escaping fragments (Fig. 5).
+    pub bound_mass_fraction: f64,
+    /// Mass of the largest target fragment over the target mass.
+    pub largest_fragment_fraction: f64,
+    /// Number of escaping target fragments.
+    pub n_escaping: usize,
+    /// Median ejection speed of the target fragments (m/s).
+    pub ejection_speed_median: f64,
+    /// Mean ejection speed of the target fragments (m/s).
+    pub ejection_speed_mean: f64,
+    /// Median ejection speed over the projectile speed.
+    pub ejection_speed_median_relative: f64,
+    /// Mean ejection speed over the projectile speed.
+    pub ejection_speed_mean_relative: f64,
+    /// The spin correction factor `√(5/(2κ_I))` used (§4.3).
+    pub spin_correction: f64,
+}
+
+/// Per-body analyses and the run's aggregates.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FragmentReport {
+    /// One entry per body, in snapshot order (the projectile included, flagged).
+    pub fragments: Vec<FragmentAnalysis>,
+    /// Aggregates over the target fragments.
+    pub summary: FragmentSummary,
+}
+
+/// Reads a snapshot (or any bodies) CSV into bodies: [`read_target`], i.e. [`crate::io::csv::read_bodies_csv`]
+/// with values checked and quaternions normalised.
+pub fn read_snapshot_bodies(path: &Path) -> Result<Vec<Body>, ImpactError> {
+    read_target(path)
+}
+
+/// The §4.3 spin correction factor `√(5/(2κ_I))`, `κ_I = inertia.inertia_kappa(kappa)`: multiply spin rates
+/// by it (divide periods). 1 for [`InertiaModel::Uniform`] and for κ = 5/2.
+pub fn spin_correction(inertia: InertiaModel, kappa: f64) -> f64 {
+    (5.0 / (2.0 * inertia.inertia_kappa(kappa))).sqrt()
+}
+
+/// `v_esc = √(1.64 G M / R_eff)` (Roig03 footnote 6, after Petit & Farinella 1993).
+pub fn escape_velocity(g: f64, mass: f64, radius: f64) -> f64 {
+    (ESCAPE_COEFFICIENT * g * mass / radius).sqrt()
+}
+
+/// `I_eff = |I ω|² / (ωᵀ I ω)` (Eq. 46, `= |L_s|²/(2K_R)`) for principal `moments` and body-frame `omega`;
+/// `None` when `ωᵀ I ω = 0` (no spin).
+pub fn effective_inertia(moments: &Vec3, omega: &Vec3) -> Option<f64> {
+    let l = moments.component_mul(omega);
+    let two_k = omega.dot(&l);
+    (two_k > 0.0).then(|| l.norm_squared() / two_k)
+}
+
+/// The axis-rotation-mode measure (module docs): with `I₁ ≤ I₂ ≤ I₃` the sorted `moments`,
+/// `(I_eff − I₂)/(I₃ − I₂)` for `I_eff ≥ I₂`, `(I_eff − I₂)/(I₂ − I₁)` below, clamped to `[−1, 1]`
+/// (0 when the relevant gap vanishes).
+pub fn rotation_mode_measure(moments: &Vec3, i_eff: f64) -> f64 {
+    let mut m = [moments.x, moments.y, moments.z];
+    m.sort_by(f64::total_cmp);
+    let [i1, i2, i3] = m;
+    let d = i_eff - i2;
+    let gap = if d >= 0.0 { i3 - i2 } else { i2 - i1 };
+    if gap > 0.0 { (d / gap).clamp(-1.0, 1.0) } else { 0.0 }
+}
+
+/// Classifies a measure from [`rotation_mode_measure`] (`None`: no spin).
+pub fn rotation_mode(measure: Option<f64>) -> RotationMode {
+    match measure {
+        None => RotationMode::None,
+        Some(s) if s > MODE_TOLERANCE => RotationMode::Sam,
+        Some(s) if s < -MODE_TOLERANCE => RotationMode::Lam,
+        Some(_) => RotationMode::Intermediate,
+    }
+}
+
+/// Binding energy magnitudes `|U_i^bind| = Σ_{j≠i} G m_i m_j / |r_i − r_j|` (Eq. 43) for every body.
+pub fn binding_energies(g: f64, bodies: &[Body]) -> Vec<f64> {
+    let mut u = vec![0.0; bodies.len()];
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let e = g * bodies[i].shape.mass * bodies[j].shape.mass / (bodies[i].position - bodies[j].position).norm();
+            u[i] += e;
+            u[j] += e;
+        }
+    }
+    u
+}
+
+/// Mass-weighted mean velocity of the bodies for which `include(index)` holds.
+fn mean_velocity(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
+    let (mut p, mut m) = (Vec3::zeros(), 0.0);
+    for (_, b) in bodies.iter().enumerate().filter(|(i, _)| include(*i)) {
+        p += b.velocity * b.shape.mass;
+        m += b.shape.mass;
+    }
+    p / m
+}
+
+/// Ejection velocities `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]` of all bodies, `V_T` the target
+/// barycentre velocity (projectile excluded). Panics if the snapshots differ in length; NaN without a target body.
+pub fn ejection_velocities(initial: &[Body], at: &[Body], projectile: usize) -> Vec<Vec3> {
+    assert_eq!(initial.len(), at.len(), "snapshots differ in size");
+    let v0 = mean_velocity(initial, |i| i != projectile);
+    let v1 = mean_velocity(at, |i| i != projectile);
+    initial
+        .iter()
+        .zip(at)
+        .map(|(b0, b1)| (b1.velocity - v1) - (b0.velocity - v0))
+        .collect()
+}
+
+/// Median of `values` (mean of the two middle values for an even count; 0 when empty).
+fn median(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Analyses the bodies at `t_at` (`at`) against those at `t = 0` (`initial`): see the module docs for every
+/// definition.
+pub fn analyse_fragments(
+    initial: &[Body],
+    at: &[Body],
+    params: &FragmentParams,
+) -> Result<FragmentReport, FragmentError> {
+    if initial.len() != at.len() {
+        return Err(FragmentError::CountMismatch {
+            initial: initial.len(),
+            at: at.len(),
+        });
+    }
+    let n = at.len();
+    let p = params.projectile;
+    if p >= n || n < 2 {
+        return Err(FragmentError::Projectile { index: p, count: n });
+    }
+    if !(params.kappa.is_finite() && params.kappa > 0.0 && params.g.is_finite() && params.g > 0.0) {
+        return Err(FragmentError::Parameters {
+            kappa: params.kappa,
+            g: params.g,
+        });
+    }
+    let kappa_i = params.inertia.inertia_kappa(params.kappa);
+    let correction = spin_correction(params.inertia, params.kappa);
+    let is_target = |i: usize| i != p;
+
+    let target_mass: f64 = at
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| is_target(*i))
+        .map(|(_, b)| b.shape.mass)
+        .sum();
+    let target_volume: f64 = at
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| is_target(*i))
+        .map(|(_, b)| b.shape.volume())
+        .sum();
+    let target_radius = (3.0 * target_volume / (4.0 * std::f64::consts::PI)).cbrt();
+
+    let v_sys0 = mean_velocity(initial, |_| true);
+    let v_sys = mean_velocity(at, |_| true);
+    let v_target0 = mean_velocity(initial, is_target);
+    let dv = ejection_velocities(initial, at, p);
+    let binding = binding_energies(params.g, at);
+
+    let fragments: Vec<FragmentAnalysis> = at
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let moments = b.shape.principal_moments(kappa_i);
+            let omega = b.spin_body;
+            let spin_rate = omega.norm();
+            let period = |rate: f64| (rate > 0.0).then(|| 2.0 * std::f64::consts::PI / rate / 3600.0);
+            let kinetic_energy = 0.5 * b.shape.mass * (b.velocity - v_sys).norm_squared();
+            let i_eff = effective_inertia(&moments, &omega);
+            let measure = i_eff.map(|ie| rotation_mode_measure(&moments, ie));
+            FragmentAnalysis {
+                index: i,
+                is_projectile: i == p,
+                mass: b.shape.mass,
+                equivalent_radius: b.shape.equivalent_radius(),
+                size: b.shape.equivalent_radius() / target_radius,
+                ejection_velocity: dv[i].into(),
+                ejection_speed: dv[i].norm(),
+                kinetic_energy,
+                rotational_energy: 0.5 * omega.dot(&moments.component_mul(&omega)),
+                binding_energy: binding[i],
+                escaping: kinetic_energy >= binding[i],
+                spin_rate,
+                spin_period_h: period(spin_rate),
+                spin_rate_corrected: spin_rate * correction,
+                spin_period_corrected_h: period(spin_rate * correction),
+                moments: moments.into(),
+                effective_inertia: i_eff,
+                rotation_mode_measure: measure,
+                rotation_mode: rotation_mode(measure),
+            }
+        })
+        .collect();
+
+    let targets: Vec<&FragmentAnalysis> = fragments.iter().filter(|f| !f.is_projectile).collect();
+    let fragment_kinetic_initial: f64 = initial
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| is_target(*i))
+        .map(|(_, b)| {
+            let moments = b.shape.principal_moments(kappa_i);
+            0.5 * b.shape.mass * (b.velocity - v_sys0).norm_squared()
+                + 0.5 * b.spin_body.dot(&moments.component_mul(&b.spin_body))
+        })
+        .sum();
+    let fragment_kinetic_translational: f64 = targets.iter().map(|f| f.kinetic_energy).sum();
+    let fragment_kinetic_rotational: f64 = targets.iter().map(|f| f.rotational_energy).sum();
+    let fragment_kinetic = fragment_kinetic_translational + fragment_kinetic_rotational;
+    let projectile_speed = (initial[p].velocity - v_target0).norm();
+    let projectile_kinetic_energy = 0.5 * initial[p].shape.mass * projectile_speed.powi(2);
+    let bound_mass: f64 = targets.iter().filter(|f| !f.escaping).map(|f| f.mass).sum();
+    let largest = targets.iter().map(|f| f.mass).fold(0.0, f64::max);
+    let speeds: Vec<f64> = targets.iter().map(|f| f.ejection_speed).collect();
+    let ejection_speed_median = median(&speeds);
+    let ejection_speed_mean = speeds.iter().sum::<f64>() / speeds.len() as f64;
+
+    let summary = FragmentSummary {
+        n_fragments: targets.len(),
+        target_mass,
+        target_radius,
+        escape_velocity: escape_velocity(params.g, target_mass, target_radius),
+        projectile_speed,
+        projectile_kinetic_energy,
+        specific_energy: projectile_kinetic_energy / target_mass,
+        fragment_kinetic_initial,
+        fragment_kinetic_translational,
+        fragment_kinetic_rotational,
+        f_ke: fragment_kinetic / projectile_kinetic_energy,
+        rotational_share: if fragment_kinetic > 0.0 {
+            fragment_kinetic_rotational / fragment_kinetic
+        } else {
+            0.0
+        },
+        bound_mass_fraction: bound_mass / target_mass,
+        largest_fragment_fraction: largest / target_mass,
+        n_escaping: targets.iter().filter(|f| f.escaping).count(),
+        ejection_speed_median,
+        ejection_speed_mean,
+        ejection_speed_median_relative: ejection_speed_median / projectile_speed,
+        ejection_speed_mean_relative: ejection_speed_mean / projectile_speed,
+        spin_correction: correction,
+    };
+    Ok(FragmentReport { fragments, summary })
+}
