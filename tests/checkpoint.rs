@@ -3,9 +3,10 @@
 //! errors); checkpoints are written atomically; bad or missing checkpoints and completed runs give
 //! one-line errors; integrator states restore exactly.
 
+mod common;
+use common::{rubblepile, temp_dir};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::process::Output;
 
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
@@ -84,27 +85,6 @@ fn scene(method: &str, bodies_file: bool) -> String {
     } else {
         s.replace("{BODIES_FILE}", "").replace("{BODIES}", BODY_TABLES)
     }
-}
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let dir = std::env::temp_dir().join(format!("rubblepile-ckpt-{tag}-{}-{n}-{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn rubblepile(cwd: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-        .args(args)
-        .current_dir(cwd)
-        .output()
-        .expect("run the binary")
 }
 
 fn describe(out: &Output) -> String {

@@ -1,10 +1,11 @@
 //! The `rubblepile` binary end to end: output directory handling, output file contract,
 //! determinism, bodies files and lossless snapshots. Small scenes so the suite stays quick in debug.
 
+mod common;
+use common::{rubblepile, temp_dir};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::process::Output;
 
 use rubblepile::io::csv::{SNAPSHOT_COLUMNS, TIMESERIES_COLUMNS, read_bodies_csv};
 use rubblepile::scene::load_scene;
@@ -53,27 +54,6 @@ const BODIES_CSV: &str = "t,id,mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz
 0,0,30000,3,2,1.5,0,0,0,0.05,0,0,0,0,0,1,0.01,0.02,0.05
 0,1,12000,2,1.5,1,5.5,0.5,0,-0.1,0,0,0,0,0.6,0.8,0,-0.03,0.01
 ";
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let dir = std::env::temp_dir().join(format!("rubblepile-cli-{tag}-{}-{n}-{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn rubblepile(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run the binary")
-}
 
 fn assert_ok(out: &Output, what: &str) {
     let stderr = String::from_utf8_lossy(&out.stderr);

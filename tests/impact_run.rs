@@ -1,16 +1,12 @@
 //! Impact runs end to end, and the committed Roig03 targets against Table 1.
 
+mod common;
+use common::{rubblepile, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("rubblepile-impact-{tag}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    d
 }
 
 fn json(path: &Path) -> serde_json::Value {
@@ -136,34 +132,35 @@ fn committed_targets_reproduce_table1() {
 #[test]
 fn target_build_is_deterministic() {
     let dir = temp_dir("build");
+    let command = |name: &str, seed: &str| {
+        let mut args = vec![
+            "target",
+            "build",
+            "--fragments",
+            "6",
+            "--r-largest-km",
+            "3",
+            "--r-smallest-km",
+            "1.5",
+        ];
+        args.extend([
+            "--total-mass",
+            "8.1e14",
+            "--f0",
+            "0.3",
+            "--period-hours",
+            "8",
+            "--seed",
+            seed,
+            "--out",
+            name,
+        ]);
+        rubblepile(&dir, &args)
+    };
     let build = |name: &str, seed: &str| {
-        let out = dir.join(name);
-        let o = Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-            .args([
-                "target",
-                "build",
-                "--fragments",
-                "6",
-                "--r-largest-km",
-                "3",
-                "--r-smallest-km",
-                "1.5",
-            ])
-            .args([
-                "--total-mass",
-                "8.1e14",
-                "--f0",
-                "0.3",
-                "--period-hours",
-                "8",
-                "--seed",
-                seed,
-                "--out",
-            ])
-            .arg(&out)
-            .output()
-            .unwrap();
+        let o = command(name, seed);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let out = dir.join(name);
         (
             std::fs::read(&out).unwrap(),
             std::fs::read(out.with_extension("json")).unwrap(),
@@ -175,31 +172,6 @@ fn target_build_is_deterministic() {
     let c = build("c.csv", "6");
     assert_ne!(a.0, c.0, "the seed changes nothing");
     // refuses to overwrite without --force
-    let again = Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-        .args([
-            "target",
-            "build",
-            "--fragments",
-            "6",
-            "--r-largest-km",
-            "3",
-            "--r-smallest-km",
-            "1.5",
-        ])
-        .args([
-            "--total-mass",
-            "8.1e14",
-            "--f0",
-            "0.3",
-            "--period-hours",
-            "8",
-            "--seed",
-            "5",
-            "--out",
-        ])
-        .arg(dir.join("a.csv"))
-        .output()
-        .unwrap();
-    assert_eq!(again.status.code(), Some(2));
+    assert_eq!(command("a.csv", "5").status.code(), Some(2));
     let _ = std::fs::remove_dir_all(&dir);
 }

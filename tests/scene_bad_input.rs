@@ -2,9 +2,10 @@
 //! (`parse_scene`) and from the binary (`rubblepile run bad.toml --out DIR`: exit code 2, one line on
 //! stderr, no output directory created).
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::temp_dir;
+use std::path::Path;
 use std::process::Command;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rubblepile::scene::{SceneError, parse_scene};
 
@@ -416,19 +417,6 @@ fn bad_input_from_strings() {
         check_message(case, &err.to_string(), expected);
     }
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-static COUNTER: AtomicUsize = AtomicUsize::new(0);
-
-fn temp_dir(tag: &str) -> PathBuf {
-    let n = COUNTER.fetch_add(1, Ordering::SeqCst);
-    let nanos = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .subsec_nanos();
-    let dir = std::env::temp_dir().join(format!("rubblepile-bad-{tag}-{}-{n}-{nanos}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
 }
 
 fn run_binary(scene: &Path, out: &Path) -> std::process::Output {

@@ -120,3 +120,26 @@ pub fn integrate(
     }
     (y, e, integ.stats())
 }
+
+static TEMP_COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// A fresh, empty directory under the system temp dir, unique per process, call and time.
+pub fn temp_dir(tag: &str) -> std::path::PathBuf {
+    let n = TEMP_COUNTER.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .subsec_nanos();
+    let dir = std::env::temp_dir().join(format!("rubblepile-test-{tag}-{}-{n}-{nanos}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Runs the `rubblepile` binary with `args` in `cwd`.
+pub fn rubblepile(cwd: &std::path::Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run the binary")
+}
