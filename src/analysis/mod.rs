@@ -3,3 +3,4 @@
 pub mod fits;
 pub mod fragments;
 pub mod rigid_rotation;
+pub mod run_analysis;

@@ -11,6 +11,7 @@
 //! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
 //! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
+//! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
 //!
@@ -18,6 +19,7 @@
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
 //! the hidden testing flag `--stop-after-checkpoints N` stopped a run after its N-th checkpoint.
 
+pub mod analyze;
 pub mod bench;
 pub mod campaign;
 pub mod impact;
@@ -56,6 +58,8 @@ pub enum Command {
     Impact(Box<impact::ImpactArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(campaign::CampaignArgs),
+    /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis.
+    Analyze(analyze::AnalyzeArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -217,6 +221,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
         Command::Campaign(args) => campaign::campaign(&args),
+        Command::Analyze(args) => analyze::analyze(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
     }
 }

@@ -1,0 +1,266 @@
+//! Analysis of one impact run directory (Roig03 §4): per-fragment table and per-run results.
+//!
+//! Reads `summary.json` (κ), `scene.toml` (inertia model, G), `impact.json` (projectile) and the snapshots at
+//! t = 0 and at `t_at` (default 400 s, "a few minutes after the impact"); writes `analysis/fragments.csv` and
+//! `analysis/analysis.json` inside the run directory. Fits that cannot be made (too few fragments, say) are
+//! recorded with their reason instead of stopping the analysis.
+
+use std::path::{Path, PathBuf};
+
+use crate::analysis::fits::{ExponentComparison, PowerLawFit, compare_exponents, fit_power_law, histogram};
+use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
+use crate::ellipsoid::equations::G_SI;
+
+/// Why a run could not be analysed. One line, naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalysisError {
+    /// A file is missing or unreadable.
+    #[error("{path}: {reason}")]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
+    /// No snapshot at the requested time.
+    #[error("{dir}: no snapshot at t = {t} s (snapshots at {available:?} s)")]
+    NoSnapshot {
+        /// The run directory.
+        dir: PathBuf,
+        /// Requested time (s).
+        t: f64,
+        /// Snapshot times found (s).
+        available: Vec<f64>,
+    },
+    /// The analysis output exists already.
+    #[error("{0}: exists; use --force to overwrite it")]
+    Exists(PathBuf),
+    /// The fragment analysis refused its input.
+    #[error("{0}")]
+    Fragments(String),
+}
+
+/// A fit, or why it could not be made.
+#[derive(Debug, Clone, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Fit<T> {
+    /// The fit.
+    Ok(T),
+    /// Why not.
+    Failed(String),
+}
+
+impl<T> Fit<T> {
+    fn from<E: std::fmt::Display>(r: Result<T, E>) -> Self {
+        match r {
+            Ok(v) => Fit::Ok(v),
+            Err(e) => Fit::Failed(e.to_string()),
+        }
+    }
+}
+
+/// Per-run results (`analysis.json`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RunAnalysis {
+    /// Time of the analysed snapshot (s).
+    pub t_at: f64,
+    /// κ of the run.
+    pub kappa: f64,
+    /// Energy partition, bound mass, v_esc, ejection statistics (see [`crate::analysis::fragments`]).
+    pub summary: crate::analysis::fragments::FragmentSummary,
+    /// Ejection speed vs normalised size, `|Δv| = c s^α` over target fragments (Fig. 4).
+    pub ejection_speed_vs_size: Fit<PowerLawFit>,
+    /// Corrected spin rate vs normalised size, `ω = c s^α` over spinning target fragments (Fig. 8).
+    pub spin_vs_size: Fit<PowerLawFit>,
+    /// Histogram of corrected spin rates (rad/s) of the target fragments: bin centres and counts (Fig. 6).
+    pub spin_histogram: (Vec<f64>, Vec<f64>),
+    /// Fits of `a xⁿ exp(−x²/b²)` to that histogram for n ∈ {0.5, 1, 1.5, 2} and free n (Eqs. 44–45).
+    pub spin_fits: Fit<ExponentComparison>,
+}
+
+fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
+    let err = |reason: String| AnalysisError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
+    serde_json::from_str(&text).map_err(|e| err(e.to_string()))
+}
+
+/// Snapshot times of a run directory, from the first line of each `snapshots/<k>.csv`.
+fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
+    let snaps = dir.join("snapshots");
+    let entries = std::fs::read_dir(&snaps).map_err(|e| AnalysisError::Read {
+        path: snaps.clone(),
+        reason: e.to_string(),
+    })?;
+    let mut out = Vec::new();
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.extension().is_none_or(|e| e != "csv") {
+            continue;
+        }
+        let mut rdr = csv::Reader::from_path(&path).map_err(|e| AnalysisError::Read {
+            path: path.clone(),
+            reason: e.to_string(),
+        })?;
+        if let Some(Ok(rec)) = rdr.records().next()
+            && let Some(t) = rec.get(0).and_then(|s| s.parse::<f64>().ok())
+        {
+            out.push((t, path));
+        }
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out)
+}
+
+/// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
+/// (or `force`). Returns the per-run results and the per-fragment report.
+pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
+    let out_dir = dir.join("analysis");
+    let (json_path, csv_path) = (out_dir.join("analysis.json"), out_dir.join("fragments.csv"));
+    if !force && (json_path.exists() || csv_path.exists()) {
+        return Err(AnalysisError::Exists(out_dir));
+    }
+    let summary = read_json(&dir.join("summary.json"))?;
+    let kappa = summary["kappa"].as_f64().ok_or_else(|| AnalysisError::Read {
+        path: dir.join("summary.json"),
+        reason: "no numeric `kappa`".into(),
+    })?;
+    let impact = read_json(&dir.join("impact.json"))?;
+    let projectile = impact["projectile_index"].as_u64().ok_or_else(|| AnalysisError::Read {
+        path: dir.join("impact.json"),
+        reason: "no `projectile_index`".into(),
+    })? as usize;
+    let scene_path = dir.join("scene.toml");
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| AnalysisError::Read {
+        path: scene_path.clone(),
+        reason: e.to_string(),
+    })?;
+    let scene =
+        crate::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| AnalysisError::Read {
+            path: scene_path.clone(),
+            reason: e.to_string(),
+        })?;
+    let g = scene.physics.gravity.and_then(|g| g.g).unwrap_or(G_SI);
+    let times = snapshot_times(dir)?;
+    let find = |t: f64| {
+        times
+            .iter()
+            .find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+            .map(|(_, p)| p.clone())
+    };
+    let missing = |t: f64| AnalysisError::NoSnapshot {
+        dir: dir.to_path_buf(),
+        t,
+        available: times.iter().map(|x| x.0).collect(),
+    };
+    let (p0, pat) = (
+        find(0.0).ok_or_else(|| missing(0.0))?,
+        find(t_at).ok_or_else(|| missing(t_at))?,
+    );
+    let read = |p: &Path| {
+        read_snapshot_bodies(p).map_err(|e| AnalysisError::Read {
+            path: p.to_path_buf(),
+            reason: e.to_string(),
+        })
+    };
+    let (initial, at) = (read(&p0)?, read(&pat)?);
+    let params = FragmentParams {
+        kappa,
+        inertia: scene.model.inertia,
+        g,
+        projectile,
+    };
+    let report = analyse_fragments(&initial, &at, &params).map_err(|e| AnalysisError::Fragments(e.to_string()))?;
+    let target: Vec<_> = report.fragments.iter().filter(|f| !f.is_projectile).collect();
+    let sizes: Vec<f64> = target.iter().map(|f| f.size).collect();
+    let speeds: Vec<f64> = target.iter().map(|f| f.ejection_speed).collect();
+    let spins: Vec<f64> = target.iter().map(|f| f.spin_rate_corrected).collect();
+    let bins = ((target.len() as f64).sqrt().round() as usize).clamp(5, 40);
+    let spin_histogram = histogram(&spins, bins, None).unwrap_or_default();
+    let analysis = RunAnalysis {
+        t_at,
+        kappa,
+        summary: report.summary.clone(),
+        ejection_speed_vs_size: Fit::from(fit_power_law(&sizes, &speeds)),
+        spin_vs_size: Fit::from(fit_power_law(&sizes, &spins)),
+        spin_fits: Fit::from(compare_exponents(
+            &spin_histogram.0,
+            &spin_histogram.1,
+            &[0.5, 1.0, 1.5, 2.0],
+        )),
+        spin_histogram,
+    };
+    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
+        path: out_dir.clone(),
+        reason: e.to_string(),
+    })?;
+    write_fragments_csv(&csv_path, &report)?;
+    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
+    std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
+        path: json_path.clone(),
+        reason: e.to_string(),
+    })?;
+    Ok((analysis, report))
+}
+
+/// `fragments.csv`: one row per body.
+fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), AnalysisError> {
+    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
+    let mut w = csv::Writer::from_path(path).map_err(|e| err(&e))?;
+    w.write_record([
+        "index",
+        "is_projectile",
+        "mass",
+        "equivalent_radius",
+        "size",
+        "dvx",
+        "dvy",
+        "dvz",
+        "ejection_speed",
+        "kinetic_energy",
+        "rotational_energy",
+        "binding_energy",
+        "escaping",
+        "spin_rate",
+        "spin_rate_corrected",
+        "effective_inertia",
+        "rotation_mode_measure",
+        "rotation_mode",
+    ])
+    .map_err(|e| err(&e))?;
+    let num = |x: f64| format!("{x:e}");
+    let opt = |x: Option<f64>| x.map_or_else(String::new, num);
+    for f in &report.fragments {
+        let mode = serde_json::to_value(f.rotation_mode)
+            .ok()
+            .and_then(|v| v.as_str().map(str::to_string))
+            .unwrap_or_default();
+        w.write_record([
+            f.index.to_string(),
+            f.is_projectile.to_string(),
+            num(f.mass),
+            num(f.equivalent_radius),
+            num(f.size),
+            num(f.ejection_velocity[0]),
+            num(f.ejection_velocity[1]),
+            num(f.ejection_velocity[2]),
+            num(f.ejection_speed),
+            num(f.kinetic_energy),
+            num(f.rotational_energy),
+            num(f.binding_energy),
+            f.escaping.to_string(),
+            num(f.spin_rate),
+            num(f.spin_rate_corrected),
+            opt(f.effective_inertia),
+            opt(f.rotation_mode_measure),
+            mode,
+        ])
+        .map_err(|e| err(&e))?;
+    }
+    w.flush().map_err(|e| err(&e))
+}

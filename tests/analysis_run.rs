@@ -1,0 +1,89 @@
+//! `rubblepile analyze` on a committed small run (N30_T4 + P1, ζ = 45°, to 200 s) reproduces its golden
+//! `analysis.json`; bad requests give one-line errors.
+
+mod common;
+use common::{rubblepile, temp_dir};
+use std::path::Path;
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_dir(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
+
+/// Every number equal to 1e-9 relative (and every string, bool and key identical).
+fn assert_json_close(a: &serde_json::Value, b: &serde_json::Value, path: &str) {
+    use serde_json::Value;
+    match (a, b) {
+        (Value::Number(x), Value::Number(y)) => {
+            let (x, y) = (x.as_f64().unwrap(), y.as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 1e-9 * x.abs().max(y.abs()),
+                "{path}: {x} vs golden {y}"
+            );
+        }
+        (Value::Array(x), Value::Array(y)) => {
+            assert_eq!(x.len(), y.len(), "{path}: lengths differ");
+            for (k, (u, v)) in x.iter().zip(y).enumerate() {
+                assert_json_close(u, v, &format!("{path}[{k}]"));
+            }
+        }
+        (Value::Object(x), Value::Object(y)) => {
+            let (kx, ky): (Vec<_>, Vec<_>) = (x.keys().collect(), y.keys().collect());
+            assert_eq!(kx, ky, "{path}: keys differ");
+            for (k, v) in x {
+                assert_json_close(v, &y[k], &format!("{path}.{k}"));
+            }
+        }
+        _ => assert_eq!(a, b, "{path}"),
+    }
+}
+
+#[test]
+fn analyze_reproduces_the_golden_analysis() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/n30_p1_z45");
+    let dir = temp_dir("analyze").join("run");
+    copy_dir(&golden_dir, &dir);
+    std::fs::remove_file(dir.join("golden_analysis.json")).unwrap();
+    let out = rubblepile(&dir, &["analyze", ".", "--at", "200"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
+    let ours = read(&dir.join("analysis/analysis.json"));
+    let golden = read(&golden_dir.join("golden_analysis.json"));
+    assert_json_close(&ours, &golden, "analysis");
+    // the run hit: the projectile was stopped and its energy mostly dissipated
+    let f_ke = ours["summary"]["f_ke"].as_f64().unwrap();
+    assert!(f_ke > 0.0 && f_ke < 0.2, "f_KE {f_ke}");
+    let rows = std::fs::read_to_string(dir.join("analysis/fragments.csv"))
+        .unwrap()
+        .lines()
+        .count();
+    assert_eq!(rows, 1 + 31, "header + 30 fragments + projectile");
+    // a second analysis refuses to overwrite, --force allows it
+    assert_eq!(
+        rubblepile(&dir, &["analyze", ".", "--at", "200"]).status.code(),
+        Some(2)
+    );
+    assert!(
+        rubblepile(&dir, &["analyze", ".", "--at", "200", "--force"])
+            .status
+            .success()
+    );
+    // no snapshot at the requested time: one line naming the available times
+    let bad = rubblepile(&dir, &["analyze", ".", "--at", "400", "--force"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("no snapshot at t = 400") && err.contains("[0.0, 200.0]"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
+}
