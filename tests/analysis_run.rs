@@ -87,3 +87,56 @@ fn analyze_reproduces_the_golden_analysis() {
     );
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
+
+/// A two-run campaign (P1 and P3 on N30_T4) analysed as a whole: one row per run with its Q, and a
+/// bound-fraction line through two Q values gives a Q*_D (or says why not) without failing.
+#[test]
+fn analyze_campaign_collects_runs_and_fits_q_star() {
+    let dir = temp_dir("campaign");
+    let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let campaign = format!(
+        "[campaign]\nout = \"c\"\ntargets = [{:?}]\nprojectiles = [\"P1\", \"P3\"]\nangles = [90.0]\nparallel = 2\n\n\
+         [impact]\nt_end = 110.0\nrtol = 1e-8\nf0 = 1e-6\n",
+        target.display().to_string()
+    );
+    std::fs::write(dir.join("c.toml"), campaign).unwrap();
+    let run = rubblepile(&dir, &["campaign", "c.toml", "--no-progress"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out = rubblepile(&dir, &["analyze-campaign", "c", "--at", "110"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let a: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("c/analysis/campaign_analysis.json")).unwrap()).unwrap();
+    let runs = a["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    let mut q: Vec<f64> = runs.iter().map(|r| r["q_erg_per_g"].as_f64().unwrap()).collect();
+    q.sort_by(f64::total_cmp);
+    assert!(
+        (q[0] / 0.44e9 - 1.0).abs() < 0.02 && (q[1] / 3.54e9 - 1.0).abs() < 0.02,
+        "Q = {q:?}"
+    );
+    for r in runs {
+        let b = r["bound_mass_fraction"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&b));
+    }
+    assert!(a["q_star_d"].get("ok").is_some() || a["q_star_d"].get("failed").is_some());
+    assert!(
+        a["bound_fraction_vs_q"].get("ok").is_some(),
+        "two Q values determine a line: {}",
+        a["bound_fraction_vs_q"]
+    );
+    // each run got its own analysis
+    assert!(
+        dir.join("c")
+            .join(runs[0]["run"].as_str().unwrap())
+            .join("analysis/analysis.json")
+            .is_file()
+    );
+    // not again without --force
+    assert_eq!(
+        rubblepile(&dir, &["analyze-campaign", "c", "--at", "110"])
+            .status
+            .code(),
+        Some(2)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

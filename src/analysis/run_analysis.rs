@@ -264,3 +264,134 @@ fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), Analy
     }
     w.flush().map_err(|e| err(&e))
 }
+
+/// One analysed run of a campaign (a row of `campaign_runs.csv`).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CampaignRun {
+    /// Run name (directory under the campaign directory).
+    pub run: String,
+    /// Target file stem.
+    pub target: String,
+    /// Projectile id.
+    pub projectile: String,
+    /// ζ (degrees).
+    pub angle_deg: f64,
+    /// Specific impact energy Q (erg/g).
+    pub q_erg_per_g: f64,
+    /// Fraction of the target mass that stays bound (Fig. 5).
+    pub bound_mass_fraction: f64,
+    /// Post-impact fragment kinetic energy over the projectile's.
+    pub f_ke: f64,
+    /// Rotational share of that energy.
+    pub rotational_share: f64,
+    /// Median ejection speed over the projectile speed.
+    pub ejection_speed_median_relative: f64,
+}
+
+/// Per-campaign results (`analysis/campaign_analysis.json` in the campaign directory).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct CampaignAnalysis {
+    /// Time of the analysed snapshots (s).
+    pub t_at: f64,
+    /// The analysed (completed) runs.
+    pub runs: Vec<CampaignRun>,
+    /// Runs listed in `campaign.csv` but not completed, skipped.
+    pub skipped: Vec<String>,
+    /// Bound mass fraction against Q (erg/g), least squares (Fig. 5).
+    pub bound_fraction_vs_q: Fit<crate::analysis::fits::LineFit>,
+    /// Q*_D: the Q at which that line gives a bound fraction of 0.5 (erg/g), with its propagated error.
+    pub q_star_d: Fit<crate::analysis::fits::LineCrossing>,
+}
+
+/// Analyses every completed run listed in `CAMPAIGN_DIR/campaign.csv` at `t_at` (each run's own
+/// `analysis/` is written or, with `force`, rewritten) and writes `CAMPAIGN_DIR/analysis/campaign_analysis.json`
+/// and `campaign_runs.csv`.
+pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAnalysis, AnalysisError> {
+    let out_dir = dir.join("analysis");
+    let json_path = out_dir.join("campaign_analysis.json");
+    if !force && json_path.exists() {
+        return Err(AnalysisError::Exists(out_dir));
+    }
+    let index = dir.join("campaign.csv");
+    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
+        path: index.clone(),
+        reason: e.to_string(),
+    };
+    let mut rdr = csv::Reader::from_path(&index).map_err(|e| err(&e))?;
+    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
+    let col = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| err(&format!("no `{name}` column")))
+    };
+    let (c_run, c_target, c_proj, c_angle, c_q, c_status) = (
+        col("run")?,
+        col("target")?,
+        col("projectile")?,
+        col("angle_deg")?,
+        col("q_erg_per_g")?,
+        col("status")?,
+    );
+    let mut runs = Vec::new();
+    let mut skipped = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| err(&e))?;
+        let run = rec[c_run].to_string();
+        if &rec[c_status] != "completed" {
+            skipped.push(run);
+            continue;
+        }
+        let run_dir = dir.join(&run);
+        let (a, _) = match analyze_run(&run_dir, t_at, force) {
+            Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
+            other => other?,
+        };
+        let num = |c: usize| rec[c].parse::<f64>().map_err(|e| err(&format!("{run}: {e}")));
+        runs.push(CampaignRun {
+            target: rec[c_target].to_string(),
+            projectile: rec[c_proj].to_string(),
+            angle_deg: num(c_angle)?,
+            q_erg_per_g: num(c_q)?,
+            bound_mass_fraction: a.summary.bound_mass_fraction,
+            f_ke: a.summary.f_ke,
+            rotational_share: a.summary.rotational_share,
+            ejection_speed_median_relative: a.summary.ejection_speed_median_relative,
+            run,
+        });
+    }
+    let q: Vec<f64> = runs.iter().map(|r| r.q_erg_per_g).collect();
+    let bound: Vec<f64> = runs.iter().map(|r| r.bound_mass_fraction).collect();
+    let line = crate::analysis::fits::fit_line(&q, &bound);
+    let q_star_d = match &line {
+        Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
+        Err(e) => Fit::Failed(e.to_string()),
+    };
+    let analysis = CampaignAnalysis {
+        t_at,
+        runs,
+        skipped,
+        bound_fraction_vs_q: Fit::from(line),
+        q_star_d,
+    };
+    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
+        path: out_dir.clone(),
+        reason: e.to_string(),
+    })?;
+    let csv_path = out_dir.join("campaign_runs.csv");
+    let werr = |e: &dyn std::fmt::Display| AnalysisError::Read {
+        path: csv_path.clone(),
+        reason: e.to_string(),
+    };
+    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| werr(&e))?;
+    for r in &analysis.runs {
+        w.serialize(r).map_err(|e| werr(&e))?;
+    }
+    w.flush().map_err(|e| werr(&e))?;
+    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
+    std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
+        path: json_path.clone(),
+        reason: e.to_string(),
+    })?;
+    Ok(analysis)
+}

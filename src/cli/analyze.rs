@@ -55,3 +55,40 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     );
     Ok(())
 }
+
+/// `rubblepile analyze-campaign`.
+#[derive(Debug, clap::Args)]
+pub struct AnalyzeCampaignArgs {
+    /// A campaign directory (holding campaign.csv).
+    pub dir: PathBuf,
+    /// Time of the post-impact snapshots to analyse (s).
+    #[arg(long, default_value_t = 400.0)]
+    pub at: f64,
+    /// Rewrite earlier analyses.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `analyze-campaign`.
+pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
+    if !(args.at.is_finite() && args.at > 0.0) {
+        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+    }
+    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force).map_err(|e| match e {
+        AnalysisError::Fragments(_) => CliError::failed(e),
+        _ => CliError::usage(e),
+    })?;
+    let q_star = match &a.q_star_d {
+        Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
+        Fit::Failed(why) => format!("n/a ({why})"),
+    };
+    println!(
+        "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {}",
+        a.t_at,
+        a.runs.len(),
+        a.skipped.len(),
+        q_star,
+        args.dir.join("analysis").display()
+    );
+    Ok(())
+}

@@ -12,6 +12,7 @@
 //! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
+//! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
 //!
@@ -60,6 +61,8 @@ pub enum Command {
     Campaign(campaign::CampaignArgs),
     /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis.
     Analyze(analyze::AnalyzeArgs),
+    /// Analyse every completed run of a campaign; bound fraction vs Q and Q*_D (Roig03 Fig. 5).
+    AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -222,6 +225,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Impact(args) => impact::impact(&args),
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
+        Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
     }
 }
