@@ -66,6 +66,18 @@ fn analyze_reproduces_the_golden_analysis() {
         .lines()
         .count();
     assert_eq!(rows, 1 + 31, "header + 30 fragments + projectile");
+    // the figures, with their axes labelled in units
+    for (file, label) in [
+        ("ejection_vs_size.svg", "ejection speed |Δv| (m/s)"),
+        ("spin_vs_size.svg", "spin rate ω, corrected (rad/s)"),
+        ("spin_histogram.svg", "spin rate ω (rad/s)"),
+    ] {
+        let svg = std::fs::read_to_string(dir.join("analysis").join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert!(
+            svg.contains("<svg") && svg.contains(label),
+            "{file} lacks its axis label {label:?}"
+        );
+    }
     // a second analysis refuses to overwrite, --force allows it
     assert_eq!(
         rubblepile(&dir, &["analyze", ".", "--at", "200"]).status.code(),

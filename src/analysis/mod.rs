@@ -1,5 +1,6 @@
 //! Post-processing of states and runs.
 
+pub mod figures;
 pub mod fits;
 pub mod fragments;
 pub mod rigid_rotation;

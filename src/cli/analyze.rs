@@ -23,10 +23,14 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
     }
-    let (a, _) = analyze_run(&args.dir, args.at, args.force).map_err(|e| match e {
+    let (a, report) = analyze_run(&args.dir, args.at, args.force).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
+    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir.join("analysis"), &a, &report);
+    for why in &not_drawn {
+        eprintln!("warning: figure not drawn: {why}");
+    }
     let s = &a.summary;
     let alpha = |f: &Fit<crate::analysis::fits::PowerLawFit>| match f {
         Fit::Ok(p) => format!("{:.2} ± {:.2}", p.alpha, p.sigma_alpha),
@@ -39,7 +43,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     println!(
         "analysis at t = {} s: f_KE {:.3} %, rotational share {:.1} %, bound mass fraction {:.3}, {} escaping, \
          median ejection {:.3} m/s ({:.4} % of v_p), v_esc {:.1} m/s; ejection-size exponent {}, spin-size exponent {}, \
-         best spin-histogram n {}; wrote {}",
+         best spin-histogram n {}; wrote {} (fragments.csv, analysis.json, {})",
         a.t_at,
         100.0 * s.f_ke,
         100.0 * s.rotational_share,
@@ -51,7 +55,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         alpha(&a.ejection_speed_vs_size),
         alpha(&a.spin_vs_size),
         best_n,
-        args.dir.join("analysis").display()
+        args.dir.join("analysis").display(),
+        figures.join(", ")
     );
     Ok(())
 }
