@@ -120,6 +120,8 @@ struct Kinematics {
     u: Vec3,
     p: Vec4,
     q_dot: Vec4,
+    /// `M(q)⁻¹` (zero when attitudes are not integrated).
+    m_inv: Mat4,
     spin_body: Vec3,
     spin_world: Vec3,
     geometry: Option<BodyGeometry>,
@@ -238,7 +240,8 @@ impl EllipsoidSystem {
             let q = Vec4::new(s[3], s[4], s[5], s[6]);
             let u = Vec3::new(s[7], s[8], s[9]);
             let p = Vec4::new(s[10], s[11], s[12], s[13]);
-            let q_dot = inverse_mass_matrix(&q, &self.inertia_ext[i]) * p;
+            let m_inv = inverse_mass_matrix(&q, &self.inertia_ext[i]);
+            let q_dot = m_inv * p;
             let wq = w_matrix(&q) * q_dot;
             let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
             let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
@@ -249,6 +252,7 @@ impl EllipsoidSystem {
                 u,
                 p,
                 q_dot,
+                m_inv,
                 spin_body,
                 spin_world: rot.transpose() * spin_body,
                 geometry,
@@ -263,6 +267,7 @@ impl EllipsoidSystem {
                 u: Vec3::new(s[3], s[4], s[5]),
                 p: Vec4::zeros(),
                 q_dot: Vec4::zeros(),
+                m_inv: Mat4::zeros(),
                 spin_body: b.spin_body,
                 spin_world,
                 // Spheres: Σ = R² 1 whatever the attitude.
@@ -529,7 +534,7 @@ impl OdeSystem for EllipsoidSystem {
             out[0..3].copy_from_slice(v.as_slice());
             if rotation {
                 let ie = &self.inertia_ext[i];
-                let m_inv = inverse_mass_matrix(&k.q, ie);
+                let m_inv = k.m_inv;
                 let g = rotational_kinetic_gradient(&k.q, &k.q_dot, ie) + gq[i];
                 let c = constraint_rhs(&k.q, &k.q_dot, &m_inv, ie);
                 let p_dot = constrained_momentum_rate(&k.q, &g, &m_inv, c);
