@@ -72,6 +72,12 @@ pub struct AnalyzeCampaignArgs {
     /// Rewrite earlier analyses.
     #[arg(long)]
     pub force: bool,
+    /// Spin distributions (Roig03 Fig. 7): pool the runs on this target (file stem) ...
+    #[arg(long, default_value = "N200_T12")]
+    pub spin_target: String,
+    /// ... at this impact angle ζ (degrees); a projectile without such a run pools all its runs.
+    #[arg(long, default_value_t = 45.0)]
+    pub spin_angle: f64,
 }
 
 /// Runs `analyze-campaign`.
@@ -79,10 +85,16 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
     }
-    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force).map_err(|e| match e {
-        AnalysisError::Fragments(_) => CliError::failed(e),
-        _ => CliError::usage(e),
-    })?;
+    let selection = crate::analysis::run_analysis::SpinSelection {
+        target: args.spin_target.clone(),
+        angle_deg: args.spin_angle,
+    };
+    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection).map_err(
+        |e| match e {
+            AnalysisError::Fragments(_) => CliError::failed(e),
+            _ => CliError::usage(e),
+        },
+    )?;
     let q_star = match &a.q_star_d {
         Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
         Fit::Failed(why) => format!("n/a ({why})"),
