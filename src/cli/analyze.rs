@@ -109,3 +109,81 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     );
     Ok(())
 }
+
+/// `rubblepile report-roig2003`.
+#[derive(Debug, clap::Args)]
+pub struct ReportRoig2003Args {
+    /// The campaign directory of analysis/roig2003/campaign.toml (holding campaign.csv).
+    pub campaign: PathBuf,
+    /// The campaign directory of analysis/roig2003/campaign_uniform.toml (the §4.3 spin-bias partner run).
+    #[arg(long)]
+    pub uniform: Option<PathBuf>,
+    /// Where REPORT.md and figures/ go (DISCUSSION.md there is included in the report).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Time of the post-impact snapshots to analyse (s).
+    #[arg(long, default_value_t = 400.0)]
+    pub at: f64,
+    /// Replace an existing OUT/REPORT.md.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `report-roig2003`: re-analyses the campaign(s) (rewriting their `analysis/`), then writes the report.
+pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
+    if !(args.at.is_finite() && args.at > 0.0) {
+        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+    }
+    let report = args.out.join("REPORT.md");
+    if report.exists() && !args.force {
+        return Err(CliError::usage(format!(
+            "{}: exists; use --force to replace it",
+            report.display()
+        )));
+    }
+    let analyse = |dir: &PathBuf| {
+        crate::analysis::run_analysis::analyze_campaign(
+            dir,
+            args.at,
+            true,
+            &crate::analysis::run_analysis::SpinSelection::default(),
+        )
+        .map_err(|e| match e {
+            AnalysisError::Fragments(_) => CliError::failed(e),
+            _ => CliError::usage(e),
+        })
+    };
+    let campaign = analyse(&args.campaign)?;
+    let uniform = match &args.uniform {
+        Some(dir) => Some((analyse(dir)?, dir.clone())),
+        None => None,
+    };
+    let mut command = format!(
+        "rubblepile report-roig2003 {} --out {}",
+        args.campaign.display(),
+        args.out.display()
+    );
+    if let Some(u) = &args.uniform {
+        command += &format!(" --uniform {}", u.display());
+    }
+    if args.at != 400.0 {
+        command += &format!(" --at {}", args.at);
+    }
+    command += " --force";
+    let inputs = crate::analysis::report_roig2003::ReportInputs {
+        campaign: &campaign,
+        campaign_dir: &args.campaign,
+        uniform: uniform.as_ref().map(|(a, d)| (a, d.as_path())),
+        command,
+    };
+    std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
+    let path = crate::analysis::report_roig2003::write_report(&inputs, &args.out)
+        .map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
+    println!(
+        "report of {} runs ({} not completed) written to {}",
+        campaign.runs.len(),
+        campaign.skipped.len(),
+        path.display()
+    );
+    Ok(())
+}
