@@ -62,7 +62,7 @@ pub struct ReportInputs<'a> {
 }
 
 /// Runs of `runs` whose values `f` are finite, as (value, run name).
-fn values<'a>(runs: &'a [CampaignRun], f: impl Fn(&CampaignRun) -> Option<f64>) -> Vec<(f64, &'a str)> {
+fn values(runs: &[CampaignRun], f: impl Fn(&CampaignRun) -> Option<f64>) -> Vec<(f64, &str)> {
     runs.iter()
         .filter_map(|r| f(r).filter(|v| v.is_finite()).map(|v| (v, r.run.as_str())))
         .collect()
