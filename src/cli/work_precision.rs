@@ -14,8 +14,7 @@ use crate::cli::CliError;
 use crate::integrate::Method;
 use crate::integrate::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use crate::integrate::work_precision::{
-    CSV_HEADER, DEFAULT_REFERENCE_TOLERANCE, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep,
-    SweepConfig, SweepRow, csv_line, sweep,
+    CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };
 
 /// `rubblepile bench work-precision`.
@@ -58,7 +57,7 @@ pub struct WorkPrecisionArgs {
     #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
     pub max_run_seconds: f64,
     /// rtol = atol of the reference runs (problems without an analytic reference).
-    #[arg(long, default_value_t = DEFAULT_REFERENCE_TOLERANCE, value_name = "TOL")]
+    #[arg(long, default_value = "1e-13", value_name = "TOL")]
     pub reference_rtol: f64,
 }
 
