@@ -360,3 +360,54 @@ fn pair_cache_never_changes_the_rhs() {
     assert!(contact_energies.len() >= 5, "{contact_energies:?}");
     assert!(contact_energies.iter().all(|&u| u > 0.0), "{contact_energies:?}");
 }
+
+/// The allocation-free right-hand side of spheres under gravity alone (the planetary N-body case) gives
+/// ṙ = u/m and u̇ = the pairwise gravity sum.
+#[test]
+fn gravity_only_spheres_take_the_packed_path_correctly() {
+    use rubblepile::ellipsoid::gravity::gravity_forces;
+    let mut rng = Random::new(5);
+    let bodies: Vec<_> = (0..5)
+        .map(|_| {
+            let r = rng.range(100.0, 300.0);
+            rock(
+                [r, r, r],
+                rng.vec3(1e5).into(),
+                rng.vec3(3.0).into(),
+                Vec4::new(0.0, 0.0, 0.0, 1.0),
+                [0.0; 3],
+            )
+        })
+        .collect();
+    let model = ModelConfig {
+        kappa: 10.0,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
+    let physics = Physics {
+        gravity: Some(GravityTerm { g: G_SI }),
+        contact: None,
+        dissipation: None,
+    };
+    let system = EllipsoidSystem::new(&bodies, model, physics);
+    assert!(!system.rotation_integrated());
+    let y = system.initial_state();
+    assert_eq!(y.len(), 6 * bodies.len());
+    let mut dy = vec![f64::NAN; y.len()];
+    system.rhs(0.0, &y, &mut dy);
+    let pos: Vec<Vec3> = bodies.iter().map(|b| b.position).collect();
+    let masses: Vec<f64> = bodies.iter().map(|b| b.shape.mass).collect();
+    let mut reference = vec![Vec3::zeros(); bodies.len()];
+    gravity_forces(G_SI, &pos, &masses, &mut reference);
+    for (i, b) in bodies.iter().enumerate() {
+        for k in 0..3 {
+            assert_eq!(dy[6 * i + k], y[6 * i + 3 + k] / b.shape.mass, "ṙ of body {i}");
+            let f = dy[6 * i + 3 + k];
+            assert!(
+                (f - reference[i][k]).abs() <= 1e-13 * reference[i].norm(),
+                "u̇ of body {i}: {f} vs {}",
+                reference[i][k]
+            );
+        }
+    }
+}

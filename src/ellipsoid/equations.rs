@@ -13,7 +13,7 @@
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
-use crate::ellipsoid::gravity::{add_gravity_forces, gravity_forces};
+use crate::ellipsoid::gravity::{BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_forces};
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
@@ -160,6 +160,8 @@ pub struct EllipsoidSystem {
     /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
     /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
     pair_cache: std::sync::Mutex<Option<PairCache>>,
+    /// Body masses (kg), contiguous for the gravity sums.
+    masses: Vec<f64>,
 }
 
 /// Skin of the candidate-pair (Verlet) list, as a fraction of each body's interaction radius.
@@ -216,6 +218,7 @@ impl EllipsoidSystem {
             neg_ln_cutoff: -cutoff.ln(),
             cull_exp: max_cull_exponent(model.kappa, cutoff),
             pair_cache: std::sync::Mutex::new(None),
+            masses: bodies.iter().map(|b| b.shape.mass).collect(),
         }
     }
 
@@ -558,6 +561,21 @@ impl OdeSystem for EllipsoidSystem {
 
     fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
         let n = self.n_bodies();
+        if !self.rotation && !self.needs_pairs() && n < BLOCKED_FROM {
+            // Spheres under gravity alone (e.g. planetary N-body problems): ṙ = u/m, u̇ = F_G, straight from
+            // the packed state, nothing allocated.
+            for (i, out) in dydt.chunks_exact_mut(self.stride).enumerate() {
+                let m = self.shapes[i].mass;
+                for k in 0..3 {
+                    out[k] = y[i * self.stride + 3 + k] / m;
+                    out[3 + k] = 0.0;
+                }
+            }
+            if let Some(gr) = self.physics.gravity {
+                add_gravity_forces_packed(gr.g, y, self.stride, &self.masses, dydt, 3);
+            }
+            return;
+        }
         let kin = self.all_kinematics(y, self.needs_pairs());
         let mut force = vec![Vec3::zeros(); n];
         let mut gq = vec![Vec4::zeros(); n];
@@ -571,8 +589,7 @@ impl OdeSystem for EllipsoidSystem {
         }
         if let Some(gr) = self.physics.gravity {
             let pos: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
-            let masses: Vec<f64> = self.shapes.iter().map(|s| s.mass).collect();
-            add_gravity_forces(gr.g, &pos, &masses, &mut force);
+            add_gravity_forces(gr.g, &pos, &self.masses, &mut force);
         }
         let stride = self.stride;
         let rotation = self.rotation;

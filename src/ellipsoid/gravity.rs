@@ -15,7 +15,7 @@ pub const PARALLEL_THRESHOLD: usize = 256;
 const BLOCKS: usize = 8;
 
 /// Below this many bodies the half loop runs serially into `forces` directly.
-const BLOCKED_FROM: usize = 64;
+pub const BLOCKED_FROM: usize = 64;
 
 /// The half loop over rows `rows` (pairs `(i, j)`, `i ∈ rows`, `j > i`), adding `G m_i m_j d/|d|³` to body `i`
 /// and subtracting it from body `j` in `out`. One square root and one division per pair.
@@ -51,6 +51,34 @@ fn block_bounds(n: usize) -> Vec<usize> {
     }
     bounds.push(n);
     bounds
+}
+
+/// The half loop on a packed state: body `i`'s position is `y[i·stride..i·stride+3]`, and its force is added to
+/// `out[i·stride + offset..+3]`. For the translational-only right-hand side of small systems, where gathering
+/// positions into vectors would cost more than the sum. Same pair order and arithmetic as [`add_gravity_forces`]
+/// below [`BLOCKED_FROM`] bodies, so the bits agree.
+pub fn add_gravity_forces_packed(g: f64, y: &[f64], stride: usize, masses: &[f64], out: &mut [f64], offset: usize) {
+    let n = masses.len();
+    let at = |i: usize| Vec3::new(y[i * stride], y[i * stride + 1], y[i * stride + 2]);
+    for i in 0..n {
+        let (pi, gmi) = (at(i), g * masses[i]);
+        let mut fi = Vec3::zeros();
+        for (j, &mj) in masses.iter().enumerate().skip(i + 1) {
+            let d = at(j) - pi;
+            let r2 = d.norm_squared();
+            let inv_r = 1.0 / r2.sqrt();
+            let f = d * (gmi * mj * inv_r * inv_r * inv_r);
+            fi += f;
+            let o = j * stride + offset;
+            out[o] -= f.x;
+            out[o + 1] -= f.y;
+            out[o + 2] -= f.z;
+        }
+        let o = i * stride + offset;
+        out[o] += fi.x;
+        out[o + 1] += fi.y;
+        out[o + 2] += fi.z;
+    }
 }
 
 /// Gravitational forces `−∂U_G/∂r_i` (N) added to `forces`, without the potential: the right-hand side's
