@@ -27,6 +27,7 @@
 
 pub mod analyze;
 pub mod bench;
+pub mod bench_impact;
 pub mod campaign;
 pub mod impact;
 pub mod nbody;
@@ -173,6 +174,9 @@ pub enum BenchCommand {
     WorkPrecision(work_precision::WorkPrecisionArgs),
     /// Timed point-mass N-body runs (Pythagorean three-body, outer Solar System) with final states (CSV).
     Nbody(nbody::NBodyArgs),
+    /// Wall-clock time of whole impact runs (default N200_T4 + P2, ζ = 45°, 10 000 s, rtol 1e-9) per F0 and
+    /// thread count, with the 60 s goal.
+    Impact(bench_impact::ImpactBenchArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -243,6 +247,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
         Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
         Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),
+        Command::Bench(BenchCommand::Impact(args)) => bench_impact::impact(&args),
     }
 }
 

@@ -1,0 +1,53 @@
+//! `rubblepile bench impact`: whole impact runs timed per F0 and thread count; the same run on 1 and 2 threads
+//! gives the same numbers (only the wall time differs); bad flags give one-line errors.
+
+mod common;
+use common::{rubblepile, temp_dir};
+
+#[test]
+fn bench_impact_rows_are_thread_independent_and_flags_checked() {
+    let dir = temp_dir("bench-impact");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let target = target.to_str().unwrap();
+    let args = [
+        "bench",
+        "impact",
+        "--target",
+        target,
+        "--projectile",
+        "P1",
+        "--t-end",
+        "100",
+        "--f0",
+        "1e-6,1e-4",
+        "--threads",
+        "1,2",
+        "--out",
+        "b",
+    ];
+    let out = rubblepile(&dir, &args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(dir.join("b/bench_impact.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        rows[0].join(","),
+        "target,projectile,angle_deg,t_end,rtol,f0,threads,median_s,min_s,repeats,steps,rhs_evaluations,energy_error"
+    );
+    assert_eq!(rows.len(), 5, "{csv}");
+    // steps, RHS evaluations and energy error do not depend on the thread count; F0 changes them
+    for pair in [(1, 2), (3, 4)] {
+        assert_eq!(rows[pair.0][10..], rows[pair.1][10..], "{csv}");
+    }
+    assert_ne!(rows[1][12], rows[3][12], "F0 must matter: {csv}");
+    assert!(rows[1][12].parse::<f64>().unwrap() < 1e-8, "energy error: {csv}");
+    assert!(dir.join("b/bench_impact.svg").is_file());
+    assert!(!dir.join("b/runs").exists(), "scratch runs removed");
+    // no overwrite without --force; bad F0 names the flag
+    let again = rubblepile(&dir, &args);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("use --force"));
+    let bad = rubblepile(&dir, &["bench", "impact", "--f0=-1", "--out", "c"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--f0: each must be >= 0"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
