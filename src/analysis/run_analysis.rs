@@ -114,6 +114,15 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     Ok(out)
 }
 
+/// The snapshot of the run in `dir` at time `t` (s, to 1e-9 relative), if there is one.
+pub fn snapshot_path(dir: &Path, t: f64) -> Option<PathBuf> {
+    snapshot_times(dir)
+        .ok()?
+        .into_iter()
+        .find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+        .map(|(_, p)| p)
+}
+
 /// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
 /// (or `force`). Returns the per-run results and the per-fragment report.
 pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {

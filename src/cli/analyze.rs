@@ -27,7 +27,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
-    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir.join("analysis"), &a, &report);
+    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir, &a, &report);
     for why in &not_drawn {
         eprintln!("warning: figure not drawn: {why}");
     }
@@ -83,17 +83,23 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
+    let (figures, not_drawn) = crate::analysis::figures::write_campaign_figures(&args.dir, &a);
+    for why in &not_drawn {
+        eprintln!("warning: figure not drawn: {why}");
+    }
     let q_star = match &a.q_star_d {
         Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
         Fit::Failed(why) => format!("n/a ({why})"),
     };
     println!(
-        "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {}",
+        "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {} \
+         (campaign_analysis.json, campaign_runs.csv, {})",
         a.t_at,
         a.runs.len(),
         a.skipped.len(),
         q_star,
-        args.dir.join("analysis").display()
+        args.dir.join("analysis").display(),
+        figures.join(", ")
     );
     Ok(())
 }
