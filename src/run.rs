@@ -5,6 +5,8 @@
 //! - `timeseries.csv`: energies, momenta and the energy residual every `output.every` seconds and
 //!   at each snapshot time (written and flushed row by row);
 //! - `snapshots/<k>.csv`: the bodies at the k-th `output.times` entry;
+//! - `tracks.csv` (only when `output.track` lists bodies): those bodies' rows, in the snapshot columns, at
+//!   every time-series sample;
 //! - `summary.json`: counters and conservation errors ([`RunSummary`]);
 //! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format;
 //! - `checkpoint.json` (only when checkpoints are due, see [`RunOptions`]): the full state the run
@@ -26,7 +28,8 @@
 //! checkpoint, and the bodies read are checked against a fingerprint stored with it (as is the
 //! scene text), so a moved or edited bodies file gives a clear error instead of a different run.
 //! `timeseries.csv` is truncated to the rows written up to the checkpoint (a process killed later
-//! may have written more); snapshots written after the checkpoint are rewritten identically.
+//! may have written more), and so is `tracks.csv`; snapshots written after the checkpoint are rewritten
+//! identically.
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -38,7 +41,7 @@ use crate::io::checkpoint::{
     CHECKPOINT_FILE, CHECKPOINT_FORMAT, CHECKPOINT_TMP_FILE, CHECKPOINT_VERSION, Checkpoint, CheckpointError,
     DriverState, ErrorState, TimeseriesAppender, fnv1a_hex, read_checkpoint, write_checkpoint,
 };
-use crate::io::csv::{TimeseriesRow, TimeseriesWriter, snapshot_records, write_snapshot};
+use crate::io::csv::{TimeseriesRow, TimeseriesWriter, TracksWriter, snapshot_records, write_snapshot};
 pub use crate::io::summary::RunSummary;
 use crate::io::summary::{CalibrationSummary, PhysicsSummary, Scales, write_summary};
 use crate::scene::{KappaSource, LoadedScene, parse_scene};
@@ -186,10 +189,11 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 }
 
 /// Files a run writes at the top of its directory (removed by `force`).
-const OUTPUT_FILES: [&str; 6] = [
+const OUTPUT_FILES: [&str; 7] = [
     "scene.toml",
     "summary.json",
     "timeseries.csv",
+    "tracks.csv",
     "last_good_state.csv",
     CHECKPOINT_FILE,
     CHECKPOINT_TMP_FILE,
@@ -555,6 +559,8 @@ struct Start {
     wall_before: f64,
     checkpoints: u64,
     timeseries: Rows,
+    /// `tracks.csv`, when the scene tracks bodies.
+    tracks: Option<TracksWriter>,
 }
 
 /// What every checkpoint of a run repeats.
@@ -600,6 +606,12 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
 
     let ts_path = out_dir.join("timeseries.csv");
     let timeseries = TimeseriesWriter::create(&ts_path).map_err(io_err(&ts_path))?;
+    let tracks = if scene.output.track.is_empty() {
+        None
+    } else {
+        let path = out_dir.join("tracks.csv");
+        Some(TracksWriter::create(&path).map_err(io_err(&path))?)
+    };
     let y = system.initial_state();
     let tracker = ErrorTracker::new(&system.diagnostics(&y));
     let start = Start {
@@ -611,6 +623,7 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         wall_before: 0.0,
         checkpoints: 0,
         timeseries,
+        tracks,
     };
     drive(scene, out_dir, options, &system, integrator, start, &identity)
 }
@@ -728,6 +741,13 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
     let ts_path = dir.join("timeseries.csv");
     let timeseries =
         TimeseriesAppender::open_truncated(&ts_path, d.timeseries_rows, d.timeseries_bytes).map_err(bad)?;
+    // Each sample wrote one row per tracked body; the checkpoint sits right after sample `next_sample − 1`.
+    let tracks = if scene.output.track.is_empty() {
+        None
+    } else {
+        let rows = d.next_sample * scene.output.track.len() as u64;
+        Some(TracksWriter::open_truncated(&dir.join("tracks.csv"), rows).map_err(bad)?)
+    };
 
     let start = Start {
         t: ckpt.t,
@@ -738,6 +758,7 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
         wall_before: d.wall_seconds,
         checkpoints: d.checkpoints,
         timeseries,
+        tracks,
     };
     drive(&scene, dir, options, &system, integrator, start, &identity)
 }
@@ -761,7 +782,9 @@ fn drive(
         wall_before,
         mut checkpoints,
         mut timeseries,
+        mut tracks,
     } = start;
+    let tracks_path = out_dir.join("tracks.csv");
     let settings = scene.integrator;
     let ts_path = out_dir.join("timeseries.csv");
     let snapshot_path = |k: usize| out_dir.join("snapshots").join(format!("{k}.csv"));
@@ -865,9 +888,16 @@ fn drive(
         };
         timeseries.write_row(&row).map_err(io_err(&ts_path))?;
         rows += 1;
-        if let Some(k) = sample.snapshot {
-            let p = snapshot_path(k);
-            write_snapshot(&p, t, &system.bodies_at(t, &y)).map_err(io_err(&p))?;
+        if sample.snapshot.is_some() || tracks.is_some() {
+            let bodies = system.bodies_at(t, &y);
+            if let Some(k) = sample.snapshot {
+                let p = snapshot_path(k);
+                write_snapshot(&p, t, &bodies).map_err(io_err(&p))?;
+            }
+            if let Some(w) = tracks.as_mut() {
+                w.write_sample(t, &bodies, &scene.output.track)
+                    .map_err(io_err(&tracks_path))?;
+            }
         }
         last_good.0 = t;
         last_good.1.copy_from_slice(&y);

@@ -430,3 +430,81 @@ fn spin_histogram_free_fit_is_unbiased_over_seeds() {
     eprintln!("mean pulls (n, b, a) over {seeds} seeds: {means:?}");
     assert!(means.iter().all(|m| m.abs() < 0.8), "{means:?}");
 }
+
+fn campaign_run(
+    run: &str,
+    target: &str,
+    projectile: &str,
+    angle_deg: f64,
+) -> rubblepile::analysis::run_analysis::CampaignRun {
+    rubblepile::analysis::run_analysis::CampaignRun {
+        run: run.into(),
+        target: target.into(),
+        projectile: projectile.into(),
+        angle_deg,
+        q_erg_per_g: if projectile == "P1" { 0.44e9 } else { 1.5e9 },
+        fragments: 0,
+        escaping: 0,
+        bound_mass_fraction: 1.0,
+        f_ke: 0.0,
+        rotational_share: 0.0,
+        ejection_speed_median: 0.0,
+        ejection_speed_median_relative: 0.0,
+        ejection_exponent: None,
+        ejection_exponent_sigma: None,
+        spin_exponent: None,
+        spin_exponent_sigma: None,
+        best_n: None,
+        maxwellian_residual_ratio: None,
+        size_site_correlation: None,
+        impact_side_median_size: None,
+        antipodal_side_median_size: None,
+        energy_error: None,
+        wall_seconds: None,
+    }
+}
+
+/// Roig03 Fig. 7: per projectile, the requested case (target, ζ) is pooled when it exists, else all runs; spins
+/// drawn from n = 0.5 come out best fitted by n = 0.5 with b near the truth, and the Eq. 45-normalised curve
+/// integrates to 1.
+#[test]
+fn spin_distributions_pool_the_requested_case_and_normalise() {
+    use rubblepile::analysis::run_analysis::{SpinSelection, spin_distributions};
+    let runs = vec![
+        campaign_run("a", "N200_T12", "P1", 45.0),
+        campaign_run("b", "N200_T12", "P1", 0.0),
+        campaign_run("c", "N30_T4", "P2", 45.0),
+        campaign_run("d", "N30_T4", "P2", 90.0),
+    ];
+    let spins = vec![
+        spin_samples(11, 4000, N_TRUE, B_TRUE),
+        vec![100.0; 10], // not selected: would wreck the fit if pooled
+        spin_samples(12, 2000, N_TRUE, B_TRUE),
+        spin_samples(13, 2000, N_TRUE, B_TRUE),
+    ];
+    let d = spin_distributions(&runs, &spins, &SpinSelection::default());
+    assert_eq!(d.len(), 2);
+    assert_eq!(
+        (d[0].projectile.as_str(), d[0].runs.clone()),
+        ("P1", vec!["a".to_string()])
+    );
+    assert_eq!(d[0].selection, "target N200_T12 at zeta 45");
+    assert_eq!(
+        (d[1].runs.len(), d[1].selection.as_str(), d[1].fragments),
+        (2, "all runs", 4000)
+    );
+    for dist in &d {
+        let best = dist.best().expect("a fit");
+        assert_eq!(best.n, 0.5, "{}: best n", dist.projectile);
+        assert!(
+            (best.b - B_TRUE).abs() < 0.1 * B_TRUE,
+            "{}: b = {}",
+            dist.projectile,
+            best.b
+        );
+        // ∫₀^∞ of the normalised curve by the midpoint rule on [0, 8b]
+        let (h, steps) = (8.0 * best.b / 200_000.0, 200_000);
+        let integral: f64 = (0..steps).map(|k| best.density((k as f64 + 0.5) * h) * h).sum();
+        assert!((integral - 1.0).abs() < 2e-3, "{}: ∫ = {integral}", dist.projectile);
+    }
+}

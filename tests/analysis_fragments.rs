@@ -363,3 +363,38 @@ fn snapshot_csv_round_trip() {
         assert!((a.spin_body - b.spin_body).norm() < 1e-15 && a.shape.mass == b.shape.mass);
     }
 }
+
+/// §4.2 "small fragments from the impact point, large ones from the antipode": a hand-made target whose two
+/// small fragments sit on the impact side (+z, toward the projectile) and two large ones at the antipode.
+#[test]
+fn ejection_sites_separate_impact_side_from_antipode() {
+    let small = |z: f64, x: f64| body(1.0, [1.0, 1.0, 1.0], [x, 0.0, z], [0.0; 3], [0.0; 3]);
+    let large = |z: f64, x: f64| body(27.0, [3.0, 3.0, 3.0], [x, 0.0, z], [0.0; 3], [0.0; 3]);
+    let initial = vec![
+        body(64.0, [4.0, 4.0, 4.0], [0.0, 0.0, 0.0], [0.0; 3], [0.0; 3]), // slow core
+        small(10.0, 1.0),
+        small(10.0, -1.0),
+        large(-10.0, 1.0),
+        large(-10.0, -1.0),
+        sphere(0.1, [0.0, 0.0, 100.0], [0.0, 0.0, -50.0]), // projectile along −z, from +z
+    ];
+    let mut at = initial.clone();
+    for (i, v) in [(1, 8.0), (2, 9.0), (3, -5.0), (4, -6.0)] {
+        at[i].velocity = Vec3::new(0.0, 0.0, v);
+    }
+    let r = analyse_fragments(&initial, &at, &params(5)).unwrap();
+    // positions relative to the target barycentre (z_c = (20 − 540)/120 = −13/3): cosines by hand
+    let zc = (2.0 * 10.0 - 2.0 * 27.0 * 10.0) / 120.0;
+    let cos = |x: f64, z: f64| (z - zc) / (x * x + (z - zc) * (z - zc)).sqrt();
+    assert!(close(r.fragments[1].impact_site_cosine, cos(1.0, 10.0), 1e-12));
+    assert!(close(r.fragments[3].impact_site_cosine, cos(1.0, -10.0), 1e-12));
+    assert_eq!(r.fragments[5].impact_site_cosine, 0.0, "projectile");
+    let s = &r.summary.ejection_sites;
+    // the target barycentre recoils by −280/120 m/s along z, so |Δv| = 2.33, 10.33, 11.33, 2.67, 3.67 m/s:
+    // the median is 3.67 and the fast ones are fragments 1, 2 (impact side) and 4 (antipode)
+    assert_eq!((s.fast_fragments, s.impact_side, s.antipodal_side), (3, 2, 1), "{s:?}");
+    let size = |i: usize| r.fragments[i].size;
+    assert!(close(s.impact_side_median_size.unwrap(), size(1), 1e-12));
+    assert!(close(s.antipodal_side_median_size.unwrap(), size(4), 1e-12));
+    assert!(s.size_cosine_correlation.unwrap() < -0.9, "{s:?}");
+}

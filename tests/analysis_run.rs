@@ -179,5 +179,38 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
             .code(),
         Some(2)
     );
+
+    // the report: every run it names is in the campaign index, and every completed run has its appendix row
+    // (the campaign stands in for its own uniform-inertia partner here, so that section is drawn too)
+    let rep = rubblepile(
+        &dir,
+        &["report-roig2003", "c", "--uniform", "c", "--out", "rep", "--at", "110"],
+    );
+    assert!(rep.status.success(), "{}", String::from_utf8_lossy(&rep.stderr));
+    let report = std::fs::read_to_string(dir.join("rep/REPORT.md")).unwrap();
+    let index = std::fs::read_to_string(dir.join("c/campaign.csv")).unwrap();
+    let names: Vec<&str> = index.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
+    let cited: Vec<&str> = report
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .filter(|t| t.starts_with("N30_T4_"))
+        .collect();
+    assert!(!cited.is_empty(), "the report names no run");
+    for c in &cited {
+        assert!(names.contains(c), "{c} is not in campaign.csv");
+    }
+    for n in &names {
+        assert!(report.contains(&format!("| `{n}` |")), "no appendix row for {n}");
+    }
+    assert!(
+        report.contains("Gaussian / uniform: **1.00**"),
+        "same runs on both sides"
+    );
+    assert!(dir.join("rep/figures").is_dir());
+    // a second report only with --force
+    let again = rubblepile(&dir, &["report-roig2003", "c", "--out", "rep", "--at", "110"]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("use --force"));
     let _ = std::fs::remove_dir_all(&dir);
 }

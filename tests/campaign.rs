@@ -306,7 +306,30 @@ fn bad_campaign_files_give_one_line_errors() {
     let (dir, _) = campaign_dir("bad", GRID);
     let ok = parse_campaign(GRID, "c.toml", &dir);
     assert!(ok.is_ok(), "{:?}", ok.err());
-    let cases: [(String, &str); 10] = [
+    // impact.inertia reaches every run's scene; a model other than gaussian/uniform is refused
+    let uniform = parse_campaign(
+        &GRID.replace("rtol = 1e-8", "rtol = 1e-8\ninertia = \"uniform\""),
+        "c.toml",
+        &dir,
+    )
+    .expect("inertia = uniform");
+    assert!(
+        uniform
+            .points
+            .iter()
+            .all(|p| p.plan.scene_toml.contains("inertia = \"uniform\""))
+    );
+    assert!(
+        ok.unwrap()
+            .points
+            .iter()
+            .all(|p| p.plan.scene_toml.contains("inertia = \"gaussian\""))
+    );
+    let cases: [(String, &str); 11] = [
+        (
+            GRID.replace("rtol = 1e-8", "rtol = 1e-8\ninertia = \"hollow\""),
+            "c.toml: impact.inertia: unknown variant `hollow`, expected `gaussian` or `uniform`",
+        ),
         (
             GRID.replace("parallel = 2", "parallel = 2\nthreads = 4"),
             "c.toml: unknown field `threads` in [campaign]",

@@ -37,6 +37,7 @@ atol = 1e-10
 [output]
 times = [0.0, 8.0, 16.0, 24.0]
 every = 1.0
+track = [3, 1]
 {BODIES}"#;
 
 const BODY_TABLES: &str = r#"
@@ -164,6 +165,14 @@ fn assert_same_run(a: &Path, b: &Path, what: &str) {
         timeseries_without_wall(b),
         "{what}: timeseries.csv"
     );
+    // tracks.csv: header + 2 tracked bodies × 25 samples, truncated and continued exactly on resume.
+    let (ta, tb) = (read(&a.join("tracks.csv")), read(&b.join("tracks.csv")));
+    assert_eq!(ta.lines().count(), 1 + 2 * 25, "{what}: tracks.csv rows");
+    assert!(
+        ta.lines().nth(1).unwrap().split(',').nth(1) == Some("3"),
+        "{what}: first tracked id"
+    );
+    assert_eq!(ta, tb, "{what}: tracks.csv");
     let (ja, jb) = (summary_without_wall(a), summary_without_wall(b));
     for key in [
         "status",

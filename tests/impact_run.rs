@@ -76,6 +76,18 @@ fn short_impact_conserves_and_decelerates_the_projectile() {
             .unwrap()
             .contains("bodies_file = \"initial_bodies.csv\"")
     );
+    // tracks.csv follows the projectile (id 30) at every time-series row (every 10 s from 0 to 200 s, plus
+    // the snapshot at 60 s which lies on that grid): its last row is the last snapshot's projectile row.
+    let tracks = std::fs::read_to_string(out.join("tracks.csv")).unwrap();
+    let rows: Vec<&str> = tracks.lines().skip(1).collect();
+    assert_eq!(rows.len(), 21, "tracks.csv rows");
+    assert!(rows.iter().all(|r| r.split(',').nth(1) == Some("30")), "tracked id");
+    let last_snapshot = std::fs::read_to_string(out.join("snapshots/2.csv")).unwrap();
+    assert_eq!(
+        Some(*rows.last().unwrap()),
+        last_snapshot.lines().last(),
+        "tracks vs snapshot"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }
 

@@ -319,6 +319,21 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
             "output.times: must be strictly increasing",
         ),
         (
+            "track out of range",
+            with("every = 1.0", "every = 1.0\ntrack = [7]"),
+            "output.track[0]: must be a body index below",
+        ),
+        (
+            "track listed twice",
+            with("every = 1.0", "every = 1.0\ntrack = [0, 0]"),
+            "output.track[1]: body 0 is listed twice",
+        ),
+        (
+            "track negative",
+            with("every = 1.0", "every = 1.0\ntrack = [-1]"),
+            "output.track",
+        ),
+        (
             "kind",
             with("\"ellipsoids\"", "\"spheres\""),
             "scene.kind: must be \"ellipsoids\", got \"spheres\"",

@@ -148,6 +148,76 @@ pub struct FragmentAnalysis {
     pub rotation_mode_measure: Option<f64>,
     /// SAM / LAM classification.
     pub rotation_mode: RotationMode,
+    /// Where the fragment sat in the target before the impact: the cosine of the angle between its position and
+    /// the projectile's, both relative to the target barycentre at `t = 0` (+1 at the impact point, −1 at the
+    /// antipode; §4.2). 0 for the projectile itself and for a fragment at the barycentre.
+    pub impact_site_cosine: f64,
+}
+
+/// Where the fast fragments come from (Roig03 §4.2: "only small fragments are ejected at the impact point, while
+/// the largest ones tend to be ejected at the antipodal point"). "Fast" = ejection speed at or above the run's
+/// median; sides split by the sign of [`FragmentAnalysis::impact_site_cosine`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EjectionSites {
+    /// Number of fast target fragments.
+    pub fast_fragments: usize,
+    /// Fast fragments from the impact hemisphere (cosine > 0).
+    pub impact_side: usize,
+    /// Fast fragments from the antipodal hemisphere (cosine ≤ 0).
+    pub antipodal_side: usize,
+    /// Median normalised size of the fast fragments from the impact hemisphere (`None` if there are none).
+    pub impact_side_median_size: Option<f64>,
+    /// Median normalised size of the fast fragments from the antipodal hemisphere (`None` if there are none).
+    pub antipodal_side_median_size: Option<f64>,
+    /// Pearson correlation of ln(size) with the impact-site cosine over the fast fragments: negative when the
+    /// small ones come from the impact side and the large ones from the antipode (`None` for < 3 fragments or
+    /// no spread).
+    pub size_cosine_correlation: Option<f64>,
+}
+
+/// [`EjectionSites`] of the target fragments in `fragments` (the projectile is skipped).
+pub fn ejection_sites(fragments: &[FragmentAnalysis]) -> EjectionSites {
+    let targets: Vec<&FragmentAnalysis> = fragments.iter().filter(|f| !f.is_projectile).collect();
+    let speeds: Vec<f64> = targets.iter().map(|f| f.ejection_speed).collect();
+    let threshold = median(&speeds);
+    let fast: Vec<&&FragmentAnalysis> = targets.iter().filter(|f| f.ejection_speed >= threshold).collect();
+    let sizes_where = |impact: bool| -> Vec<f64> {
+        fast.iter()
+            .filter(|f| (f.impact_site_cosine > 0.0) == impact)
+            .map(|f| f.size)
+            .collect()
+    };
+    let (near, far) = (sizes_where(true), sizes_where(false));
+    let med = |v: &[f64]| (!v.is_empty()).then(|| median(v));
+    let x: Vec<f64> = fast.iter().map(|f| f.size.ln()).collect();
+    let y: Vec<f64> = fast.iter().map(|f| f.impact_site_cosine).collect();
+    EjectionSites {
+        fast_fragments: fast.len(),
+        impact_side: near.len(),
+        antipodal_side: far.len(),
+        impact_side_median_size: med(&near),
+        antipodal_side_median_size: med(&far),
+        size_cosine_correlation: pearson(&x, &y),
+    }
+}
+
+/// Pearson correlation coefficient of `x` and `y` (`None` for fewer than 3 pairs or zero variance).
+pub fn pearson(x: &[f64], y: &[f64]) -> Option<f64> {
+    let n = x.len().min(y.len());
+    if n < 3 {
+        return None;
+    }
+    let (mx, my) = (
+        x[..n].iter().sum::<f64>() / n as f64,
+        y[..n].iter().sum::<f64>() / n as f64,
+    );
+    let (mut sxy, mut sxx, mut syy) = (0.0, 0.0, 0.0);
+    for (a, b) in x[..n].iter().zip(&y[..n]) {
+        sxy += (a - mx) * (b - my);
+        sxx += (a - mx) * (a - mx);
+        syy += (b - my) * (b - my);
+    }
+    (sxx > 0.0 && syy > 0.0).then(|| sxy / (sxx * syy).sqrt())
 }
 
 /// Per-run aggregates.
@@ -193,6 +263,8 @@ pub struct FragmentSummary {
     pub ejection_speed_mean_relative: f64,
     /// The spin correction factor `√(5/(2κ_I))` used (§4.3).
     pub spin_correction: f64,
+    /// Where the fast fragments come from (§4.2).
+    pub ejection_sites: EjectionSites,
 }
 
 /// Per-body analyses and the run's aggregates.
@@ -265,6 +337,15 @@ pub fn binding_energies(g: f64, bodies: &[Body]) -> Vec<f64> {
 }
 
 /// Mass-weighted mean velocity of the bodies for which `include(index)` holds.
+fn mean_position(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
+    let (mut r, mut m) = (Vec3::zeros(), 0.0);
+    for (_, b) in bodies.iter().enumerate().filter(|(i, _)| include(*i)) {
+        r += b.position * b.shape.mass;
+        m += b.shape.mass;
+    }
+    r / m
+}
+
 fn mean_velocity(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
     let (mut p, mut m) = (Vec3::zeros(), 0.0);
     for (_, b) in bodies.iter().enumerate().filter(|(i, _)| include(*i)) {
@@ -349,6 +430,10 @@ pub fn analyse_fragments(
     let v_target0 = mean_velocity(initial, is_target);
     let dv = ejection_velocities(initial, at, p);
     let binding = binding_energies(params.g, at);
+    let centre0 = mean_position(initial, is_target);
+    let impact_direction = (initial[p].position - centre0)
+        .try_normalize(0.0)
+        .unwrap_or_else(Vec3::zeros);
 
     let fragments: Vec<FragmentAnalysis> = at
         .iter()
@@ -381,6 +466,13 @@ pub fn analyse_fragments(
                 effective_inertia: i_eff,
                 rotation_mode_measure: measure,
                 rotation_mode: rotation_mode(measure),
+                impact_site_cosine: if i == p {
+                    0.0
+                } else {
+                    (initial[i].position - centre0)
+                        .try_normalize(0.0)
+                        .map_or(0.0, |r| r.dot(&impact_direction))
+                },
             }
         })
         .collect();
@@ -432,6 +524,7 @@ pub fn analyse_fragments(
         ejection_speed_median_relative: ejection_speed_median / projectile_speed,
         ejection_speed_mean_relative: ejection_speed_mean / projectile_speed,
         spin_correction: correction,
+        ejection_sites: ejection_sites(&fragments),
     };
     Ok(FragmentReport { fragments, summary })
 }

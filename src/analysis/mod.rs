@@ -3,5 +3,6 @@
 pub mod figures;
 pub mod fits;
 pub mod fragments;
+pub mod report_roig2003;
 pub mod rigid_rotation;
 pub mod run_analysis;

@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::fits::{ExponentComparison, PowerLawFit, compare_exponents, fit_power_law, histogram};
+use crate::analysis::fits::{ExponentComparison, PowerLawFit, SpinFit, compare_exponents, fit_power_law, histogram};
 use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
 use crate::ellipsoid::equations::G_SI;
 
@@ -240,6 +240,7 @@ fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), Analy
         "effective_inertia",
         "rotation_mode_measure",
         "rotation_mode",
+        "impact_site_cosine",
     ])
     .map_err(|e| err(&e))?;
     let num = |x: f64| format!("{x:e}");
@@ -268,13 +269,15 @@ fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), Analy
             opt(f.effective_inertia),
             opt(f.rotation_mode_measure),
             mode,
+            num(f.impact_site_cosine),
         ])
         .map_err(|e| err(&e))?;
     }
     w.flush().map_err(|e| err(&e))
 }
 
-/// One analysed run of a campaign (a row of `campaign_runs.csv`).
+/// One analysed run of a campaign (a row of `campaign_runs.csv`). Exponents and fit results are empty when the
+/// run's fit failed (its `analysis.json` says why).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct CampaignRun {
     /// Run name (directory under the campaign directory).
@@ -287,14 +290,74 @@ pub struct CampaignRun {
     pub angle_deg: f64,
     /// Specific impact energy Q (erg/g).
     pub q_erg_per_g: f64,
+    /// Number of target fragments.
+    pub fragments: usize,
+    /// Escaping target fragments (Eq. 43).
+    pub escaping: usize,
     /// Fraction of the target mass that stays bound (Fig. 5).
     pub bound_mass_fraction: f64,
     /// Post-impact fragment kinetic energy over the projectile's.
     pub f_ke: f64,
     /// Rotational share of that energy.
     pub rotational_share: f64,
+    /// Median ejection speed (m/s).
+    pub ejection_speed_median: f64,
     /// Median ejection speed over the projectile speed.
     pub ejection_speed_median_relative: f64,
+    /// Ejection speed vs size exponent (Fig. 4).
+    pub ejection_exponent: Option<f64>,
+    /// Its standard error.
+    pub ejection_exponent_sigma: Option<f64>,
+    /// Corrected spin rate vs size exponent (Fig. 8).
+    pub spin_exponent: Option<f64>,
+    /// Its standard error.
+    pub spin_exponent_sigma: Option<f64>,
+    /// The n ∈ {0.5, 1, 1.5, 2} with the smallest spin-histogram residual (Fig. 6).
+    pub best_n: Option<f64>,
+    /// Residual of the Maxwellian-like n = 2 fit over that of the best n (≥ 1).
+    pub maxwellian_residual_ratio: Option<f64>,
+    /// Correlation of ln(size) with the impact-site cosine over the fast fragments (§4.2; < 0: small ones from
+    /// the impact side).
+    pub size_site_correlation: Option<f64>,
+    /// Median size of the fast fragments from the impact hemisphere.
+    pub impact_side_median_size: Option<f64>,
+    /// Median size of the fast fragments from the antipodal hemisphere.
+    pub antipodal_side_median_size: Option<f64>,
+    /// The run's relative energy error (its `summary.json`).
+    pub energy_error: Option<f64>,
+    /// The run's wall-clock time (s; its `summary.json`).
+    pub wall_seconds: Option<f64>,
+}
+
+/// The spin distribution of one projectile's runs (Roig03 Fig. 7): the corrected spin rates of the target
+/// fragments of the selected runs, pooled into one histogram and fitted with Eq. 44 for n ∈ {0.5, 1, 1.5, 2} and
+/// free n. The curve of Fig. 7 is the best fixed-n fit normalised by Eq. 45 ([`SpinFit::density`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct SpinDistribution {
+    /// Projectile id.
+    pub projectile: String,
+    /// Mean specific impact energy of the runs (erg/g).
+    pub q_erg_per_g: f64,
+    /// The runs pooled.
+    pub runs: Vec<String>,
+    /// How they were chosen: `"target T at zeta Z"` when the requested case exists, else `"all runs"`.
+    pub selection: String,
+    /// Number of spin rates pooled.
+    pub fragments: usize,
+    /// Histogram of the pooled corrected spin rates (rad/s): bin centres and counts.
+    pub histogram: (Vec<f64>, Vec<f64>),
+    /// Fits of Eq. 44 to it.
+    pub fits: Fit<ExponentComparison>,
+}
+
+impl SpinDistribution {
+    /// The best fixed-n fit (the curve of Fig. 7), if the fits succeeded.
+    pub fn best(&self) -> Option<&SpinFit> {
+        match &self.fits {
+            Fit::Ok(c) => c.fixed.iter().find(|f| f.n == c.best_n),
+            Fit::Failed(_) => None,
+        }
+    }
 }
 
 /// Per-campaign results (`analysis/campaign_analysis.json` in the campaign directory).
@@ -310,12 +373,40 @@ pub struct CampaignAnalysis {
     pub bound_fraction_vs_q: Fit<crate::analysis::fits::LineFit>,
     /// Q*_D: the Q at which that line gives a bound fraction of 0.5 (erg/g), with its propagated error.
     pub q_star_d: Fit<crate::analysis::fits::LineCrossing>,
+    /// Spin distributions per projectile, in the order the projectiles first appear (Fig. 7).
+    pub spin_distributions: Vec<SpinDistribution>,
+}
+
+/// Which runs make each projectile's spin distribution (Fig. 7): those on `target` at ζ = `angle_deg`, when the
+/// campaign has them (the paper uses N200_T12 at 45°); otherwise all the projectile's runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpinSelection {
+    /// Target file stem.
+    pub target: String,
+    /// ζ (degrees).
+    pub angle_deg: f64,
+}
+
+impl Default for SpinSelection {
+    fn default() -> Self {
+        SpinSelection {
+            target: "N200_T12".into(),
+            angle_deg: 45.0,
+        }
+    }
 }
 
 /// Analyses every completed run listed in `CAMPAIGN_DIR/campaign.csv` at `t_at` (each run's own
-/// `analysis/` is written or, with `force`, rewritten) and writes `CAMPAIGN_DIR/analysis/campaign_analysis.json`
-/// and `campaign_runs.csv`.
-pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAnalysis, AnalysisError> {
+/// `analysis/` is written or, with `force`, rewritten, figures included) and writes
+/// `CAMPAIGN_DIR/analysis/campaign_analysis.json`, `campaign_runs.csv` and the campaign figures (Roig03 Figs. 5
+/// and 7, [`crate::analysis::figures::write_campaign_figures`]; a figure that cannot be drawn is a warning on
+/// stderr).
+pub fn analyze_campaign(
+    dir: &Path,
+    t_at: f64,
+    force: bool,
+    selection: &SpinSelection,
+) -> Result<CampaignAnalysis, AnalysisError> {
     let out_dir = dir.join("analysis");
     let json_path = out_dir.join("campaign_analysis.json");
     if !force && json_path.exists() {
@@ -343,6 +434,7 @@ pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAn
         col("status")?,
     );
     let mut runs = Vec::new();
+    let mut spins: Vec<Vec<f64>> = Vec::new();
     let mut skipped = Vec::new();
     for rec in rdr.records() {
         let rec = rec.map_err(|e| err(&e))?;
@@ -352,20 +444,61 @@ pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAn
             continue;
         }
         let run_dir = dir.join(&run);
-        let (a, _) = match analyze_run(&run_dir, t_at, force) {
+        let (a, report) = match analyze_run(&run_dir, t_at, force) {
             Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
             other => other?,
         };
+        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, &a, &report);
+        for why in &not_drawn {
+            eprintln!("warning: {run}: figure not drawn: {why}");
+        }
+        spins.push(
+            report
+                .fragments
+                .iter()
+                .filter(|f| !f.is_projectile)
+                .map(|f| f.spin_rate_corrected)
+                .collect(),
+        );
         let num = |c: usize| rec[c].parse::<f64>().map_err(|e| err(&format!("{run}: {e}")));
+        let run_summary = read_json(&run_dir.join("summary.json")).ok();
+        let from_summary = |key: &str| run_summary.as_ref().and_then(|v| v[key].as_f64());
+        let (ej, sp) = (fit_ok(&a.ejection_speed_vs_size), fit_ok(&a.spin_vs_size));
+        let (best_n, maxwell) = match &a.spin_fits {
+            Fit::Ok(c) => {
+                let rss = |n: f64| c.fixed.iter().find(|f| f.n == n).map(|f| f.rss);
+                let ratio = match (rss(2.0), rss(c.best_n)) {
+                    (Some(m), Some(b)) if b > 0.0 => Some(m / b),
+                    _ => None,
+                };
+                (Some(c.best_n), ratio)
+            }
+            Fit::Failed(_) => (None, None),
+        };
+        let s = &a.summary;
         runs.push(CampaignRun {
             target: rec[c_target].to_string(),
             projectile: rec[c_proj].to_string(),
             angle_deg: num(c_angle)?,
             q_erg_per_g: num(c_q)?,
-            bound_mass_fraction: a.summary.bound_mass_fraction,
-            f_ke: a.summary.f_ke,
-            rotational_share: a.summary.rotational_share,
-            ejection_speed_median_relative: a.summary.ejection_speed_median_relative,
+            fragments: s.n_fragments,
+            escaping: s.n_escaping,
+            bound_mass_fraction: s.bound_mass_fraction,
+            f_ke: s.f_ke,
+            rotational_share: s.rotational_share,
+            ejection_speed_median: s.ejection_speed_median,
+            ejection_speed_median_relative: s.ejection_speed_median_relative,
+            ejection_exponent: ej.map(|f| f.alpha),
+            ejection_exponent_sigma: ej.map(|f| f.sigma_alpha),
+            spin_exponent: sp.map(|f| f.alpha),
+            spin_exponent_sigma: sp.map(|f| f.sigma_alpha),
+            best_n,
+            maxwellian_residual_ratio: maxwell,
+            size_site_correlation: s.ejection_sites.size_cosine_correlation,
+            impact_side_median_size: s.ejection_sites.impact_side_median_size,
+            antipodal_side_median_size: s.ejection_sites.antipodal_side_median_size,
+            energy_error: from_summary("energy_error"),
+            wall_seconds: from_summary("wall_seconds"),
             run,
         });
     }
@@ -376,12 +509,14 @@ pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAn
         Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
         Err(e) => Fit::Failed(e.to_string()),
     };
+    let spin_distributions = spin_distributions(&runs, &spins, selection);
     let analysis = CampaignAnalysis {
         t_at,
         runs,
         skipped,
         bound_fraction_vs_q: Fit::from(line),
         q_star_d,
+        spin_distributions,
     };
     std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
         path: out_dir.clone(),
@@ -402,5 +537,64 @@ pub fn analyze_campaign(dir: &Path, t_at: f64, force: bool) -> Result<CampaignAn
         path: json_path.clone(),
         reason: e.to_string(),
     })?;
+    // here rather than in the CLI, so every caller (analyze-campaign, report-roig2003) gets them
+    let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
+    for why in &not_drawn {
+        eprintln!("warning: figure not drawn: {why}");
+    }
     Ok(analysis)
+}
+
+fn fit_ok(f: &Fit<PowerLawFit>) -> Option<&PowerLawFit> {
+    match f {
+        Fit::Ok(p) => Some(p),
+        Fit::Failed(_) => None,
+    }
+}
+
+/// One [`SpinDistribution`] per projectile (in order of first appearance) from the runs and their target
+/// fragments' corrected spin rates (`spins[k]` belongs to `runs[k]`).
+pub fn spin_distributions(
+    runs: &[CampaignRun],
+    spins: &[Vec<f64>],
+    selection: &SpinSelection,
+) -> Vec<SpinDistribution> {
+    let mut projectiles: Vec<&str> = Vec::new();
+    for r in runs {
+        if !projectiles.contains(&r.projectile.as_str()) {
+            projectiles.push(&r.projectile);
+        }
+    }
+    projectiles
+        .into_iter()
+        .map(|p| {
+            let of_p: Vec<usize> = (0..runs.len()).filter(|&k| runs[k].projectile == p).collect();
+            let case: Vec<usize> = of_p
+                .iter()
+                .copied()
+                .filter(|&k| runs[k].target == selection.target && runs[k].angle_deg == selection.angle_deg)
+                .collect();
+            let (chosen, how) = if case.is_empty() {
+                (of_p, "all runs".to_string())
+            } else {
+                (
+                    case,
+                    format!("target {} at zeta {}", selection.target, selection.angle_deg),
+                )
+            };
+            let pooled: Vec<f64> = chosen.iter().flat_map(|&k| spins[k].iter().copied()).collect();
+            let bins = ((pooled.len() as f64).sqrt().round() as usize).clamp(5, 40);
+            let hist = histogram(&pooled, bins, None).unwrap_or_default();
+            let fits = Fit::from(compare_exponents(&hist.0, &hist.1, &[0.5, 1.0, 1.5, 2.0]));
+            SpinDistribution {
+                projectile: p.to_string(),
+                q_erg_per_g: chosen.iter().map(|&k| runs[k].q_erg_per_g).sum::<f64>() / chosen.len() as f64,
+                runs: chosen.iter().map(|&k| runs[k].run.clone()).collect(),
+                selection: how,
+                fragments: pooled.len(),
+                histogram: hist,
+                fits,
+            }
+        })
+        .collect()
 }

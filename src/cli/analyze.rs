@@ -72,6 +72,12 @@ pub struct AnalyzeCampaignArgs {
     /// Rewrite earlier analyses.
     #[arg(long)]
     pub force: bool,
+    /// Spin distributions (Roig03 Fig. 7): pool the runs on this target (file stem) ...
+    #[arg(long, default_value = "N200_T12")]
+    pub spin_target: String,
+    /// ... at this impact angle ζ (degrees); a projectile without such a run pools all its runs.
+    #[arg(long, default_value_t = 45.0)]
+    pub spin_angle: f64,
 }
 
 /// Runs `analyze-campaign`.
@@ -79,27 +85,107 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
     }
-    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force).map_err(|e| match e {
-        AnalysisError::Fragments(_) => CliError::failed(e),
-        _ => CliError::usage(e),
-    })?;
-    let (figures, not_drawn) = crate::analysis::figures::write_campaign_figures(&args.dir, &a);
-    for why in &not_drawn {
-        eprintln!("warning: figure not drawn: {why}");
-    }
+    let selection = crate::analysis::run_analysis::SpinSelection {
+        target: args.spin_target.clone(),
+        angle_deg: args.spin_angle,
+    };
+    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection).map_err(
+        |e| match e {
+            AnalysisError::Fragments(_) => CliError::failed(e),
+            _ => CliError::usage(e),
+        },
+    )?;
     let q_star = match &a.q_star_d {
         Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
         Fit::Failed(why) => format!("n/a ({why})"),
     };
     println!(
         "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {} \
-         (campaign_analysis.json, campaign_runs.csv, {})",
+         (campaign_analysis.json, campaign_runs.csv, Figs. 5 and 7 as SVG and PNG; each run's figures in its \
+         analysis/)",
         a.t_at,
         a.runs.len(),
         a.skipped.len(),
         q_star,
         args.dir.join("analysis").display(),
-        figures.join(", ")
+    );
+    Ok(())
+}
+
+/// `rubblepile report-roig2003`.
+#[derive(Debug, clap::Args)]
+pub struct ReportRoig2003Args {
+    /// The campaign directory of analysis/roig2003/campaign.toml (holding campaign.csv).
+    pub campaign: PathBuf,
+    /// The campaign directory of analysis/roig2003/campaign_uniform.toml (the §4.3 spin-bias partner run).
+    #[arg(long)]
+    pub uniform: Option<PathBuf>,
+    /// Where REPORT.md and figures/ go (DISCUSSION.md there is included in the report).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Time of the post-impact snapshots to analyse (s).
+    #[arg(long, default_value_t = 400.0)]
+    pub at: f64,
+    /// Replace an existing OUT/REPORT.md.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `report-roig2003`: re-analyses the campaign(s) (rewriting their `analysis/`), then writes the report.
+pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
+    if !(args.at.is_finite() && args.at > 0.0) {
+        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+    }
+    let report = args.out.join("REPORT.md");
+    if report.exists() && !args.force {
+        return Err(CliError::usage(format!(
+            "{}: exists; use --force to replace it",
+            report.display()
+        )));
+    }
+    let analyse = |dir: &PathBuf| {
+        crate::analysis::run_analysis::analyze_campaign(
+            dir,
+            args.at,
+            true,
+            &crate::analysis::run_analysis::SpinSelection::default(),
+        )
+        .map_err(|e| match e {
+            AnalysisError::Fragments(_) => CliError::failed(e),
+            _ => CliError::usage(e),
+        })
+    };
+    let campaign = analyse(&args.campaign)?;
+    let uniform = match &args.uniform {
+        Some(dir) => Some((analyse(dir)?, dir.clone())),
+        None => None,
+    };
+    let mut command = format!(
+        "rubblepile report-roig2003 {} --out {}",
+        args.campaign.display(),
+        args.out.display()
+    );
+    if let Some(u) = &args.uniform {
+        command += &format!(" --uniform {}", u.display());
+    }
+    if args.at != 400.0 {
+        command += &format!(" --at {}", args.at);
+    }
+    command += " --force";
+    let inputs = crate::analysis::report_roig2003::ReportInputs {
+        campaign: &campaign,
+        campaign_dir: &args.campaign,
+        uniform: uniform.as_ref().map(|(a, d)| (a, d.as_path())),
+        command,
+    };
+    std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
+    let path = crate::analysis::report_roig2003::write_report(&inputs, &args.out)
+        .map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
+    println!(
+        "report of {} runs ({} not completed) written to {}",
+        campaign.runs.len(),
+        campaign.skipped.len(),
+        path.display()
     );
     Ok(())
 }

@@ -42,9 +42,14 @@ pub struct ImpactArgs {
     /// Relative (and absolute) tolerance of Bulirsch–Stoer.
     #[arg(long, default_value_t = 1e-9)]
     pub rtol: f64,
-    /// Dissipation coefficient F0 (s m⁻²).
-    #[arg(long, default_value_t = 1e-4)]
+    /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is the value closest to Roig03's outcomes in
+    /// analysis/roig2003/F0_SCAN.md (the paper does not give its F0).
+    #[arg(long, default_value_t = crate::impact::run::DEFAULT_F0)]
     pub f0: f64,
+    /// Inertia model of the ellipsoids: gaussian (Roig03 Eq. 4 with the model's κ) or uniform
+    /// (homogeneous ellipsoids, free of the §4.3 spin bias).
+    #[arg(long, value_parser = ["gaussian", "uniform"], default_value = "gaussian")]
+    pub inertia: String,
     /// β of Roig03 Eq. 14 (κ is calibrated over target + projectile).
     #[arg(long, default_value_t = 10.0)]
     pub beta: f64,
@@ -104,6 +109,11 @@ impl ImpactArgs {
                 .clone()
                 .unwrap_or_else(|| crate::impact::run::default_snapshots(self.t_end)),
             every: self.every,
+            inertia: if self.inertia == "uniform" {
+                crate::ellipsoid::body::InertiaModel::Uniform
+            } else {
+                crate::ellipsoid::body::InertiaModel::Gaussian
+            },
         };
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)

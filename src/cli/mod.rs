@@ -63,6 +63,8 @@ pub enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Analyse every completed run of a campaign; bound fraction vs Q and Q*_D (Roig03 Fig. 5).
     AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
+    /// Re-analyse the Roig03 campaign (and its uniform-inertia partner) and write analysis/roig2003/REPORT.md.
+    ReportRoig2003(analyze::ReportRoig2003Args),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -226,6 +228,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
+        Command::ReportRoig2003(args) => analyze::report_roig2003(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
     }
 }

@@ -157,6 +157,42 @@ pub struct EllipsoidSystem {
     /// `−ln(cutoff)`, where each pair's taper starts above its contact exponent κλ.
     neg_ln_cutoff: f64,
     cull_exp: f64,
+    /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
+    /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
+    pair_cache: std::sync::Mutex<Option<PairCache>>,
+}
+
+/// Skin of the candidate-pair (Verlet) list, as a fraction of each body's interaction radius.
+pub const PAIR_SKIN_FRACTION: f64 = 0.25;
+
+/// Candidate pairs found with each body's interaction radius grown by a skin `s_i`, valid for any state where
+/// every body satisfies `|r_i − r_i,ref| + max(0, ρ_i − ρ_i,ref) ≤ s_i`: then every pair with
+/// `|Δ| < ρ_i + ρ_j` is among the candidates. The exact cull ([`is_negligible`]) is applied to the candidates at
+/// each state, so the pairs used (and their order, sorted) are exactly those of a fresh search.
+struct PairCache {
+    positions: Vec<Vec3>,
+    radii: Vec<f64>,
+    skins: Vec<f64>,
+    candidates: Vec<(usize, usize)>,
+}
+
+impl PairCache {
+    fn build(centres: &[Vec3], radii: &[f64]) -> Self {
+        let skins: Vec<f64> = radii.iter().map(|r| PAIR_SKIN_FRACTION * r).collect();
+        let grown: Vec<f64> = radii.iter().zip(&skins).map(|(r, s)| r + s).collect();
+        PairCache {
+            positions: centres.to_vec(),
+            radii: radii.to_vec(),
+            candidates: sphere_pairs(centres, &grown),
+            skins,
+        }
+    }
+
+    fn covers(&self, centres: &[Vec3], radii: &[f64]) -> bool {
+        centres.len() == self.positions.len()
+            && (0..centres.len())
+                .all(|i| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i])
+    }
 }
 
 impl EllipsoidSystem {
@@ -179,6 +215,7 @@ impl EllipsoidSystem {
             stride: if rotation { 14 } else { 6 },
             neg_ln_cutoff: -cutoff.ln(),
             cull_exp: max_cull_exponent(model.kappa, cutoff),
+            pair_cache: std::sync::Mutex::new(None),
         }
     }
 
@@ -300,7 +337,20 @@ impl EllipsoidSystem {
             .iter()
             .map(|k| interaction_radius(kappa, k.geometry.as_ref().expect("geometry"), self.cull_exp))
             .collect();
-        let mut pairs = sphere_pairs(&centres, &radii);
+        let mut pairs = {
+            // A poisoned lock only means another thread panicked mid-update: rebuild.
+            let mut cache = self.pair_cache.lock().unwrap_or_else(|e| e.into_inner());
+            let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
+            if !finite {
+                // Not a state to remember (the integrator will reject it): the plain search.
+                sphere_pairs(&centres, &radii)
+            } else {
+                if !cache.as_ref().is_some_and(|c| c.covers(&centres, &radii)) {
+                    *cache = Some(PairCache::build(&centres, &radii));
+                }
+                cache.as_ref().map(|c| c.candidates.clone()).unwrap_or_default()
+            }
+        };
         pairs.retain(|&(i, j)| {
             let (gi, gj) = (kin[i].geometry.as_ref().unwrap(), kin[j].geometry.as_ref().unwrap());
             !is_negligible(kappa, &(kin[i].r - kin[j].r), gi, gj, self.pair_taper(i, j).end)

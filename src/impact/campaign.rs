@@ -16,12 +16,13 @@
 //! [impact]                         # optional; every key optional (defaults of `rubblepile impact`)
 //! t_end = 10000.0                  # end time (s; default 10000)
 //! rtol = 1e-9                      # Bulirsch-Stoer relative = absolute tolerance (default 1e-9)
-//! f0 = 1e-4                        # dissipation coefficient F0 (s m^-2; default 1e-4)
+//! f0 = 1e-6                        # dissipation coefficient F0 (s m^-2; default 1e-6)
 //! beta = 10.0                      # beta of Roig03 Eq. 14 for kappa (default 10)
 //! contact_time = 90.0              # time at which the surfaces first touch (s; default 90)
 //! every = 10.0                     # time-series cadence (s; default 10)
 //! snapshots = [0.0, 100.0]         # snapshot times (s; default 0, 100, 400, 1000, 10000 cut at t_end, + t_end)
 //! speed_km_s = 5.0                 # impact speed of P1-P3 and of custom projectiles without one (km/s; default 5)
+//! inertia = "gaussian"             # "gaussian" (Roig03 Eq. 4, default) or "uniform" (homogeneous ellipsoids)
 //!
 //! [[projectile]]                   # optional custom projectiles (density 3000 kg/m^3, axes 1 : 0.7 : 0.5)
 //! id = "S1"                        # name in campaign.projectiles and in run names ([A-Za-z0-9_-], not P1-P3)
@@ -150,7 +151,7 @@ pub struct ImpactSection {
     pub t_end: Option<f64>,
     /// Bulirsch–Stoer relative (= absolute) tolerance (default 1e-9).
     pub rtol: Option<f64>,
-    /// Dissipation coefficient F0 (s m⁻²; default 1e-4).
+    /// Dissipation coefficient F0 (s m⁻²; default 1e-6).
     pub f0: Option<f64>,
     /// β of Roig03 Eq. 14 (default 10).
     pub beta: Option<f64>,
@@ -162,6 +163,8 @@ pub struct ImpactSection {
     pub snapshots: Option<Vec<f64>>,
     /// Impact speed of P1–P3 and of custom projectiles without their own (km/s; default 5).
     pub speed_km_s: Option<f64>,
+    /// Inertia model of the ellipsoids: `"gaussian"` (Roig03 Eq. 4, default) or `"uniform"`.
+    pub inertia: Option<crate::ellipsoid::body::InertiaModel>,
 }
 
 /// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5).
@@ -550,6 +553,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.beta = imp.beta.unwrap_or(DEFAULT_BETA);
             base.contact_time = imp.contact_time.unwrap_or(DEFAULT_CONTACT_TIME);
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
+            base.inertia = imp.inertia.unwrap_or_default();
             base.snapshots = imp.snapshots.clone().unwrap_or_else(|| default_snapshots(t_end));
             let projectile_field = || match custom.iter().position(|(id, _)| *id == projectile.id) {
                 Some(j) => format!("projectile[{j}]"),

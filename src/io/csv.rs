@@ -62,6 +62,63 @@ pub fn snapshot_records(t: f64, bodies: &[Body]) -> Vec<Vec<String>> {
         .collect()
 }
 
+/// The snapshot rows of the bodies `ids` (indices into `bodies`, in that order) at time `t`, without the header.
+///
+/// # Panics
+/// If an index is out of range (scene validation guarantees it is not).
+pub fn tracked_records(t: f64, bodies: &[Body], ids: &[usize]) -> Vec<Vec<String>> {
+    let all = snapshot_records(t, bodies);
+    ids.iter().map(|&id| all[id].clone()).collect()
+}
+
+/// Writes `tracks.csv` (the snapshot columns, one row per tracked body per time-series sample), flushing after
+/// each sample so a crash loses nothing written.
+pub struct TracksWriter {
+    w: ::csv::Writer<BufWriter<File>>,
+}
+
+impl TracksWriter {
+    /// Creates the file and writes the header.
+    pub fn create(path: &Path) -> std::io::Result<Self> {
+        let mut w = ::csv::Writer::from_writer(BufWriter::new(File::create(path)?));
+        w.write_record(SNAPSHOT_COLUMNS).map_err(csv_to_io)?;
+        w.flush()?;
+        Ok(TracksWriter { w })
+    }
+
+    /// Reopens `path` after a checkpoint: keeps the header and the first `rows` complete rows, drops the
+    /// rest (rows written after the checkpoint, or a half-written line) and positions for appending.
+    /// Errors are one line, naming the file.
+    pub fn open_truncated(path: &Path, rows: u64) -> Result<Self, String> {
+        let io = |e: std::io::Error| format!("{}: {e}", path.display());
+        let data = std::fs::read(path).map_err(io)?;
+        let mut newlines = data.iter().enumerate().filter(|&(_, &b)| b == b'\n').map(|(i, _)| i);
+        let keep = match newlines.nth(rows as usize) {
+            Some(i) => i as u64 + 1,
+            None => {
+                return Err(format!(
+                    "{}: holds fewer than the header and the {rows} rows written before the checkpoint",
+                    path.display()
+                ));
+            }
+        };
+        let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(io)?;
+        file.set_len(keep).map_err(io)?;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(io)?;
+        Ok(TracksWriter {
+            w: ::csv::Writer::from_writer(BufWriter::new(file)),
+        })
+    }
+
+    /// Appends the rows of the tracked bodies `ids` at time `t` and flushes them to the OS.
+    pub fn write_sample(&mut self, t: f64, bodies: &[Body], ids: &[usize]) -> std::io::Result<()> {
+        for row in tracked_records(t, bodies, ids) {
+            self.w.write_record(&row).map_err(csv_to_io)?;
+        }
+        self.w.flush()
+    }
+}
+
 /// Writes a snapshot of `bodies` at time `t` to `path` (header + one row per body), lossless.
 pub fn write_snapshot(path: &Path, t: f64, bodies: &[Body]) -> std::io::Result<()> {
     let file = File::create(path)?;

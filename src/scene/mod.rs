@@ -246,6 +246,11 @@ pub struct OutputSection {
     /// Time-series cadence (s, > 0): a row of `timeseries.csv` every `every` seconds from 0 to
     /// `t_end` inclusive (plus one at each snapshot time). Required. At most 1e8 rows.
     pub every: f64,
+    /// Bodies (indices into the scene's body list, 0-based) whose full state is written to `tracks.csv` at every
+    /// time-series row, in the snapshot columns (e.g. the projectile of an impact). Each index at most once.
+    /// Default `[]`: no `tracks.csv`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub track: Option<Vec<usize>>,
 }
 
 /// `[[body]]`: one ellipsoid and its initial state.
@@ -384,6 +389,8 @@ pub struct OutputSettings {
     pub times: Vec<f64>,
     /// Time-series cadence (s, > 0).
     pub every: f64,
+    /// Tracked bodies (indices, distinct, each < the number of bodies); empty: no `tracks.csv`.
+    pub track: Vec<usize>,
 }
 
 /// A validated scene, ready to run.
@@ -724,7 +731,7 @@ impl Validator<'_> {
             }
             None => vec![0.0, t_end],
         };
-        let output = OutputSettings { times, every };
+        let track = file.output.track.clone().unwrap_or_default();
 
         // bodies
         let raw = match (&file.scene.bodies_file, file.bodies.is_empty()) {
@@ -757,6 +764,24 @@ impl Validator<'_> {
             (Some(rel), true) => self.read_bodies_file(rel, base_dir)?,
         };
         let bodies = raw.iter().map(|b| self.body(b)).collect::<Result<Vec<_>, _>>()?;
+        for (k, &id) in track.iter().enumerate() {
+            if id >= bodies.len() {
+                return Err(self.invalid(
+                    format!("output.track[{k}]"),
+                    format!(
+                        "must be a body index below {} (the number of bodies), got {id}",
+                        bodies.len()
+                    ),
+                ));
+            }
+            if track[..k].contains(&id) {
+                return Err(self.invalid(
+                    format!("output.track[{k}]"),
+                    format!("body {id} is listed twice; give each body at most once"),
+                ));
+            }
+        }
+        let output = OutputSettings { times, every, track };
 
         // κ
         let contact_g = gravity.map(|g| g.g).unwrap_or(SI_G);
