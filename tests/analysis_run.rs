@@ -161,10 +161,18 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
         "two Q values determine a line: {}",
         a["bound_fraction_vs_q"]
     );
-    // Fig. 5, SVG and PNG
+    // Figs. 5 and 7, SVG and PNG
     let svg = std::fs::read_to_string(dir.join("c/analysis/bound_fraction_vs_q.svg")).unwrap();
     assert!(svg.contains("specific impact energy Q (erg/g)"));
     assert_png(&dir.join("c/analysis/bound_fraction_vs_q.png"));
+    let svg = std::fs::read_to_string(dir.join("c/analysis/spin_distributions.svg")).unwrap();
+    assert!(svg.contains("spin rate x (rad/s)") && svg.contains("P1 (Q = ") && svg.contains("P3 (Q = "));
+    assert_png(&dir.join("c/analysis/spin_distributions.png"));
+    // each impact run tracks its projectile, so each run's Fig. 2 separates it from the fragments
+    let run0 = dir.join("c").join(runs[0]["run"].as_str().unwrap()).join("analysis");
+    let svg = std::fs::read_to_string(run0.join("energy_partition.svg")).unwrap();
+    assert!(svg.contains("projectile: kinetic energy") && svg.contains("E / K_projectile(0) (dimensionless)"));
+    assert_png(&run0.join("energy_partition.png"));
     // each run got its own analysis
     assert!(
         dir.join("c")

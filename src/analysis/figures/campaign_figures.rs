@@ -288,19 +288,44 @@ impl Figure for SpinDistributions {
 }
 
 /// Draws Fig. 7 (`spin_distributions.svg` / `.png`) into `dir` from plain `(label, n, b)` fits, `b` in
-/// `x_unit`. Returns the files written.
+/// `x_unit` (corrected spin rates, §4.3, when they come from the campaign analysis). Returns the files written.
 pub fn write_spin_distributions(dir: &Path, fits: &[(&str, f64, f64)], x_unit: &str) -> Result<[String; 2], String> {
     let fig = SpinDistributions {
-        title: "Normalised best fits of the spin distributions (Eq. 45)".into(),
+        title: "Normalised best fits of the fragments' spin distributions (Eq. 45)".into(),
         fits: fits.iter().map(|&(l, n, b)| (l.to_string(), n, b)).collect(),
         x_unit: x_unit.to_string(),
     };
     write_figure(dir, "spin_distributions", &fig)
 }
 
-/// Writes the campaign figures into `campaign_dir/analysis/`: Fig. 5 now; Fig. 7 is drawn by
-/// [`write_spin_distributions`] once the campaign analysis carries per-projectile spin fits. Returns the files
-/// written and, for each figure that could not be drawn, why.
+/// The curves of Fig. 7 from the campaign's per-projectile spin distributions: `(label, n, b)` of each best
+/// fixed-n fit (b in rad/s, corrected spins), sorted by Q so the most energetic projectile comes last (solid, as
+/// the paper's P3); plus a note for each projectile whose fits failed.
+pub fn spin_distribution_curves(analysis: &CampaignAnalysis) -> (Vec<(String, f64, f64)>, Vec<String>) {
+    let mut dists: Vec<_> = analysis.spin_distributions.iter().collect();
+    dists.sort_by(|a, b| a.q_erg_per_g.total_cmp(&b.q_erg_per_g));
+    let mut curves = Vec::new();
+    let mut missing = Vec::new();
+    for d in dists {
+        match (d.best(), &d.fits) {
+            (Some(f), _) => curves.push((
+                format!(
+                    "{} (Q = {:.2e} erg/g, {} fragments)",
+                    d.projectile, d.q_erg_per_g, d.fragments
+                ),
+                f.n,
+                f.b,
+            )),
+            (None, Fit::Failed(why)) => missing.push(format!("{}: no fit ({why})", d.projectile)),
+            (None, Fit::Ok(_)) => missing.push(format!("{}: no fit", d.projectile)),
+        }
+    }
+    (curves, missing)
+}
+
+/// Writes the campaign figures into `campaign_dir/analysis/`: Fig. 5 `bound_fraction_vs_q` and Fig. 7
+/// `spin_distributions` (from [`spin_distribution_curves`]). Returns the files written and, for each figure that
+/// could not be drawn (or projectile left out of Fig. 7), why.
 pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) -> (Vec<String>, Vec<String>) {
     let dir = campaign_dir.join("analysis");
     let mut written = Vec::new();
@@ -327,6 +352,13 @@ pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) 
     match write_figure(&dir, "bound_fraction_vs_q", &fig5) {
         Ok(files) => written.extend(files),
         Err(why) => failed.push(format!("bound_fraction_vs_q: {why}")),
+    }
+    let (curves, missing) = spin_distribution_curves(analysis);
+    failed.extend(missing.into_iter().map(|m| format!("spin_distributions: {m}")));
+    let fits: Vec<(&str, f64, f64)> = curves.iter().map(|(l, n, b)| (l.as_str(), *n, *b)).collect();
+    match write_spin_distributions(&dir, &fits, "rad/s") {
+        Ok(files) => written.extend(files),
+        Err(why) => failed.push(format!("spin_distributions: {why}")),
     }
     (written, failed)
 }

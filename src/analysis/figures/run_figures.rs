@@ -566,7 +566,8 @@ impl EnergyPartition {
                     .map_err(draw_err)?;
             }
         }
-        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)
+        // upper left: before the impact the drift sits at round-off, far below the top
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
     }
 }
 
