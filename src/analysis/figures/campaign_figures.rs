@@ -291,7 +291,7 @@ impl Figure for SpinDistributions {
 /// `x_unit` (corrected spin rates, §4.3, when they come from the campaign analysis). Returns the files written.
 pub fn write_spin_distributions(dir: &Path, fits: &[(&str, f64, f64)], x_unit: &str) -> Result<[String; 2], String> {
     let fig = SpinDistributions {
-        title: "Normalised best fits of the fragments' spin distributions (Eq. 45)".into(),
+        title: "Normalised best fits of the fragments' corrected spin distributions (Eq. 45)".into(),
         fits: fits.iter().map(|&(l, n, b)| (l.to_string(), n, b)).collect(),
         x_unit: x_unit.to_string(),
     };

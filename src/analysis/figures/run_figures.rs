@@ -756,7 +756,10 @@ mod tests {
             points: vec![(0.1, 0.0)],
             ..fig
         };
+        std::fs::write(dir.join("empty.png"), b"stale").unwrap();
         assert!(write_figure(&dir, "empty", &nothing).is_err());
+        // no blank SVG, no stale PNG left behind
+        assert!(!dir.join("empty.svg").exists() && !dir.join("empty.png").exists());
         let _ = std::fs::remove_dir_all(&dir);
     }
 

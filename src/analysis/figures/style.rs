@@ -83,15 +83,21 @@ fn render<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, figure: &impl Figur
 }
 
 /// Draws `figure` into `dir/<stem>.svg` and `dir/<stem>.png` ([`FIGURE_SIZE`]), creating `dir`; returns the
-/// two file names. The SVG is written first; a drawing error stops at the first failure.
+/// two file names. On a drawing error neither file is left behind (plotters' backends write their file when
+/// dropped, even after a failed drawing), so a stale or blank figure never passes for a good one.
 pub fn write_figure(dir: &Path, stem: &str, figure: &impl Figure) -> Result<[String; 2], String> {
     ensure_font()?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let (svg, png) = (format!("{stem}.svg"), format!("{stem}.png"));
-    let svg_path = dir.join(&svg);
-    render(&SVGBackend::new(&svg_path, FIGURE_SIZE).into_drawing_area(), figure)?;
-    let png_path = dir.join(&png);
-    render(&BitMapBackend::new(&png_path, FIGURE_SIZE).into_drawing_area(), figure)?;
+    let (svg_path, png_path) = (dir.join(&svg), dir.join(&png));
+    let drawn = render(&SVGBackend::new(&svg_path, FIGURE_SIZE).into_drawing_area(), figure)
+        .and_then(|()| render(&BitMapBackend::new(&png_path, FIGURE_SIZE).into_drawing_area(), figure));
+    // both backends are dropped (and have written whatever they hold) by now
+    if let Err(why) = drawn {
+        let _ = std::fs::remove_file(&svg_path);
+        let _ = std::fs::remove_file(&png_path);
+        return Err(why);
+    }
     Ok([svg, png])
 }
 
