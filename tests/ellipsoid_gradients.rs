@@ -8,7 +8,7 @@ use rubblepile::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use rubblepile::ellipsoid::equations::{
     constrained_momentum_rate, constrained_momentum_rate_closed_form, constraint_rhs,
 };
-use rubblepile::ellipsoid::gravity::gravity_forces;
+use rubblepile::ellipsoid::gravity::{add_gravity_forces, gravity_forces};
 use rubblepile::ellipsoid::potential::{
     BodyGeometry, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
@@ -473,6 +473,35 @@ fn gravity_parallel_rows_match_serial_pairs_and_gradient() {
         gravity_forces(G, &p, &mass[..3], &mut [Vec3::zeros(); 3])
     });
     assert!(rel_err((-f3[0]).as_slice(), &fd, 0.0) < 1e-6);
+}
+
+/// The right-hand side's force-only half loop (serial, or in blocks of equal work) equals the
+/// pairwise reference below and above the parallel threshold, adds to what is there, and conserves momentum to
+/// round-off.
+#[test]
+fn gravity_force_only_rows_match_the_pair_sum() {
+    let mut rng = Random::new(9);
+    for n in [1, 2, 7, 63, 64, 201, 300] {
+        let pos: Vec<Vec3> = (0..n).map(|_| rng.vec3(1e5)).collect();
+        let mass: Vec<f64> = (0..n).map(|_| rng.range(1e12, 1e15)).collect();
+        let mut reference = vec![Vec3::zeros(); n];
+        gravity_forces(G, &pos, &mass, &mut reference);
+        let offset = Vec3::new(1.0, -2.0, 3.0);
+        let mut f = vec![offset; n];
+        add_gravity_forces(G, &pos, &mass, &mut f);
+        let scale: f64 = reference.iter().map(|r| r.norm()).fold(0.0, f64::max);
+        let mut total = Vec3::zeros();
+        for i in 0..n {
+            let got = f[i] - offset;
+            assert!(
+                (got - reference[i]).norm() <= 1e-13 * reference[i].norm() + 1e-300,
+                "n = {n}, body {i}: {got:?} vs {:?}",
+                reference[i]
+            );
+            total += got;
+        }
+        assert!(total.norm() <= 1e-13 * scale * n as f64, "n = {n}: Σ F = {total:?}");
+    }
 }
 
 #[test]

@@ -302,9 +302,10 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     );
     let _ = writeln!(
         w,
-        "| group | runs | bound fraction | f_KE | rotational share | median ejection speed (m/s) | ejection α | spin α |"
+        "| group | runs | bound fraction | f_KE | rotational share | median ejection speed (m/s) | ejection α | spin α | \
+         best n = 0.5 | n=2 / best | size–site corr. |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|");
     // target-size groups first (N30, N100, …), then projectiles, each in order of appearance
     let mut groups: Vec<String> = Vec::new();
     for pass in 0..2 {
@@ -326,9 +327,10 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             .cloned()
             .collect();
         let med = |f: &dyn Fn(&CampaignRun) -> Option<f64>| median(&values(&sel, f));
+        let half = sel.iter().filter(|r| r.best_n == Some(0.5)).count();
         let _ = writeln!(
             w,
-            "| {g} | {} | {:.3} | {} | {} | {:.1} | {:.2} | {:.2} |",
+            "| {g} | {} | {:.3} | {} | {} | {:.1} | {:.2} | {:.2} | {half} of {} | {:.2} | {:.2} |",
             sel.len(),
             med(&|r| Some(r.bound_mass_fraction)),
             pct(med(&|r| Some(r.f_ke))),
@@ -336,6 +338,9 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             med(&|r| Some(r.ejection_speed_median)),
             med(&|r| r.ejection_exponent),
             med(&|r| r.spin_exponent),
+            sel.len(),
+            med(&|r| r.maxwellian_residual_ratio),
+            med(&|r| r.size_site_correlation),
         );
     }
     let _ = writeln!(w);

@@ -14,7 +14,12 @@
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
-//!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
+//!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads;
+//! - `rubblepile bench work-precision --problem {top,pair,pair-dissipative,n30} --out DIR [--force]
+//!   [--repeats 5]`: work–precision diagrams of Bulirsch–Stoer, Dop853, Dopri5 and Rk4 (CSV + SVG);
+//! - `rubblepile bench nbody --problem {pythagorean,outer-solar} --rtol TOL[,TOL…] --out DIR [--force]`:
+//!   timed point-mass runs with their final states, for the comparison with REBOUND
+//!   (`analysis/rebound_compare`).
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
@@ -24,7 +29,9 @@ pub mod analyze;
 pub mod bench;
 pub mod campaign;
 pub mod impact;
+pub mod nbody;
 pub mod target;
+pub mod work_precision;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -162,6 +169,10 @@ pub struct CheckArgs {
 pub enum BenchCommand {
     /// Time one right-hand-side evaluation for a random cloud of ellipsoids (1 thread vs all threads).
     Rhs(bench::RhsArgs),
+    /// Work-precision diagrams (error and energy error vs wall time) of the integrators on a canonical problem.
+    WorkPrecision(work_precision::WorkPrecisionArgs),
+    /// Timed point-mass N-body runs (Pythagorean three-body, outer Solar System) with final states (CSV).
+    Nbody(nbody::NBodyArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -230,6 +241,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
         Command::ReportRoig2003(args) => analyze::report_roig2003(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
+        Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
+        Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),
     }
 }
 

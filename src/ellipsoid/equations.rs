@@ -13,7 +13,7 @@
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
-use crate::ellipsoid::gravity::gravity_forces;
+use crate::ellipsoid::gravity::{add_gravity_forces, gravity_forces};
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
@@ -572,9 +572,7 @@ impl OdeSystem for EllipsoidSystem {
         if let Some(gr) = self.physics.gravity {
             let pos: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
             let masses: Vec<f64> = self.shapes.iter().map(|s| s.mass).collect();
-            let mut fg = vec![Vec3::zeros(); n];
-            gravity_forces(gr.g, &pos, &masses, &mut fg);
-            force.iter_mut().zip(&fg).for_each(|(f, g)| *f += g);
+            add_gravity_forces(gr.g, &pos, &masses, &mut force);
         }
         let stride = self.stride;
         let rotation = self.rotation;

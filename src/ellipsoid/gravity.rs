@@ -10,6 +10,75 @@ use rayon::prelude::*;
 /// Above this many bodies the parallel row-wise sum is used.
 pub const PARALLEL_THRESHOLD: usize = 256;
 
+/// Rows of the half loop are cut into this many blocks of about equal work, each summed into its own buffer
+/// and reduced in block order: the bits do not depend on the number of threads.
+const BLOCKS: usize = 8;
+
+/// Below this many bodies the half loop runs serially into `forces` directly.
+const BLOCKED_FROM: usize = 64;
+
+/// The half loop over rows `rows` (pairs `(i, j)`, `i ∈ rows`, `j > i`), adding `G m_i m_j d/|d|³` to body `i`
+/// and subtracting it from body `j` in `out`. One square root and one division per pair.
+fn half_loop(g: f64, positions: &[Vec3], masses: &[f64], rows: std::ops::Range<usize>, out: &mut [Vec3]) {
+    let n = positions.len();
+    for i in rows {
+        let (pi, gmi) = (positions[i], g * masses[i]);
+        let mut fi = Vec3::zeros();
+        for j in (i + 1)..n {
+            let d = positions[j] - pi;
+            let r2 = d.norm_squared();
+            let inv_r = 1.0 / r2.sqrt();
+            let f = d * (gmi * masses[j] * inv_r * inv_r * inv_r);
+            fi += f;
+            out[j] -= f;
+        }
+        out[i] += fi;
+    }
+}
+
+/// Row boundaries that split the half loop's `n(n−1)/2` pairs into [`BLOCKS`] parts of about equal size.
+fn block_bounds(n: usize) -> Vec<usize> {
+    let total = (n * n.saturating_sub(1) / 2) as f64;
+    let mut bounds = vec![0];
+    let (mut done, mut row) = (0.0, 0);
+    for b in 1..BLOCKS {
+        let goal = total * b as f64 / BLOCKS as f64;
+        while row < n && done < goal {
+            done += (n - 1 - row) as f64;
+            row += 1;
+        }
+        bounds.push(row);
+    }
+    bounds.push(n);
+    bounds
+}
+
+/// Gravitational forces `−∂U_G/∂r_i` (N) added to `forces`, without the potential: the right-hand side's
+/// version (Roig03 Eq. 6). The symmetric half loop; from [`BLOCKED_FROM`] bodies on, its rows are cut into
+/// [`BLOCKS`] blocks of equal work computed in parallel into separate buffers and added in block order, so
+/// the result is the same on any number of threads.
+pub fn add_gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &mut [Vec3]) {
+    let n = positions.len();
+    if n < BLOCKED_FROM {
+        half_loop(g, positions, masses, 0..n, forces);
+        return;
+    }
+    let bounds = block_bounds(n);
+    let partial: Vec<Vec<Vec3>> = (0..BLOCKS)
+        .into_par_iter()
+        .map(|b| {
+            let mut out = vec![Vec3::zeros(); n];
+            half_loop(g, positions, masses, bounds[b]..bounds[b + 1], &mut out);
+            out
+        })
+        .collect();
+    for block in &partial {
+        for (f, p) in forces.iter_mut().zip(block) {
+            *f += p;
+        }
+    }
+}
+
 /// Gravitational forces `−∂U_G/∂r_i` (N) on each body, and the total potential `U_G` (J).
 /// `forces` is overwritten.
 pub fn gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &mut [Vec3]) -> f64 {

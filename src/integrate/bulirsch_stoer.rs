@@ -41,8 +41,8 @@
 //!   exactly zero (e.g. `y' = t` at `t = 0`), where ODEX would halve `H` some 60 times. Note that the
 //!   check compares scaled norms, so it also fires when `f` is nearly zero in the tolerance scale
 //!   (a state starting at rest with tiny velocity tolerances may see a few halvings at the start).
-//!   The same halving happens when the error estimate grows with
-//!   the column index (`j > 2`) or is astronomically large (`err · ε ≥ 1`).
+//!   The same halving happens when the error estimate diverges with the column index (`j > 2` and
+//!   `err_j ≥ max(4 err_{j−1}, 1)`, ODEX's `ERROLD`) or is astronomically large (`err · ε ≥ 1`).
 //! * **Non-finite values**: a NaN/∞ error estimate also halves `H`; after
 //!   [`BulirschStoer::set_max_nonfinite_retries`] (default 10) consecutive such rejections, or when
 //!   the step underflows right after one, [`IntegrateError::NonFinite`] is returned. A non-finite
@@ -199,7 +199,8 @@ pub struct Rejections {
     pub error: u64,
     /// The stability check in the first substep of columns 1–2 failed (step halved).
     pub stability: u64,
-    /// The error estimate grew with the column index, or was huge (step halved).
+    /// The error estimate diverged with the column index (`err_j ≥ max(4 err_{j−1}, 1)`), or was huge
+    /// (step halved).
     pub divergence: u64,
     /// NaN/∞ in a trial value or derivative (step halved).
     pub nonfinite: u64,
@@ -534,7 +535,10 @@ impl BulirschStoer {
         if err * f64::EPSILON >= 1.0 || (j > 2 && err >= *err_prev) {
             return Column::Shrink(Shrink::Divergence);
         }
-        *err_prev = err.max(1e-4);
+        // ODEX: ERROLD = MAX(4*ERR, 1). A column only counts as diverging when its error is both above 1
+        // (not converged) and more than four times the previous one; a smaller floor would reject steps
+        // whose columns have converged to round-off noise (err ≪ 1 but not monotone), halving H forever.
+        *err_prev = (4.0 * err).max(1.0);
         let expo = 1.0 / (2 * j - 1) as f64;
         let facmin = FAC1.powf(expo);
         let fac = (FAC2 / facmin).min(facmin.max((err / SAFE1).powf(expo) / SAFE2));

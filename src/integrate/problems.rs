@@ -10,9 +10,13 @@
 //! | [`Kepler`] | 4 | exact solution via Kepler's equation, energy and angular momentum |
 //! | [`Arenstorf`] | 4 | periodic orbit of the restricted three-body problem (hard step control) |
 //! | [`ExponentialDecay`] | 1 | mildly stiff linear decay, stability of explicit methods |
-//! | [`RigidBody`] | 3 | Euler's equations of a free rigid body, energy and angular momentum |
+//! | [`RigidBody`] | 3 | Euler's equations of a free rigid body: exact solution ([`torque_free_spin`], Jacobi elliptic functions), energy and angular momentum |
+//!
+//! The problems of the ellipsoid model itself (a free top, a bouncing pair, the N30 target, N-body tests)
+//! are in [`super::ellipsoid_problems`].
 
 use super::OdeSystem;
+use super::elliptic::{incomplete_f, jacobi_sn_cn_dn};
 use std::f64::consts::PI;
 
 /// A test problem: an [`OdeSystem`] with an initial state, a natural end time and (optionally)
@@ -348,11 +352,132 @@ impl TestProblem for RigidBody {
     fn t_end(&self) -> f64 {
         20.0
     }
+    /// The torque-free solution ([`torque_free_spin`]); `None` for a symmetric body.
+    fn exact(&self, t: f64) -> Option<Vec<f64>> {
+        torque_free_spin(self.inertia, self.omega0, t).map(|w| w.to_vec())
+    }
+}
+
+/// The exact body-frame angular velocity `ω(t)` (rad/s) of a torque-free asymmetric rigid body with
+/// principal moments `inertia` (kg m², any order, pairwise different) that has `ω(0) = omega0`, i.e. the
+/// solution of Euler's equations `I ω̇ = (I ω) × ω` (Landau & Lifshitz, *Mechanics*, §37).
+///
+/// With the moments sorted `I₁ < I₂ < I₃` (an odd relabelling of the axes also flips the sign of `ω`,
+/// which keeps Euler's equations), `2E = Σ Iᵢωᵢ²` and `M² = Σ (Iᵢωᵢ)²`:
+/// * `M² ≥ 2E I₂` (rotation about the axis of `I₃`): `ω₁ = A₁ cn τ`, `ω₂ = s A₂ sn τ`, `ω₃ = s A₃ dn τ`
+///   with `A₁² = (2EI₃ − M²)/(I₁(I₃−I₁))`, `A₂² = (2EI₃ − M²)/(I₂(I₃−I₂))`, `A₃² = (M² − 2EI₁)/(I₃(I₃−I₁))`,
+///   `τ = t √((I₃−I₂)(M²−2EI₁)/(I₁I₂I₃)) + τ₀`, `m = (I₂−I₁)(2EI₃−M²)/((I₃−I₂)(M²−2EI₁))`, `s = sign ω₃(0)`;
+/// * `M² < 2E I₂` (about the axis of `I₁`): the same with the roles of axes 1 and 3 exchanged
+///   (`ω₁ = s A₁ dn τ`, `ω₂ = s A₂ sn τ`, `ω₃ = A₃ cn τ`, `s = sign ω₁(0)`).
+///
+/// The phase `τ₀ = F(φ₀ | m)` comes from the amplitude `φ₀ = atan2(sn τ₀, cn τ₀)` of the initial state.
+/// Returns `None` when two moments agree to 1e-12 (a symmetric top) or an input is not finite.
+///
+/// ```
+/// use rubblepile::integrate::problems::torque_free_spin;
+/// let (i, w0) = ([1.0, 2.0, 3.0], [0.3, -0.2, 0.9]);
+/// let w = torque_free_spin(i, w0, 10.0).unwrap();
+/// let e = |w: &[f64; 3]| (0..3).map(|k| i[k] * w[k] * w[k]).sum::<f64>();
+/// assert!((e(&w) - e(&w0)).abs() < 1e-14);
+/// ```
+pub fn torque_free_spin(inertia: [f64; 3], omega0: [f64; 3], t: f64) -> Option<[f64; 3]> {
+    if !(inertia.iter().chain(&omega0).all(|v| v.is_finite()) && t.is_finite()) {
+        return None;
+    }
+    let mut perm = [0usize, 1, 2];
+    perm.sort_by(|&a, &b| inertia[a].total_cmp(&inertia[b]));
+    // Sign of the permutation: even (cyclic) keeps the handedness, odd flips it.
+    let inversions = (0..3)
+        .flat_map(|a| ((a + 1)..3).map(move |b| (a, b)))
+        .filter(|&(a, b)| perm[a] > perm[b])
+        .count();
+    let flip = if inversions % 2 == 1 { -1.0 } else { 1.0 };
+    let (i1, i2, i3) = (inertia[perm[0]], inertia[perm[1]], inertia[perm[2]]);
+    if i1.is_nan() || i1 <= 0.0 || i2 - i1 <= 1e-12 * i3 || i3 - i2 <= 1e-12 * i3 {
+        return None;
+    }
+    let w = [flip * omega0[perm[0]], flip * omega0[perm[1]], flip * omega0[perm[2]]];
+    let e2 = i1 * w[0] * w[0] + i2 * w[1] * w[1] + i3 * w[2] * w[2];
+    if e2 == 0.0 {
+        return Some([0.0; 3]);
+    }
+    let m2 = (i1 * w[0]).powi(2) + (i2 * w[1]).powi(2) + (i3 * w[2]).powi(2);
+    let d1 = (m2 - e2 * i1).max(0.0);
+    let d3 = (e2 * i3 - m2).max(0.0);
+    let sign = |x: f64| if x < 0.0 { -1.0 } else { 1.0 };
+    let sorted = if m2 >= e2 * i2 {
+        let a1 = (d3 / (i1 * (i3 - i1))).sqrt();
+        let a2 = (d3 / (i2 * (i3 - i2))).sqrt();
+        let a3 = (d1 / (i3 * (i3 - i1))).sqrt();
+        let rate = ((i3 - i2) * d1 / (i1 * i2 * i3)).sqrt();
+        let m = ((i2 - i1) * d3 / ((i3 - i2) * d1)).clamp(0.0, 1.0);
+        let s = sign(w[2]);
+        let phi0 = (s * w[1] / a2).atan2(w[0] / a1);
+        let phi0 = if phi0.is_nan() { 0.0 } else { phi0 };
+        let (sn, cn, dn) = jacobi_sn_cn_dn(rate * t + incomplete_f(phi0, m), m);
+        [a1 * cn, s * a2 * sn, s * a3 * dn]
+    } else {
+        let a1 = (d3 / (i1 * (i3 - i1))).sqrt();
+        let a2 = (d1 / (i2 * (i2 - i1))).sqrt();
+        let a3 = (d1 / (i3 * (i3 - i1))).sqrt();
+        let rate = ((i2 - i1) * d3 / (i1 * i2 * i3)).sqrt();
+        let m = ((i3 - i2) * d1 / ((i2 - i1) * d3)).clamp(0.0, 1.0);
+        let s = sign(w[0]);
+        let phi0 = (s * w[1] / a2).atan2(w[2] / a3);
+        let phi0 = if phi0.is_nan() { 0.0 } else { phi0 };
+        let (sn, cn, dn) = jacobi_sn_cn_dn(rate * t + incomplete_f(phi0, m), m);
+        [s * a1 * dn, s * a2 * sn, a3 * cn]
+    };
+    let mut out = [0.0; 3];
+    for k in 0..3 {
+        out[perm[k]] = flip * sorted[k];
+    }
+    Some(out)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The torque-free solution satisfies Euler's equations (central differences), keeps E and |L|, and
+    /// starts at ω(0), for both cases (M² above and below 2EI₂) and for every ordering of the moments.
+    #[test]
+    fn torque_free_spin_solves_euler() {
+        let orders = [
+            [1.0, 2.0, 3.0],
+            [2.0, 3.0, 1.0],
+            [3.0, 2.0, 1.0],
+            [2.0, 1.0, 2.0 / 3.0],
+            [1.0, 3.0, 2.0],
+        ];
+        let spins = [[0.3, -0.2, 0.9], [-1.2, 0.4, 0.2], [0.5, 0.0, -0.6], [0.0, 1.0, 0.1]];
+        for inertia in orders {
+            for w0 in spins {
+                let body = RigidBody { inertia, omega0: w0 };
+                let w_init = torque_free_spin(inertia, w0, 0.0).unwrap();
+                for k in 0..3 {
+                    assert!((w_init[k] - w0[k]).abs() < 1e-13, "{inertia:?} {w0:?}: {w_init:?}");
+                }
+                for &t in &[0.7, 5.3, 40.0] {
+                    let w = torque_free_spin(inertia, w0, t).unwrap();
+                    assert!((body.energy(&w) - body.energy(&w0)).abs() < 1e-13);
+                    assert!((body.angular_momentum_norm(&w) - body.angular_momentum_norm(&w0)).abs() < 1e-13);
+                    let h = 1e-5;
+                    let (wp, wm) = (
+                        torque_free_spin(inertia, w0, t + h).unwrap(),
+                        torque_free_spin(inertia, w0, t - h).unwrap(),
+                    );
+                    let mut f = [0.0; 3];
+                    body.rhs(t, &w, &mut f);
+                    for k in 0..3 {
+                        let d = (wp[k] - wm[k]) / (2.0 * h);
+                        assert!((d - f[k]).abs() < 1e-8, "{inertia:?} {w0:?} t {t}: {d} vs {}", f[k]);
+                    }
+                }
+            }
+        }
+        assert!(torque_free_spin([1.0, 1.0, 2.0], [0.1, 0.2, 0.3], 1.0).is_none());
+    }
 
     #[test]
     fn kepler_exact_is_consistent() {

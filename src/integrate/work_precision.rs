@@ -1,0 +1,424 @@
+//! Work–precision measurements: run an integrator on a [`ProblemSetup`] at a tolerance (or fixed step),
+//! time the integration, and measure the final-state error against a reference and the energy residual.
+//!
+//! The method follows Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10 ("Numerical comparisons": error at
+//! the end point against computing time, one curve per code, tolerances one per decade) and the
+//! work–precision diagrams of DifferentialEquations.jl's SciMLBenchmarks.
+//!
+//! * **Time** is the wall-clock time of the [`Integrator::advance`] calls only: building the system, the
+//!   initial state, the diagnostics at the energy checks and all I/O are outside the clock. Each setting is
+//!   run `repeats` times and the **median** is reported; a setting whose first run takes less than
+//!   [`SHORT_RUN_SECONDS`] is run more often (up to [`SHORT_RUN_MAX_REPEATS`] times, about
+//!   [`SHORT_RUN_BUDGET_SECONDS`] in all) so that its median is not at the mercy of one scheduler hiccup, and
+//!   a setting whose first run takes longer than [`LONG_RUN_SECONDS`] is run [`LONG_RUN_REPEATS`] times at
+//!   most and the **minimum** is reported.
+//! * **CPU time** of the calling thread over the same `advance` calls is recorded beside it (from Linux's
+//!   `/proc/thread-self/schedstat`, NaN elsewhere): on a shared, loaded machine the wall time measures the
+//!   scheduler's share as much as the code, the thread's CPU time much less so. The CLI runs every setting in
+//!   a one-thread pool, so the RHS's rayon loops (used from 64 bodies / 256 pairs) stay on that thread.
+//! * **Error** is [`ProblemSetup::spin_error`] for the top (analytic reference) and otherwise
+//!   [`ProblemSetup::state_error`] (block norm) against a reference state at `t_end` computed by a
+//!   *different* method at a tight tolerance: Dop853 for Bulirsch–Stoer, Bulirsch–Stoer for every other method.
+//! * **Energy error** is the largest [`ProblemSetup::energy_residual`] over the problem's
+//!   `energy_samples` equally spaced checks (the integrator lands on each).
+
+use std::time::Instant;
+
+use super::ellipsoid_problems::{ProblemSetup, ReferenceKind};
+use super::{IntegrateError, Method, Stats, Tolerances, make_integrator};
+
+/// Runs longer than this (s) are repeated at most [`LONG_RUN_REPEATS`] times and timed by their minimum.
+pub const LONG_RUN_SECONDS: f64 = 2.0;
+/// Repeats of a run longer than [`LONG_RUN_SECONDS`].
+pub const LONG_RUN_REPEATS: usize = 2;
+/// Runs shorter than this (s) are repeated more than asked, see [`SHORT_RUN_MAX_REPEATS`].
+pub const SHORT_RUN_SECONDS: f64 = 0.05;
+/// Most repeats of a short run.
+pub const SHORT_RUN_MAX_REPEATS: usize = 25;
+/// Total time (s) the repeats of a short run aim at.
+pub const SHORT_RUN_BUDGET_SECONDS: f64 = 0.25;
+/// Default tolerances of the sweep: `rtol = atol = 10⁻⁴ … 10⁻¹²`, one per decade.
+pub const DEFAULT_TOLERANCES: [f64; 9] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12];
+/// Default tolerance of the reference runs.
+pub const DEFAULT_REFERENCE_TOLERANCE: f64 = 1e-13;
+
+/// What one run integrates with: a method and its tolerance (`rtol = atol`) or, for Rk4, its fixed step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setting {
+    /// The method.
+    pub method: Method,
+    /// `rtol = atol` of the adaptive methods (`None` for Rk4).
+    pub tolerance: Option<f64>,
+    /// Rk4's fixed step (time unit of the problem; `None` for the adaptive methods).
+    pub step: Option<f64>,
+}
+
+impl Setting {
+    /// An adaptive method at `rtol = atol = tolerance`.
+    pub fn adaptive(method: Method, tolerance: f64) -> Self {
+        Setting {
+            method,
+            tolerance: Some(tolerance),
+            step: None,
+        }
+    }
+
+    /// Rk4 with the fixed step `step`.
+    pub fn rk4(step: f64) -> Self {
+        Setting {
+            method: Method::Rk4,
+            tolerance: None,
+            step: Some(step),
+        }
+    }
+
+    /// E.g. `bulirsch-stoer rtol 1e-8` or `rk4 h 0.01`.
+    pub fn label(&self) -> String {
+        match (self.tolerance, self.step) {
+            (Some(t), _) => format!("{} rtol {t:e}", self.method),
+            (None, Some(h)) => format!("{} h {h:e}", self.method),
+            _ => self.method.to_string(),
+        }
+    }
+}
+
+/// The outcome of one run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunOutcome {
+    /// The state at `t_end`.
+    pub y: Vec<f64>,
+    /// Largest energy residual over the checks.
+    pub energy_error: f64,
+    /// The integrator's statistics.
+    pub stats: Stats,
+    /// Wall-clock time of the `advance` calls (s).
+    pub wall_seconds: f64,
+    /// CPU time of the calling thread over the `advance` calls (s; NaN where not measurable).
+    pub cpu_seconds: f64,
+}
+
+/// CPU time the calling thread has run so far (s), from `/proc/thread-self/schedstat` (Linux, ns resolution);
+/// `None` where that file is not available.
+pub fn thread_cpu_seconds() -> Option<f64> {
+    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
+    Some(ns as f64 * 1e-9)
+}
+
+/// Integrates `problem` from 0 to `t_end` with `setting`, landing on the energy checks; only the
+/// `advance` calls are timed.
+pub fn run_once(problem: &ProblemSetup, setting: &Setting) -> Result<RunOutcome, IntegrateError> {
+    let system = &problem.system;
+    let mut y = problem.initial_state();
+    let tol = setting.tolerance.unwrap_or(1e-6);
+    let mut integ = make_integrator(setting.method, Tolerances::uniform(tol, tol, y.len()), setting.step)?;
+    let d0 = system.diagnostics(&y);
+    let mut t = 0.0;
+    let mut wall = 0.0;
+    let mut cpu = 0.0;
+    let mut energy: f64 = 0.0;
+    let samples = problem.energy_samples.max(1);
+    for k in 1..=samples {
+        let target = if k == samples {
+            problem.t_end
+        } else {
+            problem.t_end * k as f64 / samples as f64
+        };
+        let cpu_start = thread_cpu_seconds();
+        let start = Instant::now();
+        let r = integ.advance(system, &mut t, &mut y, target);
+        wall += start.elapsed().as_secs_f64();
+        cpu += match (cpu_start, thread_cpu_seconds()) {
+            (Some(a), Some(b)) => b - a,
+            _ => f64::NAN,
+        };
+        r?;
+        energy = energy.max(problem.energy_residual(&d0, &y));
+    }
+    Ok(RunOutcome {
+        y,
+        energy_error: energy,
+        stats: integ.stats(),
+        wall_seconds: wall,
+        cpu_seconds: cpu,
+    })
+}
+
+/// One row of a work–precision table (one setting).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepRow {
+    /// The setting.
+    pub setting: Setting,
+    /// Final-state error (see the module docs).
+    pub error: f64,
+    /// Largest energy residual.
+    pub energy_error: f64,
+    /// Median (or, for long runs, minimum) wall time of the integration (s).
+    pub wall_seconds: f64,
+    /// RHS evaluations of one run.
+    pub rhs_evaluations: u64,
+    /// Accepted steps of one run.
+    pub steps: u64,
+    /// Rejected steps of one run.
+    pub rejected_steps: u64,
+    /// How many runs were timed.
+    pub timed_runs: usize,
+    /// `"median"` or `"min"`: which statistic `wall_seconds` (and `cpu_seconds`) is.
+    pub statistic: &'static str,
+    /// The same statistic of the thread's CPU time over the integration (s; NaN where not measurable).
+    pub cpu_seconds: f64,
+}
+
+/// Median of a non-empty slice.
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// Runs `setting` `repeats` times (more for short runs, fewer for long ones, see the module docs); the error is computed with
+/// `error_of(final state)`.
+pub fn measure(
+    problem: &ProblemSetup,
+    setting: &Setting,
+    repeats: usize,
+    error_of: &dyn Fn(&[f64]) -> f64,
+) -> Result<SweepRow, IntegrateError> {
+    let first = run_once(problem, setting)?;
+    let mut times = vec![first.wall_seconds];
+    let mut cpu = vec![first.cpu_seconds];
+    let long = first.wall_seconds > LONG_RUN_SECONDS;
+    let runs = if long {
+        repeats.clamp(1, LONG_RUN_REPEATS)
+    } else if first.wall_seconds < SHORT_RUN_SECONDS {
+        let fill = (SHORT_RUN_BUDGET_SECONDS / first.wall_seconds.max(1e-9)).ceil() as usize;
+        repeats.max(fill.min(SHORT_RUN_MAX_REPEATS))
+    } else {
+        repeats.max(1)
+    };
+    for _ in 1..runs {
+        let run = run_once(problem, setting)?;
+        times.push(run.wall_seconds);
+        cpu.push(run.cpu_seconds);
+    }
+    let min = |v: &[f64]| v.iter().copied().fold(f64::INFINITY, f64::min);
+    let (wall, cpu_seconds, statistic) = if long {
+        (min(&times), min(&cpu), "min")
+    } else {
+        (median(&times), median(&cpu), "median")
+    };
+    Ok(SweepRow {
+        setting: *setting,
+        error: error_of(&first.y),
+        energy_error: first.energy_error,
+        wall_seconds: wall,
+        rhs_evaluations: first.stats.rhs_evaluations,
+        steps: first.stats.steps_accepted,
+        rejected_steps: first.stats.steps_rejected,
+        timed_runs: times.len(),
+        statistic,
+        cpu_seconds,
+    })
+}
+
+/// The reference states of a problem with a numerical reference.
+#[derive(Debug, Clone, PartialEq)]
+pub struct References {
+    /// Tolerance of both reference runs.
+    pub tolerance: f64,
+    /// Dop853 at `tolerance`: the reference of Bulirsch–Stoer.
+    pub dop853: Vec<f64>,
+    /// Bulirsch–Stoer at `tolerance`: the reference of every other method.
+    pub bulirsch_stoer: Vec<f64>,
+    /// Block-norm distance between the two (a floor under the measurable error).
+    pub difference: f64,
+    /// Wall time of the two reference runs (s): Dop853, Bulirsch–Stoer.
+    pub wall_seconds: [f64; 2],
+}
+
+impl References {
+    /// Computes both reference runs at `tolerance`.
+    pub fn compute(problem: &ProblemSetup, tolerance: f64) -> Result<Self, IntegrateError> {
+        let d = run_once(problem, &Setting::adaptive(Method::Dop853, tolerance))?;
+        let b = run_once(problem, &Setting::adaptive(Method::BulirschStoer, tolerance))?;
+        Ok(References {
+            tolerance,
+            difference: problem.state_error(&b.y, &d.y),
+            dop853: d.y,
+            bulirsch_stoer: b.y,
+            wall_seconds: [d.wall_seconds, b.wall_seconds],
+        })
+    }
+
+    /// The reference state for runs of `method`.
+    pub fn for_method(&self, method: Method) -> &[f64] {
+        if method == Method::BulirschStoer {
+            &self.dop853
+        } else {
+            &self.bulirsch_stoer
+        }
+    }
+}
+
+/// What a sweep runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepConfig {
+    /// Adaptive methods swept over `tolerances` (in this order).
+    pub methods: Vec<Method>,
+    /// `rtol = atol` values, loosest first.
+    pub tolerances: Vec<f64>,
+    /// Rk4 steps, largest first (empty = no Rk4).
+    pub rk4_steps: Vec<f64>,
+    /// Timed repeats per setting.
+    pub repeats: usize,
+    /// A method's sweep stops after its first run longer than this (s): tighter settings would take longer.
+    pub max_run_seconds: f64,
+    /// Tolerance of the reference runs (problems with a numerical reference).
+    pub reference_tolerance: f64,
+}
+
+/// A finished sweep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Sweep {
+    /// One row per completed setting.
+    pub rows: Vec<SweepRow>,
+    /// The numerical references (`None` for the analytic top).
+    pub references: Option<References>,
+    /// Settings left out, with why (a failed run, or the time limit).
+    pub skipped: Vec<String>,
+}
+
+/// Runs the sweep; `progress` is called with every finished row and every skip note.
+pub fn sweep(
+    problem: &ProblemSetup,
+    config: &SweepConfig,
+    progress: &mut dyn FnMut(&str),
+) -> Result<Sweep, IntegrateError> {
+    let references = match problem.reference {
+        ReferenceKind::Analytic => None,
+        ReferenceKind::Numerical => {
+            progress(&format!(
+                "reference runs (dop853 and bulirsch-stoer at rtol = atol = {:e}) ...",
+                config.reference_tolerance
+            ));
+            let r = References::compute(problem, config.reference_tolerance)?;
+            progress(&format!(
+                "  done in {:.2} s + {:.2} s; the two references differ by {:.2e} (block norm)",
+                r.wall_seconds[0], r.wall_seconds[1], r.difference
+            ));
+            Some(r)
+        }
+    };
+    let t_end = problem.t_end;
+    let mut rows = Vec::new();
+    let mut skipped = Vec::new();
+    let mut plan: Vec<Vec<Setting>> = config
+        .methods
+        .iter()
+        .filter(|&&m| m != Method::Rk4)
+        .map(|&m| config.tolerances.iter().map(|&t| Setting::adaptive(m, t)).collect())
+        .collect();
+    if !config.rk4_steps.is_empty() {
+        plan.push(config.rk4_steps.iter().map(|&h| Setting::rk4(h)).collect());
+    }
+    for settings in plan {
+        for (k, setting) in settings.iter().enumerate() {
+            let error_of = |y: &[f64]| match &references {
+                None => problem.spin_error(t_end, y).unwrap_or(f64::NAN),
+                Some(r) => problem.state_error(y, r.for_method(setting.method)),
+            };
+            match measure(problem, setting, config.repeats, &error_of) {
+                Ok(row) => {
+                    progress(&format!(
+                        "{:<28} error {:.3e}  energy {:.3e}  wall {:.4e} s, cpu {:.4e} s ({} of {})  {} RHS, {} steps",
+                        setting.label(),
+                        row.error,
+                        row.energy_error,
+                        row.wall_seconds,
+                        row.cpu_seconds,
+                        row.statistic,
+                        row.timed_runs,
+                        row.rhs_evaluations,
+                        row.steps
+                    ));
+                    let slow = row.wall_seconds > config.max_run_seconds;
+                    rows.push(row);
+                    if slow && k + 1 < settings.len() {
+                        let note = format!(
+                            "{}: settings tighter than {} left out (a run took more than {} s)",
+                            setting.method,
+                            setting.label(),
+                            config.max_run_seconds
+                        );
+                        progress(&note);
+                        skipped.push(note);
+                        break;
+                    }
+                }
+                Err(e) => {
+                    let note = format!("{}: failed: {e}", setting.label());
+                    progress(&note);
+                    skipped.push(note);
+                }
+            }
+        }
+    }
+    Ok(Sweep {
+        rows,
+        references,
+        skipped,
+    })
+}
+
+/// The CSV header of a work–precision table: the required columns
+/// `method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps`, then `h,rejected_steps,timed_runs,
+/// wall_statistic,cpu_seconds`.
+pub const CSV_HEADER: &str = "method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps,h,rejected_steps,\
+                              timed_runs,wall_statistic,cpu_seconds";
+
+/// One CSV line (no newline) for `row`: `rtol` is empty for Rk4 and `h` empty for the adaptive methods.
+pub fn csv_line(row: &SweepRow) -> String {
+    let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
+    format!(
+        "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{:e}",
+        row.setting.method,
+        opt(row.setting.tolerance),
+        row.error,
+        row.energy_error,
+        row.wall_seconds,
+        row.rhs_evaluations,
+        row.steps,
+        opt(row.setting.step),
+        row.rejected_steps,
+        row.timed_runs,
+        row.statistic,
+        row.cpu_seconds
+    )
+}
+
+/// Interpolates, in log–log, the wall time at which a method's (time, error) curve reaches `error`
+/// (`points` in any order; the curve is taken as the sequence sorted by time). `None` when `error` is
+/// outside the curve's range.
+pub fn time_at_error(points: &[(f64, f64)], error: f64) -> Option<f64> {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0 && e.is_finite())
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for w in p.windows(2) {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        if (e0 - error) * (e1 - error) <= 0.0 && e0 != e1 {
+            let s = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
+            return Some((t0.ln() + s * (t1.ln() - t0.ln())).exp());
+        }
+    }
+    None
+}
