@@ -18,6 +18,20 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
+/// A PNG of the figures' 800 × 560 pixels (signature and IHDR read by hand).
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.len() > 24
+            && bytes[..8] == [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n']
+            && &bytes[12..16] == b"IHDR",
+        "{}: not a PNG",
+        path.display()
+    );
+    let be = |k: usize| u32::from_be_bytes([bytes[k], bytes[k + 1], bytes[k + 2], bytes[k + 3]]);
+    assert_eq!((be(16), be(20)), (800, 560), "{}", path.display());
+}
+
 /// Every number equal to 1e-9 relative (and every string, bool and key identical).
 fn assert_json_close(a: &serde_json::Value, b: &serde_json::Value, path: &str) {
     use serde_json::Value;
@@ -66,18 +80,29 @@ fn analyze_reproduces_the_golden_analysis() {
         .lines()
         .count();
     assert_eq!(rows, 1 + 31, "header + 30 fragments + projectile");
-    // the figures, with their axes labelled in units
-    for (file, label) in [
-        ("ejection_vs_size.svg", "ejection speed |Δv| (m/s)"),
-        ("spin_vs_size.svg", "spin rate ω, corrected (rad/s)"),
-        ("spin_histogram.svg", "spin rate ω (rad/s)"),
+    // the figures, SVG and PNG, with their axes labelled in units
+    for (stem, label) in [
+        ("velocity_field", "ejection velocity Δv_z (m/s)"),
+        ("ejection_vs_size", "ejection speed |Δv| (m/s)"),
+        ("spin_vs_size", "spin rate ω, corrected (rad/s)"),
+        ("spin_histogram", "spin rate ω, corrected (rad/s)"),
+        ("rotation_mode_vs_size", "parent-body effective radius (dimensionless)"),
     ] {
-        let svg = std::fs::read_to_string(dir.join("analysis").join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let file = format!("{stem}.svg");
+        let svg = std::fs::read_to_string(dir.join("analysis").join(&file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         assert!(
             svg.contains("<svg") && svg.contains(label),
             "{file} lacks its axis label {label:?}"
         );
+        assert_png(&dir.join("analysis").join(format!("{stem}.png")));
     }
+    // this committed run has no timeseries.csv: Fig. 2 is skipped with a warning, the analysis succeeds
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("energy_partition") && stderr.contains("timeseries.csv"),
+        "{stderr}"
+    );
+    assert!(!dir.join("analysis/energy_partition.png").exists());
     // a second analysis refuses to overwrite, --force allows it
     assert_eq!(
         rubblepile(&dir, &["analyze", ".", "--at", "200"]).status.code(),
@@ -136,6 +161,18 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
         "two Q values determine a line: {}",
         a["bound_fraction_vs_q"]
     );
+    // Figs. 5 and 7, SVG and PNG
+    let svg = std::fs::read_to_string(dir.join("c/analysis/bound_fraction_vs_q.svg")).unwrap();
+    assert!(svg.contains("specific impact energy Q (erg/g)"));
+    assert_png(&dir.join("c/analysis/bound_fraction_vs_q.png"));
+    let svg = std::fs::read_to_string(dir.join("c/analysis/spin_distributions.svg")).unwrap();
+    assert!(svg.contains("spin rate x (rad/s)") && svg.contains("P1 (Q = ") && svg.contains("P3 (Q = "));
+    assert_png(&dir.join("c/analysis/spin_distributions.png"));
+    // each impact run tracks its projectile, so each run's Fig. 2 separates it from the fragments
+    let run0 = dir.join("c").join(runs[0]["run"].as_str().unwrap()).join("analysis");
+    let svg = std::fs::read_to_string(run0.join("energy_partition.svg")).unwrap();
+    assert!(svg.contains("projectile: kinetic energy") && svg.contains("E / K_projectile(0) (dimensionless)"));
+    assert_png(&run0.join("energy_partition.png"));
     // each run got its own analysis
     assert!(
         dir.join("c")

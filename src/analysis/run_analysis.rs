@@ -114,6 +114,15 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     Ok(out)
 }
 
+/// The snapshot of the run in `dir` at time `t` (s, to 1e-9 relative), if there is one.
+pub fn snapshot_path(dir: &Path, t: f64) -> Option<PathBuf> {
+    snapshot_times(dir)
+        .ok()?
+        .into_iter()
+        .find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+        .map(|(_, p)| p)
+}
+
 /// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
 /// (or `force`). Returns the per-run results and the per-fragment report.
 pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
@@ -388,8 +397,10 @@ impl Default for SpinSelection {
 }
 
 /// Analyses every completed run listed in `CAMPAIGN_DIR/campaign.csv` at `t_at` (each run's own
-/// `analysis/` is written or, with `force`, rewritten) and writes `CAMPAIGN_DIR/analysis/campaign_analysis.json`
-/// and `campaign_runs.csv`.
+/// `analysis/` is written or, with `force`, rewritten, figures included) and writes
+/// `CAMPAIGN_DIR/analysis/campaign_analysis.json`, `campaign_runs.csv` and the campaign figures (Roig03 Figs. 5
+/// and 7, [`crate::analysis::figures::write_campaign_figures`]; a figure that cannot be drawn is a warning on
+/// stderr).
 pub fn analyze_campaign(
     dir: &Path,
     t_at: f64,
@@ -437,8 +448,7 @@ pub fn analyze_campaign(
             Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
             other => other?,
         };
-        let figures_dir = run_dir.join("analysis");
-        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&figures_dir, &a, &report);
+        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, &a, &report);
         for why in &not_drawn {
             eprintln!("warning: {run}: figure not drawn: {why}");
         }
@@ -527,6 +537,11 @@ pub fn analyze_campaign(
         path: json_path.clone(),
         reason: e.to_string(),
     })?;
+    // here rather than in the CLI, so every caller (analyze-campaign, report-roig2003) gets them
+    let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
+    for why in &not_drawn {
+        eprintln!("warning: figure not drawn: {why}");
+    }
     Ok(analysis)
 }
 

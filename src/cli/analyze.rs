@@ -27,7 +27,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
-    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir.join("analysis"), &a, &report);
+    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir, &a, &report);
     for why in &not_drawn {
         eprintln!("warning: figure not drawn: {why}");
     }
@@ -100,12 +100,14 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
         Fit::Failed(why) => format!("n/a ({why})"),
     };
     println!(
-        "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {}",
+        "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {} \
+         (campaign_analysis.json, campaign_runs.csv, Figs. 5 and 7 as SVG and PNG; each run's figures in its \
+         analysis/)",
         a.t_at,
         a.runs.len(),
         a.skipped.len(),
         q_star,
-        args.dir.join("analysis").display()
+        args.dir.join("analysis").display(),
     );
     Ok(())
 }

@@ -183,6 +183,8 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
 fn plot_rhs(path: &std::path::Path, results: &[(usize, RhsTiming)], counts: &[usize]) -> Result<(), String> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| e.to_string();
+    // plotters measures (and, in PNGs, draws) text with the font the figures embed; it must be registered first
+    crate::analysis::figures::style::ensure_font()?;
     let (mut n_lo, mut n_hi) = (f64::INFINITY, 0.0_f64);
     let (mut t_lo, mut t_hi) = (f64::INFINITY, 0.0_f64);
     for (n, r) in results {

@@ -249,6 +249,8 @@ pub fn draw_work_precision<DB: DrawingBackend>(
     title: &str,
     rows: &[SweepRow],
 ) -> Result<(), String> {
+    // plotters measures (and in bitmaps draws) text with the font the figures embed: register it first
+    crate::analysis::figures::style::ensure_font()?;
     let e = |err: &dyn std::fmt::Display| err.to_string();
     area.fill(&WHITE).map_err(|x| e(&x))?;
     let area = area.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;

@@ -1,0 +1,272 @@
+//! Shared look and output of the Roig03 figures (Figs. 2–9): the embedded font, sizes, colours, range and
+//! clipping helpers, and [`write_figure`], which renders one [`Figure`] into both an SVG and a PNG file.
+//!
+//! Each figure is drawn by a single generic [`Figure::draw`] on a `DrawingArea<DB, Shift>`, and
+//! [`write_figure`] calls it once with plotters' `SVGBackend` and once with its `BitMapBackend`: the two files
+//! cannot diverge.
+//!
+//! Text: plotters' `ab_glyph` feature lays out and rasterises glyphs in pure Rust from a font registered at
+//! run time ([`ensure_font`]); the font is DejaVu Sans, embedded in the binary from
+//! `src/analysis/figures/fonts/DejaVuSans.ttf` (licence beside it), so neither output needs system font
+//! libraries or font files. The SVG files name the family `sans-serif` and the viewer picks its own font; the
+//! embedded one still sizes the label areas and legends.
+
+use std::path::Path;
+use std::sync::OnceLock;
+
+use plotters::chart::ChartContext;
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::prelude::*;
+
+/// Font family name every figure uses, the one the embedded font is registered under.
+pub const FONT_FAMILY: &str = "sans-serif";
+/// Size of every figure (pixels; also the SVG's user units). Small, so the PNGs stay light.
+pub const FIGURE_SIZE: (u32, u32) = (800, 560);
+/// Font size of figure titles (pixels).
+pub const TITLE_FONT: u32 = 19;
+/// Font size of axis labels (pixels).
+pub const LABEL_FONT: u32 = 15;
+/// Font size of legends, tick labels and annotations (pixels).
+pub const SMALL_FONT: u32 = 13;
+
+/// Colour of data points.
+pub const DATA_COLOUR: RGBColor = RGBColor(31, 119, 180);
+/// Colour of data points singled out (escaping fragments, per-Q means …).
+pub const HIGHLIGHT_COLOUR: RGBColor = RGBColor(214, 39, 40);
+/// Colour of fitted lines.
+pub const FIT_COLOUR: RGBColor = RGBColor(200, 30, 30);
+/// Colour of theoretical or published reference lines.
+pub const REFERENCE_COLOUR: RGBColor = RGBColor(40, 40, 40);
+/// Colour of guide lines (zero, one half, escape speed).
+pub const GUIDE_COLOUR: RGBColor = RGBColor(110, 110, 110);
+/// Distinct colours for several curves in one panel.
+pub const SERIES_COLOURS: [RGBColor; 4] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(148, 103, 189),
+];
+
+/// DejaVu Sans 2.37 (Bitstream Vera licence, `fonts/LICENSE-DejaVu.txt`).
+static DEJAVU_SANS: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
+
+/// A drawing result: the reason as one line when a figure could not be drawn.
+pub type PlotResult = Result<(), String>;
+
+/// Turns a plotters error (or any other) into the one-line reason of [`PlotResult`].
+pub fn draw_err(err: impl std::fmt::Display) -> String {
+    err.to_string()
+}
+
+/// Registers the embedded font as [`FONT_FAMILY`] (once per process). Every figure needs it, the SVG ones
+/// too: plotters measures text with it to size label areas and legends.
+pub fn ensure_font() -> PlotResult {
+    static REGISTERED: OnceLock<Result<(), String>> = OnceLock::new();
+    REGISTERED
+        .get_or_init(|| {
+            plotters::style::register_font(FONT_FAMILY, FontStyle::Normal, DEJAVU_SANS)
+                .map_err(|_| "the embedded DejaVu Sans font could not be parsed".to_string())
+        })
+        .clone()
+}
+
+/// One figure, drawn the same way on any plotters backend.
+pub trait Figure {
+    /// Draws the whole figure on `root` (already filled white; [`write_figure`] presents it afterwards).
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> PlotResult;
+}
+
+fn render<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, figure: &impl Figure) -> PlotResult {
+    root.fill(&WHITE).map_err(draw_err)?;
+    figure.draw(root)?;
+    root.present().map_err(draw_err)
+}
+
+/// Draws `figure` into `dir/<stem>.svg` and `dir/<stem>.png` ([`FIGURE_SIZE`]), creating `dir`; returns the
+/// two file names. On a drawing error neither file is left behind (plotters' backends write their file when
+/// dropped, even after a failed drawing), so a stale or blank figure never passes for a good one.
+pub fn write_figure(dir: &Path, stem: &str, figure: &impl Figure) -> Result<[String; 2], String> {
+    ensure_font()?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let (svg, png) = (format!("{stem}.svg"), format!("{stem}.png"));
+    let (svg_path, png_path) = (dir.join(&svg), dir.join(&png));
+    let drawn = render(&SVGBackend::new(&svg_path, FIGURE_SIZE).into_drawing_area(), figure)
+        .and_then(|()| render(&BitMapBackend::new(&png_path, FIGURE_SIZE).into_drawing_area(), figure));
+    // both backends are dropped (and have written whatever they hold) by now
+    if let Err(why) = drawn {
+        let _ = std::fs::remove_file(&svg_path);
+        let _ = std::fs::remove_file(&png_path);
+        return Err(why);
+    }
+    Ok([svg, png])
+}
+
+/// Text style of titles.
+pub fn title_style() -> TextStyle<'static> {
+    (FONT_FAMILY, TITLE_FONT).into_font().into()
+}
+
+/// Text style of axis labels.
+pub fn label_style() -> TextStyle<'static> {
+    (FONT_FAMILY, LABEL_FONT).into_font().into()
+}
+
+/// Text style of legends, ticks and annotations.
+pub fn small_style() -> TextStyle<'static> {
+    (FONT_FAMILY, SMALL_FONT).into_font().into()
+}
+
+/// Draws the legend of `chart` (the series given a `.label`) at `position`, boxed on a light background.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+) -> PlotResult {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(small_style())
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(draw_err)
+}
+
+/// The smallest and largest of the finite values (`None` without any).
+pub fn finite_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
+    values
+        .into_iter()
+        .filter(|v| v.is_finite())
+        .fold(None, |acc, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+        })
+}
+
+/// A linear axis range around `[lo, hi]` widened by `pad` of its span on each side (a unit span when the
+/// values coincide, so plotters always gets a non-empty range).
+pub fn padded(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+    let span = hi - lo;
+    if span > 0.0 {
+        (lo - pad * span, hi + pad * span)
+    } else {
+        let half = if lo != 0.0 { 0.5 * lo.abs() } else { 0.5 };
+        (lo - half, hi + half)
+    }
+}
+
+/// A logarithmic axis range around the positive `[lo, hi]` widened by the factor `pad` (> 1) on each side
+/// (a decade each side when the values coincide), then down to the power of ten below when it would hold
+/// none: plotters places log-axis ticks from the first power of ten in the range, so a range inside one
+/// decade would get no tick labels at all.
+pub fn padded_log(lo: f64, hi: f64, pad: f64) -> (f64, f64) {
+    let (lo, hi) = if hi > lo {
+        (lo / pad, hi * pad)
+    } else {
+        (lo / 10.0, hi * 10.0)
+    };
+    let below = 10f64.powf(lo.log10().floor());
+    // a hair below the power of ten, so plotters' `ceil(ln lo / ln 10)` cannot round past it
+    if below * 10.0 > hi {
+        (below * (1.0 - 1e-6), hi)
+    } else {
+        (lo, hi)
+    }
+}
+
+/// `n + 1` points from `x0` to `x1`, evenly spaced in `ln x` (both must be > 0).
+pub fn log_samples(x0: f64, x1: f64, n: usize) -> Vec<f64> {
+    (0..=n).map(|k| x0 * (x1 / x0).powf(k as f64 / n as f64)).collect()
+}
+
+/// `n + 1` points from `x0` to `x1`, evenly spaced.
+pub fn linear_samples(x0: f64, x1: f64, n: usize) -> Vec<f64> {
+    (0..=n).map(|k| x0 + (x1 - x0) * k as f64 / n as f64).collect()
+}
+
+/// Splits a sampled curve into the runs of consecutive points that lie inside the axis ranges. Plotters does
+/// not clip lines to the plotting area, so a curve leaving it would be drawn over the labels; drawing each run
+/// separately keeps it inside (to within one sample step).
+pub fn inside_runs(points: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Vec<Vec<(f64, f64)>> {
+    let mut runs: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut current = Vec::new();
+    for &(x, y) in points {
+        if x.is_finite() && y.is_finite() && (x0..=x1).contains(&x) && (y0..=y1).contains(&y) {
+            current.push((x, y));
+        } else if !current.is_empty() {
+            runs.push(std::mem::take(&mut current));
+        }
+    }
+    if !current.is_empty() {
+        runs.push(current);
+    }
+    runs.retain(|r| r.len() >= 2);
+    runs
+}
+
+/// Margins `(top, bottom, left, right)` (pixels) that make the plotting area of a chart built on an area of
+/// `dim` pixels square, given its label-area sizes and a minimum margin: the spare length of the longer side is
+/// split between its two margins. Used for the equal-aspect velocity panels (Roig03 Fig. 3).
+pub fn square_margins(dim: (u32, u32), x_label_area: u32, y_label_area: u32, margin: u32) -> (u32, u32, u32, u32) {
+    let width = dim.0.saturating_sub(y_label_area + 2 * margin);
+    let height = dim.1.saturating_sub(x_label_area + 2 * margin);
+    let side = width.min(height);
+    let (extra_w, extra_h) = (width - side, height - side);
+    (
+        margin + extra_h / 2,
+        margin + extra_h - extra_h / 2,
+        margin + extra_w / 2,
+        margin + extra_w - extra_w / 2,
+    )
+}
+
+/// Tick label for a log axis: plain decimals between 0.01 and 1000, scientific outside.
+pub fn log_tick(v: &f64) -> String {
+    let a = v.abs();
+    if (0.01..1000.0).contains(&a) {
+        let s = format!("{v:.3}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        format!("{v:.0e}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn font_registers_and_measures_text() {
+        ensure_font().unwrap();
+        let (w, h) = plotters::style::FontDesc::new(FONT_FAMILY.into(), 20.0, FontStyle::Normal)
+            .box_size("spin rate ω (rad/s)")
+            .unwrap();
+        assert!(w > 100 && h > 10, "{w} × {h}");
+    }
+
+    #[test]
+    fn inside_runs_splits_at_the_border() {
+        let pts = [(0.0, 0.0), (1.0, 1.0), (2.0, 5.0), (3.0, 1.0), (4.0, 1.0), (5.0, 9.0)];
+        let runs = inside_runs(&pts, (0.0, 10.0), (0.0, 2.0));
+        assert_eq!(runs, vec![vec![(0.0, 0.0), (1.0, 1.0)], vec![(3.0, 1.0), (4.0, 1.0)]]);
+    }
+
+    #[test]
+    fn square_margins_give_a_square() {
+        let (t, b, l, r) = square_margins((400, 520), 40, 60, 10);
+        assert_eq!(400 - 60 - l - r, 520 - 40 - t - b);
+        assert_eq!((l, r), (10, 10));
+    }
+
+    #[test]
+    fn ranges_are_never_empty() {
+        assert_eq!(padded(2.0, 2.0, 0.1), (1.0, 3.0));
+        assert_eq!(padded(0.0, 0.0, 0.1), (-0.5, 0.5));
+        assert_eq!(padded_log(1.0, 1.0, 2.0), (0.1, 10.0));
+        // inside one decade: extended down to the power of ten, so the axis has ticks
+        let (lo, hi) = padded_log(0.2, 0.5, 1.1);
+        assert!(lo < 0.1 && lo > 0.0999 && (hi - 0.55).abs() < 1e-12, "{lo} {hi}");
+        assert_eq!(padded_log(0.05, 0.5, 1.0), (0.05, 0.5));
+        assert_eq!(finite_extent([f64::NAN, 3.0, -1.0]), Some((-1.0, 3.0)));
+        assert_eq!(finite_extent([f64::NAN]), None);
+    }
+}
