@@ -40,7 +40,7 @@ fn bench_impact_rows_are_thread_independent_and_flags_checked() {
     }
     assert_ne!(rows[1][12], rows[3][12], "F0 must matter: {csv}");
     assert!(rows[1][12].parse::<f64>().unwrap() < 1e-8, "energy error: {csv}");
-    assert!(dir.join("b/bench_impact.svg").is_file());
+    assert!(dir.join("b/bench_impact.svg").is_file() && dir.join("b/bench_impact.png").is_file());
     assert!(!dir.join("b/runs").exists(), "scratch runs removed");
     // no overwrite without --force; bad F0 names the flag
     let again = rubblepile(&dir, &args);

@@ -5,7 +5,7 @@
 //! unless `--keep-runs`); the row reports its wall time beside its energy error, as every run does.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use crate::cli::CliError;
 use crate::impact::projectile::ProjectileSpec;
@@ -39,7 +39,7 @@ pub struct ImpactBenchArgs {
     /// Repeats of each configuration (the median and the minimum are reported).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub repeats: u64,
-    /// Writes `bench_impact.csv` and `bench_impact.svg` here.
+    /// Writes `bench_impact.csv`, `bench_impact.svg` and `bench_impact.png` here.
     #[arg(long)]
     pub out: PathBuf,
     /// Overwrite an earlier `bench_impact.csv`/`.svg` in OUT.
@@ -182,69 +182,83 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         f.flush()
     };
     write().map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
-    plot(&svg, &results, args).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
-    println!("  wrote {} and {}", csv.display(), svg.display());
+    plot(&results, args).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
+    println!("  wrote {}, {} and bench_impact.png", csv.display(), svg.display());
     Ok(())
 }
 
 /// Bars of the median wall time per (F0, threads), with the 60 s goal as a line.
-fn plot(path: &Path, results: &[ImpactTiming], args: &ImpactBenchArgs) -> Result<(), String> {
-    use plotters::prelude::*;
-    let err = |e: &dyn std::fmt::Display| e.to_string();
-    let top = results.iter().map(|r| r.median_s).fold(60.0, f64::max) * 1.2;
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!(
-                "{} + {}, zeta = {} deg, {} s at rtol {:e}",
-                args.target.file_stem().and_then(|s| s.to_str()).unwrap_or("target"),
-                args.projectile,
-                args.angle,
-                args.t_end,
-                args.rtol
-            ),
-            ("sans-serif", 18),
-        )
-        .margin(12)
-        .x_label_area_size(50)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..results.len() as f64, 0.0..top)
-        .map_err(|e| err(&e))?;
-    let labels: Vec<String> = results
-        .iter()
-        .map(|r| format!("F0 {:e}, {} thr", r.f0, r.threads))
-        .collect();
-    chart
-        .configure_mesh()
-        .x_labels(results.len())
-        .x_label_formatter(&|x| labels.get(x.floor() as usize).cloned().unwrap_or_default())
-        .x_desc("configuration (F0 in s m^-2, threads)")
-        .y_desc("wall-clock time (s)")
-        .disable_x_mesh()
-        .draw()
-        .map_err(|e| err(&e))?;
-    chart
-        .draw_series(results.iter().enumerate().map(|(k, r)| {
-            Rectangle::new(
-                [(k as f64 + 0.15, 0.0), (k as f64 + 0.85, r.median_s)],
-                BLUE.mix(0.5).filled(),
-            )
-        }))
-        .map_err(|e| err(&e))?;
-    chart
-        .draw_series(LineSeries::new(
-            vec![(0.0, 60.0), (results.len() as f64, 60.0)],
-            RED.stroke_width(2),
-        ))
-        .map_err(|e| err(&e))?
-        .label("goal: 60 s on 2 cores")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
-    chart
-        .configure_series_labels()
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| err(&e))?;
-    root.present().map_err(|e| err(&e))
+struct WallTimeBars<'a> {
+    results: &'a [ImpactTiming],
+    title: String,
+}
+
+impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
+    fn draw<DB: plotters::prelude::DrawingBackend>(
+        &self,
+        root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), String> {
+        use plotters::prelude::*;
+        let err = |e: &dyn std::fmt::Display| e.to_string();
+        let results = self.results;
+        let top = results.iter().map(|r| r.median_s).fold(60.0, f64::max) * 1.2;
+        let mut chart = ChartBuilder::on(root)
+            .caption(&self.title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(50)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..results.len() as f64, 0.0..top)
+            .map_err(|e| err(&e))?;
+        let labels: Vec<String> = results
+            .iter()
+            .map(|r| format!("F0 {:e}, {} thr", r.f0, r.threads))
+            .collect();
+        chart
+            .configure_mesh()
+            .x_labels(results.len())
+            .x_label_formatter(&|x| labels.get(x.floor() as usize).cloned().unwrap_or_default())
+            .x_desc("configuration (F0 in s m^-2, threads)")
+            .y_desc("wall-clock time (s)")
+            .disable_x_mesh()
+            .draw()
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series(results.iter().enumerate().map(|(k, r)| {
+                Rectangle::new(
+                    [(k as f64 + 0.15, 0.0), (k as f64 + 0.85, r.median_s)],
+                    BLUE.mix(0.5).filled(),
+                )
+            }))
+            .map_err(|e| err(&e))?;
+        chart
+            .draw_series(LineSeries::new(
+                vec![(0.0, 60.0), (results.len() as f64, 60.0)],
+                RED.stroke_width(2),
+            ))
+            .map_err(|e| err(&e))?
+            .label("goal: 60 s on 2 cores")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.8))
+            .border_style(BLACK)
+            .draw()
+            .map_err(|e| err(&e))?;
+        Ok(())
+    }
+}
+
+fn plot(results: &[ImpactTiming], args: &ImpactBenchArgs) -> Result<(), String> {
+    let figure = WallTimeBars {
+        results,
+        title: format!(
+            "{} + {}, zeta = {} deg, {} s at rtol {:e}",
+            args.target.file_stem().and_then(|s| s.to_str()).unwrap_or("target"),
+            args.projectile,
+            args.angle,
+            args.t_end,
+            args.rtol
+        ),
+    };
+    crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure).map(|_| ())
 }
