@@ -185,6 +185,31 @@ fn work_precision_sweep_writes_csv_svg_json_and_errors_fall() {
     let mut forced = args.to_vec();
     forced.push("--force");
     assert!(rubblepile(&dir, &forced).status.success());
+    assert!(out.join("work_precision_top.png").is_file(), "PNG beside the SVG");
+
+    // --replot redraws both diagrams from the CSV alone, with the same rows
+    std::fs::remove_file(out.join("work_precision_top.svg")).unwrap();
+    std::fs::remove_file(out.join("work_precision_top.png")).unwrap();
+    let o = rubblepile(
+        &dir,
+        &[
+            "bench",
+            "work-precision",
+            "--problem",
+            "top",
+            "--out",
+            out.to_str().unwrap(),
+            "--replot",
+        ],
+    );
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let svg = std::fs::read_to_string(out.join("work_precision_top.svg")).unwrap();
+    assert!(svg.contains("bulirsch-stoer") && svg.contains("rk4"));
+    assert!(out.join("work_precision_top.png").is_file());
+    let rows = rubblepile::cli::work_precision::read_csv(&csv).unwrap();
+    assert_eq!(rows.len(), 5);
+    assert_eq!(rows[0].setting.tolerance, Some(1e-4));
+    assert_eq!(rows[3].setting.step, Some(0.2));
 }
 
 #[test]

@@ -59,6 +59,9 @@ pub struct WorkPrecisionArgs {
     /// rtol = atol of the reference runs (problems without an analytic reference).
     #[arg(long, default_value = "1e-13", value_name = "TOL")]
     pub reference_rtol: f64,
+    /// Do not run anything: redraw the diagram (SVG and PNG) from the CSV an earlier sweep left in `--out`.
+    #[arg(long)]
+    pub replot: bool,
 }
 
 const WP_AFTER_HELP: &str = "\
@@ -107,8 +110,96 @@ pub fn prepare_outputs(dir: &Path, paths: &[PathBuf], force: bool) -> Result<(),
     std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("--out: {}: {e}", dir.display())))
 }
 
+/// Draws the work–precision diagram of `rows` into `svg` and the PNG beside it (same drawing, both backends).
+fn draw_both(svg: &Path, title: &str, rows: &[SweepRow]) -> Result<PathBuf, CliError> {
+    let png = svg.with_extension("png");
+    {
+        let root = SVGBackend::new(svg, (1200, 520)).into_drawing_area();
+        draw_work_precision(&root, title, rows)
+            .and_then(|()| root.present().map_err(|e| e.to_string()))
+            .map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
+    }
+    {
+        let root = BitMapBackend::new(&png, (1200, 520)).into_drawing_area();
+        draw_work_precision(&root, title, rows)
+            .and_then(|()| root.present().map_err(|e| e.to_string()))
+            .map_err(|e| CliError::failed(format!("{}: {e}", png.display())))?;
+    }
+    Ok(png)
+}
+
+/// Reads the rows of a `work_precision_<problem>.csv` back (the columns [`write_csv`] writes).
+pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, String> {
+    let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+    let mut rdr = csv::Reader::from_path(path).map_err(|e| err(&e))?;
+    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
+    let col = |name: &str| {
+        headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| err(&format!("no `{name}` column")))
+    };
+    let c = [
+        col("method")?,
+        col("rtol")?,
+        col("error")?,
+        col("energy_error")?,
+        col("wall_seconds")?,
+        col("rhs_evaluations")?,
+        col("steps")?,
+        col("h")?,
+    ];
+    let mut rows = Vec::new();
+    for (line, rec) in rdr.records().enumerate() {
+        let rec = rec.map_err(|e| err(&e))?;
+        let at = |k: usize| format!("row {}", line + 2) + &format!(", column {}", headers.get(c[k]).unwrap_or(""));
+        let num =
+            |k: usize| -> Result<f64, String> { rec[c[k]].parse::<f64>().map_err(|e| err(&format!("{}: {e}", at(k)))) };
+        let opt = |k: usize| -> Result<Option<f64>, String> {
+            if rec[c[k]].is_empty() {
+                Ok(None)
+            } else {
+                num(k).map(Some)
+            }
+        };
+        let method =
+            <Method as clap::ValueEnum>::from_str(&rec[c[0]], true).map_err(|e| err(&format!("{}: {e}", at(0))))?;
+        rows.push(SweepRow {
+            setting: crate::integrate::work_precision::Setting {
+                method,
+                tolerance: opt(1)?,
+                step: opt(7)?,
+            },
+            error: num(2)?,
+            energy_error: num(3)?,
+            wall_seconds: num(4)?,
+            rhs_evaluations: num(5)? as u64,
+            steps: num(6)? as u64,
+            rejected_steps: 0,
+            timed_runs: 0,
+            statistic: "median",
+            cpu_seconds: f64::NAN,
+        });
+    }
+    Ok(rows)
+}
+
 /// Runs `bench work-precision`.
 pub fn work_precision(args: &WorkPrecisionArgs) -> Result<(), CliError> {
+    if args.replot {
+        let problem = args.problem.setup();
+        let paths = output_paths(&args.out, problem.name);
+        let [csv, svg, _] = &paths;
+        let rows = read_csv(csv).map_err(CliError::usage)?;
+        let png = draw_both(svg, &format!("work-precision: {}", problem.name), &rows)?;
+        println!(
+            "  redrew {} and {} from {}",
+            svg.display(),
+            png.display(),
+            csv.display()
+        );
+        return Ok(());
+    }
     let tolerances = args.rtol.clone().unwrap_or_else(|| DEFAULT_TOLERANCES.to_vec());
     positive_list("--rtol", &tolerances)?;
     let methods = args
@@ -168,12 +259,7 @@ pub fn work_precision(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     let [csv, svg, json] = &paths;
     write_csv(csv, &result.rows).map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
     let title = format!("work-precision: {}", problem.name);
-    {
-        let root = SVGBackend::new(svg, (1200, 520)).into_drawing_area();
-        draw_work_precision(&root, &title, &result.rows)
-            .and_then(|()| root.present().map_err(|e| e.to_string()))
-            .map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
-    }
+    draw_both(svg, &title, &result.rows)?;
     let meta = metadata(&problem, &config, &result);
     std::fs::write(json, serde_json::to_string_pretty(&meta).unwrap_or_default() + "\n")
         .map_err(|e| CliError::failed(format!("{}: {e}", json.display())))?;
