@@ -15,3 +15,23 @@ pub type Mat4 = nalgebra::Matrix4<f64>;
 pub fn skew(v: &Vec3) -> Mat3 {
     Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
 }
+
+/// Median of `values` (the mean of the two middle values for an even count); NaN for an empty slice.
+///
+/// ```
+/// assert_eq!(rubblepile::math::median(&[3.0, 1.0, 2.0]), 2.0);
+/// assert_eq!(rubblepile::math::median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+/// assert!(rubblepile::math::median(&[]).is_nan());
+/// ```
+pub fn median(values: &[f64]) -> f64 {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}

@@ -43,7 +43,7 @@ use std::path::Path;
 
 use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::impact::run::{ImpactError, read_target};
-use crate::math::Vec3;
+use crate::math::{Vec3, median};
 
 /// `|s|` below which the axis-rotation-mode measure counts as the intermediate-axis mode (round-off only).
 pub const MODE_TOLERANCE: f64 = 1e-9;
@@ -366,21 +366,6 @@ pub fn ejection_velocities(initial: &[Body], at: &[Body], projectile: usize) -> 
         .zip(at)
         .map(|(b0, b1)| (b1.velocity - v1) - (b0.velocity - v0))
         .collect()
-}
-
-/// Median of `values` (mean of the two middle values for an even count; 0 when empty).
-fn median(values: &[f64]) -> f64 {
-    if values.is_empty() {
-        return 0.0;
-    }
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
 }
 
 /// Analyses the bodies at `t_at` (`at`) against those at `t = 0` (`initial`): see the module docs for every

@@ -68,17 +68,9 @@ fn values(runs: &[CampaignRun], f: impl Fn(&CampaignRun) -> Option<f64>) -> Vec<
         .collect()
 }
 
+/// Median of the values of `v` (NaN when empty).
 fn median(v: &[(f64, &str)]) -> f64 {
-    let mut x: Vec<f64> = v.iter().map(|p| p.0).collect();
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
+    crate::math::median(&v.iter().map(|p| p.0).collect::<Vec<_>>())
 }
 
 /// "min (run) … max (run), median m; k of n inside [low, high]".

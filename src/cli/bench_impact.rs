@@ -69,16 +69,6 @@ pub struct ImpactTiming {
     pub energy_error: f64,
 }
 
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 /// Runs `bench impact`.
 pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     let mut projectile = ProjectileSpec::preset(&args.projectile)
@@ -143,7 +133,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
             results.push(ImpactTiming {
                 f0,
                 threads: threads as usize,
-                median_s: median(&mut walls),
+                median_s: crate::math::median(&walls),
                 min_s: min,
                 steps: s.steps_accepted,
                 rhs_evaluations: s.rhs_evaluations,

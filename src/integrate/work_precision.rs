@@ -169,19 +169,7 @@ pub struct SweepRow {
     pub cpu_seconds: f64,
 }
 
-/// Median of a non-empty slice.
-pub fn median(values: &[f64]) -> f64 {
-    let mut v = values.to_vec();
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        f64::NAN
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
+pub use crate::math::median;
 
 /// Runs `setting` `repeats` times (more for short runs, fewer for long ones, see the module docs); the error is computed with
 /// `error_of(final state)`.
