@@ -13,12 +13,11 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
+use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::G_SI;
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::io::csv::{read_bodies_csv, write_snapshot};
-use crate::math::{Vec3, Vec4};
 use crate::run::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
 use crate::scene::{LoadedScene, MAX_TIMESERIES_ROWS, SceneError, parse_scene};
 
@@ -358,16 +357,7 @@ pub fn read_target(path: &Path) -> Result<Vec<Body>, ImpactError> {
                     r.line
                 )));
             }
-            Ok(Body {
-                shape: Ellipsoid {
-                    axes: Vec3::from(r.axes),
-                    mass: r.mass,
-                },
-                position: Vec3::from(r.position),
-                velocity: Vec3::from(r.velocity),
-                quaternion: Vec4::from(r.quaternion).normalize(),
-                spin_body: Vec3::from(r.spin_body),
-            })
+            Ok(r.to_body())
         })
         .collect()
 }

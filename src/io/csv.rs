@@ -219,6 +219,22 @@ pub struct BodyRecord {
     pub spin_body: [f64; 3],
 }
 
+impl BodyRecord {
+    /// The body of this record, its quaternion normalised (no other check: validate the values first).
+    pub fn to_body(&self) -> Body {
+        Body {
+            shape: crate::ellipsoid::body::Ellipsoid {
+                axes: crate::math::Vec3::from(self.axes),
+                mass: self.mass,
+            },
+            position: crate::math::Vec3::from(self.position),
+            velocity: crate::math::Vec3::from(self.velocity),
+            quaternion: crate::math::Vec4::from(self.quaternion).normalize(),
+            spin_body: crate::math::Vec3::from(self.spin_body),
+        }
+    }
+}
+
 /// Why a bodies file could not be read. Messages are one line.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum BodiesFileError {
