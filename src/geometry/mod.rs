@@ -2,3 +2,4 @@
 
 pub mod ellipsoid_overlap;
 pub mod neighbours;
+pub mod polyhedron;
