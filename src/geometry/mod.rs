@@ -1,5 +1,7 @@
-//! Geometry shared by the engines: neighbour search (and, later, wall primitives).
+//! Geometry shared by the engines: neighbour search, ellipsoid overlap, lattices, Voronoi cells, shape models.
 
 pub mod ellipsoid_overlap;
+pub mod lattice;
 pub mod neighbours;
 pub mod polyhedron;
+pub mod voronoi;
