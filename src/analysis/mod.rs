@@ -6,3 +6,4 @@ pub mod fragments;
 pub mod report_roig2003;
 pub mod rigid_rotation;
 pub mod run_analysis;
+pub mod spinup;

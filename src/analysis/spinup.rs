@@ -1,0 +1,338 @@
+//! Post-processing of spin-up runs (Zhang17 §3): the first two critical spin limits detected in time series,
+//! the creep criterion behind the third, stresses (Eqs. 15–16), principal stresses and the Mohr–Coulomb measures
+//! (Eqs. 20–21), and the fit of Eq. 22 over bulk densities.
+//!
+//! Conventions: stresses are in Pa with compression negative (as the paper); periods in hours at the edges
+//! (function names say so), SI inside.
+
+use crate::math::{Mat3, Vec3};
+
+/// Zhang17 §3: T_c,1 is the first departure of b/a or c/a from its initial value by more than this.
+pub const AXIS_RATIO_THRESHOLD: f64 = 0.01;
+/// Zhang17 §3: T_c,2 is the first departure of η_B from its initial value by more than this.
+pub const PACKING_THRESHOLD: f64 = 0.001;
+
+/// The first sample `k` where `|values[k] − values[0]| > threshold`, if any.
+pub fn first_departure(values: &[f64], threshold: f64) -> Option<usize> {
+    let v0 = *values.first()?;
+    values.iter().position(|v| (v - v0).abs() > threshold)
+}
+
+/// How a spun-up aggregate fails (Zhang17 §3.3): the packing changes before the shape (T_c,2 reached at a longer
+/// period than T_c,1: surface shedding, as the paper's HCP and PPC), or the shape before or with the packing
+/// (internal failure, as RCP, PP1, PP2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FailureMode {
+    /// The shape changes first (T_c,2 < T_c,1): material leaves the surface while the interior packing holds.
+    SurfaceShedding,
+    /// The interior deforms: the packing loosens no earlier than the shape changes.
+    InternalFailure,
+}
+
+/// T_c,1 and T_c,2 of one spin-up run and the failure mode.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CriticalLimits {
+    /// Spin period (h) at the first departure of b/a or c/a by more than [`AXIS_RATIO_THRESHOLD`].
+    pub t_c1_hours: Option<f64>,
+    /// Spin period (h) at the first departure of η_B by more than [`PACKING_THRESHOLD`].
+    pub t_c2_hours: Option<f64>,
+    /// Surface shedding when T_c,2 < T_c,1 (the shape changes first: material leaves the surface while the
+    /// interior packing holds), internal failure otherwise (Zhang17: "surface shedding when T_c,2 < T_c,1").
+    pub failure_mode: Option<FailureMode>,
+}
+
+/// Detects T_c,1 and T_c,2 in the time series of one run: the spin period (h), b/a, c/a and η_B at each sample.
+pub fn critical_limits(period_hours: &[f64], b_over_a: &[f64], c_over_a: &[f64], packing: &[f64]) -> CriticalLimits {
+    let shape = [
+        first_departure(b_over_a, AXIS_RATIO_THRESHOLD),
+        first_departure(c_over_a, AXIS_RATIO_THRESHOLD),
+    ]
+    .into_iter()
+    .flatten()
+    .min();
+    let t_c1_hours = shape.and_then(|k| period_hours.get(k).copied());
+    let t_c2_hours = first_departure(packing, PACKING_THRESHOLD).and_then(|k| period_hours.get(k).copied());
+    let failure_mode = match (t_c1_hours, t_c2_hours) {
+        (Some(t1), Some(t2)) if t2 < t1 => Some(FailureMode::SurfaceShedding),
+        (Some(_), Some(_)) => Some(FailureMode::InternalFailure),
+        (Some(_), None) => Some(FailureMode::SurfaceShedding),
+        (None, Some(_)) => Some(FailureMode::InternalFailure),
+        (None, None) => None,
+    };
+    CriticalLimits {
+        t_c1_hours,
+        t_c2_hours,
+        failure_mode,
+    }
+}
+
+/// The creep criterion for runs held at a final period (the search for T_c,3): over the second half of the hold,
+/// a least-squares line through each diagnostic must change by less than its tolerance over that half. A
+/// diagnostic that keeps drifting means creep (the body is not geo-statically stable at that period).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CreepCriterion {
+    /// Largest allowed change of θ_max over the second half (degrees).
+    pub theta_max_deg: f64,
+    /// Largest allowed change of η_B (dimensionless).
+    pub packing: f64,
+    /// Largest allowed change of the coordination number.
+    pub coordination: f64,
+}
+
+impl Default for CreepCriterion {
+    /// θ_max 0.5°, η_B 0.0005 (half the T_c,2 threshold), coordination number 0.05.
+    fn default() -> Self {
+        CreepCriterion {
+            theta_max_deg: 0.5,
+            packing: 0.5 * PACKING_THRESHOLD,
+            coordination: 0.05,
+        }
+    }
+}
+
+/// Change over the second half of `(t, y)` of its least-squares line (0 for fewer than 3 points there).
+pub fn second_half_drift(t: &[f64], y: &[f64]) -> f64 {
+    let n = t.len().min(y.len());
+    let (t, y) = (&t[n / 2..n], &y[n / 2..n]);
+    if t.len() < 3 {
+        return 0.0;
+    }
+    let m = t.len() as f64;
+    let (tm, ym) = (t.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
+    let (mut sty, mut stt) = (0.0, 0.0);
+    for (a, b) in t.iter().zip(y) {
+        sty += (a - tm) * (b - ym);
+        stt += (a - tm) * (a - tm);
+    }
+    if stt == 0.0 {
+        return 0.0;
+    }
+    sty / stt * (t[t.len() - 1] - t[0])
+}
+
+impl CreepCriterion {
+    /// Whether a held run creeps: any diagnostic's second-half drift beyond its tolerance. Returns the names of
+    /// the drifting diagnostics (empty: stable).
+    pub fn drifting(
+        &self,
+        t: &[f64],
+        theta_max_deg: &[f64],
+        packing: &[f64],
+        coordination: &[f64],
+    ) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if second_half_drift(t, theta_max_deg).abs() > self.theta_max_deg {
+            out.push("theta_max");
+        }
+        if second_half_drift(t, packing).abs() > self.packing {
+            out.push("packing_fraction");
+        }
+        if second_half_drift(t, coordination).abs() > self.coordination {
+            out.push("coordination_number");
+        }
+        out
+    }
+}
+
+/// Zhang17 Eq. 15: the average stress in a particle of volume `volume` (its Voronoi cell, m³) from its contacts,
+/// `σ = (1/V) Σ_c x_c ⊗ f_c`, with `x_c` the branch vector from the particle's centre to the contact point (m) and
+/// `f_c` the contact force on the particle (N). Compression comes out negative. Symmetrised.
+pub fn particle_stress(volume: f64, contacts: &[(Vec3, Vec3)]) -> Mat3 {
+    let mut s = Mat3::zeros();
+    for (x, f) in contacts {
+        s += x * f.transpose();
+    }
+    let s = 0.5 * (s + s.transpose());
+    s / volume
+}
+
+/// Zhang17 Eq. 16: the volume-weighted average of particle stresses over a representative volume element.
+pub fn rve_stress(particles: &[(f64, Mat3)]) -> Mat3 {
+    let (mut s, mut v) = (Mat3::zeros(), 0.0);
+    for (vol, sigma) in particles {
+        s += sigma * *vol;
+        v += vol;
+    }
+    if v > 0.0 { s / v } else { Mat3::zeros() }
+}
+
+/// Principal stresses and the Mohr–Coulomb measures of a stress tensor (Zhang17 Eqs. 20–21).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct StressState {
+    /// Principal stresses σ₁ ≥ σ₂ ≥ σ₃ (Pa; compression negative).
+    pub principal: [f64; 3],
+    /// Deviatoric measure `s = (σ₁ − σ₃)/2` (Pa).
+    pub deviatoric: f64,
+    /// Pressure `p = (σ₁ + σ₂ + σ₃)/3` (Pa).
+    pub pressure: f64,
+    /// Mobilized friction angle `θ = arcsin((σ₃ − σ₁)/(σ₁ + σ₃))` (degrees); `None` unless both extreme principal
+    /// stresses are compressive (σ₁ + σ₃ < 0), where the Mohr circle lies in compression.
+    pub friction_angle_deg: Option<f64>,
+}
+
+/// [`StressState`] of the symmetric tensor `sigma`.
+pub fn stress_state(sigma: &Mat3) -> StressState {
+    let eig = nalgebra::SymmetricEigen::new(0.5 * (sigma + sigma.transpose()));
+    let mut p = [eig.eigenvalues[0], eig.eigenvalues[1], eig.eigenvalues[2]];
+    p.sort_by(|a, b| b.total_cmp(a));
+    let (s1, s3) = (p[0], p[2]);
+    let friction_angle_deg = (s1 + s3 < 0.0).then(|| ((s3 - s1) / (s1 + s3)).clamp(-1.0, 1.0).asin().to_degrees());
+    StressState {
+        principal: p,
+        deviatoric: 0.5 * (s1 - s3),
+        pressure: (p[0] + p[1] + p[2]) / 3.0,
+        friction_angle_deg,
+    }
+}
+
+/// Zhang17 Eq. 22: the critical spin rate scales with the bulk density as `Ω_c = κ √(4πGρ_B/3)`. Least-squares κ
+/// through the origin from `(ρ_B [kg m⁻³], critical period [h])` pairs, its standard error, and the critical bulk
+/// density at which a body spinning with `period_hours` sits at the limit, `ρ_c = 3Ω²/(4πGκ²)`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct DensityFit {
+    /// κ of Eq. 22.
+    pub kappa: f64,
+    /// Its standard error (0 with fewer than 2 points).
+    pub sigma_kappa: f64,
+    /// Critical bulk density for the given period (kg m⁻³).
+    pub critical_density: f64,
+}
+
+/// Fits [`DensityFit`] with gravitational constant `g` (m³ kg⁻¹ s⁻²); `None` without a positive point.
+pub fn fit_density(points: &[(f64, f64)], g: f64, period_hours: f64) -> Option<DensityFit> {
+    let xy: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(rho, t)| *rho > 0.0 && *t > 0.0)
+        .map(|&(rho, t)| ((4.0 * std::f64::consts::PI * g * rho / 3.0).sqrt(), omega_of_hours(t)))
+        .collect();
+    if xy.is_empty() {
+        return None;
+    }
+    let sxx: f64 = xy.iter().map(|(x, _)| x * x).sum();
+    let sxy: f64 = xy.iter().map(|(x, y)| x * y).sum();
+    let kappa = sxy / sxx;
+    let n = xy.len();
+    let sigma_kappa = if n > 1 {
+        let rss: f64 = xy.iter().map(|(x, y)| (y - kappa * x).powi(2)).sum();
+        (rss / (n - 1) as f64 / sxx).sqrt()
+    } else {
+        0.0
+    };
+    let omega = omega_of_hours(period_hours);
+    Some(DensityFit {
+        kappa,
+        sigma_kappa,
+        critical_density: 3.0 * omega * omega / (4.0 * std::f64::consts::PI * g * kappa * kappa),
+    })
+}
+
+/// Spin rate (rad/s) of a period in hours.
+pub fn omega_of_hours(period_hours: f64) -> f64 {
+    2.0 * std::f64::consts::PI / (period_hours * 3600.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn critical_limits_on_synthetic_series() {
+        // period falls from 5 h to 2 h; b/a starts to change at sample 60, η at sample 40
+        let n = 100;
+        let period: Vec<f64> = (0..n).map(|k| 5.0 - 3.0 * k as f64 / (n - 1) as f64).collect();
+        let b: Vec<f64> = (0..n)
+            .map(|k| 0.9 - if k >= 60 { 0.0023 * (k - 59) as f64 } else { 0.0 })
+            .collect();
+        let c = vec![0.8; n];
+        let eta: Vec<f64> = (0..n)
+            .map(|k| 0.74 - if k >= 40 { 0.0004 * (k - 39) as f64 } else { 0.0 })
+            .collect();
+        let l = critical_limits(&period, &b, &c, &eta);
+        // b/a: 0.0023 (k − 59) > 0.01 first at k = 64; η: 0.0004 (k − 39) > 0.001 first at k = 42
+        assert_eq!(l.t_c1_hours, Some(period[64]));
+        assert_eq!(l.t_c2_hours, Some(period[42]));
+        assert_eq!(l.failure_mode, Some(FailureMode::InternalFailure));
+        // the shape goes first: b/a leaves at k = 45 (0.0023 (k − 40) > 0.01), η at k = 73 (0.0004 (k − 70) > 0.001)
+        let b2: Vec<f64> = (0..n)
+            .map(|k| 0.9 - if k >= 40 { 0.0023 * (k - 40) as f64 } else { 0.0 })
+            .collect();
+        let eta2: Vec<f64> = (0..n)
+            .map(|k| 0.74 - if k >= 70 { 0.0004 * (k - 70) as f64 } else { 0.0 })
+            .collect();
+        let l = critical_limits(&period, &b2, &c, &eta2);
+        assert_eq!(l.t_c1_hours, Some(period[45]));
+        assert_eq!(l.t_c2_hours, Some(period[73]));
+        assert_eq!(l.failure_mode, Some(FailureMode::SurfaceShedding));
+        let none = critical_limits(&period, &c, &c, &vec![0.74; n]);
+        assert_eq!(
+            (none.t_c1_hours, none.t_c2_hours, none.failure_mode),
+            (None, None, None)
+        );
+    }
+
+    #[test]
+    fn creep_criterion_catches_a_drift_and_passes_noise() {
+        let t: Vec<f64> = (0..200).map(|k| k as f64 * 100.0).collect();
+        let noise = |k: usize| 1e-4 * ((k * 7919 % 101) as f64 / 101.0 - 0.5);
+        let flat: Vec<f64> = (0..200).map(|k| 0.74 + noise(k)).collect();
+        let theta: Vec<f64> = (0..200).map(|k| 30.0 + 10.0 * noise(k)).collect();
+        let coord: Vec<f64> = (0..200).map(|k| 6.0 + 10.0 * noise(k)).collect();
+        let crit = CreepCriterion::default();
+        assert!(crit.drifting(&t, &theta, &flat, &coord).is_empty());
+        // η_B creeping down by 0.002 over the hold: caught
+        let creeping: Vec<f64> = (0..200).map(|k| 0.74 - 0.002 * k as f64 / 199.0 + noise(k)).collect();
+        assert_eq!(crit.drifting(&t, &theta, &creeping, &coord), vec!["packing_fraction"]);
+        // a drift only in the first half (settling) is not creep
+        let settling: Vec<f64> = (0..200)
+            .map(|k| 30.0 + if k < 80 { 5.0 * (1.0 - k as f64 / 80.0) } else { 0.0 })
+            .collect();
+        assert!(crit.drifting(&t, &settling, &flat, &coord).is_empty());
+    }
+
+    #[test]
+    fn hydrostatic_particle_stress_and_mohr_coulomb() {
+        // six equal inward forces F at the ends of the axes of a particle of radius R: σ = −2RF/V · 1
+        let (r, f, v) = (2.0, 3.0, 10.0);
+        let mut contacts = Vec::new();
+        for axis in [Vec3::x(), Vec3::y(), Vec3::z()] {
+            for s in [-1.0, 1.0] {
+                contacts.push((axis * s * r, -axis * s * f));
+            }
+        }
+        let sigma = particle_stress(v, &contacts);
+        assert!((sigma - Mat3::identity() * (-2.0 * r * f / v)).norm() < 1e-14);
+        let st = stress_state(&sigma);
+        assert!((st.pressure + 2.0 * r * f / v).abs() < 1e-14);
+        assert!(st.deviatoric.abs() < 1e-14);
+        assert!(st.friction_angle_deg.unwrap().abs() < 1e-9);
+        // a rotated triaxial state: σ₁ = −1, σ₃ = −3 → θ = arcsin(−2/−4)... = arcsin((σ₃ − σ₁)/(σ₁ + σ₃)) = 30°
+        let rot = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1).into_inner();
+        let t = rot * Mat3::from_diagonal(&Vec3::new(-3.0, -1.0, -2.0)) * rot.transpose();
+        let st = stress_state(&t);
+        assert!((st.principal[0] + 1.0).abs() < 1e-12 && (st.principal[2] + 3.0).abs() < 1e-12);
+        assert!((st.friction_angle_deg.unwrap() - 30.0).abs() < 1e-9, "{st:?}");
+        assert!((st.deviatoric - 1.0).abs() < 1e-12 && (st.pressure + 2.0).abs() < 1e-12);
+        // RVE average weights by volume
+        let avg = rve_stress(&[(1.0, Mat3::identity()), (3.0, Mat3::identity() * 5.0)]);
+        assert!((avg - Mat3::identity() * 4.0).norm() < 1e-14);
+    }
+
+    #[test]
+    fn density_fit_recovers_kappa_and_critical_density() {
+        let g = 6.674e-11;
+        let kappa = 0.9;
+        let pts: Vec<(f64, f64)> = [1500.0, 2100.0, 2700.0]
+            .iter()
+            .map(|&rho| {
+                let omega = kappa * (4.0 * std::f64::consts::PI * g * rho / 3.0).sqrt();
+                (rho, 2.0 * std::f64::consts::PI / omega / 3600.0)
+            })
+            .collect();
+        let fit = fit_density(&pts, g, 2.26).unwrap();
+        assert!((fit.kappa - kappa).abs() < 1e-12 && fit.sigma_kappa < 1e-12, "{fit:?}");
+        // at the critical density the limit period is exactly 2.26 h
+        let omega = kappa * (4.0 * std::f64::consts::PI * g * fit.critical_density / 3.0).sqrt();
+        assert!((2.0 * std::f64::consts::PI / omega / 3600.0 - 2.26).abs() < 1e-12);
+    }
+}
