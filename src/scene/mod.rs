@@ -627,7 +627,7 @@ impl Validator<'_> {
         if file.scene.kind != "ellipsoids" {
             return Err(self.invalid(
                 "scene.kind",
-                format!("must be \"ellipsoids\", got {:?}", file.scene.kind),
+                format!("must be \"ellipsoids\" or \"soft-spheres\", got {:?}", file.scene.kind),
             ));
         }
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;
