@@ -15,8 +15,8 @@ use rayon::prelude::*;
 pub enum SelfGravity {
     /// Exact O(N²) summation.
     Direct,
-    /// Octree with opening angle θ (dimensionless, > 0): a node of far extent `b` seen from distance `d`
-    /// is used whole when `b < θ d`.
+    /// Octree with opening angle θ (dimensionless, > 0): a node of side `l` whose centre of mass is `δ` from
+    /// its cube's centre is used whole at distance `d > l/θ + δ` ([`octree`]).
     Tree {
         /// Opening angle θ.
         theta: f64,

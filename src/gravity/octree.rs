@@ -2,8 +2,9 @@
 //! quadrupole order and a real O(N log N) method).
 //!
 //! Each node stores its mass `M`, centre of mass `c`, traceless quadrupole `Q = Σ m (3 d dᵀ − |d|² I)`
-//! (`d = x − c`) and `b`, the largest distance from `c` to a corner of its cube. A node is used whole for a
-//! point at `r = p − c` when `b < θ |r|` (so never for a point inside its cube), with
+//! (`d = x − c`), its side `l` and the offset `δ` of `c` from the cube's centre. A node is used whole for a
+//! point at `r = p − c` when `|r| > l/θ + δ` (Barnes 1994's criterion; never for a point inside its cube when
+//! θ < 2/√3), with
 //! `φ = −G M/|r| − G rᵀQr / (2|r|⁵)` and `a = −∇φ = −G M r/|r|³ + G (Q r/|r|⁵ − 5/2 (rᵀQr) r/|r|⁷)`;
 //! leaves (≤ [`LEAF_SIZE`] particles) are summed directly. The walk for each particle is independent
 //! (rayon-parallel) and visits nodes in a fixed order, so results do not depend on the number of threads.
@@ -21,8 +22,10 @@ struct Node {
     mass: f64,
     com: Vec3,
     quad: Mat3,
-    /// Largest distance from the centre of mass to a corner of the cube (m).
-    b: f64,
+    /// Side of the cube (m).
+    side: f64,
+    /// Distance from the centre of mass to the cube's centre (m).
+    delta: f64,
     /// Children's node indices (empty for a leaf).
     children: Vec<u32>,
     /// The node's particles: `order[start..end]`.
@@ -76,12 +79,12 @@ impl Octree {
             let d = self.positions[i] - com;
             quad += (d * d.transpose() * 3.0 - Mat3::identity() * d.norm_squared()) * self.masses[i];
         }
-        let b = (com - centre).abs().add_scalar(half).norm();
         self.nodes.push(Node {
             mass,
             com,
             quad,
-            b,
+            side: 2.0 * half,
+            delta: (com - centre).norm(),
             children: Vec::new(),
             start,
             end,
@@ -139,7 +142,10 @@ impl Octree {
                     a += d * (self.masses[j] * inv * inv * inv);
                     phi -= self.masses[j] * inv;
                 }
-            } else if node.b * node.b < theta * theta * r2 {
+            } else if {
+                let reach = node.side / theta + node.delta;
+                reach * reach < r2
+            } {
                 let inv = 1.0 / r2.sqrt();
                 let inv2 = inv * inv;
                 let inv5 = inv2 * inv2 * inv;

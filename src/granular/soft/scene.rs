@@ -176,7 +176,7 @@ pub struct GravitySection {
     /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
     #[serde(default, rename = "self")]
     pub self_gravity: Option<String>,
-    /// Tree opening angle θ (in (0, 1.5]). Default 0.5.
+    /// Tree opening angle θ (in (0, 1]). Default 0.5.
     #[serde(default)]
     pub theta: Option<f64>,
     /// Gravitational constant (m³ kg⁻¹ s⁻², > 0). Default 6.674e-11.
@@ -534,8 +534,8 @@ impl V<'_> {
             }
             Some("tree") => {
                 let theta = gs.theta.unwrap_or(0.5);
-                if !(theta > 0.0 && theta <= 1.5) {
-                    return Err(self.invalid("gravity.theta", format!("must be in (0, 1.5], got {theta}")));
+                if !(theta > 0.0 && theta <= 1.0) {
+                    return Err(self.invalid("gravity.theta", format!("must be in (0, 1], got {theta}")));
                 }
                 Some(SelfGravity::Tree { theta })
             }
