@@ -140,22 +140,25 @@ pub struct Output {
 /// Adds `rate · dt` to a vector spring and applies a spring–dashpot–slider with cap `cap`:
 /// returns (generalised force, energy lost by slip, dashpot power).
 fn slider_vec(spring: &mut Vec3, rate: &Vec3, dt: f64, k: f64, c: f64, cap: f64) -> (Vec3, f64, f64) {
-    *spring += rate * dt;
     if k <= 0.0 {
         *spring = Vec3::zeros();
         return (Vec3::zeros(), 0.0, 0.0);
     }
+    // Energy in the spring before this step's stretch; on slip, the slider takes that energy plus the work of
+    // the capped force over the stretch, minus what the shortened spring keeps.
+    let before = 0.5 * k * spring.norm_squared();
+    *spring += rate * dt;
     let trial = *spring * k;
     let size = trial.norm();
     if size >= cap {
-        let before = 0.5 * k * spring.norm_squared();
         let capped = if size > 0.0 {
             trial * (cap / size)
         } else {
             Vec3::zeros()
         };
         *spring = capped / k;
-        (capped, before - 0.5 * k * spring.norm_squared(), 0.0)
+        let work = capped.dot(&(rate * dt));
+        (capped, before + work - 0.5 * k * spring.norm_squared(), 0.0)
     } else {
         let mut total = trial + rate * c;
         let t = total.norm();

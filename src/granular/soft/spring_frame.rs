@@ -22,11 +22,20 @@ use nalgebra::{Rotation3, Unit};
 /// assert!((r * Vec3::x() - Vec3::y()).norm() < 1e-15);
 /// ```
 pub fn frame_rotation(n_old: &Vec3, n_new: &Vec3, mean_spin: &Vec3, dt: f64) -> Rotation3<f64> {
-    let swing = Rotation3::rotation_between(n_old, n_new).unwrap_or_else(|| {
+    // Shortest-arc rotation by atan2(|a × b|, a·b), which stays finite when rounding puts a·b above 1
+    // (nalgebra's `rotation_between` takes acos of it).
+    let axis = n_old.cross(n_new);
+    let sin = axis.norm();
+    let cos = n_old.dot(n_new);
+    let swing = if sin > 1e-300 {
+        Rotation3::from_axis_angle(&Unit::new_unchecked(axis / sin), sin.atan2(cos))
+    } else if cos >= 0.0 {
+        Rotation3::identity()
+    } else {
         // Antiparallel normals (never in a real contact step): half a turn about any perpendicular axis.
-        let axis = if n_old.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
-        Rotation3::from_axis_angle(&Unit::new_normalize(n_old.cross(&axis)), std::f64::consts::PI)
-    });
+        let other = if n_old.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+        Rotation3::from_axis_angle(&Unit::new_normalize(n_old.cross(&other)), std::f64::consts::PI)
+    };
     let mean = n_old + n_new;
     let mean_normal = if mean.norm_squared() > 0.0 {
         mean.normalize()
