@@ -243,24 +243,19 @@ impl Book {
         v
     }
     fn from_vec(v: &[f64]) -> Option<Self> {
-        (v.len() == 16)
-            .then(|| Book {
-                e0: v[0],
-                e_scale: v[1],
-                p0: Vec3::new(v[2], v[3], v[4]),
-                p_scale: v[5],
-                l0: Vec3::new(v[6], v[7], v[8]),
-                l_scale: v[9],
-                max_energy: v[10],
-                last_energy: v[11],
-                max_p: v[12],
-                max_l: v[13],
-                max_overlap: v[14],
-            })
-            .map(|mut b| {
-                b.max_overlap = v[15].max(v[14]);
-                b
-            })
+        (v.len() == 15).then(|| Book {
+            e0: v[0],
+            e_scale: v[1],
+            p0: Vec3::new(v[2], v[3], v[4]),
+            p_scale: v[5],
+            l0: Vec3::new(v[6], v[7], v[8]),
+            l_scale: v[9],
+            max_energy: v[10],
+            last_energy: v[11],
+            max_p: v[12],
+            max_l: v[13],
+            max_overlap: v[14],
+        })
     }
 }
 
