@@ -132,6 +132,7 @@ impl Octree {
             let node = &self.nodes[k as usize];
             let r = p - node.com;
             let r2 = r.norm_squared();
+            let reach = node.side / theta + node.delta;
             if node.children.is_empty() {
                 for &j in &self.order[node.start..node.end] {
                     if Some(j) == skip {
@@ -142,10 +143,7 @@ impl Octree {
                     a += d * (self.masses[j] * inv * inv * inv);
                     phi -= self.masses[j] * inv;
                 }
-            } else if {
-                let reach = node.side / theta + node.delta;
-                reach * reach < r2
-            } {
+            } else if reach * reach < r2 {
                 let inv = 1.0 / r2.sqrt();
                 let inv2 = inv * inv;
                 let inv5 = inv2 * inv2 * inv;

@@ -91,6 +91,9 @@ pub struct SoftSystem {
 
 const PAR_MIN: usize = 64;
 
+/// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
+type WallHit = (usize, Springs, f64, Vec3, Output);
+
 fn lookup(list: &[((usize, usize), Springs)], key: (usize, usize)) -> Option<Springs> {
     list.binary_search_by(|e| e.0.cmp(&key)).ok().map(|k| list[k].1)
 }
@@ -221,7 +224,7 @@ impl SoftSystem {
         let mut wall_work = 0.0;
         if !self.walls.is_empty() {
             let old = &self.wall_springs;
-            let per_particle: Vec<Vec<(usize, Springs, f64, Vec3, Output)>> = self
+            let per_particle: Vec<Vec<WallHit>> = self
                 .particles
                 .par_iter()
                 .with_min_len(PAR_MIN)

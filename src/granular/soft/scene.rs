@@ -494,7 +494,7 @@ impl V<'_> {
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;
         let dt = self.positive("integrator.dt", file.integrator.dt)?;
         let steps = (t_end / dt).round();
-        if steps < 1.0 || steps > 1e12 {
+        if !(1.0..=1e12).contains(&steps) {
             return Err(self.invalid(
                 "integrator.dt",
                 format!("t_end/dt must be in [1, 1e12], got {}", t_end / dt),
