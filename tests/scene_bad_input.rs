@@ -336,7 +336,7 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         (
             "kind",
             with("\"ellipsoids\"", "\"spheres\""),
-            "scene.kind: must be \"ellipsoids\", got \"spheres\"",
+            "scene.kind: must be \"ellipsoids\" or \"soft-spheres\", got \"spheres\"",
         ),
         (
             "no bodies",

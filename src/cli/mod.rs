@@ -19,7 +19,12 @@
 //!   [--repeats 5]`: work–precision diagrams of Bulirsch–Stoer, Dop853, Dopri5 and Rk4 (CSV + SVG);
 //! - `rubblepile bench nbody --problem {pythagorean,outer-solar} --rtol TOL[,TOL…] --out DIR [--force]`:
 //!   timed point-mass runs with their final states, for the comparison with REBOUND
-//!   (`analysis/rebound_compare`).
+//!   (`analysis/rebound_compare`);
+//! - `rubblepile ssdem advise --radius R --density RHO [--body-radius B] [--spin-period-h T | --speed V]
+//!   [--max-overlap 0.01]` or `--scene FILE`: k_N and dt for soft spheres (see [`crate::granular::soft::advise`]);
+//! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second.
+//!
+//! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
@@ -31,6 +36,7 @@ pub mod bench_impact;
 pub mod campaign;
 pub mod impact;
 pub mod nbody;
+pub mod ssdem;
 pub mod target;
 pub mod work_precision;
 
@@ -76,6 +82,9 @@ pub enum Command {
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Soft-sphere (SSDEM) tools.
+    #[command(subcommand)]
+    Ssdem(ssdem::SsdemCommand),
 }
 
 /// `rubblepile run`.
@@ -177,6 +186,8 @@ pub enum BenchCommand {
     /// Wall-clock time of whole impact runs (default N200_T4 + P2, ζ = 45°, 10 000 s, rtol 1e-9) per F0 and
     /// thread count, with the 60 s goal.
     Impact(bench_impact::ImpactBenchArgs),
+    /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
+    Ssdem(ssdem::BenchSsdemArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -221,17 +232,30 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?
             };
+            if let Some(path) = &args.scene
+                && crate::granular::soft::scene::is_soft_scene_file(path)
+            {
+                return ssdem::run(path, &args.out, &options);
+            }
             let scene = load(args.scene.as_ref())?;
             report(run_scene(&scene, &args.out, &options))
         }
         Command::Resume(args) => {
             let options = args.checkpoints.options(!args.no_progress)?;
+            if crate::granular::soft::run::is_soft_run_dir(&args.dir) {
+                return ssdem::resume(&args.dir, &options);
+            }
             report(resume_run(&args.dir, &options))
         }
         Command::Check(args) => {
             if args.print_default {
                 print!("{}", crate::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
+            }
+            if let Some(path) = &args.scene
+                && crate::granular::soft::scene::is_soft_scene_file(path)
+            {
+                return ssdem::check(path);
             }
             let scene = load(args.scene.as_ref())?;
             print_check(&scene);
@@ -248,6 +272,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
         Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),
         Command::Bench(BenchCommand::Impact(args)) => bench_impact::impact(&args),
+        Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
+        Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
     }
 }
 

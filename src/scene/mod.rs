@@ -104,7 +104,8 @@ pub struct SceneFile {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
-    /// What is simulated. Required; must be `"ellipsoids"` (the Roig03 interacting-ellipsoids model).
+    /// What is simulated. Required; `"ellipsoids"` (the Roig03 interacting-ellipsoids model) here;
+    /// `"soft-spheres"` scenes are read by [`crate::granular::soft::scene`] instead.
     pub kind: String,
     /// End time of the run (s), > 0. Required. The run starts at t = 0.
     pub t_end: f64,
@@ -627,7 +628,7 @@ impl Validator<'_> {
         if file.scene.kind != "ellipsoids" {
             return Err(self.invalid(
                 "scene.kind",
-                format!("must be \"ellipsoids\", got {:?}", file.scene.kind),
+                format!("must be \"ellipsoids\" or \"soft-spheres\", got {:?}", file.scene.kind),
             ));
         }
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;

@@ -1,0 +1,299 @@
+//! Soft-sphere (SSDEM, Zhang17) commands: the `run`/`resume`/`check` hooks for `kind = "soft-spheres"` scenes,
+//! `rubblepile ssdem advise` and `rubblepile bench ssdem`.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use crate::cli::CliError;
+use crate::granular::soft::advise::{Advice, DEFAULT_MAX_OVERLAP, advise_for_grains};
+use crate::granular::soft::contact::Material;
+use crate::granular::soft::forces::{Gravity, SoftSystem};
+use crate::granular::soft::leapfrog;
+use crate::granular::soft::packing::fcc_ball;
+use crate::granular::soft::run::{SoftRunError, SoftSummary, resume_soft, run_soft};
+use crate::granular::soft::scene::{SoftScene, load_soft_scene};
+use crate::gravity::SelfGravity;
+use crate::math::Vec3;
+use crate::run::RunOptions;
+use crate::scene::SI_G;
+
+/// `rubblepile ssdem …`.
+#[derive(Debug, clap::Subcommand)]
+pub enum SsdemCommand {
+    /// Suggest k_N (N/m) and the step dt (s) for a requested largest overlap.
+    Advise(AdviseArgs),
+}
+
+/// `rubblepile ssdem advise`.
+#[derive(Debug, clap::Args)]
+pub struct AdviseArgs {
+    /// A soft-sphere scene: advice from its particles and gravity (the other options are then not used).
+    #[arg(long, value_name = "SCENE.toml", conflicts_with_all = ["radius", "density", "body_radius", "spin_period_h", "speed"])]
+    pub scene: Option<PathBuf>,
+    /// Smallest particle radius (m).
+    #[arg(long, required_unless_present = "scene")]
+    pub radius: Option<f64>,
+    /// Grain density (kg/m³).
+    #[arg(long, required_unless_present = "scene")]
+    pub density: Option<f64>,
+    /// Radius of the self-gravitating body (m): adds its escape speed and central pressure.
+    #[arg(long)]
+    pub body_radius: Option<f64>,
+    /// Bulk density of the body (kg/m³); default 0.64 × the grain density (random close packing).
+    #[arg(long)]
+    pub bulk_density: Option<f64>,
+    /// Spin period of the body (hours): adds its equatorial speed.
+    #[arg(long)]
+    pub spin_period_h: Option<f64>,
+    /// Largest expected impact speed (m/s).
+    #[arg(long)]
+    pub speed: Option<f64>,
+    /// Largest overlap as a fraction of the smallest radius.
+    #[arg(long, default_value_t = DEFAULT_MAX_OVERLAP)]
+    pub max_overlap: f64,
+}
+
+fn positive(name: &str, x: Option<f64>) -> Result<Option<f64>, CliError> {
+    match x {
+        Some(v) if !(v.is_finite() && v > 0.0) => {
+            Err(CliError::usage(format!("--{name} must be > 0 and finite, got {v}")))
+        }
+        other => Ok(other),
+    }
+}
+
+/// `rubblepile ssdem advise`.
+pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
+    positive("max-overlap", Some(args.max_overlap))?;
+    let advice: Advice = if let Some(path) = &args.scene {
+        let scene = load_soft_scene(path).map_err(CliError::usage)?;
+        let mut a = scene.advice;
+        if args.max_overlap != DEFAULT_MAX_OVERLAP {
+            // k_N ∝ 1/x² for the dynamic term; recompute through the generic recipe.
+            let f = DEFAULT_MAX_OVERLAP / args.max_overlap;
+            a.k_n *= f * f;
+            a.contact_time /= f;
+            a.dt /= f;
+            a.stability_limit /= f;
+        }
+        a
+    } else {
+        let r = positive("radius", args.radius)?.unwrap_or(1.0);
+        let rho = positive("density", args.density)?.unwrap_or(1.0);
+        let body = positive("body-radius", args.body_radius)?;
+        let bulk = positive("bulk-density", args.bulk_density)?.unwrap_or(0.64 * rho);
+        let period = positive("spin-period-h", args.spin_period_h)?.map(|h| h * 3600.0);
+        let speed = positive("speed", args.speed)?.unwrap_or(0.0);
+        if body.is_none() && speed == 0.0 {
+            return Err(CliError::usage(
+                "give --speed or --body-radius (and optionally --spin-period-h)",
+            ));
+        }
+        advise_for_grains(r, rho, body.map(|b| (b, bulk)), period, speed, args.max_overlap)
+    };
+    println!("k_n = {:e} N/m", advice.k_n);
+    println!("dt = {:e} s", advice.dt);
+    println!(
+        "(speed {:e} m/s, static force {:e} N, contact time {:e} s, leapfrog stability limit {:e} s)",
+        advice.speed, advice.static_force, advice.contact_time, advice.stability_limit
+    );
+    Ok(())
+}
+
+fn report(result: Result<SoftSummary, SoftRunError>) -> Result<(), CliError> {
+    match result {
+        Ok(s) => {
+            println!("{}", s.one_line());
+            Ok(())
+        }
+        Err(e) => {
+            if let SoftRunError::Failed { summary, .. } = &e {
+                println!("{}", summary.one_line());
+            }
+            Err(CliError {
+                message: e.to_string(),
+                code: e.exit_code(),
+            })
+        }
+    }
+}
+
+fn warn(scene: &SoftScene) {
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+}
+
+/// `rubblepile run` on a soft-sphere scene.
+pub fn run(path: &Path, out: &Path, options: &RunOptions) -> Result<(), CliError> {
+    let scene = load_soft_scene(path).map_err(CliError::usage)?;
+    warn(&scene);
+    report(run_soft(&scene, out, options))
+}
+
+/// `rubblepile resume` of a soft-sphere run.
+pub fn resume(dir: &Path, options: &RunOptions) -> Result<(), CliError> {
+    report(resume_soft(dir, options))
+}
+
+/// `rubblepile check` on a soft-sphere scene.
+pub fn check(path: &Path) -> Result<(), CliError> {
+    let s = load_soft_scene(path).map_err(CliError::usage)?;
+    warn(&s);
+    println!("{}: ok", s.name);
+    println!(
+        "  {} particles, {} walls, t_end = {} s, dt = {} s ({} steps)",
+        s.particles.len(),
+        s.walls.len(),
+        s.t_end,
+        s.dt,
+        s.n_steps
+    );
+    println!(
+        "  k_n = {:e} N/m (advised {:e} N/m, dt {:e} s)",
+        s.material.k_n, s.advice.k_n, s.advice.dt
+    );
+    Ok(())
+}
+
+/// `rubblepile bench ssdem`.
+#[derive(Debug, clap::Args)]
+pub struct BenchSsdemArgs {
+    /// Particles (an FCC ball of spheres of radius 1 m, grain density 2000 kg/m³, 0.5 % overlaps so every
+    /// contact is loaded, small random-free shear motion from a uniform spin of the ball).
+    #[arg(long, default_value_t = 10000, value_parser = clap::value_parser!(u64).range(2..=10_000_000))]
+    pub particles: u64,
+    /// Gravity: `off` (contacts only), `tree` (θ = 0.5) or `direct`.
+    #[arg(long, default_value = "off", value_parser = ["off", "tree", "direct"])]
+    pub gravity: String,
+    /// Timed steps per thread count.
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub steps: u64,
+    /// Thread counts to time (comma-separated).
+    #[arg(long, default_value = "1,2", value_delimiter = ',')]
+    pub threads: Vec<usize>,
+    /// Write `bench_ssdem.csv` and `bench_ssdem.svg` here.
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an earlier benchmark's files in DIR.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly.
+pub fn bench_system(n: usize, gravity: Option<SelfGravity>) -> SoftSystem {
+    let mut particles = fcc_ball(n, 1.0, 2000.0, -0.005);
+    for p in particles.iter_mut() {
+        p.velocity = Vec3::new(0.0, 0.0, 1e-3).cross(&p.position);
+    }
+    let m = particles[0].mass;
+    // k_N so that a 1 % overlap holds ~ the benchmark's loads; dt = T_c/50.
+    let k_n = 1e7;
+    let mut sys = SoftSystem::new(
+        particles,
+        Vec::new(),
+        Material::nominal(k_n),
+        Gravity {
+            uniform: Vec3::zeros(),
+            self_gravity: gravity,
+            g: SI_G,
+        },
+    );
+    sys.compute_forces(0.0, 0.0);
+    let _ = m;
+    sys
+}
+
+/// Particle-steps per second of `steps` leapfrog steps on `threads` threads.
+pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| format!("cannot build a pool of {threads} threads: {e}"))?;
+    let mut s = sys.clone();
+    let dt = std::f64::consts::PI * (0.5 * s.particles[0].mass / s.material.k_n).sqrt() / 50.0;
+    let elapsed = pool.install(|| {
+        leapfrog::step(&mut s, 0.0, dt);
+        let start = Instant::now();
+        for k in 1..=steps {
+            leapfrog::step(&mut s, k as f64 * dt, dt);
+        }
+        start.elapsed().as_secs_f64()
+    });
+    Ok(s.particles.len() as f64 * steps as f64 / elapsed)
+}
+
+/// `rubblepile bench ssdem`.
+pub fn bench(args: &BenchSsdemArgs) -> Result<(), CliError> {
+    let gravity = match args.gravity.as_str() {
+        "tree" => Some(SelfGravity::Tree { theta: 0.5 }),
+        "direct" => Some(SelfGravity::Direct),
+        _ => None,
+    };
+    if let Some(dir) = &args.out {
+        let csv = dir.join("bench_ssdem.csv");
+        if csv.exists() && !args.force {
+            return Err(CliError::usage(format!(
+                "{} exists; use --force to overwrite it",
+                csv.display()
+            )));
+        }
+        std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
+    }
+    let sys = bench_system(args.particles as usize, gravity);
+    let mut rows = Vec::new();
+    for &t in &args.threads {
+        if t == 0 {
+            return Err(CliError::usage("--threads: each count must be >= 1, got 0"));
+        }
+        let rate = time_steps(&sys, t, args.steps).map_err(CliError::failed)?;
+        println!(
+            "N = {}, gravity {}, {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
+            args.particles, args.gravity, sys.stats.pair_contacts
+        );
+        rows.push((t, rate));
+    }
+    if let Some(dir) = &args.out {
+        let csv = dir.join("bench_ssdem.csv");
+        let mut f = std::fs::File::create(&csv).map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
+        let mut text = String::from("particles,gravity,threads,steps,particle_steps_per_second\n");
+        for (t, r) in &rows {
+            text += &format!("{},{},{t},{},{r}\n", args.particles, args.gravity, args.steps);
+        }
+        f.write_all(text.as_bytes())
+            .map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
+        plot(&dir.join("bench_ssdem.svg"), &rows, &args.gravity, args.particles).map_err(CliError::failed)?;
+    }
+    Ok(())
+}
+
+fn plot(path: &Path, rows: &[(usize, f64)], gravity: &str, n: u64) -> Result<(), String> {
+    use plotters::prelude::*;
+    // plotters measures text with the embedded font (its ab_glyph feature): register it first
+    crate::analysis::figures::style::ensure_font()?;
+    let root = SVGBackend::new(path, (640, 420)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    let max_t = rows.iter().map(|r| r.0).max().unwrap_or(1) as f64 + 0.5;
+    let max_r = rows.iter().map(|r| r.1).fold(0.0, f64::max) * 1.2;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(format!("SSDEM N = {n}, gravity {gravity}"), ("sans-serif", 18))
+        .margin(10)
+        .x_label_area_size(35)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.5..max_t, 0.0..max_r.max(1.0))
+        .map_err(|e| e.to_string())?;
+    chart
+        .configure_mesh()
+        .x_desc("threads")
+        .y_desc("particle-steps / s")
+        .draw()
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(LineSeries::new(rows.iter().map(|r| (r.0 as f64, r.1)), &BLUE))
+        .map_err(|e| e.to_string())?;
+    chart
+        .draw_series(rows.iter().map(|r| Circle::new((r.0 as f64, r.1), 4, BLUE.filled())))
+        .map_err(|e| e.to_string())?;
+    root.present().map_err(|e| e.to_string())
+}

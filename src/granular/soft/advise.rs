@@ -1,0 +1,119 @@
+//! Choosing `k_N` and the step (Zhang17 §2.3.3: "k_N and the time step are chosen so that no overlap exceeds
+//! 1 % of the smallest radius"; the recipe is that of Schwartz et al. 2012, §2.6).
+//!
+//! - A collision at speed `v` of a sphere of mass `m` on a wall (the worst case, reduced mass `m`) overlaps by
+//!   `x = v √(m/k_N)`, so `k_N ≥ m v² / x_max²` with `x_max = f r_min` (f = 1 % by default), `m` the largest
+//!   particle mass and `v` the largest expected speed: the given speed, or the body's escape speed
+//!   `R √(8πGρ/3)` and its equatorial spin speed `2πR/T`, whichever is larger.
+//! - A static load `F` overlaps by `F/k_N`: for a self-gravitating body the central pressure of a uniform
+//!   sphere `p_c = 2π/3 G ρ² R²` acting on a particle's cross-section `4 r²` asks `k_N ≥ 4 r² p_c / x_max`.
+//! - The step resolves the shortest contact, `T_c = π √(μ_min/k_N)` with `μ_min = m_min/2`, in 50 steps:
+//!   `dt = T_c/50`. Leapfrog is unstable for a spring of that frequency above `dt = 2 √(μ_min/k_N)`, the
+//!   stability limit reported (and enforced by the scene check).
+
+use crate::scene::SI_G;
+use serde::Serialize;
+
+/// Default largest overlap, as a fraction of the smallest radius.
+pub const DEFAULT_MAX_OVERLAP: f64 = 0.01;
+/// Steps per contact duration in the advised step.
+pub const STEPS_PER_CONTACT: f64 = 50.0;
+
+/// What the advice is computed from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AdviceInput {
+    /// Smallest particle radius (m).
+    pub r_min: f64,
+    /// Smallest particle mass (kg).
+    pub m_min: f64,
+    /// Largest particle mass (kg).
+    pub m_max: f64,
+    /// Largest expected impact speed (m/s), before the body terms.
+    pub speed: f64,
+    /// The body, if self-gravitating: radius (m) and bulk density (kg/m³).
+    pub body: Option<(f64, f64)>,
+    /// The body's spin period (s), if spinning.
+    pub spin_period: Option<f64>,
+    /// Largest overlap as a fraction of `r_min`.
+    pub max_overlap: f64,
+    /// Gravitational constant (m³ kg⁻¹ s⁻²).
+    pub g: f64,
+}
+
+/// The advice.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Advice {
+    /// Speed used (m/s).
+    pub speed: f64,
+    /// Static contact force used (N).
+    pub static_force: f64,
+    /// Suggested normal spring constant (N/m).
+    pub k_n: f64,
+    /// Contact duration of the lightest pair, `π √(μ_min/k_N)` (s).
+    pub contact_time: f64,
+    /// Suggested step (s).
+    pub dt: f64,
+    /// Leapfrog stability limit for the stiffest contact (s).
+    pub stability_limit: f64,
+}
+
+/// Stability limit `2 √(μ_min/k_N)` (s) of leapfrog on the stiffest contact (μ_min = m_min/2).
+pub fn stability_limit(k_n: f64, m_min: f64) -> f64 {
+    2.0 * (0.5 * m_min / k_n).sqrt()
+}
+
+/// The advised `k_N` and step.
+///
+/// ```
+/// use rubblepile::granular::soft::advise::{advise, AdviceInput};
+/// let a = advise(&AdviceInput { r_min: 1.0, m_min: 1.0, m_max: 1.0, speed: 1.0, body: None,
+///     spin_period: None, max_overlap: 0.01, g: 6.674e-11 });
+/// assert!((a.k_n - 1e4).abs() < 1e-9 && a.dt < a.stability_limit);
+/// ```
+pub fn advise(input: &AdviceInput) -> Advice {
+    let x_max = input.max_overlap * input.r_min;
+    let mut speed = input.speed;
+    let mut static_force = 0.0;
+    if let Some((radius, density)) = input.body {
+        speed = speed.max(radius * (8.0 * std::f64::consts::PI * input.g * density / 3.0).sqrt());
+        let p_c = 2.0 * std::f64::consts::PI / 3.0 * input.g * density * density * radius * radius;
+        static_force = 4.0 * input.r_min * input.r_min * p_c;
+        if let Some(t) = input.spin_period {
+            speed = speed.max(std::f64::consts::TAU * radius / t);
+        }
+    }
+    let k_n = (input.m_max * speed * speed / (x_max * x_max)).max(static_force / x_max);
+    let mu = 0.5 * input.m_min;
+    let contact_time = std::f64::consts::PI * (mu / k_n).sqrt();
+    Advice {
+        speed,
+        static_force,
+        k_n,
+        contact_time,
+        dt: contact_time / STEPS_PER_CONTACT,
+        stability_limit: stability_limit(k_n, input.m_min),
+    }
+}
+
+/// Advice for spheres of radius `r` (m) and grain density `rho` (kg/m³) in a body of radius `body_radius`
+/// (m, bulk density `bulk_density`, spin period `spin_period` s) or hit at `speed` (m/s).
+pub fn advise_for_grains(
+    r: f64,
+    rho: f64,
+    body: Option<(f64, f64)>,
+    spin_period: Option<f64>,
+    speed: f64,
+    max_overlap: f64,
+) -> Advice {
+    let m = 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) * rho;
+    advise(&AdviceInput {
+        r_min: r,
+        m_min: m,
+        m_max: m,
+        speed,
+        body,
+        spin_period,
+        max_overlap,
+        g: SI_G,
+    })
+}

@@ -1,0 +1,19 @@
+//! The soft-sphere discrete element method (SSDEM) of Zhang et al. (2017, Icarus 294, §2) ("Zhang17"):
+//! spheres that touch through spring–dashpot–slider contacts (normal, sliding, twisting, rolling),
+//! self-gravity by octree or direct summation, walls, and a kick–drift–kick leapfrog with a fixed step.
+//!
+//! - [`particle`]: the spheres; [`contact`]: the contact law (Eqs. 1–12); [`spring_frame`]: springs carried
+//!   with the contact frame; [`forces`]: the force loop; [`leapfrog`]: the integrator;
+//! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
+//!   [`scene`]: the `kind = "soft-spheres"`
+//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume).
+
+pub mod advise;
+pub mod contact;
+pub mod forces;
+pub mod leapfrog;
+pub mod packing;
+pub mod particle;
+pub mod run;
+pub mod scene;
+pub mod spring_frame;

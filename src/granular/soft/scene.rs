@@ -1,0 +1,727 @@
+//! The `kind = "soft-spheres"` scene file (Zhang17 §2; parameters of §2.3.3), run by `rubblepile run`.
+//!
+//! ```toml
+//! [scene]
+//! kind = "soft-spheres"
+//! t_end = 10.0                 # s; the run takes round(t_end/dt) steps
+//! seed = 1                     # recorded; the engine draws no random numbers
+//! # particles_file = "p.csv"   # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
+//!
+//! [integrator]
+//! dt = 1e-4                    # s, fixed leapfrog step (see `rubblepile ssdem advise`)
+//!
+//! [contact]                    # Zhang17 Eqs. 1–12; defaults: the paper's nominal material
+//! k_n = 1e6                    # N/m, required; k_S = 2/7 k_N
+//! eps_n = 0.55                 # normal restitution, (0, 1]
+//! eps_t = 0.55                 # tangential restitution, (0, 1]
+//! mu_s = 1.0                   # sliding friction
+//! mu_t = 1.3                   # twisting friction
+//! mu_r = 1.05                  # rolling friction
+//! beta = 0.5                   # shape parameter (0 = no twisting/rolling resistance)
+//! max_start_overlap = 0.05     # largest initial overlap / smaller radius accepted
+//!
+//! [gravity]                    # optional; absent = no gravity
+//! uniform = [0.0, 0.0, -9.81]  # m/s²
+//! self = "tree"                # or "direct"; absent = no self-gravity
+//! theta = 0.5                  # tree opening angle
+//! G = 6.674e-11                # m³ kg⁻¹ s⁻²
+//!
+//! [output]
+//! every = 0.1                  # s, time-series cadence (rounded to whole steps)
+//! times = [0.0, 10.0]          # s, snapshots (each at the nearest step); default [0, t_end]
+//!
+//! [[wall]]
+//! kind = "plane"               # point + normal (towards the particles)
+//! point = [0.0, 0.0, 0.0]      # m
+//! normal = [0.0, 0.0, 1.0]
+//! oscillation = { amplitude = [0.0, 0.0, 0.01], frequency = 5.0 }   # m, Hz; optional
+//!
+//! [[wall]]
+//! kind = "sphere"              # the inside of a sphere: centre + radius
+//! centre = [0.0, 0.0, 0.0]     # m
+//! radius = 5.0                 # m
+//!
+//! [[particle]]
+//! radius = 0.5                 # m
+//! density = 2000.0             # kg/m³ (grain density), or mass = … (kg)
+//! position = [0.0, 0.0, 0.6]   # m
+//! velocity = [1.0, 0.0, 0.0]   # m/s, default 0
+//! spin = [0.0, 0.0, 0.0]       # rad/s, default 0
+//! ```
+//!
+//! Errors are one line naming the file, the dotted field and what was expected (the crate's [`SceneError`]).
+//! Warnings (returned with the scene, printed by the command line) flag a step more than ten times the
+//! advised one and a `k_N` far below the advised one.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::neighbours::sphere_pairs;
+use crate::geometry::wall::{Oscillation, Plane, SphereContainer, Wall};
+use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, advise};
+use crate::granular::soft::contact::Material;
+use crate::granular::soft::forces::Gravity;
+use crate::granular::soft::particle::Particle;
+use crate::gravity::SelfGravity;
+use crate::math::Vec3;
+use crate::scene::{SI_G, SceneError};
+
+/// The scene kind this module reads.
+pub const KIND: &str = "soft-spheres";
+
+/// A whole soft-sphere scene file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoftSceneFile {
+    /// `[scene]`.
+    pub scene: SoftSceneSection,
+    /// `[integrator]`.
+    pub integrator: SoftIntegratorSection,
+    /// `[contact]`.
+    pub contact: ContactSection,
+    /// `[gravity]`, optional.
+    #[serde(default)]
+    pub gravity: GravitySection,
+    /// `[output]`.
+    pub output: SoftOutputSection,
+    /// `[[wall]]` tables.
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<WallSpec>,
+    /// `[[particle]]` tables (or `scene.particles_file`).
+    #[serde(default, rename = "particle")]
+    pub particles: Vec<ParticleSpec>,
+}
+
+/// `[scene]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoftSceneSection {
+    /// Must be `"soft-spheres"`.
+    pub kind: String,
+    /// End time (s, > 0).
+    pub t_end: f64,
+    /// Seed, recorded in the summary (default 0).
+    #[serde(default)]
+    pub seed: u64,
+    /// CSV of the initial particles (relative to the scene's directory), columns
+    /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (`t`, `id` optional and ignored): a snapshot works.
+    #[serde(default)]
+    pub particles_file: Option<String>,
+}
+
+/// `[integrator]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoftIntegratorSection {
+    /// Fixed leapfrog step (s, > 0, at most the stability limit `2 √(μ_min/k_N)`).
+    pub dt: f64,
+}
+
+fn d055() -> f64 {
+    0.55
+}
+fn d1() -> f64 {
+    1.0
+}
+fn d13() -> f64 {
+    1.3
+}
+fn d105() -> f64 {
+    1.05
+}
+fn d05() -> f64 {
+    0.5
+}
+fn d005() -> f64 {
+    0.05
+}
+
+/// `[contact]`: the material (defaults: Zhang17's nominal set, §2.3.3).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSection {
+    /// Normal spring constant (N/m, > 0). Required.
+    pub k_n: f64,
+    /// Normal restitution ε_n, in (0, 1]. Default 0.55.
+    #[serde(default = "d055")]
+    pub eps_n: f64,
+    /// Tangential restitution ε_t, in (0, 1]. Default 0.55.
+    #[serde(default = "d055")]
+    pub eps_t: f64,
+    /// Sliding friction μ_S (≥ 0). Default 1.0.
+    #[serde(default = "d1")]
+    pub mu_s: f64,
+    /// Twisting friction μ_T (≥ 0). Default 1.3.
+    #[serde(default = "d13")]
+    pub mu_t: f64,
+    /// Rolling friction μ_R (≥ 0). Default 1.05.
+    #[serde(default = "d105")]
+    pub mu_r: f64,
+    /// Shape parameter β (≥ 0). Default 0.5.
+    #[serde(default = "d05")]
+    pub beta: f64,
+    /// Largest initial overlap accepted, as a fraction of the smaller radius (≥ 0). Default 0.05.
+    #[serde(default = "d005")]
+    pub max_start_overlap: f64,
+}
+
+/// `[gravity]`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySection {
+    /// Uniform external field (m/s²). Default none.
+    #[serde(default)]
+    pub uniform: Option<[f64; 3]>,
+    /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
+    #[serde(default, rename = "self")]
+    pub self_gravity: Option<String>,
+    /// Tree opening angle θ (in (0, 1]). Default 0.5.
+    #[serde(default)]
+    pub theta: Option<f64>,
+    /// Gravitational constant (m³ kg⁻¹ s⁻², > 0). Default 6.674e-11.
+    #[serde(default, rename = "G")]
+    pub g: Option<f64>,
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SoftOutputSection {
+    /// Time-series cadence (s, > 0), rounded to a whole number of steps (at least one).
+    pub every: f64,
+    /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step. Default `[0, t_end]`.
+    #[serde(default)]
+    pub times: Option<Vec<f64>>,
+}
+
+/// `[[wall]]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    /// `"plane"` or `"sphere"`.
+    pub kind: String,
+    /// Plane: a point on it (m).
+    #[serde(default)]
+    pub point: Option<[f64; 3]>,
+    /// Plane: normal towards the particles (any length > 0; normalised).
+    #[serde(default)]
+    pub normal: Option<[f64; 3]>,
+    /// Sphere: centre (m).
+    #[serde(default)]
+    pub centre: Option<[f64; 3]>,
+    /// Sphere: inner radius (m, > 0).
+    #[serde(default)]
+    pub radius: Option<f64>,
+    /// Optional sinusoidal translation.
+    #[serde(default)]
+    pub oscillation: Option<Oscillation>,
+}
+
+/// `[[particle]]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    /// Radius (m, > 0).
+    pub radius: f64,
+    /// Mass (kg, > 0); exactly one of `mass` and `density`.
+    #[serde(default)]
+    pub mass: Option<f64>,
+    /// Grain density (kg/m³, > 0); then `mass = 4/3 π r³ density`.
+    #[serde(default)]
+    pub density: Option<f64>,
+    /// Centre position (m).
+    pub position: [f64; 3],
+    /// Velocity (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Spin (rad/s). Default 0.
+    #[serde(default)]
+    pub spin: [f64; 3],
+}
+
+/// A validated soft-sphere scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SoftScene {
+    /// Name in messages.
+    pub name: String,
+    /// The scene text (copied into the run directory).
+    pub source: String,
+    /// Where `particles_file` is resolved.
+    pub base_dir: Option<PathBuf>,
+    /// End time (s).
+    pub t_end: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Step (s).
+    pub dt: f64,
+    /// Steps of the run, `round(t_end/dt)`.
+    pub n_steps: u64,
+    /// Steps between time-series rows.
+    pub every_steps: u64,
+    /// Steps of the snapshots, strictly increasing.
+    pub snapshot_steps: Vec<u64>,
+    /// Material.
+    pub material: Material,
+    /// Gravity.
+    pub gravity: Gravity,
+    /// Walls.
+    pub walls: Vec<Wall>,
+    /// Initial particles.
+    pub particles: Vec<Particle>,
+    /// `k_N` and step advised for this scene (1 % overlap).
+    pub advice: Advice,
+    /// Warnings (one line each).
+    pub warnings: Vec<String>,
+}
+
+/// The `scene.kind` of a TOML text, if it has one (used to dispatch `rubblepile run`).
+pub fn scene_kind(text: &str) -> Option<String> {
+    let value: toml::Table = toml::from_str(text).ok()?;
+    value.get("scene")?.get("kind")?.as_str().map(str::to_string)
+}
+
+/// Whether the file at `path` is a soft-sphere scene.
+pub fn is_soft_scene_file(path: &Path) -> bool {
+    std::fs::read_to_string(path).is_ok_and(|t| scene_kind(&t).as_deref() == Some(KIND))
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// Reads and validates a soft-sphere scene file.
+pub fn load_soft_scene(path: &Path) -> Result<SoftScene, SceneError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+        file: name.clone(),
+        reason: one_line(&e.to_string()),
+    })?;
+    let base = path.parent().map(|p| {
+        if p.as_os_str().is_empty() {
+            PathBuf::from(".")
+        } else {
+            p.to_path_buf()
+        }
+    });
+    parse_soft_scene(&text, &name, base.as_deref())
+}
+
+/// Parses and validates soft-sphere scene text (`name` for messages; `base_dir` resolves `particles_file`).
+pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Result<SoftScene, SceneError> {
+    let syntax = |message: String| SceneError::Syntax {
+        file: name.to_string(),
+        message: one_line(&message),
+    };
+    let de = toml::Deserializer::parse(text).map_err(|e| syntax(e.message().to_string()))?;
+    let file: SoftSceneFile = serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        syntax(format!("{path}: {}", inner.message()))
+    })?;
+    let v = V { file: name };
+    v.resolve(text, file, base_dir)
+}
+
+struct V<'a> {
+    file: &'a str,
+}
+
+impl V<'_> {
+    fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_string(),
+            field: field.into(),
+            message: one_line(&message.into()),
+        }
+    }
+    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("must be > 0 and finite, got {x}")))
+        }
+    }
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("must be >= 0 and finite, got {x}")))
+        }
+    }
+    fn restitution(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x > 0.0 && x <= 1.0 {
+            Ok(x)
+        } else {
+            Err(self.invalid(field, format!("must be in (0, 1], got {x}")))
+        }
+    }
+    fn vector(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(Vec3::from(v))
+        } else {
+            Err(self.invalid(field, format!("must be finite, got {v:?}")))
+        }
+    }
+
+    fn particle(&self, label: &str, s: &ParticleSpec) -> Result<Particle, SceneError> {
+        let radius = self.positive(&format!("{label}.radius"), s.radius)?;
+        let mass = match (s.mass, s.density) {
+            (Some(m), None) => self.positive(&format!("{label}.mass"), m)?,
+            (None, Some(rho)) => {
+                self.positive(&format!("{label}.density"), rho)? * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
+            }
+            _ => return Err(self.invalid(label, "give exactly one of `mass` (kg) and `density` (kg/m^3)")),
+        };
+        Ok(Particle {
+            mass,
+            radius,
+            position: self.vector(&format!("{label}.position"), s.position)?,
+            velocity: self.vector(&format!("{label}.velocity"), s.velocity)?,
+            spin: self.vector(&format!("{label}.spin"), s.spin)?,
+        })
+    }
+
+    fn read_particles_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<Particle>, SceneError> {
+        let path = base_dir.map(|b| b.join(rel)).unwrap_or_else(|| PathBuf::from(rel));
+        let field = "scene.particles_file";
+        let mut reader = csv::Reader::from_path(&path)
+            .map_err(|e| self.invalid(field, format!("cannot read {}: {e}", path.display())))?;
+        let headers = reader
+            .headers()
+            .map_err(|e| self.invalid(field, format!("{}: {e}", path.display())))?
+            .clone();
+        let names = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
+        let mut cols = Vec::new();
+        for name in names {
+            let k = headers.iter().position(|h| h.trim() == name).ok_or_else(|| {
+                self.invalid(
+                    field,
+                    format!(
+                        "{}: missing column `{name}` (need t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz)",
+                        path.display()
+                    ),
+                )
+            })?;
+            cols.push(k);
+        }
+        let mut out = Vec::new();
+        for (row, rec) in reader.records().enumerate() {
+            let label = format!("particle[{row}] ({rel} line {})", row + 2);
+            let rec = rec.map_err(|e| self.invalid(&label, e.to_string()))?;
+            let mut v = [0.0; 11];
+            for (slot, (&c, name)) in v.iter_mut().zip(cols.iter().zip(names)) {
+                let cell = rec.get(c).unwrap_or("").trim();
+                *slot = cell
+                    .parse()
+                    .map_err(|_| self.invalid(format!("{label}.{name}"), format!("expected a number, got {cell:?}")))?;
+            }
+            let spec = ParticleSpec {
+                radius: v[1],
+                mass: Some(v[0]),
+                density: None,
+                position: [v[2], v[3], v[4]],
+                velocity: [v[5], v[6], v[7]],
+                spin: [v[8], v[9], v[10]],
+            };
+            out.push(self.particle(&label, &spec)?);
+        }
+        Ok(out)
+    }
+
+    fn wall(&self, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
+        let label = format!("wall[{k}]");
+        if let Some(o) = &w.oscillation {
+            self.vector(&format!("{label}.oscillation.amplitude"), o.amplitude)?;
+            self.positive(&format!("{label}.oscillation.frequency"), o.frequency)?;
+        }
+        let need = |name: &str, present: bool| {
+            if present {
+                Ok(())
+            } else {
+                Err(self.invalid(
+                    format!("{label}.{name}"),
+                    format!("missing (required for a {} wall)", w.kind),
+                ))
+            }
+        };
+        let unused = |name: &str, present: bool| {
+            if present {
+                Err(self.invalid(format!("{label}.{name}"), format!("not used by a {} wall", w.kind)))
+            } else {
+                Ok(())
+            }
+        };
+        match w.kind.as_str() {
+            "plane" => {
+                need("point", w.point.is_some())?;
+                need("normal", w.normal.is_some())?;
+                unused("centre", w.centre.is_some())?;
+                unused("radius", w.radius.is_some())?;
+                let point = self.vector(&format!("{label}.point"), w.point.unwrap_or_default())?;
+                let normal = self.vector(&format!("{label}.normal"), w.normal.unwrap_or_default())?;
+                if normal.norm() == 0.0 {
+                    return Err(self.invalid(format!("{label}.normal"), "must be a non-zero vector, got [0, 0, 0]"));
+                }
+                Ok(Wall::Plane(Plane {
+                    point,
+                    normal: normal.normalize(),
+                    oscillation: w.oscillation,
+                }))
+            }
+            "sphere" => {
+                need("centre", w.centre.is_some())?;
+                need("radius", w.radius.is_some())?;
+                unused("point", w.point.is_some())?;
+                unused("normal", w.normal.is_some())?;
+                Ok(Wall::Sphere(SphereContainer {
+                    centre: self.vector(&format!("{label}.centre"), w.centre.unwrap_or_default())?,
+                    radius: self.positive(&format!("{label}.radius"), w.radius.unwrap_or_default())?,
+                    oscillation: w.oscillation,
+                }))
+            }
+            other => Err(self.invalid(
+                format!("{label}.kind"),
+                format!("must be \"plane\" or \"sphere\", got {other:?}"),
+            )),
+        }
+    }
+
+    fn resolve(&self, text: &str, file: SoftSceneFile, base_dir: Option<&Path>) -> Result<SoftScene, SceneError> {
+        if file.scene.kind != KIND {
+            return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
+        }
+        let t_end = self.positive("scene.t_end", file.scene.t_end)?;
+        let dt = self.positive("integrator.dt", file.integrator.dt)?;
+        let steps = (t_end / dt).round();
+        if !(1.0..=1e12).contains(&steps) {
+            return Err(self.invalid(
+                "integrator.dt",
+                format!("t_end/dt must be in [1, 1e12], got {}", t_end / dt),
+            ));
+        }
+        let n_steps = steps as u64;
+
+        let c = &file.contact;
+        let material = Material {
+            k_n: self.positive("contact.k_n", c.k_n)?,
+            eps_n: self.restitution("contact.eps_n", c.eps_n)?,
+            eps_t: self.restitution("contact.eps_t", c.eps_t)?,
+            mu_s: self.non_negative("contact.mu_s", c.mu_s)?,
+            mu_t: self.non_negative("contact.mu_t", c.mu_t)?,
+            mu_r: self.non_negative("contact.mu_r", c.mu_r)?,
+            beta: self.non_negative("contact.beta", c.beta)?,
+        };
+        let max_start = self.non_negative("contact.max_start_overlap", c.max_start_overlap)?;
+
+        let gs = &file.gravity;
+        let g = match gs.g {
+            Some(g) => self.positive("gravity.G", g)?,
+            None => SI_G,
+        };
+        let self_gravity = match gs.self_gravity.as_deref() {
+            None => {
+                if gs.theta.is_some() {
+                    return Err(self.invalid("gravity.theta", "only used with self = \"tree\""));
+                }
+                None
+            }
+            Some("direct") => {
+                if gs.theta.is_some() {
+                    return Err(self.invalid("gravity.theta", "only used with self = \"tree\", got self = \"direct\""));
+                }
+                Some(SelfGravity::Direct)
+            }
+            Some("tree") => {
+                let theta = gs.theta.unwrap_or(0.5);
+                if !(theta > 0.0 && theta <= 1.0) {
+                    return Err(self.invalid("gravity.theta", format!("must be in (0, 1], got {theta}")));
+                }
+                Some(SelfGravity::Tree { theta })
+            }
+            Some(other) => {
+                return Err(self.invalid("gravity.self", format!("must be \"tree\" or \"direct\", got {other:?}")));
+            }
+        };
+        let uniform = match gs.uniform {
+            Some(u) => self.vector("gravity.uniform", u)?,
+            None => Vec3::zeros(),
+        };
+        let gravity = Gravity {
+            uniform,
+            self_gravity,
+            g,
+        };
+
+        let every = self.positive("output.every", file.output.every)?;
+        let every_steps = ((every / dt).round() as u64).max(1);
+        let times = file.output.times.clone().unwrap_or_else(|| vec![0.0, t_end]);
+        let mut snapshot_steps: Vec<u64> = Vec::new();
+        for (k, &t) in times.iter().enumerate() {
+            if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+                return Err(self.invalid(
+                    format!("output.times[{k}]"),
+                    format!("must be in [0, {t_end}], got {t}"),
+                ));
+            }
+            let s = ((t / dt).round() as u64).min(n_steps);
+            if snapshot_steps.last().is_some_and(|&p| s <= p) {
+                return Err(self.invalid(
+                    format!("output.times[{k}]"),
+                    format!("must be increasing and at least one step (dt = {dt} s) after the previous, got {t}"),
+                ));
+            }
+            snapshot_steps.push(s);
+        }
+
+        let walls = file
+            .walls
+            .iter()
+            .enumerate()
+            .map(|(k, w)| self.wall(k, w))
+            .collect::<Result<Vec<_>, _>>()?;
+        let particles = match (&file.scene.particles_file, file.particles.is_empty()) {
+            (Some(_), false) => {
+                return Err(self.invalid(
+                    "scene.particles_file",
+                    "give either particles_file or [[particle]] tables, not both",
+                ));
+            }
+            (Some(f), true) => self.read_particles_file(f, base_dir)?,
+            (None, _) => file
+                .particles
+                .iter()
+                .enumerate()
+                .map(|(k, s)| self.particle(&format!("particle[{k}]"), s))
+                .collect::<Result<Vec<_>, _>>()?,
+        };
+        if particles.is_empty() {
+            return Err(self.invalid(
+                "particle",
+                "need at least one [[particle]] table or scene.particles_file",
+            ));
+        }
+
+        // Initial overlaps.
+        let centres: Vec<Vec3> = particles.iter().map(|p| p.position).collect();
+        let radii: Vec<f64> = particles.iter().map(|p| p.radius).collect();
+        for (i, j) in sphere_pairs(&centres, &radii) {
+            let overlap = radii[i] + radii[j] - (centres[j] - centres[i]).norm();
+            let fraction = overlap / radii[i].min(radii[j]);
+            if fraction > max_start {
+                return Err(self.invalid(
+                    format!("particle[{i}].position"),
+                    format!(
+                        "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start, more than contact.max_start_overlap = {max_start}"
+                    ),
+                ));
+            }
+        }
+        for (k, w) in walls.iter().enumerate() {
+            for (i, p) in particles.iter().enumerate() {
+                if let Some(touch) = w.touch(&p.position, p.radius, 0.0)
+                    && touch.overlap / p.radius > max_start
+                {
+                    return Err(self.invalid(
+                        format!("particle[{i}].position"),
+                        format!(
+                            "overlaps wall[{k}] by {} m = {:.4} of its radius at the start, more than contact.max_start_overlap = {max_start}",
+                            touch.overlap,
+                            touch.overlap / p.radius
+                        ),
+                    ));
+                }
+            }
+        }
+
+        let advice = scene_advice(&particles, &gravity, material.k_n);
+        let mut warnings = Vec::new();
+        let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
+        let limit = crate::granular::soft::advise::stability_limit(material.k_n, m_min);
+        if dt > limit {
+            return Err(self.invalid(
+                "integrator.dt",
+                format!(
+                    "must be <= the leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:e} s for contact.k_n = {:e} N/m, got {dt:e} (advised: {:e} s)",
+                    material.k_n,
+                    limit / (2.0 / std::f64::consts::PI * crate::granular::soft::advise::STEPS_PER_CONTACT)
+                ),
+            ));
+        }
+        let advised_dt = std::f64::consts::PI * (0.5 * m_min / material.k_n).sqrt()
+            / crate::granular::soft::advise::STEPS_PER_CONTACT;
+        if dt > 10.0 * advised_dt {
+            warnings.push(format!(
+                "{}: integrator.dt = {dt:e} s is more than 10 x the advised {advised_dt:e} s for contact.k_n (contacts resolved by fewer than 5 steps)",
+                self.file
+            ));
+        }
+        if material.k_n < 0.1 * advice.k_n {
+            warnings.push(format!(
+                "{}: contact.k_n = {:e} N/m is below a tenth of the advised {:e} N/m: overlaps may exceed 1 % of the smallest radius",
+                self.file, material.k_n, advice.k_n
+            ));
+        }
+        Ok(SoftScene {
+            name: self.file.to_string(),
+            source: text.to_string(),
+            base_dir: base_dir.map(Path::to_path_buf),
+            t_end,
+            seed: file.scene.seed,
+            dt,
+            n_steps,
+            every_steps,
+            snapshot_steps,
+            material,
+            gravity,
+            walls,
+            particles,
+            advice,
+            warnings,
+        })
+    }
+}
+
+/// The advice ([`advise`]) for a set of particles: the largest particle speed, the fall speed `√(2|g|H)` over
+/// the particles' extent `H` in a uniform field, and with self-gravity the body's escape speed, spin speed
+/// (largest |ω|) and central pressure, the body being the ball about the centre of mass holding every particle.
+pub fn scene_advice(particles: &[Particle], gravity: &Gravity, _k_n: f64) -> Advice {
+    let r_min = particles.iter().map(|p| p.radius).fold(f64::INFINITY, f64::min);
+    let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
+    let m_max = particles.iter().map(|p| p.mass).fold(0.0, f64::max);
+    let mut speed = particles.iter().map(|p| p.velocity.norm()).fold(0.0, f64::max);
+    let g_size = gravity.uniform.norm();
+    if g_size > 0.0 {
+        let ghat = gravity.uniform / g_size;
+        let heights: Vec<f64> = particles.iter().map(|p| p.position.dot(&ghat)).collect();
+        let h = heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - heights.iter().cloned().fold(f64::INFINITY, f64::min);
+        speed = speed.max((2.0 * g_size * h.max(r_min)).sqrt());
+    }
+    let mut body = None;
+    let mut spin_period = None;
+    if gravity.self_gravity.is_some() && particles.len() > 1 {
+        let mass: f64 = particles.iter().map(|p| p.mass).sum();
+        let com: Vec3 = particles.iter().map(|p| p.position * p.mass).sum::<Vec3>() / mass;
+        let radius = particles
+            .iter()
+            .map(|p| (p.position - com).norm() + p.radius)
+            .fold(0.0, f64::max);
+        let density = mass / (4.0 / 3.0 * std::f64::consts::PI * radius.powi(3));
+        body = Some((radius, density));
+        let w = particles.iter().map(|p| p.spin.norm()).fold(0.0, f64::max);
+        if w > 0.0 {
+            spin_period = Some(std::f64::consts::TAU / w);
+        }
+    }
+    advise(&AdviceInput {
+        r_min,
+        m_min,
+        m_max,
+        speed,
+        body,
+        spin_period,
+        max_overlap: DEFAULT_MAX_OVERLAP,
+        g: gravity.g,
+    })
+}
