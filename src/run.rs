@@ -7,6 +7,9 @@
 //! - `snapshots/<k>.csv`: the bodies at the k-th `output.times` entry;
 //! - `summary.json`: counters and conservation errors ([`RunSummary`]);
 //! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format;
+//! - `barrier_overruns.csv` (only when a pair overran its contact barrier): one row per pair and sampled
+//!   time, appended as found ([`crate::ellipsoid::barrier`]; the pairs are listed in `summary.json`'s
+//!   `barrier`, and the run goes on);
 //! - `checkpoint.json` (only when checkpoints are due, see [`RunOptions`]): the full state the run
 //!   continues from with [`resume_run`] (format in [`crate::io::checkpoint`]).
 //!
@@ -32,6 +35,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
 use crate::integrate::{IntegrateError, Integrator, OdeSystem, Tolerances, make_integrator};
 use crate::io::checkpoint::{
@@ -186,11 +190,12 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 }
 
 /// Files a run writes at the top of its directory (removed by `force`).
-const OUTPUT_FILES: [&str; 6] = [
+const OUTPUT_FILES: [&str; 7] = [
     "scene.toml",
     "summary.json",
     "timeseries.csv",
     "last_good_state.csv",
+    OVERRUN_FILE,
     CHECKPOINT_FILE,
     CHECKPOINT_TMP_FILE,
 ];
@@ -555,6 +560,7 @@ struct Start {
     wall_before: f64,
     checkpoints: u64,
     timeseries: Rows,
+    barrier: BarrierMonitor,
 }
 
 /// What every checkpoint of a run repeats.
@@ -569,8 +575,9 @@ struct RunIdentity {
 /// Refuses an existing non-empty `out_dir` unless `options.force`. On an integrator error, a
 /// non-finite diagnostic or a broken quaternion constraint (`||q| − 1| > 1e-3`), writes
 /// `last_good_state.csv` and `summary.json` (its `status` names the cause) and returns
-/// [`RunError::Failed`]. Writes checkpoints as [`RunOptions`] asks (see the module docs). Prints
-/// nothing but the progress bar; see [`RunSummary::one_line`].
+/// [`RunError::Failed`]. Contact-barrier overruns do not stop the run: they are logged to
+/// `barrier_overruns.csv` and listed in the summary ([`RunSummary::warnings`]). Writes checkpoints as
+/// [`RunOptions`] asks (see the module docs). Prints nothing but the progress bar; see [`RunSummary::one_line`].
 pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError> {
     prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
@@ -602,6 +609,11 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
     let timeseries = TimeseriesWriter::create(&ts_path).map_err(io_err(&ts_path))?;
     let y = system.initial_state();
     let tracker = ErrorTracker::new(&system.diagnostics(&y));
+    let barrier = BarrierMonitor::new(
+        BarrierSettings::for_kappa_source(&scene.kappa_source),
+        scene.physics.contact.is_some(),
+        Some(&out_dir.join(OVERRUN_FILE)),
+    );
     let start = Start {
         t: 0.0,
         y,
@@ -611,6 +623,7 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         wall_before: 0.0,
         checkpoints: 0,
         timeseries,
+        barrier,
     };
     drive(scene, out_dir, options, &system, integrator, start, &identity)
 }
@@ -729,6 +742,14 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
     let timeseries =
         TimeseriesAppender::open_truncated(&ts_path, d.timeseries_rows, d.timeseries_bytes).map_err(bad)?;
 
+    let barrier_log = dir.join(OVERRUN_FILE);
+    let barrier = BarrierMonitor::resume(
+        BarrierSettings::for_kappa_source(&scene.kappa_source),
+        scene.physics.contact.is_some(),
+        &barrier_log,
+        ckpt.t,
+    )
+    .map_err(|e| bad(format!("{}: {e}", barrier_log.display())))?;
     let start = Start {
         t: ckpt.t,
         y: ckpt.y.clone(),
@@ -738,6 +759,7 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
         wall_before: d.wall_seconds,
         checkpoints: d.checkpoints,
         timeseries,
+        barrier,
     };
     drive(&scene, dir, options, &system, integrator, start, &identity)
 }
@@ -761,9 +783,11 @@ fn drive(
         wall_before,
         mut checkpoints,
         mut timeseries,
+        mut barrier,
     } = start;
     let settings = scene.integrator;
     let ts_path = out_dir.join("timeseries.csv");
+    let barrier_path = out_dir.join(OVERRUN_FILE);
     let snapshot_path = |k: usize| out_dir.join("snapshots").join(format!("{k}.csv"));
 
     let started = Instant::now();
@@ -771,7 +795,11 @@ fn drive(
     let mut last_good = (t, y.clone());
     let pb = progress_bar(options.progress, scene.t_end, t);
 
-    let summary_of = |status: String, final_time: f64, tracker: &ErrorTracker, stats: crate::integrate::Stats| {
+    let summary_of = |status: String,
+                      final_time: f64,
+                      tracker: &ErrorTracker,
+                      barrier: &BarrierMonitor,
+                      stats: crate::integrate::Stats| {
         let scales = tracker.scales();
         RunSummary {
             status,
@@ -809,6 +837,7 @@ fn drive(
             rotation_integrated: system.rotation_integrated(),
             physics: PhysicsSummary::from(&scene.physics),
             seed: scene.seed,
+            barrier: barrier.report(),
         }
     };
 
@@ -817,16 +846,21 @@ fn drive(
                 t_good: f64,
                 y_good: &[f64],
                 tracker: &ErrorTracker,
+                barrier: &BarrierMonitor,
                 stats: crate::integrate::Stats|
      -> RunError {
         if let Some(pb) = &pb {
             pb.abandon();
         }
+        let cause = match barrier.failure_hint() {
+            Some(hint) => format!("{cause}; {hint}"),
+            None => cause,
+        };
         let lgs = out_dir.join("last_good_state.csv");
         if let Err(e) = write_snapshot(&lgs, t_good, &system.bodies_at(t_good, y_good)) {
             return RunError::Io { path: lgs, source: e };
         }
-        let summary = summary_of(cause.clone(), t_good, tracker, stats);
+        let summary = summary_of(cause.clone(), t_good, tracker, barrier, stats);
         let sp = out_dir.join("summary.json");
         if let Err(e) = write_summary(&sp, &summary) {
             return RunError::Io { path: sp, source: e };
@@ -849,14 +883,15 @@ fn drive(
             && let Err(e) = integrator.advance(system, &mut t, &mut y, sample.t)
         {
             let cause = format!("integrator error: {e}");
-            return Err(fail(cause, t, &y, &tracker, integrator.stats()));
+            return Err(fail(cause, t, &y, &tracker, &barrier, integrator.stats()));
         }
         let d = system.diagnostics(&y);
         if let Some(cause) = check_state(t, &d) {
             let (tg, yg) = &last_good;
-            return Err(fail(cause, *tg, yg, &tracker, integrator.stats()));
+            return Err(fail(cause, *tg, yg, &tracker, &barrier, integrator.stats()));
         }
         tracker.update(&d);
+        barrier.observe(t, system, &y).map_err(io_err(&barrier_path))?;
         let row = TimeseriesRow {
             t,
             diagnostics: d,
@@ -935,7 +970,7 @@ fn drive(
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let summary = summary_of("completed".into(), t, &tracker, integrator.stats());
+    let summary = summary_of("completed".into(), t, &tracker, &barrier, integrator.stats());
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;
     Ok(summary)

@@ -230,16 +230,24 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// Prints the one-line summary of a finished (or failed) run; maps errors to exit codes.
+/// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on
+/// stderr: contact-barrier overruns); maps errors to exit codes.
 pub(crate) fn report(result: Result<crate::run::RunSummary, crate::run::RunError>) -> Result<(), CliError> {
+    let warn = |summary: &crate::run::RunSummary| {
+        for w in summary.warnings() {
+            eprintln!("warning: {w}");
+        }
+    };
     match result {
         Ok(summary) => {
             println!("{}", summary.one_line());
+            warn(&summary);
             Ok(())
         }
         Err(e) => {
             if let crate::run::RunError::Failed { summary, .. } = &e {
                 println!("{}", summary.one_line());
+                warn(summary);
             }
             Err(CliError {
                 message: e.to_string(),
