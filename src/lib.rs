@@ -17,3 +17,4 @@ pub mod math;
 pub mod random;
 pub mod run;
 pub mod scene;
+pub mod stability;

@@ -14,7 +14,9 @@
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
-//!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads.
+//!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads;
+//! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
+//!   ([`crate::stability`]): `stability.csv`, `stability.md` and one run directory per case.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
@@ -24,6 +26,7 @@ pub mod analyze;
 pub mod bench;
 pub mod campaign;
 pub mod impact;
+pub mod stability;
 pub mod target;
 
 use std::path::PathBuf;
@@ -160,6 +163,9 @@ pub struct CheckArgs {
 pub enum BenchCommand {
     /// Time one right-hand-side evaluation for a random cloud of ellipsoids (1 thread vs all threads).
     Rhs(bench::RhsArgs),
+    /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
+    /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
+    Stability(stability::StabilityArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -227,6 +233,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
+        Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
     }
 }
 
