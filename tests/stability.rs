@@ -13,7 +13,7 @@ use common::{rubblepile, temp_dir};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::run::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::scene::parse_scene;
-use rubblepile::stability::cases::{QUATERNION_BOUND, all_cases};
+use rubblepile::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
 use rubblepile::stability::{CaseResult, Verdict, run_case};
 
 /// Whether case `id` is named by `prefix`: the id itself, or its part before a `-`.
@@ -145,22 +145,34 @@ fn resumed_run_keeps_the_overruns_found_before_the_checkpoint() {
     }
     let resumed = resume_run(&dir.join("split"), &quiet).unwrap();
     assert_eq!(resumed.barrier, whole.barrier);
-    assert!(whole.barrier.as_ref().unwrap().samples > 10);
+    assert!(whole.barrier.as_ref().unwrap().samples > 5);
     let read = |p: &Path| std::fs::read_to_string(p.join(OVERRUN_FILE)).unwrap();
     assert_eq!(read(&dir.join("split")), read(&dir.join("whole")));
 }
 
 #[test]
 fn theta_zero_keeps_the_quaternion_norm_and_the_analytic_top() {
-    for r in run(&["d1", "d2"]) {
+    let results = run(&["d0", "d1", "d2"]);
+    for r in &results {
         assert_eq!(r.row.verdict, Verdict::Pass, "{}: {}", r.row.case, r.row.note);
+        // the stated bound: |q| drifts by at most rtol per accepted step, and never near the driver's stop
+        let q = r.row.max_quat_norm_error;
         assert!(
-            r.row.max_quat_norm_error <= QUATERNION_BOUND,
-            "{}: {}",
+            q <= RTOL * r.row.steps as f64,
+            "{}: {q:e} after {} steps",
             r.row.case,
-            r.row.max_quat_norm_error
+            r.row.steps
         );
+        assert!(q <= QUATERNION_HARD, "{}: {q:e}", r.row.case);
     }
+    // θ = 0 is not special: no worse than the same top at a generic attitude
+    let (d0, d1) = (case(&results, "d0"), case(&results, "d1"));
+    assert!(
+        d1.row.max_quat_norm_error <= 10.0 * d0.row.max_quat_norm_error.max(RTOL),
+        "theta = 0: {:e}, generic: {:e}",
+        d1.row.max_quat_norm_error,
+        d0.row.max_quat_norm_error
+    );
 }
 
 #[test]

@@ -24,8 +24,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::ellipsoid::barrier::contacts;
+use crate::ellipsoid::barrier::{BarrierSettings, contacts};
 use crate::ellipsoid::body::{Body, Ellipsoid};
+use crate::ellipsoid::equations::EllipsoidSystem;
+use crate::integrate::{OdeSystem, Tolerances, make_integrator};
 use crate::io::csv::read_bodies_csv;
 use crate::math::{Vec3, Vec4};
 use crate::run::{RunError, RunOptions, RunSummary, run_scene};
@@ -122,16 +124,32 @@ impl CaseRun {
         Ok(out)
     }
 
-    /// The largest `relative speed / calibrated speed` of any touching pair over the snapshots
-    /// ([`crate::ellipsoid::barrier::contacts`]) and the smallest centre distance in units of the touching
-    /// distance; `(0, 1)` when no pair touched.
-    pub fn contact_extremes(&self) -> Result<(f64, f64), String> {
-        let beta = self.summary.barrier.as_ref().map_or(10.0, |b| b.beta);
+    /// The largest `relative speed / calibrated speed` of any touching pair ([`crate::ellipsoid::barrier::contacts`])
+    /// and the smallest centre distance in units of the touching distance, `(0, 1)` when no pair touched,
+    /// sampled every `dt` s: the case's scene is integrated again (same physics, method and tolerances), so that
+    /// the run itself can keep a coarse output grid and its step counts say what the dynamics costs. An
+    /// integrator failure ends the sampling quietly (the run's own row reports it).
+    pub fn contact_extremes(&self, dt: f64) -> Result<(f64, f64), String> {
+        let scene = &self.scene;
+        let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
+        let settings = scene.integrator;
+        let tolerances = Tolerances::uniform(settings.rtol, settings.atol, system.dim());
+        let mut integrator =
+            make_integrator(settings.method, tolerances, settings.step).map_err(|e| format!("integrator: {e}"))?;
+        let beta = BarrierSettings::for_kappa_source(&scene.kappa_source).beta;
+        let (mut t, mut y) = (0.0, system.initial_state());
         let (mut ratio, mut sep) = (0.0_f64, 1.0_f64);
-        for (_, bodies) in self.snapshots()? {
-            for c in contacts(&self.scene.model, beta, &bodies) {
+        loop {
+            for c in contacts(&scene.model, beta, &system.bodies_at(t, &y)) {
                 ratio = ratio.max(c.speed / c.calibrated_speed);
                 sep = sep.min(c.separation_ratio());
+            }
+            if t >= scene.t_end {
+                break;
+            }
+            let next = (t + dt).min(scene.t_end);
+            if integrator.advance(&system, &mut t, &mut y, next).is_err() {
+                break;
             }
         }
         Ok((ratio, sep))
