@@ -246,7 +246,8 @@ pub fn pair_contact(model: &ModelConfig, beta: f64, bodies: &[Body], i: usize, j
     contact.speed.is_finite().then_some(contact)
 }
 
-/// Every pair in contact (`x < κλ`), sorted by `(i, j)`: sort-and-sweep along x with [`reach`], then the exact test.
+/// Every pair in contact (`x < κλ`), sorted by `(i, j)`: sort-and-sweep along x with a bound on each body's
+/// reach, then the exact test.
 pub fn contacts(model: &ModelConfig, beta: f64, bodies: &[Body]) -> Vec<PairContact> {
     let reaches: Vec<f64> = bodies.iter().map(reach).collect();
     let max_reach = reaches.iter().copied().fold(0.0, f64::max);
