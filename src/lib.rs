@@ -19,3 +19,4 @@ pub mod math;
 pub mod random;
 pub mod run;
 pub mod scene;
+pub mod stability;

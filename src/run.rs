@@ -9,6 +9,9 @@
 //!   every time-series sample;
 //! - `summary.json`: counters and conservation errors ([`RunSummary`]);
 //! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format;
+//! - `barrier_overruns.csv` (only when a pair overran its contact barrier): one row per pair and sampled
+//!   time, appended as found ([`crate::ellipsoid::barrier`]; the pairs are listed in `summary.json`'s
+//!   `barrier`, and the run goes on);
 //! - `checkpoint.json` (only when checkpoints are due, see [`RunOptions`]): the full state the run
 //!   continues from with [`resume_run`] (format in [`crate::io::checkpoint`]).
 //!
@@ -35,6 +38,7 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
 use crate::integrate::{IntegrateError, Integrator, OdeSystem, Tolerances, make_integrator};
 use crate::io::checkpoint::{
@@ -189,12 +193,13 @@ fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
 }
 
 /// Files a run writes at the top of its directory (removed by `force`).
-const OUTPUT_FILES: [&str; 7] = [
+const OUTPUT_FILES: [&str; 8] = [
     "scene.toml",
     "summary.json",
     "timeseries.csv",
     "tracks.csv",
     "last_good_state.csv",
+    OVERRUN_FILE,
     CHECKPOINT_FILE,
     CHECKPOINT_TMP_FILE,
 ];
@@ -561,6 +566,7 @@ struct Start {
     timeseries: Rows,
     /// `tracks.csv`, when the scene tracks bodies.
     tracks: Option<TracksWriter>,
+    barrier: BarrierMonitor,
 }
 
 /// What every checkpoint of a run repeats.
@@ -575,8 +581,9 @@ struct RunIdentity {
 /// Refuses an existing non-empty `out_dir` unless `options.force`. On an integrator error, a
 /// non-finite diagnostic or a broken quaternion constraint (`||q| − 1| > 1e-3`), writes
 /// `last_good_state.csv` and `summary.json` (its `status` names the cause) and returns
-/// [`RunError::Failed`]. Writes checkpoints as [`RunOptions`] asks (see the module docs). Prints
-/// nothing but the progress bar; see [`RunSummary::one_line`].
+/// [`RunError::Failed`]. Contact-barrier overruns do not stop the run: they are logged to
+/// `barrier_overruns.csv` and listed in the summary ([`RunSummary::warnings`]). Writes checkpoints as
+/// [`RunOptions`] asks (see the module docs). Prints nothing but the progress bar; see [`RunSummary::one_line`].
 pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError> {
     prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
@@ -614,6 +621,11 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
     };
     let y = system.initial_state();
     let tracker = ErrorTracker::new(&system.diagnostics(&y));
+    let barrier = BarrierMonitor::new(
+        BarrierSettings::for_kappa_source(&scene.kappa_source),
+        scene.physics.contact.is_some(),
+        Some(&out_dir.join(OVERRUN_FILE)),
+    );
     let start = Start {
         t: 0.0,
         y,
@@ -624,6 +636,7 @@ pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> R
         checkpoints: 0,
         timeseries,
         tracks,
+        barrier,
     };
     drive(scene, out_dir, options, &system, integrator, start, &identity)
 }
@@ -749,6 +762,14 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
         Some(TracksWriter::open_truncated(&dir.join("tracks.csv"), rows).map_err(bad)?)
     };
 
+    let barrier_log = dir.join(OVERRUN_FILE);
+    let barrier = BarrierMonitor::resume(
+        BarrierSettings::for_kappa_source(&scene.kappa_source),
+        scene.physics.contact.is_some(),
+        &barrier_log,
+        ckpt.t,
+    )
+    .map_err(|e| bad(format!("{}: {e}", barrier_log.display())))?;
     let start = Start {
         t: ckpt.t,
         y: ckpt.y.clone(),
@@ -759,6 +780,7 @@ pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunErr
         checkpoints: d.checkpoints,
         timeseries,
         tracks,
+        barrier,
     };
     drive(&scene, dir, options, &system, integrator, start, &identity)
 }
@@ -783,10 +805,12 @@ fn drive(
         mut checkpoints,
         mut timeseries,
         mut tracks,
+        mut barrier,
     } = start;
     let tracks_path = out_dir.join("tracks.csv");
     let settings = scene.integrator;
     let ts_path = out_dir.join("timeseries.csv");
+    let barrier_path = out_dir.join(OVERRUN_FILE);
     let snapshot_path = |k: usize| out_dir.join("snapshots").join(format!("{k}.csv"));
 
     let started = Instant::now();
@@ -794,7 +818,11 @@ fn drive(
     let mut last_good = (t, y.clone());
     let pb = progress_bar(options.progress, scene.t_end, t);
 
-    let summary_of = |status: String, final_time: f64, tracker: &ErrorTracker, stats: crate::integrate::Stats| {
+    let summary_of = |status: String,
+                      final_time: f64,
+                      tracker: &ErrorTracker,
+                      barrier: &BarrierMonitor,
+                      stats: crate::integrate::Stats| {
         let scales = tracker.scales();
         RunSummary {
             status,
@@ -832,6 +860,7 @@ fn drive(
             rotation_integrated: system.rotation_integrated(),
             physics: PhysicsSummary::from(&scene.physics),
             seed: scene.seed,
+            barrier: barrier.report(),
         }
     };
 
@@ -840,16 +869,21 @@ fn drive(
                 t_good: f64,
                 y_good: &[f64],
                 tracker: &ErrorTracker,
+                barrier: &BarrierMonitor,
                 stats: crate::integrate::Stats|
      -> RunError {
         if let Some(pb) = &pb {
             pb.abandon();
         }
+        let cause = match barrier.failure_hint() {
+            Some(hint) => format!("{cause}; {hint}"),
+            None => cause,
+        };
         let lgs = out_dir.join("last_good_state.csv");
         if let Err(e) = write_snapshot(&lgs, t_good, &system.bodies_at(t_good, y_good)) {
             return RunError::Io { path: lgs, source: e };
         }
-        let summary = summary_of(cause.clone(), t_good, tracker, stats);
+        let summary = summary_of(cause.clone(), t_good, tracker, barrier, stats);
         let sp = out_dir.join("summary.json");
         if let Err(e) = write_summary(&sp, &summary) {
             return RunError::Io { path: sp, source: e };
@@ -872,14 +906,15 @@ fn drive(
             && let Err(e) = integrator.advance(system, &mut t, &mut y, sample.t)
         {
             let cause = format!("integrator error: {e}");
-            return Err(fail(cause, t, &y, &tracker, integrator.stats()));
+            return Err(fail(cause, t, &y, &tracker, &barrier, integrator.stats()));
         }
         let d = system.diagnostics(&y);
         if let Some(cause) = check_state(t, &d) {
             let (tg, yg) = &last_good;
-            return Err(fail(cause, *tg, yg, &tracker, integrator.stats()));
+            return Err(fail(cause, *tg, yg, &tracker, &barrier, integrator.stats()));
         }
         tracker.update(&d);
+        barrier.observe(t, system, &y).map_err(io_err(&barrier_path))?;
         let row = TimeseriesRow {
             t,
             diagnostics: d,
@@ -965,7 +1000,7 @@ fn drive(
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let summary = summary_of("completed".into(), t, &tracker, integrator.stats());
+    let summary = summary_of("completed".into(), t, &tracker, &barrier, integrator.stats());
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;
     Ok(summary)

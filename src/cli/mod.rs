@@ -25,6 +25,8 @@
 //! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second.
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
+//! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
+//!   ([`crate::stability`]): `stability.csv`, `stability.md` and one run directory per case.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
@@ -37,6 +39,7 @@ pub mod campaign;
 pub mod impact;
 pub mod nbody;
 pub mod ssdem;
+pub mod stability;
 pub mod target;
 pub mod work_precision;
 
@@ -188,6 +191,9 @@ pub enum BenchCommand {
     Impact(bench_impact::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(ssdem::BenchSsdemArgs),
+    /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
+    /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
+    Stability(stability::StabilityArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -274,19 +280,28 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Impact(args)) => bench_impact::impact(&args),
         Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
+        Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
     }
 }
 
-/// Prints the one-line summary of a finished (or failed) run; maps errors to exit codes.
+/// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on
+/// stderr: contact-barrier overruns); maps errors to exit codes.
 pub(crate) fn report(result: Result<crate::run::RunSummary, crate::run::RunError>) -> Result<(), CliError> {
+    let warn = |summary: &crate::run::RunSummary| {
+        for w in summary.warnings() {
+            eprintln!("warning: {w}");
+        }
+    };
     match result {
         Ok(summary) => {
             println!("{}", summary.one_line());
+            warn(&summary);
             Ok(())
         }
         Err(e) => {
             if let crate::run::RunError::Failed { summary, .. } = &e {
                 println!("{}", summary.one_line());
+                warn(summary);
             }
             Err(CliError {
                 message: e.to_string(),

@@ -6,8 +6,10 @@
 //! - [`calibration`]: κ from Eq. 14 and `U0` from Eq. 11;
 //! - [`gravity`]: monopole gravity (Eq. 6);
 //! - [`dissipation`]: the point dissipation function (Eqs. 40–41);
+//! - [`barrier`]: the contact-barrier overrun detector (calibration of Eqs. 13–14 checked during a run);
 //! - [`equations`]: the equations of motion (Eqs. 28–37) as an [`crate::integrate::OdeSystem`].
 
+pub mod barrier;
 pub mod body;
 pub mod calibration;
 pub mod dissipation;

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::ellipsoid::barrier::BarrierReport;
 use crate::ellipsoid::equations::Physics;
 
 /// The scales that make the conservation errors relative.
@@ -123,6 +124,10 @@ pub struct RunSummary {
     pub physics: PhysicsSummary,
     /// The scene's seed.
     pub seed: u64,
+    /// Contact-barrier overruns found at the sampled times ([`crate::ellipsoid::barrier`]); null when the
+    /// contact term is off (and in summaries written before the detector existed).
+    #[serde(default)]
+    pub barrier: Option<BarrierReport>,
 }
 
 /// β and v of a calibration.
@@ -138,6 +143,11 @@ impl RunSummary {
     /// Whether the run reached `t_end`.
     pub fn completed(&self) -> bool {
         self.status == "completed"
+    }
+
+    /// Warnings to print after the run (one line each): the contact-barrier overruns.
+    pub fn warnings(&self) -> Vec<String> {
+        self.barrier.as_ref().map(BarrierReport::warnings).unwrap_or_default()
     }
 
     /// The one-line report printed after a run, e.g.
