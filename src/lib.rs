@@ -10,6 +10,7 @@ pub mod analysis;
 pub mod cli;
 pub mod ellipsoid;
 pub mod geometry;
+pub mod granular;
 pub mod impact;
 pub mod integrate;
 pub mod io;

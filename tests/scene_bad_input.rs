@@ -336,7 +336,7 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         (
             "kind",
             with("\"ellipsoids\"", "\"spheres\""),
-            "scene.kind: must be \"ellipsoids\", got \"spheres\"",
+            "scene.kind: must be one of \"ellipsoids\", \"hard-spheres\", got \"spheres\"",
         ),
         (
             "no bodies",

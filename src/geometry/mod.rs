@@ -1,4 +1,5 @@
-//! Geometry shared by the engines: neighbour search (and, later, wall primitives).
+//! Geometry shared by the engines: neighbour search and the hard-sphere wall primitives.
 
 pub mod ellipsoid_overlap;
 pub mod neighbours;
+pub mod walls;

@@ -1,0 +1,3 @@
+//! Granular engines: spheres with contacts.
+
+pub mod hard;
