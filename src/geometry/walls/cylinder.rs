@@ -52,10 +52,10 @@ pub fn toi(p: &Vec3, d: &Vec3, s: f64, t_max: f64, radius: f64, length: Option<f
     if let Some(l) = length {
         for end in [0.5 * l, -0.5 * l] {
             let q = p - Vec3::new(0.0, 0.0, end);
-            if let Some(t) = ring::toi(&q, d, s, best.unwrap_or(t_max), radius) {
-                if best.is_none_or(|x| t < x) {
-                    best = Some(t);
-                }
+            if let Some(t) = ring::toi(&q, d, s, best.unwrap_or(t_max), radius)
+                && best.is_none_or(|x| t < x)
+            {
+                best = Some(t);
             }
         }
     }

@@ -29,10 +29,10 @@ pub fn toi(p: &Vec3, d: &Vec3, s: f64, t_max: f64, length: Option<f64>) -> Optio
     let b = 2.0 * (p.x * d.x + p.y * d.y);
     if b < 0.0 {
         let [t, _] = quadratic(a, b, p.x * p.x + p.y * p.y - s * s);
-        if let Some(t) = t {
-            if length.is_none_or(|l| (p.z + d.z * t).abs() <= 0.5 * l) {
-                keep(t);
-            }
+        if let Some(t) = t
+            && length.is_none_or(|l| (p.z + d.z * t).abs() <= 0.5 * l)
+        {
+            keep(t);
         }
     }
     if let Some(l) = length {

@@ -254,10 +254,10 @@ impl System {
             if e.gen_i != self.gens[e.i] {
                 continue;
             }
-            if let Partner::Particle(j) = e.partner {
-                if e.gen_j != self.gens[j] {
-                    continue;
-                }
+            if let Partner::Particle(j) = e.partner
+                && e.gen_j != self.gens[j]
+            {
+                continue;
             }
             d.events += 1;
             self.counters.events += 1;
