@@ -336,7 +336,7 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         (
             "kind",
             with("\"ellipsoids\"", "\"spheres\""),
-            "scene.kind: must be \"ellipsoids\" or \"soft-spheres\", got \"spheres\"",
+            "scene.kind: must be one of \"ellipsoids\", \"soft-spheres\", \"hard-spheres\", got \"spheres\"",
         ),
         (
             "no bodies",

@@ -186,8 +186,18 @@ fn stiff_dissipation_keeps_the_energy_bookkeeping_and_does_not_stall() {
         assert!(r.run.summary.physics.dissipation.unwrap().f0 == 100.0);
         // the point dissipation function conserves both momenta (Roig03 Appendix A), sticking or not
         let s = &r.run.summary;
-        assert!(s.linear_momentum_error <= 1e-8, "{}: |dP| {:e}", r.row.case, s.linear_momentum_error);
-        assert!(s.angular_momentum_error <= 1e-8, "{}: |dL| {:e}", r.row.case, s.angular_momentum_error);
+        assert!(
+            s.linear_momentum_error <= 1e-8,
+            "{}: |dP| {:e}",
+            r.row.case,
+            s.linear_momentum_error
+        );
+        assert!(
+            s.angular_momentum_error <= 1e-8,
+            "{}: |dL| {:e}",
+            r.row.case,
+            s.angular_momentum_error
+        );
     }
 }
 

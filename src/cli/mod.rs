@@ -234,6 +234,12 @@ fn load(scene: Option<&PathBuf>) -> Result<LoadedScene, CliError> {
 pub fn execute(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Run(args) => {
+            if let Some(path) = &args.scene
+                && let Ok(text) = std::fs::read_to_string(path)
+                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
+            {
+                return crate::granular::hard::run::cli_run(path, &args.out, args.force);
+            }
             let options = RunOptions {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?

@@ -1,5 +1,5 @@
-//! Geometry shared by the engines: neighbour search, ellipsoid overlap, wall primitives, lattices, Voronoi
-//! cells, shape models.
+//! Geometry shared by the engines: neighbour search, ellipsoid overlap, soft-contact walls (`wall`), the
+//! hard-sphere wall primitives with their times of impact (`walls`), lattices, Voronoi cells, shape models.
 
 pub mod ellipsoid_overlap;
 pub mod lattice;
@@ -7,3 +7,4 @@ pub mod neighbours;
 pub mod polyhedron;
 pub mod voronoi;
 pub mod wall;
+pub mod walls;

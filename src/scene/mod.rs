@@ -459,11 +459,27 @@ pub fn parse_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Lo
 
 /// Parses TOML into a [`SceneFile`] without validating values.
 pub fn parse_toml(text: &str, name: &str) -> Result<SceneFile, SceneError> {
+    parse_toml_as(text, name)
+}
+
+/// The scene kinds `rubblepile run` knows.
+pub const SCENE_KINDS: [&str; 3] = ["ellipsoids", "soft-spheres", "hard-spheres"];
+
+/// The `scene.kind` string of a scene text, if it is TOML with one (used to pick the engine before the
+/// kind-specific parse).
+pub fn peek_kind(text: &str) -> Option<String> {
+    let table: toml::Table = text.parse().ok()?;
+    table.get("scene")?.get("kind")?.as_str().map(str::to_string)
+}
+
+/// Parses TOML into any scene-file model `T` (each engine has its own) with the same one-line messages as
+/// [`parse_toml`].
+pub fn parse_toml_as<T: serde::de::DeserializeOwned>(text: &str, name: &str) -> Result<T, SceneError> {
     let de = toml::Deserializer::parse(text).map_err(|e| SceneError::Syntax {
         file: name.to_string(),
         message: format!("{}: {}", location(text, e.span()), one_line(e.message())),
     })?;
-    serde_path_to_error::deserialize::<_, SceneFile>(de).map_err(|e| {
+    serde_path_to_error::deserialize::<_, T>(de).map_err(|e| {
         let segments: Vec<serde_path_to_error::Segment> = e.path().iter().cloned().collect();
         let inner = e.into_inner();
         SceneError::Syntax {
@@ -628,7 +644,10 @@ impl Validator<'_> {
         if file.scene.kind != "ellipsoids" {
             return Err(self.invalid(
                 "scene.kind",
-                format!("must be \"ellipsoids\" or \"soft-spheres\", got {:?}", file.scene.kind),
+                format!(
+                    "must be one of \"ellipsoids\", \"soft-spheres\", \"hard-spheres\", got {:?}",
+                    file.scene.kind
+                ),
             ));
         }
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;

@@ -1,0 +1,60 @@
+//! Prescribed wall motion (Richardson11 §2.2: walls may translate, oscillate and, for cylinders, spin; notes
+//! `shared/notes/hsdem.md`, "Particle–wall").
+//!
+//! The wall's reference point is `o(t) = origin + V t + A (sin(ω t + φ) − sin φ) d̂`, so `origin` is where the wall
+//! is at t = 0 whatever the phase. Within one step `[t0, t1]` the wall moves on the straight secant from `o(t0)` to
+//! `o(t1)` with the constant velocity `(o(t1) − o(t0))/(t1 − t0)` ("the wall's velocity is held constant within a
+//! step"): the relative motion of a particle and a wall is then a straight line, every time of impact is exact, and
+//! the wall is exactly where its law puts it at the step ends. The spin Ω (rad/s, right-handed about the wall axis)
+//! moves no surface of these axisymmetric primitives; it only adds `Ω â × ρ` to the surface velocity.
+
+use crate::math::Vec3;
+
+/// Sinusoidal oscillation `A sin(ω t + φ) d̂`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Oscillation {
+    /// Amplitude A (m), ≥ 0.
+    pub amplitude: f64,
+    /// Angular frequency ω (rad/s).
+    pub omega: f64,
+    /// Phase φ (rad).
+    pub phase: f64,
+    /// Unit direction d̂.
+    pub direction: Vec3,
+}
+
+/// How a wall moves.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct WallMotion {
+    /// Constant translation velocity V (m/s).
+    pub velocity: Vec3,
+    /// Optional oscillation.
+    pub oscillation: Option<Oscillation>,
+    /// Spin Ω about the wall axis (rad/s).
+    pub spin: f64,
+}
+
+impl WallMotion {
+    /// Displacement `o(t) − origin` (m).
+    pub fn displacement(&self, t: f64) -> Vec3 {
+        let mut d = self.velocity * t;
+        if let Some(o) = &self.oscillation {
+            d += o.direction * (o.amplitude * ((o.omega * t + o.phase).sin() - o.phase.sin()));
+        }
+        d
+    }
+
+    /// Whether the wall never moves (no translation, oscillation or spin).
+    pub fn is_static(&self) -> bool {
+        self.velocity == Vec3::zeros() && self.oscillation.is_none() && self.spin == 0.0
+    }
+
+    /// The secant velocity over `[t0, t1]` (m/s), used for the whole step.
+    pub fn step_velocity(&self, t0: f64, t1: f64) -> Vec3 {
+        if t1 > t0 {
+            (self.displacement(t1) - self.displacement(t0)) / (t1 - t0)
+        } else {
+            self.velocity
+        }
+    }
+}

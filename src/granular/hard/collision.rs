@@ -1,0 +1,144 @@
+//! Collision resolution of rough spheres with normal and tangential restitution (Richardson11 §2.1, ≈Eqs. 4–8;
+//! notes `shared/notes/hsdem.md`, "Particle–particle" and "Particle–wall").
+//!
+//! Contact-point velocities decide: with n̂ from sphere 1 to sphere 2, `u = (v₂ + R₂ n̂×ω₂) − (v₁ + R₁ ω₁×n̂)`, and a
+//! collision acts only if `u·n̂ < 0`. The normal part of `u` is reversed and scaled by ε_n, the tangential part
+//! scaled by ε_t (1: smooth, 0: transverse motion killed, −1: reversed). With `μ = m₁m₂/M` and
+//! `β = 1/(1 + μ(R₁²/I₁ + R₂²/I₂))` the impulses are `p = (1+ε_n) u_n + β(1−ε_t) u_t` and
+//! `q = μβ(1−ε_t)(n̂ × u)`; momentum and angular momentum are conserved exactly (the impulses are equal and opposite
+//! and act at the contact point on the line of centres), and the energy change is the closed form of
+//! [`pair_energy_change`].
+//!
+//! The inelastic-collapse guard: a collision whose normal approach speed |u·n̂| is below `collapse_speed` is made
+//! elastic (ε_n = 1, ε_t = 1). Without it a pile at rest under gravity with ε_n < 1 makes ever faster sequences of
+//! ever smaller bounces (inelastic collapse, an infinite number of collisions in finite time) and the event loop
+//! never reaches the end of the step; with it the slowest contacts bounce elastically at speeds of order g·dt and the
+//! number of events per step stays bounded.
+
+use crate::math::Vec3;
+
+/// Restitution used for one collision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Restitution {
+    /// Normal coefficient ε_n ∈ [0, 1].
+    pub eps_n: f64,
+    /// Tangential coefficient ε_t ∈ [−1, 1].
+    pub eps_t: f64,
+}
+
+/// One side of a collision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Body {
+    /// Mass (kg).
+    pub mass: f64,
+    /// Radius (m).
+    pub radius: f64,
+    /// Moment of inertia (kg m²).
+    pub inertia: f64,
+    /// Centre position (m).
+    pub position: Vec3,
+    /// Velocity (m/s).
+    pub velocity: Vec3,
+    /// Spin (rad/s).
+    pub spin: Vec3,
+}
+
+/// What a collision did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Outcome {
+    /// Whether the bodies were approaching (otherwise nothing changed).
+    pub applied: bool,
+    /// Normal approach speed |u·n̂| (m/s).
+    pub approach_speed: f64,
+    /// Whether the collapse guard made it elastic.
+    pub guarded: bool,
+}
+
+/// The relative contact velocity `u` of body 2 with respect to body 1 and the unit normal from 1 to 2.
+pub fn contact_velocity(b1: &Body, b2: &Body) -> (Vec3, Vec3) {
+    let n = (b2.position - b1.position).normalize();
+    let u = (b2.velocity + b2.spin.cross(&(-n * b2.radius))) - (b1.velocity + b1.spin.cross(&(n * b1.radius)));
+    (u, n)
+}
+
+/// The closed-form energy change (J, ≤ 0) of a pair collision: `−½ μ (1−ε_n²) u_n² − ½ μβ (1−ε_t²) |u_t|²`.
+pub fn pair_energy_change(b1: &Body, b2: &Body, r: Restitution) -> f64 {
+    let (u, n) = contact_velocity(b1, b2);
+    let un = u.dot(&n);
+    if un >= 0.0 {
+        return 0.0;
+    }
+    let ut = u - n * un;
+    let mu = b1.mass * b2.mass / (b1.mass + b2.mass);
+    let beta = 1.0 / (1.0 + mu * (b1.radius * b1.radius / b1.inertia + b2.radius * b2.radius / b2.inertia));
+    -0.5 * mu * (1.0 - r.eps_n * r.eps_n) * un * un - 0.5 * mu * beta * (1.0 - r.eps_t * r.eps_t) * ut.norm_squared()
+}
+
+/// Resolves a collision between two free spheres in contact (velocities and spins updated in place).
+pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed: f64) -> Outcome {
+    let (u, n) = contact_velocity(b1, b2);
+    let un = u.dot(&n);
+    if un >= 0.0 {
+        return Outcome {
+            applied: false,
+            approach_speed: 0.0,
+            guarded: false,
+        };
+    }
+    let guarded = -un < collapse_speed;
+    let r = if guarded {
+        Restitution { eps_n: 1.0, eps_t: 1.0 }
+    } else {
+        r
+    };
+    let u_n = n * un;
+    let u_t = u - u_n;
+    let m = b1.mass + b2.mass;
+    let mu = b1.mass * b2.mass / m;
+    let beta = 1.0 / (1.0 + mu * (b1.radius * b1.radius / b1.inertia + b2.radius * b2.radius / b2.inertia));
+    let p = u_n * (1.0 + r.eps_n) + u_t * (beta * (1.0 - r.eps_t));
+    let q = n.cross(&u) * (mu * beta * (1.0 - r.eps_t));
+    b1.velocity += p * (b2.mass / m);
+    b2.velocity -= p * (b1.mass / m);
+    b1.spin += q * (b1.radius / b1.inertia);
+    b2.spin += q * (b2.radius / b2.inertia);
+    Outcome {
+        applied: true,
+        approach_speed: -un,
+        guarded,
+    }
+}
+
+/// Resolves a collision of a sphere with an infinitely massive surface (a wall, or a particle stuck to one):
+/// `n` is the unit normal from the contact point to the sphere's centre and `surface_velocity` the surface's
+/// velocity at the contact point. `u = v + ω × R − v_wall` with `R = −s n̂`; then
+/// `v' = v − (1+ε_n) u_n − β(1−ε_t) u_t` and `ω' = ω − (mβ/I)(1−ε_t) (R × u)` with `β = 1/(1 + m s²/I)`
+/// (= 2/7 and `mβ/I = (5/7)/s²` for a uniform sphere).
+pub fn resolve_wall(b: &mut Body, n: &Vec3, surface_velocity: &Vec3, r: Restitution, collapse_speed: f64) -> Outcome {
+    let arm = -n * b.radius;
+    let u = b.velocity + b.spin.cross(&arm) - surface_velocity;
+    let un = u.dot(n);
+    if un >= 0.0 {
+        return Outcome {
+            applied: false,
+            approach_speed: 0.0,
+            guarded: false,
+        };
+    }
+    let guarded = -un < collapse_speed;
+    let r = if guarded {
+        Restitution { eps_n: 1.0, eps_t: 1.0 }
+    } else {
+        r
+    };
+    let u_n = n * un;
+    let u_t = u - u_n;
+    let beta = 1.0 / (1.0 + b.mass * b.radius * b.radius / b.inertia);
+    b.velocity -= u_n * (1.0 + r.eps_n) + u_t * (beta * (1.0 - r.eps_t));
+    b.spin -= arm.cross(&u) * (b.mass * beta * (1.0 - r.eps_t) / b.inertia);
+    Outcome {
+        applied: true,
+        approach_speed: -un,
+        guarded,
+    }
+}

@@ -1,0 +1,608 @@
+//! The `kind = "hard-spheres"` scene file (Richardson11 §2; walls "from a text file", here `[[wall]]` tables).
+//!
+//! ```toml
+//! [scene]
+//! kind = "hard-spheres"
+//! t_end = 2.0                      # s
+//! seed = 0                         # recorded; the engine draws no random numbers
+//! # particles_file = "p.csv"       # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
+//!
+//! [stepping]
+//! dt = 1e-3                        # s
+//! collapse_speed = 1e-4            # m/s: slower normal approaches bounce elastically (inelastic-collapse guard)
+//! max_events_per_step = 10000000   # the run stops as stalled beyond this
+//!
+//! [gravity]                        # optional: uniform field
+//! g = [0.0, 0.0, -9.81]            # m/s²
+//!
+//! [material]                       # defaults for every particle
+//! eps_n = 1.0
+//! eps_t = 1.0
+//!
+//! [output]
+//! times = [0.0, 1.0, 2.0]          # s: snapshots/<k>.csv
+//! every = 0.01                     # s: timeseries.csv rows
+//!
+//! [[particle]]
+//! mass = 1.0                       # kg
+//! radius = 0.05                    # m
+//! position = [0.0, 0.0, 0.5]       # m
+//! velocity = [0.0, 0.0, 0.0]       # m/s
+//! spin = [0.0, 0.0, 0.0]           # rad/s, world frame
+//!
+//! [[wall]]
+//! type = "plane"                   # plane | disk | cylinder | ring | point | line
+//! origin = [0.0, 0.0, 0.0]         # m, reference point at t = 0
+//! axis = [0.0, 0.0, 1.0]           # normal of plane/disk/ring, axis of cylinder/line
+//! oscillation = { amplitude = 0.01, omega = 60.0, phase = 0.0, direction = [0.0, 0.0, 1.0] }
+//! ```
+//!
+//! Bad input never panics: every error is one line naming the field and what was expected.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::particle::Particle;
+use super::stepper::StepperSettings;
+use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
+use crate::math::Vec3;
+use crate::scene::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
+
+/// The scene kind this module reads.
+pub const KIND: &str = "hard-spheres";
+
+/// Columns of a particles file and of the snapshots.
+pub const PARTICLE_COLUMNS: [&str; 13] = [
+    "t", "id", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz",
+];
+
+/// The whole file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HardSceneFile {
+    /// `[scene]`. Required.
+    pub scene: HardSceneSection,
+    /// `[stepping]`. Required (for `dt`).
+    pub stepping: SteppingSection,
+    /// `[gravity]`: optional uniform field.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<GravitySection>,
+    /// `[material]`: particle defaults. Optional.
+    #[serde(default)]
+    pub material: MaterialSection,
+    /// `[output]`. Required.
+    pub output: HardOutputSection,
+    /// `[[particle]]` tables (or `scene.particles_file`).
+    #[serde(default, rename = "particle", skip_serializing_if = "Vec::is_empty")]
+    pub particles: Vec<ParticleSpec>,
+    /// `[[wall]]` tables. Optional.
+    #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
+    pub walls: Vec<WallSpec>,
+}
+
+/// `[scene]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HardSceneSection {
+    /// Must be `"hard-spheres"`.
+    pub kind: String,
+    /// End time (s), > 0. Required.
+    pub t_end: f64,
+    /// Seed (recorded in `summary.json`; the hard-sphere engine is deterministic and draws no random numbers).
+    #[serde(default)]
+    pub seed: u64,
+    /// CSV with the initial particles instead of `[[particle]]` tables, relative to the scene file's directory;
+    /// columns `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (kg, m, m/s, rad/s; `t` and `id` ignored), so a snapshot
+    /// can be used directly. Restitution comes from `[material]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub particles_file: Option<String>,
+}
+
+/// `[stepping]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteppingSection {
+    /// Kick–drift–kick step (s), > 0. Required. Steps are shortened to land on output times.
+    pub dt: f64,
+    /// Inelastic-collapse guard (m/s, ≥ 0): a collision whose normal approach speed is below this is elastic.
+    /// Default 0 (off).
+    #[serde(default)]
+    pub collapse_speed: f64,
+    /// Most events one step may process (≥ 1); beyond it the run stops as stalled. Default 1e7.
+    #[serde(default = "default_max_events")]
+    pub max_events_per_step: u64,
+}
+
+fn default_max_events() -> u64 {
+    10_000_000
+}
+
+/// `[gravity]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GravitySection {
+    /// Uniform acceleration `[gx, gy, gz]` (m/s²). Required in the table.
+    pub g: [f64; 3],
+}
+
+/// `[material]`: restitution of every particle unless its own table overrides it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSection {
+    /// Normal coefficient of restitution ε_n ∈ [0, 1] (dimensionless). Default 1 (elastic).
+    #[serde(default = "one")]
+    pub eps_n: f64,
+    /// Tangential coefficient of restitution ε_t ∈ [−1, 1] (dimensionless; 1 smooth). Default 1.
+    #[serde(default = "one")]
+    pub eps_t: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl Default for MaterialSection {
+    fn default() -> Self {
+        MaterialSection { eps_n: 1.0, eps_t: 1.0 }
+    }
+}
+
+/// `[output]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HardOutputSection {
+    /// Snapshot times (s), strictly increasing in `[0, t_end]`. Default `[0, t_end]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub times: Option<Vec<f64>>,
+    /// Time-series cadence (s), > 0. Required.
+    pub every: f64,
+}
+
+/// `[[particle]]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleSpec {
+    /// Mass (kg), > 0.
+    pub mass: f64,
+    /// Radius (m), > 0.
+    pub radius: f64,
+    /// Centre `[x, y, z]` (m).
+    pub position: [f64; 3],
+    /// Velocity (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Spin, world frame (rad/s). Default 0.
+    #[serde(default)]
+    pub spin: [f64; 3],
+    /// ε_n ∈ [0, 1]; default `material.eps_n`. A pair uses the mean of its two particles' values.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_n: Option<f64>,
+    /// ε_t ∈ [−1, 1]; default `material.eps_t`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_t: Option<f64>,
+}
+
+/// `wall.oscillation`: `A sin(ω t + φ) d̂` added to the wall's position (minus its value at t = 0).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillationSpec {
+    /// Amplitude A (m), ≥ 0.
+    pub amplitude: f64,
+    /// Angular frequency ω (rad/s).
+    pub omega: f64,
+    /// Phase φ (rad). Default 0.
+    #[serde(default)]
+    pub phase: f64,
+    /// Direction d̂ (normalised; must not vanish). Default the wall axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+}
+
+/// `[[wall]]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallSpec {
+    /// `"plane"`, `"disk"`, `"cylinder"`, `"ring"`, `"point"` or `"line"`. Required.
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// Reference point at t = 0 (m): a point of the plane, the centre of disk/ring, the centre of the cylinder's
+    /// or line's axis segment. Default the origin.
+    #[serde(default)]
+    pub origin: [f64; 3],
+    /// Orientation: plane/disk/ring normal, cylinder/line axis (normalised; must not vanish). Default `[0, 0, 1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+    /// Radius (m) of a disk (> 0), ring (≥ 0; 0 is a point) or cylinder (≥ 0; 0 is a line).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Length (m, ≥ 0) of a cylinder or line, centred on `origin`; absent = infinite. A cylinder of length 0 is a
+    /// ring.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    /// Constant translation velocity (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Sinusoidal oscillation. Optional.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oscillation: Option<OscillationSpec>,
+    /// Spin about the axis (rad/s, right-handed); moves the surface tangentially. Default 0.
+    #[serde(default)]
+    pub spin: f64,
+    /// ε_n override ∈ [0, 1] for collisions with this wall.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_n: Option<f64>,
+    /// ε_t override ∈ [−1, 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eps_t: Option<f64>,
+    /// Particles that touch it stay rigidly attached and move with it. Default false.
+    #[serde(default)]
+    pub sticky: bool,
+    /// Particles that touch it are removed and counted. Default false.
+    #[serde(default)]
+    pub absorbing: bool,
+}
+
+/// A validated hard-sphere scene.
+#[derive(Debug, Clone)]
+pub struct HardScene {
+    /// Name in messages.
+    pub name: String,
+    /// The scene text (copied to the output directory).
+    pub source: String,
+    /// The parsed file.
+    pub file: HardSceneFile,
+    /// End time (s).
+    pub t_end: f64,
+    /// Step (s).
+    pub dt: f64,
+    /// Seed.
+    pub seed: u64,
+    /// Particles at t = 0.
+    pub particles: Vec<Particle>,
+    /// Walls.
+    pub walls: Vec<Wall>,
+    /// Stepper settings.
+    pub settings: StepperSettings,
+    /// Snapshot times (s).
+    pub times: Vec<f64>,
+    /// Time-series cadence (s).
+    pub every: f64,
+}
+
+struct V<'a> {
+    file: &'a str,
+}
+
+impl V<'_> {
+    fn bad(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_string(),
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.bad(field, format!("must be > 0 and finite, got {x}")))
+        }
+    }
+    fn in_range(&self, field: &str, x: f64, lo: f64, hi: f64) -> Result<f64, SceneError> {
+        if (lo..=hi).contains(&x) {
+            Ok(x)
+        } else {
+            Err(self.bad(field, format!("must be in [{lo}, {hi}], got {x}")))
+        }
+    }
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() && x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.bad(field, format!("must be >= 0 and finite, got {x}")))
+        }
+    }
+    fn vec(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(Vec3::from(v))
+        } else {
+            Err(self.bad(field, format!("must be finite, got {v:?}")))
+        }
+    }
+    fn unit(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
+        let x = self.vec(field, v)?;
+        if x.norm() > 0.0 {
+            Ok(x.normalize())
+        } else {
+            Err(self.bad(field, format!("must be a non-zero vector, got {v:?}")))
+        }
+    }
+}
+
+/// Reads and validates a hard-sphere scene file.
+pub fn load_hard_scene(path: &Path) -> Result<HardScene, SceneError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+        file: name.clone(),
+        reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
+    })?;
+    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+    parse_hard_scene(&text, &name, &base)
+}
+
+/// Parses and validates hard-sphere scene text; `base_dir` resolves a relative `particles_file`.
+pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardScene, SceneError> {
+    let file: HardSceneFile = parse_toml_as(text, name)?;
+    let v = V { file: name };
+    if file.scene.kind != KIND {
+        return Err(v.bad(
+            "scene.kind",
+            format!("must be \"{KIND}\" here, got {:?}", file.scene.kind),
+        ));
+    }
+    let t_end = v.positive("scene.t_end", file.scene.t_end)?;
+    let dt = v.positive("stepping.dt", file.stepping.dt)?;
+    let collapse_speed = v.non_negative("stepping.collapse_speed", file.stepping.collapse_speed)?;
+    if file.stepping.max_events_per_step == 0 {
+        return Err(v.bad("stepping.max_events_per_step", "must be >= 1, got 0"));
+    }
+    let gravity = match &file.gravity {
+        Some(g) => Some(v.vec("gravity.g", g.g)?),
+        None => None,
+    };
+    let eps_n = v.in_range("material.eps_n", file.material.eps_n, 0.0, 1.0)?;
+    let eps_t = v.in_range("material.eps_t", file.material.eps_t, -1.0, 1.0)?;
+    let every = v.positive("output.every", file.output.every)?;
+    if t_end / every > MAX_TIMESERIES_ROWS {
+        return Err(v.bad(
+            "output.every",
+            format!("too small for t_end = {t_end} (at most 1e8 rows), got {every}"),
+        ));
+    }
+    let times = match &file.output.times {
+        Some(ts) => {
+            for (k, &t) in ts.iter().enumerate() {
+                if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+                    return Err(v.bad(
+                        format!("output.times[{k}]"),
+                        format!("must be in [0, {t_end}], got {t}"),
+                    ));
+                }
+                if k > 0 && t <= ts[k - 1] {
+                    return Err(v.bad(
+                        "output.times",
+                        format!("must be strictly increasing, got {} then {t}", ts[k - 1]),
+                    ));
+                }
+            }
+            ts.clone()
+        }
+        None => vec![0.0, t_end],
+    };
+
+    let mut particles = Vec::new();
+    match (&file.scene.particles_file, file.particles.is_empty()) {
+        (Some(_), false) => {
+            return Err(v.bad(
+                "scene.particles_file",
+                "give either particles_file or [[particle]] tables, got both",
+            ));
+        }
+        (None, true) => {
+            return Err(v.bad(
+                "particle",
+                "no particles: give [[particle]] tables or scene.particles_file",
+            ));
+        }
+        (None, false) => {
+            for (k, p) in file.particles.iter().enumerate() {
+                let f = |x: &str| format!("particle[{k}].{x}");
+                let mut q = Particle::new(
+                    k,
+                    v.positive(&f("mass"), p.mass)?,
+                    v.positive(&f("radius"), p.radius)?,
+                    v.vec(&f("position"), p.position)?,
+                    v.vec(&f("velocity"), p.velocity)?,
+                    v.vec(&f("spin"), p.spin)?,
+                );
+                q.eps_n = v.in_range(&f("eps_n"), p.eps_n.unwrap_or(eps_n), 0.0, 1.0)?;
+                q.eps_t = v.in_range(&f("eps_t"), p.eps_t.unwrap_or(eps_t), -1.0, 1.0)?;
+                particles.push(q);
+            }
+        }
+        (Some(rel), true) => {
+            let path: PathBuf = base_dir.join(rel);
+            let rows = read_particles_csv(&path)
+                .map_err(|m| v.bad("scene.particles_file", format!("{}: {m}", path.display())))?;
+            if rows.is_empty() {
+                return Err(v.bad("scene.particles_file", format!("{}: no data rows", path.display())));
+            }
+            for (k, r) in rows.iter().enumerate() {
+                let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
+                let mut q = Particle::new(
+                    k,
+                    v.positive(&f("mass"), r[2])?,
+                    v.positive(&f("radius"), r[3])?,
+                    v.vec(&f("x,y,z"), [r[4], r[5], r[6]])?,
+                    v.vec(&f("vx,vy,vz"), [r[7], r[8], r[9]])?,
+                    v.vec(&f("wx,wy,wz"), [r[10], r[11], r[12]])?,
+                );
+                q.eps_n = eps_n;
+                q.eps_t = eps_t;
+                particles.push(q);
+            }
+        }
+    }
+
+    let mut walls = Vec::new();
+    for (k, w) in file.walls.iter().enumerate() {
+        walls.push(wall(&v, k, w)?);
+    }
+    Ok(HardScene {
+        name: name.to_string(),
+        source: text.to_string(),
+        t_end,
+        dt,
+        seed: file.scene.seed,
+        particles,
+        walls,
+        settings: StepperSettings {
+            gravity,
+            collapse_speed,
+            max_events_per_step: file.stepping.max_events_per_step,
+        },
+        times,
+        every,
+        file,
+    })
+}
+
+fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
+    let f = |x: &str| format!("wall[{k}].{x}");
+    let need_radius = |allow_zero: bool| -> Result<f64, SceneError> {
+        match w.radius {
+            Some(r) if allow_zero => v.non_negative(&f("radius"), r),
+            Some(r) => v.positive(&f("radius"), r),
+            None => Err(v.bad(f("radius"), format!("required for a {}, got nothing", w.kind))),
+        }
+    };
+    let length = match w.length {
+        Some(l) => Some(v.non_negative(&f("length"), l)?),
+        None => None,
+    };
+    let no = |field: &str, given: bool| -> Result<(), SceneError> {
+        if given {
+            Err(v.bad(f(field), format!("not used by a {}; remove it", w.kind)))
+        } else {
+            Ok(())
+        }
+    };
+    let shape = match w.kind.as_str() {
+        "plane" => {
+            no("radius", w.radius.is_some())?;
+            no("length", length.is_some())?;
+            Shape::Plane
+        }
+        "disk" => {
+            no("length", length.is_some())?;
+            Shape::Disk {
+                radius: need_radius(false)?,
+            }
+        }
+        "ring" => {
+            no("length", length.is_some())?;
+            match need_radius(true)? {
+                0.0 => Shape::Point,
+                r => Shape::Ring { radius: r },
+            }
+        }
+        "point" => {
+            no("radius", w.radius.is_some())?;
+            no("length", length.is_some())?;
+            Shape::Point
+        }
+        "line" => {
+            no("radius", w.radius.is_some())?;
+            Shape::Line {
+                length: length.filter(|&l| l > 0.0),
+            }
+        }
+        "cylinder" => {
+            // Degenerate cases (notes): L = 0 is a ring, R = 0 a line, both a point.
+            match (need_radius(true)?, length) {
+                (0.0, Some(0.0)) => Shape::Point,
+                (0.0, l) => Shape::Line { length: l },
+                (r, Some(0.0)) => Shape::Ring { radius: r },
+                (r, l) => Shape::Cylinder { radius: r, length: l },
+            }
+        }
+        other => {
+            return Err(v.bad(
+                f("type"),
+                format!(
+                    "must be one of \"plane\", \"disk\", \"cylinder\", \"ring\", \"point\", \"line\", got {other:?}"
+                ),
+            ));
+        }
+    };
+    let axis = v.unit(&f("axis"), w.axis.unwrap_or([0.0, 0.0, 1.0]))?;
+    let mut wall = Wall::new(shape, v.vec(&f("origin"), w.origin)?, axis);
+    let oscillation = match &w.oscillation {
+        Some(o) => Some(Oscillation {
+            amplitude: v.non_negative(&f("oscillation.amplitude"), o.amplitude)?,
+            omega: {
+                if !o.omega.is_finite() {
+                    return Err(v.bad(f("oscillation.omega"), format!("must be finite, got {}", o.omega)));
+                }
+                o.omega
+            },
+            phase: {
+                if !o.phase.is_finite() {
+                    return Err(v.bad(f("oscillation.phase"), format!("must be finite, got {}", o.phase)));
+                }
+                o.phase
+            },
+            direction: match o.direction {
+                Some(d) => v.unit(&f("oscillation.direction"), d)?,
+                None => axis,
+            },
+        }),
+        None => None,
+    };
+    if !w.spin.is_finite() {
+        return Err(v.bad(f("spin"), format!("must be finite, got {}", w.spin)));
+    }
+    wall.motion = WallMotion {
+        velocity: v.vec(&f("velocity"), w.velocity)?,
+        oscillation,
+        spin: w.spin,
+    };
+    wall.eps_n = match w.eps_n {
+        Some(e) => Some(v.in_range(&f("eps_n"), e, 0.0, 1.0)?),
+        None => None,
+    };
+    wall.eps_t = match w.eps_t {
+        Some(e) => Some(v.in_range(&f("eps_t"), e, -1.0, 1.0)?),
+        None => None,
+    };
+    if w.sticky && w.absorbing {
+        return Err(v.bad(f("sticky"), "a wall cannot be both sticky and absorbing, got both true"));
+    }
+    wall.sticky = w.sticky;
+    wall.absorbing = w.absorbing;
+    Ok(wall)
+}
+
+/// Reads a particles CSV (header with at least the [`PARTICLE_COLUMNS`]); rows in that column order.
+pub fn read_particles_csv(path: &Path) -> Result<Vec<[f64; 13]>, String> {
+    let mut rdr = ::csv::ReaderBuilder::new()
+        .trim(::csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| format!("cannot read: {e}"))?;
+    let headers = rdr.headers().map_err(|e| format!("bad header: {e}"))?.clone();
+    let mut idx = [0usize; 13];
+    for (k, col) in PARTICLE_COLUMNS.iter().enumerate() {
+        idx[k] = headers
+            .iter()
+            .position(|h| h == *col)
+            .ok_or_else(|| format!("missing column `{col}` (need {})", PARTICLE_COLUMNS.join(",")))?;
+    }
+    let mut rows = Vec::new();
+    for (line, rec) in rdr.records().enumerate() {
+        let rec = rec.map_err(|e| format!("line {}: {e}", line + 2))?;
+        let mut row = [0.0; 13];
+        for k in 0..13 {
+            let s = rec.get(idx[k]).unwrap_or("");
+            row[k] = s.parse().map_err(|_| {
+                format!(
+                    "line {}: column `{}`: expected a number, got {s:?}",
+                    line + 2,
+                    PARTICLE_COLUMNS[k]
+                )
+            })?;
+        }
+        rows.push(row);
+    }
+    Ok(rows)
+}

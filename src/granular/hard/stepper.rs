@@ -1,0 +1,546 @@
+//! The hard-sphere stepper (Richardson11 §2.1; notes `shared/notes/hsdem.md`, "Stepping").
+//!
+//! One step of length h is kick–drift–kick: half a kick of uniform gravity, a drift of length h in which particles
+//! move on straight lines and collide, half a kick. Within the drift every particle's earliest events against its
+//! neighbours and the walls are predicted and queued ([`super::events`]); the globally earliest is processed, only the
+//! particles involved are re-predicted, and so on until the step ends.
+//!
+//! Neighbours: at the start of the drift each particle gets a travel allowance `L = 2 v_max h` (v_max the largest
+//! speed then), and the candidate pairs are those whose spheres grown by L overlap (a cell grid,
+//! [`crate::geometry::neighbours::sphere_pairs`]). A pair outside that list cannot meet while each particle stays
+//! within L of where it started; after every collision the particles involved are checked (distance travelled plus
+//! `|v|` times the time left), and if one could leave its allowance the list is rebuilt at that instant with the new
+//! speeds. So no collision is ever missed, whatever the collisions do to the speeds.
+//!
+//! Overlap handling: a pair or a wall contact that touches or overlaps and approaches collides at once; no overlap is
+//! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
+//! secant over the step, landing exactly on the wall's law at the step end) and act as infinite masses.
+
+use super::collision::{self, Body, Restitution};
+use super::events::{Event, EventQueue, Partner};
+use super::particle::{Attachment, Particle};
+use crate::geometry::neighbours::sphere_pairs;
+use crate::geometry::walls::Wall;
+use crate::math::Vec3;
+
+/// Settings of the stepper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepperSettings {
+    /// Uniform gravitational acceleration (m/s²), if any.
+    pub gravity: Option<Vec3>,
+    /// Inelastic-collapse guard: collisions with a normal approach speed below this (m/s) are elastic.
+    pub collapse_speed: f64,
+    /// Most events one drift may process before the run stops as stalled.
+    pub max_events_per_step: u64,
+}
+
+impl Default for StepperSettings {
+    fn default() -> Self {
+        StepperSettings {
+            gravity: None,
+            collapse_speed: 0.0,
+            max_events_per_step: 10_000_000,
+        }
+    }
+}
+
+/// Why a step failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// Too many events in one drift (inelastic collapse or a trapped particle).
+    #[error(
+        "event loop stalled: more than {limit} events in the step ending at t = {t} s (raise stepping.max_events_per_step or stepping.collapse_speed)"
+    )]
+    Stalled {
+        /// End of the step (s).
+        t: f64,
+        /// The limit.
+        limit: u64,
+    },
+    /// A particle's state became non-finite.
+    #[error("non-finite state of particle {id} at t = {t} s")]
+    NonFinite {
+        /// Particle id.
+        id: usize,
+        /// Time (s).
+        t: f64,
+    },
+}
+
+/// Counters accumulated over the run.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Counters {
+    /// Particle–particle collisions applied.
+    pub pair_collisions: u64,
+    /// Particle–wall collisions applied (including sticking and absorption).
+    pub wall_collisions: u64,
+    /// Events processed (valid ones, including those that found the bodies separating).
+    pub events: u64,
+    /// Collisions made elastic by the collapse guard.
+    pub guarded: u64,
+    /// Neighbour-list builds.
+    pub rebuilds: u64,
+    /// Particles absorbed.
+    pub absorbed: u64,
+    /// Largest overlap seen at a collision, relative to the smaller radius.
+    pub max_overlap: f64,
+    /// Energy (J) changed by collisions, sticking and absorption (so that `E − E0 − exchanged` is the integration
+    /// error).
+    pub energy_exchanged: f64,
+}
+
+/// Energies and momenta of the free particles (stuck particles belong to their wall).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Diagnostics {
+    /// Translational kinetic energy (J).
+    pub kinetic: f64,
+    /// Rotational kinetic energy (J).
+    pub rotational: f64,
+    /// Potential energy in the uniform field, `−Σ m g·r` (J).
+    pub potential: f64,
+    /// Linear momentum (kg m/s).
+    pub momentum: Vec3,
+    /// Angular momentum about the origin, orbital plus spin (kg m²/s).
+    pub angular_momentum: Vec3,
+    /// Free particles.
+    pub free: usize,
+    /// Stuck particles.
+    pub stuck: usize,
+}
+
+impl Diagnostics {
+    /// Total energy (J).
+    pub fn energy(&self) -> f64 {
+        self.kinetic + self.rotational + self.potential
+    }
+}
+
+/// Per-step wall data: reference point at the step start and secant velocity.
+#[derive(Debug, Clone, Copy)]
+struct WallStep {
+    origin0: Vec3,
+    velocity: Vec3,
+}
+
+/// The hard-sphere system: particles, walls, clock.
+#[derive(Debug, Clone)]
+pub struct System {
+    /// The particles (index = id).
+    pub particles: Vec<Particle>,
+    /// The walls.
+    pub walls: Vec<Wall>,
+    /// Settings.
+    pub settings: StepperSettings,
+    /// Current time (s).
+    pub t: f64,
+    /// Counters since t = 0.
+    pub counters: Counters,
+    gens: Vec<u64>,
+}
+
+/// Working state of one drift.
+struct Drift {
+    t0: f64,
+    t1: f64,
+    walls: Vec<WallStep>,
+    queue: EventQueue,
+    adjacency: Vec<Vec<usize>>,
+    anchors: Vec<Vec3>,
+    allowance: f64,
+    events: u64,
+}
+
+impl System {
+    /// A system at t = 0.
+    pub fn new(particles: Vec<Particle>, walls: Vec<Wall>, settings: StepperSettings) -> System {
+        let n = particles.len();
+        System {
+            particles,
+            walls,
+            settings,
+            t: 0.0,
+            counters: Counters::default(),
+            gens: vec![0; n],
+        }
+    }
+
+    /// Energies and momenta of the free, alive particles.
+    pub fn diagnostics(&self) -> Diagnostics {
+        let mut d = Diagnostics::default();
+        for p in self.particles.iter().filter(|p| p.alive) {
+            if p.stuck.is_some() {
+                d.stuck += 1;
+                continue;
+            }
+            d.free += 1;
+            d.kinetic += 0.5 * p.mass * p.velocity.norm_squared();
+            d.rotational += 0.5 * p.inertia() * p.spin.norm_squared();
+            if let Some(g) = self.settings.gravity {
+                d.potential -= p.mass * g.dot(&p.position);
+            }
+            d.momentum += p.velocity * p.mass;
+            d.angular_momentum += p.position.cross(&p.velocity) * p.mass + p.spin * p.inertia();
+        }
+        d
+    }
+
+    /// Where a stuck particle is at time `t`: the wall's law applied to its attachment offset.
+    fn attached_position(&self, a: &Attachment, t: f64) -> Vec3 {
+        let w = &self.walls[a.wall];
+        let angle = w.motion.spin * (t - a.t_stuck);
+        let (s, c) = angle.sin_cos();
+        let o = a.offset;
+        let rotated = Vec3::new(c * o.x - s * o.y, s * o.x + c * o.y, o.z);
+        w.origin_at(t) + w.to_world(&rotated)
+    }
+
+    /// Advances the system by one kick–drift–kick step of length `h` (s).
+    pub fn step(&mut self, h: f64) -> Result<(), StepError> {
+        let t0 = self.t;
+        let t1 = t0 + h;
+        self.kick(0.5 * h);
+        // Stuck particles follow their wall on the secant of this step.
+        for k in 0..self.particles.len() {
+            if let (true, Some(a)) = (self.particles[k].alive, self.particles[k].stuck) {
+                let end = self.attached_position(&a, t1);
+                let p = &mut self.particles[k];
+                p.velocity = (end - p.position) / h;
+                p.spin = self.walls[a.wall].axis * self.walls[a.wall].motion.spin;
+            }
+        }
+        self.drift(t0, t1)?;
+        self.kick(0.5 * h);
+        self.t = t1;
+        for p in self.particles.iter().filter(|p| p.alive) {
+            if !(p.position.iter().all(|x| x.is_finite()) && p.velocity.iter().all(|x| x.is_finite())) {
+                return Err(StepError::NonFinite { id: p.id, t: t1 });
+            }
+        }
+        Ok(())
+    }
+
+    fn kick(&mut self, dt: f64) {
+        if let Some(g) = self.settings.gravity {
+            for p in self.particles.iter_mut().filter(|p| p.alive && p.stuck.is_none()) {
+                p.velocity += g * dt;
+            }
+        }
+    }
+
+    fn drift(&mut self, t0: f64, t1: f64) -> Result<(), StepError> {
+        let walls = self
+            .walls
+            .iter()
+            .map(|w| WallStep {
+                origin0: w.origin_at(t0),
+                velocity: w.motion.step_velocity(t0, t1),
+            })
+            .collect();
+        let mut d = Drift {
+            t0,
+            t1,
+            walls,
+            queue: EventQueue::new(),
+            adjacency: Vec::new(),
+            anchors: Vec::new(),
+            allowance: 0.0,
+            events: 0,
+        };
+        self.rebuild(&mut d, t0);
+        while let Some(e) = d.queue.pop() {
+            if e.t > t1 {
+                break;
+            }
+            if e.gen_i != self.gens[e.i] {
+                continue;
+            }
+            if let Partner::Particle(j) = e.partner
+                && e.gen_j != self.gens[j]
+            {
+                continue;
+            }
+            d.events += 1;
+            self.counters.events += 1;
+            if d.events > self.settings.max_events_per_step {
+                return Err(StepError::Stalled {
+                    t: t1,
+                    limit: self.settings.max_events_per_step,
+                });
+            }
+            let involved = match e.partner {
+                Partner::Particle(j) => {
+                    self.collide_pair(e.i, j, e.t);
+                    [Some(e.i), Some(j)]
+                }
+                Partner::Wall(w) => {
+                    self.collide_wall(&d, e.i, w, e.t);
+                    [Some(e.i), None]
+                }
+            };
+            let mut must_rebuild = false;
+            for k in involved.into_iter().flatten() {
+                self.gens[k] += 1;
+                let p = &self.particles[k];
+                if p.alive && (p.position - d.anchors[k]).norm() + p.velocity.norm() * (t1 - e.t) > d.allowance {
+                    must_rebuild = true;
+                }
+            }
+            if must_rebuild {
+                self.rebuild(&mut d, e.t);
+            } else {
+                for k in involved.into_iter().flatten() {
+                    self.predict(&mut d, k, e.t);
+                }
+            }
+        }
+        for k in 0..self.particles.len() {
+            if !self.particles[k].alive {
+                continue;
+            }
+            self.particles[k].advance(t1);
+            if let Some(a) = self.particles[k].stuck {
+                self.particles[k].position = self.attached_position(&a, t1);
+            }
+        }
+        Ok(())
+    }
+
+    /// Brings every particle to `t`, rebuilds the neighbour lists with fresh allowances and re-predicts everything.
+    fn rebuild(&mut self, d: &mut Drift, t: f64) {
+        self.counters.rebuilds += 1;
+        let mut v_max: f64 = 0.0;
+        let mut r_min = f64::INFINITY;
+        for p in self.particles.iter_mut().filter(|p| p.alive) {
+            p.advance(t);
+            v_max = v_max.max(p.velocity.norm());
+            r_min = r_min.min(p.radius);
+        }
+        // A small floor keeps resting piles (v_max ≈ 0) from rebuilding at every collision.
+        let floor = if r_min.is_finite() { 1e-3 * r_min } else { 0.0 };
+        d.allowance = (2.0 * v_max * (d.t1 - t)).max(floor);
+        d.anchors = self.particles.iter().map(|p| p.position).collect();
+        let alive: Vec<usize> = (0..self.particles.len()).filter(|&k| self.particles[k].alive).collect();
+        let centres: Vec<Vec3> = alive.iter().map(|&k| self.particles[k].position).collect();
+        let radii: Vec<f64> = alive.iter().map(|&k| self.particles[k].radius + d.allowance).collect();
+        d.adjacency = vec![Vec::new(); self.particles.len()];
+        for (a, b) in sphere_pairs(&centres, &radii) {
+            let (i, j) = (alive[a], alive[b]);
+            d.adjacency[i].push(j);
+            d.adjacency[j].push(i);
+        }
+        d.queue.clear();
+        for k in 0..self.particles.len() {
+            if !self.particles[k].alive {
+                continue;
+            }
+            for jx in 0..d.adjacency[k].len() {
+                let j = d.adjacency[k][jx];
+                if j > k {
+                    self.predict_pair(d, k, j, t);
+                }
+            }
+            self.predict_walls(d, k, t);
+        }
+    }
+
+    /// Re-predicts particle `k` against its neighbours and the walls at time `t`.
+    fn predict(&mut self, d: &mut Drift, k: usize, t: f64) {
+        if !self.particles[k].alive {
+            return;
+        }
+        for jx in 0..d.adjacency[k].len() {
+            let j = d.adjacency[k][jx];
+            self.predict_pair(d, k, j, t);
+        }
+        self.predict_walls(d, k, t);
+    }
+
+    fn predict_pair(&self, d: &mut Drift, i: usize, j: usize, t: f64) {
+        let (pi, pj) = (&self.particles[i], &self.particles[j]);
+        if !pj.alive || (pi.stuck.is_some() && pj.stuck.is_some()) {
+            return;
+        }
+        let r = pi.position_at(t) - pj.position_at(t);
+        let v = pi.velocity - pj.velocity;
+        let b = r.dot(&v);
+        if b >= 0.0 {
+            return;
+        }
+        let s = pi.radius + pj.radius;
+        let c = r.norm_squared() - s * s;
+        let dt = if c <= 0.0 {
+            0.0
+        } else {
+            let disc = b * b - v.norm_squared() * c;
+            if disc < 0.0 {
+                return;
+            }
+            // Cancellation-free smaller root (notes, "Particle–particle").
+            c / (-b + disc.sqrt())
+        };
+        let te = t + dt;
+        if te <= d.t1 {
+            let (a, bb) = if i < j { (i, j) } else { (j, i) };
+            d.queue.push(Event {
+                t: te,
+                i: a,
+                partner: Partner::Particle(bb),
+                gen_i: self.gens[a],
+                gen_j: self.gens[bb],
+            });
+        }
+    }
+
+    fn predict_walls(&self, d: &mut Drift, k: usize, t: f64) {
+        let p = &self.particles[k];
+        if p.stuck.is_some() {
+            return;
+        }
+        let r = p.position_at(t);
+        for (w, wall) in self.walls.iter().enumerate() {
+            let ws = d.walls[w];
+            let origin_now = ws.origin0 + ws.velocity * (t - d.t0);
+            if let Some(dt) = wall.time_of_impact(&origin_now, &ws.velocity, &r, &p.velocity, p.radius, d.t1 - t) {
+                d.queue.push(Event {
+                    t: t + dt,
+                    i: k,
+                    partner: Partner::Wall(w),
+                    gen_i: self.gens[k],
+                    gen_j: 0,
+                });
+            }
+        }
+    }
+
+    fn body(p: &Particle) -> Body {
+        Body {
+            mass: p.mass,
+            radius: p.radius,
+            inertia: p.inertia(),
+            position: p.position,
+            velocity: p.velocity,
+            spin: p.spin,
+        }
+    }
+
+    fn collide_pair(&mut self, i: usize, j: usize, t: f64) {
+        self.particles[i].advance(t);
+        self.particles[j].advance(t);
+        let (pi, pj) = (&self.particles[i], &self.particles[j]);
+        let s = pi.radius + pj.radius;
+        let overlap = (s - (pi.position - pj.position).norm()) / pi.radius.min(pj.radius);
+        self.counters.max_overlap = self.counters.max_overlap.max(overlap);
+        let collapse = self.settings.collapse_speed;
+        let e_before = pi.kinetic_energy() * f64::from(pi.stuck.is_none() as u8)
+            + pj.kinetic_energy() * f64::from(pj.stuck.is_none() as u8);
+        let outcome = match (pi.stuck, pj.stuck) {
+            (None, None) => {
+                let r = Restitution {
+                    eps_n: 0.5 * (pi.eps_n + pj.eps_n),
+                    eps_t: 0.5 * (pi.eps_t + pj.eps_t),
+                };
+                let (mut b1, mut b2) = (Self::body(pi), Self::body(pj));
+                let o = collision::resolve_pair(&mut b1, &mut b2, r, collapse);
+                for (k, b) in [(i, b1), (j, b2)] {
+                    self.particles[k].velocity = b.velocity;
+                    self.particles[k].spin = b.spin;
+                }
+                o
+            }
+            (a, b) => {
+                // One side is stuck: it is part of its wall (infinite mass) with its rigid velocity.
+                let (free, fixed, att) = match (a, b) {
+                    (None, Some(att)) => (i, j, att),
+                    (Some(att), _) => (j, i, att),
+                    _ => unreachable!("both free handled above"),
+                };
+                let (pf, px) = (&self.particles[free], &self.particles[fixed]);
+                let n = (pf.position - px.position).normalize();
+                let contact = px.position + n * px.radius;
+                let surface = px.velocity + px.spin.cross(&(contact - px.position));
+                let wall = &self.walls[att.wall];
+                let r = Restitution {
+                    eps_n: wall.eps_n.unwrap_or(pf.eps_n),
+                    eps_t: wall.eps_t.unwrap_or(pf.eps_t),
+                };
+                let mut b = Self::body(pf);
+                let o = collision::resolve_wall(&mut b, &n, &surface, r, collapse);
+                self.particles[free].velocity = b.velocity;
+                self.particles[free].spin = b.spin;
+                o
+            }
+        };
+        if outcome.applied {
+            self.counters.pair_collisions += 1;
+            self.counters.guarded += u64::from(outcome.guarded);
+        }
+        let (pi, pj) = (&self.particles[i], &self.particles[j]);
+        let e_after = pi.kinetic_energy() * f64::from(pi.stuck.is_none() as u8)
+            + pj.kinetic_energy() * f64::from(pj.stuck.is_none() as u8);
+        self.counters.energy_exchanged += e_after - e_before;
+    }
+
+    fn collide_wall(&mut self, d: &Drift, i: usize, w: usize, t: f64) {
+        self.particles[i].advance(t);
+        let ws = d.walls[w];
+        let origin_now = ws.origin0 + ws.velocity * (t - d.t0);
+        let wall = &self.walls[w];
+        let p = &self.particles[i];
+        let (dist, n) = wall.nearest(&origin_now, &p.position);
+        self.counters.max_overlap = self.counters.max_overlap.max((p.radius - dist) / p.radius);
+        let e_before = p.kinetic_energy();
+        let contact = p.position - n * p.radius;
+        let surface = wall.surface_velocity(&origin_now, &ws.velocity, &contact);
+        // Approaching? (The normal part of the contact velocity is that of the centres: spin is tangential.)
+        if (p.velocity - surface).dot(&n) >= 0.0 {
+            return;
+        }
+        self.counters.wall_collisions += 1;
+        if wall.absorbing {
+            let g_pot = self
+                .settings
+                .gravity
+                .map(|g| -p.mass * g.dot(&p.position))
+                .unwrap_or(0.0);
+            self.counters.energy_exchanged -= e_before + g_pot;
+            self.counters.absorbed += 1;
+            self.particles[i].alive = false;
+            return;
+        }
+        if wall.sticky {
+            let g_pot = self
+                .settings
+                .gravity
+                .map(|g| -p.mass * g.dot(&p.position))
+                .unwrap_or(0.0);
+            self.counters.energy_exchanged -= e_before + g_pot;
+            let att = Attachment {
+                wall: w,
+                offset: wall.to_local(&(p.position - origin_now)),
+                t_stuck: t,
+            };
+            let end = self.attached_position(&att, d.t1);
+            let axis_spin = wall.axis * wall.motion.spin;
+            let p = &mut self.particles[i];
+            p.stuck = Some(att);
+            p.velocity = if d.t1 > t {
+                (end - p.position) / (d.t1 - t)
+            } else {
+                ws.velocity
+            };
+            p.spin = axis_spin;
+            return;
+        }
+        let r = Restitution {
+            eps_n: wall.eps_n.unwrap_or(p.eps_n),
+            eps_t: wall.eps_t.unwrap_or(p.eps_t),
+        };
+        let mut b = Self::body(p);
+        let o = collision::resolve_wall(&mut b, &n, &surface, r, self.settings.collapse_speed);
+        self.counters.guarded += u64::from(o.guarded);
+        let p = &mut self.particles[i];
+        p.velocity = b.velocity;
+        p.spin = b.spin;
+        self.counters.energy_exchanged += p.kinetic_energy() - e_before;
+    }
+}
