@@ -269,6 +269,24 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             {
                 return ssdem::check(path);
             }
+            if let Some(path) = &args.scene
+                && let Ok(text) = std::fs::read_to_string(path)
+                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
+            {
+                let s = crate::granular::hard::scene::load_hard_scene(path).map_err(CliError::usage)?;
+                println!(
+                    "{}: hard spheres: {} particles, {} walls, t_end = {} s, dt = {} s, {} snapshots, a time-series row \
+                     every {} s",
+                    s.name,
+                    s.particles.len(),
+                    s.walls.len(),
+                    s.t_end,
+                    s.dt,
+                    s.times.len(),
+                    s.every
+                );
+                return Ok(());
+            }
             let scene = load(args.scene.as_ref())?;
             print_check(&scene);
             Ok(())
