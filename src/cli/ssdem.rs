@@ -179,6 +179,11 @@ pub struct BenchSsdemArgs {
     /// Overwrite an earlier benchmark's files in DIR.
     #[arg(long)]
     pub force: bool,
+    /// Also write the benchmark's starting particles (before the timed steps) to FILE in the snapshot columns
+    /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, e.g. to set up the same packing in another code
+    /// (`analysis/ssdem_perf/`).
+    #[arg(long, value_name = "FILE")]
+    pub dump_particles: Option<PathBuf>,
 }
 
 /// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly.
@@ -242,6 +247,10 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), CliError> {
         std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
     }
     let sys = bench_system(args.particles as usize, gravity);
+    if let Some(path) = &args.dump_particles {
+        crate::granular::soft::run::write_particles_csv(path, 0.0, &sys.particles)
+            .map_err(|e| CliError::failed(format!("--dump-particles {}: {e}", path.display())))?;
+    }
     let mut rows = Vec::new();
     for &t in &args.threads {
         if t == 0 {
