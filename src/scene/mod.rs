@@ -587,8 +587,11 @@ fn describe_toml_error(text: &str, segments: &[serde_path_to_error::Segment], e:
 // Validation.
 // ---------------------------------------------------------------------------------------------
 
-struct Validator<'a> {
-    file: &'a str,
+/// Field checks shared by the scene parsers of every engine: each error names the file, the dotted field and the
+/// expected value on one line.
+pub(crate) struct Validator<'a> {
+    /// How the file is named in messages.
+    pub(crate) file: &'a str,
 }
 
 /// A body before conversion, from either a `[[body]]` table or a bodies-file row.
@@ -607,7 +610,7 @@ struct RawBody {
 }
 
 impl Validator<'_> {
-    fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
+    pub(crate) fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
         SceneError::Invalid {
             file: self.file.to_string(),
             field: field.into(),
@@ -615,7 +618,7 @@ impl Validator<'_> {
         }
     }
 
-    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+    pub(crate) fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         if x.is_finite() && x > 0.0 {
             Ok(x)
         } else {
@@ -623,7 +626,7 @@ impl Validator<'_> {
         }
     }
 
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+    pub(crate) fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         if x.is_finite() && x >= 0.0 {
             Ok(x)
         } else {

@@ -270,44 +270,21 @@ pub struct HardScene {
     pub every: f64,
 }
 
-struct V<'a> {
-    file: &'a str,
-}
+use crate::scene::Validator as V;
 
 impl V<'_> {
-    fn bad(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
-            file: self.file.to_string(),
-            field: field.into(),
-            message: message.into(),
-        }
-    }
-    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x.is_finite() && x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.bad(field, format!("must be > 0 and finite, got {x}")))
-        }
-    }
     fn in_range(&self, field: &str, x: f64, lo: f64, hi: f64) -> Result<f64, SceneError> {
         if (lo..=hi).contains(&x) {
             Ok(x)
         } else {
-            Err(self.bad(field, format!("must be in [{lo}, {hi}], got {x}")))
-        }
-    }
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x.is_finite() && x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.bad(field, format!("must be >= 0 and finite, got {x}")))
+            Err(self.invalid(field, format!("must be in [{lo}, {hi}], got {x}")))
         }
     }
     fn vec(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
         if v.iter().all(|x| x.is_finite()) {
             Ok(Vec3::from(v))
         } else {
-            Err(self.bad(field, format!("must be finite, got {v:?}")))
+            Err(self.invalid(field, format!("must be finite, got {v:?}")))
         }
     }
     fn unit(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
@@ -315,7 +292,7 @@ impl V<'_> {
         if x.norm() > 0.0 {
             Ok(x.normalize())
         } else {
-            Err(self.bad(field, format!("must be a non-zero vector, got {v:?}")))
+            Err(self.invalid(field, format!("must be a non-zero vector, got {v:?}")))
         }
     }
 }
@@ -336,7 +313,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let file: HardSceneFile = parse_toml_as(text, name)?;
     let v = V { file: name };
     if file.scene.kind != KIND {
-        return Err(v.bad(
+        return Err(v.invalid(
             "scene.kind",
             format!("must be \"{KIND}\" here, got {:?}", file.scene.kind),
         ));
@@ -345,7 +322,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let dt = v.positive("stepping.dt", file.stepping.dt)?;
     let collapse_speed = v.non_negative("stepping.collapse_speed", file.stepping.collapse_speed)?;
     if file.stepping.max_events_per_step == 0 {
-        return Err(v.bad("stepping.max_events_per_step", "must be >= 1, got 0"));
+        return Err(v.invalid("stepping.max_events_per_step", "must be >= 1, got 0"));
     }
     let gravity = match &file.gravity {
         Some(g) => Some(v.vec("gravity.g", g.g)?),
@@ -355,7 +332,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let eps_t = v.in_range("material.eps_t", file.material.eps_t, -1.0, 1.0)?;
     let every = v.positive("output.every", file.output.every)?;
     if t_end / every > MAX_TIMESERIES_ROWS {
-        return Err(v.bad(
+        return Err(v.invalid(
             "output.every",
             format!("too small for t_end = {t_end} (at most 1e8 rows), got {every}"),
         ));
@@ -364,13 +341,13 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         Some(ts) => {
             for (k, &t) in ts.iter().enumerate() {
                 if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
-                    return Err(v.bad(
+                    return Err(v.invalid(
                         format!("output.times[{k}]"),
                         format!("must be in [0, {t_end}], got {t}"),
                     ));
                 }
                 if k > 0 && t <= ts[k - 1] {
-                    return Err(v.bad(
+                    return Err(v.invalid(
                         "output.times",
                         format!("must be strictly increasing, got {} then {t}", ts[k - 1]),
                     ));
@@ -384,13 +361,13 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let mut particles = Vec::new();
     match (&file.scene.particles_file, file.particles.is_empty()) {
         (Some(_), false) => {
-            return Err(v.bad(
+            return Err(v.invalid(
                 "scene.particles_file",
                 "give either particles_file or [[particle]] tables, got both",
             ));
         }
         (None, true) => {
-            return Err(v.bad(
+            return Err(v.invalid(
                 "particle",
                 "no particles: give [[particle]] tables or scene.particles_file",
             ));
@@ -414,9 +391,9 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         (Some(rel), true) => {
             let path: PathBuf = base_dir.join(rel);
             let rows = read_particles_csv(&path)
-                .map_err(|m| v.bad("scene.particles_file", format!("{}: {m}", path.display())))?;
+                .map_err(|m| v.invalid("scene.particles_file", format!("{}: {m}", path.display())))?;
             if rows.is_empty() {
-                return Err(v.bad("scene.particles_file", format!("{}: no data rows", path.display())));
+                return Err(v.invalid("scene.particles_file", format!("{}: no data rows", path.display())));
             }
             for (k, r) in rows.iter().enumerate() {
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
@@ -464,7 +441,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         match w.radius {
             Some(r) if allow_zero => v.non_negative(&f("radius"), r),
             Some(r) => v.positive(&f("radius"), r),
-            None => Err(v.bad(f("radius"), format!("required for a {}, got nothing", w.kind))),
+            None => Err(v.invalid(f("radius"), format!("required for a {}, got nothing", w.kind))),
         }
     };
     let length = match w.length {
@@ -473,7 +450,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     };
     let no = |field: &str, given: bool| -> Result<(), SceneError> {
         if given {
-            Err(v.bad(f(field), format!("not used by a {}; remove it", w.kind)))
+            Err(v.invalid(f(field), format!("not used by a {}; remove it", w.kind)))
         } else {
             Ok(())
         }
@@ -518,7 +495,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
             }
         }
         other => {
-            return Err(v.bad(
+            return Err(v.invalid(
                 f("type"),
                 format!(
                     "must be one of \"plane\", \"disk\", \"cylinder\", \"ring\", \"point\", \"line\", got {other:?}"
@@ -533,13 +510,13 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
             amplitude: v.non_negative(&f("oscillation.amplitude"), o.amplitude)?,
             omega: {
                 if !o.omega.is_finite() {
-                    return Err(v.bad(f("oscillation.omega"), format!("must be finite, got {}", o.omega)));
+                    return Err(v.invalid(f("oscillation.omega"), format!("must be finite, got {}", o.omega)));
                 }
                 o.omega
             },
             phase: {
                 if !o.phase.is_finite() {
-                    return Err(v.bad(f("oscillation.phase"), format!("must be finite, got {}", o.phase)));
+                    return Err(v.invalid(f("oscillation.phase"), format!("must be finite, got {}", o.phase)));
                 }
                 o.phase
             },
@@ -551,7 +528,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         None => None,
     };
     if !w.spin.is_finite() {
-        return Err(v.bad(f("spin"), format!("must be finite, got {}", w.spin)));
+        return Err(v.invalid(f("spin"), format!("must be finite, got {}", w.spin)));
     }
     wall.motion = WallMotion {
         velocity: v.vec(&f("velocity"), w.velocity)?,
@@ -567,7 +544,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         None => None,
     };
     if w.sticky && w.absorbing {
-        return Err(v.bad(f("sticky"), "a wall cannot be both sticky and absorbing, got both true"));
+        return Err(v.invalid(f("sticky"), "a wall cannot be both sticky and absorbing, got both true"));
     }
     wall.sticky = w.sticky;
     wall.absorbing = w.absorbing;

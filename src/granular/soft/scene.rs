@@ -320,35 +320,12 @@ pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Resu
         syntax(format!("{path}: {}", inner.message()))
     })?;
     let v = V { file: name };
-    v.resolve(text, file, base_dir)
+    v.resolve_soft(text, file, base_dir)
 }
 
-struct V<'a> {
-    file: &'a str,
-}
+use crate::scene::Validator as V;
 
 impl V<'_> {
-    fn invalid(&self, field: impl Into<String>, message: impl Into<String>) -> SceneError {
-        SceneError::Invalid {
-            file: self.file.to_string(),
-            field: field.into(),
-            message: one_line(&message.into()),
-        }
-    }
-    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x.is_finite() && x > 0.0 {
-            Ok(x)
-        } else {
-            Err(self.invalid(field, format!("must be > 0 and finite, got {x}")))
-        }
-    }
-    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x.is_finite() && x >= 0.0 {
-            Ok(x)
-        } else {
-            Err(self.invalid(field, format!("must be >= 0 and finite, got {x}")))
-        }
-    }
     fn restitution(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         if x > 0.0 && x <= 1.0 {
             Ok(x)
@@ -487,7 +464,7 @@ impl V<'_> {
         }
     }
 
-    fn resolve(&self, text: &str, file: SoftSceneFile, base_dir: Option<&Path>) -> Result<SoftScene, SceneError> {
+    fn resolve_soft(&self, text: &str, file: SoftSceneFile, base_dir: Option<&Path>) -> Result<SoftScene, SceneError> {
         if file.scene.kind != KIND {
             return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
         }
