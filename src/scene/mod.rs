@@ -427,21 +427,35 @@ pub struct LoadedScene {
 // Entry points.
 // ---------------------------------------------------------------------------------------------
 
-/// Reads and validates a scene file. Errors name the file as given by `path`.
-pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+/// A scene file as every engine's loader needs it: its name for messages (the path as given), its text, and the
+/// directory relative paths in it are resolved against (`.` for a bare file name).
+pub struct SceneText {
+    /// The path as given.
+    pub name: String,
+    /// The file's contents.
+    pub text: String,
+    /// The file's directory.
+    pub base_dir: PathBuf,
+}
+
+/// Reads a scene file (a one-line [`SceneError::Read`] naming it if that fails).
+pub fn read_scene_text(path: &Path) -> Result<SceneText, SceneError> {
     let name = path.display().to_string();
     let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
         file: name.clone(),
         reason: one_line(&e.to_string()),
     })?;
-    let base = path.parent().map(|p| {
-        if p.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            p.to_path_buf()
-        }
-    });
-    parse_scene(&text, &name, base.as_deref())
+    let base_dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    Ok(SceneText { name, text, base_dir })
+}
+
+/// Reads and validates a scene file. Errors name the file as given by `path`.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    let s = read_scene_text(path)?;
+    parse_scene(&s.text, &s.name, Some(&s.base_dir))
 }
 
 /// The built-in default scene ([`DEFAULT_SCENE_TOML`]).

@@ -299,13 +299,8 @@ impl V<'_> {
 
 /// Reads and validates a hard-sphere scene file.
 pub fn load_hard_scene(path: &Path) -> Result<HardScene, SceneError> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
-        file: name.clone(),
-        reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
-    })?;
-    let base = path.parent().map(Path::to_path_buf).unwrap_or_default();
-    parse_hard_scene(&text, &name, &base)
+    let s = crate::scene::read_scene_text(path)?;
+    parse_hard_scene(&s.text, &s.name, &s.base_dir)
 }
 
 /// Parses and validates hard-sphere scene text; `base_dir` resolves a relative `particles_file`.

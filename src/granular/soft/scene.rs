@@ -292,19 +292,8 @@ fn one_line(s: &str) -> String {
 
 /// Reads and validates a soft-sphere scene file.
 pub fn load_soft_scene(path: &Path) -> Result<SoftScene, SceneError> {
-    let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
-        file: name.clone(),
-        reason: one_line(&e.to_string()),
-    })?;
-    let base = path.parent().map(|p| {
-        if p.as_os_str().is_empty() {
-            PathBuf::from(".")
-        } else {
-            p.to_path_buf()
-        }
-    });
-    parse_soft_scene(&text, &name, base.as_deref())
+    let s = crate::scene::read_scene_text(path)?;
+    parse_soft_scene(&s.text, &s.name, Some(&s.base_dir))
 }
 
 /// Parses and validates soft-sphere scene text (`name` for messages; `base_dir` resolves `particles_file`).
