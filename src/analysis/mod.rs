@@ -6,4 +6,5 @@ pub mod fragments;
 pub mod report_roig2003;
 pub mod rigid_rotation;
 pub mod run_analysis;
+pub mod shape_metrics;
 pub mod spinup;
