@@ -245,6 +245,13 @@ pub fn evaluate(m: &Material, kin: &Kinematics, springs: &mut Springs, dt: f64) 
 /// [`evaluate`] with the material's constants `law` already computed.
 #[inline(always)]
 pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
+    evaluate_inner::<true>(law, kin, springs, dt)
+}
+
+/// [`evaluate_law`] for the force loop: without `SIZES`, `Output::rolling_torque` and
+/// `Output::twisting_torque` are left at zero (they only go into contact records).
+#[inline(always)]
+pub(crate) fn evaluate_inner<const SIZES: bool>(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
     let n = kin.normal;
     // Carry the springs into the current frame (spring_frame.rs).
     let mean_spin = (kin.spin_i + kin.spin_j) * 0.5;
@@ -254,7 +261,8 @@ pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64)
     springs.normal = n;
 
     let u = kin.relative_velocity;
-    let u_n = n * u.dot(&n);
+    let u_along = u.dot(&n);
+    let u_n = n * u_along;
     let u_t = u - u_n;
     let k_s = law.k_s;
     let root_mass = kin.mass_eff.sqrt();
@@ -265,10 +273,11 @@ pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64)
     let (k_t, c_t) = (2.0 * k_s * br2, 2.0 * c_s * br2);
     let (k_r, c_r) = (law.k_n * br2, c_n * br2);
 
-    // Normal (Eq. 1).
-    let f_n = n * (-law.k_n * kin.overlap) + u_n * c_n;
-    let f_n_size = f_n.norm();
-    let mut dissipated = c_n * u_n.norm_squared() * dt;
+    // Normal (Eq. 1), along n̂: |F_N| is the size of its one component.
+    let f_n_along = -law.k_n * kin.overlap + c_n * u_along;
+    let f_n = n * f_n_along;
+    let f_n_size = f_n_along.abs();
+    let mut dissipated = c_n * u_along * u_along * dt;
 
     // Tangential stick–slip (Eq. 2).
     let (f_s, slip, power) = slider_vec(&mut springs.shear, &u_t, dt, k_s, c_s, law.mu_s * f_n_size);
@@ -282,7 +291,10 @@ pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64)
     dissipated += slip + power * dt;
 
     // Rolling (Eqs. 6–10): ω_R = (ω_j − ω_i)_⊥ + ½ (l_j − l_i)/(l_i l_j) n̂ × u_t.
-    let arm = if kin.lever_j.is_finite() {
+    let arm = if kin.lever_j == kin.lever_i {
+        // equal spheres (a division saved)
+        0.0
+    } else if kin.lever_j.is_finite() {
         0.5 * (kin.lever_j - kin.lever_i) / (kin.lever_i * kin.lever_j)
     } else {
         0.5 / kin.lever_i
@@ -303,8 +315,8 @@ pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64)
         torque_i: shear_torque * kin.lever_i + n * m_t + m_r,
         torque_j: shear_torque * lever_j - n * m_t - m_r,
         normal_force: f_n_size,
-        rolling_torque: m_r.norm(),
-        twisting_torque: m_t.abs(),
+        rolling_torque: if SIZES { m_r.norm() } else { 0.0 },
+        twisting_torque: if SIZES { m_t.abs() } else { 0.0 },
         stored_energy: stored,
         dissipated,
     }

@@ -12,7 +12,7 @@
 
 use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::wall::Wall;
-use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_law};
+use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_inner, evaluate_law};
 use crate::granular::soft::particle::Particle;
 use crate::gravity::{SelfGravity, accelerations};
 use crate::math::Vec3;
@@ -91,6 +91,8 @@ pub struct SoftSystem {
     pair_slots: Vec<Option<Springs>>,
     /// Per entry of `verlet`: this evaluation's outcome (only filled when pairs are evaluated in parallel).
     pair_hits: Vec<Option<PairHit>>,
+    /// Per sphere: the pair contacts' force and torque of the evaluation under way.
+    pair_load: Vec<(Vec3, Vec3)>,
     verlet_origin: Vec<Vec3>,
 }
 
@@ -99,16 +101,16 @@ pub struct SoftSystem {
 struct PairHit {
     /// Overlap (m).
     overlap: f64,
-    /// Overlap over the smaller radius.
-    overlap_fraction: f64,
+    /// The smaller radius (m).
+    r_small: f64,
     /// The law's output.
     out: Output,
 }
 
 /// Running sums of one evaluation, added to in key order.
 struct Sums<'a> {
-    forces: &'a mut [Vec3],
-    torques: &'a mut [Vec3],
+    /// Per sphere: contact force and torque side by side (one cache line for a random partner `j`).
+    load: &'a mut [(Vec3, Vec3)],
     stats: &'a mut ForceStats,
     dissipated: f64,
     records: Option<&'a mut Vec<ContactRecord>>,
@@ -120,13 +122,17 @@ impl Sums<'_> {
     #[inline(always)]
     fn add_pair(&mut self, i: usize, j: usize, hit: &PairHit) {
         let out = &hit.out;
-        self.forces[i] += out.force_i;
-        self.forces[j] -= out.force_i;
-        self.torques[i] += out.torque_i;
-        self.torques[j] += out.torque_j;
+        self.load[i].0 += out.force_i;
+        self.load[j].0 -= out.force_i;
+        self.load[i].1 += out.torque_i;
+        self.load[j].1 += out.torque_j;
         self.stats.spring_energy += out.stored_energy;
         self.dissipated += out.dissipated;
-        self.stats.max_overlap_fraction = self.stats.max_overlap_fraction.max(hit.overlap_fraction);
+        // max(m, x/r) with the division only when x/r may exceed m (rounding of m r is far below 1e-12).
+        let max = &mut self.stats.max_overlap_fraction;
+        if hit.overlap >= *max * hit.r_small * (1.0 - 1e-12) {
+            *max = max.max(hit.overlap / hit.r_small);
+        }
         self.stats.pair_contacts += 1;
         if let Some(records) = self.records.as_deref_mut() {
             records.push(ContactRecord {
@@ -174,7 +180,7 @@ fn pair_kinematics(particles: &[Particle], i: usize, j: usize) -> Option<Kinemat
 
 /// Evaluates pair `(i, j)` with the springs of its slot, and updates the slot (emptied if they do not touch).
 #[inline(always)]
-fn pair_contact(
+fn pair_contact<const SIZES: bool>(
     particles: &[Particle],
     law: &Law,
     (i, j): (usize, usize),
@@ -186,11 +192,11 @@ fn pair_contact(
         return None;
     };
     let mut springs = slot.unwrap_or_else(|| Springs::new(kin.normal));
-    let out = evaluate_law(law, &kin, &mut springs, dt);
+    let out = evaluate_inner::<SIZES>(law, &kin, &mut springs, dt);
     *slot = Some(springs);
     Some(PairHit {
         overlap: kin.overlap,
-        overlap_fraction: kin.overlap / particles[i].radius.min(particles[j].radius),
+        r_small: particles[i].radius.min(particles[j].radius),
         out,
     })
 }
@@ -229,6 +235,7 @@ impl SoftSystem {
             verlet: Vec::new(),
             pair_slots: Vec::new(),
             pair_hits: Vec::new(),
+            pair_load: Vec::new(),
             verlet_origin: Vec::new(),
         }
     }
@@ -284,6 +291,34 @@ impl SoftSystem {
         }
     }
 
+    /// Evaluates every pair of the Verlet list and adds the touching ones to `sums` in key order.
+    fn pair_pass<const SIZES: bool>(&mut self, law: &Law, dt: f64, sums: &mut Sums<'_>) {
+        let particles = &self.particles;
+        if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
+            self.pair_hits.resize(self.verlet.len(), None);
+            self.verlet
+                .par_chunks(PAIR_CHUNK)
+                .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
+                .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
+                .for_each(|((keys, slots), hits)| {
+                    for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
+                        *hit = pair_contact::<SIZES>(particles, law, key, slot, dt);
+                    }
+                });
+            for (&(i, j), hit) in self.verlet.iter().zip(&self.pair_hits) {
+                if let Some(hit) = hit {
+                    sums.add_pair(i, j, hit);
+                }
+            }
+        } else {
+            for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
+                if let Some(hit) = pair_contact::<SIZES>(particles, law, key, slot, dt) {
+                    sums.add_pair(key.0, key.1, &hit);
+                }
+            }
+        }
+    }
+
     /// Evaluates all forces and torques at time `t` (s) for a step of `dt` (s) (the springs advance by the
     /// relative motion over `dt`; pass `dt = 0` to evaluate without advancing them, e.g. at t = 0).
     pub fn compute_forces(&mut self, t: f64, dt: f64) {
@@ -300,47 +335,35 @@ impl SoftSystem {
             forces[k] = (forces[k] + self.gravity.uniform) * m;
             stats.gravitational_energy += 0.5 * m * potentials[k] - m * self.gravity.uniform.dot(&positions[k]);
         }
-        let mut torques = std::mem::take(&mut self.torques);
-        torques.clear();
-        torques.resize(n, Vec3::zeros());
         let mut records = std::mem::take(&mut self.records);
         records.clear();
 
         // Pair contacts.
         self.refresh_verlet();
         let law = Law::new(&self.material);
+        let mut load = std::mem::take(&mut self.pair_load);
+        load.clear();
+        load.resize(n, (Vec3::zeros(), Vec3::zeros()));
         let mut sums = Sums {
-            forces: &mut forces,
-            torques: &mut torques,
+            load: &mut load,
             stats: &mut stats,
             dissipated: 0.0,
             records: self.keep_records.then_some(&mut records),
         };
-        let particles = &self.particles;
-        if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
-            self.pair_hits.resize(self.verlet.len(), None);
-            self.verlet
-                .par_chunks(PAIR_CHUNK)
-                .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
-                .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
-                .for_each(|((keys, slots), hits)| {
-                    for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
-                        *hit = pair_contact(particles, &law, key, slot, dt);
-                    }
-                });
-            for (&(i, j), hit) in self.verlet.iter().zip(&self.pair_hits) {
-                if let Some(hit) = hit {
-                    sums.add_pair(i, j, hit);
-                }
-            }
+        // Contact records want |M_R| and |M_T|; the force loop alone does not.
+        if self.keep_records {
+            self.pair_pass::<true>(&law, dt, &mut sums);
         } else {
-            for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
-                if let Some(hit) = pair_contact(particles, &law, key, slot, dt) {
-                    sums.add_pair(key.0, key.1, &hit);
-                }
-            }
+            self.pair_pass::<false>(&law, dt, &mut sums);
         }
         let mut dissipated = sums.dissipated;
+        let mut torques = std::mem::take(&mut self.torques);
+        torques.clear();
+        torques.extend(load.iter().map(|l| l.1));
+        for (f, l) in forces.iter_mut().zip(&load) {
+            *f += l.0;
+        }
+        self.pair_load = load;
 
         // Wall contacts.
         let mut wall_springs = Vec::new();

@@ -21,6 +21,8 @@ use nalgebra::{Rotation3, Unit};
 
 /// Below this value of `1 + n_old · n_new` the swing is built as an explicit axis–angle rotation.
 const NEAR_ANTIPARALLEL: f64 = 1e-6;
+/// Values of `1 − n_old · n_new` below this take `1/(1 + cos)` and `1/|n_old + n_new|` from series.
+const SMALL_TILT: f64 = 1e-6;
 /// Twist angles (rad) below this take their sine and cosine from the Taylor series.
 const SMALL_ANGLE: f64 = 1.0 / 32.0;
 
@@ -72,18 +74,28 @@ impl FrameRotation {
     pub fn new(n_old: &Vec3, n_new: &Vec3, mean_spin: &Vec3, dt: f64) -> Self {
         let axis = n_old.cross(n_new);
         let cos = n_old.dot(n_new);
-        let inv_one_plus_cos = 1.0 / (1.0 + cos);
         let mean = n_old + n_new;
-        let twist = if 1.0 + cos > NEAR_ANTIPARALLEL {
-            // |n_old + n_new| = √(2 (1 + cos)), accurate away from antiparallel normals.
-            mean_spin.dot(&mean) * dt * (0.5 * inv_one_plus_cos).sqrt()
+        // 1/(1 + cos) and 1/|n_old + n_new| = 1/√(2 (1 + cos)); for the tiny tilts of one step, with
+        // e = 1 − cos, from their series ½ (1 + e/2 + e²/4) and ½ (1 + e/4 + 3e²/32) (the first omitted
+        // terms are below 10⁻¹⁸ for e < 10⁻⁶), else directly.
+        let e = 1.0 - cos;
+        let (inv_one_plus_cos, inv_mean_size) = if e.abs() < SMALL_TILT {
+            (
+                0.5 * (1.0 + e * (0.5 + 0.25 * e)),
+                0.5 * (1.0 + e * (0.25 + (3.0 / 32.0) * e)),
+            )
+        } else if 1.0 + cos > NEAR_ANTIPARALLEL {
+            let inv = 1.0 / (1.0 + cos);
+            (inv, (0.5 * inv).sqrt())
         } else {
+            // Nearly antiparallel: 1 + cos has lost its digits, measure the sum itself.
             let size = mean.norm();
-            if size > 0.0 {
-                mean_spin.dot(&mean) * dt / size
-            } else {
-                mean_spin.dot(n_new) * dt
-            }
+            (1.0 / (1.0 + cos), if size > 0.0 { 1.0 / size } else { 0.0 })
+        };
+        let twist = if inv_mean_size > 0.0 {
+            mean_spin.dot(&mean) * dt * inv_mean_size
+        } else {
+            mean_spin.dot(n_new) * dt
         };
         let (twist_sin, twist_cos) = sin_cos(twist);
         FrameRotation {
