@@ -192,3 +192,38 @@ fn pure_twist_leaves_the_rolling_spring_untouched() {
     );
     assert!(springs.shear.norm() < 1e-15, "the shear spring moved");
 }
+
+/// The trigonometry-free frame rotation (spring_frame.rs) equals the composition of the shortest-arc rotation
+/// from the old to the new normal and the rotation about the new normal by the mean spin about the mean normal,
+/// built with axis–angle rotations, for small and large steps and nearly antiparallel normals.
+#[test]
+fn frame_rotation_equals_the_axis_angle_composition() {
+    use nalgebra::Unit;
+    use rubblepile::granular::soft::spring_frame::FrameRotation;
+    let mut rng = rubblepile::random::generator(3);
+    let mut unit = || rubblepile::random::point_in_ball(&mut rng, 1.0).normalize();
+    let mut worst: f64 = 0.0;
+    for case in 0..400 {
+        let n_old = unit();
+        // tilts from 1e-6 rad to nearly half a turn, twist angles from 1e-7 rad to 2 rad
+        let tilt = [1e-6, 1e-3, 0.1, 1.0, 2.5, std::f64::consts::PI - 1e-4][case % 6];
+        let perp = (unit().cross(&n_old)).normalize();
+        let n_new = Rotation3::from_axis_angle(&Unit::new_normalize(perp), tilt) * n_old;
+        let spin = unit() * [1e-4, 1.0, 30.0, 1e3][case % 4];
+        let dt = 2e-3;
+        let mean_normal = (n_old + n_new).normalize();
+        let axis = n_old.cross(&n_new);
+        let swing = Rotation3::from_axis_angle(&Unit::new_normalize(axis), axis.norm().atan2(n_old.dot(&n_new)));
+        let expected = Rotation3::from_axis_angle(&Unit::new_normalize(n_new), spin.dot(&mean_normal) * dt) * swing;
+        let r = FrameRotation::new(&n_old, &n_new, &spin, dt);
+        for v in [unit(), unit() * 1e-3] {
+            let err = (r.apply(&v) - expected * v).norm() / v.norm();
+            worst = worst.max(err);
+            assert!(
+                (r.apply(&v).norm() - v.norm()).abs() <= 1e-14 * v.norm(),
+                "length not kept"
+            );
+        }
+    }
+    assert!(worst < 1e-13, "largest relative difference {worst:e}");
+}

@@ -13,7 +13,7 @@
 //! limits. The normal force is not clipped at zero, so a head-on collision returns exactly the ε_n of the
 //! damping formula ([`damping`]).
 
-use crate::granular::soft::spring_frame::{carry, frame_rotation};
+use crate::granular::soft::spring_frame::FrameRotation;
 use crate::math::Vec3;
 use serde::{Deserialize, Serialize};
 
@@ -137,97 +137,176 @@ pub struct Output {
     pub dissipated: f64,
 }
 
-/// Adds `rate · dt` to a vector spring and applies a spring–dashpot–slider with cap `cap`:
+/// The material constants in the form the force loop uses, computed once per force evaluation: the contact
+/// law for a pair only needs its reduced mass and effective radius on top of these.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Law {
+    /// `k_N` (N/m).
+    pub k_n: f64,
+    /// `k_S = 2/7 k_N` (N/m).
+    pub k_s: f64,
+    /// `C_N / √μ` (kg^½/s): [`damping`] for ε_n and `k_N` at a reduced mass of 1 kg.
+    pub c_n_unit: f64,
+    /// `C_S / √μ` (kg^½/s): [`damping`] for ε_t and `k_S` at a reduced mass of 1 kg.
+    pub c_s_unit: f64,
+    /// β (dimensionless).
+    pub beta: f64,
+    /// μ_S (dimensionless).
+    pub mu_s: f64,
+    /// `M_T,max / (R |F_N|) = μ_T β μ_S` (dimensionless, Eq. 12).
+    pub twist_cap: f64,
+    /// `M_R,max / (R |F_N|) = μ_R β` (dimensionless, Eq. 12).
+    pub roll_cap: f64,
+}
+
+impl Law {
+    /// The constants of material `m`.
+    pub fn new(m: &Material) -> Self {
+        let k_s = m.k_s();
+        Law {
+            k_n: m.k_n,
+            k_s,
+            c_n_unit: damping(m.eps_n, m.k_n, 1.0),
+            c_s_unit: damping(m.eps_t, k_s, 1.0),
+            beta: m.beta,
+            mu_s: m.mu_s,
+            twist_cap: m.mu_t * m.beta * m.mu_s,
+            roll_cap: m.mu_r * m.beta,
+        }
+    }
+}
+
+/// Adds `rate · dt` to a vector spring and applies a spring–dashpot–slider with cap `cap` (≥ 0):
 /// returns (generalised force, energy lost by slip, dashpot power).
+#[inline(always)]
 fn slider_vec(spring: &mut Vec3, rate: &Vec3, dt: f64, k: f64, c: f64, cap: f64) -> (Vec3, f64, f64) {
     if k <= 0.0 {
         *spring = Vec3::zeros();
         return (Vec3::zeros(), 0.0, 0.0);
     }
-    // Energy in the spring before this step's stretch; on slip, the slider takes that energy plus the work of
-    // the capped force over the stretch, minus what the shortened spring keeps.
-    let before = 0.5 * k * spring.norm_squared();
-    *spring += rate * dt;
+    let before = *spring;
+    let stretch = rate * dt;
+    *spring += stretch;
     let trial = *spring * k;
-    let size = trial.norm();
-    if size >= cap {
+    let size2 = trial.norm_squared();
+    if size2 >= cap * cap {
+        let size = size2.sqrt();
         let capped = if size > 0.0 {
             trial * (cap / size)
         } else {
             Vec3::zeros()
         };
         *spring = capped / k;
-        let work = capped.dot(&(rate * dt));
-        (capped, before + work - 0.5 * k * spring.norm_squared(), 0.0)
+        // The slider takes the spring's energy before this step's stretch plus the work of the capped force
+        // over the stretch, minus what the shortened spring keeps.
+        let work = capped.dot(&stretch);
+        let lost = 0.5 * k * before.norm_squared() + work - 0.5 * k * spring.norm_squared();
+        (capped, lost, 0.0)
     } else {
         let mut total = trial + rate * c;
-        let t = total.norm();
-        if t > cap {
-            total *= cap / t;
+        let t2 = total.norm_squared();
+        if t2 > cap * cap {
+            total *= cap / t2.sqrt();
         }
         (total, 0.0, c * rate.norm_squared())
     }
 }
 
 /// The scalar version of [`slider_vec`] (twisting).
+#[inline(always)]
 fn slider_scalar(spring: &mut f64, rate: f64, dt: f64, k: f64, c: f64, cap: f64) -> (f64, f64, f64) {
-    let mut v = Vec3::new(*spring, 0.0, 0.0);
-    let out = slider_vec(&mut v, &Vec3::new(rate, 0.0, 0.0), dt, k, c, cap);
-    *spring = v.x;
-    (out.0.x, out.1, out.2)
+    if k <= 0.0 {
+        *spring = 0.0;
+        return (0.0, 0.0, 0.0);
+    }
+    let before = *spring;
+    let stretch = rate * dt;
+    *spring += stretch;
+    let trial = *spring * k;
+    if trial.abs() >= cap {
+        let capped = if trial == 0.0 { 0.0 } else { cap.copysign(trial) };
+        *spring = capped / k;
+        let lost = 0.5 * k * before * before + capped * stretch - 0.5 * k * *spring * *spring;
+        (capped, lost, 0.0)
+    } else {
+        let total = trial + rate * c;
+        let total = if total.abs() > cap { cap.copysign(total) } else { total };
+        (total, 0.0, c * rate * rate)
+    }
 }
 
-/// Evaluates the contact law for one step of length `dt` (s), updating `springs` (first carried into the
-/// current contact frame, then advanced by the relative motion over the step).
+/// Evaluates the contact law of material `m` for one step of length `dt` (s), updating `springs` (first
+/// carried into the current contact frame, then advanced by the relative motion over the step). The force
+/// loop calls [`evaluate_law`] with constants computed once.
 pub fn evaluate(m: &Material, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
+    evaluate_law(&Law::new(m), kin, springs, dt)
+}
+
+/// [`evaluate`] with the material's constants `law` already computed.
+#[inline(always)]
+pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
+    evaluate_inner::<true>(law, kin, springs, dt)
+}
+
+/// [`evaluate_law`] for the force loop: without `SIZES`, `Output::rolling_torque` and
+/// `Output::twisting_torque` are left at zero (they only go into contact records).
+#[inline(always)]
+pub(crate) fn evaluate_inner<const SIZES: bool>(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
     let n = kin.normal;
     // Carry the springs into the current frame (spring_frame.rs).
     let mean_spin = (kin.spin_i + kin.spin_j) * 0.5;
-    let rot = frame_rotation(&springs.normal, &n, &mean_spin, dt);
-    springs.shear = carry(&springs.shear, &rot, &n);
-    springs.roll = carry(&springs.roll, &rot, &n);
+    let rot = FrameRotation::new(&springs.normal, &n, &mean_spin, dt);
+    springs.shear = rot.carry(&springs.shear);
+    springs.roll = rot.carry(&springs.roll);
     springs.normal = n;
 
     let u = kin.relative_velocity;
-    let u_n = n * u.dot(&n);
+    let u_along = u.dot(&n);
+    let u_n = n * u_along;
     let u_t = u - u_n;
-    let k_s = m.k_s();
-    let c_n = damping(m.eps_n, m.k_n, kin.mass_eff);
-    let c_s = damping(m.eps_t, k_s, kin.mass_eff);
-    let br2 = (m.beta * kin.r_eff).powi(2);
+    let k_s = law.k_s;
+    let root_mass = kin.mass_eff.sqrt();
+    let c_n = law.c_n_unit * root_mass;
+    let c_s = law.c_s_unit * root_mass;
+    let br = law.beta * kin.r_eff;
+    let br2 = br * br;
     let (k_t, c_t) = (2.0 * k_s * br2, 2.0 * c_s * br2);
-    let (k_r, c_r) = (m.k_n * br2, c_n * br2);
+    let (k_r, c_r) = (law.k_n * br2, c_n * br2);
 
-    // Normal (Eq. 1).
-    let f_n = n * (-m.k_n * kin.overlap) + u_n * c_n;
-    let f_n_size = f_n.norm();
-    let mut dissipated = c_n * u_n.norm_squared() * dt;
+    // Normal (Eq. 1), along n̂: |F_N| is the size of its one component.
+    let f_n_along = -law.k_n * kin.overlap + c_n * u_along;
+    let f_n = n * f_n_along;
+    let f_n_size = f_n_along.abs();
+    let mut dissipated = c_n * u_along * u_along * dt;
 
     // Tangential stick–slip (Eq. 2).
-    let (f_s, slip, power) = slider_vec(&mut springs.shear, &u_t, dt, k_s, c_s, m.mu_s * f_n_size);
+    let (f_s, slip, power) = slider_vec(&mut springs.shear, &u_t, dt, k_s, c_s, law.mu_s * f_n_size);
     dissipated += slip + power * dt;
 
     // Twisting (Eqs. 3–5).
     let spin_rel = kin.spin_j - kin.spin_i;
     let w_t = spin_rel.dot(&n);
-    let cap_t = m.mu_t * m.beta * kin.r_eff * m.mu_s * f_n_size;
+    let cap_t = law.twist_cap * kin.r_eff * f_n_size;
     let (m_t, slip, power) = slider_scalar(&mut springs.twist, w_t, dt, k_t, c_t, cap_t);
     dissipated += slip + power * dt;
 
     // Rolling (Eqs. 6–10): ω_R = (ω_j − ω_i)_⊥ + ½ (l_j − l_i)/(l_i l_j) n̂ × u_t.
-    let arm = if kin.lever_j.is_finite() {
+    let arm = if kin.lever_j == kin.lever_i {
+        // equal spheres (a division saved)
+        0.0
+    } else if kin.lever_j.is_finite() {
         0.5 * (kin.lever_j - kin.lever_i) / (kin.lever_i * kin.lever_j)
     } else {
         0.5 / kin.lever_i
     };
     let w_r = spin_rel - n * w_t + n.cross(&u_t) * arm;
-    let cap_r = m.mu_r * m.beta * kin.r_eff * f_n_size;
+    let cap_r = law.roll_cap * kin.r_eff * f_n_size;
     let (m_r, slip, power) = slider_vec(&mut springs.roll, &w_r, dt, k_r, c_r, cap_r);
     dissipated += slip + power * dt;
 
     let lever_j = if kin.lever_j.is_finite() { kin.lever_j } else { 0.0 };
     let shear_torque = n.cross(&f_s);
-    let stored = 0.5 * m.k_n * kin.overlap * kin.overlap
+    let stored = 0.5 * law.k_n * kin.overlap * kin.overlap
         + 0.5 * k_s * springs.shear.norm_squared()
         + 0.5 * k_t * springs.twist * springs.twist
         + 0.5 * k_r * springs.roll.norm_squared();
@@ -236,8 +315,8 @@ pub fn evaluate(m: &Material, kin: &Kinematics, springs: &mut Springs, dt: f64) 
         torque_i: shear_torque * kin.lever_i + n * m_t + m_r,
         torque_j: shear_torque * lever_j - n * m_t - m_r,
         normal_force: f_n_size,
-        rolling_torque: m_r.norm(),
-        twisting_torque: m_t.abs(),
+        rolling_torque: if SIZES { m_r.norm() } else { 0.0 },
+        twisting_torque: if SIZES { m_t.abs() } else { 0.0 },
         stored_energy: stored,
         dissipated,
     }

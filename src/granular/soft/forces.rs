@@ -3,14 +3,16 @@
 //! sphere–wall contact.
 //!
 //! Contacts are found from a Verlet list built on the cell grid of [`crate::geometry::neighbours`] with
-//! reach `r + skin/2`, rebuilt when any sphere has moved more than `skin/2` since the last build. Spring
-//! histories live in vectors sorted by key (`(i, j)` with `i < j` for pairs, `(i, wall)` for walls). Pair
-//! contacts are evaluated in parallel but collected and then accumulated in key order, so the forces do not
-//! depend on the number of threads nor on when the Verlet list was rebuilt.
+//! reach `r + skin/2`, rebuilt when any sphere has moved more than `skin/2` since the last build. The pair
+//! list is sorted by key `(i, j)`, `i < j`, and the pair spring histories live in an array parallel to it
+//! (no look-up; carried over by a merge on key when the list is rebuilt); wall histories live in a vector
+//! sorted by `(i, wall)`. Forces are accumulated in key order: on one thread in the same pass that evaluates
+//! the contacts, on several threads after a parallel pass that stores each pair's output. Both orders are the
+//! same, so the forces depend neither on the number of threads nor on when the Verlet list was rebuilt.
 
 use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::wall::Wall;
-use crate::granular::soft::contact::{Kinematics, Material, Output, Springs, evaluate};
+use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_inner, evaluate_law};
 use crate::granular::soft::particle::Particle;
 use crate::gravity::{SelfGravity, accelerations};
 use crate::math::Vec3;
@@ -70,8 +72,6 @@ pub struct SoftSystem {
     pub forces: Vec<Vec3>,
     /// Torques (N m) from the last evaluation.
     pub torques: Vec<Vec3>,
-    /// Pair spring histories, sorted by `(i, j)`.
-    pub pair_springs: Vec<((usize, usize), Springs)>,
     /// Wall spring histories, sorted by `(particle, wall)`.
     pub wall_springs: Vec<((usize, usize), Springs)>,
     /// Diagnostics of the last evaluation.
@@ -85,11 +85,125 @@ pub struct SoftSystem {
     /// Per-contact records of the last evaluation when [`SoftSystem::keep_records`] is set.
     pub records: Vec<ContactRecord>,
     skin: f64,
+    /// Candidate pairs `(i, j)`, `i < j`, sorted.
     verlet: Vec<(usize, usize)>,
+    /// Per entry of `verlet`: the springs if the pair touched at the last evaluation.
+    pair_slots: Vec<Option<Springs>>,
+    /// Per entry of `verlet`: this evaluation's outcome (only filled when pairs are evaluated in parallel).
+    pair_hits: Vec<Option<PairHit>>,
+    /// Per sphere: the pair contacts' force and torque of the evaluation under way.
+    pair_load: Vec<(Vec3, Vec3)>,
     verlet_origin: Vec<Vec3>,
 }
 
+/// What one touching pair contributes at one evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PairHit {
+    /// Overlap (m).
+    overlap: f64,
+    /// The smaller radius (m).
+    r_small: f64,
+    /// The law's output.
+    out: Output,
+}
+
+/// Running sums of one evaluation, added to in key order.
+struct Sums<'a> {
+    /// Per sphere: contact force and torque side by side (one cache line for a random partner `j`).
+    load: &'a mut [(Vec3, Vec3)],
+    stats: &'a mut ForceStats,
+    dissipated: f64,
+    records: Option<&'a mut Vec<ContactRecord>>,
+}
+
+impl Sums<'_> {
+    /// Adds pair `(i, j)`'s contribution (the one place that does, so that the serial and the parallel paths
+    /// add the same numbers in the same order).
+    #[inline(always)]
+    fn add_pair(&mut self, i: usize, j: usize, hit: &PairHit) {
+        let out = &hit.out;
+        self.load[i].0 += out.force_i;
+        self.load[j].0 -= out.force_i;
+        self.load[i].1 += out.torque_i;
+        self.load[j].1 += out.torque_j;
+        self.stats.spring_energy += out.stored_energy;
+        self.dissipated += out.dissipated;
+        // max(m, x/r) with the division only when x/r may exceed m (rounding of m r is far below 1e-12).
+        let max = &mut self.stats.max_overlap_fraction;
+        if hit.overlap >= *max * hit.r_small * (1.0 - 1e-12) {
+            *max = max.max(hit.overlap / hit.r_small);
+        }
+        self.stats.pair_contacts += 1;
+        if let Some(records) = self.records.as_deref_mut() {
+            records.push(ContactRecord {
+                i,
+                j,
+                overlap: hit.overlap,
+                output: *out,
+            });
+        }
+    }
+}
+
+/// The kinematics of pair `(i, j)` if the spheres overlap.
+#[inline(always)]
+fn pair_kinematics(particles: &[Particle], i: usize, j: usize) -> Option<Kinematics> {
+    let (a, b) = (&particles[i], &particles[j]);
+    let d = b.position - a.position;
+    let reach = a.radius + b.radius;
+    let dist2 = d.norm_squared();
+    if dist2 >= reach * reach {
+        return None;
+    }
+    let dist = dist2.sqrt();
+    let overlap = reach - dist;
+    if overlap <= 0.0 || dist <= 0.0 {
+        return None;
+    }
+    let n = d * (1.0 / dist);
+    let (li, lj) = (a.radius - 0.5 * overlap, b.radius - 0.5 * overlap);
+    let inv = 1.0 / (reach * (a.mass + b.mass));
+    let u = b.velocity - a.velocity - b.spin.cross(&n) * lj - a.spin.cross(&n) * li;
+    Some(Kinematics {
+        normal: n,
+        overlap,
+        lever_i: li,
+        lever_j: lj,
+        relative_velocity: u,
+        spin_i: a.spin,
+        spin_j: b.spin,
+        // R = r_i r_j/(r_i + r_j) and μ = m_i m_j/(m_i + m_j) with one division.
+        r_eff: a.radius * b.radius * (a.mass + b.mass) * inv,
+        mass_eff: a.mass * b.mass * reach * inv,
+    })
+}
+
+/// Evaluates pair `(i, j)` with the springs of its slot, and updates the slot (emptied if they do not touch).
+#[inline(always)]
+fn pair_contact<const SIZES: bool>(
+    particles: &[Particle],
+    law: &Law,
+    (i, j): (usize, usize),
+    slot: &mut Option<Springs>,
+    dt: f64,
+) -> Option<PairHit> {
+    let Some(kin) = pair_kinematics(particles, i, j) else {
+        *slot = None;
+        return None;
+    };
+    let mut springs = slot.unwrap_or_else(|| Springs::new(kin.normal));
+    let out = evaluate_inner::<SIZES>(law, &kin, &mut springs, dt);
+    *slot = Some(springs);
+    Some(PairHit {
+        overlap: kin.overlap,
+        r_small: particles[i].radius.min(particles[j].radius),
+        out,
+    })
+}
+
 const PAR_MIN: usize = 64;
+/// Pairs per parallel task.
+const PAIR_CHUNK: usize = 1024;
 
 /// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
 type WallHit = (usize, Springs, f64, Vec3, Output);
@@ -111,7 +225,6 @@ impl SoftSystem {
             gravity,
             forces: vec![Vec3::zeros(); n],
             torques: vec![Vec3::zeros(); n],
-            pair_springs: Vec::new(),
             wall_springs: Vec::new(),
             stats: ForceStats::default(),
             dissipated: 0.0,
@@ -120,8 +233,31 @@ impl SoftSystem {
             records: Vec::new(),
             skin: if r_min.is_finite() { 0.1 * r_min } else { 0.0 },
             verlet: Vec::new(),
+            pair_slots: Vec::new(),
+            pair_hits: Vec::new(),
+            pair_load: Vec::new(),
             verlet_origin: Vec::new(),
         }
+    }
+
+    /// The spring histories of the pairs that touched at the last evaluation, sorted by `(i, j)`
+    /// (for checkpoints).
+    pub fn pair_springs(&self) -> Vec<((usize, usize), Springs)> {
+        self.verlet
+            .iter()
+            .zip(&self.pair_slots)
+            .filter_map(|(&key, slot)| slot.map(|s| (key, s)))
+            .collect()
+    }
+
+    /// Replaces the pair spring histories by `springs` (as from [`SoftSystem::pair_springs`], e.g. on
+    /// resuming a checkpoint); the next evaluation rebuilds the Verlet list and carries them over.
+    pub fn set_pair_springs(&mut self, mut springs: Vec<((usize, usize), Springs)>) {
+        springs.sort_by_key(|e| e.0);
+        springs.dedup_by_key(|e| e.0);
+        self.verlet = springs.iter().map(|e| e.0).collect();
+        self.pair_slots = springs.into_iter().map(|e| Some(e.1)).collect();
+        self.verlet_origin.clear();
     }
 
     fn refresh_verlet(&mut self) {
@@ -134,33 +270,53 @@ impl SoftSystem {
         if stale {
             let centres: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
             let reach: Vec<f64> = self.particles.iter().map(|p| p.radius + 0.5 * self.skin).collect();
-            self.verlet = sphere_pairs(&centres, &reach);
+            let pairs = sphere_pairs(&centres, &reach);
+            // Carry the springs of touching pairs over: both lists are sorted by key, and every touching pair
+            // is in the new list (it holds every pair closer than the sum of radii plus the skin).
+            let mut old = self
+                .verlet
+                .iter()
+                .zip(&self.pair_slots)
+                .filter(|(_, slot)| slot.is_some())
+                .peekable();
+            let mut slots = Vec::with_capacity(pairs.len());
+            for key in &pairs {
+                while old.next_if(|(k, _)| *k < key).is_some() {}
+                slots.push(old.next_if(|(k, _)| *k == key).and_then(|(_, slot)| *slot));
+            }
+            self.verlet = pairs;
+            self.pair_slots = slots;
+            self.pair_hits.clear();
             self.verlet_origin = centres;
         }
     }
 
-    fn pair_kinematics(&self, i: usize, j: usize) -> Option<Kinematics> {
-        let (a, b) = (&self.particles[i], &self.particles[j]);
-        let d = b.position - a.position;
-        let dist = d.norm();
-        let overlap = a.radius + b.radius - dist;
-        if overlap <= 0.0 || dist <= 0.0 {
-            return None;
+    /// Evaluates every pair of the Verlet list and adds the touching ones to `sums` in key order.
+    fn pair_pass<const SIZES: bool>(&mut self, law: &Law, dt: f64, sums: &mut Sums<'_>) {
+        let particles = &self.particles;
+        if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
+            self.pair_hits.resize(self.verlet.len(), None);
+            self.verlet
+                .par_chunks(PAIR_CHUNK)
+                .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
+                .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
+                .for_each(|((keys, slots), hits)| {
+                    for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
+                        *hit = pair_contact::<SIZES>(particles, law, key, slot, dt);
+                    }
+                });
+            for (&(i, j), hit) in self.verlet.iter().zip(&self.pair_hits) {
+                if let Some(hit) = hit {
+                    sums.add_pair(i, j, hit);
+                }
+            }
+        } else {
+            for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
+                if let Some(hit) = pair_contact::<SIZES>(particles, law, key, slot, dt) {
+                    sums.add_pair(key.0, key.1, &hit);
+                }
+            }
         }
-        let n = d / dist;
-        let (li, lj) = (a.radius - 0.5 * overlap, b.radius - 0.5 * overlap);
-        let u = b.velocity - a.velocity - b.spin.cross(&n) * lj - a.spin.cross(&n) * li;
-        Some(Kinematics {
-            normal: n,
-            overlap,
-            lever_i: li,
-            lever_j: lj,
-            relative_velocity: u,
-            spin_i: a.spin,
-            spin_j: b.spin,
-            r_eff: a.radius * b.radius / (a.radius + b.radius),
-            mass_eff: a.mass * b.mass / (a.mass + b.mass),
-        })
     }
 
     /// Evaluates all forces and torques at time `t` (s) for a step of `dt` (s) (the springs advance by the
@@ -179,45 +335,35 @@ impl SoftSystem {
             forces[k] = (forces[k] + self.gravity.uniform) * m;
             stats.gravitational_energy += 0.5 * m * potentials[k] - m * self.gravity.uniform.dot(&positions[k]);
         }
-        let mut torques = vec![Vec3::zeros(); n];
+        let mut records = std::mem::take(&mut self.records);
+        records.clear();
 
         // Pair contacts.
         self.refresh_verlet();
-        let material = self.material;
-        let old = &self.pair_springs;
-        let results: Vec<((usize, usize), Springs, f64, Output)> = self
-            .verlet
-            .par_iter()
-            .with_min_len(PAR_MIN)
-            .filter_map(|&(i, j)| {
-                let kin = self.pair_kinematics(i, j)?;
-                let mut springs = lookup(old, (i, j)).unwrap_or_else(|| Springs::new(kin.normal));
-                let out = evaluate(&material, &kin, &mut springs, dt);
-                Some(((i, j), springs, kin.overlap, out))
-            })
-            .collect();
-        let mut dissipated = 0.0;
-        let mut records = Vec::new();
-        for &((i, j), _, overlap, ref out) in &results {
-            forces[i] += out.force_i;
-            forces[j] -= out.force_i;
-            torques[i] += out.torque_i;
-            torques[j] += out.torque_j;
-            stats.spring_energy += out.stored_energy;
-            dissipated += out.dissipated;
-            let r_small = self.particles[i].radius.min(self.particles[j].radius);
-            stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / r_small);
-            if self.keep_records {
-                records.push(ContactRecord {
-                    i,
-                    j,
-                    overlap,
-                    output: *out,
-                });
-            }
+        let law = Law::new(&self.material);
+        let mut load = std::mem::take(&mut self.pair_load);
+        load.clear();
+        load.resize(n, (Vec3::zeros(), Vec3::zeros()));
+        let mut sums = Sums {
+            load: &mut load,
+            stats: &mut stats,
+            dissipated: 0.0,
+            records: self.keep_records.then_some(&mut records),
+        };
+        // Contact records want |M_R| and |M_T|; the force loop alone does not.
+        if self.keep_records {
+            self.pair_pass::<true>(&law, dt, &mut sums);
+        } else {
+            self.pair_pass::<false>(&law, dt, &mut sums);
         }
-        stats.pair_contacts = results.len();
-        self.pair_springs = results.into_iter().map(|(key, s, _, _)| (key, s)).collect();
+        let mut dissipated = sums.dissipated;
+        let mut torques = std::mem::take(&mut self.torques);
+        torques.clear();
+        torques.extend(load.iter().map(|l| l.1));
+        for (f, l) in forces.iter_mut().zip(&load) {
+            *f += l.0;
+        }
+        self.pair_load = load;
 
         // Wall contacts.
         let mut wall_springs = Vec::new();
@@ -249,7 +395,7 @@ impl SoftSystem {
                             mass_eff: p.mass,
                         };
                         let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
-                        let out = evaluate(&material, &kin, &mut springs, dt);
+                        let out = evaluate_law(&law, &kin, &mut springs, dt);
                         hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
                     }
                     hits

@@ -488,7 +488,7 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
         sys.forces[k] = v(9);
         sys.torques[k] = v(12);
     }
-    sys.pair_springs = unpack(&ck.pair_springs).ok_or_else(|| bad("malformed pair springs".into()))?;
+    sys.set_pair_springs(unpack(&ck.pair_springs).ok_or_else(|| bad("malformed pair springs".into()))?);
     sys.wall_springs = unpack(&ck.wall_springs).ok_or_else(|| bad("malformed wall springs".into()))?;
     if ck.work.len() != 2 {
         return Err(bad("malformed work record".into()));
@@ -656,7 +656,7 @@ fn drive(
                 checkpoints,
                 wall_seconds: wall(&clock),
                 state,
-                pair_springs: pack(&sys.pair_springs),
+                pair_springs: pack(&sys.pair_springs()),
                 wall_springs: pack(&sys.wall_springs),
                 work: vec![sys.dissipated, sys.wall_work],
                 book: book.to_vec(),
