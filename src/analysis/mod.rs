@@ -1,5 +1,6 @@
 //! Post-processing of states and runs.
 
+pub mod atmosphere;
 pub mod figures;
 pub mod fits;
 pub mod fragments;
@@ -7,3 +8,4 @@ pub mod report_roig2003;
 pub mod rigid_rotation;
 pub mod run_analysis;
 pub mod spinup;
+pub mod tumbler;
