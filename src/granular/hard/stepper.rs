@@ -32,9 +32,9 @@ use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::walls::Wall;
 use crate::math::Vec3;
 
-/// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 16, 32 and 64 cost 2.3,
-/// 1.7 and 1.7 s of CPU for 5000 steps against 10.2 s with a fresh list every step
-/// (`analysis/richardson2011/NOTES.md`); 16 keeps the grown spheres smaller in dense piles.
+/// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 8, 16, 32 and 64 cost 3.7,
+/// 2.4, 2.0 and 1.9 s of CPU for 5000 steps against 8.8 s with a fresh list every step
+/// (`analysis/richardson2011/NOTES.md`); 16 keeps the lists shorter in dense piles.
 pub const DEFAULT_SKIN_STEPS: f64 = 16.0;
 
 /// Settings of the stepper.
