@@ -4,7 +4,6 @@
 
 mod common;
 
-use common::Random;
 use rubblepile::geometry::walls::{Oscillation, Shape, Wall};
 use rubblepile::granular::hard::particle::Particle;
 use rubblepile::granular::hard::stepper::{StepError, StepperSettings, System};
@@ -218,6 +217,7 @@ fn collapse_system(collapse_speed: f64) -> System {
             gravity: None,
             collapse_speed,
             max_events_per_step: 5000,
+            ..Default::default()
         },
     )
 }
@@ -256,34 +256,8 @@ fn inelastic_collapse_guard() {
 fn dense_elastic_box_overlap_and_energy() {
     // 400 rough elastic spheres (ε_n = 1, ε_t = −1) of radius 0.04 in the unit box bounded by six planes,
     // volume fraction 0.27.
-    let mut rng = Random::new(3);
     let r = 0.04;
-    let mut ps = Vec::new();
-    let m = 8; // lattice spacing 1/8 = 0.125 > 2r
-    for i in 0..m {
-        for j in 0..m {
-            for k in 0..m {
-                if ps.len() == 400 {
-                    continue;
-                }
-                let c = Vec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) / m as f64 + rng.vec3(0.02);
-                let mut p = Particle::new(ps.len(), rng.range(0.5, 2.0), r, c, rng.vec3(1.0), rng.vec3(5.0));
-                p.eps_t = -1.0;
-                ps.push(p);
-            }
-        }
-    }
-    let mut walls = Vec::new();
-    for (o, n) in [
-        (Vec3::zeros(), Vec3::x()),
-        (Vec3::zeros(), Vec3::y()),
-        (Vec3::zeros(), Vec3::z()),
-        (Vec3::new(1.0, 1.0, 1.0), Vec3::x()),
-        (Vec3::new(1.0, 1.0, 1.0), Vec3::y()),
-        (Vec3::new(1.0, 1.0, 1.0), Vec3::z()),
-    ] {
-        walls.push(Wall::new(Shape::Plane, o, n));
-    }
+    let (ps, walls) = common::hard_sphere_box(3, 400, 1.0);
     let mut sys = System::new(ps, walls, StepperSettings::default());
     let d0 = sys.diagnostics();
     let start = std::time::Instant::now();

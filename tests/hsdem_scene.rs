@@ -71,7 +71,7 @@ fn runs_writes_outputs_and_is_deterministic() {
     }
     assert!(summary["max_overlap"].as_f64().unwrap() < 1e-9);
     let snap = std::fs::read_to_string(dir.join("a/snapshots/2.csv")).unwrap();
-    assert!(snap.starts_with("t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz\n"));
+    assert!(snap.starts_with("t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz,stuck_to\n"));
     let ts = std::fs::read_to_string(dir.join("a/timeseries.csv")).unwrap();
     assert_eq!(ts.lines().count(), 1 + 11);
     // Same scene, same bits.

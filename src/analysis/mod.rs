@@ -1,5 +1,6 @@
 //! Post-processing of states and runs.
 
+pub mod atmosphere;
 pub mod figures;
 pub mod fits;
 pub mod fragments;
@@ -8,3 +9,4 @@ pub mod rigid_rotation;
 pub mod run_analysis;
 pub mod shape_metrics;
 pub mod spinup;
+pub mod tumbler;

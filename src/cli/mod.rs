@@ -13,6 +13,8 @@
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
+//! - `rubblepile report-richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
+//!   (`analysis/richardson2011/REPORT.md` and figures);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads;
 //! - `rubblepile bench work-precision --problem {top,pair,pair-dissipative,n30} --out DIR [--force]
@@ -38,6 +40,7 @@ pub mod bench_impact;
 pub mod campaign;
 pub mod impact;
 pub mod nbody;
+pub mod report_richardson2011;
 pub mod ssdem;
 pub mod stability;
 pub mod target;
@@ -82,6 +85,8 @@ pub enum Command {
     AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
     /// Re-analyse the Roig03 campaign (and its uniform-inertia partner) and write analysis/roig2003/REPORT.md.
     ReportRoig2003(analyze::ReportRoig2003Args),
+    /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
+    ReportRichardson2011(report_richardson2011::ReportRichardson2011Args),
     /// Benchmarks.
     #[command(subcommand)]
     Bench(BenchCommand),
@@ -234,16 +239,16 @@ fn load(scene: Option<&PathBuf>) -> Result<LoadedScene, CliError> {
 pub fn execute(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Run(args) => {
-            if let Some(path) = &args.scene
-                && let Ok(text) = std::fs::read_to_string(path)
-                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
-            {
-                return crate::granular::hard::run::cli_run(path, &args.out, args.force);
-            }
             let options = RunOptions {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?
             };
+            if let Some(path) = &args.scene
+                && let Ok(text) = std::fs::read_to_string(path)
+                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
+            {
+                return crate::granular::hard::run::cli_run(path, &args.out, &options);
+            }
             if let Some(path) = &args.scene
                 && crate::granular::soft::scene::is_soft_scene_file(path)
             {
@@ -256,6 +261,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             let options = args.checkpoints.options(!args.no_progress)?;
             if crate::granular::soft::run::is_soft_run_dir(&args.dir) {
                 return ssdem::resume(&args.dir, &options);
+            }
+            if crate::granular::hard::run::is_hard_run_dir(&args.dir) {
+                return crate::granular::hard::run::cli_resume(&args.dir, &options);
             }
             report(resume_run(&args.dir, &options))
         }
@@ -298,6 +306,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
         Command::ReportRoig2003(args) => analyze::report_roig2003(&args),
+        Command::ReportRichardson2011(args) => report_richardson2011::report(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
         Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
         Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),

@@ -143,3 +143,48 @@ pub fn rubblepile(cwd: &std::path::Path, args: &[&str]) -> std::process::Output 
         .output()
         .expect("run the binary")
 }
+
+/// `n` (≤ 512) rough elastic hard spheres (ε_n = 1, ε_t = −1) of radius 0.04 with masses in [0.5, 2), on a jittered
+/// 8³ lattice in the unit box, random velocities up to `speed` and spins up to 5 per component, and the box's six
+/// plane walls.
+pub fn hard_sphere_box(
+    seed: u64,
+    n: usize,
+    speed: f64,
+) -> (
+    Vec<rubblepile::granular::hard::particle::Particle>,
+    Vec<rubblepile::geometry::walls::Wall>,
+) {
+    use rubblepile::geometry::walls::{Shape, Wall};
+    use rubblepile::granular::hard::particle::Particle;
+    let mut rng = Random::new(seed);
+    let r = 0.04;
+    let m = 8; // lattice spacing 1/8 = 0.125 > 2r
+    let mut ps = Vec::new();
+    for i in 0..m {
+        for j in 0..m {
+            for k in 0..m {
+                if ps.len() == n {
+                    continue;
+                }
+                let c = Vec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5) / m as f64 + rng.vec3(0.02);
+                let mut p = Particle::new(ps.len(), rng.range(0.5, 2.0), r, c, rng.vec3(speed), rng.vec3(5.0));
+                p.eps_t = -1.0;
+                ps.push(p);
+            }
+        }
+    }
+    let corner = Vec3::new(1.0, 1.0, 1.0);
+    let walls = [
+        (Vec3::zeros(), Vec3::x()),
+        (Vec3::zeros(), Vec3::y()),
+        (Vec3::zeros(), Vec3::z()),
+        (corner, Vec3::x()),
+        (corner, Vec3::y()),
+        (corner, Vec3::z()),
+    ]
+    .into_iter()
+    .map(|(o, n)| Wall::new(Shape::Plane, o, n))
+    .collect();
+    (ps, walls)
+}

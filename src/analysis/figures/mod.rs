@@ -14,6 +14,7 @@
 
 pub mod campaign_figures;
 pub mod energy;
+pub mod lines;
 pub mod run_figures;
 pub mod style;
 

@@ -6,11 +6,13 @@
 //! t_end = 2.0                      # s
 //! seed = 0                         # recorded; the engine draws no random numbers
 //! # particles_file = "p.csv"       # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
+//! #                                # and optionally stuck_to (index of the wall a particle is attached to, -1 free)
 //!
 //! [stepping]
 //! dt = 1e-3                        # s
 //! collapse_speed = 1e-4            # m/s: slower normal approaches bounce elastically (inelastic-collapse guard)
 //! max_events_per_step = 10000000   # the run stops as stalled beyond this
+//! skin_steps = 16.0                # neighbour-list skin in steps (0 = a fresh list every step)
 //!
 //! [gravity]                        # optional: uniform field
 //! g = [0.0, 0.0, -9.81]            # m/s²
@@ -29,6 +31,7 @@
 //! position = [0.0, 0.0, 0.5]       # m
 //! velocity = [0.0, 0.0, 0.0]       # m/s
 //! spin = [0.0, 0.0, 0.0]           # rad/s, world frame
+//! # stuck_to = 0                   # attached to wall 0 from t = 0 (moves rigidly with it: a rough lining)
 //!
 //! [[wall]]
 //! type = "plane"                   # plane | disk | cylinder | ring | point | line
@@ -43,8 +46,8 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::particle::Particle;
-use super::stepper::StepperSettings;
+use super::particle::{Attachment, Particle};
+use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
 use crate::math::Vec3;
 use crate::scene::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
@@ -52,10 +55,23 @@ use crate::scene::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
 /// The scene kind this module reads.
 pub const KIND: &str = "hard-spheres";
 
-/// Columns of a particles file and of the snapshots.
+/// Required columns of a particles file (the snapshots add [`STUCK_COLUMN`]).
 pub const PARTICLE_COLUMNS: [&str; 13] = [
     "t", "id", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz",
 ];
+
+/// Optional particles-file column: index of the wall the particle is attached to from t = 0 (moving rigidly with
+/// it, as an infinite mass), or −1 (or empty) for a free particle.
+pub const STUCK_COLUMN: &str = "stuck_to";
+
+/// One row of a particles file: the [`PARTICLE_COLUMNS`] in order and the [`STUCK_COLUMN`] if given.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParticleRow {
+    /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`.
+    pub values: [f64; 13],
+    /// Wall index, if attached.
+    pub stuck_to: Option<usize>,
+}
 
 /// The whole file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -112,10 +128,19 @@ pub struct SteppingSection {
     /// Most events one step may process (≥ 1); beyond it the run stops as stalled. Default 1e7.
     #[serde(default = "default_max_events")]
     pub max_events_per_step: u64,
+    /// Neighbour-list skin in steps (dimensionless, ≥ 0): a particle's travel allowance is about
+    /// `skin_steps · |v| · dt` and the list is kept across steps, re-listing a particle when it could leave its
+    /// allowance; 0 = a fresh list for all at every step. Default 16.
+    #[serde(default = "default_skin_steps")]
+    pub skin_steps: f64,
 }
 
 fn default_max_events() -> u64 {
     10_000_000
+}
+
+fn default_skin_steps() -> f64 {
+    DEFAULT_SKIN_STEPS
 }
 
 /// `[gravity]`.
@@ -181,6 +206,10 @@ pub struct ParticleSpec {
     /// ε_t ∈ [−1, 1]; default `material.eps_t`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub eps_t: Option<f64>,
+    /// Index of the wall this particle is attached to from t = 0 (it then moves rigidly with the wall, as an
+    /// infinite mass: a rough lining). Default: free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stuck_to: Option<usize>,
 }
 
 /// `wall.oscillation`: `A sin(ω t + φ) d̂` added to the wall's position (minus its value at t = 0).
@@ -250,6 +279,8 @@ pub struct HardScene {
     pub name: String,
     /// The scene text (copied to the output directory).
     pub source: String,
+    /// Directory a relative `scene.particles_file` was resolved against.
+    pub base_dir: PathBuf,
     /// The parsed file.
     pub file: HardSceneFile,
     /// End time (s).
@@ -316,6 +347,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let t_end = v.positive("scene.t_end", file.scene.t_end)?;
     let dt = v.positive("stepping.dt", file.stepping.dt)?;
     let collapse_speed = v.non_negative("stepping.collapse_speed", file.stepping.collapse_speed)?;
+    let skin_steps = v.non_negative("stepping.skin_steps", file.stepping.skin_steps)?;
     if file.stepping.max_events_per_step == 0 {
         return Err(v.invalid("stepping.max_events_per_step", "must be >= 1, got 0"));
     }
@@ -353,6 +385,24 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         None => vec![0.0, t_end],
     };
 
+    let mut walls = Vec::new();
+    for (k, w) in file.walls.iter().enumerate() {
+        walls.push(wall(&v, k, w)?);
+    }
+    let attach = |field: String, w: Option<usize>, p: &Particle| -> Result<Option<Attachment>, SceneError> {
+        match w {
+            None => Ok(None),
+            Some(w) if w < walls.len() => Ok(Some(Attachment {
+                wall: w,
+                offset: walls[w].to_local(&(p.position - walls[w].origin_at(0.0))),
+                t_stuck: 0.0,
+            })),
+            Some(w) => Err(v.invalid(
+                field,
+                format!("must be a wall index in [0, {}) or -1, got {w}", walls.len()),
+            )),
+        }
+    };
     let mut particles = Vec::new();
     match (&file.scene.particles_file, file.particles.is_empty()) {
         (Some(_), false) => {
@@ -380,6 +430,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
                 );
                 q.eps_n = v.in_range(&f("eps_n"), p.eps_n.unwrap_or(eps_n), 0.0, 1.0)?;
                 q.eps_t = v.in_range(&f("eps_t"), p.eps_t.unwrap_or(eps_t), -1.0, 1.0)?;
+                q.stuck = attach(f("stuck_to"), p.stuck_to, &q)?;
                 particles.push(q);
             }
         }
@@ -390,7 +441,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             if rows.is_empty() {
                 return Err(v.invalid("scene.particles_file", format!("{}: no data rows", path.display())));
             }
-            for (k, r) in rows.iter().enumerate() {
+            for (k, row) in rows.iter().enumerate() {
+                let r = &row.values;
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
                 let mut q = Particle::new(
                     k,
@@ -402,18 +454,15 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
                 );
                 q.eps_n = eps_n;
                 q.eps_t = eps_t;
+                q.stuck = attach(f(STUCK_COLUMN), row.stuck_to, &q)?;
                 particles.push(q);
             }
         }
     }
-
-    let mut walls = Vec::new();
-    for (k, w) in file.walls.iter().enumerate() {
-        walls.push(wall(&v, k, w)?);
-    }
     Ok(HardScene {
         name: name.to_string(),
         source: text.to_string(),
+        base_dir: base_dir.to_path_buf(),
         t_end,
         dt,
         seed: file.scene.seed,
@@ -423,6 +472,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             gravity,
             collapse_speed,
             max_events_per_step: file.stepping.max_events_per_step,
+            skin_steps,
         },
         times,
         every,
@@ -546,8 +596,9 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     Ok(wall)
 }
 
-/// Reads a particles CSV (header with at least the [`PARTICLE_COLUMNS`]); rows in that column order.
-pub fn read_particles_csv(path: &Path) -> Result<Vec<[f64; 13]>, String> {
+/// Reads a particles CSV (header with at least the [`PARTICLE_COLUMNS`], optionally [`STUCK_COLUMN`]); rows in that
+/// column order.
+pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, String> {
     let mut rdr = ::csv::ReaderBuilder::new()
         .trim(::csv::Trim::All)
         .from_path(path)
@@ -560,6 +611,7 @@ pub fn read_particles_csv(path: &Path) -> Result<Vec<[f64; 13]>, String> {
             .position(|h| h == *col)
             .ok_or_else(|| format!("missing column `{col}` (need {})", PARTICLE_COLUMNS.join(",")))?;
     }
+    let stuck_idx = headers.iter().position(|h| h == STUCK_COLUMN);
     let mut rows = Vec::new();
     for (line, rec) in rdr.records().enumerate() {
         let rec = rec.map_err(|e| format!("line {}: {e}", line + 2))?;
@@ -574,7 +626,20 @@ pub fn read_particles_csv(path: &Path) -> Result<Vec<[f64; 13]>, String> {
                 )
             })?;
         }
-        rows.push(row);
+        let stuck_to = match stuck_idx.map(|i| rec.get(i).unwrap_or("")) {
+            None | Some("") => None,
+            Some(s) => match s.parse::<i64>() {
+                Ok(w) if w < 0 => None,
+                Ok(w) => Some(w as usize),
+                Err(_) => {
+                    return Err(format!(
+                        "line {}: column `{STUCK_COLUMN}`: expected a wall index or -1, got {s:?}",
+                        line + 2
+                    ));
+                }
+            },
+        };
+        rows.push(ParticleRow { values: row, stuck_to });
     }
     Ok(rows)
 }
