@@ -9,6 +9,7 @@
 //! notation), so a snapshot re-read as a bodies file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
+pub mod resume;
 pub mod csv;
 pub mod summary;
 

@@ -17,6 +17,7 @@ use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exact_f64_vec, fnv1a_hex};
 use crate::io::fmt_f64;
+use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries};
 use crate::math::Vec3;
 use crate::run::{RunError, RunOptions, Schedule, prepare_output_dir};
 
@@ -199,6 +200,15 @@ struct HardCheckpoint {
     last_wall_clock: f64,
 }
 
+impl EngineCheckpoint for HardCheckpoint {
+    fn format(&self) -> &str {
+        &self.format
+    }
+    fn scene_hash(&self) -> &str {
+        &self.scene_hash
+    }
+}
+
 /// The `format` tag of a hard-sphere checkpoint.
 pub const HARD_CHECKPOINT_FORMAT: &str = "rubblepile-hsdem-checkpoint";
 /// Numbers per particle in a checkpoint.
@@ -326,37 +336,9 @@ pub fn is_hard_run_dir(dir: &Path) -> bool {
 /// and every time-series column but `events_per_second` and `wall_seconds` are those of an uninterrupted run.
 pub fn resume_hard(dir: &Path, options: &RunOptions) -> Result<HardRunSummary, HardRunError> {
     let bad = |m: String| HardRunError::Output(RunError::BadCheckpoint(m));
-    if let Ok(text) = std::fs::read_to_string(dir.join("summary.json"))
-        && let Ok(v) = serde_json::from_str::<serde_json::Value>(&text)
-        && v["status"] == "completed"
-    {
-        return Err(HardRunError::Output(RunError::AlreadyCompleted {
-            dir: dir.to_path_buf(),
-            t: v["t_reached"].as_f64().unwrap_or(f64::NAN),
-        }));
-    }
-    let cpath = dir.join(CHECKPOINT_FILE);
-    if !cpath.is_file() {
-        return Err(HardRunError::Output(RunError::NoCheckpoint { dir: dir.to_path_buf() }));
-    }
-    let ctext = std::fs::read_to_string(&cpath).map_err(|e| bad(format!("{}: {e}", cpath.display())))?;
-    let ck: HardCheckpoint =
-        serde_json::from_str(&ctext).map_err(|e| bad(format!("{}: {}", cpath.display(), e.to_string().trim())))?;
-    if ck.format != HARD_CHECKPOINT_FORMAT {
-        return Err(bad(format!(
-            "{}: not a hard-sphere checkpoint ({:?})",
-            cpath.display(),
-            ck.format
-        )));
-    }
+    let (ck, text): (HardCheckpoint, String) =
+        open_checkpoint(dir, HARD_CHECKPOINT_FORMAT, "hard-sphere").map_err(HardRunError::Output)?;
     let spath = dir.join("scene.toml");
-    let text = std::fs::read_to_string(&spath).map_err(|e| bad(format!("{}: {e}", spath.display())))?;
-    if fnv1a_hex(text.as_bytes()) != ck.scene_hash {
-        return Err(bad(format!(
-            "{} changed since the checkpoint was written",
-            spath.display()
-        )));
-    }
     let scene = super::scene::parse_hard_scene(&text, &spath.display().to_string(), &ck.scene_base_dir)
         .map_err(|e| bad(e.to_string()))?;
     let mut system = System::new(scene.particles.clone(), scene.walls.clone(), scene.settings);
@@ -399,23 +381,7 @@ pub fn resume_hard(dir: &Path, options: &RunOptions) -> Result<HardRunSummary, H
         momentum_error: ck.book[6],
         p0: Vec3::new(ck.book[7], ck.book[8], ck.book[9]),
     };
-    for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
-        let p = dir.join(name);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(io(&p))?;
-        }
-    }
-    let ts_path = dir.join("timeseries.csv");
-    let mut file = std::fs::OpenOptions::new()
-        .write(true)
-        .open(&ts_path)
-        .map_err(|e| bad(format!("{}: {e}", ts_path.display())))?;
-    let len = file.metadata().map_err(io(&ts_path))?.len();
-    if len < ck.timeseries_bytes {
-        return Err(bad(format!("{} is shorter than at the checkpoint", ts_path.display())));
-    }
-    file.set_len(ck.timeseries_bytes).map_err(io(&ts_path))?;
-    std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(io(&ts_path))?;
+    let file = reopen_timeseries(dir, ck.timeseries_bytes).map_err(HardRunError::Output)?;
     let start = Start {
         system,
         steps: ck.steps,
