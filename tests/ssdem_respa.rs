@@ -9,7 +9,6 @@ use common::{rubblepile, temp_dir};
 use rubblepile::granular::soft::contact::Material;
 use rubblepile::granular::soft::forces::{Gravity, SoftSystem};
 use rubblepile::granular::soft::leapfrog;
-use rubblepile::granular::soft::packing::fcc_ball;
 use rubblepile::granular::soft::particle::Particle;
 use rubblepile::granular::soft::scene::{parse_soft_scene, scene_advice};
 use rubblepile::gravity::SelfGravity;
@@ -40,6 +39,17 @@ fn show(v: &[f64]) -> String {
     v.iter().map(|x| format!("{x:.3e}")).collect::<Vec<_>>().join(", ")
 }
 
+/// Largest gap in final positions between self-gravity every `k` steps and every step, over the largest
+/// displacement of the every-step run, for each `k` of `ks`.
+fn relative_gaps(sys: &SoftSystem, dt: f64, steps: u64, ks: &[u64]) -> Vec<f64> {
+    let reference = positions_after(sys.clone(), 1, dt, steps);
+    let start: Vec<Vec3> = sys.particles.iter().map(|p| p.position).collect();
+    let moved = largest_gap(&reference, &start);
+    ks.iter()
+        .map(|&k| largest_gap(&positions_after(sys.clone(), k, dt, steps), &reference) / moved)
+        .collect()
+}
+
 fn largest_gap(a: &[Vec3], b: &[Vec3]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max)
 }
@@ -67,13 +77,7 @@ fn gravity_only_cloud_converges_at_second_order_in_the_block_length() {
     }
     let sys = SoftSystem::new(particles, Vec::new(), Material::nominal(1e3), direct_gravity(1.0));
     let (dt, steps) = (1e-3, 192);
-    let reference = positions_after(sys.clone(), 1, dt, steps);
-    let start: Vec<Vec3> = sys.particles.iter().map(|p| p.position).collect();
-    let moved = largest_gap(&reference, &start);
-    let gaps: Vec<f64> = [4, 8, 16]
-        .iter()
-        .map(|&k| largest_gap(&positions_after(sys.clone(), k, dt, steps), &reference) / moved)
-        .collect();
+    let gaps = relative_gaps(&sys, dt, steps, &[4, 8, 16]);
     println!(
         "gravity-only cloud, largest position gap / largest displacement at k = 4, 8, 16: {}",
         show(&gaps)
@@ -85,20 +89,9 @@ fn gravity_only_cloud_converges_at_second_order_in_the_block_length() {
     assert!(gaps[2] < 1e-2, "k = 16: {}", gaps[2]);
 }
 
-/// The spinning 120-sphere aggregate of `ssdem_conservation.rs` (10 m spheres, 2000 kg/m³, real G), with
-/// direct gravity.
+/// The spinning 120-sphere aggregate of `ssdem_conservation.rs` (real G), with direct gravity.
 fn spinning_aggregate() -> (SoftSystem, f64) {
-    let mut particles = fcc_ball(120, 10.0, 2000.0, 0.0);
-    let mut rng = generator(11);
-    let omega = Vec3::new(0.0, 2e-5, 3e-5);
-    for p in particles.iter_mut() {
-        p.velocity = omega.cross(&p.position) + Vec3::new(symmetric(&mut rng, 1e-3), symmetric(&mut rng, 1e-3), 0.0);
-        p.spin = Vec3::new(
-            symmetric(&mut rng, 1e-4),
-            symmetric(&mut rng, 1e-4),
-            symmetric(&mut rng, 1e-4),
-        );
-    }
+    let particles = common::spinning_aggregate_particles();
     let g = direct_gravity(6.674e-11);
     let a = scene_advice(&particles, &g, 0.0);
     assert_eq!(a.gravity_interval, 10, "advised k at the advised step");
@@ -112,13 +105,7 @@ fn spinning_aggregate() -> (SoftSystem, f64) {
 fn aggregate_trajectory_with_k_steps_approaches_every_step_gravity() {
     let (sys, dt) = spinning_aggregate();
     let steps = 600;
-    let reference = positions_after(sys.clone(), 1, dt, steps);
-    let start: Vec<Vec3> = sys.particles.iter().map(|p| p.position).collect();
-    let moved = largest_gap(&reference, &start);
-    let gaps: Vec<f64> = [10, 5, 2]
-        .iter()
-        .map(|&k| largest_gap(&positions_after(sys.clone(), k, dt, steps), &reference) / moved)
-        .collect();
+    let gaps = relative_gaps(&sys, dt, steps, &[10, 5, 2]);
     println!(
         "aggregate, largest position gap / largest displacement at k = 10, 5, 2: {}",
         show(&gaps)

@@ -213,6 +213,7 @@ impl Octree {
     /// The field (in units of G) at points `x, y, z` whose bounding box is `lo..hi`. `own` is the leaf
     /// holding the points themselves (sorted indices `own_start..`), whose particle `own_start + i` is
     /// skipped for point `i`.
+    #[allow(clippy::too_many_arguments)]
     fn field(
         &self,
         x: &[f64],
@@ -290,7 +291,6 @@ impl Octree {
     }
 
     /// Adds sorted particles `s..e` to every point, directly.
-    #[allow(clippy::too_many_arguments)]
     fn add_leaf(&self, s: usize, e: usize, x: &[f64], y: &[f64], z: &[f64], f: &mut Field) {
         for j in s..e {
             let (xj, yj, zj, mj) = (self.px[j], self.py[j], self.pz[j], self.pm[j]);

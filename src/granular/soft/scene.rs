@@ -651,7 +651,7 @@ impl V<'_> {
                 self.file, material.k_n, advice.k_n
             ));
         }
-        if gravity_interval > 1 && n_steps % gravity_interval != 0 {
+        if gravity_interval > 1 && !n_steps.is_multiple_of(gravity_interval) {
             warnings.push(format!(
                 "{}: the run's {n_steps} steps are not a whole number of gravity.interval_steps = {gravity_interval}: the last block ends unclosed (its velocities lack the closing self-gravity kick)",
                 self.file
