@@ -3,6 +3,7 @@
 //! with direct gravity, ≤ 1e-5 with the tree); a 2 000-sphere self-gravitating aggregate settles with its
 //! largest overlap below 1 % of the radius at the advised k_N and dt.
 
+mod common;
 use rubblepile::geometry::wall::{SphereContainer, Wall};
 use rubblepile::granular::soft::advise::{AdviceInput, advise};
 use rubblepile::granular::soft::contact::Material;
@@ -88,19 +89,7 @@ fn elastic_frictionless_gas_conserves_energy() {
 }
 
 fn spinning_aggregate(gravity: SelfGravity) -> f64 {
-    // 120 touching spheres of 10 m (grain density 2000 kg/m³, escape speed ~ 2 cm/s), spinning at a tenth of
-    // the breakup rate with random jiggles, so that contacts slide, roll and twist.
-    let mut particles = fcc_ball(120, 10.0, 2000.0, 0.0);
-    let mut rng = generator(11);
-    let omega = Vec3::new(0.0, 2e-5, 3e-5);
-    for p in particles.iter_mut() {
-        p.velocity = omega.cross(&p.position) + Vec3::new(symmetric(&mut rng, 1e-3), symmetric(&mut rng, 1e-3), 0.0);
-        p.spin = Vec3::new(
-            symmetric(&mut rng, 1e-4),
-            symmetric(&mut rng, 1e-4),
-            symmetric(&mut rng, 1e-4),
-        );
-    }
+    let particles = common::spinning_aggregate_particles();
     let g = Gravity {
         uniform: Vec3::zeros(),
         self_gravity: Some(gravity),

@@ -76,6 +76,9 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
             a.contact_time /= f;
             a.dt /= f;
             a.stability_limit /= f;
+            a.gravity_interval = a.dynamical_time.map_or(1, |t| {
+                crate::granular::soft::advise::gravity_interval(t, a.dt, a.contact_time)
+            });
         }
         a
     } else {
@@ -98,6 +101,14 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
         "(speed {:e} m/s, static force {:e} N, contact time {:e} s, leapfrog stability limit {:e} s)",
         advice.speed, advice.static_force, advice.contact_time, advice.stability_limit
     );
+    if let Some(t_dyn) = advice.dynamical_time {
+        println!(
+            "gravity interval_steps = {} (self-gravity every k steps: k dt <= 1/sqrt(G rho)/100 = {:e} s and \
+             k dt <= contact time/5; dynamical time 1/sqrt(G rho) = {t_dyn:e} s)",
+            advice.gravity_interval,
+            t_dyn / 100.0
+        );
+    }
     Ok(())
 }
 
@@ -167,6 +178,9 @@ pub struct BenchSsdemArgs {
     /// Gravity: `off` (contacts only), `tree` (θ = 0.5) or `direct`.
     #[arg(long, default_value = "off", value_parser = ["off", "tree", "direct"])]
     pub gravity: String,
+    /// Self-gravity every K steps (r-RESPA; `[gravity] interval_steps` of a scene), K >= 1.
+    #[arg(long, default_value_t = 1, value_name = "K", value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    pub gravity_interval: u64,
     /// Timed steps per thread count.
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub steps: u64,
@@ -186,8 +200,9 @@ pub struct BenchSsdemArgs {
     pub dump_particles: Option<PathBuf>,
 }
 
-/// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly.
-pub fn bench_system(n: usize, gravity: Option<SelfGravity>) -> SoftSystem {
+/// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly, self-gravity (if
+/// any) every `gravity_interval` steps.
+pub fn bench_system(n: usize, gravity: Option<SelfGravity>, gravity_interval: u64) -> SoftSystem {
     let mut particles = fcc_ball(n, 1.0, 2000.0, -0.005);
     for p in particles.iter_mut() {
         p.velocity = Vec3::new(0.0, 0.0, 1e-3).cross(&p.position);
@@ -205,6 +220,7 @@ pub fn bench_system(n: usize, gravity: Option<SelfGravity>) -> SoftSystem {
             g: SI_G,
         },
     );
+    sys.gravity_interval = gravity_interval;
     sys.compute_forces(0.0, 0.0);
     let _ = m;
     sys
@@ -246,7 +262,7 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), CliError> {
         }
         std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
     }
-    let sys = bench_system(args.particles as usize, gravity);
+    let sys = bench_system(args.particles as usize, gravity, args.gravity_interval);
     if let Some(path) = &args.dump_particles {
         crate::granular::soft::run::write_particles_csv(path, 0.0, &sys.particles)
             .map_err(|e| CliError::failed(format!("--dump-particles {}: {e}", path.display())))?;
@@ -258,17 +274,20 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), CliError> {
         }
         let rate = time_steps(&sys, t, args.steps).map_err(CliError::failed)?;
         println!(
-            "N = {}, gravity {}, {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
-            args.particles, args.gravity, sys.stats.pair_contacts
+            "N = {}, gravity {} (interval {}), {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
+            args.particles, args.gravity, args.gravity_interval, sys.stats.pair_contacts
         );
         rows.push((t, rate));
     }
     if let Some(dir) = &args.out {
         let csv = dir.join("bench_ssdem.csv");
         let mut f = std::fs::File::create(&csv).map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
-        let mut text = String::from("particles,gravity,threads,steps,particle_steps_per_second\n");
+        let mut text = String::from("particles,gravity,threads,steps,particle_steps_per_second,gravity_interval\n");
         for (t, r) in &rows {
-            text += &format!("{},{},{t},{},{r}\n", args.particles, args.gravity, args.steps);
+            text += &format!(
+                "{},{},{t},{},{r},{}\n",
+                args.particles, args.gravity, args.steps, args.gravity_interval
+            );
         }
         f.write_all(text.as_bytes())
             .map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;

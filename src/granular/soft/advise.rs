@@ -10,6 +10,11 @@
 //! - The step resolves the shortest contact, `T_c = π √(μ_min/k_N)` with `μ_min = m_min/2`, in 50 steps:
 //!   `dt = T_c/50`. Leapfrog is unstable for a spring of that frequency above `dt = 2 √(μ_min/k_N)`, the
 //!   stability limit reported (and enforced by the scene check).
+//! - Self-gravity every `k` steps ([`crate::granular::soft::respa`]): the body's dynamical time
+//!   `t_dyn = 1/√(Gρ)` (ρ the bulk density) must hold at least 100 gravity blocks, `k dt ≤ t_dyn/100`, and a
+//!   block must stay well below half a contact oscillation, where the impulse method resonates:
+//!   `k dt ≤ T_c/5`. So `k = max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`: 10 at the advised step
+//!   (`dt = T_c/50`) for any body of asteroid density, where `t_dyn` is hours and the contact rule binds.
 
 use crate::scene::SI_G;
 use serde::Serialize;
@@ -55,6 +60,25 @@ pub struct Advice {
     pub dt: f64,
     /// Leapfrog stability limit for the stiffest contact (s).
     pub stability_limit: f64,
+    /// The body's dynamical time `1/√(Gρ)` (s), if self-gravitating.
+    pub dynamical_time: Option<f64>,
+    /// Suggested `[gravity] interval_steps` at the suggested step ([`gravity_interval`]; 1 without a body).
+    pub gravity_interval: u64,
+}
+
+/// Suggested steps between self-gravity evaluations (see the module docs):
+/// `max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`, with the dynamical time `t_dyn` (s), the step `dt` (s) and
+/// the contact time `T_c` (s).
+///
+/// ```
+/// use rubblepile::granular::soft::advise::gravity_interval;
+/// assert_eq!(gravity_interval(1e4, 1e-3, 50e-3), 10);
+/// assert_eq!(gravity_interval(0.5, 1e-3, 50e-3), 5);
+/// assert_eq!(gravity_interval(1e4, 1e-3, 1e-3), 1);
+/// ```
+pub fn gravity_interval(dynamical_time: f64, dt: f64, contact_time: f64) -> u64 {
+    let k = (dynamical_time / (100.0 * dt)).min(contact_time / (5.0 * dt)).floor();
+    if k.is_finite() && k >= 1.0 { k as u64 } else { 1 }
 }
 
 /// Stability limit `2 √(μ_min/k_N)` (s) of leapfrog on the stiffest contact (μ_min = m_min/2).
@@ -74,7 +98,9 @@ pub fn advise(input: &AdviceInput) -> Advice {
     let x_max = input.max_overlap * input.r_min;
     let mut speed = input.speed;
     let mut static_force = 0.0;
+    let mut dynamical_time = None;
     if let Some((radius, density)) = input.body {
+        dynamical_time = Some(1.0 / (input.g * density).sqrt());
         speed = speed.max(radius * (8.0 * std::f64::consts::PI * input.g * density / 3.0).sqrt());
         let p_c = 2.0 * std::f64::consts::PI / 3.0 * input.g * density * density * radius * radius;
         static_force = 4.0 * input.r_min * input.r_min * p_c;
@@ -85,13 +111,16 @@ pub fn advise(input: &AdviceInput) -> Advice {
     let k_n = (input.m_max * speed * speed / (x_max * x_max)).max(static_force / x_max);
     let mu = 0.5 * input.m_min;
     let contact_time = std::f64::consts::PI * (mu / k_n).sqrt();
+    let dt = contact_time / STEPS_PER_CONTACT;
     Advice {
         speed,
         static_force,
         k_n,
         contact_time,
-        dt: contact_time / STEPS_PER_CONTACT,
+        dt,
         stability_limit: stability_limit(k_n, input.m_min),
+        dynamical_time,
+        gravity_interval: dynamical_time.map_or(1, |t| gravity_interval(t, dt, contact_time)),
     }
 }
 

@@ -84,6 +84,15 @@ pub struct SoftSystem {
     pub keep_records: bool,
     /// Per-contact records of the last evaluation when [`SoftSystem::keep_records`] is set.
     pub records: Vec<ContactRecord>,
+    /// Self-gravity is evaluated once every this many steps (steps, ≥ 1; r-RESPA, see
+    /// [`crate::granular::soft::respa`]); 1 = with the contacts, every step.
+    pub gravity_interval: u64,
+    /// Steps taken in the current block of `gravity_interval` steps.
+    pub gravity_phase: u64,
+    /// Self-gravity accelerations (m/s²) of the last slow evaluation (only when `gravity_interval > 1`).
+    pub slow_accelerations: Vec<Vec3>,
+    /// Self-gravity potential energy (J) of the last slow evaluation (0 when `gravity_interval = 1`).
+    pub slow_energy: f64,
     skin: f64,
     /// Candidate pairs `(i, j)`, `i < j`, sorted.
     verlet: Vec<(usize, usize)>,
@@ -231,6 +240,10 @@ impl SoftSystem {
             wall_work: 0.0,
             keep_records: false,
             records: Vec::new(),
+            gravity_interval: 1,
+            gravity_phase: 0,
+            slow_accelerations: Vec::new(),
+            slow_energy: 0.0,
             skin: if r_min.is_finite() { 0.1 * r_min } else { 0.0 },
             verlet: Vec::new(),
             pair_slots: Vec::new(),
@@ -323,11 +336,18 @@ impl SoftSystem {
     /// relative motion over `dt`; pass `dt = 0` to evaluate without advancing them, e.g. at t = 0).
     pub fn compute_forces(&mut self, t: f64, dt: f64) {
         let n = self.particles.len();
+        if self.split_gravity() && self.slow_accelerations.len() != n {
+            self.update_slow_gravity();
+        }
         let positions: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
         let masses: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
-        let mut stats = ForceStats::default();
+        let mut stats = ForceStats {
+            gravitational_energy: self.slow_energy,
+            ..ForceStats::default()
+        };
+        // With r-RESPA the self-gravity is the slow force, kept apart (`respa.rs`); here only the fast ones.
         let (mut forces, potentials) = match self.gravity.self_gravity {
-            Some(mode) if n > 1 => accelerations(mode, &positions, &masses, self.gravity.g),
+            Some(mode) if n > 1 && !self.split_gravity() => accelerations(mode, &positions, &masses, self.gravity.g),
             _ => (vec![Vec3::zeros(); n], vec![0.0; n]),
         };
         for k in 0..n {

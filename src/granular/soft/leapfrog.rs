@@ -3,9 +3,11 @@
 //! `v += F/m dt/2, ω += τ/I dt/2` (kick), `x += v dt` (drift), forces at the new positions with the
 //! half-step velocities and spins (the springs advance by the relative motion over the drift), kick again.
 //! For central pair forces and the contact law's equal and opposite forces and torques, every kick and drift
-//! conserves total linear and angular momentum up to rounding.
+//! conserves total linear and angular momentum up to rounding. With `gravity_interval = k > 1` self-gravity
+//! is kicked separately once per block of `k` steps ([`crate::granular::soft::respa`]).
 
 use crate::granular::soft::forces::SoftSystem;
+use crate::granular::soft::respa::{close_block, open_block};
 
 fn kick(sys: &mut SoftSystem, half_dt: f64) {
     for ((p, f), tau) in sys.particles.iter_mut().zip(&sys.forces).zip(&sys.torques) {
@@ -17,10 +19,12 @@ fn kick(sys: &mut SoftSystem, half_dt: f64) {
 /// Advances `sys` from time `t` (s) by one step `dt` (s). The forces of `sys` must be those at `t`
 /// (from [`SoftSystem::compute_forces`] or the previous step).
 pub fn step(sys: &mut SoftSystem, t: f64, dt: f64) {
+    open_block(sys, dt);
     kick(sys, 0.5 * dt);
     for p in sys.particles.iter_mut() {
         p.position += p.velocity * dt;
     }
     sys.compute_forces(t + dt, dt);
     kick(sys, 0.5 * dt);
+    close_block(sys, dt);
 }

@@ -84,7 +84,8 @@ pub struct SoftSummary {
     pub advised_k_n: f64,
     /// Step advised for the scene's `k_N`... for the advised `k_N` (s).
     pub advised_dt: f64,
-    /// Self-gravity: `"off"`, `"direct"` or `"tree (theta = …)"`.
+    /// Self-gravity: `"off"`, `"direct"` or `"tree (theta = …)"`, with `", every k steps"` when
+    /// `[gravity] interval_steps = k > 1`.
     pub self_gravity: String,
     /// Seed.
     pub seed: u64,
@@ -282,6 +283,13 @@ struct SoftCheckpoint {
     /// dissipated, wall_work.
     #[serde(with = "exact_f64_vec")]
     work: Vec<f64>,
+    /// Steps taken in the current self-gravity block (r-RESPA; 0 without).
+    #[serde(default)]
+    gravity_phase: u64,
+    /// Self-gravity accelerations of the block's start (3 per particle) and its potential energy, when
+    /// `[gravity] interval_steps > 1`; empty otherwise.
+    #[serde(default, with = "exact_f64_vec")]
+    slow: Vec<f64>,
     #[serde(with = "exact_f64_vec")]
     book: Vec<f64>,
 }
@@ -318,10 +326,14 @@ pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::
 }
 
 fn gravity_name(scene: &SoftScene) -> String {
-    match scene.gravity.self_gravity {
-        None => "off".into(),
-        Some(crate::gravity::SelfGravity::Direct) => "direct".into(),
+    let name = match scene.gravity.self_gravity {
+        None => return "off".into(),
+        Some(crate::gravity::SelfGravity::Direct) => "direct".to_string(),
         Some(crate::gravity::SelfGravity::Tree { theta }) => format!("tree (theta = {theta})"),
+    };
+    match scene.gravity_interval {
+        1 => name,
+        k => format!("{name}, every {k} steps"),
     }
 }
 
@@ -374,6 +386,7 @@ pub fn initial_system(scene: &SoftScene) -> SoftSystem {
         scene.material,
         scene.gravity,
     );
+    sys.gravity_interval = scene.gravity_interval;
     sys.compute_forces(0.0, 0.0);
     sys
 }
@@ -495,6 +508,18 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
     }
     sys.dissipated = ck.work[0];
     sys.wall_work = ck.work[1];
+    sys.gravity_interval = scene.gravity_interval;
+    if sys.split_gravity() {
+        if ck.slow.len() != 3 * n + 1 || ck.gravity_phase >= scene.gravity_interval {
+            return Err(bad("malformed self-gravity block record (slow, gravity_phase)".into()));
+        }
+        sys.gravity_phase = ck.gravity_phase;
+        sys.slow_accelerations = ck.slow[..3 * n]
+            .chunks(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        sys.slow_energy = ck.slow[3 * n];
+    }
     let book = Book::from_vec(&ck.book).ok_or_else(|| bad("malformed bookkeeping".into()))?;
 
     for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
@@ -659,6 +684,14 @@ fn drive(
                 pair_springs: pack(&sys.pair_springs()),
                 wall_springs: pack(&sys.wall_springs),
                 work: vec![sys.dissipated, sys.wall_work],
+                gravity_phase: sys.gravity_phase,
+                slow: if sys.split_gravity() {
+                    let mut v: Vec<f64> = sys.slow_accelerations.iter().flat_map(|a| a.iter().copied()).collect();
+                    v.push(sys.slow_energy);
+                    v
+                } else {
+                    Vec::new()
+                },
                 book: book.to_vec(),
             };
             let tmp = dir.join(CHECKPOINT_TMP_FILE);

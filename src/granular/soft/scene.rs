@@ -24,6 +24,7 @@
 //! uniform = [0.0, 0.0, -9.81]  # m/s²
 //! self = "tree"                # or "direct"; absent = no self-gravity
 //! theta = 0.5                  # tree opening angle
+//! interval_steps = 1           # steps (integer >= 1): self-gravity every k steps (r-RESPA); see `ssdem advise`
 //! G = 6.674e-11                # m³ kg⁻¹ s⁻²
 //!
 //! [output]
@@ -179,6 +180,10 @@ pub struct GravitySection {
     /// Tree opening angle θ (in (0, 1]). Default 0.5.
     #[serde(default)]
     pub theta: Option<f64>,
+    /// Steps (an integer ≥ 1) between self-gravity evaluations: self-gravity is applied as kicks of `k dt/2` at
+    /// both ends of each block of `k` steps (r-RESPA, [`crate::granular::soft::respa`]). Default 1 (every step).
+    #[serde(default)]
+    pub interval_steps: Option<i64>,
     /// Gravitational constant (m³ kg⁻¹ s⁻², > 0). Default 6.674e-11.
     #[serde(default, rename = "G")]
     pub g: Option<f64>,
@@ -265,6 +270,8 @@ pub struct SoftScene {
     pub material: Material,
     /// Gravity.
     pub gravity: Gravity,
+    /// Steps between self-gravity evaluations (`[gravity] interval_steps`, ≥ 1).
+    pub gravity_interval: u64,
     /// Walls.
     pub walls: Vec<Wall>,
     /// Initial particles.
@@ -509,6 +516,22 @@ impl V<'_> {
                 return Err(self.invalid("gravity.self", format!("must be \"tree\" or \"direct\", got {other:?}")));
             }
         };
+        let gravity_interval = match gs.interval_steps {
+            None => 1,
+            Some(k) if k < 1 => {
+                return Err(self.invalid(
+                    "gravity.interval_steps",
+                    format!("must be an integer >= 1 (steps), got {k}"),
+                ));
+            }
+            Some(k) if k > 1 && self_gravity.is_none() => {
+                return Err(self.invalid(
+                    "gravity.interval_steps",
+                    format!("only used with self = \"tree\" or \"direct\", got {k} without self-gravity"),
+                ));
+            }
+            Some(k) => k as u64,
+        };
         let uniform = match gs.uniform {
             Some(u) => self.vector("gravity.uniform", u)?,
             None => Vec3::zeros(),
@@ -628,6 +651,22 @@ impl V<'_> {
                 self.file, material.k_n, advice.k_n
             ));
         }
+        if gravity_interval > 1 && !n_steps.is_multiple_of(gravity_interval) {
+            warnings.push(format!(
+                "{}: the run's {n_steps} steps are not a whole number of gravity.interval_steps = {gravity_interval}: the last block ends unclosed (its velocities lack the closing self-gravity kick)",
+                self.file
+            ));
+        }
+        if let Some(t_dyn) = advice.dynamical_time {
+            let contact_time = advised_dt * crate::granular::soft::advise::STEPS_PER_CONTACT;
+            let k = crate::granular::soft::advise::gravity_interval(t_dyn, dt, contact_time);
+            if gravity_interval > 2 * k {
+                warnings.push(format!(
+                    "{}: gravity.interval_steps = {gravity_interval} is more than twice the {k} advised for this dt and contact.k_n (rubblepile ssdem advise)",
+                    self.file
+                ));
+            }
+        }
         Ok(SoftScene {
             name: self.file.to_string(),
             source: text.to_string(),
@@ -640,6 +679,7 @@ impl V<'_> {
             snapshot_steps,
             material,
             gravity,
+            gravity_interval,
             walls,
             particles,
             advice,
