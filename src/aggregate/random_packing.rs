@@ -22,7 +22,7 @@
 //!    rest in the field; then 1 period with the field off (the load relaxes); `k_N` from the static load of the
 //!    container's full height `2 R_c` and the wall speed `2Aω`, at `shake_overlap` = 3 %;
 //! 4. settle: no container, self-gravity only, `k_N` from the central pressure of the uniform-sphere estimate at
-//!    `settle_overlap` = 1 % (twice that for margin), run in chunks of half a free-fall time of the pile until the
+//!    `settle_overlap` = 1 % (ten times stiffer, so that overlaps do not inflate the packing fraction), run in chunks of half a free-fall time of the pile until the
 //!    kinetic energy is below `settle_kinetic_fraction` = 1e-6 of the gravitational energy's magnitude, at most
 //!    `settle_max_chunks` = 8 chunks.
 //!
@@ -85,21 +85,21 @@ pub struct Recipe {
 impl Default for Recipe {
     fn default() -> Self {
         Recipe {
-            cloud_packing: 0.2,
+            cloud_packing: 0.3,
             restitution: 0.1,
-            collapse_freefall_times: 2.0,
+            collapse_freefall_times: 1.5,
             collapse_overlap: 0.1,
             container_fill: 0.56,
             container_enclose: 0.97,
             shake_g: 9.81,
             shake_gamma: 1.5,
             shake_amplitude: 0.2,
-            shake_periods: 20.0,
+            shake_periods: 10.0,
             calm_periods: 5.0,
-            shake_overlap: 0.05,
+            shake_overlap: 0.1,
             settle_overlap: 0.01,
-            settle_kinetic_fraction: 1e-6,
-            settle_max_chunks: 8,
+            settle_kinetic_fraction: 1e-4,
+            settle_max_chunks: 10,
             steps_per_contact: 20.0,
             direct_below: 1500,
             tree_theta: 0.8,
@@ -344,7 +344,10 @@ pub fn random_heap(
     let omega = (recipe.shake_gamma * recipe.shake_g / amplitude).sqrt();
     let period = std::f64::consts::TAU / omega;
     let p_field = rho * recipe.container_fill * recipe.shake_g * 2.0 * container;
-    let k_shake = loads.k_n(amplitude * omega, p_field, recipe.shake_overlap);
+    // grains thrown into the empty cap above the heap (a tenth of the container's radius) land at up to
+    // `Aω + √(2 g 0.1 R_c)`
+    let v_shake = amplitude * omega + (0.2 * recipe.shake_g * container).sqrt();
+    let k_shake = loads.k_n(v_shake, p_field, recipe.shake_overlap);
     let dt = loads.dt(k_shake, recipe.steps_per_contact);
     let field = Gravity {
         uniform: Vec3::new(0.0, 0.0, -recipe.shake_g),
@@ -424,7 +427,7 @@ pub fn random_heap(
         p.velocity = Vec3::zeros();
         p.spin = Vec3::zeros();
     }
-    let k_settle = 2.0 * loads.k_n(0.0, p_c, recipe.settle_overlap);
+    let k_settle = 10.0 * loads.k_n(0.0, p_c, recipe.settle_overlap);
     let dt = loads.dt(k_settle, recipe.steps_per_contact);
     let t_ff_pile = (3.0 * PI / (32.0 * SI_G * rho_packed)).sqrt();
     let chunk = (0.5 * t_ff_pile / dt).ceil() as u64;

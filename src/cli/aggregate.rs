@@ -38,13 +38,13 @@ pub struct BuildArgs {
     #[arg(long, conflicts_with_all = ["radius", "radius_range"])]
     pub particles: Option<usize>,
     /// Grain radius (m), monodisperse models.
-    #[arg(long, conflicts_with = "radius_range")]
+    #[arg(long, conflicts_with = "radius_range", allow_negative_numbers = true)]
     pub radius: Option<f64>,
     /// Radius range RMIN,RMAX (m), polydisperse models (dN/dr ∝ r⁻³).
     #[arg(long, value_name = "RMIN,RMAX")]
     pub radius_range: Option<String>,
     /// Bulk density (kg/m³): total mass / shape volume.
-    #[arg(long, default_value_t = 2100.0)]
+    #[arg(long, default_value_t = 2100.0, allow_negative_numbers = true)]
     pub bulk_density: f64,
     /// Core radius (m) for rcpc and ppc (default: Zhang17's 200 m scaled to the shape, 200/390 of its
     /// volume-equivalent radius).
