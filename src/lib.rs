@@ -6,6 +6,7 @@
 //! quaternion attitudes constrained by Lagrange multipliers, a Rayleigh point-dissipation function,
 //! integrated by an adaptive Bulirsch–Stoer integrator.
 
+pub mod aggregate;
 pub mod analysis;
 pub mod cli;
 pub mod ellipsoid;

@@ -24,7 +24,9 @@
 //!   (`analysis/rebound_compare`);
 //! - `rubblepile ssdem advise --radius R --density RHO [--body-radius B] [--spin-period-h T | --speed V]
 //!   [--max-overlap 0.01]` or `--scene FILE`: k_N and dt for soft spheres (see [`crate::granular::soft::advise`]);
-//! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second.
+//! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second;
+//! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius R
+//!   --bulk-density RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
@@ -34,6 +36,7 @@
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
 //! the hidden testing flag `--stop-after-checkpoints N` stopped a run after its N-th checkpoint.
 
+pub mod aggregate;
 pub mod analyze;
 pub mod bench;
 pub mod bench_impact;
@@ -93,6 +96,9 @@ pub enum Command {
     /// Soft-sphere (SSDEM) tools.
     #[command(subcommand)]
     Ssdem(ssdem::SsdemCommand),
+    /// Rubble-pile aggregates for spin-up studies (Zhang17 §2.3.2): build, bulk-density variants.
+    #[command(subcommand)]
+    Aggregate(aggregate::AggregateCommand),
 }
 
 /// `rubblepile run`.
@@ -314,6 +320,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
+        Command::Aggregate(aggregate::AggregateCommand::Build(args)) => aggregate::build_cmd(&args),
+        Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
     }
 }
 
