@@ -8,3 +8,4 @@ pub mod rigid_rotation;
 pub mod run_analysis;
 pub mod shape_metrics;
 pub mod spinup;
+pub mod spinup_diagnostics;

@@ -6,7 +6,8 @@
 //!   with the contact frame; [`forces`]: the force loop; [`leapfrog`]: the integrator;
 //! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
 //!   [`scene`]: the `kind = "soft-spheres"`
-//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume).
+//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume); [`spinup`]: the `[spinup]` forcing
+//!   (Zhang17 §2.3.4).
 
 pub mod advise;
 pub mod contact;
@@ -16,4 +17,5 @@ pub mod packing;
 pub mod particle;
 pub mod run;
 pub mod scene;
+pub mod spinup;
 pub mod spring_frame;
