@@ -4,6 +4,7 @@ pub mod figures;
 pub mod fits;
 pub mod fragments;
 pub mod report_roig2003;
+pub mod report_zhang2017;
 pub mod rigid_rotation;
 pub mod run_analysis;
 pub mod shape_metrics;

@@ -6,8 +6,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::analysis::figures::style::{
-    Figure, PlotResult, SERIES_COLOURS, SeriesLabelPosition, draw_err, draw_legend, finite_extent, label_style,
-    padded, small_style, title_style,
+    Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, finite_extent, label_style, padded, small_style,
+    title_style,
 };
 use crate::analysis::spinup_diagnostics::SpinupSample;
 
@@ -59,7 +59,7 @@ impl Figure for SpinupTimeSeries {
                 .axis_desc_style(label_style())
                 .label_style(small_style())
                 .y_labels(4)
-                .y_label_formatter(&|v| format!("{v:.3}"));
+                .y_label_formatter(&|v| format!("{v:.4}"));
             if k == 3 {
                 mesh.x_desc("time t (h)");
             } else {

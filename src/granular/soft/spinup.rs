@@ -405,7 +405,7 @@ impl SpinupDriver {
             self.reference = Some([b_over_a, c_over_a, packing]);
             return;
         };
-        let beyond = |x: f64, x0: f64, tol: f64| !((x - x0).abs() <= tol);
+        let beyond = |x: f64, x0: f64, tol: f64| (x - x0).abs() > tol || (x - x0).is_nan();
         let s = &self.settings;
         let out = beyond(b_over_a, r[0], s.release_axis_ratio)
             || beyond(c_over_a, r[1], s.release_axis_ratio)
