@@ -266,7 +266,7 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
     }
     let _ = writeln!(
         md,
-        "\nRadius scaling: the paper's HCP/RCP spheres are ~10.5–11.5 m (42 062 and 36 523 particles in \
+        "\nRadius scaling: the paper's HCP/RCP spheres are ≈ 10 m (42 062 and 36 523 particles in \
          the 780 m body) and PP1's 4–32 m; ours keep the body (D = 780 m, ρ_B = 2100 kg/m³) and use fewer, larger \
          particles (radius column), i.e. lengths scaled by (N_paper/N)^(1/3).\n"
     );
