@@ -153,7 +153,7 @@ def run_lammps(lmp, deck, work, ranks):
 
 
 BENCH_LINE = re.compile(
-    r"N = (\d+), gravity (\w+), (\d+) thread\(s\): ([0-9.eE+-]+) particle-steps/s \((\d+) contacts\)"
+    r"N = (\d+), gravity (\w+)(?: \(interval \d+\))?, (\d+) thread\(s\): ([0-9.eE+-]+) particle-steps/s \((\d+) contacts\)"
 )
 
 

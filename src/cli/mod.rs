@@ -27,6 +27,8 @@
 //! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second;
 //! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius R
 //!   --bulk-density RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
+//! - `rubblepile spinup critical …` / `rubblepile spinup density-fit …`: the T_c,3 search and the Eq. 22 fit
+//!   ([`spinup`]); `rubblepile report-zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
@@ -44,6 +46,7 @@ pub mod campaign;
 pub mod impact;
 pub mod nbody;
 pub mod report_richardson2011;
+pub mod spinup;
 pub mod ssdem;
 pub mod stability;
 pub mod target;
@@ -99,6 +102,24 @@ pub enum Command {
     /// Rubble-pile aggregates for spin-up studies (Zhang17 §2.3.2): build, bulk-density variants.
     #[command(subcommand)]
     Aggregate(aggregate::AggregateCommand),
+    /// Spin-up studies (Zhang17 §3–4): the T_c,3 search and the Eq. 22 density fit.
+    #[command(subcommand)]
+    Spinup(spinup::SpinupCommand),
+    /// Read spin-up runs (RUNS/<model>/path2, RUNS/<model>/critical) and write REPORT.md and Fig. 5-style figures.
+    ReportZhang2017(ReportZhang2017Args),
+}
+
+/// `rubblepile report-zhang2017`.
+#[derive(Debug, clap::Args)]
+pub struct ReportZhang2017Args {
+    /// Directory of the runs (e.g. runs/zhang2017).
+    pub runs: PathBuf,
+    /// Where REPORT.md and the figures go.
+    #[arg(long, value_name = "DIR", default_value = "analysis/zhang2017")]
+    pub out: PathBuf,
+    /// Overwrite an existing REPORT.md.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `rubblepile run`.
@@ -322,6 +343,14 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
         Command::Aggregate(aggregate::AggregateCommand::Build(args)) => aggregate::build_cmd(&args),
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
+        Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
+        Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
+        Command::ReportZhang2017(args) => {
+            let path = crate::analysis::report_zhang2017::write_report(&args.runs, &args.out, args.force)
+                .map_err(CliError::usage)?;
+            println!("wrote {}", path.display());
+            Ok(())
+        }
     }
 }
 

@@ -9,8 +9,8 @@
 //! notation), so a snapshot re-read as a bodies file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
-pub mod resume;
 pub mod csv;
+pub mod resume;
 pub mod summary;
 
 /// Formats an `f64` losslessly: the shortest decimal that parses back to the same bits (`{:e}`).

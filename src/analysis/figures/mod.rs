@@ -4,6 +4,7 @@
 //! * [`run_figures`]: one run — Fig. 2 `energy_partition`, Fig. 3 `velocity_field`, Fig. 4
 //!   `ejection_vs_size`, Fig. 6 `spin_histogram`, Fig. 8 `spin_vs_size`, Fig. 9 `rotation_mode_vs_size`.
 //! * [`campaign_figures`]: a campaign — Fig. 5 `bound_fraction_vs_q`, Fig. 7 `spin_distributions`.
+//! * [`spinup_figures`]: Zhang17 Fig. 5-style time series of a spin-up run.
 //! * [`energy`]: the data of Fig. 2 (energies and momentum drift over time from `timeseries.csv` and
 //!   `tracks.csv`).
 //! * [`style`]: the embedded font, the common look, and [`style::write_figure`], which renders each figure
@@ -16,6 +17,7 @@ pub mod campaign_figures;
 pub mod energy;
 pub mod lines;
 pub mod run_figures;
+pub mod spinup_figures;
 pub mod style;
 
 pub use campaign_figures::{write_campaign_figures, write_spin_distributions};

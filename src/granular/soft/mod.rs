@@ -7,7 +7,8 @@
 //!   every `k` steps (multiple time stepping);
 //! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
 //!   [`scene`]: the `kind = "soft-spheres"`
-//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume).
+//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume); [`spinup`]: the `[spinup]` forcing
+//!   (Zhang17 §2.3.4).
 
 pub mod advise;
 pub mod contact;
@@ -18,4 +19,5 @@ pub mod particle;
 pub mod respa;
 pub mod run;
 pub mod scene;
+pub mod spinup;
 pub mod spring_frame;

@@ -11,7 +11,10 @@
 //!   `|L − L₀|/Σ(|x × m v| + I|ω|)₀` (scale 1 if zero); `max_overlap_fraction` is the largest contact overlap
 //!   over the smaller radius of the contact at that step;
 //! - `snapshots/<k>.csv`: `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (usable as a `particles_file`);
-//! - `summary.json` ([`SoftSummary`]), `last_good_state.csv` on failure, `checkpoint.json` when due.
+//! - `summary.json` ([`SoftSummary`]), `last_good_state.csv` on failure, `checkpoint.json` when due;
+//! - with a `[spinup]` table: `spinup.csv`, one row of [`crate::analysis::spinup_diagnostics`] per time-series
+//!   row; the forcing ([`crate::granular::soft::spinup`]) acts after every step (the time series' angular
+//!   momentum error then measures the torque applied, not an error).
 //!
 //! Checkpoints hold every particle's state, the last forces and torques (leapfrog needs them), the spring
 //! histories and the bookkeeping, all as exact f64 bit patterns, so [`resume_soft`] continues bit for bit.
@@ -25,11 +28,13 @@ use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene::{SoftScene, parse_soft_scene, scene_kind};
+use crate::granular::soft::spinup::{SpinupDriver, central_body};
 use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exact_f64_vec, fnv1a_hex};
 use crate::math::Vec3;
 use crate::run::{RunError, RunOptions, prepare_output_dir};
@@ -292,7 +297,47 @@ struct SoftCheckpoint {
     slow: Vec<f64>,
     #[serde(with = "exact_f64_vec")]
     book: Vec<f64>,
+    /// The spin-up driver's state and the length of `spinup.csv`, for a `[spinup]` scene.
+    #[serde(default)]
+    spinup: Option<SpinupCheckpoint>,
 }
+
+// ---- spin-up hook (Zhang17 §2.3.4; crate::granular::soft::spinup) --------------------------------------
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct SpinupCheckpoint {
+    #[serde(with = "exact_f64_vec")]
+    state: Vec<f64>,
+    bytes: u64,
+}
+
+/// A spin-up run's driver and its open `spinup.csv`.
+struct SpinRun {
+    driver: SpinupDriver,
+    csv: BufWriter<File>,
+    bytes: u64,
+}
+
+impl SpinRun {
+    /// Forcing after a step ending at time `t` (s), on the central body of the step's contacts.
+    fn after_step(&self, sys: &mut SoftSystem, t: f64) {
+        if !self.driver.released {
+            let springs = sys.pair_springs();
+            let member = central_body(&sys.particles, springs.iter().map(|(k, _)| k));
+            self.driver.apply(&mut sys.particles, &member, t);
+        }
+    }
+    /// The diagnostics row at an output sample (time `t`, s), then the release check.
+    fn sample(&mut self, sys: &SoftSystem, t: f64, path: &Path) -> Result<(), SoftRunError> {
+        let d = diagnose_run(sys, &self.driver, t).sample;
+        let line = d.csv_row();
+        self.csv.write_all(line.as_bytes()).map_err(io_err(path))?;
+        self.csv.flush().map_err(io_err(path))?;
+        self.bytes += line.len() as u64;
+        self.driver.observe(t, d.b_over_a, d.c_over_a, d.packing_fraction);
+        Ok(())
+    }
+}
+// ---- end of spin-up hook ---------------------------------------------------------------------------------
 
 /// The samples of a run: `(step, Some(snapshot index))`, increasing.
 fn samples(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
@@ -401,6 +446,7 @@ struct Start {
     wall_before: f64,
     book: Book,
     timeseries: BufWriter<File>,
+    spin: Option<SpinRun>,
 }
 
 /// Runs a soft-sphere scene into `out_dir` (refuses a non-empty directory unless `options.force`).
@@ -414,7 +460,28 @@ pub fn run_soft(scene: &SoftScene, out_dir: &Path, options: &RunOptions) -> Resu
         .write_all(TIMESERIES_HEADER.as_bytes())
         .map_err(io_err(&ts))?;
     timeseries.flush().map_err(io_err(&ts))?;
-    let sys = initial_system(scene);
+    let mut sys = initial_system(scene);
+    let spin = match &scene.spinup {
+        Some(settings) => {
+            // the body starts on the path (T_start) and the t = 0 sample needs the contact records
+            let driver = SpinupDriver::new(*settings, &scene.particles);
+            let springs = sys.pair_springs();
+            let member = central_body(&sys.particles, springs.iter().map(|(k, _)| k));
+            driver.apply(&mut sys.particles, &member, 0.0);
+            sys.keep_records = true;
+            sys.set_pair_springs(Vec::new());
+            sys.compute_forces(0.0, 0.0);
+            let path = out_dir.join("spinup.csv");
+            let mut csv = BufWriter::new(File::create(&path).map_err(io_err(&path))?);
+            csv.write_all(SPINUP_HEADER.as_bytes()).map_err(io_err(&path))?;
+            Some(SpinRun {
+                driver,
+                csv,
+                bytes: SPINUP_HEADER.len() as u64,
+            })
+        }
+        None => None,
+    };
     let book = Book::new(&sys);
     let base = match &scene.base_dir {
         Some(d) => Some(
@@ -434,6 +501,7 @@ pub fn run_soft(scene: &SoftScene, out_dir: &Path, options: &RunOptions) -> Resu
         wall_before: 0.0,
         book,
         timeseries,
+        spin,
     };
     drive(scene, out_dir, options, start, base)
 }
@@ -541,6 +609,31 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
     let mut file = file;
     use std::io::Seek;
     file.seek(std::io::SeekFrom::End(0)).map_err(io_err(&ts))?;
+    let spin = match (&scene.spinup, &ck.spinup) {
+        (Some(settings), Some(sc)) => {
+            let mut driver = SpinupDriver::new(*settings, &scene.particles);
+            driver
+                .restore(&sc.state)
+                .ok_or_else(|| bad("malformed spin-up state".into()))?;
+            let path = dir.join("spinup.csv");
+            let mut f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&path)
+                .map_err(|e| bad(format!("{}: {e}", path.display())))?;
+            if f.metadata().map_err(io_err(&path))?.len() < sc.bytes {
+                return Err(bad(format!("{} is shorter than at the checkpoint", path.display())));
+            }
+            f.set_len(sc.bytes).map_err(io_err(&path))?;
+            f.seek(std::io::SeekFrom::End(0)).map_err(io_err(&path))?;
+            Some(SpinRun {
+                driver,
+                csv: BufWriter::new(f),
+                bytes: sc.bytes,
+            })
+        }
+        (None, None) => None,
+        _ => return Err(bad("the checkpoint and the scene disagree on [spinup]".into())),
+    };
     let start = Start {
         sys,
         step: ck.step,
@@ -551,6 +644,7 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
         wall_before: ck.wall_seconds,
         book,
         timeseries: BufWriter::new(file),
+        spin,
     };
     drive(&scene, dir, options, start, ck.scene_base_dir.clone())
 }
@@ -597,7 +691,9 @@ fn drive(
         wall_before,
         mut book,
         mut timeseries,
+        mut spin,
     } = start;
+    let spin_path = dir.join("spinup.csv");
     let clock = Instant::now();
     let wall = |c: &Instant| wall_before + c.elapsed().as_secs_f64();
     let ts_path = dir.join("timeseries.csv");
@@ -609,7 +705,12 @@ fn drive(
     for (index, &(sample_step, snapshot)) in plan.iter().enumerate().skip(next_sample) {
         while step < sample_step {
             let before = sys.particles.clone();
+            // the spin-up diagnostics at a sample need that step's contact records
+            sys.keep_records = spin.is_some() && step + 1 == sample_step;
             leapfrog::step(&mut sys, step as f64 * dt, dt);
+            if let Some(s) = &spin {
+                s.after_step(&mut sys, (step + 1) as f64 * dt);
+            }
             let broken = if let Some(k) = sys.particles.iter().position(|p| !p.is_finite()) {
                 Some(format!("non-finite state of particle {k}"))
             } else if sys.stats.max_overlap_fraction > BROKEN_OVERLAP {
@@ -650,6 +751,9 @@ fn drive(
         rows += 1;
         bytes += line.len() as u64;
         let t = step as f64 * dt;
+        if let Some(s) = spin.as_mut() {
+            s.sample(&sys, t, &spin_path)?;
+        }
         if let Some(k) = snapshot {
             let p = dir.join("snapshots").join(format!("{k}.csv"));
             write_particles_csv(&p, t, &sys.particles).map_err(io_err(&p))?;
@@ -693,6 +797,10 @@ fn drive(
                     Vec::new()
                 },
                 book: book.to_vec(),
+                spinup: spin.as_ref().map(|s| SpinupCheckpoint {
+                    state: s.driver.state(),
+                    bytes: s.bytes,
+                }),
             };
             let tmp = dir.join(CHECKPOINT_TMP_FILE);
             let text = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");

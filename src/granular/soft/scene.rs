@@ -92,6 +92,9 @@ pub struct SoftSceneFile {
     /// `[[particle]]` tables (or `scene.particles_file`).
     #[serde(default, rename = "particle")]
     pub particles: Vec<ParticleSpec>,
+    /// `[spinup]`, optional: spin-up forcing and diagnostics ([`crate::granular::soft::spinup`]).
+    #[serde(default)]
+    pub spinup: Option<crate::granular::soft::spinup::SpinupSection>,
 }
 
 /// `[scene]`.
@@ -280,6 +283,8 @@ pub struct SoftScene {
     pub advice: Advice,
     /// Warnings (one line each).
     pub warnings: Vec<String>,
+    /// Spin-up forcing and diagnostics (`[spinup]`), if any.
+    pub spinup: Option<crate::granular::soft::spinup::SpinupSettings>,
 }
 
 /// The `scene.kind` of a TOML text, if it has one (used to dispatch `rubblepile run`).
@@ -623,6 +628,8 @@ impl V<'_> {
             }
         }
 
+        // [spinup] (crate::granular::soft::spinup)
+        let spinup = file.spinup.as_ref().map(|s| self.spinup(s)).transpose()?;
         let advice = scene_advice(&particles, &gravity, material.k_n);
         let mut warnings = Vec::new();
         let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
@@ -684,6 +691,7 @@ impl V<'_> {
             particles,
             advice,
             warnings,
+            spinup,
         })
     }
 }

@@ -1,0 +1,298 @@
+//! `rubblepile report-zhang2017 RUNS --out analysis/zhang2017 [--force]`: the scaled-down reproduction of
+//! Zhang17 Table 3 (critical spin limits of the rubble-pile models under spin-up path 2 of Table 5) from the runs
+//! under `RUNS`, with Fig. 5-style time series.
+//!
+//! Layout read: `RUNS/<model>/path2/` (a soft-sphere run with `[spinup]`: `spinup.csv`, `summary.json`,
+//! `snapshots/0.csv`) and, optionally, `RUNS/<model>/critical/critical.json` (from `rubblepile spinup
+//! critical`, giving T_c,3 and φ). Models: any directory under RUNS with a `path2` run; the paper's Table 3 row is
+//! printed beside ours for HCP, RCP, RCPC, PP1, PP2 and PPC.
+//!
+//! Per model: N and the particle radii (the radius scaling against the paper's sizes), T_c,1 and T_c,2 from the
+//! forced part after `t_start` ([`critical_limits`]), the failure mode, T_c,3 and φ, κ₃ of Eq. 22 with
+//! `ρ_B = 2100 M/M_P` (Zhang17 §4.2, M_P = 5.23e11 kg), the largest overlap, the largest departure of the spin
+//! period from the path while forced, and the run's wall time.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::analysis::figures::spinup_figures::SpinupTimeSeries;
+use crate::analysis::figures::style::write_figure;
+use crate::analysis::spinup::{CriticalLimits, FailureMode, critical_limits, fit_density};
+use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use crate::scene::SI_G;
+
+/// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
+pub const DIDYMOS_MASS: f64 = 5.23e11;
+
+/// One row of [`TABLE3`]: model, η, φ (°), T_c1, T_c2, T_c3 (h), κ₃, failure mode.
+pub type PaperRow = (&'static str, f64, f64, f64, f64, f64, Option<f64>, &'static str);
+
+/// Zhang17 Table 3 (nominal material, path 1) and the κ₃ of §4.2.
+pub const TABLE3: [PaperRow; 6] = [
+    ("hcp", 0.739, 43.0, 2.38, 2.36, 2.40, Some(0.946), "surface shedding"),
+    ("rcp", 0.641, 30.0, 2.51, 2.53, 2.83, Some(0.806), "internal failure"),
+    ("rcpc", 0.695, 32.0, 2.46, 2.46, 2.76, None, "internal failure"),
+    ("pp1", 0.820, 39.0, 2.41, 2.44, 2.53, Some(0.902), "internal failure"),
+    ("pp2", 0.750, 38.0, 2.41, 2.44, 2.54, None, "internal failure"),
+    ("ppc", 0.820, 39.0, 2.46, 2.41, 2.49, None, "surface shedding"),
+];
+
+/// One model's row.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ModelRow {
+    /// Model name (directory).
+    pub model: String,
+    /// Particles.
+    pub n: usize,
+    /// Smallest and largest particle radius (m).
+    pub radius_range: (f64, f64),
+    /// Total mass (kg).
+    pub mass: f64,
+    /// η_B at t_start.
+    pub packing: f64,
+    /// T_c1, T_c2 and the failure mode.
+    pub limits: CriticalLimits,
+    /// T_c,3 (h) and φ (°) from `critical.json`.
+    pub t_c3: Option<f64>,
+    /// See `t_c3`.
+    pub phi: Option<f64>,
+    /// κ₃ of Eq. 22.
+    pub kappa3: Option<f64>,
+    /// Largest |T/T_path − 1| while forced.
+    pub path_error: f64,
+    /// Time the forcing was released (s), if it was.
+    pub release_time: Option<f64>,
+    /// Largest overlap / radius.
+    pub max_overlap: f64,
+    /// Wall time (s), simulated time (s), status.
+    pub wall_seconds: f64,
+    /// See `wall_seconds`.
+    pub final_time: f64,
+    /// See `wall_seconds`.
+    pub status: String,
+}
+
+fn t_start_of(dir: &Path) -> f64 {
+    std::fs::read_to_string(dir.join("scene.toml"))
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .and_then(|t| t.get("spinup")?.get("t_start")?.as_float())
+        .unwrap_or(0.0)
+}
+
+/// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0.
+fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
+    let text = std::fs::read_to_string(dir.join("snapshots/0.csv")).ok()?;
+    let (mut lo, mut hi, mut m, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
+    for line in text.lines().skip(1) {
+        let v: Vec<f64> = line.split(',').filter_map(|c| c.parse().ok()).collect();
+        if v.len() >= 4 {
+            m += v[2];
+            lo = lo.min(v[3]);
+            hi = hi.max(v[3]);
+            n += 1;
+        }
+    }
+    (m > 0.0).then_some((lo, hi, m, n))
+}
+
+/// Reads one model's runs under `RUNS/<model>`.
+pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), String> {
+    let model = model_dir
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let run = model_dir.join("path2");
+    let samples = read_spinup_csv(&run.join("spinup.csv"))?;
+    let summary: serde_json::Value = std::fs::read_to_string(run.join("summary.json"))
+        .ok()
+        .and_then(|s| serde_json::from_str(&s).ok())
+        .unwrap_or(serde_json::Value::Null);
+    let t_start = t_start_of(&run);
+    let forced: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_start && s.forcing).collect();
+    let col = |f: fn(&SpinupSample) -> f64| forced.iter().map(|s| f(s)).collect::<Vec<f64>>();
+    let limits = critical_limits(
+        &col(|s| s.period_h),
+        &col(|s| s.b_over_a),
+        &col(|s| s.c_over_a),
+        &col(|s| s.packing_fraction),
+    );
+    let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
+    let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join("critical/critical.json"))
+        .ok()
+        .and_then(|s| serde_json::from_str(&s).ok());
+    let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
+    let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
+    let rho_b = 2100.0 * mass / DIDYMOS_MASS;
+    let kappa3 = t_c3.and_then(|t| fit_density(&[(rho_b, t)], SI_G, t)).map(|f| f.kappa);
+    let path_error = samples
+        .iter()
+        .filter(|s| s.forcing)
+        .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
+        .fold(0.0, f64::max);
+    let release_time = samples.iter().find(|s| !s.forcing).map(|s| s.t);
+    let row = ModelRow {
+        model,
+        n,
+        radius_range: (lo, hi),
+        mass,
+        packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
+        limits,
+        t_c3,
+        phi,
+        kappa3,
+        path_error,
+        release_time,
+        max_overlap: summary["max_overlap_fraction"].as_f64().unwrap_or(f64::NAN),
+        wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
+        final_time: samples.last().map(|s| s.t).unwrap_or(0.0),
+        status: summary["status"]
+            .as_str()
+            .unwrap_or("running (no summary.json)")
+            .to_string(),
+    };
+    Ok((row, samples))
+}
+
+fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map(|v| format!("{v:.digits$}")).unwrap_or_else(|| "–".into())
+}
+
+fn mode(m: Option<FailureMode>) -> &'static str {
+    match m {
+        Some(FailureMode::SurfaceShedding) => "surface shedding",
+        Some(FailureMode::InternalFailure) => "internal failure",
+        None => "–",
+    }
+}
+
+/// Writes `out/REPORT.md` and `out/fig5_<model>.{svg,png}` from the runs under `runs`; refuses to overwrite an
+/// existing report without `force`. Returns the report's path.
+pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::PathBuf, String> {
+    let report = out.join("REPORT.md");
+    if report.exists() && !force {
+        return Err(format!("{} exists (use --force to overwrite it)", report.display()));
+    }
+    let mut models: Vec<_> = std::fs::read_dir(runs)
+        .map_err(|e| format!("{}: {e}", runs.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.join("path2/spinup.csv").is_file())
+        .collect();
+    models.sort();
+    if models.is_empty() {
+        return Err(format!("{}: no <model>/path2/spinup.csv found", runs.display()));
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    let mut rows = Vec::new();
+    let mut figures = Vec::new();
+    for m in &models {
+        let (row, samples) = model_row(m)?;
+        let stem = format!("fig5_{}", row.model);
+        let fig = SpinupTimeSeries {
+            title: format!("{} (N = {}), spin-up path 2", row.model.to_uppercase(), row.n),
+            samples,
+        };
+        match write_figure(out, &stem, &fig) {
+            Ok(_) => figures.push(stem),
+            Err(e) => eprintln!("warning: {stem}: {e}"),
+        }
+        rows.push(row);
+    }
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Zhang et al. (2017) Table 3, scaled down: critical spin limits under spin-up path 2\n"
+    );
+    let _ = writeln!(
+        md,
+        "Generated by `rubblepile report-zhang2017 {} --out {} --force` from the runs under `{}` (layout and \
+         definitions: `src/analysis/report_zhang2017.rs`; scenes and the commands that make the runs: \
+         `analysis/zhang2017/README.md`). Do not edit by hand.\n",
+        runs.display(),
+        out.display(),
+        runs.display()
+    );
+    let _ = writeln!(
+        md,
+        "Ours: T_c1/T_c2 from `spinup.csv` (first change of b/a or c/a by > 0.01, of η_B by > 0.001, after t_start, \
+         while forced), T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
+         ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, T_c1 and \
+         T_c2 do — faster paths give shorter ones).\n"
+    );
+    let _ = writeln!(
+        md,
+        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | paper η, φ, T_c1/2/3, κ₃, mode |"
+    );
+    let _ = writeln!(
+        md,
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
+    for r in &rows {
+        let paper = TABLE3
+            .iter()
+            .find(|p| p.0 == r.model)
+            .map(|p| {
+                format!(
+                    "{:.3}, {}°, {:.2}/{:.2}/{:.2} h, {}, {}",
+                    p.1,
+                    p.2,
+                    p.3,
+                    p.4,
+                    p.5,
+                    opt(p.6, 3),
+                    p.7
+                )
+            })
+            .unwrap_or_else(|| "–".into());
+        let radius = if (r.radius_range.1 - r.radius_range.0).abs() < 1e-9 * r.radius_range.1 {
+            format!("{:.1}", r.radius_range.0)
+        } else {
+            format!("{:.1}–{:.1}", r.radius_range.0, r.radius_range.1)
+        };
+        let _ = writeln!(
+            md,
+            "| {} | {} | {radius} | {:.4} | {} | {} | {} | {} | {} | {} | {paper} |",
+            r.model.to_uppercase(),
+            r.n,
+            r.packing,
+            opt(r.limits.t_c1_hours, 3),
+            opt(r.limits.t_c2_hours, 3),
+            opt(r.t_c3, 2),
+            opt(r.phi, 1),
+            opt(r.kappa3, 3),
+            mode(r.limits.failure_mode),
+        );
+    }
+    let _ = writeln!(
+        md,
+        "\nRadius scaling: the paper's HCP/RCP spheres are ≈ 10 m (42 062 and 36 523 particles in \
+         the 780 m body) and PP1's 4–32 m; ours keep the body (D = 780 m, ρ_B = 2100 kg/m³) and use fewer, larger \
+         particles (radius column), i.e. lengths scaled by (N_paper/N)^(1/3).\n"
+    );
+    let _ = writeln!(md, "## Runs\n");
+    let _ = writeln!(
+        md,
+        "| model | status | simulated (s) | wall (s) | largest overlap / radius | largest \\|T/T_path − 1\\| while forced | forcing released at (s) |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+    for r in &rows {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.0} | {:.0} | {:.2e} | {:.1e} | {} |",
+            r.model.to_uppercase(),
+            r.status,
+            r.final_time,
+            r.wall_seconds,
+            r.max_overlap,
+            r.path_error,
+            opt(r.release_time, 0)
+        );
+    }
+    let _ = writeln!(md, "\n## Time series (Fig. 5 style)\n");
+    for f in &figures {
+        let _ = writeln!(md, "![{f}]({f}.png)\n");
+    }
+    std::fs::write(&report, md).map_err(|e| format!("{}: {e}", report.display()))?;
+    Ok(report)
+}

@@ -1,0 +1,371 @@
+//! Run-time diagnostics of a spin-up run (Zhang17 §3, Fig. 5), one row of `spinup.csv` per output sample:
+//! spin period, b/a and c/a (§3.1), the interior packing fraction η_B (§3.2, Eqs. 13–14), coordination number
+//! and the fractions of particles with 0 and 1 contacts, and the stresses of representative volume elements
+//! (RVEs, §3.3.1, Eqs. 15–16) reduced to s_max, p_max and θ_max (Eqs. 20–21).
+//!
+//! **Packing fraction.** The Voronoi cells come from [`crate::geometry::voronoi`], each started as a cube of
+//! half-side twice the largest diameter. The paper bounds the tessellation by the shape model and then keeps only
+//! interior particles, because cells cut by the boundary measure the boundary, not the packing. Our equivalent: a
+//! cell still touching its starting cube is open to the outside (it belongs to the outermost layer, or to a shed
+//! particle) and is excluded; so is every particle within 10 % of the sum of the radii from the surface of such a
+//! particle (a proximity test rather than the contact list, so that a contact opening for a step does not let a
+//! second-layer cell flicker into the average: on a carved HCP ball that flicker moved η_B by up to 0.0008), because where the surface
+//! layer has gaps (a lattice or packing carved by a shape) the second layer's cells are closed only by distant
+//! bisectors and measure the gaps, not the packing (on a carved HCP ball keeping the second layer lowers η_B by
+//! about 0.03 and makes it noisy at the 0.001 level of T_c,2); and so is every particle outside the central body.
+//! η_B is the ratio of the summed sphere volumes to the summed cell volumes over the rest (the volume-weighted
+//! form of Eq. 14, which does not let a few small cells dominate).
+//!
+//! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
+//! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
+//! of similar size (an octree's surface octants would be partly empty). Eq. 16's RVE volume is the sum of its
+//! particles' volumes `V_i`: the Voronoi cell for a closed cell, `(4/3)π r³/η_B` (the mean interior cell of that
+//! sphere size) for an open one, whose cell measures only the starting cube. Contacts with walls carry no branch
+//! vector here and are left out of the stresses (spin-up scenes have no walls).
+//!
+//! **Reductions.** `s_max` is the largest deviatoric stress `(σ₁ − σ₃)/2`, `p_max` the largest compressive
+//! pressure `−(σ₁ + σ₂ + σ₃)/3` (reported positive, Pa), `θ_max` the largest mobilized friction angle (degrees)
+//! over the RVEs.
+
+use std::path::Path;
+
+use crate::analysis::shape_metrics::axis_lengths;
+use crate::analysis::spinup::{StressState, particle_stress, rve_stress, stress_state};
+use crate::geometry::neighbours::sphere_pairs;
+use crate::geometry::voronoi::{packing_fraction, voronoi_cells};
+use crate::granular::soft::forces::{ContactRecord, SoftSystem};
+use crate::granular::soft::spinup::{SpinupDriver, body_rotation, central_body};
+use crate::math::{Mat3, Vec3};
+
+/// The `spinup.csv` header.
+pub const SPINUP_HEADER: &str = "t,path_period_h,period_h,forcing,body_particles,body_mass_fraction,a,b,c,b_over_a,c_over_a,packing_fraction,interior_particles,coordination_number,fraction_0_contacts,fraction_1_contact,rves,s_max,p_max,theta_max_deg\n";
+
+/// One row of `spinup.csv`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct SpinupSample {
+    /// Time (s).
+    pub t: f64,
+    /// The path's period at `t` (h).
+    pub path_period_h: f64,
+    /// The central body's spin period `2π I/L` (h).
+    pub period_h: f64,
+    /// Whether the forcing is still on.
+    pub forcing: bool,
+    /// Particles in the central body.
+    pub body_particles: usize,
+    /// Mass fraction of the central body.
+    pub body_mass_fraction: f64,
+    /// Semi-axes a ≥ b ≥ c of all particles (m), maximum extents along the principal axes of inertia.
+    pub a: f64,
+    /// See `a`.
+    pub b: f64,
+    /// See `a`.
+    pub c: f64,
+    /// b/a.
+    pub b_over_a: f64,
+    /// c/a.
+    pub c_over_a: f64,
+    /// Interior packing fraction η_B (NaN without interior particles).
+    pub packing_fraction: f64,
+    /// Particles counted in η_B.
+    pub interior_particles: usize,
+    /// Mean contacts per particle (all particles).
+    pub coordination_number: f64,
+    /// Fraction of particles without contacts.
+    pub fraction_0_contacts: f64,
+    /// Fraction of particles with exactly one contact.
+    pub fraction_1_contact: f64,
+    /// RVEs.
+    pub rves: usize,
+    /// Largest deviatoric stress over the RVEs (Pa).
+    pub s_max: f64,
+    /// Largest compressive pressure over the RVEs (Pa, positive).
+    pub p_max: f64,
+    /// Largest mobilized friction angle over the RVEs (degrees; NaN if none is defined).
+    pub theta_max_deg: f64,
+}
+
+impl SpinupSample {
+    /// The CSV row (with newline).
+    pub fn csv_row(&self) -> String {
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
+            self.t,
+            self.path_period_h,
+            self.period_h,
+            u8::from(self.forcing),
+            self.body_particles,
+            self.body_mass_fraction,
+            self.a,
+            self.b,
+            self.c,
+            self.b_over_a,
+            self.c_over_a,
+            self.packing_fraction,
+            self.interior_particles,
+            self.coordination_number,
+            self.fraction_0_contacts,
+            self.fraction_1_contact,
+            self.rves,
+            self.s_max,
+            self.p_max,
+            self.theta_max_deg
+        )
+    }
+}
+
+/// Reads a `spinup.csv`; errors name the file and line.
+pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut lines = text.lines();
+    if lines.next().map(|h| h.trim()) != Some(SPINUP_HEADER.trim()) {
+        return Err(format!("{}: not a spinup.csv (unexpected header)", path.display()));
+    }
+    let mut out = Vec::new();
+    for (k, line) in lines.enumerate() {
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|c| c.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .map_err(|e| format!("{} line {}: {e}", path.display(), k + 2))?;
+        if v.len() != 20 {
+            return Err(format!(
+                "{} line {}: expected 20 columns, got {}",
+                path.display(),
+                k + 2,
+                v.len()
+            ));
+        }
+        out.push(SpinupSample {
+            t: v[0],
+            path_period_h: v[1],
+            period_h: v[2],
+            forcing: v[3] != 0.0,
+            body_particles: v[4] as usize,
+            body_mass_fraction: v[5],
+            a: v[6],
+            b: v[7],
+            c: v[8],
+            b_over_a: v[9],
+            c_over_a: v[10],
+            packing_fraction: v[11],
+            interior_particles: v[12] as usize,
+            coordination_number: v[13],
+            fraction_0_contacts: v[14],
+            fraction_1_contact: v[15],
+            rves: v[16] as usize,
+            s_max: v[17],
+            p_max: v[18],
+            theta_max_deg: v[19],
+        });
+    }
+    Ok(out)
+}
+
+/// RVEs of the points `members` (indices into `centres`): a binary median-split tree, cutting a set larger than
+/// `4/3 × target` across its longest extent. Deterministic (ties broken by index).
+pub fn rves(centres: &[Vec3], members: &[usize], target: usize) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    let mut stack = vec![members.to_vec()];
+    let limit = (target * 4).div_ceil(3).max(1);
+    while let Some(mut set) = stack.pop() {
+        if set.len() <= limit {
+            if !set.is_empty() {
+                out.push(set);
+            }
+            continue;
+        }
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for &i in &set {
+            lo = lo.inf(&centres[i]);
+            hi = hi.sup(&centres[i]);
+        }
+        let axis = (hi - lo).imax();
+        set.sort_by(|&i, &j| centres[i][axis].total_cmp(&centres[j][axis]).then(i.cmp(&j)));
+        let right = set.split_off(set.len() / 2);
+        stack.push(right);
+        stack.push(set);
+    }
+    out
+}
+
+/// The stress of one RVE.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RveStress {
+    /// Mass-less centroid of its particle centres (m).
+    pub centre: Vec3,
+    /// Particles.
+    pub particles: usize,
+    /// Volume, Σ V_i (m³).
+    pub volume: f64,
+    /// Average stress tensor (Eq. 16, Pa).
+    pub sigma: Mat3,
+    /// Principal stresses and Mohr–Coulomb measures.
+    pub state: StressState,
+}
+
+/// Eq. 15 per particle and Eq. 16 per RVE from the pair contact `records` of the last force evaluation.
+/// `volumes[i]` is particle `i`'s volume (m³); `members` the particles to divide into RVEs of about `target`.
+pub fn rve_stresses(
+    sys: &SoftSystem,
+    records: &[ContactRecord],
+    volumes: &[f64],
+    members: &[usize],
+    target: usize,
+) -> Vec<RveStress> {
+    let ps = &sys.particles;
+    let n = ps.len();
+    let mut contacts: Vec<Vec<(Vec3, Vec3)>> = vec![Vec::new(); n];
+    for r in records.iter().filter(|r| r.j < n) {
+        let d = ps[r.j].position - ps[r.i].position;
+        let dist = d.norm();
+        if dist <= 0.0 {
+            continue;
+        }
+        let nrm = d / dist;
+        let f = r.output.force_i;
+        contacts[r.i].push((nrm * (ps[r.i].radius - 0.5 * r.overlap), f));
+        contacts[r.j].push((-nrm * (ps[r.j].radius - 0.5 * r.overlap), -f));
+    }
+    let centres: Vec<Vec3> = ps.iter().map(|p| p.position).collect();
+    rves(&centres, members, target)
+        .into_iter()
+        .map(|set| {
+            let parts: Vec<(f64, Mat3)> = set
+                .iter()
+                .map(|&i| (volumes[i], particle_stress(volumes[i], &contacts[i])))
+                .collect();
+            let sigma = rve_stress(&parts);
+            RveStress {
+                centre: set.iter().map(|&i| centres[i]).sum::<Vec3>() / set.len() as f64,
+                particles: set.len(),
+                volume: parts.iter().map(|p| p.0).sum(),
+                sigma,
+                state: stress_state(&sigma),
+            }
+        })
+        .collect()
+}
+
+/// Everything measured at one sample, with the per-RVE stresses (for tests and figures).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagnosis {
+    /// The row.
+    pub sample: SpinupSample,
+    /// Per-RVE stresses.
+    pub rves: Vec<RveStress>,
+}
+
+/// Measures the system at time `t` (s). Needs the contact records of the last force evaluation
+/// (`sys.keep_records` on for it); `axis` is the spin axis, `path_period` the path's period (s).
+pub fn diagnose(
+    sys: &SoftSystem,
+    axis: &Vec3,
+    path_period: f64,
+    forcing: bool,
+    rve_target: usize,
+    t: f64,
+) -> Diagnosis {
+    let ps = &sys.particles;
+    let n = ps.len();
+    let springs = sys.pair_springs();
+    let member = central_body(ps, springs.iter().map(|(k, _)| k));
+    let rot = body_rotation(ps, &member, axis);
+    let total_mass: f64 = ps.iter().map(|p| p.mass).sum();
+    let centres: Vec<Vec3> = ps.iter().map(|p| p.position).collect();
+    let masses: Vec<f64> = ps.iter().map(|p| p.mass).collect();
+    let radii: Vec<f64> = ps.iter().map(|p| p.radius).collect();
+    let ax = axis_lengths(&centres, &masses, &radii);
+    let r_max = radii.iter().cloned().fold(0.0, f64::max);
+    let cells = voronoi_cells(&centres, 4.0 * r_max);
+    let mut inner: Vec<bool> = member.iter().zip(&cells).map(|(m, c)| *m && !c.boundary).collect();
+    let reach: Vec<f64> = radii.iter().map(|r| 1.1 * r).collect();
+    for (i, j) in sphere_pairs(&centres, &reach) {
+        if cells[i].boundary {
+            inner[j] = false;
+        }
+        if cells[j].boundary {
+            inner[i] = false;
+        }
+    }
+    let packing = packing_fraction(&cells, &radii, &inner);
+    let interior = inner.iter().filter(|&&k| k).count();
+    let eta = packing.unwrap_or(0.64);
+    let volumes: Vec<f64> = cells
+        .iter()
+        .zip(&radii)
+        .map(|(c, r)| {
+            if c.boundary {
+                4.0 / 3.0 * std::f64::consts::PI * r.powi(3) / eta
+            } else {
+                c.volume
+            }
+        })
+        .collect();
+    let mut count = vec![0u32; n];
+    for r in &sys.records {
+        count[r.i] += 1;
+        if r.j < n {
+            count[r.j] += 1;
+        }
+    }
+    let frac = |k: u32| count.iter().filter(|&&c| c == k).count() as f64 / n.max(1) as f64;
+    let members: Vec<usize> = (0..n).filter(|&i| member[i]).collect();
+    let stresses = rve_stresses(sys, &sys.records, &volumes, &members, rve_target);
+    let s_max = stresses.iter().map(|r| r.state.deviatoric).fold(0.0, f64::max);
+    let p_max = stresses.iter().map(|r| -r.state.pressure).fold(0.0, f64::max);
+    let theta_max = stresses
+        .iter()
+        .filter_map(|r| r.state.friction_angle_deg)
+        .fold(f64::NAN, f64::max);
+    let sample = SpinupSample {
+        t,
+        path_period_h: path_period / 3600.0,
+        period_h: rot.period() / 3600.0,
+        forcing,
+        body_particles: members.len(),
+        body_mass_fraction: if total_mass > 0.0 { rot.mass / total_mass } else { 0.0 },
+        a: ax.a,
+        b: ax.b,
+        c: ax.c,
+        b_over_a: ax.b_over_a(),
+        c_over_a: ax.c_over_a(),
+        packing_fraction: packing.unwrap_or(f64::NAN),
+        interior_particles: interior,
+        coordination_number: count.iter().map(|&c| c as f64).sum::<f64>() / n.max(1) as f64,
+        fraction_0_contacts: frac(0),
+        fraction_1_contact: frac(1),
+        rves: stresses.len(),
+        s_max,
+        p_max,
+        theta_max_deg: theta_max,
+    };
+    Diagnosis { sample, rves: stresses }
+}
+
+/// [`diagnose`] for a run with a spin-up driver at time `t` (s).
+pub fn diagnose_run(sys: &SoftSystem, driver: &SpinupDriver, t: f64) -> Diagnosis {
+    let s = &driver.settings;
+    diagnose(sys, &s.axis, s.path.period(t), !driver.released, s.rve_particles, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rve_tree_gives_similar_sizes_covering_every_member_once() {
+        let centres = crate::geometry::lattice::hcp_centres(1.0, 30.0);
+        let members: Vec<usize> = (0..centres.len()).collect();
+        let sets = rves(&centres, &members, 300);
+        let mut seen = vec![0; centres.len()];
+        for s in &sets {
+            assert!(s.len() >= 200 && s.len() <= 400, "RVE of {}", s.len());
+            for &i in s {
+                seen[i] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1));
+        assert!(sets.len() > 5);
+    }
+}

@@ -1,0 +1,388 @@
+//! Spin-up commands (Zhang17 §3.3.3, §4.2; Eq. 22):
+//!
+//! - `rubblepile spinup critical --scene BASE.toml --from 2.30 --to 2.60 [--step 0.01] --out DIR [--force]`:
+//!   the search for T_c,3. For T_final = from, from + step, … (hours) it writes `DIR/T<T_final>/scene.toml`
+//!   (BASE with `spinup.T_final` replaced), runs it (a run already completed there is reused), and judges the hold
+//!   after `t_final` with the creep criterion ([`CreepCriterion`], defaults tested in `analysis::spinup`): the body
+//!   is stable when the forcing was never released and neither θ_max, η_B nor the coordination number drifts over
+//!   the second half of the hold. The first stable T_final is T_c,3; φ is the largest θ_max over the holds of the
+//!   runs within ±0.01 h of it. Writes `DIR/critical.json` ([`CriticalSearch`]).
+//! - `rubblepile spinup density-fit --points RHO:T,RHO:T,… [--period 2.26]`: κ of Eq. 22 by least squares
+//!   through the origin from (bulk density kg/m³, critical period h) pairs, its standard error, and the critical
+//!   bulk density for the given period.
+//! - `rubblepile report-zhang2017 RUNS --out DIR [--force]`: see [`crate::analysis::report_zhang2017`].
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use crate::analysis::spinup::{CreepCriterion, fit_density};
+use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use crate::cli::CliError;
+use crate::run::RunOptions;
+use crate::scene::SI_G;
+
+/// `rubblepile spinup …`.
+#[derive(Debug, clap::Subcommand)]
+pub enum SpinupCommand {
+    /// Search T_c,3: hold runs at T_final stepped by 0.01 h until one is free of creep (Zhang17 §3.3.3).
+    Critical(CriticalArgs),
+    /// Fit κ of Eq. 22 over bulk densities and give the critical bulk density.
+    DensityFit(DensityFitArgs),
+}
+
+/// `rubblepile spinup critical`.
+#[derive(Debug, clap::Args)]
+pub struct CriticalArgs {
+    /// Soft-sphere scene with a `[spinup]` table whose run lasts past `t_final` (the hold).
+    #[arg(long, value_name = "SCENE.toml")]
+    pub scene: PathBuf,
+    /// First T_final (hours).
+    #[arg(long)]
+    pub from: f64,
+    /// Last T_final (hours).
+    #[arg(long)]
+    pub to: f64,
+    /// Step of T_final (hours).
+    #[arg(long, default_value_t = 0.01)]
+    pub step: f64,
+    /// Directory of the hold runs and `critical.json`.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Overwrite an earlier `critical.json` in DIR (completed runs are still reused).
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `rubblepile spinup density-fit`.
+#[derive(Debug, clap::Args)]
+pub struct DensityFitArgs {
+    /// Comma-separated `RHO:T` pairs: bulk density (kg/m³) and critical period (h).
+    #[arg(long, value_delimiter = ',')]
+    pub points: Vec<String>,
+    /// Period (h) at which to give the critical bulk density.
+    #[arg(long, default_value_t = 2.26)]
+    pub period: f64,
+}
+
+/// One hold run judged by the creep criterion.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct HoldVerdict {
+    /// T_final (h).
+    pub t_final_hours: f64,
+    /// Run directory.
+    pub dir: PathBuf,
+    /// Whether the forcing was released (global disruption).
+    pub released: bool,
+    /// Diagnostics drifting over the second half of the hold (empty: none).
+    pub drifting: Vec<&'static str>,
+    /// Largest θ_max during the hold (degrees).
+    pub theta_max_deg: f64,
+    /// Stable: not released and nothing drifting.
+    pub stable: bool,
+}
+
+/// `critical.json`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CriticalSearch {
+    /// The criterion used.
+    pub criterion: CreepCriterion,
+    /// The runs, by increasing T_final.
+    pub runs: Vec<HoldVerdict>,
+    /// T_c,3 (h): the first stable T_final.
+    pub t_c3_hours: Option<f64>,
+    /// φ (degrees): the largest θ_max over the holds within ±0.01 h of T_c,3.
+    pub friction_angle_deg: Option<f64>,
+}
+
+/// Judges the hold (samples at or after `t_final`, s) of one run.
+pub fn judge_hold(
+    samples: &[SpinupSample],
+    t_final: f64,
+    criterion: &CreepCriterion,
+) -> (bool, Vec<&'static str>, f64) {
+    let hold: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_final).collect();
+    let released = samples.iter().any(|s| !s.forcing);
+    let t: Vec<f64> = hold.iter().map(|s| s.t).collect();
+    let theta: Vec<f64> = hold.iter().map(|s| s.theta_max_deg).collect();
+    let eta: Vec<f64> = hold.iter().map(|s| s.packing_fraction).collect();
+    let coord: Vec<f64> = hold.iter().map(|s| s.coordination_number).collect();
+    let drifting = criterion.drifting(&t, &theta, &eta, &coord);
+    let theta_max = theta.iter().cloned().fold(f64::NAN, f64::max);
+    (released, drifting, theta_max)
+}
+
+/// Reduces judged runs to T_c,3 and φ (see the module docs).
+pub fn critical_from_verdicts(runs: &[HoldVerdict]) -> (Option<f64>, Option<f64>) {
+    let t_c3 = runs.iter().find(|r| r.stable).map(|r| r.t_final_hours);
+    let phi = t_c3.and_then(|t| {
+        let m = runs
+            .iter()
+            .filter(|r| (r.t_final_hours - t).abs() <= 0.01 + 1e-9)
+            .map(|r| r.theta_max_deg)
+            .fold(f64::NAN, f64::max);
+        m.is_finite().then_some(m)
+    });
+    (t_c3, phi)
+}
+
+/// `rubblepile spinup critical`.
+pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
+    let ok = |x: f64| x.is_finite() && x > 0.0;
+    if !ok(args.from) || !ok(args.to) || args.to < args.from {
+        return Err(CliError::usage(format!(
+            "--from and --to must be periods in hours with 0 < from <= to, got {} and {}",
+            args.from, args.to
+        )));
+    }
+    if !ok(args.step) {
+        return Err(CliError::usage(format!("--step must be > 0 hours, got {}", args.step)));
+    }
+    let json = args.out.join("critical.json");
+    if json.exists() && !args.force {
+        return Err(CliError::usage(format!(
+            "{} exists (use --force to overwrite it)",
+            json.display()
+        )));
+    }
+    let text =
+        std::fs::read_to_string(&args.scene).map_err(|e| CliError::usage(format!("{}: {e}", args.scene.display())))?;
+    let base = crate::granular::soft::scene::load_soft_scene(&args.scene).map_err(CliError::usage)?;
+    let Some(settings) = base.spinup else {
+        return Err(CliError::usage(format!(
+            "{}: spinup: missing (need a [spinup] table)",
+            args.scene.display()
+        )));
+    };
+    if base.t_end <= settings.path.t_final {
+        return Err(CliError::usage(format!(
+            "{}: scene.t_end must exceed spinup.t_final = {} s to leave a hold, got {}",
+            args.scene.display(),
+            settings.path.t_final,
+            base.t_end
+        )));
+    }
+    let mut table: toml::Table = toml::from_str(&text).map_err(|e| CliError::usage(e.to_string()))?;
+    // a particles_file is resolved against the base scene's directory
+    let scene_dir = args.scene.parent().map(Path::to_path_buf).unwrap_or_default();
+    if let Some(toml::Value::String(f)) = table.get("scene").and_then(|s| s.get("particles_file")).cloned() {
+        let abs = std::path::absolute(scene_dir.join(&f)).map_err(|e| CliError::usage(e.to_string()))?;
+        table["scene"]["particles_file"] = toml::Value::String(abs.display().to_string());
+    }
+    std::fs::create_dir_all(&args.out).map_err(|e| CliError::usage(format!("{}: {e}", args.out.display())))?;
+    let criterion = CreepCriterion::default();
+    let mut runs = Vec::new();
+    let n = ((args.to - args.from) / args.step + 1e-9).floor() as usize;
+    for k in 0..=n {
+        let tf = ((args.from + k as f64 * args.step) * 1e4).round() / 1e4;
+        if tf * 3600.0 > settings.path.period_inter + 1e-9 {
+            return Err(CliError::usage(format!(
+                "T_final = {tf} h is above the scene's T_inter = {} h",
+                settings.path.period_inter / 3600.0
+            )));
+        }
+        let dir = args.out.join(format!("T{tf:.2}"));
+        if !dir.join("summary.json").exists()
+            || !std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""))
+        {
+            table["spinup"]["T_final"] = toml::Value::Float(tf);
+            let scene_text = toml::to_string(&table).map_err(|e| CliError::usage(e.to_string()))?;
+            let path = args.out.join(format!("T{tf:.2}.toml"));
+            std::fs::write(&path, &scene_text).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
+            let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
+            let options = RunOptions {
+                force: true,
+                progress: false,
+                checkpoint_every: Some(crate::run::DEFAULT_CHECKPOINT_EVERY),
+                checkpoint_every_sim: None,
+                stop_after_checkpoints: None,
+            };
+            eprintln!("spinup critical: running T_final = {tf} h into {}", dir.display());
+            crate::granular::soft::run::run_soft(&scene, &dir, &options)
+                .map_err(|e| CliError::failed(e.to_string()))?;
+        }
+        let samples = read_spinup_csv(&dir.join("spinup.csv")).map_err(CliError::failed)?;
+        let (released, drifting, theta) = judge_hold(&samples, settings.path.t_final, &criterion);
+        let stable = !released && drifting.is_empty();
+        println!(
+            "T_final = {tf:.2} h: {}{}",
+            if stable { "stable" } else { "creeps" },
+            if released {
+                " (disrupted)".to_string()
+            } else if drifting.is_empty() {
+                String::new()
+            } else {
+                format!(" ({} drifting)", drifting.join(", "))
+            }
+        );
+        runs.push(HoldVerdict {
+            t_final_hours: tf,
+            dir,
+            released,
+            drifting,
+            theta_max_deg: theta,
+            stable,
+        });
+        // stop one step after the first stable T_final: φ looks ±0.01 h around T_c,3
+        let first_stable = runs.iter().position(|r| r.stable);
+        if first_stable.is_some_and(|f| runs.len() > f + 1) {
+            break;
+        }
+    }
+    let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs);
+    let out = CriticalSearch {
+        criterion,
+        runs,
+        t_c3_hours,
+        friction_angle_deg,
+    };
+    std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
+        .map_err(|e| CliError::failed(format!("{}: {e}", json.display())))?;
+    match (t_c3_hours, friction_angle_deg) {
+        (Some(t), Some(p)) => println!("T_c3 = {t:.2} h, phi = {p:.1} deg ({})", json.display()),
+        _ => println!("no stable T_final up to {} h ({})", args.to, json.display()),
+    }
+    Ok(())
+}
+
+/// Parses `RHO:T` pairs.
+pub fn parse_points(points: &[String]) -> Result<Vec<(f64, f64)>, CliError> {
+    points
+        .iter()
+        .map(|p| {
+            let (a, b) = p
+                .split_once(':')
+                .ok_or_else(|| CliError::usage(format!("--points: expected RHO:T (kg/m^3:hours), got {p:?}")))?;
+            let parse = |s: &str, what: &str| {
+                s.trim()
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite() && *x > 0.0)
+                    .ok_or_else(|| {
+                        CliError::usage(format!("--points: {what} must be a number > 0, got {s:?} in {p:?}"))
+                    })
+            };
+            Ok((parse(a, "the bulk density (kg/m^3)")?, parse(b, "the period (h)")?))
+        })
+        .collect()
+}
+
+/// `rubblepile spinup density-fit`.
+pub fn density_fit(args: &DensityFitArgs) -> Result<(), CliError> {
+    let pts = parse_points(&args.points)?;
+    if pts.is_empty() {
+        return Err(CliError::usage("--points: give at least one RHO:T pair"));
+    }
+    if !(args.period.is_finite() && args.period > 0.0) {
+        return Err(CliError::usage(format!(
+            "--period must be > 0 hours, got {}",
+            args.period
+        )));
+    }
+    let fit = fit_density(&pts, SI_G, args.period).ok_or_else(|| CliError::usage("--points: nothing to fit"))?;
+    println!(
+        "kappa = {:.4} +- {:.4} from {} points; critical bulk density at T = {} h: {:.0} kg/m^3",
+        fit.kappa,
+        fit.sigma_kappa,
+        pts.len(),
+        args.period,
+        fit.critical_density
+    );
+    Ok(())
+}
+
+/// Where a model's runs live under the report's RUNS directory.
+pub fn model_dir(runs: &Path, model: &str) -> PathBuf {
+    runs.join(model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(t: f64, theta: f64, eta: f64, coord: f64, forcing: bool) -> SpinupSample {
+        SpinupSample {
+            t,
+            path_period_h: 2.3,
+            period_h: 2.3,
+            forcing,
+            body_particles: 100,
+            body_mass_fraction: 1.0,
+            a: 1.0,
+            b: 1.0,
+            c: 1.0,
+            b_over_a: 1.0,
+            c_over_a: 1.0,
+            packing_fraction: eta,
+            interior_particles: 50,
+            coordination_number: coord,
+            fraction_0_contacts: 0.0,
+            fraction_1_contact: 0.0,
+            rves: 5,
+            s_max: 1.0,
+            p_max: 1.0,
+            theta_max_deg: theta,
+        }
+    }
+
+    /// The creep criterion on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps;
+    /// T_c,3 is the first stable T_final and φ the largest θ_max within ±0.01 h of it.
+    #[test]
+    fn hold_verdicts_give_t_c3_and_phi() {
+        let hold = |rise: f64, level: f64| -> Vec<SpinupSample> {
+            (0..100)
+                .map(|k| {
+                    sample(
+                        1000.0 + 10.0 * k as f64,
+                        level + rise * k as f64 / 99.0,
+                        0.74,
+                        9.0,
+                        true,
+                    )
+                })
+                .collect()
+        };
+        let c = CreepCriterion::default();
+        let verdict = |tf: f64, s: &[SpinupSample]| {
+            let (released, drifting, theta) = judge_hold(s, 1000.0, &c);
+            HoldVerdict {
+                t_final_hours: tf,
+                dir: PathBuf::new(),
+                released,
+                stable: !released && drifting.is_empty(),
+                drifting,
+                theta_max_deg: theta,
+            }
+        };
+        let runs = vec![
+            verdict(2.40, &hold(2.0, 40.0)),
+            verdict(2.41, &hold(0.0, 39.0)),
+            verdict(2.42, &hold(0.0, 37.5)),
+        ];
+        assert!(!runs[0].stable && runs[0].drifting == vec!["theta_max"]);
+        assert!(runs[1].stable && runs[2].stable);
+        let (t, phi) = critical_from_verdicts(&runs);
+        assert_eq!(t, Some(2.41));
+        assert_eq!(phi, Some(42.0));
+        // a released run is never stable
+        let mut s = hold(0.0, 30.0);
+        s[50].forcing = false;
+        assert!(!verdict(2.5, &s).stable);
+    }
+
+    #[test]
+    fn points_parse_and_name_the_bad_one() {
+        assert_eq!(
+            parse_points(&["2100:2.4".into(), "2500:2.2".into()]).unwrap(),
+            vec![(2100.0, 2.4), (2500.0, 2.2)]
+        );
+        let e = parse_points(&["2100-2.4".into()]).unwrap_err();
+        assert!(e.message.contains("expected RHO:T"), "{}", e.message);
+        let e = parse_points(&["2100:-1".into()]).unwrap_err();
+        assert!(
+            e.message.contains("the period (h) must be a number > 0"),
+            "{}",
+            e.message
+        );
+    }
+}

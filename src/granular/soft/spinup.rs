@@ -1,0 +1,558 @@
+//! Quasi-static spin-up of a soft-sphere rubble pile (Zhang17 §2.3.4, Fig. 3 and Table 5): the scene table
+//! `[spinup]`, the spin-period path `T(t)`, the angular-momentum forcing of the central body, and its release
+//! once global disruption is confirmed.
+//!
+//! ```toml
+//! [spinup]                     # Zhang17 Table 5, path 2; periods in hours, times in seconds
+//! T_start = 5.0                # h, period held while the body settles, 0 ≤ t ≤ t_start
+//! T_inter = 3.0                # h, reached linearly at t_inter
+//! T_final = 2.26               # h, reached at t_final, then held until the end of the run (creep tests)
+//! t_start = 700.0              # s
+//! t_inter = 7000.0             # s
+//! t_final = 32000.0            # s
+//! rests = 0                    # rest stages inserted in the slow phase (path 1: 5)
+//! rest_length = 0.0            # s, length of each rest (path 1: 7000)
+//! axis = [0.0, 0.0, 1.0]       # spin axis, fixed in space (normalised); default z
+//! release_axis_ratio = 0.1     # disruption: |Δ(b/a)| or |Δ(c/a)| above this ...
+//! release_packing = 0.01       # ... or |Δη_B| above this (both from the values at t_start) ...
+//! release_samples = 2          # ... at this many consecutive output samples: forcing released
+//! rve_particles = 300          # target particles per representative volume element (stress diagnostics)
+//! ```
+//!
+//! **The path.** `T = T_start` until `t_start` (the body settles at a slow spin); then linear in `T` (as the paper
+//! says, "linearly spun up") to `T_inter` at `t_inter`; then from `T_inter` to `T_final` at `t_final` in
+//! `rests + 1` equal spin-up stages, each linear in `T` and separated by `rests` rests of `rest_length` during which
+//! `T` is held (Fig. 3); after `t_final`, `T = T_final` (the hold of the creep tests, as long as the run lasts).
+//!
+//! **The central body** is the largest (by mass) set of particles connected through contacts at the current step.
+//! Shed or orbiting particles have no contact with it and are not forced; a particle in flight for a few steps
+//! after a bounce is also left alone for those steps, which carries no bias since it keeps its momentum.
+//!
+//! **Angular-momentum spin-up** (the authors' option): the target is an angular momentum about the body's centre
+//! of mass along `axis`, `L*(t) = I_ref Ω(t)` with `Ω = 2π/T(t)` and `I_ref` the moment of inertia of the current
+//! members *as they were placed at t = 0* (about the initial centre of mass). A body that expands therefore
+//! spins slower than the path instead of being given more angular momentum, and losing members lowers the target
+//! in proportion. After each step the difference `ΔL = L* − L` is added as a rigid-rotation increment
+//! `Δω = ΔL/I` about the body's current centre of mass (`I` its current moment of inertia about the axis through
+//! it): `v_i += Δω a × (x_i − R)`, `ω_i += Δω a` for every member. This conserves the body's linear momentum and
+//! changes its angular momentum along `a` by exactly `ΔL`.
+//!
+//! **Release** ("global disruption confirmed", Zhang17 §2.3.4 footnote 6: the packing efficiency and the axis
+//! ratios drop rapidly): at output samples the driver compares b/a, c/a and η_B with their values at the first
+//! sample at or after `t_start`; when a change exceeds ten times the T_c,1 / T_c,2 thresholds (defaults) at
+//! `release_samples` consecutive samples, the forcing stops for good and the body evolves freely.
+
+use serde::{Deserialize, Serialize};
+
+use crate::granular::soft::particle::Particle;
+use crate::math::Vec3;
+use crate::scene::SceneError;
+
+fn d_release_axis() -> f64 {
+    0.1
+}
+fn d_release_packing() -> f64 {
+    0.01
+}
+fn d_release_samples() -> u32 {
+    2
+}
+fn d_rve() -> usize {
+    300
+}
+
+/// The `[spinup]` table as written (periods in hours, times in seconds).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpinupSection {
+    /// Period held while the body settles (h, > 0).
+    #[serde(rename = "T_start")]
+    pub period_start_h: f64,
+    /// Period at `t_inter` (h, > 0, ≤ `T_start`).
+    #[serde(rename = "T_inter")]
+    pub period_inter_h: f64,
+    /// Final period, held after `t_final` (h, > 0, ≤ `T_inter`).
+    #[serde(rename = "T_final")]
+    pub period_final_h: f64,
+    /// End of the settling phase (s, ≥ 0).
+    pub t_start: f64,
+    /// End of the fast linear spin-up (s, ≥ `t_start`).
+    pub t_inter: f64,
+    /// End of the slow spin-up (s, ≥ `t_inter`).
+    pub t_final: f64,
+    /// Rest stages in the slow phase (default 0).
+    #[serde(default)]
+    pub rests: u32,
+    /// Length of each rest (s, ≥ 0; default 0); all rests together shorter than `t_final − t_inter`.
+    #[serde(default)]
+    pub rest_length: f64,
+    /// Spin axis, fixed in space (non-zero; default `[0, 0, 1]`).
+    #[serde(default)]
+    pub axis: Option<[f64; 3]>,
+    /// Release threshold on b/a and c/a (> 0; default 0.1).
+    #[serde(default = "d_release_axis")]
+    pub release_axis_ratio: f64,
+    /// Release threshold on η_B (> 0; default 0.01).
+    #[serde(default = "d_release_packing")]
+    pub release_packing: f64,
+    /// Consecutive samples beyond a release threshold that confirm disruption (≥ 1; default 2).
+    #[serde(default = "d_release_samples")]
+    pub release_samples: u32,
+    /// Target particles per RVE (≥ 8; default 300).
+    #[serde(default = "d_rve")]
+    pub rve_particles: usize,
+}
+
+/// The spin-period path `T(t)` in SI units (periods and times in s).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SpinupPath {
+    /// `T_start` (s).
+    pub period_start: f64,
+    /// `T_inter` (s).
+    pub period_inter: f64,
+    /// `T_final` (s).
+    pub period_final: f64,
+    /// `t_start` (s).
+    pub t_start: f64,
+    /// `t_inter` (s).
+    pub t_inter: f64,
+    /// `t_final` (s).
+    pub t_final: f64,
+    /// Rests in the slow phase.
+    pub rests: u32,
+    /// Length of each rest (s).
+    pub rest_length: f64,
+}
+
+impl SpinupPath {
+    /// The path's period (s) at time `t` (s).
+    pub fn period(&self, t: f64) -> f64 {
+        let lerp = |a: f64, b: f64, f: f64| a + (b - a) * f.clamp(0.0, 1.0);
+        if t <= self.t_start {
+            return self.period_start;
+        }
+        if t <= self.t_inter {
+            let span = self.t_inter - self.t_start;
+            let f = if span > 0.0 { (t - self.t_start) / span } else { 1.0 };
+            return lerp(self.period_start, self.period_inter, f);
+        }
+        if t >= self.t_final {
+            return self.period_final;
+        }
+        let stages = self.rests as f64 + 1.0;
+        let stage = (self.t_final - self.t_inter - self.rests as f64 * self.rest_length) / stages;
+        let cycle = stage + self.rest_length;
+        let s = t - self.t_inter;
+        let k = (s / cycle).floor().min(self.rests as f64);
+        let within = s - k * cycle;
+        let done = k + if stage > 0.0 { (within / stage).min(1.0) } else { 1.0 };
+        lerp(self.period_inter, self.period_final, done / stages)
+    }
+
+    /// The path's spin rate `2π/T(t)` (rad/s).
+    pub fn omega(&self, t: f64) -> f64 {
+        std::f64::consts::TAU / self.period(t)
+    }
+}
+
+/// Validated `[spinup]` settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpinupSettings {
+    /// The path.
+    pub path: SpinupPath,
+    /// Unit spin axis.
+    pub axis: Vec3,
+    /// Release threshold on b/a and c/a.
+    pub release_axis_ratio: f64,
+    /// Release threshold on η_B.
+    pub release_packing: f64,
+    /// Consecutive samples that confirm disruption.
+    pub release_samples: u32,
+    /// Target particles per RVE.
+    pub rve_particles: usize,
+}
+
+impl crate::scene::Validator<'_> {
+    /// Checks a `[spinup]` table; errors name the field (`spinup.T_final`, …) and the expected value.
+    pub(crate) fn spinup(&self, s: &SpinupSection) -> Result<SpinupSettings, SceneError> {
+        let ts = self.positive("spinup.T_start", s.period_start_h)?;
+        let ti = self.positive("spinup.T_inter", s.period_inter_h)?;
+        let tf = self.positive("spinup.T_final", s.period_final_h)?;
+        if ti > ts {
+            return Err(self.invalid("spinup.T_inter", format!("must be <= T_start = {ts} h, got {ti}")));
+        }
+        if tf > ti {
+            return Err(self.invalid("spinup.T_final", format!("must be <= T_inter = {ti} h, got {tf}")));
+        }
+        let t0 = self.non_negative("spinup.t_start", s.t_start)?;
+        let t1 = self.non_negative("spinup.t_inter", s.t_inter)?;
+        let t2 = self.non_negative("spinup.t_final", s.t_final)?;
+        if t1 < t0 {
+            return Err(self.invalid("spinup.t_inter", format!("must be >= t_start = {t0} s, got {t1}")));
+        }
+        if t2 < t1 {
+            return Err(self.invalid("spinup.t_final", format!("must be >= t_inter = {t1} s, got {t2}")));
+        }
+        let rest = self.non_negative("spinup.rest_length", s.rest_length)?;
+        if s.rests as f64 * rest >= t2 - t1 && s.rests > 0 {
+            return Err(self.invalid(
+                "spinup.rest_length",
+                format!(
+                    "rests x rest_length must be < t_final - t_inter = {} s, got {} x {rest}",
+                    t2 - t1,
+                    s.rests
+                ),
+            ));
+        }
+        let axis = Vec3::from(s.axis.unwrap_or([0.0, 0.0, 1.0]));
+        if !(axis.iter().all(|x| x.is_finite()) && axis.norm() > 0.0) {
+            return Err(self.invalid(
+                "spinup.axis",
+                format!("must be a finite non-zero vector, got {:?}", s.axis),
+            ));
+        }
+        if s.release_samples == 0 {
+            return Err(self.invalid("spinup.release_samples", "must be >= 1, got 0"));
+        }
+        if s.rve_particles < 8 {
+            return Err(self.invalid("spinup.rve_particles", format!("must be >= 8, got {}", s.rve_particles)));
+        }
+        Ok(SpinupSettings {
+            path: SpinupPath {
+                period_start: ts * 3600.0,
+                period_inter: ti * 3600.0,
+                period_final: tf * 3600.0,
+                t_start: t0,
+                t_inter: t1,
+                t_final: t2,
+                rests: s.rests,
+                rest_length: rest,
+            },
+            axis: axis.normalize(),
+            release_axis_ratio: self.positive("spinup.release_axis_ratio", s.release_axis_ratio)?,
+            release_packing: self.positive("spinup.release_packing", s.release_packing)?,
+            release_samples: s.release_samples,
+            rve_particles: s.rve_particles,
+        })
+    }
+}
+
+/// Membership of the central body: the largest-mass set of particles connected by the pair contacts `contacts`
+/// (`(i, j)` keys, as [`crate::granular::soft::forces::SoftSystem::pair_springs`] after a force evaluation); ties go
+/// to the set holding the lowest index.
+pub fn central_body<'a>(particles: &[Particle], contacts: impl Iterator<Item = &'a (usize, usize)>) -> Vec<bool> {
+    let n = particles.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for &(i, j) in contacts {
+        if i < n && j < n {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut mass = vec![0.0; n];
+    for (i, p) in particles.iter().enumerate() {
+        let r = root(&mut parent, i);
+        mass[r] += p.mass;
+    }
+    let best = (0..n).fold(0, |b, r| if mass[r] > mass[b] { r } else { b });
+    (0..n).map(|i| root(&mut parent, i) == best).collect()
+}
+
+/// Rotation of a set of particles about an axis through their centre of mass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BodyRotation {
+    /// Centre of mass (m).
+    pub centre: Vec3,
+    /// Centre-of-mass velocity (m/s).
+    pub velocity: Vec3,
+    /// Moment of inertia about the axis through the centre (kg m²), spheres' own (2/5) m r² included.
+    pub inertia: f64,
+    /// Angular momentum along the axis about the centre, orbital plus spins (kg m²/s).
+    pub angular_momentum: f64,
+    /// Mass (kg).
+    pub mass: f64,
+}
+
+impl BodyRotation {
+    /// Effective spin period `2π I/L` (s); infinite without rotation.
+    pub fn period(&self) -> f64 {
+        if self.angular_momentum.abs() > 0.0 {
+            std::f64::consts::TAU * self.inertia / self.angular_momentum.abs()
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// [`BodyRotation`] of the members of `particles` about unit `axis`.
+pub fn body_rotation(particles: &[Particle], member: &[bool], axis: &Vec3) -> BodyRotation {
+    let (mut m, mut mx, mut mv) = (0.0, Vec3::zeros(), Vec3::zeros());
+    for (p, _) in particles.iter().zip(member).filter(|(_, k)| **k) {
+        m += p.mass;
+        mx += p.position * p.mass;
+        mv += p.velocity * p.mass;
+    }
+    if m <= 0.0 {
+        return BodyRotation {
+            centre: Vec3::zeros(),
+            velocity: Vec3::zeros(),
+            inertia: 0.0,
+            angular_momentum: 0.0,
+            mass: 0.0,
+        };
+    }
+    let (centre, velocity) = (mx / m, mv / m);
+    let (mut inertia, mut l) = (0.0, 0.0);
+    for (p, _) in particles.iter().zip(member).filter(|(_, k)| **k) {
+        let d = p.position - centre;
+        let perp = d - axis * d.dot(axis);
+        inertia += p.mass * perp.norm_squared() + p.inertia();
+        l += d.cross(&(p.velocity - velocity)).dot(axis) * p.mass + p.inertia() * p.spin.dot(axis);
+    }
+    BodyRotation {
+        centre,
+        velocity,
+        inertia,
+        angular_momentum: l,
+        mass: m,
+    }
+}
+
+/// The forcing's state through a run (checkpointed by [`SpinupDriver::state`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpinupDriver {
+    /// Settings.
+    pub settings: SpinupSettings,
+    initial: Vec<Vec3>,
+    initial_centre: Vec3,
+    /// Whether the forcing has been released.
+    pub released: bool,
+    /// Time of the release (s).
+    pub release_time: Option<f64>,
+    strikes: u32,
+    /// b/a, c/a and η_B at the first sample at or after `t_start` (the release reference).
+    pub reference: Option<[f64; 3]>,
+}
+
+impl SpinupDriver {
+    /// A driver for a run starting from `initial` (the particles at t = 0).
+    pub fn new(settings: SpinupSettings, initial: &[Particle]) -> Self {
+        let m: f64 = initial.iter().map(|p| p.mass).sum();
+        let c = initial.iter().map(|p| p.position * p.mass).sum::<Vec3>() / m.max(f64::MIN_POSITIVE);
+        SpinupDriver {
+            settings,
+            initial: initial.iter().map(|p| p.position).collect(),
+            initial_centre: c,
+            released: false,
+            release_time: None,
+            strikes: 0,
+            reference: None,
+        }
+    }
+
+    /// `I_ref` of the members: their moment of inertia about the axis as placed at t = 0 (kg m²).
+    pub fn reference_inertia(&self, particles: &[Particle], member: &[bool]) -> f64 {
+        let a = self.settings.axis;
+        particles
+            .iter()
+            .zip(&self.initial)
+            .zip(member)
+            .filter(|(_, k)| **k)
+            .map(|((p, x0), _)| {
+                let d = x0 - self.initial_centre;
+                p.mass * (d - a * d.dot(&a)).norm_squared() + p.inertia()
+            })
+            .sum()
+    }
+
+    /// Applies the spin-up increment at time `t` (s) to the central body given by `member`; nothing once released.
+    /// Returns the applied `Δω` (rad/s).
+    pub fn apply(&self, particles: &mut [Particle], member: &[bool], t: f64) -> f64 {
+        if self.released {
+            return 0.0;
+        }
+        let a = self.settings.axis;
+        let rot = body_rotation(particles, member, &a);
+        if rot.inertia <= 0.0 {
+            return 0.0;
+        }
+        let target = self.reference_inertia(particles, member) * self.settings.path.omega(t);
+        let dw = (target - rot.angular_momentum) / rot.inertia;
+        for (p, _) in particles.iter_mut().zip(member).filter(|(_, k)| **k) {
+            p.velocity += a.cross(&(p.position - rot.centre)) * dw;
+            p.spin += a * dw;
+        }
+        dw
+    }
+
+    /// Feeds the diagnostics of an output sample at time `t` (s): sets the reference at the first sample at or
+    /// after `t_start`, then counts consecutive samples beyond a release threshold and releases the forcing at
+    /// `release_samples` of them. Non-finite values (e.g. no interior particle left) count as beyond.
+    pub fn observe(&mut self, t: f64, b_over_a: f64, c_over_a: f64, packing: f64) {
+        if self.released || t < self.settings.path.t_start {
+            return;
+        }
+        let Some(r) = self.reference else {
+            self.reference = Some([b_over_a, c_over_a, packing]);
+            return;
+        };
+        let beyond = |x: f64, x0: f64, tol: f64| (x - x0).abs() > tol || (x - x0).is_nan();
+        let s = &self.settings;
+        let out = beyond(b_over_a, r[0], s.release_axis_ratio)
+            || beyond(c_over_a, r[1], s.release_axis_ratio)
+            || (r[2].is_finite() && beyond(packing, r[2], s.release_packing));
+        self.strikes = if out { self.strikes + 1 } else { 0 };
+        if self.strikes >= s.release_samples {
+            self.released = true;
+            self.release_time = Some(t);
+        }
+    }
+
+    /// The checkpointed state: released, release time (NaN if none), strikes, reference (NaN × 3 if none).
+    pub fn state(&self) -> Vec<f64> {
+        let r = self.reference.unwrap_or([f64::NAN; 3]);
+        vec![
+            if self.released { 1.0 } else { 0.0 },
+            self.release_time.unwrap_or(f64::NAN),
+            self.strikes as f64,
+            if self.reference.is_some() { 1.0 } else { 0.0 },
+            r[0],
+            r[1],
+            r[2],
+        ]
+    }
+
+    /// Restores [`SpinupDriver::state`]; `None` if malformed.
+    pub fn restore(&mut self, v: &[f64]) -> Option<()> {
+        if v.len() != 7 {
+            return None;
+        }
+        self.released = v[0] == 1.0;
+        self.release_time = v[1].is_finite().then_some(v[1]);
+        self.strikes = v[2] as u32;
+        self.reference = (v[3] == 1.0).then_some([v[4], v[5], v[6]]);
+        Some(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn path(rests: u32, rest_length: f64) -> SpinupPath {
+        SpinupPath {
+            period_start: 5.0,
+            period_inter: 3.0,
+            period_final: 2.0,
+            t_start: 10.0,
+            t_inter: 30.0,
+            t_final: 130.0,
+            rests,
+            rest_length,
+        }
+    }
+
+    #[test]
+    fn path_nodes_linear_stages_and_rests() {
+        let p = path(0, 0.0);
+        assert_eq!(p.period(0.0), 5.0);
+        assert_eq!(p.period(10.0), 5.0);
+        assert!((p.period(20.0) - 4.0).abs() < 1e-12);
+        assert!((p.period(30.0) - 3.0).abs() < 1e-12);
+        assert!((p.period(80.0) - 2.5).abs() < 1e-12);
+        assert_eq!(p.period(130.0), 2.0);
+        assert_eq!(p.period(1e6), 2.0);
+        // two rests of 20 s: three stages of 20 s (0.333 h of T each), held during the rests
+        let p = path(2, 20.0);
+        assert!((p.period(50.0) - (3.0 - 1.0 / 3.0)).abs() < 1e-12);
+        assert!((p.period(60.0) - (3.0 - 1.0 / 3.0)).abs() < 1e-12);
+        assert!((p.period(70.0) - (3.0 - 1.0 / 3.0)).abs() < 1e-12);
+        assert!((p.period(80.0) - 2.5).abs() < 1e-12);
+        assert!((p.period(100.0) - (2.0 + 1.0 / 3.0)).abs() < 1e-12);
+        assert!((p.period(129.999) - 2.0).abs() < 1e-4);
+    }
+
+    #[test]
+    fn central_body_is_the_heaviest_contact_cluster() {
+        let p = |m: f64| Particle {
+            mass: m,
+            radius: 1.0,
+            position: Vec3::zeros(),
+            velocity: Vec3::zeros(),
+            spin: Vec3::zeros(),
+        };
+        let ps = [p(1.0), p(1.0), p(1.0), p(5.0), p(1.0)];
+        let contacts = [(0, 1), (1, 2), (3, 4)];
+        assert_eq!(
+            central_body(&ps, contacts.iter()),
+            vec![false, false, false, true, true]
+        );
+    }
+
+    #[test]
+    fn increment_sets_the_target_angular_momentum_and_keeps_momentum() {
+        let settings = SpinupSettings {
+            path: path(0, 0.0),
+            axis: Vec3::new(0.0, 0.0, 1.0),
+            release_axis_ratio: 0.1,
+            release_packing: 0.01,
+            release_samples: 2,
+            rve_particles: 300,
+        };
+        let mut ps: Vec<Particle> = (0..6)
+            .map(|k| Particle {
+                mass: 1.0 + k as f64,
+                radius: 0.5,
+                position: Vec3::new((k as f64).cos() * 2.0, (k as f64).sin() * 3.0, k as f64 * 0.3),
+                velocity: Vec3::new(0.1 * k as f64, -0.05, 0.02),
+                spin: Vec3::new(0.0, 0.1, 0.3),
+            })
+            .collect();
+        let d = SpinupDriver::new(settings, &ps);
+        let member = vec![true; 6];
+        let p0: Vec3 = ps.iter().map(|p| p.velocity * p.mass).sum();
+        d.apply(&mut ps, &member, 20.0);
+        let rot = body_rotation(&ps, &member, &settings.axis);
+        let want = d.reference_inertia(&ps, &member) * std::f64::consts::TAU / 4.0;
+        assert!((rot.angular_momentum - want).abs() < 1e-12 * want, "{rot:?} {want}");
+        let p1: Vec3 = ps.iter().map(|p| p.velocity * p.mass).sum();
+        assert!((p1 - p0).norm() < 1e-12);
+        // unmoved particles: I = I_ref, so the period is the path's
+        assert!((rot.period() - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn release_needs_consecutive_confirmations_and_state_round_trips() {
+        let settings = SpinupSettings {
+            path: path(0, 0.0),
+            axis: Vec3::z(),
+            release_axis_ratio: 0.1,
+            release_packing: 0.01,
+            release_samples: 2,
+            rve_particles: 300,
+        };
+        let mut d = SpinupDriver::new(settings, &[]);
+        d.observe(5.0, 0.5, 0.5, 0.5); // before t_start: ignored
+        assert_eq!(d.reference, None);
+        d.observe(10.0, 0.9, 0.8, 0.74);
+        d.observe(20.0, 0.75, 0.8, 0.74); // one strike
+        d.observe(30.0, 0.9, 0.8, 0.74); // reset
+        d.observe(40.0, 0.9, 0.8, 0.72); // η strike
+        assert!(!d.released);
+        let mut e = SpinupDriver::new(settings, &[]);
+        e.restore(&d.state()).unwrap();
+        assert_eq!(e, d);
+        d.observe(50.0, 0.9, 0.65, 0.74);
+        assert!(d.released);
+        assert_eq!(d.release_time, Some(50.0));
+    }
+}
