@@ -75,19 +75,28 @@ pub fn reopen_timeseries(dir: &Path, bytes: u64) -> Result<File, RunError> {
             std::fs::remove_file(&p).map_err(|e| io(&p, e))?;
         }
     }
-    let ts = dir.join("timeseries.csv");
+    reopen_truncated(&dir.join("timeseries.csv"), bytes)
+}
+
+/// Opens the output file `path` for appending after cutting it back to `bytes`, its length at the checkpoint.
+///
+/// Errors: [`RunError::BadCheckpoint`] when the file is missing or shorter than `bytes`; [`RunError::Io`].
+pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<File, RunError> {
+    let io = |e: std::io::Error| RunError::Io {
+        path: path.to_path_buf(),
+        source: e,
+    };
     let mut file = std::fs::OpenOptions::new()
         .write(true)
-        .open(&ts)
-        .map_err(|e| RunError::BadCheckpoint(format!("{}: {e}", ts.display())))?;
-    let len = file.metadata().map_err(|e| io(&ts, e))?.len();
-    if len < bytes {
+        .open(path)
+        .map_err(|e| RunError::BadCheckpoint(format!("{}: {e}", path.display())))?;
+    if file.metadata().map_err(io)?.len() < bytes {
         return Err(RunError::BadCheckpoint(format!(
             "{} is shorter than at the checkpoint",
-            ts.display()
+            path.display()
         )));
     }
-    file.set_len(bytes).map_err(|e| io(&ts, e))?;
-    file.seek(SeekFrom::End(0)).map_err(|e| io(&ts, e))?;
+    file.set_len(bytes).map_err(io)?;
+    file.seek(SeekFrom::End(0)).map_err(io)?;
     Ok(file)
 }

@@ -36,6 +36,7 @@ use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene::{SoftScene, parse_soft_scene, scene_kind};
 use crate::granular::soft::spinup::{SpinupDriver, central_body};
 use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exact_f64_vec, fnv1a_hex};
+use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries, reopen_truncated};
 use crate::math::Vec3;
 use crate::run::{RunError, RunOptions, prepare_output_dir};
 
@@ -302,6 +303,15 @@ struct SoftCheckpoint {
     spinup: Option<SpinupCheckpoint>,
 }
 
+impl EngineCheckpoint for SoftCheckpoint {
+    fn format(&self) -> &str {
+        &self.format
+    }
+    fn scene_hash(&self) -> &str {
+        &self.scene_hash
+    }
+}
+
 // ---- spin-up hook (Zhang17 §2.3.4; crate::granular::soft::spinup) --------------------------------------
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct SpinupCheckpoint {
@@ -515,37 +525,9 @@ pub fn is_soft_run_dir(dir: &Path) -> bool {
 /// Continues an interrupted soft-sphere run from `dir/checkpoint.json`, bit for bit.
 pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, SoftRunError> {
     let bad = |m: String| SoftRunError::Run(RunError::BadCheckpoint(m));
-    if let Ok(text) = std::fs::read_to_string(dir.join("summary.json"))
-        && let Ok(s) = serde_json::from_str::<SoftSummary>(&text)
-        && s.status == "completed"
-    {
-        return Err(SoftRunError::Run(RunError::AlreadyCompleted {
-            dir: dir.to_path_buf(),
-            t: s.final_time,
-        }));
-    }
-    let cpath = dir.join(CHECKPOINT_FILE);
-    if !cpath.is_file() {
-        return Err(SoftRunError::Run(RunError::NoCheckpoint { dir: dir.to_path_buf() }));
-    }
-    let ctext = std::fs::read_to_string(&cpath).map_err(|e| bad(format!("{}: {e}", cpath.display())))?;
-    let ck: SoftCheckpoint =
-        serde_json::from_str(&ctext).map_err(|e| bad(format!("{}: {}", cpath.display(), e.to_string().trim())))?;
-    if ck.format != SOFT_CHECKPOINT_FORMAT {
-        return Err(bad(format!(
-            "{}: not a soft-sphere checkpoint ({:?})",
-            cpath.display(),
-            ck.format
-        )));
-    }
+    let (ck, text): (SoftCheckpoint, String) =
+        open_checkpoint(dir, SOFT_CHECKPOINT_FORMAT, "soft-sphere").map_err(SoftRunError::Run)?;
     let spath = dir.join("scene.toml");
-    let text = std::fs::read_to_string(&spath).map_err(|e| bad(format!("{}: {e}", spath.display())))?;
-    if fnv1a_hex(text.as_bytes()) != ck.scene_hash {
-        return Err(bad(format!(
-            "{} changed since the checkpoint was written",
-            spath.display()
-        )));
-    }
     let scene = parse_soft_scene(&text, &spath.display().to_string(), ck.scene_base_dir.as_deref())
         .map_err(|e| bad(e.to_string()))?;
     let n = scene.particles.len();
@@ -590,41 +572,14 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
     }
     let book = Book::from_vec(&ck.book).ok_or_else(|| bad("malformed bookkeeping".into()))?;
 
-    for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
-        let p = dir.join(name);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(io_err(&p))?;
-        }
-    }
-    let ts = dir.join("timeseries.csv");
-    let file = std::fs::OpenOptions::new()
-        .write(true)
-        .open(&ts)
-        .map_err(|e| bad(format!("{}: {e}", ts.display())))?;
-    let len = file.metadata().map_err(io_err(&ts))?.len();
-    if len < ck.timeseries_bytes {
-        return Err(bad(format!("{} is shorter than at the checkpoint", ts.display())));
-    }
-    file.set_len(ck.timeseries_bytes).map_err(io_err(&ts))?;
-    let mut file = file;
-    use std::io::Seek;
-    file.seek(std::io::SeekFrom::End(0)).map_err(io_err(&ts))?;
+    let file = reopen_timeseries(dir, ck.timeseries_bytes).map_err(SoftRunError::Run)?;
     let spin = match (&scene.spinup, &ck.spinup) {
         (Some(settings), Some(sc)) => {
             let mut driver = SpinupDriver::new(*settings, &scene.particles);
             driver
                 .restore(&sc.state)
                 .ok_or_else(|| bad("malformed spin-up state".into()))?;
-            let path = dir.join("spinup.csv");
-            let mut f = std::fs::OpenOptions::new()
-                .write(true)
-                .open(&path)
-                .map_err(|e| bad(format!("{}: {e}", path.display())))?;
-            if f.metadata().map_err(io_err(&path))?.len() < sc.bytes {
-                return Err(bad(format!("{} is shorter than at the checkpoint", path.display())));
-            }
-            f.set_len(sc.bytes).map_err(io_err(&path))?;
-            f.seek(std::io::SeekFrom::End(0)).map_err(io_err(&path))?;
+            let f = reopen_truncated(&dir.join("spinup.csv"), sc.bytes).map_err(SoftRunError::Run)?;
             Some(SpinRun {
                 driver,
                 csv: BufWriter::new(f),
