@@ -526,7 +526,9 @@ fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
     None
 }
 
-fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::ProgressBar> {
+/// A progress bar on stderr for a run from `t` to `t_end` (s), when `enabled` and stderr is a terminal; shared by
+/// the ellipsoid, soft- and hard-sphere drivers.
+pub(crate) fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::ProgressBar> {
     if !enabled || !std::io::stderr().is_terminal() {
         return None;
     }
@@ -539,6 +541,12 @@ fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::Progress
     pb.set_message(format!("t = {t}/{t_end} s"));
     pb.enable_steady_tick(Duration::from_millis(250));
     Some(pb)
+}
+
+/// Moves `pb` to simulated time `t` of `t_end` (s).
+pub(crate) fn show_progress(pb: &indicatif::ProgressBar, t: f64, t_end: f64) {
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.set_message(format!("t = {t:.4}/{t_end} s"));
 }
 
 /// Fingerprint of a scene's initial bodies: FNV-1a of their lossless snapshot rows.
@@ -937,8 +945,7 @@ fn drive(
         last_good.0 = t;
         last_good.1.copy_from_slice(&y);
         if let Some(pb) = &pb {
-            pb.set_position((t / scene.t_end * 1e6) as u64);
-            pb.set_message(format!("t = {t:.4}/{} s", scene.t_end));
+            show_progress(pb, t, scene.t_end);
         }
 
         let due_wall = options

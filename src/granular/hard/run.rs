@@ -20,6 +20,7 @@ use crate::io::fmt_f64;
 use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries};
 use crate::math::Vec3;
 use crate::run::{RunError, RunOptions, Schedule, prepare_output_dir};
+use crate::run::{progress_bar, show_progress};
 
 /// Columns of `timeseries.csv`.
 pub const TIMESERIES_COLUMNS: [&str; 22] = [
@@ -453,10 +454,16 @@ fn drive(scene: &HardScene, out: &Path, options: &RunOptions, start: Start) -> R
     let mut last_checkpoint_t = system.t;
     let mut written = 0u64;
     let samples: Vec<_> = Schedule::new(scene.t_end, scene.every, &scene.times).collect();
+    let pb = progress_bar(options.progress, scene.t_end, system.t);
     for (index, sample) in samples.iter().enumerate().skip(next_sample) {
         let good = system.clone();
         let mut failed = None;
         while system.t < sample.t {
+            if let Some(pb) = &pb
+                && summary.steps.is_multiple_of(64)
+            {
+                show_progress(pb, system.t, scene.t_end);
+            }
             let left = sample.t - system.t;
             let h = if left < 1.000001 * scene.dt { left } else { scene.dt };
             if let Err(e) = system.step(h) {
@@ -629,6 +636,12 @@ fn drive(scene: &HardScene, out: &Path, options: &RunOptions, start: Start) -> R
         Some((cause, _)) => cause.clone(),
         None => "completed".into(),
     };
+    if let Some(pb) = &pb {
+        match &failure {
+            Some(_) => pb.abandon(),
+            None => pb.finish_and_clear(),
+        }
+    }
     let sp = out.join("summary.json");
     let json = serde_json::to_string_pretty(&summary).map_err(|e| io(&sp)(std::io::Error::other(e)))?;
     std::fs::write(&sp, json + "\n").map_err(io(&sp))?;

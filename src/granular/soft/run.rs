@@ -39,6 +39,7 @@ use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exa
 use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries, reopen_truncated};
 use crate::math::Vec3;
 use crate::run::{RunError, RunOptions, prepare_output_dir};
+use crate::run::{progress_bar, show_progress};
 
 /// The `format` tag of a soft-sphere checkpoint.
 pub const SOFT_CHECKPOINT_FORMAT: &str = "rubblepile-ssdem-checkpoint";
@@ -657,9 +658,17 @@ fn drive(
     let mut last_checkpoint_t = step as f64 * scene.dt;
     let mut written_this_process = 0u64;
     let dt = scene.dt;
+    let pb = progress_bar(options.progress, scene.t_end, step as f64 * dt);
+    // the state before the current step, kept for `last_good_state.csv` (allocated once)
+    let mut before = sys.particles.clone();
     for (index, &(sample_step, snapshot)) in plan.iter().enumerate().skip(next_sample) {
         while step < sample_step {
-            let before = sys.particles.clone();
+            before.clone_from(&sys.particles);
+            if let Some(pb) = &pb
+                && step.is_multiple_of(256)
+            {
+                show_progress(pb, step as f64 * dt, scene.t_end);
+            }
             // the spin-up diagnostics at a sample need that step's contact records
             sys.keep_records = spin.is_some() && step + 1 == sample_step;
             leapfrog::step(&mut sys, step as f64 * dt, dt);
@@ -677,6 +686,9 @@ fn drive(
                 None
             };
             if let Some(cause) = broken {
+                if let Some(pb) = &pb {
+                    pb.abandon();
+                }
                 let t_good = step as f64 * dt;
                 let lgs = dir.join("last_good_state.csv");
                 write_particles_csv(&lgs, t_good, &before).map_err(io_err(&lgs))?;
@@ -773,6 +785,9 @@ fn drive(
                 }));
             }
         }
+    }
+    if let Some(pb) = &pb {
+        pb.finish_and_clear();
     }
     let s = summary(scene, &sys, &book, "completed".into(), step, rows, wall(&clock));
     write_summary(&dir.join("summary.json"), &s)?;
