@@ -662,12 +662,13 @@ impl HardRunSummary {
     /// One line for the terminal.
     pub fn one_line(&self) -> String {
         format!(
-            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy error {:.2e}, max overlap {:.2e}, {} absorbed, {:.2} s",
+            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy residual {:.2e} (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
             self.status,
             self.t_reached,
             self.steps,
             self.collisions,
             self.events_per_second,
+            self.energy_residual,
             self.energy_error,
             self.max_overlap,
             self.absorbed,
