@@ -1,6 +1,6 @@
-//! Shapes that aggregates are carved from (Zhang17 §2.3.2: "the shape model of the Didymos primary is used to
-//! carve out the figure of the granular assembly"; a particle is kept when its centre is inside, so grains stick
-//! out of the surface by up to a radius, as in the paper's Fig. 4).
+//! Shapes that aggregates are carved from (Zhang17 §2.3.2 carves its packings with the Didymos primary's shape
+//! model; a particle is kept when its centre is inside, so grains stick out of the surface by up to a radius, as
+//! in the paper's Fig. 4).
 //!
 //! One enum, [`Shape`], with `contains(p)` and an exact volume: a sphere, a triaxial ellipsoid, a Didymos-like
 //! "top" ([`Top`]), and any closed triangulated OBJ model ([`crate::geometry::polyhedron::Polyhedron`]).
@@ -18,7 +18,7 @@ use crate::math::Vec3;
 /// spheroid only in a band about the equator, where it forms a sharp ridge of flank slope `atan(h/A)` to the
 /// equatorial plane; above that band the body is the spheroid.
 ///
-/// Chosen numbers ([`Top::didymos`]): overall polar-to-equatorial ratio `c_s / A = 0.84` (the brief's reading of
+/// Chosen numbers ([`Top::didymos`]): overall polar-to-equatorial ratio `c_s / A = 0.84` (our reading of
 /// the pre-DART radar model of the Didymos primary: c/a ≈ 0.83–0.85 with a ridge at the equator), ridge excess
 /// `δ = 0.04` (the ridge stands 4 % beyond the spheroid's equator), `h = A/2` (flanks at 26.6°), and the whole
 /// figure scaled so that its volume-equivalent diameter is exactly the one asked for (780 m for Didymos,
