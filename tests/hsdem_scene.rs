@@ -124,6 +124,11 @@ fn bad_input_is_one_line_naming_the_field() {
             "unknown field `foo` in [material]",
         ),
         (
+            "position = [0.01, 0.0, 0.5]",
+            "position = [0.01, 0.0, 0.35]",
+            "particle[0].position: overlaps particle[1]",
+        ),
+        (
             "omega = 30.0 }",
             "omega = 30.0, direction = [0.0, 0.0, 0.0] }",
             "wall[1].oscillation.direction",

@@ -459,6 +459,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             }
         }
     }
+    reject_deep_overlaps(&v, &particles)?;
     Ok(HardScene {
         name: name.to_string(),
         source: text.to_string(),
@@ -478,6 +479,33 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         every,
         file,
     })
+}
+
+/// Largest initial overlap of two hard spheres accepted, as a fraction of the smaller radius. Touching and
+/// round-off overlaps are resolved at once by the event loop; a sphere placed deep inside another would bounce in
+/// place forever and stall it, so such a start is refused.
+pub const MAX_START_OVERLAP: f64 = 1e-3;
+
+/// Refuses a start where two spheres, not both stuck to walls, overlap by more than [`MAX_START_OVERLAP`].
+fn reject_deep_overlaps(v: &V, particles: &[Particle]) -> Result<(), SceneError> {
+    let centres: Vec<Vec3> = particles.iter().map(|p| p.position).collect();
+    let radii: Vec<f64> = particles.iter().map(|p| p.radius).collect();
+    for (i, j) in crate::geometry::neighbours::sphere_pairs(&centres, &radii) {
+        if particles[i].stuck.is_some() && particles[j].stuck.is_some() {
+            continue;
+        }
+        let overlap = radii[i] + radii[j] - (centres[j] - centres[i]).norm();
+        let fraction = overlap / radii[i].min(radii[j]);
+        if fraction > MAX_START_OVERLAP {
+            return Err(v.invalid(
+                format!("particle[{i}].position"),
+                format!(
+                    "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start; hard spheres may overlap by at most {MAX_START_OVERLAP} of it"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
