@@ -74,22 +74,34 @@ pub fn pair_energy_change(b1: &Body, b2: &Body, r: Restitution) -> f64 {
     -0.5 * mu * (1.0 - r.eps_n * r.eps_n) * un * un - 0.5 * mu * beta * (1.0 - r.eps_t * r.eps_t) * ut.norm_squared()
 }
 
+/// The restitution a contact with normal relative velocity `un` (m/s, negative when approaching) gets: `None`
+/// when the surfaces separate (no collision); elastic, and flagged as guarded, when the approach is slower than
+/// `collapse_speed` (the inelastic-collapse guard); `r` otherwise.
+fn effective_restitution(un: f64, r: Restitution, collapse_speed: f64) -> Option<(Restitution, bool)> {
+    if un >= 0.0 {
+        return None;
+    }
+    let guarded = -un < collapse_speed;
+    Some((
+        if guarded {
+            Restitution { eps_n: 1.0, eps_t: 1.0 }
+        } else {
+            r
+        },
+        guarded,
+    ))
+}
+
 /// Resolves a collision between two free spheres in contact (velocities and spins updated in place).
 pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed: f64) -> Outcome {
     let (u, n) = contact_velocity(b1, b2);
     let un = u.dot(&n);
-    if un >= 0.0 {
+    let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
         return Outcome {
             applied: false,
             approach_speed: 0.0,
             guarded: false,
         };
-    }
-    let guarded = -un < collapse_speed;
-    let r = if guarded {
-        Restitution { eps_n: 1.0, eps_t: 1.0 }
-    } else {
-        r
     };
     let u_n = n * un;
     let u_t = u - u_n;
@@ -118,18 +130,12 @@ pub fn resolve_wall(b: &mut Body, n: &Vec3, surface_velocity: &Vec3, r: Restitut
     let arm = -n * b.radius;
     let u = b.velocity + b.spin.cross(&arm) - surface_velocity;
     let un = u.dot(n);
-    if un >= 0.0 {
+    let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
         return Outcome {
             applied: false,
             approach_speed: 0.0,
             guarded: false,
         };
-    }
-    let guarded = -un < collapse_speed;
-    let r = if guarded {
-        Restitution { eps_n: 1.0, eps_t: 1.0 }
-    } else {
-        r
     };
     let u_n = n * un;
     let u_t = u - u_n;
