@@ -143,3 +143,54 @@ fn bad_spinup_input_names_the_field() {
     bad(&format!("{PATH}period = 3.0\n"), "unknown field `period`");
     bad(&PATH.replace("T_inter = 7.0\n", ""), "missing field `T_inter`");
 }
+
+/// `spinup critical --branch`: a hold run branched off the shared path run gives the same `spinup.csv` and the
+/// same time series (wall-clock column aside) as the hold scene run from t = 0. The path's numbers make the
+/// shortened path's periods bit-identical to the full one's (T_final = 6 h at t_X = 1600 s halves the span).
+#[test]
+fn branched_hold_equals_the_hold_run_from_the_start() {
+    let dir = temp_dir("spinup-branch");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let c = rubblepile(
+        &dir,
+        &[
+            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "600", "--out",
+            "crit",
+        ],
+    );
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let hold = dir.join("crit/T6.00");
+    let scene_text = read(&hold.join("scene.toml"));
+    assert!(scene_text.contains("t_final = 1600.0"), "{scene_text}");
+    std::fs::write(dir.join("h.toml"), &scene_text).unwrap();
+    let h = rubblepile(&dir, &["run", "h.toml", "--out", "h", "--no-progress"]);
+    assert!(h.status.success(), "{}", String::from_utf8_lossy(&h.stderr));
+    assert_eq!(read(&hold.join("spinup.csv")), read(&dir.join("h/spinup.csv")));
+    let without_wall = |p: &Path| -> Vec<String> {
+        read(p)
+            .lines()
+            .map(|l| l.rsplit_once(',').map_or(l, |(a, _)| a).to_string())
+            .collect()
+    };
+    let (a, b) = (without_wall(&hold.join("timeseries.csv")), without_wall(&dir.join("h/timeseries.csv")));
+    assert_eq!(a.len(), b.len());
+    assert_eq!(a, b);
+    let json = read(&dir.join("crit/critical.json"));
+    assert!(json.contains("\"t_final_hours\": 6.0"), "{json}");
+}
+
+/// `--branch` refuses a path with rests (a shorter path with rests is not a prefix of the longer one).
+#[test]
+fn branch_refuses_a_path_with_rests() {
+    let dir = temp_dir("spinup-branch-rests");
+    let path = PATH.replace("rve_particles = 30", "rve_particles = 30\nrests = 1\nrest_length = 100.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let c = rubblepile(
+        &dir,
+        &["spinup", "critical", "--scene", "s.toml", "--from", "6.5", "--to", "6.5", "--branch", "--out", "crit"],
+    );
+    assert!(!c.status.success());
+    let err = String::from_utf8_lossy(&c.stderr);
+    assert!(err.contains("spinup.rests = 1"), "{err}");
+}

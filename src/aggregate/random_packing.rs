@@ -27,7 +27,8 @@
 //!    `settle_max_chunks` = 8 chunks.
 //!
 //! Self-gravity is direct below `direct_below` = 1500 grains and an octree with θ = `tree_theta` = 0.8 above
-//! (accuracy matters little here: it only has to pull the heap together). Every step count is deterministic.
+//! (accuracy matters little here: it only has to pull the heap together), evaluated every `gravity_interval` steps
+//! (default 1). Every step count is deterministic.
 
 use crate::geometry::wall::{Oscillation, SphereContainer, Wall};
 use crate::granular::soft::contact::Material;
@@ -80,6 +81,16 @@ pub struct Recipe {
     pub direct_below: usize,
     /// Octree opening angle above it.
     pub tree_theta: f64,
+    /// Self-gravity every this many steps in the collapse and settle stages (r-RESPA,
+    /// [`crate::granular::soft::respa`]); at most `steps_per_contact / 5`, so that the gravity kicks pulse faster
+    /// than any contact vibration ([`crate::granular::soft::advise::gravity_interval`]). Default 1 (every step;
+    /// the committed targets were built so).
+    #[serde(default = "one")]
+    pub gravity_interval: u64,
+}
+
+fn one() -> u64 {
+    1
 }
 
 impl Default for Recipe {
@@ -103,6 +114,7 @@ impl Default for Recipe {
             steps_per_contact: 20.0,
             direct_below: 1500,
             tree_theta: 0.8,
+            gravity_interval: 1,
         }
     }
 }
@@ -238,8 +250,10 @@ fn recentre(ps: &mut [Particle]) {
     }
 }
 
-/// Runs `steps` leapfrog steps of `dt` from t = 0; returns the largest overlap fraction seen.
+/// Runs `steps` leapfrog steps of `dt` from t = 0; returns the largest overlap fraction seen. Stages with
+/// self-gravity every `k` steps pass whole blocks ([`whole_blocks`]), so that each ends with its closing kick.
 fn run(sys: &mut SoftSystem, dt: f64, steps: u64) -> f64 {
+    debug_assert!(steps.is_multiple_of(sys.gravity_interval.max(1)));
     sys.compute_forces(0.0, 0.0);
     let mut worst = sys.stats.max_overlap_fraction;
     for k in 0..steps {
@@ -247,6 +261,11 @@ fn run(sys: &mut SoftSystem, dt: f64, steps: u64) -> f64 {
         worst = worst.max(sys.stats.max_overlap_fraction);
     }
     worst
+}
+
+/// `steps` rounded up to a whole number of self-gravity blocks of `k` steps.
+fn whole_blocks(steps: u64, k: u64) -> u64 {
+    steps.div_ceil(k.max(1)) * k.max(1)
 }
 
 fn log(stage: &str, sys: &SoftSystem, dt: f64, steps: u64, worst: f64, notes: String) -> StageLog {
@@ -314,6 +333,8 @@ pub fn random_heap(
         frictionless(k_collapse, recipe.restitution),
         self_gravity,
     );
+    sys.gravity_interval = recipe.gravity_interval.max(1);
+    let steps = whole_blocks(steps, sys.gravity_interval);
     let worst = run(&mut sys, dt, steps);
     stages.push(log(
         "collapse",
@@ -436,6 +457,8 @@ pub fn random_heap(
         ..self_gravity
     };
     let mut sys = SoftSystem::new(ps, Vec::new(), frictionless(k_settle, recipe.restitution), gravity);
+    sys.gravity_interval = recipe.gravity_interval.max(1);
+    let chunk = whole_blocks(chunk, sys.gravity_interval);
     let (mut steps, mut worst, mut last_worst) = (0, 0.0f64, 0.0);
     for _ in 0..recipe.settle_max_chunks {
         last_worst = run(&mut sys, dt, chunk);

@@ -56,6 +56,10 @@ pub struct BuildArgs {
     /// Shaking periods of the random-packing recipe (default 10).
     #[arg(long)]
     pub shake_periods: Option<f64>,
+    /// Self-gravity every K steps in the recipe's collapse and settle stages (r-RESPA; 1 ≤ K ≤ 4, the recipe's
+    /// 20 steps per contact over 5). Default 1.
+    #[arg(long, value_name = "K")]
+    pub gravity_interval: Option<u64>,
     /// The particle file to write; NAME.json goes beside it.
     #[arg(long, value_name = "FILE.csv")]
     pub out: PathBuf,
@@ -154,6 +158,17 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
             )));
         }
         recipe.shake_periods = p;
+    }
+    if let Some(k) = args.gravity_interval {
+        let most = (recipe.steps_per_contact / 5.0).floor() as u64;
+        if !(1..=most).contains(&k) {
+            return Err(CliError::usage(format!(
+                "--gravity-interval: steps between self-gravity evaluations, 1 to {most} \
+                 (steps per contact {} / 5), got {k}",
+                recipe.steps_per_contact
+            )));
+        }
+        recipe.gravity_interval = k;
     }
     let spec = BuildSpec {
         model,

@@ -7,6 +7,12 @@
 //!   is stable when the forcing was never released and neither θ_max, η_B nor the coordination number drifts over
 //!   the second half of the hold. The first stable T_final is T_c,3; φ is the largest θ_max over the holds of the
 //!   runs within ±0.01 h of it. Writes `DIR/critical.json` ([`CriticalSearch`]).
+//!   With `--branch [--hold SECONDS]` the hold runs share one run of BASE's path (`DIR/base`): the hold at
+//!   T_final = X starts where BASE's path passes X, with BASE's spin-up rate (Zhang17 §4.3 finds T_c,3
+//!   independent of the rate), branched off the base run's checkpoint at the output sample at or before that time
+//!   ([`crate::granular::soft::branch`]); its scene (`DIR/T<X>/scene.toml`) has `t_final` at that time and holds
+//!   for SECONDS. Each hold then costs only its hold; the result equals the hold scene run from t = 0 bit for bit
+//!   when the shortened path's periods round alike (tested).
 //! - `rubblepile spinup density-fit --points RHO:T,RHO:T,… [--period 2.26]`: κ of Eq. 22 by least squares
 //!   through the origin from (bulk density kg/m³, critical period h) pairs, its standard error, and the critical
 //!   bulk density for the given period.
@@ -52,6 +58,14 @@ pub struct CriticalArgs {
     /// Overwrite an earlier `critical.json` in DIR (completed runs are still reused).
     #[arg(long)]
     pub force: bool,
+    /// Branch the hold runs off one run of the scene's path (`DIR/base`) instead of running each from t = 0: the
+    /// hold at T_final = X starts where the scene's path passes X (the same spin-up rate, stopped at X). Needs a
+    /// path without rests.
+    #[arg(long)]
+    pub branch: bool,
+    /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
+    #[arg(long, value_name = "SECONDS")]
+    pub hold: Option<f64>,
 }
 
 /// `rubblepile spinup density-fit`.
@@ -154,7 +168,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
             args.scene.display()
         )));
     };
-    if base.t_end <= settings.path.t_final {
+    if base.t_end <= settings.path.t_final && !(args.branch && args.hold.is_some()) {
         return Err(CliError::usage(format!(
             "{}: scene.t_end must exceed spinup.t_final = {} s to leave a hold, got {}",
             args.scene.display(),
@@ -171,38 +185,53 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
     }
     std::fs::create_dir_all(&args.out).map_err(|e| CliError::usage(format!("{}: {e}", args.out.display())))?;
     let criterion = CreepCriterion::default();
-    let mut runs = Vec::new();
     let n = ((args.to - args.from) / args.step + 1e-9).floor() as usize;
-    for k in 0..=n {
-        let tf = ((args.from + k as f64 * args.step) * 1e4).round() / 1e4;
+    let grid: Vec<f64> = (0..=n)
+        .map(|k| ((args.from + k as f64 * args.step) * 1e4).round() / 1e4)
+        .collect();
+    for &tf in &grid {
         if tf * 3600.0 > settings.path.period_inter + 1e-9 {
             return Err(CliError::usage(format!(
                 "T_final = {tf} h is above the scene's T_inter = {} h",
                 settings.path.period_inter / 3600.0
             )));
         }
+    }
+    let branches = if args.branch {
+        Some(prepare_branches(args, &table, &base, &settings.path, &grid)?)
+    } else {
+        None
+    };
+    let mut runs = Vec::new();
+    for (k, &tf) in grid.iter().enumerate() {
         let dir = args.out.join(format!("T{tf:.2}"));
-        if !dir.join("summary.json").exists()
-            || !std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""))
-        {
-            table["spinup"]["T_final"] = toml::Value::Float(tf);
-            let scene_text = toml::to_string(&table).map_err(|e| CliError::usage(e.to_string()))?;
-            let path = args.out.join(format!("T{tf:.2}.toml"));
-            std::fs::write(&path, &scene_text).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
-            let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
-            let options = RunOptions {
-                force: true,
-                progress: false,
-                checkpoint_every: Some(crate::run::DEFAULT_CHECKPOINT_EVERY),
-                checkpoint_every_sim: None,
-                stop_after_checkpoints: None,
-            };
+        let completed =
+            std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
+        let options = RunOptions {
+            force: true,
+            progress: false,
+            checkpoint_every: Some(crate::run::DEFAULT_CHECKPOINT_EVERY),
+            checkpoint_every_sim: None,
+            stop_after_checkpoints: None,
+        };
+        let t_final = branches.as_ref().map_or(settings.path.t_final, |b| b[k]);
+        if !completed {
             eprintln!("spinup critical: running T_final = {tf} h into {}", dir.display());
-            crate::granular::soft::run::run_soft(&scene, &dir, &options)
-                .map_err(|e| CliError::failed(e.to_string()))?;
+            if branches.is_some() {
+                crate::granular::soft::run::resume_soft(&dir, &options).map_err(|e| CliError::failed(e.to_string()))?;
+            } else {
+                table["spinup"]["T_final"] = toml::Value::Float(tf);
+                let scene_text = toml::to_string(&table).map_err(|e| CliError::usage(e.to_string()))?;
+                let path = args.out.join(format!("T{tf:.2}.toml"));
+                std::fs::write(&path, &scene_text)
+                    .map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
+                let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
+                crate::granular::soft::run::run_soft(&scene, &dir, &options)
+                    .map_err(|e| CliError::failed(e.to_string()))?;
+            }
         }
         let samples = read_spinup_csv(&dir.join("spinup.csv")).map_err(CliError::failed)?;
-        let (released, drifting, theta) = judge_hold(&samples, settings.path.t_final, &criterion);
+        let (released, drifting, theta) = judge_hold(&samples, t_final, &criterion);
         let stable = !released && drifting.is_empty();
         println!(
             "T_final = {tf:.2} h: {}{}",
@@ -243,6 +272,160 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         _ => println!("no stable T_final up to {} h ({})", args.to, json.display()),
     }
     Ok(())
+}
+
+/// The time (s) at which the path `p` (without rests) passes the period `period_h` (hours), between `t_inter` and
+/// `t_final`; `None` outside `[T_final, T_inter]`.
+pub fn path_time_at_period(p: &crate::granular::soft::spinup::SpinupPath, period_h: f64) -> Option<f64> {
+    let x = period_h * 3600.0;
+    let (hi, lo) = (p.period_inter, p.period_final);
+    if !(lo - 1e-9..=hi + 1e-9).contains(&x) {
+        return None;
+    }
+    if hi - lo <= 0.0 {
+        return Some(p.t_final);
+    }
+    Some(p.t_inter + (hi - x) / (hi - lo) * (p.t_final - p.t_inter))
+}
+
+/// `--branch`: runs the scene's path once in `OUT/base`, stopping at the output sample at or before each hold's
+/// start `t_X` (the time the path passes X = T_final, latest first), and writes the hold run `OUT/T<X>` there as
+/// a branch ([`crate::granular::soft::branch`]) whose scene follows the same path to X at `t_X` and holds it for
+/// the hold length. Branches already written are kept. Returns `t_X` (s) per grid entry.
+fn prepare_branches(
+    args: &CriticalArgs,
+    table: &toml::Table,
+    base: &crate::granular::soft::scene::SoftScene,
+    path: &crate::granular::soft::spinup::SpinupPath,
+    grid: &[f64],
+) -> Result<Vec<f64>, CliError> {
+    use crate::granular::soft::branch::{branch_soft, checkpoint_time};
+    use crate::granular::soft::run::{resume_soft, run_soft, sample_steps};
+    if path.rests > 0 {
+        return Err(CliError::usage(format!(
+            "{}: spinup.rests = {}: --branch needs a path without rests (a shorter path with rests is not a prefix)",
+            args.scene.display(),
+            path.rests
+        )));
+    }
+    let hold = args.hold.unwrap_or(base.t_end - path.t_final);
+    if !(hold.is_finite() && hold > 0.0) {
+        return Err(CliError::usage(format!("--hold must be > 0 s, got {hold}")));
+    }
+    let mut starts = Vec::with_capacity(grid.len());
+    for &tf in grid {
+        starts.push(path_time_at_period(path, tf).ok_or_else(|| {
+            CliError::usage(format!(
+                "T_final = {tf} h is outside the scene's path from T_inter = {} h to T_final = {} h",
+                path.period_inter / 3600.0,
+                path.period_final / 3600.0
+            ))
+        })?);
+    }
+    let dt = base.dt;
+    let every = base.every_steps as f64 * dt;
+    let times: Vec<f64> = table
+        .get("output")
+        .and_then(|o| o.get("times"))
+        .and_then(|t| t.as_array())
+        .map(|a| a.iter().filter_map(|v| v.as_float()).collect())
+        .unwrap_or_else(|| vec![0.0]);
+    // the base scene: the path run to just past the earliest hold's start
+    let t_base_end = starts.iter().cloned().fold(0.0, f64::max) + 2.0 * every;
+    let mut table = table.clone();
+    table.entry("output").or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    let mut base_table = table.clone();
+    base_table["scene"]["t_end"] = toml::Value::Float(t_base_end);
+    let keep = |limit: f64| -> toml::Value {
+        toml::Value::Array(
+            times
+                .iter()
+                .filter(|&&t| t <= limit + 1e-9)
+                .map(|&t| toml::Value::Float(t))
+                .collect(),
+        )
+    };
+    base_table["output"]["times"] = keep(t_base_end);
+    let base_text = toml::to_string(&base_table).map_err(|e| CliError::usage(e.to_string()))?;
+    let parent = args.scene.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let scene_dir = std::path::absolute(parent).map_err(|e| CliError::usage(format!("{}: {e}", parent.display())))?;
+    let base_scene = crate::granular::soft::scene::parse_soft_scene(&base_text, "base", Some(&scene_dir))
+        .map_err(CliError::usage)?;
+    let plan = sample_steps(&base_scene);
+    let base_dir = args.out.join("base");
+    let failed = |e: crate::granular::soft::run::SoftRunError| CliError::failed(e.to_string());
+    // latest hold first: the base run only moves forward
+    let mut order: Vec<usize> = (0..grid.len()).collect();
+    order.sort_by(|&a, &b| starts[a].total_cmp(&starts[b]));
+    for k in order {
+        let tf = grid[k];
+        let dir = args.out.join(format!("T{tf:.2}"));
+        if dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file() {
+            continue;
+        }
+        let s_x = (starts[k] / dt + 1e-9).floor() as u64;
+        let s_ck = plan.iter().map(|p| p.0).filter(|&s| s <= s_x && s > 0).max().unwrap_or(0);
+        if s_ck == 0 {
+            return Err(CliError::usage(format!("T_final = {tf} h is reached before the first output sample")));
+        }
+        let t_ck = s_ck as f64 * dt;
+        let here = if base_dir.join("checkpoint.json").is_file() {
+            Some(checkpoint_time(&base_dir).map_err(failed)?.0)
+        } else {
+            None
+        };
+        if here.is_some_and(|h| h > s_ck) {
+            return Err(CliError::usage(format!(
+                "{}: the base run is past the start of T_final = {tf} h; remove the base directory to redo it",
+                base_dir.display()
+            )));
+        }
+        if here != Some(s_ck) {
+            let t_here = here.map_or(0.0, |h| h as f64 * dt);
+            let options = RunOptions {
+                force: true,
+                progress: false,
+                checkpoint_every: None,
+                checkpoint_every_sim: Some(t_ck - t_here - 0.5 * dt),
+                stop_after_checkpoints: Some(1),
+            };
+            eprintln!("spinup critical: base run to t = {t_ck} s (T_final = {tf} h starts at {} s)", starts[k]);
+            let result = match here {
+                Some(_) => resume_soft(&base_dir, &options),
+                None => run_soft(&base_scene, &base_dir, &options),
+            };
+            match result {
+                Err(crate::granular::soft::run::SoftRunError::Run(crate::run::RunError::Stopped { .. })) => {}
+                Err(e) => return Err(failed(e)),
+                Ok(_) => {
+                    return Err(CliError::failed(format!(
+                        "{}: the base run ended before t = {t_ck} s",
+                        base_dir.display()
+                    )));
+                }
+            }
+        }
+        let mut hold_table = table.clone();
+        hold_table["spinup"]["T_final"] = toml::Value::Float(tf);
+        hold_table["spinup"]["t_final"] = toml::Value::Float(starts[k]);
+        hold_table["scene"]["t_end"] = toml::Value::Float(starts[k] + hold);
+        let mut snaps = match keep(t_ck) {
+            toml::Value::Array(a) => a,
+            _ => Vec::new(),
+        };
+        for t in [starts[k], starts[k] + hold] {
+            if snaps.last().and_then(|v| v.as_float()).is_none_or(|last| t >= last + dt) {
+                snaps.push(toml::Value::Float(t));
+            }
+        }
+        hold_table["output"]["times"] = toml::Value::Array(snaps);
+        let hold_text = toml::to_string(&hold_table).map_err(|e| CliError::usage(e.to_string()))?;
+        if dir.exists() {
+            std::fs::remove_dir_all(&dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
+        }
+        branch_soft(&base_dir, &hold_text, &scene_dir, &dir).map_err(failed)?;
+    }
+    Ok(starts)
 }
 
 /// Parses `RHO:T` pairs.

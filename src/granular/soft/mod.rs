@@ -7,10 +7,12 @@
 //!   every `k` steps (multiple time stepping);
 //! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
 //!   [`scene`]: the `kind = "soft-spheres"`
-//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume); [`spinup`]: the `[spinup]` forcing
+//!   scene file; [`run`]: the run driver (outputs, checkpoints, resume); [`branch`]: a run continued from another's
+//!   checkpoint under a new scene; [`spinup`]: the `[spinup]` forcing
 //!   (Zhang17 §2.3.4).
 
 pub mod advise;
+pub mod branch;
 pub mod contact;
 pub mod forces;
 pub mod leapfrog;

@@ -351,7 +351,9 @@ impl SpinRun {
 // ---- end of spin-up hook ---------------------------------------------------------------------------------
 
 /// The samples of a run: `(step, Some(snapshot index))`, increasing.
-fn samples(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
+/// The run's output samples: `(step, snapshot index)` for every time-series row, in order (the `every` grid, the
+/// last step, and the snapshot steps).
+pub fn sample_steps(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
     let mut grid: Vec<u64> = (0..=scene.n_steps / scene.every_steps)
         .map(|k| k * scene.every_steps)
         .collect();
@@ -653,7 +655,7 @@ fn drive(
     let clock = Instant::now();
     let wall = |c: &Instant| wall_before + c.elapsed().as_secs_f64();
     let ts_path = dir.join("timeseries.csv");
-    let plan = samples(scene);
+    let plan = sample_steps(scene);
     let mut last_checkpoint_wall = 0.0;
     let mut last_checkpoint_t = step as f64 * scene.dt;
     let mut written_this_process = 0u64;

@@ -1,0 +1,80 @@
+//! Branching a soft-sphere run: a new run that starts from another run's checkpoint under a different scene
+//! whose physics agrees with the first run's up to the checkpoint (the same particles, contacts, gravity, output
+//! grid up to that time and spin-up path up to that time). It saves re-simulating a shared history, as in the
+//! search for Zhang17's third critical spin limit (§3.3.3), where every hold run follows the same spin-up path
+//! until its own final period.
+//!
+//! The branch directory gets the new scene as `scene.toml`, the parent's `timeseries.csv` and `spinup.csv`
+//! (cut back to the checkpoint when the branch is resumed) and the parent's `checkpoint.json` with the scene
+//! hash of the new scene; [`crate::granular::soft::run::resume_soft`] then carries it on. Whether the two
+//! scenes really agree up to the checkpoint is the caller's promise; what can be checked here is checked: the
+//! new scene must parse, hold the same number of particles, and put an output sample at the checkpoint's step
+//! with the same index.
+
+use std::path::Path;
+
+use crate::granular::soft::run::{SoftRunError, sample_steps};
+use crate::granular::soft::scene::parse_soft_scene;
+use crate::io::checkpoint::{CHECKPOINT_FILE, fnv1a_hex};
+use crate::run::RunError;
+
+/// The step and time (s) of the checkpoint in `dir`.
+pub fn checkpoint_time(dir: &Path) -> Result<(u64, f64), SoftRunError> {
+    let v = read_checkpoint(dir)?;
+    let step = v["step"].as_u64();
+    let t = v["t_seconds"].as_f64();
+    step.zip(t)
+        .ok_or_else(|| bad(format!("{}: no step/t_seconds", dir.join(CHECKPOINT_FILE).display())))
+}
+
+fn bad(m: String) -> SoftRunError {
+    SoftRunError::Run(RunError::BadCheckpoint(m))
+}
+
+fn read_checkpoint(dir: &Path) -> Result<serde_json::Value, SoftRunError> {
+    let p = dir.join(CHECKPOINT_FILE);
+    let text = std::fs::read_to_string(&p).map_err(|e| bad(format!("{}: {e}", p.display())))?;
+    serde_json::from_str(&text).map_err(|e| bad(format!("{}: {e}", p.display())))
+}
+
+/// Writes a branch of the run in `parent` (stopped at its checkpoint) into the new, empty directory `dir`, under
+/// the scene `scene_text` (its `particles_file`, if relative, resolved against `scene_dir`). Resume `dir` to run
+/// the branch.
+///
+/// Errors name what disagrees: the scene does not parse, the particle count differs, or the new scene's output
+/// grid has no sample at the checkpoint's step with the checkpoint's index.
+pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path) -> Result<(), SoftRunError> {
+    let mut ck = read_checkpoint(parent)?;
+    let name = dir.join("scene.toml").display().to_string();
+    let scene = parse_soft_scene(scene_text, &name, Some(scene_dir)).map_err(|e| bad(e.to_string()))?;
+    let n_state = ck["state"].as_array().map_or(0, Vec::len);
+    if n_state != 15 * scene.particles.len() {
+        return Err(bad(format!(
+            "{name}: {} particles, the parent's checkpoint holds {}",
+            scene.particles.len(),
+            n_state / 15
+        )));
+    }
+    let step = ck["step"].as_u64().unwrap_or(u64::MAX);
+    let index = ck["next_sample"].as_u64().unwrap_or(0) as usize;
+    let plan = sample_steps(&scene);
+    if index == 0 || plan.get(index - 1).map(|s| s.0) != Some(step) {
+        return Err(bad(format!(
+            "{name}: its output grid has no sample number {} at step {step} (the parent's checkpoint)",
+            index.saturating_sub(1)
+        )));
+    }
+    ck["scene_hash"] = serde_json::Value::String(fnv1a_hex(scene_text.as_bytes()));
+    ck["scene_base_dir"] = serde_json::Value::String(scene_dir.display().to_string());
+    let io = |p: &Path, e: std::io::Error| bad(format!("{}: {e}", p.display()));
+    std::fs::create_dir_all(dir.join("snapshots")).map_err(|e| io(dir, e))?;
+    std::fs::write(dir.join("scene.toml"), scene_text).map_err(|e| io(&dir.join("scene.toml"), e))?;
+    for f in ["timeseries.csv", "spinup.csv"] {
+        let from = parent.join(f);
+        if from.is_file() {
+            std::fs::copy(&from, dir.join(f)).map_err(|e| io(&from, e))?;
+        }
+    }
+    let text = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
+    std::fs::write(dir.join(CHECKPOINT_FILE), text).map_err(|e| io(&dir.join(CHECKPOINT_FILE), e))
+}
