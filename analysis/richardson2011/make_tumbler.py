@@ -6,7 +6,14 @@ lining, attached to wall 0, the cylinder) and one scene per Froude number, tumbl
 at omega = sqrt(Fr g / R). Particle radius 1 mm (R/d = 15; the paper used R/d ~ 57 with 6513 particles) to keep the
 event count tractable. Deterministic: the small initial jitter comes from a fixed-seed generator.
 
-Usage: python3 make_tumbler.py [--radius 1e-3] [--fr 0.001,0.01,...] [--t-end 0.6] [--dt 5e-4]"""
+--fill f sets the fraction of the disc inside the lining (radius R - 2r) that the free particles fill at the start:
+the grid's centres are cut at the height where the circular segment below it holds that fraction of the disc (0.5:
+the axis, the default, half full; the report measures the fill from the top of the bed, 0.52 for the default). A fill other than 0.5 writes tumbler_particles_fill<f>.csv and tumbler_fill<f>_fr<Fr>.toml.
+--revolutions n sets each scene's duration to n drum turns (2 pi n / omega, rounded up to 0.01 s) instead of --t-end
+and adds _<n>rev to the scene name; --snapshots k writes k + 1 evenly spaced snapshots (on whole steps).
+
+Usage: python3 make_tumbler.py [--radius 1e-3] [--fr 0.001,0.01,...] [--t-end 0.6] [--dt 5e-4] [--fill 0.5]
+                               [--revolutions n] [--snapshots 20]"""
 import argparse, math, random
 
 R_CYL, LENGTH, G = 0.030, 0.005, 9.81
@@ -15,7 +22,16 @@ ap.add_argument("--radius", type=float, default=1.0e-3, help="particle radius (m
 ap.add_argument("--fr", default="0.001,0.01,0.1,0.3,0.5,1.0,1.5", help="Froude numbers omega^2 R / g")
 ap.add_argument("--t-end", type=float, default=0.6, help="simulated time (s)")
 ap.add_argument("--dt", type=float, default=5e-4, help="step (s)")
+ap.add_argument("--fill", type=float, default=0.5, help="fraction (0..1) of the disc inside the lining filled at the start")
+ap.add_argument("--revolutions", type=float, default=None, help="run each scene for this many drum turns")
+ap.add_argument("--snapshots", type=int, default=20, help="number of snapshot intervals")
 args = ap.parse_args()
+if not 0.0 < args.fill < 1.0:
+    ap.error(f"--fill must lie in (0, 1) (a fraction of the disc), got {args.fill}")
+if args.snapshots < 1:
+    ap.error(f"--snapshots must be >= 1, got {args.snapshots}")
+if args.revolutions is not None and args.revolutions <= 0:
+    ap.error(f"--revolutions must be > 0, got {args.revolutions}")
 r = args.radius
 rows = []
 # Lining: rows along y touching the end planes' interior, centres at R - r, touching neighbours in a row, alternate
@@ -41,28 +57,55 @@ while y <= LENGTH / 2 - 1.02 * r + 1e-12:
     free_ys.append(y)
     y += s
 inner = R_CYL - 2 * r - 1.05 * r
+
+
+def segment_fraction(h, a):
+    """Fraction of a disc of radius a lying below the chord at height h (-a <= h <= a)."""
+    return (a * a * math.acos(-h / a) + h * math.sqrt(a * a - h * h)) / (math.pi * a * a)
+
+
+# Cut height: bisection for the chord whose segment holds the fill fraction of the disc inside the lining.
+a_lin = R_CYL - 2 * r
+lo, hi = -a_lin, a_lin
+for _ in range(100):
+    mid = 0.5 * (lo + hi)
+    lo, hi = (mid, hi) if segment_fraction(mid, a_lin) < args.fill else (lo, mid)
+z_cut = 0.5 * (lo + hi)
 for y in free_ys:
     nz = int(inner / s)
-    for iz in range(-nz, 1):
+    for iz in range(-nz, nz + 1):
         for ix in range(-nz, nz + 1):
             x, z = ix * s, iz * s
-            if x * x + z * z < inner * inner:
+            if x * x + z * z < inner * inner and z <= z_cut + 0.01 * s:
                 rows.append((x + rng.uniform(-0.01, 0.01) * r, y, z, -1))
-with open("tumbler_particles.csv", "w") as f:
+fill_tag = "" if args.fill == 0.5 else f"_fill{args.fill:g}"
+particles_file = f"tumbler_particles{fill_tag}.csv"
+with open(particles_file, "w") as f:
     f.write("t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz,stuck_to\n")
     m = 2500.0 * 4.0 / 3.0 * math.pi * r**3  # glass beads, 2500 kg/m^3
     for n, (x, y, z, w) in enumerate(rows):
         f.write(f"0,{n},{m!r},{r!r},{x!r},{y!r},{z!r},0,0,0,0,0,0,{w}\n")
-print(f"{n_stuck} stuck, {len(rows) - n_stuck} free, radius {r} m, R/d = {R_CYL / (2 * r):.1f}")
+print(f"{n_stuck} stuck, {len(rows) - n_stuck} free, radius {r} m, R/d = {R_CYL / (2 * r):.1f}, fill {args.fill:g} "
+      f"(cut at z = {z_cut:.3e} m): {particles_file}")
 for fr in [float(x) for x in args.fr.split(",")]:
     omega = math.sqrt(fr * G / R_CYL)
-    with open(f"tumbler_fr{fr:g}.toml", "w") as f:
-        f.write(f"""# Richardson11 §3.2 tumbler, Fr = omega^2 R / g = {fr:g} (written by make_tumbler.py).
+    t_end, rev_tag = args.t_end, ""
+    if args.revolutions is not None:
+        t_end = math.ceil(args.revolutions * 2 * math.pi / omega / 0.01 - 1e-9) * 0.01
+        rev_tag = f"_{args.revolutions:g}rev"
+    t_end = round(t_end, 6)
+    times = [round(t_end * k / args.snapshots / args.dt) * args.dt for k in range(args.snapshots + 1)]
+    # Two decimals suffice for the 20 snapshots of a default scene (and keep those files as they were).
+    fmt = ".2f" if args.snapshots == 20 and args.revolutions is None else ".4f"
+    scene = f"tumbler{fill_tag}_fr{fr:g}{rev_tag}.toml"
+    print(f"Fr {fr:g}: omega {omega:.4f} rad/s, t_end {t_end:g} s ({t_end * omega / (2 * math.pi):.2f} turns): {scene}")
+    with open(scene, "w") as f:
+        f.write(f"""# Richardson11 §3.2 tumbler, Fr = omega^2 R / g = {fr:g}{", fill " + format(args.fill, "g") if fill_tag else ""} (written by make_tumbler.py).
 [scene]
 kind = "hard-spheres"
-t_end = {args.t_end}                # s
+t_end = {t_end}                # s
 seed = 0
-particles_file = "tumbler_particles.csv"
+particles_file = "{particles_file}"
 
 [stepping]
 dt = {args.dt}                  # s
@@ -77,7 +120,7 @@ eps_t = 0.8                  # rough spheres (our choice)
 
 [output]
 every = 0.01                 # s
-times = [{", ".join(f"{t:.2f}" for t in [args.t_end * k / 20 for k in range(21)])}]
+times = [{", ".join(format(t, fmt) for t in times)}]
 
 [[wall]]                     # 0: the drum, spinning about +y at omega = sqrt(Fr g / R)
 type = "cylinder"

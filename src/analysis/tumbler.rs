@@ -8,12 +8,18 @@
 //! particle that touches another free particle (centres within 2.5 r, so flying particles do not count) is a surface
 //! point. The fit ([`crate::analysis::fits::fit_line`]) uses the columns with `−0.8 R < x < 0`; the angle is
 //! `atan(−slope)`.
+//!
+//! Centrifuging ([`centrifuging`]): the fraction of free particles moving with the drum's wall speed at their
+//! position, their mean angular velocity over ω, and the fraction above the axis (0.5 for a uniform ring). The
+//! threshold ([`centrifuging_threshold`]) is the Froude number at which a bed spread into an annulus against the
+//! lining is held there at the top all the way to its inner surface: `ω² r_in ≥ g`, i.e. `Fr ≥ R / r_in`.
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::atmosphere::{RunFiles, mean_std, read_run_files};
+use crate::analysis::atmosphere::{RunFiles, mean, mean_std, read_run_files};
 use crate::analysis::fits::fit_line;
-use crate::granular::hard::scene::read_particles_csv;
+use crate::granular::hard::scene::{ParticleRow, read_particles_csv};
+use crate::math::Vec3;
 
 /// Surface points `(x, z)` of a pile of free particles (centres `(x, z)` projected along the axis, radius `r`):
 /// per column of width `2r`, the highest particle with another within 2.5 r.
@@ -48,6 +54,113 @@ pub fn repose_angle(surface: &[(f64, f64)], x_lo: f64, x_hi: f64) -> Option<f64>
     fit_line(&x, &z).ok().map(|f| (-f.slope).atan().to_degrees())
 }
 
+/// Relative tolerance of [`co_rotates`]: a particle moves with the drum when its velocity differs from the drum's
+/// rigid rotation at its position by less than this fraction of the local drum speed `ω ρ`.
+pub const CO_ROTATION_TOLERANCE: f64 = 0.1;
+
+/// A free particle as the drum analysis sees it: centre (m) and velocity (m/s) in the lab frame, drum axis `+y`
+/// through the origin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DrumParticle {
+    /// Centre (m).
+    pub position: Vec3,
+    /// Velocity (m/s).
+    pub velocity: Vec3,
+}
+
+/// Velocity (m/s) of a point at `position` turning rigidly with the drum at `omega` (rad/s) about `+y`.
+fn drum_velocity(position: &Vec3, omega: f64) -> Vec3 {
+    Vec3::new(0.0, omega, 0.0).cross(&Vec3::new(position.x, 0.0, position.z))
+}
+
+/// Distance (m) from the drum's axis.
+fn axial_distance(position: &Vec3) -> f64 {
+    position.x.hypot(position.z)
+}
+
+/// Whether `p` moves with the drum: `|v − ω ŷ × ρ| < CO_ROTATION_TOLERANCE · |ω| ρ` (never on the axis or with
+/// `ω = 0`).
+pub fn co_rotates(p: &DrumParticle, omega: f64) -> bool {
+    let slip = (p.velocity - drum_velocity(&p.position, omega)).norm();
+    slip < CO_ROTATION_TOLERANCE * omega.abs() * axial_distance(&p.position)
+}
+
+/// Centrifuging measures of one snapshot of the free particles (equal masses), or their mean over snapshots.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Centrifuging {
+    /// Fraction of the particles that [`co_rotates`]: 1 for a bed turning rigidly with the drum, 0 for one at rest.
+    pub co_rotating: f64,
+    /// Mean angular velocity about the axis over ω, `Σ (z vx − x vz) / (ω Σ ρ²)`: the particles' angular momentum
+    /// about the axis over that of rigid co-rotation at their positions (1 rigid, 0 at rest, < 0 turning backwards).
+    pub spin_ratio: f64,
+    /// Fraction of the particles above the axis (z > 0): 0 for a half-full drum's bed below the axis, 0.5 for a
+    /// uniform ring.
+    pub above_axis: f64,
+}
+
+/// [`Centrifuging`] of `particles` in a drum turning at `omega` (rad/s); NaN fields when there are no particles,
+/// a NaN spin ratio when `omega = 0`.
+pub fn centrifuging(particles: &[DrumParticle], omega: f64) -> Centrifuging {
+    let n = particles.len() as f64;
+    let count = |f: &dyn Fn(&DrumParticle) -> bool| particles.iter().filter(|p| f(p)).count() as f64 / n;
+    let spin: f64 = particles
+        .iter()
+        .map(|p| p.position.z * p.velocity.x - p.position.x * p.velocity.z)
+        .sum();
+    let rigid: f64 = particles
+        .iter()
+        .map(|p| omega * axial_distance(&p.position).powi(2))
+        .sum();
+    Centrifuging {
+        co_rotating: count(&|p| co_rotates(p, omega)),
+        spin_ratio: spin / rigid,
+        above_axis: count(&|p| p.position.z > 0.0),
+    }
+}
+
+/// Field-by-field mean of several [`Centrifuging`] values (NaN fields for none).
+pub fn mean_centrifuging(values: &[Centrifuging]) -> Centrifuging {
+    let of = |f: fn(&Centrifuging) -> f64| mean(&values.iter().map(f).collect::<Vec<_>>());
+    Centrifuging {
+        co_rotating: of(|c| c.co_rotating),
+        spin_ratio: of(|c| c.spin_ratio),
+        above_axis: of(|c| c.above_axis),
+    }
+}
+
+/// Fraction of a disc of radius `a` lying below the horizontal chord at height `h` from its centre (`h` clamped to
+/// `[−a, a]`).
+pub fn disc_fraction_below(h: f64, a: f64) -> f64 {
+    let h = h.clamp(-a, a);
+    (a * a * (-h / a).acos() + h * (a * a - h * h).sqrt()) / (std::f64::consts::PI * a * a)
+}
+
+/// The Froude number `R / r_in` above which a bed filling the fraction `fill` of the disc inside the lining
+/// (radius `R − 2r`, the lining particles' inner surface), spread into an annulus against the lining, is held
+/// against gravity at the top down to its inner radius `r_in = (R − 2r) √(1 − fill)` (`ω² r_in ≥ g`).
+/// `drum_radius` R and `particle_radius` r in m.
+pub fn centrifuging_threshold(fill: f64, drum_radius: f64, particle_radius: f64) -> f64 {
+    drum_radius / ((drum_radius - 2.0 * particle_radius) * (1.0 - fill).sqrt())
+}
+
+/// The fill of a bed at rest (its first snapshot): the fraction of the disc inside the lining (radius
+/// `drum_radius − 2r`) below the top of its highest particle.
+pub fn initial_fill(particles: &[DrumParticle], drum_radius: f64, particle_radius: f64) -> f64 {
+    let top = particles.iter().map(|p| p.position.z).fold(f64::NEG_INFINITY, f64::max) + particle_radius;
+    disc_fraction_below(top, drum_radius - 2.0 * particle_radius)
+}
+
+/// The free particles of a snapshot's rows.
+fn drum_particles(rows: &[ParticleRow]) -> Vec<DrumParticle> {
+    rows.iter()
+        .filter(|r| r.stuck_to.is_none())
+        .map(|r| DrumParticle {
+            position: Vec3::new(r.values[4], r.values[5], r.values[6]),
+            velocity: Vec3::new(r.values[7], r.values[8], r.values[9]),
+        })
+        .collect()
+}
+
 /// The analysis of one tumbler run.
 #[derive(Debug, Clone)]
 pub struct TumblerRun {
@@ -69,9 +182,16 @@ pub struct TumblerRun {
     pub angles: Vec<(f64, f64)>,
     /// Mean and standard deviation of the angles (degrees).
     pub angle: (f64, f64),
-    /// Mean fraction of free particles above the axis (z > 0) in the late snapshots: ≈ 0 for a tumbling half-full
-    /// drum, large when the material centrifuges.
-    pub above_axis: f64,
+    /// Fill of the bed at the start ([`initial_fill`]).
+    pub fill: f64,
+    /// [`centrifuging_threshold`] for that fill.
+    pub threshold: f64,
+    /// `(t, measures)` per snapshot.
+    pub centrifuging: Vec<(f64, Centrifuging)>,
+    /// Mean measures over the snapshots of the second half of the run (t ≥ half the time reached).
+    pub late: Centrifuging,
+    /// The same over its two halves, 50–75 % and 75–100 % of the run: equal when the measures have settled.
+    pub late_halves: [Centrifuging; 2],
     /// From `summary.json`: status, time reached, events per second, wall seconds, collisions.
     pub status: String,
     /// Time reached (s).
@@ -103,8 +223,8 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, String> {
     let omega = num(drum, "spin").unwrap_or(0.0);
     let t_reached = summary["t_reached"].as_f64().unwrap_or(f64::NAN);
     let mut angles = Vec::new();
-    let mut above = Vec::new();
-    let (mut free, mut stuck, mut r) = (0, 0, f64::NAN);
+    let mut measures = Vec::new();
+    let (mut free, mut stuck, mut r, mut first) = (0, 0, f64::NAN, None);
     for path in &files {
         let rows = read_particles_csv(path).map_err(|e| format!("{}: {e}", path.display()))?;
         let t = rows.first().map_or(f64::NAN, |r| r.values[0]);
@@ -113,6 +233,9 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, String> {
             .filter(|r| r.stuck_to.is_none())
             .map(|r| (r.values[4], r.values[6]))
             .collect();
+        let particles = drum_particles(&rows);
+        measures.push((t, centrifuging(&particles, omega)));
+        first.get_or_insert(particles);
         free = centres.len();
         stuck = rows.len() - free;
         r = rows
@@ -122,12 +245,24 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, String> {
         if t < 0.5 * t_reached || centres.is_empty() {
             continue;
         }
-        above.push(centres.iter().filter(|c| c.1 > 0.0).count() as f64 / centres.len() as f64);
         if let Some(a) = repose_angle(&surface_points(&centres, r), -0.8 * radius, 0.0) {
             angles.push((t, a));
         }
     }
     let a: Vec<f64> = angles.iter().map(|p| p.1).collect();
+    let between = |lo: f64, hi: f64| {
+        let m: Vec<Centrifuging> = measures
+            .iter()
+            .filter(|(t, _)| {
+                // Half-open windows (the last one closed) with a rounding margin: snapshot times are printed.
+                let f = t / t_reached;
+                f >= lo - 1e-9 && (f < hi - 1e-9 || hi >= 1.0)
+            })
+            .map(|p| p.1)
+            .collect();
+        mean_centrifuging(&m)
+    };
+    let fill = initial_fill(first.as_deref().unwrap_or_default(), radius, r);
     Ok(TumblerRun {
         dir: dir.to_path_buf(),
         froude: omega * omega * radius / g,
@@ -138,7 +273,11 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, String> {
         stuck,
         angle: mean_std(&a),
         angles,
-        above_axis: mean_std(&above).0,
+        fill,
+        threshold: centrifuging_threshold(fill, radius, r),
+        late: between(0.5, 1.0),
+        late_halves: [between(0.5, 0.75), between(0.75, 1.0)],
+        centrifuging: measures,
         status: summary["status"].as_str().unwrap_or("?").to_string(),
         t_reached,
         events_per_second: summary["events_per_second"].as_f64().unwrap_or(f64::NAN),

@@ -10,7 +10,7 @@ use super::CliError;
 use crate::analysis::atmosphere::{AtmosphereRun, KS_FRACTIONS, analyse_atmosphere_run, mean_std};
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
-use crate::analysis::tumbler::{TumblerRun, analyse_tumbler_run};
+use crate::analysis::tumbler::{CO_ROTATION_TOLERANCE, TumblerRun, analyse_tumbler_run};
 
 /// Richardson11 §3.1: expected scale heights for masses 1, 3, 10.
 const PAPER_SCALE_HEIGHTS: [f64; 3] = [1.88, 0.626, 0.188];
@@ -221,66 +221,154 @@ fn atmosphere_section(md: &mut String, run: &AtmosphereRun, title: &str, paper: 
     );
 }
 
+/// Tumbler runs grouped by their starting fill (to 0.01), in order of fill, each group in order of Fr.
+fn by_fill(runs: &[TumblerRun]) -> Vec<(f64, Vec<&TumblerRun>)> {
+    let mut groups: Vec<(f64, Vec<&TumblerRun>)> = Vec::new();
+    for r in runs {
+        match groups.iter_mut().find(|g| (g.0 - r.fill).abs() < 0.005) {
+            Some(g) => g.1.push(r),
+            None => groups.push((r.fill, vec![r])),
+        }
+    }
+    groups.sort_by(|a, b| a.0.total_cmp(&b.0));
+    groups
+}
+
+fn tumbler_table(md: &mut String, runs: &[TumblerRun]) {
+    let _ = writeln!(
+        md,
+        "| Fr | fill (free particles) | R/r_in | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots fitted | co-rotating, 50–75 % / 75–100 % | Ω/ω, 50–75 % / 75–100 % | above axis | collisions | events/s | wall (s) |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    for r in runs {
+        let [a, b] = r.late_halves;
+        let _ = writeln!(
+            md,
+            "| {:.3} | {:.2} ({}) | {:.2} | {:.3} | {} | {:.2} | {:.1} | {:.1} ± {:.1} | {} | {:.2} / {:.2} | {:.2} / {:.2} | {:.2} | {} | {:.2e} | {:.0} |",
+            r.froude,
+            r.fill,
+            r.free,
+            r.threshold,
+            r.omega,
+            r.status,
+            r.t_reached,
+            r.t_reached * r.omega / std::f64::consts::TAU,
+            r.angle.0,
+            r.angle.1,
+            r.angles.len(),
+            a.co_rotating,
+            b.co_rotating,
+            a.spin_ratio,
+            b.spin_ratio,
+            r.late.above_axis,
+            r.collisions,
+            r.events_per_second,
+            r.wall_seconds
+        );
+    }
+}
+
+fn angle_chart(groups: &[(f64, Vec<&TumblerRun>)], r_over_d: f64) -> LineChart {
+    let series = groups
+        .iter()
+        .enumerate()
+        .map(|(k, (fill, g))| {
+            let ok: Vec<&&TumblerRun> = g.iter().filter(|r| !r.angles.is_empty()).collect();
+            Series {
+                label: format!("this work, R/d = {r_over_d:.0}, fill {fill:.2}"),
+                points: ok.iter().map(|r| (r.froude, r.angle.0)).collect(),
+                errors: ok.iter().map(|r| r.angle.1).collect(),
+                colour: k,
+                mark: Mark::Points,
+            }
+        })
+        .collect();
+    LineChart {
+        title: "Tumbler: dynamic angle of repose vs Froude number (cf. Richardson11 Fig. 10)".into(),
+        x_label: "Fr = ω² R / g".into(),
+        y_label: "dynamic angle of repose (deg)".into(),
+        series,
+        log_x: true,
+    }
+}
+
+fn centrifuging_chart(groups: &[(f64, Vec<&TumblerRun>)]) -> LineChart {
+    let mut series = Vec::new();
+    for (k, (fill, g)) in groups.iter().enumerate() {
+        series.push(Series {
+            label: format!("fill {fill:.2}: co-rotating fraction"),
+            points: g.iter().map(|r| (r.froude, r.late.co_rotating)).collect(),
+            errors: Vec::new(),
+            colour: 2 * k,
+            mark: Mark::Points,
+        });
+        series.push(Series {
+            label: format!("fill {fill:.2}: Ω/ω"),
+            points: g.iter().map(|r| (r.froude, r.late.spin_ratio)).collect(),
+            errors: Vec::new(),
+            colour: 2 * k + 1,
+            mark: Mark::Points,
+        });
+        let threshold = g.first().map_or(f64::NAN, |r| r.threshold);
+        series.push(Series {
+            label: format!("fill {fill:.2}: R/r_in = {threshold:.2}"),
+            points: vec![(threshold, 0.0), (threshold, 1.0)],
+            errors: Vec::new(),
+            colour: 2 * k,
+            mark: Mark::Dashed,
+        });
+    }
+    LineChart {
+        title: "Tumbler: centrifuging vs Froude number (second half of each run)".into(),
+        x_label: "Fr = ω² R / g".into(),
+        y_label: "co-rotating fraction; mean angular velocity / ω".into(),
+        series,
+        log_x: true,
+    }
+}
+
 fn tumbler_section(md: &mut String, runs: &[TumblerRun], fig_dir: &Path) -> Result<Vec<String>, String> {
     let _ = writeln!(md, "## Tumbler (Richardson11 §3.2)\n");
     let Some(first) = runs.first() else {
         let _ = writeln!(md, "No tumbler runs given.\n");
         return Ok(Vec::new());
     };
+    let r_over_d = first.radius / (2.0 * first.particle_radius);
     let _ = writeln!(
         md,
-        "Drum radius R = {} m, {} free particles of radius {} m (R/d = {:.1}; the paper: 6513 particles, R/d ≈ 57), {} \
-         stuck to the drum (its rough lining, turning with it). Dynamic angle: straight-line fit to the surface points \
-         with −0.8 R < x < 0 (the rising side, the paper's \"left of centre\"), mean ± 1σ over the snapshots of the \
-         second half of each run. \"Above axis\": mean fraction of free particles above the drum's axis there (≈ 0 when \
-         tumbling half full; large when centrifuging).\n",
-        first.radius,
-        first.free,
-        first.particle_radius,
-        first.radius / (2.0 * first.particle_radius),
-        first.stuck
+        "Drum radius R = {} m, free particles of radius {} m (R/d = {r_over_d:.1}; the paper: 6513 particles, R/d ≈ \
+         57), {} stuck to the drum (its rough lining, turning with it). Dynamic angle: straight-line fit to the surface \
+         points with −0.8 R < x < 0 (the rising side, the paper's \"left of centre\"), mean ± 1σ over the snapshots \
+         of the second half of each run.\n",
+        first.radius, first.particle_radius, first.stuck
     );
     let _ = writeln!(
         md,
-        "| Fr | ω (rad/s) | status | t reached (s) | angle (deg) | snapshots fitted | above axis | collisions | events/s | wall (s) |"
+        "Centrifuging (`src/analysis/tumbler.rs`, means over the snapshots of 50–75 % and 75–100 % of each run): \
+         \"co-rotating\" is the fraction of free particles whose velocity differs from the drum's rigid rotation at \
+         their position by less than {:.0} % of the local drum speed ω ρ (1 for a bed turning with the drum, 0 at \
+         rest); Ω/ω is their angular momentum about the axis over that of rigid co-rotation at their positions; \
+         \"above axis\" the fraction above the axis over 50–100 % (0 for a half-full bed below the axis, 0.5 for a \
+         uniform ring). Fill: the fraction of the disc inside the lining (radius R − 2r) below the top of the bed at \
+         t = 0. R/r_in: the Froude number at which a bed of that fill spread into an annulus against the lining, inner \
+         radius r_in = (R − 2r) √(1 − fill), is held at the top down to its inner surface (ω² r_in ≥ g).\n",
+        100.0 * CO_ROTATION_TOLERANCE
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|");
-    for r in runs {
-        let _ = writeln!(
-            md,
-            "| {:.3} | {:.3} | {} | {:.2} | {:.1} ± {:.1} | {} | {:.2} | {} | {:.2e} | {:.0} |",
-            r.froude,
-            r.omega,
-            r.status,
-            r.t_reached,
-            r.angle.0,
-            r.angle.1,
-            r.angles.len(),
-            r.above_axis,
-            r.collisions,
-            r.events_per_second,
-            r.wall_seconds
-        );
+    tumbler_table(md, runs);
+    let groups = by_fill(runs);
+    let mut made = Vec::new();
+    if runs.iter().any(|r| !r.angles.is_empty()) {
+        made.extend(write_figure(
+            fig_dir,
+            "tumbler_angle_vs_froude",
+            &angle_chart(&groups, r_over_d),
+        )?);
     }
-    let ok: Vec<&TumblerRun> = runs.iter().filter(|r| !r.angles.is_empty()).collect();
-    let chart = LineChart {
-        title: "Tumbler: dynamic angle of repose vs Froude number (cf. Richardson11 Fig. 10)".into(),
-        x_label: "Fr = ω² R / g".into(),
-        y_label: "dynamic angle of repose (deg)".into(),
-        series: vec![Series {
-            label: format!("this work, R/d = {:.0}", first.radius / (2.0 * first.particle_radius)),
-            points: ok.iter().map(|r| (r.froude, r.angle.0)).collect(),
-            errors: ok.iter().map(|r| r.angle.1).collect(),
-            colour: 0,
-            mark: Mark::Points,
-        }],
-        log_x: true,
-    };
-    let made = if ok.is_empty() {
-        Vec::new()
-    } else {
-        write_figure(fig_dir, "tumbler_angle_vs_froude", &chart)?.to_vec()
-    };
+    made.extend(write_figure(
+        fig_dir,
+        "tumbler_centrifuging_vs_froude",
+        &centrifuging_chart(&groups),
+    )?);
     let _ = writeln!(md);
     Ok(made)
 }
@@ -297,7 +385,12 @@ pub fn report(args: &ReportRichardson2011Args) -> Result<(), CliError> {
     for d in &args.tumbler {
         tumblers.push(analyse_tumbler_run(d).map_err(CliError::usage)?);
     }
-    tumblers.sort_by(|a, b| a.froude.total_cmp(&b.froude));
+    // Grouped by fill (as in the figures), then by Fr and run length.
+    let key = |r: &TumblerRun| ((r.fill * 100.0).round() as i64, r.froude, r.t_reached);
+    tumblers.sort_by(|a, b| {
+        let (ka, kb) = (key(a), key(b));
+        ka.0.cmp(&kb.0).then(ka.1.total_cmp(&kb.1)).then(ka.2.total_cmp(&kb.2))
+    });
     let mut md = String::new();
     let _ = writeln!(md, "# Richardson et al. (2011) hard-sphere DEM — reproduction\n");
     let _ = writeln!(
