@@ -82,8 +82,16 @@ fn recipe_with_gravity_every_4_steps_packs_alike() {
     let r = &agg.report;
     let eta = r.interior_packing_fraction.unwrap();
     assert!((0.55..=0.68).contains(&eta), "η = {eta}");
-    assert!(r.max_overlap_fraction < 0.01, "largest overlap {} r", r.max_overlap_fraction);
-    for st in r.stages.iter().filter(|st| st.stage == "collapse" || st.stage == "settle") {
+    assert!(
+        r.max_overlap_fraction < 0.01,
+        "largest overlap {} r",
+        r.max_overlap_fraction
+    );
+    for st in r
+        .stages
+        .iter()
+        .filter(|st| st.stage == "collapse" || st.stage == "settle")
+    {
         assert_eq!(st.steps % 4, 0, "{} ran {} steps", st.stage, st.steps);
     }
 }

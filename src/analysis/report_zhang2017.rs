@@ -69,6 +69,9 @@ pub struct ModelRow {
     pub release_time: Option<f64>,
     /// Largest overlap / radius.
     pub max_overlap: f64,
+    /// Largest energy and angular-momentum residuals of the run (`summary.json`), forcing work and torque
+    /// booked; `None` for runs made before the forcing was booked (their residuals include the forcing).
+    pub residuals: Option<(f64, f64)>,
     /// Wall time (s), simulated time (s), status.
     pub wall_seconds: f64,
     /// See `wall_seconds`.
@@ -99,6 +102,15 @@ fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
         }
     }
     (m > 0.0).then_some((lo, hi, m, n))
+}
+
+/// Whether the run's `timeseries.csv` books the spin-up forcing (has the `forcing_work` column).
+fn books_forcing(run: &Path) -> bool {
+    std::fs::read_to_string(run.join("timeseries.csv")).is_ok_and(|t| {
+        t.lines()
+            .next()
+            .is_some_and(|h| h.split(',').any(|c| c == "forcing_work"))
+    })
 }
 
 /// Reads one model's runs under `RUNS/<model>`.
@@ -162,6 +174,13 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         path_error,
         release_time,
         max_overlap: summary["max_overlap_fraction"].as_f64().unwrap_or(f64::NAN),
+        residuals: books_forcing(&run)
+            .then(|| {
+                summary["energy_error"]
+                    .as_f64()
+                    .zip(summary["angular_momentum_error"].as_f64())
+            })
+            .flatten(),
         wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
         final_time: samples.last().map(|s| s.t).unwrap_or(0.0),
         status: summary["status"]
@@ -291,13 +310,13 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
     let _ = writeln!(md, "## Runs\n");
     let _ = writeln!(
         md,
-        "| model | status | simulated (s) | wall (s) | largest overlap / radius | largest \\|T/T_path − 1\\| while forced: before T_c1 / all | forcing released at (s) |"
+        "| model | status | simulated (s) | wall (s) | largest overlap / radius | largest \\|T/T_path − 1\\| while forced: before T_c1 / all | forcing released at (s) | energy / L residual |"
     );
-    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- |");
     for r in &rows {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.0} | {:.0} | {:.2e} | {:.1e} / {:.1e} | {} |",
+            "| {} | {} | {:.0} | {:.0} | {:.2e} | {:.1e} / {:.1e} | {} | {} |",
             r.model.to_uppercase(),
             r.status,
             r.final_time,
@@ -305,7 +324,11 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
             r.max_overlap,
             r.path_error_before_t_c1,
             r.path_error,
-            opt(r.release_time, 0)
+            opt(r.release_time, 0),
+            r.residuals
+                .map_or("– (forcing not booked)".to_string(), |(e, l)| format!(
+                    "{e:.1e} / {l:.1e}"
+                ))
         );
     }
     let _ = writeln!(md, "\n## Time series (Fig. 5 style)\n");

@@ -205,8 +205,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
     let mut runs = Vec::new();
     for (k, &tf) in grid.iter().enumerate() {
         let dir = args.out.join(format!("T{tf:.2}"));
-        let completed =
-            std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
+        let completed = std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
         let options = RunOptions {
             force: true,
             progress: false,
@@ -223,8 +222,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
                 table["spinup"]["T_final"] = toml::Value::Float(tf);
                 let scene_text = toml::to_string(&table).map_err(|e| CliError::usage(e.to_string()))?;
                 let path = args.out.join(format!("T{tf:.2}.toml"));
-                std::fs::write(&path, &scene_text)
-                    .map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
+                std::fs::write(&path, &scene_text).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
                 let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
                 crate::granular::soft::run::run_soft(&scene, &dir, &options)
                     .map_err(|e| CliError::failed(e.to_string()))?;
@@ -333,7 +331,9 @@ fn prepare_branches(
     // the base scene: the path run to just past the earliest hold's start
     let t_base_end = starts.iter().cloned().fold(0.0, f64::max) + 2.0 * every;
     let mut table = table.clone();
-    table.entry("output").or_insert_with(|| toml::Value::Table(toml::Table::new()));
+    table
+        .entry("output")
+        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
     let mut base_table = table.clone();
     base_table["scene"]["t_end"] = toml::Value::Float(t_base_end);
     let keep = |limit: f64| -> toml::Value {
@@ -347,7 +347,11 @@ fn prepare_branches(
     };
     base_table["output"]["times"] = keep(t_base_end);
     let base_text = toml::to_string(&base_table).map_err(|e| CliError::usage(e.to_string()))?;
-    let parent = args.scene.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let parent = args
+        .scene
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
     let scene_dir = std::path::absolute(parent).map_err(|e| CliError::usage(format!("{}: {e}", parent.display())))?;
     let base_scene = crate::granular::soft::scene::parse_soft_scene(&base_text, "base", Some(&scene_dir))
         .map_err(CliError::usage)?;
@@ -364,9 +368,16 @@ fn prepare_branches(
             continue;
         }
         let s_x = (starts[k] / dt + 1e-9).floor() as u64;
-        let s_ck = plan.iter().map(|p| p.0).filter(|&s| s <= s_x && s > 0).max().unwrap_or(0);
+        let s_ck = plan
+            .iter()
+            .map(|p| p.0)
+            .filter(|&s| s <= s_x && s > 0)
+            .max()
+            .unwrap_or(0);
         if s_ck == 0 {
-            return Err(CliError::usage(format!("T_final = {tf} h is reached before the first output sample")));
+            return Err(CliError::usage(format!(
+                "T_final = {tf} h is reached before the first output sample"
+            )));
         }
         let t_ck = s_ck as f64 * dt;
         let here = if base_dir.join("checkpoint.json").is_file() {
@@ -389,7 +400,10 @@ fn prepare_branches(
                 checkpoint_every_sim: Some(t_ck - t_here - 0.5 * dt),
                 stop_after_checkpoints: Some(1),
             };
-            eprintln!("spinup critical: base run to t = {t_ck} s (T_final = {tf} h starts at {} s)", starts[k]);
+            eprintln!(
+                "spinup critical: base run to t = {t_ck} s (T_final = {tf} h starts at {} s)",
+                starts[k]
+            );
             let result = match here {
                 Some(_) => resume_soft(&base_dir, &options),
                 None => run_soft(&base_scene, &base_dir, &options),
@@ -414,7 +428,11 @@ fn prepare_branches(
             _ => Vec::new(),
         };
         for t in [starts[k], starts[k] + hold] {
-            if snaps.last().and_then(|v| v.as_float()).is_none_or(|last| t >= last + dt) {
+            if snaps
+                .last()
+                .and_then(|v| v.as_float())
+                .is_none_or(|last| t >= last + dt)
+            {
                 snaps.push(toml::Value::Float(t));
             }
         }

@@ -80,6 +80,10 @@ pub struct SoftSystem {
     pub dissipated: f64,
     /// Work done on the spheres by moving walls so far (J).
     pub wall_work: f64,
+    /// Work done on the spheres by an external spin-up forcing so far (J; [`crate::granular::soft::spinup`]).
+    pub forcing_work: f64,
+    /// Angular momentum given to the spheres by that forcing so far (kg m²/s, about the origin).
+    pub forcing_angular_impulse: Vec3,
     /// Keep per-contact records of the last evaluation in [`SoftSystem::records`] (off by default).
     pub keep_records: bool,
     /// Per-contact records of the last evaluation when [`SoftSystem::keep_records`] is set.
@@ -238,6 +242,8 @@ impl SoftSystem {
             stats: ForceStats::default(),
             dissipated: 0.0,
             wall_work: 0.0,
+            forcing_work: 0.0,
+            forcing_angular_impulse: Vec3::zeros(),
             keep_records: false,
             records: Vec::new(),
             gravity_interval: 1,

@@ -5,16 +5,18 @@
 //! - `scene.toml`: the scene text;
 //! - `timeseries.csv` (flushed per row), every `output.every` (whole steps) and at each snapshot:
 //!   `t,step,kinetic_energy,gravitational_energy,spring_energy,dissipated_energy,wall_work,energy_residual,
-//!   momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,wall_seconds`;
-//!   `energy_residual = (E + W_dissipated − W_walls − E₀)/S` with `E` kinetic + gravitational + spring energy
-//!   and `S = KE₀ + |U₀| + spring₀` (1 J if zero); momenta errors are `|P − P₀|/Σ m|v|₀` and
-//!   `|L − L₀|/Σ(|x × m v| + I|ω|)₀` (scale 1 if zero); `max_overlap_fraction` is the largest contact overlap
-//!   over the smaller radius of the contact at that step;
+//!   momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,forcing_work,
+//!   wall_seconds`;
+//!   `energy_residual = (E + W_dissipated − W_walls − W_forcing − E₀)/S` with `E` kinetic + gravitational + spring
+//!   energy and `S = KE₀ + |U₀| + spring₀` (1 J if zero); momenta errors are `|P − P₀|/Σ m|v|₀` and
+//!   `|L − ΔL_forcing − L₀|/Σ(|x × m v| + I|ω|)₀` (scale 1 if zero); `W_forcing` and `ΔL_forcing` are the work
+//!   and angular momentum given by the spin-up forcing (0 without `[spinup]`), so that the residuals measure the
+//!   integration error in spin-up runs too; `max_overlap_fraction` is the largest contact overlap over the smaller
+//!   radius of the contact at that step;
 //! - `snapshots/<k>.csv`: `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (usable as a `particles_file`);
 //! - `summary.json` ([`SoftSummary`]), `last_good_state.csv` on failure, `checkpoint.json` when due;
 //! - with a `[spinup]` table: `spinup.csv`, one row of [`crate::analysis::spinup_diagnostics`] per time-series
-//!   row; the forcing ([`crate::granular::soft::spinup`]) acts after every step (the time series' angular
-//!   momentum error then measures the torque applied, not an error).
+//!   row; the forcing ([`crate::granular::soft::spinup`]) acts after every step.
 //!
 //! Checkpoints hold every particle's state, the last forces and torques (leapfrog needs them), the spring
 //! histories and the bookkeeping, all as exact f64 bit patterns, so [`resume_soft`] continues bit for bit.
@@ -46,7 +48,7 @@ pub const SOFT_CHECKPOINT_FORMAT: &str = "rubblepile-ssdem-checkpoint";
 /// Overlap (fraction of the smaller radius) above which the run is declared broken.
 pub const BROKEN_OVERLAP: f64 = 0.5;
 
-const TIMESERIES_HEADER: &str = "t,step,kinetic_energy,gravitational_energy,spring_energy,dissipated_energy,wall_work,energy_residual,momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,wall_seconds\n";
+const TIMESERIES_HEADER: &str = "t,step,kinetic_energy,gravitational_energy,spring_energy,dissipated_energy,wall_work,energy_residual,momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,forcing_work,wall_seconds\n";
 
 /// `summary.json` of a soft-sphere run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -287,7 +289,7 @@ struct SoftCheckpoint {
     state: Vec<f64>,
     pair_springs: Vec<SpringRecord>,
     wall_springs: Vec<SpringRecord>,
-    /// dissipated, wall_work.
+    /// dissipated, wall_work, forcing_work, forcing angular impulse (x, y, z).
     #[serde(with = "exact_f64_vec")]
     work: Vec<f64>,
     /// Steps taken in the current self-gravity block (r-RESPA; 0 without).
@@ -334,7 +336,9 @@ impl SpinRun {
         if !self.driver.released {
             let springs = sys.pair_springs();
             let member = central_body(&sys.particles, springs.iter().map(|(k, _)| k));
-            self.driver.apply(&mut sys.particles, &member, t);
+            let inc = self.driver.apply(&mut sys.particles, &member, t);
+            sys.forcing_work += inc.work;
+            sys.forcing_angular_impulse += inc.angular_impulse;
         }
     }
     /// The diagnostics row at an output sample (time `t`, s), then the release check.
@@ -350,7 +354,6 @@ impl SpinRun {
 }
 // ---- end of spin-up hook ---------------------------------------------------------------------------------
 
-/// The samples of a run: `(step, Some(snapshot index))`, increasing.
 /// The run's output samples: `(step, snapshot index)` for every time-series row, in order (the `every` grid, the
 /// last step, and the snapshot steps).
 pub fn sample_steps(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
@@ -556,11 +559,16 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, Soft
     }
     sys.set_pair_springs(unpack(&ck.pair_springs).ok_or_else(|| bad("malformed pair springs".into()))?);
     sys.wall_springs = unpack(&ck.wall_springs).ok_or_else(|| bad("malformed wall springs".into()))?;
-    if ck.work.len() != 2 {
+    // [dissipated, wall work] before the spin-up forcing was accounted; then [.., forcing work, its L (3)]
+    if ck.work.len() != 2 && ck.work.len() != 6 {
         return Err(bad("malformed work record".into()));
     }
     sys.dissipated = ck.work[0];
     sys.wall_work = ck.work[1];
+    if ck.work.len() == 6 {
+        sys.forcing_work = ck.work[2];
+        sys.forcing_angular_impulse = Vec3::new(ck.work[3], ck.work[4], ck.work[5]);
+    }
     sys.gravity_interval = scene.gravity_interval;
     if sys.split_gravity() {
         if ck.slow.len() != 3 * n + 1 || ck.gravity_phase >= scene.gravity_interval {
@@ -612,15 +620,16 @@ fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f6
     let ke = sys.kinetic_energy();
     let s = &sys.stats;
     let residual =
-        (ke + s.gravitational_energy + s.spring_energy + sys.dissipated - sys.wall_work - book.e0) / book.e_scale;
+        (ke + s.gravitational_energy + s.spring_energy + sys.dissipated - sys.wall_work - sys.forcing_work - book.e0)
+            / book.e_scale;
     let p_err = (sys.momentum() - book.p0).norm() / book.p_scale;
-    let l_err = (sys.angular_momentum() - book.l0).norm() / book.l_scale;
+    let l_err = (sys.angular_momentum() - sys.forcing_angular_impulse - book.l0).norm() / book.l_scale;
     book.max_energy = book.max_energy.max(residual.abs());
     book.last_energy = residual;
     book.max_p = book.max_p.max(p_err);
     book.max_l = book.max_l.max(l_err);
     format!(
-        "{},{step},{ke},{},{},{},{},{residual},{p_err},{l_err},{},{},{},{wall}\n",
+        "{},{step},{ke},{},{},{},{},{residual},{p_err},{l_err},{},{},{},{},{wall}\n",
         step as f64 * scene.dt,
         s.gravitational_energy,
         s.spring_energy,
@@ -629,6 +638,7 @@ fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f6
         s.max_overlap_fraction,
         s.pair_contacts + s.wall_contacts,
         sys.coordination_number(),
+        sys.forcing_work,
     )
 }
 
@@ -756,7 +766,14 @@ fn drive(
                 state,
                 pair_springs: pack(&sys.pair_springs()),
                 wall_springs: pack(&sys.wall_springs),
-                work: vec![sys.dissipated, sys.wall_work],
+                work: vec![
+                    sys.dissipated,
+                    sys.wall_work,
+                    sys.forcing_work,
+                    sys.forcing_angular_impulse.x,
+                    sys.forcing_angular_impulse.y,
+                    sys.forcing_angular_impulse.z,
+                ],
                 gravity_phase: sys.gravity_phase,
                 slow: if sys.split_gravity() {
                     let mut v: Vec<f64> = sys.slow_accelerations.iter().flat_map(|a| a.iter().copied()).collect();

@@ -343,6 +343,17 @@ pub struct SpinupDriver {
     pub reference: Option<[f64; 3]>,
 }
 
+/// What one spin-up increment did ([`SpinupDriver::apply`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ForcingIncrement {
+    /// The rigid-rotation increment `Δω` (rad/s).
+    pub d_omega: f64,
+    /// Kinetic energy it added (J).
+    pub work: f64,
+    /// Angular momentum it added, about the origin (kg m²/s).
+    pub angular_impulse: Vec3,
+}
+
 impl SpinupDriver {
     /// A driver for a run starting from `initial` (the particles at t = 0).
     pub fn new(settings: SpinupSettings, initial: &[Particle]) -> Self {
@@ -375,23 +386,31 @@ impl SpinupDriver {
     }
 
     /// Applies the spin-up increment at time `t` (s) to the central body given by `member`; nothing once released.
-    /// Returns the applied `Δω` (rad/s).
-    pub fn apply(&self, particles: &mut [Particle], member: &[bool], t: f64) -> f64 {
+    /// Returns what it did: the applied `Δω` (rad/s), the work (J) and the angular momentum about the origin
+    /// (kg m²/s) it gave the spheres, for the run's forcing-aware energy and angular-momentum residuals.
+    pub fn apply(&self, particles: &mut [Particle], member: &[bool], t: f64) -> ForcingIncrement {
+        let mut inc = ForcingIncrement::default();
         if self.released {
-            return 0.0;
+            return inc;
         }
         let a = self.settings.axis;
         let rot = body_rotation(particles, member, &a);
         if rot.inertia <= 0.0 {
-            return 0.0;
+            return inc;
         }
         let target = self.reference_inertia(particles, member) * self.settings.path.omega(t);
         let dw = (target - rot.angular_momentum) / rot.inertia;
         for (p, _) in particles.iter_mut().zip(member).filter(|(_, k)| **k) {
-            p.velocity += a.cross(&(p.position - rot.centre)) * dw;
-            p.spin += a * dw;
+            let dv = a.cross(&(p.position - rot.centre)) * dw;
+            let ds = a * dw;
+            inc.work += p.mass * (p.velocity.dot(&dv) + 0.5 * dv.norm_squared())
+                + p.inertia() * (p.spin.dot(&ds) + 0.5 * ds.norm_squared());
+            inc.angular_impulse += p.position.cross(&dv) * p.mass + ds * p.inertia();
+            p.velocity += dv;
+            p.spin += ds;
         }
-        dw
+        inc.d_omega = dw;
+        inc
     }
 
     /// Feeds the diagnostics of an output sample at time `t` (s): sets the reference at the first sample at or
@@ -499,7 +518,7 @@ mod tests {
     }
 
     #[test]
-    fn increment_sets_the_target_angular_momentum_and_keeps_momentum() {
+    fn increment_sets_the_target_angular_momentum_keeps_momentum_and_reports_its_work() {
         let settings = SpinupSettings {
             path: path(0, 0.0),
             axis: Vec3::new(0.0, 0.0, 1.0),
@@ -520,7 +539,24 @@ mod tests {
         let d = SpinupDriver::new(settings, &ps);
         let member = vec![true; 6];
         let p0: Vec3 = ps.iter().map(|p| p.velocity * p.mass).sum();
-        d.apply(&mut ps, &member, 20.0);
+        let ke = |ps: &[Particle]| -> f64 {
+            ps.iter()
+                .map(|p| 0.5 * p.mass * p.velocity.norm_squared() + 0.5 * p.inertia() * p.spin.norm_squared())
+                .sum()
+        };
+        let l = |ps: &[Particle]| -> Vec3 {
+            ps.iter()
+                .map(|p| p.position.cross(&p.velocity) * p.mass + p.spin * p.inertia())
+                .sum()
+        };
+        let (ke0, l0) = (ke(&ps), l(&ps));
+        let inc = d.apply(&mut ps, &member, 20.0);
+        // the reported work and angular impulse are the changes of kinetic energy and angular momentum
+        assert!((ke(&ps) - ke0 - inc.work).abs() < 1e-12 * ke(&ps), "{inc:?}");
+        assert!(
+            (l(&ps) - l0 - inc.angular_impulse).norm() < 1e-12 * l(&ps).norm(),
+            "{inc:?}"
+        );
         let rot = body_rotation(&ps, &member, &settings.axis);
         let want = d.reference_inertia(&ps, &member) * std::f64::consts::TAU / 4.0;
         assert!((rot.angular_momentum - want).abs() < 1e-12 * want, "{rot:?} {want}");
