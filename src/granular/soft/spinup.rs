@@ -13,6 +13,7 @@
 //! rests = 0                    # rest stages inserted in the slow phase (path 1: 5)
 //! rest_length = 0.0            # s, length of each rest (path 1: 7000)
 //! axis = [0.0, 0.0, 1.0]       # spin axis, fixed in space (normalised); default z
+//! target = "period"            # what the forcing holds on the path: "period" (default) or "angular_momentum"
 //! release_axis_ratio = 0.1     # disruption: |Δ(b/a)| or |Δ(c/a)| above this ...
 //! release_packing = 0.01       # ... or |Δη_B| above this (both from the values at t_start) ...
 //! release_samples = 2          # ... at this many consecutive output samples: forcing released
@@ -28,14 +29,18 @@
 //! Shed or orbiting particles have no contact with it and are not forced; a particle in flight for a few steps
 //! after a bounce is also left alone for those steps, which carries no bias since it keeps its momentum.
 //!
-//! **Angular-momentum spin-up** (the authors' option): the target is an angular momentum about the body's centre
-//! of mass along `axis`, `L*(t) = I_ref Ω(t)` with `Ω = 2π/T(t)` and `I_ref` the moment of inertia of the current
-//! members *as they were placed at t = 0* (about the initial centre of mass). A body that expands therefore
-//! spins slower than the path instead of being given more angular momentum, and losing members lowers the target
-//! in proportion. After each step the difference `ΔL = L* − L` is added as a rigid-rotation increment
-//! `Δω = ΔL/I` about the body's current centre of mass (`I` its current moment of inertia about the axis through
-//! it): `v_i += Δω a × (x_i − R)`, `ω_i += Δω a` for every member. This conserves the body's linear momentum and
-//! changes its angular momentum along `a` by exactly `ΔL`.
+//! **The forcing** acts by angular-momentum increments (the authors' "angular-momentum spin-up"): after each step
+//! the body's angular momentum `L` about its centre of mass along `axis` is set to a target `L*` by adding the
+//! difference `ΔL = L* − L` as a rigid-rotation increment `Δω = ΔL/I` about the body's current centre of mass (`I`
+//! its current moment of inertia about the axis through it): `v_i += Δω a × (x_i − R)`, `ω_i += Δω a` for every
+//! member. This conserves the body's linear momentum and changes its angular momentum along `a` by exactly `ΔL`;
+//! the work and angular momentum it adds are booked in the run's residuals. The target (`target` in the table):
+//! - `"period"` (default): `L* = I Ω(t)`, `Ω = 2π/T(t)`, so that the body's rotation period `2π I/L` is the path's
+//!   after every step — Zhang17 §2.3.4: the period "is strictly constrained to the spin-up path" until global
+//!   disruption; a body that expands is given the angular momentum that keeps it on the path;
+//! - `"angular_momentum"`: `L* = I_ref Ω(t)` with `I_ref` the moment of inertia of the current members *as they were
+//!   placed at t = 0* (about the initial centre of mass): a body that expands spins slower than the path instead of
+//!   being given more angular momentum, and losing members lowers the target in proportion.
 //!
 //! **Release** ("global disruption confirmed", Zhang17 §2.3.4 footnote 6: the packing efficiency and the axis
 //! ratios drop rapidly): at output samples the driver compares b/a, c/a and η_B with their values at the first
@@ -89,6 +94,11 @@ pub struct SpinupSection {
     /// Spin axis, fixed in space (non-zero; default `[0, 0, 1]`).
     #[serde(default)]
     pub axis: Option<[f64; 3]>,
+    /// What the forcing holds on the path: `"period"` (default; the body's rotation period `2π I/L` equals `T(t)`
+    /// after every step, Zhang17 §2.3.4: "strictly constrained to the spin-up path") or `"angular_momentum"`
+    /// (`L = I_ref 2π/T(t)` with `I_ref` the members' inertia as placed at t = 0, so an expanding body slows).
+    #[serde(default)]
+    pub target: Option<String>,
     /// Release threshold on b/a and c/a (> 0; default 0.1).
     #[serde(default = "d_release_axis")]
     pub release_axis_ratio: f64,
@@ -155,11 +165,23 @@ impl SpinupPath {
     }
 }
 
+/// What the spin-up forcing holds on the path (`[spinup] target`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpinupTarget {
+    /// The body's rotation period `2π I/L` (current inertia) equals the path's after every step.
+    Period,
+    /// The body's angular momentum equals `I_ref 2π/T(t)`, `I_ref` its members' inertia as placed at t = 0.
+    AngularMomentum,
+}
+
 /// Validated `[spinup]` settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpinupSettings {
     /// The path.
     pub path: SpinupPath,
+    /// What the forcing holds on the path.
+    pub target: SpinupTarget,
     /// Unit spin axis.
     pub axis: Vec3,
     /// Release threshold on b/a and c/a.
@@ -214,6 +236,16 @@ impl crate::scene::Validator<'_> {
         if s.release_samples == 0 {
             return Err(self.invalid("spinup.release_samples", "must be >= 1, got 0"));
         }
+        let target = match s.target.as_deref() {
+            None | Some("period") => SpinupTarget::Period,
+            Some("angular_momentum") => SpinupTarget::AngularMomentum,
+            Some(other) => {
+                return Err(self.invalid(
+                    "spinup.target",
+                    format!("must be \"period\" or \"angular_momentum\", got {other:?}"),
+                ));
+            }
+        };
         if s.rve_particles < 8 {
             return Err(self.invalid("spinup.rve_particles", format!("must be >= 8, got {}", s.rve_particles)));
         }
@@ -229,6 +261,7 @@ impl crate::scene::Validator<'_> {
                 rest_length: rest,
             },
             axis: axis.normalize(),
+            target,
             release_axis_ratio: self.positive("spinup.release_axis_ratio", s.release_axis_ratio)?,
             release_packing: self.positive("spinup.release_packing", s.release_packing)?,
             release_samples: s.release_samples,
@@ -398,7 +431,11 @@ impl SpinupDriver {
         if rot.inertia <= 0.0 {
             return inc;
         }
-        let target = self.reference_inertia(particles, member) * self.settings.path.omega(t);
+        let inertia = match self.settings.target {
+            SpinupTarget::Period => rot.inertia,
+            SpinupTarget::AngularMomentum => self.reference_inertia(particles, member),
+        };
+        let target = inertia * self.settings.path.omega(t);
         let dw = (target - rot.angular_momentum) / rot.inertia;
         for (p, _) in particles.iter_mut().zip(member).filter(|(_, k)| **k) {
             let dv = a.cross(&(p.position - rot.centre)) * dw;
@@ -522,6 +559,7 @@ mod tests {
         let settings = SpinupSettings {
             path: path(0, 0.0),
             axis: Vec3::new(0.0, 0.0, 1.0),
+            target: SpinupTarget::AngularMomentum,
             release_axis_ratio: 0.1,
             release_packing: 0.01,
             release_samples: 2,
@@ -566,11 +604,54 @@ mod tests {
         assert!((rot.period() - 4.0).abs() < 1e-12);
     }
 
+    /// A body that has expanded by 10 % since t = 0: the period target puts its period on the path, the
+    /// angular-momentum target leaves it slower by the inertia ratio I/I_ref = 1.21.
+    #[test]
+    fn period_target_holds_the_path_on_an_expanded_body_angular_momentum_target_does_not() {
+        let ps0: Vec<Particle> = (0..6)
+            .map(|k| Particle {
+                mass: 1.0 + k as f64,
+                radius: 0.5,
+                position: Vec3::new((k as f64).cos() * 2.0, (k as f64).sin() * 3.0, k as f64 * 0.3),
+                velocity: Vec3::zeros(),
+                spin: Vec3::zeros(),
+            })
+            .collect();
+        let member = vec![true; 6];
+        let centre = ps0.iter().map(|p| p.position * p.mass).sum::<Vec3>() / ps0.iter().map(|p| p.mass).sum::<f64>();
+        let mut expanded = ps0.clone();
+        for p in &mut expanded {
+            p.position = centre + (p.position - centre) * 1.1;
+        }
+        let period_after = |target: SpinupTarget| {
+            let settings = SpinupSettings {
+                path: path(0, 0.0),
+                axis: Vec3::z(),
+                target,
+                release_axis_ratio: 0.1,
+                release_packing: 0.01,
+                release_samples: 2,
+                rve_particles: 300,
+            };
+            let d = SpinupDriver::new(settings, &ps0);
+            let mut ps = expanded.clone();
+            d.apply(&mut ps, &member, 20.0);
+            let rot = body_rotation(&ps, &member, &Vec3::z());
+            (rot.period(), rot.inertia / d.reference_inertia(&ps, &member))
+        };
+        let (t_period, _) = period_after(SpinupTarget::Period);
+        assert!((t_period / 4.0 - 1.0).abs() < 1e-13, "{t_period}");
+        let (t_am, ratio) = period_after(SpinupTarget::AngularMomentum);
+        assert!(ratio > 1.15, "the expansion must raise the inertia: {ratio}");
+        assert!((t_am / (4.0 * ratio) - 1.0).abs() < 1e-12, "{t_am} vs {}", 4.0 * ratio);
+    }
+
     #[test]
     fn release_needs_consecutive_confirmations_and_state_round_trips() {
         let settings = SpinupSettings {
             path: path(0, 0.0),
             axis: Vec3::z(),
+            target: SpinupTarget::Period,
             release_axis_ratio: 0.1,
             release_packing: 0.01,
             release_samples: 2,
