@@ -1,6 +1,6 @@
 //! Barnes–Hut octree with quadrupole moments and a group walk (Zhang17 §2.1 uses pkdgrav's tree; our notes
 //! ask for at least quadrupole order and a real O(N log N) method; the group walk is Barnes 1990, J. Comput.
-//! Phys. 87, 161).
+//! Phys. 87, 161; the opening criterion Barnes 1994, in Computational Astrophysics, Springer).
 //!
 //! Build: each particle gets a 63-bit Morton key (21 bits per axis over the bounding cube); the particles are
 //! sorted by key, so every node's particles are one contiguous run of the sorted array, and the nodes are
@@ -13,13 +13,19 @@
 //! for a point at `r = p − c` when `|r| > l/θ + δ` (Barnes 1994's criterion; never for a point inside its cube
 //! when θ < 2/√3), with
 //! `φ = −G M/|r| − G rᵀQr / (2|r|⁵)` and `a = −∇φ = −G M r/|r|³ + G (Q r/|r|⁵ − 5/2 (rᵀQr) r/|r|⁷)`.
-//! This holds for leaves too, but only for leaves of at least [`FAR_LEAF_MIN`] particles; smaller leaves
-//! are summed directly (their multipole costs as much as their particles).
+//! Leaves are used whole in the same way ("far leaves") when they hold at least [`FAR_LEAF_MIN`] particles
+//! and the tree at least [`FAR_LEAVES_FROM`]; other leaves are summed directly. Small leaves are excluded
+//! because on a lattice they are all alike (an FCC ball's octree has leaves of the four sites of one cubic
+//! cell), so the octupole their quadrupole misses adds up coherently instead of averaging out: on a
+//! 10 000-site FCC ball at θ = 0.5 the largest force error, relative to the largest force, was 3.0e-3 with
+//! leaves of four used whole and 7e-4 with five or more (as with no leaf used whole). Small trees are
+//! excluded because there direct sums cost little and keep a small aggregate's forces pairwise (its
+//! angular momentum to rounding, `ssdem_conservation`).
 //!
-//! Group walk: the particles of one bucket (the largest node of at most [`BUCKET_SIZE`] particles on each
-//! branch, a leaf or a small subtree) share one interaction list, built by one walk in which a node is used
-//! whole when the criterion holds at the point of the bucket's bounding box nearest to the node's centre of
-//! mass, hence for every particle of the bucket: the forces are those of the per-particle walk with some
+//! Group walk (Barnes 1990): the particles of one bucket (the largest node of at most [`BUCKET_SIZE`]
+//! particles on each branch, a leaf or a small subtree) share one interaction list, built by one walk in
+//! which a node is used whole when the criterion holds at the point of the bucket's bounding box nearest to
+//! the node's centre of mass, hence for every particle of the bucket: the forces are those of the per-particle walk with some
 //! nodes opened further, so the error is never larger. The list is then applied to the bucket's particles
 //! four at a time, each list entry (a node's moments or a particle, stored contiguously) read once per four
 //! particles, so the sums stay in registers and the compiler vectorises over the four particles. A source
@@ -36,10 +42,10 @@ pub const LEAF_SIZE: usize = 8;
 /// deepest level.
 pub const BUCKET_SIZE: usize = 32;
 /// Fewest particles of a leaf that may be used whole (by its multipole); smaller leaves are always summed
-/// directly.
+/// directly (see the module header: lattice leaves of four would add their errors coherently).
 pub const FAR_LEAF_MIN: usize = 5;
 /// Fewest particles in a tree whose leaves may be used whole: below it every leaf is summed directly, which
-/// costs little there and keeps the forces between particles within a few leaves' reach exactly pairwise.
+/// costs little at that size and keeps the forces between neighbouring particles exactly pairwise.
 pub const FAR_LEAVES_FROM: usize = 1000;
 /// Bits of the Morton key per axis: the deepest level of subdivision.
 const KEY_BITS: u32 = 21;
@@ -330,8 +336,8 @@ impl Octree {
         self.walk(&self.reach2(theta), *p, *p, &mut lists);
         let f = self.sum(&lists, &[p.x; LANES], &[p.y; LANES], &[p.z; LANES]);
         let (mut a, mut phi) = (Vec3::new(f[0][0], f[1][0], f[2][0]), f[3][0]);
-        // `skip` away from `p` was summed as a particle of its leaf (a skipped particle is in a leaf summed
-        // directly, since its leaf's box holds `p` then): remove its term.
+        // A particle at `p` itself was skipped by the sums; `skip` elsewhere was included: remove its direct
+        // term (exact when its leaf was summed directly, as it is whenever `p` lies near it).
         if let Some(sorted) = skip.and_then(|i| self.order.iter().position(|&o| o as usize == i)) {
             let [xj, yj, zj, mj] = self.particles[sorted];
             let d = Vec3::new(xj, yj, zj) - p;
