@@ -26,10 +26,11 @@
 //! particles on each branch, a leaf or a small subtree) share one interaction list, built by one walk in
 //! which a node is used whole when the criterion holds at the point of the bucket's bounding box nearest to
 //! the node's centre of mass, hence for every particle of the bucket: the forces are those of the per-particle walk with some
-//! nodes opened further, so the error is never larger. The list is then applied to the bucket's particles
-//! four at a time, each list entry (a node's moments or a particle, stored contiguously) read once per four
-//! particles, so the sums stay in registers and the compiler vectorises over the four particles. A source
-//! at distance zero (the particle itself) is skipped by a select, not a branch. Buckets are independent
+//! nodes opened further, so the error is never larger. The walk gathers the particles of the leaves summed
+//! directly into one contiguous list. The lists are then applied to the bucket's particles four at a time
+//! (a last one or two as a pair), each entry (a node's moments or a particle) read once per block, so the
+//! sums stay in registers and the compiler vectorises over the block. A source at distance zero (the
+//! particle itself) is skipped by a select, not a branch. Buckets are independent
 //! (rayon-parallel, buffers reused per worker); each particle sums its list in a fixed order, so results do
 //! not depend on the number of threads.
 
@@ -58,7 +59,7 @@ type Source = [f64; 4];
 /// (kg m²).
 type Moments = [f64; 10];
 /// Per-lane sums: ax, ay, az, φ (in units of G).
-type Sums = [[f64; LANES]; 4];
+type Sums<const N: usize> = [[f64; N]; 4];
 
 /// An octree over point masses (positions in m, masses in kg).
 #[derive(Debug, Clone, Default)]
@@ -102,16 +103,23 @@ fn spread(v: u64) -> u64 {
 struct Lists {
     /// Nodes used whole.
     cells: Vec<u32>,
-    /// Leaves summed directly.
-    direct: Vec<u32>,
+    /// The particles of the leaves summed directly, gathered.
+    sources: Vec<Source>,
 }
 
 /// Adds the monopole and quadrupole of every node in `cells` to the sums of points `x, y, z`.
-fn add_cells(cells: &[u32], moments: &[Moments], x: &[f64; LANES], y: &[f64; LANES], z: &[f64; LANES], f: &mut Sums) {
+fn add_cells<const N: usize>(
+    cells: &[u32],
+    moments: &[Moments],
+    x: &[f64; N],
+    y: &[f64; N],
+    z: &[f64; N],
+    f: &mut Sums<N>,
+) {
     let [ax, ay, az, phi] = f;
     for &c in cells {
         let [cx, cy, cz, m, qxx, qxy, qxz, qyy, qyz, qzz] = moments[c as usize];
-        for l in 0..LANES {
+        for l in 0..N {
             let (rx, ry, rz) = (x[l] - cx, y[l] - cy, z[l] - cz);
             let r2 = rx * rx + ry * ry + rz * rz;
             let inv = 1.0 / r2.sqrt();
@@ -132,10 +140,10 @@ fn add_cells(cells: &[u32], moments: &[Moments], x: &[f64; LANES], y: &[f64; LAN
 }
 
 /// Adds the particles `sources` to the sums of points `x, y, z` directly, skipping a source at distance zero.
-fn add_sources(sources: &[Source], x: &[f64; LANES], y: &[f64; LANES], z: &[f64; LANES], f: &mut Sums) {
+fn add_sources<const N: usize>(sources: &[Source], x: &[f64; N], y: &[f64; N], z: &[f64; N], f: &mut Sums<N>) {
     let [ax, ay, az, phi] = f;
     for &[xj, yj, zj, mj] in sources {
-        for l in 0..LANES {
+        for l in 0..N {
             let (dx, dy, dz) = (xj - x[l], yj - y[l], zj - z[l]);
             let r2 = dx * dx + dy * dy + dz * dz;
             let inv = if r2 > 0.0 { 1.0 / r2.sqrt() } else { 0.0 };
@@ -288,7 +296,7 @@ impl Octree {
     /// Fills `lists` for points whose bounding box is `lo..hi`: nodes used whole, and leaves summed directly.
     fn walk(&self, reach2: &[f64], lo: Vec3, hi: Vec3, lists: &mut Lists) {
         lists.cells.clear();
-        lists.direct.clear();
+        lists.sources.clear();
         let count = self.next.len() as u32;
         let mut k = 0u32;
         while k < count {
@@ -301,7 +309,8 @@ impl Octree {
                 if far && self.far_leaves && (self.end[kk] - self.start[kk]) as usize >= FAR_LEAF_MIN {
                     lists.cells.push(k);
                 } else {
-                    lists.direct.push(k);
+                    let (s, e) = (self.start[kk] as usize, self.end[kk] as usize);
+                    lists.sources.extend_from_slice(&self.particles[s..e]);
                 }
                 k = self.next[kk];
             } else if far {
@@ -313,16 +322,23 @@ impl Octree {
         }
     }
 
-    /// The field (in units of G) at up to [`LANES`] points `x, y, z` (unused lanes are ignored) from the
-    /// interaction lists: cells first, then direct leaves, each in list order.
-    fn sum(&self, lists: &Lists, x: &[f64; LANES], y: &[f64; LANES], z: &[f64; LANES]) -> Sums {
-        let mut f = [[0.0; LANES]; 4];
+    /// The field (in units of G) at `N` points `x, y, z` from the interaction lists: cells first, then the
+    /// directly summed particles, each in list order.
+    fn sum<const N: usize>(&self, lists: &Lists, x: &[f64; N], y: &[f64; N], z: &[f64; N]) -> Sums<N> {
+        let mut f = [[0.0; N]; 4];
         add_cells(&lists.cells, &self.moments, x, y, z, &mut f);
-        for &l in &lists.direct {
-            let (s, e) = (self.start[l as usize] as usize, self.end[l as usize] as usize);
-            add_sources(&self.particles[s..e], x, y, z, &mut f);
-        }
+        add_sources(&lists.sources, x, y, z, &mut f);
         f
+    }
+
+    /// Accelerations and potentials (`g` times the sums) of up to `N` particles `block` into `out`; unused
+    /// lanes repeat the last particle.
+    fn block<const N: usize>(&self, lists: &Lists, block: &[Source], out: &mut [[f64; 4]], g: f64) {
+        let lane = |c: usize| std::array::from_fn(|l| block[l.min(block.len() - 1)][c]);
+        let f = self.sum::<N>(lists, &lane(0), &lane(1), &lane(2));
+        for (l, o) in out.iter_mut().enumerate() {
+            *o = [f[0][l] * g, f[1][l] * g, f[2][l] * g, f[3][l] * g];
+        }
     }
 
     /// Field at point `p`: acceleration (m/s²) and potential (J/kg), skipping particle `skip` (its input index
@@ -334,7 +350,7 @@ impl Octree {
         }
         let mut lists = Lists::default();
         self.walk(&self.reach2(theta), *p, *p, &mut lists);
-        let f = self.sum(&lists, &[p.x; LANES], &[p.y; LANES], &[p.z; LANES]);
+        let f = self.sum(&lists, &[p.x], &[p.y], &[p.z]);
         let (mut a, mut phi) = (Vec3::new(f[0][0], f[1][0], f[2][0]), f[3][0]);
         // A particle at `p` itself was skipped by the sums; `skip` elsewhere was included: remove its direct
         // term (exact when its leaf was summed directly, as it is whenever `p` lies near it).
@@ -384,13 +400,18 @@ impl Octree {
                 hi = hi.sup(&p);
             }
             self.walk(&reach2, lo, hi, lists);
-            for (block, out) in points.chunks(LANES).zip(out.chunks_mut(LANES)) {
-                // Unused lanes repeat the last point.
-                let lane = |c: usize| std::array::from_fn(|l| block[l.min(block.len() - 1)][c]);
-                let f = self.sum(lists, &lane(0), &lane(1), &lane(2));
-                for (l, o) in out.iter_mut().enumerate() {
-                    *o = [f[0][l] * g, f[1][l] * g, f[2][l] * g, f[3][l] * g];
-                }
+            // Blocks of four; a last one or two particles as a block of two.
+            let split = if points.len() % LANES <= 2 {
+                points.len() / LANES * LANES
+            } else {
+                points.len()
+            };
+            let (out4, out2) = out.split_at_mut(split);
+            for (block, out) in points[..split].chunks(LANES).zip(out4.chunks_mut(LANES)) {
+                self.block::<LANES>(lists, block, out, g);
+            }
+            for (block, out) in points[split..].chunks(2).zip(out2.chunks_mut(2)) {
+                self.block::<2>(lists, block, out, g);
             }
         });
         let mut acc = vec![Vec3::zeros(); n];
