@@ -25,14 +25,14 @@
 //! Group walk (Barnes 1990): the particles of one bucket (the largest node of at most [`BUCKET_SIZE`]
 //! particles on each branch, a leaf or a small subtree) share one interaction list, built by one walk in
 //! which a node is used whole when the criterion holds at the point of the bucket's bounding box nearest to
-//! the node's centre of mass, hence for every particle of the bucket: the forces are those of the per-particle walk with some
-//! nodes opened further, so the error is never larger. The walk gathers the particles of the leaves summed
-//! directly into one contiguous list. The lists are then applied to the bucket's particles four at a time
-//! (a last one or two as a pair), each entry (a node's moments or a particle) read once per block, so the
-//! sums stay in registers and the compiler vectorises over the block. A source at distance zero (the
-//! particle itself) is skipped by a select, not a branch. Buckets are independent
-//! (rayon-parallel, buffers reused per worker); each particle sums its list in a fixed order, so results do
-//! not depend on the number of threads.
+//! the node's centre of mass, hence for every particle of the bucket: the forces are those of the
+//! per-particle walk with some nodes opened further, so the error is never larger. The walk gathers the
+//! particles of the leaves summed directly into one contiguous list. The lists are then applied to the
+//! bucket's particles four at a time (a last one or two as a pair), each entry (a node's moments or a
+//! particle) read once per block, so the sums stay in registers and the compiler vectorises over the block.
+//! A source at distance zero (the particle itself) is skipped by a select, not a branch. Buckets are
+//! independent (rayon-parallel, buffers reused per worker); each particle sums its list in a fixed order,
+//! so results do not depend on the number of threads.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
