@@ -1,6 +1,6 @@
-//! Octree self-gravity against direct summation on 10 000 particles (uniform ball, clumpy distribution):
-//! RMS relative force error ≤ 1e-3 at θ = 0.5, falling with θ; interior field of a uniform ball
-//! `g = 4/3 π G ρ r` within 1 %.
+//! Octree self-gravity against direct summation on 10 000 particles (uniform ball, clumpy distribution, many
+//! small isolated clusters whose leaves are used whole): RMS relative force error ≤ 1e-3 at θ = 0.5, falling
+//! with θ; interior field of a uniform ball `g = 4/3 π G ρ r` within 1 %.
 
 use rubblepile::gravity::direct;
 use rubblepile::gravity::octree::Octree;
@@ -52,6 +52,33 @@ fn tree_matches_direct_on_a_clumpy_distribution() {
         })
         .collect();
     check("clumpy", &x);
+}
+
+#[test]
+fn far_leaves_of_small_clusters_match_direct() {
+    // 2 000 clusters (radius 2) in a ball of radius 100, each of `FAR_LEAF_MIN + 1` particles: an
+    // isolated cluster is one leaf, used by its multipole beyond the opening distance.
+    let size = rubblepile::gravity::octree::FAR_LEAF_MIN + 1;
+    let mut rng = generator(9);
+    let mut x = Vec::new();
+    for _ in 0..2000 {
+        let c = point_in_ball(&mut rng, 100.0);
+        for _ in 0..size {
+            x.push(c + point_in_ball(&mut rng, 2.0));
+        }
+    }
+    check("small clusters", &x);
+}
+
+#[test]
+fn far_leaves_of_a_lattice_ball_match_direct() {
+    // The FCC ball of the benchmarks and spin-up scenes: its small leaves hold a few lattice sites at their
+    // cube's corners, the worst case for a leaf's quadrupole.
+    let x: Vec<Vec3> = rubblepile::granular::soft::packing::fcc_ball(2000, 10.0, 2000.0, 0.0)
+        .iter()
+        .map(|p| p.position)
+        .collect();
+    check("FCC ball", &x);
 }
 
 #[test]
