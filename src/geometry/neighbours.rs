@@ -5,8 +5,10 @@
 //! cells of side `ρ_ref`, sorted by `(z, y, x)` cell index so that a run of cells along x is contiguous;
 //! each body scans the cell runs that its reach `ρ_i + ρ_ref` overlaps. The few larger bodies query the
 //! same grid with their own reach and are paired with each other directly, so a wide size distribution
-//! does not inflate the cells. Cost O(N + pairs) for piles of bounded density. The output is sorted
-//! `(i, j)` with `i < j` and does not depend on the number of threads, so runs are deterministic.
+//! does not inflate the cells. Cost O(N + pairs) for piles of bounded density. Where the grid's bounding box
+//! holds at most [`DENSE_CELLS_PER_BODY`] cells per body, a dense table of where each cell's run starts finds a
+//! run in O(1); otherwise (sparse clouds, far debris) a binary search over the sorted keys does. The output is
+//! sorted `(i, j)` with `i < j` and does not depend on the number of threads, so runs are deterministic.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
@@ -16,6 +18,9 @@ const BRUTE_FORCE_BELOW: usize = 24;
 /// From this many bodies on, rows are built in parallel.
 const PARALLEL_FROM: usize = 256;
 
+/// Largest number of cells per binned body for which the dense start table is built.
+pub const DENSE_CELLS_PER_BODY: usize = 16;
+
 /// Cells of the regular bodies, in `(z, y, x)` order.
 struct Grid {
     cell: f64,
@@ -23,6 +28,61 @@ struct Grid {
     centres: Vec<Vec3>,
     radii: Vec<f64>,
     ids: Vec<usize>,
+    dense: Option<DenseStarts>,
+}
+
+/// For a box of cells `lo..lo + dims` (in `(z, y, x)` order), the index in the sorted arrays where each cell's
+/// bodies start (`starts[c]..starts[c + 1]`), `c` the cell's linear index in the same order as the sort.
+struct DenseStarts {
+    lo: [i64; 3],
+    dims: [i64; 3],
+    starts: Vec<u32>,
+}
+
+impl DenseStarts {
+    /// The table for sorted `keys`, if the box holds at most `max_cells` cells.
+    fn new(keys: &[[i64; 3]], max_cells: usize) -> Option<Self> {
+        let (first, last) = (keys.first()?, keys.last()?);
+        let (mut lo, mut hi) = (*first, *last);
+        for k in keys {
+            for a in 1..3 {
+                lo[a] = lo[a].min(k[a]);
+                hi[a] = hi[a].max(k[a]);
+            }
+        }
+        let dims = [hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1];
+        let cells = dims
+            .iter()
+            .try_fold(1usize, |acc, &d| acc.checked_mul(usize::try_from(d).ok()?))?;
+        if cells > max_cells || keys.len() >= u32::MAX as usize {
+            return None;
+        }
+        let mut starts = vec![0u32; cells + 1];
+        // counts per cell, then running sums: starts[c] = bodies in cells before c
+        for k in keys {
+            starts[Self::linear(&lo, &dims, k) + 1] += 1;
+        }
+        for c in 1..=cells {
+            starts[c] += starts[c - 1];
+        }
+        Some(DenseStarts { lo, dims, starts })
+    }
+
+    fn linear(lo: &[i64; 3], dims: &[i64; 3], k: &[i64; 3]) -> usize {
+        (((k[0] - lo[0]) * dims[1] + (k[1] - lo[1])) * dims[2] + (k[2] - lo[2])) as usize
+    }
+
+    /// The sorted-array range of the cells `(kz, ky, x0..=x1)`, clipped to the box (empty outside it).
+    fn row(&self, kz: i64, ky: i64, x0: i64, x1: i64) -> std::ops::Range<usize> {
+        let inside = |v: i64, a: usize| v >= self.lo[a] && v < self.lo[a] + self.dims[a];
+        let (x0, x1) = (x0.max(self.lo[2]), x1.min(self.lo[2] + self.dims[2] - 1));
+        if !inside(kz, 0) || !inside(ky, 1) || x0 > x1 {
+            return 0..0;
+        }
+        let a = Self::linear(&self.lo, &self.dims, &[kz, ky, x0]);
+        let b = Self::linear(&self.lo, &self.dims, &[kz, ky, x1]);
+        self.starts[a] as usize..self.starts[b + 1] as usize
+    }
 }
 
 impl Grid {
@@ -42,15 +102,19 @@ impl Grid {
         let hi = self.key(&(c + Vec3::from_element(reach)));
         for kz in lo[0]..=hi[0] {
             for ky in lo[1]..=hi[1] {
-                let first = [kz, ky, lo[2]];
-                let last = [kz, ky, hi[2]];
-                let mut m = self.keys.partition_point(|k| *k < first);
-                while m < self.keys.len() && self.keys[m] <= last {
+                let run = match &self.dense {
+                    Some(d) => d.row(kz, ky, lo[2], hi[2]),
+                    None => {
+                        let first = [kz, ky, lo[2]];
+                        let last = [kz, ky, hi[2]];
+                        self.keys.partition_point(|k| *k < first)..self.keys.partition_point(|k| *k <= last)
+                    }
+                };
+                for m in run {
                     let reach_ij = r + self.radii[m];
                     if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
                         visit(self.ids[m]);
                     }
-                    m += 1;
                 }
             }
         }
@@ -82,6 +146,7 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
         centres: Vec::new(),
         radii: Vec::new(),
         ids: Vec::new(),
+        dense: None,
     };
     let mut binned: Vec<([i64; 3], usize)> = regular.iter().map(|&i| (grid.key(&centres[i]), i)).collect();
     binned.sort_unstable();
@@ -89,6 +154,7 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
     grid.ids = binned.iter().map(|b| b.1).collect();
     grid.centres = grid.ids.iter().map(|&i| centres[i]).collect();
     grid.radii = grid.ids.iter().map(|&i| radii[i]).collect();
+    grid.dense = DenseStarts::new(&grid.keys, DENSE_CELLS_PER_BODY * grid.keys.len().max(1));
 
     // Regular–regular pairs: each body lists its partners of higher index.
     let row_of = |i: usize| -> Vec<usize> {
@@ -162,5 +228,48 @@ mod tests {
             assert!(!brute.is_empty());
             assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
         }
+    }
+
+    /// Both ways of finding a cell run give the brute-force pairs: the dense start table on a compact pile, the
+    /// binary search once two far bodies make the grid's box too large for the table.
+    #[test]
+    fn dense_table_and_binary_search_both_equal_brute_force() {
+        let mut state = 99u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 2000;
+        let mut centres: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next()) * 22.0).collect();
+        let mut radii: Vec<f64> = (0..n).map(|_| 0.5 + 0.3 * next()).collect();
+        let cell = 2.0 * 0.65;
+        let key = |p: &Vec3| {
+            [
+                (p.z / cell).floor() as i64,
+                (p.y / cell).floor() as i64,
+                (p.x / cell).floor() as i64,
+            ]
+        };
+        let mut keys: Vec<[i64; 3]> = centres.iter().map(key).collect();
+        keys.sort_unstable();
+        assert!(
+            DenseStarts::new(&keys, DENSE_CELLS_PER_BODY * n).is_some(),
+            "compact pile: dense table"
+        );
+        assert_eq!(sphere_pairs(&centres, &radii), brute_force_pairs(&centres, &radii));
+        centres.push(Vec3::new(5e4, -3e4, 1e4));
+        centres.push(Vec3::new(5e4 + 1.0, -3e4, 1e4));
+        radii.extend([0.6, 0.6]);
+        keys.extend([key(&centres[n]), key(&centres[n + 1])]);
+        keys.sort_unstable();
+        assert!(
+            DenseStarts::new(&keys, DENSE_CELLS_PER_BODY * (n + 2)).is_none(),
+            "far bodies: no table"
+        );
+        let pairs = sphere_pairs(&centres, &radii);
+        assert!(pairs.contains(&(n, n + 1)));
+        assert_eq!(pairs, brute_force_pairs(&centres, &radii));
     }
 }
