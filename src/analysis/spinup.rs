@@ -76,17 +76,20 @@ pub struct CreepCriterion {
     pub theta_max_deg: f64,
     /// Largest allowed change of η_B (dimensionless).
     pub packing: f64,
-    /// Largest allowed change of the coordination number.
-    pub coordination: f64,
+    /// Largest allowed change of the coordination number, if it is judged at all. Not judged by default: in our
+    /// scaled RCP runs (23 Nov 2026) the coordination number falls by about 0.1 over the second half of a
+    /// 16 000 s hold at every held period from 3.00 h (θ_max 25°, far from yield) down to 2.74 h, with θ_max and
+    /// η_B flat, so its drift there is a slow loss of marginal contacts, not the creep that precedes failure.
+    pub coordination: Option<f64>,
 }
 
 impl Default for CreepCriterion {
-    /// θ_max 0.5°, η_B 0.0005 (half the T_c,2 threshold), coordination number 0.05.
+    /// θ_max 0.5°, η_B 0.0005 (half the T_c,2 threshold); the coordination number is not judged.
     fn default() -> Self {
         CreepCriterion {
             theta_max_deg: 0.5,
             packing: 0.5 * PACKING_THRESHOLD,
-            coordination: 0.05,
+            coordination: None,
         }
     }
 }
@@ -128,7 +131,10 @@ impl CreepCriterion {
         if second_half_drift(t, packing).abs() > self.packing {
             out.push("packing_fraction");
         }
-        if second_half_drift(t, coordination).abs() > self.coordination {
+        if self
+            .coordination
+            .is_some_and(|tol| second_half_drift(t, coordination).abs() > tol)
+        {
             out.push("coordination_number");
         }
         out
@@ -288,6 +294,14 @@ mod tests {
             .map(|k| 30.0 + if k < 80 { 5.0 * (1.0 - k as f64 / 80.0) } else { 0.0 })
             .collect();
         assert!(crit.drifting(&t, &settling, &flat, &coord).is_empty());
+        // the coordination number is judged only when asked for
+        let losing: Vec<f64> = (0..200).map(|k| 6.0 - 0.2 * k as f64 / 199.0).collect();
+        assert!(crit.drifting(&t, &theta, &flat, &losing).is_empty());
+        let strict = CreepCriterion {
+            coordination: Some(0.05),
+            ..crit
+        };
+        assert_eq!(strict.drifting(&t, &theta, &flat, &losing), vec!["coordination_number"]);
     }
 
     #[test]

@@ -4,8 +4,8 @@
 //!   the search for T_c,3. For T_final = from, from + step, … (hours) it writes `DIR/T<T_final>/scene.toml`
 //!   (BASE with `spinup.T_final` replaced), runs it (a run already completed there is reused), and judges the hold
 //!   after `t_final` with the creep criterion ([`CreepCriterion`], defaults tested in `analysis::spinup`): the body
-//!   is stable when the forcing was never released and neither θ_max, η_B nor the coordination number drifts over
-//!   the second half of the hold. The first stable T_final is T_c,3; φ is the largest θ_max over the holds of the
+//!   is stable when the forcing was never released and neither θ_max nor η_B (nor, with
+//!   `--coordination-tolerance`, the coordination number) drifts over the second half of the hold. The first stable T_final is T_c,3; φ is the largest θ_max over the holds of the
 //!   runs within ±0.01 h of it. Writes `DIR/critical.json` ([`CriticalSearch`]).
 //!   With `--branch [--hold SECONDS]` the hold runs share one run of BASE's path (`DIR/base`): the hold at
 //!   T_final = X starts where BASE's path passes X, with BASE's spin-up rate (Zhang17 §4.3 finds T_c,3
@@ -63,6 +63,10 @@ pub struct CriticalArgs {
     /// path without rests.
     #[arg(long)]
     pub branch: bool,
+    /// Also judge the coordination number: largest allowed change over the second half of a hold (not judged by
+    /// default, see `analysis::spinup::CreepCriterion::coordination`).
+    #[arg(long, value_name = "CHANGE")]
+    pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
     #[arg(long, value_name = "SECONDS")]
     pub hold: Option<f64>,
@@ -184,7 +188,17 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         table["scene"]["particles_file"] = toml::Value::String(abs.display().to_string());
     }
     std::fs::create_dir_all(&args.out).map_err(|e| CliError::usage(format!("{}: {e}", args.out.display())))?;
-    let criterion = CreepCriterion::default();
+    if let Some(c) = args.coordination_tolerance
+        && !(c.is_finite() && c > 0.0)
+    {
+        return Err(CliError::usage(format!(
+            "--coordination-tolerance must be > 0, got {c}"
+        )));
+    }
+    let criterion = CreepCriterion {
+        coordination: args.coordination_tolerance,
+        ..CreepCriterion::default()
+    };
     let n = ((args.to - args.from) / args.step + 1e-9).floor() as usize;
     let grid: Vec<f64> = (0..=n)
         .map(|k| ((args.from + k as f64 * args.step) * 1e4).round() / 1e4)
@@ -357,6 +371,20 @@ fn prepare_branches(
         .map_err(CliError::usage)?;
     let plan = sample_steps(&base_scene);
     let base_dir = args.out.join("base");
+    // a base run from an earlier search over a shorter span cannot be extended (its scene is fixed)
+    if let Ok(text) = std::fs::read_to_string(base_dir.join("scene.toml"))
+        && text != base_text
+        && grid.iter().any(|tf| {
+            let dir = args.out.join(format!("T{tf:.2}"));
+            !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())
+        })
+    {
+        return Err(CliError::usage(format!(
+            "{}: the base run was made for another range of T_final; remove that directory to start it again \
+             (the hold runs already branched are kept)",
+            base_dir.display()
+        )));
+    }
     let failed = |e: crate::granular::soft::run::SoftRunError| CliError::failed(e.to_string());
     // latest hold first: the base run only moves forward
     let mut order: Vec<usize> = (0..grid.len()).collect();
