@@ -175,6 +175,10 @@ fn bad_spinup_input_names_the_field() {
         "spinup.axis: must be a finite non-zero vector",
     );
     bad(&format!("{PATH}period = 3.0\n"), "unknown field `period`");
+    bad(
+        &format!("{PATH}target = \"spin\"\n"),
+        "spinup.target: must be \"period\" or \"angular_momentum\", got \"spin\"",
+    );
     bad(&PATH.replace("T_inter = 7.0\n", ""), "missing field `T_inter`");
 }
 
