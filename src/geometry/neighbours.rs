@@ -208,16 +208,21 @@ pub fn brute_force_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)>
 mod tests {
     use super::*;
 
-    /// The grid search must find exactly the pairs of the brute-force search (polydisperse, clustered).
-    #[test]
-    fn grid_search_equals_brute_force() {
-        let mut state = 12345u64;
-        let mut next = || {
+    /// Uniform numbers in [0, 1) from a 64-bit linear congruential generator seeded with `seed`.
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        }
+    }
+
+    /// The grid search must find exactly the pairs of the brute-force search (polydisperse, clustered).
+    #[test]
+    fn grid_search_equals_brute_force() {
+        let mut next = uniform(12345);
         for n in [17, 300, 1200] {
             let centres: Vec<Vec3> = (0..n)
                 .map(|_| Vec3::new(next(), next(), next() * 0.4) * 4.0 * (n as f64).cbrt())
@@ -234,13 +239,7 @@ mod tests {
     /// binary search once two far bodies make the grid's box too large for the table.
     #[test]
     fn dense_table_and_binary_search_both_equal_brute_force() {
-        let mut state = 99u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = uniform(99);
         let n = 2000;
         let mut centres: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next()) * 22.0).collect();
         let mut radii: Vec<f64> = (0..n).map(|_| 0.5 + 0.3 * next()).collect();
