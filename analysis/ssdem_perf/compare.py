@@ -12,6 +12,8 @@ What it does (standard library only):
 3. Times, interleaved and `--repeats` times: LAMMPS on 1 MPI rank (and 2 ranks with `--mpi`), and
    `rubblepile bench ssdem --gravity off` on 1 and 2 threads, same N and steps; medians go to
    `results.csv` (code,N,threads,particle_steps_per_s,contacts).
+   Also the median of the per-repeat ratios ours/LAMMPS (1 core each) to `paired_ratios.csv`
+   (N,median_ratio,min_ratio,max_ratio,repeats): neighbouring samples see about the same machine load.
 4. With `--gravity-table`, also times `bench ssdem --gravity off` and `--gravity tree` at each N (1 and 2
    threads) into `gravity.csv` (gravity,N,threads,steps,particle_steps_per_s).
 
@@ -181,13 +183,14 @@ def main():
     ap.add_argument("--gravity-table", action="store_true", help="also time bench ssdem off vs tree")
     ap.add_argument("--tree-steps", type=ints, default=[20], help="timed steps per N for --gravity-table tree")
     ap.add_argument("--out", default=HERE)
+    ap.add_argument("--threads", type=ints, default=[1, 2], help="rubblepile thread counts to time (default 1,2)")
     a = ap.parse_args()
     steps = a.steps * len(a.particles) if len(a.steps) == 1 else a.steps
     tree_steps = a.tree_steps * len(a.particles) if len(a.tree_steps) == 1 else a.tree_steps
     work = os.path.join(a.out, "work")
     os.makedirs(work, exist_ok=True)
 
-    rows, grows = [], []
+    rows, grows, paired = [], [], []
     for n, s, ts in zip(a.particles, steps, tree_steps):
         dump = os.path.join(work, f"particles_{n}.csv")
         run_bench(a.bin, n, "off", 1, [1], ["--dump-particles", dump])
@@ -202,7 +205,7 @@ def main():
                 samples.setdefault(("lammps", ranks), []).append(rate)
                 contacts[("lammps", ranks)] = c
                 print(f"  rep {rep}: LAMMPS {ranks} rank(s) {rate:.4e} particle-steps/s ({c} contacts)", flush=True)
-            for t, (rate, c) in run_bench(a.bin, n, "off", s, [1, 2]).items():
+            for t, (rate, c) in run_bench(a.bin, n, "off", s, a.threads).items():
                 samples.setdefault(("rubblepile", t), []).append(rate)
                 contacts[("rubblepile", t)] = c
                 print(f"  rep {rep}: rubblepile {t} thread(s) {rate:.4e} particle-steps/s ({c} contacts)", flush=True)
@@ -210,6 +213,13 @@ def main():
                 for t, (rate, _) in run_bench(a.bin, n, "tree", ts, [1, 2]).items():
                     samples.setdefault(("tree", t), []).append(rate)
                     print(f"  rep {rep}: rubblepile tree {t} thread(s) {rate:.4e} particle-steps/s", flush=True)
+        # Paired ratios (ours / LAMMPS, 1 core each, same repeat): on a shared machine the load drifts between
+        # repeats, and a pair of neighbouring samples sees about the same load.
+        if ("rubblepile", 1) in samples:
+            ratios = sorted(r / l for r, l in zip(samples[("rubblepile", 1)], samples[("lammps", 1)]))
+            paired.append((n, statistics.median(ratios), ratios[0], ratios[-1], len(ratios)))
+            print(f"N = {n}: paired ratio ours/LAMMPS (1 core) median {paired[-1][1]:.3f}, "
+                  f"range {ratios[0]:.3f}-{ratios[-1]:.3f} over {len(ratios)} repeats", flush=True)
         for (code, t), v in sorted(samples.items()):
             med = statistics.median(v)
             if code == "tree":
@@ -223,6 +233,10 @@ def main():
         f.write("code,N,threads,particle_steps_per_s,contacts\n")
         for code, n, t, r, c in rows:
             f.write(f"{code},{n},{t},{r:.6e},{c}\n")
+    with open(os.path.join(a.out, "paired_ratios.csv"), "w") as f:
+        f.write("N,median_ratio,min_ratio,max_ratio,repeats\n")
+        for n, med, lo, hi, k in paired:
+            f.write(f"{n},{med:.4f},{lo:.4f},{hi:.4f},{k}\n")
     if a.gravity_table:
         with open(os.path.join(a.out, "gravity.csv"), "w") as f:
             f.write("gravity,N,threads,steps,particle_steps_per_s\n")
