@@ -2,9 +2,9 @@
 //! self-gravity, frictionless) on small piles: a monodisperse random packing lands in the plausible range of
 //! random packings with overlaps under 1 % of r, and the same seed gives byte-identical particle files.
 
-use rubblepile::aggregate::random_packing::Recipe;
+use rubblepile::aggregate::random_packing::{BuildProgress, Recipe};
 use rubblepile::aggregate::shape::Shape;
-use rubblepile::aggregate::{BuildSpec, Grains, Model, build};
+use rubblepile::aggregate::{BuildSpec, Grains, Model, build, build_with_progress};
 use rubblepile::granular::soft::run::write_particles_csv;
 
 fn spec(model: Model, shape: Shape, grains: Grains, seed: u64) -> BuildSpec {
@@ -93,5 +93,44 @@ fn recipe_with_gravity_every_4_steps_packs_alike() {
         .filter(|st| st.stage == "collapse" || st.stage == "settle")
     {
         assert_eq!(st.steps % 4, 0, "{} ran {} steps", st.stage, st.steps);
+    }
+}
+
+/// The progress a long build reports (guards the background build's log): every stage starts at step 0, its
+/// steps rise to the stage's total, the stages come in the recipe's order, and the last report of each stage
+/// matches the steps its log records; reporting changes nothing in the result.
+#[test]
+fn build_progress_follows_the_stages_and_changes_nothing() {
+    let s = spec(Model::Rcp, Shape::Sphere { radius: 100.0 }, Grains::Count(40), 5);
+    let mut reports: Vec<(String, u64, u64)> = Vec::new();
+    let agg = build_with_progress(&s, &mut |p: BuildProgress<'_>| {
+        reports.push((p.stage.to_string(), p.step, p.steps))
+    })
+    .unwrap();
+    let plain = build(&s).unwrap();
+    assert_eq!(agg.particles, plain.particles);
+    // runs of one stage (settle chunks are runs of their own): from 0 up to the total
+    let mut runs: Vec<Vec<(String, u64, u64)>> = Vec::new();
+    for r in reports {
+        if r.1 == 0 {
+            runs.push(Vec::new());
+        }
+        runs.last_mut().expect("a run starts at step 0").push(r);
+    }
+    for run in &runs {
+        assert!(run.windows(2).all(|w| w[0].1 < w[1].1 && w[0].2 == w[1].2), "{run:?}");
+        let last = run.last().unwrap();
+        assert_eq!(last.1, last.2, "a run ends at its total: {run:?}");
+    }
+    let names: Vec<&str> = runs.iter().map(|r| r[0].0.as_str()).collect();
+    assert_eq!(&names[..4], &["collapse", "shake", "calm", "unload"]);
+    assert!(names[4..].iter().all(|n| *n == "settle") && names.len() > 4);
+    for st in &agg.report.stages {
+        let total: u64 = runs
+            .iter()
+            .filter(|r| r[0].0 == st.stage)
+            .map(|r| r.last().unwrap().2)
+            .sum();
+        assert_eq!(total, st.steps, "stage {}", st.stage);
     }
 }

@@ -19,7 +19,7 @@ pub mod report;
 pub mod shape;
 pub mod size_distribution;
 
-use crate::aggregate::random_packing::{Recipe, random_heap};
+use crate::aggregate::random_packing::{BuildProgress, Recipe, random_heap};
 use crate::aggregate::report::{AggregateReport, measure};
 use crate::aggregate::shape::Shape;
 use crate::aggregate::size_distribution::PowerLawRadii;
@@ -212,6 +212,14 @@ fn grain_sizes(spec: &BuildSpec) -> Result<(Option<f64>, Option<PowerLawRadii>, 
 
 /// Builds an aggregate. Deterministic: the same spec gives the same particles bit for bit.
 pub fn build(spec: &BuildSpec) -> Result<Aggregate, AggregateError> {
+    build_with_progress(spec, &mut |_| {})
+}
+
+/// [`build`], telling `progress` where the random-packing recipe stands (HCP lattices are built at once).
+pub fn build_with_progress(
+    spec: &BuildSpec,
+    progress: &mut dyn FnMut(BuildProgress<'_>),
+) -> Result<Aggregate, AggregateError> {
     let started = std::time::Instant::now();
     if !(spec.bulk_density.is_finite() && spec.bulk_density > 0.0) {
         return Err(input(
@@ -271,8 +279,15 @@ pub fn build(spec: &BuildSpec) -> Result<Aggregate, AggregateError> {
             _ => None,
         };
         let rho_build = spec.bulk_density / expected_packing(spec.model);
-        let heap = random_heap(&heap_radii, rho_build, &spec.recipe, &mut rng, insert.as_ref())
-            .ok_or_else(|| AggregateError::Failed("the random cloud could not be placed".into()))?;
+        let heap = random_heap(
+            &heap_radii,
+            rho_build,
+            &spec.recipe,
+            &mut rng,
+            insert.as_ref(),
+            progress,
+        )
+        .ok_or_else(|| AggregateError::Failed("the random cloud could not be placed".into()))?;
         heap_n = Some(heap.centres.len());
         stages = heap.stages;
         heap.centres

@@ -250,16 +250,39 @@ fn recentre(ps: &mut [Particle]) {
     }
 }
 
+/// Where a build stands: the stage's name, the steps done and the steps the stage will take (for progress
+/// displays; the settle stage reports each chunk as its own run of steps).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BuildProgress<'a> {
+    /// Stage name (collapse, shake, calm, unload, settle).
+    pub stage: &'a str,
+    /// Steps done in this stage (or settle chunk).
+    pub step: u64,
+    /// Steps of this stage (or settle chunk).
+    pub steps: u64,
+}
+
+/// Steps between two progress reports.
+const PROGRESS_EVERY: u64 = 500;
+
 /// Runs `steps` leapfrog steps of `dt` from t = 0; returns the largest overlap fraction seen. Stages with
 /// self-gravity every `k` steps pass whole blocks ([`whole_blocks`]), so that each ends with its closing kick.
-fn run(sys: &mut SoftSystem, dt: f64, steps: u64) -> f64 {
+fn run(sys: &mut SoftSystem, dt: f64, steps: u64, stage: &str, progress: &mut dyn FnMut(BuildProgress<'_>)) -> f64 {
     debug_assert!(steps.is_multiple_of(sys.gravity_interval.max(1)));
     sys.compute_forces(0.0, 0.0);
     let mut worst = sys.stats.max_overlap_fraction;
     for k in 0..steps {
+        if k % PROGRESS_EVERY == 0 {
+            progress(BuildProgress { stage, step: k, steps });
+        }
         step(sys, k as f64 * dt, dt);
         worst = worst.max(sys.stats.max_overlap_fraction);
     }
+    progress(BuildProgress {
+        stage,
+        step: steps,
+        steps,
+    });
     worst
 }
 
@@ -283,13 +306,15 @@ fn log(stage: &str, sys: &SoftSystem, dt: f64, steps: u64, worst: f64, notes: St
 
 /// Builds a settled self-gravitating heap of grains with these `radii` (m) and grain density `rho` (kg/m³) by
 /// the [`Recipe`], seeded by `rng`; `insert` (if any) replaces the heap's centre before the settle stage.
-/// `None` if the random cloud could not be placed.
+/// `progress` hears where the build stands every few hundred steps. `None` if the random cloud could not be
+/// placed.
 pub fn random_heap(
     radii: &[f64],
     rho: f64,
     recipe: &Recipe,
     rng: &mut Generator,
     insert: Option<&Insert>,
+    progress: &mut dyn FnMut(BuildProgress<'_>),
 ) -> Option<Heap> {
     let n = radii.len();
     let v_grains: f64 = radii.iter().map(|&r| ball_volume(r)).sum();
@@ -335,7 +360,7 @@ pub fn random_heap(
     );
     sys.gravity_interval = recipe.gravity_interval.max(1);
     let steps = whole_blocks(steps, sys.gravity_interval);
-    let worst = run(&mut sys, dt, steps);
+    let worst = run(&mut sys, dt, steps, "collapse", progress);
     stages.push(log(
         "collapse",
         &sys,
@@ -394,11 +419,11 @@ pub fn random_heap(
     );
     let mut sys = SoftSystem::new(ps, vec![wall(Some(osc))], material, field);
     let steps = (recipe.shake_periods * period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps);
+    let worst = run(&mut sys, dt, steps, "shake", progress);
     stages.push(log("shake", &sys, dt, steps, worst, notes));
     let mut sys = SoftSystem::new(sys.particles, vec![wall(None)], material, field);
     let steps = (recipe.calm_periods * period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps);
+    let worst = run(&mut sys, dt, steps, "calm", progress);
     stages.push(log(
         "calm",
         &sys,
@@ -413,7 +438,7 @@ pub fn random_heap(
     };
     let mut sys = SoftSystem::new(sys.particles, vec![wall(None)], material, no_field);
     let steps = (period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps);
+    let worst = run(&mut sys, dt, steps, "unload", progress);
     stages.push(log(
         "unload",
         &sys,
@@ -461,7 +486,7 @@ pub fn random_heap(
     let chunk = whole_blocks(chunk, sys.gravity_interval);
     let (mut steps, mut worst, mut last_worst) = (0, 0.0f64, 0.0);
     for _ in 0..recipe.settle_max_chunks {
-        last_worst = run(&mut sys, dt, chunk);
+        last_worst = run(&mut sys, dt, chunk, "settle", progress);
         worst = worst.max(last_worst);
         steps += chunk;
         if sys.kinetic_energy() < recipe.settle_kinetic_fraction * sys.stats.gravitational_energy.abs() {

@@ -4,10 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::aggregate::random_packing::Recipe;
+use crate::aggregate::random_packing::{BuildProgress, Recipe};
 use crate::aggregate::report::AggregateReport;
 use crate::aggregate::shape::Shape;
-use crate::aggregate::{BuildSpec, Grains, Model, build, density};
+use crate::aggregate::{BuildSpec, Grains, Model, build_with_progress, density};
 use crate::cli::CliError;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::run::write_particles_csv;
@@ -179,7 +179,7 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
         core_radius: args.core_radius,
         recipe,
     };
-    let agg = build(&spec).map_err(|e| match e {
+    let agg = build_with_progress(&spec, &mut build_progress()).map_err(|e| match e {
         crate::aggregate::AggregateError::Input { .. } => CliError::usage(e),
         crate::aggregate::AggregateError::Failed(_) => CliError::failed(e),
     })?;
@@ -200,6 +200,38 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
         r.build_seconds
     );
     Ok(())
+}
+
+/// Wall time between two progress lines when stderr is not a terminal (s).
+const PROGRESS_LINE_EVERY_S: f64 = 300.0;
+
+/// The build's progress display: a spinner on a terminal; otherwise (a log file) a line on stderr at the start
+/// of every stage and every few minutes within one, so that a background build shows where it stands.
+fn build_progress() -> impl FnMut(BuildProgress<'_>) {
+    use std::io::IsTerminal;
+    let started = std::time::Instant::now();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new_spinner();
+        b.enable_steady_tick(std::time::Duration::from_millis(200));
+        b
+    });
+    let mut last_line = f64::NEG_INFINITY;
+    move |p: BuildProgress<'_>| {
+        let wall = started.elapsed().as_secs_f64();
+        let percent = 100.0 * p.step as f64 / p.steps.max(1) as f64;
+        let text = format!(
+            "aggregate build: {} step {}/{} ({percent:.0} %), {wall:.0} s",
+            p.stage, p.step, p.steps
+        );
+        match &bar {
+            Some(b) => b.set_message(text),
+            None if p.step == 0 || wall - last_line >= PROGRESS_LINE_EVERY_S => {
+                eprintln!("{text}");
+                last_line = wall;
+            }
+            None => {}
+        }
+    }
 }
 
 /// Reads a particle file written by `aggregate build` (zero velocities and spins).
