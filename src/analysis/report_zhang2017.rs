@@ -11,6 +11,11 @@
 //! forced part after `t_start` ([`critical_limits`]), the failure mode, T_c,3 and φ, κ₃ of Eq. 22 with
 //! `ρ_B = 2100 M/M_P` (Zhang17 §4.2, M_P = 5.23e11 kg), the largest overlap, the largest departure of the spin
 //! period from the path while forced, and the run's wall time.
+//!
+//! Bulk-density variants (Zhang17 §4.2, Fig. 19, Table 4) are runs of the same target with scaled masses, in
+//! directories named `<model>_rho<ρ_B>` (e.g. `rcp_rho1800`): they are left out of the Table 3 rows and go, with
+//! the nominal run, into an Eq. 22 section: κ₁, κ₂, κ₃ fitted over the densities ([`density_series`]) and the
+//! critical bulk density at the Didymos period, beside the paper's Table 4.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -18,7 +23,7 @@ use std::path::Path;
 use crate::analysis::figures::spinup_figures::SpinupTimeSeries;
 use crate::analysis::figures::style::write_figure;
 use crate::analysis::spinup::{
-    AXIS_RATIO_THRESHOLD, CriticalLimits, FailureMode, critical_limits, first_departure, fit_density,
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, first_departure, fit_density,
 };
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::scene::SI_G;
@@ -38,6 +43,81 @@ pub const TABLE3: [PaperRow; 6] = [
     ("pp2", 0.750, 38.0, 2.41, 2.44, 2.54, None, "internal failure"),
     ("ppc", 0.820, 39.0, 2.46, 2.41, 2.49, None, "surface shedding"),
 ];
+
+/// One row of [`TABLE4`]: model and, for limits 1, 2, 3, the critical bulk density (kg/m³) and κ.
+pub type Table4Row = (&'static str, [(f64, f64); 3]);
+
+/// Zhang17 Table 4: critical bulk densities at the Didymos period and κ of Eq. 22, per limit.
+pub const TABLE4: [Table4Row; 6] = [
+    ("hcp", [(2349.0, 0.953), (2269.0, 0.970), (2383.0, 0.946)]),
+    ("rcp", [(2583.0, 0.909), (2662.0, 0.895), (3284.0, 0.806)]),
+    ("rcpc", [(2478.0, 0.928), (2478.0, 0.928), (3077.0, 0.833)]),
+    ("pp1", [(2388.0, 0.945), (2443.0, 0.935), (2626.0, 0.902)]),
+    ("pp2", [(2419.0, 0.939), (2457.0, 0.932), (2662.0, 0.895)]),
+    ("ppc", [(2469.0, 0.930), (2378.0, 0.947), (2519.0, 0.920)]),
+];
+
+/// Zhang17: the observed spin period of the Didymos primary (h), at which critical bulk densities are given.
+pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
+
+/// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`).
+///
+/// ```
+/// use rubblepile::analysis::report_zhang2017::base_model;
+/// assert_eq!(base_model("rcp_rho1800"), "rcp");
+/// assert_eq!(base_model("hcp"), "hcp");
+/// ```
+pub fn base_model(name: &str) -> &str {
+    name.split("_rho").next().unwrap_or(name)
+}
+
+/// One model over its bulk densities: the points (ρ_B in kg/m³, T_c1, T_c2, T_c3 in h where found) and the
+/// Eq. 22 fit of each limit over the points that have it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DensitySeries {
+    /// Model name.
+    pub model: String,
+    /// (ρ_B, [T_c1, T_c2, T_c3]) by increasing density.
+    pub points: Vec<(f64, [Option<f64>; 3])>,
+    /// Fit of limit i (κ_i ± σ, critical bulk density at [`DIDYMOS_PERIOD_HOURS`]) over at least 2 densities.
+    pub fits: [Option<DensityFit>; 3],
+}
+
+/// The bulk density of a row (kg/m³): `ρ_B = 2100 M/M_P` (Zhang17 §4.2).
+fn bulk_density(row: &ModelRow) -> f64 {
+    2100.0 * row.mass / DIDYMOS_MASS
+}
+
+/// The models run at two or more bulk densities, with their Eq. 22 fits (Zhang17 Fig. 19, Table 4).
+pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
+    let mut models: Vec<&str> = rows.iter().map(|r| base_model(&r.model)).collect();
+    models.sort();
+    models.dedup();
+    let mut out = Vec::new();
+    for m in models {
+        let mut points: Vec<(f64, [Option<f64>; 3])> = rows
+            .iter()
+            .filter(|r| base_model(&r.model) == m && r.mass.is_finite())
+            .map(|r| (bulk_density(r), [r.limits.t_c1_hours, r.limits.t_c2_hours, r.t_c3]))
+            .collect();
+        if points.len() < 2 {
+            continue;
+        }
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let fits = [0, 1, 2].map(|i| {
+            let xy: Vec<(f64, f64)> = points.iter().filter_map(|(rho, t)| t[i].map(|t| (*rho, t))).collect();
+            (xy.len() >= 2)
+                .then(|| fit_density(&xy, SI_G, DIDYMOS_PERIOD_HOURS))
+                .flatten()
+        });
+        out.push(DensitySeries {
+            model: m.to_string(),
+            points,
+            fits,
+        });
+    }
+    out
+}
 
 /// One model's row.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -225,6 +305,10 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
     let mut figures = Vec::new();
     for m in &models {
         let (row, samples) = model_row(m)?;
+        if base_model(&row.model) != row.model {
+            rows.push(row);
+            continue;
+        }
         let stem = format!("fig5_{}", row.model);
         let fig = SpinupTimeSeries {
             title: format!("{} (N = {}), spin-up path 2", row.model.to_uppercase(), row.n),
@@ -265,7 +349,8 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
         md,
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
-    for r in &rows {
+    let nominal: Vec<&ModelRow> = rows.iter().filter(|r| base_model(&r.model) == r.model).collect();
+    for r in &nominal {
         let paper = TABLE3
             .iter()
             .find(|p| p.0 == r.model)
@@ -331,10 +416,144 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
                 ))
         );
     }
+    write_density_section(&mut md, &rows);
     let _ = writeln!(md, "\n## Time series (Fig. 5 style)\n");
     for f in &figures {
         let _ = writeln!(md, "![{f}]({f}.png)\n");
     }
     std::fs::write(&report, md).map_err(|e| format!("{}: {e}", report.display()))?;
     Ok(report)
+}
+
+/// The Eq. 22 section: per model run at several bulk densities, the limits per density and the fits beside
+/// Table 4 (nothing when no model has two densities).
+fn write_density_section(md: &mut String, rows: &[ModelRow]) {
+    let series = density_series(rows);
+    if series.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        md,
+        "\n## Eq. 22 over bulk densities (Zhang17 §4.2, Fig. 19, Table 4)\n\nThe same target with every mass \
+         scaled (`rubblepile aggregate density`, ρ_B = 2100 M/M_P; runs `<model>_rho<ρ_B>`), path 2 and T_c,3 \
+         searches as for the nominal run. Fit of Ω_c = κ √(4πGρ_B/3) through the origin by least squares over the \
+         densities (± its standard error), and the critical bulk density ρ_B^c at which Ω_c is the Didymos spin \
+         (P = {DIDYMOS_PERIOD_HOURS} h).\n"
+    );
+    for s in &series {
+        let _ = writeln!(md, "### {}\n", s.model.to_uppercase());
+        let _ = writeln!(
+            md,
+            "| ρ_B (kg/m³) | T_c1 (h) | T_c2 (h) | T_c3 (h) | κ₁ | κ₂ | κ₃ (single point) |"
+        );
+        let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+        for (rho, t) in &s.points {
+            let kappa = |t: Option<f64>| {
+                t.and_then(|t| fit_density(&[(*rho, t)], SI_G, DIDYMOS_PERIOD_HOURS))
+                    .map(|f| f.kappa)
+            };
+            let _ = writeln!(
+                md,
+                "| {rho:.0} | {} | {} | {} | {} | {} | {} |",
+                opt(t[0], 3),
+                opt(t[1], 3),
+                opt(t[2], 2),
+                opt(kappa(t[0]), 3),
+                opt(kappa(t[1]), 3),
+                opt(kappa(t[2]), 3)
+            );
+        }
+        let paper = TABLE4.iter().find(|p| p.0 == s.model);
+        let _ = writeln!(
+            md,
+            "\n| limit | points | κ (fit) | ρ_B^c (kg/m³) | paper κ, ρ_B^c (full size, path 1) |"
+        );
+        let _ = writeln!(md, "| --- | --- | --- | --- | --- |");
+        for (i, fit) in s.fits.iter().enumerate() {
+            let n = s.points.iter().filter(|p| p.1[i].is_some()).count();
+            let fitted = fit
+                .as_ref()
+                .map_or("– (fewer than 2 densities) | –".to_string(), |f: &DensityFit| {
+                    format!("{:.3} ± {:.3} | {:.0}", f.kappa, f.sigma_kappa, f.critical_density)
+                });
+            let p = paper.map_or("–".to_string(), |p| format!("{:.3}, {:.0}", p.1[i].1, p.1[i].0));
+            let _ = writeln!(md, "| T_c,{} | {n} | {fitted} | {p} |", i + 1);
+        }
+        let _ = writeln!(md);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(model: &str, rho: f64, t: [Option<f64>; 3]) -> ModelRow {
+        ModelRow {
+            model: model.into(),
+            n: 1,
+            radius_range: (1.0, 1.0),
+            mass: rho / 2100.0 * DIDYMOS_MASS,
+            packing: 0.6,
+            limits: CriticalLimits {
+                t_c1_hours: t[0],
+                t_c2_hours: t[1],
+                failure_mode: None,
+            },
+            t_c3: t[2],
+            phi: None,
+            kappa3: None,
+            path_error: 0.0,
+            path_error_before_t_c1: 0.0,
+            release_time: None,
+            max_overlap: 0.0,
+            residuals: None,
+            wall_seconds: 0.0,
+            final_time: 0.0,
+            status: "completed".into(),
+        }
+    }
+
+    /// Periods made exactly by Eq. 22 with κ = 0.8 give κ = 0.8 back with zero spread, and the critical density
+    /// at 2.26 h solves Eq. 22; a model at one density only and a limit found at one density only are not fitted.
+    #[test]
+    fn density_series_recovers_the_kappa_of_synthetic_periods() {
+        let period = |kappa: f64, rho: f64| {
+            let omega = kappa * (4.0 * std::f64::consts::PI * SI_G * rho / 3.0).sqrt();
+            Some(2.0 * std::f64::consts::PI / omega / 3600.0)
+        };
+        let rows = vec![
+            row(
+                "rcp",
+                2100.0,
+                [period(0.9, 2100.0), period(0.85, 2100.0), period(0.8, 2100.0)],
+            ),
+            row(
+                "rcp_rho1800",
+                1800.0,
+                [period(0.9, 1800.0), period(0.85, 1800.0), period(0.8, 1800.0)],
+            ),
+            row("rcp_rho2400", 2400.0, [period(0.9, 2400.0), period(0.85, 2400.0), None]),
+            row("hcp", 2100.0, [Some(2.4), None, None]),
+        ];
+        let series = density_series(&rows);
+        assert_eq!(series.len(), 1, "only RCP has several densities");
+        let s = &series[0];
+        assert_eq!(s.model, "rcp");
+        assert_eq!(
+            s.points.iter().map(|p| p.0.round()).collect::<Vec<_>>(),
+            vec![1800.0, 2100.0, 2400.0]
+        );
+        for (i, kappa) in [0.9, 0.85, 0.8].into_iter().enumerate() {
+            let f = s.fits[i].as_ref().expect("fitted");
+            assert!((f.kappa - kappa).abs() < 1e-12, "κ{} = {}", i + 1, f.kappa);
+            assert!(f.sigma_kappa < 1e-12);
+            let t = period(kappa, f.critical_density).unwrap();
+            assert!((t - DIDYMOS_PERIOD_HOURS).abs() < 1e-9, "ρ_c gives {t} h");
+        }
+        let mut md = String::new();
+        write_density_section(&mut md, &rows);
+        assert!(md.contains("### RCP") && !md.contains("### HCP"));
+        // κ₃ from 2 of the 3 densities
+        assert!(md.contains("| T_c,3 | 2 | 0.800 ± 0.000"), "{md}");
+    }
 }
