@@ -23,7 +23,8 @@ use std::path::Path;
 use crate::analysis::figures::spinup_figures::SpinupTimeSeries;
 use crate::analysis::figures::style::write_figure;
 use crate::analysis::spinup::{
-    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, first_departure, fit_density,
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, dynamical_time, first_departure,
+    fit_density, smoothed_critical_limits,
 };
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::scene::SI_G;
@@ -132,8 +133,11 @@ pub struct ModelRow {
     pub mass: f64,
     /// η_B at t_start.
     pub packing: f64,
-    /// T_c1, T_c2 and the failure mode.
+    /// T_c1, T_c2 and the failure mode, from b/a, c/a and η_B averaged over the body's dynamical time
+    /// ([`smoothed_critical_limits`]).
     pub limits: CriticalLimits,
+    /// The same from the samples themselves (the paper's rule as written).
+    pub limits_raw: CriticalLimits,
     /// T_c,3 (h) and φ (°) from `critical.json`.
     pub t_c3: Option<f64>,
     /// See `t_c3`.
@@ -208,13 +212,21 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
     let t_start = t_start_of(&run);
     let forced: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_start && s.forcing).collect();
     let col = |f: fn(&SpinupSample) -> f64| forced.iter().map(|s| f(s)).collect::<Vec<f64>>();
-    let limits = critical_limits(
+    let limits_raw = critical_limits(
         &col(|s| s.period_h),
         &col(|s| s.b_over_a),
         &col(|s| s.c_over_a),
         &col(|s| s.packing_fraction),
     );
     let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
+    let limits = smoothed_critical_limits(
+        &col(|s| s.t),
+        &col(|s| s.period_h),
+        &col(|s| s.b_over_a),
+        &col(|s| s.c_over_a),
+        &col(|s| s.packing_fraction),
+        dynamical_time(SI_G, 2100.0 * mass / DIDYMOS_MASS),
+    );
     let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join("critical/critical.json"))
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok());
@@ -248,6 +260,7 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         mass,
         packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
         limits,
+        limits_raw,
         t_c3,
         phi,
         kappa3,
@@ -337,17 +350,19 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
     let _ = writeln!(
         md,
         "Ours: T_c1/T_c2 from `spinup.csv` (first change of b/a or c/a by > 0.01, of η_B by > 0.001, after t_start, \
-         while forced), T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
+         while forced), applied to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s: η_B of these \
+         piles of a few thousand particles breathes with about that period by ±6e-4, which alone trips the 0.001 \
+         rule (the unsmoothed values, the paper's rule as written, are in the last column but one). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
          ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, T_c1 and \
          T_c2 do — faster paths give shorter ones).\n"
     );
     let _ = writeln!(
         md,
-        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | paper η, φ, T_c1/2/3, κ₃, mode |"
+        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | unsmoothed T_c1/T_c2, mode | paper η, φ, T_c1/2/3, κ₃, mode |"
     );
     let _ = writeln!(
         md,
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     let nominal: Vec<&ModelRow> = rows.iter().filter(|r| base_model(&r.model) == r.model).collect();
     for r in &nominal {
@@ -374,7 +389,7 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
         };
         let _ = writeln!(
             md,
-            "| {} | {} | {radius} | {:.4} | {} | {} | {} | {} | {} | {} | {paper} |",
+            "| {} | {} | {radius} | {:.4} | {} | {} | {} | {} | {} | {} | {}/{}, {} | {paper} |",
             r.model.to_uppercase(),
             r.n,
             r.packing,
@@ -384,6 +399,9 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
             opt(r.phi, 1),
             opt(r.kappa3, 3),
             mode(r.limits.failure_mode),
+            opt(r.limits_raw.t_c1_hours, 3),
+            opt(r.limits_raw.t_c2_hours, 3),
+            mode(r.limits_raw.failure_mode),
         );
     }
     let _ = writeln!(
@@ -497,6 +515,11 @@ mod tests {
             limits: CriticalLimits {
                 t_c1_hours: t[0],
                 t_c2_hours: t[1],
+                failure_mode: None,
+            },
+            limits_raw: CriticalLimits {
+                t_c1_hours: None,
+                t_c2_hours: None,
                 failure_mode: None,
             },
             t_c3: t[2],
