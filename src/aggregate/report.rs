@@ -5,7 +5,7 @@
 use crate::aggregate::random_packing::{Recipe, StageLog};
 use crate::aggregate::shape::Shape;
 use crate::analysis::shape_metrics::axis_lengths;
-use crate::geometry::voronoi::{packing_fraction, voronoi_cells};
+use crate::geometry::voronoi::{packing_fraction, radical_cells};
 use crate::granular::soft::particle::Particle;
 use serde::{Deserialize, Serialize};
 
@@ -98,7 +98,7 @@ pub fn interior_packing(particles: &[Particle], shape: &Shape) -> (Option<f64>, 
     let centres: Vec<_> = particles.iter().map(|p| p.position).collect();
     let radii: Vec<f64> = particles.iter().map(|p| p.radius).collect();
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
-    let cells = voronoi_cells(&centres, VORONOI_HALF_SIZE * r_max);
+    let cells = radical_cells(&centres, &radii, VORONOI_HALF_SIZE * r_max);
     let interior: Vec<bool> = centres
         .iter()
         .map(|c| shape.contains_with_margin(c, INTERIOR_DEPTH * r_max))

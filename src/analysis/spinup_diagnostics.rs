@@ -32,7 +32,7 @@ use std::path::Path;
 use crate::analysis::shape_metrics::axis_lengths;
 use crate::analysis::spinup::{StressState, particle_stress, rve_stress, stress_state};
 use crate::geometry::neighbours::sphere_pairs;
-use crate::geometry::voronoi::{packing_fraction, voronoi_cells};
+use crate::geometry::voronoi::{packing_fraction, radical_cells};
 use crate::granular::soft::forces::{ContactRecord, SoftSystem};
 use crate::granular::soft::spinup::{SpinupDriver, body_rotation, central_body};
 use crate::math::{Mat3, Vec3};
@@ -277,7 +277,7 @@ pub fn diagnose(
     let radii: Vec<f64> = ps.iter().map(|p| p.radius).collect();
     let ax = axis_lengths(&centres, &masses, &radii);
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
-    let cells = voronoi_cells(&centres, 4.0 * r_max);
+    let cells = radical_cells(&centres, &radii, 4.0 * r_max);
     let mut inner: Vec<bool> = member.iter().zip(&cells).map(|(m, c)| *m && !c.boundary).collect();
     let reach: Vec<f64> = radii.iter().map(|r| 1.1 * r).collect();
     for (i, j) in sphere_pairs(&centres, &reach) {

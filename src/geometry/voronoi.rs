@@ -3,7 +3,16 @@
 //!
 //! Our own cell-based construction, written for this one use: each particle's cell starts as a cube around it and
 //! is clipped by the bisector planes of its neighbours in order of distance, until the next neighbour lies beyond
-//! twice the cell's farthest vertex (no farther neighbour can cut it). Cells are convex polyhedra kept as face
+//! twice the cell's farthest vertex (no farther neighbour can cut it).
+//!
+//! **Unequal spheres.** [`radical_cells`] uses the radical (power, Laguerre) planes instead of bisectors: the
+//! plane between spheres `i` and `j` at distance `d` lies `(d² + r_i² − r_j²)/(2d)` from `i`, where the power
+//! distances `|x − c|² − r²` are equal, so it passes through the contact circle of touching spheres and every
+//! cell holds its whole sphere (Voro++'s radical option, used for polydisperse packings). Plain bisectors cut
+//! into the larger sphere of a pair and hand that volume to the smaller one's cell; over a set of interior cells
+//! chosen near a rough surface (where large spheres are more often excluded) that bias is large (a PP1 pile of
+//! radii 10.7–85.4 m gave η_B 0.47 with bisectors against a filling fraction of 0.73). With equal radii the
+//! two are the same cells, bit for bit. Cells are convex polyhedra kept as face
 //! polygons; the volume is Σ_faces area × (distance of the face plane from the particle) / 3.
 //!
 //! Why not a crate: the Voro++ bindings need a C++ build, and the pure-Rust tessellators we looked at build
@@ -142,7 +151,29 @@ fn cube_around(g: &Vec3, h: f64) -> Vec<Face> {
 /// it larger than any interior cell: a few mean spacings). Cells are independent, so they are built in parallel;
 /// the result does not depend on the number of threads.
 pub fn voronoi_cells(centres: &[Vec3], half_size: f64) -> Vec<VoronoiCell> {
+    tessellate(centres, None, half_size)
+}
+
+/// The radical (power) cells of spheres with these `centres` and `radii` (m), each started as a cube of
+/// half-side `half_size` (m; a few largest diameters); with equal radii, exactly [`voronoi_cells`].
+///
+/// ```
+/// use rubblepile::geometry::voronoi::radical_cells;
+/// use rubblepile::math::Vec3;
+/// // two touching spheres of radii 1 and 3: the radical plane is their tangent plane, 1 m from the first
+/// // centre, so the first cell is the cube of side 4 cut at x = 1: 4 × 4 × 3
+/// let cells = radical_cells(&[Vec3::zeros(), Vec3::new(4.0, 0.0, 0.0)], &[1.0, 3.0], 2.0);
+/// assert!((cells[0].volume - 48.0).abs() < 1e-9);
+/// ```
+pub fn radical_cells(centres: &[Vec3], radii: &[f64], half_size: f64) -> Vec<VoronoiCell> {
+    let equal = radii.iter().all(|&r| r == radii[0]);
+    tessellate(centres, (!equal).then_some(radii), half_size)
+}
+
+/// Bisector cells (`radii` = `None`) or radical cells.
+fn tessellate(centres: &[Vec3], radii: Option<&[f64]>, half_size: f64) -> Vec<VoronoiCell> {
     let n = centres.len();
+    let largest = radii.map_or(0.0, |r| r.iter().cloned().fold(0.0, f64::max));
     // candidates: every pair within the security radius of the starting cube, 2 √3 h
     let reach = vec![half_size * 3f64.sqrt(); n];
     let mut neighbours: Vec<Vec<usize>> = vec![Vec::new(); n];
@@ -164,14 +195,27 @@ pub fn voronoi_cells(centres: &[Vec3], half_size: f64) -> Vec<VoronoiCell> {
                     .flat_map(|f| f.polygon.iter())
                     .map(|p| (p - g).norm())
                     .fold(0.0, f64::max);
-                if dist > 2.0 * r_max {
-                    break; // no farther neighbour can reach the cell
-                }
                 if dist == 0.0 {
                     continue; // a duplicate point has no bisector
                 }
                 let normal = (centres[j] - g) / dist;
-                clip(&mut cell, normal, normal.dot(&(0.5 * (g + centres[j]))), eps);
+                match radii {
+                    None => {
+                        if dist > 2.0 * r_max {
+                            break; // no farther neighbour can reach the cell
+                        }
+                        clip(&mut cell, normal, normal.dot(&(0.5 * (g + centres[j]))), eps);
+                    }
+                    Some(r) => {
+                        // the plane of a neighbour at `dist` lies at least (dist² − r_largest²)/(2 dist) away,
+                        // which grows with dist: once beyond the cell, no farther neighbour can cut it
+                        if (dist * dist - largest * largest) / (2.0 * dist) > r_max {
+                            break;
+                        }
+                        let t = (dist * dist + r[i] * r[i] - r[j] * r[j]) / (2.0 * dist);
+                        clip(&mut cell, normal, normal.dot(&g) + t, eps);
+                    }
+                }
             }
             let volume = cell
                 .iter()
