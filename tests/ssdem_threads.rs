@@ -84,3 +84,28 @@ fn forces_are_bit_identical_on_one_and_two_threads_and_after_a_spring_hand_over(
     run(&mut resumed, 2, 60, 40, dt);
     assert_same(&one, &resumed, "after the hand-over");
 }
+
+/// Skipping the stored spring energy between samples (`spring_energy_wanted = false`, what a run does for the
+/// steps that end between output samples) changes nothing but that number: the trajectory, forces, springs and
+/// dissipation stay bit-identical, and the step that wants it again gives the same spring energy as a system
+/// that summed it at every step.
+#[test]
+fn skipping_the_spring_energy_between_samples_changes_nothing_else() {
+    let (mut every, dt) = jostled_ball();
+    every.keep_records = false;
+    let mut lazy = every.clone();
+    lazy.spring_energy_wanted = false;
+    run(&mut every, 1, 0, 30, dt);
+    run(&mut lazy, 2, 0, 30, dt);
+    assert_eq!(lazy.stats.spring_energy, 0.0, "the pair springs' energy was skipped");
+    assert!(every.stats.spring_energy > 0.0);
+    assert_eq!(lazy.particles, every.particles);
+    assert_eq!(lazy.forces, every.forces);
+    assert_eq!(lazy.torques, every.torques);
+    assert_eq!(lazy.dissipated.to_bits(), every.dissipated.to_bits());
+    assert_eq!(lazy.pair_springs(), every.pair_springs());
+    lazy.spring_energy_wanted = true;
+    run(&mut every, 1, 30, 1, dt);
+    run(&mut lazy, 1, 30, 1, dt);
+    assert_same(&lazy, &every, "the sample step");
+}

@@ -245,13 +245,20 @@ pub fn evaluate(m: &Material, kin: &Kinematics, springs: &mut Springs, dt: f64) 
 /// [`evaluate`] with the material's constants `law` already computed.
 #[inline(always)]
 pub fn evaluate_law(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
-    evaluate_inner::<true>(law, kin, springs, dt)
+    evaluate_inner::<true, true>(law, kin, springs, dt)
 }
 
 /// [`evaluate_law`] for the force loop: without `SIZES`, `Output::rolling_torque` and
-/// `Output::twisting_torque` are left at zero (they only go into contact records).
+/// `Output::twisting_torque` are left at zero (they only go into contact records); without `STORED`,
+/// `Output::stored_energy` is (it is read only at output samples; the dissipation is always summed, because the
+/// energy balance integrates it over every step).
 #[inline(always)]
-pub(crate) fn evaluate_inner<const SIZES: bool>(law: &Law, kin: &Kinematics, springs: &mut Springs, dt: f64) -> Output {
+pub(crate) fn evaluate_inner<const SIZES: bool, const STORED: bool>(
+    law: &Law,
+    kin: &Kinematics,
+    springs: &mut Springs,
+    dt: f64,
+) -> Output {
     let n = kin.normal;
     // Carry the springs into the current frame (spring_frame.rs).
     let mean_spin = (kin.spin_i + kin.spin_j) * 0.5;
@@ -306,10 +313,14 @@ pub(crate) fn evaluate_inner<const SIZES: bool>(law: &Law, kin: &Kinematics, spr
 
     let lever_j = if kin.lever_j.is_finite() { kin.lever_j } else { 0.0 };
     let shear_torque = n.cross(&f_s);
-    let stored = 0.5 * law.k_n * kin.overlap * kin.overlap
-        + 0.5 * k_s * springs.shear.norm_squared()
-        + 0.5 * k_t * springs.twist * springs.twist
-        + 0.5 * k_r * springs.roll.norm_squared();
+    let stored = if STORED {
+        0.5 * law.k_n * kin.overlap * kin.overlap
+            + 0.5 * k_s * springs.shear.norm_squared()
+            + 0.5 * k_t * springs.twist * springs.twist
+            + 0.5 * k_r * springs.roll.norm_squared()
+    } else {
+        0.0
+    };
     Output {
         force_i: f_n + f_s,
         torque_i: shear_torque * kin.lever_i + n * m_t + m_r,

@@ -88,6 +88,11 @@ pub struct SoftSystem {
     pub keep_records: bool,
     /// Per-contact records of the last evaluation when [`SoftSystem::keep_records`] is set.
     pub records: Vec<ContactRecord>,
+    /// Sum the pair springs' stored energy into [`ForceStats::spring_energy`] at the next evaluations (default
+    /// true). Runs turn it off for the steps that end between output samples, where nothing reads it (as MD codes
+    /// compute energies only on output steps); the pair springs' share of `spring_energy` is then 0. The
+    /// dissipation is summed either way.
+    pub spring_energy_wanted: bool,
     /// Self-gravity is evaluated once every this many steps (steps, ≥ 1; r-RESPA, see
     /// [`crate::granular::soft::respa`]); 1 = with the contacts, every step.
     pub gravity_interval: u64,
@@ -235,7 +240,7 @@ fn pair_kinematics(particles: &[Particle], i: usize, j: usize) -> Option<Kinemat
 
 /// Evaluates pair `(i, j)` with the springs of its slot, and updates the slot (emptied if they do not touch).
 #[inline(always)]
-fn pair_contact<const SIZES: bool>(
+fn pair_contact<const SIZES: bool, const STORED: bool>(
     particles: &[Particle],
     law: &Law,
     key: PairKey,
@@ -248,7 +253,7 @@ fn pair_contact<const SIZES: bool>(
         return None;
     };
     let mut springs = slot.get().unwrap_or_else(|| Springs::new(kin.normal));
-    let out = evaluate_inner::<SIZES>(law, &kin, &mut springs, dt);
+    let out = evaluate_inner::<SIZES, STORED>(law, &kin, &mut springs, dt);
     *slot = Slot::full(springs);
     Some(PairHit {
         overlap: kin.overlap,
@@ -289,6 +294,7 @@ impl SoftSystem {
             forcing_angular_impulse: Vec3::zeros(),
             keep_records: false,
             records: Vec::new(),
+            spring_energy_wanted: true,
             gravity_interval: 1,
             gravity_phase: 0,
             slow_accelerations: Vec::new(),
@@ -358,7 +364,7 @@ impl SoftSystem {
     }
 
     /// Evaluates every pair of the Verlet list and adds the touching ones to `sums` in key order.
-    fn pair_pass<const SIZES: bool>(&mut self, law: &Law, dt: f64, sums: &mut Sums<'_>) {
+    fn pair_pass<const SIZES: bool, const STORED: bool>(&mut self, law: &Law, dt: f64, sums: &mut Sums<'_>) {
         let particles = &self.particles;
         if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
             self.pair_hits.resize(self.verlet.len(), None);
@@ -368,7 +374,7 @@ impl SoftSystem {
                 .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
                 .for_each(|((keys, slots), hits)| {
                     for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
-                        *hit = pair_contact::<SIZES>(particles, law, key, slot, dt);
+                        *hit = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt);
                     }
                 });
             for (&key, hit) in self.verlet.iter().zip(&self.pair_hits) {
@@ -379,7 +385,7 @@ impl SoftSystem {
             }
         } else {
             for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
-                if let Some(hit) = pair_contact::<SIZES>(particles, law, key, slot, dt) {
+                if let Some(hit) = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt) {
                     let (i, j) = pair_indices(key);
                     sums.add_pair(i, j, &hit);
                 }
@@ -437,11 +443,12 @@ impl SoftSystem {
             dissipated: 0.0,
             records: self.keep_records.then_some(&mut records),
         };
-        // Contact records want |M_R| and |M_T|; the force loop alone does not.
-        if self.keep_records {
-            self.pair_pass::<true>(&law, dt, &mut sums);
-        } else {
-            self.pair_pass::<false>(&law, dt, &mut sums);
+        // Contact records want |M_R| and |M_T|; the force loop alone does not. Records always come with the
+        // stored energy.
+        match (self.keep_records, self.spring_energy_wanted) {
+            (true, _) => self.pair_pass::<true, true>(&law, dt, &mut sums),
+            (false, true) => self.pair_pass::<false, true>(&law, dt, &mut sums),
+            (false, false) => self.pair_pass::<false, false>(&law, dt, &mut sums),
         }
         let mut dissipated = sums.dissipated;
         let mut torques = std::mem::take(&mut self.torques);

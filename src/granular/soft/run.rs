@@ -683,6 +683,8 @@ fn drive(
             }
             // the spin-up diagnostics at a sample need that step's contact records
             sys.keep_records = spin.is_some() && step + 1 == sample_step;
+            // the spring energy is read only at samples (the energy residual of the row)
+            sys.spring_energy_wanted = step + 1 == sample_step;
             leapfrog::step(&mut sys, step as f64 * dt, dt);
             if let Some(s) = &spin {
                 s.after_step(&mut sys, (step + 1) as f64 * dt);
