@@ -120,6 +120,25 @@ pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
     out
 }
 
+/// RMS of the successive differences of `values` over √2 (the standard deviation of white noise; a slow trend
+/// adds little); 0 with fewer than two values.
+pub fn successive_scatter(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let sum: f64 = values.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+    (sum / (values.len() - 1) as f64 / 2.0).sqrt()
+}
+
+/// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
+/// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
+/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. Scaled RCP: 2e-4 scatter, 13 samples → 6e-5, resolved; PP1,
+/// whose radii span 8×: 3e-3 → 8e-4, not resolved.
+pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
+    let samples = (window / spacing).max(1.0);
+    noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
+}
+
 /// One model's row.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ModelRow {
@@ -138,6 +157,12 @@ pub struct ModelRow {
     pub limits: CriticalLimits,
     /// The same from the samples themselves (the paper's rule as written).
     pub limits_raw: CriticalLimits,
+    /// Sample-to-sample scatter of η_B while forced and before the shape changes: the RMS of successive
+    /// differences over √2 (for white noise, its standard deviation).
+    pub packing_noise: f64,
+    /// Whether that scatter, averaged over the smoothing window's samples, is below half the T_c,2 threshold, so
+    /// that T_c,2 measures the packing and not the scatter ([`t_c2_resolved`]).
+    pub t_c2_resolved: bool,
     /// T_c,3 (h) and φ (°) from `critical.json`.
     pub t_c3: Option<f64>,
     /// See `t_c3`.
@@ -247,6 +272,14 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
     .flatten()
     .min()
     .unwrap_or(forced.len());
+    let before: Vec<f64> = forced[..shape_change].iter().map(|s| s.packing_fraction).collect();
+    let packing_noise = successive_scatter(&before);
+    let window = dynamical_time(SI_G, 2100.0 * mass / DIDYMOS_MASS);
+    let spacing = match (forced.first(), forced.get(1)) {
+        (Some(a), Some(b)) => b.t - a.t,
+        _ => window,
+    };
+    let resolved = t_c2_resolved(packing_noise, window, spacing);
     let path_error_before_t_c1 = forced[..shape_change]
         .iter()
         .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
@@ -261,6 +294,8 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
         limits,
         limits_raw,
+        packing_noise,
+        t_c2_resolved: resolved,
         t_c3,
         phi,
         kappa3,
@@ -352,7 +387,8 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
         "Ours: T_c1/T_c2 from `spinup.csv` (first change of b/a or c/a by > 0.01, of η_B by > 0.001, after t_start, \
          while forced), applied to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s: η_B of these \
          piles of a few thousand particles breathes with about that period by ±6e-4, which alone trips the 0.001 \
-         rule (the unsmoothed values, the paper's rule as written, are in the last column but one). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
+         rule (the unsmoothed values, the paper's rule as written, are in the last column but one). T_c2 is marked \
+         unresolved when η_B's sample scatter, averaged over the window, exceeds half the threshold. T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
          ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, T_c1 and \
          T_c2 do — faster paths give shorter ones).\n"
     );
@@ -394,11 +430,23 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
             r.n,
             r.packing,
             opt(r.limits.t_c1_hours, 3),
-            opt(r.limits.t_c2_hours, 3),
+            if r.t_c2_resolved {
+                opt(r.limits.t_c2_hours, 3)
+            } else {
+                format!(
+                    "unresolved ({}; η_B scatter {:.1e})",
+                    opt(r.limits.t_c2_hours, 3),
+                    r.packing_noise
+                )
+            },
             opt(r.t_c3, 2),
             opt(r.phi, 1),
             opt(r.kappa3, 3),
-            mode(r.limits.failure_mode),
+            if r.t_c2_resolved {
+                mode(r.limits.failure_mode)
+            } else {
+                "– (needs T_c2)"
+            },
             opt(r.limits_raw.t_c1_hours, 3),
             opt(r.limits_raw.t_c2_hours, 3),
             mode(r.limits_raw.failure_mode),
@@ -522,6 +570,8 @@ mod tests {
                 t_c2_hours: None,
                 failure_mode: None,
             },
+            packing_noise: 0.0,
+            t_c2_resolved: true,
             t_c3: t[2],
             phi: None,
             kappa3: None,
@@ -578,5 +628,19 @@ mod tests {
         assert!(md.contains("### RCP") && !md.contains("### HCP"));
         // κ₃ from 2 of the 3 densities
         assert!(md.contains("| T_c,3 | 2 | 0.800 ± 0.000"), "{md}");
+    }
+
+    /// The scatter estimate sees white noise and not a slow trend; the resolution rule separates the scaled RCP
+    /// (2e-4 scatter, 13 samples per window) from PP1 (3e-3).
+    #[test]
+    fn packing_scatter_and_t_c2_resolution() {
+        let alternating: Vec<f64> = (0..100).map(|k| 0.6 + if k % 2 == 0 { 1e-3 } else { -1e-3 }).collect();
+        // successive differences of 2e-3: RMS/√2 = 1.41e-3
+        assert!((successive_scatter(&alternating) - 2e-3 / 2f64.sqrt()).abs() < 1e-12);
+        let trend: Vec<f64> = (0..100).map(|k| 0.6 - 1e-5 * k as f64).collect();
+        assert!(successive_scatter(&trend) < 1e-5);
+        assert_eq!(successive_scatter(&[0.6]), 0.0);
+        assert!(t_c2_resolved(2e-4, 2700.0, 200.0));
+        assert!(!t_c2_resolved(3e-3, 2700.0, 200.0));
     }
 }
