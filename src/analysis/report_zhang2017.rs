@@ -244,20 +244,22 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         &col(|s| s.packing_fraction),
     );
     let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
+    let rho_b = 2100.0 * mass / DIDYMOS_MASS;
+    // the smoothing window of the limits and of the T_c,2 resolution test
+    let window = dynamical_time(SI_G, rho_b);
     let limits = smoothed_critical_limits(
         &col(|s| s.t),
         &col(|s| s.period_h),
         &col(|s| s.b_over_a),
         &col(|s| s.c_over_a),
         &col(|s| s.packing_fraction),
-        dynamical_time(SI_G, 2100.0 * mass / DIDYMOS_MASS),
+        window,
     );
     let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join("critical/critical.json"))
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok());
     let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
     let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
-    let rho_b = 2100.0 * mass / DIDYMOS_MASS;
     let kappa3 = t_c3.and_then(|t| fit_density(&[(rho_b, t)], SI_G, t)).map(|f| f.kappa);
     let path_error = samples
         .iter()
@@ -274,7 +276,6 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
     .unwrap_or(forced.len());
     let before: Vec<f64> = forced[..shape_change].iter().map(|s| s.packing_fraction).collect();
     let packing_noise = successive_scatter(&before);
-    let window = dynamical_time(SI_G, 2100.0 * mass / DIDYMOS_MASS);
     let spacing = match (forced.first(), forced.get(1)) {
         (Some(a), Some(b)) => b.t - a.t,
         _ => window,
