@@ -18,7 +18,11 @@
 //! because on a lattice they are all alike (an FCC ball's octree has leaves of the four sites of one cubic
 //! cell), so the octupole their quadrupole misses adds up coherently instead of averaging out: on a
 //! 10 000-site FCC ball at θ = 0.5 the largest force error, relative to the largest force, was 3.0e-3 with
-//! leaves of four used whole and 7e-4 with five or more (as with no leaf used whole). Small trees are
+//! leaves of four used whole and 7e-4 with five or more (as with no leaf used whole), with leaves of up to
+//! eight. Leaves now hold up to 32: on the FCC ball the near field is summed directly over a few hundred
+//! more particles, but a node is used whole only farther out, the RMS error at θ = 0.5 fell from 4.4e-4 to
+//! 1.9e-4 (uniform ball 5.6e-4 → 3.4e-4), and the step got faster (10 000 spheres: tree every step
+//! 1.4e5 → 1.85e5 particle-steps/s; leaves of 16 and buckets of 32 were as fast). Small trees are
 //! excluded because there direct sums cost little and keep a small aggregate's forces pairwise (its
 //! angular momentum to rounding, `ssdem_conservation`).
 //!
@@ -28,20 +32,32 @@
 //! the node's centre of mass, hence for every particle of the bucket: the forces are those of the
 //! per-particle walk with some nodes opened further, so the error is never larger. The walk gathers the
 //! particles of the leaves summed directly into one contiguous list. The lists are then applied to the
-//! bucket's particles four at a time (a last one or two as a pair), each entry (a node's moments or a
+//! bucket's particles eight at a time in single precision, four in double (a last few as a half block),
+//! each entry (a node's moments or a
 //! particle) read once per block, so the sums stay in registers and the compiler vectorises over the block.
 //! A source at distance zero (the particle itself) is skipped by a select, not a branch. Buckets are
 //! independent (rayon-parallel, buffers reused per worker); each particle sums its list in a fixed order,
 //! so results do not depend on the number of threads.
+//!
+//! Precision: a tree large enough to use leaves whole (at least [`FAR_LEAVES_FROM`] particles, where the
+//! multipole error is 1e-5 to 1e-3 anyway) sums its lists in single precision, as pkdgrav3 does (Potter,
+//! Stadel & Teyssier 2017, Comput. Astrophys. Cosmol. 4, 2): every list entry is stored relative to its
+//! bucket's centre, lengths in units of a power of two near the bucket's side and masses in units of a power
+//! of two near the total mass (exact rescalings that keep the f32 sums far from overflow), so only the
+//! rounding of the offsets and the sums (~1e-7 relative; the unit test `single_precision_changes_the_field_
+//! by_rounding_only` bounds it) is added. Twice as many lanes fit a vector register: the tree step at 10 000
+//! spheres went from 1.0e5 to 1.4e5 particle-steps/s. Smaller trees, summed directly and exactly pairwise,
+//! stay in double precision.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
+use std::ops::{Add, AddAssign, Div, Mul, Sub, SubAssign};
 
 /// Most particles in a leaf, except at the deepest level.
-pub const LEAF_SIZE: usize = 8;
+pub const LEAF_SIZE: usize = 32;
 /// Most particles in a bucket of the group walk (a node sharing one interaction list), except at the
 /// deepest level.
-pub const BUCKET_SIZE: usize = 32;
+pub const BUCKET_SIZE: usize = 64;
 /// Fewest particles of a leaf that may be used whole (by its multipole); smaller leaves are always summed
 /// directly (see the module header: lattice leaves of four would add their errors coherently).
 pub const FAR_LEAF_MIN: usize = 5;
@@ -50,16 +66,68 @@ pub const FAR_LEAF_MIN: usize = 5;
 pub const FAR_LEAVES_FROM: usize = 1000;
 /// Bits of the Morton key per axis: the deepest level of subdivision.
 const KEY_BITS: u32 = 21;
-/// Particles evaluated together against one interaction list.
-const LANES: usize = 4;
 
-/// A sorted particle: x, y, z (m), mass (kg).
-type Source = [f64; 4];
+/// A sorted particle: x, y, z (m), mass (kg); in a bucket's list, relative to its centre and rescaled.
+type Source<T = f64> = [T; 4];
 /// A node's moments: centre of mass x, y, z (m), mass (kg), traceless quadrupole `xx, xy, xz, yy, yz, zz`
-/// (kg m²).
-type Moments = [f64; 10];
-/// Per-lane sums: ax, ay, az, φ (in units of G).
-type Sums<const N: usize> = [[f64; N]; 4];
+/// (kg m²); in a bucket's list, relative to its centre and rescaled.
+type Moments<T = f64> = [T; 10];
+/// Per-lane sums: ax, ay, az, φ (in units of G and of the bucket's scales).
+type Sums<T, const N: usize> = [[T; N]; 4];
+
+/// The floating-point type a list is summed in (f32 for large trees, f64 for small ones).
+trait Real:
+    Copy
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + AddAssign
+    + SubAssign
+    + Send
+    + Sync
+{
+    const ZERO: Self;
+    fn of(x: f64) -> Self;
+    fn f64(self) -> f64;
+    fn sqrt(self) -> Self;
+}
+
+impl Real for f32 {
+    const ZERO: Self = 0.0;
+    fn of(x: f64) -> Self {
+        x as f32
+    }
+    fn f64(self) -> f64 {
+        self as f64
+    }
+    fn sqrt(self) -> Self {
+        f32::sqrt(self)
+    }
+}
+
+impl Real for f64 {
+    const ZERO: Self = 0.0;
+    fn of(x: f64) -> Self {
+        x
+    }
+    fn f64(self) -> f64 {
+        self
+    }
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+}
+
+/// The power of two nearest `x` (> 0): rescaling by it is exact.
+fn power_of_two_near(x: f64) -> f64 {
+    if x > 0.0 && x.is_finite() {
+        2f64.powi(x.log2().round() as i32)
+    } else {
+        1.0
+    }
+}
 
 /// An octree over point masses (positions in m, masses in kg).
 #[derive(Debug, Clone, Default)]
@@ -98,31 +166,33 @@ fn spread(v: u64) -> u64 {
     x
 }
 
-/// Buffers reused from bucket to bucket: the interaction lists.
+/// Buffers reused from bucket to bucket: the interaction lists, as the walk finds them.
 #[derive(Debug, Clone, Default)]
 struct Lists {
     /// Nodes used whole.
     cells: Vec<u32>,
-    /// The particles of the leaves summed directly, gathered.
-    sources: Vec<Source>,
+    /// Leaves summed directly: their runs `start..end` of sorted particles.
+    leaves: Vec<(u32, u32)>,
+}
+
+/// A bucket's interaction lists gathered for summing: relative to the bucket's centre, in its scales.
+#[derive(Debug, Clone)]
+struct Local<T> {
+    /// Moments of the nodes used whole.
+    cells: Vec<Moments<T>>,
+    /// The particles of the leaves summed directly.
+    sources: Vec<Source<T>>,
 }
 
 /// Adds the monopole and quadrupole of every node in `cells` to the sums of points `x, y, z`.
-fn add_cells<const N: usize>(
-    cells: &[u32],
-    moments: &[Moments],
-    x: &[f64; N],
-    y: &[f64; N],
-    z: &[f64; N],
-    f: &mut Sums<N>,
-) {
+fn add_cells<T: Real, const N: usize>(cells: &[Moments<T>], x: &[T; N], y: &[T; N], z: &[T; N], f: &mut Sums<T, N>) {
     let [ax, ay, az, phi] = f;
-    for &c in cells {
-        let [cx, cy, cz, m, qxx, qxy, qxz, qyy, qyz, qzz] = moments[c as usize];
+    let (one, half, five_halves) = (T::of(1.0), T::of(0.5), T::of(2.5));
+    for &[cx, cy, cz, m, qxx, qxy, qxz, qyy, qyz, qzz] in cells {
         for l in 0..N {
             let (rx, ry, rz) = (x[l] - cx, y[l] - cy, z[l] - cz);
             let r2 = rx * rx + ry * ry + rz * rz;
-            let inv = 1.0 / r2.sqrt();
+            let inv = one / r2.sqrt();
             let inv2 = inv * inv;
             let inv3 = inv * inv2;
             let inv5 = inv3 * inv2;
@@ -130,23 +200,24 @@ fn add_cells<const N: usize>(
             let qy = qxy * rx + qyy * ry + qyz * rz;
             let qz = qxz * rx + qyz * ry + qzz * rz;
             let rqr = rx * qx + ry * qy + rz * qz;
-            let radial = m * inv3 + 2.5 * rqr * inv5 * inv2;
+            let radial = m * inv3 + five_halves * rqr * inv5 * inv2;
             ax[l] += qx * inv5 - rx * radial;
             ay[l] += qy * inv5 - ry * radial;
             az[l] += qz * inv5 - rz * radial;
-            phi[l] -= m * inv + 0.5 * rqr * inv5;
+            phi[l] -= m * inv + half * rqr * inv5;
         }
     }
 }
 
 /// Adds the particles `sources` to the sums of points `x, y, z` directly, skipping a source at distance zero.
-fn add_sources<const N: usize>(sources: &[Source], x: &[f64; N], y: &[f64; N], z: &[f64; N], f: &mut Sums<N>) {
+fn add_sources<T: Real, const N: usize>(sources: &[Source<T>], x: &[T; N], y: &[T; N], z: &[T; N], f: &mut Sums<T, N>) {
     let [ax, ay, az, phi] = f;
+    let one = T::of(1.0);
     for &[xj, yj, zj, mj] in sources {
         for l in 0..N {
             let (dx, dy, dz) = (xj - x[l], yj - y[l], zj - z[l]);
             let r2 = dx * dx + dy * dy + dz * dz;
-            let inv = if r2 > 0.0 { 1.0 / r2.sqrt() } else { 0.0 };
+            let inv = if r2 > T::ZERO { one / r2.sqrt() } else { T::ZERO };
             let minv = mj * inv;
             let minv3 = minv * inv * inv;
             ax[l] += dx * minv3;
@@ -154,6 +225,35 @@ fn add_sources<const N: usize>(sources: &[Source], x: &[f64; N], y: &[f64; N], z
             az[l] += dz * minv3;
             phi[l] -= minv;
         }
+    }
+}
+
+/// A bucket's frame: its centre (m), length unit (m) and mass unit (kg), both powers of two.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    origin: Vec3,
+    length: f64,
+    mass: f64,
+}
+
+impl<T> Default for Local<T> {
+    fn default() -> Self {
+        Local {
+            cells: Vec::new(),
+            sources: Vec::new(),
+        }
+    }
+}
+
+impl Frame {
+    /// A position (m) in the frame.
+    fn point<T: Real>(&self, x: f64, y: f64, z: f64) -> [T; 3] {
+        let s = 1.0 / self.length;
+        [
+            T::of((x - self.origin.x) * s),
+            T::of((y - self.origin.y) * s),
+            T::of((z - self.origin.z) * s),
+        ]
     }
 }
 
@@ -296,7 +396,7 @@ impl Octree {
     /// Fills `lists` for points whose bounding box is `lo..hi`: nodes used whole, and leaves summed directly.
     fn walk(&self, reach2: &[f64], lo: Vec3, hi: Vec3, lists: &mut Lists) {
         lists.cells.clear();
-        lists.sources.clear();
+        lists.leaves.clear();
         let count = self.next.len() as u32;
         let mut k = 0u32;
         while k < count {
@@ -309,8 +409,7 @@ impl Octree {
                 if far && self.far_leaves && (self.end[kk] - self.start[kk]) as usize >= FAR_LEAF_MIN {
                     lists.cells.push(k);
                 } else {
-                    let (s, e) = (self.start[kk] as usize, self.end[kk] as usize);
-                    lists.sources.extend_from_slice(&self.particles[s..e]);
+                    lists.leaves.push((self.start[kk], self.end[kk]));
                 }
                 k = self.next[kk];
             } else if far {
@@ -322,22 +421,86 @@ impl Octree {
         }
     }
 
-    /// The field (in units of G) at `N` points `x, y, z` from the interaction lists: cells first, then the
-    /// directly summed particles, each in list order.
-    fn sum<const N: usize>(&self, lists: &Lists, x: &[f64; N], y: &[f64; N], z: &[f64; N]) -> Sums<N> {
-        let mut f = [[0.0; N]; 4];
-        add_cells(&lists.cells, &self.moments, x, y, z, &mut f);
-        add_sources(&lists.sources, x, y, z, &mut f);
-        f
+    /// Gathers the walk's `lists` into `local`, in `frame`.
+    fn gather<T: Real>(&self, lists: &Lists, frame: &Frame, local: &mut Local<T>) {
+        let mu = 1.0 / frame.mass;
+        // the quadrupole carries mass × length²
+        let q_unit = mu / (frame.length * frame.length);
+        local.cells.clear();
+        local.cells.extend(lists.cells.iter().map(|&c| {
+            let m = &self.moments[c as usize];
+            let [x, y, z] = frame.point::<T>(m[0], m[1], m[2]);
+            let q = |k: usize| T::of(m[k] * q_unit);
+            [x, y, z, T::of(m[3] * mu), q(4), q(5), q(6), q(7), q(8), q(9)]
+        }));
+        local.sources.clear();
+        for &(s, e) in &lists.leaves {
+            local
+                .sources
+                .extend(self.particles[s as usize..e as usize].iter().map(|&[x, y, z, m]| {
+                    let [x, y, z] = frame.point::<T>(x, y, z);
+                    [x, y, z, T::of(m * mu)]
+                }));
+        }
     }
 
-    /// Accelerations and potentials (`g` times the sums) of up to `N` particles `block` into `out`; unused
-    /// lanes repeat the last particle.
-    fn block<const N: usize>(&self, lists: &Lists, block: &[Source], out: &mut [[f64; 4]], g: f64) {
-        let lane = |c: usize| std::array::from_fn(|l| block[l.min(block.len() - 1)][c]);
-        let f = self.sum::<N>(lists, &lane(0), &lane(1), &lane(2));
+    /// The field at `N` points `x, y, z` (in the list's frame) from a gathered list: cells first, then the
+    /// directly summed particles, each in list order.
+    ///
+    /// The list is summed in runs of [`RUN`] entries, each run in `T` and the runs' totals in f64, so that
+    /// the rounding of a single-precision sum grows with the run, not with the whole list (the potential,
+    /// whose terms all have one sign, would otherwise lose ~1e-6 over a few thousand entries).
+    fn sum<T: Real, const N: usize>(local: &Local<T>, x: &[T; N], y: &[T; N], z: &[T; N]) -> Sums<f64, N> {
+        const RUN: usize = 64;
+        let mut total = [[0.0; N]; 4];
+        let mut add = |f: Sums<T, N>| {
+            for (t, f) in total.iter_mut().zip(f) {
+                for (t, f) in t.iter_mut().zip(f) {
+                    *t += f.f64();
+                }
+            }
+        };
+        for cells in local.cells.chunks(RUN) {
+            let mut f = [[T::ZERO; N]; 4];
+            add_cells(cells, x, y, z, &mut f);
+            add(f);
+        }
+        for sources in local.sources.chunks(RUN) {
+            let mut f = [[T::ZERO; N]; 4];
+            add_sources(sources, x, y, z, &mut f);
+            add(f);
+        }
+        total
+    }
+
+    /// Accelerations and potentials (`g` times the sums, back in SI units) of up to `N` particles `block`
+    /// into `out`; unused lanes repeat the last particle.
+    fn block<T: Real, const N: usize>(local: &Local<T>, frame: &Frame, block: &[Source], out: &mut [[f64; 4]], g: f64) {
+        let points: [[T; 3]; N] = std::array::from_fn(|l| {
+            let [x, y, z, _] = block[l.min(block.len() - 1)];
+            frame.point(x, y, z)
+        });
+        let lane = |c: usize| std::array::from_fn(|l| points[l][c]);
+        let f = Self::sum::<T, N>(local, &lane(0), &lane(1), &lane(2));
+        let phi_unit = g * frame.mass / frame.length;
+        let a_unit = phi_unit / frame.length;
         for (l, o) in out.iter_mut().enumerate() {
-            *o = [f[0][l] * g, f[1][l] * g, f[2][l] * g, f[3][l] * g];
+            *o = [f[0][l] * a_unit, f[1][l] * a_unit, f[2][l] * a_unit, f[3][l] * phi_unit];
+        }
+    }
+
+    /// Whether lists are summed in single precision ([`FAR_LEAVES_FROM`] particles or more: see the module
+    /// header).
+    fn single_precision(&self) -> bool {
+        self.far_leaves
+    }
+
+    /// The frame of points around `origin` spanning about `side` (m).
+    fn frame(&self, origin: Vec3, side: f64) -> Frame {
+        Frame {
+            origin,
+            length: power_of_two_near(side),
+            mass: power_of_two_near(self.moments[0][3]),
         }
     }
 
@@ -350,8 +513,20 @@ impl Octree {
         }
         let mut lists = Lists::default();
         self.walk(&self.reach2(theta), *p, *p, &mut lists);
-        let f = self.sum(&lists, &[p.x], &[p.y], &[p.z]);
-        let (mut a, mut phi) = (Vec3::new(f[0][0], f[1][0], f[2][0]), f[3][0]);
+        // the frame of the smallest leaf side: the point's neighbours lie within a few of them
+        let frame = self.frame(*p, self.side[0] / (1u64 << (KEY_BITS / 3)) as f64);
+        let point = [[p.x, p.y, p.z, 0.0]];
+        let mut out = [[0.0; 4]];
+        if self.single_precision() {
+            let mut local = Local::<f32>::default();
+            self.gather(&lists, &frame, &mut local);
+            Self::block::<f32, 1>(&local, &frame, &point, &mut out, 1.0);
+        } else {
+            let mut local = Local::<f64>::default();
+            self.gather(&lists, &frame, &mut local);
+            Self::block::<f64, 1>(&local, &frame, &point, &mut out, 1.0);
+        }
+        let (mut a, mut phi) = (Vec3::new(out[0][0], out[0][1], out[0][2]), out[0][3]);
         // A particle at `p` itself was skipped by the sums; `skip` elsewhere was included: remove its direct
         // term (exact when its leaf was summed directly, as it is whenever `p` lies near it).
         if let Some(sorted) = skip.and_then(|i| self.order.iter().position(|&o| o as usize == i)) {
@@ -379,41 +554,13 @@ impl Octree {
     /// ```
     pub fn accelerations(&self, theta: f64, g: f64) -> (Vec<Vec3>, Vec<f64>) {
         let n = self.order.len();
-        let reach2 = self.reach2(theta);
         // Sorted-order results, one disjoint chunk per bucket (buckets cover the sorted particles in order).
         let mut sorted = vec![[0.0; 4]; n];
-        let mut chunks = Vec::with_capacity(self.buckets.len());
-        let mut rest = &mut sorted[..];
-        for &b in &self.buckets {
-            let (s, e) = (self.start[b as usize] as usize, self.end[b as usize] as usize);
-            let (chunk, tail) = rest.split_at_mut(e - s);
-            chunks.push((s, chunk));
-            rest = tail;
+        if self.single_precision() {
+            self.sum_buckets::<f32, 8, 4>(theta, g, &mut sorted);
+        } else {
+            self.sum_buckets::<f64, 4, 2>(theta, g, &mut sorted);
         }
-        chunks.into_par_iter().for_each_init(Lists::default, |lists, (s, out)| {
-            let points = &self.particles[s..s + out.len()];
-            let mut lo = Vec3::new(points[0][0], points[0][1], points[0][2]);
-            let mut hi = lo;
-            for p in points {
-                let p = Vec3::new(p[0], p[1], p[2]);
-                lo = lo.inf(&p);
-                hi = hi.sup(&p);
-            }
-            self.walk(&reach2, lo, hi, lists);
-            // Blocks of four; a last one or two particles as a block of two.
-            let split = if points.len() % LANES <= 2 {
-                points.len() / LANES * LANES
-            } else {
-                points.len()
-            };
-            let (out4, out2) = out.split_at_mut(split);
-            for (block, out) in points[..split].chunks(LANES).zip(out4.chunks_mut(LANES)) {
-                self.block::<LANES>(lists, block, out, g);
-            }
-            for (block, out) in points[split..].chunks(2).zip(out2.chunks_mut(2)) {
-                self.block::<2>(lists, block, out, g);
-            }
-        });
         let mut acc = vec![Vec3::zeros(); n];
         let mut pot = vec![0.0; n];
         for (&input, r) in self.order.iter().zip(&sorted) {
@@ -421,5 +568,95 @@ impl Octree {
             pot[input as usize] = r[3];
         }
         (acc, pot)
+    }
+
+    /// Fills `sorted` (per sorted particle: acceleration, potential) bucket by bucket, summing in `T`, `W`
+    /// particles at a time against one list (a last `H = W/2` or fewer as a half block).
+    fn sum_buckets<T: Real, const W: usize, const H: usize>(&self, theta: f64, g: f64, sorted: &mut [[f64; 4]]) {
+        let reach2 = self.reach2(theta);
+        let mut chunks = Vec::with_capacity(self.buckets.len());
+        let mut rest = sorted;
+        for &b in &self.buckets {
+            let (s, e) = (self.start[b as usize] as usize, self.end[b as usize] as usize);
+            let (chunk, tail) = rest.split_at_mut(e - s);
+            chunks.push((b as usize, s, chunk));
+            rest = tail;
+        }
+        let init = || (Lists::default(), Local::<T>::default());
+        chunks
+            .into_par_iter()
+            .for_each_init(init, |(lists, local), (b, s, out)| {
+                let points = &self.particles[s..s + out.len()];
+                let mut lo = Vec3::new(points[0][0], points[0][1], points[0][2]);
+                let mut hi = lo;
+                for p in points {
+                    let p = Vec3::new(p[0], p[1], p[2]);
+                    lo = lo.inf(&p);
+                    hi = hi.sup(&p);
+                }
+                self.walk(&reach2, lo, hi, lists);
+                let frame = self.frame((lo + hi) * 0.5, self.side[b]);
+                self.gather(lists, &frame, local);
+                let (w, h, len): (usize, usize, usize) = (W, H, points.len());
+                let split = if len % w <= h { len / w * w } else { len };
+                let (out_w, out_h) = out.split_at_mut(split);
+                for (block, out) in points[..split].chunks(W).zip(out_w.chunks_mut(W)) {
+                    Self::block::<T, W>(local, &frame, block, out, g);
+                }
+                for (block, out) in points[split..].chunks(H).zip(out_h.chunks_mut(H)) {
+                    Self::block::<T, H>(local, &frame, block, out, g);
+                }
+            });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::{generator, point_in_ball};
+
+    /// Sorted-order sums of `tree` in `T`.
+    fn sums<T: Real, const W: usize, const H: usize>(tree: &Octree, theta: f64) -> Vec<[f64; 4]> {
+        let mut out = vec![[0.0; 4]; tree.order.len()];
+        tree.sum_buckets::<T, W, H>(theta, 1.0, &mut out);
+        out
+    }
+
+    /// The single-precision lists of a large tree differ from the same lists summed in double precision by
+    /// rounding (~1e-7), far below the multipole error (~1e-4): RMS relative change of the acceleration
+    /// ≤ 1e-6, largest ≤ 1e-5, potential ≤ 1e-6. Masses of 1e12 kg at 1 km keep it there (the rescaling).
+    #[test]
+    fn single_precision_changes_the_field_by_rounding_only() {
+        let mut rng = generator(11);
+        let x: Vec<Vec3> = (0..5000).map(|_| point_in_ball(&mut rng, 1000.0)).collect();
+        let m = vec![1e12; x.len()];
+        let tree = Octree::build(&x, &m);
+        assert!(tree.single_precision());
+        let (single, double) = (sums::<f32, 8, 4>(&tree, 0.5), sums::<f64, 4, 2>(&tree, 0.5));
+        let (mut sq, mut worst, mut worst_phi) = (0.0, 0.0f64, 0.0f64);
+        for (s, d) in single.iter().zip(&double) {
+            let a = Vec3::new(d[0], d[1], d[2]);
+            let e = (Vec3::new(s[0], s[1], s[2]) - a).norm() / a.norm();
+            sq += e * e;
+            worst = worst.max(e);
+            worst_phi = worst_phi.max(((s[3] - d[3]) / d[3]).abs());
+        }
+        let rms = (sq / x.len() as f64).sqrt();
+        println!("f32 vs f64 lists: RMS {rms:.2e}, largest {worst:.2e}, potential {worst_phi:.2e}");
+        assert!(
+            rms <= 1e-6 && worst <= 1e-5 && worst_phi <= 1e-6,
+            "{rms:e} {worst:e} {worst_phi:e}"
+        );
+    }
+
+    /// The frame's rescaling is by powers of two, so it is exact.
+    #[test]
+    fn frame_units_are_powers_of_two() {
+        for x in [1e-9, 0.3, 1.0, 7.5, 1e12, 3e24] {
+            let p = power_of_two_near(x);
+            assert_eq!(p.log2().fract(), 0.0, "{x}");
+            assert!(p / x < 1.5 && x / p < 1.5, "{x} -> {p}");
+        }
+        assert_eq!(power_of_two_near(0.0), 1.0);
     }
 }
