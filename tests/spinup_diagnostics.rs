@@ -2,12 +2,13 @@
 //! self-gravitating ball against the uniform sphere's `(2π/3) G ρ_B² R²`, and the axis ratios and interior
 //! packing fraction of a lattice-carved ellipsoid against the shape's and HCP's `π/(3√2)`.
 
-use rubblepile::analysis::spinup_diagnostics::{diagnose, rve_stresses};
+use rubblepile::analysis::spinup_diagnostics::{depth_weights, diagnose, rve_stresses};
 use rubblepile::geometry::lattice::hcp_centres;
-use rubblepile::geometry::voronoi::voronoi_cells;
+use rubblepile::geometry::voronoi::{packing_fraction, radical_cells, voronoi_cells, weighted_packing_fraction};
 use rubblepile::granular::soft::contact::Material;
 use rubblepile::granular::soft::forces::{Gravity, SoftSystem};
 use rubblepile::granular::soft::particle::Particle;
+use rubblepile::granular::soft::spinup::InteriorRule;
 use rubblepile::gravity::SelfGravity;
 use rubblepile::math::Vec3;
 
@@ -77,7 +78,7 @@ fn central_rve_pressure_of_a_settled_ball_matches_the_uniform_sphere() {
         (central.centre - com).norm()
     );
     // the run-time reduction over the tree's RVEs (~60 particles each): none exceeds the central pressure much
-    let d = diagnose(&sys, &Vec3::z(), 1.0, false, 60, 0.0);
+    let d = diagnose(&sys, &Vec3::z(), 1.0, false, 60, InteriorRule::Layers, 0.0);
     assert!(
         d.sample.p_max > 0.5 * p_c && d.sample.p_max < 1.15 * p_c,
         "{:?}",
@@ -111,7 +112,7 @@ fn carved_ellipsoid_gives_its_axis_ratios_and_hcp_packing() {
         .collect();
     assert!(particles.len() > 500, "{}", particles.len());
     let sys = system(particles, 6.674e-11, 1e6);
-    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, 0.0).sample;
+    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, InteriorRule::Layers, 0.0).sample;
     for (got, want, name) in [(s.b_over_a, b / a, "b/a"), (s.c_over_a, c / a, "c/a")] {
         assert!((got / want - 1.0).abs() < 0.01, "{name}: {got} vs the shape's {want}");
     }
@@ -123,4 +124,69 @@ fn carved_ellipsoid_gives_its_axis_ratios_and_hcp_packing() {
         s.interior_particles
     );
     assert!(s.coordination_number > 8.0 && s.fraction_0_contacts == 0.0, "{s:?}");
+    // the depth rule (weights from two diameters below the surface layer, full at three) sees the same lattice
+    let rule = InteriorRule::Depth {
+        depth: 1.5 * d,
+        ramp: d,
+    };
+    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, rule, 0.0).sample;
+    assert!(
+        (s.packing_fraction - hcp).abs() < 0.002 && s.interior_particles > 40,
+        "depth rule: η_B = {} over {} effective interior particles, HCP {hcp}",
+        s.packing_fraction,
+        s.interior_particles
+    );
+}
+
+/// Regression for PP1's flickering η_B: in a ball of spheres of radii 0.6–0.95 on a lattice of spacing 2, one
+/// sphere of radius 0.95 two layers deeper moves 2.4 outwards in 400 steps. The layer rule's η_B jumps (by
+/// 8e-4 among ~240 spheres) when the sphere comes within 10 % of touching a surface sphere; the depth rule's η_B
+/// moves by at most 1e-4 per step (measured 2.3e-5).
+#[test]
+fn depth_rule_packing_moves_continuously_where_the_layer_rule_jumps() {
+    let mut rng = rubblepile::random::generator(5);
+    let lattice: Vec<Vec3> = hcp_centres(1.0, 9.0).into_iter().filter(|p| p.norm() <= 8.0).collect();
+    let mut radii: Vec<f64> = lattice
+        .iter()
+        .map(|_| 0.6 + 0.35 * rubblepile::random::uniform(&mut rng))
+        .collect();
+    // the mover: the lattice site nearest (6, 0, 0), a large sphere
+    let mover = (0..lattice.len())
+        .min_by(|&i, &j| {
+            (lattice[i] - Vec3::new(4.0, 0.0, 0.0))
+                .norm()
+                .total_cmp(&(lattice[j] - Vec3::new(4.0, 0.0, 0.0)).norm())
+        })
+        .unwrap();
+    radii[mover] = 0.95;
+    let member = vec![true; lattice.len()];
+    let (mut layer_jump, mut depth_step) = (0.0f64, 0.0f64);
+    let mut last: Option<(f64, f64)> = None;
+    for k in 0..=400 {
+        let mut x = lattice.clone();
+        x[mover] += Vec3::new(2.4 * k as f64 / 400.0, 0.0, 0.0);
+        let cells = radical_cells(&x, &radii, 4.0);
+        let mut inner: Vec<bool> = cells.iter().map(|c| !c.boundary).collect();
+        for (i, j) in
+            rubblepile::geometry::neighbours::sphere_pairs(&x, &radii.iter().map(|r| 1.1 * r).collect::<Vec<_>>())
+        {
+            if cells[i].boundary {
+                inner[j] = false;
+            }
+            if cells[j].boundary {
+                inner[i] = false;
+            }
+        }
+        let layers = packing_fraction(&cells, &radii, &inner).unwrap();
+        let w = depth_weights(&x, &cells, &member, 2.0, 2.0);
+        let depth = weighted_packing_fraction(&cells, &radii, &w).unwrap();
+        if let Some((l0, d0)) = last {
+            layer_jump = layer_jump.max((layers - l0).abs());
+            depth_step = depth_step.max((depth - d0).abs());
+        }
+        last = Some((layers, depth));
+    }
+    println!("largest change per step: layer rule {layer_jump:.2e}, depth rule {depth_step:.2e}");
+    assert!(layer_jump > 5e-4, "the layer rule should jump here: {layer_jump:e}");
+    assert!(depth_step < 1e-4, "depth rule: {depth_step:e}");
 }

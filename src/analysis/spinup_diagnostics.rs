@@ -14,7 +14,12 @@
 //! bisectors and measure the gaps, not the packing (on a carved HCP ball keeping the second layer lowers η_B by
 //! about 0.03 and makes it noisy at the 0.001 level of T_c,2); and so is every particle outside the central body.
 //! η_B is the ratio of the summed sphere volumes to the summed cell volumes over the rest (the volume-weighted
-//! form of Eq. 14, which does not let a few small cells dominate).
+//! form of Eq. 14, which does not let a few small cells dominate). That is the default rule,
+//! [`InteriorRule::Layers`]. For unequal spheres it flickers: in our PP1 (radii 10.7–85 m) one large sphere
+//! entering or leaving the set moves η_B by about 0.01 between samples. The depth rule
+//! ([`InteriorRule::Depth`], `[spinup] interior_depth`) weights every closed cell by its depth below the surface
+//! layer instead (distance to the nearest centre with an open cell; the weight ramps linearly from 0 to 1), so
+//! that η_B is a continuous function of the positions as long as the set of open cells holds.
 //!
 //! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
 //! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
@@ -32,9 +37,9 @@ use std::path::Path;
 use crate::analysis::shape_metrics::axis_lengths;
 use crate::analysis::spinup::{StressState, particle_stress, rve_stress, stress_state};
 use crate::geometry::neighbours::sphere_pairs;
-use crate::geometry::voronoi::{packing_fraction, radical_cells};
+use crate::geometry::voronoi::{VoronoiCell, packing_fraction, radical_cells, weighted_packing_fraction};
 use crate::granular::soft::forces::{ContactRecord, SoftSystem};
-use crate::granular::soft::spinup::{SpinupDriver, body_rotation, central_body};
+use crate::granular::soft::spinup::{InteriorRule, SpinupDriver, body_rotation, central_body};
 use crate::math::{Mat3, Vec3};
 
 /// The `spinup.csv` header.
@@ -256,14 +261,42 @@ pub struct Diagnosis {
     pub rves: Vec<RveStress>,
 }
 
+/// Weights of the particles in η_B by [`InteriorRule::Depth`]: members with closed cells, by their centre's
+/// distance `d` (m) to the nearest centre with an open cell, `clamp((d − depth)/ramp, 0, 1)`. O(N × open).
+pub fn depth_weights(centres: &[Vec3], cells: &[VoronoiCell], member: &[bool], depth: f64, ramp: f64) -> Vec<f64> {
+    let open: Vec<Vec3> = centres
+        .iter()
+        .zip(cells)
+        .filter(|(_, c)| c.boundary)
+        .map(|(x, _)| *x)
+        .collect();
+    centres
+        .iter()
+        .zip(cells)
+        .zip(member)
+        .map(|((x, c), &m)| {
+            if !m || c.boundary {
+                return 0.0;
+            }
+            let d2 = open
+                .iter()
+                .map(|o| (o - x).norm_squared())
+                .fold(f64::INFINITY, f64::min);
+            ((d2.sqrt() - depth) / ramp).clamp(0.0, 1.0)
+        })
+        .collect()
+}
+
 /// Measures the system at time `t` (s). Needs the contact records of the last force evaluation
-/// (`sys.keep_records` on for it); `axis` is the spin axis, `path_period` the path's period (s).
+/// (`sys.keep_records` on for it); `axis` is the spin axis, `path_period` the path's period (s), `interior` the
+/// rule for η_B's particles.
 pub fn diagnose(
     sys: &SoftSystem,
     axis: &Vec3,
     path_period: f64,
     forcing: bool,
     rve_target: usize,
+    interior: InteriorRule,
     t: f64,
 ) -> Diagnosis {
     let ps = &sys.particles;
@@ -278,18 +311,32 @@ pub fn diagnose(
     let ax = axis_lengths(&centres, &masses, &radii);
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
     let cells = radical_cells(&centres, &radii, 4.0 * r_max);
-    let mut inner: Vec<bool> = member.iter().zip(&cells).map(|(m, c)| *m && !c.boundary).collect();
-    let reach: Vec<f64> = radii.iter().map(|r| 1.1 * r).collect();
-    for (i, j) in sphere_pairs(&centres, &reach) {
-        if cells[i].boundary {
-            inner[j] = false;
+    let (packing, interior) = match interior {
+        InteriorRule::Layers => {
+            let mut inner: Vec<bool> = member.iter().zip(&cells).map(|(m, c)| *m && !c.boundary).collect();
+            let reach: Vec<f64> = radii.iter().map(|r| 1.1 * r).collect();
+            for (i, j) in sphere_pairs(&centres, &reach) {
+                if cells[i].boundary {
+                    inner[j] = false;
+                }
+                if cells[j].boundary {
+                    inner[i] = false;
+                }
+            }
+            (
+                packing_fraction(&cells, &radii, &inner),
+                inner.iter().filter(|&&k| k).count(),
+            )
         }
-        if cells[j].boundary {
-            inner[i] = false;
+        InteriorRule::Depth { depth, ramp } => {
+            let w = depth_weights(&centres, &cells, &member, depth, ramp);
+            // the count reported is the weights' sum, rounded: the effective number of interior particles
+            (
+                weighted_packing_fraction(&cells, &radii, &w),
+                w.iter().sum::<f64>().round() as usize,
+            )
         }
-    }
-    let packing = packing_fraction(&cells, &radii, &inner);
-    let interior = inner.iter().filter(|&&k| k).count();
+    };
     let eta = packing.unwrap_or(0.64);
     let volumes: Vec<f64> = cells
         .iter()
@@ -346,7 +393,15 @@ pub fn diagnose(
 /// [`diagnose`] for a run with a spin-up driver at time `t` (s).
 pub fn diagnose_run(sys: &SoftSystem, driver: &SpinupDriver, t: f64) -> Diagnosis {
     let s = &driver.settings;
-    diagnose(sys, &s.axis, s.path.period(t), !driver.released, s.rve_particles, t)
+    diagnose(
+        sys,
+        &s.axis,
+        s.path.period(t),
+        !driver.released,
+        s.rve_particles,
+        s.interior,
+        t,
+    )
 }
 
 #[cfg(test)]

@@ -242,6 +242,19 @@ pub fn packing_fraction(cells: &[VoronoiCell], radii: &[f64], interior: &[bool])
     (total > 0.0).then(|| solid / total)
 }
 
+/// Weighted packing fraction Σ wᵢ (4/3)π rᵢ³ / Σ wᵢ Vᵢ over the particles with closed cells (weights ≥ 0);
+/// `None` when no closed cell has a positive weight. With 0/1 weights it is [`packing_fraction`].
+pub fn weighted_packing_fraction(cells: &[VoronoiCell], radii: &[f64], weights: &[f64]) -> Option<f64> {
+    let (mut solid, mut total) = (0.0, 0.0);
+    for ((c, &r), &w) in cells.iter().zip(radii).zip(weights) {
+        if w > 0.0 && !c.boundary {
+            solid += w * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+            total += w * c.volume;
+        }
+    }
+    (total > 0.0).then(|| solid / total)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,6 +18,8 @@
 //! release_packing = 0.01       # ... or |Δη_B| above this (both from the values at t_start) ...
 //! release_samples = 2          # ... at this many consecutive output samples: forcing released
 //! rve_particles = 300          # target particles per representative volume element (stress diagnostics)
+//! interior_depth = 170.0       # m, optional: η_B over particles this deep below the surface layer ...
+//! interior_ramp = 170.0        # m, ... with weights rising from 0 to 1 over this further depth (default: depth)
 //! ```
 //!
 //! **The path.** `T = T_start` until `t_start` (the body settles at a slow spin); then linear in `T` (as the paper
@@ -111,6 +113,34 @@ pub struct SpinupSection {
     /// Target particles per RVE (≥ 8; default 300).
     #[serde(default = "d_rve")]
     pub rve_particles: usize,
+    /// Which particles η_B is taken over ([`InteriorRule`]): unset, the layer rule (default); set, the depth (m,
+    /// ≥ 0) below the surface layer from which a particle counts, with weight rising linearly to 1 over
+    /// `interior_ramp` (m, > 0; default `interior_depth`). Meant for piles of unequal spheres (PP1).
+    #[serde(default)]
+    pub interior_depth: Option<f64>,
+    /// See `interior_depth` (m, > 0).
+    #[serde(default)]
+    pub interior_ramp: Option<f64>,
+}
+
+/// Which particles the interior packing fraction η_B is taken over
+/// ([`crate::analysis::spinup_diagnostics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum InteriorRule {
+    /// Closed cells, less every particle within 10 % of the sum of the radii from a particle with an open cell
+    /// (two surface layers of equal spheres). A sphere is in or out, so for unequal spheres (PP1, radii over
+    /// 8×) η_B jumps by ±0.01 as large spheres near the surface enter or leave the set.
+    #[default]
+    Layers,
+    /// Every closed cell weighted by its depth `d` below the surface layer (the distance from its centre to the
+    /// nearest centre with an open cell): weight 0 for `d ≤ depth`, rising linearly to 1 at `depth + ramp` (m).
+    /// The weights and the cell volumes change continuously with the positions, so η_B does too.
+    Depth {
+        /// Depth (m) from which a particle counts.
+        depth: f64,
+        /// Depth span (m) over which its weight rises from 0 to 1.
+        ramp: f64,
+    },
 }
 
 /// The spin-period path `T(t)` in SI units (periods and times in s).
@@ -192,6 +222,8 @@ pub struct SpinupSettings {
     pub release_samples: u32,
     /// Target particles per RVE.
     pub rve_particles: usize,
+    /// Which particles η_B is taken over.
+    pub interior: InteriorRule,
 }
 
 impl crate::scene::Validator<'_> {
@@ -246,6 +278,26 @@ impl crate::scene::Validator<'_> {
                 ));
             }
         };
+        let interior = match (s.interior_depth, s.interior_ramp) {
+            (None, None) => InteriorRule::Layers,
+            (None, Some(_)) => {
+                return Err(self.invalid("spinup.interior_ramp", "needs spinup.interior_depth (m, >= 0)"));
+            }
+            (Some(d), ramp) => {
+                let depth = self.non_negative("spinup.interior_depth", d)?;
+                let ramp = match ramp {
+                    Some(w) => self.positive("spinup.interior_ramp", w)?,
+                    None if depth > 0.0 => depth,
+                    None => {
+                        return Err(self.invalid(
+                            "spinup.interior_ramp",
+                            "must be given (m, > 0) when spinup.interior_depth is 0",
+                        ));
+                    }
+                };
+                InteriorRule::Depth { depth, ramp }
+            }
+        };
         if s.rve_particles < 8 {
             return Err(self.invalid("spinup.rve_particles", format!("must be >= 8, got {}", s.rve_particles)));
         }
@@ -266,6 +318,7 @@ impl crate::scene::Validator<'_> {
             release_packing: self.positive("spinup.release_packing", s.release_packing)?,
             release_samples: s.release_samples,
             rve_particles: s.rve_particles,
+            interior,
         })
     }
 }
@@ -564,6 +617,7 @@ mod tests {
             release_packing: 0.01,
             release_samples: 2,
             rve_particles: 300,
+            interior: InteriorRule::Layers,
         };
         let mut ps: Vec<Particle> = (0..6)
             .map(|k| Particle {
@@ -632,6 +686,7 @@ mod tests {
                 release_packing: 0.01,
                 release_samples: 2,
                 rve_particles: 300,
+                interior: InteriorRule::Layers,
             };
             let d = SpinupDriver::new(settings, &ps0);
             let mut ps = expanded.clone();
@@ -656,6 +711,7 @@ mod tests {
             release_packing: 0.01,
             release_samples: 2,
             rve_particles: 300,
+            interior: InteriorRule::Layers,
         };
         let mut d = SpinupDriver::new(settings, &[]);
         d.observe(5.0, 0.5, 0.5, 0.5); // before t_start: ignored
