@@ -6,7 +6,9 @@ Runs `rubblepile bench ssdem` interleaved, `--repeats` times, for every N and mo
   tree           --gravity tree (theta = 0.5, self-gravity every step)
   tree-K         --gravity tree --gravity-interval K (r-RESPA: self-gravity every K steps)
 on 1 and 2 threads, and writes the medians to gravity.csv (binary, gravity, N, threads, steps,
-gravity_interval, particle_steps_per_s) and every sample to gravity_run.log. Standard library only.
+gravity_interval, particle_steps_per_s), every sample to gravity_run.log, and the paired ratios of each gravity
+mode to contact only (same binary, N, threads and repeat, so neighbouring samples that saw the same load) to
+gravity_paired.csv (median and quartiles over the repeats). Standard library only.
 
     cargo build --release
     python3 analysis/ssdem_perf/gravity_bench.py --particles 10000,40000 --interval 10 --repeats 3
@@ -68,6 +70,7 @@ def main():
     modes = [("off", "off", 1, "off"), ("tree", "tree", 1, "tree"), (f"tree-{a.interval}", "tree", a.interval, "respa")]
     modes = [m for m in modes if m[3] in wanted]
     samples = {}
+    per_rep = {}
     with open(log_path, "w") as log:
         log.write(f"load average at start: {os.getloadavg()}\n")
         for rep in range(a.repeats):
@@ -77,6 +80,7 @@ def main():
                     rates, cmd = bench(binary, n, gravity, interval, s, "1,2")
                     for t, r in rates.items():
                         samples.setdefault((label, name, n, t, s, interval), []).append(r)
+                        per_rep[(label, name, n, t, rep)] = r
                     line = f"repeat {rep} load {os.getloadavg()[0]:.2f}: {cmd} -> {rates}"
                     print(line, flush=True)
                     log.write(line + "\n")
@@ -86,7 +90,19 @@ def main():
         f.write("binary,gravity,N,threads,steps,gravity_interval,particle_steps_per_s\n")
         for (label, name, n, t, s, k), rs in samples.items():
             f.write(f"{label},{name},{n},{t},{s},{k},{statistics.median(rs):.6e}\n")
-    print(f"wrote {csv_path} and {log_path}")
+    paired_path = os.path.join(a.out, "gravity_paired.csv")
+    with open(paired_path, "w") as f:
+        f.write("binary,gravity,N,threads,repeats,median_ratio_to_off,q1,q3\n")
+        for (label, _), n, t, (name, _, _, _) in itertools.product(bins, ns, (1, 2), modes):
+            if name == "off":
+                continue
+            rs = sorted(per_rep[(label, name, n, t, r)] / per_rep[(label, "off", n, t, r)]
+                        for r in range(a.repeats)
+                        if (label, name, n, t, r) in per_rep and (label, "off", n, t, r) in per_rep)
+            if len(rs) >= 2:
+                q = statistics.quantiles(rs, n=4)
+                f.write(f"{label},{name},{n},{t},{len(rs)},{statistics.median(rs):.4f},{q[0]:.4f},{q[2]:.4f}\n")
+    print(f"wrote {csv_path}, {paired_path} and {log_path}")
 
 
 if __name__ == "__main__":
