@@ -213,6 +213,26 @@ fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
     (m > 0.0).then_some((lo, hi, m, n))
 }
 
+/// The `wall_seconds` of the last row of the run's `timeseries.csv` (cumulative over resumes): the wall time
+/// so far of a run that has not finished.
+fn last_wall_seconds(run: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(run.join("timeseries.csv")).ok()?;
+    let mut lines = text.lines();
+    let col = lines.next()?.split(',').position(|c| c == "wall_seconds")?;
+    lines.last()?.split(',').nth(col)?.parse().ok()
+}
+
+/// The scene's `t_end` (s) of a run directory.
+fn t_end_of(dir: &Path) -> Option<f64> {
+    std::fs::read_to_string(dir.join("scene.toml"))
+        .ok()?
+        .parse::<toml::Table>()
+        .ok()?
+        .get("scene")?
+        .get("t_end")?
+        .as_float()
+}
+
 /// Whether the run's `timeseries.csv` books the spin-up forcing (has the `forcing_work` column).
 fn books_forcing(run: &Path) -> bool {
     std::fs::read_to_string(run.join("timeseries.csv")).is_ok_and(|t| {
@@ -310,7 +330,10 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
                     .zip(summary["angular_momentum_error"].as_f64())
             })
             .flatten(),
-        wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
+        wall_seconds: summary["wall_seconds"]
+            .as_f64()
+            .or_else(|| last_wall_seconds(&run))
+            .unwrap_or(f64::NAN),
         final_time: samples.last().map(|s| s.t).unwrap_or(0.0),
         status: summary["status"]
             .as_str()
@@ -332,13 +355,8 @@ fn mode(m: Option<FailureMode>) -> &'static str {
     }
 }
 
-/// Writes `out/REPORT.md` and `out/fig5_<model>.{svg,png}` from the runs under `runs`; refuses to overwrite an
-/// existing report without `force`. Returns the report's path.
-pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::PathBuf, String> {
-    let report = out.join("REPORT.md");
-    if report.exists() && !force {
-        return Err(format!("{} exists (use --force to overwrite it)", report.display()));
-    }
+/// Model directories under `runs` that hold `path2/spinup.csv`, sorted.
+fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
     let mut models: Vec<_> = std::fs::read_dir(runs)
         .map_err(|e| format!("{}: {e}", runs.display()))?
         .filter_map(|e| e.ok())
@@ -346,6 +364,103 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
         .filter(|p| p.join("path2/spinup.csv").is_file())
         .collect();
     models.sort();
+    Ok(models)
+}
+
+/// The full-size section: one row per model under `full` (`<model>/path2`), finished or not, with its wall
+/// time on this machine, and its Fig. 5-style figure `fig5_<model>_full`.
+fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), String> {
+    let models = model_dirs(full)?;
+    let _ = writeln!(md, "\n## Full size\n");
+    let _ = writeln!(
+        md,
+        "Runs under `{}` at the paper's particle count (lengths unscaled); limits as in Table 3 above. A run still \
+         going is read as far as it has got (`simulated` against the scene's `t_end`; wall time from the last row of \
+         `timeseries.csv`, summed over resumes).\n",
+        full.display()
+    );
+    let _ = writeln!(
+        md,
+        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | failure mode | status | simulated / t_end (s) | wall (s) | largest overlap / radius | energy / L residual |"
+    );
+    let _ = writeln!(
+        md,
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
+    let mut figures = Vec::new();
+    for m in &models {
+        let (r, samples) = model_row(m)?;
+        let ts = read_timeseries_tail(&m.join("path2"));
+        let _ = writeln!(
+            md,
+            "| {} | {} | {:.2} | {:.4} | {} | {} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
+            r.model.to_uppercase(),
+            r.n,
+            r.radius_range.1,
+            r.packing,
+            opt(r.limits.t_c1_hours, 3),
+            opt(r.limits.t_c2_hours, 3),
+            mode(r.limits.failure_mode),
+            r.status,
+            r.final_time,
+            opt(t_end_of(&m.join("path2")), 0),
+            r.wall_seconds,
+            if r.max_overlap.is_finite() {
+                format!("{:.2e}", r.max_overlap)
+            } else {
+                ts.map_or("–".into(), |t| format!("{:.2e} (so far)", t.0))
+            },
+            r.residuals
+                .map(|(e, l)| format!("{e:.1e} / {l:.1e}"))
+                .or(ts.map(|t| format!("{:.1e} / {:.1e} (so far)", t.1, t.2)))
+                .unwrap_or_else(|| "–".into()),
+        );
+        let stem = format!("fig5_{}_full", r.model);
+        let fig = SpinupTimeSeries {
+            title: format!("{} (N = {}), full size, spin-up path 2", r.model.to_uppercase(), r.n),
+            samples,
+        };
+        match write_figure(out, &stem, &fig) {
+            Ok(_) => figures.push(stem),
+            Err(e) => eprintln!("warning: {stem}: {e}"),
+        }
+    }
+    for f in &figures {
+        let _ = writeln!(md, "\n![{f}]({f}.png)");
+    }
+    Ok(())
+}
+
+/// Largest overlap fraction, and the largest |energy residual| and |L residual|, over the rows of the run's
+/// `timeseries.csv` so far.
+fn read_timeseries_tail(run: &Path) -> Option<(f64, f64, f64)> {
+    let text = std::fs::read_to_string(run.join("timeseries.csv")).ok()?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let col = |name: &str| header.iter().position(|c| *c == name);
+    let (o, e, l) = (
+        col("max_overlap_fraction")?,
+        col("energy_residual")?,
+        col("angular_momentum_error")?,
+    );
+    let mut worst = (0.0f64, 0.0f64, 0.0f64);
+    for line in lines {
+        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect();
+        let get = |k: usize| v.get(k).copied().unwrap_or(0.0).abs();
+        worst = (worst.0.max(get(o)), worst.1.max(get(e)), worst.2.max(get(l)));
+    }
+    Some(worst)
+}
+
+/// Writes `out/REPORT.md` and `out/fig5_<model>.{svg,png}` from the runs under `runs` (and, with `full`, a
+/// full-size section from the runs under it); refuses to overwrite an existing report without `force`. Returns
+/// the report's path.
+pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -> Result<std::path::PathBuf, String> {
+    let report = out.join("REPORT.md");
+    if report.exists() && !force {
+        return Err(format!("{} exists (use --force to overwrite it)", report.display()));
+    }
+    let models = model_dirs(runs)?;
     if models.is_empty() {
         return Err(format!("{}: no <model>/path2/spinup.csv found", runs.display()));
     }
@@ -376,10 +491,11 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
     );
     let _ = writeln!(
         md,
-        "Generated by `rubblepile report-zhang2017 {} --out {} --force` from the runs under `{}` (layout and \
+        "Generated by `rubblepile report-zhang2017 {}{} --out {} --force` from the runs under `{}` (layout and \
          definitions: `src/analysis/report_zhang2017.rs`; scenes and the commands that make the runs: \
          `analysis/zhang2017/README.md`). Do not edit by hand.\n",
         runs.display(),
+        full.map(|f| format!(" --full {}", f.display())).unwrap_or_default(),
         out.display(),
         runs.display()
     );
@@ -484,6 +600,9 @@ pub fn write_report(runs: &Path, out: &Path, force: bool) -> Result<std::path::P
         );
     }
     write_density_section(&mut md, &rows);
+    if let Some(full) = full {
+        write_full_section(&mut md, full, out)?;
+    }
     let _ = writeln!(md, "\n## Time series (Fig. 5 style)\n");
     for f in &figures {
         let _ = writeln!(md, "![{f}]({f}.png)\n");

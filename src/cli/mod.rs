@@ -114,6 +114,10 @@ pub enum Command {
 pub struct ReportZhang2017Args {
     /// Directory of the runs (e.g. runs/zhang2017).
     pub runs: PathBuf,
+    /// Directory of full-size runs (`<model>/path2`, e.g. runs/zhang2017_full), read into a "Full size" section,
+    /// finished or still running.
+    #[arg(long, value_name = "DIR")]
+    pub full: Option<PathBuf>,
     /// Where REPORT.md and the figures go.
     #[arg(long, value_name = "DIR", default_value = "analysis/zhang2017")]
     pub out: PathBuf,
@@ -346,8 +350,13 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
         Command::ReportZhang2017(args) => {
-            let path = crate::analysis::report_zhang2017::write_report(&args.runs, &args.out, args.force)
-                .map_err(CliError::usage)?;
+            let path = crate::analysis::report_zhang2017::write_report(
+                &args.runs,
+                args.full.as_deref(),
+                &args.out,
+                args.force,
+            )
+            .map_err(CliError::usage)?;
             println!("wrote {}", path.display());
             Ok(())
         }

@@ -1,0 +1,97 @@
+//! `report-zhang2017` with `--full`: a full-size run still going is read as far as it has got (status, simulated
+//! time against the scene's t_end, wall time so far from `timeseries.csv`, residuals so far), next to the
+//! scaled runs' Table 3.
+
+use rubblepile::analysis::report_zhang2017::write_report;
+use rubblepile::analysis::spinup_diagnostics::{SPINUP_HEADER, SpinupSample};
+use std::path::Path;
+
+/// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
+/// with `t_end`, and a time series whose wall clock reads `wall` at the end; `summary` if finished.
+fn fake_run(dir: &Path, n: usize, t_last: f64, t_end: f64, wall: f64, finished: bool) {
+    let run = dir.join("path2");
+    std::fs::create_dir_all(run.join("snapshots")).unwrap();
+    let mut csv = SPINUP_HEADER.to_string();
+    let mut ts = "t,step,energy_residual,angular_momentum_error,max_overlap_fraction,wall_seconds\n".to_string();
+    let mut t = 0.0;
+    while t <= t_last {
+        let period = 5.0 - 2.0 * t / 38300.0;
+        let s = SpinupSample {
+            t,
+            path_period_h: period,
+            period_h: period,
+            forcing: true,
+            body_particles: n,
+            body_mass_fraction: 1.0,
+            a: 400.0,
+            b: 390.0,
+            c: 350.0,
+            b_over_a: 0.975,
+            c_over_a: 0.875,
+            packing_fraction: 0.74,
+            interior_particles: n / 2,
+            coordination_number: 9.0,
+            fraction_0_contacts: 0.0,
+            fraction_1_contact: 0.0,
+            rves: 10,
+            s_max: 1.0,
+            p_max: 2.0,
+            theta_max_deg: 20.0,
+        };
+        csv += &s.csv_row();
+        ts += &format!(
+            "{t},{},{},2e-5,{},{}\n",
+            (t / 0.66) as u64,
+            1e-3 * t / t_last,
+            3e-3,
+            wall * t / t_last
+        );
+        t += 200.0;
+    }
+    std::fs::write(run.join("spinup.csv"), csv).unwrap();
+    std::fs::write(run.join("timeseries.csv"), ts).unwrap();
+    let mut snap = "t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz\n".to_string();
+    for k in 0..n {
+        snap += &format!("0,{k},1e7,10.0,{},0,0,0,0,0,0,0,0\n", 20.0 * k as f64);
+    }
+    std::fs::write(run.join("snapshots/0.csv"), snap).unwrap();
+    std::fs::write(
+        run.join("scene.toml"),
+        format!("[scene]\nt_end = {t_end:.1}\n\n[spinup]\nt_start = 700.0\n"),
+    )
+    .unwrap();
+    if finished {
+        std::fs::write(
+            run.join("summary.json"),
+            format!("{{\"status\": \"completed\", \"wall_seconds\": {wall}, \"max_overlap_fraction\": 0.004}}"),
+        )
+        .unwrap();
+    }
+}
+
+#[test]
+fn full_size_section_reads_a_run_still_going() {
+    let root = std::env::temp_dir().join(format!("rp_report_full_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    fake_run(&root.join("full/hcp"), 50, 12000.0, 38300.0, 9000.0, false);
+    let out = root.join("out");
+    let report = write_report(&root.join("runs"), Some(&root.join("full")), &out, false).unwrap();
+    let md = std::fs::read_to_string(&report).unwrap();
+    let section = &md[md.find("## Full size").expect("a full-size section")..];
+    let row = section
+        .lines()
+        .find(|l| l.starts_with("| HCP |"))
+        .expect("the full-size row");
+    println!("{row}");
+    assert!(row.contains("| 50 |"), "N: {row}");
+    assert!(row.contains("running"), "status: {row}");
+    assert!(row.contains("| 12000 / 38300 |"), "simulated / t_end: {row}");
+    assert!(row.contains("| 9000 |"), "wall so far: {row}");
+    assert!(row.contains("1.0e-3 / 2.0e-5 (so far)"), "residuals so far: {row}");
+    assert!(out.join("fig5_hcp_full.svg").is_file() || out.join("fig5_hcp_full.png").is_file());
+    // the command line written into the report names --full, and a second write needs force
+    assert!(md.contains("--full "), "{}", &md[..400]);
+    assert!(write_report(&root.join("runs"), Some(&root.join("full")), &out, false).is_err());
+    let _ = std::fs::remove_dir_all(&root);
+}
