@@ -178,7 +178,7 @@ fn depth_rule_packing_moves_continuously_where_the_layer_rule_jumps() {
             }
         }
         let layers = packing_fraction(&cells, &radii, &inner).unwrap();
-        let w = depth_weights(&x, &cells, &member, 2.0, 2.0);
+        let w = depth_weights(&x, &cells, &member, 4.0, 2.0, 2.0);
         let depth = weighted_packing_fraction(&cells, &radii, &w).unwrap();
         if let Some((l0, d0)) = last {
             layer_jump = layer_jump.max((layers - l0).abs());
@@ -189,4 +189,42 @@ fn depth_rule_packing_moves_continuously_where_the_layer_rule_jumps() {
     println!("largest change per step: layer rule {layer_jump:.2e}, depth rule {depth_step:.2e}");
     assert!(layer_jump > 5e-4, "the layer rule should jump here: {layer_jump:e}");
     assert!(depth_step < 1e-4, "depth rule: {depth_step:e}");
+}
+
+/// Regression for PP1's quarter-turn dips: the depth rule's η_B of a polydisperse ball does not depend on how the
+/// ball is turned about z (19 angles over 90°; spread ≤ 1e-9), because its open test is the sphere inscribed in
+/// the axis-aligned starting cube. With the cube's faces as the test (`open_radius` infinite) it does.
+#[test]
+fn depth_rule_packing_does_not_turn_with_the_starting_cube() {
+    let mut rng = rubblepile::random::generator(6);
+    let lattice: Vec<Vec3> = hcp_centres(1.0, 9.0).into_iter().filter(|p| p.norm() <= 8.0).collect();
+    let radii: Vec<f64> = lattice
+        .iter()
+        .map(|_| 0.5 + 0.5 * rubblepile::random::uniform(&mut rng))
+        .collect();
+    let member = vec![true; lattice.len()];
+    let spread = |open_radius: f64| {
+        let etas: Vec<f64> = (0..19)
+            .map(|k| {
+                let a = std::f64::consts::FRAC_PI_2 * k as f64 / 18.0;
+                let (s, c) = a.sin_cos();
+                let x: Vec<Vec3> = lattice
+                    .iter()
+                    .map(|p| Vec3::new(c * p.x - s * p.y, s * p.x + c * p.y, p.z))
+                    .collect();
+                let cells = radical_cells(&x, &radii, 4.0);
+                let w = depth_weights(&x, &cells, &member, open_radius, 2.0, 2.0);
+                weighted_packing_fraction(&cells, &radii, &w).unwrap()
+            })
+            .collect();
+        let lo = etas.iter().cloned().fold(f64::INFINITY, f64::min);
+        etas.iter().cloned().fold(0.0, f64::max) - lo
+    };
+    let (sphere, cube) = (spread(4.0), spread(f64::INFINITY));
+    println!("η_B spread over 90° of turn: sphere test {sphere:.2e}, cube faces {cube:.2e}");
+    assert!(sphere <= 1e-9, "{sphere:e}");
+    assert!(
+        cube > 1e-6,
+        "the cube-face test should turn with the cube here: {cube:e}"
+    );
 }

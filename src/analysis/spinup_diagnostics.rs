@@ -19,7 +19,8 @@
 //! entering or leaving the set moves η_B by about 0.01 between samples. The depth rule
 //! ([`InteriorRule::Depth`], `[spinup] interior_depth`) weights every closed cell by its depth below the surface
 //! layer instead (distance to the nearest centre with an open cell; the weight ramps linearly from 0 to 1), so
-//! that η_B is a continuous function of the positions as long as the set of open cells holds.
+//! that η_B is a continuous function of the positions as long as the set of open cells holds. Its open test is
+//! whether a cell reaches the sphere inscribed in the starting cube, which does not change as the body turns.
 //!
 //! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
 //! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
@@ -261,13 +262,26 @@ pub struct Diagnosis {
     pub rves: Vec<RveStress>,
 }
 
-/// Weights of the particles in η_B by [`InteriorRule::Depth`]: members with closed cells, by their centre's
-/// distance `d` (m) to the nearest centre with an open cell, `clamp((d − depth)/ramp, 0, 1)`. O(N × open).
-pub fn depth_weights(centres: &[Vec3], cells: &[VoronoiCell], member: &[bool], depth: f64, ramp: f64) -> Vec<f64> {
+/// Weights of the particles in η_B by [`InteriorRule::Depth`]: a cell is open when it reaches `open_radius`
+/// (m, at most the starting cube's half-side: [`VoronoiCell::reaches`], a test that does not turn with the
+/// cube); members with closed cells are weighted by their centre's distance `d` (m) to the nearest centre with
+/// an open cell, `clamp((d − depth)/ramp, 0, 1)`. O(N × open).
+///
+/// The rotation-free test matters: with the cube's own faces as the test, a few surface cells of a spinning
+/// PP1 closed and opened as the body turned through the cube's 90° symmetry, and a large surface sphere whose
+/// cell closed dropped η_B by 0.005 for one sample every quarter turn.
+pub fn depth_weights(
+    centres: &[Vec3],
+    cells: &[VoronoiCell],
+    member: &[bool],
+    open_radius: f64,
+    depth: f64,
+    ramp: f64,
+) -> Vec<f64> {
     let open: Vec<Vec3> = centres
         .iter()
         .zip(cells)
-        .filter(|(_, c)| c.boundary)
+        .filter(|(_, c)| c.reaches(open_radius))
         .map(|(x, _)| *x)
         .collect();
     centres
@@ -275,7 +289,7 @@ pub fn depth_weights(centres: &[Vec3], cells: &[VoronoiCell], member: &[bool], d
         .zip(cells)
         .zip(member)
         .map(|((x, c), &m)| {
-            if !m || c.boundary {
+            if !m || c.reaches(open_radius) {
                 return 0.0;
             }
             let d2 = open
@@ -310,6 +324,7 @@ pub fn diagnose(
     let radii: Vec<f64> = ps.iter().map(|p| p.radius).collect();
     let ax = axis_lengths(&centres, &masses, &radii);
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
+    // the starting cube's half-side; the depth rule's open test uses the sphere inscribed in it
     let cells = radical_cells(&centres, &radii, 4.0 * r_max);
     let (packing, interior) = match interior {
         InteriorRule::Layers => {
@@ -329,7 +344,7 @@ pub fn diagnose(
             )
         }
         InteriorRule::Depth { depth, ramp } => {
-            let w = depth_weights(&centres, &cells, &member, depth, ramp);
+            let w = depth_weights(&centres, &cells, &member, 4.0 * r_max, depth, ramp);
             // the count reported is the weights' sum, rounded: the effective number of interior particles
             (
                 weighted_packing_fraction(&cells, &radii, &w),

@@ -35,6 +35,18 @@ pub struct VoronoiCell {
     pub volume: f64,
     /// Whether a face of the starting cube survived: the cell is open to the outside of the packing.
     pub boundary: bool,
+    /// Largest distance from the centre to a vertex of the cell (m).
+    pub reach: f64,
+}
+
+impl VoronoiCell {
+    /// Whether the cell reaches `radius` (m) from its centre (or the starting cube): open by a test that does
+    /// not depend on how the packing is turned relative to the axis-aligned starting cube, for any `radius` up
+    /// to the cube's half-side. [`VoronoiCell::boundary`] alone does: a surface cell closed by its neighbours'
+    /// planes just inside a cube corner is open once the packing has turned so that a face lies there.
+    pub fn reaches(&self, radius: f64) -> bool {
+        self.boundary || self.reach >= radius
+    }
 }
 
 /// A face: the plane `normal · x = offset` (outward normal) and its polygon.
@@ -224,6 +236,11 @@ fn tessellate(centres: &[Vec3], radii: Option<&[f64]>, half_size: f64) -> Vec<Vo
             VoronoiCell {
                 volume,
                 boundary: cell.iter().any(|f| f.from_box),
+                reach: cell
+                    .iter()
+                    .flat_map(|f| f.polygon.iter())
+                    .map(|p| (p - g).norm())
+                    .fold(0.0, f64::max),
             }
         })
         .collect()
