@@ -390,7 +390,7 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
     let mut figures = Vec::new();
     for m in &models {
         let (r, samples) = model_row(m)?;
-        let ts = read_timeseries_tail(&m.join("path2"));
+        let ts = timeseries_worst(&m.join("path2"));
         let _ = writeln!(
             md,
             "| {} | {} | {:.2} | {:.4} | {} | {} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
@@ -415,15 +415,8 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
                 .or(ts.map(|t| format!("{:.1e} / {:.1e} (so far)", t.1, t.2)))
                 .unwrap_or_else(|| "–".into()),
         );
-        let stem = format!("fig5_{}_full", r.model);
-        let fig = SpinupTimeSeries {
-            title: format!("{} (N = {}), full size, spin-up path 2", r.model.to_uppercase(), r.n),
-            samples,
-        };
-        match write_figure(out, &stem, &fig) {
-            Ok(_) => figures.push(stem),
-            Err(e) => eprintln!("warning: {stem}: {e}"),
-        }
+        let title = format!("{} (N = {}), full size, spin-up path 2", r.model.to_uppercase(), r.n);
+        figures.extend(fig5(out, format!("fig5_{}_full", r.model), title, samples));
     }
     for f in &figures {
         let _ = writeln!(md, "\n![{f}]({f}.png)");
@@ -431,9 +424,20 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
     Ok(())
 }
 
+/// Writes the Fig. 5-style figure `out/<stem>.{svg,png}`; returns the stem, or warns and returns `None`.
+fn fig5(out: &Path, stem: String, title: String, samples: Vec<SpinupSample>) -> Option<String> {
+    match write_figure(out, &stem, &SpinupTimeSeries { title, samples }) {
+        Ok(_) => Some(stem),
+        Err(e) => {
+            eprintln!("warning: {stem}: {e}");
+            None
+        }
+    }
+}
+
 /// Largest overlap fraction, and the largest |energy residual| and |L residual|, over the rows of the run's
 /// `timeseries.csv` so far.
-fn read_timeseries_tail(run: &Path) -> Option<(f64, f64, f64)> {
+fn timeseries_worst(run: &Path) -> Option<(f64, f64, f64)> {
     let text = std::fs::read_to_string(run.join("timeseries.csv")).ok()?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next()?.split(',').collect();
@@ -473,15 +477,8 @@ pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -
             rows.push(row);
             continue;
         }
-        let stem = format!("fig5_{}", row.model);
-        let fig = SpinupTimeSeries {
-            title: format!("{} (N = {}), spin-up path 2", row.model.to_uppercase(), row.n),
-            samples,
-        };
-        match write_figure(out, &stem, &fig) {
-            Ok(_) => figures.push(stem),
-            Err(e) => eprintln!("warning: {stem}: {e}"),
-        }
+        let title = format!("{} (N = {}), spin-up path 2", row.model.to_uppercase(), row.n);
+        figures.extend(fig5(out, format!("fig5_{}", row.model), title, samples));
         rows.push(row);
     }
     let mut md = String::new();
