@@ -19,8 +19,14 @@
 //! entering or leaving the set moves η_B by about 0.01 between samples. The depth rule
 //! ([`InteriorRule::Depth`], `[spinup] interior_depth`) weights every closed cell by its depth below the surface
 //! layer instead (distance to the nearest centre with an open cell; the weight ramps linearly from 0 to 1), so
-//! that η_B is a continuous function of the positions as long as the set of open cells holds. Its open test is
-//! whether a cell reaches the sphere inscribed in the starting cube, which does not change as the body turns.
+//! that η_B is a continuous function of the positions as long as the set of open cells holds.
+//!
+//! **Open cells** are those that reach the sphere inscribed in the starting cube ([`VoronoiCell::reaches`]), in
+//! both rules. Until 23 Nov 2026 the test was whether a face of the (axis-aligned) cube survived, which turns
+//! with the body: a few surface cells closed and opened every quarter of a spin period, and η_B wiggled with
+//! period T/4 (±5e-4 in the scaled RCP, dips of 0.005 in PP1; the wiggle's minima fell at the same times in the
+//! RCP runs at 1800, 2100 and 2400 kg/m³, whose dynamical times differ, and their spacing follows T/4 along
+//! the path). The HCP, RCP and RCPC path-2 runs of `analysis/zhang2017` were made with the old test.
 //!
 //! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
 //! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
@@ -324,17 +330,20 @@ pub fn diagnose(
     let radii: Vec<f64> = ps.iter().map(|p| p.radius).collect();
     let ax = axis_lengths(&centres, &masses, &radii);
     let r_max = radii.iter().cloned().fold(0.0, f64::max);
-    // the starting cube's half-side; the depth rule's open test uses the sphere inscribed in it
-    let cells = radical_cells(&centres, &radii, 4.0 * r_max);
+    // the starting cube's half-side; a cell is open when it reaches the sphere inscribed in the cube, a test
+    // that does not turn with the cube (VoronoiCell::reaches)
+    let open_radius = 4.0 * r_max;
+    let cells = radical_cells(&centres, &radii, open_radius);
     let (packing, interior) = match interior {
         InteriorRule::Layers => {
-            let mut inner: Vec<bool> = member.iter().zip(&cells).map(|(m, c)| *m && !c.boundary).collect();
+            let open: Vec<bool> = cells.iter().map(|c| c.reaches(open_radius)).collect();
+            let mut inner: Vec<bool> = member.iter().zip(&open).map(|(m, o)| *m && !o).collect();
             let reach: Vec<f64> = radii.iter().map(|r| 1.1 * r).collect();
             for (i, j) in sphere_pairs(&centres, &reach) {
-                if cells[i].boundary {
+                if open[i] {
                     inner[j] = false;
                 }
-                if cells[j].boundary {
+                if open[j] {
                     inner[i] = false;
                 }
             }
@@ -344,7 +353,7 @@ pub fn diagnose(
             )
         }
         InteriorRule::Depth { depth, ramp } => {
-            let w = depth_weights(&centres, &cells, &member, 4.0 * r_max, depth, ramp);
+            let w = depth_weights(&centres, &cells, &member, open_radius, depth, ramp);
             // the count reported is the weights' sum, rounded: the effective number of interior particles
             (
                 weighted_packing_fraction(&cells, &radii, &w),
@@ -357,7 +366,7 @@ pub fn diagnose(
         .iter()
         .zip(&radii)
         .map(|(c, r)| {
-            if c.boundary {
+            if c.reaches(open_radius) {
                 4.0 / 3.0 * std::f64::consts::PI * r.powi(3) / eta
             } else {
                 c.volume
