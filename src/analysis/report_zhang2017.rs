@@ -499,9 +499,11 @@ pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -
     let _ = writeln!(
         md,
         "Ours: T_c1/T_c2 from `spinup.csv` (first change of b/a or c/a by > 0.01, of η_B by > 0.001, after t_start, \
-         while forced), applied to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s: η_B of these \
-         piles of a few thousand particles breathes with about that period by ±6e-4, which alone trips the 0.001 \
-         rule (the unsmoothed values, the paper's rule as written, are in the last column but one). T_c2 is marked \
+         while forced), applied to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s. η_B of the HCP, \
+         RCP and RCPC runs wiggles by ±5e-4 with a quarter of the spin period, which alone trips the 0.001 rule \
+         (the unsmoothed values, the paper's rule as written, are in the last column but one); the wiggle was an \
+         artefact of the Voronoi open-cell test, which turned with the axis-aligned starting cube, fixed after \
+         those runs (`spinup_diagnostics`); the PP1 run has the fixed test. T_c2 is marked \
          unresolved when η_B's sample scatter, averaged over the window, exceeds half the threshold. T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
          ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, T_c1 and \
          T_c2 do — faster paths give shorter ones).\n"
