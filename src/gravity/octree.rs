@@ -513,7 +513,7 @@ impl Octree {
         }
         let mut lists = Lists::default();
         self.walk(&self.reach2(theta), *p, *p, &mut lists);
-        // the frame of the smallest leaf side: the point's neighbours lie within a few of them
+        // a length unit of 1/128 of the root side: the point's list spans a few leaves around it
         let frame = self.frame(*p, self.side[0] / (1u64 << (KEY_BITS / 3)) as f64);
         let point = [[p.x, p.y, p.z, 0.0]];
         let mut out = [[0.0; 4]];
