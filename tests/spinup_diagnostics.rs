@@ -191,17 +191,23 @@ fn depth_rule_packing_moves_continuously_where_the_layer_rule_jumps() {
     assert!(depth_step < 1e-4, "depth rule: {depth_step:e}");
 }
 
+/// The HCP sites (spacing 2) within 8 of the origin, with radii drawn uniformly from `lo..lo + span` (seed `seed`).
+fn lattice_ball(seed: u64, lo: f64, span: f64) -> (Vec<Vec3>, Vec<f64>) {
+    let mut rng = rubblepile::random::generator(seed);
+    let sites: Vec<Vec3> = hcp_centres(1.0, 9.0).into_iter().filter(|p| p.norm() <= 8.0).collect();
+    let radii = sites
+        .iter()
+        .map(|_| lo + span * rubblepile::random::uniform(&mut rng))
+        .collect();
+    (sites, radii)
+}
+
 /// Regression for PP1's quarter-turn dips: the depth rule's η_B of a polydisperse ball does not depend on how the
 /// ball is turned about z (19 angles over 90°; spread ≤ 1e-9), because its open test is the sphere inscribed in
 /// the axis-aligned starting cube. With the cube's faces as the test (`open_radius` infinite) it does.
 #[test]
 fn depth_rule_packing_does_not_turn_with_the_starting_cube() {
-    let mut rng = rubblepile::random::generator(6);
-    let lattice: Vec<Vec3> = hcp_centres(1.0, 9.0).into_iter().filter(|p| p.norm() <= 8.0).collect();
-    let radii: Vec<f64> = lattice
-        .iter()
-        .map(|_| 0.5 + 0.5 * rubblepile::random::uniform(&mut rng))
-        .collect();
+    let (lattice, radii) = lattice_ball(6, 0.5, 0.5);
     let member = vec![true; lattice.len()];
     let spread = |open_radius: f64| {
         let etas: Vec<f64> = (0..19)
@@ -230,17 +236,12 @@ fn depth_rule_packing_does_not_turn_with_the_starting_cube() {
 }
 
 /// The layer rule's η_B (the default rule, HCP/RCP/RCPC scenes) of a ball of unequal spheres on a lattice (radii
-/// 1.0–1.3, spacing 2, all in contact; they overlap, so η_B exceeds 1: only its invariance is tested) does not depend on how the ball is turned about z (7 angles over 90°;
-/// spread ≤ 1e-9): its open test does not turn with the axis-aligned starting cube. Regression for the
+/// 1.0–1.3, spacing 2, all in contact; they overlap, so η_B exceeds 1: only its invariance is tested) does not
+/// depend on how the ball is turned about z (7 angles over 90°; spread ≤ 1e-9): its open test does not turn with the axis-aligned starting cube. Regression for the
 /// quarter-turn wiggle of the scaled RCP's η_B (±5e-4).
 #[test]
 fn layer_rule_packing_does_not_turn_with_the_starting_cube() {
-    let mut rng = rubblepile::random::generator(7);
-    let sites: Vec<Vec3> = hcp_centres(1.0, 9.0).into_iter().filter(|p| p.norm() <= 8.0).collect();
-    let radii: Vec<f64> = sites
-        .iter()
-        .map(|_| 1.0 + 0.3 * rubblepile::random::uniform(&mut rng))
-        .collect();
+    let (sites, radii) = lattice_ball(7, 1.0, 0.3);
     let etas: Vec<f64> = (0..7)
         .map(|k| {
             let (s, c) = (std::f64::consts::FRAC_PI_2 * k as f64 / 6.0).sin_cos();
