@@ -132,8 +132,8 @@ pub fn successive_scatter(values: &[f64]) -> f64 {
 
 /// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
 /// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
-/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. Scaled RCP: 2e-4 scatter, 13 samples → 6e-5, resolved; PP1,
-/// whose radii span 8×: 3e-3 → 8e-4, not resolved.
+/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
+/// the scaled runs with the rotation-free open test resolve (sample scatter 2.6e-5 to 1.0e-4, 23 Nov 2026).
 pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
     let samples = (window / spacing).max(1.0);
     noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
@@ -152,16 +152,16 @@ pub struct ModelRow {
     pub mass: f64,
     /// η_B at t_start.
     pub packing: f64,
-    /// T_c1, T_c2 and the failure mode, from b/a, c/a and η_B averaged over the body's dynamical time
-    /// ([`smoothed_critical_limits`]).
+    /// T_c1, T_c2 and the failure mode from the samples themselves (the paper's rule as written).
     pub limits: CriticalLimits,
-    /// The same from the samples themselves (the paper's rule as written).
-    pub limits_raw: CriticalLimits,
+    /// The same from b/a, c/a and η_B averaged over the body's dynamical time ([`smoothed_critical_limits`]):
+    /// a check on the sampled values, biased towards longer periods by the window's look-ahead.
+    pub limits_smoothed: CriticalLimits,
     /// Sample-to-sample scatter of η_B while forced and before the shape changes: the RMS of successive
     /// differences over √2 (for white noise, its standard deviation).
     pub packing_noise: f64,
-    /// Whether that scatter, averaged over the smoothing window's samples, is below half the T_c,2 threshold, so
-    /// that T_c,2 measures the packing and not the scatter ([`t_c2_resolved`]).
+    /// Whether that scatter of single samples is below half the T_c,2 threshold, so that T_c,2 measures the
+    /// packing and not the scatter ([`t_c2_resolved`] with a window of one sample).
     pub t_c2_resolved: bool,
     /// T_c,3 (h) and φ (°) from `critical.json`.
     pub t_c3: Option<f64>,
@@ -257,7 +257,7 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
     let t_start = t_start_of(&run);
     let forced: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_start && s.forcing).collect();
     let col = |f: fn(&SpinupSample) -> f64| forced.iter().map(|s| f(s)).collect::<Vec<f64>>();
-    let limits_raw = critical_limits(
+    let limits = critical_limits(
         &col(|s| s.period_h),
         &col(|s| s.b_over_a),
         &col(|s| s.c_over_a),
@@ -265,9 +265,9 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
     );
     let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
     let rho_b = 2100.0 * mass / DIDYMOS_MASS;
-    // the smoothing window of the limits and of the T_c,2 resolution test
+    // the smoothing window of the check on the limits
     let window = dynamical_time(SI_G, rho_b);
-    let limits = smoothed_critical_limits(
+    let limits_smoothed = smoothed_critical_limits(
         &col(|s| s.t),
         &col(|s| s.period_h),
         &col(|s| s.b_over_a),
@@ -300,7 +300,8 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         (Some(a), Some(b)) => b.t - a.t,
         _ => window,
     };
-    let resolved = t_c2_resolved(packing_noise, window, spacing);
+    // the limits are read from single samples: the window of the resolution test is one sample
+    let resolved = t_c2_resolved(packing_noise, spacing, spacing);
     let path_error_before_t_c1 = forced[..shape_change]
         .iter()
         .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
@@ -314,7 +315,7 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         mass,
         packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
         limits,
-        limits_raw,
+        limits_smoothed,
         packing_noise,
         t_c2_resolved: resolved,
         t_c3,
@@ -498,19 +499,20 @@ pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -
     );
     let _ = writeln!(
         md,
-        "Ours: T_c1/T_c2 from `spinup.csv` (first change of b/a or c/a by > 0.01, of η_B by > 0.001, after t_start, \
-         while forced), applied to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s. η_B of the HCP, \
-         RCP and RCPC runs wiggles by ±5e-4 with a quarter of the spin period, which alone trips the 0.001 rule \
-         (the unsmoothed values, the paper's rule as written, are in the last column but one); the wiggle was an \
-         artefact of the Voronoi open-cell test, which turned with the axis-aligned starting cube, fixed after \
-         those runs (`spinup_diagnostics`); the PP1 run has the fixed test. T_c2 is marked \
-         unresolved when η_B's sample scatter, averaged over the window, exceeds half the threshold. T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of Eq. 22 with \
-         ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, T_c1 and \
-         T_c2 do — faster paths give shorter ones).\n"
+        "Ours: T_c1/T_c2 from `spinup.csv` by the paper's rule as written: the first sample, after t_start and \
+         while forced, at which b/a or c/a has changed by > 0.01, or η_B by > 0.001, from its value at t_start. \
+         T_c2 is marked unresolved when the sample-to-sample scatter of η_B exceeds half that threshold. The \
+         column 'smoothed' applies the rule to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s, a \
+         check that the limits are not set by one sample; its look-ahead of half a window moves them to longer \
+         periods by up to ≈ 0.04 h on path 2. η_B counts closed Voronoi cells by the rotation-free test \
+         (`VoronoiCell::reaches`; the axis-aligned test used before 23 Nov 2026 made η_B wiggle by ±5e-4 with a \
+         quarter of the spin period). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of \
+         Eq. 22 with ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, \
+         T_c1 and T_c2 do — faster paths give shorter ones).\n"
     );
     let _ = writeln!(
         md,
-        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | unsmoothed T_c1/T_c2, mode | paper η, φ, T_c1/2/3, κ₃, mode |"
+        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | smoothed T_c1/T_c2, mode | paper η, φ, T_c1/2/3, κ₃, mode |"
     );
     let _ = writeln!(
         md,
@@ -563,9 +565,9 @@ pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -
             } else {
                 "– (needs T_c2)"
             },
-            opt(r.limits_raw.t_c1_hours, 3),
-            opt(r.limits_raw.t_c2_hours, 3),
-            mode(r.limits_raw.failure_mode),
+            opt(r.limits_smoothed.t_c1_hours, 3),
+            opt(r.limits_smoothed.t_c2_hours, 3),
+            mode(r.limits_smoothed.failure_mode),
         );
     }
     let _ = writeln!(
@@ -684,7 +686,7 @@ mod tests {
                 t_c2_hours: t[1],
                 failure_mode: None,
             },
-            limits_raw: CriticalLimits {
+            limits_smoothed: CriticalLimits {
                 t_c1_hours: None,
                 t_c2_hours: None,
                 failure_mode: None,
@@ -761,5 +763,8 @@ mod tests {
         assert_eq!(successive_scatter(&[0.6]), 0.0);
         assert!(t_c2_resolved(2e-4, 2700.0, 200.0));
         assert!(!t_c2_resolved(3e-3, 2700.0, 200.0));
+        // single samples (the report's limits): resolved below half the threshold only
+        assert!(t_c2_resolved(4e-4, 200.0, 200.0));
+        assert!(!t_c2_resolved(6e-4, 200.0, 200.0));
     }
 }

@@ -68,8 +68,8 @@ pub fn critical_limits(period_hours: &[f64], b_over_a: &[f64], c_over_a: &[f64],
 }
 
 /// The body's dynamical time `1/√(G ρ_B)` (s) for bulk density `rho_b` (kg/m³) and gravitational constant `g`.
-/// In our scaled spin-up runs η_B oscillates with about this period (a breathing of the whole pile, ±6e-4 in the
-/// RCP run, comparable to [`PACKING_THRESHOLD`]); [`smoothed_critical_limits`] averages over it.
+/// The Zhang17 report averages over it in [`smoothed_critical_limits`], its check that a limit is not set by one
+/// sample (the slowest collective motion of a self-gravitating pile has about this period).
 pub fn dynamical_time(g: f64, rho_b: f64) -> f64 {
     1.0 / (g * rho_b).sqrt()
 }
