@@ -504,7 +504,7 @@ pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -
          T_c2 is marked unresolved when the sample-to-sample scatter of η_B exceeds half that threshold. The \
          column 'smoothed' applies the rule to running means over the body's dynamical time 1/√(Gρ_B) ≈ 2700 s, a \
          check that the limits are not set by one sample; its look-ahead of half a window moves them to longer \
-         periods by up to ≈ 0.04 h on path 2. η_B counts closed Voronoi cells by the rotation-free test \
+         periods by up to ≈ 0.05 h on path 2. η_B counts closed Voronoi cells by the rotation-free test \
          (`VoronoiCell::reaches`; the axis-aligned test used before 23 Nov 2026 made η_B wiggle by ±5e-4 with a \
          quarter of the spin period). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of \
          Eq. 22 with ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, \
