@@ -26,7 +26,7 @@
 //! with the body: a few surface cells closed and opened every quarter of a spin period, and η_B wiggled with
 //! period T/4 (±5e-4 in the scaled RCP, dips of 0.005 in PP1; the wiggle's minima fell at the same times in the
 //! RCP runs at 1800, 2100 and 2400 kg/m³, whose dynamical times differ, and their spacing follows T/4 along
-//! the path). The HCP, RCP and RCPC path-2 runs of `analysis/zhang2017` were made with the old test.
+//! the path). The `analysis/zhang2017` runs were made again with the new test on 23 Nov 2026.
 //!
 //! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
 //! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
