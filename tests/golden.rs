@@ -1,0 +1,235 @@
+//! Golden outputs of the run driver: one run per engine (ellipsoids on the built-in default scene, soft spheres,
+//! hard spheres), an impact and a spin-up run, compared file by file with the outputs recorded before the three
+//! drivers were merged into one (`tests/golden/<case>/expected/`). Every byte must match except what measures the
+//! machine rather than the physics: the `wall_seconds` column and field, and the hard-sphere engine's
+//! `events_per_second` (events per wall-clock second).
+//!
+//! To re-record after an intended change of the outputs: `RUBBLEPILE_BLESS_GOLDEN=1 cargo test --release --test
+//! golden`, then review the diff of `tests/golden/` before committing it.
+
+mod common;
+use common::{rubblepile, temp_dir};
+use std::path::{Path, PathBuf};
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Columns (CSV) and keys (JSON) that depend on the machine's speed.
+const MACHINE_DEPENDENT: [&str; 2] = ["wall_seconds", "events_per_second"];
+
+/// The text of an output file with the machine-dependent columns or lines removed.
+fn scrub(path: &Path) -> String {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    if path.extension().is_some_and(|e| e == "json") {
+        return text
+            .lines()
+            .filter(|l| {
+                let key = l.trim_start();
+                !MACHINE_DEPENDENT.iter().any(|k| key.starts_with(&format!("\"{k}\"")))
+            })
+            .map(|l| format!("{l}\n"))
+            .collect();
+    }
+    if path.extension().is_some_and(|e| e == "csv") {
+        let mut lines = text.lines();
+        let Some(header) = lines.next() else {
+            return text;
+        };
+        let names: Vec<&str> = header.split(',').collect();
+        let keep: Vec<bool> = names.iter().map(|n| !MACHINE_DEPENDENT.contains(n)).collect();
+        let filter = |l: &str| -> String {
+            let cells: Vec<&str> = l.split(',').collect();
+            if cells.len() != keep.len() {
+                return format!("{l}\n");
+            }
+            let kept: Vec<&str> = cells.iter().zip(&keep).filter(|(_, k)| **k).map(|(c, _)| *c).collect();
+            format!("{}\n", kept.join(","))
+        };
+        return std::iter::once(header).chain(lines).map(filter).collect();
+    }
+    text
+}
+
+/// Every file below `dir`, as paths relative to it, sorted.
+fn files(dir: &Path) -> Vec<PathBuf> {
+    fn walk(base: &Path, dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let p = entry.unwrap().path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.push(p.strip_prefix(base).unwrap().to_path_buf());
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+/// Writes the ~90-sphere HCP ball of the soft-sphere cases (r = 1 m, 1000 kg/m³).
+fn write_ball(dir: &Path) {
+    let mut csv = String::from("t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz\n");
+    let m = 1000.0 * 4.0 / 3.0 * std::f64::consts::PI;
+    for (k, p) in rubblepile::geometry::lattice::hcp_centres(1.0, 5.0).iter().enumerate() {
+        csv += &format!("0,{k},{m},1.0,{},{},{},0,0,0,0,0,0\n", p.x, p.y, p.z);
+    }
+    std::fs::write(dir.join("ball.csv"), csv).unwrap();
+}
+
+/// Runs one case: `args` (with `OUT` replaced by the output directory) in `cwd`, then compares (or, when blessing,
+/// records) every output file.
+fn check_case(name: &str, cwd: &Path, args: &[&str]) {
+    let out = temp_dir(&format!("golden-{name}")).join("out");
+    let out_s = out.display().to_string();
+    let args: Vec<&str> = args
+        .iter()
+        .map(|a| if *a == "OUT" { out_s.as_str() } else { a })
+        .collect();
+    let o = rubblepile(cwd, &args);
+    assert!(
+        o.status.success(),
+        "{name}: {args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let expected_dir = root().join("tests/golden").join(name).join("expected");
+    let produced: Vec<PathBuf> = files(&out)
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|f| f != "checkpoint.json"))
+        .collect();
+    if std::env::var_os("RUBBLEPILE_BLESS_GOLDEN").is_some() {
+        if expected_dir.exists() {
+            std::fs::remove_dir_all(&expected_dir).unwrap();
+        }
+        for rel in &produced {
+            let dst = expected_dir.join(rel);
+            std::fs::create_dir_all(dst.parent().unwrap()).unwrap();
+            std::fs::write(&dst, scrub(&out.join(rel))).unwrap();
+        }
+        return;
+    }
+    let expected = files(&expected_dir);
+    assert_eq!(
+        produced, expected,
+        "{name}: the run wrote other files than the golden run"
+    );
+    for rel in &expected {
+        let got = scrub(&out.join(rel));
+        let want = std::fs::read_to_string(expected_dir.join(rel)).unwrap();
+        if got != want {
+            let line = got
+                .lines()
+                .zip(want.lines())
+                .position(|(a, b)| a != b)
+                .unwrap_or(got.lines().count().min(want.lines().count()));
+            panic!(
+                "{name}: {} differs from the golden output at line {}:\n  got:  {}\n  want: {}",
+                rel.display(),
+                line + 1,
+                got.lines().nth(line).unwrap_or("<end>"),
+                want.lines().nth(line).unwrap_or("<end>")
+            );
+        }
+    }
+}
+
+/// A temporary copy of `tests/golden/<name>` (its scene and inputs) with the HCP ball written beside it.
+fn case_dir(name: &str) -> PathBuf {
+    let dir = temp_dir(&format!("golden-in-{name}"));
+    let src = root().join("tests/golden").join(name);
+    for entry in std::fs::read_dir(&src).unwrap() {
+        let p = entry.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, dir.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    write_ball(&dir);
+    dir
+}
+
+#[test]
+fn golden_ellipsoids_default_scene() {
+    check_case(
+        "ellipsoids_default",
+        &root(),
+        &["run", "--out", "OUT", "--no-progress", "--checkpoint-every", "0"],
+    );
+}
+
+#[test]
+fn golden_impact_n30() {
+    check_case(
+        "impact_n30",
+        &root(),
+        &[
+            "impact",
+            "--target",
+            "targets/N30_T4.csv",
+            "--t-end",
+            "300",
+            "--every",
+            "20",
+            "--out",
+            "OUT",
+            "--no-progress",
+            "--checkpoint-every",
+            "0",
+        ],
+    );
+}
+
+#[test]
+fn golden_soft_spheres() {
+    let dir = case_dir("soft_ball");
+    check_case(
+        "soft_ball",
+        &dir,
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "OUT",
+            "--no-progress",
+            "--checkpoint-every",
+            "0",
+        ],
+    );
+}
+
+#[test]
+fn golden_spinup() {
+    let dir = case_dir("spinup_ball");
+    check_case(
+        "spinup_ball",
+        &dir,
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "OUT",
+            "--no-progress",
+            "--checkpoint-every",
+            "0",
+        ],
+    );
+}
+
+#[test]
+fn golden_hard_spheres() {
+    let dir = case_dir("hard_box");
+    check_case(
+        "hard_box",
+        &dir,
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "OUT",
+            "--no-progress",
+            "--checkpoint-every",
+            "0",
+        ],
+    );
+}
