@@ -8,8 +8,11 @@
 
 pub mod aggregate;
 pub mod analysis;
+pub mod bits;
 pub mod cli;
+pub mod driver;
 pub mod ellipsoid;
+pub mod engine;
 pub mod geometry;
 pub mod granular;
 pub mod gravity;
@@ -18,6 +21,5 @@ pub mod integrate;
 pub mod io;
 pub mod math;
 pub mod random;
-pub mod run;
 pub mod scene;
 pub mod stability;

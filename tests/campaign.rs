@@ -18,7 +18,7 @@ use rubblepile::impact::campaign::{
 use rubblepile::impact::run::run_impact;
 use rubblepile::impact::target::{TargetSpec, build_target};
 use rubblepile::io::csv::write_snapshot;
-use rubblepile::run::RunOptions;
+use rubblepile::driver::RunOptions;
 use std::f64::consts::PI;
 
 fn temp_dir(tag: &str) -> PathBuf {

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use crate::cli::CliError;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, run_impact};
-use crate::run::RunOptions;
+use crate::driver::RunOptions;
 
 /// `rubblepile bench impact`.
 #[derive(Debug, clap::Args)]

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use crate::cli::{CheckpointArgs, CliError, report};
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, ImpactError, prepare_impact};
-use crate::run::{RunOptions, run_scene};
+use crate::driver::{RunOptions, run_scene};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]

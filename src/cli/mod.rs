@@ -57,8 +57,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::run::{DEFAULT_CHECKPOINT_EVERY, RunOptions, resume_run, run_scene};
-use crate::scene::{LoadedScene, default_scene, load_scene};
+use crate::driver::{DEFAULT_CHECKPOINT_EVERY, RunOptions};
 
 /// Dynamics of rubble-pile asteroids: interacting ellipsoids (Roig et al. 2003).
 #[derive(Debug, Parser)]
@@ -258,14 +257,6 @@ impl CliError {
     }
 }
 
-fn load(scene: Option<&PathBuf>) -> Result<LoadedScene, CliError> {
-    match scene {
-        Some(path) => load_scene(path),
-        None => default_scene(),
-    }
-    .map_err(CliError::usage)
-}
-
 /// Runs a parsed command line.
 pub fn execute(cli: Cli) -> Result<(), CliError> {
     match cli.command {
@@ -274,60 +265,24 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?
             };
-            if let Some(path) = &args.scene
-                && let Ok(text) = std::fs::read_to_string(path)
-                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
-            {
-                return crate::granular::hard::run::cli_run(path, &args.out, &options);
-            }
-            if let Some(path) = &args.scene
-                && crate::granular::soft::scene::is_soft_scene_file(path)
-            {
-                return ssdem::run(path, &args.out, &options);
-            }
-            let scene = load(args.scene.as_ref())?;
-            report(run_scene(&scene, &args.out, &options))
+            report(crate::driver::run_file(args.scene.as_deref(), &args.out, &options))
         }
         Command::Resume(args) => {
             let options = args.checkpoints.options(!args.no_progress)?;
-            if crate::granular::soft::run::is_soft_run_dir(&args.dir) {
-                return ssdem::resume(&args.dir, &options);
-            }
-            if crate::granular::hard::run::is_hard_run_dir(&args.dir) {
-                return crate::granular::hard::run::cli_resume(&args.dir, &options);
-            }
-            report(resume_run(&args.dir, &options))
+            report(crate::driver::resume_dir(&args.dir, &options))
         }
         Command::Check(args) => {
             if args.print_default {
                 print!("{}", crate::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
             }
-            if let Some(path) = &args.scene
-                && crate::granular::soft::scene::is_soft_scene_file(path)
-            {
-                return ssdem::check(path);
+            let (warnings, lines) = crate::driver::check_file(args.scene.as_deref()).map_err(CliError::usage)?;
+            for w in warnings {
+                eprintln!("warning: {w}");
             }
-            if let Some(path) = &args.scene
-                && let Ok(text) = std::fs::read_to_string(path)
-                && crate::scene::peek_kind(&text).as_deref() == Some(crate::granular::hard::scene::KIND)
-            {
-                let s = crate::granular::hard::scene::load_hard_scene(path).map_err(CliError::usage)?;
-                println!(
-                    "{}: hard spheres: {} particles, {} walls, t_end = {} s, dt = {} s, {} snapshots, a time-series row \
-                     every {} s",
-                    s.name,
-                    s.particles.len(),
-                    s.walls.len(),
-                    s.t_end,
-                    s.dt,
-                    s.times.len(),
-                    s.every
-                );
-                return Ok(());
+            for l in lines {
+                println!("{l}");
             }
-            let scene = load(args.scene.as_ref())?;
-            print_check(&scene);
             Ok(())
         }
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
@@ -363,81 +318,31 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
     }
 }
 
-/// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on
-/// stderr: contact-barrier overruns); maps errors to exit codes.
-pub(crate) fn report(result: Result<crate::run::RunSummary, crate::run::RunError>) -> Result<(), CliError> {
-    let warn = |summary: &crate::run::RunSummary| {
+/// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on stderr, e.g.
+/// contact-barrier overruns); maps errors to exit codes.
+pub(crate) fn report<S: crate::engine::RunReport>(
+    result: Result<S, crate::driver::RunError<S>>,
+) -> Result<(), CliError> {
+    let print = |summary: &S| {
+        println!("{}", summary.one_line());
         for w in summary.warnings() {
             eprintln!("warning: {w}");
         }
     };
     match result {
         Ok(summary) => {
-            println!("{}", summary.one_line());
-            warn(&summary);
+            print(&summary);
             Ok(())
         }
         Err(e) => {
-            if let crate::run::RunError::Failed { summary, .. } = &e {
-                println!("{}", summary.one_line());
-                warn(summary);
+            if let crate::driver::RunError::Failed { summary, .. } = &e {
+                print(summary);
             }
             Err(CliError {
                 message: e.to_string(),
                 code: e.exit_code(),
             })
         }
-    }
-}
-
-fn print_check(s: &LoadedScene) {
-    let kappa = match s.kappa_source {
-        crate::scene::KappaSource::Given => format!("kappa = {} (given)", s.model.kappa),
-        crate::scene::KappaSource::Calibrated { beta, v } => {
-            format!("kappa = {} (calibrated: beta = {beta}, v = {v} m/s)", s.model.kappa)
-        }
-    };
-    println!("{}: ok", s.name);
-    println!("  {} bodies, t_end = {} s, {kappa}", s.bodies.len(), s.t_end);
-    let p = &s.physics;
-    let mut terms = Vec::new();
-    if let Some(g) = p.gravity {
-        terms.push(format!("gravity (G = {:e})", g.g));
-    }
-    if let Some(c) = p.contact {
-        terms.push(format!("contact (cutoff = {:e})", c.cutoff));
-    }
-    if let Some(d) = p.dissipation {
-        terms.push(format!("dissipation (F0 = {})", d.f0));
-    }
-    if terms.is_empty() {
-        terms.push("none (free motion)".into());
-    }
-    println!("  physics: {}", terms.join(", "));
-    println!(
-        "  integrator: {} (rtol {:e}, atol {:e}{})",
-        s.integrator.method,
-        s.integrator.rtol,
-        s.integrator.atol,
-        s.integrator.step.map(|h| format!(", step {h} s")).unwrap_or_default()
-    );
-    println!(
-        "  output: every {} s, {} snapshots",
-        s.output.every,
-        s.output.times.len()
-    );
-    for (k, b) in s.bodies.iter().enumerate() {
-        println!(
-            "  body[{k}]: axes [{}, {}, {}] m, mass {:e} kg, R_eq {:.4e} m, at [{:e}, {:e}, {:e}] m",
-            b.shape.axes.x,
-            b.shape.axes.y,
-            b.shape.axes.z,
-            b.shape.mass,
-            b.shape.equivalent_radius(),
-            b.position.x,
-            b.position.y,
-            b.position.z
-        );
     }
 }
 

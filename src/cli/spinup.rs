@@ -25,7 +25,7 @@ use serde::Serialize;
 use crate::analysis::spinup::{CreepCriterion, fit_density};
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::cli::CliError;
-use crate::run::RunOptions;
+use crate::driver::RunOptions;
 use crate::scene::SI_G;
 
 /// `rubblepile spinup …`.
@@ -223,7 +223,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         let options = RunOptions {
             force: true,
             progress: false,
-            checkpoint_every: Some(crate::run::DEFAULT_CHECKPOINT_EVERY),
+            checkpoint_every: Some(crate::driver::DEFAULT_CHECKPOINT_EVERY),
             checkpoint_every_sim: None,
             stop_after_checkpoints: None,
         };
@@ -231,14 +231,14 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         if !completed {
             eprintln!("spinup critical: running T_final = {tf} h into {}", dir.display());
             if branches.is_some() {
-                crate::granular::soft::run::resume_soft(&dir, &options).map_err(|e| CliError::failed(e.to_string()))?;
+                crate::driver::resume_soft(&dir, &options).map_err(|e| CliError::failed(e.to_string()))?;
             } else {
                 table["spinup"]["T_final"] = toml::Value::Float(tf);
                 let scene_text = toml::to_string(&table).map_err(|e| CliError::usage(e.to_string()))?;
                 let path = args.out.join(format!("T{tf:.2}.toml"));
                 std::fs::write(&path, &scene_text).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
                 let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
-                crate::granular::soft::run::run_soft(&scene, &dir, &options)
+                crate::driver::run_soft(&scene, &dir, &options)
                     .map_err(|e| CliError::failed(e.to_string()))?;
             }
         }
@@ -311,8 +311,9 @@ fn prepare_branches(
     path: &crate::granular::soft::spinup::SpinupPath,
     grid: &[f64],
 ) -> Result<Vec<f64>, CliError> {
-    use crate::granular::soft::branch::{branch_soft, checkpoint_time};
-    use crate::granular::soft::run::{resume_soft, run_soft, sample_steps};
+    use crate::driver::branch::{branch_soft, checkpoint_time};
+    use crate::driver::{resume_soft, run_soft};
+    use crate::granular::soft::run::sample_steps;
     if path.rests > 0 {
         return Err(CliError::usage(format!(
             "{}: spinup.rests = {}: --branch needs a path without rests (a shorter path with rests is not a prefix)",
@@ -385,7 +386,7 @@ fn prepare_branches(
             base_dir.display()
         )));
     }
-    let failed = |e: crate::granular::soft::run::SoftRunError| CliError::failed(e.to_string());
+    let failed = |e: crate::driver::RunError<crate::granular::soft::run::SoftSummary>| CliError::failed(e.to_string());
     // latest hold first: the base run only moves forward
     let mut order: Vec<usize> = (0..grid.len()).collect();
     order.sort_by(|&a, &b| starts[a].total_cmp(&starts[b]));
@@ -437,7 +438,7 @@ fn prepare_branches(
                 None => run_soft(&base_scene, &base_dir, &options),
             };
             match result {
-                Err(crate::granular::soft::run::SoftRunError::Run(crate::run::RunError::Stopped { .. })) => {}
+                Err(crate::driver::RunError::Stopped { .. }) => {}
                 Err(e) => return Err(failed(e)),
                 Ok(_) => {
                     return Err(CliError::failed(format!(

@@ -11,11 +11,9 @@ use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::{Gravity, SoftSystem};
 use crate::granular::soft::leapfrog;
 use crate::granular::soft::packing::fcc_ball;
-use crate::granular::soft::run::{SoftRunError, SoftSummary, resume_soft, run_soft};
-use crate::granular::soft::scene::{SoftScene, load_soft_scene};
+use crate::granular::soft::scene::load_soft_scene;
 use crate::gravity::SelfGravity;
 use crate::math::Vec3;
-use crate::run::RunOptions;
 use crate::scene::SI_G;
 
 /// `rubblepile ssdem …`.
@@ -109,62 +107,6 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
             t_dyn / 100.0
         );
     }
-    Ok(())
-}
-
-fn report(result: Result<SoftSummary, SoftRunError>) -> Result<(), CliError> {
-    match result {
-        Ok(s) => {
-            println!("{}", s.one_line());
-            Ok(())
-        }
-        Err(e) => {
-            if let SoftRunError::Failed { summary, .. } = &e {
-                println!("{}", summary.one_line());
-            }
-            Err(CliError {
-                message: e.to_string(),
-                code: e.exit_code(),
-            })
-        }
-    }
-}
-
-fn warn(scene: &SoftScene) {
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-}
-
-/// `rubblepile run` on a soft-sphere scene.
-pub fn run(path: &Path, out: &Path, options: &RunOptions) -> Result<(), CliError> {
-    let scene = load_soft_scene(path).map_err(CliError::usage)?;
-    warn(&scene);
-    report(run_soft(&scene, out, options))
-}
-
-/// `rubblepile resume` of a soft-sphere run.
-pub fn resume(dir: &Path, options: &RunOptions) -> Result<(), CliError> {
-    report(resume_soft(dir, options))
-}
-
-/// `rubblepile check` on a soft-sphere scene.
-pub fn check(path: &Path) -> Result<(), CliError> {
-    let s = load_soft_scene(path).map_err(CliError::usage)?;
-    warn(&s);
-    println!("{}: ok", s.name);
-    println!(
-        "  {} particles, {} walls, t_end = {} s, dt = {} s ({} steps)",
-        s.particles.len(),
-        s.walls.len(),
-        s.t_end,
-        s.dt,
-        s.n_steps
-    );
-    println!(
-        "  k_n = {:e} N/m (advised {:e} N/m, dt {:e} s)",
-        s.material.k_n, s.advice.k_n, s.advice.dt
-    );
     Ok(())
 }
 

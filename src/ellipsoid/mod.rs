@@ -17,3 +17,4 @@ pub mod equations;
 pub mod gravity;
 pub mod potential;
 pub mod quaternion;
+pub mod run;

@@ -77,7 +77,7 @@ use crate::impact::run::{
 use crate::io::checkpoint::CHECKPOINT_FILE;
 use crate::io::csv::read_bodies_csv;
 use crate::io::fmt_f64;
-use crate::run::{RunError, RunOptions, RunSummary, resume_run};
+use crate::driver::{RunError, RunOptions, RunSummary, resume_run};
 
 /// Name of the campaign table in the campaign directory.
 pub const CAMPAIGN_CSV: &str = "campaign.csv";

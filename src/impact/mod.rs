@@ -2,7 +2,7 @@
 //!
 //! - [`target`]: the Monte-Carlo rubble-pile builder and its relaxation to a rigidly rotating pile;
 //! - [`projectile`]: the projectiles P1–P3 and the impact geometry;
-//! - [`run`]: one impact run (target + projectile → run directory → [`crate::run::run_scene`]);
+//! - [`run`]: one impact run (target + projectile → run directory → [`crate::driver::run_scene`]);
 //! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
 //!   in parallel, resumable, summarised in `campaign.csv`.
 

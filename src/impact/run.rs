@@ -8,7 +8,7 @@
 //!   Eq. 14 over target + projectile at the impact speed; gravity, contact, dissipation; Bulirsch–Stoer),
 //!
 //! and runs that scene with [`run_scene`]; the same run again is `rubblepile run DIR/scene.toml --out OTHER`,
-//! and an interrupted one continues with [`crate::run::resume_run`]. `rubblepile impact` and
+//! and an interrupted one continues with [`crate::driver::resume_run`]. `rubblepile impact` and
 //! `rubblepile campaign` are thin wrappers around this module.
 
 use std::path::{Path, PathBuf};
@@ -18,7 +18,7 @@ use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::G_SI;
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::io::csv::{read_bodies_csv, write_snapshot};
-use crate::run::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
+use crate::driver::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
 use crate::scene::{LoadedScene, MAX_TIMESERIES_ROWS, SceneError, parse_scene};
 
 /// Default end time (s).
@@ -314,7 +314,7 @@ pub enum ImpactError {
     },
     /// The run itself (or the preparation of its directory) failed.
     #[error(transparent)]
-    Run(#[from] RunError),
+    Run(#[from] RunError<RunSummary>),
 }
 
 impl ImpactError {

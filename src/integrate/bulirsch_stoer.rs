@@ -50,7 +50,7 @@
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
 use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
-use crate::io::checkpoint::{exact_f64, exact_f64_opt, exact_f64_vec};
+use crate::bits::{exact_f64, exact_f64_opt, exact_f64_vec};
 
 /// Step-size factor bound parameter (ODEX `fac1`).
 const FAC1: f64 = 0.02;

@@ -99,7 +99,7 @@ pub struct SavedStats {
     /// Evaluations of the right-hand side.
     pub rhs_evaluations: u64,
     /// Smallest accepted step size (s), exact.
-    #[serde(with = "crate::io::checkpoint::exact_f64")]
+    #[serde(with = "crate::bits::exact_f64")]
     pub smallest_step: f64,
 }
 

@@ -35,7 +35,7 @@
 //!   step was accepted), never at a trial state.
 
 use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
-use crate::io::checkpoint::{exact_f64, exact_f64_opt};
+use crate::bits::{exact_f64, exact_f64_opt};
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dop853, Dopri5, OutputType, Rk4, System};
 use std::cell::Cell;

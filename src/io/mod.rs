@@ -10,7 +10,6 @@
 
 pub mod checkpoint;
 pub mod csv;
-pub mod resume;
 pub mod summary;
 
 /// Formats an `f64` losslessly: the shortest decimal that parses back to the same bits (`{:e}`).

@@ -1,5 +1,5 @@
 //! The stability suite: the interacting-ellipsoids model (Roig03 §2, Eqs. 10–14, 28–41) pushed to its
-//! regimes of trouble, each as an ordinary scene run through [`crate::run::run_scene`].
+//! regimes of trouble, each as an ordinary scene run through [`crate::driver::run_scene`].
 //!
 //! The cases ([`cases::all_cases`]) are (a) head-on impacts at the calibrated speed of Roig03 Eq. 14 and
 //! above it (the contact-barrier detector of [`crate::ellipsoid::barrier`] must name the pair), (b) needles
@@ -30,7 +30,7 @@ use crate::ellipsoid::equations::EllipsoidSystem;
 use crate::integrate::{OdeSystem, Tolerances, make_integrator};
 use crate::io::csv::read_bodies_csv;
 use crate::math::{Vec3, Vec4};
-use crate::run::{RunError, RunOptions, RunSummary, run_scene};
+use crate::driver::{RunError, RunOptions, RunSummary, run_scene};
 use crate::scene::{LoadedScene, parse_scene};
 
 /// Columns of `stability.csv`.

@@ -7,7 +7,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
@@ -15,12 +15,10 @@ use serde::{Deserialize, Serialize};
 use super::particle::Attachment;
 use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
-use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exact_f64_vec, fnv1a_hex};
+use crate::bits::exact_f64_vec;
+use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
 use crate::io::fmt_f64;
-use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries};
 use crate::math::Vec3;
-use crate::run::{RunError, RunOptions, Schedule, prepare_output_dir};
-use crate::run::{progress_bar, show_progress};
 
 /// Columns of `timeseries.csv`.
 pub const TIMESERIES_COLUMNS: [&str; 22] = [
@@ -106,35 +104,6 @@ pub struct HardRunSummary {
     pub stuck: usize,
 }
 
-/// Why a hard-sphere run did not complete.
-#[derive(Debug, thiserror::Error)]
-pub enum HardRunError {
-    /// Output directory problems (exists, not a directory, I/O).
-    #[error(transparent)]
-    Output(#[from] RunError),
-    /// The run failed; the summary and `last_good_state.csv` were written.
-    #[error("run failed: {cause}; last good state (t = {t} s) in {}", .last_good_state.display())]
-    Failed {
-        /// Last good time (s).
-        t: f64,
-        /// The cause.
-        cause: String,
-        /// The state file.
-        last_good_state: PathBuf,
-        /// The summary written.
-        summary: Box<HardRunSummary>,
-    },
-}
-
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> HardRunError + '_ {
-    move |source| {
-        HardRunError::Output(RunError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
-    }
-}
-
 /// Writes the alive particles in the particles-file columns.
 pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<()> {
     let mut w = BufWriter::new(File::create(path)?);
@@ -160,58 +129,6 @@ pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<
     w.flush()
 }
 
-/// Everything a hard-sphere run needs to continue bit for bit (`checkpoint.json`, written atomically at an output
-/// sample). Every `f64` that influences the continuation is stored as its bit pattern ([`exact_f64`]).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct HardCheckpoint {
-    format: String,
-    version: u32,
-    writer: String,
-    /// FNV-1a hash of the run's `scene.toml` copy.
-    scene_hash: String,
-    /// Directory a relative `scene.particles_file` is resolved against.
-    scene_base_dir: PathBuf,
-    /// For people reading the file only.
-    t_seconds: f64,
-    #[serde(with = "exact_f64")]
-    t: f64,
-    steps: u64,
-    next_sample: u64,
-    rows: u64,
-    timeseries_bytes: u64,
-    checkpoints: u64,
-    #[serde(with = "exact_f64")]
-    wall_seconds: f64,
-    /// Per particle ([`PARTICLE_STATE`] numbers): alive, x, v, ω, t_local, stuck wall (−1 free), offset, t_stuck.
-    #[serde(with = "exact_f64_vec")]
-    state: Vec<f64>,
-    /// Neighbour-list anchors (3 per particle) and allowances (1 per particle); empty before the first build.
-    #[serde(with = "exact_f64_vec")]
-    anchors: Vec<f64>,
-    #[serde(with = "exact_f64_vec")]
-    allowances: Vec<f64>,
-    /// pair, wall, events, guarded, rebuilds, re-anchors, absorbed.
-    counts: [u64; 7],
-    /// max_overlap, energy_exchanged, then the run's book: E0, scale, energy error, residual, momentum error, P0.
-    #[serde(with = "exact_f64_vec")]
-    book: Vec<f64>,
-    /// Counters at the last time-series row: collisions, pair, wall, events.
-    last_counts: [u64; 4],
-    #[serde(with = "exact_f64")]
-    last_wall_clock: f64,
-}
-
-impl EngineCheckpoint for HardCheckpoint {
-    fn format(&self) -> &str {
-        &self.format
-    }
-    fn scene_hash(&self) -> &str {
-        &self.scene_hash
-    }
-}
-
-/// The `format` tag of a hard-sphere checkpoint.
-pub const HARD_CHECKPOINT_FORMAT: &str = "rubblepile-hsdem-checkpoint";
 /// Numbers per particle in a checkpoint.
 const PARTICLE_STATE: usize = 16;
 
@@ -224,21 +141,6 @@ struct Book {
     energy_residual: f64,
     momentum_error: f64,
     p0: Vec3,
-}
-
-/// Where a run starts from: a fresh system or a checkpoint.
-struct Start {
-    system: System,
-    steps: u64,
-    next_sample: usize,
-    rows: u64,
-    bytes: u64,
-    checkpoints: u64,
-    wall_before: f64,
-    book: Book,
-    last_counts: [u64; 4],
-    last_wall_clock: f64,
-    timeseries: File,
 }
 
 fn pack_particles(system: &System) -> Vec<f64> {
@@ -292,193 +194,180 @@ fn unpack_particles(system: &mut System, v: &[f64]) -> Result<(), String> {
     Ok(())
 }
 
-/// Runs a hard-sphere scene into `out` (checkpoints as `options` asks; `options.force` overwrites a previous run).
-pub fn run_hard_scene(scene: &HardScene, out: &Path, options: &RunOptions) -> Result<HardRunSummary, HardRunError> {
-    prepare_output_dir(out, options.force)?;
-    let scene_copy = out.join("scene.toml");
-    std::fs::write(&scene_copy, &scene.source).map_err(io(&scene_copy))?;
-    let ts_path = out.join("timeseries.csv");
-    let mut ts = File::create(&ts_path).map_err(io(&ts_path))?;
-    let header = format!("{}\n", TIMESERIES_COLUMNS.join(","));
-    ts.write_all(header.as_bytes()).map_err(io(&ts_path))?;
-    let system = System::new(scene.particles.clone(), scene.walls.clone(), scene.settings);
-    let d0 = system.diagnostics();
-    let book = Book {
-        e0: d0.energy(),
-        scale: d0.energy().abs().max(d0.kinetic + d0.rotational).max(f64::MIN_POSITIVE),
-        energy_error: 0.0,
-        energy_residual: 0.0,
-        momentum_error: 0.0,
-        p0: d0.momentum,
-    };
-    let start = Start {
-        system,
-        steps: 0,
-        next_sample: 0,
-        rows: 0,
-        bytes: header.len() as u64,
-        checkpoints: 0,
-        wall_before: 0.0,
-        book,
-        last_counts: [0; 4],
-        last_wall_clock: 0.0,
-        timeseries: ts,
-    };
-    drive(scene, out, options, start)
-}
-
-/// Whether `dir` holds a hard-sphere run (its `scene.toml` has `kind = "hard-spheres"`).
-pub fn is_hard_run_dir(dir: &Path) -> bool {
-    std::fs::read_to_string(dir.join("scene.toml"))
-        .is_ok_and(|t| crate::scene::peek_kind(&t).as_deref() == Some(super::scene::KIND))
-}
-
-/// Continues an interrupted hard-sphere run from `dir/checkpoint.json`, bit for bit: the snapshots, the final state
-/// and every time-series column but `events_per_second` and `wall_seconds` are those of an uninterrupted run.
-pub fn resume_hard(dir: &Path, options: &RunOptions) -> Result<HardRunSummary, HardRunError> {
-    let bad = |m: String| HardRunError::Output(RunError::BadCheckpoint(m));
-    let (ck, text): (HardCheckpoint, String) =
-        open_checkpoint(dir, HARD_CHECKPOINT_FORMAT, "hard-sphere").map_err(HardRunError::Output)?;
-    let spath = dir.join("scene.toml");
-    let scene = super::scene::parse_hard_scene(&text, &spath.display().to_string(), &ck.scene_base_dir)
-        .map_err(|e| bad(e.to_string()))?;
-    let mut system = System::new(scene.particles.clone(), scene.walls.clone(), scene.settings);
-    unpack_particles(&mut system, &ck.state).map_err(bad)?;
-    system.t = ck.t;
-    let anchors = match ck.anchors.len() {
-        0 => None,
-        n if n == 3 * system.particles.len() => Some(NeighbourState {
-            anchors: ck.anchors.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect(),
-            allowances: ck.allowances.clone(),
-        }),
-        n => {
-            return Err(bad(format!(
-                "{n} anchor numbers for {} particles",
-                system.particles.len()
-            )));
-        }
-    };
-    system.restore_neighbours(anchors).map_err(bad)?;
-    if ck.book.len() != 10 {
-        return Err(bad("malformed bookkeeping".into()));
+impl HardRunSummary {
+    /// One line for the terminal.
+    pub fn one_line(&self) -> String {
+        format!(
+            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy residual {:.2e} (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
+            self.status,
+            self.t_reached,
+            self.steps,
+            self.collisions,
+            self.events_per_second,
+            self.energy_residual,
+            self.energy_error,
+            self.max_overlap,
+            self.absorbed,
+            self.wall_seconds
+        )
     }
-    let [pair, wall, events, guarded, rebuilds, reanchors, absorbed] = ck.counts;
-    system.counters = Counters {
-        pair_collisions: pair,
-        wall_collisions: wall,
-        events,
-        guarded,
-        rebuilds,
-        reanchors,
-        absorbed,
-        max_overlap: ck.book[0],
-        energy_exchanged: ck.book[1],
-    };
-    let book = Book {
-        e0: ck.book[2],
-        scale: ck.book[3],
-        energy_error: ck.book[4],
-        energy_residual: ck.book[5],
-        momentum_error: ck.book[6],
-        p0: Vec3::new(ck.book[7], ck.book[8], ck.book[9]),
-    };
-    let file = reopen_timeseries(dir, ck.timeseries_bytes).map_err(HardRunError::Output)?;
-    let start = Start {
-        system,
-        steps: ck.steps,
-        next_sample: ck.next_sample as usize,
-        rows: ck.rows,
-        bytes: ck.timeseries_bytes,
-        checkpoints: ck.checkpoints,
-        wall_before: ck.wall_seconds,
-        book,
-        last_counts: ck.last_counts,
-        last_wall_clock: ck.last_wall_clock,
-        timeseries: file,
-    };
-    drive(&scene, dir, options, start)
 }
 
-fn drive(scene: &HardScene, out: &Path, options: &RunOptions, start: Start) -> Result<HardRunSummary, HardRunError> {
-    let Start {
-        mut system,
-        steps,
-        next_sample,
-        mut rows,
-        mut bytes,
-        mut checkpoints,
-        wall_before,
-        mut book,
-        last_counts,
-        mut last_wall_clock,
-        timeseries: mut ts,
-    } = start;
-    let ts_path = out.join("timeseries.csv");
-    let clock = Instant::now();
-    let wall_now = |c: &Instant| wall_before + c.elapsed().as_secs_f64();
-    let base_dir = std::fs::canonicalize(&scene.base_dir)
-        .or_else(|_| std::path::absolute(&scene.base_dir))
-        .map_err(io(&scene.base_dir))?;
-    let mut summary = HardRunSummary {
-        status: "running".into(),
-        kind: super::scene::KIND.into(),
-        scene: scene.name.clone(),
-        seed: scene.seed,
-        t_end: scene.t_end,
-        t_reached: system.t,
-        steps,
-        particles: scene.particles.len(),
-        wall_seconds: 0.0,
-        energy_initial: book.e0,
-        energy_final: book.e0,
-        energy_error: 0.0,
-        energy_residual: 0.0,
-        energy_exchanged: 0.0,
-        momentum_error: 0.0,
-        collisions: 0,
-        pair_collisions: 0,
-        wall_collisions: 0,
-        events: 0,
-        events_per_second: 0.0,
-        guarded_collisions: 0,
-        neighbour_rebuilds: 0,
-        neighbour_reanchors: 0,
-        max_overlap: 0.0,
-        absorbed: 0,
-        stuck: 0,
-    };
-    let events_before = system.counters.events;
-    let [mut last_coll, mut last_pair, mut last_wall, mut last_events] = last_counts;
-    let mut failure: Option<(String, System)> = None;
-    let mut last_checkpoint_wall = 0.0;
-    let mut last_checkpoint_t = system.t;
-    let mut written = 0u64;
-    let samples: Vec<_> = Schedule::new(scene.t_end, scene.every, &scene.times).collect();
-    let pb = progress_bar(options.progress, scene.t_end, system.t);
-    for (index, sample) in samples.iter().enumerate().skip(next_sample) {
-        let good = system.clone();
-        let mut failed = None;
-        while system.t < sample.t {
-            if let Some(pb) = &pb
-                && summary.steps.is_multiple_of(64)
-            {
-                show_progress(pb, system.t, scene.t_end);
+
+impl RunReport for HardRunSummary {
+    fn one_line(&self) -> String {
+        HardRunSummary::one_line(self)
+    }
+}
+
+/// What a hard-sphere run's checkpoint holds beside the driver's envelope. Every `f64` that influences the
+/// continuation is stored as its bit pattern.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HardState {
+    steps: u64,
+    /// Per particle ([`PARTICLE_STATE`] numbers): alive, x, v, ω, t_local, stuck wall (−1 free), offset, t_stuck.
+    #[serde(with = "exact_f64_vec")]
+    state: Vec<f64>,
+    /// Neighbour-list anchors (3 per particle) and allowances (1 per particle); empty before the first build.
+    #[serde(with = "exact_f64_vec")]
+    anchors: Vec<f64>,
+    #[serde(with = "exact_f64_vec")]
+    allowances: Vec<f64>,
+    /// pair, wall, events, guarded, rebuilds, re-anchors, absorbed.
+    counts: [u64; 7],
+    /// max_overlap, energy_exchanged, then the run's book: E0, scale, energy error, residual, momentum error, P0.
+    #[serde(with = "exact_f64_vec")]
+    book: Vec<f64>,
+    /// Counters at the last time-series row: collisions, pair, wall, events.
+    last_counts: [u64; 4],
+    #[serde(with = "crate::bits::exact_f64")]
+    last_wall_clock: f64,
+}
+
+/// A hard-sphere run (Richardson11): steps of `dt` within which collisions are predicted and applied in time order.
+pub struct HardEngine {
+    scene: HardScene,
+    system: System,
+    /// The state at the start of the current sample interval: the last good state if a step fails.
+    good: System,
+    steps: u64,
+    book: Book,
+    last_counts: [u64; 4],
+    last_wall_clock: f64,
+    /// Events when this process started, and its clock (for the summary's events per second).
+    events_before: u64,
+    clock: Instant,
+}
+
+impl HardEngine {
+    /// The engine for a validated scene, at t = 0.
+    pub fn new(scene: HardScene) -> Self {
+        let system = System::new(scene.particles.clone(), scene.walls.clone(), scene.settings);
+        let d0 = system.diagnostics();
+        let book = Book {
+            e0: d0.energy(),
+            scale: d0.energy().abs().max(d0.kinetic + d0.rotational).max(f64::MIN_POSITIVE),
+            energy_error: 0.0,
+            energy_residual: 0.0,
+            momentum_error: 0.0,
+            p0: d0.momentum,
+        };
+        HardEngine {
+            scene,
+            good: system.clone(),
+            system,
+            steps: 0,
+            book,
+            last_counts: [0; 4],
+            last_wall_clock: 0.0,
+            events_before: 0,
+            clock: Instant::now(),
+        }
+    }
+
+    /// Loads and validates the scene file at `path`. Errors are one line naming the field.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        Ok(HardEngine::new(super::scene::load_hard_scene(path).map_err(|e| e.to_string())?))
+    }
+
+    /// What the scene resolves to, for `rubblepile check`.
+    pub fn describe(&self) -> Vec<String> {
+        let s = &self.scene;
+        vec![format!(
+            "{}: hard spheres: {} particles, {} walls, t_end = {} s, dt = {} s, {} snapshots, a time-series row every \
+             {} s",
+            s.name,
+            s.particles.len(),
+            s.walls.len(),
+            s.t_end,
+            s.dt,
+            s.times.len(),
+            s.every
+        )]
+    }
+}
+
+impl Engine for HardEngine {
+    type Summary = HardRunSummary;
+    type State = HardState;
+    const KIND: &'static str = super::scene::KIND;
+
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
+        let base = base_dir.unwrap_or(Path::new("."));
+        Ok(HardEngine::new(
+            super::scene::parse_hard_scene(text, name, base).map_err(|e| e.to_string())?,
+        ))
+    }
+
+    fn scene_source(&self) -> &str {
+        &self.scene.source
+    }
+
+    fn scene_base_dir(&self) -> Option<&Path> {
+        Some(&self.scene.base_dir)
+    }
+
+    fn t_end(&self) -> f64 {
+        self.scene.t_end
+    }
+
+    fn time(&self) -> f64 {
+        self.system.t
+    }
+
+    fn samples(&self) -> Vec<Sample> {
+        Schedule::new(self.scene.t_end, self.scene.every, &self.scene.times).collect()
+    }
+
+    fn timeseries_header(&self) -> String {
+        format!("{}\n", TIMESERIES_COLUMNS.join(","))
+    }
+
+    fn open_outputs(&mut self, _dir: &Path) -> std::io::Result<()> {
+        Ok(())
+    }
+
+    fn advance(&mut self, _index: usize, to: &Sample, progress: &mut dyn FnMut(f64)) -> Result<(), Failure> {
+        self.good.clone_from(&self.system);
+        let dt = self.scene.dt;
+        while self.system.t < to.t {
+            if self.steps.is_multiple_of(64) {
+                progress(self.system.t);
             }
-            let left = sample.t - system.t;
-            let h = if left < 1.000001 * scene.dt { left } else { scene.dt };
-            if let Err(e) = system.step(h) {
-                failed = Some(e.to_string());
-                break;
-            }
-            summary.steps += 1;
+            let left = to.t - self.system.t;
+            let h = if left < 1.000001 * dt { left } else { dt };
+            self.system.step(h).map_err(|e| Failure::new(e.to_string()))?;
+            self.steps += 1;
             if left == h {
-                system.t = sample.t;
+                self.system.t = to.t;
             }
         }
-        if let Some(cause) = failed {
-            failure = Some((cause, good));
-            break;
-        }
+        Ok(())
+    }
+
+    fn sample(&mut self, to: &Sample, wall: f64) -> Result<String, SampleError> {
+        let system = &self.system;
+        let book = &mut self.book;
         let d: Diagnostics = system.diagnostics();
         let c = system.counters;
         let e = d.energy();
@@ -487,15 +376,15 @@ fn drive(scene: &HardScene, out: &Path, options: &RunOptions, start: Start) -> R
             .energy_residual
             .max((e - book.e0 - c.energy_exchanged).abs() / book.scale);
         book.momentum_error = book.momentum_error.max((d.momentum - book.p0).norm());
-        let wall = wall_now(&clock);
+        let [last_coll, last_pair, last_wall, last_events] = self.last_counts;
         let coll = c.pair_collisions + c.wall_collisions;
-        let eps = if wall > last_wall_clock {
-            (c.events - last_events) as f64 / (wall - last_wall_clock)
+        let eps = if wall > self.last_wall_clock {
+            (c.events - last_events) as f64 / (wall - self.last_wall_clock)
         } else {
             0.0
         };
         let row = [
-            sample.t,
+            to.t,
             d.kinetic,
             d.rotational,
             d.potential,
@@ -519,187 +408,144 @@ fn drive(scene: &HardScene, out: &Path, options: &RunOptions, start: Start) -> R
             wall,
         ];
         let cols: Vec<String> = row.iter().map(|&x| fmt_f64(x)).collect();
-        let line = cols.join(",") + "\n";
-        ts.write_all(line.as_bytes()).map_err(io(&ts_path))?;
-        rows += 1;
-        bytes += line.len() as u64;
-        (last_coll, last_pair, last_wall, last_events, last_wall_clock) =
-            (coll, c.pair_collisions, c.wall_collisions, c.events, wall);
-        if let Some(k) = sample.snapshot {
-            let p = out.join("snapshots").join(format!("{k}.csv"));
-            write_particles(&p, sample.t, &system).map_err(io(&p))?;
-        }
-        let last = index + 1 == samples.len();
-        let due_wall = options
-            .checkpoint_every
-            .is_some_and(|w| w > 0.0 && clock.elapsed().as_secs_f64() - last_checkpoint_wall >= w);
-        let due_sim = options
-            .checkpoint_every_sim
-            .is_some_and(|s| system.t - last_checkpoint_t >= s);
-        if !last && (due_wall || due_sim) {
-            checkpoints += 1;
-            let c = system.counters;
-            let nb = system.neighbour_state();
-            let ck = HardCheckpoint {
-                format: HARD_CHECKPOINT_FORMAT.into(),
-                version: 1,
-                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
-                scene_hash: fnv1a_hex(scene.source.as_bytes()),
-                scene_base_dir: base_dir.clone(),
-                t_seconds: system.t,
-                t: system.t,
-                steps: summary.steps,
-                next_sample: index as u64 + 1,
-                rows,
-                timeseries_bytes: bytes,
-                checkpoints,
-                wall_seconds: wall,
-                state: pack_particles(&system),
-                anchors: nb
-                    .as_ref()
-                    .map(|s| s.anchors.iter().flat_map(|a| a.iter().copied()).collect())
-                    .unwrap_or_default(),
-                allowances: nb.as_ref().map(|s| s.allowances.clone()).unwrap_or_default(),
-                counts: [
-                    c.pair_collisions,
-                    c.wall_collisions,
-                    c.events,
-                    c.guarded,
-                    c.rebuilds,
-                    c.reanchors,
-                    c.absorbed,
-                ],
-                book: vec![
-                    c.max_overlap,
-                    c.energy_exchanged,
-                    book.e0,
-                    book.scale,
-                    book.energy_error,
-                    book.energy_residual,
-                    book.momentum_error,
-                    book.p0.x,
-                    book.p0.y,
-                    book.p0.z,
-                ],
-                last_counts: [last_coll, last_pair, last_wall, last_events],
-                last_wall_clock,
-            };
-            let tmp = out.join(CHECKPOINT_TMP_FILE);
-            let text = serde_json::to_string_pretty(&ck).map_err(|e| io(&tmp)(std::io::Error::other(e)))?;
-            std::fs::write(&tmp, text + "\n").map_err(io(&tmp))?;
-            let fin = out.join(CHECKPOINT_FILE);
-            std::fs::rename(&tmp, &fin).map_err(io(&fin))?;
-            last_checkpoint_wall = clock.elapsed().as_secs_f64();
-            last_checkpoint_t = system.t;
-            written += 1;
-            if options.stop_after_checkpoints == Some(written) {
-                return Err(HardRunError::Output(RunError::Stopped {
-                    dir: out.to_path_buf(),
-                    t: system.t,
-                    checkpoints: written,
-                }));
-            }
+        self.last_counts = [coll, c.pair_collisions, c.wall_collisions, c.events];
+        self.last_wall_clock = wall;
+        Ok(cols.join(",") + "\n")
+    }
+
+    fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
+        write_particles(path, self.system.t, &self.system)
+    }
+
+    fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {
+        write_particles(path, self.good.t, &self.good)?;
+        Ok(self.good.t)
+    }
+
+    fn summary(&self, outcome: Outcome<'_>, _samples: u64, wall_seconds: f64) -> HardRunSummary {
+        let (state, status) = match outcome {
+            Outcome::Completed => (&self.system, "completed".to_string()),
+            Outcome::Failed(f) => (&self.good, f.cause.clone()),
+        };
+        let c = self.system.counters;
+        let d = state.diagnostics();
+        let book = &self.book;
+        let this_process = self.clock.elapsed().as_secs_f64();
+        HardRunSummary {
+            status,
+            kind: super::scene::KIND.into(),
+            scene: self.scene.name.clone(),
+            seed: self.scene.seed,
+            t_end: self.scene.t_end,
+            t_reached: state.t,
+            steps: self.steps,
+            particles: self.scene.particles.len(),
+            wall_seconds,
+            energy_initial: book.e0,
+            energy_final: d.energy(),
+            energy_error: book.energy_error,
+            energy_residual: book.energy_residual,
+            energy_exchanged: c.energy_exchanged,
+            momentum_error: book.momentum_error,
+            collisions: c.pair_collisions + c.wall_collisions,
+            pair_collisions: c.pair_collisions,
+            wall_collisions: c.wall_collisions,
+            events: c.events,
+            events_per_second: if this_process > 0.0 {
+                (c.events - self.events_before) as f64 / this_process
+            } else {
+                0.0
+            },
+            guarded_collisions: c.guarded,
+            neighbour_rebuilds: c.rebuilds,
+            neighbour_reanchors: c.reanchors,
+            max_overlap: c.max_overlap,
+            absorbed: c.absorbed,
+            stuck: d.stuck,
         }
     }
-    let wall = wall_now(&clock);
-    let state = match &failure {
-        Some((_, good)) => good,
-        None => &system,
-    };
-    let c = system.counters;
-    let d = state.diagnostics();
-    summary.t_reached = state.t;
-    summary.wall_seconds = wall;
-    summary.energy_initial = book.e0;
-    summary.energy_final = d.energy();
-    summary.energy_error = book.energy_error;
-    summary.energy_residual = book.energy_residual;
-    summary.momentum_error = book.momentum_error;
-    summary.energy_exchanged = c.energy_exchanged;
-    summary.collisions = c.pair_collisions + c.wall_collisions;
-    summary.pair_collisions = c.pair_collisions;
-    summary.wall_collisions = c.wall_collisions;
-    summary.events = c.events;
-    let this_process = clock.elapsed().as_secs_f64();
-    summary.events_per_second = if this_process > 0.0 {
-        (c.events - events_before) as f64 / this_process
-    } else {
-        0.0
-    };
-    summary.guarded_collisions = c.guarded;
-    summary.neighbour_rebuilds = c.rebuilds;
-    summary.neighbour_reanchors = c.reanchors;
-    summary.max_overlap = c.max_overlap;
-    summary.absorbed = c.absorbed;
-    summary.stuck = d.stuck;
-    summary.status = match &failure {
-        Some((cause, _)) => cause.clone(),
-        None => "completed".into(),
-    };
-    if let Some(pb) = &pb {
-        match &failure {
-            Some(_) => pb.abandon(),
-            None => pb.finish_and_clear(),
+
+    fn save(&mut self) -> std::io::Result<HardState> {
+        let system = &self.system;
+        let c = system.counters;
+        let nb = system.neighbour_state();
+        let book = &self.book;
+        Ok(HardState {
+            steps: self.steps,
+            state: pack_particles(system),
+            anchors: nb
+                .as_ref()
+                .map(|s| s.anchors.iter().flat_map(|a| a.iter().copied()).collect())
+                .unwrap_or_default(),
+            allowances: nb.as_ref().map(|s| s.allowances.clone()).unwrap_or_default(),
+            counts: [
+                c.pair_collisions,
+                c.wall_collisions,
+                c.events,
+                c.guarded,
+                c.rebuilds,
+                c.reanchors,
+                c.absorbed,
+            ],
+            book: vec![
+                c.max_overlap,
+                c.energy_exchanged,
+                book.e0,
+                book.scale,
+                book.energy_error,
+                book.energy_residual,
+                book.momentum_error,
+                book.p0.x,
+                book.p0.y,
+                book.p0.z,
+            ],
+            last_counts: self.last_counts,
+            last_wall_clock: self.last_wall_clock,
+        })
+    }
+
+    fn restore(&mut self, ck: HardState, _dir: &Path, at: Resumed) -> Result<(), String> {
+        let system = &mut self.system;
+        unpack_particles(system, &ck.state)?;
+        system.t = at.t;
+        let anchors = match ck.anchors.len() {
+            0 => None,
+            n if n == 3 * system.particles.len() => Some(NeighbourState {
+                anchors: ck.anchors.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect(),
+                allowances: ck.allowances.clone(),
+            }),
+            n => return Err(format!("{n} anchor numbers for {} particles", system.particles.len())),
+        };
+        system.restore_neighbours(anchors)?;
+        if ck.book.len() != 10 {
+            return Err("malformed bookkeeping".into());
         }
+        let [pair, wall, events, guarded, rebuilds, reanchors, absorbed] = ck.counts;
+        system.counters = Counters {
+            pair_collisions: pair,
+            wall_collisions: wall,
+            events,
+            guarded,
+            rebuilds,
+            reanchors,
+            absorbed,
+            max_overlap: ck.book[0],
+            energy_exchanged: ck.book[1],
+        };
+        self.book = Book {
+            e0: ck.book[2],
+            scale: ck.book[3],
+            energy_error: ck.book[4],
+            energy_residual: ck.book[5],
+            momentum_error: ck.book[6],
+            p0: Vec3::new(ck.book[7], ck.book[8], ck.book[9]),
+        };
+        self.steps = ck.steps;
+        self.last_counts = ck.last_counts;
+        self.last_wall_clock = ck.last_wall_clock;
+        self.events_before = events;
+        self.good = self.system.clone();
+        self.clock = Instant::now();
+        Ok(())
     }
-    let sp = out.join("summary.json");
-    let json = serde_json::to_string_pretty(&summary).map_err(|e| io(&sp)(std::io::Error::other(e)))?;
-    std::fs::write(&sp, json + "\n").map_err(io(&sp))?;
-    if let Some((cause, good)) = failure {
-        let p = out.join("last_good_state.csv");
-        write_particles(&p, good.t, &good).map_err(io(&p))?;
-        return Err(HardRunError::Failed {
-            t: good.t,
-            cause,
-            last_good_state: p,
-            summary: Box::new(summary),
-        });
-    }
-    Ok(summary)
-}
-
-impl HardRunSummary {
-    /// One line for the terminal.
-    pub fn one_line(&self) -> String {
-        format!(
-            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy residual {:.2e} (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
-            self.status,
-            self.t_reached,
-            self.steps,
-            self.collisions,
-            self.events_per_second,
-            self.energy_residual,
-            self.energy_error,
-            self.max_overlap,
-            self.absorbed,
-            self.wall_seconds
-        )
-    }
-}
-
-fn cli_result(r: Result<HardRunSummary, HardRunError>) -> Result<(), crate::cli::CliError> {
-    match r {
-        Ok(s) => {
-            println!("{}", s.one_line());
-            Ok(())
-        }
-        Err(HardRunError::Output(e)) => Err(crate::cli::CliError {
-            message: e.to_string(),
-            code: e.exit_code(),
-        }),
-        Err(e) => Err(crate::cli::CliError::failed(e)),
-    }
-}
-
-/// `rubblepile run SCENE --out DIR [--force] [--checkpoint-every …]` for a hard-sphere scene: prints the one-line
-/// summary; exit code 2 for bad input or an existing output directory, 1 for a failed run, 3 when stopped after a
-/// checkpoint on request.
-pub fn cli_run(path: &Path, out: &Path, options: &RunOptions) -> Result<(), crate::cli::CliError> {
-    let scene = super::scene::load_hard_scene(path).map_err(crate::cli::CliError::usage)?;
-    cli_result(run_hard_scene(&scene, out, options))
-}
-
-/// `rubblepile resume DIR` of a hard-sphere run.
-pub fn cli_resume(dir: &Path, options: &RunOptions) -> Result<(), crate::cli::CliError> {
-    cli_result(resume_hard(dir, options))
 }

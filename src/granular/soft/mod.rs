@@ -12,7 +12,6 @@
 //!   (Zhang17 §2.3.4).
 
 pub mod advise;
-pub mod branch;
 pub mod contact;
 pub mod forces;
 pub mod leapfrog;

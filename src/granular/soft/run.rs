@@ -25,8 +25,7 @@
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
@@ -35,16 +34,12 @@ use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
-use crate::granular::soft::scene::{SoftScene, parse_soft_scene, scene_kind};
+use crate::bits::exact_f64_vec;
+use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
+use crate::granular::soft::scene::{SoftScene, load_soft_scene, parse_soft_scene};
 use crate::granular::soft::spinup::{SpinupDriver, central_body};
-use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE, exact_f64, exact_f64_vec, fnv1a_hex};
-use crate::io::resume::{EngineCheckpoint, open_checkpoint, reopen_timeseries, reopen_truncated};
 use crate::math::Vec3;
-use crate::run::{RunError, RunOptions, prepare_output_dir};
-use crate::run::{progress_bar, show_progress};
 
-/// The `format` tag of a soft-sphere checkpoint.
-pub const SOFT_CHECKPOINT_FORMAT: &str = "rubblepile-ssdem-checkpoint";
 /// Overlap (fraction of the smaller radius) above which the run is declared broken.
 pub const BROKEN_OVERLAP: f64 = 0.5;
 
@@ -115,46 +110,6 @@ impl SoftSummary {
             self.max_overlap_fraction,
             self.wall_seconds
         )
-    }
-}
-
-/// Why a soft-sphere run did not complete.
-#[derive(Debug, thiserror::Error)]
-pub enum SoftRunError {
-    /// Output directory or file-system problems shared with the core driver (existing output without
-    /// `--force`, I/O errors).
-    #[error(transparent)]
-    Run(#[from] RunError),
-    /// The run broke (non-finite state, overlap above [`BROKEN_OVERLAP`]); summary and last good state written.
-    #[error("run failed: {cause}; last good state (t = {t} s) in {}", .last_good_state.display())]
-    Failed {
-        /// Last good time (s).
-        t: f64,
-        /// Cause.
-        cause: String,
-        /// Where the last good state is.
-        last_good_state: PathBuf,
-        /// The summary written.
-        summary: Box<SoftSummary>,
-    },
-}
-
-impl SoftRunError {
-    /// Exit code for the command line: as [`RunError::exit_code`], 1 for a failed run.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            SoftRunError::Run(e) => e.exit_code(),
-            SoftRunError::Failed { .. } => 1,
-        }
-    }
-}
-
-fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> SoftRunError + '_ {
-    move |source| {
-        SoftRunError::Run(RunError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
     }
 }
 
@@ -269,52 +224,6 @@ impl Book {
     }
 }
 
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct SoftCheckpoint {
-    format: String,
-    version: u32,
-    writer: String,
-    scene_hash: String,
-    scene_base_dir: Option<PathBuf>,
-    step: u64,
-    t_seconds: f64,
-    next_sample: u64,
-    rows: u64,
-    timeseries_bytes: u64,
-    checkpoints: u64,
-    #[serde(with = "exact_f64")]
-    wall_seconds: f64,
-    /// Per particle: x, v, ω, F, τ (15 numbers).
-    #[serde(with = "exact_f64_vec")]
-    state: Vec<f64>,
-    pair_springs: Vec<SpringRecord>,
-    wall_springs: Vec<SpringRecord>,
-    /// dissipated, wall_work, forcing_work, forcing angular impulse (x, y, z).
-    #[serde(with = "exact_f64_vec")]
-    work: Vec<f64>,
-    /// Steps taken in the current self-gravity block (r-RESPA; 0 without).
-    #[serde(default)]
-    gravity_phase: u64,
-    /// Self-gravity accelerations of the block's start (3 per particle) and its potential energy, when
-    /// `[gravity] interval_steps > 1`; empty otherwise.
-    #[serde(default, with = "exact_f64_vec")]
-    slow: Vec<f64>,
-    #[serde(with = "exact_f64_vec")]
-    book: Vec<f64>,
-    /// The spin-up driver's state and the length of `spinup.csv`, for a `[spinup]` scene.
-    #[serde(default)]
-    spinup: Option<SpinupCheckpoint>,
-}
-
-impl EngineCheckpoint for SoftCheckpoint {
-    fn format(&self) -> &str {
-        &self.format
-    }
-    fn scene_hash(&self) -> &str {
-        &self.scene_hash
-    }
-}
-
 // ---- spin-up hook (Zhang17 §2.3.4; crate::granular::soft::spinup) --------------------------------------
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct SpinupCheckpoint {
@@ -342,11 +251,11 @@ impl SpinRun {
         }
     }
     /// The diagnostics row at an output sample (time `t`, s), then the release check.
-    fn sample(&mut self, sys: &SoftSystem, t: f64, path: &Path) -> Result<(), SoftRunError> {
+    fn sample(&mut self, sys: &SoftSystem, t: f64) -> std::io::Result<()> {
         let d = diagnose_run(sys, &self.driver, t).sample;
         let line = d.csv_row();
-        self.csv.write_all(line.as_bytes()).map_err(io_err(path))?;
-        self.csv.flush().map_err(io_err(path))?;
+        self.csv.write_all(line.as_bytes())?;
+        self.csv.flush()?;
         self.bytes += line.len() as u64;
         self.driver.observe(t, d.b_over_a, d.c_over_a, d.packing_fraction);
         Ok(())
@@ -434,11 +343,6 @@ fn summary(
     }
 }
 
-fn write_summary(path: &Path, s: &SoftSummary) -> Result<(), SoftRunError> {
-    let text = serde_json::to_string_pretty(s).expect("summary serialises");
-    std::fs::write(path, text + "\n").map_err(io_err(path))
-}
-
 /// A fresh system for the scene, forces evaluated at t = 0.
 pub fn initial_system(scene: &SoftScene) -> SoftSystem {
     let mut sys = SoftSystem::new(
@@ -452,170 +356,6 @@ pub fn initial_system(scene: &SoftScene) -> SoftSystem {
     sys
 }
 
-struct Start {
-    sys: SoftSystem,
-    step: u64,
-    next_sample: usize,
-    rows: u64,
-    bytes: u64,
-    checkpoints: u64,
-    wall_before: f64,
-    book: Book,
-    timeseries: BufWriter<File>,
-    spin: Option<SpinRun>,
-}
-
-/// Runs a soft-sphere scene into `out_dir` (refuses a non-empty directory unless `options.force`).
-pub fn run_soft(scene: &SoftScene, out_dir: &Path, options: &RunOptions) -> Result<SoftSummary, SoftRunError> {
-    prepare_output_dir(out_dir, options.force)?;
-    let copy = out_dir.join("scene.toml");
-    std::fs::write(&copy, &scene.source).map_err(io_err(&copy))?;
-    let ts = out_dir.join("timeseries.csv");
-    let mut timeseries = BufWriter::new(File::create(&ts).map_err(io_err(&ts))?);
-    timeseries
-        .write_all(TIMESERIES_HEADER.as_bytes())
-        .map_err(io_err(&ts))?;
-    timeseries.flush().map_err(io_err(&ts))?;
-    let mut sys = initial_system(scene);
-    let spin = match &scene.spinup {
-        Some(settings) => {
-            // the body starts on the path (T_start) and the t = 0 sample needs the contact records
-            let driver = SpinupDriver::new(*settings, &scene.particles);
-            let springs = sys.pair_springs();
-            let member = central_body(&sys.particles, springs.iter().map(|(k, _)| k));
-            driver.apply(&mut sys.particles, &member, 0.0);
-            sys.keep_records = true;
-            sys.set_pair_springs(Vec::new());
-            sys.compute_forces(0.0, 0.0);
-            let path = out_dir.join("spinup.csv");
-            let mut csv = BufWriter::new(File::create(&path).map_err(io_err(&path))?);
-            csv.write_all(SPINUP_HEADER.as_bytes()).map_err(io_err(&path))?;
-            Some(SpinRun {
-                driver,
-                csv,
-                bytes: SPINUP_HEADER.len() as u64,
-            })
-        }
-        None => None,
-    };
-    let book = Book::new(&sys);
-    let base = match &scene.base_dir {
-        Some(d) => Some(
-            std::fs::canonicalize(d)
-                .or_else(|_| std::path::absolute(d))
-                .map_err(io_err(d))?,
-        ),
-        None => None,
-    };
-    let start = Start {
-        sys,
-        step: 0,
-        next_sample: 0,
-        rows: 0,
-        bytes: TIMESERIES_HEADER.len() as u64,
-        checkpoints: 0,
-        wall_before: 0.0,
-        book,
-        timeseries,
-        spin,
-    };
-    drive(scene, out_dir, options, start, base)
-}
-
-/// Whether `dir` holds a soft-sphere run (its `scene.toml` has `kind = "soft-spheres"`).
-pub fn is_soft_run_dir(dir: &Path) -> bool {
-    std::fs::read_to_string(dir.join("scene.toml"))
-        .is_ok_and(|t| scene_kind(&t).as_deref() == Some(crate::granular::soft::scene::KIND))
-}
-
-/// Continues an interrupted soft-sphere run from `dir/checkpoint.json`, bit for bit.
-pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, SoftRunError> {
-    let bad = |m: String| SoftRunError::Run(RunError::BadCheckpoint(m));
-    let (ck, text): (SoftCheckpoint, String) =
-        open_checkpoint(dir, SOFT_CHECKPOINT_FORMAT, "soft-sphere").map_err(SoftRunError::Run)?;
-    let spath = dir.join("scene.toml");
-    let scene = parse_soft_scene(&text, &spath.display().to_string(), ck.scene_base_dir.as_deref())
-        .map_err(|e| bad(e.to_string()))?;
-    let n = scene.particles.len();
-    if ck.state.len() != 15 * n {
-        return Err(bad(format!(
-            "the checkpoint holds {} numbers for {n} particles",
-            ck.state.len()
-        )));
-    }
-    let mut sys = SoftSystem::new(
-        scene.particles.clone(),
-        scene.walls.clone(),
-        scene.material,
-        scene.gravity,
-    );
-    for (k, c) in ck.state.chunks(15).enumerate() {
-        let v = |o: usize| Vec3::new(c[o], c[o + 1], c[o + 2]);
-        sys.particles[k].position = v(0);
-        sys.particles[k].velocity = v(3);
-        sys.particles[k].spin = v(6);
-        sys.forces[k] = v(9);
-        sys.torques[k] = v(12);
-    }
-    sys.set_pair_springs(unpack(&ck.pair_springs).ok_or_else(|| bad("malformed pair springs".into()))?);
-    sys.wall_springs = unpack(&ck.wall_springs).ok_or_else(|| bad("malformed wall springs".into()))?;
-    // [dissipated, wall work] before the spin-up forcing was accounted; then [.., forcing work, its L (3)]
-    if ck.work.len() != 2 && ck.work.len() != 6 {
-        return Err(bad("malformed work record".into()));
-    }
-    sys.dissipated = ck.work[0];
-    sys.wall_work = ck.work[1];
-    if ck.work.len() == 6 {
-        sys.forcing_work = ck.work[2];
-        sys.forcing_angular_impulse = Vec3::new(ck.work[3], ck.work[4], ck.work[5]);
-    }
-    sys.gravity_interval = scene.gravity_interval;
-    if sys.split_gravity() {
-        if ck.slow.len() != 3 * n + 1 || ck.gravity_phase >= scene.gravity_interval {
-            return Err(bad("malformed self-gravity block record (slow, gravity_phase)".into()));
-        }
-        sys.gravity_phase = ck.gravity_phase;
-        sys.slow_accelerations = ck.slow[..3 * n]
-            .chunks(3)
-            .map(|c| Vec3::new(c[0], c[1], c[2]))
-            .collect();
-        sys.slow_energy = ck.slow[3 * n];
-    }
-    let book = Book::from_vec(&ck.book).ok_or_else(|| bad("malformed bookkeeping".into()))?;
-
-    let file = reopen_timeseries(dir, ck.timeseries_bytes).map_err(SoftRunError::Run)?;
-    let spin = match (&scene.spinup, &ck.spinup) {
-        (Some(settings), Some(sc)) => {
-            let mut driver = SpinupDriver::new(*settings, &scene.particles);
-            driver
-                .restore(&sc.state)
-                .ok_or_else(|| bad("malformed spin-up state".into()))?;
-            let f = reopen_truncated(&dir.join("spinup.csv"), sc.bytes).map_err(SoftRunError::Run)?;
-            Some(SpinRun {
-                driver,
-                csv: BufWriter::new(f),
-                bytes: sc.bytes,
-            })
-        }
-        (None, None) => None,
-        _ => return Err(bad("the checkpoint and the scene disagree on [spinup]".into())),
-    };
-    let start = Start {
-        sys,
-        step: ck.step,
-        next_sample: ck.next_sample as usize,
-        rows: ck.rows,
-        bytes: ck.timeseries_bytes,
-        checkpoints: ck.checkpoints,
-        wall_before: ck.wall_seconds,
-        book,
-        timeseries: BufWriter::new(file),
-        spin,
-    };
-    drive(&scene, dir, options, start, ck.scene_base_dir.clone())
-}
-
-#[allow(clippy::too_many_arguments)]
 fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f64) -> String {
     let ke = sys.kinetic_energy();
     let s = &sys.stats;
@@ -642,175 +382,337 @@ fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f6
     )
 }
 
-fn drive(
-    scene: &SoftScene,
-    dir: &Path,
-    options: &RunOptions,
-    start: Start,
-    base: Option<PathBuf>,
-) -> Result<SoftSummary, SoftRunError> {
-    let Start {
-        mut sys,
-        mut step,
-        next_sample,
-        mut rows,
-        mut bytes,
-        mut checkpoints,
-        wall_before,
-        mut book,
-        mut timeseries,
-        mut spin,
-    } = start;
-    let spin_path = dir.join("spinup.csv");
-    let clock = Instant::now();
-    let wall = |c: &Instant| wall_before + c.elapsed().as_secs_f64();
-    let ts_path = dir.join("timeseries.csv");
-    let plan = sample_steps(scene);
-    let mut last_checkpoint_wall = 0.0;
-    let mut last_checkpoint_t = step as f64 * scene.dt;
-    let mut written_this_process = 0u64;
-    let dt = scene.dt;
-    let pb = progress_bar(options.progress, scene.t_end, step as f64 * dt);
-    // the state before the current step, kept for `last_good_state.csv` (allocated once)
-    let mut before = sys.particles.clone();
-    for (index, &(sample_step, snapshot)) in plan.iter().enumerate().skip(next_sample) {
-        while step < sample_step {
-            before.clone_from(&sys.particles);
-            if let Some(pb) = &pb
-                && step.is_multiple_of(256)
-            {
-                show_progress(pb, step as f64 * dt, scene.t_end);
+
+/// What a soft-sphere run's checkpoint holds beside the driver's envelope: every particle's state, the last forces
+/// and torques (leapfrog needs them), the spring histories and the bookkeeping, as exact f64 bit patterns.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SoftState {
+    step: u64,
+    /// Per particle: x, v, ω, F, τ (15 numbers).
+    #[serde(with = "exact_f64_vec")]
+    state: Vec<f64>,
+    pair_springs: Vec<SpringRecord>,
+    wall_springs: Vec<SpringRecord>,
+    /// dissipated, wall_work, forcing_work, forcing angular impulse (x, y, z).
+    #[serde(with = "exact_f64_vec")]
+    work: Vec<f64>,
+    /// Steps taken in the current self-gravity block (r-RESPA; 0 without).
+    gravity_phase: u64,
+    /// Self-gravity accelerations of the block's start (3 per particle) and its potential energy, when
+    /// `[gravity] interval_steps > 1`; empty otherwise.
+    #[serde(with = "exact_f64_vec")]
+    slow: Vec<f64>,
+    #[serde(with = "exact_f64_vec")]
+    book: Vec<f64>,
+    /// The spin-up driver's state and the length of `spinup.csv`, for a `[spinup]` scene.
+    spinup: Option<SpinupCheckpoint>,
+}
+
+impl SoftState {
+    /// The step of the checkpoint.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+    /// Particles whose state the checkpoint holds.
+    pub fn particles(&self) -> usize {
+        self.state.len() / 15
+    }
+}
+
+/// A soft-sphere run (Zhang17): leapfrog steps of a fixed `dt`, with the spin-up forcing after every step when the
+/// scene has a `[spinup]` table.
+pub struct SoftEngine {
+    scene: SoftScene,
+    sys: SoftSystem,
+    step: u64,
+    book: Book,
+    spin: Option<SpinRun>,
+    plan: Vec<(u64, Option<usize>)>,
+    /// The state before the current step, kept for `last_good_state.csv` (allocated once).
+    before: Vec<Particle>,
+}
+
+impl SoftEngine {
+    /// The engine for a validated scene, forces evaluated at t = 0.
+    pub fn new(scene: SoftScene) -> Self {
+        let sys = initial_system(&scene);
+        let book = Book::new(&sys);
+        let plan = sample_steps(&scene);
+        let before = sys.particles.clone();
+        SoftEngine {
+            scene,
+            sys,
+            step: 0,
+            book,
+            spin: None,
+            plan,
+            before,
+        }
+    }
+
+    /// Loads and validates the scene file at `path`. Errors are one line naming the field.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        Ok(SoftEngine::new(load_soft_scene(path).map_err(|e| e.to_string())?))
+    }
+
+    /// The scene's warnings (e.g. a step longer than advised).
+    pub fn scene_warnings(&self) -> &[String] {
+        &self.scene.warnings
+    }
+
+    /// The scene being run.
+    pub fn scene(&self) -> &SoftScene {
+        &self.scene
+    }
+
+    /// What the scene resolves to, for `rubblepile check`.
+    pub fn describe(&self) -> Vec<String> {
+        let s = &self.scene;
+        vec![
+            format!("{}: ok", s.name),
+            format!(
+                "  {} particles, {} walls, t_end = {} s, dt = {} s ({} steps)",
+                s.particles.len(),
+                s.walls.len(),
+                s.t_end,
+                s.dt,
+                s.n_steps
+            ),
+            format!(
+                "  k_n = {:e} N/m (advised {:e} N/m, dt {:e} s)",
+                s.material.k_n, s.advice.k_n, s.advice.dt
+            ),
+        ]
+    }
+}
+
+impl RunReport for SoftSummary {
+    fn one_line(&self) -> String {
+        SoftSummary::one_line(self)
+    }
+}
+
+impl Engine for SoftEngine {
+    type Summary = SoftSummary;
+    type State = SoftState;
+    const KIND: &'static str = crate::granular::soft::scene::KIND;
+
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
+        Ok(SoftEngine::new(parse_soft_scene(text, name, base_dir).map_err(|e| e.to_string())?))
+    }
+
+    fn scene_source(&self) -> &str {
+        &self.scene.source
+    }
+
+    fn scene_base_dir(&self) -> Option<&Path> {
+        self.scene.base_dir.as_deref()
+    }
+
+    fn t_end(&self) -> f64 {
+        self.scene.t_end
+    }
+
+    fn time(&self) -> f64 {
+        self.step as f64 * self.scene.dt
+    }
+
+    fn samples(&self) -> Vec<Sample> {
+        self.plan
+            .iter()
+            .map(|&(step, snapshot)| Sample {
+                t: step as f64 * self.scene.dt,
+                snapshot,
+            })
+            .collect()
+    }
+
+    fn timeseries_header(&self) -> String {
+        TIMESERIES_HEADER.to_string()
+    }
+
+    fn open_outputs(&mut self, dir: &Path) -> std::io::Result<()> {
+        if let Some(settings) = &self.scene.spinup {
+            // the body starts on the path (T_start) and the t = 0 sample needs the contact records
+            let sys = &mut self.sys;
+            let driver = SpinupDriver::new(*settings, &self.scene.particles);
+            let springs = sys.pair_springs();
+            let member = central_body(&sys.particles, springs.iter().map(|(k, _)| k));
+            driver.apply(&mut sys.particles, &member, 0.0);
+            sys.keep_records = true;
+            sys.set_pair_springs(Vec::new());
+            sys.compute_forces(0.0, 0.0);
+            let mut csv = BufWriter::new(File::create(dir.join("spinup.csv"))?);
+            csv.write_all(SPINUP_HEADER.as_bytes())?;
+            self.spin = Some(SpinRun {
+                driver,
+                csv,
+                bytes: SPINUP_HEADER.len() as u64,
+            });
+            self.book = Book::new(&self.sys);
+        }
+        Ok(())
+    }
+
+    fn advance(&mut self, index: usize, _to: &Sample, progress: &mut dyn FnMut(f64)) -> Result<(), Failure> {
+        let sample_step = self.plan[index].0;
+        let dt = self.scene.dt;
+        let sys = &mut self.sys;
+        while self.step < sample_step {
+            let step = self.step;
+            self.before.clone_from(&sys.particles);
+            if step.is_multiple_of(256) {
+                progress(step as f64 * dt);
             }
             // the spin-up diagnostics at a sample need that step's contact records
-            sys.keep_records = spin.is_some() && step + 1 == sample_step;
+            sys.keep_records = self.spin.is_some() && step + 1 == sample_step;
             // the spring energy is read only at samples (the energy residual of the row)
             sys.spring_energy_wanted = step + 1 == sample_step;
-            leapfrog::step(&mut sys, step as f64 * dt, dt);
-            if let Some(s) = &spin {
-                s.after_step(&mut sys, (step + 1) as f64 * dt);
+            leapfrog::step(sys, step as f64 * dt, dt);
+            if let Some(s) = &self.spin {
+                s.after_step(sys, (step + 1) as f64 * dt);
             }
-            let broken = if let Some(k) = sys.particles.iter().position(|p| !p.is_finite()) {
-                Some(format!("non-finite state of particle {k}"))
-            } else if sys.stats.max_overlap_fraction > BROKEN_OVERLAP {
-                Some(format!(
+            if let Some(k) = sys.particles.iter().position(|p| !p.is_finite()) {
+                return Err(Failure::new(format!("non-finite state of particle {k}")));
+            }
+            if sys.stats.max_overlap_fraction > BROKEN_OVERLAP {
+                return Err(Failure::new(format!(
                     "overlap of {} of a radius (> {BROKEN_OVERLAP}): contacts too soft or step too long",
                     sys.stats.max_overlap_fraction
-                ))
+                )));
+            }
+            self.book.max_overlap = self.book.max_overlap.max(sys.stats.max_overlap_fraction);
+            self.step += 1;
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self, _to: &Sample, wall_seconds: f64) -> Result<String, SampleError> {
+        let line = row(&self.scene, &self.sys, &mut self.book, self.step, wall_seconds);
+        let t = self.time();
+        if let Some(s) = self.spin.as_mut() {
+            s.sample(&self.sys, t).map_err(|source| SampleError::Io {
+                path: "spinup.csv".into(),
+                source,
+            })?;
+        }
+        Ok(line)
+    }
+
+    fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
+        write_particles_csv(path, self.time(), &self.sys.particles)
+    }
+
+    fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {
+        let t_good = self.time();
+        write_particles_csv(path, t_good, &self.before)?;
+        Ok(t_good)
+    }
+
+    fn summary(&self, outcome: Outcome<'_>, samples: u64, wall_seconds: f64) -> SoftSummary {
+        let status = match outcome {
+            Outcome::Completed => "completed".to_string(),
+            Outcome::Failed(f) => format!("failed: {} at t = {} s", f.cause, self.time() + self.scene.dt),
+        };
+        summary(&self.scene, &self.sys, &self.book, status, self.step, samples, wall_seconds)
+    }
+
+    fn save(&mut self) -> std::io::Result<SoftState> {
+        let sys = &self.sys;
+        let mut state = Vec::with_capacity(15 * sys.particles.len());
+        for (k, p) in sys.particles.iter().enumerate() {
+            for v in [p.position, p.velocity, p.spin, sys.forces[k], sys.torques[k]] {
+                state.extend(v.iter());
+            }
+        }
+        Ok(SoftState {
+            step: self.step,
+            state,
+            pair_springs: pack(&sys.pair_springs()),
+            wall_springs: pack(&sys.wall_springs),
+            work: vec![
+                sys.dissipated,
+                sys.wall_work,
+                sys.forcing_work,
+                sys.forcing_angular_impulse.x,
+                sys.forcing_angular_impulse.y,
+                sys.forcing_angular_impulse.z,
+            ],
+            gravity_phase: sys.gravity_phase,
+            slow: if sys.split_gravity() {
+                let mut v: Vec<f64> = sys.slow_accelerations.iter().flat_map(|a| a.iter().copied()).collect();
+                v.push(sys.slow_energy);
+                v
             } else {
-                None
-            };
-            if let Some(cause) = broken {
-                if let Some(pb) = &pb {
-                    pb.abandon();
-                }
-                let t_good = step as f64 * dt;
-                let lgs = dir.join("last_good_state.csv");
-                write_particles_csv(&lgs, t_good, &before).map_err(io_err(&lgs))?;
-                let s = summary(
-                    scene,
-                    &sys,
-                    &book,
-                    format!("failed: {cause} at t = {} s", t_good + dt),
-                    step,
-                    rows,
-                    wall(&clock),
-                );
-                write_summary(&dir.join("summary.json"), &s)?;
-                return Err(SoftRunError::Failed {
-                    t: t_good,
-                    cause,
-                    last_good_state: lgs,
-                    summary: Box::new(s),
-                });
-            }
-            book.max_overlap = book.max_overlap.max(sys.stats.max_overlap_fraction);
-            step += 1;
-        }
-        let line = row(scene, &sys, &mut book, step, wall(&clock));
-        timeseries.write_all(line.as_bytes()).map_err(io_err(&ts_path))?;
-        timeseries.flush().map_err(io_err(&ts_path))?;
-        rows += 1;
-        bytes += line.len() as u64;
-        let t = step as f64 * dt;
-        if let Some(s) = spin.as_mut() {
-            s.sample(&sys, t, &spin_path)?;
-        }
-        if let Some(k) = snapshot {
-            let p = dir.join("snapshots").join(format!("{k}.csv"));
-            write_particles_csv(&p, t, &sys.particles).map_err(io_err(&p))?;
-        }
-        let last = index + 1 == plan.len();
-        let due_wall = options
-            .checkpoint_every
-            .is_some_and(|w| w > 0.0 && clock.elapsed().as_secs_f64() - last_checkpoint_wall >= w);
-        let due_sim = options.checkpoint_every_sim.is_some_and(|s| t - last_checkpoint_t >= s);
-        if !last && (due_wall || due_sim) {
-            checkpoints += 1;
-            let mut state = Vec::with_capacity(15 * sys.particles.len());
-            for (k, p) in sys.particles.iter().enumerate() {
-                for v in [p.position, p.velocity, p.spin, sys.forces[k], sys.torques[k]] {
-                    state.extend(v.iter());
-                }
-            }
-            let ck = SoftCheckpoint {
-                format: SOFT_CHECKPOINT_FORMAT.into(),
-                version: 1,
-                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
-                scene_hash: fnv1a_hex(scene.source.as_bytes()),
-                scene_base_dir: base.clone(),
-                step,
-                t_seconds: t,
-                next_sample: index as u64 + 1,
-                rows,
-                timeseries_bytes: bytes,
-                checkpoints,
-                wall_seconds: wall(&clock),
-                state,
-                pair_springs: pack(&sys.pair_springs()),
-                wall_springs: pack(&sys.wall_springs),
-                work: vec![
-                    sys.dissipated,
-                    sys.wall_work,
-                    sys.forcing_work,
-                    sys.forcing_angular_impulse.x,
-                    sys.forcing_angular_impulse.y,
-                    sys.forcing_angular_impulse.z,
-                ],
-                gravity_phase: sys.gravity_phase,
-                slow: if sys.split_gravity() {
-                    let mut v: Vec<f64> = sys.slow_accelerations.iter().flat_map(|a| a.iter().copied()).collect();
-                    v.push(sys.slow_energy);
-                    v
-                } else {
-                    Vec::new()
-                },
-                book: book.to_vec(),
-                spinup: spin.as_ref().map(|s| SpinupCheckpoint {
-                    state: s.driver.state(),
-                    bytes: s.bytes,
-                }),
-            };
-            let tmp = dir.join(CHECKPOINT_TMP_FILE);
-            let text = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
-            std::fs::write(&tmp, text).map_err(io_err(&tmp))?;
-            let fin = dir.join(CHECKPOINT_FILE);
-            std::fs::rename(&tmp, &fin).map_err(io_err(&fin))?;
-            last_checkpoint_wall = clock.elapsed().as_secs_f64();
-            last_checkpoint_t = t;
-            written_this_process += 1;
-            if options.stop_after_checkpoints == Some(written_this_process) {
-                return Err(SoftRunError::Run(RunError::Stopped {
-                    dir: dir.to_path_buf(),
-                    t,
-                    checkpoints: written_this_process,
-                }));
-            }
-        }
+                Vec::new()
+            },
+            book: self.book.to_vec(),
+            spinup: self.spin.as_ref().map(|s| SpinupCheckpoint {
+                state: s.driver.state(),
+                bytes: s.bytes,
+            }),
+        })
     }
-    if let Some(pb) = &pb {
-        pb.finish_and_clear();
+
+    fn restore(&mut self, ck: SoftState, dir: &Path, _at: Resumed) -> Result<(), String> {
+        let scene = &self.scene;
+        let n = scene.particles.len();
+        if ck.state.len() != 15 * n {
+            return Err(format!("the checkpoint holds {} numbers for {n} particles", ck.state.len()));
+        }
+        let mut sys = SoftSystem::new(
+            scene.particles.clone(),
+            scene.walls.clone(),
+            scene.material,
+            scene.gravity,
+        );
+        for (k, c) in ck.state.chunks(15).enumerate() {
+            let v = |o: usize| Vec3::new(c[o], c[o + 1], c[o + 2]);
+            sys.particles[k].position = v(0);
+            sys.particles[k].velocity = v(3);
+            sys.particles[k].spin = v(6);
+            sys.forces[k] = v(9);
+            sys.torques[k] = v(12);
+        }
+        sys.set_pair_springs(unpack(&ck.pair_springs).ok_or("malformed pair springs")?);
+        sys.wall_springs = unpack(&ck.wall_springs).ok_or("malformed wall springs")?;
+        if ck.work.len() != 6 {
+            return Err("malformed work record".into());
+        }
+        sys.dissipated = ck.work[0];
+        sys.wall_work = ck.work[1];
+        sys.forcing_work = ck.work[2];
+        sys.forcing_angular_impulse = Vec3::new(ck.work[3], ck.work[4], ck.work[5]);
+        sys.gravity_interval = scene.gravity_interval;
+        if sys.split_gravity() {
+            if ck.slow.len() != 3 * n + 1 || ck.gravity_phase >= scene.gravity_interval {
+                return Err("malformed self-gravity block record (slow, gravity_phase)".into());
+            }
+            sys.gravity_phase = ck.gravity_phase;
+            sys.slow_accelerations = ck.slow[..3 * n]
+                .chunks(3)
+                .map(|c| Vec3::new(c[0], c[1], c[2]))
+                .collect();
+            sys.slow_energy = ck.slow[3 * n];
+        }
+        self.book = Book::from_vec(&ck.book).ok_or("malformed bookkeeping")?;
+        self.spin = match (&scene.spinup, &ck.spinup) {
+            (Some(settings), Some(sc)) => {
+                let mut driver = SpinupDriver::new(*settings, &scene.particles);
+                driver.restore(&sc.state).ok_or("malformed spin-up state")?;
+                let f = crate::engine::reopen_truncated(&dir.join("spinup.csv"), sc.bytes)?;
+                Some(SpinRun {
+                    driver,
+                    csv: BufWriter::new(f),
+                    bytes: sc.bytes,
+                })
+            }
+            (None, None) => None,
+            _ => return Err("the checkpoint and the scene disagree on [spinup]".into()),
+        };
+        self.before = sys.particles.clone();
+        self.sys = sys;
+        self.step = ck.step;
+        Ok(())
     }
-    let s = summary(scene, &sys, &book, "completed".into(), step, rows, wall(&clock));
-    write_summary(&dir.join("summary.json"), &s)?;
-    Ok(s)
 }

@@ -6,32 +6,39 @@
 //!
 //! The branch directory gets the new scene as `scene.toml`, the parent's `timeseries.csv` and `spinup.csv`
 //! (cut back to the checkpoint when the branch is resumed) and the parent's `checkpoint.json` with the scene
-//! hash of the new scene; [`crate::granular::soft::run::resume_soft`] then carries it on. Whether the two
+//! hash of the new scene; [`crate::driver::resume_soft`] then carries it on. Whether the two
 //! scenes really agree up to the checkpoint is the caller's promise; what can be checked here is checked: the
 //! new scene must parse, hold the same number of particles, and put an output sample at the checkpoint's step
 //! with the same index.
 
 use std::path::Path;
 
-use crate::granular::soft::run::{SoftRunError, sample_steps};
+use super::{CHECKPOINT_FILE, RunError};
+use crate::bits::fnv1a_hex;
+use crate::granular::soft::run::{SoftSummary, sample_steps};
 use crate::granular::soft::scene::parse_soft_scene;
-use crate::io::checkpoint::{CHECKPOINT_FILE, fnv1a_hex};
-use crate::run::RunError;
+
+/// Errors of branching: those of a soft-sphere run.
+type BranchError = RunError<SoftSummary>;
 
 /// The step and time (s) of the checkpoint in `dir`.
-pub fn checkpoint_time(dir: &Path) -> Result<(u64, f64), SoftRunError> {
+pub fn checkpoint_time(dir: &Path) -> Result<(u64, f64), BranchError> {
     let v = read_checkpoint(dir)?;
-    let step = v["step"].as_u64();
+    let step = v["engine"]["step"].as_u64();
     let t = v["t_seconds"].as_f64();
-    step.zip(t)
-        .ok_or_else(|| bad(format!("{}: no step/t_seconds", dir.join(CHECKPOINT_FILE).display())))
+    step.zip(t).ok_or_else(|| {
+        bad(format!(
+            "{}: no engine.step/t_seconds (not a soft-sphere checkpoint of this build)",
+            dir.join(CHECKPOINT_FILE).display()
+        ))
+    })
 }
 
-fn bad(m: String) -> SoftRunError {
-    SoftRunError::Run(RunError::BadCheckpoint(m))
+fn bad(m: String) -> BranchError {
+    RunError::BadCheckpoint(m)
 }
 
-fn read_checkpoint(dir: &Path) -> Result<serde_json::Value, SoftRunError> {
+fn read_checkpoint(dir: &Path) -> Result<serde_json::Value, BranchError> {
     let p = dir.join(CHECKPOINT_FILE);
     let text = std::fs::read_to_string(&p).map_err(|e| bad(format!("{}: {e}", p.display())))?;
     serde_json::from_str(&text).map_err(|e| bad(format!("{}: {e}", p.display())))
@@ -43,11 +50,11 @@ fn read_checkpoint(dir: &Path) -> Result<serde_json::Value, SoftRunError> {
 ///
 /// Errors name what disagrees: the scene does not parse, the particle count differs, or the new scene's output
 /// grid has no sample at the checkpoint's step with the checkpoint's index.
-pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path) -> Result<(), SoftRunError> {
+pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path) -> Result<(), BranchError> {
     let mut ck = read_checkpoint(parent)?;
     let name = dir.join("scene.toml").display().to_string();
     let scene = parse_soft_scene(scene_text, &name, Some(scene_dir)).map_err(|e| bad(e.to_string()))?;
-    let n_state = ck["state"].as_array().map_or(0, Vec::len);
+    let n_state = ck["engine"]["state"].as_array().map_or(0, Vec::len);
     if n_state != 15 * scene.particles.len() {
         return Err(bad(format!(
             "{name}: {} particles, the parent's checkpoint holds {}",
@@ -55,7 +62,7 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
             n_state / 15
         )));
     }
-    let step = ck["step"].as_u64().unwrap_or(u64::MAX);
+    let step = ck["engine"]["step"].as_u64().unwrap_or(u64::MAX);
     let index = ck["next_sample"].as_u64().unwrap_or(0) as usize;
     let plan = sample_steps(&scene);
     if index == 0 || plan.get(index - 1).map(|s| s.0) != Some(step) {

@@ -1,0 +1,729 @@
+//! The one run driver: integrates any [`Engine`] from t = 0 (or from a checkpoint) to its end time and writes the
+//! outputs, the same way for the ellipsoids, the soft spheres and the hard spheres.
+//!
+//! Files written in the output directory (engines add their own, e.g. `tracks.csv`, `spinup.csv`):
+//! - `scene.toml`: a copy of the scene text;
+//! - `timeseries.csv`: the engine's diagnostics row at every output sample, written and flushed row by row;
+//! - `snapshots/<k>.csv`: the state at the k-th snapshot time (landed on exactly);
+//! - `summary.json`: the engine's summary (status, counters, conservation errors beside the wall time);
+//! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format, the cause named in
+//!   `summary.json` and on stderr;
+//! - `checkpoint.json` (only when due, see [`RunOptions`]): the state [`resume`] continues from.
+//!
+//! # Checkpoints and resume
+//!
+//! A checkpoint is taken at an output sample (never mid-step, never after the last sample) when
+//! [`RunOptions::checkpoint_every`] wall-clock seconds have passed since the last one (or since the process
+//! started), or [`RunOptions::checkpoint_every_sim`] simulated seconds since the last checkpoint's time. It is
+//! written atomically (`checkpoint.json.tmp`, fsync, rename, directory fsync) after the rows it counts are on disk.
+//! Its envelope (format, version, engine kind, scene fingerprint, time, sample index, time-series length, wall
+//! time) is the driver's; the engine's state sits under `engine`. Every `f64` that influences the continuation is
+//! stored as its bit pattern ([`crate::bits::exact_f64`]), so a run resumed from a checkpoint ends with the same
+//! snapshots, time series (`wall_seconds` aside) and summary counters as an uninterrupted one, bit for bit.
+//!
+//! On resume the scene is re-read from the run's `scene.toml` copy (refused if it changed since the checkpoint),
+//! relative input files are resolved against the original scene's directory stored in the checkpoint,
+//! `timeseries.csv` is cut back to its length at the checkpoint, and the engine reopens its own files likewise.
+
+pub mod branch;
+pub mod kind;
+
+use std::fs::File;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use serde::{Deserialize, Serialize};
+
+use crate::bits::{exact_f64, fnv1a_hex};
+use crate::ellipsoid::run::EllipsoidEngine;
+use crate::engine::{Engine, Outcome, Resumed, RunReport, SampleError};
+use crate::granular::soft::run::{SoftEngine, SoftSummary};
+use crate::granular::soft::scene::SoftScene;
+pub use crate::io::summary::RunSummary;
+use crate::scene::LoadedScene;
+
+pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
+
+pub use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
+/// The `format` tag of a checkpoint.
+pub const CHECKPOINT_FORMAT: &str = "rubblepile-checkpoint";
+/// The checkpoint layout this build writes and reads (1: one layout per engine, before the one driver).
+pub const CHECKPOINT_VERSION: u32 = 2;
+
+/// Default wall-clock checkpoint cadence (s) of [`RunOptions::default`] and of the command line: runs shorter than
+/// this never write a checkpoint.
+pub const DEFAULT_CHECKPOINT_EVERY: f64 = 600.0;
+
+/// How a run behaves (not what it simulates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunOptions {
+    /// Write into an existing non-empty output directory (removing a previous run's files first).
+    pub force: bool,
+    /// Show a progress bar on stderr when stderr is a terminal.
+    pub progress: bool,
+    /// Checkpoint at the first output sample after this many wall-clock seconds since the last checkpoint (or the
+    /// start of the process); `None` or a value ≤ 0 = never by wall clock.
+    pub checkpoint_every: Option<f64>,
+    /// Checkpoint at the first output sample at least this many simulated seconds after the last checkpoint's time
+    /// (or the start); `Some(0.0)` = at every output sample; `None` = never by simulated time.
+    pub checkpoint_every_sim: Option<f64>,
+    /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many checkpoints
+    /// (as if the process had been killed then).
+    pub stop_after_checkpoints: Option<u64>,
+}
+
+impl Default for RunOptions {
+    /// `force: false, progress: true`, checkpoints every [`DEFAULT_CHECKPOINT_EVERY`] wall-clock seconds, none by
+    /// simulated time, no stop.
+    fn default() -> Self {
+        RunOptions {
+            force: false,
+            progress: true,
+            checkpoint_every: Some(DEFAULT_CHECKPOINT_EVERY),
+            checkpoint_every_sim: None,
+            stop_after_checkpoints: None,
+        }
+    }
+}
+
+/// Why a run did not complete; `S` is the engine's summary (carried by [`RunError::Failed`]). Messages are one line.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError<S> {
+    /// The output directory holds files and `force` was not given.
+    #[error("output directory {} exists and is not empty; use --force to overwrite it", .dir.display())]
+    OutputExists {
+        /// The directory.
+        dir: PathBuf,
+    },
+    /// The output path exists and is not a directory.
+    #[error("output path {} exists and is not a directory", .dir.display())]
+    NotADirectory {
+        /// The path.
+        dir: PathBuf,
+    },
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", .path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The engine could not be set up from the scene (e.g. bad integrator tolerances).
+    #[error("{0}")]
+    Setup(String),
+    /// The run failed; `summary.json` and `last_good_state.csv` were written.
+    #[error("run failed: {cause}; last good state (t = {t} s) in {}", .last_good_state.display())]
+    Failed {
+        /// Last good time (s).
+        t: f64,
+        /// The cause (also in the summary's `status`).
+        cause: String,
+        /// Where the last good state was written.
+        last_good_state: PathBuf,
+        /// The summary written.
+        summary: Box<S>,
+    },
+    /// [`resume`]: the directory holds no checkpoint.
+    #[error("nothing to resume: {} does not exist (checkpoints are written only when due, see --checkpoint-every)", .dir.join(CHECKPOINT_FILE).display())]
+    NoCheckpoint {
+        /// The run directory.
+        dir: PathBuf,
+    },
+    /// [`resume`]: the run already completed.
+    #[error("the run in {} already completed (t = {t} s); nothing to resume", .dir.display())]
+    AlreadyCompleted {
+        /// The run directory.
+        dir: PathBuf,
+        /// Its final time (s).
+        t: f64,
+    },
+    /// [`resume`]: the checkpoint or the run directory cannot be used (corrupt checkpoint, changed scene or input
+    /// file, truncated time series, …).
+    #[error("cannot resume: {0}")]
+    BadCheckpoint(String),
+    /// The run stopped after a checkpoint as asked by [`RunOptions::stop_after_checkpoints`].
+    #[error("stopped after checkpoint {checkpoints} at t = {t} s (--stop-after-checkpoints); continue with `rubblepile resume {}`", .dir.display())]
+    Stopped {
+        /// The run directory.
+        dir: PathBuf,
+        /// Time of the checkpoint (s).
+        t: f64,
+        /// Checkpoints this process wrote.
+        checkpoints: u64,
+    },
+}
+
+impl<S> RunError<S> {
+    /// Whether the error is the caller's (bad arguments) rather than a failed run: the CLI exits with code 2 for
+    /// these and 1 otherwise.
+    pub fn is_usage(&self) -> bool {
+        matches!(
+            self,
+            RunError::OutputExists { .. }
+                | RunError::NotADirectory { .. }
+                | RunError::Setup(_)
+                | RunError::NoCheckpoint { .. }
+                | RunError::AlreadyCompleted { .. }
+                | RunError::BadCheckpoint(_)
+        )
+    }
+
+    /// The command line's exit code: 2 for [`RunError::is_usage`], 3 for [`RunError::Stopped`], 1 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        if self.is_usage() {
+            2
+        } else if matches!(self, RunError::Stopped { .. }) {
+            3
+        } else {
+            1
+        }
+    }
+
+    /// The same error with the failed run's summary mapped by `f` (every other variant unchanged).
+    pub fn map_summary<T>(self, f: impl FnOnce(S) -> T) -> RunError<T> {
+        match self {
+            RunError::OutputExists { dir } => RunError::OutputExists { dir },
+            RunError::NotADirectory { dir } => RunError::NotADirectory { dir },
+            RunError::Io { path, source } => RunError::Io { path, source },
+            RunError::Setup(m) => RunError::Setup(m),
+            RunError::Failed {
+                t,
+                cause,
+                last_good_state,
+                summary,
+            } => RunError::Failed {
+                t,
+                cause,
+                last_good_state,
+                summary: Box::new(f(*summary)),
+            },
+            RunError::NoCheckpoint { dir } => RunError::NoCheckpoint { dir },
+            RunError::AlreadyCompleted { dir, t } => RunError::AlreadyCompleted { dir, t },
+            RunError::BadCheckpoint(m) => RunError::BadCheckpoint(m),
+            RunError::Stopped { dir, t, checkpoints } => RunError::Stopped { dir, t, checkpoints },
+        }
+    }
+}
+
+fn io_err<S>(path: &Path) -> impl FnOnce(std::io::Error) -> RunError<S> + '_ {
+    move |source| RunError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Files a run writes at the top of its directory (removed by `force`).
+const OUTPUT_FILES: [&str; 10] = [
+    "scene.toml",
+    "summary.json",
+    "timeseries.csv",
+    "tracks.csv",
+    "spinup.csv",
+    "last_good_state.csv",
+    "barrier_overruns.csv",
+    CHECKPOINT_FILE,
+    CHECKPOINT_TMP_FILE,
+    "impact.json",
+];
+
+/// Checks `dir` is usable and creates it (and `snapshots/`). With `force`, a previous run's files are removed first
+/// (only those: other files are left alone).
+pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<(), RunError<S>> {
+    if dir.exists() {
+        if !dir.is_dir() {
+            return Err(RunError::NotADirectory { dir: dir.to_path_buf() });
+        }
+        let non_empty = std::fs::read_dir(dir).map_err(io_err(dir))?.next().is_some();
+        if non_empty {
+            if !force {
+                return Err(RunError::OutputExists { dir: dir.to_path_buf() });
+            }
+            for name in OUTPUT_FILES {
+                let p = dir.join(name);
+                if p.is_file() && name != "impact.json" {
+                    std::fs::remove_file(&p).map_err(io_err(&p))?;
+                }
+            }
+            let snaps = dir.join("snapshots");
+            if snaps.is_dir() {
+                for entry in std::fs::read_dir(&snaps).map_err(io_err(&snaps))? {
+                    let entry = entry.map_err(io_err(&snaps))?;
+                    let name = entry.file_name();
+                    let name = name.to_string_lossy();
+                    let is_snapshot = name
+                        .strip_suffix(".csv")
+                        .is_some_and(|stem| !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit()));
+                    if is_snapshot {
+                        std::fs::remove_file(entry.path()).map_err(io_err(&entry.path()))?;
+                    }
+                }
+            }
+        }
+    }
+    let snaps = dir.join("snapshots");
+    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    Ok(())
+}
+
+/// A progress bar on stderr for a run from `t` to `t_end` (s), when `enabled` and stderr is a terminal.
+pub fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::ProgressBar> {
+    if !enabled || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let pb = indicatif::ProgressBar::with_draw_target(Some(1_000_000), indicatif::ProgressDrawTarget::stderr());
+    let style = indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg} ETA {eta}")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    pb.set_style(style);
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.reset_eta();
+    pb.set_message(format!("t = {t}/{t_end} s"));
+    pb.enable_steady_tick(Duration::from_millis(250));
+    Some(pb)
+}
+
+/// Moves `pb` to simulated time `t` of `t_end` (s).
+pub fn show_progress(pb: &indicatif::ProgressBar, t: f64, t_end: f64) {
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.set_message(format!("t = {t:.4}/{t_end} s"));
+}
+
+/// `checkpoint.json`: the driver's envelope around the engine's state `S`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Checkpoint<S> {
+    format: String,
+    version: u32,
+    writer: String,
+    /// The engine's scene kind.
+    kind: String,
+    /// FNV-1a hash of the run's `scene.toml` copy.
+    scene_hash: String,
+    /// Directory relative input files of the scene are resolved against (absolute).
+    scene_base_dir: Option<PathBuf>,
+    #[serde(with = "exact_f64")]
+    t: f64,
+    /// For people reading the file only.
+    t_seconds: f64,
+    /// Index of the next output sample.
+    next_sample: u64,
+    timeseries_rows: u64,
+    timeseries_bytes: u64,
+    /// Checkpoints written by the run so far (all processes).
+    checkpoints: u64,
+    #[serde(with = "exact_f64")]
+    wall_seconds: f64,
+    engine: S,
+}
+
+/// The envelope alone, read first to say clearly which checkpoint this is before its engine part is parsed.
+#[derive(Debug, Deserialize)]
+struct Header {
+    format: Option<String>,
+    version: Option<u32>,
+    kind: Option<String>,
+}
+
+/// Where [`drive`] starts: t = 0, or a checkpoint.
+struct Start {
+    next_sample: u64,
+    rows: u64,
+    bytes: u64,
+    wall_before: f64,
+    checkpoints: u64,
+    timeseries: File,
+}
+
+/// What every checkpoint of a run repeats.
+struct Identity {
+    scene_base_dir: Option<PathBuf>,
+    scene_hash: String,
+}
+
+fn absolute_base<S>(engine: &impl Engine) -> Result<Option<PathBuf>, RunError<S>> {
+    match engine.scene_base_dir() {
+        Some(d) => Ok(Some(
+            std::fs::canonicalize(d)
+                .or_else(|_| std::path::absolute(d))
+                .map_err(io_err(d))?,
+        )),
+        None => Ok(None),
+    }
+}
+
+/// Runs `engine` from its initial state, writing the outputs into `out_dir` (see the module docs).
+///
+/// Refuses an existing non-empty `out_dir` unless `options.force`. When the engine fails (non-finite state, step
+/// size underflow, a broken constraint), writes `last_good_state.csv` and `summary.json` (naming the cause) and
+/// returns [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunReport::one_line`].
+pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    prepare_output_dir(out_dir, options.force)?;
+    let scene_copy = out_dir.join("scene.toml");
+    std::fs::write(&scene_copy, engine.scene_source()).map_err(io_err(&scene_copy))?;
+    let identity = Identity {
+        scene_base_dir: absolute_base(&engine)?,
+        scene_hash: fnv1a_hex(engine.scene_source().as_bytes()),
+    };
+    let ts_path = out_dir.join("timeseries.csv");
+    let mut timeseries = File::create(&ts_path).map_err(io_err(&ts_path))?;
+    let header = engine.timeseries_header();
+    timeseries.write_all(header.as_bytes()).map_err(io_err(&ts_path))?;
+    engine.open_outputs(out_dir).map_err(io_err(out_dir))?;
+    let start = Start {
+        next_sample: 0,
+        rows: 0,
+        bytes: header.len() as u64,
+        wall_before: 0.0,
+        checkpoints: 0,
+        timeseries,
+    };
+    drive(&mut engine, out_dir, options, start, &identity)
+}
+
+/// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
+fn completed_run(dir: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    (v.get("status")?.as_str()? == "completed").then(|| {
+        v.get("final_time")
+            .or(v.get("t_reached"))
+            .and_then(|t| t.as_f64())
+            .unwrap_or(f64::NAN)
+    })
+}
+
+/// Reads `dir/checkpoint.json` as a checkpoint of engine `E`, with one-line errors naming what is wrong.
+fn read_checkpoint<E: Engine>(dir: &Path) -> Result<Checkpoint<E::State>, RunError<E::Summary>> {
+    let path = dir.join(CHECKPOINT_FILE);
+    let corrupt = |reason: String| {
+        RunError::BadCheckpoint(format!(
+            "{}: corrupt or incompatible checkpoint: {}",
+            path.display(),
+            reason.split_whitespace().collect::<Vec<_>>().join(" ")
+        ))
+    };
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(RunError::NoCheckpoint { dir: dir.to_path_buf() });
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => return Err(corrupt("not UTF-8 text".into())),
+        Err(source) => return Err(RunError::Io { path, source }),
+    };
+    let header: Header = serde_json::from_str(&text).map_err(|e| corrupt(e.to_string()))?;
+    match header.format.as_deref() {
+        Some(CHECKPOINT_FORMAT) => {}
+        Some(f @ ("rubblepile-ssdem-checkpoint" | "rubblepile-hsdem-checkpoint")) => {
+            return Err(RunError::BadCheckpoint(format!(
+                "{}: format {f:?} was written by an older rubblepile (before the one run driver); this build reads \
+                 {CHECKPOINT_FORMAT:?} version {CHECKPOINT_VERSION}: re-run the scene from the start",
+                path.display()
+            )));
+        }
+        other => {
+            return Err(corrupt(format!(
+                "format is {:?}, expected {CHECKPOINT_FORMAT:?}",
+                other.unwrap_or("missing")
+            )));
+        }
+    }
+    if header.version != Some(CHECKPOINT_VERSION) {
+        return Err(RunError::BadCheckpoint(format!(
+            "{}: version {} (this build reads version {CHECKPOINT_VERSION}; version 1 was written by an older \
+             rubblepile, before the one run driver): re-run the scene from the start",
+            path.display(),
+            header.version.map_or("missing".to_string(), |v| v.to_string())
+        )));
+    }
+    if header.kind.as_deref() != Some(E::KIND) {
+        return Err(RunError::BadCheckpoint(format!(
+            "{}: a checkpoint of a {:?} run, but the run's scene is of kind {:?}",
+            path.display(),
+            header.kind.as_deref().unwrap_or("missing"),
+            E::KIND
+        )));
+    }
+    let de = &mut serde_json::Deserializer::from_str(&text);
+    let c: Checkpoint<E::State> = serde_path_to_error::deserialize(de).map_err(|e| {
+        let at = e.path().to_string();
+        let inner = e.into_inner();
+        if at.is_empty() || at == "." {
+            corrupt(inner.to_string())
+        } else {
+            corrupt(format!("{at}: {inner}"))
+        }
+    })?;
+    if !c.t.is_finite() {
+        return Err(corrupt("non-finite time".into()));
+    }
+    Ok(c)
+}
+
+/// Cuts the output file `path` back to `bytes` (its length at the checkpoint) and opens it for appending.
+///
+/// Errors: [`RunError::BadCheckpoint`] when the file is missing or shorter than `bytes`.
+pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>> {
+    crate::engine::reopen_truncated(path, bytes).map_err(RunError::BadCheckpoint)
+}
+
+/// Continues the run in `dir` from its `checkpoint.json` (see the module docs), as if it had never stopped: same
+/// snapshots, time-series rows (after cutting those written after the checkpoint) and summary. `options.force` is
+/// ignored; the checkpoint options apply to the continued run.
+///
+/// Errors: [`RunError::AlreadyCompleted`] when `dir/summary.json` says the run completed, [`RunError::NoCheckpoint`]
+/// without a checkpoint, [`RunError::BadCheckpoint`] when the checkpoint is corrupt or does not match the directory
+/// (scene copy, input files, time series); otherwise as [`run`].
+pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    if let Some(t) = completed_run(dir) {
+        return Err(RunError::AlreadyCompleted {
+            dir: dir.to_path_buf(),
+            t,
+        });
+    }
+    let ckpt = read_checkpoint::<E>(dir)?;
+    let bad = RunError::BadCheckpoint;
+    let scene_path = dir.join("scene.toml");
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| bad(format!("{}: {e}", scene_path.display())))?;
+    if fnv1a_hex(text.as_bytes()) != ckpt.scene_hash {
+        return Err(bad(format!(
+            "{} changed since the checkpoint was written",
+            scene_path.display()
+        )));
+    }
+    let mut engine = E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
+        .map_err(bad)?;
+
+    // The checkpoint must sit right after one of the run's samples.
+    let samples = engine.samples();
+    let prev = ckpt.next_sample.checked_sub(1).and_then(|i| samples.get(i as usize));
+    if ckpt.next_sample as usize >= samples.len() || prev.is_none_or(|p| p.t.to_bits() != ckpt.t.to_bits()) {
+        return Err(bad(format!(
+            "the checkpoint (t = {} s, next sample {}) does not match the scene's output samples",
+            ckpt.t, ckpt.next_sample
+        )));
+    }
+    if ckpt.timeseries_rows != ckpt.next_sample {
+        return Err(bad(format!(
+            "the checkpoint counts {} time-series rows for {} samples",
+            ckpt.timeseries_rows, ckpt.next_sample
+        )));
+    }
+    engine
+        .restore(
+            ckpt.engine,
+            dir,
+            Resumed {
+                t: ckpt.t,
+                samples_done: ckpt.next_sample,
+            },
+        )
+        .map_err(bad)?;
+
+    // Stale files of the interrupted process (a failure summary, a half-written checkpoint).
+    for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
+        let p = dir.join(name);
+        if p.is_file() {
+            std::fs::remove_file(&p).map_err(io_err(&p))?;
+        }
+    }
+    let snaps = dir.join("snapshots");
+    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    let ts_path = dir.join("timeseries.csv");
+    let timeseries = reopen_truncated(&ts_path, ckpt.timeseries_bytes)?;
+    let identity = Identity {
+        scene_base_dir: ckpt.scene_base_dir.clone(),
+        scene_hash: ckpt.scene_hash.clone(),
+    };
+    let start = Start {
+        next_sample: ckpt.next_sample,
+        rows: ckpt.timeseries_rows,
+        bytes: ckpt.timeseries_bytes,
+        wall_before: ckpt.wall_seconds,
+        checkpoints: ckpt.checkpoints,
+        timeseries,
+    };
+    drive(&mut engine, dir, options, start, &identity)
+}
+
+/// Writes `checkpoint` into `dir/checkpoint.json` atomically (temporary file, fsync, rename, directory fsync).
+fn write_checkpoint<S: Serialize>(dir: &Path, checkpoint: &Checkpoint<S>) -> std::io::Result<()> {
+    let tmp = dir.join(CHECKPOINT_TMP_FILE);
+    let dst = dir.join(CHECKPOINT_FILE);
+    {
+        let mut w = std::io::BufWriter::new(File::create(&tmp)?);
+        serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
+        w.write_all(b"\n")?;
+        let file = w.into_inner().map_err(|e| e.into_error())?;
+        file.sync_all()?;
+    }
+    std::fs::rename(&tmp, &dst)?;
+    // Make the rename durable; not every platform can open a directory, so failures are ignored.
+    if let Ok(d) = File::open(dir) {
+        let _ = d.sync_all();
+    }
+    Ok(())
+}
+
+fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> {
+    let text = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
+    std::fs::write(path, text + "\n")
+}
+
+/// The sampling loop shared by [`run`] and [`resume`].
+fn drive<E: Engine>(
+    engine: &mut E,
+    out_dir: &Path,
+    options: &RunOptions,
+    start: Start,
+    identity: &Identity,
+) -> Result<E::Summary, RunError<E::Summary>> {
+    let Start {
+        next_sample,
+        mut rows,
+        mut bytes,
+        wall_before,
+        mut checkpoints,
+        mut timeseries,
+    } = start;
+    let ts_path = out_dir.join("timeseries.csv");
+    let t_end = engine.t_end();
+    let started = Instant::now();
+    let wall = || wall_before + started.elapsed().as_secs_f64();
+    let pb = progress_bar(options.progress, t_end, engine.time());
+
+    // On failure: last good state + summary, then the error.
+    let fail = |engine: &E, failure: &crate::engine::Failure, rows: u64| -> RunError<E::Summary> {
+        if let Some(pb) = &pb {
+            pb.abandon();
+        }
+        let lgs = out_dir.join("last_good_state.csv");
+        let t_good = match engine.write_last_good_state(&lgs) {
+            Ok(t) => t,
+            Err(e) => return RunError::Io { path: lgs, source: e },
+        };
+        let summary = engine.summary(Outcome::Failed(failure), rows, wall());
+        let sp = out_dir.join("summary.json");
+        if let Err(e) = write_summary(&sp, &summary) {
+            return RunError::Io { path: sp, source: e };
+        }
+        RunError::Failed {
+            t: t_good,
+            cause: failure.cause.clone(),
+            last_good_state: lgs,
+            summary: Box::new(summary),
+        }
+    };
+
+    let samples = engine.samples();
+    let total = samples.len() as u64;
+    let mut last_checkpoint_wall = Instant::now();
+    let mut last_checkpoint_t = engine.time();
+    let mut checkpoints_here: u64 = 0;
+    for (index, sample) in samples.iter().enumerate().skip(next_sample as usize) {
+        let mut progress = |t: f64| {
+            if let Some(pb) = &pb {
+                show_progress(pb, t, t_end);
+            }
+        };
+        if let Err(failure) = engine.advance(index, sample, &mut progress) {
+            return Err(fail(engine, &failure, rows));
+        }
+        let row = match engine.sample(sample, wall()) {
+            Ok(row) => row,
+            Err(SampleError::Failed(failure)) => return Err(fail(engine, &failure, rows)),
+            Err(SampleError::Io { path, source }) => return Err(RunError::Io { path, source }),
+        };
+        timeseries.write_all(row.as_bytes()).map_err(io_err(&ts_path))?;
+        rows += 1;
+        bytes += row.len() as u64;
+        if let Some(k) = sample.snapshot {
+            let p = out_dir.join("snapshots").join(format!("{k}.csv"));
+            engine.write_snapshot(&p).map_err(io_err(&p))?;
+        }
+        let t = engine.time();
+        progress(t);
+
+        let due_wall = options
+            .checkpoint_every
+            .is_some_and(|s| s > 0.0 && last_checkpoint_wall.elapsed().as_secs_f64() >= s);
+        let due_sim = options
+            .checkpoint_every_sim
+            .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
+        if (index as u64) + 1 < total && (due_wall || due_sim) {
+            // The rows the checkpoint counts must be on disk before it is.
+            timeseries.sync_all().map_err(io_err(&ts_path))?;
+            let state = engine.save().map_err(io_err(out_dir))?;
+            checkpoints += 1;
+            let ckpt = Checkpoint {
+                format: CHECKPOINT_FORMAT.into(),
+                version: CHECKPOINT_VERSION,
+                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
+                kind: E::KIND.into(),
+                scene_hash: identity.scene_hash.clone(),
+                scene_base_dir: identity.scene_base_dir.clone(),
+                t,
+                t_seconds: t,
+                next_sample: index as u64 + 1,
+                timeseries_rows: rows,
+                timeseries_bytes: bytes,
+                checkpoints,
+                wall_seconds: wall(),
+                engine: state,
+            };
+            let cp = out_dir.join(CHECKPOINT_FILE);
+            write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+            last_checkpoint_wall = Instant::now();
+            last_checkpoint_t = t;
+            checkpoints_here += 1;
+            if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
+                if let Some(pb) = &pb {
+                    pb.abandon();
+                }
+                return Err(RunError::Stopped {
+                    dir: out_dir.to_path_buf(),
+                    t,
+                    checkpoints,
+                });
+            }
+        }
+    }
+    timeseries.sync_all().map_err(io_err(&ts_path))?;
+    if let Some(pb) = &pb {
+        pb.finish_and_clear();
+    }
+    let summary = engine.summary(Outcome::Completed, rows, wall());
+    let sp = out_dir.join("summary.json");
+    write_summary(&sp, &summary).map_err(io_err(&sp))?;
+    Ok(summary)
+}
+
+/// Runs an ellipsoid scene ([`run`] with [`EllipsoidEngine`]).
+pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError<RunSummary>> {
+    let engine = EllipsoidEngine::new(scene.clone()).map_err(RunError::Setup)?;
+    run(engine, out_dir, options)
+}
+
+/// Continues an ellipsoid run ([`resume`] with [`EllipsoidEngine`]).
+pub fn resume_run(dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError<RunSummary>> {
+    resume::<EllipsoidEngine>(dir, options)
+}
+
+/// Runs a soft-sphere scene ([`run`] with [`SoftEngine`]).
+pub fn run_soft(scene: &SoftScene, out_dir: &Path, options: &RunOptions) -> Result<SoftSummary, RunError<SoftSummary>> {
+    run(SoftEngine::new(scene.clone()), out_dir, options)
+}
+
+/// Continues a soft-sphere run ([`resume`] with [`SoftEngine`]).
+pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, RunError<SoftSummary>> {
+    resume::<SoftEngine>(dir, options)
+}
+
+/// [`RunReport`] of any engine, for code that runs whichever engine a scene names.
+impl RunReport for AnyReport {
+    fn one_line(&self) -> String {
+        self.line.clone()
+    }
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+}

@@ -1,0 +1,573 @@
+//! The ellipsoid engine as the run driver sees it ([`crate::engine::Engine`]): Roig03's equations of motion
+//! ([`EllipsoidSystem`]) under an adaptive integrator (Bulirsch–Stoer by default), sampled at the scene's output
+//! times.
+//!
+//! Its outputs, beside the driver's: `timeseries.csv` in [`TIMESERIES_COLUMNS`] (energies, the energy residual,
+//! momenta); snapshots in [`crate::io::csv::SNAPSHOT_COLUMNS`]; `tracks.csv` (only when `output.track` lists bodies):
+//! those bodies' rows at every sample; `barrier_overruns.csv` (only when a pair overran its contact barrier, see
+//! [`crate::ellipsoid::barrier`]); `summary.json` as [`RunSummary`]. A sampled state with a non-finite diagnostic or a
+//! quaternion norm off by more than [`QUATERNION_NORM_LIMIT`] stops the run, as does an integrator error (step-size
+//! underflow, too many steps).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
+use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
+use crate::ellipsoid::body::InertiaModel;
+use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
+use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
+use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
+use crate::io::csv::{TracksWriter, snapshot_records, write_snapshot};
+use crate::io::fmt_f64;
+use crate::io::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
+use crate::math::Vec3;
+use crate::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
+
+/// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
+pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
+
+/// Columns of `timeseries.csv`: time (s); energies (J): translational and rotational kinetic, contact and
+/// gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
+/// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum about the origin
+/// (kg m²/s); wall-clock seconds since the run started.
+pub const TIMESERIES_COLUMNS: [&str; 14] = [
+    "t",
+    "kinetic_translational",
+    "kinetic_rotational",
+    "potential_contact",
+    "potential_gravity",
+    "dissipated",
+    "energy_residual",
+    "px",
+    "py",
+    "pz",
+    "lx",
+    "ly",
+    "lz",
+    "wall_seconds",
+];
+
+/// Running maxima of the conservation errors (absolute; made relative at the end), as stored in checkpoints.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ErrorTracker {
+    #[serde(with = "exact_f64")]
+    h0: f64,
+    #[serde(with = "exact_f64")]
+    dissipated0: f64,
+    #[serde(with = "exact_f64_array")]
+    p0: [f64; 3],
+    #[serde(with = "exact_f64_array")]
+    l0: [f64; 3],
+    #[serde(with = "exact_f64_array")]
+    scales0: [f64; 3],
+    #[serde(with = "exact_f64_array")]
+    scales_max: [f64; 3],
+    #[serde(with = "exact_f64")]
+    energy: f64,
+    #[serde(with = "exact_f64")]
+    momentum: f64,
+    #[serde(with = "exact_f64")]
+    angular: f64,
+    #[serde(with = "exact_f64")]
+    quaternion: f64,
+    samples: u64,
+}
+
+impl ErrorTracker {
+    fn new(d0: &Diagnostics) -> Self {
+        let s = [d0.energy_scale, d0.momentum_scale, d0.angular_momentum_scale];
+        ErrorTracker {
+            h0: d0.energy(),
+            dissipated0: d0.dissipated,
+            p0: [d0.momentum.x, d0.momentum.y, d0.momentum.z],
+            l0: [d0.angular_momentum.x, d0.angular_momentum.y, d0.angular_momentum.z],
+            scales0: s,
+            scales_max: s,
+            energy: 0.0,
+            momentum: 0.0,
+            angular: 0.0,
+            quaternion: 0.0,
+            samples: 0,
+        }
+    }
+
+    /// Absolute signed energy residual `H − H0 − (dissipated − dissipated0)`.
+    fn energy_residual(&self, d: &Diagnostics) -> f64 {
+        d.energy() - self.h0 - (d.dissipated - self.dissipated0)
+    }
+
+    /// The energy scale used for the time series (energy_scale(0), or 1 J if that is 0).
+    fn energy_scale_for_rows(&self) -> f64 {
+        if self.scales0[0] > 0.0 && self.scales0[0].is_finite() {
+            self.scales0[0]
+        } else {
+            1.0
+        }
+    }
+
+    fn update(&mut self, d: &Diagnostics) {
+        self.energy = self.energy.max(self.energy_residual(d).abs());
+        self.momentum = self.momentum.max((d.momentum - Vec3::from(self.p0)).norm());
+        self.angular = self.angular.max((d.angular_momentum - Vec3::from(self.l0)).norm());
+        self.quaternion = self.quaternion.max(d.quaternion_norm_error);
+        for (m, s) in self
+            .scales_max
+            .iter_mut()
+            .zip([d.energy_scale, d.momentum_scale, d.angular_momentum_scale])
+        {
+            if s.is_finite() {
+                *m = m.max(s);
+            }
+        }
+        self.samples += 1;
+    }
+
+    /// `(scale, definition)` for each quantity: the value at t = 0, or, if that is zero, the largest value over the
+    /// run (or 1 if that is zero too).
+    fn scales(&self) -> Scales {
+        let pick = |k: usize, def0: &str, unit: &str| -> (f64, String) {
+            let s0 = self.scales0[k];
+            if s0 > 0.0 && s0.is_finite() {
+                (s0, format!("{def0} at t = 0 ({unit})"))
+            } else if self.scales_max[k] > 0.0 {
+                (
+                    self.scales_max[k],
+                    format!("{def0}: largest value over the sampled times, since it is 0 at t = 0 ({unit})"),
+                )
+            } else {
+                (1.0, format!("1 {unit}: {def0} is 0 throughout, so errors are absolute"))
+            }
+        };
+        let (energy, energy_definition) = pick(0, "K_T + K_R + |U_C| + |U_G|", "J");
+        let (momentum, momentum_definition) = pick(1, "sum over bodies of m |v|", "kg m/s");
+        let (angular_momentum, angular_momentum_definition) =
+            pick(2, "sum over bodies of |r x m v| + |I w| (about the origin)", "kg m^2/s");
+        Scales {
+            energy,
+            energy_definition,
+            momentum,
+            momentum_definition,
+            angular_momentum,
+            angular_momentum_definition,
+        }
+    }
+}
+
+fn diagnostics_finite(d: &Diagnostics) -> bool {
+    [
+        d.kinetic_translational,
+        d.kinetic_rotational,
+        d.potential_contact,
+        d.potential_gravity,
+        d.dissipated,
+        d.momentum_scale,
+        d.angular_momentum_scale,
+        d.energy_scale,
+        d.quaternion_norm_error,
+    ]
+    .iter()
+    .all(|x| x.is_finite())
+        && d.momentum.iter().all(|x| x.is_finite())
+        && d.angular_momentum.iter().all(|x| x.is_finite())
+}
+
+/// What went wrong with a sampled state, if anything.
+fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
+    if !diagnostics_finite(d) {
+        return Some(format!(
+            "non-finite diagnostics at t = {t} s (energy {}, |P| {}, |L| {})",
+            d.energy(),
+            d.momentum.norm(),
+            d.angular_momentum.norm()
+        ));
+    }
+    if d.quaternion_norm_error > QUATERNION_NORM_LIMIT {
+        return Some(format!(
+            "quaternion norm constraint broken at t = {t} s: max||q|-1| = {:.3e} > {QUATERNION_NORM_LIMIT:e}",
+            d.quaternion_norm_error
+        ));
+    }
+    None
+}
+
+/// Fingerprint of a scene's initial bodies: FNV-1a of their lossless snapshot rows.
+fn bodies_hash(scene: &LoadedScene) -> String {
+    let mut text = String::new();
+    for row in snapshot_records(0.0, &scene.bodies) {
+        text.push_str(&row.join(","));
+        text.push('\n');
+    }
+    fnv1a_hex(text.as_bytes())
+}
+
+/// What an ellipsoid run's checkpoint holds beside the driver's envelope.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct EllipsoidState {
+    /// Fingerprint of the initial bodies (a replaced `bodies_file` is refused).
+    bodies_hash: String,
+    /// Bodies.
+    n_bodies: usize,
+    /// The ODE state.
+    #[serde(with = "exact_f64_vec")]
+    y: Vec<f64>,
+    /// The integrator's complete internal state.
+    integrator: IntegratorState,
+    /// Error maxima and t = 0 references.
+    errors: ErrorTracker,
+}
+
+/// A run of interacting ellipsoids (Roig03).
+pub struct EllipsoidEngine {
+    scene: LoadedScene,
+    system: EllipsoidSystem,
+    integrator: Box<dyn Integrator + Send>,
+    t: f64,
+    y: Vec<f64>,
+    tracker: ErrorTracker,
+    /// `(t, y)` of the last good state (the last sample, or where the integrator stopped).
+    last_good: (f64, Vec<f64>),
+    barrier: BarrierMonitor,
+    tracks: Option<(TracksWriter, PathBuf)>,
+}
+
+impl EllipsoidEngine {
+    /// The engine for a validated scene, at t = 0. Errors: the integrator cannot be built from the scene's settings.
+    pub fn new(scene: LoadedScene) -> Result<Self, String> {
+        let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
+        let settings = scene.integrator;
+        let integrator = make_integrator(
+            settings.method,
+            Tolerances::uniform(settings.rtol, settings.atol, system.dim()),
+            settings.step,
+        )
+        .map_err(|e| format!("integrator setup: {e}"))?;
+        let y = system.initial_state();
+        let tracker = ErrorTracker::new(&system.diagnostics(&y));
+        let barrier = BarrierMonitor::new(
+            BarrierSettings::for_kappa_source(&scene.kappa_source),
+            scene.physics.contact.is_some(),
+            None,
+        );
+        Ok(EllipsoidEngine {
+            scene,
+            system,
+            integrator,
+            t: 0.0,
+            last_good: (0.0, y.clone()),
+            y,
+            tracker,
+            barrier,
+            tracks: None,
+        })
+    }
+
+    /// Loads and validates the scene file at `path`. Errors are one line naming the field.
+    pub fn load(path: &Path) -> Result<Self, String> {
+        EllipsoidEngine::new(load_scene(path).map_err(|e| e.to_string())?)
+    }
+
+    /// The built-in default scene.
+    pub fn default_scene() -> Result<Self, String> {
+        EllipsoidEngine::new(default_scene().map_err(|e| e.to_string())?)
+    }
+
+    /// The scene being run.
+    pub fn scene(&self) -> &LoadedScene {
+        &self.scene
+    }
+
+    /// What the scene resolves to, for `rubblepile check` (κ, physics terms, integrator, outputs, bodies).
+    pub fn describe(&self) -> Vec<String> {
+        let s = &self.scene;
+        let kappa = match s.kappa_source {
+            KappaSource::Given => format!("kappa = {} (given)", s.model.kappa),
+            KappaSource::Calibrated { beta, v } => {
+                format!("kappa = {} (calibrated: beta = {beta}, v = {v} m/s)", s.model.kappa)
+            }
+        };
+        let mut lines = vec![
+            format!("{}: ok", s.name),
+            format!("  {} bodies, t_end = {} s, {kappa}", s.bodies.len(), s.t_end),
+        ];
+        let p = &s.physics;
+        let mut terms = Vec::new();
+        if let Some(g) = p.gravity {
+            terms.push(format!("gravity (G = {:e})", g.g));
+        }
+        if let Some(c) = p.contact {
+            terms.push(format!("contact (cutoff = {:e})", c.cutoff));
+        }
+        if let Some(d) = p.dissipation {
+            terms.push(format!("dissipation (F0 = {})", d.f0));
+        }
+        if terms.is_empty() {
+            terms.push("none (free motion)".into());
+        }
+        lines.push(format!("  physics: {}", terms.join(", ")));
+        lines.push(format!(
+            "  integrator: {} (rtol {:e}, atol {:e}{})",
+            s.integrator.method,
+            s.integrator.rtol,
+            s.integrator.atol,
+            s.integrator.step.map(|h| format!(", step {h} s")).unwrap_or_default()
+        ));
+        lines.push(format!(
+            "  output: every {} s, {} snapshots",
+            s.output.every,
+            s.output.times.len()
+        ));
+        for (k, b) in s.bodies.iter().enumerate() {
+            lines.push(format!(
+                "  body[{k}]: axes [{}, {}, {}] m, mass {:e} kg, R_eq {:.4e} m, at [{:e}, {:e}, {:e}] m",
+                b.shape.axes.x,
+                b.shape.axes.y,
+                b.shape.axes.z,
+                b.shape.mass,
+                b.shape.equivalent_radius(),
+                b.position.x,
+                b.position.y,
+                b.position.z
+            ));
+        }
+        lines
+    }
+
+    /// `cause` with the contact barrier's hint, when overruns may explain the failure.
+    fn failure(&self, cause: String) -> Failure {
+        Failure::new(match self.barrier.failure_hint() {
+            Some(hint) => format!("{cause}; {hint}"),
+            None => cause,
+        })
+    }
+}
+
+impl RunReport for RunSummary {
+    fn one_line(&self) -> String {
+        RunSummary::one_line(self)
+    }
+    fn warnings(&self) -> Vec<String> {
+        RunSummary::warnings(self)
+    }
+}
+
+impl Engine for EllipsoidEngine {
+    type Summary = RunSummary;
+    type State = EllipsoidState;
+    const KIND: &'static str = "ellipsoids";
+
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
+        EllipsoidEngine::new(parse_scene(text, name, base_dir).map_err(|e| e.to_string())?)
+    }
+
+    fn scene_source(&self) -> &str {
+        &self.scene.source
+    }
+
+    fn scene_base_dir(&self) -> Option<&Path> {
+        self.scene.base_dir.as_deref()
+    }
+
+    fn t_end(&self) -> f64 {
+        self.scene.t_end
+    }
+
+    fn time(&self) -> f64 {
+        self.t
+    }
+
+    fn samples(&self) -> Vec<Sample> {
+        Schedule::new(self.scene.t_end, self.scene.output.every, &self.scene.output.times).collect()
+    }
+
+    fn timeseries_header(&self) -> String {
+        TIMESERIES_COLUMNS.join(",") + "\n"
+    }
+
+    fn open_outputs(&mut self, dir: &Path) -> std::io::Result<()> {
+        self.barrier = BarrierMonitor::new(
+            BarrierSettings::for_kappa_source(&self.scene.kappa_source),
+            self.scene.physics.contact.is_some(),
+            Some(&dir.join(OVERRUN_FILE)),
+        );
+        if !self.scene.output.track.is_empty() {
+            let path = dir.join("tracks.csv");
+            self.tracks = Some((TracksWriter::create(&path)?, path));
+        }
+        Ok(())
+    }
+
+    fn advance(&mut self, _index: usize, to: &Sample, _progress: &mut dyn FnMut(f64)) -> Result<(), Failure> {
+        if to.t > self.t
+            && let Err(e) = self.integrator.advance(&self.system, &mut self.t, &mut self.y, to.t)
+        {
+            // The integrator stopped at its last accepted step: that is the last good state.
+            self.last_good = (self.t, self.y.clone());
+            return Err(self.failure(format!("integrator error: {e}")));
+        }
+        Ok(())
+    }
+
+    fn sample(&mut self, _to: &Sample, wall_seconds: f64) -> Result<String, SampleError> {
+        let d = self.system.diagnostics(&self.y);
+        if let Some(cause) = check_state(self.t, &d) {
+            return Err(self.failure(cause).into());
+        }
+        self.tracker.update(&d);
+        let barrier_path = || PathBuf::from(OVERRUN_FILE);
+        self.barrier
+            .observe(self.t, &self.system, &self.y)
+            .map_err(|source| SampleError::Io {
+                path: barrier_path(),
+                source,
+            })?;
+        if let Some((w, path)) = self.tracks.as_mut() {
+            let bodies = self.system.bodies_at(self.t, &self.y);
+            w.write_sample(self.t, &bodies, &self.scene.output.track)
+                .map_err(|source| SampleError::Io {
+                    path: path.clone(),
+                    source,
+                })?;
+        }
+        self.last_good.0 = self.t;
+        self.last_good.1.copy_from_slice(&self.y);
+        let fields = [
+            self.t,
+            d.kinetic_translational,
+            d.kinetic_rotational,
+            d.potential_contact,
+            d.potential_gravity,
+            d.dissipated,
+            self.tracker.energy_residual(&d) / self.tracker.energy_scale_for_rows(),
+            d.momentum.x,
+            d.momentum.y,
+            d.momentum.z,
+            d.angular_momentum.x,
+            d.angular_momentum.y,
+            d.angular_momentum.z,
+            wall_seconds,
+        ];
+        let cells: Vec<String> = fields.iter().map(|&x| fmt_f64(x)).collect();
+        Ok(cells.join(",") + "\n")
+    }
+
+    fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
+        write_snapshot(path, self.t, &self.system.bodies_at(self.t, &self.y))
+    }
+
+    fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {
+        let (t, y) = &self.last_good;
+        write_snapshot(path, *t, &self.system.bodies_at(*t, y))?;
+        Ok(*t)
+    }
+
+    fn summary(&self, outcome: Outcome<'_>, _samples: u64, wall_seconds: f64) -> RunSummary {
+        let scene = &self.scene;
+        let settings = scene.integrator;
+        let stats = self.integrator.stats();
+        let scales = self.tracker.scales();
+        let (status, final_time) = match outcome {
+            Outcome::Completed => ("completed".to_string(), self.t),
+            Outcome::Failed(f) => (f.cause.clone(), self.last_good.0),
+        };
+        RunSummary {
+            status,
+            wall_seconds,
+            final_time,
+            t_end: scene.t_end,
+            steps_accepted: stats.steps_accepted,
+            steps_rejected: stats.steps_rejected,
+            rhs_evaluations: stats.rhs_evaluations,
+            smallest_step: stats.smallest_step.is_finite().then_some(stats.smallest_step),
+            energy_error: self.tracker.energy / scales.energy,
+            linear_momentum_error: self.tracker.momentum / scales.momentum,
+            angular_momentum_error: self.tracker.angular / scales.angular_momentum,
+            quaternion_norm_error: self.tracker.quaternion,
+            scales,
+            samples: self.tracker.samples,
+            kappa: scene.model.kappa,
+            kappa_source: match scene.kappa_source {
+                KappaSource::Given => "given".into(),
+                KappaSource::Calibrated { .. } => "calibrated".into(),
+            },
+            calibration: match scene.kappa_source {
+                KappaSource::Given => None,
+                KappaSource::Calibrated { beta, v } => Some(CalibrationSummary { beta, v }),
+            },
+            inertia: match scene.model.inertia {
+                InertiaModel::Gaussian => "gaussian".into(),
+                InertiaModel::Uniform => "uniform".into(),
+            },
+            integrator: settings.method.to_string(),
+            rtol: settings.rtol,
+            atol: settings.atol,
+            step: settings.step,
+            n_bodies: self.system.n_bodies(),
+            rotation_integrated: self.system.rotation_integrated(),
+            physics: PhysicsSummary::from(&scene.physics),
+            seed: scene.seed,
+            barrier: self.barrier.report(),
+        }
+    }
+
+    fn save(&mut self) -> std::io::Result<EllipsoidState> {
+        Ok(EllipsoidState {
+            bodies_hash: bodies_hash(&self.scene),
+            n_bodies: self.system.n_bodies(),
+            y: self.y.clone(),
+            integrator: self.integrator.save_state(),
+            errors: self.tracker.clone(),
+        })
+    }
+
+    fn restore(&mut self, state: EllipsoidState, dir: &Path, at: Resumed) -> Result<(), String> {
+        if state.bodies_hash != bodies_hash(&self.scene) || state.n_bodies != self.scene.bodies.len() {
+            let from = match (&self.scene.file.scene.bodies_file, &self.scene.base_dir) {
+                (Some(f), Some(base)) => format!(" (bodies_file {})", base.join(f).display()),
+                (Some(f), None) => format!(" (bodies_file {f})"),
+                _ => String::new(),
+            };
+            return Err(format!("the scene's bodies{from} differ from those the run started with"));
+        }
+        if state.y.len() != self.system.dim() {
+            return Err(format!(
+                "the checkpoint's state has {} components, the scene's system {}",
+                state.y.len(),
+                self.system.dim()
+            ));
+        }
+        if !state.y.iter().all(|v| v.is_finite()) {
+            return Err("the checkpoint's state is not finite".into());
+        }
+        let method = self.scene.integrator.method;
+        if state.integrator.method() != method {
+            return Err(format!(
+                "the checkpoint is of a {} run, the scene asks for {method}",
+                state.integrator.method()
+            ));
+        }
+        self.integrator
+            .restore_state(&state.integrator)
+            .map_err(|e| format!("integrator: {e}"))?;
+        self.t = at.t;
+        self.y = state.y;
+        self.last_good = (self.t, self.y.clone());
+        self.tracker = state.errors;
+        if !self.scene.output.track.is_empty() {
+            // Each sample wrote one row per tracked body.
+            let rows = at.samples_done * self.scene.output.track.len() as u64;
+            let path = dir.join("tracks.csv");
+            self.tracks = Some((TracksWriter::open_truncated(&path, rows)?, path));
+        }
+        let log = dir.join(OVERRUN_FILE);
+        self.barrier = BarrierMonitor::resume(
+            BarrierSettings::for_kappa_source(&self.scene.kappa_source),
+            self.scene.physics.contact.is_some(),
+            &log,
+            at.t,
+        )
+        .map_err(|e| format!("{}: {e}", log.display()))?;
+        Ok(())
+    }
+}

@@ -1,0 +1,165 @@
+//! The contract between a physics engine and the one run driver ([`crate::driver`]).
+//!
+//! An engine (the ellipsoids of Roig03, the soft spheres of Zhang17, the hard spheres of Richardson11) knows its
+//! state, how to advance it to a time, and what its outputs look like: the columns of `timeseries.csv`, the rows of a
+//! snapshot, the fields of `summary.json`, the state a checkpoint must hold to continue bit for bit. The driver owns
+//! everything else, once for all engines: the output directory, the sample schedule's walk, the time series file,
+//! snapshots, progress, wall-clock and simulated-time checkpoints (written atomically), `resume`, the summary file
+//! and failure handling with the last good state saved.
+//!
+//! This module sits on the low floor of the crate (beside [`crate::io`]): engines implement [`Engine`], the driver
+//! above them calls it, and nothing here knows any engine.
+
+pub mod schedule;
+
+use std::path::Path;
+
+use serde::Serialize;
+use serde::de::DeserializeOwned;
+
+pub use schedule::{Sample, Schedule};
+
+/// Why an engine stopped: the cause, one line (e.g. `"integrator error: step size underflow at t = …"`). The
+/// engine keeps its last good state and writes it when asked ([`Engine::write_last_good_state`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Failure {
+    /// The cause, as reported to the user.
+    pub cause: String,
+}
+
+impl Failure {
+    /// A failure with this cause.
+    pub fn new(cause: impl Into<String>) -> Self {
+        Failure { cause: cause.into() }
+    }
+}
+
+/// What went wrong while an engine sampled its state: the run broke ([`Failure`]) or one of the engine's own
+/// output files could not be written.
+#[derive(Debug)]
+pub enum SampleError {
+    /// The sampled state is broken (non-finite, constraint violated): the run stops.
+    Failed(Failure),
+    /// Writing an engine-owned file (a track, a log) failed.
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+impl From<Failure> for SampleError {
+    fn from(f: Failure) -> Self {
+        SampleError::Failed(f)
+    }
+}
+
+/// How a run ended, for [`Engine::summary`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Outcome<'a> {
+    /// Every sample was reached.
+    Completed,
+    /// The run stopped with this failure.
+    Failed(&'a Failure),
+}
+
+/// What the driver tells an engine when it continues from a checkpoint.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Resumed {
+    /// Simulated time of the checkpoint (s).
+    pub t: f64,
+    /// Time-series samples written before the checkpoint (the index of the next sample).
+    pub samples_done: u64,
+}
+
+/// The summary an engine writes to `summary.json`, as the command line reports it.
+pub trait RunReport: Serialize + std::fmt::Debug + Clone {
+    /// One line for the terminal (status, time reached, the errors beside the wall time).
+    fn one_line(&self) -> String;
+    /// Warnings to print after the line (e.g. contact-barrier overruns); none by default.
+    fn warnings(&self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// A physics engine as the run driver sees it. The driver calls, in order: [`Engine::open_outputs`] (fresh run) or
+/// [`Engine::restore`] (resume); then for each remaining sample [`Engine::advance`], [`Engine::sample`] and, at
+/// snapshot times, [`Engine::write_snapshot`]; [`Engine::save`] when a checkpoint is due; and [`Engine::summary`] at
+/// the end. On a [`Failure`] it calls [`Engine::write_last_good_state`] and [`Engine::summary`] with
+/// [`Outcome::Failed`].
+pub trait Engine: Sized {
+    /// The engine's `summary.json`.
+    type Summary: RunReport;
+    /// Everything the engine needs to continue bit for bit, stored in `checkpoint.json` under `engine`.
+    type State: Serialize + DeserializeOwned;
+
+    /// The scene kind (`scene.kind` in a scene file), also recorded in checkpoints.
+    const KIND: &'static str;
+
+    /// Builds the engine from a scene file's text (`name` names it in errors; a relative input file named in the
+    /// scene is resolved against `base_dir`). Used by `resume`, on the run's `scene.toml` copy.
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String>;
+
+    /// The scene text, copied to `scene.toml`.
+    fn scene_source(&self) -> &str;
+
+    /// The directory relative input files of the scene were read from, if any (recorded in checkpoints).
+    fn scene_base_dir(&self) -> Option<&Path>;
+
+    /// The requested end time (s).
+    fn t_end(&self) -> f64;
+
+    /// The current simulated time (s).
+    fn time(&self) -> f64;
+
+    /// Every output sample of the run, in time order (the last one ends the run).
+    fn samples(&self) -> Vec<Sample>;
+
+    /// The header line of `timeseries.csv`, with its newline.
+    fn timeseries_header(&self) -> String;
+
+    /// Creates the engine's own output files in `dir` (e.g. `tracks.csv`) for a fresh run.
+    fn open_outputs(&mut self, dir: &Path) -> std::io::Result<()>;
+
+    /// Advances the state to `to.t` (`index` is the sample's position in [`Engine::samples`]), calling
+    /// `progress(t)` now and then with the simulated time reached.
+    fn advance(&mut self, index: usize, to: &Sample, progress: &mut dyn FnMut(f64)) -> Result<(), Failure>;
+
+    /// Checks and records the state at a sample, writes the engine's own per-sample files, and returns the
+    /// time-series row (with its newline); `wall_seconds` is the run's wall-clock time so far.
+    fn sample(&mut self, to: &Sample, wall_seconds: f64) -> Result<String, SampleError>;
+
+    /// Writes the current state as a snapshot file.
+    fn write_snapshot(&self, path: &Path) -> std::io::Result<()>;
+
+    /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).
+    fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64>;
+
+    /// The summary; `samples` is the number of time-series rows written, `wall_seconds` the run's wall-clock time.
+    fn summary(&self, outcome: Outcome<'_>, samples: u64, wall_seconds: f64) -> Self::Summary;
+
+    /// The state to checkpoint (flushing the engine's own files first, so that what the state counts is on disk).
+    fn save(&mut self) -> std::io::Result<Self::State>;
+
+    /// Continues from a checkpoint's state: restores it and reopens the engine's own files in `dir`, cut back to
+    /// what they held at the checkpoint. Errors are one line.
+    fn restore(&mut self, state: Self::State, dir: &Path, at: Resumed) -> Result<(), String>;
+}
+
+/// Cuts an output file back to `bytes` (its length at a checkpoint) and opens it for appending, so that a resumed
+/// run continues it exactly. Errors are one line naming the file (missing, or shorter than at the checkpoint).
+pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, String> {
+    let err = |e: std::io::Error| format!("{}: {e}", path.display());
+    let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(err)?;
+    let len = file.metadata().map_err(err)?.len();
+    if len < bytes {
+        return Err(format!(
+            "{} holds {len} bytes, fewer than the {bytes} written before the checkpoint",
+            path.display()
+        ));
+    }
+    file.set_len(bytes).map_err(err)?;
+    std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(err)?;
+    Ok(file)
+}
