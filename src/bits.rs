@@ -107,4 +107,3 @@ pub fn fnv1a_hex(bytes: &[u8]) -> String {
     }
     format!("{h:016x}")
 }
-

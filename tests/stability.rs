@@ -10,8 +10,8 @@ mod common;
 use std::path::Path;
 
 use common::{rubblepile, temp_dir};
-use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
+use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::scene::parse_scene;
 use rubblepile::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
 use rubblepile::stability::{CaseResult, Verdict, run_case};

@@ -8,9 +8,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use crate::cli::CliError;
+use crate::driver::RunOptions;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, run_impact};
-use crate::driver::RunOptions;
 
 /// `rubblepile bench impact`.
 #[derive(Debug, clap::Args)]

@@ -8,9 +8,9 @@
 use std::path::PathBuf;
 
 use crate::cli::{CheckpointArgs, CliError, report};
+use crate::driver::{RunOptions, run_scene};
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, ImpactError, prepare_impact};
-use crate::driver::{RunOptions, run_scene};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]

@@ -238,8 +238,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
                 let path = args.out.join(format!("T{tf:.2}.toml"));
                 std::fs::write(&path, &scene_text).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))?;
                 let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(CliError::usage)?;
-                crate::driver::run_soft(&scene, &dir, &options)
-                    .map_err(|e| CliError::failed(e.to_string()))?;
+                crate::driver::run_soft(&scene, &dir, &options).map_err(|e| CliError::failed(e.to_string()))?;
             }
         }
         let samples = read_spinup_csv(&dir.join("spinup.csv")).map_err(CliError::failed)?;

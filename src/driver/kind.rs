@@ -68,7 +68,8 @@ impl AnyReport {
 type AnyResult = Result<AnyReport, RunError<AnyReport>>;
 
 fn erase<S: RunReport>(r: Result<S, RunError<S>>) -> AnyResult {
-    r.map(|s| AnyReport::of(&s)).map_err(|e| e.map_summary(|s| AnyReport::of(&s)))
+    r.map(|s| AnyReport::of(&s))
+        .map_err(|e| e.map_summary(|s| AnyReport::of(&s)))
 }
 
 /// Loads the scene at `path` (the built-in default scene when `None`) and runs it into `out` with the engine its
@@ -86,14 +87,16 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             erase(super::run(engine, out, options))
         }
         SceneKind::SoftSpheres => {
-            let engine = SoftEngine::load(path.expect("a soft-sphere scene comes from a file")).map_err(RunError::Setup)?;
+            let engine =
+                SoftEngine::load(path.expect("a soft-sphere scene comes from a file")).map_err(RunError::Setup)?;
             for w in engine.scene_warnings() {
                 eprintln!("warning: {w}");
             }
             erase(super::run(engine, out, options))
         }
         SceneKind::HardSpheres => {
-            let engine = HardEngine::load(path.expect("a hard-sphere scene comes from a file")).map_err(RunError::Setup)?;
+            let engine =
+                HardEngine::load(path.expect("a hard-sphere scene comes from a file")).map_err(RunError::Setup)?;
             erase(super::run(engine, out, options))
         }
     }
@@ -119,7 +122,8 @@ pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), Str
         .map(|e| (Vec::new(), e.describe())),
         SceneKind::SoftSpheres => SoftEngine::load(path.expect("a soft-sphere scene comes from a file"))
             .map(|e| (e.scene_warnings().to_vec(), e.describe())),
-        SceneKind::HardSpheres => HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
-            .map(|e| (Vec::new(), e.describe())),
+        SceneKind::HardSpheres => {
+            HardEngine::load(path.expect("a hard-sphere scene comes from a file")).map(|e| (Vec::new(), e.describe()))
+        }
     }
 }

@@ -490,8 +490,8 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             scene_path.display()
         )));
     }
-    let mut engine = E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
-        .map_err(bad)?;
+    let mut engine =
+        E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref()).map_err(bad)?;
 
     // The checkpoint must sit right after one of the run's samples.
     let samples = engine.samples();
@@ -698,7 +698,11 @@ fn drive<E: Engine>(
 }
 
 /// Runs an ellipsoid scene ([`run`] with [`EllipsoidEngine`]).
-pub fn run_scene(scene: &LoadedScene, out_dir: &Path, options: &RunOptions) -> Result<RunSummary, RunError<RunSummary>> {
+pub fn run_scene(
+    scene: &LoadedScene,
+    out_dir: &Path,
+    options: &RunOptions,
+) -> Result<RunSummary, RunError<RunSummary>> {
     let engine = EllipsoidEngine::new(scene.clone()).map_err(RunError::Setup)?;
     run(engine, out_dir, options)
 }

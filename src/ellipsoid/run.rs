@@ -528,7 +528,9 @@ impl Engine for EllipsoidEngine {
                 (Some(f), None) => format!(" (bodies_file {f})"),
                 _ => String::new(),
             };
-            return Err(format!("the scene's bodies{from} differ from those the run started with"));
+            return Err(format!(
+                "the scene's bodies{from} differ from those the run started with"
+            ));
         }
         if state.y.len() != self.system.dim() {
             return Err(format!(

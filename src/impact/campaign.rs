@@ -68,6 +68,7 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
+use crate::driver::{RunError, RunOptions, RunSummary, resume_run};
 use crate::ellipsoid::body::Body;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{
@@ -77,7 +78,6 @@ use crate::impact::run::{
 use crate::io::checkpoint::CHECKPOINT_FILE;
 use crate::io::csv::read_bodies_csv;
 use crate::io::fmt_f64;
-use crate::driver::{RunError, RunOptions, RunSummary, resume_run};
 
 /// Name of the campaign table in the campaign directory.
 pub const CAMPAIGN_CSV: &str = "campaign.csv";

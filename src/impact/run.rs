@@ -13,12 +13,12 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::driver::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
 use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::G_SI;
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::io::csv::{read_bodies_csv, write_snapshot};
-use crate::driver::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
 use crate::scene::{LoadedScene, MAX_TIMESERIES_ROWS, SceneError, parse_scene};
 
 /// Default end time (s).
@@ -141,8 +141,16 @@ impl ImpactConfig {
         if !positive(self.t_end) {
             return invalid("t_end", format!("must be > 0 s and finite, got {}", self.t_end));
         }
-        if !positive(self.rtol) {
-            return invalid("rtol", format!("must be > 0 and finite, got {}", self.rtol));
+        let min_rtol = crate::scene::MIN_RTOL;
+        if !(self.rtol.is_finite() && (min_rtol..1.0).contains(&self.rtol)) {
+            return invalid(
+                "rtol",
+                format!(
+                    "must be in [{min_rtol:e}, 1), got {:e} (1 or more controls nothing; below {min_rtol:e} the error \
+                     estimate is round-off)",
+                    self.rtol
+                ),
+            );
         }
         if !(self.f0 >= 0.0 && self.f0.is_finite()) {
             return invalid("f0", format!("must be >= 0 s m^-2 and finite, got {}", self.f0));

@@ -62,6 +62,10 @@ pub const DEFAULT_CONTACT_CUTOFF: f64 = 1e-16;
 /// Largest allowed `||q| − 1|` of an input quaternion.
 pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
 
+/// Smallest relative tolerance accepted: below it the integrators' error estimates are dominated by round-off
+/// (f64 epsilon is 2.2e-16, and a Bulirsch–Stoer estimate sums many such terms).
+pub const MIN_RTOL: f64 = 1e-15;
+
 /// Most time-series rows a scene may ask for (`t_end / every`).
 pub const MAX_TIMESERIES_ROWS: f64 = 1e8;
 
@@ -438,6 +442,31 @@ pub struct SceneText {
     pub base_dir: PathBuf,
 }
 
+/// Refuses particles whose kinetic energy, momentum or angular momentum is not finite at t = 0 (finite inputs can
+/// overflow: a speed of 1e300 m/s gives an infinite energy), naming the particle and the field.
+pub(crate) fn check_finite_motion(
+    particles: impl Iterator<Item = (f64, f64, crate::math::Vec3, crate::math::Vec3, crate::math::Vec3)>,
+) -> Result<(), (String, String)> {
+    for (k, (mass, radius, x, v, w)) in particles.enumerate() {
+        if !(0.5 * mass * v.norm_squared()).is_finite() || !(mass * x.norm() * v.norm()).is_finite() {
+            return Err((
+                format!("particle[{k}].velocity"),
+                format!(
+                    "gives a non-finite kinetic energy or momentum at t = 0 (mass {mass:e} kg, |v| = {:e} m/s)",
+                    v.norm()
+                ),
+            ));
+        }
+        if !(0.2 * mass * radius * radius * w.norm_squared()).is_finite() {
+            return Err((
+                format!("particle[{k}].spin"),
+                "gives a non-finite rotational energy at t = 0".to_string(),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Reads a scene file (a one-line [`SceneError::Read`] naming it if that fails).
 pub fn read_scene_text(path: &Path) -> Result<SceneText, SceneError> {
     let name = path.display().to_string();
@@ -656,8 +685,35 @@ impl Validator<'_> {
         }
     }
 
+    /// Validates every section in order and builds the scene (each section's rules in its own function below).
     fn resolve(&self, text: &str, file: SceneFile, base_dir: Option<&Path>) -> Result<LoadedScene, SceneError> {
-        // [scene]
+        let t_end = self.scene_section(&file)?;
+        self.model_section(&file.model)?;
+        let physics = self.physics_section(&file.physics)?;
+        let integrator = self.integrator_section(&file.integrator)?;
+        let output = self.output_section(&file.output, t_end)?;
+        let bodies = self.bodies_section(&file, base_dir)?;
+        self.track_section(&output.track, bodies.len())?;
+        self.initial_state_finite(&bodies)?;
+        let (model, kappa_source) = self.kappa_section(&file.model, &bodies, &physics)?;
+        Ok(LoadedScene {
+            name: self.file.to_string(),
+            source: text.to_string(),
+            base_dir: base_dir.map(Path::to_path_buf),
+            t_end,
+            seed: file.scene.seed,
+            file,
+            bodies,
+            model,
+            kappa_source,
+            physics,
+            integrator,
+            output,
+        })
+    }
+
+    /// `[scene]`: the kind and `t_end` (s).
+    fn scene_section(&self, file: &SceneFile) -> Result<f64, SceneError> {
         if file.scene.kind != "ellipsoids" {
             return Err(self.invalid(
                 "scene.kind",
@@ -669,8 +725,12 @@ impl Validator<'_> {
         }
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;
 
-        // [model] (κ itself after the bodies, since calibration needs them)
-        let m = &file.model;
+        Ok(t_end)
+    }
+
+    /// `[model]`: exactly one of `kappa` (> 1.5) or `calibrate` (β, v > 0); κ itself is computed after the bodies
+    /// ([`Validator::kappa_section`]), since calibration needs them.
+    fn model_section(&self, m: &ModelSection) -> Result<(), SceneError> {
         match (m.kappa, m.calibrate) {
             (Some(_), Some(_)) => {
                 return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got both"));
@@ -689,8 +749,11 @@ impl Validator<'_> {
             }
         }
 
-        // [physics]
-        let p = &file.physics;
+        Ok(())
+    }
+
+    /// `[physics]`: each term optional (absent = not computed).
+    fn physics_section(&self, p: &PhysicsSection) -> Result<Physics, SceneError> {
         let gravity = match p.gravity {
             Some(g) => Some(GravityTerm {
                 g: self.positive("physics.gravity.G", g.g.unwrap_or(SI_G))?,
@@ -713,15 +776,25 @@ impl Validator<'_> {
             }),
             None => None,
         };
-        let physics = Physics {
+        Ok(Physics {
             gravity,
             contact,
             dissipation,
-        };
+        })
+    }
 
-        // [integrator]
-        let i = &file.integrator;
-        let rtol = self.positive("integrator.rtol", i.rtol)?;
+    /// `[integrator]`: method, tolerances (`rtol` in [[`MIN_RTOL`], 1), `atol` finite and ≥ 0), fixed step.
+    fn integrator_section(&self, i: &IntegratorSection) -> Result<IntegratorSettings, SceneError> {
+        let rtol = i.rtol;
+        if !(rtol.is_finite() && (MIN_RTOL..1.0).contains(&rtol)) {
+            return Err(self.invalid(
+                "integrator.rtol",
+                format!(
+                    "must be in [{MIN_RTOL:e}, 1), got {rtol:e}: a relative tolerance of 1 or more controls nothing, \
+                     and below {MIN_RTOL:e} the integrators' error estimates are round-off (f64 epsilon is 2.2e-16)"
+                ),
+            ));
+        }
         let atol = self.non_negative("integrator.atol", i.atol)?;
         let step = match i.step {
             Some(h) => Some(self.positive("integrator.step", h)?),
@@ -730,15 +803,17 @@ impl Validator<'_> {
         if i.method == Method::Rk4 && step.is_none() {
             return Err(self.invalid("integrator.step", "method \"rk4\" needs a fixed step: step = <s> (> 0)"));
         }
-        let integrator = IntegratorSettings {
+        Ok(IntegratorSettings {
             method: i.method,
             rtol,
             atol,
             step,
-        };
+        })
+    }
 
-        // [output]
-        let every = self.positive("output.every", file.output.every)?;
+    /// `[output]`: time-series cadence `every` (s), snapshot times (s) in [0, t_end], tracked body ids.
+    fn output_section(&self, o: &OutputSection, t_end: f64) -> Result<OutputSettings, SceneError> {
+        let every = self.positive("output.every", o.every)?;
         if t_end / every > MAX_TIMESERIES_ROWS {
             return Err(self.invalid(
                 "output.every",
@@ -748,7 +823,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let times = match &file.output.times {
+        let times = match &o.times {
             Some(times) => {
                 for (k, &t) in times.iter().enumerate() {
                     if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
@@ -768,9 +843,13 @@ impl Validator<'_> {
             }
             None => vec![0.0, t_end],
         };
-        let track = file.output.track.clone().unwrap_or_default();
+        let track = o.track.clone().unwrap_or_default();
 
-        // bodies
+        Ok(OutputSettings { times, every, track })
+    }
+
+    /// The bodies: `[[body]]` tables or `scene.bodies_file`, each validated ([`Validator::body`]).
+    fn bodies_section(&self, file: &SceneFile, base_dir: Option<&Path>) -> Result<Vec<Body>, SceneError> {
         let raw = match (&file.scene.bodies_file, file.bodies.is_empty()) {
             (Some(_), false) => {
                 return Err(self.invalid(
@@ -800,14 +879,18 @@ impl Validator<'_> {
                 .collect::<Vec<_>>(),
             (Some(rel), true) => self.read_bodies_file(rel, base_dir)?,
         };
-        let bodies = raw.iter().map(|b| self.body(b)).collect::<Result<Vec<_>, _>>()?;
+        raw.iter().map(|b| self.body(b)).collect()
+    }
+
+    /// `output.track`: body ids below the number of bodies, each at most once.
+    fn track_section(&self, track: &[usize], n_bodies: usize) -> Result<(), SceneError> {
         for (k, &id) in track.iter().enumerate() {
-            if id >= bodies.len() {
+            if id >= n_bodies {
                 return Err(self.invalid(
                     format!("output.track[{k}]"),
                     format!(
                         "must be a body index below {} (the number of bodies), got {id}",
-                        bodies.len()
+                        n_bodies
                     ),
                 ));
             }
@@ -818,9 +901,51 @@ impl Validator<'_> {
                 ));
             }
         }
-        let output = OutputSettings { times, every, track };
+        Ok(())
+    }
 
-        // κ
+    /// Refuses a state whose energy or momentum is not finite at t = 0 (finite inputs can still overflow, e.g. a
+    /// velocity of 1e300 m/s gives an infinite kinetic energy), naming the body and the field.
+    fn initial_state_finite(&self, bodies: &[Body]) -> Result<(), SceneError> {
+        for (k, b) in bodies.iter().enumerate() {
+            let m = b.shape.mass;
+            let v2 = b.velocity.norm_squared();
+            if !(0.5 * m * v2).is_finite() || !(m * b.velocity.norm()).is_finite() {
+                return Err(self.invalid(
+                    format!("body[{k}].velocity"),
+                    format!(
+                        "gives a non-finite kinetic energy or momentum at t = 0 (mass {m:e} kg, |v| = {:e} m/s)",
+                        b.velocity.norm()
+                    ),
+                ));
+            }
+            let l = m * b.position.norm() * b.velocity.norm();
+            if !l.is_finite() {
+                return Err(self.invalid(
+                    format!("body[{k}].position"),
+                    "gives a non-finite angular momentum at t = 0 (|r| |m v| overflows)",
+                ));
+            }
+            let a2 = b.shape.axes.norm_squared();
+            let spin_energy = 0.5 * m * a2 * b.spin_body.norm_squared();
+            if !spin_energy.is_finite() {
+                return Err(self.invalid(
+                    format!("body[{k}].spin"),
+                    "gives a non-finite rotational energy at t = 0",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// κ: given, or calibrated from the bodies (Roig03 Eq. 14) with β and v of `[model]`.
+    fn kappa_section(
+        &self,
+        m: &ModelSection,
+        bodies: &[Body],
+        physics: &Physics,
+    ) -> Result<(ModelConfig, KappaSource), SceneError> {
+        let gravity = physics.gravity;
         let contact_g = gravity.map(|g| g.g).unwrap_or(SI_G);
         let (kappa, kappa_source) = match (m.kappa, m.calibrate) {
             (Some(k), _) => (k, KappaSource::Given),
@@ -852,26 +977,14 @@ impl Validator<'_> {
             }
             (None, None) => unreachable!("checked above"),
         };
-        let model = ModelConfig {
-            kappa,
-            inertia: m.inertia,
-            contact_g,
-        };
-
-        Ok(LoadedScene {
-            name: self.file.to_string(),
-            source: text.to_string(),
-            base_dir: base_dir.map(Path::to_path_buf),
-            t_end,
-            seed: file.scene.seed,
-            file,
-            bodies,
-            model,
+        Ok((
+            ModelConfig {
+                kappa,
+                inertia: m.inertia,
+                contact_g,
+            },
             kappa_source,
-            physics,
-            integrator,
-            output,
-        })
+        ))
     }
 
     fn read_bodies_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<RawBody>, SceneError> {

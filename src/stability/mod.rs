@@ -24,13 +24,13 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use crate::driver::{RunError, RunOptions, RunSummary, run_scene};
 use crate::ellipsoid::barrier::{BarrierSettings, contacts};
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::equations::EllipsoidSystem;
 use crate::integrate::{OdeSystem, Tolerances, make_integrator};
 use crate::io::csv::read_bodies_csv;
 use crate::math::{Vec3, Vec4};
-use crate::driver::{RunError, RunOptions, RunSummary, run_scene};
 use crate::scene::{LoadedScene, parse_scene};
 
 /// Columns of `stability.csv`.

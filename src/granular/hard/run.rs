@@ -213,7 +213,6 @@ impl HardRunSummary {
     }
 }
 
-
 impl RunReport for HardRunSummary {
     fn one_line(&self) -> String {
         HardRunSummary::one_line(self)
@@ -287,7 +286,9 @@ impl HardEngine {
 
     /// Loads and validates the scene file at `path`. Errors are one line naming the field.
     pub fn load(path: &Path) -> Result<Self, String> {
-        Ok(HardEngine::new(super::scene::load_hard_scene(path).map_err(|e| e.to_string())?))
+        Ok(HardEngine::new(
+            super::scene::load_hard_scene(path).map_err(|e| e.to_string())?,
+        ))
     }
 
     /// What the scene resolves to, for `rubblepile check`.

@@ -460,6 +460,12 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         }
     }
     reject_deep_overlaps(&v, &particles)?;
+    crate::scene::check_finite_motion(
+        particles
+            .iter()
+            .map(|p| (p.mass, p.radius, p.position, p.velocity, p.spin)),
+    )
+    .map_err(|(field, message)| v.invalid(field, message))?;
     Ok(HardScene {
         name: name.to_string(),
         source: text.to_string(),

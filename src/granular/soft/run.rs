@@ -30,12 +30,12 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::analysis::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
+use crate::bits::exact_f64_vec;
+use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
-use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::scene::{SoftScene, load_soft_scene, parse_soft_scene};
 use crate::granular::soft::spinup::{SpinupDriver, central_body};
 use crate::math::Vec3;
@@ -382,7 +382,6 @@ fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f6
     )
 }
 
-
 /// What a soft-sphere run's checkpoint holds beside the driver's envelope: every particle's state, the last forces
 /// and torques (leapfrog needs them), the spring histories and the bookkeeping, as exact f64 bit patterns.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -498,7 +497,9 @@ impl Engine for SoftEngine {
     const KIND: &'static str = crate::granular::soft::scene::KIND;
 
     fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
-        Ok(SoftEngine::new(parse_soft_scene(text, name, base_dir).map_err(|e| e.to_string())?))
+        Ok(SoftEngine::new(
+            parse_soft_scene(text, name, base_dir).map_err(|e| e.to_string())?,
+        ))
     }
 
     fn scene_source(&self) -> &str {
@@ -614,7 +615,15 @@ impl Engine for SoftEngine {
             Outcome::Completed => "completed".to_string(),
             Outcome::Failed(f) => format!("failed: {} at t = {} s", f.cause, self.time() + self.scene.dt),
         };
-        summary(&self.scene, &self.sys, &self.book, status, self.step, samples, wall_seconds)
+        summary(
+            &self.scene,
+            &self.sys,
+            &self.book,
+            status,
+            self.step,
+            samples,
+            wall_seconds,
+        )
     }
 
     fn save(&mut self) -> std::io::Result<SoftState> {
@@ -658,7 +667,10 @@ impl Engine for SoftEngine {
         let scene = &self.scene;
         let n = scene.particles.len();
         if ck.state.len() != 15 * n {
-            return Err(format!("the checkpoint holds {} numbers for {n} particles", ck.state.len()));
+            return Err(format!(
+                "the checkpoint holds {} numbers for {n} particles",
+                ck.state.len()
+            ));
         }
         let mut sys = SoftSystem::new(
             scene.particles.clone(),

@@ -674,6 +674,12 @@ impl V<'_> {
                 ));
             }
         }
+        crate::scene::check_finite_motion(
+            particles
+                .iter()
+                .map(|p| (p.mass, p.radius, p.position, p.velocity, p.spin)),
+        )
+        .map_err(|(field, message)| self.invalid(field, message))?;
         Ok(SoftScene {
             name: self.file.to_string(),
             source: text.to_string(),

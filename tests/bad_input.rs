@@ -1,0 +1,185 @@
+//! The bad-input corpus (`tests/bad_input/cases.toml`): malformed scenes of the three engines, bodies and particles
+//! files, campaign files, aggregate and spin-up options, and damaged checkpoints, each run through the binary. Every
+//! case must end with a non-zero exit code (not a signal), a one-line `error: …` naming what it expects, no panic,
+//! and no output directory that a later run would take for a finished one.
+
+mod common;
+use common::temp_dir;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Corpus {
+    case: Vec<Case>,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Case {
+    name: String,
+    kind: String,
+    expect: String,
+    base: Option<String>,
+    replace: Option<[String; 2]>,
+    args: Option<Vec<String>>,
+    prepare: Option<String>,
+    damage: Option<Damage>,
+    #[serde(default)]
+    files: BTreeMap<String, String>,
+}
+
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Damage {
+    op: String,
+    from: Option<String>,
+    to: Option<String>,
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn rubblepile(cwd: &Path, args: &[String]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+        .args(args)
+        .current_dir(cwd)
+        .output()
+        .expect("run the binary")
+}
+
+/// Whether `out` holds a run that claims to have completed.
+fn looks_finished(out: &Path) -> bool {
+    std::fs::read_to_string(out.join("summary.json")).is_ok_and(|t| t.contains("\"status\": \"completed\""))
+}
+
+/// Sets the case up in `dir`; returns an error text for a broken case (a replacement that matches nothing).
+fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
+    let root_s = root().display().to_string();
+    if let Some(base) = &case.base {
+        let mut text = std::fs::read_to_string(root().join("tests/bad_input").join(base)).map_err(|e| e.to_string())?;
+        if case.prepare.is_none()
+            && let Some([old, new]) = &case.replace
+        {
+            if !text.contains(old.as_str()) {
+                return Err(format!("replace: {old:?} is not in {base}"));
+            }
+            text = text.replacen(old.as_str(), new, 1);
+        }
+        std::fs::write(dir.join("scene.toml"), text.replace("ROOT", &root_s)).map_err(|e| e.to_string())?;
+    }
+    for (name, text) in &case.files {
+        std::fs::write(dir.join(name), text.replace("ROOT", &root_s)).map_err(|e| e.to_string())?;
+    }
+    if case.prepare.as_deref() == Some("checkpoint") {
+        let out_s = out.display().to_string();
+        let args: Vec<String> = [
+            "run",
+            "scene.toml",
+            "--out",
+            &out_s,
+            "--no-progress",
+            "--checkpoint-every-sim",
+            "0",
+            "--stop-after-checkpoints",
+            "1",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let o = rubblepile(dir, &args);
+        if o.status.code() != Some(3) {
+            return Err(format!(
+                "preparing the checkpoint: exit {:?}: {}",
+                o.status.code(),
+                String::from_utf8_lossy(&o.stderr)
+            ));
+        }
+        let ckpt = out.join("checkpoint.json");
+        let damage = case.damage.as_ref().ok_or("prepare = \"checkpoint\" needs a damage")?;
+        match damage.op.as_str() {
+            "truncate" => {
+                let b = std::fs::read(&ckpt).map_err(|e| e.to_string())?;
+                std::fs::write(&ckpt, &b[..b.len() / 2]).map_err(|e| e.to_string())?;
+            }
+            "delete" => std::fs::remove_file(&ckpt).map_err(|e| e.to_string())?,
+            "replace" => {
+                let (from, to) = (damage.from.as_deref().unwrap_or(""), damage.to.as_deref().unwrap_or(""));
+                let t = std::fs::read_to_string(&ckpt).map_err(|e| e.to_string())?;
+                if !t.contains(from) {
+                    return Err(format!("damage: {from:?} is not in the checkpoint"));
+                }
+                std::fs::write(&ckpt, t.replacen(from, to, 1)).map_err(|e| e.to_string())?;
+            }
+            "edit-scene" => {
+                let p = out.join("scene.toml");
+                let t = std::fs::read_to_string(&p).map_err(|e| e.to_string())?;
+                std::fs::write(&p, t + "\n# edited\n").map_err(|e| e.to_string())?;
+            }
+            "truncate-timeseries" => {
+                std::fs::write(out.join("timeseries.csv"), "t\n").map_err(|e| e.to_string())?;
+            }
+            other => return Err(format!("unknown damage {other:?}")),
+        }
+    }
+    Ok(())
+}
+
+#[test]
+fn every_bad_input_gets_one_clear_error() {
+    let text = std::fs::read_to_string(root().join("tests/bad_input/cases.toml")).unwrap();
+    let corpus: Corpus = toml::from_str(&text).unwrap();
+    let mut failures = Vec::new();
+    let mut per_kind: BTreeMap<&str, usize> = BTreeMap::new();
+    for case in &corpus.case {
+        *per_kind.entry(case.kind.as_str()).or_default() += 1;
+        let dir = temp_dir(&format!("bad-{}", case.name));
+        let out = dir.join("out");
+        if let Err(e) = prepare(case, &dir, &out) {
+            failures.push(format!("{}: broken case: {e}", case.name));
+            continue;
+        }
+        let out_s = out.display().to_string();
+        let default_args = vec!["check".to_string(), "SCENE".to_string()];
+        let args: Vec<String> = case
+            .args
+            .as_ref()
+            .unwrap_or(&default_args)
+            .iter()
+            .map(|a| a.replace("SCENE", "scene.toml").replace("OUT", &out_s))
+            .collect();
+        let o = rubblepile(&dir, &args);
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
+        let problem = if o.status.code().is_none() {
+            Some("killed by a signal".to_string())
+        } else if o.status.success() {
+            Some("accepted (exit 0)".to_string())
+        } else if stderr.contains("panicked") {
+            Some(format!("panicked: {stderr}"))
+        } else if errors.len() != 1 {
+            Some(format!("expected one `error: ` line, got: {stderr:?}"))
+        } else if !errors[0].contains(case.expect.as_str()) {
+            Some(format!("error does not name {:?}: {}", case.expect, errors[0]))
+        } else if looks_finished(&out) {
+            Some("left an output directory that looks finished".to_string())
+        } else {
+            None
+        };
+        if let Some(p) = problem {
+            failures.push(format!("{} ({}): {p}", case.name, case.kind));
+        }
+    }
+    let counts: Vec<String> = per_kind.iter().map(|(k, n)| format!("{k}: {n}")).collect();
+    println!("{} cases ({})", corpus.case.len(), counts.join(", "));
+    assert!(corpus.case.len() >= 60, "the corpus must hold at least 60 cases");
+    assert!(
+        failures.is_empty(),
+        "{} of {} cases failed:\n{}",
+        failures.len(),
+        corpus.case.len(),
+        failures.join("\n")
+    );
+}
