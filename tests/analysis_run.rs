@@ -192,7 +192,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     // (the campaign stands in for its own uniform-inertia partner here, so that section is drawn too)
     let rep = rubblepile(
         &dir,
-        &["report-roig2003", "c", "--uniform", "c", "--out", "rep", "--at", "110"],
+        &["report", "roig2003", "c", "--uniform", "c", "--out", "rep", "--at", "110"],
     );
     assert!(rep.status.success(), "{}", String::from_utf8_lossy(&rep.stderr));
     let report = std::fs::read_to_string(dir.join("rep/REPORT.md")).unwrap();
@@ -217,7 +217,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     );
     assert!(dir.join("rep/figures").is_dir());
     // a second report only with --force
-    let again = rubblepile(&dir, &["report-roig2003", "c", "--out", "rep", "--at", "110"]);
+    let again = rubblepile(&dir, &["report", "roig2003", "c", "--out", "rep", "--at", "110"]);
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("use --force"));
     let _ = std::fs::remove_dir_all(&dir);

@@ -495,3 +495,24 @@ fn example_scenes_are_valid() {
         assert!(kinds.iter().any(|x| x == k), "no {k} example: {kinds:?}");
     }
 }
+
+/// `report roig2003|zhang2017|richardson2011` and the old hyphenated spellings (hidden aliases) all parse.
+#[test]
+fn report_verb_and_its_old_spellings_parse() {
+    let dir = common::temp_dir("report-verb");
+    for args in [
+        &["report", "roig2003", "--help"][..],
+        &["report", "zhang2017", "--help"],
+        &["report", "richardson2011", "--help"],
+        &["report-roig2003", "--help"],
+        &["report-zhang2017", "--help"],
+        &["report-richardson2011", "--help"],
+    ] {
+        let out = common::rubblepile(&dir, args);
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let help = common::rubblepile(&dir, &["--help"]);
+    let text = String::from_utf8_lossy(&help.stdout);
+    assert!(text.contains("report "), "{text}");
+    assert!(!text.contains("report-roig2003"), "old spellings are hidden: {text}");
+}

@@ -1,4 +1,4 @@
-//! `report-zhang2017` with `--full`: a full-size run still going is read as far as it has got (status, simulated
+//! `report zhang2017` with `--full`: a full-size run still going is read as far as it has got (status, simulated
 //! time against the scene's t_end, wall time so far from `timeseries.csv`, residuals so far), next to the
 //! scaled runs' Table 3.
 

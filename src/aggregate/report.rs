@@ -4,7 +4,7 @@
 
 use crate::aggregate::random_packing::{Recipe, StageLog};
 use crate::aggregate::shape::Shape;
-use crate::analysis::shape_metrics::axis_lengths;
+use crate::geometry::shape_metrics::axis_lengths;
 use crate::geometry::voronoi::{packing_fraction, radical_cells};
 use crate::granular::soft::particle::Particle;
 use serde::{Deserialize, Serialize};

@@ -537,7 +537,7 @@ pub fn analyze_campaign(
         path: json_path.clone(),
         reason: e.to_string(),
     })?;
-    // here rather than in the CLI, so every caller (analyze-campaign, report-roig2003) gets them
+    // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them
     let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
     for why in &not_drawn {
         eprintln!("warning: figure not drawn: {why}");

@@ -112,7 +112,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `rubblepile report-roig2003`.
+/// `rubblepile report roig2003`.
 #[derive(Debug, clap::Args)]
 pub struct ReportRoig2003Args {
     /// The campaign directory of analysis/roig2003/campaign.toml (holding campaign.csv).
@@ -131,7 +131,7 @@ pub struct ReportRoig2003Args {
     pub force: bool,
 }
 
-/// Runs `report-roig2003`: re-analyses the campaign(s) (rewriting their `analysis/`), then writes the report.
+/// Runs `report roig2003`: re-analyses the campaign(s) (rewriting their `analysis/`), then writes the report.
 pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
@@ -161,7 +161,7 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
         None => None,
     };
     let mut command = format!(
-        "rubblepile report-roig2003 {} --out {}",
+        "rubblepile report roig2003 {} --out {}",
         args.campaign.display(),
         args.out.display()
     );

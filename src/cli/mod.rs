@@ -13,7 +13,7 @@
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
-//! - `rubblepile report-richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
+//! - `rubblepile report richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
 //!   (`analysis/richardson2011/REPORT.md` and figures);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side
 //!   evaluation of a random cloud of N ellipsoids, on 1 thread and on all threads;
@@ -28,7 +28,7 @@
 //! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius R
 //!   --bulk-density RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
 //! - `rubblepile spinup critical …` / `rubblepile spinup density-fit …`: the T_c,3 search and the Eq. 22 fit
-//!   ([`spinup`]); `rubblepile report-zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
+//!   ([`spinup`]); `rubblepile report zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
@@ -88,9 +88,14 @@ pub enum Command {
     Analyze(analyze::AnalyzeArgs),
     /// Analyse every completed run of a campaign; bound fraction vs Q and Q*_D (Roig03 Fig. 5).
     AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
-    /// Re-analyse the Roig03 campaign (and its uniform-inertia partner) and write analysis/roig2003/REPORT.md.
+    /// Reproduction reports of the three papers: `report roig2003|zhang2017|richardson2011 …`.
+    #[command(subcommand)]
+    Report(ReportCommand),
+    /// Old spelling of `report roig2003`.
+    #[command(hide = true)]
     ReportRoig2003(analyze::ReportRoig2003Args),
-    /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
+    /// Old spelling of `report richardson2011`.
+    #[command(hide = true)]
     ReportRichardson2011(report_richardson2011::ReportRichardson2011Args),
     /// Benchmarks.
     #[command(subcommand)]
@@ -104,11 +109,23 @@ pub enum Command {
     /// Spin-up studies (Zhang17 §3–4): the T_c,3 search and the Eq. 22 density fit.
     #[command(subcommand)]
     Spinup(spinup::SpinupCommand),
-    /// Read spin-up runs (RUNS/<model>/path2, RUNS/<model>/critical) and write REPORT.md and Fig. 5-style figures.
+    /// Old spelling of `report zhang2017`.
+    #[command(hide = true)]
     ReportZhang2017(ReportZhang2017Args),
 }
 
-/// `rubblepile report-zhang2017`.
+/// `rubblepile report …`: one verb for the papers' reproduction reports.
+#[derive(Debug, Subcommand)]
+pub enum ReportCommand {
+    /// Re-analyse the Roig03 campaign (and its uniform-inertia partner) and write analysis/roig2003/REPORT.md.
+    Roig2003(analyze::ReportRoig2003Args),
+    /// Read spin-up runs (RUNS/<model>/path2, RUNS/<model>/critical) and write REPORT.md and Fig. 5-style figures.
+    Zhang2017(ReportZhang2017Args),
+    /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
+    Richardson2011(report_richardson2011::ReportRichardson2011Args),
+}
+
+/// `rubblepile report zhang2017`.
 #[derive(Debug, clap::Args)]
 pub struct ReportZhang2017Args {
     /// Directory of the runs (e.g. runs/zhang2017).
@@ -291,8 +308,13 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
-        Command::ReportRoig2003(args) => analyze::report_roig2003(&args),
-        Command::ReportRichardson2011(args) => report_richardson2011::report(&args),
+        Command::Report(ReportCommand::Roig2003(args)) | Command::ReportRoig2003(args) => {
+            analyze::report_roig2003(&args)
+        }
+        Command::Report(ReportCommand::Richardson2011(args)) | Command::ReportRichardson2011(args) => {
+            report_richardson2011::report(&args)
+        }
+        Command::Report(ReportCommand::Zhang2017(args)) | Command::ReportZhang2017(args) => report_zhang2017(&args),
         Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
         Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
         Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),
@@ -304,18 +326,14 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
-        Command::ReportZhang2017(args) => {
-            let path = crate::analysis::report_zhang2017::write_report(
-                &args.runs,
-                args.full.as_deref(),
-                &args.out,
-                args.force,
-            )
-            .map_err(CliError::usage)?;
-            println!("wrote {}", path.display());
-            Ok(())
-        }
     }
+}
+
+fn report_zhang2017(args: &ReportZhang2017Args) -> Result<(), CliError> {
+    let path = crate::analysis::report_zhang2017::write_report(&args.runs, args.full.as_deref(), &args.out, args.force)
+        .map_err(CliError::usage)?;
+    println!("wrote {}", path.display());
+    Ok(())
 }
 
 /// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on stderr, e.g.

@@ -16,7 +16,7 @@
 //! - `rubblepile spinup density-fit --points RHO:T,RHO:T,… [--period 2.26]`: κ of Eq. 22 by least squares
 //!   through the origin from (bulk density kg/m³, critical period h) pairs, its standard error, and the critical
 //!   bulk density for the given period.
-//! - `rubblepile report-zhang2017 RUNS --out DIR [--force]`: see [`crate::analysis::report_zhang2017`].
+//! - `rubblepile report zhang2017 RUNS --out DIR [--force]`: see [`crate::analysis::report_zhang2017`].
 
 use std::path::{Path, PathBuf};
 

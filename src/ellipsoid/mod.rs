@@ -17,4 +17,5 @@ pub mod equations;
 pub mod gravity;
 pub mod potential;
 pub mod quaternion;
+pub mod rigid_rotation;
 pub mod run;

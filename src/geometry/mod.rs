@@ -5,6 +5,7 @@ pub mod ellipsoid_overlap;
 pub mod lattice;
 pub mod neighbours;
 pub mod polyhedron;
+pub mod shape_metrics;
 pub mod voronoi;
 pub mod wall;
 pub mod walls;

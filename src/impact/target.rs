@@ -16,7 +16,7 @@
 //! 5. κ from Roig03 Eq. 14 with β = 10, v = 5 km/s over the fragments (the projectiles of Table 2 are smaller
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
-use crate::analysis::rigid_rotation::{RigidFit, fit_rigid_rotation};
+use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
 use crate::ellipsoid::equations::{

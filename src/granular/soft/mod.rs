@@ -21,4 +21,6 @@ pub mod respa;
 pub mod run;
 pub mod scene;
 pub mod spinup;
+pub mod spinup_diagnostics;
 pub mod spring_frame;
+pub mod stress;

@@ -29,7 +29,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::analysis::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
+use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
 use crate::bits::exact_f64_vec;
 use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::contact::Springs;

@@ -41,8 +41,8 @@
 
 use std::path::Path;
 
-use crate::analysis::shape_metrics::axis_lengths;
-use crate::analysis::spinup::{StressState, particle_stress, rve_stress, stress_state};
+use crate::geometry::shape_metrics::axis_lengths;
+use crate::granular::soft::stress::{StressState, particle_stress, rve_stress, stress_state};
 use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::voronoi::{VoronoiCell, packing_fraction, radical_cells, weighted_packing_fraction};
 use crate::granular::soft::forces::{ContactRecord, SoftSystem};
