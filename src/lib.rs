@@ -21,5 +21,4 @@ pub mod integrate;
 pub mod io;
 pub mod math;
 pub mod random;
-pub mod scene;
 pub mod stability;

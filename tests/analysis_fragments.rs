@@ -5,7 +5,7 @@ use rubblepile::analysis::fragments::{
     ejection_velocities, escape_velocity, read_snapshot_bodies, rotation_mode, rotation_mode_measure, spin_correction,
 };
 use rubblepile::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
-use rubblepile::io::csv::write_snapshot;
+use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::math::{Vec3, Vec4};
 
 fn body(mass: f64, axes: [f64; 3], position: [f64; 3], velocity: [f64; 3], spin: [f64; 3]) -> Body {

@@ -18,7 +18,7 @@ use rubblepile::impact::campaign::{
 };
 use rubblepile::impact::run::run_impact;
 use rubblepile::impact::target::{TargetSpec, build_target};
-use rubblepile::io::csv::write_snapshot;
+use rubblepile::ellipsoid::output::write_snapshot;
 use std::f64::consts::PI;
 
 fn temp_dir(tag: &str) -> PathBuf {

@@ -7,8 +7,8 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use rubblepile::io::csv::{SNAPSHOT_COLUMNS, TIMESERIES_COLUMNS, read_bodies_csv};
-use rubblepile::scene::load_scene;
+use rubblepile::ellipsoid::output::{SNAPSHOT_COLUMNS, TIMESERIES_COLUMNS, read_bodies_csv};
+use rubblepile::ellipsoid::scene::load_scene;
 
 /// Two ellipsoids drifting into contact: gravity + contact + dissipation.
 const SCENE: &str = r#"[scene]
@@ -368,7 +368,7 @@ fn snapshot_reread_as_bodies_file_is_lossless() {
             assert_eq!(got, want, "snapshot {k}");
         }
         // And the snapshot text itself re-formats identically.
-        let rewritten = rubblepile::io::csv::snapshot_records(
+        let rewritten = rubblepile::ellipsoid::output::snapshot_records(
             read(&snap)
                 .lines()
                 .nth(1)
@@ -473,7 +473,7 @@ fn example_scenes_are_valid() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let text = std::fs::read_to_string(&path).unwrap();
-            let kind = rubblepile::scene::peek_kind(&text).unwrap_or_default();
+            let kind = rubblepile::io::scene_file::peek_kind(&text).unwrap_or_default();
             if kind == "ellipsoids" {
                 load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
             }

@@ -7,7 +7,8 @@ use common::temp_dir;
 use std::path::Path;
 use std::process::Command;
 
-use rubblepile::scene::{SceneError, parse_scene};
+use rubblepile::io::scene_file::{SceneError};
+use rubblepile::ellipsoid::scene::{parse_scene};
 
 const BASE: &str = r#"[scene]
 kind = "ellipsoids"

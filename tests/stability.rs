@@ -12,7 +12,7 @@ use std::path::Path;
 use common::{rubblepile, temp_dir};
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
-use rubblepile::scene::parse_scene;
+use rubblepile::ellipsoid::scene::parse_scene;
 use rubblepile::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
 use rubblepile::stability::{CaseResult, Verdict, run_case};
 

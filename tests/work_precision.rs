@@ -306,7 +306,7 @@ fn rebound_compare_scenes_match_the_library_problems() {
         ("pythagorean.toml", NBodyProblem::Pythagorean),
         ("outer_solar.toml", NBodyProblem::OuterSolar),
     ] {
-        let scene = rubblepile::scene::load_scene(&root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let scene = rubblepile::ellipsoid::scene::load_scene(&root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         let p = problem.setup();
         assert_eq!(scene.t_end, p.t_end);
         assert_eq!(scene.physics.gravity.unwrap().g, 1.0);

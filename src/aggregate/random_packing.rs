@@ -38,7 +38,7 @@ use crate::granular::soft::particle::Particle;
 use crate::gravity::SelfGravity;
 use crate::math::Vec3;
 use crate::random::{Generator, point_in_ball};
-use crate::scene::SI_G;
+use crate::io::scene_file::SI_G;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 

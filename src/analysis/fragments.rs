@@ -276,7 +276,7 @@ pub struct FragmentReport {
     pub summary: FragmentSummary,
 }
 
-/// Reads a snapshot (or any bodies) CSV into bodies: [`read_target`], i.e. [`crate::io::csv::read_bodies_csv`]
+/// Reads a snapshot (or any bodies) CSV into bodies: [`read_target`], i.e. [`crate::ellipsoid::output::read_bodies_csv`]
 /// with values checked and quaternions normalised.
 pub fn read_snapshot_bodies(path: &Path) -> Result<Vec<Body>, ImpactError> {
     read_target(path)

@@ -27,7 +27,7 @@ use crate::analysis::spinup::{
     fit_density, smoothed_critical_limits,
 };
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
-use crate::scene::SI_G;
+use crate::io::scene_file::SI_G;
 
 /// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
 pub const DIDYMOS_MASS: f64 = 5.23e11;

@@ -147,7 +147,7 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         reason: e.to_string(),
     })?;
     let scene =
-        crate::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| AnalysisError::Read {
+        crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| AnalysisError::Read {
             path: scene_path.clone(),
             reason: e.to_string(),
         })?;

@@ -8,8 +8,9 @@ use crate::cli::CliError;
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
 use crate::integrate::OdeSystem;
-use crate::scene::cloud::{CloudParams, random_cloud};
-use crate::scene::{DEFAULT_CONTACT_CUTOFF, SI_G};
+use crate::ellipsoid::cloud::{CloudParams, random_cloud};
+use crate::io::scene_file::{SI_G};
+use crate::ellipsoid::scene::{DEFAULT_CONTACT_CUTOFF};
 
 /// `rubblepile bench rhs`.
 #[derive(Debug, clap::Args)]

@@ -290,7 +290,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         }
         Command::Check(args) => {
             if args.print_default {
-                print!("{}", crate::scene::DEFAULT_SCENE_TOML);
+                print!("{}", crate::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
             }
             let (warnings, lines) = crate::driver::check_file(args.scene.as_deref()).map_err(CliError::usage)?;

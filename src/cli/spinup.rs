@@ -26,7 +26,7 @@ use crate::analysis::spinup::{CreepCriterion, fit_density};
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::cli::CliError;
 use crate::driver::RunOptions;
-use crate::scene::SI_G;
+use crate::io::scene_file::SI_G;
 
 /// `rubblepile spinup …`.
 #[derive(Debug, clap::Subcommand)]

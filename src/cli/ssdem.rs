@@ -14,7 +14,7 @@ use crate::granular::soft::packing::fcc_ball;
 use crate::granular::soft::scene::load_soft_scene;
 use crate::gravity::SelfGravity;
 use crate::math::Vec3;
-use crate::scene::SI_G;
+use crate::io::scene_file::SI_G;
 
 /// `rubblepile ssdem …`.
 #[derive(Debug, clap::Subcommand)]

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use crate::cli::CliError;
 use crate::impact::target::{TargetSpec, build_target};
-use crate::io::csv::write_snapshot;
+use crate::ellipsoid::output::write_snapshot;
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]

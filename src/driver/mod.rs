@@ -40,8 +40,8 @@ use crate::ellipsoid::run::EllipsoidEngine;
 use crate::engine::{Engine, Outcome, Resumed, RunReport, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
-pub use crate::io::summary::RunSummary;
-use crate::scene::LoadedScene;
+pub use crate::ellipsoid::summary::RunSummary;
+use crate::ellipsoid::scene::LoadedScene;
 
 pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
 

@@ -56,7 +56,7 @@ use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::Mat3;
-use crate::scene::KappaSource;
+use crate::ellipsoid::scene::KappaSource;
 
 /// β used when κ is given rather than calibrated (Roig03 after Eq. 13: "β ~ 10").
 pub const DEFAULT_BETA: f64 = 10.0;

@@ -12,10 +12,14 @@
 pub mod barrier;
 pub mod body;
 pub mod calibration;
+pub mod cloud;
 pub mod dissipation;
 pub mod equations;
 pub mod gravity;
+pub mod output;
 pub mod potential;
 pub mod quaternion;
 pub mod rigid_rotation;
 pub mod run;
+pub mod scene;
+pub mod summary;

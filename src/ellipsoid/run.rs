@@ -3,7 +3,7 @@
 //! times.
 //!
 //! Its outputs, beside the driver's: `timeseries.csv` in [`TIMESERIES_COLUMNS`] (energies, the energy residual,
-//! momenta); snapshots in [`crate::io::csv::SNAPSHOT_COLUMNS`]; `tracks.csv` (only when `output.track` lists bodies):
+//! momenta); snapshots in [`crate::ellipsoid::output::SNAPSHOT_COLUMNS`]; `tracks.csv` (only when `output.track` lists bodies):
 //! those bodies' rows at every sample; `barrier_overruns.csv` (only when a pair overran its contact barrier, see
 //! [`crate::ellipsoid::barrier`]); `summary.json` as [`RunSummary`]. A sampled state with a non-finite diagnostic or a
 //! quaternion norm off by more than [`QUATERNION_NORM_LIMIT`] stops the run, as does an integrator error (step-size
@@ -19,11 +19,11 @@ use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
 use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
 use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
-use crate::io::csv::{TracksWriter, snapshot_records, write_snapshot};
+use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
 use crate::io::fmt_f64;
-use crate::io::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
+use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
 use crate::math::Vec3;
-use crate::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
+use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;

@@ -76,7 +76,7 @@ use crate::impact::run::{
     ImpactError, ImpactPlan, default_snapshots, read_target, run_impact,
 };
 use crate::io::checkpoint::CHECKPOINT_FILE;
-use crate::io::csv::read_bodies_csv;
+use crate::ellipsoid::output::read_bodies_csv;
 use crate::io::fmt_f64;
 
 /// Name of the campaign table in the campaign directory.

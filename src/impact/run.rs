@@ -18,8 +18,9 @@ use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::G_SI;
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
-use crate::io::csv::{read_bodies_csv, write_snapshot};
-use crate::scene::{LoadedScene, MAX_TIMESERIES_ROWS, SceneError, parse_scene};
+use crate::ellipsoid::output::{read_bodies_csv, write_snapshot};
+use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
+use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 
 /// Default end time (s).
 pub const DEFAULT_T_END: f64 = 10_000.0;
@@ -141,7 +142,7 @@ impl ImpactConfig {
         if !positive(self.t_end) {
             return invalid("t_end", format!("must be > 0 s and finite, got {}", self.t_end));
         }
-        let min_rtol = crate::scene::MIN_RTOL;
+        let min_rtol = crate::io::scene_file::MIN_RTOL;
         if !(self.rtol.is_finite() && (min_rtol..1.0).contains(&self.rtol)) {
             return invalid(
                 "rtol",

@@ -315,10 +315,10 @@ pub const N30_F0: f64 = 1e-4;
 /// the impact speed), gravity (SI G) + contact + dissipation (F0 = 1e-4 s m⁻²); t = 0..60 s: the projectile
 /// ploughs through the target and the struck fragments fly apart. 31 bodies, 435 state components.
 pub fn n30_impact() -> ProblemSetup {
-    let target: Vec<Body> = crate::io::csv::read_bodies(N30_T4_CSV.as_bytes())
+    let target: Vec<Body> = crate::ellipsoid::output::read_bodies(N30_T4_CSV.as_bytes())
         .expect("the embedded N30_T4 target parses")
         .iter()
-        .map(crate::io::csv::BodyRecord::to_body)
+        .map(crate::ellipsoid::output::BodyRecord::to_body)
         .collect();
     let projectile = ProjectileSpec::preset("P1").expect("P1 is a preset");
     let mut cfg = crate::impact::run::ImpactConfig::new("targets/N30_T4.csv".into(), projectile.clone());

@@ -1,16 +1,12 @@
-//! Output files of a run (and the bodies-file reader).
+//! The engine-independent floor of file input and output: lossless float formatting ([`fmt_f64`]), the checkpoint
+//! file names ([`checkpoint`]), and the scene-file reading, parsing and field checks every engine's scene uses
+//! ([`scene_file`]). Each engine's own output formats live with the engine (e.g. [`crate::ellipsoid::output`]).
 //!
-//! - [`csv`] writes `snapshots/<k>.csv`, `last_good_state.csv`, `timeseries.csv`, and the reader for a
-//!   scene's `bodies_file` (which takes the snapshot format);
-//! - [`summary`] writes `summary.json`;
-//! - [`checkpoint`] writes and reads `checkpoint.json` (the state a run resumes from).
-//!
-//! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific
-//! notation), so a snapshot re-read as a bodies file gives the same `f64`s bit for bit.
+//! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific notation), so a
+//! snapshot re-read as an input file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
-pub mod csv;
-pub mod summary;
+pub mod scene_file;
 
 /// Formats an `f64` losslessly: the shortest decimal that parses back to the same bits (`{:e}`).
 pub fn fmt_f64(x: f64) -> String {

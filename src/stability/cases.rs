@@ -16,7 +16,7 @@ use crate::ellipsoid::calibration::lambda;
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::{Vec3, Vec4};
-use crate::scene::cloud::{CloudParams, random_cloud};
+use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 
 /// Density of every case body (kg/m³).
 pub const DENSITY: f64 = 3000.0;
@@ -222,7 +222,7 @@ fn final_bodies(run: &CaseRun) -> Result<Vec<Body>, String> {
         .ok_or_else(|| "no snapshot".to_string())
 }
 
-/// The rows of a run's `timeseries.csv` as numbers (columns of [`crate::io::csv::TIMESERIES_COLUMNS`]).
+/// The rows of a run's `timeseries.csv` as numbers (columns of [`crate::ellipsoid::output::TIMESERIES_COLUMNS`]).
 fn timeseries(run: &CaseRun) -> Result<Vec<Vec<f64>>, String> {
     let path = run.dir.join("timeseries.csv");
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;

@@ -29,9 +29,9 @@ use crate::ellipsoid::barrier::{BarrierSettings, contacts};
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::equations::EllipsoidSystem;
 use crate::integrate::{OdeSystem, Tolerances, make_integrator};
-use crate::io::csv::read_bodies_csv;
+use crate::ellipsoid::output::read_bodies_csv;
 use crate::math::{Vec3, Vec4};
-use crate::scene::{LoadedScene, parse_scene};
+use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 
 /// Columns of `stability.csv`.
 pub const CSV_COLUMNS: [&str; 11] = [

@@ -50,7 +50,7 @@ use super::particle::{Attachment, Particle};
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
 use crate::math::Vec3;
-use crate::scene::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
+use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
 
 /// The scene kind this module reads.
 pub const KIND: &str = "hard-spheres";
@@ -301,7 +301,7 @@ pub struct HardScene {
     pub every: f64,
 }
 
-use crate::scene::Validator as V;
+use crate::io::scene_file::Validator as V;
 
 impl V<'_> {
     fn in_range(&self, field: &str, x: f64, lo: f64, hi: f64) -> Result<f64, SceneError> {
@@ -330,7 +330,7 @@ impl V<'_> {
 
 /// Reads and validates a hard-sphere scene file.
 pub fn load_hard_scene(path: &Path) -> Result<HardScene, SceneError> {
-    let s = crate::scene::read_scene_text(path)?;
+    let s = crate::io::scene_file::read_scene_text(path)?;
     parse_hard_scene(&s.text, &s.name, &s.base_dir)
 }
 
@@ -460,7 +460,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         }
     }
     reject_deep_overlaps(&v, &particles)?;
-    crate::scene::check_finite_motion(
+    crate::io::scene_file::check_finite_motion(
         particles
             .iter()
             .map(|p| (p.mass, p.radius, p.position, p.velocity, p.spin)),

@@ -16,7 +16,7 @@
 //!   `k dt ≤ T_c/5`. So `k = max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`: 10 at the advised step
 //!   (`dt = T_c/50`) for any body of asteroid density, where `t_dyn` is hours and the contact rule binds.
 
-use crate::scene::SI_G;
+use crate::io::scene_file::SI_G;
 use serde::Serialize;
 
 /// Default largest overlap, as a fraction of the smallest radius.

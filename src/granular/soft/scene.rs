@@ -66,7 +66,7 @@ use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
 use crate::gravity::SelfGravity;
 use crate::math::Vec3;
-use crate::scene::{SI_G, SceneError};
+use crate::io::scene_file::{SI_G, SceneError};
 
 /// The scene kind this module reads.
 pub const KIND: &str = "soft-spheres";
@@ -304,7 +304,7 @@ fn one_line(s: &str) -> String {
 
 /// Reads and validates a soft-sphere scene file.
 pub fn load_soft_scene(path: &Path) -> Result<SoftScene, SceneError> {
-    let s = crate::scene::read_scene_text(path)?;
+    let s = crate::io::scene_file::read_scene_text(path)?;
     parse_soft_scene(&s.text, &s.name, Some(&s.base_dir))
 }
 
@@ -324,7 +324,7 @@ pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Resu
     v.resolve_soft(text, file, base_dir)
 }
 
-use crate::scene::Validator as V;
+use crate::io::scene_file::Validator as V;
 
 impl V<'_> {
     fn restitution(&self, field: &str, x: f64) -> Result<f64, SceneError> {
@@ -674,7 +674,7 @@ impl V<'_> {
                 ));
             }
         }
-        crate::scene::check_finite_motion(
+        crate::io::scene_file::check_finite_motion(
             particles
                 .iter()
                 .map(|p| (p.mass, p.radius, p.position, p.velocity, p.spin)),

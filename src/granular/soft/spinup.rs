@@ -53,7 +53,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::granular::soft::particle::Particle;
 use crate::math::Vec3;
-use crate::scene::SceneError;
+use crate::io::scene_file::SceneError;
 
 fn d_release_axis() -> f64 {
     0.1
@@ -226,7 +226,7 @@ pub struct SpinupSettings {
     pub interior: InteriorRule,
 }
 
-impl crate::scene::Validator<'_> {
+impl crate::io::scene_file::Validator<'_> {
     /// Checks a `[spinup]` table; errors name the field (`spinup.T_final`, …) and the expected value.
     pub(crate) fn spinup(&self, s: &SpinupSection) -> Result<SpinupSettings, SceneError> {
         let ts = self.positive("spinup.T_start", s.period_start_h)?;
