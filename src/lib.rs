@@ -8,6 +8,7 @@
 
 pub mod aggregate;
 pub mod analysis;
+pub mod bench;
 pub mod bits;
 pub mod cli;
 pub mod driver;
@@ -21,4 +22,3 @@ pub mod integrate;
 pub mod io;
 pub mod math;
 pub mod random;
-pub mod stability;

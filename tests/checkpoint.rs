@@ -10,7 +10,7 @@ use std::process::Output;
 
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
-use rubblepile::integrate::problems::{Arenstorf, TestProblem};
+use rubblepile::bench::problems::{Arenstorf, TestProblem};
 use rubblepile::integrate::{Integrator, IntegratorState, Method, Tolerances, make_integrator};
 use rubblepile::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 

@@ -5,7 +5,7 @@
 
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
-use rubblepile::integrate::problems::{
+use rubblepile::bench::problems::{
     Arenstorf, ExponentialDecay, HarmonicOscillator, Kepler, RigidBody, TestProblem,
 };
 use rubblepile::integrate::{IntegrateError, Integrator, Method, OdeSystem, Stats, Tolerances, make_integrator};

@@ -13,8 +13,8 @@ use common::{rubblepile, temp_dir};
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::ellipsoid::scene::parse_scene;
-use rubblepile::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
-use rubblepile::stability::{CaseResult, Verdict, run_case};
+use rubblepile::bench::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
+use rubblepile::bench::stability::{CaseResult, Verdict, run_case};
 
 /// Whether case `id` is named by `prefix`: the id itself, or its part before a `-`.
 fn named(id: &str, prefix: &str) -> bool {

@@ -7,8 +7,8 @@ mod common;
 
 use common::{rubblepile, temp_dir};
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
-use rubblepile::integrate::ellipsoid_problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
-use rubblepile::integrate::work_precision::{CSV_HEADER, Setting, run_once, time_at_error};
+use rubblepile::bench::ellipsoid_problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
+use rubblepile::bench::work_precision::{CSV_HEADER, Setting, run_once, time_at_error};
 use rubblepile::integrate::{Integrator, Method, OdeSystem, Tolerances};
 use std::path::Path;
 

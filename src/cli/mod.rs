@@ -32,7 +32,7 @@
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
-//!   ([`crate::stability`]): `stability.csv`, `stability.md` and one run directory per case.
+//!   ([`crate::bench::stability`]): `stability.csv`, `stability.md` and one run directory per case.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when

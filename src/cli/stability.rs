@@ -1,11 +1,11 @@
-//! `rubblepile bench stability`: runs the stability suite of [`crate::stability`] (Roig03 model in its
+//! `rubblepile bench stability`: runs the stability suite of [`crate::bench::stability`] (Roig03 model in its
 //! regimes of trouble) and writes `stability.csv`, `stability.md` and one run directory per case.
 
 use std::path::PathBuf;
 
 use crate::cli::CliError;
-use crate::stability::cases::all_cases;
-use crate::stability::{StabilityRow, Verdict, prepare_out, result_paths, run_case, write_csv, write_markdown};
+use crate::bench::stability::cases::all_cases;
+use crate::bench::stability::{StabilityRow, Verdict, prepare_out, result_paths, run_case, write_csv, write_markdown};
 
 /// `rubblepile bench stability`.
 #[derive(Debug, clap::Args)]

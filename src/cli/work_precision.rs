@@ -1,7 +1,7 @@
 //! `rubblepile bench work-precision`: work–precision diagrams (final-state error and energy residual against
 //! integration wall time) of Bulirsch–Stoer, Dop853, Dopri5 and Rk4 on the canonical problems of
-//! [`crate::integrate::ellipsoid_problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
-//! The measurement itself is [`crate::integrate::work_precision`]; this file holds the command line, the CSV
+//! [`crate::bench::ellipsoid_problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
+//! The measurement itself is [`crate::bench::work_precision`]; this file holds the command line, the CSV
 //! and the plot.
 
 use std::io::Write;
@@ -12,8 +12,8 @@ use plotters::prelude::*;
 
 use crate::cli::CliError;
 use crate::integrate::Method;
-use crate::integrate::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
-use crate::integrate::work_precision::{
+use crate::bench::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
+use crate::bench::work_precision::{
     CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };
 
@@ -165,7 +165,7 @@ pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, String> {
         let method =
             <Method as clap::ValueEnum>::from_str(&rec[c[0]], true).map_err(|e| err(&format!("{}: {e}", at(0))))?;
         rows.push(SweepRow {
-            setting: crate::integrate::work_precision::Setting {
+            setting: crate::bench::work_precision::Setting {
                 method,
                 tolerance: opt(1)?,
                 step: opt(7)?,

@@ -94,7 +94,7 @@ pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = 10;
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, bulirsch_stoer::BulirschStoer};
-/// use rubblepile::integrate::problems::{HarmonicOscillator, TestProblem};
+/// use rubblepile::bench::problems::{HarmonicOscillator, TestProblem};
 ///
 /// let osc = HarmonicOscillator::new(1.0);
 /// let mut bs = BulirschStoer::new(Tolerances::uniform(1e-12, 1e-12, 2), None).unwrap();

@@ -4,18 +4,14 @@
 //! - [`bulirsch_stoer`]: our own adaptive Gragg–Bulirsch–Stoer extrapolation integrator in the style of
 //!   Hairer's ODEX (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9), the method Roig03 §3 used;
 //! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dop853, Dopri5 and Rk4, for cross-checks;
-//! - [`problems`]: canonical test problems with known solutions, shared by tests and benchmarks;
-//! - [`ellipsoid_problems`]: canonical problems of the ellipsoid model (free top, bouncing pair, N30 impact,
-//!   N-body tests), shared by tests and benchmarks;
-//! - [`work_precision`]: work–precision measurements (timed runs, final-state and energy errors);
 //! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution).
+//!
+//! The canonical test problems and the work–precision measurements that exercise these solvers live in
+//! [`crate::bench`].
 
 pub mod bulirsch_stoer;
-pub mod ellipsoid_problems;
 pub mod elliptic;
 pub mod ode_solvers_adapter;
-pub mod problems;
-pub mod work_precision;
 
 use std::fmt;
 

@@ -25,7 +25,7 @@
 use std::time::Instant;
 
 use super::ellipsoid_problems::{ProblemSetup, ReferenceKind};
-use super::{IntegrateError, Method, Stats, Tolerances, make_integrator};
+use crate::integrate::{IntegrateError, Method, Stats, Tolerances, make_integrator};
 
 /// Runs longer than this (s) are repeated at most [`LONG_RUN_REPEATS`] times and timed by their minimum.
 pub const LONG_RUN_SECONDS: f64 = 2.0;
