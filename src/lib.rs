@@ -4,7 +4,26 @@
 //! The core is the interacting-ellipsoids model of Roig et al. (2003, Icarus 165) ("Roig03"):
 //! rigid triaxial fragments with a Gaussian-overlap contact potential, monopole gravity,
 //! quaternion attitudes constrained by Lagrange multipliers, a Rayleigh point-dissipation function,
-//! integrated by an adaptive Bulirsch–Stoer integrator.
+//! integrated by an adaptive Bulirsch–Stoer integrator. Beside it, two granular engines: soft spheres (Zhang et al.
+//! 2017, "Zhang17") and hard spheres (Richardson et al. 2011, "Richardson11").
+//!
+//! # Layers
+//!
+//! Imports only go down: a module may use the modules of lower layers, never those of its own layer or above, so
+//! there is no import cycle and no engine sees the driver, the analysis or the command line. `tests/layers.rs` reads
+//! every `crate::` path in `src/` and checks this table (the table below is what it reads).
+//!
+//! - **L0**: `math`, `bits` — fixed-size linear algebra, bit-exact floats;
+//! - **L1**: `random` — seeded random numbers (`rand_pcg`; seeds live in scene files);
+//! - **L2**: `geometry`, `gravity`, `integrate`, `io`, `engine` — shapes, walls and neighbour search; self-gravity;
+//!   the ODE solvers; the scene-file floor and lossless formatting; the contract between an engine and the driver;
+//! - **L3**: `ellipsoid`, `granular` — the engines (interacting ellipsoids; soft and hard spheres), each with its scene
+//!   schema, equations, outputs and [`engine::Engine`] implementation;
+//! - **L4**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
+//! - **L5**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
+//! - **L6**: `analysis`, `bench` — science on finished runs (the three papers' reports) and benchmarks with the
+//!   canonical test problems;
+//! - **L7**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;

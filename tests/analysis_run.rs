@@ -192,7 +192,17 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     // (the campaign stands in for its own uniform-inertia partner here, so that section is drawn too)
     let rep = rubblepile(
         &dir,
-        &["report", "roig2003", "c", "--uniform", "c", "--out", "rep", "--at", "110"],
+        &[
+            "report",
+            "roig2003",
+            "c",
+            "--uniform",
+            "c",
+            "--out",
+            "rep",
+            "--at",
+            "110",
+        ],
     );
     assert!(rep.status.success(), "{}", String::from_utf8_lossy(&rep.stderr));
     let report = std::fs::read_to_string(dir.join("rep/REPORT.md")).unwrap();

@@ -13,12 +13,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::SystemTime;
 
 use rubblepile::driver::RunOptions;
+use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::impact::campaign::{
     Action, CAMPAIGN_COLUMNS, CampaignOptions, RunStatus, load_campaign, parse_campaign, run_campaign,
 };
 use rubblepile::impact::run::run_impact;
 use rubblepile::impact::target::{TargetSpec, build_target};
-use rubblepile::ellipsoid::output::write_snapshot;
 use std::f64::consts::PI;
 
 fn temp_dir(tag: &str) -> PathBuf {

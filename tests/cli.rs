@@ -509,7 +509,11 @@ fn report_verb_and_its_old_spellings_parse() {
         &["report-richardson2011", "--help"],
     ] {
         let out = common::rubblepile(&dir, args);
-        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let help = common::rubblepile(&dir, &["--help"]);
     let text = String::from_utf8_lossy(&help.stdout);

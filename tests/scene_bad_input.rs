@@ -7,8 +7,8 @@ use common::temp_dir;
 use std::path::Path;
 use std::process::Command;
 
-use rubblepile::io::scene_file::{SceneError};
-use rubblepile::ellipsoid::scene::{parse_scene};
+use rubblepile::ellipsoid::scene::parse_scene;
+use rubblepile::io::scene_file::SceneError;
 
 const BASE: &str = r#"[scene]
 kind = "ellipsoids"

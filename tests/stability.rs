@@ -10,11 +10,11 @@ mod common;
 use std::path::Path;
 
 use common::{rubblepile, temp_dir};
+use rubblepile::bench::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
+use rubblepile::bench::stability::{CaseResult, Verdict, run_case};
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::ellipsoid::scene::parse_scene;
-use rubblepile::bench::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
-use rubblepile::bench::stability::{CaseResult, Verdict, run_case};
 
 /// Whether case `id` is named by `prefix`: the id itself, or its part before a `-`.
 fn named(id: &str, prefix: &str) -> bool {

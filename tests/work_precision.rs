@@ -6,9 +6,9 @@
 mod common;
 
 use common::{rubblepile, temp_dir};
-use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::bench::ellipsoid_problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
 use rubblepile::bench::work_precision::{CSV_HEADER, Setting, run_once, time_at_error};
+use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::{Integrator, Method, OdeSystem, Tolerances};
 use std::path::Path;
 
@@ -306,7 +306,8 @@ fn rebound_compare_scenes_match_the_library_problems() {
         ("pythagorean.toml", NBodyProblem::Pythagorean),
         ("outer_solar.toml", NBodyProblem::OuterSolar),
     ] {
-        let scene = rubblepile::ellipsoid::scene::load_scene(&root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        let scene =
+            rubblepile::ellipsoid::scene::load_scene(&root.join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         let p = problem.setup();
         assert_eq!(scene.t_end, p.t_end);
         assert_eq!(scene.physics.gravity.unwrap().g, 1.0);

@@ -36,9 +36,9 @@ use crate::granular::soft::forces::{Gravity, SoftSystem};
 use crate::granular::soft::leapfrog::step;
 use crate::granular::soft::particle::Particle;
 use crate::gravity::SelfGravity;
+use crate::io::scene_file::SI_G;
 use crate::math::Vec3;
 use crate::random::{Generator, point_in_ball};
-use crate::io::scene_file::SI_G;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 

@@ -146,11 +146,12 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         path: scene_path.clone(),
         reason: e.to_string(),
     })?;
-    let scene =
-        crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| AnalysisError::Read {
+    let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| {
+        AnalysisError::Read {
             path: scene_path.clone(),
             reason: e.to_string(),
-        })?;
+        }
+    })?;
     let g = scene.physics.gravity.and_then(|g| g.g).unwrap_or(G_SI);
     let times = snapshot_times(dir)?;
     let find = |t: f64| {

@@ -205,7 +205,6 @@ impl CreepCriterion {
     }
 }
 
-
 /// Zhang17 Eq. 22: the critical spin rate scales with the bulk density as `Ω_c = κ √(4πGρ_B/3)`. Least-squares κ
 /// through the origin from `(ρ_B [kg m⁻³], critical period [h])` pairs, its standard error, and the critical bulk
 /// density at which a body spinning with `period_hours` sits at the limit, `ρ_c = 3Ω²/(4πGκ²)`.

@@ -6,11 +6,11 @@ use std::time::Instant;
 
 use crate::cli::CliError;
 use crate::ellipsoid::body::InertiaModel;
-use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
-use crate::integrate::OdeSystem;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::io::scene_file::{SI_G};
-use crate::ellipsoid::scene::{DEFAULT_CONTACT_CUTOFF};
+use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
+use crate::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
+use crate::integrate::OdeSystem;
+use crate::io::scene_file::SI_G;
 
 /// `rubblepile bench rhs`.
 #[derive(Debug, clap::Args)]

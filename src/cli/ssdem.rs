@@ -13,8 +13,8 @@ use crate::granular::soft::leapfrog;
 use crate::granular::soft::packing::fcc_ball;
 use crate::granular::soft::scene::load_soft_scene;
 use crate::gravity::SelfGravity;
-use crate::math::Vec3;
 use crate::io::scene_file::SI_G;
+use crate::math::Vec3;
 
 /// `rubblepile ssdem …`.
 #[derive(Debug, clap::Subcommand)]

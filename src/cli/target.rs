@@ -4,8 +4,8 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::cli::CliError;
-use crate::impact::target::{TargetSpec, build_target};
 use crate::ellipsoid::output::write_snapshot;
+use crate::impact::target::{TargetSpec, build_target};
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]

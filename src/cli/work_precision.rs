@@ -10,12 +10,12 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::cli::CliError;
-use crate::integrate::Method;
 use crate::bench::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use crate::bench::work_precision::{
     CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };
+use crate::cli::CliError;
+use crate::integrate::Method;
 
 /// `rubblepile bench work-precision`.
 ///

@@ -37,11 +37,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::bits::{exact_f64, fnv1a_hex};
 use crate::ellipsoid::run::EllipsoidEngine;
+use crate::ellipsoid::scene::LoadedScene;
+pub use crate::ellipsoid::summary::RunSummary;
 use crate::engine::{Engine, Outcome, Resumed, RunReport, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
-pub use crate::ellipsoid::summary::RunSummary;
-use crate::ellipsoid::scene::LoadedScene;
 
 pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
 

@@ -55,8 +55,8 @@ use crate::ellipsoid::body::Body;
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
 use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::math::Mat3;
 use crate::ellipsoid::scene::KappaSource;
+use crate::math::Mat3;
 
 /// β used when κ is given rather than calibrated (Roig03 after Eq. 13: "β ~ 10").
 pub const DEFAULT_BETA: f64 = 10.0;

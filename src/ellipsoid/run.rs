@@ -17,13 +17,13 @@ use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
 use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
+use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
+use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
+use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
 use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
 use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
-use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
 use crate::io::fmt_f64;
-use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
 use crate::math::Vec3;
-use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;

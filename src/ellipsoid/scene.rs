@@ -40,31 +40,26 @@
 //! is one line naming the file, the field and what was expected, e.g.
 //! `scene.toml: body[3].axes: need A >= B >= C > 0, got [1, 2, 3]`.
 
-
-
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
-pub use crate::io::scene_file::{
-    MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
-};
-use crate::io::scene_file::{Validator, fmt_list};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
 use crate::integrate::Method;
+pub use crate::io::scene_file::{
+    MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
+};
+use crate::io::scene_file::{Validator, fmt_list};
 use crate::math::{Vec3, Vec4};
-
 
 /// Default contact cutoff (dimensionless): see [`ContactSpec::cutoff`].
 pub const DEFAULT_CONTACT_CUTOFF: f64 = 1e-16;
 
 /// Largest allowed `||q| − 1|` of an input quaternion.
 pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
-
-
 
 /// The built-in default scene (`targets/default.toml`), run by `rubblepile run` without a scene file.
 pub const DEFAULT_SCENE_TOML: &str = include_str!("../../targets/default.toml");
@@ -395,7 +390,6 @@ pub fn parse_toml(text: &str, name: &str) -> Result<SceneFile, SceneError> {
 // ---------------------------------------------------------------------------------------------
 // Validation.
 // ---------------------------------------------------------------------------------------------
-
 
 /// A body before conversion, from either a `[[body]]` table or a bodies-file row.
 struct RawBody {

@@ -70,13 +70,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::driver::{RunError, RunOptions, RunSummary, resume_run};
 use crate::ellipsoid::body::Body;
+use crate::ellipsoid::output::read_bodies_csv;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{
     DEFAULT_BETA, DEFAULT_CONTACT_TIME, DEFAULT_EVERY, DEFAULT_F0, DEFAULT_RTOL, DEFAULT_T_END, ImpactConfig,
     ImpactError, ImpactPlan, default_snapshots, read_target, run_impact,
 };
 use crate::io::checkpoint::CHECKPOINT_FILE;
-use crate::ellipsoid::output::read_bodies_csv;
 use crate::io::fmt_f64;
 
 /// Name of the campaign table in the campaign directory.

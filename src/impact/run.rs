@@ -17,10 +17,10 @@ use crate::driver::{RunError, RunOptions, RunSummary, prepare_output_dir, run_sc
 use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::G_SI;
-use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::ellipsoid::output::{read_bodies_csv, write_snapshot};
-use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
+use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
+use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
 
 /// Default end time (s).
 pub const DEFAULT_T_END: f64 = 10_000.0;

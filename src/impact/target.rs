@@ -16,13 +16,13 @@
 //! 5. κ from Roig03 Eq. 14 with β = 10, v = 5 km/s over the fragments (the projectiles of Table 2 are smaller
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
-use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
 use crate::ellipsoid::equations::{
     ContactTerm, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
 };
 use crate::ellipsoid::quaternion::rotation_matrix;
+use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
 use crate::integrate::{IntegrateError, Method, OdeSystem, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};

@@ -74,7 +74,6 @@ pub(crate) fn fmt_list(v: &[f64]) -> String {
     format!("[{}]", parts.join(", "))
 }
 
-
 /// A scene file as every engine's loader needs it: its name for messages (the path as given), its text, and the
 /// directory relative paths in it are resolved against (`.` for a bare file name).
 pub struct SceneText {
@@ -124,7 +123,6 @@ pub fn read_scene_text(path: &Path) -> Result<SceneText, SceneError> {
     };
     Ok(SceneText { name, text, base_dir })
 }
-
 
 /// The scene kinds `rubblepile run` knows.
 pub const SCENE_KINDS: [&str; 3] = ["ellipsoids", "soft-spheres", "hard-spheres"];
@@ -247,7 +245,6 @@ fn describe_toml_error(text: &str, segments: &[serde_path_to_error::Segment], e:
     }
 }
 
-
 /// Field checks shared by the scene parsers of every engine: each error names the file, the dotted field and the
 /// expected value on one line.
 pub(crate) struct Validator<'a> {
@@ -287,5 +284,4 @@ impl Validator<'_> {
             Err(self.invalid(field, format!("non-finite value, got {}", fmt_list(v))))
         }
     }
-
 }

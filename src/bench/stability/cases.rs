@@ -13,10 +13,10 @@ use super::{Case, CaseRun, Judgement, judge};
 use crate::ellipsoid::barrier::SPEED_MARGIN;
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::calibration::lambda;
+use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::{Vec3, Vec4};
-use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 
 /// Density of every case body (kg/m³).
 pub const DENSITY: f64 = 3000.0;

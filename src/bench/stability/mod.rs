@@ -28,10 +28,10 @@ use crate::driver::{RunError, RunOptions, RunSummary, run_scene};
 use crate::ellipsoid::barrier::{BarrierSettings, contacts};
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::equations::EllipsoidSystem;
-use crate::integrate::{OdeSystem, Tolerances, make_integrator};
 use crate::ellipsoid::output::read_bodies_csv;
-use crate::math::{Vec3, Vec4};
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
+use crate::integrate::{OdeSystem, Tolerances, make_integrator};
+use crate::math::{Vec3, Vec4};
 
 /// Columns of `stability.csv`.
 pub const CSV_COLUMNS: [&str; 11] = [

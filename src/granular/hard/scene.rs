@@ -49,8 +49,8 @@ use serde::{Deserialize, Serialize};
 use super::particle::{Attachment, Particle};
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
-use crate::math::Vec3;
 use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
+use crate::math::Vec3;
 
 /// The scene kind this module reads.
 pub const KIND: &str = "hard-spheres";

@@ -29,7 +29,6 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
 use crate::bits::exact_f64_vec;
 use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::contact::Springs;
@@ -38,6 +37,7 @@ use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene::{SoftScene, load_soft_scene, parse_soft_scene};
 use crate::granular::soft::spinup::{SpinupDriver, central_body};
+use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
 use crate::math::Vec3;
 
 /// Overlap (fraction of the smaller radius) above which the run is declared broken.

@@ -65,8 +65,8 @@ use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
 use crate::gravity::SelfGravity;
-use crate::math::Vec3;
 use crate::io::scene_file::{SI_G, SceneError};
+use crate::math::Vec3;
 
 /// The scene kind this module reads.
 pub const KIND: &str = "soft-spheres";

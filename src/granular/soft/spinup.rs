@@ -52,8 +52,8 @@
 use serde::{Deserialize, Serialize};
 
 use crate::granular::soft::particle::Particle;
-use crate::math::Vec3;
 use crate::io::scene_file::SceneError;
+use crate::math::Vec3;
 
 fn d_release_axis() -> f64 {
     0.1

@@ -41,12 +41,12 @@
 
 use std::path::Path;
 
-use crate::geometry::shape_metrics::axis_lengths;
-use crate::granular::soft::stress::{StressState, particle_stress, rve_stress, stress_state};
 use crate::geometry::neighbours::sphere_pairs;
+use crate::geometry::shape_metrics::axis_lengths;
 use crate::geometry::voronoi::{VoronoiCell, packing_fraction, radical_cells, weighted_packing_fraction};
 use crate::granular::soft::forces::{ContactRecord, SoftSystem};
 use crate::granular::soft::spinup::{InteriorRule, SpinupDriver, body_rotation, central_body};
+use crate::granular::soft::stress::{StressState, particle_stress, rve_stress, stress_state};
 use crate::math::{Mat3, Vec3};
 
 /// The `spinup.csv` header.
