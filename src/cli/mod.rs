@@ -175,7 +175,7 @@ pub struct ResumeArgs {
 }
 
 /// When `run` and `resume` write `DIR/checkpoint.json` (always at an output sample).
-#[derive(Debug, Clone, Copy, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct CheckpointArgs {
     /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
@@ -184,6 +184,10 @@ pub struct CheckpointArgs {
     /// checkpoint (0 = at every output sample).
     #[arg(long, value_name = "SECONDS")]
     pub checkpoint_every_sim: Option<f64>,
+    /// Extra snapshot format(s) beside the CSV snapshots, e.g. `--format xyz` (extended XYZ for OVITO/VMD/ASE);
+    /// repeat for several.
+    #[arg(long, value_name = "NAME")]
+    pub format: Vec<String>,
     /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after_checkpoints: Option<u64>,
@@ -214,6 +218,7 @@ impl CheckpointArgs {
             progress,
             checkpoint_every: (self.checkpoint_every > 0.0).then_some(self.checkpoint_every),
             checkpoint_every_sim: self.checkpoint_every_sim,
+            formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
             stop_after_checkpoints: self.stop_after_checkpoints,
         })
     }

@@ -225,6 +225,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
             progress: false,
             checkpoint_every: Some(crate::driver::DEFAULT_CHECKPOINT_EVERY),
             checkpoint_every_sim: None,
+            formats: crate::driver::formats::Formats::NONE,
             stop_after_checkpoints: None,
         };
         let t_final = branches.as_ref().map_or(settings.path.t_final, |b| b[k]);
@@ -426,6 +427,7 @@ fn prepare_branches(
                 progress: false,
                 checkpoint_every: None,
                 checkpoint_every_sim: Some(t_ck - t_here - 0.5 * dt),
+                formats: crate::driver::formats::Formats::NONE,
                 stop_after_checkpoints: Some(1),
             };
             eprintln!(

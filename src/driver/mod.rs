@@ -26,6 +26,7 @@
 //! `timeseries.csv` is cut back to its length at the checkpoint, and the engine reopens its own files likewise.
 
 pub mod branch;
+pub mod formats;
 pub mod kind;
 
 use std::fs::File;
@@ -68,6 +69,8 @@ pub struct RunOptions {
     /// Checkpoint at the first output sample at least this many simulated seconds after the last checkpoint's time
     /// (or the start); `Some(0.0)` = at every output sample; `None` = never by simulated time.
     pub checkpoint_every_sim: Option<f64>,
+    /// Extra snapshot formats to write beside the engine's CSV snapshots ([`formats`]).
+    pub formats: formats::Formats,
     /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many checkpoints
     /// (as if the process had been killed then).
     pub stop_after_checkpoints: Option<u64>,
@@ -82,6 +85,7 @@ impl Default for RunOptions {
             progress: true,
             checkpoint_every: Some(DEFAULT_CHECKPOINT_EVERY),
             checkpoint_every_sim: None,
+            formats: formats::Formats::NONE,
             stop_after_checkpoints: None,
         }
     }
@@ -616,6 +620,7 @@ fn drive<E: Engine>(
 
     let samples = engine.samples();
     let total = samples.len() as u64;
+    let extra_formats = options.formats.selected();
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
@@ -639,6 +644,12 @@ fn drive<E: Engine>(
         if let Some(k) = sample.snapshot {
             let p = out_dir.join("snapshots").join(format!("{k}.csv"));
             engine.write_snapshot(&p).map_err(io_err(&p))?;
+            if !extra_formats.is_empty() {
+                let particles = engine.particles();
+                for f in &extra_formats {
+                    f.write(out_dir, k, sample.t, &particles).map_err(io_err(&p))?;
+                }
+            }
         }
         let t = engine.time();
         progress(t);

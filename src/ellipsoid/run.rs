@@ -18,9 +18,10 @@ use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
 use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
+use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
-use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
+use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule};
 use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
 use crate::io::fmt_f64;
 use crate::math::Vec3;
@@ -454,6 +455,27 @@ impl Engine for EllipsoidEngine {
 
     fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
         write_snapshot(path, self.t, &self.system.bodies_at(self.t, &self.y))
+    }
+
+    fn particles(&self) -> Vec<ParticleView> {
+        self.system
+            .bodies_at(self.t, &self.y)
+            .iter()
+            .enumerate()
+            .map(|(id, b)| {
+                // R(q) maps world to body; its transpose takes body vectors to the world.
+                let to_world = rotation_matrix(&b.quaternion).transpose();
+                ParticleView {
+                    id,
+                    mass: b.shape.mass,
+                    position: b.position,
+                    velocity: b.velocity,
+                    spin_world: to_world * b.spin_body,
+                    axes: b.shape.axes,
+                    rotation: to_world,
+                }
+            })
+            .collect()
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

@@ -19,6 +19,26 @@ use serde::de::DeserializeOwned;
 
 pub use schedule::{Sample, Schedule};
 
+/// One particle of a snapshot, the same for every engine, for output formats that know no engine
+/// ([`crate::driver::formats`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParticleView {
+    /// Index in the scene.
+    pub id: usize,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Centre (m).
+    pub position: crate::math::Vec3,
+    /// Velocity of the centre (m/s).
+    pub velocity: crate::math::Vec3,
+    /// Spin in the world frame (rad/s).
+    pub spin_world: crate::math::Vec3,
+    /// Semi-axes A ≥ B ≥ C (m); a sphere's radius three times.
+    pub axes: crate::math::Vec3,
+    /// Rotation from the body frame to the world frame (the identity for spheres).
+    pub rotation: crate::math::Mat3,
+}
+
 /// Why an engine stopped: the cause, one line (e.g. `"integrator error: step size underflow at t = …"`). The
 /// engine keeps its last good state and writes it when asked ([`Engine::write_last_good_state`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -132,6 +152,9 @@ pub trait Engine: Sized {
 
     /// Writes the current state as a snapshot file.
     fn write_snapshot(&self, path: &Path) -> std::io::Result<()>;
+
+    /// The particles of the current state, for the driver's extra snapshot formats.
+    fn particles(&self) -> Vec<ParticleView>;
 
     /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64>;

@@ -289,6 +289,7 @@ pub fn run_case(case: &Case, runs_dir: &Path, force: bool) -> Result<CaseResult,
         progress: false,
         checkpoint_every: None,
         checkpoint_every_sim: None,
+        formats: crate::driver::formats::Formats::NONE,
         stop_after_checkpoints: None,
     };
     let started = Instant::now();

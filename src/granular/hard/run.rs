@@ -16,7 +16,7 @@ use super::particle::Attachment;
 use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError, Schedule};
+use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule};
 use crate::io::fmt_f64;
 use crate::math::Vec3;
 
@@ -416,6 +416,23 @@ impl Engine for HardEngine {
 
     fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
         write_particles(path, self.system.t, &self.system)
+    }
+
+    fn particles(&self) -> Vec<ParticleView> {
+        self.system
+            .particles
+            .iter()
+            .filter(|p| p.alive)
+            .map(|p| ParticleView {
+                id: p.id,
+                mass: p.mass,
+                position: p.position,
+                velocity: p.velocity,
+                spin_world: p.spin,
+                axes: Vec3::repeat(p.radius),
+                rotation: crate::math::Mat3::identity(),
+            })
+            .collect()
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

@@ -30,7 +30,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, Failure, Outcome, Resumed, RunReport, Sample, SampleError};
+use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
@@ -602,6 +602,23 @@ impl Engine for SoftEngine {
 
     fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
         write_particles_csv(path, self.time(), &self.sys.particles)
+    }
+
+    fn particles(&self) -> Vec<ParticleView> {
+        self.sys
+            .particles
+            .iter()
+            .enumerate()
+            .map(|(id, p)| ParticleView {
+                id,
+                mass: p.mass,
+                position: p.position,
+                velocity: p.velocity,
+                spin_world: p.spin,
+                axes: Vec3::repeat(p.radius),
+                rotation: crate::math::Mat3::identity(),
+            })
+            .collect()
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

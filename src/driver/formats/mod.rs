@@ -1,0 +1,61 @@
+//! Extra snapshot formats beside each engine's own CSV snapshots, written at every snapshot time of any engine.
+//!
+//! A format is one file implementing [`SnapshotFormat`] plus one line in [`registered`]; the command line
+//! offers it as `--format NAME` and the driver calls it for every snapshot through [`crate::engine::Engine::particles`],
+//! so the formats know no engine.
+
+pub mod xyz;
+
+use std::path::Path;
+
+use crate::engine::ParticleView;
+
+/// An output format for snapshots.
+pub trait SnapshotFormat: Send + Sync {
+    /// The name users select it by (`--format NAME`).
+    fn name(&self) -> &'static str;
+    /// Writes the particles of the k-th snapshot (time `t`, s) into the run directory `dir`.
+    fn write(&self, dir: &Path, k: usize, t: f64, particles: &[ParticleView]) -> std::io::Result<()>;
+}
+
+/// Every format, in the order of [`Formats`]' bits. Adding a format: one new file and one line here.
+pub fn registered() -> Vec<Box<dyn SnapshotFormat>> {
+    vec![Box::new(xyz::ExtendedXyz)]
+}
+
+/// A set of [`registered`] formats (bit `i` = the i-th format), small and `Copy` so that it rides in
+/// [`super::RunOptions`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Formats(u32);
+
+impl Formats {
+    /// No extra format.
+    pub const NONE: Formats = Formats(0);
+
+    /// The formats named in `names`; an unknown name is an error listing the known ones.
+    pub fn parse(names: &[String]) -> Result<Formats, String> {
+        let all = registered();
+        let mut bits = 0u32;
+        for name in names {
+            let Some(i) = all.iter().position(|f| f.name() == name) else {
+                let known: Vec<&str> = all.iter().map(|f| f.name()).collect();
+                return Err(format!(
+                    "--format: unknown format {name:?}; known: {}",
+                    known.join(", ")
+                ));
+            };
+            bits |= 1 << i;
+        }
+        Ok(Formats(bits))
+    }
+
+    /// The selected formats.
+    pub fn selected(self) -> Vec<Box<dyn SnapshotFormat>> {
+        registered()
+            .into_iter()
+            .enumerate()
+            .filter(|(i, _)| self.0 & (1 << i) != 0)
+            .map(|(_, f)| f)
+            .collect()
+    }
+}
