@@ -1,11 +1,10 @@
-//! CSV files: snapshots (and `last_good_state.csv`), the time series, and bodies files.
+//! CSV files of the ellipsoid engine: snapshots (and `last_good_state.csv`), tracks, and bodies files.
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::BufWriter;
 use std::path::Path;
 
 use crate::ellipsoid::body::Body;
-use crate::ellipsoid::equations::Diagnostics;
 use crate::io::fmt_f64;
 
 /// Columns of a snapshot (and of a bodies file): time (s), body index, mass (kg), semi-axes A, B, C
@@ -14,26 +13,7 @@ pub const SNAPSHOT_COLUMNS: [&str; 19] = [
     "t", "id", "mass", "a", "b", "c", "x", "y", "z", "vx", "vy", "vz", "qa", "qb", "qc", "qd", "wx", "wy", "wz",
 ];
 
-/// Columns of `timeseries.csv`: time (s); energies (J): translational and rotational kinetic,
-/// contact and gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
-/// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum
-/// about the origin (kg m²/s); wall-clock seconds since the integration started.
-pub const TIMESERIES_COLUMNS: [&str; 14] = [
-    "t",
-    "kinetic_translational",
-    "kinetic_rotational",
-    "potential_contact",
-    "potential_gravity",
-    "dissipated",
-    "energy_residual",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-    "wall_seconds",
-];
+pub use crate::ellipsoid::run::TIMESERIES_COLUMNS;
 
 fn csv_to_io(e: ::csv::Error) -> std::io::Error {
     match e.into_kind() {
@@ -129,75 +109,6 @@ pub fn write_snapshot(path: &Path, t: f64, bodies: &[Body]) -> std::io::Result<(
     }
     let inner = w.into_inner().map_err(|e| e.into_error())?;
     inner.into_inner().map_err(|e| e.into_error())?.sync_all()
-}
-
-/// One row of `timeseries.csv`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TimeseriesRow {
-    /// Time (s).
-    pub t: f64,
-    /// The diagnostics at `t`.
-    pub diagnostics: Diagnostics,
-    /// `(H − H0 − (dissipated − dissipated0)) / energy_scale(0)` (signed).
-    pub energy_residual: f64,
-    /// Wall-clock seconds since the integration started.
-    pub wall_seconds: f64,
-}
-
-/// Writes `timeseries.csv` row by row, flushing after each row so a crash loses nothing written.
-pub struct TimeseriesWriter {
-    w: ::csv::Writer<BufWriter<File>>,
-}
-
-impl TimeseriesWriter {
-    /// Creates the file and writes the header.
-    pub fn create(path: &Path) -> std::io::Result<Self> {
-        let mut w = ::csv::Writer::from_writer(BufWriter::new(File::create(path)?));
-        w.write_record(TIMESERIES_COLUMNS).map_err(csv_to_io)?;
-        w.flush()?;
-        Ok(TimeseriesWriter { w })
-    }
-
-    /// Continues a file already positioned after its last complete row (no header is written); used when a
-    /// run resumes from a checkpoint.
-    pub fn continue_file(file: File) -> Self {
-        TimeseriesWriter {
-            w: ::csv::Writer::from_writer(BufWriter::new(file)),
-        }
-    }
-
-    /// Appends a row and flushes it to the OS.
-    pub fn write_row(&mut self, row: &TimeseriesRow) -> std::io::Result<()> {
-        let d = &row.diagnostics;
-        let fields = [
-            row.t,
-            d.kinetic_translational,
-            d.kinetic_rotational,
-            d.potential_contact,
-            d.potential_gravity,
-            d.dissipated,
-            row.energy_residual,
-            d.momentum.x,
-            d.momentum.y,
-            d.momentum.z,
-            d.angular_momentum.x,
-            d.angular_momentum.y,
-            d.angular_momentum.z,
-            row.wall_seconds,
-        ];
-        self.w
-            .write_record(fields.iter().map(|&x| fmt_f64(x)))
-            .map_err(csv_to_io)?;
-        self.w.flush()
-    }
-
-    /// Flushes and syncs the file.
-    pub fn finish(self) -> std::io::Result<()> {
-        let inner = self.w.into_inner().map_err(|e| e.into_error())?;
-        let mut file = inner.into_inner().map_err(|e| e.into_error())?;
-        file.flush()?;
-        file.sync_all()
-    }
 }
 
 /// One body read from a bodies file (values unchecked; the scene validates them).

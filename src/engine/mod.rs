@@ -39,6 +39,28 @@ pub struct ParticleView {
     pub rotation: crate::math::Mat3,
 }
 
+impl ParticleView {
+    /// A sphere of `radius` (m): axes all equal to it, no rotation.
+    pub fn sphere(
+        id: usize,
+        mass: f64,
+        radius: f64,
+        position: crate::math::Vec3,
+        velocity: crate::math::Vec3,
+        spin_world: crate::math::Vec3,
+    ) -> Self {
+        ParticleView {
+            id,
+            mass,
+            position,
+            velocity,
+            spin_world,
+            axes: crate::math::Vec3::repeat(radius),
+            rotation: crate::math::Mat3::identity(),
+        }
+    }
+}
+
 /// Why an engine stopped: the cause, one line (e.g. `"integrator error: step size underflow at t = …"`). The
 /// engine keeps its last good state and writes it when asked ([`Engine::write_last_good_state`]).
 #[derive(Debug, Clone, PartialEq)]

@@ -423,15 +423,7 @@ impl Engine for HardEngine {
             .particles
             .iter()
             .filter(|p| p.alive)
-            .map(|p| ParticleView {
-                id: p.id,
-                mass: p.mass,
-                position: p.position,
-                velocity: p.velocity,
-                spin_world: p.spin,
-                axes: Vec3::repeat(p.radius),
-                rotation: crate::math::Mat3::identity(),
-            })
+            .map(|p| ParticleView::sphere(p.id, p.mass, p.radius, p.position, p.velocity, p.spin))
             .collect()
     }
 

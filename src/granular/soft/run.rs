@@ -609,15 +609,7 @@ impl Engine for SoftEngine {
             .particles
             .iter()
             .enumerate()
-            .map(|(id, p)| ParticleView {
-                id,
-                mass: p.mass,
-                position: p.position,
-                velocity: p.velocity,
-                spin_world: p.spin,
-                axes: Vec3::repeat(p.radius),
-                rotation: crate::math::Mat3::identity(),
-            })
+            .map(|(id, p)| ParticleView::sphere(id, p.mass, p.radius, p.position, p.velocity, p.spin))
             .collect()
     }
 
