@@ -120,3 +120,16 @@ fn imports_only_go_down_the_layers() {
         upward.join("\n")
     );
 }
+
+/// The command line parses and dispatches; science and timed systems live in `analysis` and `bench`. Its size is a
+/// cheap guard against logic creeping back in.
+#[test]
+fn the_command_line_stays_small() {
+    let mut files = Vec::new();
+    rust_files(&src().join("cli"), &mut files);
+    let lines: usize = files
+        .iter()
+        .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
+        .sum();
+    assert!(lines <= 2000, "src/cli/ has {lines} lines (at most 2000: move logic to analysis/ or bench/)");
+}

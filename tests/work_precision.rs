@@ -206,7 +206,7 @@ fn work_precision_sweep_writes_csv_svg_json_and_errors_fall() {
     let svg = std::fs::read_to_string(out.join("work_precision_top.svg")).unwrap();
     assert!(svg.contains("bulirsch-stoer") && svg.contains("rk4"));
     assert!(out.join("work_precision_top.png").is_file());
-    let rows = rubblepile::cli::work_precision::read_csv(&csv).unwrap();
+    let rows = rubblepile::bench::work_precision_sweep::read_csv(&csv).unwrap();
     assert_eq!(rows.len(), 5);
     assert_eq!(rows[0].setting.tolerance, Some(1e-4));
     assert_eq!(rows[3].setting.step, Some(0.2));

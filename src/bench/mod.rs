@@ -4,9 +4,45 @@
 //! - [`ellipsoid_problems`]: canonical problems of the ellipsoid model (free top, bouncing pair, N30 impact, N-body
 //!   tests);
 //! - [`work_precision`]: work–precision measurements (timed runs, final-state and energy errors);
-//! - [`stability`]: the stability suite of stiff and extreme cases (`rubblepile bench stability`).
+//! - [`stability`]: the stability suite of stiff and extreme cases (`rubblepile bench stability`);
+//! - the timed systems behind `rubblepile bench …`, each writing CSV and a plot: [`rhs`] (µs per right-hand side,
+//!   1 thread vs all), [`work_precision_sweep`] (error vs time per method), [`nbody`] (point-mass runs, REBOUND
+//!   comparison), [`impact_wall_time`] (the N200 impact's wall time). Their option structs derive `clap::Args` so the
+//!   command line embeds them; the command line itself only parses and dispatches.
 
 pub mod ellipsoid_problems;
+pub mod impact_wall_time;
+pub mod nbody;
 pub mod problems;
+pub mod rhs;
 pub mod stability;
 pub mod work_precision;
+pub mod work_precision_sweep;
+
+/// Why a benchmark did not run: bad options (the caller's, exit code 2 on the command line) or a failure while
+/// running or writing its files (exit code 1).
+#[derive(Debug, thiserror::Error)]
+#[error("{message}")]
+pub struct BenchError {
+    /// One line.
+    pub message: String,
+    /// 2 for bad options, 1 for a failure.
+    pub code: u8,
+}
+
+impl BenchError {
+    /// Bad options or inputs.
+    pub fn usage(message: impl std::fmt::Display) -> Self {
+        BenchError {
+            message: message.to_string(),
+            code: 2,
+        }
+    }
+    /// A failure while running or writing.
+    pub fn failed(message: impl std::fmt::Display) -> Self {
+        BenchError {
+            message: message.to_string(),
+            code: 1,
+        }
+    }
+}

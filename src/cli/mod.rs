@@ -40,17 +40,13 @@
 
 pub mod aggregate;
 pub mod analyze;
-pub mod bench;
-pub mod bench_impact;
 pub mod campaign;
 pub mod impact;
-pub mod nbody;
 pub mod report_richardson2011;
 pub mod spinup;
 pub mod ssdem;
 pub mod stability;
 pub mod target;
-pub mod work_precision;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -238,14 +234,14 @@ pub struct CheckArgs {
 #[derive(Debug, Subcommand)]
 pub enum BenchCommand {
     /// Time one right-hand-side evaluation for a random cloud of ellipsoids (1 thread vs all threads).
-    Rhs(bench::RhsArgs),
+    Rhs(crate::bench::rhs::RhsArgs),
     /// Work-precision diagrams (error and energy error vs wall time) of the integrators on a canonical problem.
-    WorkPrecision(work_precision::WorkPrecisionArgs),
+    WorkPrecision(crate::bench::work_precision_sweep::WorkPrecisionArgs),
     /// Timed point-mass N-body runs (Pythagorean three-body, outer Solar System) with final states (CSV).
-    Nbody(nbody::NBodyArgs),
+    Nbody(crate::bench::nbody::NBodyArgs),
     /// Wall-clock time of whole impact runs (default N200_T4 + P2, ζ = 45°, 10 000 s, rtol 1e-9) per F0 and
     /// thread count, with the 60 s goal.
-    Impact(bench_impact::ImpactBenchArgs),
+    Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(ssdem::BenchSsdemArgs),
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
@@ -320,10 +316,14 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             report_richardson2011::report(&args)
         }
         Command::Report(ReportCommand::Zhang2017(args)) | Command::ReportZhang2017(args) => report_zhang2017(&args),
-        Command::Bench(BenchCommand::Rhs(args)) => bench::rhs(&args),
-        Command::Bench(BenchCommand::WorkPrecision(args)) => work_precision::work_precision(&args),
-        Command::Bench(BenchCommand::Nbody(args)) => nbody::nbody(&args),
-        Command::Bench(BenchCommand::Impact(args)) => bench_impact::impact(&args),
+        Command::Bench(BenchCommand::Rhs(args)) => crate::bench::rhs::rhs(&args).map_err(CliError::from),
+        Command::Bench(BenchCommand::WorkPrecision(args)) => {
+            crate::bench::work_precision_sweep::work_precision(&args).map_err(CliError::from)
+        }
+        Command::Bench(BenchCommand::Nbody(args)) => crate::bench::nbody::nbody(&args).map_err(CliError::from),
+        Command::Bench(BenchCommand::Impact(args)) => {
+            crate::bench::impact_wall_time::impact(&args).map_err(CliError::from)
+        }
         Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
@@ -331,6 +331,15 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
+    }
+}
+
+impl From<crate::bench::BenchError> for CliError {
+    fn from(e: crate::bench::BenchError) -> Self {
+        CliError {
+            message: e.message,
+            code: e.code,
+        }
     }
 }
 

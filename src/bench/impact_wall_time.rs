@@ -7,7 +7,7 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use crate::cli::CliError;
+use super::BenchError as CliError;
 use crate::driver::RunOptions;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, run_impact};

@@ -10,11 +10,11 @@ use std::path::{Path, PathBuf};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
+use super::BenchError as CliError;
 use crate::bench::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use crate::bench::work_precision::{
     CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };
-use crate::cli::CliError;
 use crate::integrate::Method;
 
 /// `rubblepile bench work-precision`.

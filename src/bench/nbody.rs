@@ -13,10 +13,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+use super::BenchError as CliError;
 use crate::bench::ellipsoid_problems::{NBodyProblem, PointMassGravity, ProblemSetup};
 use crate::bench::work_precision::{Setting, median, run_once, thread_cpu_seconds};
-use crate::cli::CliError;
-use crate::cli::work_precision::prepare_outputs;
+use crate::bench::work_precision_sweep::prepare_outputs;
 use crate::integrate::{IntegrateError, Method, OdeSystem, Stats, Tolerances, make_integrator};
 
 /// `rubblepile bench nbody`.

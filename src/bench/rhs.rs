@@ -4,7 +4,7 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use crate::cli::CliError;
+use super::BenchError as CliError;
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
