@@ -21,9 +21,10 @@
 //!   schema, equations, outputs and [`engine::Engine`] implementation;
 //! - **L4**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
 //! - **L5**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
-//! - **L6**: `analysis`, `bench` — science on finished runs (the three papers' reports) and benchmarks with the
-//!   canonical test problems;
-//! - **L7**: `cli` — argument parsing and dispatch.
+//! - **L6**: `analysis` — science on finished runs (the three papers' reports, fragment statistics, figures);
+//! - **L7**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
+//!   problems shared by tests;
+//! - **L8**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;

@@ -131,5 +131,8 @@ fn the_command_line_stays_small() {
         .iter()
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
-    assert!(lines <= 2000, "src/cli/ has {lines} lines (at most 2000: move logic to analysis/ or bench/)");
+    assert!(
+        lines <= 2000,
+        "src/cli/ has {lines} lines (at most 2000: move logic to analysis/ or bench/)"
+    );
 }

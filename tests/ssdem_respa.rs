@@ -197,8 +197,12 @@ fn run_cut_by_a_checkpoint_inside_a_gravity_block_resumes_bit_for_bit() {
     );
     assert_eq!(c.status.code(), Some(3), "{}", String::from_utf8_lossy(&c.stderr));
     let ck: serde_json::Value = serde_json::from_str(&read(&dir.join("c/checkpoint.json"))).unwrap();
-    assert_eq!(ck["step"], 500);
-    assert_eq!(ck["gravity_phase"], 500 % 7, "the checkpoint is not inside a block");
+    assert_eq!(ck["engine"]["step"], 500);
+    assert_eq!(
+        ck["engine"]["gravity_phase"],
+        500 % 7,
+        "the checkpoint is not inside a block"
+    );
     let r = rubblepile(&dir, &["resume", "c", "--no-progress"]);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let strip = |d: &str| -> Vec<String> {

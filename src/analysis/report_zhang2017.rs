@@ -17,6 +17,7 @@
 //! the nominal run, into an Eq. 22 section: κ₁, κ₂, κ₃ fitted over the densities ([`density_series`]) and the
 //! critical bulk density at the Didymos period, beside the paper's Table 4.
 
+use crate::io::table::{Cells, read_header, read_table};
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -199,16 +200,14 @@ fn t_start_of(dir: &Path) -> f64 {
 
 /// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0.
 fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
-    let text = std::fs::read_to_string(dir.join("snapshots/0.csv")).ok()?;
+    let table = read_table(&dir.join("snapshots/0.csv"), Cells::Lenient).ok()?;
+    let (km, kr) = (table.column("mass")?, table.column("radius")?);
     let (mut lo, mut hi, mut m, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
-    for line in text.lines().skip(1) {
-        let v: Vec<f64> = line.split(',').filter_map(|c| c.parse().ok()).collect();
-        if v.len() >= 4 {
-            m += v[2];
-            lo = lo.min(v[3]);
-            hi = hi.max(v[3]);
-            n += 1;
-        }
+    for v in table.rows.iter().filter(|v| v.len() > km.max(kr)) {
+        m += v[km];
+        lo = lo.min(v[kr]);
+        hi = hi.max(v[kr]);
+        n += 1;
     }
     (m > 0.0).then_some((lo, hi, m, n))
 }
@@ -216,10 +215,9 @@ fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
 /// The `wall_seconds` of the last row of the run's `timeseries.csv` (cumulative over resumes): the wall time
 /// so far of a run that has not finished.
 fn last_wall_seconds(run: &Path) -> Option<f64> {
-    let text = std::fs::read_to_string(run.join("timeseries.csv")).ok()?;
-    let mut lines = text.lines();
-    let col = lines.next()?.split(',').position(|c| c == "wall_seconds")?;
-    lines.last()?.split(',').nth(col)?.parse().ok()
+    let table = read_table(&run.join("timeseries.csv"), Cells::Lenient).ok()?;
+    let col = table.column("wall_seconds")?;
+    table.rows.last()?.get(col).copied().filter(|x| x.is_finite())
 }
 
 /// The scene's `t_end` (s) of a run directory.
@@ -235,11 +233,7 @@ fn t_end_of(dir: &Path) -> Option<f64> {
 
 /// Whether the run's `timeseries.csv` books the spin-up forcing (has the `forcing_work` column).
 fn books_forcing(run: &Path) -> bool {
-    std::fs::read_to_string(run.join("timeseries.csv")).is_ok_and(|t| {
-        t.lines()
-            .next()
-            .is_some_and(|h| h.split(',').any(|c| c == "forcing_work"))
-    })
+    read_header(&run.join("timeseries.csv")).is_ok_and(|h| h.iter().any(|c| c == "forcing_work"))
 }
 
 /// Reads one model's runs under `RUNS/<model>`.
@@ -249,7 +243,7 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), Stri
         .map(|s| s.to_string_lossy().to_string())
         .unwrap_or_default();
     let run = model_dir.join("path2");
-    let samples = read_spinup_csv(&run.join("spinup.csv"))?;
+    let samples = read_spinup_csv(&run.join("spinup.csv")).map_err(|e| e.to_string())?;
     let summary: serde_json::Value = std::fs::read_to_string(run.join("summary.json"))
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok())
@@ -439,18 +433,15 @@ fn fig5(out: &Path, stem: String, title: String, samples: Vec<SpinupSample>) -> 
 /// Largest overlap fraction, and the largest |energy residual| and |L residual|, over the rows of the run's
 /// `timeseries.csv` so far.
 fn timeseries_worst(run: &Path) -> Option<(f64, f64, f64)> {
-    let text = std::fs::read_to_string(run.join("timeseries.csv")).ok()?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next()?.split(',').collect();
-    let col = |name: &str| header.iter().position(|c| *c == name);
+    let table = read_table(&run.join("timeseries.csv"), Cells::Lenient).ok()?;
+    let col = |name: &str| table.column(name);
     let (o, e, l) = (
         col("max_overlap_fraction")?,
         col("energy_residual")?,
         col("angular_momentum_error")?,
     );
     let mut worst = (0.0f64, 0.0f64, 0.0f64);
-    for line in lines {
-        let v: Vec<f64> = line.split(',').map(|c| c.parse().unwrap_or(f64::NAN)).collect();
+    for v in &table.rows {
         let get = |k: usize| v.get(k).copied().unwrap_or(0.0).abs();
         worst = (worst.0.max(get(o)), worst.1.max(get(e)), worst.2.max(get(l)));
     }

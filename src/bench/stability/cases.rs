@@ -225,18 +225,9 @@ fn final_bodies(run: &CaseRun) -> Result<Vec<Body>, String> {
 /// The rows of a run's `timeseries.csv` as numbers (columns of [`crate::ellipsoid::output::TIMESERIES_COLUMNS`]).
 fn timeseries(run: &CaseRun) -> Result<Vec<Vec<f64>>, String> {
     let path = run.dir.join("timeseries.csv");
-    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    text.lines()
-        .skip(1)
-        .map(|line| {
-            line.split(',')
-                .map(|f| {
-                    f.parse::<f64>()
-                        .map_err(|_| format!("{}: bad number {f:?}", path.display()))
-                })
-                .collect()
-        })
-        .collect()
+    crate::io::table::read_table(&path, crate::io::table::Cells::Strict)
+        .map(|t| t.rows)
+        .map_err(|e| e.to_string())
 }
 
 /// `(t, wall_seconds)` of every time-series row of a run.

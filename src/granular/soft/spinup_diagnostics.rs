@@ -126,28 +126,19 @@ impl SpinupSample {
     }
 }
 
-/// Reads a `spinup.csv`; errors name the file and line.
-pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let mut lines = text.lines();
-    if lines.next().map(|h| h.trim()) != Some(SPINUP_HEADER.trim()) {
-        return Err(format!("{}: not a spinup.csv (unexpected header)", path.display()));
+/// Reads a `spinup.csv` (header [`SPINUP_HEADER`], 20 numbers a row); errors name the file, line and column.
+pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, crate::io::table::TableError> {
+    use crate::io::table::{Cells, TableError, read_table};
+    let table = read_table(path, Cells::Strict)?;
+    let expected: Vec<&str> = SPINUP_HEADER.trim().split(',').collect();
+    if table.columns != expected {
+        return Err(TableError::Header {
+            path: path.to_path_buf(),
+            expected: SPINUP_HEADER.trim().to_string(),
+        });
     }
-    let mut out = Vec::new();
-    for (k, line) in lines.enumerate() {
-        let v: Vec<f64> = line
-            .split(',')
-            .map(|c| c.trim().parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|e| format!("{} line {}: {e}", path.display(), k + 2))?;
-        if v.len() != 20 {
-            return Err(format!(
-                "{} line {}: expected 20 columns, got {}",
-                path.display(),
-                k + 2,
-                v.len()
-            ));
-        }
+    let mut out = Vec::with_capacity(table.rows.len());
+    for v in &table.rows {
         out.push(SpinupSample {
             t: v[0],
             path_period_h: v[1],
