@@ -13,6 +13,7 @@
 //! ([`ks_exponential`]), once with the measured mean height and once with the equipartition value. The paper's
 //! caveat applies: with the scale fitted from the same data the formal KS probability is biased high.
 
+use crate::analysis::AnalysisError;
 use std::path::{Path, PathBuf};
 
 use statrs::distribution::Exp;
@@ -95,9 +96,9 @@ pub fn mean_std(values: &[f64]) -> (f64, f64) {
 /// Kolmogorov–Smirnov test of `heights` against the exponential law `1 − exp(−z/h)`: the statistic D and the
 /// two-sided probability (asymptotic Kolmogorov distribution, `statrs`). Errors: fewer than 2 heights, a scale
 /// height that is not positive and finite.
-pub fn ks_exponential(heights: &[f64], h: f64) -> Result<(f64, f64), String> {
+pub fn ks_exponential(heights: &[f64], h: f64) -> Result<(f64, f64), AnalysisError> {
     if !(h.is_finite() && h > 0.0) {
-        return Err(format!("scale height must be positive and finite, got {h}"));
+        return Err(format!("scale height must be positive and finite, got {h}").into());
     }
     let law = Exp::new(1.0 / h).map_err(|e| format!("exponential law of scale {h}: {e}"))?;
     ks_onesample(
@@ -106,7 +107,7 @@ pub fn ks_exponential(heights: &[f64], h: f64) -> Result<(f64, f64), String> {
         KSOneSampleAlternativeMethod::TwoSidedAsymptotic,
         NaNPolicy::Error,
     )
-    .map_err(|e| format!("KS test on {} heights: {e:?}", heights.len()))
+    .map_err(|e| AnalysisError::Input(format!("KS test on {} heights: {e:?}", heights.len())))
 }
 
 /// One snapshot of a run reduced to per-species numbers.
@@ -195,7 +196,7 @@ pub struct RunFiles {
 }
 
 /// Reads [`RunFiles`]; errors (one line, naming the file) when a file is missing or gravity does not point down.
-pub fn read_run_files(dir: &Path) -> Result<RunFiles, String> {
+pub fn read_run_files(dir: &Path) -> Result<RunFiles, AnalysisError> {
     let sp = dir.join("scene.toml");
     let text = std::fs::read_to_string(&sp).map_err(|e| format!("{}: {e}", sp.display()))?;
     let scene: toml::Value = toml::from_str(&text).map_err(|e| format!("{}: {e}", sp.display()))?;
@@ -232,7 +233,7 @@ pub fn read_run_files(dir: &Path) -> Result<RunFiles, String> {
 
 /// Reads a finished atmosphere run (`scene.toml`, `summary.json`, `timeseries.csv`, `snapshots/*.csv`): the plane is
 /// `z = 0`, gravity `−g ẑ` and the cylinder radius are read from the scene copy.
-pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, String> {
+pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, AnalysisError> {
     let RunFiles {
         scene: value,
         g,
@@ -250,7 +251,7 @@ pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, String> {
         .and_then(|r| r.as_float())
         .unwrap_or(f64::NAN);
     if files.len() < 2 {
-        return Err(format!("{}: fewer than 2 snapshots", dir.join("snapshots").display()));
+        return Err(format!("{}: fewer than 2 snapshots", dir.join("snapshots").display()).into());
     }
     let mut snapshots = Vec::new();
     let mut all_heights = Vec::new();
@@ -270,7 +271,7 @@ pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, String> {
         }
         energy_last = e;
         if species.iter().map(|s| s.mass).collect::<Vec<_>>() != masses {
-            return Err(format!("{}: not the species of the first snapshot", path.display()));
+            return Err(format!("{}: not the species of the first snapshot", path.display()).into());
         }
         snapshots.push(SnapshotStats {
             t,
@@ -334,7 +335,7 @@ pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, String> {
 }
 
 /// `(t, energy_change)` columns of a hard-sphere `timeseries.csv`.
-pub fn read_energy_series(path: &Path) -> Result<Vec<(f64, f64)>, String> {
+pub fn read_energy_series(path: &Path) -> Result<Vec<(f64, f64)>, AnalysisError> {
     let mut rdr = ::csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let headers = rdr.headers().map_err(|e| format!("{}: {e}", path.display()))?.clone();
     let col = |name: &str| {

@@ -389,14 +389,14 @@ fn tumbler_section(md: &mut String, runs: &[TumblerRun], fig_dir: &Path) -> Resu
 /// Analyses the runs and writes `REPORT.md` and its figures; returns the report's path and the number of figure files.
 pub fn write_report(args: &Richardson2011Inputs) -> Result<(PathBuf, usize), ReportError> {
     let fig_dir = args.out.join("figures");
-    let full = analyse_atmosphere_run(&args.atmosphere).map_err(ReportError::Input)?;
+    let full = analyse_atmosphere_run(&args.atmosphere).map_err(|e| ReportError::Input(e.to_string()))?;
     let half = match &args.half {
-        Some(d) => Some(analyse_atmosphere_run(d).map_err(ReportError::Input)?),
+        Some(d) => Some(analyse_atmosphere_run(d).map_err(|e| ReportError::Input(e.to_string()))?),
         None => None,
     };
     let mut tumblers = Vec::new();
     for d in &args.tumbler {
-        tumblers.push(analyse_tumbler_run(d).map_err(ReportError::Input)?);
+        tumblers.push(analyse_tumbler_run(d).map_err(|e| ReportError::Input(e.to_string()))?);
     }
     // Grouped by fill (as in the figures), then by Fr and run length.
     let key = |r: &TumblerRun| ((r.fill * 100.0).round() as i64, r.froude, r.t_reached);

@@ -237,7 +237,7 @@ fn books_forcing(run: &Path) -> bool {
 }
 
 /// Reads one model's runs under `RUNS/<model>`.
-pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), String> {
+pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
     let model = model_dir
         .file_name()
         .map(|s| s.to_string_lossy().to_string())
@@ -451,14 +451,19 @@ fn timeseries_worst(run: &Path) -> Option<(f64, f64, f64)> {
 /// Writes `out/REPORT.md` and `out/fig5_<model>.{svg,png}` from the runs under `runs` (and, with `full`, a
 /// full-size section from the runs under it); refuses to overwrite an existing report without `force`. Returns
 /// the report's path.
-pub fn write_report(runs: &Path, full: Option<&Path>, out: &Path, force: bool) -> Result<std::path::PathBuf, String> {
+pub fn write_report(
+    runs: &Path,
+    full: Option<&Path>,
+    out: &Path,
+    force: bool,
+) -> Result<std::path::PathBuf, crate::analysis::AnalysisError> {
     let report = out.join("REPORT.md");
     if report.exists() && !force {
-        return Err(format!("{} exists (use --force to overwrite it)", report.display()));
+        return Err(format!("{} exists (use --force to overwrite it)", report.display()).into());
     }
     let models = model_dirs(runs)?;
     if models.is_empty() {
-        return Err(format!("{}: no <model>/path2/spinup.csv found", runs.display()));
+        return Err(format!("{}: no <model>/path2/spinup.csv found", runs.display()).into());
     }
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mut rows = Vec::new();

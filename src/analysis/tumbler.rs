@@ -205,7 +205,7 @@ pub struct TumblerRun {
 }
 
 /// Reads a tumbler run: `scene.toml` (wall 0 the drum: its radius and spin; gravity), `summary.json`, snapshots.
-pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, String> {
+pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::AnalysisError> {
     let RunFiles {
         scene: v,
         g,

@@ -187,7 +187,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
     fn draw<DB: plotters::prelude::DrawingBackend>(
         &self,
         root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-    ) -> Result<(), String> {
+    ) -> crate::analysis::figures::style::PlotResult {
         use plotters::prelude::*;
         let err = |e: &dyn std::fmt::Display| e.to_string();
         let results = self.results;
@@ -250,5 +250,7 @@ fn plot(results: &[ImpactTiming], args: &ImpactBenchArgs) -> Result<(), String> 
             args.rtol
         ),
     };
-    crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure).map(|_| ())
+    crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure)
+        .map(|_| ())
+        .map_err(String::from)
 }

@@ -46,3 +46,17 @@ impl BenchError {
         }
     }
 }
+
+impl From<String> for BenchError {
+    /// A message from a reader or a timed system: a failure.
+    fn from(message: String) -> Self {
+        BenchError::failed(message)
+    }
+}
+
+impl From<BenchError> for String {
+    /// The one-line message, for callers that report errors as text.
+    fn from(e: BenchError) -> Self {
+        e.message
+    }
+}

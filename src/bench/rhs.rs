@@ -54,7 +54,11 @@ pub struct RhsTiming {
 
 /// Times `repeats` RHS evaluations of `system` at its initial state on a pool of `threads` threads
 /// (after one untimed warm-up evaluation).
-pub fn time_rhs(system: &EllipsoidSystem, threads: usize, repeats: usize) -> Result<RhsTiming, String> {
+pub fn time_rhs(
+    system: &EllipsoidSystem,
+    threads: usize,
+    repeats: usize,
+) -> Result<RhsTiming, crate::bench::BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

@@ -129,7 +129,7 @@ fn draw_both(svg: &Path, title: &str, rows: &[SweepRow]) -> Result<PathBuf, CliE
 }
 
 /// Reads the rows of a `work_precision_<problem>.csv` back (the columns [`write_csv`] writes).
-pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, String> {
+pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, crate::bench::BenchError> {
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
     let mut rdr = csv::Reader::from_path(path).map_err(|e| err(&e))?;
     let headers = rdr.headers().map_err(|e| err(&e))?.clone();

@@ -170,7 +170,7 @@ pub fn bench_system(n: usize, gravity: Option<SelfGravity>, gravity_interval: u6
 
 /// Particle-steps per second of `steps` leapfrog steps on `threads` threads, as the steps of a run between output
 /// samples: the dissipation is summed at every step, the springs' stored energy is not (runs sum it only at samples).
-pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, String> {
+pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, crate::bench::BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()

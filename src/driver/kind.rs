@@ -83,20 +83,20 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
                 Some(p) => EllipsoidEngine::load(p),
                 None => EllipsoidEngine::default_scene(),
             }
-            .map_err(RunError::Setup)?;
+            .map_err(|e| RunError::Setup(e.to_string()))?;
             erase(super::run(engine, out, options))
         }
         SceneKind::SoftSpheres => {
-            let engine =
-                SoftEngine::load(path.expect("a soft-sphere scene comes from a file")).map_err(RunError::Setup)?;
+            let engine = SoftEngine::load(path.expect("a soft-sphere scene comes from a file"))
+                .map_err(|e| RunError::Setup(e.to_string()))?;
             for w in engine.scene_warnings() {
                 eprintln!("warning: {w}");
             }
             erase(super::run(engine, out, options))
         }
         SceneKind::HardSpheres => {
-            let engine =
-                HardEngine::load(path.expect("a hard-sphere scene comes from a file")).map_err(RunError::Setup)?;
+            let engine = HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
+                .map_err(|e| RunError::Setup(e.to_string()))?;
             erase(super::run(engine, out, options))
         }
     }
@@ -113,7 +113,7 @@ pub fn resume_dir(dir: &Path, options: &RunOptions) -> AnyResult {
 
 /// Validates the scene at `path` (the default scene when `None`) and describes what it resolves to: `(warnings,
 /// lines)` for the terminal. Errors are one line naming the field.
-pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), String> {
+pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), crate::engine::EngineError> {
     match path.map_or(SceneKind::Ellipsoids, SceneKind::of_file) {
         SceneKind::Ellipsoids => match path {
             Some(p) => EllipsoidEngine::load(p),

@@ -467,7 +467,7 @@ fn read_checkpoint<E: Engine>(dir: &Path) -> Result<Checkpoint<E::State>, RunErr
 ///
 /// Errors: [`RunError::BadCheckpoint`] when the file is missing or shorter than `bytes`.
 pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>> {
-    crate::engine::reopen_truncated(path, bytes).map_err(RunError::BadCheckpoint)
+    crate::engine::reopen_truncated(path, bytes).map_err(|e| RunError::BadCheckpoint(e.to_string()))
 }
 
 /// Continues the run in `dir` from its `checkpoint.json` (see the module docs), as if it had never stopped: same
@@ -494,8 +494,8 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             scene_path.display()
         )));
     }
-    let mut engine =
-        E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref()).map_err(bad)?;
+    let mut engine = E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
+        .map_err(|e| bad(e.to_string()))?;
 
     // The checkpoint must sit right after one of the run's samples.
     let samples = engine.samples();
@@ -521,7 +521,7 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
                 samples_done: ckpt.next_sample,
             },
         )
-        .map_err(bad)?;
+        .map_err(|e| bad(e.to_string()))?;
 
     // Stale files of the interrupted process (a failure summary, a half-written checkpoint).
     for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
@@ -714,7 +714,7 @@ pub fn run_scene(
     out_dir: &Path,
     options: &RunOptions,
 ) -> Result<RunSummary, RunError<RunSummary>> {
-    let engine = EllipsoidEngine::new(scene.clone()).map_err(RunError::Setup)?;
+    let engine = EllipsoidEngine::new(scene.clone()).map_err(|e| RunError::Setup(e.to_string()))?;
     run(engine, out_dir, options)
 }
 

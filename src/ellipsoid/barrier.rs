@@ -408,16 +408,14 @@ impl BarrierMonitor {
             Err(e) => return Err(e),
         };
         let mut kept = String::new();
-        for (n, line) in text.lines().enumerate() {
-            if n == 0 {
-                continue;
-            }
-            let o = parse_row(line).ok_or_else(|| {
-                std::io::Error::other(format!("{} line {}: malformed row {line:?}", log.display(), n + 1))
-            })?;
+        let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(text.as_bytes());
+        for (n, record) in reader.records().enumerate() {
+            let malformed = |what: String| std::io::Error::other(format!("{} line {}: {what}", log.display(), n + 2));
+            let record = record.map_err(|e| malformed(e.to_string()))?;
+            let o = parse_row(&record).ok_or_else(|| malformed(format!("malformed row {:?}", record.as_slice())))?;
             if o.t <= t_max {
                 m.record(&o);
-                kept.push_str(line);
+                kept.push_str(&record.iter().collect::<Vec<_>>().join(","));
                 kept.push('\n');
             }
         }
@@ -550,13 +548,12 @@ impl BarrierMonitor {
 
 /// Parses one row of [`OVERRUN_FILE`] back into an [`Overrun`] (only the columns the report needs are
 /// restored; the energies are not logged and come back as 0, the level as written).
-fn parse_row(line: &str) -> Option<Overrun> {
-    let f: Vec<&str> = line.trim_end().split(',').collect();
+fn parse_row(f: &csv::StringRecord) -> Option<Overrun> {
     if f.len() != OVERRUN_COLUMNS.len() {
         return None;
     }
     let num = |k: usize| f[k].parse::<f64>().ok();
-    let level = match f[3] {
+    let level = match &f[3] {
         "overrun" => OverrunLevel::Overrun,
         "broke-through" => OverrunLevel::BrokeThrough,
         _ => return None,

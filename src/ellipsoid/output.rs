@@ -69,22 +69,20 @@ impl TracksWriter {
     /// Reopens `path` after a checkpoint: keeps the header and the first `rows` complete rows, drops the
     /// rest (rows written after the checkpoint, or a half-written line) and positions for appending.
     /// Errors are one line, naming the file.
-    pub fn open_truncated(path: &Path, rows: u64) -> Result<Self, String> {
-        let io = |e: std::io::Error| format!("{}: {e}", path.display());
-        let data = std::fs::read(path).map_err(io)?;
+    pub fn open_truncated(path: &Path, rows: u64) -> std::io::Result<Self> {
+        let data = std::fs::read(path)?;
         let mut newlines = data.iter().enumerate().filter(|&(_, &b)| b == b'\n').map(|(i, _)| i);
         let keep = match newlines.nth(rows as usize) {
             Some(i) => i as u64 + 1,
             None => {
-                return Err(format!(
-                    "{}: holds fewer than the header and the {rows} rows written before the checkpoint",
-                    path.display()
-                ));
+                return Err(std::io::Error::other(format!(
+                    "holds fewer than the header and the {rows} rows written before the checkpoint"
+                )));
             }
         };
-        let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(io)?;
-        file.set_len(keep).map_err(io)?;
-        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(io)?;
+        let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
+        file.set_len(keep)?;
+        std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(TracksWriter {
             w: ::csv::Writer::from_writer(BufWriter::new(file)),
         })

@@ -21,7 +21,9 @@ use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
-use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule};
+use crate::engine::{
+    Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule,
+};
 use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
 use crate::io::fmt_f64;
 use crate::math::Vec3;
@@ -235,7 +237,7 @@ pub struct EllipsoidEngine {
 
 impl EllipsoidEngine {
     /// The engine for a validated scene, at t = 0. Errors: the integrator cannot be built from the scene's settings.
-    pub fn new(scene: LoadedScene) -> Result<Self, String> {
+    pub fn new(scene: LoadedScene) -> Result<Self, EngineError> {
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
         let settings = scene.integrator;
         let integrator = make_integrator(
@@ -243,7 +245,7 @@ impl EllipsoidEngine {
             Tolerances::uniform(settings.rtol, settings.atol, system.dim()),
             settings.step,
         )
-        .map_err(|e| format!("integrator setup: {e}"))?;
+        .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         let y = system.initial_state();
         let tracker = ErrorTracker::new(&system.diagnostics(&y));
         let barrier = BarrierMonitor::new(
@@ -265,13 +267,13 @@ impl EllipsoidEngine {
     }
 
     /// Loads and validates the scene file at `path`. Errors are one line naming the field.
-    pub fn load(path: &Path) -> Result<Self, String> {
-        EllipsoidEngine::new(load_scene(path).map_err(|e| e.to_string())?)
+    pub fn load(path: &Path) -> Result<Self, EngineError> {
+        EllipsoidEngine::new(load_scene(path)?)
     }
 
     /// The built-in default scene.
-    pub fn default_scene() -> Result<Self, String> {
-        EllipsoidEngine::new(default_scene().map_err(|e| e.to_string())?)
+    pub fn default_scene() -> Result<Self, EngineError> {
+        EllipsoidEngine::new(default_scene()?)
     }
 
     /// The scene being run.
@@ -358,8 +360,8 @@ impl Engine for EllipsoidEngine {
     type State = EllipsoidState;
     const KIND: &'static str = "ellipsoids";
 
-    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
-        EllipsoidEngine::new(parse_scene(text, name, base_dir).map_err(|e| e.to_string())?)
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError> {
+        EllipsoidEngine::new(parse_scene(text, name, base_dir)?)
     }
 
     fn scene_source(&self) -> &str {
@@ -543,7 +545,14 @@ impl Engine for EllipsoidEngine {
         })
     }
 
-    fn restore(&mut self, state: EllipsoidState, dir: &Path, at: Resumed) -> Result<(), String> {
+    fn restore(&mut self, state: EllipsoidState, dir: &Path, at: Resumed) -> Result<(), EngineError> {
+        self.restore_from(state, dir, at).map_err(EngineError::State)
+    }
+}
+
+impl EllipsoidEngine {
+    /// [`Engine::restore`] with one-line `String` errors (made [`EngineError::State`] there).
+    fn restore_from(&mut self, state: EllipsoidState, dir: &Path, at: Resumed) -> Result<(), String> {
         if state.bodies_hash != bodies_hash(&self.scene) || state.n_bodies != self.scene.bodies.len() {
             let from = match (&self.scene.file.scene.bodies_file, &self.scene.base_dir) {
                 (Some(f), Some(base)) => format!(" (bodies_file {})", base.join(f).display()),
@@ -582,7 +591,8 @@ impl Engine for EllipsoidEngine {
             // Each sample wrote one row per tracked body.
             let rows = at.samples_done * self.scene.output.track.len() as u64;
             let path = dir.join("tracks.csv");
-            self.tracks = Some((TracksWriter::open_truncated(&path, rows)?, path));
+            let writer = TracksWriter::open_truncated(&path, rows).map_err(|e| format!("{}: {e}", path.display()))?;
+            self.tracks = Some((writer, path));
         }
         let log = dir.join(OVERRUN_FILE);
         self.barrier = BarrierMonitor::resume(

@@ -61,6 +61,28 @@ impl ParticleView {
     }
 }
 
+/// Why an engine could not be set up from a scene, or could not continue from a checkpoint's state.
+#[derive(Debug, thiserror::Error)]
+pub enum EngineError {
+    /// The scene is invalid (one line naming the file and the field).
+    #[error(transparent)]
+    Scene(#[from] crate::io::scene_file::SceneError),
+    /// The scene is valid but the engine cannot be built from it (e.g. the integrator refuses its tolerances).
+    #[error("{0}")]
+    Setup(String),
+    /// The checkpoint's state does not fit the scene (counts, lengths, non-finite values, another method).
+    #[error("{0}")]
+    State(String),
+    /// An output file to continue is missing, unreadable or shorter than at the checkpoint.
+    #[error("{}: {reason}", .path.display())]
+    File {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
 /// Why an engine stopped: the cause, one line (e.g. `"integrator error: step size underflow at t = …"`). The
 /// engine keeps its last good state and writes it when asked ([`Engine::write_last_good_state`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -141,7 +163,7 @@ pub trait Engine: Sized {
 
     /// Builds the engine from a scene file's text (`name` names it in errors; a relative input file named in the
     /// scene is resolved against `base_dir`). Used by `resume`, on the run's `scene.toml` copy.
-    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String>;
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError>;
 
     /// The scene text, copied to `scene.toml`.
     fn scene_source(&self) -> &str;
@@ -189,20 +211,23 @@ pub trait Engine: Sized {
 
     /// Continues from a checkpoint's state: restores it and reopens the engine's own files in `dir`, cut back to
     /// what they held at the checkpoint. Errors are one line.
-    fn restore(&mut self, state: Self::State, dir: &Path, at: Resumed) -> Result<(), String>;
+    fn restore(&mut self, state: Self::State, dir: &Path, at: Resumed) -> Result<(), EngineError>;
 }
 
 /// Cuts an output file back to `bytes` (its length at a checkpoint) and opens it for appending, so that a resumed
 /// run continues it exactly. Errors are one line naming the file (missing, or shorter than at the checkpoint).
-pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, String> {
-    let err = |e: std::io::Error| format!("{}: {e}", path.display());
+pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, EngineError> {
+    let err = |e: std::io::Error| EngineError::File {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    };
     let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(err)?;
     let len = file.metadata().map_err(err)?.len();
     if len < bytes {
-        return Err(format!(
-            "{} holds {len} bytes, fewer than the {bytes} written before the checkpoint",
-            path.display()
-        ));
+        return Err(EngineError::File {
+            path: path.to_path_buf(),
+            reason: format!("holds {len} bytes, fewer than the {bytes} written before the checkpoint"),
+        });
     }
     file.set_len(bytes).map_err(err)?;
     std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(err)?;

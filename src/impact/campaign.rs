@@ -927,7 +927,11 @@ fn last_time(path: &Path) -> Option<f64> {
     f.read_to_string(&mut tail).ok()?;
     let complete = &tail[..tail.rfind('\n')?];
     let line = complete.rsplit('\n').next()?;
-    line.split(',').next()?.trim().parse().ok()
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(false)
+        .flexible(true)
+        .from_reader(line.as_bytes());
+    reader.records().next()?.ok()?.get(0)?.trim().parse().ok()
 }
 
 fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {

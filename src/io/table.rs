@@ -146,7 +146,7 @@ mod tests {
         assert_eq!(t.rows.len(), 3);
         assert!(t.rows[1][1].is_nan());
         assert_eq!(t.rows[2], vec![2.0, 4.0], "a row still being written is kept short");
-        assert_eq!(t.values("y").unwrap()[2].is_nan(), true);
+        assert!(t.values("y").unwrap()[2].is_nan());
         assert_eq!(read_header(&p).unwrap(), vec!["t", "x", "y"]);
         let exact = file("b.csv", "v\n0.1\n6.674e-11\n");
         let t = read_table(&exact, Cells::Strict).unwrap();

@@ -289,7 +289,11 @@ impl Figure for SpinDistributions {
 
 /// Draws Fig. 7 (`spin_distributions.svg` / `.png`) into `dir` from plain `(label, n, b)` fits, `b` in
 /// `x_unit` (corrected spin rates, §4.3, when they come from the campaign analysis). Returns the files written.
-pub fn write_spin_distributions(dir: &Path, fits: &[(&str, f64, f64)], x_unit: &str) -> Result<[String; 2], String> {
+pub fn write_spin_distributions(
+    dir: &Path,
+    fits: &[(&str, f64, f64)],
+    x_unit: &str,
+) -> Result<[String; 2], crate::analysis::AnalysisError> {
     let fig = SpinDistributions {
         title: "Normalised best fits of the fragments' corrected spin distributions (Eq. 45)".into(),
         fits: fits.iter().map(|&(l, n, b)| (l.to_string(), n, b)).collect(),

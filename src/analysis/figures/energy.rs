@@ -181,14 +181,17 @@ fn norm(v: [f64; 3]) -> f64 {
 
 /// Reads `run_dir/timeseries.csv` (required) and `run_dir/tracks.csv` (optional; see the module docs) into the
 /// curves of Fig. 2.
-pub fn read_energy_series(run_dir: &Path, inputs: &EnergyInputs) -> Result<EnergySeries, String> {
+pub fn read_energy_series(
+    run_dir: &Path,
+    inputs: &EnergyInputs,
+) -> Result<EnergySeries, crate::analysis::AnalysisError> {
     let ts_path = run_dir.join("timeseries.csv");
     if !ts_path.is_file() {
-        return Err(format!("{}: not found", ts_path.display()));
+        return Err(format!("{}: not found", ts_path.display()).into());
     }
     let rows = read_columns(&ts_path, &TIMESERIES)?;
     if rows.is_empty() {
-        return Err(format!("{}: no rows", ts_path.display()));
+        return Err(format!("{}: no rows", ts_path.display()).into());
     }
     let tracks = read_tracks(&run_dir.join("tracks.csv"), inputs);
     let (m_p, m_t) = (inputs.projectile_mass, inputs.target_mass);
@@ -333,6 +336,6 @@ pub(crate) mod tests {
     fn missing_timeseries_is_an_error_not_a_panic() {
         let dir = std::env::temp_dir().join(format!("rubblepile-fig2-missing-{}", std::process::id()));
         let err = read_energy_series(&dir, &inputs()).unwrap_err();
-        assert!(err.contains("timeseries.csv"), "{err}");
+        assert!(err.to_string().contains("timeseries.csv"), "{err}");
     }
 }

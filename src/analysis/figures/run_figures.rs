@@ -656,7 +656,7 @@ pub fn write_run_figures(
                 series,
                 scale_names,
             };
-            write_figure(&dir, "energy_partition", &fig)
+            Ok(write_figure(&dir, "energy_partition", &fig)?)
         });
     record("energy_partition", fig2);
 
@@ -665,7 +665,10 @@ pub fn write_run_figures(
         fragments: target.iter().map(|f| (f.ejection_velocity, f.escaping)).collect(),
         escape_velocity: analysis.summary.escape_velocity,
     };
-    record("velocity_field", write_figure(&dir, "velocity_field", &fig3));
+    record(
+        "velocity_field",
+        write_figure(&dir, "velocity_field", &fig3).map_err(String::from),
+    );
 
     let fig4 = SizeScatter {
         title: format!("Ejection speed vs size at t = {t_at} s"),
@@ -678,7 +681,10 @@ pub fn write_run_figures(
             format!("escape speed v_esc = {:.1} m/s", analysis.summary.escape_velocity),
         )),
     };
-    record("ejection_vs_size", write_figure(&dir, "ejection_vs_size", &fig4));
+    record(
+        "ejection_vs_size",
+        write_figure(&dir, "ejection_vs_size", &fig4).map_err(String::from),
+    );
 
     let fig6 = SpinHistogram {
         title: format!("Spin rates of the target fragments at t = {t_at} s"),
@@ -692,7 +698,10 @@ pub fn write_run_figures(
             Fit::Failed(_) => Vec::new(),
         },
     };
-    record("spin_histogram", write_figure(&dir, "spin_histogram", &fig6));
+    record(
+        "spin_histogram",
+        write_figure(&dir, "spin_histogram", &fig6).map_err(String::from),
+    );
 
     let fig8 = SizeScatter {
         title: format!("Spin rate vs size at t = {t_at} s"),
@@ -702,7 +711,10 @@ pub fn write_run_figures(
         reference: Some((-2.5, "−5/2 power law (equipartition)".into())),
         horizontal: None,
     };
-    record("spin_vs_size", write_figure(&dir, "spin_vs_size", &fig8));
+    record(
+        "spin_vs_size",
+        write_figure(&dir, "spin_vs_size", &fig8).map_err(String::from),
+    );
 
     let fig9 = RotationModeVsSize {
         title: format!("Axis rotation mode vs size at t = {t_at} s"),
@@ -713,7 +725,7 @@ pub fn write_run_figures(
     };
     record(
         "rotation_mode_vs_size",
-        write_figure(&dir, "rotation_mode_vs_size", &fig9),
+        write_figure(&dir, "rotation_mode_vs_size", &fig9).map_err(String::from),
     );
     (written, failed)
 }

@@ -51,7 +51,7 @@ pub const SERIES_COLOURS: [RGBColor; 4] = [
 static DEJAVU_SANS: &[u8] = include_bytes!("fonts/DejaVuSans.ttf");
 
 /// A drawing result: the reason as one line when a figure could not be drawn.
-pub type PlotResult = Result<(), String>;
+pub type PlotResult = Result<(), crate::analysis::AnalysisError>;
 
 /// Turns a plotters error (or any other) into the one-line reason of [`PlotResult`].
 pub fn draw_err(err: impl std::fmt::Display) -> String {
@@ -68,6 +68,7 @@ pub fn ensure_font() -> PlotResult {
                 .map_err(|_| "the embedded DejaVu Sans font could not be parsed".to_string())
         })
         .clone()
+        .map_err(crate::analysis::AnalysisError::Output)
 }
 
 /// One figure, drawn the same way on any plotters backend.
@@ -79,13 +80,17 @@ pub trait Figure {
 fn render<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, figure: &impl Figure) -> PlotResult {
     root.fill(&WHITE).map_err(draw_err)?;
     figure.draw(root)?;
-    root.present().map_err(draw_err)
+    Ok(root.present().map_err(draw_err)?)
 }
 
 /// Draws `figure` into `dir/<stem>.svg` and `dir/<stem>.png` ([`FIGURE_SIZE`]), creating `dir`; returns the
 /// two file names. On a drawing error neither file is left behind (plotters' backends write their file when
 /// dropped, even after a failed drawing), so a stale or blank figure never passes for a good one.
-pub fn write_figure(dir: &Path, stem: &str, figure: &impl Figure) -> Result<[String; 2], String> {
+pub fn write_figure(
+    dir: &Path,
+    stem: &str,
+    figure: &impl Figure,
+) -> Result<[String; 2], crate::analysis::AnalysisError> {
     ensure_font()?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let (svg, png) = (format!("{stem}.svg"), format!("{stem}.png"));
@@ -128,7 +133,7 @@ pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .draw()
-        .map_err(draw_err)
+        .map_err(|e| crate::analysis::AnalysisError::Output(draw_err(e)))
 }
 
 /// The smallest and largest of the finite values (`None` without any).

@@ -336,7 +336,7 @@ pub fn head_on(id: &str, factor: f64) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(every / 10.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let pairs = run
             .summary
@@ -518,7 +518,7 @@ pub fn tiny_orbit(id: &str) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let (mut dr, mut dphi) = (0.0_f64, 0.0_f64);
         for (t, b) in &snaps {
@@ -582,7 +582,7 @@ pub fn tiny_resting(id: &str) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let Some((_, last)) = snaps.last() else {
@@ -663,7 +663,7 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let (mut spin_err, mut q_err, mut off_axis) = (0.0_f64, 0.0_f64, 0.0_f64);
         let w0 = (wobble * wobble + w3 * w3).sqrt();
@@ -925,7 +925,7 @@ pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(2.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let report = run.summary.barrier.clone();
         let got = run.overrun_pairs() > 0;
@@ -1036,7 +1036,7 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let beta = run.summary.barrier.as_ref().map_or(10.0, |b| b.beta);
         let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, beta, b).len();
@@ -1122,7 +1122,7 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
     let check: super::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e),
+            Err(e) => return failed_to_read(e.into()),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let n = snaps.len();

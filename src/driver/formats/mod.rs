@@ -23,6 +23,16 @@ pub fn registered() -> Vec<Box<dyn SnapshotFormat>> {
     vec![Box::new(xyz::ExtendedXyz)]
 }
 
+/// A format name that is not [`registered`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("--format: unknown format {name:?}; known: {}", .known.join(", "))]
+pub struct UnknownFormat {
+    /// The name given.
+    pub name: String,
+    /// The registered names.
+    pub known: Vec<&'static str>,
+}
+
 /// A set of [`registered`] formats (bit `i` = the i-th format), small and `Copy` so that it rides in
 /// [`super::RunOptions`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -33,16 +43,15 @@ impl Formats {
     pub const NONE: Formats = Formats(0);
 
     /// The formats named in `names`; an unknown name is an error listing the known ones.
-    pub fn parse(names: &[String]) -> Result<Formats, String> {
+    pub fn parse(names: &[String]) -> Result<Formats, UnknownFormat> {
         let all = registered();
         let mut bits = 0u32;
         for name in names {
             let Some(i) = all.iter().position(|f| f.name() == name) else {
-                let known: Vec<&str> = all.iter().map(|f| f.name()).collect();
-                return Err(format!(
-                    "--format: unknown format {name:?}; known: {}",
-                    known.join(", ")
-                ));
+                return Err(UnknownFormat {
+                    name: name.clone(),
+                    known: all.iter().map(|f| f.name()).collect(),
+                });
             };
             bits |= 1 << i;
         }

@@ -16,7 +16,9 @@ use super::particle::Attachment;
 use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule};
+use crate::engine::{
+    Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule,
+};
 use crate::io::fmt_f64;
 use crate::math::Vec3;
 
@@ -285,10 +287,8 @@ impl HardEngine {
     }
 
     /// Loads and validates the scene file at `path`. Errors are one line naming the field.
-    pub fn load(path: &Path) -> Result<Self, String> {
-        Ok(HardEngine::new(
-            super::scene::load_hard_scene(path).map_err(|e| e.to_string())?,
-        ))
+    pub fn load(path: &Path) -> Result<Self, EngineError> {
+        Ok(HardEngine::new(super::scene::load_hard_scene(path)?))
     }
 
     /// What the scene resolves to, for `rubblepile check`.
@@ -313,11 +313,9 @@ impl Engine for HardEngine {
     type State = HardState;
     const KIND: &'static str = super::scene::KIND;
 
-    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError> {
         let base = base_dir.unwrap_or(Path::new("."));
-        Ok(HardEngine::new(
-            super::scene::parse_hard_scene(text, name, base).map_err(|e| e.to_string())?,
-        ))
+        Ok(HardEngine::new(super::scene::parse_hard_scene(text, name, base)?))
     }
 
     fn scene_source(&self) -> &str {
@@ -514,7 +512,14 @@ impl Engine for HardEngine {
         })
     }
 
-    fn restore(&mut self, ck: HardState, _dir: &Path, at: Resumed) -> Result<(), String> {
+    fn restore(&mut self, ck: HardState, dir: &Path, at: Resumed) -> Result<(), EngineError> {
+        self.restore_from(ck, dir, at).map_err(EngineError::State)
+    }
+}
+
+impl HardEngine {
+    /// [`Engine::restore`] with one-line `String` errors (made [`EngineError::State`] there).
+    fn restore_from(&mut self, ck: HardState, _dir: &Path, at: Resumed) -> Result<(), String> {
         let system = &mut self.system;
         unpack_particles(system, &ck.state)?;
         system.t = at.t;

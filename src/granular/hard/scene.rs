@@ -630,34 +630,60 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     Ok(wall)
 }
 
+/// Why a particles CSV could not be read (one line, without the file name, which the caller adds).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParticlesFileError {
+    /// The file cannot be opened, or its header or a row is not CSV.
+    #[error("{0}")]
+    Read(String),
+    /// A required column is missing.
+    #[error("missing column `{column}` (need {})", PARTICLE_COLUMNS.join(","))]
+    MissingColumn {
+        /// The column.
+        column: &'static str,
+    },
+    /// A cell is not what its column holds.
+    #[error("line {line}: column `{column}`: expected {expected}, got {value:?}")]
+    Cell {
+        /// 1-based line.
+        line: usize,
+        /// The column.
+        column: &'static str,
+        /// What the column holds.
+        expected: &'static str,
+        /// The cell.
+        value: String,
+    },
+}
+
 /// Reads a particles CSV (header with at least the [`PARTICLE_COLUMNS`], optionally [`STUCK_COLUMN`]); rows in that
 /// column order.
-pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, String> {
+pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, ParticlesFileError> {
+    use ParticlesFileError as E;
     let mut rdr = ::csv::ReaderBuilder::new()
         .trim(::csv::Trim::All)
         .from_path(path)
-        .map_err(|e| format!("cannot read: {e}"))?;
-    let headers = rdr.headers().map_err(|e| format!("bad header: {e}"))?.clone();
+        .map_err(|e| E::Read(format!("cannot read: {e}")))?;
+    let headers = rdr.headers().map_err(|e| E::Read(format!("bad header: {e}")))?.clone();
     let mut idx = [0usize; 13];
     for (k, col) in PARTICLE_COLUMNS.iter().enumerate() {
         idx[k] = headers
             .iter()
             .position(|h| h == *col)
-            .ok_or_else(|| format!("missing column `{col}` (need {})", PARTICLE_COLUMNS.join(",")))?;
+            .ok_or(E::MissingColumn { column: col })?;
     }
     let stuck_idx = headers.iter().position(|h| h == STUCK_COLUMN);
     let mut rows = Vec::new();
     for (line, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| format!("line {}: {e}", line + 2))?;
+        let rec = rec.map_err(|e| E::Read(format!("line {}: {e}", line + 2)))?;
         let mut row = [0.0; 13];
         for k in 0..13 {
             let s = rec.get(idx[k]).unwrap_or("");
-            row[k] = s.parse().map_err(|_| {
-                format!(
-                    "line {}: column `{}`: expected a number, got {s:?}",
-                    line + 2,
-                    PARTICLE_COLUMNS[k]
-                )
+            row[k] = s.parse().map_err(|_| E::Cell {
+                line: line + 2,
+                column: PARTICLE_COLUMNS[k],
+                expected: "a number",
+                value: s.to_string(),
             })?;
         }
         let stuck_to = match stuck_idx.map(|i| rec.get(i).unwrap_or("")) {
@@ -666,10 +692,12 @@ pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, String> {
                 Ok(w) if w < 0 => None,
                 Ok(w) => Some(w as usize),
                 Err(_) => {
-                    return Err(format!(
-                        "line {}: column `{STUCK_COLUMN}`: expected a wall index or -1, got {s:?}",
-                        line + 2
-                    ));
+                    return Err(E::Cell {
+                        line: line + 2,
+                        column: STUCK_COLUMN,
+                        expected: "a wall index or -1",
+                        value: s.to_string(),
+                    });
                 }
             },
         };

@@ -216,7 +216,7 @@ impl System {
 
     /// Restores a neighbour list saved by [`System::neighbour_state`] (its pairs are found again from the anchors,
     /// as the build found them). Returns an error when the anchors do not match the particles.
-    pub fn restore_neighbours(&mut self, state: Option<NeighbourState>) -> Result<(), String> {
+    pub(crate) fn restore_neighbours(&mut self, state: Option<NeighbourState>) -> Result<(), String> {
         let Some(st) = state else {
             self.neighbours = Neighbours::default();
             return Ok(());

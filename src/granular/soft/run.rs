@@ -30,7 +30,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError};
+use crate::engine::{Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError};
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
@@ -450,8 +450,8 @@ impl SoftEngine {
     }
 
     /// Loads and validates the scene file at `path`. Errors are one line naming the field.
-    pub fn load(path: &Path) -> Result<Self, String> {
-        Ok(SoftEngine::new(load_soft_scene(path).map_err(|e| e.to_string())?))
+    pub fn load(path: &Path) -> Result<Self, EngineError> {
+        Ok(SoftEngine::new(load_soft_scene(path)?))
     }
 
     /// The scene's warnings (e.g. a step longer than advised).
@@ -496,10 +496,8 @@ impl Engine for SoftEngine {
     type State = SoftState;
     const KIND: &'static str = crate::granular::soft::scene::KIND;
 
-    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, String> {
-        Ok(SoftEngine::new(
-            parse_soft_scene(text, name, base_dir).map_err(|e| e.to_string())?,
-        ))
+    fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError> {
+        Ok(SoftEngine::new(parse_soft_scene(text, name, base_dir)?))
     }
 
     fn scene_source(&self) -> &str {
@@ -672,7 +670,14 @@ impl Engine for SoftEngine {
         })
     }
 
-    fn restore(&mut self, ck: SoftState, dir: &Path, _at: Resumed) -> Result<(), String> {
+    fn restore(&mut self, ck: SoftState, dir: &Path, at: Resumed) -> Result<(), EngineError> {
+        self.restore_from(ck, dir, at).map_err(EngineError::State)
+    }
+}
+
+impl SoftEngine {
+    /// [`Engine::restore`] with one-line `String` errors (made [`EngineError::State`] there).
+    fn restore_from(&mut self, ck: SoftState, dir: &Path, _at: Resumed) -> Result<(), String> {
         let scene = &self.scene;
         let n = scene.particles.len();
         if ck.state.len() != 15 * n {
@@ -721,7 +726,8 @@ impl Engine for SoftEngine {
             (Some(settings), Some(sc)) => {
                 let mut driver = SpinupDriver::new(*settings, &scene.particles);
                 driver.restore(&sc.state).ok_or("malformed spin-up state")?;
-                let f = crate::engine::reopen_truncated(&dir.join("spinup.csv"), sc.bytes)?;
+                let f =
+                    crate::engine::reopen_truncated(&dir.join("spinup.csv"), sc.bytes).map_err(|e| e.to_string())?;
                 Some(SpinRun {
                     driver,
                     csv: BufWriter::new(f),

@@ -130,8 +130,7 @@ impl SpinupSample {
 pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, crate::io::table::TableError> {
     use crate::io::table::{Cells, TableError, read_table};
     let table = read_table(path, Cells::Strict)?;
-    let expected: Vec<&str> = SPINUP_HEADER.trim().split(',').collect();
-    if table.columns != expected {
+    if table.columns.join(",") != SPINUP_HEADER.trim() {
         return Err(TableError::Header {
             path: path.to_path_buf(),
             expected: SPINUP_HEADER.trim().to_string(),
