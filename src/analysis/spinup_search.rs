@@ -10,7 +10,7 @@
 //!   With `--branch [--hold SECONDS]` the hold runs share one run of BASE's path (`DIR/base`): the hold at
 //!   T_final = X starts where BASE's path passes X, with BASE's spin-up rate (Zhang17 §4.3 finds T_c,3
 //!   independent of the rate), branched off the base run's checkpoint at the output sample at or before that time
-//!   ([`crate::granular::soft::branch`]); its scene (`DIR/T<X>/scene.toml`) has `t_final` at that time and holds
+//!   ([`crate::driver::branch`]); its scene (`DIR/T<X>/scene.toml`) has `t_final` at that time and holds
 //!   for SECONDS. Each hold then costs only its hold; the result equals the hold scene run from t = 0 bit for bit
 //!   when the shortened path's periods round alike (tested).
 //! - `rubblepile spinup density-fit --points RHO:T,RHO:T,… [--period 2.26]`: κ of Eq. 22 by least squares

@@ -5,7 +5,7 @@
 //! the end point against computing time, one curve per code, tolerances one per decade) and the
 //! work–precision diagrams of DifferentialEquations.jl's SciMLBenchmarks.
 //!
-//! * **Time** is the wall-clock time of the [`Integrator::advance`] calls only: building the system, the
+//! * **Time** is the wall-clock time of the [`crate::integrate::Integrator::advance`] calls only: building the system, the
 //!   initial state, the diagnostics at the energy checks and all I/O are outside the clock. Each setting is
 //!   run `repeats` times and the **median** is reported; a setting whose first run takes less than
 //!   [`SHORT_RUN_SECONDS`] is run more often (up to [`SHORT_RUN_MAX_REPEATS`] times, about

@@ -4,7 +4,7 @@
 //!   [--checkpoint-every-sim S]`: runs a scene (the built-in default scene without SCENE) and writes
 //!   its outputs into DIR, with checkpoints as asked;
 //! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
-//!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::run`]);
+//!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::driver`]);
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to;
 //! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;

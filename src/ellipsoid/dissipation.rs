@@ -1,4 +1,5 @@
-//! The point dissipation function (Roig03 Eqs. 40–41) in the closed form of `shared/notes/ellipsoid-model.md`.
+//! The point dissipation function (Roig03 Eqs. 40–41) in closed form (see [`crate::ellipsoid`], "Conventions and
+//! corrected forms").
 //!
 //! With the product-Gaussian centre offsets `d_i = r_ij − r_i = −Σ_i G⁻¹Δ`, `d_j = r_ij − r_j = Σ_j G⁻¹Δ`,
 //! its covariance `P = Σ_i G⁻¹ Σ_j`, relative spin `w = ω_i − ω_j` (world frame) and relative point velocity

@@ -1,5 +1,5 @@
 //! The Gaussian-overlap contact potential (Roig03 Eqs. 7–12) in the equivalent, cheaper form of
-//! `shared/notes/ellipsoid-model.md`:
+//! [`crate::ellipsoid`] ("Conventions and corrected forms"):
 //!
 //! `Σ_i = R_iᵀ diag(A², B², C²) R_i`, `G = Σ_i + Σ_j`, `Δ = r_i − r_j`,
 //! `U_C = P_ij · det(G)^{−1/2} · exp(−κ Δᵀ G⁻¹ Δ)` with `P_ij = U0_ij m_i m_j (κ/π)^{3/2}`.

@@ -1,7 +1,7 @@
 //! Quaternion attitude algebra of Roig03 §2.2: `R(q)` (Eq. 21), `W(q)` (Eq. 24), the mass matrix
 //! `M = 4 Wᵀ Ĩ W` (Eqs. 25–26) and the derivatives the equations of motion need.
 //!
-//! Convention (see `shared/notes/ellipsoid-model.md`, checked by `tests/ellipsoid_gradients.rs`):
+//! Convention (see [`crate::ellipsoid`] ("Conventions and corrected forms"), checked by `tests/ellipsoid_gradients.rs`):
 //! `q = (α, β, γ, δ)`, vector part first, scalar `δ` last. `R(q)` maps world to body coordinates,
 //! `s = R (r − r_i)`. Body spin: `(ω_b, 0) = 2 W(q) q̇`; world spin `ω_w = Rᵀ ω_b`; `Ṙᵀ R = [ω_w]×`.
 //! `R(q)` equals the transpose of the active rotation matrix of the Hamilton quaternion

@@ -1,4 +1,4 @@
-//! Point wall (Richardson11 §2.2; notes `shared/notes/hsdem.md`: a cylinder with zero radius and length, or a ring
+//! Point wall (Richardson11 §2.2; derivations in [`crate::geometry::walls`]: a cylinder with zero radius and length, or a ring
 //! of zero radius). A sphere of radius s touches it when `|p| = s`: the particle–particle quadratic.
 
 use super::roots::quadratic;

@@ -1,5 +1,5 @@
 //! Collision resolution of rough spheres with normal and tangential restitution (Richardson11 §2.1, ≈Eqs. 4–8;
-//! notes `shared/notes/hsdem.md`, "Particle–particle" and "Particle–wall").
+//! [`crate::granular::hard`], "Collisions", "Particle–particle" and "Particle–wall").
 //!
 //! Contact-point velocities decide: with n̂ from sphere 1 to sphere 2, `u = (v₂ + R₂ n̂×ω₂) − (v₁ + R₁ ω₁×n̂)`, and a
 //! collision acts only if `u·n̂ < 0`. The normal part of `u` is reversed and scaled by ε_n, the tangential part

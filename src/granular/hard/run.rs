@@ -1,9 +1,8 @@
-//! The hard-sphere run driver, with the crate's output contract (see [`crate::run`]): `scene.toml` (copy),
-//! `timeseries.csv` (flushed row by row), `snapshots/<k>.csv` (in the particles-file columns), `summary.json`
+//! The hard-sphere engine as the run driver ([`crate::driver`]) sees it: `timeseries.csv` in [`TIMESERIES_COLUMNS`]
+//! (flushed row by row), `snapshots/<k>.csv` in the particles-file columns, `summary.json` as [`HardRunSummary`]
 //! (status, wall_seconds, energy error, collision count, events per second, max overlap, absorbed count) and, on
-//! failure, `last_good_state.csv` with the cause in the summary. A previous run's output is never overwritten
-//! without `force`. Long runs write `checkpoint.json` at output samples (as [`RunOptions`] asks) and continue with
-//! [`resume_hard`] (`rubblepile resume DIR`) bit for bit.
+//! failure, `last_good_state.csv` with the cause in the summary. Checkpoints ([`HardState`]) continue bit for bit
+//! (`rubblepile resume DIR`).
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

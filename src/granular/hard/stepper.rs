@@ -1,4 +1,4 @@
-//! The hard-sphere stepper (Richardson11 §2.1; notes `shared/notes/hsdem.md`, "Stepping").
+//! The hard-sphere stepper (Richardson11 §2.1; [`crate::granular::hard`], "Collisions", "Stepping").
 //!
 //! One step of length h is kick–drift–kick: half a kick of uniform gravity, a drift of length h in which particles
 //! move on straight lines and collide, half a kick. Within the drift every particle's earliest events against its

@@ -1,5 +1,5 @@
-//! The soft-sphere run driver (`rubblepile run` on a `kind = "soft-spheres"` scene): the core's output
-//! contract adapted to spheres.
+//! The soft-sphere engine as the run driver ([`crate::driver`]) sees it (`rubblepile run` on a `kind = "soft-spheres"`
+//! scene): the output contract of the crate adapted to spheres.
 //!
 //! Files in the output directory:
 //! - `scene.toml`: the scene text;
@@ -19,7 +19,7 @@
 //!   row; the forcing ([`crate::granular::soft::spinup`]) acts after every step.
 //!
 //! Checkpoints hold every particle's state, the last forces and torques (leapfrog needs them), the spring
-//! histories and the bookkeeping, all as exact f64 bit patterns, so [`resume_soft`] continues bit for bit.
+//! histories and the bookkeeping, all as exact f64 bit patterns, so `rubblepile resume` continues bit for bit.
 //! A non-finite state or an overlap above half the smaller radius stops the run with the last good state
 //! saved and the cause named.
 
