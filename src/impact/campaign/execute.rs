@@ -1,0 +1,359 @@
+//! Running a campaign: which runs to start, resume or skip, the pool of workers, progress, and the index kept
+//! current as runs start and end.
+
+use std::io::IsTerminal;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+
+use crate::driver::{RunError, RunOptions, resume_run};
+use crate::ellipsoid::output::read_bodies_csv;
+use crate::impact::run::{ImpactError, ImpactPlan, run_impact};
+use crate::io::checkpoint::CHECKPOINT_FILE;
+
+use super::*;
+
+// ---------------------------------------------------------------------------------------------
+// Running.
+// ---------------------------------------------------------------------------------------------
+
+/// How a campaign runs (not what it runs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CampaignOptions {
+    /// Options of every run: the checkpoint cadence and the testing stop (`force` is ignored: a run is
+    /// started afresh only as the module docs say); `progress` = the campaign's progress display on stderr
+    /// (only when stderr is a terminal). The runs' own progress bars are never shown.
+    pub run: RunOptions,
+    /// Runs at once, overriding `campaign.parallel`.
+    pub parallel: Option<usize>,
+    /// Print one line per finished run on stdout.
+    pub verbose: bool,
+}
+
+impl Default for CampaignOptions {
+    /// [`RunOptions::default`], the file's `parallel`, quiet.
+    fn default() -> Self {
+        CampaignOptions {
+            run: RunOptions::default(),
+            parallel: None,
+            verbose: false,
+        }
+    }
+}
+
+/// What the campaign does with a grid point (decided when it starts; see the module docs).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Action {
+    /// Already completed: skipped.
+    Skip,
+    /// Half finished: continued from its checkpoint.
+    Resume,
+    /// Started afresh.
+    Start,
+    /// The directory holds a different run: left alone, recorded as failed.
+    Conflict(String),
+}
+
+/// Whether `dir` holds the run `plan` describes: its `scene.toml` (comment lines aside) and its
+/// `initial_bodies.csv` (bit for bit) are those this campaign would write.
+fn same_run(dir: &Path, plan: &ImpactPlan) -> Result<(), String> {
+    let strip = |s: &str| -> Vec<String> {
+        s.lines()
+            .filter(|l| !l.trim_start().starts_with('#'))
+            .map(|l| l.trim_end().to_string())
+            .collect()
+    };
+    let scene = std::fs::read_to_string(dir.join("scene.toml")).map_err(|e| format!("scene.toml: {e}"))?;
+    if strip(&scene) != strip(&plan.scene_toml) {
+        return Err("its scene.toml differs from this campaign's (changed [impact] settings?)".into());
+    }
+    let records = read_bodies_csv(&dir.join("initial_bodies.csv")).map_err(|e| e.to_string())?;
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let same = records.len() == plan.bodies.len()
+        && records.iter().zip(&plan.bodies).all(|(r, b)| {
+            bits(&[r.mass]) == bits(&[b.shape.mass])
+                && bits(&r.axes) == bits(b.shape.axes.as_slice())
+                && bits(&r.position) == bits(b.position.as_slice())
+                && bits(&r.velocity) == bits(b.velocity.as_slice())
+                && bits(&r.quaternion) == bits(b.quaternion.as_slice())
+                && bits(&r.spin_body) == bits(b.spin_body.as_slice())
+        });
+    if !same {
+        return Err("its initial_bodies.csv differs from this campaign's (a rebuilt target?)".into());
+    }
+    Ok(())
+}
+
+/// What to do with the run directory `dir` of `plan`, with the completed run's numbers when skipped.
+pub fn decide(dir: &Path, plan: &ImpactPlan) -> (Action, Option<RunNumbers>) {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok();
+    let completed = text
+        .as_deref()
+        .and_then(|t| serde_json::from_str::<serde_json::Value>(t).ok())
+        .is_some_and(|v| v.get("status").and_then(|s| s.as_str()) == Some("completed"));
+    let numbers = text.as_deref().map(RunNumbers::from_summary_text);
+    let conflict = |why: String| {
+        Action::Conflict(format!(
+            "the run directory {} holds a different run: {why}; move it away to redo this run",
+            dir.display()
+        ))
+    };
+    if completed {
+        return match same_run(dir, plan) {
+            Ok(()) => (Action::Skip, numbers),
+            Err(why) => (conflict(why), numbers),
+        };
+    }
+    if dir.join(CHECKPOINT_FILE).is_file() {
+        return match same_run(dir, plan) {
+            Ok(()) => (Action::Resume, None),
+            Err(why) => (conflict(why), None),
+        };
+    }
+    (Action::Start, None)
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    m.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Runs one grid point: its new status, whether it stopped on request, its numbers.
+fn execute(
+    point: &GridPoint,
+    dir: &Path,
+    action: &Action,
+    options: &RunOptions,
+) -> (RunStatus, bool, Option<RunNumbers>) {
+    let options = RunOptions {
+        force: true,
+        progress: false,
+        ..*options
+    };
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match action {
+        Action::Resume => resume_run(dir, &options).map_err(ImpactError::Run),
+        _ => run_impact(&point.config, dir, &options),
+    }));
+    match result {
+        Ok(Ok(summary)) => (RunStatus::Completed, false, Some(RunNumbers::from(&summary))),
+        Ok(Err(ImpactError::Run(RunError::Failed { cause, summary, .. }))) => (
+            RunStatus::Failed(cause),
+            false,
+            Some(RunNumbers::from(summary.as_ref())),
+        ),
+        Ok(Err(ImpactError::Run(RunError::Stopped { .. }))) => (RunStatus::Pending, true, None),
+        Ok(Err(e)) => (RunStatus::Failed(e.to_string()), false, None),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_else(|| "unknown".into());
+            (RunStatus::Failed(format!("panic: {what}")), false, None)
+        }
+    }
+}
+
+/// The progress display: a bar of finished runs and a line per active run.
+struct Display {
+    multi: indicatif::MultiProgress,
+    main: indicatif::ProgressBar,
+    active: Mutex<Vec<(usize, indicatif::ProgressBar, Instant)>>,
+}
+
+impl Display {
+    fn new(total: u64, finished: u64) -> Self {
+        let multi = indicatif::MultiProgress::with_draw_target(indicatif::ProgressDrawTarget::stderr());
+        let main = multi.add(indicatif::ProgressBar::new(total));
+        let style = indicatif::ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {pos}/{len} runs {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+        main.set_style(style);
+        main.set_position(finished);
+        main.enable_steady_tick(Duration::from_millis(500));
+        Display {
+            multi,
+            main,
+            active: Mutex::new(Vec::new()),
+        }
+    }
+
+    fn start(&self, index: usize, name: &str) {
+        let pb = self.multi.add(indicatif::ProgressBar::new_spinner());
+        let style = indicatif::ProgressStyle::with_template("  {spinner} {prefix}: {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner());
+        pb.set_style(style);
+        pb.set_prefix(name.to_string());
+        pb.set_message("starting");
+        lock(&self.active).push((index, pb, Instant::now()));
+    }
+
+    fn finish(&self, index: usize, failed: usize) {
+        let mut active = lock(&self.active);
+        if let Some(k) = active.iter().position(|(i, _, _)| *i == index) {
+            let (_, pb, _) = active.remove(k);
+            pb.finish_and_clear();
+            self.multi.remove(&pb);
+        }
+        self.main.inc(1);
+        if failed > 0 {
+            self.main.set_message(format!("({failed} failed)"));
+        }
+    }
+
+    fn tick(&self, points: &[GridPoint], out: &Path) {
+        for (i, pb, started) in lock(&self.active).iter() {
+            let p = &points[*i];
+            let t_end = p.config.t_end;
+            let elapsed = started.elapsed().as_secs();
+            let when = format!("{}:{:02}:{:02}", elapsed / 3600, elapsed / 60 % 60, elapsed % 60);
+            match last_time(&out.join(&p.name).join("timeseries.csv")) {
+                Some(t) => pb.set_message(format!("t = {t:.0}/{t_end} s ({:.0} %), {when}", 100.0 * t / t_end)),
+                None => pb.set_message(format!("starting, {when}")),
+            }
+            pb.tick();
+        }
+    }
+
+    fn println(&self, line: &str) {
+        self.multi.suspend(|| println!("{line}"));
+    }
+}
+
+/// Runs `campaign` (see the module docs): creates its directory, decides what to do with each grid point,
+/// writes `campaign.csv`, runs what needs running with `parallel` runs at once, rewriting `campaign.csv`
+/// whenever a run starts or ends. Failed runs are recorded, not returned: the error is only for the
+/// campaign directory or `campaign.csv` that cannot be written.
+pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<CampaignReport, CampaignError> {
+    let started = Instant::now();
+    let out = &campaign.out;
+    std::fs::create_dir_all(out).map_err(|source| CampaignError::Io {
+        path: out.clone(),
+        source,
+    })?;
+    let points = &campaign.points;
+    let mut runs = Vec::with_capacity(points.len());
+    for p in points {
+        let (action, numbers) = decide(&out.join(&p.name), &p.plan);
+        let status = match &action {
+            Action::Skip => RunStatus::Completed,
+            Action::Conflict(why) => RunStatus::Failed(why.clone()),
+            Action::Resume | Action::Start => RunStatus::Pending,
+        };
+        runs.push(RunRecord {
+            name: p.name.clone(),
+            action,
+            status,
+            stopped: false,
+            numbers,
+        });
+    }
+    write_campaign_csv(out, points, &runs)?;
+    let todo: Vec<usize> = (0..runs.len())
+        .filter(|&i| matches!(runs[i].action, Action::Resume | Action::Start))
+        .collect();
+    let finished_before = (runs.len() - todo.len()) as u64;
+    let display = (options.run.progress && std::io::stderr().is_terminal() && !todo.is_empty())
+        .then(|| Display::new(runs.len() as u64, finished_before));
+    let say = |line: String| {
+        if options.verbose {
+            match &display {
+                Some(d) => d.println(&line),
+                None => println!("{line}"),
+            }
+        }
+    };
+    for r in &runs {
+        if let Action::Conflict(why) = &r.action {
+            say(format!("{}: failed: {why}", r.name));
+        }
+    }
+    let state = Mutex::new((runs, None::<CampaignError>));
+    let next = AtomicUsize::new(0);
+    let done_count = AtomicUsize::new(0);
+    let all_done = AtomicBool::new(false);
+    let parallel = options
+        .parallel
+        .unwrap_or(campaign.parallel)
+        .max(1)
+        .min(todo.len().max(1));
+
+    std::thread::scope(|s| {
+        let ticker = display.as_ref().map(|d| {
+            s.spawn(|| {
+                while !all_done.load(Ordering::Relaxed) {
+                    d.tick(points, out);
+                    std::thread::sleep(Duration::from_millis(250));
+                }
+            })
+        });
+        let workers: Vec<_> = (0..parallel)
+            .map(|_| {
+                s.spawn(|| {
+                    loop {
+                        let k = next.fetch_add(1, Ordering::SeqCst);
+                        let Some(&i) = todo.get(k) else { break };
+                        let point = &points[i];
+                        let action = {
+                            let mut st = lock(&state);
+                            st.0[i].status = RunStatus::Running;
+                            if let Err(e) = write_campaign_csv(out, points, &st.0) {
+                                st.1.get_or_insert(e);
+                            }
+                            st.0[i].action.clone()
+                        };
+                        if let Some(d) = &display {
+                            d.start(i, &point.name);
+                        }
+                        let (status, stopped, numbers) = execute(point, &out.join(&point.name), &action, &options.run);
+                        let n = done_count.fetch_add(1, Ordering::SeqCst) + 1;
+                        let line = match (&status, &numbers) {
+                            (RunStatus::Completed, Some(x)) => format!(
+                                "completed, wall {:.1} s, energy error {:.1e}",
+                                x.wall_seconds.unwrap_or(f64::NAN),
+                                x.energy_error.unwrap_or(f64::NAN)
+                            ),
+                            (RunStatus::Pending, _) if stopped => "stopped after a checkpoint (pending)".into(),
+                            (s, _) => s.to_string(),
+                        };
+                        let failed = {
+                            let mut st = lock(&state);
+                            let r = &mut st.0[i];
+                            r.status = status;
+                            r.stopped = stopped;
+                            if numbers.is_some() {
+                                r.numbers = numbers;
+                            }
+                            if let Err(e) = write_campaign_csv(out, points, &st.0) {
+                                st.1.get_or_insert(e);
+                            }
+                            st.0.iter().filter(|r| matches!(r.status, RunStatus::Failed(_))).count()
+                        };
+                        if let Some(d) = &display {
+                            d.finish(i, failed);
+                        }
+                        say(format!("[{n}/{}] {}: {line}", todo.len(), point.name));
+                    }
+                })
+            })
+            .collect();
+        for w in workers {
+            let _ = w.join();
+        }
+        all_done.store(true, Ordering::Relaxed);
+        if let Some(t) = ticker {
+            let _ = t.join();
+        }
+    });
+    if let Some(d) = &display {
+        d.main.finish_and_clear();
+        let _ = d.multi.clear();
+    }
+    let (runs, error) = state.into_inner().unwrap_or_else(|e| e.into_inner());
+    if let Some(e) = error {
+        return Err(e);
+    }
+    Ok(CampaignReport {
+        runs,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,99 @@
+//! The campaign file format (see [`super`]): its TOML schema and its parsing.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use super::*;
+
+// ---------------------------------------------------------------------------------------------
+// The file.
+// ---------------------------------------------------------------------------------------------
+
+/// A campaign file, as written (see the module docs).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignFile {
+    /// `[campaign]`: the grid and where it goes.
+    pub campaign: CampaignSection,
+    /// `[impact]`: overrides of the impact defaults shared by every run.
+    #[serde(default)]
+    pub impact: ImpactSection,
+    /// `[[projectile]]`: custom projectiles.
+    #[serde(default, rename = "projectile")]
+    pub projectiles: Vec<CustomProjectile>,
+}
+
+/// `[campaign]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignSection {
+    /// Campaign directory (relative to the campaign file's directory); required.
+    pub out: PathBuf,
+    /// Target bodies files (relative to the campaign file's directory), at least one; the file stems name
+    /// the runs, so they must differ.
+    pub targets: Vec<PathBuf>,
+    /// Projectiles: `P1`, `P2`, `P3` (Roig03 Table 2; any case) or ids of `[[projectile]]` tables.
+    pub projectiles: Vec<String>,
+    /// Impact angles ζ (degrees, in [0, 180]).
+    pub angles: Vec<f64>,
+    /// Seeds of the projectile's attitude (default `[1]`).
+    #[serde(default = "default_seeds")]
+    pub seeds: Vec<u64>,
+    /// Runs at once (≥ 1; default: the number of cores).
+    #[serde(default)]
+    pub parallel: Option<usize>,
+}
+
+fn default_seeds() -> Vec<u64> {
+    vec![1]
+}
+
+/// `[impact]`: every key optional; absent = the default of [`ImpactConfig::new`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ImpactSection {
+    /// End time (s; default 10 000).
+    pub t_end: Option<f64>,
+    /// Bulirsch–Stoer relative (= absolute) tolerance (default 1e-9).
+    pub rtol: Option<f64>,
+    /// Dissipation coefficient F0 (s m⁻²; default 1e-6).
+    pub f0: Option<f64>,
+    /// β of Roig03 Eq. 14 (default 10).
+    pub beta: Option<f64>,
+    /// Time at which the surfaces first touch (s; default 90).
+    pub contact_time: Option<f64>,
+    /// Time-series cadence (s; default 10).
+    pub every: Option<f64>,
+    /// Snapshot times (s; default 0, 100, 400, 1000, 10 000 cut to `t_end`, plus `t_end`).
+    pub snapshots: Option<Vec<f64>>,
+    /// Impact speed of P1–P3 and of custom projectiles without their own (km/s; default 5).
+    pub speed_km_s: Option<f64>,
+    /// Inertia model of the ellipsoids: `"gaussian"` (Roig03 Eq. 4, default) or `"uniform"`.
+    pub inertia: Option<crate::ellipsoid::body::InertiaModel>,
+}
+
+/// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CustomProjectile {
+    /// Its name in `campaign.projectiles` and in run names: letters, digits, `_`, `-`; not P1–P3.
+    pub id: String,
+    /// Equivalent radius (km, > 0).
+    pub radius_km: f64,
+    /// Impact speed (km/s, > 0; default `impact.speed_km_s`).
+    #[serde(default)]
+    pub speed_km_s: Option<f64>,
+}
+
+/// Parses the TOML with the scene files' parser ([`crate::io::scene_file::parse_toml_as`]): the same one-line
+/// messages naming the line and the field (`unknown field `x` in [campaign]`, `campaign.out: missing …`).
+pub(crate) fn parse_toml(text: &str, name: &str) -> Result<CampaignFile, CampaignError> {
+    crate::io::scene_file::parse_toml_as(text, name).map_err(|e| match e {
+        crate::io::scene_file::SceneError::Syntax { file, message } => CampaignError::Syntax { file, message },
+        other => CampaignError::Syntax {
+            file: name.to_string(),
+            message: other.to_string(),
+        },
+    })
+}

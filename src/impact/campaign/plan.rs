@@ -1,0 +1,309 @@
+//! A campaign file resolved into its grid of impact runs, every value validated (errors name the field).
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use crate::ellipsoid::body::Body;
+use crate::impact::projectile::ProjectileSpec;
+use crate::impact::run::{
+    DEFAULT_BETA, DEFAULT_CONTACT_TIME, DEFAULT_EVERY, DEFAULT_F0, DEFAULT_RTOL, DEFAULT_T_END, ImpactConfig,
+    ImpactError, ImpactPlan, default_snapshots, read_target,
+};
+
+use super::*;
+
+/// One grid point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridPoint {
+    /// Run name = directory name under the campaign directory, e.g. `N30_T4_P1_z45_s1`.
+    pub name: String,
+    /// The target file's stem.
+    pub target: String,
+    /// The projectile's id.
+    pub projectile: String,
+    /// ζ (degrees).
+    pub angle_deg: f64,
+    /// Seed.
+    pub seed: u64,
+    /// The impact.
+    pub config: ImpactConfig,
+    /// The impact set up in memory (what the run directory must hold).
+    pub plan: ImpactPlan,
+}
+
+/// A validated campaign.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Campaign {
+    /// How the campaign file is named in messages.
+    pub name: String,
+    /// The campaign directory (resolved).
+    pub out: PathBuf,
+    /// Runs at once.
+    pub parallel: usize,
+    /// The grid: targets (outermost), projectiles, angles, seeds (innermost).
+    pub points: Vec<GridPoint>,
+    /// The file as written.
+    pub file: CampaignFile,
+}
+
+/// Reads and validates a campaign file; relative paths in it are resolved against its directory.
+pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| CampaignError::Read {
+        file: name.clone(),
+        reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
+    })?;
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    parse_campaign(&text, &name, &base)
+}
+
+/// Parses and validates campaign text; `name` is used in messages, `base_dir` resolves relative paths.
+pub fn parse_campaign(text: &str, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
+    let file = parse_toml(text, name)?;
+    resolve(file, name, base_dir)
+}
+
+/// `base.join(rel)` with `.` and `dir/..` removed lexically (for readable paths in messages and files).
+fn join_clean(base: &Path, rel: &Path) -> PathBuf {
+    use std::path::Component;
+    let joined = base.join(rel);
+    let mut out: Vec<Component> = Vec::new();
+    for c in joined.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    if out.is_empty() {
+        PathBuf::from(".")
+    } else {
+        out.iter().collect()
+    }
+}
+
+fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
+    let invalid = |field: String, message: String| CampaignError::Invalid {
+        file: name.to_string(),
+        field,
+        message,
+    };
+    let c = &file.campaign;
+    let imp = &file.impact;
+    if c.out.as_os_str().is_empty() {
+        return Err(invalid("campaign.out".into(), "must name a directory, got \"\"".into()));
+    }
+    let parallel = match c.parallel {
+        Some(0) => return Err(invalid("campaign.parallel".into(), "must be at least 1, got 0".into())),
+        Some(n) => n,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+
+    // [impact]
+    let t_end = imp.t_end.unwrap_or(DEFAULT_T_END);
+    let speed_km_s = imp.speed_km_s.unwrap_or(5.0);
+    if !(speed_km_s.is_finite() && speed_km_s > 0.0) {
+        return Err(invalid(
+            "impact.speed_km_s".into(),
+            format!("must be > 0 km/s and finite, got {speed_km_s}"),
+        ));
+    }
+
+    // [[projectile]]
+    let mut custom: Vec<(String, ProjectileSpec)> = Vec::new();
+    for (k, p) in file.projectiles.iter().enumerate() {
+        let field = |f: &str| format!("projectile[{k}].{f}");
+        let id_ok = !p.id.is_empty()
+            && p.id
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-');
+        if !id_ok {
+            return Err(invalid(
+                field("id"),
+                format!(
+                    "need letters, digits, `_` or `-` (it names run directories), got {:?}",
+                    p.id
+                ),
+            ));
+        }
+        if ProjectileSpec::preset(&p.id).is_some() || custom.iter().any(|(id, _)| *id == p.id) {
+            return Err(invalid(
+                field("id"),
+                format!(
+                    "`{}` is already a projectile (P1-P3 or an earlier [[projectile]])",
+                    p.id
+                ),
+            ));
+        }
+        if !(p.radius_km.is_finite() && p.radius_km > 0.0) {
+            return Err(invalid(
+                field("radius_km"),
+                format!("must be > 0 km and finite, got {}", p.radius_km),
+            ));
+        }
+        let speed = p.speed_km_s.unwrap_or(speed_km_s);
+        if !(speed.is_finite() && speed > 0.0) {
+            return Err(invalid(
+                field("speed_km_s"),
+                format!("must be > 0 km/s and finite, got {speed}"),
+            ));
+        }
+        custom.push((
+            p.id.clone(),
+            ProjectileSpec::custom(p.id.clone(), p.radius_km * 1e3, speed * 1e3),
+        ));
+    }
+
+    // [campaign] lists
+    if c.targets.is_empty() {
+        return Err(invalid(
+            "campaign.targets".into(),
+            "must list at least one target bodies file, got []".into(),
+        ));
+    }
+    let mut targets: Vec<(String, PathBuf, Vec<Body>)> = Vec::new();
+    for (k, rel) in c.targets.iter().enumerate() {
+        let field = format!("campaign.targets[{k}]");
+        let path = join_clean(base_dir, rel);
+        let stem = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        if stem.is_empty() {
+            return Err(invalid(
+                field,
+                format!("not a file name: {:?}", rel.display().to_string()),
+            ));
+        }
+        if targets.iter().any(|(s, _, _)| *s == stem) {
+            return Err(invalid(
+                field,
+                format!("another target file is also named `{stem}` (its stem names the run directories)"),
+            ));
+        }
+        let bodies = read_target(&path).map_err(|e| invalid(field.clone(), one_line(&e.to_string())))?;
+        targets.push((stem, path, bodies));
+    }
+    if c.projectiles.is_empty() {
+        return Err(invalid(
+            "campaign.projectiles".into(),
+            "must list at least one projectile, got []".into(),
+        ));
+    }
+    let mut projectiles: Vec<ProjectileSpec> = Vec::new();
+    for (k, id) in c.projectiles.iter().enumerate() {
+        let field = format!("campaign.projectiles[{k}]");
+        let p = match (ProjectileSpec::preset(id), custom.iter().find(|(c, _)| c == id)) {
+            (Some(mut p), _) => {
+                p.speed = speed_km_s * 1e3;
+                p
+            }
+            (None, Some((_, p))) => p.clone(),
+            (None, None) => {
+                return Err(invalid(
+                    field,
+                    format!("expected P1, P2, P3 or the id of a [[projectile]] table, got {id:?}"),
+                ));
+            }
+        };
+        if projectiles.iter().any(|q| q.id == p.id) {
+            return Err(invalid(field, format!("`{}` is listed twice", p.id)));
+        }
+        projectiles.push(p);
+    }
+    if c.angles.is_empty() {
+        return Err(invalid(
+            "campaign.angles".into(),
+            "must list at least one angle (degrees), got []".into(),
+        ));
+    }
+    let mut angles: Vec<f64> = Vec::new();
+    for (k, &a) in c.angles.iter().enumerate() {
+        let field = format!("campaign.angles[{k}]");
+        if !(0.0..=180.0).contains(&a) {
+            return Err(invalid(field, format!("expected 0 to 180 degrees, got {a}")));
+        }
+        let a = a + 0.0; // -0 → 0
+        if angles.contains(&a) {
+            return Err(invalid(field, format!("{a} is listed twice")));
+        }
+        angles.push(a);
+    }
+    if c.seeds.is_empty() {
+        return Err(invalid(
+            "campaign.seeds".into(),
+            "must list at least one seed, got []".into(),
+        ));
+    }
+    let mut seen = HashSet::new();
+    for (k, s) in c.seeds.iter().enumerate() {
+        if !seen.insert(*s) {
+            return Err(invalid(format!("campaign.seeds[{k}]"), format!("{s} is listed twice")));
+        }
+    }
+
+    // The grid; each configuration validated (an error names the campaign's field).
+    let mut points = Vec::new();
+    for (stem, path, bodies) in &targets {
+        for (pk, projectile) in projectiles.iter().enumerate() {
+            let mut base = ImpactConfig::new(path.clone(), projectile.clone());
+            base.t_end = t_end;
+            base.rtol = imp.rtol.unwrap_or(DEFAULT_RTOL);
+            base.f0 = imp.f0.unwrap_or(DEFAULT_F0);
+            base.beta = imp.beta.unwrap_or(DEFAULT_BETA);
+            base.contact_time = imp.contact_time.unwrap_or(DEFAULT_CONTACT_TIME);
+            base.every = imp.every.unwrap_or(DEFAULT_EVERY);
+            base.inertia = imp.inertia.unwrap_or_default();
+            base.snapshots = imp.snapshots.clone().unwrap_or_else(|| default_snapshots(t_end));
+            let projectile_field = || match custom.iter().position(|(id, _)| *id == projectile.id) {
+                Some(j) => format!("projectile[{j}]"),
+                None => format!("campaign.projectiles[{pk}]"),
+            };
+            base.validate().map_err(|e| match e {
+                ImpactError::Invalid { field, message } if field.starts_with("projectile") => {
+                    invalid(projectile_field(), format!("{field}: {message}"))
+                }
+                ImpactError::Invalid { field, message } => invalid(format!("impact.{field}"), message),
+                other => invalid("impact".into(), other.to_string()),
+            })?;
+            base.kappa(bodies).map_err(|e| {
+                let message = match e {
+                    ImpactError::Invalid { message, .. } => message,
+                    other => other.to_string(),
+                };
+                invalid(projectile_field(), format!("on target `{stem}`: {message}"))
+            })?;
+            for &angle in &angles {
+                for &seed in &c.seeds {
+                    let config = ImpactConfig {
+                        angle_deg: angle,
+                        seed,
+                        ..base.clone()
+                    };
+                    let plan = config.plan(bodies);
+                    points.push(GridPoint {
+                        name: format!("{stem}_{}_z{angle}_s{seed}", projectile.id),
+                        target: stem.clone(),
+                        projectile: projectile.id.clone(),
+                        angle_deg: angle,
+                        seed,
+                        config,
+                        plan,
+                    });
+                }
+            }
+        }
+    }
+    Ok(Campaign {
+        name: name.to_string(),
+        out: join_clean(base_dir, &c.out),
+        parallel,
+        points,
+        file,
+    })
+}
