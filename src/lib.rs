@@ -15,16 +15,17 @@
 //!
 //! - **L0**: `math`, `bits` — fixed-size linear algebra, bit-exact floats;
 //! - **L1**: `random` — seeded random numbers (`rand_pcg`; seeds live in scene files);
-//! - **L2**: `geometry`, `gravity`, `integrate`, `io`, `engine` — shapes, walls and neighbour search; self-gravity;
-//!   the ODE solvers; the scene-file floor and lossless formatting; the contract between an engine and the driver;
-//! - **L3**: `ellipsoid`, `granular` — the engines (interacting ellipsoids; soft and hard spheres), each with its scene
+//! - **L2**: `geometry`, `gravity`, `integrate`, `io` — shapes, walls and neighbour search; self-gravity; the ODE
+//!   solvers; the scene-file floor and lossless formatting;
+//! - **L3**: `engine` — the contract between an engine and the driver ([`engine::Engine`]);
+//! - **L4**: `ellipsoid`, `granular` — the engines (interacting ellipsoids; soft and hard spheres), each with its scene
 //!   schema, equations, outputs and [`engine::Engine`] implementation;
-//! - **L4**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
-//! - **L5**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
-//! - **L6**: `analysis` — science on finished runs (the three papers' reports, fragment statistics, figures);
-//! - **L7**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
+//! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
+//! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
+//! - **L7**: `analysis` — science on finished runs (the three papers' reports, fragment statistics, figures);
+//! - **L8**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
 //!   problems shared by tests;
-//! - **L8**: `cli` — argument parsing and dispatch.
+//! - **L9**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;
