@@ -4,7 +4,7 @@
 //! largest overlap below 1 % of the radius at the advised k_N and dt.
 
 mod common;
-use rubblepile::geometry::wall::{SphereContainer, Wall};
+use rubblepile::geometry::walls::soft::{SphereContainer, Wall};
 use rubblepile::granular::soft::advise::{AdviceInput, advise};
 use rubblepile::granular::soft::contact::Material;
 use rubblepile::granular::soft::forces::{Gravity, SoftSystem};

@@ -1,7 +1,7 @@
 //! SSDEM contact law (Zhang17 Eqs. 1–12): restitution of head-on collisions, sliding → rolling at 5/7 v0, rolling
 //! resistance stopping a sphere within the torque cap.
 
-use rubblepile::geometry::wall::{Plane, Wall};
+use rubblepile::geometry::walls::soft::{Plane, Wall};
 use rubblepile::granular::soft::contact::Material;
 use rubblepile::granular::soft::forces::{Gravity, SoftSystem};
 use rubblepile::granular::soft::leapfrog;

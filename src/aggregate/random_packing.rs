@@ -30,7 +30,7 @@
 //! (accuracy matters little here: it only has to pull the heap together), evaluated every `gravity_interval` steps
 //! (default 1). Every step count is deterministic.
 
-use crate::geometry::wall::{Oscillation, SphereContainer, Wall};
+use crate::geometry::walls::soft::{Oscillation, SphereContainer, Wall};
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::{Gravity, SoftSystem};
 use crate::granular::soft::leapfrog::step;

@@ -1,5 +1,6 @@
-//! Geometry shared by the engines: neighbour search, ellipsoid overlap, soft-contact walls (`wall`), the
-//! hard-sphere wall primitives with their times of impact (`walls`), lattices, Voronoi cells, shape models.
+//! Geometry shared by the engines: neighbour search, ellipsoid overlap, walls (`walls`: the hard-sphere wall
+//! primitives with their times of impact, and the soft-contact walls in `walls::soft`), lattices, Voronoi cells,
+//! shape metrics, shape models.
 
 pub mod ellipsoid_overlap;
 pub mod lattice;
@@ -7,5 +8,4 @@ pub mod neighbours;
 pub mod polyhedron;
 pub mod shape_metrics;
 pub mod voronoi;
-pub mod wall;
 pub mod walls;

@@ -1,3 +1,10 @@
+//! Walls: the hard-sphere wall primitives and their times of impact, and ([`soft`]) the soft-sphere walls.
+//!
+//! The two engines meet walls differently, so the module holds two families: a hard sphere needs the *time* at which
+//! it first touches a wall (the primitives below, each with `nearest` and `toi`), a soft sphere needs the *overlap*
+//! and normal of a penalty contact at the current time ([`soft::Wall`]). Both give the wall infinite mass and a
+//! prescribed motion.
+//!
 //! Hard-sphere wall primitives and their times of impact (Richardson11 §2.2; the derivations are
 //! below, under "Derivations").
 //!
@@ -48,6 +55,7 @@ pub mod plane;
 pub mod point;
 pub mod ring;
 pub mod roots;
+pub mod soft;
 
 use crate::math::Vec3;
 pub use motion::{Oscillation, WallMotion};

@@ -11,7 +11,7 @@
 //! same, so the forces depend neither on the number of threads nor on when the Verlet list was rebuilt.
 
 use crate::geometry::neighbours::sphere_pairs;
-use crate::geometry::wall::Wall;
+use crate::geometry::walls::soft::Wall;
 use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_inner, evaluate_law};
 use crate::granular::soft::particle::Particle;
 use crate::gravity::{SelfGravity, accelerations};

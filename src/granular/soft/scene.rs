@@ -59,7 +59,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::neighbours::sphere_pairs;
-use crate::geometry::wall::{Oscillation, Plane, SphereContainer, Wall};
+use crate::geometry::walls::soft::{Oscillation, Plane, SphereContainer, Wall};
 use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, advise};
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;

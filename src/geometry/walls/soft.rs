@@ -84,7 +84,7 @@ impl Plane {
     /// Contact of a sphere (`centre`, `radius`) with the plane at time `t`, if they overlap.
     ///
     /// ```
-    /// use rubblepile::geometry::wall::Plane;
+    /// use rubblepile::geometry::walls::soft::Plane;
     /// use rubblepile::math::Vec3;
     /// let floor = Plane { point: Vec3::zeros(), normal: Vec3::z(), oscillation: None };
     /// let touch = floor.touch(&Vec3::new(0.0, 0.0, 0.99), 1.0, 0.0).unwrap();
