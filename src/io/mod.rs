@@ -6,6 +6,7 @@
 //! snapshot re-read as an input file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
+pub mod particles;
 pub mod scene_file;
 pub mod table;
 

@@ -630,70 +630,24 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     Ok(wall)
 }
 
-/// Why a particles CSV could not be read (one line, without the file name, which the caller adds).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ParticlesFileError {
-    /// The file cannot be opened, or its header or a row is not CSV.
-    #[error("{0}")]
-    Read(String),
-    /// A required column is missing.
-    #[error("missing column `{column}` (need {})", PARTICLE_COLUMNS.join(","))]
-    MissingColumn {
-        /// The column.
-        column: &'static str,
-    },
-    /// A cell is not what its column holds.
-    #[error("line {line}: column `{column}`: expected {expected}, got {value:?}")]
-    Cell {
-        /// 1-based line.
-        line: usize,
-        /// The column.
-        column: &'static str,
-        /// What the column holds.
-        expected: &'static str,
-        /// The cell.
-        value: String,
-    },
-}
+pub use crate::io::particles::ParticlesFileError;
 
 /// Reads a particles CSV (header with at least the [`PARTICLE_COLUMNS`], optionally [`STUCK_COLUMN`]); rows in that
 /// column order.
 pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, ParticlesFileError> {
-    use ParticlesFileError as E;
-    let mut rdr = ::csv::ReaderBuilder::new()
-        .trim(::csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| E::Read(format!("cannot read: {e}")))?;
-    let headers = rdr.headers().map_err(|e| E::Read(format!("bad header: {e}")))?.clone();
-    let mut idx = [0usize; 13];
-    for (k, col) in PARTICLE_COLUMNS.iter().enumerate() {
-        idx[k] = headers
-            .iter()
-            .position(|h| h == *col)
-            .ok_or(E::MissingColumn { column: col })?;
-    }
-    let stuck_idx = headers.iter().position(|h| h == STUCK_COLUMN);
-    let mut rows = Vec::new();
-    for (line, rec) in rdr.records().enumerate() {
-        let rec = rec.map_err(|e| E::Read(format!("line {}: {e}", line + 2)))?;
-        let mut row = [0.0; 13];
-        for k in 0..13 {
-            let s = rec.get(idx[k]).unwrap_or("");
-            row[k] = s.parse().map_err(|_| E::Cell {
-                line: line + 2,
-                column: PARTICLE_COLUMNS[k],
-                expected: "a number",
-                value: s.to_string(),
-            })?;
-        }
-        let stuck_to = match stuck_idx.map(|i| rec.get(i).unwrap_or("")) {
+    let records = crate::io::particles::read_particles(path, &PARTICLE_COLUMNS, &[STUCK_COLUMN])?;
+    let mut rows = Vec::with_capacity(records.len());
+    for r in records {
+        let mut values = [0.0; 13];
+        values.copy_from_slice(&r.values);
+        let stuck_to = match r.optional[0].as_deref() {
             None | Some("") => None,
             Some(s) => match s.parse::<i64>() {
                 Ok(w) if w < 0 => None,
                 Ok(w) => Some(w as usize),
                 Err(_) => {
-                    return Err(E::Cell {
-                        line: line + 2,
+                    return Err(ParticlesFileError::Cell {
+                        line: r.line,
                         column: STUCK_COLUMN,
                         expected: "a wall index or -1",
                         value: s.to_string(),
@@ -701,7 +655,7 @@ pub fn read_particles_csv(path: &Path) -> Result<Vec<ParticleRow>, ParticlesFile
                 }
             },
         };
-        rows.push(ParticleRow { values: row, stuck_to });
+        rows.push(ParticleRow { values, stuck_to });
     }
     Ok(rows)
 }

@@ -363,37 +363,29 @@ impl V<'_> {
     fn read_particles_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<Particle>, SceneError> {
         let path = base_dir.map(|b| b.join(rel)).unwrap_or_else(|| PathBuf::from(rel));
         let field = "scene.particles_file";
-        let mut reader = csv::Reader::from_path(&path)
-            .map_err(|e| self.invalid(field, format!("cannot read {}: {e}", path.display())))?;
-        let headers = reader
-            .headers()
-            .map_err(|e| self.invalid(field, format!("{}: {e}", path.display())))?
-            .clone();
         let names = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
-        let mut cols = Vec::new();
-        for name in names {
-            let k = headers.iter().position(|h| h.trim() == name).ok_or_else(|| {
-                self.invalid(
-                    field,
-                    format!(
-                        "{}: missing column `{name}` (need t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz)",
-                        path.display()
-                    ),
-                )
-            })?;
-            cols.push(k);
-        }
-        let mut out = Vec::new();
-        for (row, rec) in reader.records().enumerate() {
-            let label = format!("particle[{row}] ({rel} line {})", row + 2);
-            let rec = rec.map_err(|e| self.invalid(&label, e.to_string()))?;
-            let mut v = [0.0; 11];
-            for (slot, (&c, name)) in v.iter_mut().zip(cols.iter().zip(names)) {
-                let cell = rec.get(c).unwrap_or("").trim();
-                *slot = cell
-                    .parse()
-                    .map_err(|_| self.invalid(format!("{label}.{name}"), format!("expected a number, got {cell:?}")))?;
+        let records = crate::io::particles::read_particles(&path, &names, &[]).map_err(|e| match e {
+            crate::io::particles::ParticlesFileError::Cell {
+                line, column, value, ..
+            } => self.invalid(
+                format!("particle[{}] ({rel} line {line}).{column}", line - 2),
+                format!("expected a number, got {value:?}"),
+            ),
+            crate::io::particles::ParticlesFileError::MissingColumn { column, .. } => self.invalid(
+                field,
+                format!(
+                    "{}: missing column `{column}` (need t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz)",
+                    path.display()
+                ),
+            ),
+            crate::io::particles::ParticlesFileError::Read(m) => {
+                self.invalid(field, format!("{}: {m}", path.display()))
             }
+        })?;
+        let mut out = Vec::new();
+        for (row, r) in records.iter().enumerate() {
+            let label = format!("particle[{row}] ({rel} line {})", r.line);
+            let v = &r.values;
             let spec = ParticleSpec {
                 radius: v[1],
                 mass: Some(v[0]),

@@ -1,0 +1,122 @@
+//! The one reader of particle CSV files (a header of column names, then one particle a row) over the `csv` crate,
+//! shared by the sphere engines' `particles_file` and the analyses of their snapshots: the caller names the columns
+//! it needs (in the order it wants the numbers) and those it may use; other columns are ignored. Errors name the
+//! line and the column.
+
+use std::path::Path;
+
+/// Why a particles file could not be read (one line, without the file name, which the caller adds).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ParticlesFileError {
+    /// The file cannot be opened, or its header or a row is not CSV.
+    #[error("{0}")]
+    Read(String),
+    /// A required column is missing.
+    #[error("missing column `{column}` (need {})", .required.join(","))]
+    MissingColumn {
+        /// The column.
+        column: &'static str,
+        /// Every required column.
+        required: Vec<&'static str>,
+    },
+    /// A cell is not what its column holds.
+    #[error("line {line}: column `{column}`: expected {expected}, got {value:?}")]
+    Cell {
+        /// 1-based line.
+        line: usize,
+        /// The column.
+        column: &'static str,
+        /// What the column holds.
+        expected: &'static str,
+        /// The cell.
+        value: String,
+    },
+}
+
+/// One row: the required columns' numbers in the order asked for, and the optional columns' cells (trimmed; `None`
+/// where the file has no such column).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParticleRecord {
+    /// 1-based line in the file.
+    pub line: usize,
+    /// The required columns, in the order asked for.
+    pub values: Vec<f64>,
+    /// The optional columns, in the order asked for.
+    pub optional: Vec<Option<String>>,
+}
+
+/// Reads the particles file at `path`: every `required` column must be present and hold numbers; `optional` columns
+/// are returned as text for the caller to interpret.
+pub fn read_particles(
+    path: &Path,
+    required: &[&'static str],
+    optional: &[&'static str],
+) -> Result<Vec<ParticleRecord>, ParticlesFileError> {
+    use ParticlesFileError as E;
+    let mut reader = csv::ReaderBuilder::new()
+        .trim(csv::Trim::All)
+        .from_path(path)
+        .map_err(|e| E::Read(format!("cannot read: {e}")))?;
+    let headers = reader
+        .headers()
+        .map_err(|e| E::Read(format!("bad header: {e}")))?
+        .clone();
+    let mut idx = Vec::with_capacity(required.len());
+    for &column in required {
+        idx.push(
+            headers
+                .iter()
+                .position(|h| h == column)
+                .ok_or_else(|| E::MissingColumn {
+                    column,
+                    required: required.to_vec(),
+                })?,
+        );
+    }
+    let opt_idx: Vec<Option<usize>> = optional.iter().map(|c| headers.iter().position(|h| h == *c)).collect();
+    let mut rows = Vec::new();
+    for (k, record) in reader.records().enumerate() {
+        let line = k + 2;
+        let record = record.map_err(|e| E::Read(format!("line {line}: {e}")))?;
+        let mut values = Vec::with_capacity(required.len());
+        for (&i, &column) in idx.iter().zip(required) {
+            let cell = record.get(i).unwrap_or("");
+            values.push(cell.parse().map_err(|_| E::Cell {
+                line,
+                column,
+                expected: "a number",
+                value: cell.to_string(),
+            })?);
+        }
+        let optional = opt_idx
+            .iter()
+            .map(|i| i.and_then(|i| record.get(i)).map(str::to_string))
+            .collect();
+        rows.push(ParticleRecord { line, values, optional });
+    }
+    Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn columns_are_found_by_name_and_errors_name_line_and_column() {
+        let dir = std::env::temp_dir().join(format!("rubblepile-particles-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("p.csv");
+        std::fs::write(&p, "radius,extra,mass,tag\n0.5,x,2.0,7\n 1e-1 ,y,3,\n").unwrap();
+        let rows = read_particles(&p, &["mass", "radius"], &["tag", "none"]).unwrap();
+        assert_eq!(rows[0].values, vec![2.0, 0.5]);
+        assert_eq!(rows[1].values, vec![3.0, 0.1]);
+        assert_eq!(rows[0].optional, vec![Some("7".to_string()), None]);
+        assert_eq!(rows[1].optional, vec![Some(String::new()), None]);
+        assert_eq!(rows[1].line, 3);
+        let e = read_particles(&p, &["mass", "spin"], &[]).unwrap_err().to_string();
+        assert_eq!(e, "missing column `spin` (need mass,spin)");
+        std::fs::write(&p, "mass\n1\nheavy\n").unwrap();
+        let e = read_particles(&p, &["mass"], &[]).unwrap_err().to_string();
+        assert_eq!(e, "line 3: column `mass`: expected a number, got \"heavy\"");
+    }
+}
