@@ -180,11 +180,11 @@ fn golden_impact_n30() {
     );
 }
 
-#[test]
-fn golden_soft_spheres() {
-    let dir = case_dir("soft_ball");
+/// A case whose scene (and inputs) sit in `tests/golden/<name>/`, run with `rubblepile run scene.toml`.
+fn check_scene_case(name: &str) {
+    let dir = case_dir(name);
     check_case(
-        "soft_ball",
+        name,
         &dir,
         &[
             "run",
@@ -196,40 +196,19 @@ fn golden_soft_spheres() {
             "0",
         ],
     );
+}
+
+#[test]
+fn golden_soft_spheres() {
+    check_scene_case("soft_ball");
 }
 
 #[test]
 fn golden_spinup() {
-    let dir = case_dir("spinup_ball");
-    check_case(
-        "spinup_ball",
-        &dir,
-        &[
-            "run",
-            "scene.toml",
-            "--out",
-            "OUT",
-            "--no-progress",
-            "--checkpoint-every",
-            "0",
-        ],
-    );
+    check_scene_case("spinup_ball");
 }
 
 #[test]
 fn golden_hard_spheres() {
-    let dir = case_dir("hard_box");
-    check_case(
-        "hard_box",
-        &dir,
-        &[
-            "run",
-            "scene.toml",
-            "--out",
-            "OUT",
-            "--no-progress",
-            "--checkpoint-every",
-            "0",
-        ],
-    );
+    check_scene_case("hard_box");
 }
