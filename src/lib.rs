@@ -23,9 +23,10 @@
 //! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
 //! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
 //! - **L7**: `analysis` — science on finished runs (the three papers' reports, fragment statistics, figures);
-//! - **L8**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
+//! - **L8**: `render` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF;
+//! - **L9**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
 //!   problems shared by tests;
-//! - **L9**: `cli` — argument parsing and dispatch.
+//! - **L10**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;
@@ -43,3 +44,4 @@ pub mod integrate;
 pub mod io;
 pub mod math;
 pub mod random;
+pub mod render;
