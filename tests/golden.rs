@@ -1,4 +1,5 @@
-//! Golden outputs of the run driver: one run per engine (ellipsoids on the built-in default scene, soft spheres,
+//! Golden outputs of the run driver: one run per engine (ellipsoids on the four-fragment scene that was the built-in
+//! default until the default became an impact, soft spheres,
 //! hard spheres), an impact and a spin-up run, compared file by file with the outputs recorded before the three
 //! drivers were merged into one (`tests/golden/<case>/expected/`). Every byte must match except what measures the
 //! machine rather than the physics: the `wall_seconds` column and field, and the hard-sphere engine's
@@ -150,11 +151,19 @@ fn case_dir(name: &str) -> PathBuf {
 }
 
 #[test]
-fn golden_ellipsoids_default_scene() {
+fn golden_ellipsoids_four_fragments() {
     check_case(
-        "ellipsoids_default",
+        "ellipsoids_four_fragments",
         &root(),
-        &["run", "--out", "OUT", "--no-progress", "--checkpoint-every", "0"],
+        &[
+            "run",
+            "targets/examples/four_fragments.toml",
+            "--out",
+            "OUT",
+            "--no-progress",
+            "--checkpoint-every",
+            "0",
+        ],
     );
 }
 

@@ -599,3 +599,59 @@ pub fn spin_distributions(
         })
         .collect()
 }
+
+/// Per-body results of an analysed run (`analysis/fragments.csv`), as scalars for visualisation files and
+/// pictures: `bound` (1 when the body stays bound, 0 when it escapes) and `ejection_speed` (m/s), both as found at
+/// the analysed time.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct FragmentFields {
+    /// `(bound, ejection_speed)` by body index.
+    by_index: std::collections::BTreeMap<usize, (f64, f64)>,
+}
+
+impl FragmentFields {
+    /// The fields of the run in `dir`; `None` when it has not been analysed (no `analysis/fragments.csv`).
+    pub fn read(dir: &Path) -> Result<Option<FragmentFields>, AnalysisError> {
+        let path = dir.join("analysis").join("fragments.csv");
+        if !path.exists() {
+            return Ok(None);
+        }
+        let err = |reason: String| AnalysisError::Read {
+            path: path.clone(),
+            reason,
+        };
+        let mut rdr = csv::Reader::from_path(&path).map_err(|e| err(e.to_string()))?;
+        let headers = rdr.headers().map_err(|e| err(e.to_string()))?.clone();
+        let col = |name: &str| {
+            headers
+                .iter()
+                .position(|h| h == name)
+                .ok_or_else(|| err(format!("missing column `{name}`")))
+        };
+        let (i_index, i_escaping, i_speed) = (col("index")?, col("escaping")?, col("ejection_speed")?);
+        let mut by_index = std::collections::BTreeMap::new();
+        for (row, rec) in rdr.records().enumerate() {
+            let rec = rec.map_err(|e| err(e.to_string()))?;
+            let bad = |column: &str| err(format!("row {}: bad `{column}` value", row + 1));
+            let index: usize = rec[i_index].parse().map_err(|_| bad("index"))?;
+            let escaping: bool = rec[i_escaping].parse().map_err(|_| bad("escaping"))?;
+            let speed: f64 = rec[i_speed].parse().map_err(|_| bad("ejection_speed"))?;
+            by_index.insert(index, (if escaping { 0.0 } else { 1.0 }, speed));
+        }
+        Ok(Some(FragmentFields { by_index }))
+    }
+
+    /// The `bound` and `ejection_speed` columns for the bodies `ids` (NaN for a body the analysis does not list).
+    pub fn columns(&self, ids: impl Iterator<Item = usize> + Clone) -> Vec<(String, Vec<f64>)> {
+        let get = |k: usize| {
+            ids.clone()
+                .map(|id| {
+                    self.by_index
+                        .get(&id)
+                        .map_or(f64::NAN, |v| if k == 0 { v.0 } else { v.1 })
+                })
+                .collect()
+        };
+        vec![("bound".to_string(), get(0)), ("ejection_speed".to_string(), get(1))]
+    }
+}

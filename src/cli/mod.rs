@@ -47,6 +47,7 @@ pub mod spinup;
 pub mod ssdem;
 pub mod stability;
 pub mod target;
+pub mod visual;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -108,6 +109,8 @@ pub enum Command {
     /// Old spelling of `report zhang2017`.
     #[command(hide = true)]
     ReportZhang2017(ReportZhang2017Args),
+    /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
+    Export(visual::ExportArgs),
 }
 
 /// `rubblepile report …`: one verb for the papers' reproduction reports.
@@ -331,6 +334,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
+        Command::Export(args) => visual::export_cmd(&args),
     }
 }
 

@@ -26,6 +26,7 @@
 //! `timeseries.csv` is cut back to its length at the checkpoint, and the engine reopens its own files likewise.
 
 pub mod branch;
+pub mod export;
 pub mod formats;
 pub mod kind;
 
@@ -620,7 +621,7 @@ fn drive<E: Engine>(
 
     let samples = engine.samples();
     let total = samples.len() as u64;
-    let extra_formats = options.formats.selected();
+    let extra_formats = options.formats.with(&engine.scene_formats()).selected();
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
@@ -645,9 +646,14 @@ fn drive<E: Engine>(
             let p = out_dir.join("snapshots").join(format!("{k}.csv"));
             engine.write_snapshot(&p).map_err(io_err(&p))?;
             if !extra_formats.is_empty() {
-                let particles = engine.particles();
+                let view = engine.view();
+                // Every snapshot up to this one (a resumed run's earlier ones included), for formats' run indexes.
+                let written: Vec<(usize, f64)> = samples[..=index]
+                    .iter()
+                    .filter_map(|s| s.snapshot.map(|k| (k, s.t)))
+                    .collect();
                 for f in &extra_formats {
-                    f.write(out_dir, k, sample.t, &particles).map_err(io_err(&p))?;
+                    f.write(out_dir, k, &view, &written).map_err(io_err(out_dir))?;
                 }
             }
         }

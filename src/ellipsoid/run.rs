@@ -17,12 +17,13 @@ use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
 use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
-use crate::ellipsoid::output::{TracksWriter, snapshot_records, write_snapshot};
+use crate::ellipsoid::output::{TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
 use crate::engine::{
     Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule,
+    SnapshotView,
 };
 use crate::integrate::{Integrator, IntegratorState, OdeSystem, Tolerances, make_integrator};
 use crate::io::fmt_f64;
@@ -193,6 +194,22 @@ fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
         ));
     }
     None
+}
+
+/// A body as the output formats see it.
+fn particle_view(id: usize, b: &crate::ellipsoid::body::Body) -> ParticleView {
+    // R(q) maps world to body; its transpose takes body vectors to the world. The state's quaternion is unit only
+    // to the integrator's constraint error (~1e-10 after a hard impact): normalised, R is a rotation to round-off.
+    let to_world = rotation_matrix(&b.quaternion.normalize()).transpose();
+    ParticleView {
+        id,
+        mass: b.shape.mass,
+        position: b.position,
+        velocity: b.velocity,
+        spin_world: to_world * b.spin_body,
+        axes: b.shape.axes,
+        rotation: to_world,
+    }
 }
 
 /// Fingerprint of a scene's initial bodies: FNV-1a of their lossless snapshot rows.
@@ -460,24 +477,42 @@ impl Engine for EllipsoidEngine {
     }
 
     fn particles(&self) -> Vec<ParticleView> {
-        self.system
-            .bodies_at(self.t, &self.y)
-            .iter()
-            .enumerate()
-            .map(|(id, b)| {
-                // R(q) maps world to body; its transpose takes body vectors to the world.
-                let to_world = rotation_matrix(&b.quaternion).transpose();
-                ParticleView {
-                    id,
-                    mass: b.shape.mass,
-                    position: b.position,
-                    velocity: b.velocity,
-                    spin_world: to_world * b.spin_body,
-                    axes: b.shape.axes,
-                    rotation: to_world,
-                }
-            })
-            .collect()
+        let bodies = self.system.bodies_at(self.t, &self.y);
+        bodies.iter().enumerate().map(|(id, b)| particle_view(id, b)).collect()
+    }
+
+    const SPHERES: bool = false;
+
+    fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError> {
+        let file_error = |reason: String| EngineError::File {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let records = read_bodies_csv(path).map_err(|e| file_error(e.to_string()))?;
+        let times = crate::io::particles::read_particles(path, &["t"], &[]).map_err(|e| file_error(e.to_string()))?;
+        Ok(SnapshotView {
+            t: times.first().map_or(0.0, |r| r.values[0]),
+            spheres: false,
+            // As written: the state's quaternion, not renormalised, so the view is the one the run showed.
+            particles: records
+                .iter()
+                .enumerate()
+                .map(|(id, r)| {
+                    let mut b = r.to_body();
+                    b.quaternion = crate::math::Vec4::from(r.quaternion);
+                    particle_view(id, &b)
+                })
+                .collect(),
+            ..Default::default()
+        })
+    }
+
+    fn scene_formats(&self) -> Vec<&'static str> {
+        if self.scene.file.output.vtk {
+            vec!["vtk"]
+        } else {
+            Vec::new()
+        }
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

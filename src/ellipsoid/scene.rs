@@ -248,6 +248,10 @@ pub struct OutputSection {
     /// Default `[]`: no `tracks.csv`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub track: Option<Vec<usize>>,
+    /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
+    /// `--format vtk` does. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vtk: bool,
 }
 
 /// `[[body]]`: one ellipsoid and its initial state.

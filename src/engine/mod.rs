@@ -61,6 +61,66 @@ impl ParticleView {
     }
 }
 
+/// A contact between two particles at a snapshot (a force chain's link).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactLine {
+    /// First particle (index into the snapshot's particles).
+    pub i: usize,
+    /// Second particle.
+    pub j: usize,
+    /// Magnitude of the normal force between them (N).
+    pub normal_force: f64,
+}
+
+/// A wall (or other fixed-shape surface) at a snapshot, where its motion has carried it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct NamedSurface {
+    /// Name (`wall0`, `wall1`, …), also the name of its file.
+    pub name: String,
+    /// The surface (m).
+    pub mesh: crate::geometry::mesh::SurfaceMesh,
+}
+
+/// Everything a snapshot shows, the same for every engine: the particles, and the contact network and surfaces of
+/// the engines that have them. Output formats ([`crate::driver::formats`]) and pictures read only this.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SnapshotView {
+    /// Simulated time (s).
+    pub t: f64,
+    /// Whether the particles are spheres (their axes are one radius) rather than triaxial ellipsoids.
+    pub spheres: bool,
+    /// The particles.
+    pub particles: Vec<ParticleView>,
+    /// Particle–particle contacts (soft spheres; `None` for engines without a contact network).
+    pub contacts: Option<Vec<ContactLine>>,
+    /// Walls (hard spheres; empty for the other engines).
+    pub surfaces: Vec<NamedSurface>,
+    /// Extra per-particle scalars found by an analysis (name, one value per particle), e.g. `bound`.
+    pub extra: Vec<(String, Vec<f64>)>,
+}
+
+/// Reads a sphere engine's snapshot (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, other columns ignored): its time
+/// (s; 0 for a file without particles) and particles.
+pub fn read_sphere_snapshot(path: &Path) -> Result<(f64, Vec<ParticleView>), EngineError> {
+    const COLUMNS: [&str; 13] = [
+        "t", "id", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz",
+    ];
+    let records = crate::io::particles::read_particles(path, &COLUMNS, &[]).map_err(|e| EngineError::File {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })?;
+    let t = records.first().map_or(0.0, |r| r.values[0]);
+    let particles = records
+        .iter()
+        .map(|r| {
+            let v = &r.values;
+            let vec3 = |k: usize| crate::math::Vec3::new(v[k], v[k + 1], v[k + 2]);
+            ParticleView::sphere(v[1] as usize, v[2], v[3], vec3(4), vec3(7), vec3(10))
+        })
+        .collect();
+    Ok((t, particles))
+}
+
 /// Why an engine could not be set up from a scene, or could not continue from a checkpoint's state.
 #[derive(Debug, thiserror::Error)]
 pub enum EngineError {
@@ -199,6 +259,40 @@ pub trait Engine: Sized {
 
     /// The particles of the current state, for the driver's extra snapshot formats.
     fn particles(&self) -> Vec<ParticleView>;
+
+    /// Whether the engine's particles are spheres (for output formats: a radius rather than axes and attitude).
+    const SPHERES: bool;
+
+    /// Particle–particle contacts now (engines with a contact network, the soft spheres; `None` for the others).
+    fn contacts(&self) -> Option<Vec<ContactLine>> {
+        None
+    }
+
+    /// Walls now (engines with walls: the hard spheres).
+    fn surfaces(&self) -> Vec<NamedSurface> {
+        Vec::new()
+    }
+
+    /// What the state shows now ([`SnapshotView`]).
+    fn view(&self) -> SnapshotView {
+        SnapshotView {
+            t: self.time(),
+            spheres: Self::SPHERES,
+            particles: self.particles(),
+            contacts: self.contacts(),
+            surfaces: self.surfaces(),
+            extra: Vec::new(),
+        }
+    }
+
+    /// What the snapshot file `path` (written by [`Engine::write_snapshot`] of a run of this scene) shows, its
+    /// contacts and walls recomputed for the snapshot's state and time. Does not change the engine.
+    fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError>;
+
+    /// The extra snapshot formats the scene itself asks for (e.g. `"vtk"` for `[output] vtk = true`).
+    fn scene_formats(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
 
     /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64>;

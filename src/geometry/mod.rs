@@ -4,6 +4,7 @@
 
 pub mod ellipsoid_overlap;
 pub mod lattice;
+pub mod mesh;
 pub mod neighbours;
 pub mod polyhedron;
 pub mod shape_metrics;

@@ -9,6 +9,7 @@ pub mod checkpoint;
 pub mod particles;
 pub mod scene_file;
 pub mod table;
+pub mod vtk;
 
 /// Formats an `f64` losslessly: the shortest decimal that parses back to the same bits (`{:e}`).
 pub fn fmt_f64(x: f64) -> String {

@@ -1,26 +1,44 @@
 //! Extra snapshot formats beside each engine's own CSV snapshots, written at every snapshot time of any engine.
 //!
 //! A format is one file implementing [`SnapshotFormat`] plus one line in [`registered`]; the command line
-//! offers it as `--format NAME` and the driver calls it for every snapshot through [`crate::engine::Engine::particles`],
-//! so the formats know no engine.
+//! offers it as `--format NAME` (and a scene may ask for it, e.g. `[output] vtk = true`); the driver calls it for
+//! every snapshot with the engine's [`SnapshotView`], so the formats know no engine. `rubblepile export` calls the
+//! same code on a finished run's snapshots ([`crate::driver::export`]).
 
+pub mod vtk;
 pub mod xyz;
 
 use std::path::Path;
 
-use crate::engine::ParticleView;
+use crate::engine::SnapshotView;
 
 /// An output format for snapshots.
 pub trait SnapshotFormat: Send + Sync {
     /// The name users select it by (`--format NAME`).
     fn name(&self) -> &'static str;
-    /// Writes the particles of the k-th snapshot (time `t`, s) into the run directory `dir`.
-    fn write(&self, dir: &Path, k: usize, t: f64, particles: &[ParticleView]) -> std::io::Result<()>;
+    /// Writes the k-th snapshot into the run directory `dir`. `written` lists every snapshot of the run so far as
+    /// `(k, t)` (this one last), for formats that keep an index of the whole run.
+    fn write(&self, dir: &Path, k: usize, view: &SnapshotView, written: &[(usize, f64)]) -> std::io::Result<()>;
+    /// The files this format has written into the run directory `dir` (none: the format was not written there).
+    fn files(&self, dir: &Path) -> Vec<std::path::PathBuf>;
 }
 
 /// Every format, in the order of [`Formats`]' bits. Adding a format: one new file and one line here.
 pub fn registered() -> Vec<Box<dyn SnapshotFormat>> {
-    vec![Box::new(xyz::ExtendedXyz)]
+    vec![Box::new(xyz::ExtendedXyz), Box::new(vtk::Vtk)]
+}
+
+/// The files in `dir` whose names end in `.ext` (none if `dir` cannot be read).
+pub fn files_with_extension(dir: &Path, ext: &str) -> Vec<std::path::PathBuf> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    let mut out: Vec<_> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    out.sort();
+    out
 }
 
 /// A format name that is not [`registered`].
@@ -56,6 +74,17 @@ impl Formats {
             bits |= 1 << i;
         }
         Ok(Formats(bits))
+    }
+
+    /// These formats and those named in `names` (names known to be registered, e.g. from
+    /// [`crate::engine::Engine::scene_formats`]).
+    pub fn with(self, names: &[&str]) -> Formats {
+        let all = registered();
+        let bits = names
+            .iter()
+            .filter_map(|n| all.iter().position(|f| f.name() == *n))
+            .fold(self.0, |b, i| b | (1 << i));
+        Formats(bits)
     }
 
     /// The selected formats.

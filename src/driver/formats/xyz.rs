@@ -7,7 +7,7 @@ use std::io::Write;
 use std::path::Path;
 
 use super::SnapshotFormat;
-use crate::engine::ParticleView;
+use crate::engine::SnapshotView;
 use crate::io::fmt_f64;
 
 /// The extended XYZ format.
@@ -18,7 +18,8 @@ impl SnapshotFormat for ExtendedXyz {
         "xyz"
     }
 
-    fn write(&self, dir: &Path, k: usize, t: f64, particles: &[ParticleView]) -> std::io::Result<()> {
+    fn write(&self, dir: &Path, k: usize, view: &SnapshotView, _written: &[(usize, f64)]) -> std::io::Result<()> {
+        let (t, particles) = (view.t, &view.particles);
         let path = dir.join("snapshots").join(format!("{k}.xyz"));
         let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
         writeln!(w, "{}", particles.len())?;
@@ -27,7 +28,7 @@ impl SnapshotFormat for ExtendedXyz {
             "Properties=species:S:1:pos:R:3:velo:R:3:spin:R:3:mass:R:1:axes:R:3 Time={}",
             fmt_f64(t)
         )?;
-        for p in particles {
+        for p in particles.iter() {
             let species = if p.axes.x == p.axes.y && p.axes.y == p.axes.z {
                 "S"
             } else {
@@ -43,5 +44,9 @@ impl SnapshotFormat for ExtendedXyz {
             writeln!(w, "{species} {}", numbers.join(" "))?;
         }
         w.flush()
+    }
+
+    fn files(&self, dir: &Path) -> Vec<std::path::PathBuf> {
+        super::files_with_extension(&dir.join("snapshots"), "xyz")
     }
 }

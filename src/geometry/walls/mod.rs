@@ -56,6 +56,7 @@ pub mod point;
 pub mod ring;
 pub mod roots;
 pub mod soft;
+pub mod surface;
 
 use crate::math::Vec3;
 pub use motion::{Oscillation, WallMotion};

@@ -16,7 +16,8 @@ use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::bits::exact_f64_vec;
 use crate::engine::{
-    Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError, Schedule,
+    Engine, EngineError, Failure, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError,
+    Schedule, SnapshotView, read_sphere_snapshot,
 };
 use crate::io::fmt_f64;
 use crate::math::Vec3;
@@ -103,6 +104,25 @@ pub struct HardRunSummary {
     pub absorbed: u64,
     /// Particles stuck to walls at the end.
     pub stuck: usize,
+}
+
+/// The walls at time `t` (s), unbounded ones cut to a piece reaching past every particle.
+fn wall_surfaces(walls: &[crate::geometry::walls::Wall], t: f64, particles: &[ParticleView]) -> Vec<NamedSurface> {
+    walls
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            let origin = w.origin_at(t);
+            let reach = particles
+                .iter()
+                .map(|p| (p.position - origin).norm() + p.axes.x)
+                .fold(0.0, f64::max);
+            NamedSurface {
+                name: format!("wall{k}"),
+                mesh: w.surface_at(t, if reach > 0.0 { reach } else { 1.0 }),
+            }
+        })
+        .collect()
 }
 
 /// Writes the alive particles in the particles-file columns.
@@ -422,6 +442,31 @@ impl Engine for HardEngine {
             .filter(|p| p.alive)
             .map(|p| ParticleView::sphere(p.id, p.mass, p.radius, p.position, p.velocity, p.spin))
             .collect()
+    }
+
+    const SPHERES: bool = true;
+
+    fn surfaces(&self) -> Vec<NamedSurface> {
+        wall_surfaces(&self.system.walls, self.system.t, &self.particles())
+    }
+
+    fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError> {
+        let (t, particles) = read_sphere_snapshot(path)?;
+        Ok(SnapshotView {
+            t,
+            spheres: true,
+            surfaces: wall_surfaces(&self.system.walls, t, &particles),
+            particles,
+            ..Default::default()
+        })
+    }
+
+    fn scene_formats(&self) -> Vec<&'static str> {
+        if self.scene.file.output.vtk {
+            vec!["vtk"]
+        } else {
+            Vec::new()
+        }
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

@@ -182,6 +182,10 @@ pub struct HardOutputSection {
     pub times: Option<Vec<f64>>,
     /// Time-series cadence (s), > 0. Required.
     pub every: f64,
+    /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
+    /// `--format vtk` does. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vtk: bool,
 }
 
 /// `[[particle]]`.

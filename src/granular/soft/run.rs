@@ -30,7 +30,10 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::bits::exact_f64_vec;
-use crate::engine::{Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError};
+use crate::engine::{
+    ContactLine, Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError,
+    SnapshotView, read_sphere_snapshot,
+};
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
@@ -293,6 +296,25 @@ pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::
         )?;
     }
     w.flush()
+}
+
+/// The particle–particle contacts of `sys` at time `t` (s) with their normal forces, from one force evaluation on a
+/// copy (the run's own state and spring histories are untouched; the normal force needs no history).
+fn contact_lines(sys: &SoftSystem, t: f64) -> Vec<ContactLine> {
+    let mut probe = sys.clone();
+    probe.keep_records = true;
+    probe.compute_forces(t, 0.0);
+    let n = probe.particles.len();
+    probe
+        .records
+        .iter()
+        .filter(|r| r.j < n)
+        .map(|r| ContactLine {
+            i: r.i,
+            j: r.j,
+            normal_force: r.output.normal_force,
+        })
+        .collect()
 }
 
 fn gravity_name(scene: &SoftScene) -> String {
@@ -609,6 +631,37 @@ impl Engine for SoftEngine {
             .enumerate()
             .map(|(id, p)| ParticleView::sphere(id, p.mass, p.radius, p.position, p.velocity, p.spin))
             .collect()
+    }
+
+    const SPHERES: bool = true;
+
+    fn contacts(&self) -> Option<Vec<ContactLine>> {
+        Some(contact_lines(&self.sys, self.time()))
+    }
+
+    fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError> {
+        let (t, particles) = read_sphere_snapshot(path)?;
+        let mut sys = self.sys.clone();
+        if particles.len() != sys.particles.len() {
+            return Err(EngineError::File {
+                path: path.to_path_buf(),
+                reason: format!("{} particles, the scene has {}", particles.len(), sys.particles.len()),
+            });
+        }
+        for (p, v) in sys.particles.iter_mut().zip(&particles) {
+            (p.position, p.velocity, p.spin) = (v.position, v.velocity, v.spin_world);
+        }
+        Ok(SnapshotView {
+            t,
+            spheres: true,
+            contacts: Some(contact_lines(&sys, t)),
+            particles,
+            ..Default::default()
+        })
+    }
+
+    fn scene_formats(&self) -> Vec<&'static str> {
+        if self.scene.vtk { vec!["vtk"] } else { Vec::new() }
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

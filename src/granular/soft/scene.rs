@@ -201,6 +201,10 @@ pub struct SoftOutputSection {
     /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step. Default `[0, t_end]`.
     #[serde(default)]
     pub times: Option<Vec<f64>>,
+    /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
+    /// `--format vtk` does. Default false.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub vtk: bool,
 }
 
 /// `[[wall]]`.
@@ -269,6 +273,8 @@ pub struct SoftScene {
     pub every_steps: u64,
     /// Steps of the snapshots, strictly increasing.
     pub snapshot_steps: Vec<u64>,
+    /// `[output] vtk`: also write VTK snapshots.
+    pub vtk: bool,
     /// Material.
     pub material: Material,
     /// Gravity.
@@ -682,6 +688,7 @@ impl V<'_> {
             n_steps,
             every_steps,
             snapshot_steps,
+            vtk: file.output.vtk,
             material,
             gravity,
             gravity_interval,

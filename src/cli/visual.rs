@@ -1,0 +1,61 @@
+//! `rubblepile export FORMAT RUN_DIR` (visualisation files of a finished run) and `rubblepile render RUN_DIR`
+//! (PNG frames and an animated GIF).
+
+use std::path::PathBuf;
+
+use crate::analysis::run_analysis::FragmentFields;
+use crate::cli::CliError;
+use crate::driver::export::{ExportError, export};
+use crate::driver::formats::Formats;
+
+/// `rubblepile export`.
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Format: `vtk` (ParaView: DIR/vtk/*.vtp and DIR/vtk/run.pvd) or `xyz` (DIR/snapshots/<k>.xyz).
+    pub format: String,
+    /// The run directory (any engine).
+    pub dir: PathBuf,
+    /// Overwrite files an earlier export (or the run itself) wrote in this format.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `export`.
+pub fn export_cmd(args: &ExportArgs) -> Result<(), CliError> {
+    let formats = Formats::parse(std::slice::from_ref(&args.format))
+        .map_err(|e| CliError::usage(e.to_string().replacen("--format", "FORMAT", 1)))?;
+    let fields = FragmentFields::read(&args.dir).map_err(CliError::usage)?;
+    let extra = |view: &crate::engine::SnapshotView| {
+        Ok(fields
+            .as_ref()
+            .map(|f| f.columns(view.particles.iter().map(|p| p.id)))
+            .unwrap_or_default())
+    };
+    let report = export(&args.dir, formats, args.force, &extra).map_err(|e| match e {
+        ExportError::Io { .. } => CliError::failed(e),
+        _ => CliError::usage(e),
+    })?;
+    println!(
+        "exported {} snapshots as {} in {:.2} s ({:.1} MB, {:.0} MB/s){}",
+        report.snapshots,
+        args.format,
+        report.seconds,
+        report.bytes as f64 / 1e6,
+        report.bytes as f64 / 1e6 / report.seconds.max(1e-9),
+        if fields.is_some() {
+            "; with the analysis' bound and ejection_speed per body"
+        } else {
+            ""
+        }
+    );
+    if args.format == "vtk" {
+        println!(
+            "open {} in ParaView",
+            args.dir
+                .join("vtk")
+                .join(crate::driver::formats::vtk::COLLECTION_FILE)
+                .display()
+        );
+    }
+    Ok(())
+}
