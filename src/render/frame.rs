@@ -1,0 +1,249 @@
+//! One finished frame: the bodies coloured by a [`ColourScale`] and ray-cast ([`render_frame`]), with a vertical
+//! colour bar (label and end values, or category names) at the right edge and a caption at the top left; and the
+//! image type every step passes along ([`RgbImage`]).
+//!
+//! Text is drawn with plotters on the frame's own pixel buffer, in the embedded font the figures use, so frames
+//! need no system fonts.
+
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+use crate::analysis::figures::style::{FONT_FAMILY, ensure_font};
+use crate::math::{Mat3, Vec3};
+
+use super::RenderError;
+use super::camera::{BoundingSphere, Camera};
+use super::colour::{ColourScale, ScaleKind};
+use super::raycast::{RenderBody, render_bodies};
+
+/// Frame background: a dark blue-grey, so that both ends of viridis and the white text read on it.
+pub const BACKGROUND: [u8; 3] = [24, 26, 34];
+/// Colour of the caption and colour-bar text.
+const TEXT_COLOUR: RGBColor = RGBColor(235, 235, 235);
+
+/// An RGB image, 8 bits per channel.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RgbImage {
+    /// Width (pixels).
+    pub width: u32,
+    /// Height (pixels).
+    pub height: u32,
+    /// RGB triplets, row-major, top row first (`3·width·height` bytes).
+    pub pixels: Vec<u8>,
+}
+
+impl RgbImage {
+    /// A `width × height` image filled with `fill`.
+    pub fn new(width: u32, height: u32, fill: [u8; 3]) -> RgbImage {
+        let n = width as usize * height as usize;
+        let mut pixels = Vec::with_capacity(3 * n);
+        for _ in 0..n {
+            pixels.extend_from_slice(&fill);
+        }
+        RgbImage { width, height, pixels }
+    }
+
+    /// Colour of pixel `(x, y)` (`(0, 0)` = top left). Panics outside the image.
+    pub fn get(&self, x: u32, y: u32) -> [u8; 3] {
+        let i = self.index(x, y);
+        [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
+    }
+
+    /// Sets pixel `(x, y)`. Panics outside the image.
+    pub fn set(&mut self, x: u32, y: u32, colour: [u8; 3]) {
+        let i = self.index(x, y);
+        self.pixels[i..i + 3].copy_from_slice(&colour);
+    }
+
+    fn index(&self, x: u32, y: u32) -> usize {
+        assert!(
+            x < self.width && y < self.height,
+            "pixel ({x}, {y}) outside {}×{}",
+            self.width,
+            self.height
+        );
+        3 * (y as usize * self.width as usize + x as usize)
+    }
+}
+
+/// One body of a frame: an ellipsoid and the scalar that colours it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameBody {
+    /// Centre (m).
+    pub centre: Vec3,
+    /// Rotation body → world (identity for a sphere).
+    pub rotation: Mat3,
+    /// Semi-axes A, B, C (m; equal for a sphere).
+    pub axes: Vec3,
+    /// The scalar drawn (speed, bound flag, …), in the unit of the scale.
+    pub value: f64,
+}
+
+impl BoundingSphere for FrameBody {
+    fn bounding_sphere(&self) -> (Vec3, f64) {
+        (self.centre, self.axes.max())
+    }
+}
+
+/// Renders one frame: `bodies` coloured by `scale` and ray-cast through `camera` on [`BACKGROUND`], then a colour
+/// bar with the scale's label and range at the right edge and `caption` (e.g. "t = 123.4 s") at the top left.
+pub fn render_frame(
+    bodies: &[FrameBody],
+    scale: &ColourScale,
+    camera: &Camera,
+    caption: &str,
+) -> Result<RgbImage, RenderError> {
+    let coloured: Vec<RenderBody> = bodies
+        .iter()
+        .map(|b| RenderBody {
+            centre: b.centre,
+            rotation: b.rotation,
+            axes: b.axes,
+            colour: scale.colour(b.value),
+        })
+        .collect();
+    let mut image = render_bodies(&coloured, camera, BACKGROUND);
+    let layout = Layout::new(image.width, image.height);
+    draw_bar(&mut image, scale, &layout);
+    draw_text(&mut image, scale, &layout, caption)?;
+    Ok(image)
+}
+
+/// Sizes and places of the overlays, in pixels, scaled with the image.
+struct Layout {
+    margin: i32,
+    font: u32,
+    bar_x0: i32,
+    bar_x1: i32,
+    bar_y0: i32,
+    bar_y1: i32,
+}
+
+impl Layout {
+    fn new(width: u32, height: u32) -> Layout {
+        let (w, h) = (width as i32, height as i32);
+        let short = w.min(h);
+        let margin = (short / 50).max(6);
+        let bar_width = (short / 40).max(8);
+        let font = (short / 45).max(11) as u32;
+        Layout {
+            margin,
+            font,
+            bar_x0: w - margin - bar_width,
+            bar_x1: w - margin,
+            // Room above the bar for the label.
+            bar_y0: h / 5,
+            bar_y1: h - h / 5,
+        }
+    }
+}
+
+/// Fills the colour bar's pixels directly (no anti-aliasing wanted): top = max, bottom = min for a continuous
+/// scale; one block per category, the first on top, for a categorical one.
+fn draw_bar(image: &mut RgbImage, scale: &ColourScale, l: &Layout) {
+    let (w, h) = (image.width as i32, image.height as i32);
+    if l.bar_x0 < 0 || l.bar_y1 <= l.bar_y0 {
+        return;
+    }
+    let span = f64::from(l.bar_y1 - l.bar_y0 - 1).max(1.0);
+    for y in l.bar_y0.max(0)..l.bar_y1.min(h) {
+        let colour = match &scale.kind {
+            ScaleKind::Continuous { map, .. } => map.colour(1.0 - f64::from(y - l.bar_y0) / span),
+            ScaleKind::Categorical(categories) if !categories.is_empty() => {
+                let k = ((y - l.bar_y0) as usize * categories.len()) / (l.bar_y1 - l.bar_y0) as usize;
+                categories[k.min(categories.len() - 1)].colour
+            }
+            ScaleKind::Categorical(_) => continue,
+        };
+        for x in l.bar_x0.max(0)..l.bar_x1.min(w) {
+            image.set(x as u32, y as u32, colour);
+        }
+    }
+}
+
+/// Draws the caption and the colour bar's label and values with plotters on the image's own buffer.
+fn draw_text(image: &mut RgbImage, scale: &ColourScale, l: &Layout, caption: &str) -> Result<(), RenderError> {
+    ensure_font().map_err(|e| RenderError::Text(e.to_string()))?;
+    let text_err = |e: DrawingAreaErrorKind<_>| RenderError::Text(e.to_string());
+    let (w, h) = (image.width, image.height);
+    let root = BitMapBackend::with_buffer(&mut image.pixels, (w, h)).into_drawing_area();
+    let style = |h_pos, v_pos| {
+        TextStyle::from((FONT_FAMILY, l.font))
+            .color(&TEXT_COLOUR)
+            .pos(Pos::new(h_pos, v_pos))
+    };
+    if !caption.is_empty() {
+        root.draw(&Text::new(caption, (l.margin, l.margin), style(HPos::Left, VPos::Top)))
+            .map_err(text_err)?;
+    }
+    if !scale.label.is_empty() {
+        root.draw(&Text::new(
+            scale.label.as_str(),
+            (l.bar_x1, l.bar_y0 - l.margin / 2),
+            style(HPos::Right, VPos::Bottom),
+        ))
+        .map_err(text_err)?;
+    }
+    let tick_x = l.bar_x0 - l.margin / 2;
+    match &scale.kind {
+        ScaleKind::Continuous { min, max, .. } => {
+            for (value, y) in [(*max, l.bar_y0), (*min, l.bar_y1 - 1)] {
+                root.draw(&Text::new(
+                    format_value(value),
+                    (tick_x, y),
+                    style(HPos::Right, VPos::Center),
+                ))
+                .map_err(text_err)?;
+            }
+        }
+        ScaleKind::Categorical(categories) => {
+            let n = categories.len().max(1) as i32;
+            let block = (l.bar_y1 - l.bar_y0) / n;
+            for (k, category) in categories.iter().enumerate() {
+                let y = l.bar_y0 + block * k as i32 + block / 2;
+                root.draw(&Text::new(
+                    category.name.as_str(),
+                    (tick_x, y),
+                    style(HPos::Right, VPos::Center),
+                ))
+                .map_err(text_err)?;
+            }
+        }
+    }
+    root.present().map_err(text_err)?;
+    Ok(())
+}
+
+/// A bar end value in about three significant digits: plain for moderate magnitudes, scientific otherwise.
+fn format_value(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        "0".to_string()
+    } else if !(1e-2..1e4).contains(&a) {
+        format!("{v:.2e}")
+    } else {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{v:.decimals$}");
+        // 1.50 → 1.5, 2.00 → 2: trailing zeros say nothing.
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::format_value;
+
+    #[test]
+    fn values_print_short() {
+        assert_eq!(format_value(0.0), "0");
+        assert_eq!(format_value(1.5), "1.5");
+        assert_eq!(format_value(123.456), "123");
+        assert_eq!(format_value(0.01234), "0.0123");
+        assert_eq!(format_value(2.0), "2");
+        assert_eq!(format_value(12345.0), "1.23e4");
+    }
+}
