@@ -111,6 +111,8 @@ pub enum Command {
     ReportZhang2017(ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
     Export(visual::ExportArgs),
+    /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
+    Render(visual::RenderArgs),
 }
 
 /// `rubblepile report …`: one verb for the papers' reproduction reports.
@@ -155,6 +157,10 @@ pub struct RunArgs {
     /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
     #[arg(long)]
     pub no_progress: bool,
+    /// Render the run afterwards (DIR/frames: PNGs and run.gif, as `rubblepile render`); always done for the
+    /// built-in default scene (its animation is DIR/frames/impact.gif).
+    #[arg(long)]
+    pub render: bool,
     /// Checkpoint options.
     #[command(flatten)]
     pub checkpoints: CheckpointArgs,
@@ -286,7 +292,28 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?
             };
-            report(crate::driver::run_file(args.scene.as_deref(), &args.out, &options))
+            let result = crate::driver::run_file(args.scene.as_deref(), &args.out, &options);
+            if result.is_err() || !(args.render || args.scene.is_none()) {
+                return report(result);
+            }
+            let default = args.scene.is_none();
+            let opts = crate::render::run::RenderRunOptions {
+                gif_name: if default { "impact.gif" } else { "run.gif" }.into(),
+                force: args.force,
+                ..Default::default()
+            };
+            let r = visual::render_dir(&args.out, &opts)?;
+            println!(
+                "rendered {} frames in {:.1} s (median {:.0} ms per frame)",
+                r.frames, r.seconds, r.median_frame_ms
+            );
+            report(result)?;
+            let pvd = args.out.join("vtk").join(crate::driver::formats::vtk::COLLECTION_FILE);
+            println!("look at it: {}", r.gif.display());
+            if pvd.exists() {
+                println!("in ParaView: open {} (see README, \"Looking at a run\")", pvd.display());
+            }
+            Ok(())
         }
         Command::Resume(args) => {
             let options = args.checkpoints.options(!args.no_progress)?;
@@ -335,6 +362,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
         Command::Export(args) => visual::export_cmd(&args),
+        Command::Render(args) => visual::render_cmd(&args),
     }
 }
 

@@ -25,6 +25,7 @@ pub mod colour;
 pub mod encode;
 pub mod frame;
 pub mod raycast;
+pub mod run;
 
 pub use camera::{BoundingSphere, Camera, Framing, Projection, Ray, View};
 pub use colour::{Category, ColourMap, ColourScale, ScaleKind};
