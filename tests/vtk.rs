@@ -403,3 +403,13 @@ fn export_of_a_finished_run_writes_the_files_the_run_wrote() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+#[test]
+fn a_42000_sphere_snapshot_stays_under_5_mb() {
+    let view = rubblepile::bench::render::cloud_view(42_000, true);
+    let bytes: usize = rubblepile::driver::formats::vtk::pieces(&view)
+        .iter()
+        .map(|(_, p)| p.to_bytes().unwrap().len())
+        .sum();
+    assert!(bytes < 5_000_000, "{bytes} bytes");
+}

@@ -14,6 +14,7 @@ pub mod ellipsoid_problems;
 pub mod impact_wall_time;
 pub mod nbody;
 pub mod problems;
+pub mod render;
 pub mod rhs;
 pub mod stability;
 pub mod work_precision;

@@ -112,7 +112,7 @@ pub enum Command {
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
     Export(visual::ExportArgs),
     /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
-    Render(visual::RenderArgs),
+    Render(crate::render::args::RenderArgs),
 }
 
 /// `rubblepile report …`: one verb for the papers' reproduction reports.
@@ -256,6 +256,8 @@ pub enum BenchCommand {
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
     /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
     Stability(stability::StabilityArgs),
+    /// Milliseconds per rendered frame at N bodies on 1 and all threads, and VTK export MB/s (CSV + plot).
+    Render(crate::bench::render::RenderBenchArgs),
 }
 
 /// A CLI failure: the message (one line) and the exit code.
@@ -357,6 +359,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
+        Command::Bench(BenchCommand::Render(args)) => crate::bench::render::render(&args).map_err(CliError::from),
         Command::Aggregate(aggregate::AggregateCommand::Build(args)) => aggregate::build_cmd(&args),
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),

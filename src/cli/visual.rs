@@ -7,8 +7,8 @@ use crate::analysis::run_analysis::FragmentFields;
 use crate::cli::CliError;
 use crate::driver::export::{ExportError, export};
 use crate::driver::formats::Formats;
-use crate::render::run::{ColourBy, RenderReport, RenderRunError, RenderRunOptions, render_run};
-use crate::render::{Projection, View};
+use crate::render::args::RenderArgs;
+use crate::render::run::{RenderReport, RenderRunError, RenderRunOptions, render_run};
 
 /// `rubblepile export`.
 #[derive(Debug, clap::Args)]
@@ -62,71 +62,6 @@ pub fn export_cmd(args: &ExportArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// `rubblepile render`.
-#[derive(Debug, clap::Args)]
-pub struct RenderArgs {
-    /// The run directory (any engine).
-    pub dir: PathBuf,
-    /// Direction of view: x, y, z (looking down each axis) or iso.
-    #[arg(long, default_value = "iso")]
-    pub view: String,
-    /// Colour of the bodies: speed (m/s), bound (after `rubblepile analyze`), spin (rev/day) or id.
-    #[arg(long, default_value = "speed")]
-    pub color: String,
-    /// Frame size in pixels, WIDTHxHEIGHT.
-    #[arg(long, default_value = "800x800")]
-    pub size: String,
-    /// Perspective camera with this field of view (degrees) instead of the orthographic one.
-    #[arg(long, value_name = "DEGREES")]
-    pub perspective: Option<f64>,
-    /// Half-width of the picture (m) about the first snapshot's centre [default: the first snapshot's bodies].
-    #[arg(long, value_name = "METRES")]
-    pub extent: Option<f64>,
-    /// File name of the animation in DIR/frames.
-    #[arg(long, default_value = "run.gif")]
-    pub gif: String,
-    /// Overwrite an earlier DIR/frames.
-    #[arg(long)]
-    pub force: bool,
-}
-
-impl RenderArgs {
-    /// The options these arguments ask for (errors name the flag).
-    pub fn options(&self) -> Result<RenderRunOptions, CliError> {
-        let view: View = self.view.parse().map_err(CliError::usage)?;
-        let colour: ColourBy = self.color.parse().map_err(CliError::usage)?;
-        let bad_size = || CliError::usage(format!("--size: expected WIDTHxHEIGHT in pixels, got {:?}", self.size));
-        let (w, h) = self.size.split_once('x').ok_or_else(bad_size)?;
-        let (width, height) = (w.parse().map_err(|_| bad_size())?, h.parse().map_err(|_| bad_size())?);
-        let projection = match self.perspective {
-            None => Projection::Orthographic,
-            Some(f) if f.is_finite() && f > 1.0 && f < 170.0 => Projection::Perspective { fov_deg: f },
-            Some(f) => {
-                return Err(CliError::usage(format!(
-                    "--perspective: expected 1 to 170 degrees, got {f}"
-                )));
-            }
-        };
-        if self.gif.contains(['/', '\\']) || !self.gif.ends_with(".gif") {
-            return Err(CliError::usage(format!(
-                "--gif: expected a file name ending in .gif, got {:?}",
-                self.gif
-            )));
-        }
-        Ok(RenderRunOptions {
-            view,
-            projection,
-            width,
-            height,
-            colour,
-            extent: self.extent,
-            gif_name: self.gif.clone(),
-            force: self.force,
-            ..RenderRunOptions::default()
-        })
-    }
-}
-
 /// Renders the run in `dir` with `opts`; errors mapped to exit codes (bad input 2, failures 1).
 pub fn render_dir(dir: &std::path::Path, opts: &RenderRunOptions) -> Result<RenderReport, CliError> {
     render_run(dir, opts).map_err(|e| match e {
@@ -137,7 +72,7 @@ pub fn render_dir(dir: &std::path::Path, opts: &RenderRunOptions) -> Result<Rend
 
 /// Runs `render`.
 pub fn render_cmd(args: &RenderArgs) -> Result<(), CliError> {
-    let r = render_dir(&args.dir, &args.options()?)?;
+    let r = render_dir(&args.dir, &args.options().map_err(CliError::usage)?)?;
     println!(
         "rendered {} frames into {} in {:.1} s (median {:.0} ms per frame drawn); animation: {}",
         r.frames,

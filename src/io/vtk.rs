@@ -6,7 +6,7 @@
 //! little-endian `UInt64` followed by its values in little-endian order, the two base64-encoded together (the `base64`
 //! crate), as the VTK XML format's `header_type="UInt64"` describes. Binary keeps floats exact (`Float64` arrays hold
 //! the run's values bit for bit) and files small: a 42 000-sphere snapshot with positions, velocities, spins, radii
-//! and ids is 5.0 MB. (Raw appended data would save the base64 third, but it makes the file invalid XML, which
+//! and ids is 4.9 MB. (Raw appended data would save the base64 third, but it makes the file invalid XML, which
 //! XML-based readers such as `vtkio` refuse.) Integers are `Int32` where every value fits, else `Int64`.
 
 use std::io::Write;
@@ -131,11 +131,15 @@ impl Cells {
         self.offsets.push(self.connectivity.len() as i64);
     }
 
-    /// One single-point cell per point `0..n` (how particles become visible as points).
-    pub fn one_per_point(n: usize) -> Self {
+    /// One poly-vertex cell through the points `0..n` (how particles become visible as points; one cell rather
+    /// than one per point halves the cost of the cells, which matters at 10⁵ particles). No cell for `n = 0`.
+    pub fn poly_vertex(n: usize) -> Self {
+        if n == 0 {
+            return Cells::default();
+        }
         Cells {
             connectivity: (0..n as i64).collect(),
-            offsets: (1..=n as i64).collect(),
+            offsets: vec![n as i64],
         }
     }
 
@@ -337,7 +341,7 @@ mod tests {
     fn an_array_of_the_wrong_length_is_refused_by_name() {
         let pd = PolyData {
             points: vec![[0.0; 3]; 2],
-            verts: Cells::one_per_point(2),
+            verts: Cells::poly_vertex(2),
             point_data: vec![DataArray::scalars("radius", vec![1.0])],
             ..Default::default()
         };

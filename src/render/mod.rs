@@ -20,6 +20,7 @@
 
 use std::path::PathBuf;
 
+pub mod args;
 pub mod camera;
 pub mod colour;
 pub mod encode;

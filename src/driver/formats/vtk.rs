@@ -4,13 +4,15 @@
 //! values bit for bit).
 //!
 //! Parts:
-//! - `particles_<k>.vtp` (part 0): one point per body at its centre, a vertex cell each, and point data
-//!   `id`, `mass` (kg), `velocity` (m/s), `speed` (m/s), then
-//!   - ellipsoids: `axes` (A, B, C, m), `spin_world` (rad/s, world frame) and `shape`, the 3×3 tensor R·diag(A, B, C)
+//! - `particles_<k>.vtp` (part 0): one point per body at its centre (all in one poly-vertex cell) with point data
+//!   `id` and `velocity` (m/s), then
+//!   - ellipsoids: `mass` (kg), `speed` (m/s), `axes` (A, B, C, m), `spin_world` (rad/s, world frame) and `shape`,
+//!     the 3×3 tensor R·diag(A, B, C)
 //!     whose columns are the body's principal axes scaled by its semi-axes (R rotates body to world): ParaView's
 //!     Tensor Glyph filter with a sphere glyph, *Extract eigenvalues* off and scale factor 1 draws each body as its
 //!     true ellipsoid in its true attitude;
-//!   - spheres: `radius` (m) and `spin` (rad/s);
+//!   - spheres: `radius` (m) and `spin` (rad/s, world frame) — no more, so that a 42 000-sphere snapshot stays
+//!     under 5 MB (mass is in the CSV snapshot; ParaView colours by the velocity's magnitude directly);
 //!   - any per-body scalars an analysis adds (e.g. `bound`, `ejection_speed` after `rubblepile analyze`).
 //! - `contacts_<k>.vtp` (part 1; soft spheres): the contact network, one line cell between the centres of each
 //!   touching pair, with cell data `normal_force` (N): ParaView's Tube filter coloured by it shows the force chains.
@@ -111,14 +113,17 @@ fn particles(view: &SnapshotView) -> PolyData {
     let vec3 = |f: fn(&crate::engine::ParticleView) -> crate::math::Vec3| ps.iter().map(move |p| f(p).into());
     let mut data = vec![
         DataArray::ids("id", ps.iter().map(|p| p.id as i64).collect()),
-        DataArray::scalars("mass", ps.iter().map(|p| p.mass).collect()),
         DataArray::vectors("velocity", vec3(|p| p.velocity)),
-        DataArray::scalars("speed", ps.iter().map(|p| p.velocity.norm()).collect()),
     ];
     if view.spheres {
         data.push(DataArray::scalars("radius", ps.iter().map(|p| p.axes.x).collect()));
         data.push(DataArray::vectors("spin", vec3(|p| p.spin_world)));
     } else {
+        data.push(DataArray::scalars("mass", ps.iter().map(|p| p.mass).collect()));
+        data.push(DataArray::scalars(
+            "speed",
+            ps.iter().map(|p| p.velocity.norm()).collect(),
+        ));
         data.push(DataArray::vectors("axes", vec3(|p| p.axes)));
         data.push(DataArray::vectors("spin_world", vec3(|p| p.spin_world)));
         data.push(DataArray::tensors(
@@ -134,7 +139,7 @@ fn particles(view: &SnapshotView) -> PolyData {
     }
     PolyData {
         points: ps.iter().map(|p| p.position.into()).collect(),
-        verts: Cells::one_per_point(ps.len()),
+        verts: Cells::poly_vertex(ps.len()),
         point_data: data,
         ..Default::default()
     }

@@ -1,0 +1,69 @@
+//! The command-line arguments of `rubblepile render` and the options they ask for (errors name the flag).
+
+use std::path::PathBuf;
+
+use super::run::{ColourBy, RenderRunOptions};
+use super::{Projection, View};
+
+/// `rubblepile render`.
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// The run directory (any engine).
+    pub dir: PathBuf,
+    /// Direction of view: x, y, z (looking down each axis) or iso.
+    #[arg(long, default_value = "iso")]
+    pub view: String,
+    /// Colour of the bodies: speed (m/s), bound (after `rubblepile analyze`), spin (rev/day) or id.
+    #[arg(long, default_value = "speed")]
+    pub color: String,
+    /// Frame size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "800x800")]
+    pub size: String,
+    /// Perspective camera with this field of view (degrees) instead of the orthographic one.
+    #[arg(long, value_name = "DEGREES")]
+    pub perspective: Option<f64>,
+    /// Half-width of the picture (m) about the first snapshot's centre [default: the first snapshot's bodies].
+    #[arg(long, value_name = "METRES")]
+    pub extent: Option<f64>,
+    /// File name of the animation in DIR/frames.
+    #[arg(long, default_value = "run.gif")]
+    pub gif: String,
+    /// Overwrite an earlier DIR/frames.
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl RenderArgs {
+    /// The options these arguments ask for (errors name the flag).
+    pub fn options(&self) -> Result<RenderRunOptions, String> {
+        let view: View = self.view.parse().map_err(|e: super::RenderError| e.to_string())?;
+        let colour: ColourBy = self.color.parse()?;
+        let bad_size = || format!("--size: expected WIDTHxHEIGHT in pixels, got {:?}", self.size);
+        let (w, h) = self.size.split_once('x').ok_or_else(bad_size)?;
+        let (width, height) = (w.parse().map_err(|_| bad_size())?, h.parse().map_err(|_| bad_size())?);
+        let projection = match self.perspective {
+            None => Projection::Orthographic,
+            Some(f) if f.is_finite() && f > 1.0 && f < 170.0 => Projection::Perspective { fov_deg: f },
+            Some(f) => {
+                return Err(format!("--perspective: expected 1 to 170 degrees, got {f}"));
+            }
+        };
+        if self.gif.contains(['/', '\\']) || !self.gif.ends_with(".gif") {
+            return Err(format!(
+                "--gif: expected a file name ending in .gif, got {:?}",
+                self.gif
+            ));
+        }
+        Ok(RenderRunOptions {
+            view,
+            projection,
+            width,
+            height,
+            colour,
+            extent: self.extent,
+            gif_name: self.gif.clone(),
+            force: self.force,
+            ..RenderRunOptions::default()
+        })
+    }
+}
