@@ -30,6 +30,10 @@
 //! - `rubblepile spinup critical …` / `rubblepile spinup density-fit …`: the T_c,3 search and the Eq. 22 fit
 //!   ([`spinup`]); `rubblepile report zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
 //!
+//! - `rubblepile export vtk|xyz DIR [--force]`: a finished run's snapshots for ParaView or OVITO
+//!   ([`crate::driver::export`]); `rubblepile render DIR [--view iso] [--color speed] [--size 800x800]`: PNG frames
+//!   and an animated GIF ([`crate::render::run`]); `rubblepile bench render`: their cost.
+//!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
 //!   ([`crate::bench::stability`]): `stability.csv`, `stability.md` and one run directory per case.
