@@ -115,6 +115,8 @@ pub enum Command {
     ReportZhang2017(ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
     Export(visual::ExportArgs),
+    /// Convert pkdgrav `.ss` files to and from bodies/particles CSV (units converted at the edge).
+    Convert(crate::driver::convert::ConvertArgs),
     /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
     Render(crate::render::args::RenderArgs),
 }
@@ -370,6 +372,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
         Command::Export(args) => visual::export_cmd(&args),
         Command::Render(args) => visual::render_cmd(&args),
+        Command::Convert(args) => visual::convert_cmd(&args),
     }
 }
 

@@ -1,5 +1,5 @@
-//! `rubblepile export FORMAT RUN_DIR` (visualisation files of a finished run) and `rubblepile render RUN_DIR`
-//! (PNG frames and an animated GIF).
+//! `rubblepile export FORMAT RUN_DIR` (visualisation files of a finished run), `rubblepile render RUN_DIR`
+//! (PNG frames and an animated GIF) and `rubblepile convert FILE --to FILE` (pkdgrav `.ss` files).
 
 use std::path::PathBuf;
 
@@ -81,5 +81,13 @@ pub fn render_cmd(args: &RenderArgs) -> Result<(), CliError> {
         r.median_frame_ms,
         r.gif.display()
     );
+    Ok(())
+}
+
+/// Runs `convert`.
+pub fn convert_cmd(args: &crate::driver::convert::ConvertArgs) -> Result<(), CliError> {
+    let c =
+        crate::driver::convert::convert(&args.input, &args.to, args.spheres, args.force).map_err(CliError::usage)?;
+    println!("wrote {} ({} bodies): {}", args.to.display(), c.count, c.note);
     Ok(())
 }

@@ -26,6 +26,7 @@
 //! `timeseries.csv` is cut back to its length at the checkpoint, and the engine reopens its own files likewise.
 
 pub mod branch;
+pub mod convert;
 pub mod export;
 pub mod formats;
 pub mod kind;

@@ -162,7 +162,12 @@ pub enum BodiesFileError {
 
 /// Reads a bodies file: a CSV with a header naming the columns `mass,a,b,c,x,y,z,vx,vy,vz,qa,qb,qc,qd,wx,wy,wz`
 /// in any order (plus optional `t` and `id`, ignored); any other column is an error.
+///
+/// A pkdgrav `.ss` file (by its extension) is read too ([`read_ss_bodies`]).
 pub fn read_bodies_csv(path: &Path) -> Result<Vec<BodyRecord>, BodiesFileError> {
+    if crate::io::ss::is_ss(path) {
+        return read_ss_bodies(path).map(|(_, records, _)| records);
+    }
     let file = File::open(path).map_err(|e| BodiesFileError::Read(e.to_string()))?;
     read_bodies(file)
 }
@@ -242,6 +247,44 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
 
 fn one_line_csv(e: &::csv::Error) -> String {
     e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// The sidecar of a `.ss` file: `<stem>.bodies.csv` beside it, where `rubblepile convert` keeps the exact
+/// ellipsoids it wrote to pkdgrav as spheres.
+pub fn ss_sidecar(ss: &Path) -> std::path::PathBuf {
+    ss.with_extension("bodies.csv")
+}
+
+/// The bodies of a pkdgrav `.ss` file (SI, see [`crate::io::ss`]) and its time (s): spheres as bodies with
+/// A = B = C = radius, no rotation and their spin — or, when its sidecar ([`ss_sidecar`]) lists the same masses and
+/// positions (to the units conversion's round-off), the sidecar's exact ellipsoids (`true`).
+pub fn read_ss_bodies(path: &Path) -> Result<(f64, Vec<BodyRecord>, bool), BodiesFileError> {
+    let ss = crate::io::ss::SsFile::read(path).map_err(|e| BodiesFileError::Read(e.to_string()))?;
+    if let Ok(side) = read_bodies_csv(&ss_sidecar(path)) {
+        let close = |a: f64, b: f64| (a - b).abs() <= 4.0 * f64::EPSILON * a.abs().max(b.abs());
+        let same = side.len() == ss.particles.len()
+            && side.iter().zip(&ss.particles).all(|(r, p)| {
+                close(r.mass, p.mass) && r.position.iter().zip(p.position.iter()).all(|(a, b)| close(*a, *b))
+            });
+        if same {
+            return Ok((ss.time, side, true));
+        }
+    }
+    let records = ss
+        .particles
+        .iter()
+        .enumerate()
+        .map(|(k, p)| BodyRecord {
+            line: k as u64 + 1,
+            mass: p.mass,
+            axes: [p.radius; 3],
+            position: p.position.into(),
+            velocity: p.velocity.into(),
+            quaternion: [0.0, 0.0, 0.0, 1.0],
+            spin_body: p.spin.into(),
+        })
+        .collect();
+    Ok((ss.time, records, false))
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@
 pub mod checkpoint;
 pub mod particles;
 pub mod scene_file;
+pub mod ss;
 pub mod table;
 pub mod vtk;
 

@@ -53,6 +53,9 @@ pub fn read_particles(
     optional: &[&'static str],
 ) -> Result<Vec<ParticleRecord>, ParticlesFileError> {
     use ParticlesFileError as E;
+    if crate::io::ss::is_ss(path) {
+        return read_ss_particles(path, required, optional);
+    }
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
         .from_path(path)
@@ -95,6 +98,59 @@ pub fn read_particles(
         rows.push(ParticleRecord { line, values, optional });
     }
     Ok(rows)
+}
+
+/// A pkdgrav `.ss` file read as a particles file with the columns `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (SI;
+/// see [`crate::io::ss`]); `line` is the 1-based particle number.
+fn read_ss_particles(
+    path: &Path,
+    required: &[&'static str],
+    optional: &[&'static str],
+) -> Result<Vec<ParticleRecord>, ParticlesFileError> {
+    const COLUMNS: [&str; 13] = [
+        "t", "id", "mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz",
+    ];
+    let ss = crate::io::ss::SsFile::read(path).map_err(|e| ParticlesFileError::Read(e.to_string()))?;
+    let find = |c: &str| COLUMNS.iter().position(|k| *k == c);
+    let idx: Vec<usize> = required
+        .iter()
+        .map(|&column| {
+            find(column).ok_or_else(|| ParticlesFileError::MissingColumn {
+                column,
+                required: required.to_vec(),
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(ss
+        .particles
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let row: [f64; 13] = [
+                ss.time,
+                k as f64,
+                p.mass,
+                p.radius,
+                p.position.x,
+                p.position.y,
+                p.position.z,
+                p.velocity.x,
+                p.velocity.y,
+                p.velocity.z,
+                p.spin.x,
+                p.spin.y,
+                p.spin.z,
+            ];
+            ParticleRecord {
+                line: k + 1,
+                values: idx.iter().map(|&i| row[i]).collect(),
+                optional: optional
+                    .iter()
+                    .map(|c| find(c).map(|i| crate::io::fmt_f64(row[i])))
+                    .collect(),
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]
