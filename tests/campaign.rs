@@ -15,7 +15,8 @@ use std::time::SystemTime;
 use rubblepile::driver::RunOptions;
 use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::impact::campaign::{
-    Action, CAMPAIGN_COLUMNS, CampaignOptions, RunStatus, load_campaign, parse_campaign, run_campaign,
+    Action, CAMPAIGN_COLUMNS, CampaignOptions, RunStatus, Shard, load_campaign, merge_campaign, parse_campaign,
+    run_campaign,
 };
 use rubblepile::impact::run::run_impact;
 use rubblepile::impact::target::{TargetSpec, build_target};
@@ -109,6 +110,7 @@ fn quiet() -> CampaignOptions {
         },
         parallel: None,
         verbose: false,
+        shard: None,
     }
 }
 
@@ -491,4 +493,84 @@ fn roig2003_campaign_files_are_valid() {
             Err(e) => assert!(e.to_string().contains(": campaign.targets["), "{file}: {e}"),
         }
     }
+}
+
+/// Shards of a job array: all N shards run separately into one directory and merged give the index of one
+/// unsharded run (machine-dependent wall times aside), and the same run directories.
+#[test]
+fn shards_merged_give_the_unsharded_index() {
+    let (dir, file) = campaign_dir("shards", GRID);
+    let whole = load_campaign(&file).unwrap();
+    run_campaign(&whole, &quiet()).unwrap();
+    let mut sharded = load_campaign(&file).unwrap();
+    sharded.out = dir.join("sharded");
+    for i in 0..3 {
+        let shard = Some(Shard { index: i, count: 3 });
+        let r = run_campaign(&sharded, &CampaignOptions { shard, ..quiet() }).unwrap();
+        let mine = (0..4).filter(|k| k % 3 == i).count();
+        let ran = r
+            .runs
+            .iter()
+            .filter(|x| x.action == Action::Start && x.status == RunStatus::Completed)
+            .count();
+        assert_eq!(ran, mine, "shard {i}: {}", r.one_line());
+        assert!(dir.join(format!("sharded/campaign.shard-{i}-of-3.csv")).exists());
+    }
+    assert!(
+        !dir.join("sharded/campaign.csv").exists(),
+        "shards never write the campaign's index"
+    );
+    let merged = merge_campaign(&dir.join("sharded")).unwrap();
+    assert_eq!(merged.completed(), 4);
+    let machine_free = |rows: Vec<Vec<String>>| -> Vec<Vec<String>> {
+        rows.into_iter()
+            .map(|mut r| {
+                r[7].clear(); // wall_seconds
+                r
+            })
+            .collect()
+    };
+    assert_eq!(
+        machine_free(read_csv(&dir.join("sharded/campaign.csv"))),
+        machine_free(read_csv(&dir.join("out/campaign.csv")))
+    );
+    for p in &whole.points {
+        for f in ["snapshots/0.csv", "timeseries.csv", "initial_bodies.csv"] {
+            let a = std::fs::read(dir.join("out").join(&p.name).join(f)).unwrap();
+            let b = std::fs::read(dir.join("sharded").join(&p.name).join(f)).unwrap();
+            if f == "timeseries.csv" {
+                // the last column is the wall clock
+                let strip = |t: &[u8]| -> Vec<String> {
+                    String::from_utf8_lossy(t)
+                        .lines()
+                        .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+                        .collect()
+                };
+                assert_eq!(strip(&a), strip(&b), "{} {f}", p.name);
+            } else {
+                assert_eq!(a, b, "{} {f}", p.name);
+            }
+        }
+    }
+    // Bad shard specifications are refused by name.
+    for bad in ["3/3", "1", "a/2", "0/0"] {
+        let e = bad.parse::<Shard>().unwrap_err();
+        assert!(e.contains("--shard"), "{e}");
+    }
+    // The Slurm script runs every shard of this campaign.
+    let o = bin(&["campaign", "slurm", file.to_str().unwrap(), "--tasks", "3"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let script = std::fs::read_to_string(dir.join("out/campaign.slurm")).unwrap();
+    assert!(script.starts_with("#!/bin/bash\n"), "{script}");
+    assert!(script.contains("#SBATCH --array=0-2\n"), "{script}");
+    assert!(script.contains("--shard $SLURM_ARRAY_TASK_ID/3"), "{script}");
+    assert!(
+        script.contains(&format!("campaign merge {}", dir.join("out").display())),
+        "{script}"
+    );
+    // The merge command through the binary.
+    let o = bin(&["campaign", "merge", dir.join("sharded").to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("4 completed"));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -8,10 +8,22 @@ use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
 pub struct CampaignArgs {
+    /// `merge DIR` or `slurm FILE --tasks N` instead of running a campaign.
+    #[command(subcommand)]
+    pub action: Option<crate::impact::campaign::CampaignAction>,
     /// Campaign file (TOML): `[campaign]` out, targets, projectiles, angles, seeds, parallel; optional
     /// `[impact]` overrides and `[[projectile]]` custom projectiles.
-    pub file: PathBuf,
+    #[arg(required = true)]
+    pub file: Option<PathBuf>,
+    /// The campaign directory (overrides `campaign.out`).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Run only shard I of N (0 <= I < N): the grid points k with k mod N = I (a job array's task); its index
+    /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<crate::impact::campaign::Shard>,
     /// Runs at once (overrides `campaign.parallel`).
     #[arg(long, value_name = "N")]
     pub parallel: Option<usize>,
@@ -27,6 +39,18 @@ pub struct CampaignArgs {
 /// campaign file, 1 when a run failed (the others still ran), 3 when runs stopped after a checkpoint on
 /// request (`--stop-after-checkpoints`).
 pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
+    let to_cli = |e: crate::impact::campaign::CampaignError| CliError {
+        message: e.to_string(),
+        code: e.exit_code(),
+    };
+    if let Some(action) = &args.action {
+        action.run().map_err(to_cli)?.iter().for_each(|l| println!("{l}"));
+        return Ok(());
+    }
+    let file = args
+        .file
+        .as_deref()
+        .ok_or_else(|| CliError::usage("a campaign file is required"))?;
     if args.parallel == Some(0) {
         return Err(CliError::usage("--parallel: must be at least 1, got 0"));
     }
@@ -34,17 +58,18 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
         run: args.checkpoints.options(!args.no_progress)?,
         parallel: args.parallel,
         verbose: true,
+        shard: args.shard,
     };
-    let campaign = load_campaign(&args.file).map_err(|e| CliError {
-        message: e.to_string(),
-        code: e.exit_code(),
-    })?;
-    let report = run_campaign(&campaign, &options).map_err(|e| CliError {
-        message: e.to_string(),
-        code: e.exit_code(),
-    })?;
+    let mut campaign = load_campaign(file).map_err(to_cli)?;
+    if let Some(out) = &args.out {
+        campaign.out = out.clone();
+    }
+    let report = run_campaign(&campaign, &options).map_err(to_cli)?;
     println!("{}", report.one_line());
-    let csv = campaign.out.join(crate::impact::campaign::CAMPAIGN_CSV);
+    let index = args
+        .shard
+        .map_or(crate::impact::campaign::CAMPAIGN_CSV.to_string(), |s| s.index_file());
+    let csv = campaign.out.join(index);
     if report.failed() > 0 {
         return Err(CliError::failed(format!(
             "{} of {} runs failed (causes in {})",

@@ -114,7 +114,7 @@ pub enum Command {
     #[command(hide = true)]
     ReportZhang2017(ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
-    Export(visual::ExportArgs),
+    Export(crate::driver::export::ExportArgs),
     /// Convert pkdgrav `.ss` files to and from bodies/particles CSV (units converted at the edge).
     Convert(crate::driver::convert::ConvertArgs),
     /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
@@ -304,23 +304,11 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             if result.is_err() || !(args.render || args.scene.is_none()) {
                 return report(result);
             }
-            let default = args.scene.is_none();
-            let opts = crate::render::run::RenderRunOptions {
-                gif_name: if default { "impact.gif" } else { "run.gif" }.into(),
-                force: args.force,
-                ..Default::default()
-            };
-            let r = visual::render_dir(&args.out, &opts)?;
-            println!(
-                "rendered {} frames in {:.1} s (median {:.0} ms per frame)",
-                r.frames, r.seconds, r.median_frame_ms
-            );
+            let (before, after) =
+                crate::render::run::after_run(&args.out, args.scene.is_none(), args.force).map_err(CliError::failed)?;
+            println!("{before}");
             report(result)?;
-            let pvd = args.out.join("vtk").join(crate::driver::formats::vtk::COLLECTION_FILE);
-            println!("look at it: {}", r.gif.display());
-            if pvd.exists() {
-                println!("in ParaView: open {} (see README, \"Looking at a run\")", pvd.display());
-            }
+            after.iter().for_each(|l| println!("{l}"));
             Ok(())
         }
         Command::Resume(args) => {

@@ -1,8 +1,6 @@
 //! `rubblepile export FORMAT RUN_DIR` (visualisation files of a finished run), `rubblepile render RUN_DIR`
 //! (PNG frames and an animated GIF) and `rubblepile convert FILE --to FILE` (pkdgrav `.ss` files).
 
-use std::path::PathBuf;
-
 use crate::analysis::run_analysis::FragmentFields;
 use crate::cli::CliError;
 use crate::driver::export::{ExportError, export};
@@ -10,20 +8,8 @@ use crate::driver::formats::Formats;
 use crate::render::args::RenderArgs;
 use crate::render::run::{RenderReport, RenderRunError, RenderRunOptions, render_run};
 
-/// `rubblepile export`.
-#[derive(Debug, clap::Args)]
-pub struct ExportArgs {
-    /// Format: `vtk` (ParaView: DIR/vtk/*.vtp and DIR/vtk/run.pvd) or `xyz` (DIR/snapshots/<k>.xyz).
-    pub format: String,
-    /// The run directory (any engine).
-    pub dir: PathBuf,
-    /// Overwrite files an earlier export (or the run itself) wrote in this format.
-    #[arg(long)]
-    pub force: bool,
-}
-
 /// Runs `export`.
-pub fn export_cmd(args: &ExportArgs) -> Result<(), CliError> {
+pub fn export_cmd(args: &crate::driver::export::ExportArgs) -> Result<(), CliError> {
     let formats = Formats::parse(std::slice::from_ref(&args.format))
         .map_err(|e| CliError::usage(e.to_string().replacen("--format", "FORMAT", 1)))?;
     let fields = FragmentFields::read(&args.dir).map_err(CliError::usage)?;

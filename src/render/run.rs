@@ -256,3 +256,27 @@ fn caption(t: f64) -> String {
         format!("t = {t:.1} s")
     }
 }
+
+/// Renders a run just finished by `rubblepile run` (`--render`, or always for the built-in default scene, whose
+/// animation is `impact.gif`): the line to print before the run's summary, and those after it (what to open).
+pub fn after_run(out: &Path, default_scene: bool, force: bool) -> Result<(String, Vec<String>), RenderRunError> {
+    let opts = RenderRunOptions {
+        gif_name: if default_scene { "impact.gif" } else { "run.gif" }.into(),
+        force,
+        ..Default::default()
+    };
+    let r = render_run(out, &opts)?;
+    let before = format!(
+        "rendered {} frames in {:.1} s (median {:.0} ms per frame)",
+        r.frames, r.seconds, r.median_frame_ms
+    );
+    let mut after = vec![format!("look at it: {}", r.gif.display())];
+    let pvd = out.join("vtk").join(crate::driver::formats::vtk::COLLECTION_FILE);
+    if pvd.exists() {
+        after.push(format!(
+            "in ParaView: open {} (see README, \"Looking at a run\")",
+            pvd.display()
+        ));
+    }
+    Ok((before, after))
+}

@@ -29,6 +29,8 @@ pub struct CampaignOptions {
     pub parallel: Option<usize>,
     /// Print one line per finished run on stdout.
     pub verbose: bool,
+    /// Run only this shard of the grid ([`Shard`]); its index goes to its own file.
+    pub shard: Option<Shard>,
 }
 
 impl Default for CampaignOptions {
@@ -38,6 +40,7 @@ impl Default for CampaignOptions {
             run: RunOptions::default(),
             parallel: None,
             verbose: false,
+            shard: None,
         }
     }
 }
@@ -230,6 +233,16 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         path: out.clone(),
         source,
     })?;
+    if let Some(src) = &campaign.source {
+        let pointer = out.join(CAMPAIGN_SOURCE);
+        let line = format!("{}\n", src.display());
+        // Rewritten only when it changes: a resumed campaign leaves its directory's files untouched.
+        if std::fs::read_to_string(&pointer).ok().as_deref() != Some(line.as_str()) {
+            std::fs::write(&pointer, line).map_err(|source| CampaignError::Io { path: pointer, source })?;
+        }
+    }
+    let index_file = options.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());
+    let index_file = index_file.as_str();
     let points = &campaign.points;
     let mut runs = Vec::with_capacity(points.len());
     for p in points {
@@ -247,9 +260,10 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
             numbers,
         });
     }
-    write_campaign_csv(out, points, &runs)?;
+    write_campaign_csv(out, index_file, points, &runs)?;
     let todo: Vec<usize> = (0..runs.len())
         .filter(|&i| matches!(runs[i].action, Action::Resume | Action::Start))
+        .filter(|&i| options.shard.is_none_or(|s| s.contains(i)))
         .collect();
     let finished_before = (runs.len() - todo.len()) as u64;
     let display = (options.run.progress && std::io::stderr().is_terminal() && !todo.is_empty())
@@ -296,7 +310,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
                         let action = {
                             let mut st = lock(&state);
                             st.0[i].status = RunStatus::Running;
-                            if let Err(e) = write_campaign_csv(out, points, &st.0) {
+                            if let Err(e) = write_campaign_csv(out, index_file, points, &st.0) {
                                 st.1.get_or_insert(e);
                             }
                             st.0[i].action.clone()
@@ -323,7 +337,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
                             if numbers.is_some() {
                                 r.numbers = numbers;
                             }
-                            if let Err(e) = write_campaign_csv(out, points, &st.0) {
+                            if let Err(e) = write_campaign_csv(out, index_file, points, &st.0) {
                                 st.1.get_or_insert(e);
                             }
                             st.0.iter().filter(|r| matches!(r.status, RunStatus::Failed(_))).count()

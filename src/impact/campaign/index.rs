@@ -177,9 +177,14 @@ pub(crate) fn fmt_num(x: f64) -> String {
 }
 
 /// Writes `campaign.csv` (via `campaign.csv.tmp` and a rename).
-pub(crate) fn write_campaign_csv(out: &Path, points: &[GridPoint], runs: &[RunRecord]) -> Result<(), CampaignError> {
-    let path = out.join(CAMPAIGN_CSV);
-    let tmp = out.join(format!("{CAMPAIGN_CSV}.tmp"));
+pub(crate) fn write_campaign_csv(
+    out: &Path,
+    file: &str,
+    points: &[GridPoint],
+    runs: &[RunRecord],
+) -> Result<(), CampaignError> {
+    let path = out.join(file);
+    let tmp = out.join(format!("{file}.tmp"));
     let io = |p: &Path| {
         let path = p.to_path_buf();
         move |source| CampaignError::Io { path, source }

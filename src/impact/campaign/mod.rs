@@ -69,16 +69,21 @@ pub mod execute;
 pub mod file;
 pub mod index;
 pub mod plan;
+pub mod shard;
 
 pub use execute::*;
 pub use file::*;
 pub use index::*;
 pub use plan::*;
+pub use shard::*;
 
 use std::path::PathBuf;
 
 /// Name of the campaign table in the campaign directory.
 pub const CAMPAIGN_CSV: &str = "campaign.csv";
+
+/// The file in the campaign directory naming the campaign file (one line, its absolute path).
+pub const CAMPAIGN_SOURCE: &str = "campaign.source";
 
 /// Columns of `campaign.csv`.
 pub const CAMPAIGN_COLUMNS: [&str; 14] = [

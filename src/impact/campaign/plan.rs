@@ -44,6 +44,9 @@ pub struct Campaign {
     pub points: Vec<GridPoint>,
     /// The file as written.
     pub file: CampaignFile,
+    /// The campaign file's absolute path, when it was read from a file (recorded in the campaign directory so
+    /// that `rubblepile campaign merge DIR` finds the grid).
+    pub source: Option<PathBuf>,
 }
 
 /// Reads and validates a campaign file; relative paths in it are resolved against its directory.
@@ -57,7 +60,9 @@ pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
-    parse_campaign(&text, &name, &base)
+    let mut campaign = parse_campaign(&text, &name, &base)?;
+    campaign.source = std::fs::canonicalize(path).ok();
+    Ok(campaign)
 }
 
 /// Parses and validates campaign text; `name` is used in messages, `base_dir` resolves relative paths.
@@ -305,5 +310,6 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         parallel,
         points,
         file,
+        source: None,
     })
 }

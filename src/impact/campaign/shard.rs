@@ -1,0 +1,227 @@
+//! Campaigns past one machine without a distributed system of our own: deterministic shards of the grid for any
+//! scheduler's job array (Slurm, PBS, GNU parallel), the merge of their run directories into one `campaign.csv`,
+//! and a ready Slurm job-array script.
+//!
+//! Shard `I/N` (0 ≤ I < N) runs the grid points whose index k (in the grid's order: targets, projectiles, angles,
+//! seeds) has k mod N = I, so N shards cover the grid exactly once and interleave long and short runs. A sharded
+//! campaign keeps its index in `campaign.shard-I-of-N.csv` (shards never write the same file); `rubblepile
+//! campaign merge DIR` rebuilds `campaign.csv` from the run directories themselves, so it is right whatever
+//! shards ran, died or ran twice.
+
+use std::path::{Path, PathBuf};
+use std::str::FromStr;
+use std::time::Instant;
+
+use super::*;
+
+/// One of N deterministic parts of a grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Which part, 0-based (`SLURM_ARRAY_TASK_ID` of an array `0-(N-1)`).
+    pub index: usize,
+    /// How many parts.
+    pub count: usize,
+}
+
+impl FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Shard, String> {
+        let bad = || format!("--shard: expected I/N with 0 <= I < N (e.g. 0/8), got {s:?}");
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (
+            i.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if count == 0 || index >= count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+impl Shard {
+    /// Whether grid point `k` belongs to this shard.
+    pub fn contains(&self, k: usize) -> bool {
+        k % self.count == self.index
+    }
+
+    /// The shard's own index file.
+    pub fn index_file(&self) -> String {
+        format!("campaign.shard-{}-of-{}.csv", self.index, self.count)
+    }
+}
+
+/// The status a run directory shows by itself: completed (with its numbers), failed (its summary says so and it
+/// has no checkpoint), a different run (conflict), or pending (not started, or checkpointed and unfinished).
+fn status_of(dir: &Path, point: &GridPoint) -> (RunStatus, Option<RunNumbers>) {
+    let (action, numbers) = decide(dir, &point.plan);
+    match action {
+        Action::Skip => (RunStatus::Completed, numbers),
+        Action::Conflict(why) => (RunStatus::Failed(why), numbers),
+        Action::Resume => (RunStatus::Pending, None),
+        Action::Start => {
+            let text = std::fs::read_to_string(dir.join("summary.json")).ok();
+            let status = text
+                .as_deref()
+                .and_then(|t| serde_json::from_str::<serde_json::Value>(t).ok())
+                .and_then(|v| v.get("status")?.as_str().map(str::to_string));
+            match status {
+                Some(s) if s.starts_with("failed") => (
+                    RunStatus::Failed(one_line(s.trim_start_matches("failed").trim_start_matches(':').trim())),
+                    text.as_deref().map(RunNumbers::from_summary_text),
+                ),
+                _ => (RunStatus::Pending, None),
+            }
+        }
+    }
+}
+
+/// The campaign whose directory is `dir` (from the campaign file recorded there, [`CAMPAIGN_SOURCE`]).
+pub fn campaign_of_dir(dir: &Path) -> Result<Campaign, CampaignError> {
+    let pointer = dir.join(CAMPAIGN_SOURCE);
+    let text = std::fs::read_to_string(&pointer).map_err(|e| CampaignError::Read {
+        file: pointer.display().to_string(),
+        reason: format!("{e} (is {} a campaign directory?)", dir.display()),
+    })?;
+    let mut campaign = load_campaign(Path::new(text.trim()))?;
+    // The directory given wins over the file's `out` (the campaign may have been run with --out).
+    campaign.out = dir.to_path_buf();
+    Ok(campaign)
+}
+
+/// Rebuilds `campaign.csv` of the campaign directory `dir` from its run directories; returns the report (every
+/// run `Skip`ped, as nothing ran).
+pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
+    let started = Instant::now();
+    let campaign = campaign_of_dir(dir)?;
+    let runs: Vec<RunRecord> = campaign
+        .points
+        .iter()
+        .map(|p| {
+            let (status, numbers) = status_of(&dir.join(&p.name), p);
+            RunRecord {
+                name: p.name.clone(),
+                action: Action::Skip,
+                status,
+                stopped: false,
+                numbers,
+            }
+        })
+        .collect();
+    index::write_campaign_csv(dir, CAMPAIGN_CSV, &campaign.points, &runs)?;
+    Ok(CampaignReport {
+        runs,
+        wall_seconds: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// A Slurm job-array script running `campaign` as `tasks` shards, one array task each, with `threads` cores per
+/// task; `binary` is the rubblepile executable the tasks call.
+pub fn slurm_script(campaign: &Campaign, campaign_file: &Path, tasks: usize, threads: usize, binary: &Path) -> String {
+    let out = campaign.out.display();
+    let name = campaign_file
+        .file_stem()
+        .map_or("campaign".into(), |s| s.to_string_lossy().into_owned());
+    let runs = campaign.points.len();
+    format!(
+        "#!/bin/bash\n\
+         # {runs} impact runs of {file} in {tasks} shards (written by `rubblepile campaign slurm`).\n\
+         # Submit:  jobid=$(sbatch --parsable {out}/campaign.slurm)\n\
+         # Then:    sbatch --dependency=afterany:$jobid --wrap \"{bin} campaign merge {out}\"\n\
+         # A task that dies leaves its finished runs and checkpoints; resubmitting the array resumes them.\n\
+         #SBATCH --job-name=rubblepile-{name}\n\
+         #SBATCH --array=0-{last}\n\
+         #SBATCH --ntasks=1\n\
+         #SBATCH --cpus-per-task={threads}\n\
+         #SBATCH --output={out}/slurm-%A_%a.out\n\
+         set -euo pipefail\n\
+         export RAYON_NUM_THREADS=$SLURM_CPUS_PER_TASK\n\
+         srun {bin} campaign {file} --out {out} --shard $SLURM_ARRAY_TASK_ID/{tasks} --parallel 1 --no-progress\n",
+        file = campaign_file.display(),
+        bin = binary.display(),
+        last = tasks - 1,
+    )
+}
+
+/// Where `campaign slurm` writes its script.
+pub fn slurm_script_path(campaign: &Campaign) -> PathBuf {
+    campaign.out.join("campaign.slurm")
+}
+
+/// `rubblepile campaign merge|slurm …`.
+#[derive(Debug, clap::Subcommand)]
+pub enum CampaignAction {
+    /// Rebuild DIR/campaign.csv from the run directories (after shards ran separately).
+    Merge {
+        /// The campaign directory.
+        dir: PathBuf,
+    },
+    /// Write DIR/campaign.slurm, a Slurm job array running the campaign as N shards (not submitted).
+    Slurm {
+        /// The campaign file.
+        file: PathBuf,
+        /// The campaign directory (overrides `campaign.out`).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Array tasks (shards).
+        #[arg(long, value_name = "N")]
+        tasks: usize,
+        /// Cores per task (each task runs one impact at a time on them).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        threads_per_task: usize,
+    },
+}
+
+impl CampaignAction {
+    /// Does it; the lines to print.
+    pub fn run(&self) -> Result<Vec<String>, CampaignError> {
+        match self {
+            CampaignAction::Merge { dir } => {
+                let r = merge_campaign(dir)?;
+                Ok(vec![format!(
+                    "merged {} runs into {}: {} completed, {} failed, {} pending",
+                    r.runs.len(),
+                    dir.join(CAMPAIGN_CSV).display(),
+                    r.completed(),
+                    r.failed(),
+                    r.pending()
+                )])
+            }
+            CampaignAction::Slurm {
+                file,
+                out,
+                tasks,
+                threads_per_task,
+            } => {
+                let invalid = |field: &str, message: String| CampaignError::Invalid {
+                    file: file.display().to_string(),
+                    field: field.into(),
+                    message,
+                };
+                if *tasks == 0 || *threads_per_task == 0 {
+                    return Err(invalid("--tasks/--threads-per-task", "must be at least 1".into()));
+                }
+                let mut campaign = load_campaign(file)?;
+                if let Some(o) = out {
+                    campaign.out = std::path::absolute(o).unwrap_or_else(|_| o.clone());
+                }
+                let abs_file = campaign.source.clone().unwrap_or_else(|| file.clone());
+                let binary = std::env::current_exe().unwrap_or_else(|_| PathBuf::from("rubblepile"));
+                let text = slurm_script(&campaign, &abs_file, *tasks, *threads_per_task, &binary);
+                let path = slurm_script_path(&campaign);
+                let io = |source| CampaignError::Io {
+                    path: path.clone(),
+                    source,
+                };
+                std::fs::create_dir_all(&campaign.out).map_err(io)?;
+                std::fs::write(&path, text).map_err(io)?;
+                Ok(vec![format!(
+                    "wrote {} ({} runs in {tasks} array tasks); submit it with sbatch, then run `campaign merge {}`",
+                    path.display(),
+                    campaign.points.len(),
+                    campaign.out.display()
+                )])
+            }
+        }
+    }
+}
