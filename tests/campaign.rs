@@ -574,3 +574,182 @@ fn shards_merged_give_the_unsharded_index() {
     assert!(String::from_utf8_lossy(&o.stdout).contains("4 completed"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A default build started by `mpirun` with several ranks must not run (every rank would run the whole grid into
+/// the same directories): one line saying how to build with MPI.
+#[cfg(not(feature = "mpi"))]
+#[test]
+fn a_default_build_under_mpirun_refuses_to_run() {
+    let (dir, file) = campaign_dir("no-mpi", GRID);
+    let o = Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+        .args(["campaign", file.to_str().unwrap(), "--no-progress"])
+        .env("OMPI_COMM_WORLD_SIZE", "3")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--features mpi"), "{}", stderr(&o));
+    assert!(!dir.join("out").exists(), "nothing was run");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Every file of every run directory, with the machine-dependent wall-clock fields blanked.
+#[cfg(feature = "mpi")]
+fn run_files(out: &Path, points: &[String]) -> Vec<(String, String)> {
+    let mut files = Vec::new();
+    for name in points {
+        for (p, bytes, _) in tree(&out.join(name)) {
+            let rel = p.strip_prefix(out).unwrap().display().to_string();
+            let text = String::from_utf8_lossy(&bytes).into_owned();
+            let text = if rel.ends_with("timeseries.csv") {
+                text.lines()
+                    .map(|l| l.rsplit_once(',').unwrap().0.to_string() + "\n")
+                    .collect()
+            } else if rel.ends_with(".json") {
+                text.lines()
+                    .filter(|l| !l.contains("wall_seconds"))
+                    .map(|l| l.to_string() + "\n")
+                    .collect()
+            } else {
+                text
+            };
+            files.push((rel, text));
+        }
+    }
+    files
+}
+
+#[cfg(feature = "mpi")]
+fn mpirun(ranks: usize, args: &[&str]) -> Command {
+    let mut c = Command::new("mpirun");
+    c.args([
+        "-n",
+        &ranks.to_string(),
+        "--oversubscribe",
+        env!("CARGO_BIN_EXE_rubblepile"),
+    ])
+    .args(args)
+    .env("OMPI_ALLOW_RUN_AS_ROOT", "1")
+    .env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    c
+}
+
+#[cfg(feature = "mpi")]
+fn index_without_wall(path: &Path) -> Vec<Vec<String>> {
+    read_csv(path)
+        .into_iter()
+        .map(|mut r| {
+            r[7].clear();
+            r
+        })
+        .collect()
+}
+
+/// Three MPI ranks (one coordinator, two workers) give the run directories and the index of the threaded runner.
+#[cfg(feature = "mpi")]
+#[test]
+fn mpi_campaign_matches_the_threaded_runner() {
+    let (dir, file) = campaign_dir("mpi", GRID);
+    let campaign = load_campaign(&file).unwrap();
+    run_campaign(&campaign, &quiet()).unwrap();
+    let o = mpirun(
+        3,
+        &[
+            "campaign",
+            file.to_str().unwrap(),
+            "--out",
+            dir.join("mpi").to_str().unwrap(),
+            "--no-progress",
+        ],
+    )
+    .output()
+    .expect("mpirun (Open MPI) must be installed for the mpi feature's tests");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let names: Vec<String> = campaign.points.iter().map(|p| p.name.clone()).collect();
+    assert_eq!(
+        index_without_wall(&dir.join("mpi/campaign.csv")),
+        index_without_wall(&dir.join("out/campaign.csv"))
+    );
+    let (a, b) = (run_files(&dir.join("out"), &names), run_files(&dir.join("mpi"), &names));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!(x, y, "{}", x.0);
+    }
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("(rank 1)") && out.contains("(rank 2)"),
+        "both workers ran: {out}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A worker rank killed (SIGKILL) mid-campaign: the index on disk stays a valid table, and running the command
+/// again completes the campaign with nothing lost or duplicated (the same index as an uninterrupted run).
+#[cfg(feature = "mpi")]
+#[test]
+fn a_rank_killed_mid_campaign_loses_nothing() {
+    // Longer runs (to 3000 s) with checkpoints at every output sample, so that the kill lands mid-run.
+    let grid = GRID
+        .replace("t_end = 40.0", "t_end = 3000.0")
+        .replace("angles = [0, 90.0]", "angles = [0, 45.0, 90.0]");
+    let (dir, file) = campaign_dir("mpi-kill", &grid);
+    let mpi_out = dir.join("mpi");
+    let args = [
+        "campaign",
+        file.to_str().unwrap(),
+        "--out",
+        mpi_out.to_str().unwrap(),
+        "--no-progress",
+    ];
+    let mut child = mpirun(3, &[&args[..], &["--checkpoint-every-sim", "0"]].concat())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until a run has completed and another is running, then kill worker rank 1.
+    let index = dir.join("mpi/campaign.csv");
+    let t0 = std::time::Instant::now();
+    let victim = loop {
+        assert!(t0.elapsed().as_secs() < 120, "the campaign never got going");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+        let Ok(text) = std::fs::read_to_string(&index) else {
+            continue;
+        };
+        if !(text.contains(",completed,") && text.contains(",running,")) {
+            continue;
+        }
+        // The rank-1 process: its environment names its rank.
+        let pid = std::fs::read_dir("/proc")
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .find_map(|e| {
+                let pid: u32 = e.file_name().to_str()?.parse().ok()?;
+                let cmd = std::fs::read(format!("/proc/{pid}/cmdline")).ok()?;
+                let env = std::fs::read(format!("/proc/{pid}/environ")).ok()?;
+                let has = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).any(|w| w == needle);
+                (has(&cmd, file.to_str()?.as_bytes()) && has(&env, b"OMPI_COMM_WORLD_RANK=1\0")).then_some(pid)
+            });
+        if let Some(pid) = pid {
+            break pid;
+        }
+    };
+    Command::new("kill").args(["-9", &victim.to_string()]).status().unwrap();
+    let status = child.wait().unwrap();
+    assert!(!status.success(), "Open MPI ends the job when a rank dies");
+    // The index on disk is a whole table of the grid (replaced atomically, never half written).
+    let rows = read_csv(&index);
+    assert_eq!(rows.len(), 6);
+    let done_before = rows.iter().filter(|r| r[6] == "completed").count();
+    assert!((1..6).contains(&done_before), "{rows:?}");
+    // Again: the rest is completed, nothing is run twice.
+    let o = mpirun(3, &args).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains(&format!("{} runs to do of 6", 6 - done_before)), "{out}");
+    let reference = load_campaign(&file).unwrap();
+    run_campaign(&reference, &quiet()).unwrap();
+    assert_eq!(
+        index_without_wall(&index),
+        index_without_wall(&dir.join("out/campaign.csv"))
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

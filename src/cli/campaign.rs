@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::cli::{CheckpointArgs, CliError};
-use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign};
+use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign_anywhere};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
@@ -24,6 +24,9 @@ pub struct CampaignArgs {
     /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<crate::impact::campaign::Shard>,
+    /// Threads of each process's rayon pool [default: the node's cores over its MPI ranks; all cores without MPI].
+    #[arg(long, value_name = "N")]
+    pub threads_per_rank: Option<usize>,
     /// Runs at once (overrides `campaign.parallel`).
     #[arg(long, value_name = "N")]
     pub parallel: Option<usize>,
@@ -64,28 +67,17 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
     if let Some(out) = &args.out {
         campaign.out = out.clone();
     }
-    let report = run_campaign(&campaign, &options).map_err(to_cli)?;
+    let threads = crate::impact::campaign::threads_per_rank(args.threads_per_rank);
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().ok();
+    let Some(report) = run_campaign_anywhere(&campaign, &options).map_err(to_cli)? else {
+        return Ok(()); // an MPI worker rank: rank 0 reports
+    };
     println!("{}", report.one_line());
     let index = args
         .shard
         .map_or(crate::impact::campaign::CAMPAIGN_CSV.to_string(), |s| s.index_file());
-    let csv = campaign.out.join(index);
-    if report.failed() > 0 {
-        return Err(CliError::failed(format!(
-            "{} of {} runs failed (causes in {})",
-            report.failed(),
-            report.runs.len(),
-            csv.display()
-        )));
+    match report.problem(&campaign.out.join(index)) {
+        Some((message, code)) => Err(CliError { message, code }),
+        None => Ok(()),
     }
-    let stopped = report.runs.iter().filter(|r| r.stopped).count();
-    if stopped > 0 {
-        return Err(CliError {
-            message: format!(
-                "{stopped} runs stopped after a checkpoint (--stop-after-checkpoints); run the campaign again to resume them"
-            ),
-            code: 3,
-        });
-    }
-    Ok(())
 }

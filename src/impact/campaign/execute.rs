@@ -117,12 +117,12 @@ pub fn decide(dir: &Path, plan: &ImpactPlan) -> (Action, Option<RunNumbers>) {
     (Action::Start, None)
 }
 
-fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+pub(crate) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Runs one grid point: its new status, whether it stopped on request, its numbers.
-fn execute(
+pub(crate) fn execute(
     point: &GridPoint,
     dir: &Path,
     action: &Action,

@@ -147,6 +147,27 @@ impl CampaignReport {
             .filter_map(|r| Some((r.numbers?.energy_error?, r.name.as_str())))
             .max_by(|a, b| a.0.total_cmp(&b.0))
     }
+
+    /// What the command line must report as an error, with its exit code: failed runs (1, their causes are in
+    /// `index`), runs stopped after a checkpoint on request (3).
+    pub fn problem(&self, index: &Path) -> Option<(String, u8)> {
+        let stopped = self.runs.iter().filter(|r| r.stopped).count();
+        if self.failed() > 0 {
+            let (n, all) = (self.failed(), self.runs.len());
+            Some((format!("{n} of {all} runs failed (causes in {})", index.display()), 1))
+        } else if stopped > 0 {
+            Some((
+                format!(
+                    "{stopped} runs stopped after a checkpoint (--stop-after-checkpoints); run the campaign again to \
+                     resume them"
+                ),
+                3,
+            ))
+        } else {
+            None
+        }
+    }
+
     /// The one-line summary printed at the end, e.g. `campaign: 18 runs: 18 completed (6 skipped,
     /// 2 resumed), 0 failed, 0 pending; wall 812.3 s; worst energy error 3.1e-10 (N30_T4_P3_z0_s1)`.
     pub fn one_line(&self) -> String {

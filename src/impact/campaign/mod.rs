@@ -65,12 +65,16 @@
 //! [`file`] is the campaign file format, [`plan`] expands it into the grid of runs, [`execute`] runs the grid
 //! (in parallel, resumable), and [`index`] keeps `campaign.csv`.
 
+pub mod distributed;
 pub mod execute;
 pub mod file;
 pub mod index;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod plan;
 pub mod shard;
 
+pub use distributed::*;
 pub use execute::*;
 pub use file::*;
 pub use index::*;
