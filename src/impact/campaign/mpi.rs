@@ -24,6 +24,11 @@ use super::*;
 
 const TAG: i32 = 7;
 
+/// Grids up to this size get `campaign.csv` rewritten at every event; larger ones at most once a second (and at
+/// the end): the index grows with the grid and is rewritten whole, so at 10⁴ runs and hundreds of workers writing
+/// it per event would make rank 0 the bottleneck (analysis/campaign_scaling/README.md).
+pub const EVERY_EVENT_UP_TO: usize = 2000;
+
 fn send(world: &::mpi::topology::SimpleCommunicator, rank: i32, text: &str) {
     world.process_at_rank(rank).send_with_tag(text.as_bytes(), TAG);
 }
@@ -117,6 +122,7 @@ fn coordinate(
         );
     }
     let (mut next, mut done, mut active) = (0, 0, workers);
+    let mut last_write = Instant::now();
     while active > 0 {
         let Some(status) = world.any_process().immediate_probe_with_tag(TAG) else {
             std::thread::sleep(Duration::from_millis(2));
@@ -151,8 +157,12 @@ fn coordinate(
                 active -= 1;
             }
         }
-        index::write_campaign_csv(out, &index_file, points, &runs)?;
+        if points.len() <= EVERY_EVENT_UP_TO || last_write.elapsed() >= Duration::from_secs(1) {
+            index::write_campaign_csv(out, &index_file, points, &runs)?;
+            last_write = Instant::now();
+        }
     }
+    index::write_campaign_csv(out, &index_file, points, &runs)?;
     Ok(CampaignReport {
         runs,
         wall_seconds: started.elapsed().as_secs_f64(),
