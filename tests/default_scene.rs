@@ -33,4 +33,9 @@ fn the_default_scene_is_the_n30_p2_impact_of_its_header() {
     assert_eq!(scene.output.times, cfg.snapshots);
     assert!(scene.file.output.vtk, "the default run writes VTK");
     assert_eq!(scene.output.track, vec![30], "the projectile is tracked");
+    // The impact.json its runs get is this plan's setup.
+    let mut setup = serde_json::to_value(&plan.setup).unwrap();
+    setup["target"] = "targets/N30_T4.csv".into();
+    let committed: serde_json::Value = serde_json::from_str(rubblepile::ellipsoid::scene::DEFAULT_IMPACT_JSON).unwrap();
+    assert_eq!(committed, setup);
 }

@@ -74,7 +74,8 @@ fn erase<S: RunReport>(r: Result<S, RunError<S>>) -> AnyResult {
 
 /// Loads the scene at `path` (the built-in default scene when `None`) and runs it into `out` with the engine its
 /// `scene.kind` names. Scene errors come back as [`RunError::Setup`] (one line naming the field). Scene warnings are
-/// printed to stderr as `warning: …` before the run starts.
+/// printed to stderr as `warning: …` before the run starts. The built-in scene's run also gets its
+/// `impact.json` (the impact setup [`crate::ellipsoid::scene::DEFAULT_IMPACT_JSON`]), as `rubblepile impact` writes.
 pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyResult {
     let kind = path.map_or(SceneKind::Ellipsoids, SceneKind::of_file);
     match kind {
@@ -84,7 +85,14 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
                 None => EllipsoidEngine::default_scene(),
             }
             .map_err(|e| RunError::Setup(e.to_string()))?;
-            erase(super::run(engine, out, options))
+            let result = erase(super::run(engine, out, options));
+            if path.is_none() && result.is_ok() {
+                // The built-in scene is an impact: its setup lets `rubblepile analyze` read the run.
+                let json = out.join("impact.json");
+                std::fs::write(&json, crate::ellipsoid::scene::DEFAULT_IMPACT_JSON)
+                    .map_err(|source| RunError::Io { path: json, source })?;
+            }
+            result
         }
         SceneKind::SoftSpheres => {
             let engine = SoftEngine::load(path.expect("a soft-sphere scene comes from a file"))

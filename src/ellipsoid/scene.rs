@@ -64,6 +64,10 @@ pub const QUATERNION_NORM_TOLERANCE: f64 = 1e-6;
 /// The built-in default scene (`targets/default.toml`), run by `rubblepile run` without a scene file.
 pub const DEFAULT_SCENE_TOML: &str = include_str!("../../targets/default.toml");
 
+/// The setup of the built-in scene's impact (`targets/default_impact.json`: Q, impact time, projectile, target),
+/// written as `impact.json` beside its run so that `rubblepile analyze` reads it like any impact run.
+pub const DEFAULT_IMPACT_JSON: &str = include_str!("../../targets/default_impact.json");
+
 /// Name used for the built-in scene in messages.
 pub const DEFAULT_SCENE_NAME: &str = "<built-in default scene>";
 
