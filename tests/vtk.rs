@@ -413,3 +413,64 @@ fn a_42000_sphere_snapshot_stays_under_5_mb() {
         .sum();
     assert!(bytes < 5_000_000, "{bytes} bytes");
 }
+
+#[test]
+fn soft_sphere_walls_lie_on_their_plane_and_sphere_where_they_oscillated_to() {
+    let scene = r#"
+[scene]
+kind = "soft-spheres"
+t_end = 0.02
+[integrator]
+dt = 1e-3
+[contact]
+k_n = 1e5
+[output]
+every = 0.01
+times = [0.0, 0.013]
+vtk = true
+[[wall]]
+kind = "plane"
+point = [0.0, 0.0, -0.5]
+normal = [0.0, 0.6, 0.8]
+oscillation = { amplitude = [0.0, 0.0, 0.05], frequency = 5.0 }
+[[wall]]
+kind = "sphere"
+centre = [0.1, 0.0, 0.2]
+radius = 4.0
+oscillation = { amplitude = [0.02, 0.0, 0.0], frequency = 3.0 }
+[[particle]]
+radius = 0.5
+mass = 1.0
+position = [0.0, 0.0, 1.0]
+"#;
+    let dir = scratch("soft-walls");
+    run(
+        SoftEngine::from_scene_text(scene, "w.toml", None).unwrap(),
+        &dir,
+        &quiet(),
+    )
+    .unwrap();
+    let entries = collection(&dir.join("vtk/run.pvd"));
+    // particles, contacts, two walls at each of the two snapshot times (the second lands on step 13)
+    assert_eq!(entries.len(), 2 * 4);
+    for (t, part, file) in entries.iter().filter(|e| e.1 >= 2) {
+        let piece = read_piece(&dir.join("vtk").join(file));
+        let IOBuffer::F64(points) = &piece.points else { panic!() };
+        let tau = std::f64::consts::TAU;
+        for p in points.chunks(3) {
+            let p = nalgebra::Vector3::new(p[0], p[1], p[2]);
+            let off = if *part == 2 {
+                nalgebra::Vector3::new(0.0, 0.0, 0.05 * (tau * 5.0 * t).sin())
+            } else {
+                nalgebra::Vector3::new(0.02 * (tau * 3.0 * t).sin(), 0.0, 0.0)
+            };
+            let miss = if *part == 2 {
+                (p - (nalgebra::Vector3::new(0.0, 0.0, -0.5) + off)).dot(&nalgebra::Vector3::new(0.0, 0.6, 0.8))
+            } else {
+                (p - (nalgebra::Vector3::new(0.1, 0.0, 0.2) + off)).norm() - 4.0
+            };
+            assert!(miss.abs() < 1e-9, "{file} at t = {t}: {miss:e} m off");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -99,6 +99,16 @@ pub struct SnapshotView {
     pub extra: Vec<(String, Vec<f64>)>,
 }
 
+/// How far the particles reach from `from` (m): the largest distance to a particle's centre plus its largest
+/// semi-axis; 1 m without particles. Unbounded walls are drawn this far.
+pub fn reach(particles: &[ParticleView], from: &crate::math::Vec3) -> f64 {
+    let r = particles
+        .iter()
+        .map(|p| (p.position - from).norm() + p.axes.max())
+        .fold(0.0, f64::max);
+    if r > 0.0 && r.is_finite() { r } else { 1.0 }
+}
+
 /// Reads a sphere engine's snapshot (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, other columns ignored): its time
 /// (s; 0 for a file without particles) and particles.
 pub fn read_sphere_snapshot(path: &Path) -> Result<(f64, Vec<ParticleView>), EngineError> {

@@ -16,8 +16,9 @@
 //!   - any per-body scalars an analysis adds (e.g. `bound`, `ejection_speed` after `rubblepile analyze`).
 //! - `contacts_<k>.vtp` (part 1; soft spheres): the contact network, one line cell between the centres of each
 //!   touching pair, with cell data `normal_force` (N): ParaView's Tube filter coloured by it shows the force chains.
-//! - `wall<i>_<k>.vtp` (parts 2, 3, …; hard spheres): each wall's surface where its motion has carried it (planes as
-//!   finite patches reaching past every particle, disks, cylinders, rings, lines, points).
+//! - `wall<i>_<k>.vtp` (the next parts; soft and hard spheres): each wall's surface where its motion has carried it
+//!   (planes as finite patches reaching past every particle, disks, cylinders, rings, lines, points, spherical
+//!   containers).
 
 use std::path::Path;
 

@@ -79,3 +79,44 @@ impl Wall {
             .map_points(|p| origin + self.to_world(p))
     }
 }
+
+/// Latitude bands of a spherical container's mesh.
+pub const SPHERE_BANDS: usize = 32;
+
+impl super::soft::Wall {
+    /// The soft-sphere wall's surface at time `t` (s), where its oscillation has carried it: a plane as a square
+    /// patch of half-size `extent` (m) about its point, a spherical container as a latitude–longitude mesh whose
+    /// vertices lie on the sphere.
+    pub fn surface_at(&self, t: f64, extent: f64) -> SurfaceMesh {
+        let offset = |o: &Option<super::soft::Oscillation>| o.as_ref().map_or(Vec3::zeros(), |o| o.offset(t));
+        match self {
+            super::soft::Wall::Plane(p) => {
+                Wall::new(Shape::Plane, p.point + offset(&p.oscillation), p.normal).surface_at(0.0, extent)
+            }
+            super::soft::Wall::Sphere(s) => {
+                let centre = s.centre + offset(&s.oscillation);
+                let mut m = SurfaceMesh::default();
+                let north = m.add_point(centre + Vec3::z() * s.radius);
+                for j in 1..SPHERE_BANDS {
+                    let theta = std::f64::consts::PI * j as f64 / SPHERE_BANDS as f64;
+                    circle(s.radius * theta.sin(), s.radius * theta.cos()).for_each(|p| {
+                        m.add_point(centre + p);
+                    });
+                }
+                let south = m.add_point(centre - Vec3::z() * s.radius);
+                let n = CIRCLE_SEGMENTS;
+                let ring = |j: usize, k: usize| 1 + (j - 1) * n + k % n;
+                for k in 0..n {
+                    m.polys.push(vec![north, ring(1, k), ring(1, k + 1)]);
+                    for j in 1..SPHERE_BANDS - 1 {
+                        m.polys
+                            .push(vec![ring(j, k), ring(j + 1, k), ring(j + 1, k + 1), ring(j, k + 1)]);
+                    }
+                    m.polys
+                        .push(vec![ring(SPHERE_BANDS - 1, k), south, ring(SPHERE_BANDS - 1, k + 1)]);
+                }
+                m
+            }
+        }
+    }
+}

@@ -111,16 +111,9 @@ fn wall_surfaces(walls: &[crate::geometry::walls::Wall], t: f64, particles: &[Pa
     walls
         .iter()
         .enumerate()
-        .map(|(k, w)| {
-            let origin = w.origin_at(t);
-            let reach = particles
-                .iter()
-                .map(|p| (p.position - origin).norm() + p.axes.x)
-                .fold(0.0, f64::max);
-            NamedSurface {
-                name: format!("wall{k}"),
-                mesh: w.surface_at(t, if reach > 0.0 { reach } else { 1.0 }),
-            }
+        .map(|(k, w)| NamedSurface {
+            name: format!("wall{k}"),
+            mesh: w.surface_at(t, crate::engine::reach(particles, &w.origin_at(t))),
         })
         .collect()
 }

@@ -31,8 +31,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::bits::exact_f64_vec;
 use crate::engine::{
-    ContactLine, Engine, EngineError, Failure, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError,
-    SnapshotView, read_sphere_snapshot,
+    ContactLine, Engine, EngineError, Failure, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample,
+    SampleError, SnapshotView, read_sphere_snapshot,
 };
 use crate::granular::soft::contact::Springs;
 use crate::granular::soft::forces::SoftSystem;
@@ -313,6 +313,29 @@ fn contact_lines(sys: &SoftSystem, t: f64) -> Vec<ContactLine> {
             i: r.i,
             j: r.j,
             normal_force: r.output.normal_force,
+        })
+        .collect()
+}
+
+/// The walls at time `t` (s); planes cut to a patch reaching past every particle.
+fn wall_surfaces(
+    walls: &[crate::geometry::walls::soft::Wall],
+    t: f64,
+    particles: &[ParticleView],
+) -> Vec<NamedSurface> {
+    use crate::geometry::walls::soft::Wall;
+    walls
+        .iter()
+        .enumerate()
+        .map(|(k, w)| {
+            let anchor = match w {
+                Wall::Plane(p) => p.point,
+                Wall::Sphere(s) => s.centre,
+            };
+            NamedSurface {
+                name: format!("wall{k}"),
+                mesh: w.surface_at(t, crate::engine::reach(particles, &anchor)),
+            }
         })
         .collect()
 }
@@ -639,8 +662,13 @@ impl Engine for SoftEngine {
         Some(contact_lines(&self.sys, self.time()))
     }
 
+    fn surfaces(&self) -> Vec<NamedSurface> {
+        wall_surfaces(&self.sys.walls, self.time(), &self.particles())
+    }
+
     fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError> {
         let (t, particles) = read_sphere_snapshot(path)?;
+        let surfaces = wall_surfaces(&self.sys.walls, t, &particles);
         let mut sys = self.sys.clone();
         if particles.len() != sys.particles.len() {
             return Err(EngineError::File {
@@ -656,6 +684,7 @@ impl Engine for SoftEngine {
             spheres: true,
             contacts: Some(contact_lines(&sys, t)),
             particles,
+            surfaces,
             ..Default::default()
         })
     }
