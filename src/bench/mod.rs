@@ -17,6 +17,7 @@ pub mod problems;
 pub mod render;
 pub mod rhs;
 pub mod stability;
+pub mod tolerance;
 pub mod work_precision;
 pub mod work_precision_sweep;
 

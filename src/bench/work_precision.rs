@@ -369,13 +369,14 @@ pub fn sweep(
 /// `method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps`, then `h,rejected_steps,timed_runs,
 /// wall_statistic,cpu_seconds`.
 pub const CSV_HEADER: &str = "method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps,h,rejected_steps,\
-                              timed_runs,wall_statistic,cpu_seconds";
+                              timed_runs,wall_statistic,cpu_seconds,error_over_tol";
 
-/// One CSV line (no newline) for `row`: `rtol` is empty for Rk4 and `h` empty for the adaptive methods.
+/// One CSV line (no newline) for `row`: `rtol` is empty for Rk4 and `h` empty for the adaptive methods;
+/// `error_over_tol` is the final-state error over `rtol` (tolerance proportionality; empty for Rk4).
 pub fn csv_line(row: &SweepRow) -> String {
     let opt = |v: Option<f64>| v.map(|x| format!("{x:e}")).unwrap_or_default();
     format!(
-        "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{:e}",
+        "{},{},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{}",
         row.setting.method,
         opt(row.setting.tolerance),
         row.error,
@@ -387,7 +388,8 @@ pub fn csv_line(row: &SweepRow) -> String {
         row.rejected_steps,
         row.timed_runs,
         row.statistic,
-        row.cpu_seconds
+        row.cpu_seconds,
+        opt(row.setting.tolerance.map(|t| row.error / t))
     )
 }
 

@@ -22,10 +22,12 @@ use crate::integrate::Method;
 /// Writes into DIR:
 /// * `work_precision_<problem>.csv` with the columns
 ///   `method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps,h,rejected_steps,timed_runs,wall_statistic,
-///   cpu_seconds`: one row per setting; `rtol` (= atol) is empty for rk4, whose fixed step is in `h` (empty for the
+///   cpu_seconds,error_over_tol`: one row per setting; `rtol` (= atol) is empty for rk4, whose fixed step is in `h`
+///   (empty for the
 ///   adaptive methods); `error` is the final-state error, `energy_error` the largest energy residual,
 ///   `wall_seconds` the integration time (median of the timed runs, or minimum when `wall_statistic` = `min`),
-///   `steps` the accepted steps of one run, `cpu_seconds` the same statistic of the thread's CPU time;
+///   `steps` the accepted steps of one run, `cpu_seconds` the same statistic of the thread's CPU time,
+///   `error_over_tol` the error over `rtol` (tolerance proportionality);
 /// * `work_precision_<problem>.svg`: log–log error and energy error against wall time, one line per method;
 /// * `work_precision_<problem>.json`: the problem, the references and the settings.
 #[derive(Debug, clap::Args)]
@@ -77,7 +79,8 @@ Time: wall-clock time of the integration only (no set-up, diagnostics or I/O), m
   under 0.05 s: more runs, up to 25; runs over 2 s: at most 2 runs, minimum); cpu_seconds: the same for the
   thread's CPU time. Every run is on one thread.
 CSV columns: method,rtol,error,energy_error,wall_seconds,rhs_evaluations,steps,h,rejected_steps,timed_runs,
-  wall_statistic,cpu_seconds (rtol empty for rk4, whose fixed step is h; h empty for the adaptive methods).";
+  wall_statistic,cpu_seconds,error_over_tol (rtol empty for rk4, whose fixed step is h; h empty for the adaptive
+  methods; error_over_tol = error / rtol).";
 
 fn positive_list(flag: &str, values: &[f64]) -> Result<(), CliError> {
     if values.is_empty() {

@@ -262,6 +262,8 @@ pub enum BenchCommand {
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
     /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
     Stability(stability::StabilityArgs),
+    /// Tolerance proportionality: final-state error over rtol on the canonical problems, rtol 1e-6…1e-12 (CSV).
+    Tolerance(crate::bench::tolerance::ToleranceArgs),
     /// Milliseconds per rendered frame at N bodies on 1 and all threads, and VTK export MB/s (CSV + plot).
     Render(crate::bench::render::RenderBenchArgs),
 }
@@ -353,6 +355,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
+        Command::Bench(BenchCommand::Tolerance(args)) => {
+            crate::bench::tolerance::tolerance(&args).map_err(CliError::from)
+        }
         Command::Bench(BenchCommand::Render(args)) => crate::bench::render::render(&args).map_err(CliError::from),
         Command::Aggregate(aggregate::AggregateCommand::Build(args)) => aggregate::build_cmd(&args),
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
