@@ -102,13 +102,7 @@ pub fn convert(input: &Path, output: &Path, spheres: bool, force: bool) -> Resul
         (true, false) => {
             let (t, records, exact) = read_ss_bodies(input).map_err(|e| err(input, e))?;
             // As read: a sidecar's quaternions are not renormalised, so a round trip is exact.
-            let bodies: Vec<Body> = records
-                .iter()
-                .map(|r| Body {
-                    quaternion: Vec4::from(r.quaternion),
-                    ..r.to_body()
-                })
-                .collect();
+            let bodies: Vec<Body> = records.iter().map(|r| r.to_body_as_written()).collect();
             write_snapshot(output, t, &bodies).map_err(io)?;
             let note = if exact {
                 format!(

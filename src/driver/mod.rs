@@ -622,7 +622,8 @@ fn drive<E: Engine>(
 
     let samples = engine.samples();
     let total = samples.len() as u64;
-    let extra_formats = options.formats.with(&engine.scene_formats()).selected();
+    let scene_formats: &[&str] = if engine.scene_vtk() { &["vtk"] } else { &[] };
+    let extra_formats = options.formats.with(scene_formats).selected();
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;

@@ -36,7 +36,7 @@
 //!
 //! # Why a warning and not a stop
 //!
-//! The run driver ([`crate::driver`]) checks every sampled state (every time-series row) and goes on:
+//! The run driver (`driver`) checks every sampled state (every time-series row) and goes on:
 //! an overrun makes the colliding pair's outcome unphysical (deep interpenetration, too little
 //! rebound), but every other pair stays valid, nothing becomes NaN, and an impact campaign loses no
 //! run. Each overrun sample is appended (and flushed) to `barrier_overruns.csv` as it is found, so a

@@ -129,6 +129,15 @@ pub struct BodyRecord {
 }
 
 impl BodyRecord {
+    /// The body of this record exactly as written: its quaternion not renormalised (what the run's state held, so
+    /// that views and conversions of a snapshot repeat the run's own numbers).
+    pub fn to_body_as_written(&self) -> Body {
+        Body {
+            quaternion: crate::math::Vec4::from(self.quaternion),
+            ..self.to_body()
+        }
+    }
+
     /// The body of this record, its quaternion normalised (no other check: validate the values first).
     pub fn to_body(&self) -> Body {
         Body {

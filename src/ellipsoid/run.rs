@@ -497,22 +497,14 @@ impl Engine for EllipsoidEngine {
             particles: records
                 .iter()
                 .enumerate()
-                .map(|(id, r)| {
-                    let mut b = r.to_body();
-                    b.quaternion = crate::math::Vec4::from(r.quaternion);
-                    particle_view(id, &b)
-                })
+                .map(|(id, r)| particle_view(id, &r.to_body_as_written()))
                 .collect(),
             ..Default::default()
         })
     }
 
-    fn scene_formats(&self) -> Vec<&'static str> {
-        if self.scene.file.output.vtk {
-            vec!["vtk"]
-        } else {
-            Vec::new()
-        }
+    fn scene_vtk(&self) -> bool {
+        self.scene.file.output.vtk
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

@@ -105,7 +105,7 @@ pub struct SceneFile {
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
     /// What is simulated. Required; `"ellipsoids"` (the Roig03 interacting-ellipsoids model) here;
-    /// `"soft-spheres"` scenes are read by [`crate::granular::soft::scene`] instead.
+    /// `"soft-spheres"` scenes are read by `granular::soft::scene` instead.
     pub kind: String,
     /// End time of the run (s), > 0. Required. The run starts at t = 0.
     pub t_end: f64,

@@ -1,4 +1,4 @@
-//! The contract between a physics engine and the one run driver ([`crate::driver`]).
+//! The contract between a physics engine and the one run driver (`driver`).
 //!
 //! An engine (the ellipsoids of Roig03, the soft spheres of Zhang17, the hard spheres of Richardson11) knows its
 //! state, how to advance it to a time, and what its outputs look like: the columns of `timeseries.csv`, the rows of a
@@ -20,7 +20,7 @@ use serde::de::DeserializeOwned;
 pub use schedule::{Sample, Schedule};
 
 /// One particle of a snapshot, the same for every engine, for output formats that know no engine
-/// ([`crate::driver::formats`]).
+/// (`driver::formats`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParticleView {
     /// Index in the scene.
@@ -82,7 +82,7 @@ pub struct NamedSurface {
 }
 
 /// Everything a snapshot shows, the same for every engine: the particles, and the contact network and surfaces of
-/// the engines that have them. Output formats ([`crate::driver::formats`]) and pictures read only this.
+/// the engines that have them. Output formats (`driver::formats`) and pictures read only this.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SnapshotView {
     /// Simulated time (s).
@@ -299,9 +299,9 @@ pub trait Engine: Sized {
     /// contacts and walls recomputed for the snapshot's state and time. Does not change the engine.
     fn view_of_snapshot(&self, path: &Path) -> Result<SnapshotView, EngineError>;
 
-    /// The extra snapshot formats the scene itself asks for (e.g. `"vtk"` for `[output] vtk = true`).
-    fn scene_formats(&self) -> Vec<&'static str> {
-        Vec::new()
+    /// Whether the scene itself asks for VTK snapshots (`[output] vtk = true`).
+    fn scene_vtk(&self) -> bool {
+        false
     }
 
     /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).

@@ -7,7 +7,7 @@
 //! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution).
 //!
 //! The canonical test problems and the work–precision measurements that exercise these solvers live in
-//! [`crate::bench`].
+//! `bench`.
 
 pub mod bulirsch_stoer;
 pub mod elliptic;

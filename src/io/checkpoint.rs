@@ -1,5 +1,5 @@
 //! Names of the checkpoint files in a run directory. The checkpoint itself (an envelope written by the run driver
-//! around the engine's state) is described in [`crate::driver`]; its bit-exact floats in [`crate::bits`].
+//! around the engine's state) is described in `driver`; its bit-exact floats in [`crate::bits`].
 
 /// Name of the checkpoint file in a run directory.
 pub const CHECKPOINT_FILE: &str = "checkpoint.json";

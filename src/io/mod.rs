@@ -1,6 +1,6 @@
 //! The engine-independent floor of file input and output: lossless float formatting ([`fmt_f64`]), the checkpoint
 //! file names ([`checkpoint`]), and the scene-file reading, parsing and field checks every engine's scene uses
-//! ([`scene_file`]). Each engine's own output formats live with the engine (e.g. [`crate::ellipsoid::output`]).
+//! ([`scene_file`]). Each engine's own output formats live with the engine (e.g. `ellipsoid::output`).
 //!
 //! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific notation), so a
 //! snapshot re-read as an input file gives the same `f64`s bit for bit.

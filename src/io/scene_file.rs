@@ -135,7 +135,7 @@ pub fn peek_kind(text: &str) -> Option<String> {
 }
 
 /// Parses TOML into any scene-file model `T` (each engine has its own) with the same one-line messages as
-/// [`crate::ellipsoid::scene::parse_toml`].
+/// `ellipsoid::scene::parse_toml`.
 pub fn parse_toml_as<T: serde::de::DeserializeOwned>(text: &str, name: &str) -> Result<T, SceneError> {
     let de = toml::Deserializer::parse(text).map_err(|e| SceneError::Syntax {
         file: name.to_string(),

@@ -77,7 +77,7 @@ impl Formats {
     }
 
     /// These formats and those named in `names` (names known to be registered, e.g. from
-    /// [`crate::engine::Engine::scene_formats`]).
+    /// [`crate::engine::Engine::scene_vtk`]).
     pub fn with(self, names: &[&str]) -> Formats {
         let all = registered();
         let bits = names

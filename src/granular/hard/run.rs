@@ -1,4 +1,4 @@
-//! The hard-sphere engine as the run driver ([`crate::driver`]) sees it: `timeseries.csv` in [`TIMESERIES_COLUMNS`]
+//! The hard-sphere engine as the run driver (`driver`) sees it: `timeseries.csv` in [`TIMESERIES_COLUMNS`]
 //! (flushed row by row), `snapshots/<k>.csv` in the particles-file columns, `summary.json` as [`HardRunSummary`]
 //! (status, wall_seconds, energy error, collision count, events per second, max overlap, absorbed count) and, on
 //! failure, `last_good_state.csv` with the cause in the summary. Checkpoints ([`HardState`]) continue bit for bit
@@ -454,12 +454,8 @@ impl Engine for HardEngine {
         })
     }
 
-    fn scene_formats(&self) -> Vec<&'static str> {
-        if self.scene.file.output.vtk {
-            vec!["vtk"]
-        } else {
-            Vec::new()
-        }
+    fn scene_vtk(&self) -> bool {
+        self.scene.file.output.vtk
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

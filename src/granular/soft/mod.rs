@@ -7,7 +7,7 @@
 //!   every `k` steps (multiple time stepping);
 //! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
 //!   [`scene`]: the `kind = "soft-spheres"`
-//!   scene file; [`run`]: the engine as the run driver sees it (outputs, checkpoint state); [`crate::driver::branch`]: a run continued from another's
+//!   scene file; [`run`]: the engine as the run driver sees it (outputs, checkpoint state); `driver::branch`: a run continued from another's
 //!   checkpoint under a new scene; [`spinup`]: the `[spinup]` forcing
 //!   (Zhang17 §2.3.4).
 

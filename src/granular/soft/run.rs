@@ -1,4 +1,4 @@
-//! The soft-sphere engine as the run driver ([`crate::driver`]) sees it (`rubblepile run` on a `kind = "soft-spheres"`
+//! The soft-sphere engine as the run driver (`driver`) sees it (`rubblepile run` on a `kind = "soft-spheres"`
 //! scene): the output contract of the crate adapted to spheres.
 //!
 //! Files in the output directory:
@@ -15,8 +15,8 @@
 //!   radius of the contact at that step;
 //! - `snapshots/<k>.csv`: `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (usable as a `particles_file`);
 //! - `summary.json` ([`SoftSummary`]), `last_good_state.csv` on failure, `checkpoint.json` when due;
-//! - with a `[spinup]` table: `spinup.csv`, one row of [`crate::analysis::spinup_diagnostics`] per time-series
-//!   row; the forcing ([`crate::granular::soft::spinup`]) acts after every step.
+//! - with a `[spinup]` table: `spinup.csv`, one row of `analysis::spinup_diagnostics` per time-series
+//!   row; the forcing (`granular::soft::spinup`) acts after every step.
 //!
 //! Checkpoints hold every particle's state, the last forces and torques (leapfrog needs them), the spring
 //! histories and the bookkeeping, all as exact f64 bit patterns, so `rubblepile resume` continues bit for bit.
@@ -689,8 +689,8 @@ impl Engine for SoftEngine {
         })
     }
 
-    fn scene_formats(&self) -> Vec<&'static str> {
-        if self.scene.vtk { vec!["vtk"] } else { Vec::new() }
+    fn scene_vtk(&self) -> bool {
+        self.scene.vtk
     }
 
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64> {

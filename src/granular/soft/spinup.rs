@@ -124,7 +124,7 @@ pub struct SpinupSection {
 }
 
 /// Which particles the interior packing fraction η_B is taken over
-/// ([`crate::analysis::spinup_diagnostics`]).
+/// (`analysis::spinup_diagnostics`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum InteriorRule {
     /// Closed cells, less every particle within 10 % of the sum of the radii from a particle with an open cell
@@ -324,7 +324,7 @@ impl crate::io::scene_file::Validator<'_> {
 }
 
 /// Membership of the central body: the largest-mass set of particles connected by the pair contacts `contacts`
-/// (`(i, j)` keys, as [`crate::granular::soft::forces::SoftSystem::pair_springs`] after a force evaluation); ties go
+/// (`(i, j)` keys, as `granular::soft::forces::SoftSystem::pair_springs` after a force evaluation); ties go
 /// to the set holding the lowest index.
 pub fn central_body<'a>(particles: &[Particle], contacts: impl Iterator<Item = &'a (usize, usize)>) -> Vec<bool> {
     let n = particles.len();

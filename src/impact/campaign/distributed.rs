@@ -1,5 +1,5 @@
 //! Where a campaign runs: on this machine's threads ([`run_campaign`]), or, when the process was started by
-//! `mpirun` and rubblepile was built with the `mpi` cargo feature, over MPI ranks ([`super::mpi`]): rank 0 hands
+//! `mpirun` and rubblepile was built with the `mpi` cargo feature, over MPI ranks (`campaign::mpi`, feature `mpi`): rank 0 hands
 //! runs out one at a time and keeps `campaign.csv`, the other ranks run them. The default build needs no MPI; a
 //! default build started by `mpirun` with several ranks refuses to run (every rank would run the whole grid into
 //! the same directories) and says how to build with MPI.
