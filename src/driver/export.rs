@@ -94,8 +94,27 @@ pub fn visit_snapshots(
         visit: &mut dyn FnMut(usize, SnapshotView) -> Result<(), ExportError>,
         engine_err: &dyn Fn(EngineError) -> ExportError,
     ) -> Result<(), ExportError> {
+        // A long run's snapshots take a while to read and draw: a bar on a terminal, nothing otherwise.
+        let pb = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
+            let pb = indicatif::ProgressBar::with_draw_target(
+                Some(files.len() as u64),
+                indicatif::ProgressDrawTarget::stderr(),
+            );
+            if let Ok(style) =
+                indicatif::ProgressStyle::with_template("[{elapsed_precise}] {wide_bar} {pos}/{len} snapshots")
+            {
+                pb.set_style(style);
+            }
+            pb
+        });
         for (k, path) in files {
             visit(*k, engine.view_of_snapshot(path).map_err(engine_err)?)?;
+            if let Some(pb) = &pb {
+                pb.inc(1);
+            }
+        }
+        if let Some(pb) = pb {
+            pb.finish_and_clear();
         }
         Ok(())
     }
