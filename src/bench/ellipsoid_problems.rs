@@ -6,9 +6,9 @@
 //! | problem | bodies | physics | reference |
 //! |---|---|---|---|
 //! | [`WorkPrecisionProblem::Top`] | 1 ellipsoid | none (torque-free) | analytic body-frame ω ([`torque_free_spin`]) |
-//! | [`WorkPrecisionProblem::Pair`] | 2 ellipsoids, G = 1, one bounce | gravity + contact | another method at 1e-13 |
-//! | [`WorkPrecisionProblem::PairDissipative`] | the same | + dissipation, F0 = 0.1 | another method at 1e-13 |
-//! | [`WorkPrecisionProblem::N30`] | `targets/N30_T4.csv` + projectile P1 | SI gravity + contact + dissipation | another method at 1e-13 |
+//! | [`WorkPrecisionProblem::Pair`] | 2 ellipsoids, G = 1, one bounce | gravity + contact | another method at 1e-14 |
+//! | [`WorkPrecisionProblem::PairDissipative`] | the same | + dissipation, F0 = 0.1 | another method at 1e-14 |
+//! | [`WorkPrecisionProblem::N30`] | `targets/N30_T4.csv` + projectile P1 | SI gravity + contact + dissipation | another method at 1e-14 |
 //! | [`NBodyProblem::Pythagorean`] | 3 point masses (tiny spheres), G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
 //! | [`NBodyProblem::OuterSolar`] | Sun + 4 giants, G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
 //!

@@ -83,7 +83,8 @@ fn integrate_timed(
     setting: &Setting,
 ) -> Result<(Vec<f64>, Stats, f64, f64), IntegrateError> {
     let tol = setting.tolerance.unwrap_or(1e-6);
-    let mut integ = make_integrator(setting.method, Tolerances::uniform(tol, tol, y0.len()), setting.step)?;
+    let mut integ = make_integrator(setting.method, Tolerances::scale_free(tol, tol, system), setting.step)?;
+    integ.set_span(t_end);
     let (mut t, mut y) = (0.0, y0.to_vec());
     let cpu_start = thread_cpu_seconds();
     let start = Instant::now();

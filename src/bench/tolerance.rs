@@ -2,7 +2,7 @@
 //! error follow `rtol`? On the canonical problems (the free top with its analytic reference; the bouncing pair,
 //! conservative and dissipative; the N30 impact; the Pythagorean three-body problem; the outer Solar System), each
 //! method runs once per `rtol = atol` from 1e-6 to 1e-12 and the error (as in `bench work-precision`, against a
-//! reference by a different method at 1e-13) is divided by `rtol`. A tolerance means what it says when
+//! reference by a different method at 1e-14) is divided by `rtol`. A tolerance means what it says when
 //! `error_over_tol` stays of order one, at most 100, and the error falls monotonically as `rtol` does.
 //! Writes `tolerance.csv` and prints, per problem and method, the worst `error_over_tol` at `rtol ≥ 1e-11` and
 //! whether the error is monotone.

@@ -40,7 +40,7 @@ pub const SHORT_RUN_BUDGET_SECONDS: f64 = 0.25;
 /// Default tolerances of the sweep: `rtol = atol = 10⁻⁴ … 10⁻¹²`, one per decade.
 pub const DEFAULT_TOLERANCES: [f64; 9] = [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12];
 /// Default tolerance of the reference runs.
-pub const DEFAULT_REFERENCE_TOLERANCE: f64 = 1e-13;
+pub const DEFAULT_REFERENCE_TOLERANCE: f64 = 1e-14;
 
 /// What one run integrates with: a method and its tolerance (`rtol = atol`) or, for Rk4, its fixed step.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -111,7 +111,8 @@ pub fn run_once(problem: &ProblemSetup, setting: &Setting) -> Result<RunOutcome,
     let system = &problem.system;
     let mut y = problem.initial_state();
     let tol = setting.tolerance.unwrap_or(1e-6);
-    let mut integ = make_integrator(setting.method, Tolerances::uniform(tol, tol, y.len()), setting.step)?;
+    let mut integ = make_integrator(setting.method, Tolerances::scale_free(tol, tol, system), setting.step)?;
+    integ.set_span(problem.t_end);
     let d0 = system.diagnostics(&y);
     let mut t = 0.0;
     let mut wall = 0.0;

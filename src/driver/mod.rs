@@ -51,8 +51,9 @@ pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
 pub use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 /// The `format` tag of a checkpoint.
 pub const CHECKPOINT_FORMAT: &str = "rubblepile-checkpoint";
-/// The checkpoint layout this build writes and reads (1: one layout per engine, before the one driver).
-pub const CHECKPOINT_VERSION: u32 = 2;
+/// The checkpoint layout this build writes and reads (1: one layout per engine, before the one driver; 2: before
+/// the scale-free error norm and error-per-unit-step control, whose step-size state means another norm).
+pub const CHECKPOINT_VERSION: u32 = 3;
 
 /// Default wall-clock checkpoint cadence (s) of [`RunOptions::default`] and of the command line: runs shorter than
 /// this never write a checkpoint.
@@ -435,8 +436,9 @@ fn read_checkpoint<E: Engine>(dir: &Path) -> Result<Checkpoint<E::State>, RunErr
     }
     if header.version != Some(CHECKPOINT_VERSION) {
         return Err(RunError::BadCheckpoint(format!(
-            "{}: version {} (this build reads version {CHECKPOINT_VERSION}; version 1 was written by an older \
-             rubblepile, before the one run driver): re-run the scene from the start",
+            "{}: version {} was written by an older rubblepile (this build reads version {CHECKPOINT_VERSION}; version \
+             1 predates the one run driver, version 2 the scale-free error norm of the integrator): re-run the scene \
+             from the start",
             path.display(),
             header.version.map_or("missing".to_string(), |v| v.to_string())
         )));

@@ -559,6 +559,30 @@ impl OdeSystem for EllipsoidSystem {
         self.n_bodies() * self.stride + usize::from(self.physics.dissipation.is_some())
     }
 
+    /// User units of the state blocks (see [`OdeSystem::state_units`]): `r` 1 (m), `q` 1 (an attitude error of
+    /// `δq` is about `2 δq` rad), `u` the body's mass `m` (kg, so the norm sees m/s), `p` twice the mean principal
+    /// moment `2 (I₁ + I₂ + I₃)/3` (kg m², since `p = 2 W(q)ᵀ (I ω, 0)` has `|p| ≈ 2 I |ω|`: the norm sees rad/s),
+    /// and `∫F dt` the initial energy scale `K + |U_C| + |U_G|` (J, so the dissipated energy is judged relative
+    /// to the system's energy; 1 J if that is zero).
+    fn state_units(&self) -> Option<Vec<f64>> {
+        let mut units = vec![1.0; self.dim()];
+        for (i, chunk) in units.chunks_exact_mut(self.stride).enumerate() {
+            let m = self.shapes[i].mass;
+            if self.rotation {
+                let moments = self.moments[i];
+                chunk[7..10].fill(m);
+                chunk[10..14].fill(2.0 * (moments.x + moments.y + moments.z) / 3.0);
+            } else {
+                chunk[3..6].fill(m);
+            }
+        }
+        if let Some(idx) = self.dissipation_index() {
+            let scale = self.diagnostics(&self.initial_state()).energy_scale;
+            units[idx] = if scale.is_finite() && scale > 0.0 { scale } else { 1.0 };
+        }
+        Some(units)
+    }
+
     fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
         let n = self.n_bodies();
         if !self.rotation && !self.needs_pairs() && n < BLOCKED_FROM {

@@ -257,12 +257,14 @@ impl EllipsoidEngine {
     pub fn new(scene: LoadedScene) -> Result<Self, EngineError> {
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
         let settings = scene.integrator;
-        let integrator = make_integrator(
+        let mut integrator = make_integrator(
             settings.method,
-            Tolerances::uniform(settings.rtol, settings.atol, system.dim()),
+            Tolerances::scale_free(settings.rtol, settings.atol, &system),
             settings.step,
         )
         .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
+        // The error budget is the run's: rtol bounds the accumulated error, not each step's.
+        integrator.set_span(scene.t_end);
         let y = system.initial_state();
         let tracker = ErrorTracker::new(&system.diagnostics(&y));
         let barrier = BarrierMonitor::new(

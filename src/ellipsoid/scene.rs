@@ -205,10 +205,16 @@ pub struct IntegratorSection {
     /// (adaptive Dormand–Prince) or `"rk4"` (fixed step; needs `step`). Default `"bulirsch-stoer"`.
     #[serde(default = "default_method")]
     pub method: Method,
-    /// Relative tolerance per state component (dimensionless, > 0). Default 1e-10.
+    /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
+    /// is judged in the units a user thinks in (position in m, velocity in m/s, spin in rad/s, attitude as a
+    /// unit quaternion, dissipated energy relative to the initial energy scale), whatever its mass. With
+    /// `"bulirsch-stoer"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
+    /// quarter of it (error per unit step), so the final error follows `rtol`; the other methods apply it to each
+    /// step.
     #[serde(default = "default_tolerance")]
     pub rtol: f64,
-    /// Absolute tolerance per state component (SI units of the component, ≥ 0). Default 1e-10.
+    /// Absolute tolerance (≥ 0). Default 1e-10. In the user units above: m for positions, m/s for velocities,
+    /// rad/s for spins (the integrator scales it by each body's mass and moment of inertia).
     #[serde(default = "default_tolerance")]
     pub atol: f64,
     /// Step (s, > 0): the fixed step for `"rk4"` (required there), an initial step guess for the

@@ -24,7 +24,7 @@ use crate::ellipsoid::equations::{
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
-use crate::integrate::{IntegrateError, Method, OdeSystem, Tolerances, make_integrator};
+use crate::integrate::{IntegrateError, Method, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};
 use crate::random::{Generator, generator, point_in_ball, random_quaternion, uniform};
 use std::f64::consts::PI;
@@ -305,7 +305,7 @@ fn relax_round(
     let mut y = system.initial_state();
     let mut integrator = make_integrator(
         Method::BulirschStoer,
-        Tolerances::uniform(spec.rtol, spec.rtol, system.dim()),
+        Tolerances::scale_free(spec.rtol, spec.rtol, &system),
         None,
     )?;
     let d0 = system.diagnostics(&y);

@@ -21,6 +21,15 @@ pub trait OdeSystem: Sync {
     fn dim(&self) -> usize;
     /// Writes `f(t, y)` into `dydt` (both of length [`OdeSystem::dim`]).
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]);
+    /// The *user unit* of each state component, in the component's own units: how much of the component one
+    /// unit of the quantity a user thinks in amounts to. A momentum `u = m v` has unit `m` (so one unit is
+    /// 1 m/s of velocity), a conjugate quaternion momentum has `2 I` (one unit is 1 rad/s of spin), a position or
+    /// a quaternion has 1. [`Tolerances::scale_free`] multiplies `atol` by these, so that the error norm
+    /// measures every block in user units and a tolerance means the same for a light and a heavy body.
+    /// `None` (the default): every component is its own user unit.
+    fn state_units(&self) -> Option<Vec<f64>> {
+        None
+    }
 }
 
 /// Which integrator runs a system (the scene's `[integrator] method`).
@@ -54,6 +63,11 @@ impl fmt::Display for Method {
 /// The error of a step is measured in the scaled RMS norm
 /// `err = sqrt( (1/n) Σ_i (e_i / (atol_i + rtol_i · max(|y_i(t)|, |y_i(t+h)|)))² )`
 /// and a step is accepted when `err ≤ 1`.
+///
+/// **Scale-free norm.** [`Tolerances::scale_free`] sets `atol_i = atol · unit_i` with the system's
+/// [`OdeSystem::state_units`]. Dividing numerator and denominator by `unit_i` shows that this is the same norm
+/// applied to the state expressed in user units (`e_i / unit_i` against `atol + rtol |y_i / unit_i|`): the
+/// relative part is unit-free anyway, and the absolute part then reads in m, m/s, rad/s, … whatever the masses.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tolerances {
     /// Relative tolerance per component (dimensionless, > 0).
@@ -63,6 +77,33 @@ pub struct Tolerances {
 }
 
 impl Tolerances {
+    /// The scale-free tolerances of `system`: `rtol` for every component and `atol` in user units, i.e.
+    /// `atol_i = atol · unit_i` with [`OdeSystem::state_units`] (uniform when the system gives none).
+    ///
+    /// ```
+    /// use rubblepile::integrate::{OdeSystem, Tolerances};
+    /// /// A particle of mass 1e6 kg on a line: state (x, u = m v).
+    /// struct Heavy;
+    /// impl OdeSystem for Heavy {
+    ///     fn dim(&self) -> usize { 2 }
+    ///     fn rhs(&self, _t: f64, y: &[f64], d: &mut [f64]) { d[0] = y[1] / 1e6; d[1] = 0.0; }
+    ///     fn state_units(&self) -> Option<Vec<f64>> { Some(vec![1.0, 1e6]) }
+    /// }
+    /// let tol = Tolerances::scale_free(1e-9, 1e-9, &Heavy);
+    /// assert_eq!(tol.atol, vec![1e-9, 1e-3]); // 1e-9 m and 1e-9 m/s
+    /// assert_eq!(tol.rtol, vec![1e-9, 1e-9]);
+    /// ```
+    pub fn scale_free(rtol: f64, atol: f64, system: &dyn OdeSystem) -> Self {
+        let n = system.dim();
+        match system.state_units() {
+            Some(units) if units.len() == n => Tolerances {
+                rtol: vec![rtol; n],
+                atol: units.iter().map(|u| atol * u).collect(),
+            },
+            _ => Tolerances::uniform(rtol, atol, n),
+        }
+    }
+
     /// The same `rtol` and `atol` for all `n` components.
     pub fn uniform(rtol: f64, atol: f64, n: usize) -> Self {
         Tolerances {
@@ -188,6 +229,11 @@ pub trait Integrator {
     ) -> Result<(), IntegrateError>;
     /// Cumulative statistics.
     fn stats(&self) -> Stats;
+    /// Tells the integrator the span of the whole run (s), so that a method that can control the error per unit
+    /// step does (Bulirsch–Stoer; see its module docs): the local errors of the run then add up to a share of
+    /// the tolerance instead of one tolerance per step. A span that is not positive and finite switches it
+    /// off. The default does nothing (the `ode_solvers` methods control the error per step).
+    fn set_span(&mut self, _span: f64) {}
     /// Which method this is.
     fn method(&self) -> Method;
     /// Everything that influences later calls to [`Integrator::advance`] (see [`IntegratorState`]).

@@ -2,9 +2,13 @@
 //! cross-checks against [`super::bulirsch_stoer`].
 //!
 //! Notes on how the crate is driven (read from `ode_solvers` 0.6.2):
-//! * **Scalar tolerances.** `ode_solvers` accepts one `rtol` and one `atol` for all components; the
-//!   adapter uses the *minimum* over the components of each vector (the most demanding), so every
-//!   component is integrated at least as accurately as requested.
+//! * **Scalar tolerances.** `ode_solvers` accepts one `rtol` and one `atol` for all components. When `rtol`
+//!   is the same for every component and only `atol` varies (the scale-free tolerances of
+//!   [`Tolerances::scale_free`]), the adaptive methods integrate the rescaled state `z_i = y_i / c_i`,
+//!   `c_i = atol_i / min_j atol_j`, with the scalar pair `(rtol, min atol)`: its error norm is then exactly the
+//!   per-component norm of `y` (numerator and denominator both scale by `c_i`). Otherwise the adapter uses the
+//!   *minimum* over the components of each vector (the most demanding), so every component is integrated at
+//!   least as accurately as requested.
 //! * **Output.** The solvers are run with `OutputType::Sparse`, which records the state after every
 //!   accepted step (the dense-output mode is unreliable for our purpose: it interpolates at
 //!   multiples of `dx` and, near the end point, extrapolates; its `dx` is ignored in sparse mode).
@@ -38,7 +42,7 @@ use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Save
 use crate::bits::{exact_f64, exact_f64_opt};
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dop853, Dopri5, OutputType, Rk4, System};
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 
 /// Default per-chunk memory budget for stored step states (bytes).
 const CHUNK_BYTES: usize = 64 << 20;
@@ -53,13 +57,31 @@ struct Wrapped<'a> {
     time_in_state: bool,
     evals: &'a Cell<u64>,
     nonfinite: &'a Cell<bool>,
+    /// Per-component state scale `c` (the solver sees `z = y / c`) and a buffer for `y`.
+    units: Option<(&'a [f64], &'a RefCell<Vec<f64>>)>,
 }
 
 impl System<f64, DVector<f64>> for Wrapped<'_> {
     fn system(&self, x: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
         self.evals.set(self.evals.get() + 1);
         let dydt = dy.as_mut_slice();
-        if self.time_in_state {
+        if let Some((c, buffer)) = self.units {
+            // y = c z; dz/dt = f(y) / c (Dop853 carries τ as the last component, with c = 1 implied).
+            let mut yb = buffer.borrow_mut();
+            let n = c.len();
+            let z = y.as_slice();
+            for ((v, &zi), &ci) in yb.iter_mut().zip(z).zip(c) {
+                *v = zi * ci;
+            }
+            let time = if self.time_in_state { z[n] } else { x };
+            self.system.rhs(time, &yb, &mut dydt[..n]);
+            for (d, &ci) in dydt[..n].iter_mut().zip(c) {
+                *d /= ci;
+            }
+            if self.time_in_state {
+                dydt[n] = 1.0;
+            }
+        } else if self.time_in_state {
             let y = y.as_slice();
             let n = y.len() - 1;
             self.system.rhs(y[n], &y[..n], &mut dydt[..n]);
@@ -96,6 +118,8 @@ pub struct OdeSolversAdapter {
     method: Method,
     rtol: f64,
     atol: f64,
+    /// `c_i = atol_i / atol` when only `atol` varies between components (see the module docs).
+    units: Option<Vec<f64>>,
     n_tol: usize,
     step: Option<f64>,
     /// Step to start the next call with (adaptive methods); 0 = automatic.
@@ -175,10 +199,15 @@ impl OdeSolversAdapter {
             }
             _ => {}
         }
+        let uniform_rtol = tolerances.rtol.iter().all(|&r| r == rtol);
+        let units: Option<Vec<f64>> = (uniform_rtol && atol > 0.0)
+            .then(|| tolerances.atol.iter().map(|&a| a / atol).collect::<Vec<f64>>())
+            .filter(|c| c.iter().any(|&ci| ci != 1.0));
         Ok(OdeSolversAdapter {
             method,
             rtol,
             atol,
+            units,
             n_tol: tolerances.rtol.len(),
             step: step.map(f64::abs),
             h_next: if method == Method::Rk4 {
@@ -246,14 +275,27 @@ impl OdeSolversAdapter {
         let mut x = *t;
         // Dop853 integrates (y, τ), see the module docs.
         let time_in_state = self.method == Method::Dop853;
+        let units = self.units.clone();
+        let buffer = RefCell::new(vec![0.0; n]);
+        // The solver's state: z = y / c (or y itself), then τ for Dop853.
+        let mut z: Vec<f64> = match &units {
+            Some(c) => y.iter().zip(c).map(|(yi, ci)| yi / ci).collect(),
+            None => y.to_vec(),
+        };
+        let to_user = |z: &[f64], y: &mut [f64]| match &units {
+            Some(c) => {
+                for ((yi, &zi), &ci) in y.iter_mut().zip(z).zip(c) {
+                    *yi = zi * ci;
+                }
+            }
+            None => y.copy_from_slice(&z[..y.len()]),
+        };
         let (rtol, atol, mut state) = if time_in_state {
             let c = (n as f64 / (n + 1) as f64).sqrt();
-            let mut v = DVector::zeros(n + 1);
-            v.as_mut_slice()[..n].copy_from_slice(y);
-            v[n] = x;
-            (self.rtol * c, self.atol * c, v)
+            z.push(x);
+            (self.rtol * c, self.atol * c, DVector::from_vec(z))
         } else {
-            (self.rtol, self.atol, DVector::from_column_slice(y))
+            (self.rtol, self.atol, DVector::from_vec(z))
         };
         let mut steps: u64 = 0;
         let dir = if t_target > x { 1.0 } else { -1.0 };
@@ -273,6 +315,7 @@ impl OdeSolversAdapter {
                 time_in_state,
                 evals: &evals,
                 nonfinite: &nonfinite,
+                units: units.as_deref().map(|c| (c, &buffer)),
             };
             let h0 = dir * self.h_next;
             let evals_before = evals.get();
@@ -356,7 +399,7 @@ impl OdeSolversAdapter {
             }
             match res {
                 Ok(_) if finite_end => {
-                    y.copy_from_slice(&state.as_slice()[..n]);
+                    to_user(&state.as_slice()[..n], y);
                     *t = t_target;
                     break Ok(());
                 }
@@ -391,7 +434,7 @@ impl OdeSolversAdapter {
         if result.is_err() {
             // Leave the caller at the last accepted state.
             *t = x;
-            y.copy_from_slice(&state.as_slice()[..n]);
+            to_user(&state.as_slice()[..n], y);
         }
         result
     }
@@ -438,6 +481,7 @@ impl OdeSolversAdapter {
                 time_in_state: false,
                 evals: &evals,
                 nonfinite: &nonfinite,
+                units: None,
             };
             let mut s = Rk4::new(f, 0.0, state.clone(), m as f64, 1.0);
             // Rk4::integrate never fails.

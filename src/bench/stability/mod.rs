@@ -30,7 +30,7 @@ use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::equations::EllipsoidSystem;
 use crate::ellipsoid::output::read_bodies_csv;
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
-use crate::integrate::{OdeSystem, Tolerances, make_integrator};
+use crate::integrate::{Tolerances, make_integrator};
 use crate::math::{Vec3, Vec4};
 
 /// Columns of `stability.csv`.
@@ -133,9 +133,10 @@ impl CaseRun {
         let scene = &self.scene;
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
         let settings = scene.integrator;
-        let tolerances = Tolerances::uniform(settings.rtol, settings.atol, system.dim());
+        let tolerances = Tolerances::scale_free(settings.rtol, settings.atol, &system);
         let mut integrator =
             make_integrator(settings.method, tolerances, settings.step).map_err(|e| format!("integrator: {e}"))?;
+        integrator.set_span(scene.t_end);
         let beta = BarrierSettings::for_kappa_source(&scene.kappa_source).beta;
         let (mut t, mut y) = (0.0, system.initial_state());
         let (mut ratio, mut sep) = (0.0_f64, 1.0_f64);
