@@ -100,6 +100,18 @@ impl Grid {
         let reach = r + r_ref;
         let lo = self.key(&(c - Vec3::from_element(reach)));
         let hi = self.key(&(c + Vec3::from_element(reach)));
+        // A sphere far larger than the cells (a wild trial state of the integrator can give one) would walk more
+        // cell rows than there are bodies: scanning the bodies is then cheaper, and finishes.
+        let rows = (hi[0] as f64 - lo[0] as f64 + 1.0) * (hi[1] as f64 - lo[1] as f64 + 1.0);
+        if !(rows <= self.keys.len() as f64) {
+            for m in 0..self.keys.len() {
+                let reach_ij = r + self.radii[m];
+                if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
+                    visit(self.ids[m]);
+                }
+            }
+            return;
+        }
         for kz in lo[0]..=hi[0] {
             for ky in lo[1]..=hi[1] {
                 let run = match &self.dense {
@@ -233,6 +245,20 @@ mod tests {
             assert!(!brute.is_empty());
             assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
         }
+    }
+
+    /// A sphere of radius 1e12 cells (an integrator's wild trial state: an attitude quaternion of huge norm) among
+    /// a pile: the search finishes at once (it used to walk 1e24 cell rows) and finds the brute-force pairs.
+    #[test]
+    fn huge_sphere_scans_the_bodies_instead_of_the_cells() {
+        let mut next = uniform(7);
+        let n = 300;
+        let centres: Vec<Vec3> = (0..n).map(|_| Vec3::new(next(), next(), next()) * 20.0).collect();
+        let mut radii: Vec<f64> = (0..n).map(|_| 0.5 + 0.3 * next()).collect();
+        radii[17] = 1e12;
+        let pairs = sphere_pairs(&centres, &radii);
+        assert_eq!(pairs, brute_force_pairs(&centres, &radii));
+        assert_eq!(pairs.iter().filter(|p| p.0 == 17 || p.1 == 17).count(), n - 1);
     }
 
     /// Both ways of finding a cell run give the brute-force pairs: the dense start table on a compact pile, the
