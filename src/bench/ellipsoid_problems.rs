@@ -38,6 +38,8 @@ use crate::math::{Vec3, Vec4};
 /// The N30_T4 target of Roig03 §3 (`targets/N30_T4.csv`), embedded so the problem does not depend on the
 /// working directory.
 pub const N30_T4_CSV: &str = include_str!("../../targets/N30_T4.csv");
+/// The N200_T4 target (the Roig03 campaign's), embedded so the problem needs no files.
+pub const N200_T4_CSV: &str = include_str!("../../targets/N200_T4.csv");
 
 /// The problems of `rubblepile bench work-precision --problem`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -50,15 +52,19 @@ pub enum WorkPrecisionProblem {
     PairDissipative,
     /// The N30_T4 target hit by projectile P1 (5 km/s, 45°), SI units, gravity + contact + dissipation.
     N30,
+    /// The N200_T4 target hit by projectile P2 (5 km/s, 45°) as in the Roig03 campaign (F0 = 1e-6 s m⁻²), to
+    /// 400 s: the impact and the first 310 s of ejection.
+    N200,
 }
 
 impl WorkPrecisionProblem {
     /// All problems, in `--problem` order.
-    pub const ALL: [WorkPrecisionProblem; 4] = [
+    pub const ALL: [WorkPrecisionProblem; 5] = [
         WorkPrecisionProblem::Top,
         WorkPrecisionProblem::Pair,
         WorkPrecisionProblem::PairDissipative,
         WorkPrecisionProblem::N30,
+        WorkPrecisionProblem::N200,
     ];
 
     /// The `--problem` value, e.g. `"pair-dissipative"`.
@@ -68,6 +74,7 @@ impl WorkPrecisionProblem {
             WorkPrecisionProblem::Pair => "pair",
             WorkPrecisionProblem::PairDissipative => "pair-dissipative",
             WorkPrecisionProblem::N30 => "n30",
+            WorkPrecisionProblem::N200 => "n200",
         }
     }
 
@@ -78,6 +85,7 @@ impl WorkPrecisionProblem {
             WorkPrecisionProblem::Pair => bouncing_pair(None),
             WorkPrecisionProblem::PairDissipative => bouncing_pair(Some(PAIR_F0)),
             WorkPrecisionProblem::N30 => n30_impact(),
+            WorkPrecisionProblem::N200 => n200_impact(),
         }
     }
 }
@@ -350,6 +358,52 @@ pub fn n30_impact() -> ProblemSetup {
         t_end: N30_T_END,
         energy_samples: 12,
         rk4_steps: vec![0.2, 0.1, 0.05, 0.02, 0.01, 0.005],
+        reference: ReferenceKind::Numerical,
+    }
+}
+
+/// End time of the N200 impact (s).
+pub const N200_T_END: f64 = 400.0;
+
+/// The N200_T4 target ([`N200_T4_CSV`]) hit by projectile P2 at ζ = 45°, placed to touch at t = 90 s, as the
+/// Roig03 campaign runs it (κ calibrated with β = 10, F0 = 1e-6 s m⁻², SI gravity + contact + dissipation), to
+/// t = 400 s, where the campaign measures its outcomes. 201 bodies, 2815 state components.
+pub fn n200_impact() -> ProblemSetup {
+    let target: Vec<Body> = crate::ellipsoid::output::read_bodies(N200_T4_CSV.as_bytes())
+        .expect("the embedded N200_T4 target parses")
+        .iter()
+        .map(crate::ellipsoid::output::BodyRecord::to_body)
+        .collect();
+    let projectile = ProjectileSpec::preset("P2").expect("P2 is a preset");
+    let cfg = crate::impact::run::ImpactConfig::new("targets/N200_T4.csv".into(), projectile.clone());
+    let kappa = cfg.kappa(&target).expect("N200 + P2 calibrates");
+    let (bodies, _) = set_up_impact(&target, &projectile, cfg.angle_deg, cfg.contact_time, cfg.seed);
+    let model = ModelConfig {
+        kappa,
+        inertia: InertiaModel::Gaussian,
+        contact_g: G_SI,
+    };
+    let physics = Physics {
+        gravity: Some(GravityTerm { g: G_SI }),
+        contact: Some(ContactTerm::default()),
+        dissipation: Some(DissipationTerm { f0: cfg.f0 }),
+    };
+    let system = EllipsoidSystem::new(&bodies, model, physics);
+    ProblemSetup {
+        name: "n200",
+        description: format!(
+            "N200_T4 target + projectile P2 (5 km/s, {} deg, contact at t = {} s), SI, kappa = {kappa:.4}, gravity + \
+             contact + dissipation F0 = {:e} s/m^2, {} bodies, t = 0..{N200_T_END} s",
+            cfg.angle_deg,
+            cfg.contact_time,
+            cfg.f0,
+            bodies.len()
+        ),
+        bodies,
+        system,
+        t_end: N200_T_END,
+        energy_samples: 8,
+        rk4_steps: vec![0.05, 0.02],
         reference: ReferenceKind::Numerical,
     }
 }

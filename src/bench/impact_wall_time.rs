@@ -1,5 +1,5 @@
 //! `rubblepile bench impact`: the wall-clock time of whole impact runs (Roig03 §3), for the speed goal of the
-//! N200_T4 + P2, ζ = 45°, 10 000 s run at rtol 1e-9, across dissipation coefficients and thread counts.
+//! N200_T4 + P2, ζ = 45°, 10 000 s run at the impact default rtol (1e-6 over the run), across dissipation coefficients and thread counts.
 //!
 //! Each configuration is a complete [`run_impact`] into a scratch directory under `--out` (removed afterwards
 //! unless `--keep-runs`); the row reports its wall time beside its energy error, as every run does.
@@ -28,7 +28,7 @@ pub struct ImpactBenchArgs {
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
     /// Bulirsch–Stoer tolerance (rtol = atol).
-    #[arg(long, default_value_t = 1e-9)]
+    #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
     pub rtol: f64,
     /// Dissipation coefficients F0 (s m⁻²), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1e-6")]

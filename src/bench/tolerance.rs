@@ -1,6 +1,7 @@
 //! `rubblepile bench tolerance`: tolerance proportionality of the adaptive integrators — does the final-state
 //! error follow `rtol`? On the canonical problems (the free top with its analytic reference; the bouncing pair,
-//! conservative and dissipative; the N30 impact; the Pythagorean three-body problem; the outer Solar System), each
+//! conservative and dissipative; the N30 impact; the N200 impact to 400 s; the Pythagorean three-body problem; the
+//! outer Solar System), each
 //! method runs once per `rtol = atol` from 1e-6 to 1e-12 and the error (as in `bench work-precision`, against a
 //! reference by a different method at 1e-14) is divided by `rtol`. A tolerance means what it says when
 //! `error_over_tol` stays of order one, at most 100, and the error falls monotonically as `rtol` does.
@@ -27,7 +28,7 @@ pub struct ToleranceArgs {
     /// Methods, comma-separated (default bulirsch-stoer,dop853).
     #[arg(long, value_enum, value_delimiter = ',', value_name = "METHOD")]
     pub methods: Option<Vec<Method>>,
-    /// Problems, comma-separated, from top, pair, pair-dissipative, n30, pythagorean, outer-solar (default all).
+    /// Problems, comma-separated, from top, pair, pair-dissipative, n30, n200, pythagorean, outer-solar (default all).
     #[arg(long, value_delimiter = ',', value_name = "PROBLEM")]
     pub problems: Option<Vec<String>>,
 }
@@ -45,6 +46,7 @@ pub fn problems() -> Vec<NamedProblem> {
         ("pair", || WorkPrecisionProblem::Pair.setup()),
         ("pair-dissipative", || WorkPrecisionProblem::PairDissipative.setup()),
         ("n30", || WorkPrecisionProblem::N30.setup()),
+        ("n200", || WorkPrecisionProblem::N200.setup()),
         ("pythagorean", || NBodyProblem::Pythagorean.setup()),
         ("outer-solar", || NBodyProblem::OuterSolar.setup()),
     ]

@@ -40,7 +40,7 @@ pub struct ImpactArgs {
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
     /// Relative (and absolute) tolerance of Bulirsch–Stoer.
-    #[arg(long, default_value_t = 1e-9)]
+    #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
     pub rtol: f64,
     /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is the value closest to Roig03's outcomes in
     /// analysis/roig2003/F0_SCAN.md (the paper does not give its F0).
