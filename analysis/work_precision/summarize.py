@@ -14,7 +14,7 @@ import math
 import os
 import sys
 
-PROBLEMS = ["top", "pair", "pair_dissipative", "n30"]
+PROBLEMS = ["top", "pair", "pair_dissipative", "n30", "n200"]
 METHODS = ["bulirsch-stoer", "dop853", "dopri5", "rk4"]
 
 
