@@ -13,7 +13,9 @@
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
-use crate::ellipsoid::gravity::{BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_forces};
+use crate::ellipsoid::gravity::{
+    BLOCKED_FROM, add_gravity_blocks, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
+};
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
@@ -25,6 +27,7 @@ use crate::geometry::neighbours::sphere_pairs;
 use crate::integrate::OdeSystem;
 use crate::math::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
+use std::sync::Arc;
 
 /// SI gravitational constant (m³ kg⁻¹ s⁻²), the default of `gravity = { G = … }`.
 pub const G_SI: f64 = 6.674e-11;
@@ -118,6 +121,8 @@ struct Kinematics {
     r: Vec3,
     q: Vec4,
     u: Vec3,
+    /// `ṙ = u/m` (m/s).
+    velocity: Vec3,
     p: Vec4,
     q_dot: Vec4,
     /// `M(q)⁻¹` (zero when attitudes are not integrated).
@@ -142,6 +147,28 @@ struct PairTerms {
     /// `F_ij` (W).
     dissipation: f64,
 }
+
+/// A candidate pair of the neighbour search with its constants, which depend only on the two bodies: computed
+/// once when the candidate list is built instead of at every evaluation (the prefactor costs an `exp`).
+#[derive(Debug, Clone, Copy)]
+struct CandidatePair {
+    i: usize,
+    j: usize,
+    /// `U0_ij m_i m_j (κ/π)^{3/2}` (J m³), see [`pair_prefactor`].
+    prefactor: f64,
+    /// The far-pair taper ([`EllipsoidSystem::pair_taper`]).
+    taper: Taper,
+}
+
+/// Below this many candidate pairs the cull and pair terms run serially: the work does not pay for waking the
+/// thread pool.
+const PARALLEL_CANDIDATES: usize = 512;
+
+/// Candidates per parallel task at least (a culled candidate costs a few ns, a kept one ~100 ns).
+const CANDIDATES_PER_TASK: usize = 64;
+
+/// From this many bodies on, the per-body passes (kinematics, gravity blocks, body rates) run in parallel.
+const PARALLEL_BODIES: usize = 64;
 
 /// The N-ellipsoid system.
 pub struct EllipsoidSystem {
@@ -175,17 +202,18 @@ struct PairCache {
     positions: Vec<Vec3>,
     radii: Vec<f64>,
     skins: Vec<f64>,
-    candidates: Vec<(usize, usize)>,
+    /// Shared with the evaluations that use it, so that none copies it or holds the lock while using it.
+    candidates: Arc<Vec<CandidatePair>>,
 }
 
 impl PairCache {
-    fn build(centres: &[Vec3], radii: &[f64]) -> Self {
+    fn build(centres: &[Vec3], radii: &[f64], candidate: impl Fn((usize, usize)) -> CandidatePair) -> Self {
         let skins: Vec<f64> = radii.iter().map(|r| PAIR_SKIN_FRACTION * r).collect();
         let grown: Vec<f64> = radii.iter().zip(&skins).map(|(r, s)| r + s).collect();
         PairCache {
             positions: centres.to_vec(),
             radii: radii.to_vec(),
-            candidates: sphere_pairs(centres, &grown),
+            candidates: Arc::new(sphere_pairs(centres, &grown).into_iter().map(candidate).collect()),
             skins,
         }
     }
@@ -290,6 +318,7 @@ impl EllipsoidSystem {
                 r,
                 q,
                 u,
+                velocity: u / self.shapes[i].mass,
                 p,
                 q_dot,
                 m_inv,
@@ -301,10 +330,12 @@ impl EllipsoidSystem {
             let b = &self.initial[i];
             let q = b.quaternion.normalize();
             let spin_world = rotation_matrix(&q).transpose() * b.spin_body;
+            let u = Vec3::new(s[3], s[4], s[5]);
             Kinematics {
                 r,
                 q,
-                u: Vec3::new(s[3], s[4], s[5]),
+                u,
+                velocity: u / self.shapes[i].mass,
                 p: Vec4::zeros(),
                 q_dot: Vec4::zeros(),
                 m_inv: Mat4::zeros(),
@@ -318,7 +349,7 @@ impl EllipsoidSystem {
 
     fn all_kinematics(&self, y: &[f64], with_geometry: bool) -> Vec<Kinematics> {
         let n = self.n_bodies();
-        if n >= 64 {
+        if n >= PARALLEL_BODIES {
             (0..n)
                 .into_par_iter()
                 .map(|i| self.kinematics(i, y, with_geometry))
@@ -332,33 +363,49 @@ impl EllipsoidSystem {
         self.physics.contact.is_some() || self.physics.dissipation.is_some()
     }
 
-    /// Candidate pairs that are not provably negligible (bounding-sphere search, then the exact bound).
-    fn interacting_pairs(&self, kin: &[Kinematics]) -> Vec<(usize, usize)> {
+    /// Candidate pairs of the bounding-sphere search (the cached Verlet list when it covers the state), with their
+    /// constants; [`Self::pair_terms`] applies the exact cull.
+    fn candidate_pairs(&self, kin: &[Kinematics]) -> Arc<Vec<CandidatePair>> {
         let kappa = self.model.kappa;
         let centres: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
         let radii: Vec<f64> = kin
             .iter()
             .map(|k| interaction_radius(kappa, k.geometry.as_ref().expect("geometry"), self.cull_exp))
             .collect();
-        let mut pairs = {
-            // A poisoned lock only means another thread panicked mid-update: rebuild.
-            let mut cache = self.pair_cache.lock().unwrap_or_else(|e| e.into_inner());
-            let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
-            if !finite {
-                // Not a state to remember (the integrator will reject it): the plain search.
-                sphere_pairs(&centres, &radii)
-            } else {
-                if !cache.as_ref().is_some_and(|c| c.covers(&centres, &radii)) {
-                    *cache = Some(PairCache::build(&centres, &radii));
-                }
-                cache.as_ref().map(|c| c.candidates.clone()).unwrap_or_default()
+        let candidate = |(i, j): (usize, usize)| self.candidate_pair(i, j);
+        // A poisoned lock only means another thread panicked mid-update: rebuild.
+        let mut cache = self.pair_cache.lock().unwrap_or_else(|e| e.into_inner());
+        let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
+        if !finite {
+            // Not a state to remember (the integrator will reject it): the plain search.
+            return Arc::new(sphere_pairs(&centres, &radii).into_iter().map(candidate).collect());
+        }
+        match cache.as_ref() {
+            Some(c) if c.covers(&centres, &radii) => Arc::clone(&c.candidates),
+            _ => {
+                let fresh = PairCache::build(&centres, &radii, candidate);
+                let candidates = Arc::clone(&fresh.candidates);
+                *cache = Some(fresh);
+                candidates
             }
-        };
-        pairs.retain(|&(i, j)| {
-            let (gi, gj) = (kin[i].geometry.as_ref().unwrap(), kin[j].geometry.as_ref().unwrap());
-            !is_negligible(kappa, &(kin[i].r - kin[j].r), gi, gj, self.pair_taper(i, j).end)
-        });
-        pairs
+        }
+    }
+
+    /// The state-independent constants of pair `(i, j)`.
+    fn candidate_pair(&self, i: usize, j: usize) -> CandidatePair {
+        CandidatePair {
+            i,
+            j,
+            prefactor: pair_prefactor(
+                self.model.contact_g,
+                self.model.kappa,
+                self.radii[i],
+                self.shapes[i].mass,
+                self.radii[j],
+                self.shapes[j].mass,
+            ),
+            taper: self.pair_taper(i, j),
+        }
     }
 
     /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
@@ -370,19 +417,23 @@ impl EllipsoidSystem {
         }
     }
 
-    fn pair_terms(&self, i: usize, j: usize, kin: &[Kinematics], with_forces: bool) -> PairTerms {
+    /// The terms of a candidate pair, or `None` when it provably contributes nothing: culled by the bound of
+    /// [`is_negligible`], or (for the forces, `with_forces`) beyond its taper's end, where the potential, its
+    /// gradients and the dissipation are all zeros (skipping them leaves every sum's bits unchanged; the
+    /// diagnostics keep such pairs so that their sums stay exactly as they were).
+    fn pair_terms(&self, c: &CandidatePair, kin: &[Kinematics], with_forces: bool) -> Option<PairTerms> {
         let kappa = self.model.kappa;
+        let (i, j) = (c.i, c.j);
         let (ki, kj) = (&kin[i], &kin[j]);
         let (gi, gj) = (ki.geometry.as_ref().unwrap(), kj.geometry.as_ref().unwrap());
-        let prefactor = pair_prefactor(
-            self.model.contact_g,
-            kappa,
-            self.radii[i],
-            self.shapes[i].mass,
-            self.radii[j],
-            self.shapes[j].mass,
-        );
-        let ov = overlap(prefactor, kappa, &(ki.r - kj.r), gi, gj, &self.pair_taper(i, j));
+        let delta = ki.r - kj.r;
+        if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
+            return None;
+        }
+        let ov = overlap(c.prefactor, kappa, &delta, gi, gj, &c.taper);
+        if with_forces && ov.exponent >= c.taper.end {
+            return None;
+        }
         let mut t = PairTerms {
             i,
             j,
@@ -405,11 +456,11 @@ impl EllipsoidSystem {
         }
         if let Some(d) = self.physics.dissipation {
             let vi = BodyVelocity {
-                velocity: ki.u / self.shapes[i].mass,
+                velocity: ki.velocity,
                 spin_world: ki.spin_world,
             };
             let vj = BodyVelocity {
-                velocity: kj.u / self.shapes[j].mass,
+                velocity: kj.velocity,
                 spin_world: kj.spin_world,
             };
             let pd = pair_dissipation(d.f0, kappa, &ov, gi, gj, &vi, &vj);
@@ -420,25 +471,26 @@ impl EllipsoidSystem {
                 t.gq_j += spin_force_to_quaternion(&kj.q, gj, &pd.d_wj);
             }
         }
-        t
+        Some(t)
     }
 
+    /// The terms of the interacting pairs, in candidate (sorted) order whatever the number of threads.
     fn all_pair_terms(&self, kin: &[Kinematics], with_forces: bool) -> Vec<PairTerms> {
         if !self.needs_pairs() {
             return Vec::new();
         }
-        let pairs = self.interacting_pairs(kin);
-        // Below a few hundred pairs the work per pair does not pay for waking the thread pool.
-        if pairs.len() >= 256 {
-            pairs
+        let candidates = self.candidate_pairs(kin);
+        let terms = |c: &CandidatePair| self.pair_terms(c, kin, with_forces);
+        // The exact cull runs in the same parallel pass as the pair terms (one fork-join, not two); rayon's
+        // collect keeps the candidates' order.
+        if candidates.len() >= PARALLEL_CANDIDATES {
+            candidates
                 .par_iter()
-                .map(|&(i, j)| self.pair_terms(i, j, kin, with_forces))
+                .with_min_len(CANDIDATES_PER_TASK)
+                .filter_map(terms)
                 .collect()
         } else {
-            pairs
-                .iter()
-                .map(|&(i, j)| self.pair_terms(i, j, kin, with_forces))
-                .collect()
+            candidates.iter().filter_map(terms).collect()
         }
     }
 
@@ -600,7 +652,22 @@ impl OdeSystem for EllipsoidSystem {
             }
             return;
         }
-        let kin = self.all_kinematics(y, self.needs_pairs());
+        let positions = || -> Vec<Vec3> {
+            y.chunks_exact(self.stride)
+                .take(n)
+                .map(|s| Vec3::new(s[0], s[1], s[2]))
+                .collect()
+        };
+        // From BLOCKED_FROM bodies on, the gravity blocks (positions only) are computed in the same parallel
+        // section as the kinematics and added after the pair forces, in the order of `add_gravity_forces`.
+        let blocked_gravity = self.physics.gravity.filter(|_| n >= BLOCKED_FROM);
+        let gravity_blocks = || blocked_gravity.map(|gr| gravity_blocks(gr.g, &positions(), &self.masses));
+        let kinematics = || self.all_kinematics(y, self.needs_pairs());
+        let (kin, blocks) = if n >= PARALLEL_BODIES {
+            rayon::join(kinematics, gravity_blocks)
+        } else {
+            (kinematics(), gravity_blocks())
+        };
         let mut force = vec![Vec3::zeros(); n];
         let mut gq = vec![Vec4::zeros(); n];
         let mut dissipation_rate = 0.0;
@@ -611,16 +678,16 @@ impl OdeSystem for EllipsoidSystem {
             gq[t.j] += t.gq_j;
             dissipation_rate += t.dissipation;
         }
-        if let Some(gr) = self.physics.gravity {
-            let pos: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
-            add_gravity_forces(gr.g, &pos, &self.masses, &mut force);
+        match (self.physics.gravity, blocks) {
+            (_, Some(blocks)) => add_gravity_blocks(&blocks, &mut force),
+            (Some(gr), None) => add_gravity_forces(gr.g, &positions(), &self.masses, &mut force),
+            (None, None) => {}
         }
         let stride = self.stride;
         let rotation = self.rotation;
         let body_rate = |(i, out): (usize, &mut [f64])| {
             let k = &kin[i];
-            let v = k.u / self.shapes[i].mass;
-            out[0..3].copy_from_slice(v.as_slice());
+            out[0..3].copy_from_slice(k.velocity.as_slice());
             if rotation {
                 let ie = &self.inertia_ext[i];
                 let m_inv = k.m_inv;
@@ -635,7 +702,7 @@ impl OdeSystem for EllipsoidSystem {
             }
         };
         let (bodies, rest) = dydt.split_at_mut(n * stride);
-        if n >= 64 {
+        if n >= PARALLEL_BODIES {
             bodies.par_chunks_mut(stride).enumerate().for_each(body_rate);
         } else {
             bodies.chunks_mut(stride).enumerate().for_each(body_rate);

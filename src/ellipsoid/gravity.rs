@@ -91,16 +91,29 @@ pub fn add_gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &m
         half_loop(g, positions, masses, 0..n, forces);
         return;
     }
+    add_gravity_blocks(&gravity_blocks(g, positions, masses), forces);
+}
+
+/// The blocked half loop of [`add_gravity_forces`] (for [`BLOCKED_FROM`] bodies or more) without the final
+/// sum: one force buffer per block, computed in parallel. Split from [`add_gravity_blocks`] so that a caller can
+/// compute the blocks before (or while) it computes the forces they are added to; adding them later with
+/// [`add_gravity_blocks`] gives the bits of [`add_gravity_forces`].
+pub fn gravity_blocks(g: f64, positions: &[Vec3], masses: &[f64]) -> Vec<Vec<Vec3>> {
+    let n = positions.len();
     let bounds = block_bounds(n);
-    let partial: Vec<Vec<Vec3>> = (0..BLOCKS)
+    (0..BLOCKS)
         .into_par_iter()
         .map(|b| {
             let mut out = vec![Vec3::zeros(); n];
             half_loop(g, positions, masses, bounds[b]..bounds[b + 1], &mut out);
             out
         })
-        .collect();
-    for block in &partial {
+        .collect()
+}
+
+/// Adds the buffers of [`gravity_blocks`] to `forces`, in block order.
+pub fn add_gravity_blocks(blocks: &[Vec<Vec3>], forces: &mut [Vec3]) {
+    for block in blocks {
         for (f, p) in forces.iter_mut().zip(block) {
             *f += p;
         }

@@ -31,6 +31,8 @@ pub struct BodyGeometry {
     pub sigma: Mat3,
     /// `∂R/∂q_k`, k = α, β, γ, δ.
     pub d_rot: [Mat3; 4],
+    /// `diag(A², B², C²) R` (m²), shared by `Σ` and every pair's quaternion gradient.
+    pub axes_rot: Mat3,
     /// `(A², B², C²)` (m²).
     pub axes_sq: Vec3,
     /// An upper bound on the largest eigenvalue of `Σ` (m²), used by far-pair culling:
@@ -43,14 +45,15 @@ impl BodyGeometry {
     pub fn new(axes: &Vec3, q: &Vec4) -> Self {
         let rot = rotation_matrix(q);
         let axes_sq = axes.component_mul(axes);
-        let d_rot_x = Mat3::from_diagonal(&axes_sq) * rot;
-        let sigma = rot.transpose() * d_rot_x;
+        let axes_rot = Mat3::from_diagonal(&axes_sq) * rot;
+        let sigma = rot.transpose() * axes_rot;
         let q2 = q.norm_squared();
         let stretch = q2 + (q2 - 1.0).abs();
         BodyGeometry {
             rot,
             sigma,
             d_rot: rotation_matrix_derivatives(q),
+            axes_rot,
             axes_sq,
             sigma_bound: axes_sq.x * stretch * stretch,
         }
@@ -126,9 +129,8 @@ pub fn overlap(
     taper: &Taper,
 ) -> Overlap {
     let g = gi.sigma + gj.sigma;
-    let det = g.determinant();
     // G is symmetric positive definite for any non-degenerate bodies; the closed-form 3×3 inverse is exact enough.
-    let g_inv = g.try_inverse().unwrap_or_else(|| Mat3::from_element(f64::NAN));
+    let (det, g_inv) = determinant_and_inverse(&g);
     let y = g_inv * delta;
     let exponent = kappa * delta.dot(&y);
     let amplitude = prefactor / det.sqrt();
@@ -144,6 +146,34 @@ pub fn overlap(
     }
 }
 
+/// `det(m)` and `m⁻¹` (NaN where `det(m) = 0`) by cofactors, sharing the minors that nalgebra's
+/// `determinant` and `try_inverse` would each compute (with the same operations in the same order, so the bits
+/// are theirs): the determinant is needed by every pair's amplitude, the inverse by its exponent.
+fn determinant_and_inverse(m: &Mat3) -> (f64, Mat3) {
+    let (m11, m12, m13) = (m[(0, 0)], m[(0, 1)], m[(0, 2)]);
+    let (m21, m22, m23) = (m[(1, 0)], m[(1, 1)], m[(1, 2)]);
+    let (m31, m32, m33) = (m[(2, 0)], m[(2, 1)], m[(2, 2)]);
+    let minor_m12_m23 = m22 * m33 - m32 * m23;
+    let minor_m11_m23 = m21 * m33 - m31 * m23;
+    let minor_m11_m22 = m21 * m32 - m31 * m22;
+    let det = m11 * minor_m12_m23 - m12 * minor_m11_m23 + m13 * minor_m11_m22;
+    if det == 0.0 {
+        return (det, Mat3::from_element(f64::NAN));
+    }
+    let inv = Mat3::new(
+        minor_m12_m23 / det,
+        (m13 * m32 - m33 * m12) / det,
+        (m12 * m23 - m22 * m13) / det,
+        -minor_m11_m23 / det,
+        (m11 * m33 - m31 * m13) / det,
+        (m13 * m21 - m23 * m11) / det,
+        minor_m11_m22 / det,
+        (m12 * m31 - m32 * m11) / det,
+        (m11 * m22 - m21 * m12) / det,
+    );
+    (det, inv)
+}
+
 /// Gradients of `U_C` with respect to the positions and quaternions of a pair.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactGradient {
@@ -157,7 +187,7 @@ pub struct ContactGradient {
 
 /// `∂U_C/∂q` of one body of the pair, `2 U_C ⟨D R S, ∂R/∂q_k⟩_F`.
 fn quaternion_gradient(u: f64, s: &Mat3, body: &BodyGeometry) -> Vec4 {
-    let x = Mat3::from_diagonal(&body.axes_sq) * body.rot * s;
+    let x = body.axes_rot * s;
     let mut out = Vec4::zeros();
     for k in 0..4 {
         out[k] = 2.0 * u * x.dot(&body.d_rot[k]);
