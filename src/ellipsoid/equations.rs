@@ -18,6 +18,7 @@ use crate::ellipsoid::gravity::{
 };
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
+    overlap_within_taper,
 };
 use crate::ellipsoid::quaternion::{
     extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin, rotation_matrix,
@@ -430,10 +431,11 @@ impl EllipsoidSystem {
         if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
             return None;
         }
-        let ov = overlap(c.prefactor, kappa, &delta, gi, gj, &c.taper);
-        if with_forces && ov.exponent >= c.taper.end {
-            return None;
-        }
+        let ov = if with_forces {
+            overlap_within_taper(c.prefactor, kappa, &delta, gi, gj, &c.taper)?
+        } else {
+            overlap(c.prefactor, kappa, &delta, gi, gj, &c.taper)
+        };
         let mut t = PairTerms {
             i,
             j,

@@ -19,7 +19,7 @@
 //! (it drove Bulirsch–Stoer to step-size underflow when a non-spinning projectile came within range).
 //! With the taper: `∂U/∂Δ = −2κ U (T − T′) G⁻¹Δ` and `S = −½ T G⁻¹ + κ (T − T′) y yᵀ`, `U = U_raw T`.
 
-use crate::ellipsoid::quaternion::{rotation_matrix, rotation_matrix_derivatives};
+use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::{Mat3, Vec3, Vec4};
 
 /// Per-body quantities of one state that every pair involving the body reuses.
@@ -29,8 +29,8 @@ pub struct BodyGeometry {
     pub rot: Mat3,
     /// `Σ = Rᵀ diag(A², B², C²) R` (m²), the world-frame covariance shape of the body.
     pub sigma: Mat3,
-    /// `∂R/∂q_k`, k = α, β, γ, δ.
-    pub d_rot: [Mat3; 4],
+    /// The attitude `q` (its `∂R/∂q_k` are linear in it, see [`quaternion_gradient`]).
+    pub q: Vec4,
     /// `diag(A², B², C²) R` (m²), shared by `Σ` and every pair's quaternion gradient.
     pub axes_rot: Mat3,
     /// `(A², B², C²)` (m²).
@@ -52,7 +52,7 @@ impl BodyGeometry {
         BodyGeometry {
             rot,
             sigma,
-            d_rot: rotation_matrix_derivatives(q),
+            q: *q,
             axes_rot,
             axes_sq,
             sigma_bound: axes_sq.x * stretch * stretch,
@@ -110,6 +110,8 @@ pub struct Overlap {
     pub amplitude: f64,
     /// `κ Δᵀ G⁻¹ Δ` (dimensionless).
     pub exponent: f64,
+    /// `U_raw = amplitude · exp(−x)` (J), the untapered potential (not `U / T`: `T` is 0 beyond the taper).
+    pub potential_raw: f64,
     /// `U_C` (J), tapered: `U_raw · T(x)`.
     pub potential: f64,
     /// `T(x)`.
@@ -128,19 +130,51 @@ pub fn overlap(
     gj: &BodyGeometry,
     taper: &Taper,
 ) -> Overlap {
+    let (g_inv, det, y, exponent) = overlap_exponent(kappa, delta, gi, gj);
+    finish_overlap(prefactor, taper, g_inv, det, y, exponent)
+}
+
+/// [`overlap`] for a pair whose exponent is below its taper's end, else `None`: beyond the end the potential,
+/// its gradients and the dissipation weight are all exactly zero, and the `exp`, square root and division of
+/// the amplitude are not worth computing. The same bits as [`overlap`] where it returns a value.
+pub fn overlap_within_taper(
+    prefactor: f64,
+    kappa: f64,
+    delta: &Vec3,
+    gi: &BodyGeometry,
+    gj: &BodyGeometry,
+    taper: &Taper,
+) -> Option<Overlap> {
+    let (g_inv, det, y, exponent) = overlap_exponent(kappa, delta, gi, gj);
+    // (a NaN exponent is kept, so that a broken state still shows in the forces)
+    if exponent >= taper.end {
+        return None;
+    }
+    Some(finish_overlap(prefactor, taper, g_inv, det, y, exponent))
+}
+
+/// `G⁻¹`, `det G`, `y = G⁻¹Δ` and the exponent `x = κ Δ·y` of a pair.
+fn overlap_exponent(kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: &BodyGeometry) -> (Mat3, f64, Vec3, f64) {
     let g = gi.sigma + gj.sigma;
     // G is symmetric positive definite for any non-degenerate bodies; the closed-form 3×3 inverse is exact enough.
     let (det, g_inv) = determinant_and_inverse(&g);
     let y = g_inv * delta;
     let exponent = kappa * delta.dot(&y);
+    (g_inv, det, y, exponent)
+}
+
+/// The rest of [`overlap`] once the exponent is known.
+fn finish_overlap(prefactor: f64, taper: &Taper, g_inv: Mat3, det: f64, y: Vec3, exponent: f64) -> Overlap {
     let amplitude = prefactor / det.sqrt();
     let (t, t_slope) = taper.value_and_slope(exponent);
+    let potential_raw = amplitude * (-exponent).exp();
     Overlap {
         g_inv,
         y,
         amplitude,
         exponent,
-        potential: amplitude * (-exponent).exp() * t,
+        potential_raw,
+        potential: potential_raw * t,
         taper: t,
         taper_slope: t_slope,
     }
@@ -186,19 +220,79 @@ pub struct ContactGradient {
 }
 
 /// `∂U_C/∂q` of one body of the pair, `2 U_C ⟨D R S, ∂R/∂q_k⟩_F`.
+///
+/// `∂R/∂q_k` ([`crate::ellipsoid::quaternion::rotation_matrix_derivatives`]) is linear in `q` with a few zero
+/// entries; each Frobenius product is written out over its non-zero entries, in the column-major order (and
+/// from the `0.0` start) of nalgebra's `dot`, so the bits are those of `x.dot(&d_rot[k])`: a skipped term is
+/// `x·0 = ±0`, which leaves a sum that started at +0 unchanged. The factors `2·(2a)`, `2·(−d)` … are the exact
+/// entries of `2 M_k`.
 fn quaternion_gradient(u: f64, s: &Mat3, body: &BodyGeometry) -> Vec4 {
     let x = body.axes_rot * s;
+    let (a, b, g, d) = (body.q.x, body.q.y, body.q.z, body.q.w);
+    let (a2, b2, g2, d2) = (2.0 * a, 2.0 * b, 2.0 * g, 2.0 * d);
+    let (a4, b4, g4, d4) = (2.0 * a2, 2.0 * b2, 2.0 * g2, 2.0 * d2);
+    // Σ over (row, col, entry) in column-major order, starting from +0 as nalgebra's dot does.
+    let frobenius = |terms: &[(usize, usize, f64)]| {
+        let mut sum = 0.0;
+        for &(r, c, m) in terms {
+            sum += x[(r, c)] * m;
+        }
+        sum
+    };
+    let dots = [
+        // 2 [2a b g; b 0 d; g −d 0]
+        frobenius(&[
+            (0, 0, a4),
+            (1, 0, b2),
+            (2, 0, g2),
+            (0, 1, b2),
+            (2, 1, -d2),
+            (0, 2, g2),
+            (1, 2, d2),
+        ]),
+        // 2 [0 a −d; a 2b g; d g 0]
+        frobenius(&[
+            (1, 0, a2),
+            (2, 0, d2),
+            (0, 1, a2),
+            (1, 1, b4),
+            (2, 1, g2),
+            (0, 2, -d2),
+            (1, 2, g2),
+        ]),
+        // 2 [0 d a; −d 0 b; a b 2g]
+        frobenius(&[
+            (1, 0, -d2),
+            (2, 0, a2),
+            (0, 1, d2),
+            (2, 1, b2),
+            (0, 2, a2),
+            (1, 2, b2),
+            (2, 2, g4),
+        ]),
+        // 2 [2d g −b; −g 2d a; b −a 2d]
+        frobenius(&[
+            (0, 0, d4),
+            (1, 0, -g2),
+            (2, 0, b2),
+            (0, 1, g2),
+            (1, 1, d4),
+            (2, 1, -a2),
+            (0, 2, -b2),
+            (1, 2, a2),
+            (2, 2, d4),
+        ]),
+    ];
     let mut out = Vec4::zeros();
     for k in 0..4 {
-        out[k] = 2.0 * u * x.dot(&body.d_rot[k]);
+        out[k] = 2.0 * u * dots[k];
     }
     out
 }
 
 /// Analytic gradients of the contact potential of a pair (see the module doc).
 pub fn contact_gradient(ov: &Overlap, kappa: f64, gi: &BodyGeometry, gj: &BodyGeometry) -> ContactGradient {
-    // The untapered potential from the amplitude and exponent (not U / T: T is 0 beyond the taper).
-    let u_raw = ov.amplitude * (-ov.exponent).exp();
+    let u_raw = ov.potential_raw;
     let (t, dt) = (ov.taper, ov.taper_slope);
     let s = -0.5 * t * ov.g_inv + kappa * (t - dt) * ov.y * ov.y.transpose();
     ContactGradient {
@@ -227,4 +321,35 @@ pub fn is_negligible(kappa: f64, delta: &Vec3, gi: &BodyGeometry, gj: &BodyGeome
 /// `√(a+b) ≤ √a + √b`.
 pub fn interaction_radius(kappa: f64, gi: &BodyGeometry, cull_exp: f64) -> f64 {
     (cull_exp * gi.sigma_bound / kappa).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ellipsoid::quaternion::rotation_matrix_derivatives;
+
+    /// The written-out quaternion gradient has the bits of the Frobenius products with `∂R/∂q_k`.
+    #[test]
+    fn quaternion_gradient_matches_frobenius_products_bitwise() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..200 {
+            let q = Vec4::new(rand(), rand(), rand(), rand()) * 1.1;
+            let axes = Vec3::new(1.0 + rand().abs(), 0.7, 0.5 + 0.1 * rand());
+            let body = BodyGeometry::new(&axes, &q);
+            let s = Mat3::from_fn(|_, _| rand());
+            let u = rand() * 1e3;
+            let got = quaternion_gradient(u, &s, &body);
+            let x = Mat3::from_diagonal(&body.axes_sq) * body.rot * s;
+            let d_rot = rotation_matrix_derivatives(&q);
+            for k in 0..4 {
+                assert_eq!(got[k].to_bits(), (2.0 * u * x.dot(&d_rot[k])).to_bits(), "k = {k}");
+            }
+        }
+    }
 }
