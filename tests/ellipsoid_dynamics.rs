@@ -294,17 +294,16 @@ fn spheres_without_dissipation_skip_rotation() {
     assert_eq!(sys2.dim(), 29);
 }
 
-/// The Verlet list of candidate pairs is a cache only: along a sequence of states where bodies move less and
-/// then far more than the skin (and come back), the RHS of one long-lived system is bit-identical to that of a
-/// system built afresh at each state. Guards the cache's validity test and its rebuilds.
-#[test]
-fn pair_cache_never_changes_the_rhs() {
-    let mut rng = Random::new(77);
+/// A lattice of `counts` rocks 1–2 km in size, spaced so that neighbours are just within reach, with random
+/// attitudes, velocities and spins; gravity, contact and dissipation on.
+fn rock_lattice(
+    rng: &mut Random,
+    counts: [usize; 3],
+) -> (Vec<rubblepile::ellipsoid::body::Body>, ModelConfig, Physics) {
     let mut bodies = Vec::new();
-    // a 4 × 4 × 3 lattice of rocks 1–2 km in size, spaced so that neighbours are just within reach
-    for ix in 0..4 {
-        for iy in 0..4 {
-            for iz in 0..3 {
+    for ix in 0..counts[0] {
+        for iy in 0..counts[1] {
+            for iz in 0..counts[2] {
                 let axes = rng.axes(1000.0, 2000.0);
                 bodies.push(rock(
                     [axes.x, axes.y, axes.z],
@@ -326,6 +325,72 @@ fn pair_cache_never_changes_the_rhs() {
         contact: Some(ContactTerm::default()),
         dissipation: Some(DissipationTerm { f0: 1e-4 }),
     };
+    (bodies, model, physics)
+}
+
+/// The right-hand side of a system large enough for every parallel pass (144 bodies, thousands of candidate
+/// pairs) has the same bits on 1 and 2 threads, and when several threads evaluate the same system at once (the
+/// evaluation reuses buffers held by the system; a caller that finds them in use must not disturb another).
+#[test]
+fn ellipsoid_rhs_bits_do_not_depend_on_threads_or_concurrent_callers() {
+    let mut rng = Random::new(78);
+    let (bodies, model, physics) = rock_lattice(&mut rng, [6, 6, 4]);
+    let system = EllipsoidSystem::new(&bodies, model, physics);
+    let y0 = system.initial_state();
+    let states: Vec<Vec<f64>> = (0..4)
+        .map(|k| {
+            y0.iter()
+                .enumerate()
+                .map(|(i, &v)| {
+                    if i % 14 < 3 {
+                        v + 150.0 * ((i * 7 + k) % 5) as f64
+                    } else {
+                        v
+                    }
+                })
+                .collect()
+        })
+        .collect();
+    let eval = |y: &[f64]| {
+        let mut d = vec![0.0; y.len()];
+        system.rhs(0.0, y, &mut d);
+        d.iter().map(|x| x.to_bits()).collect::<Vec<u64>>()
+    };
+    let on = |threads: usize| -> Vec<Vec<u64>> {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| states.iter().map(|y| eval(y)).collect())
+    };
+    let reference = on(1);
+    assert!(
+        system.diagnostics(&states[0]).potential_contact > 0.0,
+        "the lattice has contacts"
+    );
+    assert_eq!(on(2), reference, "1 and 2 threads");
+    std::thread::scope(|scope| {
+        let handles: Vec<_> = (0..3)
+            .map(|_| scope.spawn(|| (0..5).flat_map(|_| states.iter().map(|y| eval(y))).collect::<Vec<_>>()))
+            .collect();
+        for h in handles {
+            let got = h.join().unwrap();
+            for (k, bits) in got.iter().enumerate() {
+                assert_eq!(
+                    bits,
+                    &reference[k % states.len()],
+                    "concurrent caller, state {}",
+                    k % states.len()
+                );
+            }
+        }
+    });
+}
+
+/// The Verlet list of candidate pairs is a cache only: along a sequence of states where bodies move less and
+/// then far more than the skin (and come back), the RHS of one long-lived system is bit-identical to that of a
+/// system built afresh at each state. Guards the cache's validity test and its rebuilds.
+#[test]
+fn pair_cache_never_changes_the_rhs() {
+    let mut rng = Random::new(77);
+    let (bodies, model, physics) = rock_lattice(&mut rng, [4, 4, 3]);
     let long_lived = EllipsoidSystem::new(&bodies, model, physics);
     let y0 = long_lived.initial_state();
     let stride = (long_lived.dim() - 1) / bodies.len();

@@ -384,7 +384,7 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
         checkpoints: 0,
         timeseries,
     };
-    drive(&mut engine, out_dir, options, start, &identity)
+    on_pool(|| drive(&mut engine, out_dir, options, start, &identity))
 }
 
 /// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
@@ -550,7 +550,7 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         checkpoints: ckpt.checkpoints,
         timeseries,
     };
-    drive(&mut engine, dir, options, start, &identity)
+    on_pool(|| drive(&mut engine, dir, options, start, &identity))
 }
 
 /// Writes `checkpoint` into `dir/checkpoint.json` atomically (temporary file, fsync, rename, directory fsync).
@@ -578,6 +578,18 @@ fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> 
 }
 
 /// The sampling loop shared by [`run`] and [`resume`].
+/// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
+/// worker). An engine's parallel passes are then forked from inside the pool; forked from outside it, every pass
+/// is injected into the pool and the caller sleeps until it ends, which cost 45 µs per right-hand side of the
+/// N200 impact on two threads (212 against 167 µs).
+fn on_pool<R: Send>(op: impl FnOnce() -> R + Send) -> R {
+    if rayon::current_thread_index().is_some() {
+        op()
+    } else {
+        rayon::scope(|_| op())
+    }
+}
+
 fn drive<E: Engine>(
     engine: &mut E,
     out_dir: &Path,
@@ -750,5 +762,20 @@ impl RunReport for AnyReport {
     }
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::on_pool;
+
+    /// The driver's loop runs on a worker of the pool, so that the engines' parallel passes fork from inside it.
+    #[test]
+    fn runs_are_driven_from_a_pool_worker() {
+        assert_eq!(rayon::current_thread_index(), None, "the test thread is not a worker");
+        assert!(on_pool(|| rayon::current_thread_index().is_some()));
+        // already on a worker (of another pool): stays there
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        assert_eq!(pool.install(|| on_pool(|| rayon::current_thread_index())), Some(0));
     }
 }

@@ -14,7 +14,7 @@ use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use crate::ellipsoid::gravity::{
-    BLOCKED_FROM, add_gravity_blocks, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
+    BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
@@ -161,6 +161,25 @@ struct CandidatePair {
     taper: Taper,
 }
 
+/// Candidates per block of the pair pass: each block keeps its interacting pairs in its own reused buffer.
+const PAIR_BLOCK: usize = 64;
+
+/// Buffers of the right-hand side kept between evaluations, so that an evaluation allocates nothing once they
+/// have grown (fresh buffers of ~100 kB per evaluation cost page faults worth ~10 % of it).
+#[derive(Default)]
+struct RhsScratch {
+    kin: Vec<Kinematics>,
+    positions: Vec<Vec3>,
+    /// The interacting pairs of candidate block `b` (candidates `b·PAIR_BLOCK ..`), in candidate order.
+    blocks: Vec<Vec<PairTerms>>,
+    /// Per-block gravity forces ([`gravity_blocks`]).
+    gravity: Vec<Vec<Vec3>>,
+    /// Pair forces per body (N).
+    force: Vec<Vec3>,
+    /// Pair generalised forces on the quaternions per body (J).
+    gq: Vec<Vec4>,
+}
+
 /// Below this many candidate pairs the cull and pair terms run serially: the work does not pay for waking the
 /// thread pool.
 const PARALLEL_CANDIDATES: usize = 512;
@@ -188,6 +207,8 @@ pub struct EllipsoidSystem {
     /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
     /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
     pair_cache: std::sync::Mutex<Option<PairCache>>,
+    /// Buffers reused by [`OdeSystem::rhs`] (an evaluation that finds them in use allocates its own).
+    scratch: std::sync::Mutex<RhsScratch>,
     /// Body masses (kg), contiguous for the gravity sums.
     masses: Vec<f64>,
 }
@@ -247,6 +268,7 @@ impl EllipsoidSystem {
             neg_ln_cutoff: -cutoff.ln(),
             cull_exp: max_cull_exponent(model.kappa, cutoff),
             pair_cache: std::sync::Mutex::new(None),
+            scratch: std::sync::Mutex::new(RhsScratch::default()),
             masses: bodies.iter().map(|b| b.shape.mass).collect(),
         }
     }
@@ -349,14 +371,40 @@ impl EllipsoidSystem {
     }
 
     fn all_kinematics(&self, y: &[f64], with_geometry: bool) -> Vec<Kinematics> {
+        let mut kin = Vec::new();
+        self.kinematics_into(y, with_geometry, &mut kin);
+        kin
+    }
+
+    /// [`Self::kinematics`] of every body into `out` (its allocation reused).
+    fn kinematics_into(&self, y: &[f64], with_geometry: bool, out: &mut Vec<Kinematics>) {
         let n = self.n_bodies();
         if n >= PARALLEL_BODIES {
             (0..n)
                 .into_par_iter()
                 .map(|i| self.kinematics(i, y, with_geometry))
-                .collect()
+                .collect_into_vec(out);
         } else {
-            (0..n).map(|i| self.kinematics(i, y, with_geometry)).collect()
+            out.clear();
+            out.extend((0..n).map(|i| self.kinematics(i, y, with_geometry)));
+        }
+    }
+
+    /// The interacting pairs among `candidates` with their forces, into one reused buffer per block of
+    /// [`PAIR_BLOCK`] candidates (each block culled and evaluated by one task, in candidate order).
+    fn pair_forces_into(&self, candidates: &[CandidatePair], kin: &[Kinematics], blocks: &mut Vec<Vec<PairTerms>>) {
+        blocks.resize_with(candidates.len().div_ceil(PAIR_BLOCK), Vec::new);
+        let block = |(terms, cands): (&mut Vec<PairTerms>, &[CandidatePair])| {
+            terms.clear();
+            terms.extend(cands.iter().filter_map(|c| self.pair_terms(c, kin, true)));
+        };
+        if candidates.len() >= PARALLEL_CANDIDATES {
+            blocks
+                .par_iter_mut()
+                .zip(candidates.par_chunks(PAIR_BLOCK))
+                .for_each(block);
+        } else {
+            blocks.iter_mut().zip(candidates.chunks(PAIR_BLOCK)).for_each(block);
         }
     }
 
@@ -654,40 +702,68 @@ impl OdeSystem for EllipsoidSystem {
             }
             return;
         }
-        let positions = || -> Vec<Vec3> {
-            y.chunks_exact(self.stride)
-                .take(n)
-                .map(|s| Vec3::new(s[0], s[1], s[2]))
-                .collect()
+        // Three parallel passes: the kinematics; the pair terms, summed per body in candidate order, beside the
+        // gravity blocks (both need only the kinematics); per body, the gravity blocks added in block order and the
+        // body's rates. The sums are those of a serial evaluation, whatever the number of threads.
+        let mut own = None;
+        let mut guard = self.scratch.try_lock().ok();
+        let scratch: &mut RhsScratch = match guard.as_deref_mut() {
+            Some(s) => s,
+            None => own.insert(RhsScratch::default()),
         };
-        // From BLOCKED_FROM bodies on, the gravity blocks (positions only) are computed in the same parallel
-        // section as the kinematics and added after the pair forces, in the order of `add_gravity_forces`.
-        let blocked_gravity = self.physics.gravity.filter(|_| n >= BLOCKED_FROM);
-        let gravity_blocks = || blocked_gravity.map(|gr| gravity_blocks(gr.g, &positions(), &self.masses));
-        let kinematics = || self.all_kinematics(y, self.needs_pairs());
-        let (kin, blocks) = if n >= PARALLEL_BODIES {
-            rayon::join(kinematics, gravity_blocks)
-        } else {
-            (kinematics(), gravity_blocks())
-        };
-        let mut force = vec![Vec3::zeros(); n];
-        let mut gq = vec![Vec4::zeros(); n];
+        let RhsScratch {
+            kin,
+            positions,
+            blocks,
+            gravity,
+            force,
+            gq,
+        } = scratch;
+        self.kinematics_into(y, self.needs_pairs(), kin);
+        let kin = &*kin;
+        positions.clear();
+        positions.extend(kin.iter().map(|k| k.r));
         let mut dissipation_rate = 0.0;
-        for t in self.all_pair_terms(&kin, true) {
-            force[t.i] += t.force_i;
-            force[t.j] -= t.force_i;
-            gq[t.i] += t.gq_i;
-            gq[t.j] += t.gq_j;
-            dissipation_rate += t.dissipation;
+        let mut pairs = || {
+            force.clear();
+            force.resize(n, Vec3::zeros());
+            gq.clear();
+            gq.resize(n, Vec4::zeros());
+            if !self.needs_pairs() {
+                return;
+            }
+            self.pair_forces_into(&self.candidate_pairs(kin), kin, blocks);
+            for t in blocks.iter().flatten() {
+                force[t.i] += t.force_i;
+                force[t.j] -= t.force_i;
+                gq[t.i] += t.gq_i;
+                gq[t.j] += t.gq_j;
+                dissipation_rate += t.dissipation;
+            }
+        };
+        // From BLOCKED_FROM bodies on the gravity blocks, added per body below; small systems add the half loop.
+        let blocked_gravity = self.physics.gravity.filter(|_| n >= BLOCKED_FROM);
+        let mut gravity_pass = || match blocked_gravity {
+            Some(gr) => gravity_blocks(gr.g, positions, &self.masses, gravity),
+            None => gravity.clear(),
+        };
+        if n >= PARALLEL_BODIES {
+            rayon::join(pairs, gravity_pass);
+        } else {
+            pairs();
+            gravity_pass();
         }
-        match (self.physics.gravity, blocks) {
-            (_, Some(blocks)) => add_gravity_blocks(&blocks, &mut force),
-            (Some(gr), None) => add_gravity_forces(gr.g, &positions(), &self.masses, &mut force),
-            (None, None) => {}
+        if let (Some(gr), None) = (self.physics.gravity, blocked_gravity) {
+            add_gravity_forces(gr.g, positions, &self.masses, force);
         }
+        let (force, gq, gravity) = (&*force, &*gq, &*gravity);
         let stride = self.stride;
         let rotation = self.rotation;
         let body_rate = |(i, out): (usize, &mut [f64])| {
+            let mut force = force[i];
+            for block in gravity {
+                force += block[i];
+            }
             let k = &kin[i];
             out[0..3].copy_from_slice(k.velocity.as_slice());
             if rotation {
@@ -697,10 +773,10 @@ impl OdeSystem for EllipsoidSystem {
                 let c = constraint_rhs(&k.q, &k.q_dot, &m_inv, ie);
                 let p_dot = constrained_momentum_rate(&k.q, &g, &m_inv, c);
                 out[3..7].copy_from_slice(k.q_dot.as_slice());
-                out[7..10].copy_from_slice(force[i].as_slice());
+                out[7..10].copy_from_slice(force.as_slice());
                 out[10..14].copy_from_slice(p_dot.as_slice());
             } else {
-                out[3..6].copy_from_slice(force[i].as_slice());
+                out[3..6].copy_from_slice(force.as_slice());
             }
         };
         let (bodies, rest) = dydt.split_at_mut(n * stride);

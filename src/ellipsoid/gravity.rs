@@ -17,20 +17,56 @@ const BLOCKS: usize = 8;
 /// Below this many bodies the half loop runs serially into `forces` directly.
 pub const BLOCKED_FROM: usize = 64;
 
+/// Positions split into coordinate arrays, so that the pair forces of a row vectorise.
+struct Columns {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    z: Vec<f64>,
+}
+
+impl Columns {
+    fn of(positions: &[Vec3]) -> Self {
+        Columns {
+            x: positions.iter().map(|p| p.x).collect(),
+            y: positions.iter().map(|p| p.y).collect(),
+            z: positions.iter().map(|p| p.z).collect(),
+        }
+    }
+
+    fn zeros(n: usize) -> Self {
+        Columns {
+            x: vec![0.0; n],
+            y: vec![0.0; n],
+            z: vec![0.0; n],
+        }
+    }
+}
+
 /// The half loop over rows `rows` (pairs `(i, j)`, `i ∈ rows`, `j > i`), adding `G m_i m_j d/|d|³` to body `i`
-/// and subtracting it from body `j` in `out`. One square root and one division per pair.
-fn half_loop(g: f64, positions: &[Vec3], masses: &[f64], rows: std::ops::Range<usize>, out: &mut [Vec3]) {
-    let n = positions.len();
+/// and subtracting it from body `j` in `out`. One square root and one division per pair, computed for a whole
+/// row first over coordinate arrays (the compiler vectorises that loop), then added pair by pair.
+fn half_loop(g: f64, pos: &Columns, masses: &[f64], rows: std::ops::Range<usize>, out: &mut [Vec3]) {
+    let n = masses.len();
+    let mut f = Columns::zeros(n);
     for i in rows {
-        let (pi, gmi) = (positions[i], g * masses[i]);
-        let mut fi = Vec3::zeros();
-        for j in (i + 1)..n {
-            let d = positions[j] - pi;
-            let r2 = d.norm_squared();
+        let (xi, yi, zi, gmi) = (pos.x[i], pos.y[i], pos.z[i], g * masses[i]);
+        let len = n - i - 1;
+        let (fx, fy, fz) = (&mut f.x[..len], &mut f.y[..len], &mut f.z[..len]);
+        let (xs, ys, zs, ms) = (&pos.x[i + 1..], &pos.y[i + 1..], &pos.z[i + 1..], &masses[i + 1..]);
+        for k in 0..len {
+            let (dx, dy, dz) = (xs[k] - xi, ys[k] - yi, zs[k] - zi);
+            let r2 = dx * dx + dy * dy + dz * dz;
             let inv_r = 1.0 / r2.sqrt();
-            let f = d * (gmi * masses[j] * inv_r * inv_r * inv_r);
-            fi += f;
-            out[j] -= f;
+            let s = gmi * ms[k] * inv_r * inv_r * inv_r;
+            fx[k] = dx * s;
+            fy[k] = dy * s;
+            fz[k] = dz * s;
+        }
+        let mut fi = Vec3::zeros();
+        for (k, o) in out[i + 1..].iter_mut().enumerate() {
+            let fk = Vec3::new(fx[k], fy[k], fz[k]);
+            fi += fk;
+            *o -= fk;
         }
         out[i] += fi;
     }
@@ -88,27 +124,28 @@ pub fn add_gravity_forces_packed(g: f64, y: &[f64], stride: usize, masses: &[f64
 pub fn add_gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &mut [Vec3]) {
     let n = positions.len();
     if n < BLOCKED_FROM {
-        half_loop(g, positions, masses, 0..n, forces);
+        half_loop(g, &Columns::of(positions), masses, 0..n, forces);
         return;
     }
-    add_gravity_blocks(&gravity_blocks(g, positions, masses), forces);
+    let mut blocks = Vec::new();
+    gravity_blocks(g, positions, masses, &mut blocks);
+    add_gravity_blocks(&blocks, forces);
 }
 
 /// The blocked half loop of [`add_gravity_forces`] (for [`BLOCKED_FROM`] bodies or more) without the final
-/// sum: one force buffer per block, computed in parallel. Split from [`add_gravity_blocks`] so that a caller can
-/// compute the blocks before (or while) it computes the forces they are added to; adding them later with
-/// [`add_gravity_blocks`] gives the bits of [`add_gravity_forces`].
-pub fn gravity_blocks(g: f64, positions: &[Vec3], masses: &[f64]) -> Vec<Vec<Vec3>> {
+/// sum, into `blocks` (its buffers reused): one force buffer per block, computed in parallel. Adding the
+/// buffers to the other forces in block order ([`add_gravity_blocks`], or per body) gives the bits of
+/// [`add_gravity_forces`]; split so that a caller can compute the blocks while it computes the other forces.
+pub fn gravity_blocks(g: f64, positions: &[Vec3], masses: &[f64], blocks: &mut Vec<Vec<Vec3>>) {
     let n = positions.len();
     let bounds = block_bounds(n);
-    (0..BLOCKS)
-        .into_par_iter()
-        .map(|b| {
-            let mut out = vec![Vec3::zeros(); n];
-            half_loop(g, positions, masses, bounds[b]..bounds[b + 1], &mut out);
-            out
-        })
-        .collect()
+    let columns = Columns::of(positions);
+    blocks.resize_with(BLOCKS, Vec::new);
+    blocks.par_iter_mut().enumerate().for_each(|(b, out)| {
+        out.clear();
+        out.resize(n, Vec3::zeros());
+        half_loop(g, &columns, masses, bounds[b]..bounds[b + 1], out);
+    });
 }
 
 /// Adds the buffers of [`gravity_blocks`] to `forces`, in block order.

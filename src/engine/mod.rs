@@ -221,10 +221,10 @@ pub trait RunReport: Serialize + std::fmt::Debug + Clone {
 /// [`Engine::restore`] (resume); then for each remaining sample [`Engine::advance`], [`Engine::sample`] and, at
 /// snapshot times, [`Engine::write_snapshot`]; [`Engine::save`] when a checkpoint is due; and [`Engine::summary`] at
 /// the end. On a [`Failure`] it calls [`Engine::write_last_good_state`] and [`Engine::summary`] with
-/// [`Outcome::Failed`].
-pub trait Engine: Sized {
+/// [`Outcome::Failed`]. The driver runs all of this on a worker thread of rayon's pool, hence `Send`.
+pub trait Engine: Sized + Send {
     /// The engine's `summary.json`.
-    type Summary: RunReport;
+    type Summary: RunReport + Send;
     /// Everything the engine needs to continue bit for bit, stored in `checkpoint.json` under `engine`.
     type State: Serialize + DeserializeOwned;
 
