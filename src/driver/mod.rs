@@ -776,6 +776,6 @@ mod tests {
         assert!(on_pool(|| rayon::current_thread_index().is_some()));
         // already on a worker (of another pool): stays there
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        assert_eq!(pool.install(|| on_pool(|| rayon::current_thread_index())), Some(0));
+        assert_eq!(pool.install(|| on_pool(rayon::current_thread_index)), Some(0));
     }
 }
