@@ -6,9 +6,13 @@
 //! more component at the end carries `∫F dt` (J), so `H(t) − H0 − 2∫F dt` is a checkable residual.
 //!
 //! `u̇ = ∂L/∂r + ∂F/∂ṙ`; `ṗ = ∂L/∂q + ∂F/∂q̇ − λ q` with λ fixed by differentiating `q·q̇ = 0` twice:
-//! `qᵀ M⁻¹ ṗ = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` (Roig03 Eq. 35 as corrected in the notes), solved per body as
-//! the 4×4 system of Eq. 36 by LU ([`constrained_momentum_rate`]); [`constrained_momentum_rate_closed_form`]
-//! is the equivalent closed form used as a test oracle.
+//! `qᵀ M⁻¹ ṗ = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` (Roig03 Eq. 35 as corrected in the notes). The right-hand side
+//! solves it per body in the closed form [`constrained_momentum_rate_closed_form`] (`ṗ = g − λ q`); the paper's
+//! 4×4 system of Eq. 36 solved by LU ([`constrained_momentum_rate`]) is its test oracle.
+//!
+//! The attitude parts of the pair forces are summed per body as torques conjugate to the world spin
+//! ([`contact_spin_gradient`], the dissipation's `∂F/∂ω`) and mapped to the quaternion once per body: that is the
+//! tangential part of `∂U_C/∂q` on `|q| = 1`, and `ṗ` does not depend on the radial part (it only shifts `λ`).
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
@@ -17,11 +21,11 @@ use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
 use crate::ellipsoid::potential::{
-    BodyGeometry, TAPER_WIDTH, Taper, contact_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
-    overlap_within_taper,
+    BodyGeometry, TAPER_WIDTH, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
+    overlap, overlap_within_taper,
 };
 use crate::ellipsoid::quaternion::{
-    extended_inertia, from_unit_quaternion, inverse_mass_matrix, mass_matrix, q_dot_from_body_spin, rotation_matrix,
+    extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin, rotation_matrix,
     rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
 };
 use crate::geometry::neighbours::sphere_pairs;
@@ -126,8 +130,8 @@ struct Kinematics {
     velocity: Vec3,
     p: Vec4,
     q_dot: Vec4,
-    /// `M(q)⁻¹` (zero when attitudes are not integrated).
-    m_inv: Mat4,
+    /// `M(q)⁻¹ q` (zero when attitudes are not integrated).
+    m_inv_q: Vec4,
     spin_body: Vec3,
     spin_world: Vec3,
     geometry: Option<BodyGeometry>,
@@ -140,9 +144,10 @@ struct PairTerms {
     j: usize,
     /// Generalised force on `r_i` (N); `r_j` gets its negative.
     force_i: Vec3,
-    /// Generalised force on `q_i`, `q_j` (J).
-    gq_i: Vec4,
-    gq_j: Vec4,
+    /// Generalised forces conjugate to the world spins `ω_i`, `ω_j` (N m): `−∂U_C/∂ω + ∂F/∂ω`, mapped to the
+    /// quaternions per body ([`spin_force_to_quaternion`]) after all pairs are summed.
+    torque_i: Vec3,
+    torque_j: Vec3,
     /// `U_C` of the pair (J), counted only when the contact term is on.
     potential: f64,
     /// `F_ij` (W).
@@ -176,8 +181,8 @@ struct RhsScratch {
     gravity: Vec<Vec<Vec3>>,
     /// Pair forces per body (N).
     force: Vec<Vec3>,
-    /// Pair generalised forces on the quaternions per body (J).
-    gq: Vec<Vec4>,
+    /// Pair torques per body (N m, world frame; [`PairTerms::torque_i`]).
+    torque: Vec<Vec3>,
 }
 
 /// Below this many candidate pairs the cull and pair terms run serially: the work does not pay for waking the
@@ -331,8 +336,8 @@ impl EllipsoidSystem {
             let q = Vec4::new(s[3], s[4], s[5], s[6]);
             let u = Vec3::new(s[7], s[8], s[9]);
             let p = Vec4::new(s[10], s[11], s[12], s[13]);
-            let m_inv = inverse_mass_matrix(&q, &self.inertia_ext[i]);
-            let q_dot = m_inv * p;
+            let q_dot = inverse_mass_apply(&q, &self.inertia_ext[i], &p);
+            let m_inv_q = inverse_mass_apply(&q, &self.inertia_ext[i], &q);
             let wq = w_matrix(&q) * q_dot;
             let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
             let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
@@ -344,7 +349,7 @@ impl EllipsoidSystem {
                 velocity: u / self.shapes[i].mass,
                 p,
                 q_dot,
-                m_inv,
+                m_inv_q,
                 spin_body,
                 spin_world: rot.transpose() * spin_body,
                 geometry,
@@ -361,7 +366,7 @@ impl EllipsoidSystem {
                 velocity: u / self.shapes[i].mass,
                 p: Vec4::zeros(),
                 q_dot: Vec4::zeros(),
-                m_inv: Mat4::zeros(),
+                m_inv_q: Vec4::zeros(),
                 spin_body: b.spin_body,
                 spin_world,
                 // Spheres: Σ = R² 1 whatever the attitude.
@@ -488,19 +493,19 @@ impl EllipsoidSystem {
             i,
             j,
             force_i: Vec3::zeros(),
-            gq_i: Vec4::zeros(),
-            gq_j: Vec4::zeros(),
+            torque_i: Vec3::zeros(),
+            torque_j: Vec3::zeros(),
             potential: 0.0,
             dissipation: 0.0,
         };
         if self.physics.contact.is_some() {
             t.potential = ov.potential;
             if with_forces {
-                let grad = contact_gradient(&ov, kappa, gi, gj);
+                let grad = contact_spin_gradient(&ov, kappa, gi, gj);
                 t.force_i -= grad.d_ri;
                 if self.rotation {
-                    t.gq_i -= grad.d_qi;
-                    t.gq_j -= grad.d_qj;
+                    t.torque_i -= grad.d_wi;
+                    t.torque_j -= grad.d_wj;
                 }
             }
         }
@@ -517,8 +522,8 @@ impl EllipsoidSystem {
             t.dissipation = pd.value;
             if with_forces {
                 t.force_i += pd.d_vi;
-                t.gq_i += spin_force_to_quaternion(&ki.q, gi, &pd.d_wi);
-                t.gq_j += spin_force_to_quaternion(&kj.q, gj, &pd.d_wj);
+                t.torque_i += pd.d_wi;
+                t.torque_j += pd.d_wj;
             }
         }
         Some(t)
@@ -618,12 +623,13 @@ fn spin_force_to_quaternion(q: &Vec4, g: &BodyGeometry, d_spin_world: &Vec3) -> 
 
 /// The right side `c = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` of the differentiated constraint (corrected Roig03 Eq. 35),
 /// with `M⁻¹ p = q̇` and `Ṁ = 4 (W(q̇)ᵀ Ĩ W(q) + W(q)ᵀ Ĩ W(q̇))`.
-pub fn constraint_rhs(q: &Vec4, q_dot: &Vec4, m_inv: &Mat4, inertia_ext: &Vec4) -> f64 {
+/// `m_inv_q` is `M⁻¹ q`.
+pub fn constraint_rhs(q: &Vec4, q_dot: &Vec4, m_inv_q: &Vec4, inertia_ext: &Vec4) -> f64 {
     let (w, w_dot) = (w_matrix(q), w_matrix(q_dot));
     let m_dot_q_dot = 4.0
         * (w_dot.transpose() * inertia_ext.component_mul(&(w * q_dot))
             + w.transpose() * inertia_ext.component_mul(&(w_dot * q_dot)));
-    (m_inv * q).dot(&m_dot_q_dot) - q_dot.norm_squared()
+    m_inv_q.dot(&m_dot_q_dot) - q_dot.norm_squared()
 }
 
 /// `ṗ` from Roig03 Eq. 36: three rows of the projector `|q|² 1 − q qᵀ` (the row of the largest `|q_k|`
@@ -649,9 +655,12 @@ pub fn constrained_momentum_rate(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Ve
     a.lu().solve(&b).unwrap_or_else(|| Vec4::from_element(f64::NAN))
 }
 
-/// Closed form equivalent to [`constrained_momentum_rate`]: `ṗ = g − λ q`, `λ = (qᵀM⁻¹g − c)/(qᵀM⁻¹q)`.
-pub fn constrained_momentum_rate_closed_form(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Vec4 {
-    let mq = m_inv * q;
+/// Closed form equivalent to [`constrained_momentum_rate`]: `ṗ = g − λ q`, `λ = (qᵀM⁻¹g − c)/(qᵀM⁻¹q)` (the
+/// projector rows of Eq. 36 hold because they remove `q`, the constraint row by the choice of λ). The right-hand
+/// side's form: about a tenth of the LU solve's cost.
+/// `m_inv_q` is `M⁻¹ q`.
+pub fn constrained_momentum_rate_closed_form(q: &Vec4, g: &Vec4, m_inv_q: &Vec4, c: f64) -> Vec4 {
+    let mq = m_inv_q;
     let lambda = (mq.dot(g) - c) / mq.dot(q);
     g - lambda * q
 }
@@ -717,7 +726,7 @@ impl OdeSystem for EllipsoidSystem {
             blocks,
             gravity,
             force,
-            gq,
+            torque,
         } = scratch;
         self.kinematics_into(y, self.needs_pairs(), kin);
         let kin = &*kin;
@@ -727,8 +736,8 @@ impl OdeSystem for EllipsoidSystem {
         let mut pairs = || {
             force.clear();
             force.resize(n, Vec3::zeros());
-            gq.clear();
-            gq.resize(n, Vec4::zeros());
+            torque.clear();
+            torque.resize(n, Vec3::zeros());
             if !self.needs_pairs() {
                 return;
             }
@@ -736,8 +745,8 @@ impl OdeSystem for EllipsoidSystem {
             for t in blocks.iter().flatten() {
                 force[t.i] += t.force_i;
                 force[t.j] -= t.force_i;
-                gq[t.i] += t.gq_i;
-                gq[t.j] += t.gq_j;
+                torque[t.i] += t.torque_i;
+                torque[t.j] += t.torque_j;
                 dissipation_rate += t.dissipation;
             }
         };
@@ -756,7 +765,7 @@ impl OdeSystem for EllipsoidSystem {
         if let (Some(gr), None) = (self.physics.gravity, blocked_gravity) {
             add_gravity_forces(gr.g, positions, &self.masses, force);
         }
-        let (force, gq, gravity) = (&*force, &*gq, &*gravity);
+        let (force, torque, gravity) = (&*force, &*torque, &*gravity);
         let stride = self.stride;
         let rotation = self.rotation;
         let body_rate = |(i, out): (usize, &mut [f64])| {
@@ -768,10 +777,14 @@ impl OdeSystem for EllipsoidSystem {
             out[0..3].copy_from_slice(k.velocity.as_slice());
             if rotation {
                 let ie = &self.inertia_ext[i];
-                let m_inv = k.m_inv;
-                let g = rotational_kinetic_gradient(&k.q, &k.q_dot, ie) + gq[i];
-                let c = constraint_rhs(&k.q, &k.q_dot, &m_inv, ie);
-                let p_dot = constrained_momentum_rate(&k.q, &g, &m_inv, c);
+
+                let mut g = rotational_kinetic_gradient(&k.q, &k.q_dot, ie);
+                // (no geometry: no pairs, no torque)
+                if let Some(geometry) = &k.geometry {
+                    g += spin_force_to_quaternion(&k.q, geometry, &torque[i]);
+                }
+                let c = constraint_rhs(&k.q, &k.q_dot, &k.m_inv_q, ie);
+                let p_dot = constrained_momentum_rate_closed_form(&k.q, &g, &k.m_inv_q, c);
                 out[3..7].copy_from_slice(k.q_dot.as_slice());
                 out[7..10].copy_from_slice(force.as_slice());
                 out[10..14].copy_from_slice(p_dot.as_slice());

@@ -88,6 +88,13 @@ pub fn inverse_mass_matrix(q: &Vec4, inertia_ext: &Vec4) -> Mat4 {
     w.transpose() * Mat4::from_diagonal(&inv) * w / (4.0 * q.norm_squared().powi(2))
 }
 
+/// `M(q)⁻¹ v` without forming `M⁻¹`: `Wᵀ (Ĩ⁻¹ ∘ (W v)) / (4 |q|⁴)` (two 4×4 products with a vector instead of
+/// two with a matrix). The right-hand side needs only `M⁻¹ p = q̇` and `M⁻¹ q`.
+pub fn inverse_mass_apply(q: &Vec4, inertia_ext: &Vec4, v: &Vec4) -> Vec4 {
+    let w = w_matrix(q);
+    w.transpose() * (w * v).component_div(inertia_ext) / (4.0 * q.norm_squared().powi(2))
+}
+
 /// `∂K_R/∂q` at fixed `q̇`, where `K_R = ½ q̇ᵀ M(q) q̇`: `4 B(q̇)ᵀ Ĩ W(q) q̇`.
 pub fn rotational_kinetic_gradient(q: &Vec4, q_dot: &Vec4, inertia_ext: &Vec4) -> Vec4 {
     let wq = w_matrix(q) * q_dot;
