@@ -45,7 +45,8 @@ impl BodyGeometry {
     pub fn new(axes: &Vec3, q: &Vec4) -> Self {
         let rot = rotation_matrix(q);
         let axes_sq = axes.component_mul(axes);
-        let axes_rot = Mat3::from_diagonal(&axes_sq) * rot;
+        // diag(A², B², C²) R: row k of R scaled by the k-th squared axis.
+        let axes_rot = Mat3::from_fn(|r, c| axes_sq[r] * rot[(r, c)]);
         let sigma = rot.transpose() * axes_rot;
         let q2 = q.norm_squared();
         let stretch = q2 + (q2 - 1.0).abs();
