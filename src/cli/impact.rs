@@ -42,8 +42,8 @@ pub struct ImpactArgs {
     /// Relative (and absolute) tolerance of Bulirsch–Stoer.
     #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
     pub rtol: f64,
-    /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is the value closest to Roig03's outcomes in
-    /// analysis/roig2003/F0_SCAN.md (the paper does not give its F0).
+    /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is Roig03's "F0 ≈ 1" in km and s, and the value
+    /// closest to its outcomes in analysis/roig2003/F0_SCAN.md.
     #[arg(long, default_value_t = crate::impact::run::DEFAULT_F0)]
     pub f0: f64,
     /// Inertia model of the ellipsoids: gaussian (Roig03 Eq. 4 with the model's κ) or uniform

@@ -28,8 +28,9 @@ pub const DEFAULT_T_END: f64 = 10_000.0;
 /// same RHS evaluations as the per-step 1e-9 of earlier builds on the N200 impact and conserves energy better
 /// (7e-12 against 4.6e-11; analysis/work_precision/REPORT.md).
 pub const DEFAULT_RTOL: f64 = 1e-6;
-/// Default dissipation coefficient F0 (s m⁻²): the paper gives none; 1e-6 reproduces its bound fraction, f_KE,
-/// spin–size exponent and best spin-histogram n most closely (analysis/roig2003/F0_SCAN.md).
+/// Default dissipation coefficient F0 (s m⁻²): Roig03 §2.4's "F0 ≈ 1" in its kilometres and seconds (1 s km⁻²);
+/// a scan made before that reading found 1e-6 reproduces the bound fraction, f_KE, spin–size exponent and best
+/// spin-histogram n most closely (analysis/roig2003/F0_SCAN.md).
 pub const DEFAULT_F0: f64 = 1e-6;
 /// Default β of Roig03 Eq. 14.
 pub const DEFAULT_BETA: f64 = 10.0;
