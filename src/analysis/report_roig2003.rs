@@ -45,6 +45,8 @@ pub const EJECTION_RELATIVE: Published = Published { low: 1e-4, high: 5e-4 };
 pub const Q_STAR_D: f64 = 2.6e9;
 /// Roig03 Fig. 5: bound fraction ≈ 1.04 − 0.2e-9 Q (Q in erg/g).
 pub const BOUND_LINE: (f64, f64) = (1.04, -0.2e-9);
+/// Roig03 Fig. 4 (N200_T4, ζ = 45°): ejection-speed–size exponents for P1, P2, P3 (its caption).
+pub const FIG4_EXPONENTS: [(&str, f64); 3] = [("P1", -0.42), ("P2", -0.28), ("P3", -0.32)];
 /// Roig03 Fig. 8 (N200_T4, ζ = 45°): spin–size exponents for P1, P2, P3.
 pub const FIG8_EXPONENTS: [(&str, f64); 3] = [("P1", -1.09), ("P2", -1.11), ("P3", -1.13)];
 
@@ -364,30 +366,21 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         );
     }
 
-    // ---------------------------------------------------------------- Fig. 8 exponents
-    let _ = writeln!(
+    // ---------------------------------------------------------------- Fig. 4 and Fig. 8 exponents
+    exponent_table(
         w,
-        "**Fig. 8 (N200_T4, ζ = 45°).** Spin–size exponents, paper vs ours:\n"
+        runs,
+        "**Fig. 4 (N200_T4, ζ = 45°).** Ejection speed–size exponents, paper vs ours:",
+        &FIG4_EXPONENTS,
+        |r| (r.ejection_exponent, r.ejection_exponent_sigma),
     );
-    let _ = writeln!(w, "| projectile | paper | ours | run |");
-    let _ = writeln!(w, "|---|---|---|---|");
-    for (p, paper) in FIG8_EXPONENTS {
-        match find(runs, "N200_T4", p, 45.0) {
-            Some(r) => {
-                let _ = writeln!(
-                    w,
-                    "| {p} | {paper:.2} | {} ± {} | `{}` |",
-                    opt(r.spin_exponent, &num2),
-                    opt(r.spin_exponent_sigma, &num2),
-                    r.run
-                );
-            }
-            None => {
-                let _ = writeln!(w, "| {p} | {paper:.2} | not run | – |");
-            }
-        }
-    }
-    let _ = writeln!(w);
+    exponent_table(
+        w,
+        runs,
+        "**Fig. 8 (N200_T4, ζ = 45°).** Spin–size exponents, paper vs ours:",
+        &FIG8_EXPONENTS,
+        |r| (r.spin_exponent, r.spin_exponent_sigma),
+    );
 
     // ---------------------------------------------------------------- spin bias
     if let Some((u, u_dir)) = inputs.uniform {
@@ -586,13 +579,19 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     let _ = writeln!(w, "## Appendix: every run\n");
     let _ = writeln!(
         w,
-        "| run | Q (erg/g) | bound | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | energy error | wall (s) |"
+        "| run | Q (erg/g) | bound | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | energy error | barrier overruns | wall (s) |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut overrun_runs = (0, 0);
     for r in runs {
+        let overruns = overrun_pairs(&inputs.campaign_dir.join(&r.run));
+        if let Some(k) = overruns {
+            overrun_runs.0 += usize::from(k > 0);
+            overrun_runs.1 += 1;
+        }
         let _ = writeln!(
             w,
-            "| `{}` | {:.3e} | {:.3} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| `{}` | {:.3e} | {:.3} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
             r.run,
             r.q_erg_per_g,
             r.bound_mass_fraction,
@@ -606,6 +605,7 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             opt(r.best_n, &|x| format!("{x}")),
             opt(r.maxwellian_residual_ratio, &num2),
             opt(r.energy_error, &|x| format!("{x:.1e}")),
+            overruns.map_or_else(|| "–".to_string(), |k| k.to_string()),
             opt(r.wall_seconds, &|x| format!("{x:.1}")),
         );
     }
@@ -619,9 +619,58 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         total_wall,
         worst.map_or_else(|| "–".into(), |(e, r)| format!("{e:.1e} (`{r}`)"))
     );
+    let _ = writeln!(
+        w,
+        "\nContact-barrier overruns (pairs that went deeper than the calibrated barrier allows, `barrier.overrun_pairs` \
+         of each `summary.json`; `barrier_overruns.csv` lists them): {} of the {} runs that record them had any; {} \
+         runs predate the detector.",
+        overrun_runs.0,
+        overrun_runs.1,
+        runs.len() - overrun_runs.1
+    );
     let path = out_dir.join("REPORT.md");
     std::fs::write(&path, md)?;
     Ok(path)
+}
+
+/// A "paper vs ours" table of per-run power-law exponents of the N200_T4, ζ = 45° runs (`value` gives the exponent
+/// and its standard error).
+fn exponent_table(
+    w: &mut String,
+    runs: &[CampaignRun],
+    title: &str,
+    paper: &[(&str, f64)],
+    value: impl Fn(&CampaignRun) -> (Option<f64>, Option<f64>),
+) {
+    let _ = writeln!(w, "{title}\n");
+    let _ = writeln!(w, "| projectile | paper | ours | run |");
+    let _ = writeln!(w, "|---|---|---|---|");
+    for &(p, published) in paper {
+        match find(runs, "N200_T4", p, 45.0) {
+            Some(r) => {
+                let (x, sigma) = value(r);
+                let _ = writeln!(
+                    w,
+                    "| {p} | {published:.2} | {} ± {} | `{}` |",
+                    opt(x, &num2),
+                    opt(sigma, &num2),
+                    r.run
+                );
+            }
+            None => {
+                let _ = writeln!(w, "| {p} | {published:.2} | not run | – |");
+            }
+        }
+    }
+    let _ = writeln!(w);
+}
+
+/// The number of contact-barrier overrun pairs a run recorded (`barrier.overrun_pairs` of its `summary.json`), or
+/// `None` when the run has no such record (it predates the detector, or its summary is missing).
+fn overrun_pairs(run_dir: &Path) -> Option<u64> {
+    let text = std::fs::read_to_string(run_dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("barrier")?.get("overrun_pairs")?.as_u64()
 }
 
 /// Median raw and corrected spin rates of the target fragments of an analysed run (from its
@@ -641,4 +690,24 @@ fn median_spin(run_dir: &Path) -> Option<(f64, f64, f64)> {
     }
     let (r, c) = (median(&raw), median(&corrected));
     (r > 0.0).then_some((r, c, c / r))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::overrun_pairs;
+
+    /// The overrun count is read from `barrier.overrun_pairs`; a summary without it (a run from before the
+    /// detector) or no summary gives `None`, never 0.
+    #[test]
+    fn overrun_pairs_reads_the_barrier_record_or_nothing() {
+        let dir = std::env::temp_dir().join(format!("rubblepile_overrun_pairs_{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        assert_eq!(overrun_pairs(&dir), None);
+        std::fs::write(dir.join("summary.json"), r#"{"status": "completed"}"#).unwrap();
+        assert_eq!(overrun_pairs(&dir), None);
+        std::fs::write(dir.join("summary.json"), r#"{"barrier": {"overrun_pairs": 3}}"#).unwrap();
+        assert_eq!(overrun_pairs(&dir), Some(3));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
