@@ -287,6 +287,9 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     );
     let _ = writeln!(w);
 
+    // ---------------------------------------------------------------- seed scatter
+    seed_scatter(w, runs);
+
     // ---------------------------------------------------------------- by target size and projectile
     let _ = writeln!(w, "### By target and projectile\n");
     let _ = writeln!(
@@ -646,23 +649,127 @@ fn exponent_table(
     let _ = writeln!(w, "| projectile | paper | ours | run |");
     let _ = writeln!(w, "|---|---|---|---|");
     for &(p, published) in paper {
-        match find(runs, "N200_T4", p, 45.0) {
-            Some(r) => {
-                let (x, sigma) = value(r);
-                let _ = writeln!(
-                    w,
-                    "| {p} | {published:.2} | {} ± {} | `{}` |",
-                    opt(x, &num2),
-                    opt(sigma, &num2),
-                    r.run
-                );
-            }
-            None => {
-                let _ = writeln!(w, "| {p} | {published:.2} | not run | – |");
-            }
+        let cell = cell_runs(runs, "N200_T4", p, 45.0);
+        if cell.is_empty() {
+            let _ = writeln!(w, "| {p} | {published:.2} | not run | – |");
+            continue;
         }
+        let per_seed: Vec<String> = cell
+            .iter()
+            .map(|r| {
+                let (x, sigma) = value(r);
+                format!("{} ± {}", opt(x, &num2), opt(sigma, &num2))
+            })
+            .collect();
+        let xs: Vec<f64> = cell.iter().filter_map(|r| value(r).0).collect();
+        let ours = match mean_sd(&xs) {
+            Some((m, sd)) if xs.len() > 1 => {
+                format!("{m:.2} ± {sd:.2} over {} seeds ({})", xs.len(), per_seed.join("; "))
+            }
+            _ => per_seed.join("; "),
+        };
+        let names: Vec<String> = cell.iter().map(|r| format!("`{}`", r.run)).collect();
+        let _ = writeln!(w, "| {p} | {published:.2} | {ours} | {} |", names.join(", "));
     }
     let _ = writeln!(w);
+}
+
+/// The runs of one grid cell (all seeds), in campaign order.
+fn cell_runs<'a>(runs: &'a [CampaignRun], target: &str, projectile: &str, angle: f64) -> Vec<&'a CampaignRun> {
+    runs.iter()
+        .filter(|r| r.target == target && r.projectile == projectile && r.angle_deg == angle)
+        .collect()
+}
+
+/// Mean and sample standard deviation (0 for one value); `None` when empty.
+fn mean_sd(x: &[f64]) -> Option<(f64, f64)> {
+    if x.is_empty() {
+        return None;
+    }
+    let n = x.len() as f64;
+    let m = x.iter().sum::<f64>() / n;
+    let var = if x.len() > 1 {
+        x.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    Some((m, var.sqrt()))
+}
+
+/// The scatter over seeds (the projectile's attitude) of every grid cell's outcomes: mean ± sample standard
+/// deviation per cell, and the median standard deviation over the cells, the error bar of a single run.
+fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
+    let mut cells: Vec<(String, String, f64)> = Vec::new();
+    for r in runs {
+        let key = (r.target.clone(), r.projectile.clone(), r.angle_deg);
+        if !cells.contains(&key) {
+            cells.push(key);
+        }
+    }
+    let seeds = cells
+        .iter()
+        .map(|(t, p, a)| cell_runs(runs, t, p, *a).len())
+        .max()
+        .unwrap_or(0);
+    if seeds < 2 {
+        let _ = writeln!(w, "One seed per grid cell: the outcomes above carry no seed scatter.\n");
+        return;
+    }
+    type Outcome = (&'static str, fn(&CampaignRun) -> Option<f64>, fn(f64) -> String);
+    let outcomes: [Outcome; 7] = [
+        ("bound", |r| Some(r.bound_mass_fraction), |x| format!("{x:.3}")),
+        ("f_KE (%)", |r| Some(100.0 * r.f_ke), |x| format!("{x:.2}")),
+        (
+            "rot. share (%)",
+            |r| Some(100.0 * r.rotational_share),
+            |x| format!("{x:.1}"),
+        ),
+        (
+            "median Δv (m/s)",
+            |r| Some(r.ejection_speed_median),
+            |x| format!("{x:.1}"),
+        ),
+        ("ejection α", |r| r.ejection_exponent, |x| format!("{x:.2}")),
+        ("spin α", |r| r.spin_exponent, |x| format!("{x:.2}")),
+        ("best n", |r| r.best_n, |x| format!("{x:.2}")),
+    ];
+    let _ = writeln!(w, "### Seed scatter\n");
+    let _ = writeln!(
+        w,
+        "Each grid cell was run with {seeds} attitudes of the projectile (seeds 1–{seeds}; everything else equal). Mean ± \
+         sample standard deviation over the seeds:\n"
+    );
+    let header: Vec<&str> = outcomes.iter().map(|o| o.0).collect();
+    let _ = writeln!(w, "| cell | seeds | {} |", header.join(" | "));
+    let _ = writeln!(w, "|---|---|{}", "---|".repeat(outcomes.len()));
+    let mut sds: Vec<Vec<f64>> = vec![Vec::new(); outcomes.len()];
+    for (t, p, a) in &cells {
+        let cell = cell_runs(runs, t, p, *a);
+        let mut row = format!("| {t} {p} ζ = {a}° | {} |", cell.len());
+        for (k, (_, f, fmt)) in outcomes.iter().enumerate() {
+            let xs: Vec<f64> = cell.iter().filter_map(|r| f(r)).filter(|x| x.is_finite()).collect();
+            match mean_sd(&xs) {
+                Some((m, sd)) => {
+                    if xs.len() > 1 {
+                        sds[k].push(sd);
+                    }
+                    let _ = write!(row, " {} ± {} |", fmt(m), fmt(sd));
+                }
+                None => row.push_str(" – |"),
+            }
+        }
+        let _ = writeln!(w, "{row}");
+    }
+    let typical: Vec<String> = outcomes
+        .iter()
+        .zip(&sds)
+        .map(|((name, _, fmt), s)| format!("{name} {}", fmt(crate::math::median(s))))
+        .collect();
+    let _ = writeln!(
+        w,
+        "\nMedian over the cells of the seed standard deviation (the error bar of one run): {}.\n",
+        typical.join(", ")
+    );
 }
 
 /// The number of contact-barrier overrun pairs a run recorded (`barrier.overrun_pairs` of its `summary.json`), or
@@ -694,7 +801,65 @@ fn median_spin(run_dir: &Path) -> Option<(f64, f64, f64)> {
 
 #[cfg(test)]
 mod tests {
-    use super::overrun_pairs;
+    use super::{CampaignRun, exponent_table, mean_sd, overrun_pairs, seed_scatter};
+
+    fn run(name: &str, projectile: &str, bound: f64, spin: Option<f64>) -> CampaignRun {
+        CampaignRun {
+            run: name.into(),
+            target: "N200_T4".into(),
+            projectile: projectile.into(),
+            angle_deg: 45.0,
+            q_erg_per_g: 1.5e9,
+            fragments: 200,
+            escaping: 3,
+            bound_mass_fraction: bound,
+            f_ke: 0.02,
+            rotational_share: 0.05,
+            ejection_speed_median: 40.0,
+            ejection_speed_median_relative: 0.008,
+            ejection_exponent: Some(-0.3),
+            ejection_exponent_sigma: Some(0.1),
+            spin_exponent: spin,
+            spin_exponent_sigma: Some(0.2),
+            best_n: Some(0.5),
+            maxwellian_residual_ratio: Some(2.0),
+            size_site_correlation: None,
+            impact_side_median_size: None,
+            antipodal_side_median_size: None,
+            energy_error: Some(1e-12),
+            wall_seconds: Some(1.0),
+        }
+    }
+
+    /// Mean and sample standard deviation: (1, 2, 3) → 2 ± 1; one value → ± 0; none → nothing.
+    #[test]
+    fn mean_sd_is_the_sample_one() {
+        assert_eq!(mean_sd(&[1.0, 2.0, 3.0]), Some((2.0, 1.0)));
+        assert_eq!(mean_sd(&[4.0]), Some((4.0, 0.0)));
+        assert_eq!(mean_sd(&[]), None);
+    }
+
+    /// Three seeds of a cell give its mean ± standard deviation (bound 0.8, 0.9, 1.0 → 0.900 ± 0.100) and the
+    /// exponent table quotes the seeds; one seed per cell says that there is no scatter.
+    #[test]
+    fn seed_scatter_and_exponents_use_every_seed_of_a_cell() {
+        let runs = vec![
+            run("N200_T4_P2_z45_s1", "P2", 0.8, Some(-1.0)),
+            run("N200_T4_P2_z45_s2", "P2", 0.9, Some(-1.2)),
+            run("N200_T4_P2_z45_s3", "P2", 1.0, Some(-1.4)),
+        ];
+        let mut w = String::new();
+        seed_scatter(&mut w, &runs);
+        assert!(w.contains("| N200_T4 P2 ζ = 45° | 3 | 0.900 ± 0.100 |"), "{w}");
+        let mut t = String::new();
+        exponent_table(&mut t, &runs, "title", &[("P2", -1.11)], |r| {
+            (r.spin_exponent, r.spin_exponent_sigma)
+        });
+        assert!(t.contains("| P2 | -1.11 | -1.20 ± 0.20 over 3 seeds"), "{t}");
+        let mut one = String::new();
+        seed_scatter(&mut one, &runs[..1]);
+        assert!(one.contains("One seed per grid cell"), "{one}");
+    }
 
     /// The overrun count is read from `barrier.overrun_pairs`; a summary without it (a run from before the
     /// detector) or no summary gives `None`, never 0.
