@@ -315,17 +315,7 @@ fn rock_lattice(
             }
         }
     }
-    let model = ModelConfig {
-        kappa: 10.0,
-        inertia: InertiaModel::Gaussian,
-        contact_g: G_SI,
-    };
-    let physics = Physics {
-        gravity: Some(GravityTerm { g: G_SI }),
-        contact: Some(ContactTerm::default()),
-        dissipation: Some(DissipationTerm { f0: 1e-4 }),
-    };
-    (bodies, model, physics)
+    (bodies, ModelConfig::gaussian_si(10.0), Physics::impact(1e-4))
 }
 
 /// The right-hand side of a system large enough for every parallel pass (144 bodies, thousands of candidate

@@ -394,17 +394,7 @@ impl ImpactProblem {
         }
         let kappa = cfg.kappa(&target).expect("the target and projectile calibrate");
         let (bodies, _) = set_up_impact(&target, &projectile, cfg.angle_deg, cfg.contact_time, cfg.seed);
-        let model = ModelConfig {
-            kappa,
-            inertia: InertiaModel::Gaussian,
-            contact_g: G_SI,
-        };
-        let physics = Physics {
-            gravity: Some(GravityTerm { g: G_SI }),
-            contact: Some(ContactTerm::default()),
-            dissipation: Some(DissipationTerm { f0: cfg.f0 }),
-        };
-        let system = EllipsoidSystem::new(&bodies, model, physics);
+        let system = EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), Physics::impact(cfg.f0));
         ProblemSetup {
             name: self.name,
             description: format!(

@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::BenchError as CliError;
-use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
 use crate::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
@@ -93,11 +92,7 @@ pub fn time_rhs(
 /// The system benchmarked by `bench rhs`: gravity + contact + dissipation (F0 = 1 s/m²).
 pub fn bench_system(n: usize, seed: u64, kappa: f64) -> EllipsoidSystem {
     let bodies = random_cloud(n, seed, &CloudParams::default());
-    let model = ModelConfig {
-        kappa,
-        inertia: InertiaModel::Gaussian,
-        contact_g: SI_G,
-    };
+    let model = ModelConfig::gaussian_si(kappa);
     let physics = Physics {
         gravity: Some(GravityTerm { g: SI_G }),
         contact: Some(ContactTerm {

@@ -75,6 +75,18 @@ pub struct Physics {
     pub dissipation: Option<DissipationTerm>,
 }
 
+impl Physics {
+    /// Everything on, as the impact experiments run it: gravity with SI G, contact with the default cutoff,
+    /// dissipation with `f0` (s m⁻²).
+    pub fn impact(f0: f64) -> Self {
+        Physics {
+            gravity: Some(GravityTerm { g: G_SI }),
+            contact: Some(ContactTerm::default()),
+            dissipation: Some(DissipationTerm { f0 }),
+        }
+    }
+}
+
 /// Model constants shared by all pairs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ModelConfig {
@@ -84,6 +96,17 @@ pub struct ModelConfig {
     pub inertia: InertiaModel,
     /// G used in `U0_ij` (Roig03 Eq. 11) — the gravity term's G, or [`G_SI`] when gravity is off.
     pub contact_g: f64,
+}
+
+impl ModelConfig {
+    /// Gaussian moments of inertia (Roig03 Eq. 4) and SI G in `U0_ij`, with the given κ.
+    pub fn gaussian_si(kappa: f64) -> Self {
+        ModelConfig {
+            kappa,
+            inertia: InertiaModel::Gaussian,
+            contact_g: G_SI,
+        }
+    }
 }
 
 /// Energies, momenta and constraint errors of a state.

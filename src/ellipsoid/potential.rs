@@ -371,17 +371,21 @@ mod tests {
     use super::*;
     use crate::ellipsoid::quaternion::rotation_matrix_derivatives;
 
-    /// The symmetric cofactor inverse agrees with nalgebra's general determinant and inverse on the `G` of random
-    /// pairs, to round-off.
-    #[test]
-    fn symmetric_inverse_matches_the_general_one() {
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rand = || {
+    /// A xorshift stream of numbers in [−1, 1) (no dependency for a few hundred test draws).
+    fn uniform_in_minus_one_one(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
             seed ^= seed << 13;
             seed ^= seed >> 7;
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        }
+    }
+
+    /// The symmetric cofactor inverse agrees with nalgebra's general determinant and inverse on the `G` of random
+    /// pairs, to round-off.
+    #[test]
+    fn symmetric_inverse_matches_the_general_one() {
+        let mut rand = uniform_in_minus_one_one(0x9e37_79b9_7f4a_7c15);
         for _ in 0..500 {
             let q = Vec4::new(rand(), rand(), rand(), rand()).normalize();
             let p = Vec4::new(rand(), rand(), rand(), rand()).normalize();
@@ -398,13 +402,7 @@ mod tests {
     /// The written-out quaternion gradient has the bits of the Frobenius products with `∂R/∂q_k`.
     #[test]
     fn quaternion_gradient_matches_frobenius_products_bitwise() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rand = uniform_in_minus_one_one(0x2545_f491_4f6c_dd1d);
         for _ in 0..200 {
             let q = Vec4::new(rand(), rand(), rand(), rand()) * 1.1;
             let axes = Vec3::new(1.0 + rand().abs(), 0.7, 0.5 + 0.1 * rand());

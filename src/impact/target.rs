@@ -16,11 +16,9 @@
 //! 5. κ from Roig03 Eq. 14 with β = 10, v = 5 km/s over the fragments (the projectiles of Table 2 are smaller
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
-use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
+use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
-use crate::ellipsoid::equations::{
-    ContactTerm, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
-};
+use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
@@ -374,16 +372,8 @@ pub fn build_target(
         large.equivalent_radius(),
         G_SI,
     )?;
-    let model = ModelConfig {
-        kappa,
-        inertia: InertiaModel::Gaussian,
-        contact_g: G_SI,
-    };
-    let physics = Physics {
-        gravity: Some(GravityTerm { g: G_SI }),
-        contact: Some(ContactTerm::default()),
-        dissipation: Some(DissipationTerm { f0: spec.f0 }),
-    };
+    let model = ModelConfig::gaussian_si(kappa);
+    let physics = Physics::impact(spec.f0);
     let omega = Vec3::new(0.0, 0.0, 2.0 * PI / (spec.period_hours * 3600.0));
     let total_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
     // free-fall time of the placement sphere's mean density
