@@ -454,7 +454,7 @@ fn impact_command_still_works() {
     // the run directory's scene is an ordinary scene
     let scene = std::fs::read_to_string(out_dir.join("scene.toml")).unwrap();
     assert!(scene.contains("bodies_file = \"initial_bodies.csv\""));
-    assert!(scene.contains("calibrate = { beta = 10.0, v = 20.0 }"));
+    assert!(scene.contains("calibrate = { beta = 10.0, v = 20.0, reading = \"printed\" }"));
     // existing directory without --force; bad angle: one line naming the flag
     let out = run(&args("30"));
     assert_eq!(out.status.code(), Some(2));
@@ -469,16 +469,26 @@ fn impact_command_still_works() {
 }
 
 /// The committed Roig03 campaign files parse: 6 targets × 3 projectiles × 3 angles × 3 seeds (when the targets have
-/// been built; otherwise the only complaint is a missing target), and the smoke campaign is 2 short runs.
+/// been built; otherwise the only complaint is a missing target), and the smoke campaign is 2 short runs. The main
+/// grid calibrates κ with the reduced reading of Eq. 13 (the one that gives the paper's κ ≈ 10), its partner with
+/// Eq. 14 as printed, and the scene each run writes says so.
 #[test]
 fn roig2003_campaign_files_are_valid() {
+    use rubblepile::ellipsoid::calibration::KappaReading;
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    for (file, runs) in [("campaign.toml", 162), ("smoke_campaign.toml", 2)] {
+    for (file, runs, reading) in [
+        ("campaign.toml", 162, KappaReading::Reduced),
+        ("campaign_printed.toml", 162, KappaReading::Printed),
+        ("smoke_campaign.toml", 2, KappaReading::Printed),
+    ] {
         let path = root.join("analysis/roig2003").join(file);
         match load_campaign(&path) {
             Ok(c) => {
                 assert_eq!(c.points.len(), runs, "{file}");
                 assert!(c.points.iter().all(|p| p.config.rtol == 1e-6), "{file}");
+                assert!(c.points.iter().all(|p| p.config.kappa_reading == reading), "{file}");
+                let scene = c.points[0].config.scene_toml("t", 0);
+                assert!(scene.contains(&format!("reading = \"{reading}\"")), "{file}: {scene}");
                 let seeds = if runs == 162 { vec![1, 2, 3] } else { vec![1] };
                 assert!(c.points.iter().all(|p| seeds.contains(&p.seed)), "{file}");
                 assert!(c.out.file_name().unwrap().to_str().unwrap().starts_with("roig2003"));

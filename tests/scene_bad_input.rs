@@ -254,6 +254,11 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
             "model: give exactly one of `kappa` or `calibrate`",
         ),
         (
+            "calibrate reading unknown",
+            with("kappa = 10.0", "calibrate = { beta = 10.0, v = 1.0, reading = \"mu\" }"),
+            "unknown variant `mu`, expected one of `printed`, `impactor`, `reduced`",
+        ),
+        (
             "calibrate beta negative",
             with("kappa = 10.0", "calibrate = { beta = -1.0, v = 1.0 }"),
             "model.calibrate.beta: must be > 0",
@@ -555,6 +560,37 @@ fn bad_bodies_file_names_line_and_column() {
         check_cli(case, &out, &dir.join("out"), expected);
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `model.calibrate.reading` reaches the κ of the run: the reduced reading gives the softer κ of
+/// `calibrate_kappa_read` for the scene's lightest and heaviest bodies, and the default is the printed one.
+#[test]
+fn calibrate_reading_sets_the_scenes_kappa() {
+    use rubblepile::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
+    let kappa = |reading: &str| {
+        let text = with(
+            "kappa = 10.0",
+            &format!("calibrate = {{ beta = 10.0, v = 20.0{reading} }}"),
+        );
+        let scene = parse_scene(&text, "scene.toml", None).expect("valid scene");
+        let m = |f: fn(f64, f64) -> f64| scene.bodies.iter().map(|b| b.shape.mass).fold(f64::NAN, f);
+        let body = |mass: f64| {
+            let b = scene.bodies.iter().find(|b| b.shape.mass == mass).unwrap();
+            (b.shape.equivalent_radius(), b.shape.mass)
+        };
+        (
+            scene.model.kappa,
+            scene.model.contact_g,
+            body(m(f64::min)),
+            body(m(f64::max)),
+        )
+    };
+    let (printed, g, small, large) = kappa("");
+    let (reduced, ..) = kappa(", reading = \"reduced\"");
+    let expect = |r| calibrate_kappa_read(r, 10.0, 20.0, small, large, g).unwrap();
+    assert_eq!(printed, expect(KappaReading::Printed));
+    assert_eq!(reduced, expect(KappaReading::Reduced));
+    assert!(reduced < printed, "reduced {reduced}, printed {printed}");
 }
 
 /// Needs `calibrate_kappa` (the physics).

@@ -59,6 +59,8 @@ pub struct ReportInputs<'a> {
     pub campaign_dir: &'a Path,
     /// The uniform-inertia campaign, analysed, and its directory (§4.3 spin bias), if there is one.
     pub uniform: Option<(&'a CampaignAnalysis, &'a Path)>,
+    /// The same grid under another reading of Roig03 Eq. 13's `K`, analysed, and its directory, if there is one.
+    pub other_kappa: Option<(&'a CampaignAnalysis, &'a Path)>,
     /// The command that regenerates the report, quoted in it.
     pub command: String,
 }
@@ -383,6 +385,15 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         "**Fig. 8 (N200_T4, ζ = 45°).** Spin–size exponents, paper vs ours:",
         &FIG8_EXPONENTS,
         |r| (r.spin_exponent, r.spin_exponent_sigma),
+    );
+
+    // ---------------------------------------------------------------- κ readings
+    crate::analysis::report_roig2003_kappa::write_kappa_section(
+        w,
+        c,
+        inputs.campaign_dir,
+        inputs.other_kappa,
+        crate::ellipsoid::equations::G_SI,
     );
 
     // ---------------------------------------------------------------- spin bias
@@ -774,7 +785,7 @@ fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
 
 /// The number of contact-barrier overrun pairs a run recorded (`barrier.overrun_pairs` of its `summary.json`), or
 /// `None` when the run has no such record (it predates the detector, or its summary is missing).
-fn overrun_pairs(run_dir: &Path) -> Option<u64> {
+pub(crate) fn overrun_pairs(run_dir: &Path) -> Option<u64> {
     let text = std::fs::read_to_string(run_dir.join("summary.json")).ok()?;
     let v: serde_json::Value = serde_json::from_str(&text).ok()?;
     v.get("barrier")?.get("overrun_pairs")?.as_u64()

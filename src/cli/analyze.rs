@@ -120,6 +120,10 @@ pub struct ReportRoig2003Args {
     /// The campaign directory of analysis/roig2003/campaign_uniform.toml (the §4.3 spin-bias partner run).
     #[arg(long)]
     pub uniform: Option<PathBuf>,
+    /// A campaign directory of the same grid under another reading of Roig03 Eq. 13's K
+    /// (analysis/roig2003/campaign_printed.toml): its outcomes are shown beside this campaign's.
+    #[arg(long)]
+    pub other_kappa: Option<PathBuf>,
     /// Where REPORT.md and figures/ go (DISCUSSION.md there is included in the report).
     #[arg(long)]
     pub out: PathBuf,
@@ -160,6 +164,10 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
         Some(dir) => Some((analyse(dir)?, dir.clone())),
         None => None,
     };
+    let other_kappa = match &args.other_kappa {
+        Some(dir) => Some((analyse(dir)?, dir.clone())),
+        None => None,
+    };
     let mut command = format!(
         "rubblepile report roig2003 {} --out {}",
         args.campaign.display(),
@@ -167,6 +175,9 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
     );
     if let Some(u) = &args.uniform {
         command += &format!(" --uniform {}", u.display());
+    }
+    if let Some(o) = &args.other_kappa {
+        command += &format!(" --other-kappa {}", o.display());
     }
     if args.at != 400.0 {
         command += &format!(" --at {}", args.at);
@@ -176,6 +187,7 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
         campaign: &campaign,
         campaign_dir: &args.campaign,
         uniform: uniform.as_ref().map(|(a, d)| (a, d.as_path())),
+        other_kappa: other_kappa.as_ref().map(|(a, d)| (a, d.as_path())),
         command,
     };
     std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;

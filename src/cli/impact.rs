@@ -53,6 +53,11 @@ pub struct ImpactArgs {
     /// β of Roig03 Eq. 14 (κ is calibrated over target + projectile).
     #[arg(long, default_value_t = 10.0)]
     pub beta: f64,
+    /// Which kinetic energy K the contact barrier is β times (Roig03 Eq. 13): printed (½ m_l v², Eq. 14 as
+    /// printed), impactor (½ m_k v²) or reduced (½ μ v², the pair's collision energy; gives Roig03's
+    /// κ ≈ 10). See analysis/roig2003/DISCUSSION.md.
+    #[arg(long, default_value_t = crate::ellipsoid::calibration::KappaReading::Printed)]
+    pub kappa_reading: crate::ellipsoid::calibration::KappaReading,
     /// Snapshot times (s), comma-separated [default: 0,100,400,1000,10000, cut at --t-end, plus --t-end].
     #[arg(long, value_delimiter = ',')]
     pub snapshots: Option<Vec<f64>>,
@@ -104,6 +109,7 @@ impl ImpactArgs {
             rtol: self.rtol,
             f0: self.f0,
             beta: self.beta,
+            kappa_reading: self.kappa_reading,
             snapshots: self
                 .snapshots
                 .clone()

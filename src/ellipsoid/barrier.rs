@@ -19,8 +19,10 @@
 //!   during a head-on contact this is nearly constant (kinetic energy turns into overlap and back);
 //! - the pair's *relative speed* `v_eq = √(2E/μ)` (m/s): the head-on impact speed this state corresponds to;
 //! - the pair's *calibrated speed* `v_c`: Eq. 14 applied to the pair itself,
-//!   `v_c² = G m_min e^{κλ}/(β κλ (R_i + R_j))` with `m_min = min(m_i, m_j)` (for the smallest–largest
-//!   pair of a calibrated scene this is exactly `model.calibrate.v`);
+//!   `v_c² = G M_ref e^{κλ}/(β κλ (R_i + R_j))` with the calibration's reading of `K`
+//!   (`M_ref = min(m_i, m_j)` as printed, `max(m_i, m_j)` or `m_i + m_j`; see
+//!   [`KappaReading`]); for the smallest–largest pair of a calibrated scene this is exactly
+//!   `model.calibrate.v`;
 //! - the barrier height `B = a (1 − e^{−κλ})` (J): the energy needed to push the centres together.
 //!
 //! # Verdicts
@@ -52,7 +54,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::Body;
-use crate::ellipsoid::calibration::{lambda, pair_prefactor};
+use crate::ellipsoid::calibration::{KappaReading, lambda, pair_prefactor};
 use crate::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::KappaSource;
@@ -90,6 +92,8 @@ pub const OVERRUN_COLUMNS: [&str; 9] = [
 pub struct BarrierSettings {
     /// β of Roig03 Eqs. 13–14 (dimensionless, > 0).
     pub beta: f64,
+    /// Which `K` of Eq. 13 the calibrated speeds use: the calibration's, or the printed one for a given κ.
+    pub reading: KappaReading,
     /// Where β came from: `"model.calibrate"` or `"default"` ([`DEFAULT_BETA`]).
     pub beta_source: &'static str,
     /// Overrun when the relative speed exceeds `speed_margin ×` the calibrated speed (≥ 1).
@@ -100,13 +104,15 @@ impl BarrierSettings {
     /// β of the scene's calibration, or [`DEFAULT_BETA`] for a given κ; margin [`SPEED_MARGIN`].
     pub fn for_kappa_source(source: &KappaSource) -> Self {
         match *source {
-            KappaSource::Calibrated { beta, .. } => BarrierSettings {
+            KappaSource::Calibrated { beta, reading, .. } => BarrierSettings {
                 beta,
+                reading,
                 beta_source: "model.calibrate",
                 speed_margin: SPEED_MARGIN,
             },
             KappaSource::Given => BarrierSettings {
                 beta: DEFAULT_BETA,
+                reading: KappaReading::Printed,
                 beta_source: "default",
                 speed_margin: SPEED_MARGIN,
             },
@@ -187,12 +193,12 @@ pub struct Overrun {
 }
 
 /// The pair's calibrated speed (m/s): Roig03 Eq. 14 solved for `v` with the pair's own equivalent radii
-/// `r_i, r_j` (m), masses (kg) and `κλ_ij`: `v² = G m_min e^{κλ}/(β κλ (R_i + R_j))`.
-pub fn calibrated_speed(g: f64, kappa: f64, beta: f64, r_i: f64, m_i: f64, r_j: f64, m_j: f64) -> f64 {
+/// `r_i, r_j` (m), `κλ_ij` and the reading's reference mass `m_ref` (kg, [`KappaReading::reference_mass`]):
+/// `v² = G m_ref e^{κλ}/(β κλ (R_i + R_j))`.
+pub fn calibrated_speed(g: f64, kappa: f64, beta: f64, r_i: f64, r_j: f64, m_ref: f64) -> f64 {
     let x = kappa * lambda(r_i, r_j);
-    let m_min = m_i.min(m_j);
     // exp(x)/x in log form: finite up to x ≈ 1400.
-    (g * m_min / (beta * (r_i + r_j))).sqrt() * (0.5 * (x - x.ln())).exp()
+    (g * m_ref / (beta * (r_i + r_j))).sqrt() * (0.5 * (x - x.ln())).exp()
 }
 
 /// World-frame shape matrix `Σ = Rᵀ diag(A², B², C²) R` of a body (m²), as the contact potential uses it.
@@ -210,7 +216,13 @@ fn reach(b: &Body) -> f64 {
 }
 
 /// The contact state of pair `(i, j)`, or `None` when it is not in contact (`x ≥ κλ`) or degenerate.
-pub fn pair_contact(model: &ModelConfig, beta: f64, bodies: &[Body], i: usize, j: usize) -> Option<PairContact> {
+pub fn pair_contact(
+    model: &ModelConfig,
+    settings: &BarrierSettings,
+    bodies: &[Body],
+    i: usize,
+    j: usize,
+) -> Option<PairContact> {
     let (bi, bj) = (&bodies[i], &bodies[j]);
     let kappa = model.kappa;
     let (ri, rj) = (bi.shape.equivalent_radius(), bj.shape.equivalent_radius());
@@ -241,14 +253,21 @@ pub fn pair_contact(model: &ModelConfig, beta: f64, bodies: &[Body], i: usize, j
         collision_energy,
         barrier: amplitude * (1.0 - touch),
         speed: (2.0 * collision_energy / mu).sqrt(),
-        calibrated_speed: calibrated_speed(model.contact_g, kappa, beta, ri, mi, rj, mj),
+        calibrated_speed: calibrated_speed(
+            model.contact_g,
+            kappa,
+            settings.beta,
+            ri,
+            rj,
+            settings.reading.reference_mass(mi.min(mj), mi.max(mj)),
+        ),
     };
     contact.speed.is_finite().then_some(contact)
 }
 
 /// Every pair in contact (`x < κλ`), sorted by `(i, j)`: sort-and-sweep along x with a bound on each body's
 /// reach, then the exact test.
-pub fn contacts(model: &ModelConfig, beta: f64, bodies: &[Body]) -> Vec<PairContact> {
+pub fn contacts(model: &ModelConfig, settings: &BarrierSettings, bodies: &[Body]) -> Vec<PairContact> {
     let reaches: Vec<f64> = bodies.iter().map(reach).collect();
     let max_reach = reaches.iter().copied().fold(0.0, f64::max);
     let mut order: Vec<usize> = (0..bodies.len())
@@ -267,7 +286,7 @@ pub fn contacts(model: &ModelConfig, beta: f64, bodies: &[Body]) -> Vec<PairCont
                 continue;
             }
             let (i, j) = (a.min(b), a.max(b));
-            if let Some(c) = pair_contact(model, beta, bodies, i, j) {
+            if let Some(c) = pair_contact(model, settings, bodies, i, j) {
                 out.push(c);
             }
         }
@@ -328,6 +347,9 @@ impl PairOverrun {
 pub struct BarrierReport {
     /// β used for the calibrated speeds.
     pub beta: f64,
+    /// Which `K` of Roig03 Eq. 13 the calibrated speeds use (summaries written before the option: printed).
+    #[serde(default)]
+    pub reading: KappaReading,
     /// `"model.calibrate"` or `"default"`.
     pub beta_source: String,
     /// Overrun when relative speed > `speed_margin ×` calibrated speed.
@@ -472,7 +494,7 @@ impl BarrierMonitor {
         if !self.enabled {
             return Vec::new();
         }
-        contacts(model, self.settings.beta, bodies)
+        contacts(model, &self.settings, bodies)
             .into_iter()
             .filter_map(|contact| contact.level(&self.settings).map(|level| Overrun { t, contact, level }))
             .collect()
@@ -536,6 +558,7 @@ impl BarrierMonitor {
         pairs.truncate(MAX_LISTED_PAIRS);
         Some(BarrierReport {
             beta: self.settings.beta,
+            reading: self.settings.reading,
             beta_source: self.settings.beta_source.to_string(),
             speed_margin: self.settings.speed_margin,
             overrun_pairs,
@@ -579,7 +602,7 @@ fn parse_row(f: &csv::StringRecord) -> Option<Overrun> {
 mod tests {
     use super::*;
     use crate::ellipsoid::body::{Ellipsoid, InertiaModel};
-    use crate::ellipsoid::calibration::calibrate_kappa;
+    use crate::ellipsoid::calibration::calibrate_kappa_read;
     use crate::ellipsoid::equations::{ContactTerm, G_SI, GravityTerm, Physics};
     use crate::math::{Vec3, Vec4};
 
@@ -608,15 +631,23 @@ mod tests {
         }
     }
 
-    /// The smallest–largest pair of a calibrated scene gets exactly the calibration's v.
+    /// The detector's settings for a given κ (β = 10, printed reading).
+    fn printed() -> BarrierSettings {
+        BarrierSettings::for_kappa_source(&KappaSource::Given)
+    }
+
+    /// The smallest–largest pair of a calibrated scene gets exactly the calibration's v, under every reading.
     #[test]
     fn calibrated_speed_inverts_eq14() {
         let (a, b) = (sphere(400.0, 0.0, 0.0), sphere(900.0, 1300.0, 0.0));
         let (r_a, r_b) = (a.shape.equivalent_radius(), b.shape.equivalent_radius());
-        for v in [0.7, 2.0, 5.0, 40.0] {
-            let kappa = calibrate_kappa(10.0, v, r_a, a.shape.mass, r_b, G_SI).unwrap();
-            let vc = calibrated_speed(G_SI, kappa, 10.0, r_a, a.shape.mass, r_b, b.shape.mass);
-            assert!((vc / v - 1.0).abs() < 1e-9, "v = {v}: calibrated speed {vc}");
+        let (m_a, m_b) = (a.shape.mass, b.shape.mass);
+        for reading in KappaReading::ALL {
+            for v in [0.7, 2.0, 5.0, 40.0] {
+                let kappa = calibrate_kappa_read(reading, 10.0, v, (r_a, m_a), (r_b, m_b), G_SI).unwrap();
+                let vc = calibrated_speed(G_SI, kappa, 10.0, r_a, r_b, reading.reference_mass(m_a, m_b));
+                assert!((vc / v - 1.0).abs() < 1e-9, "{reading}, v = {v}: calibrated speed {vc}");
+            }
         }
     }
 
@@ -629,7 +660,7 @@ mod tests {
         let bodies = [sphere(r1, 0.0, 1.0), sphere(r2, d, -0.5)];
         let kappa = 6.0;
         let m = model(kappa);
-        let c = pair_contact(&m, 10.0, &bodies, 0, 1).unwrap();
+        let c = pair_contact(&m, &printed(), &bodies, 0, 1).unwrap();
         let x = kappa * d * d / (r1 * r1 + r2 * r2);
         assert!((c.exponent / x - 1.0).abs() < 1e-12);
         assert!((c.separation_ratio() - 0.8).abs() < 1e-12);
@@ -648,34 +679,40 @@ mod tests {
         assert!((c.collision_energy - (0.5 * mu * 2.25 + c.stored_energy)).abs() < 1e-9 * c.collision_energy);
         // out of contact: nothing
         let apart = [sphere(r1, 0.0, 0.0), sphere(r2, 1.01 * (r1 + r2), 0.0)];
-        assert!(pair_contact(&m, 10.0, &apart, 0, 1).is_none());
+        assert!(pair_contact(&m, &printed(), &apart, 0, 1).is_none());
     }
 
     /// The verdicts: below the margin nothing, above it an overrun, with more than the barrier a break-through.
+    /// The break-through speed pins each reading's `K`: the barrier is β·½ M_K v_c² against the pair's
+    /// collision energy ½ μ v², so it breaks through above √(β M_K/μ) v_c.
     #[test]
     fn levels_follow_speed_and_barrier() {
         let (r, kappa) = (600.0, 5.0);
-        let settings = BarrierSettings {
-            beta: 10.0,
-            beta_source: "default",
-            speed_margin: SPEED_MARGIN,
-        };
         let m = model(kappa);
-        let probe = |v: f64| {
-            let bodies = [sphere(r, 0.0, v / 2.0), sphere(r, 1.99 * r, -v / 2.0)];
-            pair_contact(&m, 10.0, &bodies, 0, 1).unwrap()
-        };
-        let vc = probe(0.0).calibrated_speed;
-        assert_eq!(probe(vc).level(&settings), None);
-        assert_eq!(probe(1.2 * vc).level(&settings), None);
-        assert_eq!(probe(1.3 * vc).level(&settings), Some(OverrunLevel::Overrun));
-        // equal spheres: barrier = β·½ m v_c² = 2β × ½ μ v_c², so break-through above √(2β) v_c
-        let through = (2.0 * settings.beta).sqrt();
-        assert_eq!(probe(0.98 * through * vc).level(&settings), Some(OverrunLevel::Overrun));
-        assert_eq!(
-            probe(1.02 * through * vc).level(&settings),
-            Some(OverrunLevel::BrokeThrough)
-        );
+        for reading in KappaReading::ALL {
+            let settings = BarrierSettings { reading, ..printed() };
+            let probe = |v: f64| {
+                let bodies = [sphere(r, 0.0, v / 2.0), sphere(r, 1.99 * r, -v / 2.0)];
+                pair_contact(&m, &settings, &bodies, 0, 1).unwrap()
+            };
+            let vc = probe(0.0).calibrated_speed;
+            assert_eq!(probe(vc).level(&settings), None);
+            assert_eq!(probe(1.2 * vc).level(&settings), None);
+            assert_eq!(probe(1.3 * vc).level(&settings), Some(OverrunLevel::Overrun));
+            // equal spheres of mass m: μ = m/2, M_K = m (printed, impactor) or m/2 (reduced)
+            let mass = sphere(r, 0.0, 0.0).shape.mass;
+            let through = (settings.beta * reading.kinetic_mass(mass, mass) / (0.5 * mass)).sqrt();
+            assert_eq!(
+                probe(0.98 * through * vc).level(&settings),
+                Some(OverrunLevel::Overrun),
+                "{reading}"
+            );
+            assert_eq!(
+                probe(1.02 * through * vc).level(&settings),
+                Some(OverrunLevel::BrokeThrough),
+                "{reading}"
+            );
+        }
     }
 
     /// The sweep finds exactly the touching pairs, whatever their order along x, including rotated ellipsoids.
@@ -693,11 +730,11 @@ mod tests {
             bodies.push(b);
         }
         let m = model(4.0);
-        let found: Vec<(usize, usize)> = contacts(&m, 10.0, &bodies).iter().map(|c| (c.i, c.j)).collect();
+        let found: Vec<(usize, usize)> = contacts(&m, &printed(), &bodies).iter().map(|c| (c.i, c.j)).collect();
         let mut brute = Vec::new();
         for i in 0..bodies.len() {
             for j in i + 1..bodies.len() {
-                if pair_contact(&m, 10.0, &bodies, i, j).is_some() {
+                if pair_contact(&m, &printed(), &bodies, i, j).is_some() {
                     brute.push((i, j));
                 }
             }
@@ -722,7 +759,7 @@ mod tests {
         };
         let mut mon = BarrierMonitor::new(settings, true, Some(&log));
         let bodies = [sphere(600.0, 0.0, 0.0), sphere(600.0, 1.9 * 600.0, 0.0)];
-        let vc = pair_contact(&m, settings.beta, &bodies, 0, 1).unwrap().calibrated_speed;
+        let vc = pair_contact(&m, &settings, &bodies, 0, 1).unwrap().calibrated_speed;
         let mut states = Vec::new();
         for (k, v) in [0.5, 2.0, 3.0, 2.5].iter().enumerate() {
             let moving = [sphere(600.0, 0.0, v * vc), sphere(600.0, 1.9 * 600.0, 0.0)];

@@ -305,8 +305,11 @@ impl EllipsoidEngine {
         let s = &self.scene;
         let kappa = match s.kappa_source {
             KappaSource::Given => format!("kappa = {} (given)", s.model.kappa),
-            KappaSource::Calibrated { beta, v } => {
-                format!("kappa = {} (calibrated: beta = {beta}, v = {v} m/s)", s.model.kappa)
+            KappaSource::Calibrated { beta, v, reading } => {
+                format!(
+                    "kappa = {} (calibrated: beta = {beta}, v = {v} m/s, reading {reading})",
+                    s.model.kappa
+                )
             }
         };
         let mut lines = vec![
@@ -546,7 +549,7 @@ impl Engine for EllipsoidEngine {
             },
             calibration: match scene.kappa_source {
                 KappaSource::Given => None,
-                KappaSource::Calibrated { beta, v } => Some(CalibrationSummary { beta, v }),
+                KappaSource::Calibrated { beta, v, reading } => Some(CalibrationSummary { beta, v, reading }),
             },
             inertia: match scene.model.inertia {
                 InertiaModel::Gaussian => "gaussian".into(),

@@ -46,7 +46,7 @@ use nalgebra::{Quaternion, UnitQuaternion};
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
-use crate::ellipsoid::calibration::calibrate_kappa;
+use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
 use crate::integrate::Method;
 pub use crate::io::scene_file::{
@@ -150,6 +150,11 @@ pub struct CalibrateSpec {
     pub beta: f64,
     /// Relative speed `v` of Eq. 14 (m/s, > 0) the contact must withstand. Required.
     pub v: f64,
+    /// Which kinetic energy the barrier is β times (Roig03 Eq. 13's `K`): `"printed"` (`½ m_l v²`, Eq. 14
+    /// as printed; the default), `"impactor"` (`½ m_k v²`) or `"reduced"` (`½ μ v²`, the pair's relative
+    /// kinetic energy). See [`KappaReading`].
+    #[serde(default)]
+    pub reading: KappaReading,
 }
 
 /// `[physics]`: every term is optional; an absent term is not computed at all.
@@ -317,6 +322,8 @@ pub enum KappaSource {
         beta: f64,
         /// v used (m/s).
         v: f64,
+        /// Which `K` of Eq. 13 (see [`KappaReading`]).
+        reading: KappaReading,
     },
 }
 
@@ -694,12 +701,12 @@ impl Validator<'_> {
                     .iter()
                     .max_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
                     .expect("at least one body (checked above)");
-                let k = calibrate_kappa(
+                let k = calibrate_kappa_read(
+                    c.reading,
                     c.beta,
                     c.v,
-                    small.shape.equivalent_radius(),
-                    small.shape.mass,
-                    large.shape.equivalent_radius(),
+                    (small.shape.equivalent_radius(), small.shape.mass),
+                    (large.shape.equivalent_radius(), large.shape.mass),
                     contact_g,
                 )
                 .map_err(|source| SceneError::Calibration {
@@ -709,7 +716,14 @@ impl Validator<'_> {
                 if !(k.is_finite() && k > 1.5) {
                     return Err(self.invalid("model.calibrate", format!("calibration gave kappa = {k}, need > 1.5")));
                 }
-                (k, KappaSource::Calibrated { beta: c.beta, v: c.v })
+                (
+                    k,
+                    KappaSource::Calibrated {
+                        beta: c.beta,
+                        v: c.v,
+                        reading: c.reading,
+                    },
+                )
             }
             (None, None) => unreachable!("checked above"),
         };

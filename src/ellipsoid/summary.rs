@@ -5,6 +5,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::barrier::BarrierReport;
+use crate::ellipsoid::calibration::KappaReading;
 use crate::ellipsoid::equations::Physics;
 
 /// The scales that make the conservation errors relative.
@@ -137,6 +138,9 @@ pub struct CalibrationSummary {
     pub beta: f64,
     /// v (m/s).
     pub v: f64,
+    /// Which `K` of Roig03 Eq. 13 (runs written before the option existed used `printed`).
+    #[serde(default)]
+    pub reading: KappaReading,
 }
 
 impl RunSummary {

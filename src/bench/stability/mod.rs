@@ -137,11 +137,11 @@ impl CaseRun {
         let mut integrator =
             make_integrator(settings.method, tolerances, settings.step).map_err(|e| format!("integrator: {e}"))?;
         integrator.set_span(scene.t_end);
-        let beta = BarrierSettings::for_kappa_source(&scene.kappa_source).beta;
+        let barrier = BarrierSettings::for_kappa_source(&scene.kappa_source);
         let (mut t, mut y) = (0.0, system.initial_state());
         let (mut ratio, mut sep) = (0.0_f64, 1.0_f64);
         loop {
-            for c in contacts(&scene.model, beta, &system.bodies_at(t, &y)) {
+            for c in contacts(&scene.model, &barrier, &system.bodies_at(t, &y)) {
                 ratio = ratio.max(c.speed / c.calibrated_speed);
                 sep = sep.min(c.separation_ratio());
             }

@@ -61,6 +61,8 @@ pub struct ImpactSection {
     pub f0: Option<f64>,
     /// β of Roig03 Eq. 14 (default 10).
     pub beta: Option<f64>,
+    /// Which `K` of Roig03 Eq. 13 κ is calibrated against: `"printed"` (default), `"impactor"`, `"reduced"`.
+    pub kappa_reading: Option<crate::ellipsoid::calibration::KappaReading>,
     /// Time at which the surfaces first touch (s; default 90).
     pub contact_time: Option<f64>,
     /// Time-series cadence (s; default 10).

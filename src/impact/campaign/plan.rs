@@ -261,6 +261,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.rtol = imp.rtol.unwrap_or(DEFAULT_RTOL);
             base.f0 = imp.f0.unwrap_or(DEFAULT_F0);
             base.beta = imp.beta.unwrap_or(DEFAULT_BETA);
+            base.kappa_reading = imp.kappa_reading.unwrap_or_default();
             base.contact_time = imp.contact_time.unwrap_or(DEFAULT_CONTACT_TIME);
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();

@@ -65,8 +65,8 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
             Ok(s) => s,
             Err(e) => return failed_to_read(e.into()),
         };
-        let beta = run.summary.barrier.as_ref().map_or(10.0, |b| b.beta);
-        let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, beta, b).len();
+        let settings = crate::ellipsoid::barrier::BarrierSettings::for_kappa_source(&run.scene.kappa_source);
+        let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, &settings, b).len();
         let (c0, c1) = (
             snaps.first().map_or(0, |(_, b)| count(b)),
             snaps.last().map_or(0, |(_, b)| count(b)),
