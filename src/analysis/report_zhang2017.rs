@@ -18,7 +18,9 @@
 //! critical bulk density at the Didymos period, beside the paper's Table 4.
 //!
 //! When a `critical.json` records T_c,3 by both creep criteria ([`crate::analysis::creep`]), a section gives both
-//! beside Table 3.
+//! beside Table 3. The hand-written `NOTES.md` in the output directory (the paper-vs-ours table over every table
+//! and figure of Zhang17, what is missing and what would decide it) is appended verbatim at the end
+//! ([`crate::analysis::report_notes`]).
 
 use crate::io::table::{Cells, read_header, read_table};
 use std::fmt::Write as _;
@@ -622,6 +624,8 @@ pub fn write_report(
     for f in &figures {
         let _ = writeln!(md, "![{f}]({f}.png)\n");
     }
+    // the hand-written discussion (paper vs ours, what is missing), kept across regenerations
+    crate::analysis::report_notes::append_notes(&mut md, out);
     std::fs::write(&report, md).map_err(|e| format!("{}: {e}", report.display()))?;
     Ok(report)
 }
