@@ -140,3 +140,19 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     assert_eq!(row, "| HCP | 2.70, 44.0 | 2.64, 45.2 | 2.40, 43 |");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// The committed `analysis/zhang2017/REPORT.md` ends with the committed `NOTES.md` exactly as the generator
+/// appends it, so that the hand-written part and the report cannot drift apart between regenerations.
+#[test]
+fn committed_report_ends_with_the_committed_notes() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/zhang2017");
+    let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    let notes = std::fs::read_to_string(dir.join("NOTES.md")).unwrap();
+    let mut expected = String::new();
+    rubblepile::analysis::report_notes::append_notes(&mut expected, &dir);
+    assert_eq!(expected, format!("\n{notes}\n"));
+    assert!(
+        report.ends_with(&expected),
+        "REPORT.md does not end with NOTES.md as appended"
+    );
+}
