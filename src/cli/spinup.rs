@@ -41,11 +41,10 @@ pub struct CriticalArgs {
     /// path without rests.
     #[arg(long)]
     pub branch: bool,
-    /// Which creep criterion gives critical.json's top-level T_c,3 and φ: `paper` (Zhang17 §3.3.3: a rising
-    /// θ_max, a falling η_B or a falling coordination number over the second half of a hold is creep) or `ours`
-    /// (θ_max or η_B moving either way; the coordination number not judged). Both are judged and recorded for
-    /// every hold, and the search runs until both have a stable hold (see `analysis::creep`).
-    #[arg(long, value_name = "paper|ours", default_value = "paper", value_parser = parse_criterion)]
+    /// Which creep criterion gives critical.json's top-level T_c,3 and φ: `paper` (Zhang17 §3.3.3: θ_max rising,
+    /// η_B or the coordination number falling over a hold's second half is creep) or `ours` (θ_max or η_B moving
+    /// either way). Both are judged and recorded per hold; the search runs until both have a stable hold.
+    #[arg(long, value_name = "paper|ours", default_value = "paper")]
     pub creep_criterion: CreepCriterionKind,
     /// Largest fall of the coordination number (contacts per particle) over the second half of a hold that the
     /// paper's criterion lets pass (default 0.05).
@@ -65,10 +64,6 @@ pub struct DensityFitArgs {
     /// Period (h) at which to give the critical bulk density.
     #[arg(long, default_value_t = 2.26)]
     pub period: f64,
-}
-
-fn parse_criterion(s: &str) -> Result<CreepCriterionKind, String> {
-    s.parse()
 }
 
 fn cli_error(e: SearchError) -> CliError {
