@@ -95,3 +95,64 @@ fn full_size_section_reads_a_run_still_going() {
     assert!(write_report(&root.join("runs"), Some(&root.join("full")), &out, false).is_err());
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// The hand-written `NOTES.md` in the output directory is appended verbatim at the end of REPORT.md (the hook
+/// shared with the Richardson11 report, `analysis::report_notes`); without it the report ends with the figures.
+/// A `critical.json` that records T_c,3 by both creep criteria adds a section with both beside Table 3; one from
+/// before the paper's criterion came in (only the top-level T_c,3) adds nothing.
+#[test]
+fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
+    let root = std::env::temp_dir().join(format!("rp_report_notes_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    let crit = root.join("runs/hcp/critical");
+    std::fs::create_dir_all(&crit).unwrap();
+    std::fs::write(
+        crit.join("critical.json"),
+        r#"{"t_c3_hours": 2.64, "friction_angle_deg": 45.2, "runs": []}"#,
+    )
+    .unwrap();
+    let out = root.join("out");
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, &out, false).unwrap()).unwrap();
+    assert!(
+        !md.contains("by creep criterion"),
+        "old critical.json: no criterion section"
+    );
+    assert!(
+        md.trim_end().ends_with("![fig5_hcp](fig5_hcp.png)"),
+        "{}",
+        &md[md.len() - 200..]
+    );
+    let notes = "## Paper vs ours (hand-written)\n\n| item | paper | ours | verdict |\n| --- | --- | --- | --- |\n\
+                 | Table 3 HCP T_c3 | 2.40 h | 2.64 h | not |\n";
+    std::fs::write(out.join("NOTES.md"), notes).unwrap();
+    std::fs::write(
+        crit.join("critical.json"),
+        r#"{"t_c3_hours": 2.70, "friction_angle_deg": 44.0, "runs": [],
+            "paper": {"t_c3_hours": 2.70, "friction_angle_deg": 44.0},
+            "ours": {"t_c3_hours": 2.64, "friction_angle_deg": 45.2}}"#,
+    )
+    .unwrap();
+    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, &out, true).unwrap()).unwrap();
+    assert!(md2.ends_with(&format!("\n\n{notes}\n")), "{}", &md2[md2.len() - 300..]);
+    let section = &md2[md2.find("## T_c,3 by creep criterion").expect("criterion section")..];
+    let row = section.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
+    assert_eq!(row, "| HCP | 2.70, 44.0 | 2.64, 45.2 | 2.40, 43 |");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// The committed `analysis/zhang2017/REPORT.md` ends with the committed `NOTES.md` exactly as the generator
+/// appends it, so that the hand-written part and the report cannot drift apart between regenerations.
+#[test]
+fn committed_report_ends_with_the_committed_notes() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/zhang2017");
+    let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    let notes = std::fs::read_to_string(dir.join("NOTES.md")).unwrap();
+    let mut expected = String::new();
+    rubblepile::analysis::report_notes::append_notes(&mut expected, &dir);
+    assert_eq!(expected, format!("\n{notes}\n"));
+    assert!(
+        report.ends_with(&expected),
+        "REPORT.md does not end with NOTES.md as appended"
+    );
+}

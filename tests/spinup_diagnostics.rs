@@ -267,3 +267,54 @@ fn layer_rule_packing_does_not_turn_with_the_starting_cube() {
     println!("layer rule: η_B over 90° of turn {etas:?}, spread {spread:.2e}");
     assert!(spread <= 1e-9, "{etas:?}");
 }
+
+/// The coordination number of `spinup.csv` (Zhang17 §4.1.1, Fig. 5; judged by the paper's creep test, §3.3.3)
+/// comes from the force evaluation's contact list: on an HCP ball of spheres 0.1 % larger than the lattice's
+/// touching radius, every sphere whose 12 lattice neighbours are all in the ball has exactly 12 contacts, and
+/// the mean over all spheres equals twice the number of centre pairs closer than two radii (counted here by brute
+/// force, independently of the contact search) over N — below 12 because the surface spheres have fewer.
+#[test]
+fn coordination_number_counts_the_contact_list_twelve_inside_an_hcp_ball() {
+    use rubblepile::analysis::spinup_diagnostics::{contact_counts, mean_coordination};
+    let (r_lattice, extent) = (1.0, 7.0);
+    let r = 1.001 * r_lattice;
+    let centres = hcp_centres(r_lattice, extent);
+    let particles: Vec<Particle> = centres
+        .iter()
+        .map(|&position| Particle {
+            mass: 1.0,
+            radius: r,
+            position,
+            velocity: Vec3::zeros(),
+            spin: Vec3::zeros(),
+        })
+        .collect();
+    let n = particles.len();
+    let sys = system(particles, 0.0, 1e6);
+    let counts = contact_counts(&sys.records, n);
+    // interior: all 12 neighbours at distance 2 r_lattice are inside the ball of radius `extent`
+    let interior: Vec<usize> = (0..n)
+        .filter(|&i| centres[i].norm() <= extent - 2.0 * r_lattice)
+        .collect();
+    assert!(interior.len() > 50, "{} interior spheres", interior.len());
+    for &i in &interior {
+        assert_eq!(
+            counts[i],
+            12,
+            "sphere {i} at {:.3} m from the centre",
+            centres[i].norm()
+        );
+    }
+    let pairs = (0..n)
+        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+        .filter(|&(i, j)| (centres[i] - centres[j]).norm() < 2.0 * r)
+        .count();
+    let expected = 2.0 * pairs as f64 / n as f64;
+    assert!((mean_coordination(&counts) - expected).abs() < 1e-12);
+    let d = diagnose(&sys, &Vec3::z(), 5.0 * 3600.0, true, 300, InteriorRule::Layers, 0.0);
+    assert!((d.sample.coordination_number - expected).abs() < 1e-12);
+    assert!(expected > 6.0 && expected < 12.0, "mean coordination {expected}");
+    // the fractions of spheres with 0 and 1 contacts come from the same counts (none in a touching lattice)
+    assert_eq!(d.sample.fraction_0_contacts, 0.0);
+    assert_eq!(d.sample.fraction_1_contact, 0.0);
+}

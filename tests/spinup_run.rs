@@ -233,6 +233,51 @@ fn branched_hold_equals_the_hold_run_from_the_start() {
     assert_eq!(a, b);
     let json = read(&dir.join("crit/critical.json"));
     assert!(json.contains("\"t_final_hours\": 6.0"), "{json}");
+    // both creep criteria are judged and recorded per hold, the paper's selected by default (Zhang17 §3.3.3)
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    assert_eq!(v["criterion"]["kind"], "paper", "{json}");
+    assert_eq!(v["paper"]["criterion"]["kind"], "paper", "{json}");
+    assert_eq!(v["ours"]["criterion"]["kind"], "ours", "{json}");
+    let run = &v["runs"][0];
+    assert!(run["drift"]["coordination"].is_f64(), "{json}");
+    assert!(
+        run["paper"]["stable"].is_boolean() && run["ours"]["stable"].is_boolean(),
+        "{json}"
+    );
+    assert_eq!(run["stable"], run["paper"]["stable"], "{json}");
+    let out = String::from_utf8_lossy(&c.stdout);
+    assert!(out.contains("T_final = 6.00 h: paper "), "{out}");
+    let csv = read(&dir.join("crit/critical.csv"));
+    assert!(csv.starts_with("t_final_h,released,theta_max_deg,"), "{csv}");
+    assert!(csv.lines().nth(1).unwrap().starts_with("6.00,"), "{csv}");
+}
+
+/// `--creep-criterion` takes `paper` or `ours`; anything else is refused with the expected values.
+#[test]
+fn creep_criterion_option_names_the_expected_values() {
+    let dir = temp_dir("spinup-criterion");
+    std::fs::write(dir.join("s.toml"), scene(&dir, PATH)).unwrap();
+    let c = rubblepile(
+        &dir,
+        &[
+            "spinup",
+            "critical",
+            "--scene",
+            "s.toml",
+            "--from",
+            "6",
+            "--to",
+            "6",
+            "--creep-criterion",
+            "Paper",
+            "--out",
+            "crit",
+        ],
+    );
+    assert!(!c.status.success());
+    let err = String::from_utf8_lossy(&c.stderr);
+    assert!(err.contains("expected `paper` or `ours`, got `Paper`"), "{err}");
+    assert!(!dir.join("crit").exists(), "nothing is written for a refused option");
 }
 
 /// `--branch` refuses a path with rests (a shorter path with rests is not a prefix of the longer one).

@@ -1,9 +1,11 @@
 //! Post-processing of states and runs.
 
 pub mod atmosphere;
+pub mod creep;
 pub mod figures;
 pub mod fits;
 pub mod fragments;
+pub mod report_notes;
 pub mod report_richardson2011;
 pub mod report_roig2003;
 pub mod report_roig2003_kappa;

@@ -16,6 +16,11 @@
 //! directories named `<model>_rho<ρ_B>` (e.g. `rcp_rho1800`): they are left out of the Table 3 rows and go, with
 //! the nominal run, into an Eq. 22 section: κ₁, κ₂, κ₃ fitted over the densities ([`density_series`]) and the
 //! critical bulk density at the Didymos period, beside the paper's Table 4.
+//!
+//! When a `critical.json` records T_c,3 by both creep criteria ([`crate::analysis::creep`]), a section gives both
+//! beside Table 3. The hand-written `NOTES.md` in the output directory (the paper-vs-ours table over every table
+//! and figure of Zhang17, what is missing and what would decide it) is appended verbatim at the end
+//! ([`crate::analysis::report_notes`]).
 
 use crate::io::table::{Cells, read_header, read_table};
 use std::fmt::Write as _;
@@ -32,6 +37,9 @@ use crate::io::scene_file::SI_G;
 
 /// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
 pub const DIDYMOS_MASS: f64 = 5.23e11;
+
+/// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
+pub type LimitAndAngle = (Option<f64>, Option<f64>);
 
 /// One row of [`TABLE3`]: model, η, φ (°), T_c1, T_c2, T_c3 (h), κ₃, failure mode.
 pub type PaperRow = (&'static str, f64, f64, f64, f64, f64, Option<f64>, &'static str);
@@ -168,6 +176,9 @@ pub struct ModelRow {
     pub t_c3: Option<f64>,
     /// See `t_c3`.
     pub phi: Option<f64>,
+    /// T_c,3 (h) and φ (°) by the paper's creep criterion and by ours, from a `critical.json` that records both
+    /// (searches made after the paper's criterion came in; [`crate::analysis::creep`]); `None` for older ones.
+    pub t_c3_by_criterion: Option<[LimitAndAngle; 2]>,
     /// κ₃ of Eq. 22.
     pub kappa3: Option<f64>,
     /// Largest |T/T_path − 1| while forced.
@@ -274,6 +285,13 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crat
         .and_then(|s| serde_json::from_str(&s).ok());
     let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
     let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
+    let t_c3_by_criterion = critical.as_ref().and_then(|c| {
+        let get = |k: &str| {
+            c.get(k)
+                .map(|r| (r["t_c3_hours"].as_f64(), r["friction_angle_deg"].as_f64()))
+        };
+        Some([get("paper")?, get("ours")?])
+    });
     let kappa3 = t_c3.and_then(|t| fit_density(&[(rho_b, t)], SI_G, t)).map(|f| f.kappa);
     let path_error = samples
         .iter()
@@ -314,6 +332,7 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crat
         t_c2_resolved: resolved,
         t_c3,
         phi,
+        t_c3_by_criterion,
         kappa3,
         path_error,
         release_time,
@@ -572,6 +591,7 @@ pub fn write_report(
          the 780 m body) and PP1's 4–32 m; ours keep the body (D = 780 m, ρ_B = 2100 kg/m³) and use fewer, larger \
          particles (radius column), i.e. lengths scaled by (N_paper/N)^(1/3).\n"
     );
+    write_criterion_section(&mut md, &nominal);
     let _ = writeln!(md, "## Runs\n");
     let _ = writeln!(
         md,
@@ -604,8 +624,51 @@ pub fn write_report(
     for f in &figures {
         let _ = writeln!(md, "![{f}]({f}.png)\n");
     }
+    // the hand-written discussion (paper vs ours, what is missing), kept across regenerations
+    crate::analysis::report_notes::append_notes(&mut md, out);
     std::fs::write(&report, md).map_err(|e| format!("{}: {e}", report.display()))?;
     Ok(report)
+}
+
+/// T_c,3 and φ by both creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]) for the models whose
+/// `critical.json` records both; nothing when none does (searches made before the paper's criterion came in).
+fn write_criterion_section(md: &mut String, rows: &[&ModelRow]) {
+    let with: Vec<(&ModelRow, [LimitAndAngle; 2])> = rows
+        .iter()
+        .filter_map(|r| r.t_c3_by_criterion.map(|b| (*r, b)))
+        .collect();
+    if with.is_empty() {
+        return;
+    }
+    let _ = writeln!(md, "## T_c,3 by creep criterion (Zhang17 §3.3.3)\n");
+    let _ = writeln!(
+        md,
+        "Both verdicts on the same holds (`critical.json`): the paper's criterion counts a rising θ_max, a falling \
+         η_B or a falling coordination number over the second half of a hold as creep; ours counts θ_max or η_B \
+         moving either way and does not judge the coordination number (`src/analysis/creep.rs`).\n"
+    );
+    let _ = writeln!(
+        md,
+        "| model | paper's criterion: T_c3 (h), φ (°) | ours: T_c3 (h), φ (°) | paper Table 3: T_c3 (h), φ (°) |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- |");
+    for (r, [(tp, pp), (to, po)]) in with {
+        let paper = TABLE3
+            .iter()
+            .find(|p| p.0 == r.model)
+            .map(|p| format!("{:.2}, {}", p.5, p.2))
+            .unwrap_or_else(|| "–".into());
+        let _ = writeln!(
+            md,
+            "| {} | {}, {} | {}, {} | {paper} |",
+            r.model.to_uppercase(),
+            opt(tp, 2),
+            opt(pp, 1),
+            opt(to, 2),
+            opt(po, 1)
+        );
+    }
+    let _ = writeln!(md);
 }
 
 /// The Eq. 22 section: per model run at several bulk densities, the limits per density and the fits beside
@@ -691,6 +754,7 @@ mod tests {
             t_c2_resolved: true,
             t_c3: t[2],
             phi: None,
+            t_c3_by_criterion: None,
             kappa3: None,
             path_error: 0.0,
             path_error_before_t_c1: 0.0,

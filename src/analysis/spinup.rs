@@ -1,5 +1,5 @@
-//! Post-processing of spin-up runs (Zhang17 §3): the first two critical spin limits detected in time series,
-//! the creep criterion behind the third, stresses (Eqs. 15–16), principal stresses and the Mohr–Coulomb measures
+//! Post-processing of spin-up runs (Zhang17 §3): the first two critical spin limits detected in time series
+//! (the creep criterion behind the third is [`crate::analysis::creep`]), stresses (Eqs. 15–16), principal stresses and the Mohr–Coulomb measures
 //! (Eqs. 20–21), and the fit of Eq. 22 over bulk densities.
 //!
 //! Conventions: stresses are in Pa with compression negative (as the paper); periods in hours at the edges
@@ -131,80 +131,6 @@ pub fn smoothed_critical_limits(
     )
 }
 
-/// The creep criterion for runs held at a final period (the search for T_c,3): over the second half of the hold,
-/// a least-squares line through each diagnostic must change by less than its tolerance over that half. A
-/// diagnostic that keeps drifting means creep (the body is not geo-statically stable at that period).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct CreepCriterion {
-    /// Largest allowed change of θ_max over the second half (degrees).
-    pub theta_max_deg: f64,
-    /// Largest allowed change of η_B (dimensionless).
-    pub packing: f64,
-    /// Largest allowed change of the coordination number, if it is judged at all. Not judged by default: in our
-    /// scaled RCP runs (23 Nov 2026) the coordination number falls by about 0.1 over the second half of a
-    /// 16 000 s hold at every held period from 3.00 h (θ_max 25°, far from yield) down to 2.74 h, with θ_max and
-    /// η_B flat, so its drift there is a slow loss of marginal contacts, not the creep that precedes failure.
-    pub coordination: Option<f64>,
-}
-
-impl Default for CreepCriterion {
-    /// θ_max 0.5°, η_B 0.0005 (half the T_c,2 threshold); the coordination number is not judged.
-    fn default() -> Self {
-        CreepCriterion {
-            theta_max_deg: 0.5,
-            packing: 0.5 * PACKING_THRESHOLD,
-            coordination: None,
-        }
-    }
-}
-
-/// Change over the second half of `(t, y)` of its least-squares line (0 for fewer than 3 points there).
-pub fn second_half_drift(t: &[f64], y: &[f64]) -> f64 {
-    let n = t.len().min(y.len());
-    let (t, y) = (&t[n / 2..n], &y[n / 2..n]);
-    if t.len() < 3 {
-        return 0.0;
-    }
-    let m = t.len() as f64;
-    let (tm, ym) = (t.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
-    let (mut sty, mut stt) = (0.0, 0.0);
-    for (a, b) in t.iter().zip(y) {
-        sty += (a - tm) * (b - ym);
-        stt += (a - tm) * (a - tm);
-    }
-    if stt == 0.0 {
-        return 0.0;
-    }
-    sty / stt * (t[t.len() - 1] - t[0])
-}
-
-impl CreepCriterion {
-    /// Whether a held run creeps: any diagnostic's second-half drift beyond its tolerance. Returns the names of
-    /// the drifting diagnostics (empty: stable).
-    pub fn drifting(
-        &self,
-        t: &[f64],
-        theta_max_deg: &[f64],
-        packing: &[f64],
-        coordination: &[f64],
-    ) -> Vec<&'static str> {
-        let mut out = Vec::new();
-        if second_half_drift(t, theta_max_deg).abs() > self.theta_max_deg {
-            out.push("theta_max");
-        }
-        if second_half_drift(t, packing).abs() > self.packing {
-            out.push("packing_fraction");
-        }
-        if self
-            .coordination
-            .is_some_and(|tol| second_half_drift(t, coordination).abs() > tol)
-        {
-            out.push("coordination_number");
-        }
-        out
-    }
-}
-
 /// Zhang17 Eq. 22: the critical spin rate scales with the bulk density as `Ω_c = κ √(4πGρ_B/3)`. Least-squares κ
 /// through the origin from `(ρ_B [kg m⁻³], critical period [h])` pairs, its standard error, and the critical bulk
 /// density at which a body spinning with `period_hours` sits at the limit, `ρ_c = 3Ω²/(4πGκ²)`.
@@ -330,33 +256,6 @@ mod tests {
         );
         assert_eq!(running_mean(&times, &eta, 0.0), eta);
         assert!((dynamical_time(6.674e-11, 2100.0) - 2671.1).abs() < 0.1);
-    }
-
-    #[test]
-    fn creep_criterion_catches_a_drift_and_passes_noise() {
-        let t: Vec<f64> = (0..200).map(|k| k as f64 * 100.0).collect();
-        let noise = |k: usize| 1e-4 * ((k * 7919 % 101) as f64 / 101.0 - 0.5);
-        let flat: Vec<f64> = (0..200).map(|k| 0.74 + noise(k)).collect();
-        let theta: Vec<f64> = (0..200).map(|k| 30.0 + 10.0 * noise(k)).collect();
-        let coord: Vec<f64> = (0..200).map(|k| 6.0 + 10.0 * noise(k)).collect();
-        let crit = CreepCriterion::default();
-        assert!(crit.drifting(&t, &theta, &flat, &coord).is_empty());
-        // η_B creeping down by 0.002 over the hold: caught
-        let creeping: Vec<f64> = (0..200).map(|k| 0.74 - 0.002 * k as f64 / 199.0 + noise(k)).collect();
-        assert_eq!(crit.drifting(&t, &theta, &creeping, &coord), vec!["packing_fraction"]);
-        // a drift only in the first half (settling) is not creep
-        let settling: Vec<f64> = (0..200)
-            .map(|k| 30.0 + if k < 80 { 5.0 * (1.0 - k as f64 / 80.0) } else { 0.0 })
-            .collect();
-        assert!(crit.drifting(&t, &settling, &flat, &coord).is_empty());
-        // the coordination number is judged only when asked for
-        let losing: Vec<f64> = (0..200).map(|k| 6.0 - 0.2 * k as f64 / 199.0).collect();
-        assert!(crit.drifting(&t, &theta, &flat, &losing).is_empty());
-        let strict = CreepCriterion {
-            coordination: Some(0.05),
-            ..crit
-        };
-        assert_eq!(strict.drifting(&t, &theta, &flat, &losing), vec!["coordination_number"]);
     }
 
     #[test]

@@ -1,12 +1,18 @@
 //! The spin-up searches behind `rubblepile spinup …` (Zhang17 §3.3.3, §4.2; Eq. 22):
 //!
-//! - `rubblepile spinup critical --scene BASE.toml --from 2.30 --to 2.60 [--step 0.01] --out DIR [--force]`:
-//!   the search for T_c,3. For T_final = from, from + step, … (hours) it writes `DIR/T<T_final>/scene.toml`
-//!   (BASE with `spinup.T_final` replaced), runs it (a run already completed there is reused), and judges the hold
-//!   after `t_final` with the creep criterion ([`CreepCriterion`], defaults tested in `analysis::spinup`): the body
-//!   is stable when the forcing was never released and neither θ_max nor η_B (nor, with
-//!   `--coordination-tolerance`, the coordination number) drifts over the second half of the hold. The first stable T_final is T_c,3; φ is the largest θ_max over the holds of the
-//!   runs within ±0.01 h of it. Writes `DIR/critical.json` ([`CriticalSearch`]).
+//! - `rubblepile spinup critical --scene BASE.toml --from 2.30 --to 2.60 [--step 0.01] --out DIR [--force]
+//!   [--creep-criterion paper|ours] [--coordination-tolerance C]`: the search for T_c,3. For T_final = from,
+//!   from + step, … (hours) it writes `DIR/T<T_final>/scene.toml` (BASE with `spinup.T_final` replaced), runs it (a
+//!   run already completed there is reused), and judges the hold after `t_final` by both creep criteria of
+//!   [`crate::analysis::creep`]: the paper's (a rising θ_max, a falling η_B or a falling coordination number over
+//!   the second half of the hold is creep; `C` is the largest fall of the coordination number let pass, default
+//!   0.05) and ours (θ_max or η_B moving either way; the coordination number not judged). A hold is stable under a
+//!   criterion when the forcing was never released and nothing drifts by it. T_c,3 under a criterion is its first
+//!   stable T_final, and φ the largest θ_max over the holds within ±0.01 h of it. The search goes on until both
+//!   criteria have a stable hold and one step beyond it (for φ), or to `--to`. `critical.json` ([`CriticalSearch`])
+//!   holds both T_c,3 values (`paper`, `ours`), the measured drifts and both verdicts per hold; its top-level
+//!   `t_c3_hours` and `friction_angle_deg` are those of `--creep-criterion` (default `paper`). `critical.csv` is
+//!   the same per hold as a table, and the verdicts are printed as each hold is judged.
 //!   With `--branch [--hold SECONDS]` the hold runs share one run of BASE's path (`DIR/base`): the hold at
 //!   T_final = X starts where BASE's path passes X, with BASE's spin-up rate (Zhang17 §4.3 finds T_c,3
 //!   independent of the rate), branched off the base run's checkpoint at the output sample at or before that time
@@ -22,7 +28,8 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::spinup::{CreepCriterion, fit_density};
+use crate::analysis::creep::{CreepCriterion, CreepCriterionKind, HoldDrift};
+use crate::analysis::spinup::fit_density;
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::driver::RunOptions;
 use crate::io::scene_file::SI_G;
@@ -44,7 +51,10 @@ pub struct CriticalOptions {
     pub force: bool,
     /// Branch the hold runs off one run of the scene's path (`out/base`) instead of running each from t = 0.
     pub branch: bool,
-    /// Also judge the coordination number: largest allowed change over the second half of a hold.
+    /// The criterion whose T_c,3 and φ are `critical.json`'s top-level values (both are always judged).
+    pub criterion: CreepCriterionKind,
+    /// Largest fall of the coordination number (contacts per particle) over the second half of a hold that the
+    /// paper's criterion lets pass; default [`crate::analysis::creep::PAPER_COORDINATION_TOLERANCE`].
     pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `branch`; default: the scene's `t_end − t_final`.
     pub hold: Option<f64>,
@@ -70,7 +80,16 @@ impl SearchError {
     }
 }
 
-/// One hold run judged by the creep criterion.
+/// One criterion's verdict on a hold.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct CriterionVerdict {
+    /// Diagnostics drifting beyond the criterion's tolerance over the second half of the hold (empty: none).
+    pub drifting: Vec<&'static str>,
+    /// Stable: the forcing was not released and nothing drifts.
+    pub stable: bool,
+}
+
+/// One hold run judged by both creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HoldVerdict {
     /// T_final (h).
@@ -79,47 +98,110 @@ pub struct HoldVerdict {
     pub dir: PathBuf,
     /// Whether the forcing was released (global disruption).
     pub released: bool,
-    /// Diagnostics drifting over the second half of the hold (empty: none).
-    pub drifting: Vec<&'static str>,
+    /// The measured second-half changes of θ_max, η_B and the coordination number.
+    pub drift: HoldDrift,
     /// Largest θ_max during the hold (degrees).
     pub theta_max_deg: f64,
-    /// Stable: not released and nothing drifting.
+    /// The paper's criterion (one-sided, coordination number included).
+    pub paper: CriterionVerdict,
+    /// Ours (two-sided on θ_max and η_B).
+    pub ours: CriterionVerdict,
+    /// The selected criterion's drifting diagnostics (as `paper` or `ours`).
+    pub drifting: Vec<&'static str>,
+    /// The selected criterion's verdict.
     pub stable: bool,
+}
+
+impl HoldVerdict {
+    /// The verdict of criterion `kind`.
+    pub fn verdict(&self, kind: CreepCriterionKind) -> &CriterionVerdict {
+        match kind {
+            CreepCriterionKind::Paper => &self.paper,
+            CreepCriterionKind::Ours => &self.ours,
+        }
+    }
+}
+
+/// T_c,3 and φ under one criterion.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct CriterionResult {
+    /// The criterion and its tolerances.
+    pub criterion: CreepCriterion,
+    /// T_c,3 (h): the first T_final stable under it.
+    pub t_c3_hours: Option<f64>,
+    /// φ (degrees): the largest θ_max over the holds within ±0.01 h of that T_c,3.
+    pub friction_angle_deg: Option<f64>,
 }
 
 /// `critical.json`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CriticalSearch {
-    /// The criterion used.
+    /// The selected criterion (the one behind `t_c3_hours` and `friction_angle_deg`).
     pub criterion: CreepCriterion,
     /// The runs, by increasing T_final.
     pub runs: Vec<HoldVerdict>,
-    /// T_c,3 (h): the first stable T_final.
+    /// T_c,3 (h) under the selected criterion.
     pub t_c3_hours: Option<f64>,
-    /// φ (degrees): the largest θ_max over the holds within ±0.01 h of T_c,3.
+    /// φ (degrees) under the selected criterion.
     pub friction_angle_deg: Option<f64>,
+    /// T_c,3 and φ under the paper's criterion.
+    pub paper: CriterionResult,
+    /// T_c,3 and φ under ours.
+    pub ours: CriterionResult,
 }
 
-/// Judges the hold (samples at or after `t_final`, s) of one run.
+/// Judges the hold (samples at or after `t_final`, s) of one run of T_final = `t_final_hours` in `dir` by both
+/// criteria; `selected` fills [`HoldVerdict::stable`] and [`HoldVerdict::drifting`].
 pub fn judge_hold(
     samples: &[SpinupSample],
     t_final: f64,
-    criterion: &CreepCriterion,
-) -> (bool, Vec<&'static str>, f64) {
+    paper: &CreepCriterion,
+    ours: &CreepCriterion,
+    selected: CreepCriterionKind,
+    t_final_hours: f64,
+    dir: PathBuf,
+) -> HoldVerdict {
     let hold: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_final).collect();
     let released = samples.iter().any(|s| !s.forcing);
-    let t: Vec<f64> = hold.iter().map(|s| s.t).collect();
-    let theta: Vec<f64> = hold.iter().map(|s| s.theta_max_deg).collect();
-    let eta: Vec<f64> = hold.iter().map(|s| s.packing_fraction).collect();
-    let coord: Vec<f64> = hold.iter().map(|s| s.coordination_number).collect();
-    let drifting = criterion.drifting(&t, &theta, &eta, &coord);
-    let theta_max = theta.iter().cloned().fold(f64::NAN, f64::max);
-    (released, drifting, theta_max)
+    let col = |f: fn(&SpinupSample) -> f64| hold.iter().map(|s| f(s)).collect::<Vec<f64>>();
+    let theta = col(|s| s.theta_max_deg);
+    let drift = HoldDrift::of(
+        &col(|s| s.t),
+        &theta,
+        &col(|s| s.packing_fraction),
+        &col(|s| s.coordination_number),
+    );
+    let theta_max_deg = theta.iter().cloned().fold(f64::NAN, f64::max);
+    let verdict = |c: &CreepCriterion| {
+        let drifting = c.judge(&drift);
+        CriterionVerdict {
+            stable: !released && drifting.is_empty(),
+            drifting,
+        }
+    };
+    let (paper, ours) = (verdict(paper), verdict(ours));
+    let chosen = match selected {
+        CreepCriterionKind::Paper => &paper,
+        CreepCriterionKind::Ours => &ours,
+    }
+    .clone();
+    HoldVerdict {
+        t_final_hours,
+        dir,
+        released,
+        drift,
+        theta_max_deg,
+        paper,
+        ours,
+        drifting: chosen.drifting,
+        stable: chosen.stable,
+    }
 }
 
-/// Reduces judged runs to T_c,3 and φ (see the module docs).
-pub fn critical_from_verdicts(runs: &[HoldVerdict]) -> (Option<f64>, Option<f64>) {
-    let t_c3 = runs.iter().find(|r| r.stable).map(|r| r.t_final_hours);
+/// Reduces judged runs to T_c,3 and φ under criterion `kind`: the first T_final stable under it, and the largest
+/// θ_max over the holds within ±0.01 h of it (Zhang17 §3.3.3).
+pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) -> (Option<f64>, Option<f64>) {
+    let t_c3 = runs.iter().find(|r| r.verdict(kind).stable).map(|r| r.t_final_hours);
     let phi = t_c3.and_then(|t| {
         let m = runs
             .iter()
@@ -129,6 +211,76 @@ pub fn critical_from_verdicts(runs: &[HoldVerdict]) -> (Option<f64>, Option<f64>
         m.is_finite().then_some(m)
     });
     (t_c3, phi)
+}
+
+/// Whether the search may stop after `runs`: every criterion has a stable hold and a judged hold after it (φ looks
+/// ±0.01 h around T_c,3).
+pub fn search_done(runs: &[HoldVerdict]) -> bool {
+    CreepCriterionKind::ALL.iter().all(|&k| {
+        runs.iter()
+            .position(|r| r.verdict(k).stable)
+            .is_some_and(|f| runs.len() > f + 1)
+    })
+}
+
+/// One line per hold of the verdicts by both criteria (printed as the search goes).
+pub fn verdict_line(r: &HoldVerdict) -> String {
+    let word = |v: &CriterionVerdict| {
+        if v.stable {
+            "stable".to_string()
+        } else if r.released {
+            "disrupted".to_string()
+        } else {
+            format!("creeps ({})", v.drifting.join(", "))
+        }
+    };
+    format!(
+        "T_final = {:.2} h: paper {}, ours {}; drift over the second half: theta_max {:+.2} deg, eta_B {:+.5}, \
+         coordination {:+.3}",
+        r.t_final_hours,
+        word(&r.paper),
+        word(&r.ours),
+        r.drift.theta_max_deg,
+        r.drift.packing,
+        r.drift.coordination
+    )
+}
+
+/// The `critical.csv` header: one row per hold with the drifts and both verdicts.
+pub const CRITICAL_CSV_HEADER: &str = "t_final_h,released,theta_max_deg,drift_theta_max_deg,drift_packing,drift_coordination,paper_stable,paper_drifting,ours_stable,ours_drifting\n";
+
+/// `critical.csv`: [`CRITICAL_CSV_HEADER`] and one row per hold (drifting diagnostics joined by `;`).
+pub fn critical_csv(runs: &[HoldVerdict]) -> String {
+    let mut out = CRITICAL_CSV_HEADER.to_string();
+    for r in runs {
+        out += &format!(
+            "{:.2},{},{:.3},{:.4},{:.6},{:.4},{},{},{},{}\n",
+            r.t_final_hours,
+            r.released,
+            r.theta_max_deg,
+            r.drift.theta_max_deg,
+            r.drift.packing,
+            r.drift.coordination,
+            r.paper.stable,
+            r.paper.drifting.join(";"),
+            r.ours.stable,
+            r.ours.drifting.join(";"),
+        );
+    }
+    out
+}
+
+/// The paper's criterion with the coordination tolerance `tol` (contacts per particle; `None`: the default), or
+/// a usage error naming `--coordination-tolerance` when it is not a positive number.
+pub fn paper_criterion(tol: Option<f64>) -> Result<CreepCriterion, SearchError> {
+    match tol {
+        None => Ok(CreepCriterion::of_kind(CreepCriterionKind::Paper)),
+        Some(c) if c.is_finite() && c > 0.0 => Ok(CreepCriterion::paper(c)),
+        Some(c) => Err(SearchError::usage(format!(
+            "--coordination-tolerance must be a change of the coordination number > 0 (contacts per particle), \
+             got {c}"
+        ))),
+    }
 }
 
 /// Runs the T_c,3 search (Zhang17 §3.3.3) and writes `critical.json` in `args.out`.
@@ -178,17 +330,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         table["scene"]["particles_file"] = toml::Value::String(abs.display().to_string());
     }
     std::fs::create_dir_all(&args.out).map_err(|e| SearchError::usage(format!("{}: {e}", args.out.display())))?;
-    if let Some(c) = args.coordination_tolerance
-        && !(c.is_finite() && c > 0.0)
-    {
-        return Err(SearchError::usage(format!(
-            "--coordination-tolerance must be > 0, got {c}"
-        )));
-    }
-    let criterion = CreepCriterion {
-        coordination: args.coordination_tolerance,
-        ..CreepCriterion::default()
-    };
+    let (paper, ours) = (paper_criterion(args.coordination_tolerance)?, CreepCriterion::ours());
     let n = ((args.to - args.from) / args.step + 1e-9).floor() as usize;
     let grid: Vec<f64> = (0..=n)
         .map(|k| ((args.from + k as f64 * args.step) * 1e4).round() / 1e4)
@@ -234,46 +376,58 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             }
         }
         let samples = read_spinup_csv(&dir.join("spinup.csv")).map_err(SearchError::failed)?;
-        let (released, drifting, theta) = judge_hold(&samples, t_final, &criterion);
-        let stable = !released && drifting.is_empty();
-        println!(
-            "T_final = {tf:.2} h: {}{}",
-            if stable { "stable" } else { "creeps" },
-            if released {
-                " (disrupted)".to_string()
-            } else if drifting.is_empty() {
-                String::new()
-            } else {
-                format!(" ({} drifting)", drifting.join(", "))
-            }
-        );
-        runs.push(HoldVerdict {
-            t_final_hours: tf,
-            dir,
-            released,
-            drifting,
-            theta_max_deg: theta,
-            stable,
-        });
-        // stop one step after the first stable T_final: φ looks ±0.01 h around T_c,3
-        let first_stable = runs.iter().position(|r| r.stable);
-        if first_stable.is_some_and(|f| runs.len() > f + 1) {
+        let verdict = judge_hold(&samples, t_final, &paper, &ours, args.criterion, tf, dir);
+        println!("{}", verdict_line(&verdict));
+        runs.push(verdict);
+        if search_done(&runs) {
             break;
         }
     }
-    let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs);
+    let result = |criterion: CreepCriterion| {
+        let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs, criterion.kind);
+        CriterionResult {
+            criterion,
+            t_c3_hours,
+            friction_angle_deg,
+        }
+    };
+    let (paper, ours) = (result(paper), result(ours));
+    let selected = match args.criterion {
+        CreepCriterionKind::Paper => paper,
+        CreepCriterionKind::Ours => ours,
+    };
+    let (t_c3_hours, friction_angle_deg) = (selected.t_c3_hours, selected.friction_angle_deg);
+    let csv = args.out.join("critical.csv");
+    std::fs::write(&csv, critical_csv(&runs)).map_err(|e| SearchError::failed(format!("{}: {e}", csv.display())))?;
     let out = CriticalSearch {
-        criterion,
+        criterion: selected.criterion,
         runs,
         t_c3_hours,
         friction_angle_deg,
+        paper,
+        ours,
     };
     std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
-    match (t_c3_hours, friction_angle_deg) {
-        (Some(t), Some(p)) => println!("T_c3 = {t:.2} h, phi = {p:.1} deg ({})", json.display()),
-        _ => println!("no stable T_final up to {} h ({})", args.to, json.display()),
+    for r in [&out.paper, &out.ours] {
+        match (r.t_c3_hours, r.friction_angle_deg) {
+            (Some(t), Some(p)) => println!(
+                "{} criterion: T_c3 = {t:.2} h, phi = {p:.1} deg",
+                r.criterion.kind.name()
+            ),
+            _ => println!(
+                "{} criterion: no stable T_final up to {} h",
+                r.criterion.kind.name(),
+                args.to
+            ),
+        }
     }
+    println!(
+        "selected ({}): {} ({})",
+        args.criterion.name(),
+        t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
+        json.display()
+    );
     Ok(())
 }
 
@@ -550,49 +704,114 @@ mod tests {
         }
     }
 
-    /// The creep criterion on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps;
-    /// T_c,3 is the first stable T_final and φ the largest θ_max within ±0.01 h of it.
+    fn hold(theta: impl Fn(f64) -> f64, eta: impl Fn(f64) -> f64, coord: impl Fn(f64) -> f64) -> Vec<SpinupSample> {
+        (0..100)
+            .map(|k| {
+                let x = k as f64 / 99.0;
+                sample(1000.0 + 10.0 * k as f64, theta(x), eta(x), coord(x), true)
+            })
+            .collect()
+    }
+
+    fn verdict(tf: f64, s: &[SpinupSample], selected: CreepCriterionKind) -> HoldVerdict {
+        let paper = paper_criterion(None).unwrap();
+        judge_hold(s, 1000.0, &paper, &CreepCriterion::ours(), selected, tf, PathBuf::new())
+    }
+
+    /// The creep criteria on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps
+    /// under both; T_c,3 is the first stable T_final and φ the largest θ_max within ±0.01 h of it.
     #[test]
     fn hold_verdicts_give_t_c3_and_phi() {
-        let hold = |rise: f64, level: f64| -> Vec<SpinupSample> {
-            (0..100)
-                .map(|k| {
-                    sample(
-                        1000.0 + 10.0 * k as f64,
-                        level + rise * k as f64 / 99.0,
-                        0.74,
-                        9.0,
-                        true,
-                    )
-                })
-                .collect()
-        };
-        let c = CreepCriterion::default();
-        let verdict = |tf: f64, s: &[SpinupSample]| {
-            let (released, drifting, theta) = judge_hold(s, 1000.0, &c);
-            HoldVerdict {
-                t_final_hours: tf,
-                dir: PathBuf::new(),
-                released,
-                stable: !released && drifting.is_empty(),
-                drifting,
-                theta_max_deg: theta,
-            }
-        };
+        let flat = |v: f64| move |_: f64| v;
         let runs = vec![
-            verdict(2.40, &hold(2.0, 40.0)),
-            verdict(2.41, &hold(0.0, 39.0)),
-            verdict(2.42, &hold(0.0, 37.5)),
+            verdict(
+                2.40,
+                &hold(|x| 40.0 + 2.0 * x, flat(0.74), flat(9.0)),
+                CreepCriterionKind::Paper,
+            ),
+            verdict(
+                2.41,
+                &hold(flat(39.0), flat(0.74), flat(9.0)),
+                CreepCriterionKind::Paper,
+            ),
+            verdict(
+                2.42,
+                &hold(flat(37.5), flat(0.74), flat(9.0)),
+                CreepCriterionKind::Paper,
+            ),
         ];
         assert!(!runs[0].stable && runs[0].drifting == vec!["theta_max"]);
+        assert_eq!(runs[0].ours.drifting, vec!["theta_max"]);
         assert!(runs[1].stable && runs[2].stable);
-        let (t, phi) = critical_from_verdicts(&runs);
-        assert_eq!(t, Some(2.41));
-        assert_eq!(phi, Some(42.0));
-        // a released run is never stable
-        let mut s = hold(0.0, 30.0);
+        for k in CreepCriterionKind::ALL {
+            assert_eq!(critical_from_verdicts(&runs, k), (Some(2.41), Some(42.0)));
+        }
+        assert!(search_done(&runs) && !search_done(&runs[..2]));
+        // a released run is never stable, under either criterion
+        let mut s = hold(flat(30.0), flat(0.74), flat(9.0));
         s[50].forcing = false;
-        assert!(!verdict(2.5, &s).stable);
+        let v = verdict(2.5, &s, CreepCriterionKind::Paper);
+        assert!(!v.stable && !v.paper.stable && !v.ours.stable && v.released);
+        assert!(
+            verdict_line(&v).contains("paper disrupted, ours disrupted"),
+            "{}",
+            verdict_line(&v)
+        );
+    }
+
+    /// Both T_c,3 values from one search: holds at 2.55–2.58 h lose 0.2 contacts per particle over the hold with
+    /// θ_max and η_B flat (our RCP holds), 2.59 h and later keep them. Ours finds T_c,3 = 2.55 h, the paper's
+    /// 2.59 h; the selected criterion fills the top-level verdict, and the search is done only once both have a
+    /// stable hold and one more.
+    #[test]
+    fn both_criteria_give_their_own_t_c3_when_only_the_coordination_number_drifts() {
+        let grid = [2.55, 2.56, 2.57, 2.58, 2.59, 2.60];
+        let runs: Vec<HoldVerdict> = grid
+            .iter()
+            .map(|&tf| {
+                let loss = if tf < 2.585 { 0.2 } else { 0.0 };
+                let theta = 50.0 - 10.0 * (tf - 2.55);
+                verdict(
+                    tf,
+                    &hold(move |_| theta, |_| 0.65, move |x| 5.5 - loss * x),
+                    CreepCriterionKind::Ours,
+                )
+            })
+            .collect();
+        assert!(runs[0].stable && !runs[0].paper.stable);
+        assert_eq!(runs[0].paper.drifting, vec!["coordination_number"]);
+        assert!(runs[0].drift.coordination < -0.09 && runs[0].drift.coordination > -0.11);
+        let (t_ours, phi_ours) = critical_from_verdicts(&runs, CreepCriterionKind::Ours);
+        let (t_paper, phi_paper) = critical_from_verdicts(&runs, CreepCriterionKind::Paper);
+        assert_eq!(t_ours, Some(2.55));
+        assert_eq!(t_paper, Some(2.59));
+        assert!((phi_ours.unwrap() - 50.0).abs() < 1e-9);
+        assert!((phi_paper.unwrap() - (50.0 - 10.0 * 0.03)).abs() < 1e-9);
+        assert!(!search_done(&runs[..4]) && !search_done(&runs[..5]) && search_done(&runs));
+        let csv = critical_csv(&runs);
+        assert!(csv.starts_with(CRITICAL_CSV_HEADER));
+        assert!(
+            csv.lines()
+                .nth(1)
+                .unwrap()
+                .ends_with(",false,coordination_number,true,"),
+            "{csv}"
+        );
+        assert_eq!(csv.lines().count(), grid.len() + 1);
+    }
+
+    /// Regression guard: a bad `--coordination-tolerance` is refused with the option's name and the expected
+    /// value, before any run starts.
+    #[test]
+    fn coordination_tolerance_must_be_positive() {
+        for bad in [0.0, -0.1, f64::NAN] {
+            let e = paper_criterion(Some(bad)).unwrap_err().to_string();
+            assert!(
+                e.contains("--coordination-tolerance must be") && e.contains("> 0"),
+                "{e}"
+            );
+        }
+        assert_eq!(paper_criterion(Some(0.1)).unwrap().coordination, Some(0.1));
     }
 
     #[test]

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use crate::analysis::creep::CreepCriterionKind;
 use crate::analysis::spinup_search::{CriticalOptions, SearchError, critical as run_critical, density_fit as fit};
 use crate::cli::CliError;
 
@@ -40,8 +41,13 @@ pub struct CriticalArgs {
     /// path without rests.
     #[arg(long)]
     pub branch: bool,
-    /// Also judge the coordination number: largest allowed change over the second half of a hold (not judged by
-    /// default, see `analysis::spinup::CreepCriterion::coordination`).
+    /// Which creep criterion gives critical.json's top-level T_c,3 and φ: `paper` (Zhang17 §3.3.3: θ_max rising,
+    /// η_B or the coordination number falling over a hold's second half is creep) or `ours` (θ_max or η_B moving
+    /// either way). Both are judged and recorded per hold; the search runs until both have a stable hold.
+    #[arg(long, value_name = "paper|ours", default_value = "paper")]
+    pub creep_criterion: CreepCriterionKind,
+    /// Largest fall of the coordination number (contacts per particle) over the second half of a hold that the
+    /// paper's criterion lets pass (default 0.05).
     #[arg(long, value_name = "CHANGE")]
     pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
@@ -77,6 +83,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         out: args.out.clone(),
         force: args.force,
         branch: args.branch,
+        criterion: args.creep_criterion,
         coordination_tolerance: args.coordination_tolerance,
         hold: args.hold,
     };

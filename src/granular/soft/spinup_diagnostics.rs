@@ -297,6 +297,26 @@ pub fn depth_weights(
         .collect()
 }
 
+/// Contacts per particle from a force evaluation's contact list: `records` holds each touching pair once (and each
+/// sphere–wall contact once, with the wall's `j ≥ n`), so a pair adds one contact to both spheres and a wall
+/// contact one to its sphere. `n` is the number of spheres.
+pub fn contact_counts(records: &[ContactRecord], n: usize) -> Vec<u32> {
+    let mut count = vec![0u32; n];
+    for r in records {
+        count[r.i] += 1;
+        if r.j < n {
+            count[r.j] += 1;
+        }
+    }
+    count
+}
+
+/// The coordination number of Zhang17 §4.1.1 (Fig. 5, bottom frame; the creep test of §3.3.3): the mean number
+/// of contacts per particle over all spheres, from [`contact_counts`] (0 for no spheres).
+pub fn mean_coordination(counts: &[u32]) -> f64 {
+    counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64
+}
+
 /// Measures the system at time `t` (s). Needs the contact records of the last force evaluation
 /// (`sys.keep_records` on for it); `axis` is the spin axis, `path_period` the path's period (s), `interior` the
 /// rule for η_B's particles.
@@ -363,13 +383,7 @@ pub fn diagnose(
             }
         })
         .collect();
-    let mut count = vec![0u32; n];
-    for r in &sys.records {
-        count[r.i] += 1;
-        if r.j < n {
-            count[r.j] += 1;
-        }
-    }
+    let count = contact_counts(&sys.records, n);
     let frac = |k: u32| count.iter().filter(|&&c| c == k).count() as f64 / n.max(1) as f64;
     let members: Vec<usize> = (0..n).filter(|&i| member[i]).collect();
     let stresses = rve_stresses(sys, &sys.records, &volumes, &members, rve_target);
@@ -393,7 +407,7 @@ pub fn diagnose(
         c_over_a: ax.c_over_a(),
         packing_fraction: packing.unwrap_or(f64::NAN),
         interior_particles: interior,
-        coordination_number: count.iter().map(|&c| c as f64).sum::<f64>() / n.max(1) as f64,
+        coordination_number: mean_coordination(&count),
         fraction_0_contacts: frac(0),
         fraction_1_contact: frac(1),
         rves: stresses.len(),

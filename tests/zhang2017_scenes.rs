@@ -1,0 +1,97 @@
+//! Every scene in `analysis/zhang2017/` loads (the soft-sphere parser and validator, as `rubblepile check` and
+//! `run` use it), and the spin-up paths of the path scenes are Zhang17 Table 5's. Scenes whose target is not
+//! committed (built by the command in their header: PP2, PPC, the full-size HCP) are checked with PP1's target in
+//! its place, so that everything but the particle file is still validated.
+
+use std::path::{Path, PathBuf};
+
+use rubblepile::granular::soft::scene::{SoftScene, parse_soft_scene};
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("analysis/zhang2017")
+}
+
+/// Loads `name` from analysis/zhang2017; a `particles_file` that is not in the repository is replaced by PP1's.
+fn load(name: &str) -> (SoftScene, bool) {
+    let d = dir();
+    let text = std::fs::read_to_string(d.join(name)).unwrap();
+    let table: toml::Table = toml::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let file = table["scene"]["particles_file"]
+        .as_str()
+        .expect("particles_file")
+        .to_string();
+    let present = d.join(&file).is_file();
+    let text = if present {
+        text
+    } else {
+        text.replace(&file, "../../targets/zhang2017/pp1.csv")
+    };
+    let scene = parse_soft_scene(&text, name, Some(Path::new(&d))).unwrap_or_else(|e| panic!("{name}: {e}"));
+    (scene, present)
+}
+
+#[test]
+fn every_zhang2017_scene_loads() {
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 14, "{names:?}");
+    for name in &names {
+        let (scene, _) = load(name);
+        assert!(scene.spinup.is_some(), "{name}: no [spinup] table");
+        assert!(!scene.particles.is_empty(), "{name}");
+    }
+    // the targets that must be committed for the runs behind REPORT.md
+    for name in ["hcp_path2.toml", "rcp_path2.toml", "rcpc_path2.toml", "pp1_path2.toml"] {
+        assert!(load(name).1, "{name}: its target is not in the repository");
+    }
+}
+
+/// Zhang17 Table 5: (T_inter h, t_final s, rests, rest length s) of paths 1, 2, 3; all start at 5 h, settle until
+/// 700 s, reach T_inter at 7000 s and end at 2.26 h. The path-1 and path-3 scenes differ from path 2's only in
+/// the path (and, for path 1, the run's length and snapshot times).
+#[test]
+fn path_scenes_follow_table_5_and_differ_from_path_2_only_in_the_path() {
+    let table5 = [
+        (1, 3.0, 320_000.0, 5, 7000.0),
+        (2, 3.0, 32_000.0, 0, 0.0),
+        (3, 4.0, 32_000.0, 0, 0.0),
+    ];
+    for model in ["hcp", "rcp"] {
+        let (base, _) = load(&format!("{model}_path2.toml"));
+        for (path, t_inter_h, t_final, rests, rest) in table5 {
+            let name = format!("{model}_path{path}.toml");
+            let (scene, present) = load(&name);
+            assert!(present, "{name}: its target is not in the repository");
+            let p = scene.spinup.as_ref().unwrap().path;
+            let got = (
+                p.period_start / 3600.0,
+                p.period_inter / 3600.0,
+                p.period_final / 3600.0,
+                p.t_start,
+                p.t_inter,
+                p.t_final,
+                p.rests,
+                p.rest_length,
+            );
+            assert_eq!(
+                got,
+                (5.0, t_inter_h, 2.26, 700.0, 7000.0, t_final, rests, rest),
+                "{name}"
+            );
+            assert!(
+                (scene.t_end - (t_final + 4000.0)).abs() < 1e-9,
+                "{name}: hold of 4000 s"
+            );
+            assert_eq!(
+                (scene.dt, scene.gravity_interval, scene.material, scene.every_steps),
+                (base.dt, base.gravity_interval, base.material, base.every_steps),
+                "{name}"
+            );
+            assert_eq!(scene.particles, base.particles, "{name}");
+        }
+    }
+}
