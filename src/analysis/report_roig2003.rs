@@ -9,7 +9,9 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::analysis::run_analysis::{CampaignAnalysis, CampaignRun, Fit};
+use crate::analysis::run_analysis::{
+    AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_campaign,
+};
 
 /// A published outcome of Roig03 as a closed interval (with the paper's words).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,6 +65,60 @@ pub struct ReportInputs<'a> {
     pub other_kappa: Option<(&'a CampaignAnalysis, &'a Path)>,
     /// The command that regenerates the report, quoted in it.
     pub command: String,
+}
+
+/// The campaign directories a report is made from (see `rubblepile report roig2003 --help`).
+#[derive(Debug, Clone, Copy)]
+pub struct CampaignDirs<'a> {
+    /// The main campaign (`analysis/roig2003/campaign.toml`).
+    pub campaign: &'a Path,
+    /// The uniform-inertia partner (`campaign_uniform.toml`), if any.
+    pub uniform: Option<&'a Path>,
+    /// The same grid under another reading of Eq. 13's `K` (`campaign_printed.toml`), if any.
+    pub other_kappa: Option<&'a Path>,
+}
+
+impl CampaignDirs<'_> {
+    /// The command that regenerates the report from these directories into `out` at `at` seconds.
+    fn command(&self, out: &Path, at: f64) -> String {
+        let mut command = format!(
+            "rubblepile report roig2003 {} --out {}",
+            self.campaign.display(),
+            out.display()
+        );
+        for (flag, dir) in [("--uniform", self.uniform), ("--other-kappa", self.other_kappa)] {
+            if let Some(d) = dir {
+                command += &format!(" {flag} {}", d.display());
+            }
+        }
+        if at != 400.0 {
+            command += &format!(" --at {at}");
+        }
+        command + " --force"
+    }
+}
+
+/// Re-analyses every campaign of `dirs` at `at` seconds (rewriting their `analysis/`) and writes `out/REPORT.md`;
+/// returns its path and the main campaign's analysis.
+pub fn regenerate(dirs: &CampaignDirs<'_>, at: f64, out: &Path) -> Result<(PathBuf, CampaignAnalysis), AnalysisError> {
+    let analyse = |dir: &Path| analyze_campaign(dir, at, true, &SpinSelection::default());
+    let campaign = analyse(dirs.campaign)?;
+    let uniform = dirs.uniform.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
+    let other_kappa = dirs.other_kappa.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
+    let inputs = ReportInputs {
+        campaign: &campaign,
+        campaign_dir: dirs.campaign,
+        uniform: uniform.as_ref().map(|(a, d)| (a, *d)),
+        other_kappa: other_kappa.as_ref().map(|(a, d)| (a, *d)),
+        command: dirs.command(out, at),
+    };
+    let write_error = |e: std::io::Error| AnalysisError::Write {
+        path: out.to_path_buf(),
+        reason: e.to_string(),
+    };
+    std::fs::create_dir_all(out).map_err(write_error)?;
+    let path = write_report(&inputs, out).map_err(write_error)?;
+    Ok((path, campaign))
 }
 
 /// Runs of `runs` whose values `f` are finite, as (value, run name).

@@ -38,6 +38,14 @@ pub enum AnalysisError {
     /// The fragment analysis refused its input.
     #[error("{0}")]
     Fragments(String),
+    /// A report or its directory could not be written.
+    #[error("{path}: {reason}")]
+    Write {
+        /// The file or directory.
+        path: PathBuf,
+        /// What went wrong.
+        reason: String,
+    },
 }
 
 /// A fit, or why it could not be made.

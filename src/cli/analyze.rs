@@ -147,52 +147,16 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
             report.display()
         )));
     }
-    let analyse = |dir: &PathBuf| {
-        crate::analysis::run_analysis::analyze_campaign(
-            dir,
-            args.at,
-            true,
-            &crate::analysis::run_analysis::SpinSelection::default(),
-        )
-        .map_err(|e| match e {
-            AnalysisError::Fragments(_) => CliError::failed(e),
+    let dirs = crate::analysis::report_roig2003::CampaignDirs {
+        campaign: &args.campaign,
+        uniform: args.uniform.as_deref(),
+        other_kappa: args.other_kappa.as_deref(),
+    };
+    let (path, campaign) =
+        crate::analysis::report_roig2003::regenerate(&dirs, args.at, &args.out).map_err(|e| match e {
+            AnalysisError::Fragments(_) | AnalysisError::Write { .. } => CliError::failed(e),
             _ => CliError::usage(e),
-        })
-    };
-    let campaign = analyse(&args.campaign)?;
-    let uniform = match &args.uniform {
-        Some(dir) => Some((analyse(dir)?, dir.clone())),
-        None => None,
-    };
-    let other_kappa = match &args.other_kappa {
-        Some(dir) => Some((analyse(dir)?, dir.clone())),
-        None => None,
-    };
-    let mut command = format!(
-        "rubblepile report roig2003 {} --out {}",
-        args.campaign.display(),
-        args.out.display()
-    );
-    if let Some(u) = &args.uniform {
-        command += &format!(" --uniform {}", u.display());
-    }
-    if let Some(o) = &args.other_kappa {
-        command += &format!(" --other-kappa {}", o.display());
-    }
-    if args.at != 400.0 {
-        command += &format!(" --at {}", args.at);
-    }
-    command += " --force";
-    let inputs = crate::analysis::report_roig2003::ReportInputs {
-        campaign: &campaign,
-        campaign_dir: &args.campaign,
-        uniform: uniform.as_ref().map(|(a, d)| (a, d.as_path())),
-        other_kappa: other_kappa.as_ref().map(|(a, d)| (a, d.as_path())),
-        command,
-    };
-    std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
-    let path = crate::analysis::report_roig2003::write_report(&inputs, &args.out)
-        .map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
+        })?;
     println!(
         "report of {} runs ({} not completed) written to {}",
         campaign.runs.len(),
