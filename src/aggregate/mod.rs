@@ -13,6 +13,7 @@
 
 pub mod core;
 pub mod density;
+pub mod files;
 pub mod hcp;
 pub mod random_packing;
 pub mod report;

@@ -16,6 +16,7 @@ pub mod nbody;
 pub mod problems;
 pub mod render;
 pub mod rhs;
+pub mod ssdem;
 pub mod stability;
 pub mod tolerance;
 pub mod work_precision;

@@ -2,16 +2,13 @@
 //! see [`crate::aggregate`]) written as a particle file (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, the
 //! soft-sphere scene's `particles_file`) with a JSON report beside it (`NAME.json`).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
+use crate::aggregate::files::{check_outputs, density_variant, write_aggregate};
 use crate::aggregate::random_packing::{BuildProgress, Recipe};
-use crate::aggregate::report::AggregateReport;
 use crate::aggregate::shape::Shape;
-use crate::aggregate::{BuildSpec, Grains, Model, build_with_progress, density};
+use crate::aggregate::{BuildSpec, Grains, Model, build_with_progress};
 use crate::cli::CliError;
-use crate::granular::soft::particle::Particle;
-use crate::granular::soft::run::write_particles_csv;
-use crate::math::Vec3;
 
 /// `rubblepile aggregate …`.
 #[derive(Debug, clap::Subcommand)]
@@ -85,36 +82,12 @@ pub struct DensityArgs {
     pub force: bool,
 }
 
-fn report_path(csv: &Path) -> PathBuf {
-    csv.with_extension("json")
-}
-
-fn check_outputs(out: &Path, force: bool) -> Result<(), CliError> {
-    if out.extension().and_then(|e| e.to_str()) != Some("csv") {
-        return Err(CliError::usage(format!(
-            "--out: expected a FILE.csv path, got {}",
-            out.display()
-        )));
+/// Bad input to the aggregate layer is a usage error; a failed build is a failure.
+fn cli_error(e: crate::aggregate::AggregateError) -> CliError {
+    match e {
+        crate::aggregate::AggregateError::Input { .. } => CliError::usage(e),
+        crate::aggregate::AggregateError::Failed(_) => CliError::failed(e),
     }
-    for p in [out.to_path_buf(), report_path(out)] {
-        if p.exists() && !force {
-            return Err(CliError::usage(format!(
-                "{} exists; pass --force to overwrite it",
-                p.display()
-            )));
-        }
-    }
-    Ok(())
-}
-
-fn write(out: &Path, particles: &[Particle], report: &AggregateReport) -> Result<(), CliError> {
-    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
-    }
-    write_particles_csv(out, 0.0, particles).map_err(|e| CliError::failed(format!("{}: {e}", out.display())))?;
-    let json = serde_json::to_string_pretty(report).expect("report serialises") + "\n";
-    let path = report_path(out);
-    std::fs::write(&path, json).map_err(|e| CliError::failed(format!("{}: {e}", path.display())))
 }
 
 fn grains(args: &BuildArgs) -> Result<Grains, CliError> {
@@ -148,7 +121,7 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
             args.model
         ))
     })?;
-    check_outputs(&args.out, args.force)?;
+    check_outputs(&args.out, args.force).map_err(cli_error)?;
     let shape = Shape::parse(&args.shape, args.obj_scale).map_err(CliError::usage)?;
     let mut recipe = Recipe::default();
     if let Some(p) = args.shake_periods {
@@ -179,11 +152,8 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
         core_radius: args.core_radius,
         recipe,
     };
-    let agg = build_with_progress(&spec, &mut build_progress()).map_err(|e| match e {
-        crate::aggregate::AggregateError::Input { .. } => CliError::usage(e),
-        crate::aggregate::AggregateError::Failed(_) => CliError::failed(e),
-    })?;
-    write(&args.out, &agg.particles, &agg.report)?;
+    let agg = build_with_progress(&spec, &mut build_progress()).map_err(cli_error)?;
+    write_aggregate(&args.out, &agg.particles, &agg.report).map_err(cli_error)?;
     let r = &agg.report;
     println!(
         "{}: {} N = {}, r {:.4}–{:.4} m, grain density {:.1} kg/m³, bulk {:.1} kg/m³, interior packing {}, b/a {:.4}, c/a {:.4}, {:.1} s",
@@ -234,67 +204,11 @@ fn build_progress() -> impl FnMut(BuildProgress<'_>) {
     }
 }
 
-/// Reads a particle file written by `aggregate build` (zero velocities and spins).
-pub fn read_aggregate_csv(path: &Path) -> Result<Vec<Particle>, CliError> {
-    let bad = |m: String| CliError::usage(format!("{}: {m}", path.display()));
-    let mut reader = csv::Reader::from_path(path).map_err(|e| bad(e.to_string()))?;
-    let mut out = Vec::new();
-    for (k, rec) in reader.records().enumerate() {
-        let rec = rec.map_err(|e| bad(e.to_string()))?;
-        let v: Vec<f64> = rec
-            .iter()
-            .map(|x| x.parse::<f64>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                bad(format!(
-                    "row {}: expected 13 numbers t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz",
-                    k + 1
-                ))
-            })?;
-        if v.len() != 13 {
-            return Err(bad(format!("row {}: expected 13 columns, got {}", k + 1, v.len())));
-        }
-        out.push(Particle {
-            mass: v[2],
-            radius: v[3],
-            position: Vec3::new(v[4], v[5], v[6]),
-            velocity: Vec3::new(v[7], v[8], v[9]),
-            spin: Vec3::new(v[10], v[11], v[12]),
-        });
-    }
-    Ok(out)
-}
-
 /// Runs `aggregate density`.
 pub fn density_cmd(args: &DensityArgs) -> Result<(), CliError> {
-    if !(args.bulk_density.is_finite() && args.bulk_density > 0.0) {
-        return Err(CliError::usage(format!(
-            "--bulk-density: a positive density in kg/m³, got {}",
-            args.bulk_density
-        )));
-    }
-    check_outputs(&args.out, args.force)?;
-    let json_in = report_path(&args.input);
-    let text = std::fs::read_to_string(&json_in).map_err(|e| CliError::usage(format!("{}: {e}", json_in.display())))?;
-    let old: AggregateReport =
-        serde_json::from_str(&text).map_err(|e| CliError::usage(format!("{}: {e}", json_in.display())))?;
-    let mut particles = read_aggregate_csv(&args.input)?;
-    let factor = density::rescale_bulk_density(&mut particles, old.shape_volume_m3, args.bulk_density);
-    // geometry is unchanged; recompute only what the masses change
-    let total: f64 = particles.iter().map(|p| p.mass).sum();
-    let report = AggregateReport {
-        grain_density_kg_m3: old.grain_density_kg_m3 * factor,
-        core_grain_density_kg_m3: old.core_grain_density_kg_m3.map(|x| x * factor),
-        total_mass_kg: total,
-        bulk_density_kg_m3: total / old.shape_volume_m3,
-        notes: format!(
-            "{}; bulk-density variant of {} (masses × {factor})",
-            old.notes,
-            args.input.display()
-        ),
-        ..old
-    };
-    write(&args.out, &particles, &report)?;
+    let (particles, report, factor) = density_variant(&args.input, args.bulk_density).map_err(cli_error)?;
+    check_outputs(&args.out, args.force).map_err(cli_error)?;
+    write_aggregate(&args.out, &particles, &report).map_err(cli_error)?;
     println!(
         "{}: bulk density {:.1} kg/m³, grain density {:.1} kg/m³ (masses × {factor:.6})",
         args.out.display(),

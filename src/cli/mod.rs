@@ -258,7 +258,7 @@ pub enum BenchCommand {
     /// thread count, with the 60 s goal.
     Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
-    Ssdem(ssdem::BenchSsdemArgs),
+    Ssdem(crate::bench::ssdem::BenchSsdemArgs),
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
     /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
     Stability(stability::StabilityArgs),
@@ -352,7 +352,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Bench(BenchCommand::Impact(args)) => {
             crate::bench::impact_wall_time::impact(&args).map_err(CliError::from)
         }
-        Command::Bench(BenchCommand::Ssdem(args)) => ssdem::bench(&args),
+        Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
         Command::Bench(BenchCommand::Tolerance(args)) => {
