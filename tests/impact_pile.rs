@@ -62,7 +62,15 @@ fn two_pile_collision_conserves_energy_momentum_and_angular_momentum() {
     let series = std::fs::read_to_string(out.join("timeseries.csv")).unwrap();
     let header: Vec<&str> = series.lines().next().unwrap().split(',').collect();
     let col = header.iter().position(|h| *h == "dissipated").unwrap();
-    let dissipated: f64 = series.lines().last().unwrap().split(',').nth(col).unwrap().parse().unwrap();
+    let dissipated: f64 = series
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .nth(col)
+        .unwrap()
+        .parse()
+        .unwrap();
     assert!(dissipated.abs() > 0.0, "no dissipated work recorded");
 
     let impact = json(&out.join("impact.json"));
@@ -100,7 +108,11 @@ fn pile_set_up_touches_at_contact_time() {
         assert!((total_mass(&bodies[30..]) - p.mass()).abs() <= 1e-12 * p.mass());
         assert!(barycentre_velocity(&bodies).norm() < 1e-9);
         let relative = barycentre_velocity(&bodies[30..]) - barycentre_velocity(&bodies[..30]);
-        assert!((relative.norm() - 5000.0).abs() < 1e-6, "relative speed {}", relative.norm());
+        assert!(
+            (relative.norm() - 5000.0).abs() < 1e-6,
+            "relative speed {}",
+            relative.norm()
+        );
         let zeta = f64::to_radians(angle);
         let n = Vec3::new(0.0, zeta.sin(), zeta.cos());
         assert!((relative.normalize() + n).norm() < 1e-12, "not aimed along -n");
@@ -113,7 +125,10 @@ fn pile_set_up_touches_at_contact_time() {
         };
         assert!(!piles_overlap(&bodies, 30), "ζ = {angle}: overlap at t = 0");
         assert!(!piles_overlap(&moved(89.99), 30), "ζ = {angle}: overlap before contact");
-        assert!(piles_overlap(&moved(90.01), 30), "ζ = {angle}: no contact after contact_time");
+        assert!(
+            piles_overlap(&moved(90.01), 30),
+            "ζ = {angle}: no contact after contact_time"
+        );
     }
 }
 
@@ -163,11 +178,11 @@ fn composition_of_a_constructed_outcome() {
     };
     assert!(CLUMP_MARGIN >= 0.05, "B's 0.1 gap must fall inside the margin");
     let bodies = vec![
-        sphere(2.0, 0.0, 0.0, 0.0),   // T0
-        sphere(2.0, 1.9, 0.0, 0.0),   // T1
-        sphere(1.0, 0.0, 1.9, 0.0),   // P2
-        sphere(1.0, 50.0, 0.0, 0.0),  // P3
-        sphere(3.0, 52.1, 0.0, 0.0),  // T4
+        sphere(2.0, 0.0, 0.0, 0.0),    // T0
+        sphere(2.0, 1.9, 0.0, 0.0),    // T1
+        sphere(1.0, 0.0, 1.9, 0.0),    // P2
+        sphere(1.0, 50.0, 0.0, 0.0),   // P3
+        sphere(3.0, 52.1, 0.0, 0.0),   // T4
         sphere(0.01, -50.0, 0.0, 1e3), // P5
     ];
     let projectile = [2usize, 3, 5];
@@ -176,7 +191,11 @@ fn composition_of_a_constructed_outcome() {
     let bodies: Vec<Body> = order.iter().map(|&i| bodies[i].clone()).collect();
     let c = composition(&bodies, 3..6, 100.0, |b| b.shape.principal_moments(2.5)).unwrap();
     for (k, &i) in order.iter().enumerate() {
-        let expected = if projectile.contains(&i) { Origin::Projectile } else { Origin::Target };
+        let expected = if projectile.contains(&i) {
+            Origin::Projectile
+        } else {
+            Origin::Target
+        };
         assert_eq!(c.origins[k], expected);
     }
     assert_eq!(c.n_clumps, 3);
@@ -226,7 +245,10 @@ fn clump_spin_of_a_rigid_rotation_is_its_rate() {
     let c = composition(&bodies, 1..2, 1e-3, moments).unwrap();
     let period = c.largest_remnant.spin_period_h.unwrap();
     let expected = 2.0 * std::f64::consts::PI / 3e-4 / 3600.0;
-    assert!((period - expected).abs() < 1e-9 * expected, "{period} h against {expected} h");
+    assert!(
+        (period - expected).abs() < 1e-9 * expected,
+        "{period} h against {expected} h"
+    );
     assert!((c.largest_remnant.projectile_fraction - 2.0 / 3.0).abs() < 1e-15);
 }
 
@@ -260,7 +282,10 @@ speed_km_s = 3.0
     assert!(!pile.random_attitude);
     assert_eq!(point.config.projectile.speed, 3000.0);
     assert_eq!(point.plan.bodies.len(), 60);
-    assert_eq!(point.plan.setup.projectile_pile.as_ref().unwrap().projectile_bodies, [30, 60]);
+    assert_eq!(
+        point.plan.setup.projectile_pile.as_ref().unwrap().projectile_bodies,
+        [30, 60]
+    );
     assert!(c.points[1].config.pile.is_none());
     assert_eq!(c.points[1].plan.bodies.len(), 31);
 
@@ -273,7 +298,10 @@ speed_km_s = 3.0
     let e = error(("projectile_pile = \"targets/N30_T12.csv\"", ""));
     assert!(e.contains("projectile[0].radius_km"), "{e}");
     let e = error(("N30_T12.csv", "missing.csv"));
-    assert!(e.contains("projectile[0].projectile_pile") && e.contains("missing.csv"), "{e}");
+    assert!(
+        e.contains("projectile[0].projectile_pile") && e.contains("missing.csv"),
+        "{e}"
+    );
     let e = error(("random_attitude = false", "random_attitude = 3"));
     assert!(e.contains("random_attitude"), "{e}");
     let e = error((

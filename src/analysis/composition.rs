@@ -108,6 +108,32 @@ pub struct Composition {
     pub clump_of: Vec<usize>,
 }
 
+impl Composition {
+    /// One line for the terminal: bound fraction, largest remnant (mass, spin, projectile fraction), mixing.
+    pub fn summary_line(&self) -> String {
+        let lr = &self.largest_remnant;
+        format!(
+            "composition: {} clumps ({} bound, {:.3} of the mass); largest remnant {} bodies, {:.4e} kg ({:.3} of \
+             the system, {}), spin period {}, projectile fraction {:.3}; other bound clumps {} ({:.4e} kg, projectile \
+             fraction {}, {} mixed)",
+            self.n_clumps,
+            self.n_bound_clumps,
+            self.bound_mass_fraction,
+            lr.n_bodies,
+            lr.mass_kg,
+            lr.mass_fraction_of_system,
+            if lr.bound { "bound" } else { "unbound" },
+            lr.spin_period_h.map_or("none".into(), |p| format!("{p:.3} h")),
+            lr.projectile_fraction,
+            self.n_other_bound,
+            self.other_bound_mass_kg,
+            self.other_bound_projectile_fraction
+                .map_or("n/a".into(), |f| format!("{f:.3}")),
+            self.other_bound_mixed,
+        )
+    }
+}
+
 /// World-frame shape matrix `Rᵀ diag(a², b², c²) R` with every semi-axis times `scale`.
 fn shape_matrix(b: &Body, scale: f64) -> Mat3 {
     let r = rotation_matrix(&b.quaternion);
@@ -157,8 +183,16 @@ pub fn find_clumps(bodies: &[Body]) -> Vec<Vec<usize>> {
 /// point mass).
 pub fn clump_spin(bodies: &[Body], members: &[usize], moments: impl Fn(&Body) -> Vec3) -> Vec3 {
     let mass: f64 = members.iter().map(|&i| bodies[i].shape.mass).sum();
-    let centre = members.iter().map(|&i| bodies[i].position * bodies[i].shape.mass).sum::<Vec3>() / mass;
-    let velocity = members.iter().map(|&i| bodies[i].velocity * bodies[i].shape.mass).sum::<Vec3>() / mass;
+    let centre = members
+        .iter()
+        .map(|&i| bodies[i].position * bodies[i].shape.mass)
+        .sum::<Vec3>()
+        / mass;
+    let velocity = members
+        .iter()
+        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
+        .sum::<Vec3>()
+        / mass;
     let (mut inertia, mut l) = (Mat3::zeros(), Vec3::zeros());
     for &i in members {
         let b = &bodies[i];
@@ -185,12 +219,19 @@ pub fn composition(
         return None;
     }
     let origins: Vec<Origin> = (0..n)
-        .map(|i| if projectile.contains(&i) { Origin::Projectile } else { Origin::Target })
+        .map(|i| {
+            if projectile.contains(&i) {
+                Origin::Projectile
+            } else {
+                Origin::Target
+            }
+        })
         .collect();
     let mass_of = |ids: &mut dyn Iterator<Item = usize>, origin: Option<Origin>| -> f64 {
         ids.filter(|&i| origin.is_none_or(|o| origins[i] == o))
             .map(|i| bodies[i].shape.mass)
-            .sum()
+            .sum::<f64>()
+            + 0.0 // -0 → 0 when empty
     };
     let total = mass_of(&mut (0..n), None);
     let target_mass = mass_of(&mut (0..n), Some(Origin::Target));
@@ -202,7 +243,11 @@ pub fn composition(
         .map(|ids| {
             let mass = mass_of(&mut ids.iter().copied(), None);
             let from_projectile = mass_of(&mut ids.iter().copied(), Some(Origin::Projectile));
-            let v = ids.iter().map(|&i| bodies[i].velocity * bodies[i].shape.mass).sum::<Vec3>() / mass;
+            let v = ids
+                .iter()
+                .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
+                .sum::<Vec3>()
+                / mass;
             let kinetic = 0.5 * mass * (v - v_sys).norm_squared();
             let mut binding = 0.0;
             for &i in &ids {
@@ -236,7 +281,8 @@ pub fn composition(
             .flat_map(|c| c.bodies.iter())
             .filter(|&&i| origins[i] == origin)
             .map(|&i| bodies[i].shape.mass)
-            .sum()
+            .sum::<f64>()
+            + 0.0 // -0 → 0 when empty
     };
     let largest = &clumps[0];
     let spin = clump_spin(bodies, &largest.bodies, &moments).norm();

@@ -432,7 +432,11 @@ pub fn analyse_fragments(
         (initial[p].position, initial[p].velocity, initial[p].shape.mass)
     } else {
         let mass = initial[p..p + pc].iter().map(|b| b.shape.mass).sum();
-        (mean_position(initial, is_projectile), mean_velocity(initial, is_projectile), mass)
+        (
+            mean_position(initial, is_projectile),
+            mean_velocity(initial, is_projectile),
+            mass,
+        )
     };
     let impact_direction = (projectile_position0 - centre0)
         .try_normalize(0.0)

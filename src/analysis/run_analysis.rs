@@ -244,7 +244,11 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
 fn write_composition_csv(path: &Path, c: &Composition) -> Result<(), AnalysisError> {
     let mut text = String::from("index,origin,clump,clump_bound,clump_projectile_fraction\n");
     for (i, (origin, &k)) in c.origins.iter().zip(&c.clump_of).enumerate() {
-        let origin = if *origin == Origin::Projectile { "projectile" } else { "target" };
+        let origin = if *origin == Origin::Projectile {
+            "projectile"
+        } else {
+            "target"
+        };
         let clump = &c.clumps[k];
         text += &format!("{i},{origin},{k},{},{:e}\n", clump.bound, clump.projectile_fraction);
     }

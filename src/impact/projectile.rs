@@ -162,7 +162,12 @@ pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) ->
             })
         })
     };
-    let reach = |bodies: &[Body]| bodies.iter().map(|b| b.position.norm() + b.shape.axes.x).fold(0.0, f64::max);
+    let reach = |bodies: &[Body]| {
+        bodies
+            .iter()
+            .map(|b| b.position.norm() + b.shape.axes.x)
+            .fold(0.0, f64::max)
+    };
     let outer = reach(target) + reach(projectile);
     let step = 0.02 * projectile.iter().map(|b| b.shape.axes.z).fold(f64::INFINITY, f64::min);
     let mut s = outer;

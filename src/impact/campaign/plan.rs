@@ -159,7 +159,10 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 ProjectileSpec::custom(p.id.clone(), r * 1e3, speed * 1e3)
             }
             (Some(r), None) if !(r.is_finite() && r > 0.0) => {
-                return Err(invalid(field("radius_km"), format!("must be > 0 km and finite, got {r}")));
+                return Err(invalid(
+                    field("radius_km"),
+                    format!("must be > 0 km and finite, got {r}"),
+                ));
             }
             (Some(_), None) => {
                 return Err(invalid(
@@ -289,7 +292,10 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();
             base.snapshots = imp.snapshots.clone().unwrap_or_else(|| default_snapshots(t_end));
-            base.pile = piles.iter().find(|(id, _)| *id == projectile.id).map(|(_, p)| p.clone());
+            base.pile = piles
+                .iter()
+                .find(|(id, _)| *id == projectile.id)
+                .map(|(_, p)| p.clone());
             let projectile_field = || match custom.iter().position(|(id, _)| *id == projectile.id) {
                 Some(j) => format!("projectile[{j}]"),
                 None => format!("campaign.projectiles[{pk}]"),
