@@ -176,8 +176,8 @@ fn composition_of_a_constructed_outcome() {
         quaternion: Vec4::new(0.0, 0.0, 0.0, 1.0),
         spin_body: Vec3::zeros(),
     };
-    assert!(CLUMP_MARGIN >= 0.05, "B's 0.1 gap must fall inside the margin");
-    let bodies = vec![
+    const { assert!(CLUMP_MARGIN >= 0.05, "B's 0.1 gap must fall inside the margin") };
+    let bodies = [
         sphere(2.0, 0.0, 0.0, 0.0),    // T0
         sphere(2.0, 1.9, 0.0, 0.0),    // T1
         sphere(1.0, 0.0, 1.9, 0.0),    // P2
