@@ -31,6 +31,7 @@ fn params(projectile: usize) -> FragmentParams {
         inertia: InertiaModel::Gaussian,
         g: 1.0,
         projectile,
+        projectile_count: 1,
     }
 }
 

@@ -3,7 +3,8 @@
 //!
 //! Everything is computed from two snapshots of the same bodies (same order and count): the state at
 //! `t = 0` and the state at the analysis time `t_at` (the paper uses `t = 400 s`, ≈ 300 s after the impact).
-//! One body is the projectile: it is analysed and flagged, but excluded from every "target" quantity
+//! One body is the projectile (or, for a rubble-pile projectile, a contiguous range of bodies, whose barycentre
+//! then stands for "the projectile" below): it is analysed and flagged, but excluded from every "target" quantity
 //! (parent-body size, target barycentre, bound mass fraction, fragment kinetic energy, ejection-speed
 //! statistics). It still counts in the binding energy of Eq. 43 (the sum runs over all other bodies) and
 //! in the barycentre of the whole system.
@@ -74,8 +75,11 @@ pub struct FragmentParams {
     pub inertia: InertiaModel,
     /// Gravitational constant (SI).
     pub g: f64,
-    /// Index of the projectile among the bodies.
+    /// Index of the projectile among the bodies (of its first body for a rubble-pile projectile).
     pub projectile: usize,
+    /// Number of projectile bodies, `projectile..projectile + projectile_count` (1 for a single ellipsoid; the
+    /// pile's N for a rubble-pile projectile, [`crate::impact::pile`]). 0 counts as 1.
+    pub projectile_count: usize,
 }
 
 /// Why the analysis could not be done.
@@ -358,9 +362,14 @@ fn mean_velocity(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
 /// Ejection velocities `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]` of all bodies, `V_T` the target
 /// barycentre velocity (projectile excluded). Panics if the snapshots differ in length; NaN without a target body.
 pub fn ejection_velocities(initial: &[Body], at: &[Body], projectile: usize) -> Vec<Vec3> {
+    ejection_velocities_of(initial, at, |i| i != projectile)
+}
+
+/// [`ejection_velocities`] with the target bodies those for which `is_target(index)` holds.
+fn ejection_velocities_of(initial: &[Body], at: &[Body], is_target: impl Fn(usize) -> bool + Copy) -> Vec<Vec3> {
     assert_eq!(initial.len(), at.len(), "snapshots differ in size");
-    let v0 = mean_velocity(initial, |i| i != projectile);
-    let v1 = mean_velocity(at, |i| i != projectile);
+    let v0 = mean_velocity(initial, is_target);
+    let v1 = mean_velocity(at, is_target);
     initial
         .iter()
         .zip(at)
@@ -383,7 +392,8 @@ pub fn analyse_fragments(
     }
     let n = at.len();
     let p = params.projectile;
-    if p >= n || n < 2 {
+    let pc = params.projectile_count.max(1);
+    if p + pc > n || n < pc + 1 {
         return Err(FragmentError::Projectile { index: p, count: n });
     }
     if !(params.kappa.is_finite() && params.kappa > 0.0 && params.g.is_finite() && params.g > 0.0) {
@@ -394,7 +404,8 @@ pub fn analyse_fragments(
     }
     let kappa_i = params.inertia.inertia_kappa(params.kappa);
     let correction = spin_correction(params.inertia, params.kappa);
-    let is_target = |i: usize| i != p;
+    let is_projectile = |i: usize| (p..p + pc).contains(&i);
+    let is_target = |i: usize| !is_projectile(i);
 
     let target_mass: f64 = at
         .iter()
@@ -413,10 +424,21 @@ pub fn analyse_fragments(
     let v_sys0 = mean_velocity(initial, |_| true);
     let v_sys = mean_velocity(at, |_| true);
     let v_target0 = mean_velocity(initial, is_target);
-    let dv = ejection_velocities(initial, at, p);
+    let dv = ejection_velocities_of(initial, at, is_target);
     let binding = binding_energies(params.g, at);
     let centre0 = mean_position(initial, is_target);
-    let impact_direction = (initial[p].position - centre0)
+    // A single projectile's own position and velocity (bit for bit as before); a pile's barycentre.
+    let (projectile_position0, projectile_velocity0, projectile_mass) = if pc == 1 {
+        (initial[p].position, initial[p].velocity, initial[p].shape.mass)
+    } else {
+        let mass = initial[p..p + pc].iter().map(|b| b.shape.mass).sum();
+        (
+            mean_position(initial, is_projectile),
+            mean_velocity(initial, is_projectile),
+            mass,
+        )
+    };
+    let impact_direction = (projectile_position0 - centre0)
         .try_normalize(0.0)
         .unwrap_or_else(Vec3::zeros);
 
@@ -433,7 +455,7 @@ pub fn analyse_fragments(
             let measure = i_eff.map(|ie| rotation_mode_measure(&moments, ie));
             FragmentAnalysis {
                 index: i,
-                is_projectile: i == p,
+                is_projectile: is_projectile(i),
                 mass: b.shape.mass,
                 equivalent_radius: b.shape.equivalent_radius(),
                 size: b.shape.equivalent_radius() / target_radius,
@@ -451,7 +473,7 @@ pub fn analyse_fragments(
                 effective_inertia: i_eff,
                 rotation_mode_measure: measure,
                 rotation_mode: rotation_mode(measure),
-                impact_site_cosine: if i == p {
+                impact_site_cosine: if is_projectile(i) {
                     0.0
                 } else {
                     (initial[i].position - centre0)
@@ -476,8 +498,8 @@ pub fn analyse_fragments(
     let fragment_kinetic_translational: f64 = targets.iter().map(|f| f.kinetic_energy).sum();
     let fragment_kinetic_rotational: f64 = targets.iter().map(|f| f.rotational_energy).sum();
     let fragment_kinetic = fragment_kinetic_translational + fragment_kinetic_rotational;
-    let projectile_speed = (initial[p].velocity - v_target0).norm();
-    let projectile_kinetic_energy = 0.5 * initial[p].shape.mass * projectile_speed.powi(2);
+    let projectile_speed = (projectile_velocity0 - v_target0).norm();
+    let projectile_kinetic_energy = 0.5 * projectile_mass * projectile_speed.powi(2);
     let bound_mass: f64 = targets.iter().filter(|f| !f.escaping).map(|f| f.mass).sum();
     let largest = targets.iter().map(|f| f.mass).fold(0.0, f64::max);
     let speeds: Vec<f64> = targets.iter().map(|f| f.ejection_speed).collect();

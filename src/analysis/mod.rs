@@ -1,6 +1,7 @@
 //! Post-processing of states and runs.
 
 pub mod atmosphere;
+pub mod composition;
 pub mod creep;
 pub mod figures;
 pub mod fits;

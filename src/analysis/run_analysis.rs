@@ -7,6 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::composition::{Composition, Origin, composition};
 use crate::analysis::fits::{ExponentComparison, PowerLawFit, SpinFit, compare_exponents, fit_power_law, histogram};
 use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
 use crate::ellipsoid::equations::G_SI;
@@ -84,6 +85,10 @@ pub struct RunAnalysis {
     pub spin_histogram: (Vec<f64>, Vec<f64>),
     /// Fits of `a xⁿ exp(−x²/b²)` to that histogram for n ∈ {0.5, 1, 1.5, 2} and free n (Eqs. 44–45).
     pub spin_fits: Fit<ExponentComparison>,
+    /// For a rubble-pile projectile only: clumps, largest remnant (mass, spin, composition) and mixing
+    /// ([`crate::analysis::composition`]); its per-body table is `analysis/composition.csv`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub composition: Option<Composition>,
 }
 
 fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
@@ -149,6 +154,10 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         path: dir.join("impact.json"),
         reason: "no `projectile_index`".into(),
     })? as usize;
+    // A rubble-pile projectile: bodies `start..end` (crate::impact::pile::PileRecord).
+    let pile_range = impact["projectile_pile"]["projectile_bodies"]
+        .as_array()
+        .and_then(|r| Some(r.first()?.as_u64()? as usize..r.get(1)?.as_u64()? as usize));
     let scene_path = dir.join("scene.toml");
     let text = std::fs::read_to_string(&scene_path).map_err(|e| AnalysisError::Read {
         path: scene_path.clone(),
@@ -189,6 +198,7 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         inertia: scene.model.inertia,
         g,
         projectile,
+        projectile_count: pile_range.as_ref().map_or(1, |r| r.len()),
     };
     let report = analyse_fragments(&initial, &at, &params).map_err(|e| AnalysisError::Fragments(e.to_string()))?;
     let target: Vec<_> = report.fragments.iter().filter(|f| !f.is_projectile).collect();
@@ -209,18 +219,43 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
             &[0.5, 1.0, 1.5, 2.0],
         )),
         spin_histogram,
+        composition: pile_range.and_then(|r| {
+            let kappa_i = scene.model.inertia.inertia_kappa(kappa);
+            composition(&at, r, g, |b| b.shape.principal_moments(kappa_i))
+        }),
     };
     std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
         path: out_dir.clone(),
         reason: e.to_string(),
     })?;
     write_fragments_csv(&csv_path, &report)?;
+    if let Some(c) = &analysis.composition {
+        write_composition_csv(&out_dir.join("composition.csv"), c)?;
+    }
     let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
     std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
         path: json_path.clone(),
         reason: e.to_string(),
     })?;
     Ok((analysis, report))
+}
+
+/// `composition.csv`: one row per body: its origin, its clump (0 = the largest remnant) and whether that is bound.
+fn write_composition_csv(path: &Path, c: &Composition) -> Result<(), AnalysisError> {
+    let mut text = String::from("index,origin,clump,clump_bound,clump_projectile_fraction\n");
+    for (i, (origin, &k)) in c.origins.iter().zip(&c.clump_of).enumerate() {
+        let origin = if *origin == Origin::Projectile {
+            "projectile"
+        } else {
+            "target"
+        };
+        let clump = &c.clumps[k];
+        text += &format!("{i},{origin},{k},{},{:e}\n", clump.bound, clump.projectile_fraction);
+    }
+    std::fs::write(path, text).map_err(|e| AnalysisError::Write {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
 }
 
 /// `fragments.csv`: one row per body.

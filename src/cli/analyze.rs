@@ -58,6 +58,9 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         args.dir.join("analysis").display(),
         figures.join(", ")
     );
+    if let Some(c) = &a.composition {
+        println!("{}", c.summary_line());
+    }
     Ok(())
 }
 

@@ -73,6 +73,9 @@ pub struct ImpactArgs {
     /// Never show the progress bar.
     #[arg(long)]
     pub no_progress: bool,
+    /// Rubble-pile projectile.
+    #[command(flatten)]
+    pub pile: crate::impact::pile::PileArgs,
     /// Checkpoint options.
     #[command(flatten)]
     pub checkpoints: CheckpointArgs,
@@ -99,6 +102,8 @@ impl ImpactArgs {
                 self.projectile_speed_km_s
             )));
         }
+        let pile = self.pile.read().map_err(cli_error)?;
+        let projectile = pile.as_ref().map_or(projectile, |p| p.equivalent_spec(p.id(), speed));
         let cfg = ImpactConfig {
             target: self.target.clone(),
             projectile,
@@ -120,6 +125,7 @@ impl ImpactArgs {
             } else {
                 crate::ellipsoid::body::InertiaModel::Gaussian
             },
+            pile,
         };
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)
@@ -135,6 +141,7 @@ fn flag(field: &str) -> String {
     let name = match head {
         "angle_deg" => "angle",
         "projectile.speed" => "projectile-speed-km-s",
+        "projectile_pile" => "projectile-pile",
         f if f.starts_with("projectile") => "projectile-radius-km",
         f => f,
     };

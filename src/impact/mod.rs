@@ -2,11 +2,13 @@
 //!
 //! - [`target`]: the Monte-Carlo rubble-pile builder and its relaxation to a rigidly rotating pile;
 //! - [`projectile`]: the projectiles P1–P3 and the impact geometry;
+//! - [`pile`]: rubble-pile projectiles (a whole pile thrown at the target);
 //! - [`run`]: one impact run (target + projectile → run directory → [`crate::driver::run_scene`]);
 //! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
 //!   in parallel, resumable, summarised in `campaign.csv`.
 
 pub mod campaign;
+pub mod pile;
 pub mod projectile;
 pub mod run;
 pub mod target;

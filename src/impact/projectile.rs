@@ -84,8 +84,12 @@ pub struct ImpactSetup {
     pub impact_time_s: f64,
     /// Seed of the projectile's attitude.
     pub seed: u64,
-    /// Index of the projectile among the bodies (the last one).
+    /// Index of the projectile among the bodies (the last one); for a rubble-pile projectile, its first body.
     pub projectile_index: usize,
+    /// The rubble-pile projectile (file, N, mass, which bodies are whose), when there is one
+    /// ([`crate::impact::pile`]); absent for a single ellipsoid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub projectile_pile: Option<crate::impact::pile::PileRecord>,
 }
 
 /// Adds the projectile to `target` (bodies of the target, any frame) and returns the whole system in its
@@ -104,40 +108,14 @@ pub fn set_up_impact(
     let n = Vec3::new(0.0, zeta.sin(), zeta.cos());
     let shape = projectile.shape();
     let quaternion = random_quaternion(&mut generator(seed));
-    let sigma_p = {
-        let r = rotation_matrix(&quaternion);
-        r.transpose() * Mat3::from_diagonal(&shape.axes.component_mul(&shape.axes)) * r
-    };
-    let sigmas: Vec<Mat3> = bodies
-        .iter()
-        .map(|b| {
-            let r = rotation_matrix(&b.quaternion);
-            r.transpose() * Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
-        })
-        .collect();
-    let touching = |s: f64| {
-        let p = n * s;
-        bodies.iter().zip(&sigmas).any(|(b, sig)| {
-            let d = p - b.position;
-            d.norm() < shape.axes.x + b.shape.axes.x && !are_apart(&d, &sigma_p, sig)
-        })
-    };
-    // Distance along n of first contact: start beyond every bounding sphere, walk in, then bisect.
-    let outer = bodies
-        .iter()
-        .map(|b| b.position.norm() + b.shape.axes.x)
-        .fold(0.0, f64::max)
-        + shape.axes.x;
-    let step = 0.02 * shape.axes.z;
-    let mut s = outer;
-    while s > 0.0 && !touching(s) {
-        s -= step;
-    }
-    let (mut lo, mut hi) = (s, s + step); // touching at lo, apart at hi
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if touching(mid) { lo = mid } else { hi = mid }
-    }
+    let incoming = [Body {
+        shape,
+        position: Vec3::zeros(),
+        velocity: Vec3::zeros(),
+        quaternion,
+        spin_body: Vec3::zeros(),
+    }];
+    let hi = first_contact_distance(&bodies, &incoming, &n);
     let start = hi + projectile.speed * contact_time;
     bodies.push(Body {
         shape,
@@ -158,6 +136,48 @@ pub fn set_up_impact(
         impact_time_s: contact_time,
         seed,
         projectile_index: bodies.len() - 1,
+        projectile_pile: None,
     };
     (bodies, setup)
+}
+
+/// Distance `s` (m) along the unit vector `n` at which `projectile` (bodies in its own frame, moved rigidly by
+/// `s n`) first touches `target` (centre-of-mass frame) when coming in from afar: the largest `s` at which some
+/// pair of ellipsoids overlaps, to bisection precision (60 halvings of a step of 2 % of the smallest semi-axis
+/// of the projectile). The walk starts beyond every bounding sphere and moves in by that step.
+pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) -> f64 {
+    let sigma = |b: &Body| {
+        let r = rotation_matrix(&b.quaternion);
+        r.transpose() * Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
+    };
+    let sigmas_t: Vec<Mat3> = target.iter().map(sigma).collect();
+    let sigmas_p: Vec<Mat3> = projectile.iter().map(sigma).collect();
+    let touching = |s: f64| {
+        let shift = n * s;
+        projectile.iter().zip(&sigmas_p).any(|(p, sig_p)| {
+            let centre = shift + p.position;
+            target.iter().zip(&sigmas_t).any(|(b, sig)| {
+                let d = centre - b.position;
+                d.norm() < p.shape.axes.x + b.shape.axes.x && !are_apart(&d, sig_p, sig)
+            })
+        })
+    };
+    let reach = |bodies: &[Body]| {
+        bodies
+            .iter()
+            .map(|b| b.position.norm() + b.shape.axes.x)
+            .fold(0.0, f64::max)
+    };
+    let outer = reach(target) + reach(projectile);
+    let step = 0.02 * projectile.iter().map(|b| b.shape.axes.z).fold(f64::INFINITY, f64::min);
+    let mut s = outer;
+    while s > 0.0 && !touching(s) {
+        s -= step;
+    }
+    let (mut lo, mut hi) = (s, s + step); // touching at lo, apart at hi
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if touching(mid) { lo = mid } else { hi = mid }
+    }
+    hi
 }

@@ -19,6 +19,7 @@ use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::output::{read_bodies_csv, write_snapshot};
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
+use crate::impact::pile::{ProjectilePile, set_up_pile_impact};
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
 
@@ -84,6 +85,10 @@ pub struct ImpactConfig {
     /// Inertia model of the ellipsoids (default Gaussian, Roig03 Eq. 4; `Uniform` = homogeneous solids, to show
     /// the spin bias of §4.3).
     pub inertia: InertiaModel,
+    /// A rubble-pile projectile ([`crate::impact::pile`]; default none): when given, it is thrown instead of
+    /// the single ellipsoid, at `projectile.speed` (`projectile` then describes the same-mass ellipsoid, see
+    /// [`ProjectilePile::equivalent_spec`]).
+    pub pile: Option<ProjectilePile>,
 }
 
 impl ImpactConfig {
@@ -103,6 +108,7 @@ impl ImpactConfig {
             snapshots: DEFAULT_SNAPSHOTS.to_vec(),
             every: DEFAULT_EVERY,
             inertia: InertiaModel::Gaussian,
+            pile: None,
         }
     }
 
@@ -227,7 +233,11 @@ impl ImpactConfig {
     /// `target` + projectile, at the impact speed), or why there is none.
     pub fn kappa(&self, target: &[Body]) -> Result<f64, ImpactError> {
         let projectile = self.projectile.shape();
-        let masses = target.iter().map(|b| b.shape).chain(std::iter::once(projectile));
+        let incoming: Vec<_> = match &self.pile {
+            Some(pile) => pile.bodies.iter().map(|b| b.shape).collect(),
+            None => vec![projectile],
+        };
+        let masses = target.iter().map(|b| b.shape).chain(incoming);
         let small = masses
             .clone()
             .min_by(|a, b| a.mass.total_cmp(&b.mass))
@@ -256,10 +266,24 @@ impl ImpactConfig {
 
     /// The impact in memory: bodies, setup, title and scene text (nothing is written).
     pub fn plan(&self, target: &[Body]) -> ImpactPlan {
-        let (bodies, setup) = set_up_impact(target, &self.projectile, self.angle_deg, self.contact_time, self.seed);
+        let (bodies, setup) = match &self.pile {
+            Some(pile) => set_up_pile_impact(
+                target,
+                pile,
+                &self.projectile,
+                self.angle_deg,
+                self.contact_time,
+                self.seed,
+            ),
+            None => set_up_impact(target, &self.projectile, self.angle_deg, self.contact_time, self.seed),
+        };
+        let what = match &self.pile {
+            Some(pile) => format!("the rubble pile {} (N = {})", pile.file.display(), pile.bodies.len()),
+            None => self.projectile.id.clone(),
+        };
         let title = format!(
             "Impact of {} ({:.2} km, {:.1} km/s) on {} at zeta = {} deg; Q = {:.3e} erg/g",
-            self.projectile.id,
+            what,
             self.projectile.equivalent_radius / 1e3,
             self.projectile.speed / 1e3,
             self.target.display(),

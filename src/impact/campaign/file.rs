@@ -75,14 +75,24 @@ pub struct ImpactSection {
     pub inertia: Option<crate::ellipsoid::body::InertiaModel>,
 }
 
-/// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5).
+/// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5), or a rubble-pile
+/// projectile (`projectile_pile`, [`crate::impact::pile`]). Exactly one of `radius_km` and `projectile_pile`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CustomProjectile {
     /// Its name in `campaign.projectiles` and in run names: letters, digits, `_`, `-`; not P1–P3.
     pub id: String,
-    /// Equivalent radius (km, > 0).
-    pub radius_km: f64,
+    /// Equivalent radius (km, > 0) of a single-ellipsoid projectile.
+    #[serde(default)]
+    pub radius_km: Option<f64>,
+    /// A rubble-pile projectile: a bodies file such as `targets/N30_T4.csv` (relative to the campaign file),
+    /// thrown whole; no default.
+    #[serde(default)]
+    pub projectile_pile: Option<PathBuf>,
+    /// Whether the projectile pile is turned by a random attitude drawn from the run's seed (default true;
+    /// false keeps the file's orientation). Only with `projectile_pile`.
+    #[serde(default)]
+    pub random_attitude: Option<bool>,
     /// Impact speed (km/s, > 0; default `impact.speed_km_s`).
     #[serde(default)]
     pub speed_km_s: Option<f64>,

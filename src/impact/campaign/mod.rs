@@ -28,6 +28,11 @@
 //! id = "S1"                        # name in campaign.projectiles and in run names ([A-Za-z0-9_-], not P1-P3)
 //! radius_km = 1.0                  # equivalent radius (km)
 //! speed_km_s = 0.05                # impact speed (km/s; default impact.speed_km_s)
+//!
+//! [[projectile]]                   # a rubble-pile projectile (crate::impact::pile): instead of radius_km,
+//! id = "pile30"                    # a bodies file thrown whole (relative to the campaign file)
+//! projectile_pile = "../../targets/N30_T4.csv"
+//! random_attitude = true           # turn it by a random attitude drawn from the seed (default true)
 //! ```
 //!
 //! Unknown keys are refused; every error is one line naming the field (`campaign.angles[2]: …`). Relative

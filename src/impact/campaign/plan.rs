@@ -4,6 +4,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use crate::ellipsoid::body::Body;
+use crate::impact::pile::ProjectilePile;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{
     DEFAULT_BETA, DEFAULT_CONTACT_TIME, DEFAULT_EVERY, DEFAULT_F0, DEFAULT_RTOL, DEFAULT_T_END, ImpactConfig,
@@ -121,6 +122,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
 
     // [[projectile]]
     let mut custom: Vec<(String, ProjectileSpec)> = Vec::new();
+    let mut piles: Vec<(String, ProjectilePile)> = Vec::new();
     for (k, p) in file.projectiles.iter().enumerate() {
         let field = |f: &str| format!("projectile[{k}].{f}");
         let id_ok = !p.id.is_empty()
@@ -145,12 +147,6 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 ),
             ));
         }
-        if !(p.radius_km.is_finite() && p.radius_km > 0.0) {
-            return Err(invalid(
-                field("radius_km"),
-                format!("must be > 0 km and finite, got {}", p.radius_km),
-            ));
-        }
         let speed = p.speed_km_s.unwrap_or(speed_km_s);
         if !(speed.is_finite() && speed > 0.0) {
             return Err(invalid(
@@ -158,10 +154,40 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 format!("must be > 0 km/s and finite, got {speed}"),
             ));
         }
-        custom.push((
-            p.id.clone(),
-            ProjectileSpec::custom(p.id.clone(), p.radius_km * 1e3, speed * 1e3),
-        ));
+        let spec = match (p.radius_km, &p.projectile_pile) {
+            (Some(r), None) if r.is_finite() && r > 0.0 && p.random_attitude.is_none() => {
+                ProjectileSpec::custom(p.id.clone(), r * 1e3, speed * 1e3)
+            }
+            (Some(r), None) if !(r.is_finite() && r > 0.0) => {
+                return Err(invalid(
+                    field("radius_km"),
+                    format!("must be > 0 km and finite, got {r}"),
+                ));
+            }
+            (Some(_), None) => {
+                return Err(invalid(
+                    field("random_attitude"),
+                    "only for a `projectile_pile`, got it with `radius_km`".into(),
+                ));
+            }
+            (None, Some(rel)) => {
+                let path = join_clean(base_dir, rel);
+                let pile = ProjectilePile::read(&path, p.random_attitude.unwrap_or(true))
+                    .map_err(|e| invalid(field("projectile_pile"), one_line(&e.to_string())))?;
+                let spec = pile.equivalent_spec(p.id.clone(), speed * 1e3);
+                piles.push((p.id.clone(), pile));
+                spec
+            }
+            (r, _) => {
+                return Err(invalid(
+                    field(if r.is_some() { "projectile_pile" } else { "radius_km" }),
+                    "give exactly one of `radius_km` (km, a single ellipsoid) and `projectile_pile` (a bodies \
+                     file)"
+                        .into(),
+                ));
+            }
+        };
+        custom.push((p.id.clone(), spec));
     }
 
     // [campaign] lists
@@ -266,6 +292,10 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();
             base.snapshots = imp.snapshots.clone().unwrap_or_else(|| default_snapshots(t_end));
+            base.pile = piles
+                .iter()
+                .find(|(id, _)| *id == projectile.id)
+                .map(|(_, p)| p.clone());
             let projectile_field = || match custom.iter().position(|(id, _)| *id == projectile.id) {
                 Some(j) => format!("projectile[{j}]"),
                 None => format!("campaign.projectiles[{pk}]"),

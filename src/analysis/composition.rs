@@ -1,0 +1,324 @@
+//! Composition of the outcome of a collision between two rubble piles (issue 20; the escape test is Roig03
+//! Eq. 43 applied to clumps): which bodies stick together, whether each clump stays bound, and how much of each
+//! clump came from the projectile.
+//!
+//! Definitions (choices of ours; the paper has a single-ellipsoid projectile and no clumps):
+//! * **Origin**: every body is tagged `target` or `projectile` by its index (the ranges in `impact.json`).
+//! * **Clump**: a connected set of bodies in contact, two bodies being in contact when their ellipsoids,
+//!   each semi-axis enlarged by [`CLUMP_MARGIN`], overlap (the overlap test of the contact model,
+//!   [`are_apart`]). Resting bodies sit in shallow overlap under the contact barrier; the margin also joins
+//!   those a hair apart.
+//! * **Bound clump** (Eq. 43 with the clump as one body): `K_c = ½ M_c |V_c − V_sys|²` (barycentric frame of
+//!   the whole system) below `|U_c| = Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`.
+//! * **Largest remnant**: the most massive clump. Its spin is `ω = I⁻¹ L` about its barycentre, with
+//!   `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))` and `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ω_bᵢ)` (`dᵢ`, `uᵢ` position and
+//!   velocity relative to the clump's barycentre, `Iᵢ` the principal moments of the run's inertia model);
+//!   period `2π/|ω|`, no §4.3 correction (the aggregate's inertia is mostly the parallel-axis terms).
+//! * **Mixing** of the other bound clumps: their mass-weighted projectile fraction
+//!   `Σ_c m_c^proj / Σ_c M_c`, and how many hold bodies of both origins.
+
+use crate::ellipsoid::body::Body;
+use crate::ellipsoid::quaternion::rotation_matrix;
+use crate::geometry::ellipsoid_overlap::are_apart;
+use crate::math::{Mat3, Vec3};
+
+/// Relative enlargement of every semi-axis in the contact test that defines clumps (0.1 = 10 %).
+pub const CLUMP_MARGIN: f64 = 0.1;
+
+/// Where a body came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Origin {
+    /// A body of the target pile.
+    Target,
+    /// A body of the projectile (pile).
+    Projectile,
+}
+
+/// One clump (connected set of bodies in contact).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Clump {
+    /// Body indices, increasing.
+    pub bodies: Vec<usize>,
+    /// Total mass (kg).
+    pub mass_kg: f64,
+    /// Mass of its projectile bodies over its mass.
+    pub projectile_fraction: f64,
+    /// Whether it is bound (module docs).
+    pub bound: bool,
+}
+
+/// The largest remnant (most massive clump).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LargestRemnant {
+    /// Number of bodies.
+    pub n_bodies: usize,
+    /// Mass (kg).
+    pub mass_kg: f64,
+    /// Mass over the mass of the whole system (target + projectile).
+    pub mass_fraction_of_system: f64,
+    /// Mass over the target's mass.
+    pub mass_over_target: f64,
+    /// Mass fraction from the projectile.
+    pub projectile_fraction: f64,
+    /// Whether it is bound (module docs).
+    pub bound: bool,
+    /// Spin rate `|ω|` of the clump as a whole (rad/s).
+    pub spin_rate: f64,
+    /// Spin period `2π/|ω|` (h); `None` without spin.
+    pub spin_period_h: Option<f64>,
+}
+
+/// Composition of a two-pile collision outcome (`analysis.json`'s `composition`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Composition {
+    /// The contact margin used ([`CLUMP_MARGIN`]).
+    pub clump_margin: f64,
+    /// Target mass (kg).
+    pub target_mass_kg: f64,
+    /// Projectile mass (kg).
+    pub projectile_mass_kg: f64,
+    /// Number of clumps (single bodies included).
+    pub n_clumps: usize,
+    /// Number of bound clumps.
+    pub n_bound_clumps: usize,
+    /// Mass in bound clumps over the system mass.
+    pub bound_mass_fraction: f64,
+    /// Target mass in bound clumps over the target mass.
+    pub bound_target_fraction: f64,
+    /// Projectile mass in bound clumps over the projectile mass.
+    pub bound_projectile_fraction: f64,
+    /// The largest remnant.
+    pub largest_remnant: LargestRemnant,
+    /// Share of the projectile's mass that ends in the largest remnant.
+    pub projectile_in_largest_remnant: f64,
+    /// Number of bound clumps other than the largest remnant.
+    pub n_other_bound: usize,
+    /// Their total mass (kg).
+    pub other_bound_mass_kg: f64,
+    /// Their mass-weighted projectile fraction; `None` when there are none.
+    pub other_bound_projectile_fraction: Option<f64>,
+    /// How many of them hold bodies of both origins.
+    pub other_bound_mixed: usize,
+    /// Every clump, the most massive first.
+    pub clumps: Vec<Clump>,
+    /// Per body: its origin.
+    pub origins: Vec<Origin>,
+    /// Per body: the index of its clump in [`Composition::clumps`].
+    pub clump_of: Vec<usize>,
+}
+
+impl Composition {
+    /// One line for the terminal: bound fraction, largest remnant (mass, spin, projectile fraction), mixing.
+    pub fn summary_line(&self) -> String {
+        let lr = &self.largest_remnant;
+        format!(
+            "composition: {} clumps ({} bound, {:.3} of the mass); largest remnant {} bodies, {:.4e} kg ({:.3} of \
+             the system, {}), spin period {}, projectile fraction {:.3}; other bound clumps {} ({:.4e} kg, projectile \
+             fraction {}, {} mixed)",
+            self.n_clumps,
+            self.n_bound_clumps,
+            self.bound_mass_fraction,
+            lr.n_bodies,
+            lr.mass_kg,
+            lr.mass_fraction_of_system,
+            if lr.bound { "bound" } else { "unbound" },
+            lr.spin_period_h.map_or("none".into(), |p| format!("{p:.3} h")),
+            lr.projectile_fraction,
+            self.n_other_bound,
+            self.other_bound_mass_kg,
+            self.other_bound_projectile_fraction
+                .map_or("n/a".into(), |f| format!("{f:.3}")),
+            self.other_bound_mixed,
+        )
+    }
+}
+
+/// World-frame shape matrix `Rᵀ diag(a², b², c²) R` with every semi-axis times `scale`.
+fn shape_matrix(b: &Body, scale: f64) -> Mat3 {
+    let r = rotation_matrix(&b.quaternion);
+    let axes = b.shape.axes * scale;
+    r.transpose() * Mat3::from_diagonal(&axes.component_mul(&axes)) * r
+}
+
+/// The clumps of `bodies`: connected components of the contact graph with [`CLUMP_MARGIN`], as body lists.
+pub fn find_clumps(bodies: &[Body]) -> Vec<Vec<usize>> {
+    let scale = 1.0 + CLUMP_MARGIN;
+    let sigmas: Vec<Mat3> = bodies.iter().map(|b| shape_matrix(b, scale)).collect();
+    // Union–find with path halving.
+    let mut parent: Vec<usize> = (0..bodies.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let d = bodies[j].position - bodies[i].position;
+            if d.norm() < scale * (bodies[i].shape.axes.x + bodies[j].shape.axes.x)
+                && !are_apart(&d, &sigmas[i], &sigmas[j])
+            {
+                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut clumps: Vec<Vec<usize>> = Vec::new();
+    let mut slot = vec![usize::MAX; bodies.len()];
+    for i in 0..bodies.len() {
+        let r = root(&mut parent, i);
+        if slot[r] == usize::MAX {
+            slot[r] = clumps.len();
+            clumps.push(Vec::new());
+        }
+        clumps[slot[r]].push(i);
+    }
+    clumps
+}
+
+/// Spin `ω` (world frame, rad/s) of the bodies `members` as one aggregate about their barycentre, with
+/// `moments(body)` the principal moments of each body (kg m²); zero when the inertia tensor is singular (one
+/// point mass).
+pub fn clump_spin(bodies: &[Body], members: &[usize], moments: impl Fn(&Body) -> Vec3) -> Vec3 {
+    let mass: f64 = members.iter().map(|&i| bodies[i].shape.mass).sum();
+    let centre = members
+        .iter()
+        .map(|&i| bodies[i].position * bodies[i].shape.mass)
+        .sum::<Vec3>()
+        / mass;
+    let velocity = members
+        .iter()
+        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
+        .sum::<Vec3>()
+        / mass;
+    let (mut inertia, mut l) = (Mat3::zeros(), Vec3::zeros());
+    for &i in members {
+        let b = &bodies[i];
+        let r = rotation_matrix(&b.quaternion);
+        let own = r.transpose() * Mat3::from_diagonal(&moments(b)) * r;
+        let (d, u) = (b.position - centre, b.velocity - velocity);
+        inertia += own + b.shape.mass * (Mat3::identity() * d.norm_squared() - d * d.transpose());
+        l += b.shape.mass * d.cross(&u) + own * (r.transpose() * b.spin_body);
+    }
+    inertia.try_inverse().map_or_else(Vec3::zeros, |inv| inv * l)
+}
+
+/// The composition of `bodies` (one snapshot) whose projectile bodies are `projectile` (a range of indices);
+/// `moments` gives each body's principal moments (kg m²), `g` the gravitational constant (SI). `None` when the
+/// range is empty, out of bounds or covers every body.
+pub fn composition(
+    bodies: &[Body],
+    projectile: std::ops::Range<usize>,
+    g: f64,
+    moments: impl Fn(&Body) -> Vec3,
+) -> Option<Composition> {
+    let n = bodies.len();
+    if projectile.is_empty() || projectile.end > n || projectile.len() == n {
+        return None;
+    }
+    let origins: Vec<Origin> = (0..n)
+        .map(|i| {
+            if projectile.contains(&i) {
+                Origin::Projectile
+            } else {
+                Origin::Target
+            }
+        })
+        .collect();
+    let mass_of = |ids: &mut dyn Iterator<Item = usize>, origin: Option<Origin>| -> f64 {
+        ids.filter(|&i| origin.is_none_or(|o| origins[i] == o))
+            .map(|i| bodies[i].shape.mass)
+            .sum::<f64>()
+            + 0.0 // -0 → 0 when empty
+    };
+    let total = mass_of(&mut (0..n), None);
+    let target_mass = mass_of(&mut (0..n), Some(Origin::Target));
+    let projectile_mass = mass_of(&mut (0..n), Some(Origin::Projectile));
+    let v_sys = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / total;
+
+    let mut clumps: Vec<Clump> = find_clumps(bodies)
+        .into_iter()
+        .map(|ids| {
+            let mass = mass_of(&mut ids.iter().copied(), None);
+            let from_projectile = mass_of(&mut ids.iter().copied(), Some(Origin::Projectile));
+            let v = ids
+                .iter()
+                .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
+                .sum::<Vec3>()
+                / mass;
+            let kinetic = 0.5 * mass * (v - v_sys).norm_squared();
+            let mut binding = 0.0;
+            for &i in &ids {
+                for (j, other) in bodies.iter().enumerate() {
+                    if ids.binary_search(&j).is_err() {
+                        binding +=
+                            g * bodies[i].shape.mass * other.shape.mass / (bodies[i].position - other.position).norm();
+                    }
+                }
+            }
+            Clump {
+                bound: kinetic < binding,
+                projectile_fraction: from_projectile / mass,
+                mass_kg: mass,
+                bodies: ids,
+            }
+        })
+        .collect();
+    // Most massive first; ties by first body, for determinism.
+    clumps.sort_by(|a, b| b.mass_kg.total_cmp(&a.mass_kg).then(a.bodies[0].cmp(&b.bodies[0])));
+    let mut clump_of = vec![0; n];
+    for (k, c) in clumps.iter().enumerate() {
+        for &i in &c.bodies {
+            clump_of[i] = k;
+        }
+    }
+    let bound: Vec<&Clump> = clumps.iter().filter(|c| c.bound).collect();
+    let bound_of = |origin: Origin| -> f64 {
+        bound
+            .iter()
+            .flat_map(|c| c.bodies.iter())
+            .filter(|&&i| origins[i] == origin)
+            .map(|&i| bodies[i].shape.mass)
+            .sum::<f64>()
+            + 0.0 // -0 → 0 when empty
+    };
+    let largest = &clumps[0];
+    let spin = clump_spin(bodies, &largest.bodies, &moments).norm();
+    // Clumps are sorted by mass: every bound clump after the first.
+    let others: Vec<&Clump> = clumps.iter().skip(1).filter(|c| c.bound).collect();
+    let other_mass: f64 = others.iter().map(|c| c.mass_kg).sum::<f64>() + 0.0; // -0 → 0 when empty
+    let other_projectile: f64 = others.iter().map(|c| c.mass_kg * c.projectile_fraction).sum();
+    Some(Composition {
+        clump_margin: CLUMP_MARGIN,
+        target_mass_kg: target_mass,
+        projectile_mass_kg: projectile_mass,
+        n_clumps: clumps.len(),
+        n_bound_clumps: bound.len(),
+        bound_mass_fraction: (bound_of(Origin::Target) + bound_of(Origin::Projectile)) / total,
+        bound_target_fraction: bound_of(Origin::Target) / target_mass,
+        bound_projectile_fraction: bound_of(Origin::Projectile) / projectile_mass,
+        largest_remnant: LargestRemnant {
+            n_bodies: largest.bodies.len(),
+            mass_kg: largest.mass_kg,
+            mass_fraction_of_system: largest.mass_kg / total,
+            mass_over_target: largest.mass_kg / target_mass,
+            projectile_fraction: largest.projectile_fraction,
+            bound: largest.bound,
+            spin_rate: spin,
+            spin_period_h: (spin > 0.0).then(|| 2.0 * std::f64::consts::PI / spin / 3600.0),
+        },
+        projectile_in_largest_remnant: largest.mass_kg * largest.projectile_fraction / projectile_mass,
+        n_other_bound: others.len(),
+        other_bound_mass_kg: other_mass,
+        other_bound_projectile_fraction: (other_mass > 0.0).then(|| other_projectile / other_mass),
+        other_bound_mixed: others
+            .iter()
+            .filter(|c| c.projectile_fraction > 0.0 && c.projectile_fraction < 1.0)
+            .count(),
+        clumps,
+        origins,
+        clump_of,
+    })
+}
