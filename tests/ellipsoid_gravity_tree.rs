@@ -22,7 +22,10 @@ fn target_points(name: &str) -> (Vec<Vec3>, Vec<f64>) {
         .iter()
         .map(|r| r.to_body())
         .collect();
-    (bodies.iter().map(|b| b.position).collect(), bodies.iter().map(|b| b.shape.mass).collect())
+    (
+        bodies.iter().map(|b| b.position).collect(),
+        bodies.iter().map(|b| b.shape.mass).collect(),
+    )
 }
 
 /// RMS over bodies of |F_tree − F_exact| / |F_exact|, and the relative potential error.
@@ -32,7 +35,11 @@ fn tree_error(x: &[Vec3], m: &[f64], theta: f64) -> (f64, f64) {
     let u = gravity_forces(g, x, m, &mut exact);
     let mut tree = Vec::new();
     let ut = tree_gravity_forces(g, theta, x, m, &mut tree);
-    let sq: f64 = tree.iter().zip(&exact).map(|(a, b)| ((a - b).norm() / b.norm()).powi(2)).sum();
+    let sq: f64 = tree
+        .iter()
+        .zip(&exact)
+        .map(|(a, b)| ((a - b).norm() / b.norm()).powi(2))
+        .sum();
     ((sq / x.len() as f64).sqrt(), ((ut - u) / u).abs())
 }
 
@@ -57,7 +64,9 @@ fn tree_gravity_matches_pair_sum_on_a_2000_body_packing() {
     let m: Vec<f64> = bodies.iter().map(|b| b.shape.mass).collect();
     let (rms, pot) = tree_error(&x, &m, DEFAULT_THETA);
     let (rms_fine, _) = tree_error(&x, &m, 0.3);
-    println!("2000-body packing: theta 0.5 RMS force error {rms:.2e}, potential {pot:.2e}; theta 0.3 RMS {rms_fine:.2e}");
+    println!(
+        "2000-body packing: theta 0.5 RMS force error {rms:.2e}, potential {pot:.2e}; theta 0.3 RMS {rms_fine:.2e}"
+    );
     assert!(rms < 1e-3 && pot < 1e-4, "theta 0.5: RMS {rms:e}, potential {pot:e}");
     assert!(rms_fine < rms, "theta 0.3 ({rms_fine:e}) not better than 0.5 ({rms:e})");
 }
@@ -162,8 +171,7 @@ fn tree_scene_conserves_energy_over_a_short_span() {
         let s = scene_of(&dir, "ring.csv", method);
         let sys = EllipsoidSystem::new(&s.bodies, s.model, s.physics);
         let mut y = sys.initial_state();
-        let mut integ =
-            make_integrator(Method::BulirschStoer, Tolerances::scale_free(1e-9, 1e-9, &sys), None).unwrap();
+        let mut integ = make_integrator(Method::BulirschStoer, Tolerances::scale_free(1e-9, 1e-9, &sys), None).unwrap();
         let d0 = sys.diagnostics(&y);
         let (mut t, mut worst) = (0.0, 0.0f64);
         for k in 1..=4 {
@@ -185,7 +193,10 @@ fn tree_scene_conserves_energy_over_a_short_span() {
         "1000 bodies, theta 0.5: RMS force error {rms:.2e}; 100 s: energy error tree {tree_error:.2e}, \
          direct {direct_error:.2e}; largest offset {moved:.2e} m"
     );
-    assert!(rms > 1e-6, "the tree does not approximate on this scene ({rms:e}): the test would test nothing");
+    assert!(
+        rms > 1e-6,
+        "the tree does not approximate on this scene ({rms:e}): the test would test nothing"
+    );
     assert!(tree_error < 1e-6, "tree energy error {tree_error:e}");
     assert!(moved < 10.0, "tree and direct bodies {moved} m apart");
 }

@@ -127,17 +127,23 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         )));
     }
     if !(args.theta > 0.0 && args.theta <= MAX_THETA) {
-        return Err(CliError::usage(format!("--theta: must be in (0, 1], got {}", args.theta)));
+        return Err(CliError::usage(format!(
+            "--theta: must be in (0, 1], got {}",
+            args.theta
+        )));
     }
     let repeats = args.repeats as usize;
     let all = match args.threads {
         Some(k) => k as usize,
         None => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
     };
-    let paths = args
-        .out
-        .as_ref()
-        .map(|dir| (dir.join("bench_rhs.csv"), dir.join("bench_rhs.svg"), dir.join("bench_rhs.png")));
+    let paths = args.out.as_ref().map(|dir| {
+        (
+            dir.join("bench_rhs.csv"),
+            dir.join("bench_rhs.svg"),
+            dir.join("bench_rhs.png"),
+        )
+    });
     if let (Some(dir), Some((csv, svg, png))) = (&args.out, &paths) {
         if !args.force && (csv.exists() || svg.exists() || png.exists()) {
             return Err(CliError::usage(format!(
@@ -152,7 +158,11 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         counts.push(all);
     }
     let mut results: Vec<(usize, RhsTiming, String)> = Vec::new();
-    for (&bodies, gravity) in args.bodies.iter().flat_map(|b| args.gravity.iter().map(move |g| (b, g))) {
+    for (&bodies, gravity) in args
+        .bodies
+        .iter()
+        .flat_map(|b| args.gravity.iter().map(move |g| (b, g)))
+    {
         let n = bodies as usize;
         let theta = args.theta;
         let method = match gravity.as_str() {
@@ -163,7 +173,11 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         let system = bench_system_with(n, args.seed, args.kappa, method);
         println!(
             "bench rhs: {n} bodies, gravity {gravity} ({}), {repeats} repeats, seed {}, kappa {}",
-            if method.tree_theta(n).is_some() { "tree" } else { "exact" },
+            if method.tree_theta(n).is_some() {
+                "tree"
+            } else {
+                "exact"
+            },
             args.seed,
             args.kappa
         );

@@ -20,8 +20,8 @@ use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
-pub use crate::ellipsoid::gravity_tree::{GravityMethod, TREE_FROM};
 use crate::ellipsoid::gravity_tree::tree_gravity_forces;
+pub use crate::ellipsoid::gravity_tree::{GravityMethod, TREE_FROM};
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
     overlap, overlap_within_taper,
@@ -794,7 +794,10 @@ impl OdeSystem for EllipsoidSystem {
         };
         // From BLOCKED_FROM bodies on the gravity blocks, added per body below; small systems add the half loop.
         // The tree's forces (when the method asks for it at this N) are one block.
-        let blocked_gravity = self.physics.gravity.filter(|_| n >= BLOCKED_FROM || tree_theta.is_some());
+        let blocked_gravity = self
+            .physics
+            .gravity
+            .filter(|_| n >= BLOCKED_FROM || tree_theta.is_some());
         let mut gravity_pass = || match (blocked_gravity, tree_theta) {
             (Some(gr), Some(theta)) => {
                 gravity.resize_with(1, Vec::new);

@@ -101,7 +101,11 @@ mod tests {
         let error = |theta: f64| {
             let mut f = Vec::new();
             let ut = tree_gravity_forces(6.674e-11, theta, &x, &m, &mut f);
-            let sq: f64 = f.iter().zip(&exact).map(|(a, b)| ((a - b).norm() / b.norm()).powi(2)).sum();
+            let sq: f64 = f
+                .iter()
+                .zip(&exact)
+                .map(|(a, b)| ((a - b).norm() / b.norm()).powi(2))
+                .sum();
             ((sq / x.len() as f64).sqrt(), ((ut - u) / u).abs())
         };
         let (coarse, fine) = (error(0.5), error(0.2));
