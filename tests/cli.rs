@@ -440,10 +440,14 @@ fn bench_rhs_writes_csv_and_plot() {
     assert_ok(&out, "bench");
     let csv = read(&dir.join("bench/bench_rhs.csv"));
     let mut lines = csv.lines();
-    assert_eq!(lines.next().unwrap(), "bodies,threads,median_us,min_us,repeats");
+    assert_eq!(lines.next().unwrap(), "bodies,threads,median_us,min_us,repeats,gravity");
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 4);
-    assert!(rows[0].starts_with("8,1,") && rows[0].ends_with(",3"), "{}", rows[0]);
+    assert!(
+        rows[0].starts_with("8,1,") && rows[0].ends_with(",3,auto"),
+        "{}",
+        rows[0]
+    );
     assert!(rows[1].starts_with("8,2,"), "{}", rows[1]);
     assert!(rows[3].starts_with("30,2,"), "{}", rows[3]);
     let svg = read(&dir.join("bench/bench_rhs.svg"));

@@ -122,7 +122,7 @@ const T_COLLISION: f64 = 4000.0;
 
 fn conservative() -> Physics {
     Physics {
-        gravity: Some(GravityTerm { g: G_SI }),
+        gravity: Some(GravityTerm::new(G_SI)),
         contact: Some(ContactTerm::default()),
         dissipation: None,
     }
@@ -440,7 +440,7 @@ fn gravity_only_spheres_take_the_packed_path_correctly() {
         contact_g: G_SI,
     };
     let physics = Physics {
-        gravity: Some(GravityTerm { g: G_SI }),
+        gravity: Some(GravityTerm::new(G_SI)),
         contact: None,
         dissipation: None,
     };

@@ -385,6 +385,21 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
         ),
         ("G inf", with("G = 6.674e-11", "G = inf"), "physics.gravity.G"),
         (
+            "gravity theta zero",
+            with("G = 6.674e-11", "G = 6.674e-11, method = \"tree\", theta = 0.0"),
+            "physics.gravity.theta: must be in (0, 1], got 0",
+        ),
+        (
+            "gravity theta large",
+            with("G = 6.674e-11", "G = 6.674e-11, theta = 1.5"),
+            "physics.gravity.theta: must be in (0, 1]",
+        ),
+        (
+            "gravity method unknown",
+            with("G = 6.674e-11", "G = 6.674e-11, method = \"fast\""),
+            "physics.gravity.method",
+        ),
+        (
             "cutoff zero",
             with("contact = {}", "contact = { cutoff = 0.0 }"),
             "physics.contact.cutoff: must be in (0, 1), got 0",

@@ -97,9 +97,7 @@ fn satellite(s: f64) -> (EllipsoidSystem, f64) {
         sphere(q * s, 1.0 / (1.0 + q), v / (1.0 + q)),
     ];
     let physics = Physics {
-        gravity: Some(GravityTerm {
-            g: OMEGA * OMEGA / ((1.0 + q) * s),
-        }),
+        gravity: Some(GravityTerm::new(OMEGA * OMEGA / ((1.0 + q) * s))),
         contact: None,
         dissipation: None,
     };

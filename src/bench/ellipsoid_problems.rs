@@ -290,7 +290,7 @@ pub fn bouncing_pair(f0: Option<f64>) -> ProblemSetup {
         contact_g: 1.0,
     };
     let physics = Physics {
-        gravity: Some(GravityTerm { g: 1.0 }),
+        gravity: Some(GravityTerm::new(1.0)),
         contact: Some(ContactTerm::default()),
         dissipation: f0.map(|f0| DissipationTerm { f0 }),
     };
@@ -429,7 +429,7 @@ fn point_masses(name: &'static str, description: String, bodies: Vec<Body>, t_en
         contact_g: 1.0,
     };
     let physics = Physics {
-        gravity: Some(GravityTerm { g: 1.0 }),
+        gravity: Some(GravityTerm::new(1.0)),
         contact: None,
         dissipation: None,
     };

@@ -1,4 +1,5 @@
-//! `rubblepile bench rhs`: the cost of one right-hand-side evaluation, serial and parallel.
+//! `rubblepile bench rhs`: the cost of one right-hand-side evaluation, serial and parallel, with gravity among
+//! centres (Roig03 Eq. 6) summed exactly or by the octree ([`crate::ellipsoid::gravity_tree`]).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -7,6 +8,7 @@ use std::time::Instant;
 use super::BenchError as CliError;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
+use crate::ellipsoid::gravity_tree::{GravityMethod, MAX_THETA};
 use crate::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
 use crate::integrate::OdeSystem;
 use crate::io::scene_file::SI_G;
@@ -31,8 +33,16 @@ pub struct RhsArgs {
     /// Threads of the parallel run (default: all available).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Option<u64>,
-    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats) and the plot `bench_rhs.svg`
-    /// (median µs per RHS against N, one line per thread count) into this directory.
+    /// Gravity methods to time, comma-separated: `auto` (exact below 1000 bodies, tree from there on),
+    /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`).
+    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree"])]
+    pub gravity: Vec<String>,
+    /// Opening angle θ of the tree (dimensionless, in (0, 1]).
+    #[arg(long, default_value_t = crate::ellipsoid::gravity_tree::DEFAULT_THETA)]
+    pub theta: f64,
+    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats, gravity) and the plot
+    /// `bench_rhs.svg` + `bench_rhs.png` (median µs per RHS against N, one line per thread count and gravity
+    /// method) into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Overwrite `bench_rhs.csv`/`bench_rhs.svg` of an earlier benchmark in DIR.
@@ -89,12 +99,17 @@ pub fn time_rhs(
     })
 }
 
-/// The system benchmarked by `bench rhs`: gravity + contact + dissipation (F0 = 1 s/m²).
+/// The system benchmarked by `bench rhs`: gravity (default method) + contact + dissipation (F0 = 1 s/m²).
 pub fn bench_system(n: usize, seed: u64, kappa: f64) -> EllipsoidSystem {
+    bench_system_with(n, seed, kappa, GravityMethod::default())
+}
+
+/// [`bench_system`] with gravity summed by `method`.
+pub fn bench_system_with(n: usize, seed: u64, kappa: f64, method: GravityMethod) -> EllipsoidSystem {
     let bodies = random_cloud(n, seed, &CloudParams::default());
     let model = ModelConfig::gaussian_si(kappa);
     let physics = Physics {
-        gravity: Some(GravityTerm { g: SI_G }),
+        gravity: Some(GravityTerm { g: SI_G, method }),
         contact: Some(ContactTerm {
             cutoff: DEFAULT_CONTACT_CUTOFF,
         }),
@@ -111,17 +126,26 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
             args.kappa
         )));
     }
+    if !(args.theta > 0.0 && args.theta <= MAX_THETA) {
+        return Err(CliError::usage(format!(
+            "--theta: must be in (0, 1], got {}",
+            args.theta
+        )));
+    }
     let repeats = args.repeats as usize;
     let all = match args.threads {
         Some(k) => k as usize,
         None => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
     };
-    let paths = args
-        .out
-        .as_ref()
-        .map(|dir| (dir.join("bench_rhs.csv"), dir.join("bench_rhs.svg")));
-    if let (Some(dir), Some((csv, svg))) = (&args.out, &paths) {
-        if !args.force && (csv.exists() || svg.exists()) {
+    let paths = args.out.as_ref().map(|dir| {
+        (
+            dir.join("bench_rhs.csv"),
+            dir.join("bench_rhs.svg"),
+            dir.join("bench_rhs.png"),
+        )
+    });
+    if let (Some(dir), Some((csv, svg, png))) = (&args.out, &paths) {
+        if !args.force && (csv.exists() || svg.exists() || png.exists()) {
             return Err(CliError::usage(format!(
                 "--out: {} already holds a benchmark; use --force to overwrite it",
                 dir.display()
@@ -133,13 +157,29 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
     if all > 1 {
         counts.push(all);
     }
-    let mut results: Vec<(usize, RhsTiming)> = Vec::new();
-    for &bodies in &args.bodies {
+    let mut results: Vec<(usize, RhsTiming, String)> = Vec::new();
+    for (&bodies, gravity) in args
+        .bodies
+        .iter()
+        .flat_map(|b| args.gravity.iter().map(move |g| (b, g)))
+    {
         let n = bodies as usize;
-        let system = bench_system(n, args.seed, args.kappa);
+        let theta = args.theta;
+        let method = match gravity.as_str() {
+            "direct" => GravityMethod::Direct,
+            "tree" => GravityMethod::Tree { theta },
+            _ => GravityMethod::Auto { theta },
+        };
+        let system = bench_system_with(n, args.seed, args.kappa, method);
         println!(
-            "bench rhs: {n} bodies, {repeats} repeats, seed {}, kappa {}",
-            args.seed, args.kappa
+            "bench rhs: {n} bodies, gravity {gravity} ({}), {repeats} repeats, seed {}, kappa {}",
+            if method.tree_theta(n).is_some() {
+                "tree"
+            } else {
+                "exact"
+            },
+            args.seed,
+            args.kappa
         );
         let mut row = Vec::new();
         for &threads in &counts {
@@ -161,41 +201,56 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
                 row[1].threads
             );
         }
-        results.extend(row.into_iter().map(|r| (n, r)));
+        results.extend(row.into_iter().map(|r| (n, r, gravity.clone())));
     }
-    if let Some((csv, svg)) = &paths {
+    if let Some((csv, svg, png)) = &paths {
         let write = || -> std::io::Result<()> {
             let mut f = std::io::BufWriter::new(std::fs::File::create(csv)?);
-            writeln!(f, "bodies,threads,median_us,min_us,repeats")?;
-            for (n, r) in &results {
-                writeln!(f, "{n},{},{:e},{:e},{repeats}", r.threads, r.median_us, r.min_us)?;
+            writeln!(f, "bodies,threads,median_us,min_us,repeats,gravity")?;
+            for (n, r, g) in &results {
+                writeln!(f, "{n},{},{:e},{:e},{repeats},{g}", r.threads, r.median_us, r.min_us)?;
             }
             f.flush()
         };
         write().map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
-        plot_rhs(svg, &results, &counts).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
-        println!("  wrote {} and {}", csv.display(), svg.display());
+        let lines: Vec<(usize, String)> = args
+            .gravity
+            .iter()
+            .flat_map(|g| counts.iter().map(move |&c| (c, g.clone())))
+            .collect();
+        {
+            use plotters::prelude::*;
+            let svg_root = SVGBackend::new(svg, (720, 480)).into_drawing_area();
+            plot_rhs(&svg_root, &results, &lines).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
+            let png_root = BitMapBackend::new(png, (720, 480)).into_drawing_area();
+            plot_rhs(&png_root, &results, &lines).map_err(|e| CliError::failed(format!("{}: {e}", png.display())))?;
+        }
+        println!("  wrote {}, {} and {}", csv.display(), svg.display(), png.display());
     }
     Ok(())
 }
 
-/// Log–log plot of the median µs per RHS against the number of bodies, one line per thread count.
-fn plot_rhs(path: &std::path::Path, results: &[(usize, RhsTiming)], counts: &[usize]) -> Result<(), String> {
+/// Log–log plot of the median µs per RHS against the number of bodies, one line per (thread count, gravity
+/// method) in `lines`.
+fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
+    root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
+    results: &[(usize, RhsTiming, String)],
+    lines: &[(usize, String)],
+) -> Result<(), String> {
     use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| e.to_string();
     // plotters measures (and, in PNGs, draws) text with the font the figures embed; it must be registered first
     crate::analysis::figures::style::ensure_font()?;
     let (mut n_lo, mut n_hi) = (f64::INFINITY, 0.0_f64);
     let (mut t_lo, mut t_hi) = (f64::INFINITY, 0.0_f64);
-    for (n, r) in results {
+    for (n, r, _) in results {
         n_lo = n_lo.min(*n as f64);
         n_hi = n_hi.max(*n as f64);
         t_lo = t_lo.min(r.median_us);
         t_hi = t_hi.max(r.median_us);
     }
-    let root = SVGBackend::new(path, (720, 480)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
-    let mut chart = ChartBuilder::on(&root)
+    let mut chart = ChartBuilder::on(root)
         .caption("rubblepile bench rhs: cost of one right-hand side", ("sans-serif", 18))
         .margin(12)
         .x_label_area_size(40)
@@ -211,17 +266,20 @@ fn plot_rhs(path: &std::path::Path, results: &[(usize, RhsTiming)], counts: &[us
         .y_desc("median time per RHS (µs)")
         .draw()
         .map_err(|e| err(&e))?;
-    for (k, &threads) in counts.iter().enumerate() {
-        let color = Palette99::pick(k).to_rgba();
+    for (k, (threads, gravity)) in lines.iter().enumerate() {
+        let (threads, color) = (*threads, Palette99::pick(k).to_rgba());
         let points: Vec<(f64, f64)> = results
             .iter()
-            .filter(|(_, r)| r.threads == threads)
-            .map(|(n, r)| (*n as f64, r.median_us))
+            .filter(|(_, r, g)| r.threads == threads && g == gravity)
+            .map(|(n, r, _)| (*n as f64, r.median_us))
             .collect();
         chart
             .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
             .map_err(|e| err(&e))?
-            .label(format!("{threads} thread{}", if threads == 1 { "" } else { "s" }))
+            .label(format!(
+                "{threads} thread{}, gravity {gravity}",
+                if threads == 1 { "" } else { "s" }
+            ))
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
         chart
             .draw_series(points.into_iter().map(|p| Circle::new(p, 3, color.filled())))

@@ -665,7 +665,7 @@ mod tests {
         assert!((c.exponent / x - 1.0).abs() < 1e-12);
         assert!((c.separation_ratio() - 0.8).abs() < 1e-12);
         let physics = Physics {
-            gravity: Some(GravityTerm { g: G_SI }),
+            gravity: Some(GravityTerm::new(G_SI)),
             contact: Some(ContactTerm::default()),
             dissipation: None,
         };

@@ -5,6 +5,7 @@
 //! - [`potential`]: the Gaussian-overlap contact potential (Eqs. 7–12) and its gradients;
 //! - [`calibration`]: κ from Eq. 14 and `U0` from Eq. 11;
 //! - [`gravity`]: monopole gravity (Eq. 6);
+//! - [`gravity_tree`]: the same by a Barnes–Hut octree for large N, and the choice between the two;
 //! - [`dissipation`]: the point dissipation function (Eqs. 40–41);
 //! - [`barrier`]: the contact-barrier overrun detector (calibration of Eqs. 13–14 checked during a run);
 //! - [`equations`]: the equations of motion (Eqs. 28–37) as an [`crate::integrate::OdeSystem`].
@@ -44,6 +45,7 @@ pub mod cloud;
 pub mod dissipation;
 pub mod equations;
 pub mod gravity;
+pub mod gravity_tree;
 pub mod output;
 pub mod potential;
 pub mod quaternion;

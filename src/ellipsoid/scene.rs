@@ -15,7 +15,7 @@
 //! inertia = "gaussian"          # or "uniform"
 //!
 //! [physics]                     # every term optional: absent = left out
-//! gravity = { G = 6.674e-11 }
+//! gravity = { G = 6.674e-11 }     # method = "auto" | "direct" | "tree", theta = 0.5
 //! contact = {}
 //! dissipation = { F0 = 1.0 }
 //!
@@ -180,6 +180,29 @@ pub struct GravitySpec {
     /// contact amplitude U0 (Roig03 Eq. 11) and in `model.calibrate`.
     #[serde(default, rename = "G", skip_serializing_if = "Option::is_none")]
     pub g: Option<f64>,
+    /// How the pair sum is done: `"direct"` (exact, O(N²)), `"tree"` (Barnes–Hut octree, O(N log N)) or
+    /// `"auto"` (exact below 1000 bodies, tree from there on). Default `"auto"`. See
+    /// [`crate::ellipsoid::gravity_tree`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub method: Option<GravityMethodSpec>,
+    /// Opening angle θ of the tree (dimensionless, in (0, 1]): a node is used whole beyond `side/θ` from a
+    /// body. Default 0.5 (RMS relative force error 2.6e-4 against the exact sum on 2000 ellipsoids). Ignored by
+    /// `"direct"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub theta: Option<f64>,
+}
+
+/// `physics.gravity.method`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GravityMethodSpec {
+    /// Exact pair sum.
+    Direct,
+    /// Barnes–Hut octree at any N.
+    Tree,
+    /// Exact below [`crate::ellipsoid::gravity_tree::TREE_FROM`] bodies, tree from there on.
+    #[default]
+    Auto,
 }
 
 /// `physics.contact`.
@@ -498,9 +521,21 @@ impl Validator<'_> {
     /// `[physics]`: each term optional (absent = not computed).
     fn physics_section(&self, p: &PhysicsSection) -> Result<Physics, SceneError> {
         let gravity = match p.gravity {
-            Some(g) => Some(GravityTerm {
-                g: self.positive("physics.gravity.G", g.g.unwrap_or(SI_G))?,
-            }),
+            Some(g) => {
+                use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod, MAX_THETA};
+                let theta = g.theta.unwrap_or(DEFAULT_THETA);
+                if !(theta > 0.0 && theta <= MAX_THETA) {
+                    return Err(self.invalid("physics.gravity.theta", format!("must be in (0, 1], got {theta}")));
+                }
+                Some(GravityTerm {
+                    g: self.positive("physics.gravity.G", g.g.unwrap_or(SI_G))?,
+                    method: match g.method.unwrap_or_default() {
+                        GravityMethodSpec::Direct => GravityMethod::Direct,
+                        GravityMethodSpec::Tree => GravityMethod::Tree { theta },
+                        GravityMethodSpec::Auto => GravityMethod::Auto { theta },
+                    },
+                })
+            }
             None => None,
         };
         let contact = match p.contact {
