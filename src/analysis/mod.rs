@@ -4,6 +4,7 @@ pub mod atmosphere;
 pub mod creep;
 pub mod figures;
 pub mod fits;
+pub mod flyby;
 pub mod fragments;
 pub mod report_notes;
 pub mod report_richardson2011;

@@ -7,6 +7,7 @@
 //! - [`gravity`]: monopole gravity (Eq. 6);
 //! - [`dissipation`]: the point dissipation function (Eqs. 40–41);
 //! - [`barrier`]: the contact-barrier overrun detector (calibration of Eqs. 13–14 checked during a run);
+//! - [`tide`]: a planet on a prescribed Kepler orbit (the `[physics.flyby]` term);
 //! - [`equations`]: the equations of motion (Eqs. 28–37) as an [`crate::integrate::OdeSystem`].
 //!
 //! # Conventions and corrected forms
@@ -51,3 +52,4 @@ pub mod rigid_rotation;
 pub mod run;
 pub mod scene;
 pub mod summary;
+pub mod tide;
