@@ -5,7 +5,7 @@
 mod common;
 
 use common::{Random, temp_dir};
-use rubblepile::driver::{RunOptions, run_scene};
+use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::scene::parse_scene;
 use rubblepile::ellipsoid::tide::TideTerm;
 use rubblepile::gravity::kepler::{KeplerOrbit, orientation_matrix, solve_elliptic, solve_hyperbolic};
@@ -236,4 +236,33 @@ fn tidal_energy_bookkeeping_closes_in_a_close_flyby() {
         change > 1e3 * s.energy_error.max(1e-12),
         "H changed by only {change:e} of the scale"
     );
+}
+
+#[test]
+fn flyby_run_resumed_from_a_checkpoint_matches_the_whole_run() {
+    let flyby = "[physics.flyby]\nmass = 5.9722e25\nradius = 6.371e6\nq = 9.5e6\nv_inf = 3000.0\nt_perigee = 1500.0";
+    let text = pile_scene(flyby, 3000.0);
+    let (whole, s_whole) = run(&text, "flyby-whole");
+    let dir = temp_dir("flyby-split");
+    let scene = parse_scene(&text, "flyby.toml", Some(&dir)).unwrap();
+    let quiet = RunOptions {
+        force: true,
+        progress: false,
+        checkpoint_every: None,
+        ..RunOptions::default()
+    };
+    let stopping = RunOptions {
+        checkpoint_every_sim: Some(1000.0),
+        stop_after_checkpoints: Some(1),
+        ..quiet
+    };
+    let split = dir.join("run");
+    match run_scene(&scene, &split, &stopping) {
+        Err(RunError::Stopped { .. }) => {}
+        other => panic!("expected a stop after the checkpoint, got {other:?}"),
+    }
+    let resumed = resume_run(&split, &quiet).unwrap();
+    assert_eq!(resumed.energy_error, s_whole.energy_error);
+    let read = |p: &std::path::Path| std::fs::read(p.join("snapshots/2.csv")).unwrap();
+    assert!(read(&split) == read(&whole), "the resumed run's last snapshot differs");
 }

@@ -773,8 +773,8 @@ impl OdeSystem for EllipsoidSystem {
                 for (i, out) in dydt.chunks_exact_mut(self.stride).enumerate() {
                     let r = Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]);
                     let f = tide.acceleration(&r, planet) * self.masses[i];
-                    for k in 0..3 {
-                        out[3 + k] += f[k];
+                    for (o, fk) in out[3..6].iter_mut().zip(f.iter()) {
+                        *o += fk;
                     }
                 }
             }

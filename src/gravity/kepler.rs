@@ -153,7 +153,7 @@ impl KeplerOrbit {
     /// when an ellipse never gets that far (r above apogee).
     pub fn time_from_perigee_at_distance(&self, r: f64) -> Option<f64> {
         let e = self.e;
-        if !(r >= self.q) {
+        if r.is_nan() || r < self.q {
             return None;
         }
         if self.gm == 0.0 {
