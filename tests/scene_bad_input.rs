@@ -62,6 +62,11 @@ fn with_body1(from: &str, to: &str) -> String {
     format!("{head}{}", tail.replacen(from, to, 1))
 }
 
+/// A `[physics.flyby]` table (placed before `[integrator]`) with the planet line(s) `planet` and orbit line(s) `orbit`.
+fn flyby(planet: &str, orbit: &str) -> String {
+    format!("[physics.flyby]\n{planet}\nq = 1e7\n{orbit}\nt_perigee = 100.0\n\n[integrator]")
+}
+
 /// (case name, scene text, text the one-line error must contain)
 fn cases() -> Vec<(&'static str, String, &'static str)> {
     let mut v: Vec<(&'static str, String, &'static str)> = vec![
@@ -418,6 +423,57 @@ fn cases() -> Vec<(&'static str, String, &'static str)> {
             "cutoff nan",
             with("contact = {}", "contact = { cutoff = nan }"),
             "physics.contact.cutoff",
+        ),
+        (
+            "flyby negative mass",
+            with("[integrator]", &flyby("mass = -1.0", "v_inf = 5800.0")),
+            "physics.flyby.mass: must be >= 0",
+        ),
+        (
+            "flyby perigee inside the planet",
+            with("[integrator]", &flyby("mass = 6e24\nradius = 2e7", "v_inf = 5800.0")),
+            "physics.flyby.q: must exceed the planet's radius",
+        ),
+        (
+            "flyby both v_inf and eccentricity",
+            with(
+                "[integrator]",
+                &flyby("mass = 6e24", "v_inf = 5800.0\neccentricity = 2.0"),
+            ),
+            "physics.flyby: give exactly one of `v_inf` or `eccentricity`, got both",
+        ),
+        (
+            "flyby neither v_inf nor eccentricity",
+            with("[integrator]", &flyby("mass = 6e24", "")),
+            "physics.flyby: give exactly one of `v_inf` or `eccentricity`, got neither",
+        ),
+        (
+            "flyby parabolic",
+            with("[integrator]", &flyby("mass = 6e24", "eccentricity = 1.0")),
+            "physics.flyby.eccentricity: must be >= 0 and != 1",
+        ),
+        (
+            "flyby zero v_inf",
+            with("[integrator]", &flyby("mass = 6e24", "v_inf = 0.0")),
+            "physics.flyby.v_inf: must be > 0",
+        ),
+        (
+            "flyby missing q",
+            with(
+                "[integrator]",
+                &flyby("mass = 6e24", "v_inf = 5800.0").replace("q = 1e7\n", ""),
+            ),
+            "q",
+        ),
+        (
+            "flyby unknown key",
+            with("[integrator]", &flyby("mass = 6e24\nJ2 = 1e-3", "v_inf = 5800.0")),
+            "unknown field `J2`",
+        ),
+        (
+            "flyby massless with eccentricity",
+            with("[integrator]", &flyby("mass = 0.0", "eccentricity = 0.5")),
+            "physics.flyby.mass: must be > 0 kg with `eccentricity`",
         ),
     ];
     v.sort_by_key(|c| c.0);

@@ -5,6 +5,7 @@ pub mod composition;
 pub mod creep;
 pub mod figures;
 pub mod fits;
+pub mod flyby;
 pub mod fragments;
 pub mod report_notes;
 pub mod report_richardson2011;

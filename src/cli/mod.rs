@@ -83,6 +83,8 @@ pub enum Command {
     Target(target::TargetCommand),
     /// Run an impact of a projectile (P1, P2, P3 or custom) on a target.
     Impact(Box<impact::ImpactArgs>),
+    /// Run a tidal flyby of a target pile past a planet (default Earth); analysis in DIR/analysis/flyby.json.
+    Flyby(Box<crate::impact::flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(campaign::CampaignArgs),
     /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis.
@@ -334,6 +336,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
+        Command::Flyby(args) => crate::analysis::flyby::flyby_command(&args)
+            .map(|lines| lines.iter().for_each(|l| println!("{l}")))
+            .map_err(|(message, code)| CliError { message, code }),
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),

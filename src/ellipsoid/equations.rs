@@ -30,6 +30,7 @@ use crate::ellipsoid::quaternion::{
     extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin, rotation_matrix,
     rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
 };
+use crate::ellipsoid::tide::TideTerm;
 use crate::geometry::neighbours::sphere_pairs;
 use crate::integrate::OdeSystem;
 use crate::math::{Mat4, Vec3, Vec4};
@@ -136,6 +137,9 @@ pub struct Diagnostics {
     pub potential_gravity: f64,
     /// `2 ∫ F dt` so far (J, ≤ 0).
     pub dissipated: f64,
+    /// Tidal energy `E_tide` of a flyby (J, see [`crate::ellipsoid::tide`]); 0 without one or from
+    /// [`EllipsoidSystem::diagnostics`] (which has no time).
+    pub potential_tidal: f64,
     /// Total linear momentum (kg m/s).
     pub momentum: Vec3,
     /// Total angular momentum about the origin, orbital + spin (kg m²/s).
@@ -144,16 +148,20 @@ pub struct Diagnostics {
     pub momentum_scale: f64,
     /// Scale for angular-momentum errors: Σ (|r × m v| + |I ω|) (kg m²/s).
     pub angular_momentum_scale: f64,
-    /// Scale for energy errors: K + |U_C| + |U_G| (J).
+    /// Scale for energy errors: K + |U_C| + |U_G| + |E_tide| (J).
     pub energy_scale: f64,
     /// max over bodies of ||q| − 1|.
     pub quaternion_norm_error: f64,
 }
 
 impl Diagnostics {
-    /// Total mechanical energy H = K_T + K_R + U_C + U_G (J).
+    /// Total mechanical energy H = K_T + K_R + U_C + U_G (+ E_tide in a flyby) (J).
     pub fn energy(&self) -> f64 {
-        self.kinetic_translational + self.kinetic_rotational + self.potential_contact + self.potential_gravity
+        self.kinetic_translational
+            + self.kinetic_rotational
+            + self.potential_contact
+            + self.potential_gravity
+            + self.potential_tidal
     }
 }
 
@@ -253,6 +261,8 @@ pub struct EllipsoidSystem {
     scratch: std::sync::Mutex<RhsScratch>,
     /// Body masses (kg), contiguous for the gravity sums.
     masses: Vec<f64>,
+    /// A planet on a prescribed orbit ([`EllipsoidSystem::with_tide`]); `None`: no tide computed.
+    tide: Option<TideTerm>,
 }
 
 /// Skin of the candidate-pair (Verlet) list, as a fraction of each body's interaction radius.
@@ -312,7 +322,19 @@ impl EllipsoidSystem {
             pair_cache: std::sync::Mutex::new(None),
             scratch: std::sync::Mutex::new(RhsScratch::default()),
             masses: bodies.iter().map(|b| b.shape.mass).collect(),
+            tide: None,
         }
+    }
+
+    /// The same system with the flyby tide `tide` (`None`: none) added to every body's force.
+    pub fn with_tide(mut self, tide: Option<TideTerm>) -> Self {
+        self.tide = tide;
+        self
+    }
+
+    /// The flyby tide, if any.
+    pub fn tide(&self) -> Option<&TideTerm> {
+        self.tide.as_ref()
     }
 
     /// The packed initial state (quaternions normalised, `q̇ ⊥ q`).
@@ -654,6 +676,20 @@ impl EllipsoidSystem {
             d.kinetic_translational + d.kinetic_rotational + d.potential_contact.abs() + d.potential_gravity.abs();
         d
     }
+
+    /// [`EllipsoidSystem::diagnostics`] at time `t` (s): with a flyby, the tidal energy `E_tide` is filled in (and
+    /// counted in the energy and its scale), so that `H + E_tide` is the conserved energy.
+    pub fn diagnostics_at(&self, t: f64, y: &[f64]) -> Diagnostics {
+        let mut d = self.diagnostics(y);
+        if let Some(tide) = &self.tide {
+            let positions: Vec<Vec3> = (0..self.n_bodies())
+                .map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]))
+                .collect();
+            d.potential_tidal = tide.energy(t, &positions, &self.masses, &d.momentum);
+            d.energy_scale += d.potential_tidal.abs();
+        }
+        d
+    }
 }
 
 /// `∂F/∂q̇ = 2 W₃(q)ᵀ R ∂F/∂ω_w` (the chain rule through `ω_w = Rᵀ 2 W₃ q̇`).
@@ -735,7 +771,8 @@ impl OdeSystem for EllipsoidSystem {
         Some(units)
     }
 
-    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+    fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
+        let tide = self.tide.map(|tide| (tide, tide.planet_position(t)));
         let n = self.n_bodies();
         let tree_theta = self.physics.gravity.and_then(|gr| gr.method.tree_theta(n));
         if !self.rotation && !self.needs_pairs() && n < BLOCKED_FROM && tree_theta.is_none() {
@@ -750,6 +787,15 @@ impl OdeSystem for EllipsoidSystem {
             }
             if let Some(gr) = self.physics.gravity {
                 add_gravity_forces_packed(gr.g, y, self.stride, &self.masses, dydt, 3);
+            }
+            if let Some((tide, planet)) = &tide {
+                for (i, out) in dydt.chunks_exact_mut(self.stride).enumerate() {
+                    let r = Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]);
+                    let f = tide.acceleration(&r, planet) * self.masses[i];
+                    for (o, fk) in out[3..6].iter_mut().zip(f.iter()) {
+                        *o += fk;
+                    }
+                }
             }
             return;
         }
@@ -824,6 +870,9 @@ impl OdeSystem for EllipsoidSystem {
                 force += block[i];
             }
             let k = &kin[i];
+            if let Some((tide, planet)) = &tide {
+                force += tide.acceleration(&k.r, planet) * self.masses[i];
+            }
             out[0..3].copy_from_slice(k.velocity.as_slice());
             if rotation {
                 let ie = &self.inertia_ext[i];

@@ -8,6 +8,7 @@
 //! - [`gravity_tree`]: the same by a Barnes–Hut octree for large N, and the choice between the two;
 //! - [`dissipation`]: the point dissipation function (Eqs. 40–41);
 //! - [`barrier`]: the contact-barrier overrun detector (calibration of Eqs. 13–14 checked during a run);
+//! - [`tide`]: a planet on a prescribed Kepler orbit (the `[physics.flyby]` term);
 //! - [`equations`]: the equations of motion (Eqs. 28–37) as an [`crate::integrate::OdeSystem`].
 //!
 //! # Conventions and corrected forms
@@ -53,3 +54,4 @@ pub mod rigid_rotation;
 pub mod run;
 pub mod scene;
 pub mod summary;
+pub mod tide;

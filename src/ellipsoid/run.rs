@@ -144,6 +144,7 @@ impl ErrorTracker {
                 (1.0, format!("1 {unit}: {def0} is 0 throughout, so errors are absolute"))
             }
         };
+        // With a flyby the energy and this scale also hold the tidal energy E_tide (crate::ellipsoid::tide).
         let (energy, energy_definition) = pick(0, "K_T + K_R + |U_C| + |U_G|", "J");
         let (momentum, momentum_definition) = pick(1, "sum over bodies of m |v|", "kg m/s");
         let (angular_momentum, angular_momentum_definition) =
@@ -165,6 +166,7 @@ fn diagnostics_finite(d: &Diagnostics) -> bool {
         d.kinetic_rotational,
         d.potential_contact,
         d.potential_gravity,
+        d.potential_tidal,
         d.dissipated,
         d.momentum_scale,
         d.angular_momentum_scale,
@@ -255,7 +257,7 @@ pub struct EllipsoidEngine {
 impl EllipsoidEngine {
     /// The engine for a validated scene, at t = 0. Errors: the integrator cannot be built from the scene's settings.
     pub fn new(scene: LoadedScene) -> Result<Self, EngineError> {
-        let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
+        let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics).with_tide(scene.tide);
         let settings = scene.integrator;
         let mut integrator = make_integrator(
             settings.method,
@@ -266,7 +268,7 @@ impl EllipsoidEngine {
         // The error budget is the run's: rtol bounds the accumulated error, not each step's.
         integrator.set_span(scene.t_end);
         let y = system.initial_state();
-        let tracker = ErrorTracker::new(&system.diagnostics(&y));
+        let tracker = ErrorTracker::new(&system.diagnostics_at(0.0, &y));
         let barrier = BarrierMonitor::new(
             BarrierSettings::for_kappa_source(&scene.kappa_source),
             scene.physics.contact.is_some(),
@@ -326,6 +328,12 @@ impl EllipsoidEngine {
         }
         if let Some(d) = p.dissipation {
             terms.push(format!("dissipation (F0 = {})", d.f0));
+        }
+        if let Some(t) = &s.tide {
+            terms.push(format!(
+                "flyby tide (GM = {:e} m^3/s^2, q = {:e} m, e = {}, t_perigee = {} s)",
+                t.gm, t.orbit.q, t.orbit.e, t.orbit.t_perigee
+            ));
         }
         if terms.is_empty() {
             terms.push("none (free motion)".into());
@@ -435,7 +443,7 @@ impl Engine for EllipsoidEngine {
     }
 
     fn sample(&mut self, _to: &Sample, wall_seconds: f64) -> Result<String, SampleError> {
-        let d = self.system.diagnostics(&self.y);
+        let d = self.system.diagnostics_at(self.t, &self.y);
         if let Some(cause) = check_state(self.t, &d) {
             return Err(self.failure(cause).into());
         }

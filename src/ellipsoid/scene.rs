@@ -48,6 +48,8 @@ use serde::{Deserialize, Serialize};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
+pub use crate::ellipsoid::tide::FlybySpec;
+use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
 use crate::integrate::Method;
 pub use crate::io::scene_file::{
     MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
@@ -170,6 +172,9 @@ pub struct PhysicsSection {
     /// Point dissipation (Roig03 Eqs. 40–41): `dissipation = { F0 = … }`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub dissipation: Option<DissipationSpec>,
+    /// Tide of a planet on a prescribed orbit, `[physics.flyby]` (see [`FlybySpec`]). Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub flyby: Option<FlybySpec>,
 }
 
 /// `physics.gravity`.
@@ -397,6 +402,8 @@ pub struct LoadedScene {
     pub kappa_source: KappaSource,
     /// Physics terms.
     pub physics: Physics,
+    /// The flyby tide of `[physics.flyby]`, if any.
+    pub tide: Option<TideTerm>,
     /// Integrator settings.
     pub integrator: IntegratorSettings,
     /// Output settings.
@@ -456,6 +463,8 @@ impl Validator<'_> {
         let t_end = self.scene_section(&file)?;
         self.model_section(&file.model)?;
         let physics = self.physics_section(&file.physics)?;
+        let g = physics.gravity.map_or(SI_G, |g| g.g);
+        let tide = file.physics.flyby.map(|f| resolve_flyby(self, &f, g)).transpose()?;
         let integrator = self.integrator_section(&file.integrator)?;
         let output = self.output_section(&file.output, t_end)?;
         let bodies = self.bodies_section(&file, base_dir)?;
@@ -473,6 +482,7 @@ impl Validator<'_> {
             model,
             kappa_source,
             physics,
+            tide,
             integrator,
             output,
         })

@@ -4,7 +4,11 @@
 //!
 //! Both return, per particle, the acceleration (m/s²) and the potential φ (J/kg, the particle itself
 //! excluded), each summed in a fixed order per particle, so results do not depend on the number of threads.
+//!
+//! [`kepler`]: two-body orbits (Kepler's equation, elliptic and hyperbolic) for an external body on a prescribed
+//! orbit (the flyby tide).
 
+pub mod kepler;
 pub mod octree;
 
 use crate::math::Vec3;

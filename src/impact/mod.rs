@@ -5,9 +5,11 @@
 //! - [`pile`]: rubble-pile projectiles (a whole pile thrown at the target);
 //! - [`run`]: one impact run (target + projectile → run directory → [`crate::driver::run_scene`]);
 //! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
-//!   in parallel, resumable, summarised in `campaign.csv`.
+//!   in parallel, resumable, summarised in `campaign.csv`;
+//! - [`flyby`]: a tidal flyby of a pile past a planet (`rubblepile flyby`).
 
 pub mod campaign;
+pub mod flyby;
 pub mod pile;
 pub mod projectile;
 pub mod run;

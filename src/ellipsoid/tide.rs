@@ -1,0 +1,196 @@
+//! Tide of a planet on a prescribed (Kepler) orbit: the `[physics.flyby]` term (issue 20; the setting of
+//! Richardson, Bottke & Love 1998, Icarus 134, 47–76, "Tidal distortion and disruption of Earth-crossing asteroids").
+//!
+//! The frame's origin falls freely on a Kepler orbit `s(t)` about the planet ([`crate::gravity::kepler`]); the
+//! planet sits at `R(t) = −s(t)` in the frame. Each body (a point mass at its centre: the planet's torque on a single
+//! ellipsoid's own quadrupole is left out, as the ellipsoids' mutual gravity is a monopole, Roig03 Eq. 6) gets the
+//! planet's full attraction minus the origin's, exactly (not linearised):
+//! `a_i = −GM (r_i − R)/|r_i − R|³ − GM R/|R|³`.
+//!
+//! **Energy.** The tide does work, so `H = K + U_C + U_G` is not conserved. The motion in this frame is exactly the
+//! restricted problem of a fixed planet seen from the freely falling origin, whose inertial energy
+//! `Σ ½ m_i |v_i + V₀|² + U_C + U_G − Σ GM m_i/|r_i − R|` (`V₀ = ṡ` the origin's velocity relative to the planet) is
+//! conserved. Subtracting the constant Kepler energy of the origin, `M (½|V₀|² − GM/|R|)` (`M` the total mass),
+//! leaves `H + E_tide` conserved (up to the dissipated `2∫F dt`), with the tidal energy
+//! `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (`P` the total momentum in the frame). [`TideTerm::energy`]
+//! computes it; the run's energy residual adds it to `H`, so no state component is added and the integrator's state
+//! (and checkpoints) keep their shape. Both differences of nearly equal terms are evaluated in forms free of
+//! cancellation (`|R| − |d| = (2 r·R − r·r)/(|R| + |d|)`).
+//!
+//! The planet's J2 is not modelled.
+
+use serde::{Deserialize, Serialize};
+
+use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
+use crate::io::scene_file::{SceneError, Validator};
+use crate::math::Vec3;
+
+/// `physics.flyby`: a planet on a prescribed orbit about the frame's origin (the pile's centre of mass at t = 0).
+///
+/// ```toml
+/// [physics.flyby]
+/// mass = 5.9722e24            # kg (Earth)
+/// radius = 6.371e6            # m, optional
+/// q = 3.8e7                   # perigee distance (m)
+/// v_inf = 5800.0              # m/s (hyperbolic); or eccentricity = 0.5
+/// t_perigee = 1.2e5           # s
+/// orientation_deg = [0, 0, 0] # [node, inclination, argument of perigee] (deg)
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FlybySpec {
+    /// Planet mass (kg, ≥ 0). Required. `GM` uses the scene's `physics.gravity.G` (SI G without gravity). A mass of
+    /// 0 is allowed: the planet then pulls on nothing and the frame moves in a straight line at `v_inf`.
+    pub mass: f64,
+    /// Planet radius (m, > 0). Optional (no default): when given, the perigee must lie outside it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radius: Option<f64>,
+    /// Perigee distance `q` (m, > 0) between the planet's centre and the frame origin. Required.
+    pub q: f64,
+    /// Speed at infinity `v∞` (m/s, > 0) of a hyperbolic flyby, `e = 1 + q v∞²/GM`. Give exactly one of `v_inf`
+    /// and `eccentricity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v_inf: Option<f64>,
+    /// Eccentricity `e` (≥ 0, ≠ 1; < 1 elliptic, > 1 hyperbolic), the explicit form. Give exactly one of `v_inf`
+    /// and `eccentricity`; needs `mass > 0`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eccentricity: Option<f64>,
+    /// Time of perigee passage (s, finite). Required.
+    pub t_perigee: f64,
+    /// Orientation `[Ω, i, ω]` (degrees) of the frame origin's orbit about the planet: longitude of the node,
+    /// inclination and argument of perigee, perifocal → frame `R_z(Ω) R_x(i) R_z(ω)`. Default `[0, 0, 0]`: the orbit
+    /// in the x–y plane, anticlockwise about +z, the origin at `+q x̂` from the planet at perigee (the planet at
+    /// `−q x̂` in the frame).
+    #[serde(default)]
+    pub orientation_deg: [f64; 3],
+}
+
+/// The resolved flyby term.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TideTerm {
+    /// `G M` of the planet (m³ s⁻², ≥ 0).
+    pub gm: f64,
+    /// Planet radius (m), when given.
+    pub radius: Option<f64>,
+    /// The frame origin's orbit about the planet (`gm` as above; a straight line when it is 0).
+    pub orbit: KeplerOrbit,
+}
+
+impl TideTerm {
+    /// The planet's position `R(t) = −s(t)` (m) in the frame at time `t` (s).
+    pub fn planet_position(&self, t: f64) -> Vec3 {
+        -self.orbit.state(t).0
+    }
+
+    /// The frame origin's velocity `V₀ = ṡ(t)` (m/s) relative to the planet at time `t` (s).
+    pub fn frame_velocity(&self, t: f64) -> Vec3 {
+        self.orbit.state(t).1
+    }
+
+    /// Tidal acceleration (m/s²) at `r` (m) with the planet at `planet` (m):
+    /// `−GM (r − R)/|r − R|³ − GM R/|R|³`, in the cancellation-free form
+    /// `GM [R (|R|³ − |d|³)/(|d|³ |R|³) − r/|d|³]`, `d = r − R`.
+    pub fn acceleration(&self, r: &Vec3, planet: &Vec3) -> Vec3 {
+        if self.gm == 0.0 {
+            return Vec3::zeros();
+        }
+        let big = planet.norm();
+        let d = (r - planet).norm();
+        // |R| − |d| = (|R|² − |d|²)/(|R| + |d|) = (2 r·R − r·r)/(|R| + |d|).
+        let diff = (2.0 * r.dot(planet) - r.norm_squared()) / (big + d);
+        let cube_diff = diff * (big * big + big * d + d * d);
+        let (d3, big3) = (d * d * d, big * big * big);
+        self.gm * (planet * (cube_diff / (d3 * big3)) - r / d3)
+    }
+
+    /// Adds `m_i a_i` (N) to `forces` for bodies at `positions` (m) with `masses` (kg), at time `t` (s).
+    pub fn add_forces(&self, t: f64, positions: &[Vec3], masses: &[f64], forces: &mut [Vec3]) {
+        let planet = self.planet_position(t);
+        for ((f, r), m) in forces.iter_mut().zip(positions).zip(masses) {
+            *f += self.acceleration(r, &planet) * *m;
+        }
+    }
+
+    /// Tidal energy `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (J) of bodies at `positions` (m) with
+    /// `masses` (kg) and total momentum `momentum` (kg m/s), at time `t` (s): `H + E_tide` is conserved (see the
+    /// module docs).
+    pub fn energy(&self, t: f64, positions: &[Vec3], masses: &[f64], momentum: &Vec3) -> f64 {
+        let (s, v0) = self.orbit.state(t);
+        let planet = -s;
+        let big = planet.norm();
+        let mut potential = 0.0;
+        if self.gm != 0.0 {
+            for (r, m) in positions.iter().zip(masses) {
+                let d = (r - planet).norm();
+                // 1/|R| − 1/|d| = (|d| − |R|)/(|R| |d|), |d| − |R| = (r·r − 2 r·R)/(|R| + |d|).
+                let diff = (r.norm_squared() - 2.0 * r.dot(&planet)) / (big + d);
+                potential += m * diff / (big * d);
+            }
+        }
+        momentum.dot(&v0) + self.gm * potential
+    }
+}
+
+/// Validates `physics.flyby` (errors name the field) and resolves it with the scene's `G` (m³ kg⁻¹ s⁻²).
+pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<TideTerm, SceneError> {
+    let mass = v.non_negative("physics.flyby.mass", spec.mass)?;
+    let gm = g * mass;
+    let q = v.positive("physics.flyby.q", spec.q)?;
+    let radius = match spec.radius {
+        Some(r) => Some(v.positive("physics.flyby.radius", r)?),
+        None => None,
+    };
+    if let Some(r) = radius
+        && q <= r
+    {
+        return Err(v.invalid(
+            "physics.flyby.q",
+            format!("must exceed the planet's radius {r} m (the orbit would hit the planet), got {q}"),
+        ));
+    }
+    if !spec.t_perigee.is_finite() {
+        return Err(v.invalid(
+            "physics.flyby.t_perigee",
+            format!("must be finite (s), got {}", spec.t_perigee),
+        ));
+    }
+    v.finite_vec("physics.flyby.orientation_deg", &spec.orientation_deg)?;
+    let [node, inc, peri] = spec.orientation_deg.map(f64::to_radians);
+    let rotation = orientation_matrix(node, inc, peri);
+    let orbit = match (spec.v_inf, spec.eccentricity) {
+        (Some(_), Some(_)) => {
+            return Err(v.invalid(
+                "physics.flyby",
+                "give exactly one of `v_inf` or `eccentricity`, got both",
+            ));
+        }
+        (None, None) => {
+            return Err(v.invalid(
+                "physics.flyby",
+                "give exactly one of `v_inf` or `eccentricity`, got neither",
+            ));
+        }
+        (Some(vi), None) => {
+            let vi = v.positive("physics.flyby.v_inf", vi)?;
+            KeplerOrbit::hyperbolic(gm, q, vi, spec.t_perigee, rotation)
+                .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
+        }
+        (None, Some(e)) => {
+            if !(e.is_finite() && e >= 0.0 && e != 1.0) {
+                return Err(v.invalid(
+                    "physics.flyby.eccentricity",
+                    format!("must be >= 0 and != 1 (parabolic orbits are not supported), got {e}"),
+                ));
+            }
+            if gm <= 0.0 {
+                return Err(v.invalid(
+                    "physics.flyby.mass",
+                    format!("must be > 0 kg with `eccentricity` (a massless planet has no orbit), got {mass}"),
+                ));
+            }
+            KeplerOrbit::new(gm, q, e, spec.t_perigee, rotation)
+                .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
+        }
+    };
+    Ok(TideTerm { gm, radius, orbit })
+}

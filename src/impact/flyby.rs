@@ -1,0 +1,331 @@
+//! A tidal flyby of a rubble pile past a planet (issue 20; the experiment of Richardson, Bottke & Love 1998, Icarus
+//! 134, 47–76) as a library call: the `[physics.flyby]` term ([`crate::ellipsoid::tide`]) on a target pile.
+//!
+//! [`prepare_flyby`] reads a target bodies file (e.g. from `rubblepile target build`), optionally rescales it to a
+//! given radius (lengths × s, masses × s³, velocities × s: at the same density the dynamics is similar, with the
+//! same κ, when F0 scales as s⁻²) and sets a rigid spin, moves it to its centre-of-mass frame, and writes into the
+//! run directory `initial_bodies.csv`, `flyby.json` ([`FlybySetup`]) and `scene.toml` (gravity, contact,
+//! dissipation, the flyby; Bulirsch–Stoer). The run starts with the planet at `start_q · q` on the way in and ends
+//! at the same distance on the way out. The same run again: `rubblepile run DIR/scene.toml --out OTHER`.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::driver::{RunOptions, prepare_output_dir};
+use crate::ellipsoid::body::Body;
+use crate::ellipsoid::equations::G_SI;
+use crate::ellipsoid::output::write_snapshot;
+use crate::ellipsoid::quaternion::rotation_matrix;
+use crate::ellipsoid::scene::{LoadedScene, parse_scene};
+use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
+use crate::impact::run::{ImpactError, read_target};
+use crate::math::Vec3;
+
+/// Earth's mass (kg; IAU 2015 nominal GM 3.986004e14 m³ s⁻² over G = 6.674e-11).
+pub const EARTH_MASS_KG: f64 = 5.9722e24;
+/// Earth's mean radius (m; IUGG).
+pub const EARTH_RADIUS_M: f64 = 6.371e6;
+/// Default start (and end) distance in units of q: at 10 q the tidal acceleration is 1e-3 of its perigee value
+/// and the tidal impulse still to come (∝ d⁻² for a straight-line passage) ~1 % of the whole; 20 q would take it
+/// to 0.25 % at about twice the run time (the outer legs dominate the duration).
+pub const DEFAULT_START_Q: f64 = 10.0;
+/// Dissipation F0 of a pile of radius [`F0_REFERENCE_RADIUS_M`] (s m⁻², Roig03's "F0 ≈ 1" in km and s, the impact
+/// default); other radii get `F0 (R_ref/R)²`, which keeps the damping of the similar pile the same.
+pub const F0_REFERENCE: f64 = 1e-6;
+/// Radius (m) at which [`F0_REFERENCE`] applies (Roig03's 100 km piles).
+pub const F0_REFERENCE_RADIUS_M: f64 = 1e5;
+
+/// `rubblepile flyby`: a rubble pile (a target file) past a planet on a hyperbolic orbit.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FlybyArgs {
+    /// Target bodies file (snapshot columns, e.g. from `rubblepile target build`).
+    #[arg(long)]
+    pub target: PathBuf,
+    /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A) [default: as built].
+    #[arg(long)]
+    pub radius_m: Option<f64>,
+    /// Set the pile into rigid rotation about its z axis with this period (hours) [default: the target's spins].
+    #[arg(long)]
+    pub period_hours: Option<f64>,
+    /// Planet mass (kg; 0 for a control run without tide, the frame then moves straight at v∞) [default: Earth].
+    #[arg(long, default_value_t = EARTH_MASS_KG)]
+    pub planet_mass: f64,
+    /// Planet radius (m) [default: Earth's mean radius].
+    #[arg(long, default_value_t = EARTH_RADIUS_M)]
+    pub planet_radius_m: f64,
+    /// Perigee distance from the planet's centre (m).
+    #[arg(long)]
+    pub q_m: f64,
+    /// Speed at infinity (km/s).
+    #[arg(long, default_value_t = 5.8)]
+    pub v_inf_km_s: f64,
+    /// Orbit orientation Ω,i,ω (degrees; see `physics.flyby.orientation_deg`) [default: 0,0,0, prograde in x–y].
+    #[arg(long, value_delimiter = ',', num_args = 3, allow_hyphen_values = true)]
+    pub orientation_deg: Option<Vec<f64>>,
+    /// Start and end with the planet this many q away.
+    #[arg(long, default_value_t = DEFAULT_START_Q)]
+    pub start_q: f64,
+    /// κ of the pile [default: "kappa" of the target's NAME.json, as built].
+    #[arg(long)]
+    pub kappa: Option<f64>,
+    /// Dissipation F0 (s m⁻²) [default: 1e-6 (100 km/R)², R the pile's apparent radius].
+    #[arg(long)]
+    pub f0: Option<f64>,
+    /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run.
+    #[arg(long, default_value_t = 1e-6)]
+    pub rtol: f64,
+    /// Number of snapshots, evenly spaced from start to end (≥ 2).
+    #[arg(long, default_value_t = 9)]
+    pub snapshots: usize,
+    /// Output directory.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Overwrite an earlier run in DIR.
+    #[arg(long)]
+    pub force: bool,
+    /// Write the run directory (scene, bodies) but do not run it.
+    #[arg(long)]
+    pub no_run: bool,
+}
+
+/// What `flyby.json` records about a flyby run (SI units).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlybySetup {
+    /// The target file.
+    pub target: String,
+    /// Planet GM (m³ s⁻²).
+    pub gm: f64,
+    /// Planet radius (m).
+    pub planet_radius: f64,
+    /// Perigee distance (m).
+    pub q: f64,
+    /// Speed at infinity (m/s).
+    pub v_inf: f64,
+    /// Eccentricity.
+    pub eccentricity: f64,
+    /// Speed at perigee (m/s).
+    pub v_perigee: f64,
+    /// Time of perigee (s) = half the run.
+    pub t_perigee: f64,
+    /// End time (s).
+    pub t_end: f64,
+    /// Start/end distance (m).
+    pub start_distance: f64,
+    /// Scale factor applied to the target's lengths.
+    pub scale: f64,
+    /// Apparent radius of the pile (m).
+    pub radius: f64,
+    /// Total mass (kg).
+    pub mass: f64,
+    /// Rigid spin period set (h), if any.
+    pub period_hours: Option<f64>,
+    /// κ.
+    pub kappa: f64,
+    /// F0 (s m⁻²).
+    pub f0: f64,
+}
+
+fn invalid(field: &str, message: String) -> ImpactError {
+    ImpactError::Invalid {
+        field: field.into(),
+        message,
+    }
+}
+
+/// Apparent radius (m): max over bodies of `|r − r_cm| + A`.
+pub fn apparent_radius(bodies: &[Body]) -> f64 {
+    let (cm, _) = centre_of_mass(bodies);
+    bodies
+        .iter()
+        .map(|b| (b.position - cm).norm() + b.shape.axes.x)
+        .fold(0.0, f64::max)
+}
+
+/// Centre-of-mass position (m) and velocity (m/s).
+fn centre_of_mass(bodies: &[Body]) -> (Vec3, Vec3) {
+    let m: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let r = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / m;
+    let v = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / m;
+    (r, v)
+}
+
+/// The pile of `args`: rescaled, spun and in its centre-of-mass frame; returns the bodies and the scale factor.
+pub fn prepare_pile(target: &[Body], radius_m: Option<f64>, period_hours: Option<f64>) -> (Vec<Body>, f64) {
+    let (cm, vcm) = centre_of_mass(target);
+    let scale = radius_m.map_or(1.0, |r| r / apparent_radius(target));
+    let bodies = target
+        .iter()
+        .map(|b| {
+            let mut b = b.clone();
+            b.position = (b.position - cm) * scale;
+            b.velocity = (b.velocity - vcm) * scale;
+            b.shape.axes *= scale;
+            b.shape.mass *= scale * scale * scale;
+            if let Some(p) = period_hours {
+                let w = Vec3::new(0.0, 0.0, 2.0 * std::f64::consts::PI / (p * 3600.0));
+                b.velocity = w.cross(&b.position);
+                b.spin_body = rotation_matrix(&b.quaternion.normalize()) * w;
+            }
+            b
+        })
+        .collect::<Vec<_>>();
+    // Rigid rotation about the centre of mass leaves it at rest; without it the shift above already did.
+    (bodies, scale)
+}
+
+/// κ stored by `target build` in the target's `NAME.json`.
+fn target_kappa(target: &Path) -> Option<f64> {
+    let text = std::fs::read_to_string(target.with_extension("json")).ok()?;
+    serde_json::from_str::<serde_json::Value>(&text).ok()?["kappa"].as_f64()
+}
+
+/// Validates `args`, writes the run directory (refused when not empty unless `force`) and returns the scene.
+pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), ImpactError> {
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    for (field, x) in [
+        ("planet_radius_m", args.planet_radius_m),
+        ("q_m", args.q_m),
+        ("v_inf_km_s", args.v_inf_km_s),
+        ("rtol", args.rtol),
+        ("radius_m", args.radius_m.unwrap_or(1.0)),
+        ("period_hours", args.period_hours.unwrap_or(1.0)),
+        ("kappa", args.kappa.unwrap_or(2.0)),
+        ("f0", args.f0.unwrap_or(1.0)),
+    ] {
+        if !positive(x) {
+            return Err(invalid(field, format!("must be > 0 and finite, got {x}")));
+        }
+    }
+    if !(args.planet_mass.is_finite() && args.planet_mass >= 0.0) {
+        return Err(invalid(
+            "planet_mass",
+            format!(
+                "must be >= 0 kg (0: a control run without tide), got {}",
+                args.planet_mass
+            ),
+        ));
+    }
+    if !(args.start_q.is_finite() && args.start_q > 1.0) {
+        return Err(invalid(
+            "start_q",
+            format!("must be > 1 (in units of q), got {}", args.start_q),
+        ));
+    }
+    if args.q_m <= args.planet_radius_m {
+        return Err(invalid(
+            "q_m",
+            format!(
+                "must exceed the planet radius {} m, got {}",
+                args.planet_radius_m, args.q_m
+            ),
+        ));
+    }
+    if args.snapshots < 2 {
+        return Err(invalid("snapshots", format!("need at least 2, got {}", args.snapshots)));
+    }
+    let orientation = args.orientation_deg.clone().unwrap_or(vec![0.0; 3]);
+    let target = read_target(&args.target)?;
+    let kappa = match args.kappa.or_else(|| target_kappa(&args.target)) {
+        Some(k) if k > 1.5 => k,
+        Some(k) => return Err(invalid("kappa", format!("must be > 1.5, got {k}"))),
+        None => {
+            return Err(invalid(
+                "kappa",
+                format!(
+                    "no --kappa and no \"kappa\" in {}",
+                    args.target.with_extension("json").display()
+                ),
+            ));
+        }
+    };
+    let (bodies, scale) = prepare_pile(&target, args.radius_m, args.period_hours);
+    let radius = apparent_radius(&bodies);
+    let f0 = args
+        .f0
+        .unwrap_or(F0_REFERENCE * (F0_REFERENCE_RADIUS_M / radius).powi(2));
+    let gm = G_SI * args.planet_mass;
+    let v_inf = args.v_inf_km_s * 1e3;
+    let rot = orientation_matrix(0.0, 0.0, 0.0);
+    let orbit = KeplerOrbit::hyperbolic(gm, args.q_m, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let start_distance = args.start_q * args.q_m;
+    let t_perigee = orbit
+        .time_from_perigee_at_distance(start_distance)
+        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
+    let t_end = 2.0 * t_perigee;
+    let times: Vec<String> = (0..args.snapshots)
+        .map(|k| format!("{:?}", t_end * k as f64 / (args.snapshots - 1) as f64))
+        .collect();
+    let setup = FlybySetup {
+        target: args.target.display().to_string(),
+        gm,
+        planet_radius: args.planet_radius_m,
+        q: args.q_m,
+        v_inf,
+        eccentricity: orbit.e,
+        v_perigee: (v_inf * v_inf + 2.0 * gm / args.q_m).sqrt(),
+        t_perigee,
+        t_end,
+        start_distance,
+        scale,
+        radius,
+        mass: bodies.iter().map(|b| b.shape.mass).sum(),
+        period_hours: args.period_hours,
+        kappa,
+        f0,
+    };
+    let title = format!(
+        "Flyby of {} (R = {radius:.1} m) at q = {:.4e} m ({:.2} planet radii), v_inf = {} km/s",
+        args.target.display(),
+        args.q_m,
+        args.q_m / args.planet_radius_m,
+        args.v_inf_km_s
+    );
+    let scene_toml = format!(
+        "# {title}\n# Generated by `rubblepile flyby`; the same run: `rubblepile run scene.toml --out OTHER_DIR`.\n\
+         [scene]\nkind = \"ellipsoids\"\nt_end = {t_end:?}\nbodies_file = \"initial_bodies.csv\"\n\n\
+         [model]\nkappa = {kappa:?}\n\n\
+         [physics]\ngravity = {{}}\ncontact = {{}}\ndissipation = {{ F0 = {f0:?} }}\n\n\
+         [physics.flyby]\nmass = {mass:?}\nradius = {pr:?}\nq = {q:?}\nv_inf = {v_inf:?}\nt_perigee = {t_perigee:?}\n\
+         orientation_deg = [{o0:?}, {o1:?}, {o2:?}]\n\n\
+         [integrator]\nmethod = \"bulirsch-stoer\"\nrtol = {rtol:?}\natol = {rtol:?}\n\n\
+         [output]\ntimes = [{times}]\nevery = {every:?}\n",
+        mass = args.planet_mass,
+        pr = args.planet_radius_m,
+        q = args.q_m,
+        o0 = orientation[0],
+        o1 = orientation[1],
+        o2 = orientation[2],
+        rtol = args.rtol,
+        times = times.join(", "),
+        every = t_end / 400.0,
+    );
+    let out = &args.out;
+    prepare_output_dir(out, args.force)?;
+    let io = |p: &Path| {
+        let path = p.to_path_buf();
+        move |source| ImpactError::Io { path, source }
+    };
+    let bodies_path = out.join("initial_bodies.csv");
+    write_snapshot(&bodies_path, 0.0, &bodies).map_err(io(&bodies_path))?;
+    let json_path = out.join("flyby.json");
+    let json = serde_json::to_string_pretty(&setup).unwrap_or_default() + "\n";
+    std::fs::write(&json_path, json).map_err(io(&json_path))?;
+    let scene_path = out.join("scene.toml");
+    std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
+    let scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
+    Ok((scene, setup))
+}
+
+/// Prepares and (unless `no_run`) runs the flyby of `args`; the run's summary, if run.
+pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<crate::driver::RunSummary>, ImpactError> {
+    let (scene, _) = prepare_flyby(args)?;
+    if args.no_run {
+        return Ok(None);
+    }
+    let options = RunOptions {
+        force: true,
+        ..*options
+    };
+    Ok(Some(crate::driver::run_scene(&scene, &args.out, &options)?))
+}
