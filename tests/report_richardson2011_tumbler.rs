@@ -111,7 +111,7 @@ fn a_stopped_run_of_a_bed_tilted_at_35_degrees_reports_35_degrees_and_its_time_s
     })
     .unwrap();
     let md = std::fs::read_to_string(&path).unwrap();
-    assert_eq!(md, tumbler_paper_markdown(&[run.clone()], &md_command(&run_dir, &out)));
+    assert_eq!(md, tumbler_paper_markdown(std::slice::from_ref(&run), &md_command(&run_dir, &out)));
     let row = md.lines().find(|l| l.contains("| interrupted |")).expect("table row");
     assert!(
         row.contains(&format!("{:.1} ± {:.1}", run.angle.0, run.angle.1)),
