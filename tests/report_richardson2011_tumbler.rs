@@ -95,6 +95,19 @@ fn a_stopped_run_of_a_bed_tilted_at_35_degrees_reports_35_degrees_and_its_time_s
     assert_eq!(run.angles.len(), 3);
     assert!((run.angle.0 - 35.0).abs() < 2.0, "angle {:?}", run.angle);
     assert_eq!(run.angle_fit_errors.len(), 3);
+    // The history holds every snapshot: flat (0°, an exact line, no fit error) before the tilt.
+    assert_eq!(run.angle_history.len(), 5);
+    assert!(
+        run.angle_history[..2]
+            .iter()
+            .all(|h| h.1.abs() < 1e-9 && h.2.abs() < 1e-9),
+        "{:?}",
+        run.angle_history
+    );
+    assert_eq!(
+        &run.angle_history[2..].iter().map(|h| (h.0, h.1)).collect::<Vec<_>>(),
+        &run.angles
+    );
     assert!(
         run.angle_fit_errors.iter().all(|e| *e > 0.0 && *e < 1.0),
         "{:?}",
@@ -111,7 +124,10 @@ fn a_stopped_run_of_a_bed_tilted_at_35_degrees_reports_35_degrees_and_its_time_s
     })
     .unwrap();
     let md = std::fs::read_to_string(&path).unwrap();
-    assert_eq!(md, tumbler_paper_markdown(std::slice::from_ref(&run), &md_command(&run_dir, &out)));
+    assert_eq!(
+        md,
+        tumbler_paper_markdown(std::slice::from_ref(&run), &md_command(&run_dir, &out))
+    );
     let row = md.lines().find(|l| l.contains("| interrupted |")).expect("table row");
     assert!(
         row.contains(&format!("{:.1} ± {:.1}", run.angle.0, run.angle.1)),

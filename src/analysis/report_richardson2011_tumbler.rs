@@ -94,14 +94,14 @@ fn time_chart(runs: &[TumblerRun]) -> LineChart {
         .enumerate()
         .map(|(k, run)| Series {
             label: format!("Fr = {:.3}, {}", lining_froude(run), restitution_label(run)),
-            points: run.angles.clone(),
-            errors: run.angle_fit_errors.clone(),
+            points: run.angle_history.iter().map(|h| (h.0, h.1)).collect(),
+            errors: run.angle_history.iter().map(|h| h.2).collect(),
             colour: k,
             mark: Mark::Points,
         })
         .collect();
     LineChart {
-        title: "Tumbler at the paper's scale: fitted surface angle per snapshot (second half of each run)".into(),
+        title: "Tumbler at the paper's scale: fitted surface angle per snapshot (whole run)".into(),
         x_label: "time (s)".into(),
         y_label: "surface angle (deg) ± fit error".into(),
         series,
@@ -139,16 +139,16 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
     }
     let _ = writeln!(
         md,
-        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | above axis | collisions | events/s | wall (s) |"
+        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | last snapshot: t (s), angle ± fit error (deg) | above axis | collisions | events/s | wall (s) |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for run in runs {
         let a: Vec<f64> = run.angles.iter().map(|p| p.1).collect();
         let half = a.len() / 2;
         let (first_half, second_half) = (mean_std(&a[..half]).0, mean_std(&a[half..]).0);
         let _ = writeln!(
             md,
-            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.1} ± {:.1} | {} | {:.1} | {:.1} / {:.1} | {:.2} | {} | {:.2e} | {:.0} |",
+            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.1} ± {:.1} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {} | {:.2e} | {:.0} |",
             lining_froude(run),
             run.restitution.0,
             run.restitution.1,
@@ -162,6 +162,9 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
             mean_std(&run.angle_fit_errors).0,
             first_half,
             second_half,
+            run.angle_history
+                .last()
+                .map_or("—".to_string(), |h| format!("{:.3}, {:.1} ± {:.1}", h.0, h.1, h.2)),
             run.late.above_axis,
             run.collisions,
             run.events_per_second,

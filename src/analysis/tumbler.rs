@@ -193,6 +193,9 @@ pub struct TumblerRun {
     pub angle: (f64, f64),
     /// The fit error ([`repose_fit`], degrees) of each angle in `angles`, in the same order.
     pub angle_fit_errors: Vec<f64>,
+    /// `(t, angle, fit error)` in degrees for every snapshot with a fit, the first half of the run included (how
+    /// the surface got there: a bed still tilting with the drum, or settled).
+    pub angle_history: Vec<(f64, f64, f64)>,
     /// Normal and tangential coefficients of restitution from the scene's `[material]` (NaN when absent).
     pub restitution: (f64, f64),
     /// Fill of the bed at the start ([`initial_fill`]).
@@ -245,6 +248,7 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
     let t_reached = summary["t_reached"].as_f64().unwrap_or(f64::NAN);
     let mut angles = Vec::new();
     let mut fit_errors = Vec::new();
+    let mut history = Vec::new();
     let mut measures = Vec::new();
     let (mut free, mut stuck, mut r, mut first) = (0, 0, f64::NAN, None);
     for path in &files {
@@ -264,12 +268,15 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
             .iter()
             .find(|r| r.stuck_to.is_none())
             .map_or(f64::NAN, |r| r.values[3]);
-        if t < 0.5 * t_reached || centres.is_empty() {
+        if centres.is_empty() {
             continue;
         }
         if let Some((a, e)) = repose_fit(&surface_points(&centres, r), -0.8 * radius, 0.0) {
-            angles.push((t, a));
-            fit_errors.push(e);
+            history.push((t, a, e));
+            if t >= 0.5 * t_reached {
+                angles.push((t, a));
+                fit_errors.push(e);
+            }
         }
     }
     let a: Vec<f64> = angles.iter().map(|p| p.1).collect();
@@ -297,6 +304,7 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
         angle: mean_std(&a),
         angles,
         angle_fit_errors: fit_errors,
+        angle_history: history,
         restitution: (material("eps_n"), material("eps_t")),
         fill,
         threshold: centrifuging_threshold(fill, radius, r),
