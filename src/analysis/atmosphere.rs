@@ -195,7 +195,33 @@ pub struct RunFiles {
     pub snapshots: Vec<PathBuf>,
 }
 
-/// Reads [`RunFiles`]; errors (one line, naming the file) when a file is missing or gravity does not point down.
+/// The summary of a run that has no `summary.json` (stopped before its end), from its `timeseries.csv`:
+/// `status = "interrupted"`, `t_reached` and `wall_seconds` of the last row, `collisions` the sum of the per-row
+/// counts, `events_per_second` their ratio. `None` without a time series or with no data row.
+pub fn interrupted_summary(dir: &Path) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(dir.join("timeseries.csv")).ok()?;
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name);
+    let (it, ic, iw) = (col("t")?, col("collisions")?, col("wall_seconds")?);
+    let (mut t, mut collisions, mut wall) = (None, 0.0, f64::NAN);
+    for line in lines.filter(|l| !l.trim().is_empty()) {
+        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap_or(f64::NAN)).collect();
+        t = Some(*v.get(it)?);
+        collisions += v.get(ic).copied().unwrap_or(0.0);
+        wall = v.get(iw).copied().unwrap_or(f64::NAN);
+    }
+    Some(serde_json::json!({
+        "status": "interrupted",
+        "t_reached": t?,
+        "wall_seconds": wall,
+        "collisions": collisions as u64,
+        "events_per_second": collisions / wall,
+    }))
+}
+
+/// Reads [`RunFiles`]; errors (one line, naming the file) when a file is missing or gravity does not point down. A
+/// run without `summary.json` but with a time series is read as interrupted ([`interrupted_summary`]).
 pub fn read_run_files(dir: &Path) -> Result<RunFiles, AnalysisError> {
     let sp = dir.join("scene.toml");
     let text = std::fs::read_to_string(&sp).map_err(|e| format!("{}: {e}", sp.display()))?;
@@ -210,8 +236,11 @@ pub fn read_run_files(dir: &Path) -> Result<RunFiles, AnalysisError> {
         .filter(|g| *g > 0.0)
         .ok_or_else(|| format!("{}: gravity.g must point down (gz < 0)", sp.display()))?;
     let jp = dir.join("summary.json");
-    let text = std::fs::read_to_string(&jp).map_err(|e| format!("{}: {e}", jp.display()))?;
-    let summary = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", jp.display()))?;
+    let summary = match std::fs::read_to_string(&jp) {
+        Ok(text) => serde_json::from_str(&text).map_err(|e| format!("{}: {e}", jp.display()))?,
+        // A run stopped before its end (killed, or still going) has no summary yet: take its time series instead.
+        Err(e) => interrupted_summary(dir).ok_or_else(|| format!("{}: {e}", jp.display()))?,
+    };
     let snap_dir = dir.join("snapshots");
     let mut files: Vec<(usize, PathBuf)> = std::fs::read_dir(&snap_dir)
         .map_err(|e| format!("{}: {e}", snap_dir.display()))?

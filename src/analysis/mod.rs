@@ -9,6 +9,7 @@ pub mod flyby;
 pub mod fragments;
 pub mod report_notes;
 pub mod report_richardson2011;
+pub mod report_richardson2011_tumbler;
 pub mod report_roig2003;
 pub mod report_roig2003_kappa;
 pub mod report_zhang2017;

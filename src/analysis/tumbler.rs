@@ -47,11 +47,20 @@ pub fn surface_points(centres: &[(f64, f64)], r: f64) -> Vec<(f64, f64)> {
 /// Dynamic angle of repose (degrees) from surface points with `x_lo < x < x_hi`: `atan(−slope)` of the
 /// least-squares line. `None` with fewer than 3 points.
 pub fn repose_angle(surface: &[(f64, f64)], x_lo: f64, x_hi: f64) -> Option<f64> {
+    repose_fit(surface, x_lo, x_hi).map(|a| a.0)
+}
+
+/// [`repose_angle`] and its fit error (degrees): the slope's standard error `σ_s` carried through `atan`,
+/// `σ_θ = σ_s / (1 + s²)`. `None` with fewer than 3 points.
+pub fn repose_fit(surface: &[(f64, f64)], x_lo: f64, x_hi: f64) -> Option<(f64, f64)> {
     let (x, z): (Vec<f64>, Vec<f64>) = surface.iter().filter(|p| p.0 > x_lo && p.0 < x_hi).copied().unzip();
     if x.len() < 3 {
         return None;
     }
-    fit_line(&x, &z).ok().map(|f| (-f.slope).atan().to_degrees())
+    fit_line(&x, &z).ok().map(|f| {
+        let sigma = f.sigma_slope / (1.0 + f.slope * f.slope);
+        ((-f.slope).atan().to_degrees(), sigma.to_degrees())
+    })
 }
 
 /// Relative tolerance of [`co_rotates`]: a particle moves with the drum when its velocity differs from the drum's
@@ -182,6 +191,13 @@ pub struct TumblerRun {
     pub angles: Vec<(f64, f64)>,
     /// Mean and standard deviation of the angles (degrees).
     pub angle: (f64, f64),
+    /// The fit error ([`repose_fit`], degrees) of each angle in `angles`, in the same order.
+    pub angle_fit_errors: Vec<f64>,
+    /// `(t, angle, fit error)` in degrees for every snapshot with a fit, the first half of the run included (how
+    /// the surface got there: a bed still tilting with the drum, or settled).
+    pub angle_history: Vec<(f64, f64, f64)>,
+    /// Normal and tangential coefficients of restitution from the scene's `[material]` (NaN when absent).
+    pub restitution: (f64, f64),
     /// Fill of the bed at the start ([`initial_fill`]).
     pub fill: f64,
     /// [`centrifuging_threshold`] for that fill.
@@ -204,6 +220,13 @@ pub struct TumblerRun {
     pub collisions: u64,
 }
 
+impl TumblerRun {
+    /// The lining's inner radius over the particle radius, `(R − 2r) / r` (R the wall radius).
+    pub fn radius_ratio(&self) -> f64 {
+        (self.radius - 2.0 * self.particle_radius) / self.particle_radius
+    }
+}
+
 /// Reads a tumbler run: `scene.toml` (wall 0 the drum: its radius and spin; gravity), `summary.json`, snapshots.
 pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::AnalysisError> {
     let RunFiles {
@@ -221,8 +244,11 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
     let num = |t: &toml::Value, k: &str| t.get(k).and_then(|x| x.as_float());
     let radius = num(drum, "radius").ok_or_else(|| format!("{}: wall[0].radius missing", sp.display()))?;
     let omega = num(drum, "spin").unwrap_or(0.0);
+    let material = |k: &str| v.get("material").and_then(|m| num(m, k)).unwrap_or(f64::NAN);
     let t_reached = summary["t_reached"].as_f64().unwrap_or(f64::NAN);
     let mut angles = Vec::new();
+    let mut fit_errors = Vec::new();
+    let mut history = Vec::new();
     let mut measures = Vec::new();
     let (mut free, mut stuck, mut r, mut first) = (0, 0, f64::NAN, None);
     for path in &files {
@@ -242,11 +268,15 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
             .iter()
             .find(|r| r.stuck_to.is_none())
             .map_or(f64::NAN, |r| r.values[3]);
-        if t < 0.5 * t_reached || centres.is_empty() {
+        if centres.is_empty() {
             continue;
         }
-        if let Some(a) = repose_angle(&surface_points(&centres, r), -0.8 * radius, 0.0) {
-            angles.push((t, a));
+        if let Some((a, e)) = repose_fit(&surface_points(&centres, r), -0.8 * radius, 0.0) {
+            history.push((t, a, e));
+            if t >= 0.5 * t_reached {
+                angles.push((t, a));
+                fit_errors.push(e);
+            }
         }
     }
     let a: Vec<f64> = angles.iter().map(|p| p.1).collect();
@@ -273,6 +303,9 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
         stuck,
         angle: mean_std(&a),
         angles,
+        angle_fit_errors: fit_errors,
+        angle_history: history,
+        restitution: (material("eps_n"), material("eps_t")),
         fill,
         threshold: centrifuging_threshold(fill, radius, r),
         late: between(0.5, 1.0),

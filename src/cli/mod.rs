@@ -132,6 +132,8 @@ pub enum ReportCommand {
     Zhang2017(ReportZhang2017Args),
     /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
     Richardson2011(report_richardson2011::ReportRichardson2011Args),
+    /// Read Richardson11 tumbler runs at the paper's scale; write analysis/richardson2011/TUMBLER_PAPER.md.
+    Richardson2011Tumbler(crate::analysis::report_richardson2011_tumbler::TumblerPaperArgs),
 }
 
 /// `rubblepile report zhang2017`.
@@ -347,6 +349,11 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         }
         Command::Report(ReportCommand::Richardson2011(args)) | Command::ReportRichardson2011(args) => {
             report_richardson2011::report(&args)
+        }
+        Command::Report(ReportCommand::Richardson2011Tumbler(a)) => {
+            let path = crate::analysis::report_richardson2011_tumbler::write_tumbler_paper_report(&a);
+            println!("wrote {}", path.map_err(CliError::usage)?.display());
+            Ok(())
         }
         Command::Report(ReportCommand::Zhang2017(args)) | Command::ReportZhang2017(args) => report_zhang2017(&args),
         Command::Bench(BenchCommand::Rhs(args)) => crate::bench::rhs::rhs(&args).map_err(CliError::from),
