@@ -2,8 +2,8 @@
 //! Kepler's equation solved by Newton's method: elliptic `E − e sin E = M`, hyperbolic `e sinh H − H = M`
 //! (Danby, *Fundamentals of Celestial Mechanics*, 2nd ed., §6.3–6.4 and §6.6; Murray & Dermott 1999 §2.4–2.6).
 //!
-//! Used by the flyby tide ([`crate::ellipsoid`]'s `tide`): the frame origin falls freely on such an orbit about a
-//! planet. The orbit is the relative motion `s(t)` of the orbiting point with respect to the central mass.
+//! Used by the ellipsoid engine's flyby tide (a layer above this one): the frame origin falls freely on such an
+//! orbit about a planet. The orbit is the relative motion `s(t)` of the orbiting point with respect to the central mass.
 //! Conventions: the perifocal frame has `x̂` towards perigee and `ẑ` along the orbital angular momentum; the
 //! orientation is the classical `(Ω, i, ω)` (longitude of the node, inclination, argument of perigee), so that
 //! the perifocal axes in the frame are the columns of `R_z(Ω) R_x(i) R_z(ω)`. Angles in radians internally.
