@@ -440,11 +440,14 @@ fn bench_rhs_writes_csv_and_plot() {
     assert_ok(&out, "bench");
     let csv = read(&dir.join("bench/bench_rhs.csv"));
     let mut lines = csv.lines();
-    assert_eq!(lines.next().unwrap(), "bodies,threads,median_us,min_us,repeats,gravity");
+    assert_eq!(
+        lines.next().unwrap(),
+        "bodies,threads,median_us,min_us,repeats,gravity,packing"
+    );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 4);
     assert!(
-        rows[0].starts_with("8,1,") && rows[0].ends_with(",3,auto"),
+        rows[0].starts_with("8,1,") && rows[0].ends_with(",3,auto,lattice"),
         "{}",
         rows[0]
     );
@@ -465,6 +468,45 @@ fn bench_rhs_writes_csv_and_plot() {
     let mut forced = args.to_vec();
     forced.push("--force");
     assert_ok(&rubblepile(&dir, &forced), "bench --force");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `bench rhs --targets` times a relaxed pile (its N from the file, its κ from `FILE.json`) in rows labelled by
+/// the file's stem, and a target without its report is refused naming the flag.
+#[test]
+fn bench_rhs_times_relaxed_targets() {
+    let dir = temp_dir("bench_targets");
+    let target = Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let target = target.to_str().unwrap();
+    let args = [
+        "bench",
+        "rhs",
+        "--targets",
+        target,
+        "--repeats",
+        "2",
+        "--threads",
+        "1",
+        "--out",
+        "b",
+    ];
+    assert_ok(&rubblepile(&dir, &args), "bench --targets");
+    let csv = read(&dir.join("b/bench_rhs.csv"));
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 1, "{csv}");
+    assert!(
+        rows[0].starts_with("30,1,") && rows[0].ends_with(",2,auto,N30_T4"),
+        "{}",
+        rows[0]
+    );
+    std::fs::copy(target, dir.join("lonely.csv")).unwrap();
+    let out = rubblepile(&dir, &["bench", "rhs", "--targets", "lonely.csv", "--repeats", "1"]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("--targets") && stderr.contains("lonely.json"),
+        "{stderr}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -3,10 +3,14 @@
 mod common;
 use common::Random;
 use rubblepile::analysis::rigid_rotation::fit_rigid_rotation;
+use rubblepile::ellipsoid::equations::G_SI;
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::geometry::ellipsoid_overlap::are_apart;
 use rubblepile::impact::projectile::{ProjectileSpec, set_up_impact};
-use rubblepile::impact::target::{TargetSpec, build_target, draw_sizes, place_fragments, set_rigid_rotation};
+use rubblepile::impact::target::{
+    TargetSpec, build_target, build_target_resumable, draw_sizes, first_round_spin, place_fragments, set_rigid_rotation,
+};
+use rubblepile::impact::target_checkpoint::BuildCheckpoint;
 use rubblepile::math::{Mat3, Vec3};
 use rubblepile::random::generator;
 use std::f64::consts::PI;
@@ -109,8 +113,8 @@ fn rigid_rotation_fit_recovers_omega_and_zero_relative_energy() {
 
 /// A small pile (12 fragments, 6→3 km) builds quickly: rigid at the end, spin period near the request,
 /// in the centre-of-mass frame, and the same seed gives the same bodies and report bit for bit.
-#[test]
-fn small_target_relaxes_to_rigid_rotation_deterministically() {
+/// The 12-fragment pile (6→3 km) of the small-target tests.
+fn small_spec() -> TargetSpec {
     let mut spec = TargetSpec::table1(30, 6.0, 11).unwrap();
     spec.fragments = 12;
     spec.r_largest = 6e3;
@@ -125,6 +129,12 @@ fn small_target_relaxes_to_rigid_rotation_deterministically() {
         3000.0 * 4.0 / 3.0 * PI * (6e3f64.powi(3) + 3e3f64.powi(3) + 10.0 * mean_r3)
     };
     spec.mass_tolerance = 0.05;
+    spec
+}
+
+#[test]
+fn small_target_relaxes_to_rigid_rotation_deterministically() {
+    let spec = small_spec();
     let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
     let (bodies, report) = build_target(&spec, &mut quiet).unwrap();
     assert!(
@@ -150,6 +160,57 @@ fn small_target_relaxes_to_rigid_rotation_deterministically() {
         serde_json::to_string(&report).unwrap(),
         serde_json::to_string(&report2).unwrap()
     );
+}
+
+/// A build stopped after any relaxation check and resumed from its checkpoint (through its JSON form) ends
+/// with the same bodies and report, bit for bit, as the build that was never stopped; a checkpoint of other
+/// inputs is refused, naming them.
+#[test]
+fn resumed_target_build_is_bit_identical() {
+    let spec = small_spec();
+    let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
+    let mut saved: Vec<String> = Vec::new();
+    let mut keep = |c: &BuildCheckpoint| saved.push(serde_json::to_string(c).unwrap());
+    let (bodies, report) = build_target_resumable(&spec, None, &mut quiet, &mut keep).unwrap();
+    assert!(saved.len() >= 3, "only {} checkpoints", saved.len());
+    let rounds: Vec<usize> = saved
+        .iter()
+        .map(|s| serde_json::from_str::<BuildCheckpoint>(s).unwrap().round)
+        .collect();
+    // one checkpoint early in the first round, one in the last round
+    for pick in [1, saved.len() - 1] {
+        let checkpoint: BuildCheckpoint = serde_json::from_str(&saved[pick]).unwrap();
+        let (again, report2) = build_target_resumable(&spec, Some(checkpoint), &mut quiet, &mut |_| {}).unwrap();
+        assert_eq!(bodies, again, "resumed from checkpoint {pick} (round {})", rounds[pick]);
+        assert_eq!(
+            serde_json::to_string(&report).unwrap(),
+            serde_json::to_string(&report2).unwrap()
+        );
+    }
+    let mut other = spec.clone();
+    other.seed += 1;
+    let checkpoint: BuildCheckpoint = serde_json::from_str(&saved[1]).unwrap();
+    let err = build_target_resumable(&other, Some(checkpoint), &mut quiet, &mut |_| {}).unwrap_err();
+    assert!(
+        err.to_string()
+            .contains("checkpoint: it was written by a build with other inputs"),
+        "{err}"
+    );
+}
+
+/// The first round's spin keeps the placement sphere's equator bound: unchanged where `Ω² R_p³ ≤ G M` (Table 1's
+/// targets), otherwise centrifugal acceleration at `R_p` equal to half of gravity (the N = 2000 pile's case,
+/// whose outer fragments flew off at 4 h and kept K_rel/K rising).
+#[test]
+fn first_round_spin_keeps_the_placement_equator_bound() {
+    let (mass, radius) = (1.0e19, 145.66e3);
+    let omega = Vec3::new(0.0, 0.0, 2.0 * PI / (4.0 * 3600.0));
+    assert_eq!(first_round_spin(&omega, mass, radius), omega);
+    let loose = 159.16e3;
+    let first = first_round_spin(&omega, mass, loose);
+    assert!(first.norm() < omega.norm() && first.cross(&omega).norm() == 0.0);
+    let ratio = first.norm_squared() * loose / (G_SI * mass / loose.powi(2));
+    assert!((ratio - 0.5).abs() < 1e-12, "centrifugal / gravity = {ratio}");
 }
 
 /// Table 2: Q for P1/P2/P3 on a 1e19 kg target at 5 km/s is 0.44, 1.49, 3.54 × 10⁹ erg/g.

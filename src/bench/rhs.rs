@@ -19,8 +19,12 @@ pub struct RhsArgs {
     /// Number of ellipsoids (density 3000 kg/m³, equivalent radii 1–5 km, on a jittered cubic
     /// lattice with spacing 1.9 × the mean radius, random attitudes, spins and velocities).
     /// Several sizes may be given, comma-separated (`--bodies 30,200,2000`), to see how the cost scales.
-    #[arg(long, required = true, value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
+    #[arg(long, value_delimiter = ',', value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub bodies: Vec<u64>,
+    /// Relaxed piles to time instead of (or beside) the lattices: target files written by `target build`
+    /// (`FILE.csv`, comma-separated), each at the κ of its `FILE.json`, with the same physics as the lattices.
+    #[arg(long, value_delimiter = ',', value_name = "FILE.csv")]
+    pub targets: Vec<PathBuf>,
     /// Timed evaluations per thread count (the median and minimum are reported).
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub repeats: u64,
@@ -42,7 +46,8 @@ pub struct RhsArgs {
     pub theta: f64,
     /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats, gravity) and the plot
     /// `bench_rhs.svg` + `bench_rhs.png` (median µs per RHS against N, one line per thread count and gravity
-    /// method) into this directory.
+    /// method, lattices and relaxed piles apart) into this directory; `bench_rhs.csv` also has `packing`
+    /// (`lattice` or the target file's stem).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Overwrite `bench_rhs.csv`/`bench_rhs.svg` of an earlier benchmark in DIR.
@@ -107,19 +112,54 @@ pub fn bench_system(n: usize, seed: u64, kappa: f64) -> EllipsoidSystem {
 /// [`bench_system`] with gravity summed by `method`.
 pub fn bench_system_with(n: usize, seed: u64, kappa: f64, method: GravityMethod) -> EllipsoidSystem {
     let bodies = random_cloud(n, seed, &CloudParams::default());
-    let model = ModelConfig::gaussian_si(kappa);
-    let physics = Physics {
+    EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), bench_physics(method))
+}
+
+/// The physics of every `bench rhs` system: gravity by `method`, contact, dissipation (F0 = 1 s/m²).
+fn bench_physics(method: GravityMethod) -> Physics {
+    Physics {
         gravity: Some(GravityTerm { g: SI_G, method }),
         contact: Some(ContactTerm {
             cutoff: DEFAULT_CONTACT_CUTOFF,
         }),
         dissipation: Some(DissipationTerm { f0: 1.0 }),
-    };
-    EllipsoidSystem::new(&bodies, model, physics)
+    }
+}
+
+/// What one benchmark row times: a lattice of N bodies, or a relaxed pile read from a target file.
+enum Packing {
+    /// `bench_system_with`'s jittered lattice.
+    Lattice(usize),
+    /// A target's bodies at its κ, labelled by the file's stem.
+    Pile(String, Vec<crate::ellipsoid::body::Body>, f64),
+}
+
+/// Reads a target file and the κ of its `FILE.json` report.
+fn read_pile(path: &std::path::Path) -> Result<Packing, CliError> {
+    let bodies = crate::impact::run::read_target(path).map_err(|e| CliError::usage(format!("--targets: {e}")))?;
+    let json = path.with_extension("json");
+    let text = std::fs::read_to_string(&json)
+        .map_err(|e| CliError::usage(format!("--targets: {} ({e}); κ is read from it", json.display())))?;
+    let report: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| CliError::usage(format!("--targets: {}: {e}", json.display())))?;
+    let kappa = report["kappa"]
+        .as_f64()
+        .filter(|k| k.is_finite() && *k > 1.5)
+        .ok_or_else(|| CliError::usage(format!("--targets: {}: expected a number kappa > 1.5", json.display())))?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    Ok(Packing::Pile(stem, bodies, kappa))
 }
 
 /// Runs `bench rhs`.
 pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
+    if args.bodies.is_empty() && args.targets.is_empty() {
+        return Err(CliError::usage(
+            "--bodies or --targets: give at least one lattice size or one target file".to_string(),
+        ));
+    }
     if !(args.kappa.is_finite() && args.kappa > 1.5) {
         return Err(CliError::usage(format!(
             "--kappa: must be > 1.5 and finite, got {}",
@@ -157,29 +197,40 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
     if all > 1 {
         counts.push(all);
     }
-    let mut results: Vec<(usize, RhsTiming, String)> = Vec::new();
-    for (&bodies, gravity) in args
-        .bodies
-        .iter()
-        .flat_map(|b| args.gravity.iter().map(move |g| (b, g)))
-    {
-        let n = bodies as usize;
+    let mut packings: Vec<Packing> = args.bodies.iter().map(|&n| Packing::Lattice(n as usize)).collect();
+    for path in &args.targets {
+        packings.push(read_pile(path)?);
+    }
+    // (bodies, timing, gravity method, packing: "lattice" or the target's stem)
+    let mut results: Vec<(usize, RhsTiming, String, String)> = Vec::new();
+    for (packing, gravity) in packings.iter().flat_map(|p| args.gravity.iter().map(move |g| (p, g))) {
         let theta = args.theta;
         let method = match gravity.as_str() {
             "direct" => GravityMethod::Direct,
             "tree" => GravityMethod::Tree { theta },
             _ => GravityMethod::Auto { theta },
         };
-        let system = bench_system_with(n, args.seed, args.kappa, method);
+        let (system, name, kappa) = match packing {
+            Packing::Lattice(n) => (
+                bench_system_with(*n, args.seed, args.kappa, method),
+                "lattice",
+                args.kappa,
+            ),
+            Packing::Pile(stem, bodies, kappa) => (
+                EllipsoidSystem::new(bodies, ModelConfig::gaussian_si(*kappa), bench_physics(method)),
+                stem.as_str(),
+                *kappa,
+            ),
+        };
+        let n = system.n_bodies();
         println!(
-            "bench rhs: {n} bodies, gravity {gravity} ({}), {repeats} repeats, seed {}, kappa {}",
+            "bench rhs: {n} bodies ({name}), gravity {gravity} ({}), {repeats} repeats, seed {}, kappa {kappa}",
             if method.tree_theta(n).is_some() {
                 "tree"
             } else {
                 "exact"
             },
             args.seed,
-            args.kappa
         );
         let mut row = Vec::new();
         for &threads in &counts {
@@ -201,23 +252,44 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
                 row[1].threads
             );
         }
-        results.extend(row.into_iter().map(|r| (n, r, gravity.clone())));
+        results.extend(row.into_iter().map(|r| (n, r, gravity.clone(), name.to_string())));
     }
     if let Some((csv, svg, png)) = &paths {
         let write = || -> std::io::Result<()> {
             let mut f = std::io::BufWriter::new(std::fs::File::create(csv)?);
-            writeln!(f, "bodies,threads,median_us,min_us,repeats,gravity")?;
-            for (n, r, g) in &results {
-                writeln!(f, "{n},{},{:e},{:e},{repeats},{g}", r.threads, r.median_us, r.min_us)?;
+            writeln!(f, "bodies,threads,median_us,min_us,repeats,gravity,packing")?;
+            for (n, r, g, p) in &results {
+                writeln!(
+                    f,
+                    "{n},{},{:e},{:e},{repeats},{g},{p}",
+                    r.threads, r.median_us, r.min_us
+                )?;
             }
             f.flush()
         };
         write().map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
-        let lines: Vec<(usize, String)> = args
-            .gravity
+        // one line per (threads, gravity) over the lattices, and one over the relaxed piles
+        let labelled: Vec<(usize, RhsTiming, String)> = results
             .iter()
-            .flat_map(|g| counts.iter().map(move |&c| (c, g.clone())))
+            .map(|(n, r, g, p)| {
+                (
+                    *n,
+                    *r,
+                    if p == "lattice" {
+                        g.clone()
+                    } else {
+                        format!("{g}, relaxed piles")
+                    },
+                )
+            })
             .collect();
+        let mut lines: Vec<(usize, String)> = Vec::new();
+        for (_, r, label) in &labelled {
+            if !lines.contains(&(r.threads, label.clone())) {
+                lines.push((r.threads, label.clone()));
+            }
+        }
+        let results = labelled;
         {
             use plotters::prelude::*;
             let svg_root = SVGBackend::new(svg, (720, 480)).into_drawing_area();

@@ -4,8 +4,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::cli::CliError;
+use crate::driver::DEFAULT_CHECKPOINT_EVERY;
 use crate::ellipsoid::output::write_snapshot;
-use crate::impact::target::{TargetSpec, build_target};
+use crate::impact::target::{TargetSpec, build_target_resumable};
+use crate::impact::target_checkpoint::BuildCheckpoint;
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]
@@ -121,9 +123,39 @@ pub struct BuildArgs {
     /// Dissipation coefficient F0 while relaxing (s m⁻²).
     #[arg(long)]
     pub f0: Option<f64>,
-    /// Overwrite FILE.csv / FILE.json of an earlier build.
+    /// Overwrite FILE.csv / FILE.json (and a checkpoint) of an earlier build.
     #[arg(long)]
     pub force: bool,
+    /// Continue an interrupted build from `FILE.checkpoint.json` (same options as the interrupted build).
+    #[arg(long, conflicts_with = "force")]
+    pub resume: bool,
+    /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s).
+    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
+    pub checkpoint_every: f64,
+}
+
+/// Path of the checkpoint of an interrupted build beside a target CSV.
+pub fn checkpoint_path(csv: &Path) -> PathBuf {
+    csv.with_extension("checkpoint.json")
+}
+
+/// Reads the checkpoint `--resume` continues from.
+fn read_checkpoint(path: &Path) -> Result<BuildCheckpoint, CliError> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        CliError::usage(format!(
+            "--resume: cannot read {} ({e}); nothing to resume",
+            path.display()
+        ))
+    })?;
+    serde_json::from_str(&text)
+        .map_err(|e| CliError::usage(format!("--resume: {} is not a target checkpoint: {e}", path.display())))
+}
+
+/// Writes a checkpoint atomically (a temporary file renamed over the old one).
+fn write_checkpoint(path: &Path, checkpoint: &BuildCheckpoint) -> std::io::Result<()> {
+    let tmp = path.with_extension("checkpoint.json.tmp");
+    std::fs::write(&tmp, serde_json::to_string(checkpoint)?)?;
+    std::fs::rename(&tmp, path)
 }
 
 /// Path of the JSON report beside a target CSV.
@@ -172,31 +204,67 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
+    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
+        return Err(CliError::usage(format!(
+            "--checkpoint-every: expected seconds >= 0, got {}",
+            args.checkpoint_every
+        )));
+    }
+    let checkpoint_file = checkpoint_path(&args.out);
+    let resume = if args.resume {
+        Some(read_checkpoint(&checkpoint_file)?)
+    } else if checkpoint_file.exists() && !args.force {
+        return Err(CliError::usage(format!(
+            "--out: {} holds an interrupted build; continue it with --resume or start afresh with --force",
+            checkpoint_file.display()
+        )));
+    } else {
+        None
+    };
+    if let Some(dir) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
+    }
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new_spinner();
         b.enable_steady_tick(std::time::Duration::from_millis(200));
         b
     });
     let mut progress = |round: usize, t: f64, fraction: f64, period_h: f64| {
-        if let Some(b) = &bar {
-            b.set_message(format!(
-                "relaxing: round {round}, t = {t:.0} s, K_rel/K = {fraction:.2e} (target {:.0e}), period {period_h:.3} h",
-                spec.rigidity
-            ));
+        let line = format!(
+            "relaxing: round {round}, t = {t:.0} s, K_rel/K = {fraction:.2e} (target {:.0e}), period {period_h:.3} h",
+            spec.rigidity
+        );
+        // a log file (no terminal) gets one line per check, so a long build can be followed
+        match &bar {
+            Some(b) => b.set_message(line),
+            None => eprintln!("{line}"),
         }
     };
     let started = std::time::Instant::now();
-    let (bodies, report) =
-        build_target(&spec, &mut progress).map_err(|e| CliError::failed(format!("target build: {e}")))?;
+    let mut last_checkpoint = std::time::Instant::now();
+    let mut checkpoint_error = None;
+    let mut checkpoint = |c: &BuildCheckpoint| {
+        if last_checkpoint.elapsed().as_secs_f64() >= args.checkpoint_every && checkpoint_error.is_none() {
+            checkpoint_error = write_checkpoint(&checkpoint_file, c).err();
+            last_checkpoint = std::time::Instant::now();
+        }
+    };
+    let built = build_target_resumable(&spec, resume, &mut progress, &mut checkpoint);
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    if let Some(dir) = args.out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| CliError::failed(format!("{}: {e}", dir.display())))?;
+    if let Some(e) = checkpoint_error {
+        eprintln!("warning: could not write {}: {e}", checkpoint_file.display());
     }
+    let (bodies, report) = built.map_err(|e| CliError::failed(format!("target build: {e}")))?;
     write_snapshot(&args.out, 0.0, &bodies).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| CliError::failed(e.to_string()))?;
     std::fs::write(&json, text + "\n").map_err(|e| CliError::failed(format!("{}: {e}", json.display())))?;
+    if checkpoint_file.exists() {
+        // the build is complete: its checkpoint would only block the next build of this name
+        std::fs::remove_file(&checkpoint_file)
+            .map_err(|e| CliError::failed(format!("{}: {e}", checkpoint_file.display())))?;
+    }
     println!(
         "target: {} fragments, M = {:.4e} kg, R_eff = {:.2} km, R_app = {:.2} km, porosity {:.3}, period {:.3} h, \
          kappa {:.3}; relaxed {:.0} s in {} rounds (K_rel/K = {:.1e}, energy error {:.1e}); wall {:.1} s; wrote {} and {}",

@@ -14,3 +14,4 @@ pub mod pile;
 pub mod projectile;
 pub mod run;
 pub mod target;
+pub mod target_checkpoint;

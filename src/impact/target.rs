@@ -22,6 +22,7 @@ use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
+use crate::impact::target_checkpoint::{BuildCheckpoint, RoundState};
 use crate::integrate::{IntegrateError, Method, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};
 use crate::random::{Generator, generator, point_in_ball, random_quaternion, uniform};
@@ -153,6 +154,11 @@ pub struct TargetReport {
     pub relaxation_time_s: f64,
     /// Relaxation rounds (each ends rigid; later rounds reset the spin to the requested period).
     pub relaxation_rounds: usize,
+    /// Spin period of the first round's rigid rotation (hours): the requested period, or longer when that
+    /// spin would unbind the placement sphere's equator (see [`first_round_spin`]). Absent (0) in reports
+    /// written before it was recorded.
+    #[serde(default)]
+    pub first_round_period_hours: f64,
     /// κ (Roig03 Eq. 14).
     pub kappa: f64,
     /// Largest relative energy residual `|H − H0 − 2∫F| / scale` of the relaxation runs.
@@ -289,14 +295,17 @@ struct Relaxation<'a> {
     check_every: f64,
 }
 
-/// One relaxation round: evolves until rigid (two successive checks) after at least `t_min`.
+/// One relaxation round: evolves until rigid (two successive checks) after at least `t_min`, from the round's
+/// start or from `resume`. After every check `save` is given the round's state (for a checkpoint).
 /// Returns the bodies, the simulated time and the largest energy residual.
 fn relax_round(
     bodies: &[Body],
     relaxation: &Relaxation<'_>,
     t_min: f64,
     round: usize,
+    resume: Option<RoundState>,
     progress: &mut RelaxProgress<'_>,
+    save: &mut dyn FnMut(RoundState),
 ) -> Result<(Vec<Body>, f64, f64), TargetError> {
     let (spec, check_every) = (relaxation.spec, relaxation.check_every);
     let system = EllipsoidSystem::new(bodies, relaxation.model, relaxation.physics);
@@ -310,6 +319,17 @@ fn relax_round(
     let mut t = 0.0;
     let mut rigid_checks = 0;
     let mut energy_error: f64 = 0.0;
+    if let Some(r) = resume {
+        if r.y.len() != y.len() {
+            return Err(TargetError::Invalid(format!(
+                "checkpoint: state of {} values, expected {}",
+                r.y.len(),
+                y.len()
+            )));
+        }
+        integrator.restore_state(&r.integrator)?;
+        (t, y, rigid_checks, energy_error) = (r.t, r.y, r.rigid_checks, r.energy_error);
+    }
     loop {
         let target = t + check_every;
         integrator.advance(&system, &mut t, &mut y, target)?;
@@ -332,6 +352,30 @@ fn relax_round(
                 fraction: fit.non_rigid_fraction(),
             });
         }
+        save(RoundState {
+            t,
+            y: y.clone(),
+            integrator: integrator.save_state(),
+            rigid_checks,
+            energy_error,
+        });
+    }
+}
+
+/// The rigid rotation the first relaxation round starts from: `ω` itself, unless `ω` would unbind the equator
+/// of the placement sphere (`ω² R_p³ > G M`: there the centrifugal acceleration exceeds the pile's gravity, and
+/// the outer fragments fly off during the collapse instead of settling). Then the first round spins at the
+/// rate where the centrifugal acceleration on that equator is half of gravity, `√(G M / (2 R_p³))`, and the
+/// later rounds reset the spin to `ω` as usual. Loose placements of many small fragments need this: the N = 2000
+/// pile of `analysis/n2000/` is placed in a sphere of 159 km, where a 4 h spin gives `ω² R_p³ / G M = 1.15`
+/// and K_rel/K rose for ever; Table 1's targets (at most 0.88) keep `ω`.
+pub fn first_round_spin(omega: &Vec3, total_mass: f64, placement_radius: f64) -> Vec3 {
+    let gm = G_SI * total_mass;
+    let r3 = placement_radius.powi(3);
+    if omega.norm_squared() * r3 > gm {
+        omega.normalize() * (0.5 * gm / r3).sqrt()
+    } else {
+        *omega
     }
 }
 
@@ -358,7 +402,22 @@ pub fn build_target(
     spec: &TargetSpec,
     progress: &mut RelaxProgress<'_>,
 ) -> Result<(Vec<Body>, TargetReport), TargetError> {
+    build_target_resumable(spec, None, progress, &mut |_| {})
+}
+
+/// [`build_target`] that continues from `resume` (a checkpoint of the same `spec`) when given, and hands a
+/// [`BuildCheckpoint`] to `checkpoint` after every relaxation check that does not end the build. A resumed
+/// build gives the same bits as one that was never stopped.
+pub fn build_target_resumable(
+    spec: &TargetSpec,
+    resume: Option<BuildCheckpoint>,
+    progress: &mut RelaxProgress<'_>,
+    checkpoint: &mut dyn FnMut(&BuildCheckpoint),
+) -> Result<(Vec<Body>, TargetReport), TargetError> {
     validate(spec)?;
+    if let Some(c) = &resume {
+        c.check(spec)?;
+    }
     let mut rng = generator(spec.seed);
     let (radii, size_draws) = draw_sizes(spec, &mut rng)?;
     let (mut bodies, placement_radius) = place_fragments(spec, &radii, &mut rng);
@@ -380,7 +439,14 @@ pub fn build_target(
     let density = total_mass / (4.0 / 3.0 * PI * placement_radius.powi(3));
     let t_ff = (3.0 * PI / (32.0 * G_SI * density)).sqrt();
     let (mut time, mut energy_error, mut rounds) = (0.0, 0.0_f64, 0);
-    set_rigid_rotation(&mut bodies, &omega);
+    let omega_first = first_round_spin(&omega, total_mass, placement_radius);
+    set_rigid_rotation(&mut bodies, &omega_first);
+    let mut resume_round = None;
+    if let Some(c) = resume {
+        bodies = c.round_start_bodies(&bodies);
+        (rounds, time, energy_error) = (c.round - 1, c.time_before, c.energy_error_before);
+        resume_round = Some(c.state);
+    }
     loop {
         rounds += 1;
         let t_min = if rounds == 1 { 3.0 * t_ff } else { t_ff };
@@ -390,7 +456,18 @@ pub fn build_target(
             physics,
             check_every: 0.25 * t_ff,
         };
-        let (relaxed, t, e) = relax_round(&bodies, &relaxation, t_min, rounds, progress)?;
+        let mut save = |state: RoundState| {
+            checkpoint(&BuildCheckpoint::new(spec, rounds, &bodies, time, energy_error, state));
+        };
+        let (relaxed, t, e) = relax_round(
+            &bodies,
+            &relaxation,
+            t_min,
+            rounds,
+            resume_round.take(),
+            progress,
+            &mut save,
+        )?;
         time += t;
         energy_error = energy_error.max(e);
         bodies = relaxed;
@@ -425,6 +502,7 @@ pub fn build_target(
         non_rigid_fraction: fit.non_rigid_fraction(),
         relaxation_time_s: time,
         relaxation_rounds: rounds,
+        first_round_period_hours: 2.0 * PI / omega_first.norm() / 3600.0,
         kappa,
         relaxation_energy_error: energy_error,
         placement_radius_m: placement_radius,
