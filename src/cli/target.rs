@@ -123,6 +123,10 @@ pub struct BuildArgs {
     /// Dissipation coefficient F0 while relaxing (s m⁻²).
     #[arg(long)]
     pub f0: Option<f64>,
+    /// Rigidity criterion: a relaxation round ends when the kinetic energy relative to the best-fit rigid
+    /// rotation is below this fraction of the total at two successive checks (dimensionless, in (0, 1)).
+    #[arg(long, default_value_t = 1e-4)]
+    pub rigidity: f64,
     /// Overwrite FILE.csv / FILE.json (and a checkpoint) of an earlier build.
     #[arg(long)]
     pub force: bool,
@@ -191,6 +195,13 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
     if let Some(f0) = args.f0 {
         spec.f0 = f0;
     }
+    if !(args.rigidity > 0.0 && args.rigidity < 1.0) {
+        return Err(CliError::usage(format!(
+            "--rigidity: expected a fraction in (0, 1), got {}",
+            args.rigidity
+        )));
+    }
+    spec.rigidity = args.rigidity;
     if args.out.extension().is_none_or(|e| e != "csv") {
         return Err(CliError::usage(format!(
             "--out: expected a path ending in .csv, got {}",

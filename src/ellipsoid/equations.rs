@@ -363,6 +363,13 @@ impl EllipsoidSystem {
         self.rotation
     }
 
+    /// Whether the forces are smooth functions of the state: false when gravity is summed by the tree, whose
+    /// forces jump where an interaction list changes (see [`crate::ellipsoid::gravity_tree`]).
+    pub fn forces_are_smooth(&self) -> bool {
+        let n = self.n_bodies();
+        self.physics.gravity.is_none_or(|g| g.method.tree_theta(n).is_none())
+    }
+
     /// Number of bodies.
     pub fn n_bodies(&self) -> usize {
         self.shapes.len()

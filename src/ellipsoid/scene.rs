@@ -186,7 +186,7 @@ pub struct GravitySpec {
     #[serde(default, rename = "G", skip_serializing_if = "Option::is_none")]
     pub g: Option<f64>,
     /// How the pair sum is done: `"direct"` (exact, O(N²)), `"tree"` (Barnes–Hut octree, O(N log N)) or
-    /// `"auto"` (exact below 1000 bodies, tree from there on). Default `"auto"`. See
+    /// `"auto"` (exact below 5000 bodies, tree from there on). Default `"auto"`. See
     /// [`crate::ellipsoid::gravity_tree`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub method: Option<GravityMethodSpec>,
