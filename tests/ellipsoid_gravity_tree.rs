@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use rubblepile::ellipsoid::equations::{EllipsoidSystem, GravityMethod, TREE_FROM};
+use rubblepile::ellipsoid::equations::{EllipsoidSystem, GravityMethod};
 use rubblepile::ellipsoid::gravity::gravity_forces;
 use rubblepile::ellipsoid::gravity_tree::{DEFAULT_THETA, tree_gravity_forces};
 use rubblepile::ellipsoid::output::read_bodies_csv;
@@ -203,7 +203,7 @@ fn tree_scene_conserves_energy_over_a_short_span() {
 
 /// Tree forces jump where interaction lists change, so a scene summing gravity by the tree reports its forces
 /// as not smooth (its run then bounds each step's error instead of the run's: the N2000 impact stalled under
-/// error-per-unit-step control), while the exact sum and `auto` below [`TREE_FROM`] stay smooth.
+/// error-per-unit-step control), while the exact sum and `auto` below its threshold (5000 bodies) stay smooth.
 #[test]
 fn tree_scenes_give_up_error_per_unit_step_control() {
     let system = |method: &str| {
