@@ -442,12 +442,12 @@ fn bench_rhs_writes_csv_and_plot() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "bodies,threads,median_us,min_us,repeats,gravity,packing"
+        "bodies,threads,median_us,min_us,repeats,gravity,packing,candidate_pairs,interacting_pairs,touching_pairs"
     );
     let rows: Vec<&str> = lines.collect();
     assert_eq!(rows.len(), 4);
     assert!(
-        rows[0].starts_with("8,1,") && rows[0].ends_with(",3,auto,lattice"),
+        rows[0].starts_with("8,1,") && rows[0].contains(",3,auto,lattice,"),
         "{}",
         rows[0]
     );
@@ -487,18 +487,29 @@ fn bench_rhs_times_relaxed_targets() {
         "2",
         "--threads",
         "1",
+        "--gravity",
+        "auto,none",
         "--out",
         "b",
     ];
     assert_ok(&rubblepile(&dir, &args), "bench --targets");
     let csv = read(&dir.join("b/bench_rhs.csv"));
-    let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 1, "{csv}");
-    assert!(
-        rows[0].starts_with("30,1,") && rows[0].ends_with(",2,auto,N30_T4"),
-        "{}",
-        rows[0]
-    );
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    for (row, gravity) in rows.iter().zip(["auto", "none"]) {
+        assert_eq!(
+            (row[0], row[1], row[4], row[5], row[6]),
+            ("30", "1", "2", gravity, "N30_T4"),
+            "{csv}"
+        );
+        // the relaxed pile's pair counts: candidates ≥ interacting ≥ touching > 0, the same for both rows
+        let counts: Vec<usize> = row[7..10].iter().map(|c| c.parse().unwrap()).collect();
+        assert!(
+            counts[0] >= counts[1] && counts[1] >= counts[2] && counts[2] > 0,
+            "{csv}"
+        );
+    }
+    assert_eq!(rows[0][7..], rows[1][7..], "{csv}");
     std::fs::copy(target, dir.join("lonely.csv")).unwrap();
     let out = rubblepile(&dir, &["bench", "rhs", "--targets", "lonely.csv", "--repeats", "1"]);
     assert_eq!(out.status.code(), Some(2));

@@ -416,6 +416,52 @@ fn pair_cache_never_changes_the_rhs() {
     assert!(contact_energies.iter().all(|&u| u > 0.0), "{contact_energies:?}");
 }
 
+/// The pair census (what `bench rhs` reports beside its timings) counts the same pairs as a brute-force pass over
+/// all N(N−1)/2 pairs with the overlap exponent `x = κ Δᵀ G⁻¹ Δ` of each: interacting where x lies below the
+/// pair's taper end `κλ − ln(cutoff) + 4`, touching where x ≤ κλ (Roig03 Eq. 12). Guards the neighbour
+/// search, the cull and the census against dropping or double-counting pairs.
+#[test]
+fn pair_census_matches_a_brute_force_count_over_all_pairs() {
+    use rubblepile::ellipsoid::calibration::lambda;
+    use rubblepile::ellipsoid::potential::{BodyGeometry, TAPER_WIDTH, Taper, overlap};
+    let mut rng = Random::new(79);
+    let (mut bodies, model, physics) = rock_lattice(&mut rng, [5, 5, 4]);
+    // squeeze the lattice so that many pairs touch and many more sit inside the taper
+    for b in &mut bodies {
+        b.position *= 0.6;
+    }
+    let system = EllipsoidSystem::new(&bodies, model, physics);
+    let census = system.pair_census(&system.initial_state());
+    let cutoff = physics.contact.unwrap().cutoff;
+    let (mut interacting, mut touching) = (0, 0);
+    for i in 0..bodies.len() {
+        for j in i + 1..bodies.len() {
+            let (a, b) = (&bodies[i], &bodies[j]);
+            let gi = BodyGeometry::new(&a.shape.axes, &a.quaternion);
+            let gj = BodyGeometry::new(&b.shape.axes, &b.quaternion);
+            let kl = model.kappa * lambda(a.shape.equivalent_radius(), b.shape.equivalent_radius());
+            let taper = Taper::for_pair(cutoff, kl);
+            let x = overlap(1.0, model.kappa, &(a.position - b.position), &gi, &gj, &taper).exponent;
+            if x < kl - cutoff.ln() + TAPER_WIDTH {
+                interacting += 1;
+            }
+            if x <= kl {
+                touching += 1;
+            }
+        }
+    }
+    assert_eq!(
+        (census.interacting, census.touching),
+        (interacting, touching),
+        "{census:?}"
+    );
+    assert!(touching >= 50 && interacting > touching, "{census:?}");
+    assert!(census.candidates >= census.exponent_evaluated && census.exponent_evaluated >= census.interacting);
+    // no pair term, no census
+    let bare = EllipsoidSystem::new(&bodies, model, Physics::default());
+    assert_eq!(bare.pair_census(&bare.initial_state()), Default::default());
+}
+
 /// The allocation-free right-hand side of spheres under gravity alone (the planetary N-body case) gives
 /// ṙ = u/m and u̇ = the pairwise gravity sum.
 #[test]

@@ -1,5 +1,6 @@
 //! `rubblepile bench rhs`: the cost of one right-hand-side evaluation, serial and parallel, with gravity among
-//! centres (Roig03 Eq. 6) summed exactly or by the octree ([`crate::ellipsoid::gravity_tree`]).
+//! centres (Roig03 Eq. 6) summed exactly, by the octree ([`crate::ellipsoid::gravity_tree`]) or left out (the
+//! pair work alone), with the pair counts ([`crate::ellipsoid::equations::PairCensus`]) that set the pair work.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -7,7 +8,9 @@ use std::time::Instant;
 
 use super::BenchError as CliError;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, Physics};
+use crate::ellipsoid::equations::{
+    ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, PairCensus, Physics,
+};
 use crate::ellipsoid::gravity_tree::{GravityMethod, MAX_THETA};
 use crate::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
 use crate::integrate::OdeSystem;
@@ -37,17 +40,18 @@ pub struct RhsArgs {
     /// Threads of the parallel run (default: all available).
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Option<u64>,
-    /// Gravity methods to time, comma-separated: `auto` (exact below 1000 bodies, tree from there on),
-    /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`).
-    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree"])]
+    /// Gravity methods to time, comma-separated: `auto` (exact below 5000 bodies, tree from there on),
+    /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`), `none` (no gravity: contact and dissipation
+    /// only, so that the pair work is timed alone).
+    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree", "none"])]
     pub gravity: Vec<String>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]).
     #[arg(long, default_value_t = crate::ellipsoid::gravity_tree::DEFAULT_THETA)]
     pub theta: f64,
-    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats, gravity) and the plot
-    /// `bench_rhs.svg` + `bench_rhs.png` (median µs per RHS against N, one line per thread count and gravity
-    /// method, lattices and relaxed piles apart) into this directory; `bench_rhs.csv` also has `packing`
-    /// (`lattice` or the target file's stem).
+    /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats, gravity, packing: `lattice` or the
+    /// target file's stem, and the pair counts of the timed state: candidate_pairs, interacting_pairs,
+    /// touching_pairs) and the plot `bench_rhs.svg` + `bench_rhs.png` (median µs per RHS against N, one line per
+    /// thread count and gravity method, lattices and relaxed piles apart) into this directory.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Overwrite `bench_rhs.csv`/`bench_rhs.svg` of an earlier benchmark in DIR.
@@ -111,14 +115,19 @@ pub fn bench_system(n: usize, seed: u64, kappa: f64) -> EllipsoidSystem {
 
 /// [`bench_system`] with gravity summed by `method`.
 pub fn bench_system_with(n: usize, seed: u64, kappa: f64, method: GravityMethod) -> EllipsoidSystem {
+    lattice_system(n, seed, kappa, Some(method))
+}
+
+fn lattice_system(n: usize, seed: u64, kappa: f64, method: Option<GravityMethod>) -> EllipsoidSystem {
     let bodies = random_cloud(n, seed, &CloudParams::default());
     EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), bench_physics(method))
 }
 
-/// The physics of every `bench rhs` system: gravity by `method`, contact, dissipation (F0 = 1 s/m²).
-fn bench_physics(method: GravityMethod) -> Physics {
+/// The physics of every `bench rhs` system: gravity by `method` (`None`: no gravity), contact, dissipation
+/// (F0 = 1 s/m²).
+fn bench_physics(method: Option<GravityMethod>) -> Physics {
     Physics {
-        gravity: Some(GravityTerm { g: SI_G, method }),
+        gravity: method.map(|method| GravityTerm { g: SI_G, method }),
         contact: Some(ContactTerm {
             cutoff: DEFAULT_CONTACT_CUTOFF,
         }),
@@ -201,21 +210,18 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
     for path in &args.targets {
         packings.push(read_pile(path)?);
     }
-    // (bodies, timing, gravity method, packing: "lattice" or the target's stem)
-    let mut results: Vec<(usize, RhsTiming, String, String)> = Vec::new();
+    // (bodies, timing, gravity method, packing: "lattice" or the target's stem, pair counts)
+    let mut results: Vec<(usize, RhsTiming, String, String, PairCensus)> = Vec::new();
     for (packing, gravity) in packings.iter().flat_map(|p| args.gravity.iter().map(move |g| (p, g))) {
         let theta = args.theta;
         let method = match gravity.as_str() {
-            "direct" => GravityMethod::Direct,
-            "tree" => GravityMethod::Tree { theta },
-            _ => GravityMethod::Auto { theta },
+            "direct" => Some(GravityMethod::Direct),
+            "tree" => Some(GravityMethod::Tree { theta }),
+            "none" => None,
+            _ => Some(GravityMethod::Auto { theta }),
         };
         let (system, name, kappa) = match packing {
-            Packing::Lattice(n) => (
-                bench_system_with(*n, args.seed, args.kappa, method),
-                "lattice",
-                args.kappa,
-            ),
+            Packing::Lattice(n) => (lattice_system(*n, args.seed, args.kappa, method), "lattice", args.kappa),
             Packing::Pile(stem, bodies, kappa) => (
                 EllipsoidSystem::new(bodies, ModelConfig::gaussian_si(*kappa), bench_physics(method)),
                 stem.as_str(),
@@ -223,14 +229,22 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
             ),
         };
         let n = system.n_bodies();
+        let census = system.pair_census(&system.initial_state());
         println!(
             "bench rhs: {n} bodies ({name}), gravity {gravity} ({}), {repeats} repeats, seed {}, kappa {kappa}",
-            if method.tree_theta(n).is_some() {
-                "tree"
-            } else {
-                "exact"
+            match method {
+                None => "none",
+                Some(m) if m.tree_theta(n).is_some() => "tree",
+                Some(_) => "exact",
             },
             args.seed,
+        );
+        println!(
+            "  pairs: {} candidates, {} interacting ({:.1} per body), {} touching",
+            census.candidates,
+            census.interacting,
+            2.0 * census.interacting as f64 / n.max(1) as f64,
+            census.touching
         );
         let mut row = Vec::new();
         for &threads in &counts {
@@ -252,17 +266,23 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
                 row[1].threads
             );
         }
-        results.extend(row.into_iter().map(|r| (n, r, gravity.clone(), name.to_string())));
+        results.extend(
+            row.into_iter()
+                .map(|r| (n, r, gravity.clone(), name.to_string(), census)),
+        );
     }
     if let Some((csv, svg, png)) = &paths {
         let write = || -> std::io::Result<()> {
             let mut f = std::io::BufWriter::new(std::fs::File::create(csv)?);
-            writeln!(f, "bodies,threads,median_us,min_us,repeats,gravity,packing")?;
-            for (n, r, g, p) in &results {
+            writeln!(
+                f,
+                "bodies,threads,median_us,min_us,repeats,gravity,packing,candidate_pairs,interacting_pairs,touching_pairs"
+            )?;
+            for (n, r, g, p, c) in &results {
                 writeln!(
                     f,
-                    "{n},{},{:e},{:e},{repeats},{g},{p}",
-                    r.threads, r.median_us, r.min_us
+                    "{n},{},{:e},{:e},{repeats},{g},{p},{},{},{}",
+                    r.threads, r.median_us, r.min_us, c.candidates, c.interacting, c.touching
                 )?;
             }
             f.flush()
@@ -271,7 +291,7 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         // one line per (threads, gravity) over the lattices, and one over the relaxed piles
         let labelled: Vec<(usize, RhsTiming, String)> = results
             .iter()
-            .map(|(n, r, g, p)| {
+            .map(|(n, r, g, p, _)| {
                 (
                     *n,
                     *r,

@@ -165,6 +165,20 @@ impl Diagnostics {
     }
 }
 
+/// What the pair pass does with the neighbour search's candidates at one state ([`EllipsoidSystem::pair_census`]):
+/// the counts that, with the cost of each stage, make up the contact part of a right-hand side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct PairCensus {
+    /// Candidate pairs of the bounding-sphere search (the Verlet list, grown by its skin).
+    pub candidates: usize,
+    /// Candidates that pass the cheap bound ([`is_negligible`]) and need the overlap exponent (a 3×3 inverse).
+    pub exponent_evaluated: usize,
+    /// Pairs whose exponent lies below their taper's end: potential, gradients and dissipation computed.
+    pub interacting: usize,
+    /// Interacting pairs at or inside the contact of their equivalent spheres (exponent ≤ κλ_ij, Roig03 Eq. 12).
+    pub touching: usize,
+}
+
 /// Kinematic quantities of one body in one state.
 #[derive(Debug, Clone, Copy)]
 struct Kinematics {
@@ -613,6 +627,36 @@ impl EllipsoidSystem {
         } else {
             candidates.iter().filter_map(terms).collect()
         }
+    }
+
+    /// How the candidate pairs of state `y` split between the cull, the taper and contact (see [`PairCensus`]);
+    /// all zeros when no pair term is on.
+    pub fn pair_census(&self, y: &[f64]) -> PairCensus {
+        if !self.needs_pairs() {
+            return PairCensus::default();
+        }
+        let kin = self.all_kinematics(y, true);
+        let candidates = self.candidate_pairs(&kin);
+        let mut census = PairCensus {
+            candidates: candidates.len(),
+            ..PairCensus::default()
+        };
+        let kappa = self.model.kappa;
+        for c in candidates.iter() {
+            let (gi, gj) = (kin[c.i].geometry.as_ref().unwrap(), kin[c.j].geometry.as_ref().unwrap());
+            let delta = kin[c.i].r - kin[c.j].r;
+            if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
+                continue;
+            }
+            census.exponent_evaluated += 1;
+            if let Some(ov) = overlap_within_taper(c.prefactor, kappa, &delta, gi, gj, &c.taper) {
+                census.interacting += 1;
+                if ov.exponent <= c.taper.start - self.neg_ln_cutoff {
+                    census.touching += 1;
+                }
+            }
+        }
+        census
     }
 
     /// The bodies' state at time `t` from the packed state `y` (`spin_body` from `q̇`; for non-integrated
