@@ -25,6 +25,7 @@ fn distant_tide_matches_the_linear_tidal_field() {
         gm: GM_EARTH,
         radius: None,
         orbit,
+        j2: None,
     };
     let mut rng = Random::new(7);
     for t in [-3e5, 0.0, 1e5] {
@@ -265,4 +266,111 @@ fn flyby_run_resumed_from_a_checkpoint_matches_the_whole_run() {
     assert_eq!(resumed.energy_error, s_whole.energy_error);
     let read = |p: &std::path::Path| std::fs::read(p.join("snapshots/2.csv")).unwrap();
     assert!(read(&split) == read(&whole), "the resumed run's last snapshot differs");
+}
+
+/// With an oblate planet (J2 exaggerated to 0.05 so that its work is large, pole tilted), `H + E_tide` with the
+/// zonal energy `Σ m Φ_J2` still closes, and the J2 really acts: the pile ends elsewhere than under a point mass.
+#[test]
+fn j2_energy_bookkeeping_closes_with_a_tilted_pole() {
+    let point = "[physics.flyby]\nmass = 5.9722e25\nradius = 6.371e6\nq = 9.5e6\nv_inf = 3000.0\nt_perigee = 1500.0";
+    let oblate = format!("{point}\nj2 = 0.05\npole = [0.3, 0.5, 1.0]");
+    let (point_dir, s0) = run(&pile_scene(point, 3000.0), "flyby-point");
+    let (oblate_dir, s1) = run(&pile_scene(&oblate, 3000.0), "flyby-j2");
+    assert_eq!(s1.status, "completed");
+    assert!(s1.energy_error < 1e-6, "energy error {:e}", s1.energy_error);
+    let positions = |dir: &std::path::Path| {
+        rubblepile::io::particles::read_particles(&dir.join("snapshots/2.csv"), &["x", "y", "z"], &[])
+            .unwrap()
+            .iter()
+            .map(|r| Vec3::new(r.values[0], r.values[1], r.values[2]))
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (positions(&point_dir), positions(&oblate_dir));
+    let shift = a.iter().zip(&b).map(|(p, q)| (p - q).norm()).fold(0.0, f64::max);
+    // J2 (R/q)² ≈ 0.02 of the planet's pull: the pile's centre drifts by metres over the 3000 s
+    assert!(shift > 0.1, "largest shift {shift} m");
+    assert!(s0.energy_error < 1e-6);
+}
+
+/// `j2 = 0` is a point mass: the run is bit-identical to one without `j2`; `j2` without `radius` and `pole`
+/// without `j2` are refused, naming the field.
+#[test]
+fn zero_j2_leaves_the_run_bit_identical_and_bad_j2_input_is_refused() {
+    let point = "[physics.flyby]\nmass = 5.9722e24\nradius = 6.371e6\nq = 2e7\nv_inf = 5800.0\nt_perigee = 500.0";
+    let (a, _) = run(&pile_scene(point, 1000.0), "flyby-nozonal");
+    let (b, _) = run(
+        &pile_scene(&format!("{point}\nj2 = 0.0\npole = [1.0, 0.0, 0.0]"), 1000.0),
+        "flyby-zerozonal",
+    );
+    for k in 0..3 {
+        let sa = std::fs::read(a.join(format!("snapshots/{k}.csv"))).unwrap();
+        let sb = std::fs::read(b.join(format!("snapshots/{k}.csv"))).unwrap();
+        assert!(sa == sb, "snapshot {k} differs");
+    }
+    let no_radius = "[physics.flyby]\nmass = 5.9722e24\nq = 2e7\nv_inf = 5800.0\nt_perigee = 500.0\nj2 = 1e-3";
+    let pole_alone = format!("{point}\npole = [0.0, 0.0, 1.0]");
+    for (text, field) in [
+        (no_radius.to_string(), "physics.flyby.radius"),
+        (pole_alone, "physics.flyby.pole"),
+    ] {
+        let Err(err) = parse_scene(&pile_scene(&text, 1000.0), "bad.toml", None) else {
+            panic!("{field}: the scene was accepted");
+        };
+        assert!(err.to_string().contains(field), "{err}");
+    }
+}
+
+/// `rubblepile flyby --planet-j2 … --planet-pole …` writes the J2 term into the run's scene and `flyby.json`;
+/// a pole without J2 is refused, naming the flag's field.
+#[test]
+fn flyby_command_writes_the_planet_j2() {
+    let dir = temp_dir("flyby-cli-j2");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let flyby = |extra: &[&str], out: &str| {
+        let mut args = vec![
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--q-m",
+            "3.8e7",
+            "--no-run",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .unwrap()
+    };
+    let out = flyby(
+        &[
+            "--planet-j2",
+            "1.0826e-3",
+            "--planet-radius-m",
+            "6378137",
+            "--planet-pole",
+            "1,0,0",
+        ],
+        "j2",
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let scene = std::fs::read_to_string(dir.join("j2/scene.toml")).unwrap();
+    assert!(
+        scene.contains("j2 = 0.0010826") && scene.contains("pole = [1.0, 0.0, 0.0]"),
+        "{scene}"
+    );
+    let setup = std::fs::read_to_string(dir.join("j2/flyby.json")).unwrap();
+    assert!(setup.contains("\"j2\": 0.0010826"), "{setup}");
+    // the point-mass default writes no J2
+    assert!(flyby(&[], "point").status.success());
+    assert!(
+        !std::fs::read_to_string(dir.join("point/scene.toml"))
+            .unwrap()
+            .contains("j2")
+    );
+    let refused = flyby(&["--planet-pole", "0,0,1"], "pole-alone");
+    assert!(!refused.status.success());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("planet_pole"));
 }

@@ -31,3 +31,17 @@ for v in 5.8 12; do
     one "sweep_v${v}_q${qr}" --q-m "$q" --v-inf-km-s "$v"
   done
 done
+# Earth's J2 (1.0826e-3 about the equatorial radius 6378.137 km) with two spin axes that bracket the real one:
+# normal to the flyby plane (the pass stays over the equator) and along the perigee direction (over a pole at
+# perigee). For Apophis and for the closest pass of the sweep (1.2 R_E, 5.8 km/s).
+for pole in eq:0,0,1 polar:1,0,0; do
+  name=${pole%%:*}; axis=${pole#*:}
+  J2=(--planet-j2 1.0826e-3 --planet-radius-m 6378137 --planet-pole "$axis")
+  one "j2${name}_apophis" --q-m 3.8e7 --v-inf-km-s 5.8 "${J2[@]}"
+  one "j2${name}_q1.2" --q-m "$(python3 -c "print(1.2*$RE)")" --v-inf-km-s 5.8 "${J2[@]}"
+done
+# How far the 1.2 R_E outcome moves anyway: the point-mass pass with q changed by 1e-5 and 1e-4 (relative), an
+# effect of the order of J2's there (J2 (R/q)^2 = 7.5e-4 of the pull, a smaller share of the tide's gradient).
+for f in 1.00001 1.0001; do
+  one "perturb_q1.2_$f" --q-m "$(python3 -c "print(1.2*$RE*$f)")" --v-inf-km-s 5.8
+done

@@ -17,11 +17,17 @@
 //! (and checkpoints) keep their shape. Both differences of nearly equal terms are evaluated in forms free of
 //! cancellation (`|R| − |d| = (2 r·R − r·r)/(|R| + |d|)`).
 //!
-//! The planet's J2 is not modelled.
+//! **J2** (optional, `j2` with `radius`): the planet's field gains the zonal term of [`crate::gravity::zonal`] about
+//! a fixed spin axis `pole`, at each body's position relative to the planet, `a_i += g_J2(r_i − R)`. The frame still
+//! falls on the Kepler orbit, so the origin's acceleration is not changed: the equations stay those of a frame with a
+//! prescribed acceleration, exact for any prescribed orbit, and the pile's centre of mass drifts off the origin by
+//! the J2 pull (of order `J2 (R/q)²` of the tidal acceleration). The conserved energy gains `Σ m_i Φ_J2(r_i − R)` in
+//! `E_tide` (the field is static in the planet's frame).
 
 use serde::{Deserialize, Serialize};
 
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
+use crate::gravity::zonal::J2Field;
 use crate::io::scene_file::{SceneError, Validator};
 use crate::math::Vec3;
 
@@ -35,6 +41,8 @@ use crate::math::Vec3;
 /// v_inf = 5800.0              # m/s (hyperbolic); or eccentricity = 0.5
 /// t_perigee = 1.2e5           # s
 /// orientation_deg = [0, 0, 0] # [node, inclination, argument of perigee] (deg)
+/// j2 = 1.0826e-3              # optional (needs radius); Earth's
+/// pole = [0.0, 0.0, 1.0]      # optional: the planet's spin axis in the frame
 /// ```
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -63,6 +71,14 @@ pub struct FlybySpec {
     /// `−q x̂` in the frame).
     #[serde(default)]
     pub orientation_deg: [f64; 3],
+    /// The planet's second zonal harmonic J2 (dimensionless, finite; Earth 1.0826e-3 with its equatorial radius
+    /// 6378.137 km). Optional, default none (a point mass); needs `radius`, the reference radius of J2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub j2: Option<f64>,
+    /// The planet's spin axis (frame coordinates, any non-zero length; normalised), used with `j2`. Default
+    /// `[0, 0, 1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pole: Option<[f64; 3]>,
 }
 
 /// The resolved flyby term.
@@ -74,6 +90,8 @@ pub struct TideTerm {
     pub radius: Option<f64>,
     /// The frame origin's orbit about the planet (`gm` as above; a straight line when it is 0).
     pub orbit: KeplerOrbit,
+    /// The planet's J2 field, when given (`None`: a point mass).
+    pub j2: Option<J2Field>,
 }
 
 impl TideTerm {
@@ -89,11 +107,19 @@ impl TideTerm {
 
     /// Tidal acceleration (m/s²) at `r` (m) with the planet at `planet` (m):
     /// `−GM (r − R)/|r − R|³ − GM R/|R|³`, in the cancellation-free form
-    /// `GM [R (|R|³ − |d|³)/(|d|³ |R|³) − r/|d|³]`, `d = r − R`.
+    /// `GM [R (|R|³ − |d|³)/(|d|³ |R|³) − r/|d|³]`, `d = r − R`; plus `g_J2(d)` with J2.
     pub fn acceleration(&self, r: &Vec3, planet: &Vec3) -> Vec3 {
         if self.gm == 0.0 {
             return Vec3::zeros();
         }
+        let point = self.point_mass_acceleration(r, planet);
+        match &self.j2 {
+            Some(j2) => point + j2.acceleration(&(r - planet)),
+            None => point,
+        }
+    }
+
+    fn point_mass_acceleration(&self, r: &Vec3, planet: &Vec3) -> Vec3 {
         let big = planet.norm();
         let d = (r - planet).norm();
         // |R| − |d| = (|R|² − |d|²)/(|R| + |d|) = (2 r·R − r·r)/(|R| + |d|).
@@ -111,7 +137,8 @@ impl TideTerm {
         }
     }
 
-    /// Tidal energy `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (J) of bodies at `positions` (m) with
+    /// Tidal energy `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (+ `Σ m_i Φ_J2(r_i − R)` with J2) (J) of
+    /// bodies at `positions` (m) with
     /// `masses` (kg) and total momentum `momentum` (kg m/s), at time `t` (s): `H + E_tide` is conserved (see the
     /// module docs).
     pub fn energy(&self, t: f64, positions: &[Vec3], masses: &[f64], momentum: &Vec3) -> f64 {
@@ -127,7 +154,15 @@ impl TideTerm {
                 potential += m * diff / (big * d);
             }
         }
-        momentum.dot(&v0) + self.gm * potential
+        let zonal: f64 = match &self.j2 {
+            Some(j2) if self.gm != 0.0 => positions
+                .iter()
+                .zip(masses)
+                .map(|(r, m)| m * j2.potential(&(r - planet)))
+                .sum(),
+            _ => 0.0,
+        };
+        momentum.dot(&v0) + self.gm * potential + zonal
     }
 }
 
@@ -192,5 +227,37 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
                 .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
         }
     };
-    Ok(TideTerm { gm, radius, orbit })
+    let j2 = match spec.j2 {
+        None => None,
+        Some(j2) => {
+            if !j2.is_finite() {
+                return Err(v.invalid("physics.flyby.j2", format!("must be finite, got {j2}")));
+            }
+            let Some(r) = radius else {
+                return Err(v.invalid(
+                    "physics.flyby.radius",
+                    format!("is needed with j2 = {j2} (the reference radius of J2, m)"),
+                ));
+            };
+            let pole = Vec3::from(spec.pole.unwrap_or([0.0, 0.0, 1.0]));
+            if !(pole.iter().all(|x| x.is_finite()) && pole.norm() > 0.0) {
+                return Err(v.invalid(
+                    "physics.flyby.pole",
+                    format!(
+                        "must be a finite non-zero vector (the planet's spin axis), got {:?}",
+                        spec.pole
+                    ),
+                ));
+            }
+            // J2 = 0 is a point mass: no term, so the run is bit-identical to one without `j2`.
+            (j2 != 0.0).then(|| J2Field::new(gm, j2, r, pole))
+        }
+    };
+    if spec.pole.is_some() && spec.j2.is_none() {
+        return Err(v.invalid(
+            "physics.flyby.pole",
+            "is the planet's spin axis for `j2`; give `j2` too, or leave `pole` out".to_string(),
+        ));
+    }
+    Ok(TideTerm { gm, radius, orbit, j2 })
 }

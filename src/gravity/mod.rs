@@ -6,10 +6,11 @@
 //! excluded), each summed in a fixed order per particle, so results do not depend on the number of threads.
 //!
 //! [`kepler`]: two-body orbits (Kepler's equation, elliptic and hyperbolic) for an external body on a prescribed
-//! orbit (the flyby tide).
+//! orbit (the flyby tide). [`zonal`]: the J2 field of an oblate planet (the flyby tide's optional term).
 
 pub mod kepler;
 pub mod octree;
+pub mod zonal;
 
 use crate::math::Vec3;
 use rayon::prelude::*;

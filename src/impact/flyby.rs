@@ -54,6 +54,14 @@ pub struct FlybyArgs {
     /// Planet radius (m) [default: Earth's mean radius].
     #[arg(long, default_value_t = EARTH_RADIUS_M)]
     pub planet_radius_m: f64,
+    /// The planet's J2 (dimensionless; Earth 1.0826e-3), with `--planet-radius-m` as its reference radius
+    /// [default: none, a point mass].
+    #[arg(long)]
+    pub planet_j2: Option<f64>,
+    /// The planet's spin axis X,Y,Z in the run's frame (the flyby orbit lies in the x–y plane), used with
+    /// `--planet-j2` [default: 0,0,1].
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
+    pub planet_pole: Option<Vec<f64>>,
     /// Perigee distance from the planet's centre (m).
     #[arg(long)]
     pub q_m: f64,
@@ -61,7 +69,7 @@ pub struct FlybyArgs {
     #[arg(long, default_value_t = 5.8)]
     pub v_inf_km_s: f64,
     /// Orbit orientation Ω,i,ω (degrees; see `physics.flyby.orientation_deg`) [default: 0,0,0, prograde in x–y].
-    #[arg(long, value_delimiter = ',', num_args = 3, allow_hyphen_values = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub orientation_deg: Option<Vec<f64>>,
     /// Start and end with the planet this many q away.
     #[arg(long, default_value_t = DEFAULT_START_Q)]
@@ -124,6 +132,12 @@ pub struct FlybySetup {
     pub kappa: f64,
     /// F0 (s m⁻²).
     pub f0: f64,
+    /// The planet's J2 (none: a point mass).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub j2: Option<f64>,
+    /// The planet's spin axis in the frame (with `j2`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pole: Option<[f64; 3]>,
 }
 
 fn invalid(field: &str, message: String) -> ImpactError {
@@ -225,6 +239,44 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
         return Err(invalid("snapshots", format!("need at least 2, got {}", args.snapshots)));
     }
     let orientation = args.orientation_deg.clone().unwrap_or(vec![0.0; 3]);
+    for (field, values) in [
+        ("orientation_deg", Some(&orientation)),
+        ("planet_pole", args.planet_pole.as_ref()),
+    ] {
+        if let Some(v) = values
+            && v.len() != 3
+        {
+            return Err(invalid(
+                field,
+                format!("needs three comma-separated numbers, got {v:?}"),
+            ));
+        }
+    }
+    if let Some(j2) = args.planet_j2
+        && !j2.is_finite()
+    {
+        return Err(invalid("planet_j2", format!("must be finite, got {j2}")));
+    }
+    let pole = match (&args.planet_pole, args.planet_j2) {
+        (Some(_), None) => {
+            return Err(invalid(
+                "planet_pole",
+                "is the planet's spin axis for --planet-j2; give --planet-j2 too".to_string(),
+            ));
+        }
+        (Some(p), Some(_)) => {
+            let p = [p[0], p[1], p[2]];
+            if !(p.iter().all(|x| x.is_finite()) && p.iter().any(|x| *x != 0.0)) {
+                return Err(invalid(
+                    "planet_pole",
+                    format!("must be a finite non-zero vector, got {p:?}"),
+                ));
+            }
+            Some(p)
+        }
+        (None, Some(_)) => Some([0.0, 0.0, 1.0]),
+        (None, None) => None,
+    };
     let target = read_target(&args.target)?;
     let kappa = match args.kappa.or_else(|| target_kappa(&args.target)) {
         Some(k) if k > 1.5 => k,
@@ -273,6 +325,8 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
         period_hours: args.period_hours,
         kappa,
         f0,
+        j2: args.planet_j2,
+        pole,
     };
     let title = format!(
         "Flyby of {} (R = {radius:.1} m) at q = {:.4e} m ({:.2} planet radii), v_inf = {} km/s",
@@ -287,7 +341,7 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
          [model]\nkappa = {kappa:?}\n\n\
          [physics]\ngravity = {{}}\ncontact = {{}}\ndissipation = {{ F0 = {f0:?} }}\n\n\
          [physics.flyby]\nmass = {mass:?}\nradius = {pr:?}\nq = {q:?}\nv_inf = {v_inf:?}\nt_perigee = {t_perigee:?}\n\
-         orientation_deg = [{o0:?}, {o1:?}, {o2:?}]\n\n\
+         orientation_deg = [{o0:?}, {o1:?}, {o2:?}]\n{zonal}\n\
          [integrator]\nmethod = \"bulirsch-stoer\"\nrtol = {rtol:?}\natol = {rtol:?}\n\n\
          [output]\ntimes = [{times}]\nevery = {every:?}\n",
         mass = args.planet_mass,
@@ -299,6 +353,10 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
         rtol = args.rtol,
         times = times.join(", "),
         every = t_end / 400.0,
+        zonal = match (args.planet_j2, pole) {
+            (Some(j2), Some([x, y, z])) => format!("j2 = {j2:?}\npole = [{x:?}, {y:?}, {z:?}]\n"),
+            _ => String::new(),
+        },
     );
     let out = &args.out;
     prepare_output_dir(out, args.force)?;
