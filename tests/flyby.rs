@@ -374,3 +374,30 @@ fn flyby_command_writes_the_planet_j2() {
     assert!(!refused.status.success());
     assert!(String::from_utf8_lossy(&refused.stderr).contains("planet_pole"));
 }
+
+/// `rubblepile analyze DIR` recognises a flyby run (a scene with `[physics.flyby]`) and writes its remnant analysis;
+/// it does not overwrite that analysis without `--force`.
+#[test]
+fn analyze_command_handles_flyby_runs() {
+    let flyby = "[physics.flyby]\nmass = 5.9722e25\nradius = 6.371e6\nq = 9.5e6\nv_inf = 3000.0\nt_perigee = 500.0";
+    let (dir, _) = run(&pile_scene(flyby, 1000.0), "flyby-analyze");
+    let analyze = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+            .arg("analyze")
+            .arg(&dir)
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let first = analyze(&[]);
+    assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
+    assert!(String::from_utf8_lossy(&first.stdout).contains("flyby: "));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("analysis/flyby.json")).unwrap()).unwrap();
+    let lost = json["mass_lost"].as_f64().unwrap();
+    assert!((0.0..=1.0).contains(&lost), "{json}");
+    let again = analyze(&[]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
+    assert!(analyze(&["--force"]).status.success());
+}

@@ -283,19 +283,28 @@ pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };
     let o = analyze_flyby(&args.out).map_err(|e| (e.to_string(), 1))?;
-    Ok(vec![
-        summary.one_line(),
+    Ok(vec![summary.one_line(), o.one_line()])
+}
+
+impl FlybyOutcome {
+    /// One line for the terminal: class, mass lost, period and axis ratios before and after.
+    pub fn one_line(&self) -> String {
         format!(
             "flyby: {} (RBL98 {}): mass lost {:.4}, P {:.3} h -> {:.3} h, b/a {:.3} -> {:.3}, c/a {:.3} -> {:.3}",
-            o.class,
-            o.rbl98_class,
-            o.mass_lost,
-            o.before.period_hours,
-            o.after.period_hours,
-            o.before.b_over_a,
-            o.after.b_over_a,
-            o.before.c_over_a,
-            o.after.c_over_a
-        ),
-    ])
+            self.class,
+            self.rbl98_class,
+            self.mass_lost,
+            self.before.period_hours,
+            self.after.period_hours,
+            self.before.b_over_a,
+            self.after.b_over_a,
+            self.before.c_over_a,
+            self.after.c_over_a
+        )
+    }
+}
+
+/// Whether `dir` holds a flyby run: its `scene.toml` loads and has a `[physics.flyby]` section.
+pub fn is_flyby_run(dir: &Path) -> bool {
+    crate::ellipsoid::scene::load_scene(&dir.join("scene.toml")).is_ok_and(|s| s.tide.is_some())
 }

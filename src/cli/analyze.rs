@@ -1,4 +1,5 @@
-//! `rubblepile analyze RUN_DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4).
+//! `rubblepile analyze RUN_DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4); of a
+//! flyby run, the largest remnant before and after (`analysis/flyby.json`).
 
 use std::path::PathBuf;
 
@@ -8,7 +9,8 @@ use crate::cli::CliError;
 /// `rubblepile analyze`.
 #[derive(Debug, clap::Args)]
 pub struct AnalyzeArgs {
-    /// An impact run directory (from `rubblepile impact` or a campaign).
+    /// An impact run directory (from `rubblepile impact` or a campaign), or a flyby run (`rubblepile flyby`, or any
+    /// scene with `[physics.flyby]`).
     pub dir: PathBuf,
     /// Time of the post-impact snapshot to analyse (s); there must be a snapshot at that time.
     #[arg(long, default_value_t = 400.0)]
@@ -20,6 +22,9 @@ pub struct AnalyzeArgs {
 
 /// Runs `analyze`.
 pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
+    if crate::analysis::flyby::is_flyby_run(&args.dir) {
+        return analyze_flyby_run(args);
+    }
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
     }
@@ -166,5 +171,20 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
         campaign.skipped.len(),
         path.display()
     );
+    Ok(())
+}
+
+/// `analyze` of a flyby run (from `rubblepile flyby` or any scene with `[physics.flyby]`): the first and last
+/// snapshots' largest remnant into `DIR/analysis/flyby.json` (`--at` does not apply).
+fn analyze_flyby_run(args: &AnalyzeArgs) -> Result<(), CliError> {
+    let out = args.dir.join("analysis/flyby.json");
+    if out.exists() && !args.force {
+        return Err(CliError::usage(format!(
+            "{} exists: use --force to analyse the flyby run again",
+            out.display()
+        )));
+    }
+    let o = crate::analysis::flyby::analyze_flyby(&args.dir).map_err(CliError::failed)?;
+    println!("{} (wrote {})", o.one_line(), out.display());
     Ok(())
 }

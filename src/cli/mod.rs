@@ -87,7 +87,8 @@ pub enum Command {
     Flyby(Box<crate::impact::flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(campaign::CampaignArgs),
-    /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis.
+    /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis; a flyby run: its
+    /// largest remnant before and after (DIR/analysis/flyby.json).
     Analyze(analyze::AnalyzeArgs),
     /// Analyse every completed run of a campaign; bound fraction vs Q and Q*_D (Roig03 Fig. 5).
     AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
