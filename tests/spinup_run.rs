@@ -182,6 +182,40 @@ fn bad_spinup_input_names_the_field() {
     bad(&PATH.replace("T_inter = 7.0\n", ""), "missing field `T_inter`");
 }
 
+/// `spinup critical --all-holds` runs every hold of the grid whatever the verdicts (the default search may stop
+/// once both criteria have a stable hold): three holds, three rows in `critical.csv`, in grid order.
+#[test]
+fn all_holds_runs_the_whole_grid() {
+    let dir = temp_dir("spinup-all-holds");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let c = rubblepile(
+        &dir,
+        &[
+            "spinup",
+            "critical",
+            "--scene",
+            "s.toml",
+            "--from",
+            "5.8",
+            "--to",
+            "6.0",
+            "--step",
+            "0.1",
+            "--branch",
+            "--hold",
+            "600",
+            "--all-holds",
+            "--out",
+            "crit",
+        ],
+    );
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let csv = read(&dir.join("crit/critical.csv"));
+    let periods: Vec<&str> = csv.lines().skip(1).map(|l| l.split(',').next().unwrap()).collect();
+    assert_eq!(periods, ["5.80", "5.90", "6.00"], "{csv}");
+}
+
 /// `spinup critical --branch`: a hold run branched off the shared path run gives the same `spinup.csv` and the
 /// same time series (wall-clock column aside) as the hold scene run from t = 0. The path's numbers make the
 /// shortened path's periods bit-identical to the full one's (T_final = 6 h at t_X = 1600 s halves the span).

@@ -58,6 +58,9 @@ pub struct CriticalOptions {
     pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `branch`; default: the scene's `t_end − t_final`.
     pub hold: Option<f64>,
+    /// Run every hold of the grid, also after both criteria have a stable hold (whether the verdicts stay stable
+    /// at slower spins); default: stop there.
+    pub all_holds: bool,
 }
 
 /// Why a search or a fit could not be made: bad options or inputs (the caller's), or a run or file that failed.
@@ -223,6 +226,12 @@ pub fn search_done(runs: &[HoldVerdict]) -> bool {
     })
 }
 
+/// Whether the search stops after `runs`: when it is done ([`search_done`]), unless `all_holds` asks for the whole
+/// grid.
+pub fn search_stops(runs: &[HoldVerdict], all_holds: bool) -> bool {
+    !all_holds && search_done(runs)
+}
+
 /// One line per hold of the verdicts by both criteria (printed as the search goes).
 pub fn verdict_line(r: &HoldVerdict) -> String {
     let word = |v: &CriterionVerdict| {
@@ -379,7 +388,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         let verdict = judge_hold(&samples, t_final, &paper, &ours, args.criterion, tf, dir);
         println!("{}", verdict_line(&verdict));
         runs.push(verdict);
-        if search_done(&runs) {
+        if search_stops(&runs, args.all_holds) {
             break;
         }
     }
@@ -747,6 +756,8 @@ mod tests {
             assert_eq!(critical_from_verdicts(&runs, k), (Some(2.41), Some(42.0)));
         }
         assert!(search_done(&runs) && !search_done(&runs[..2]));
+        // `--all-holds` never stops early; the default stops exactly when the search is done
+        assert!(search_stops(&runs, false) && !search_stops(&runs, true) && !search_stops(&runs[..2], false));
         // a released run is never stable, under either criterion
         let mut s = hold(flat(30.0), flat(0.74), flat(9.0));
         s[50].forcing = false;

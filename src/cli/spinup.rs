@@ -53,6 +53,10 @@ pub struct CriticalArgs {
     /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
     #[arg(long, value_name = "SECONDS")]
     pub hold: Option<f64>,
+    /// Run every hold from --from to --to, also after both criteria have found a stable one (by default the
+    /// search stops one hold after that): shows whether the verdicts stay stable at slower spins.
+    #[arg(long)]
+    pub all_holds: bool,
 }
 
 /// `rubblepile spinup density-fit`.
@@ -86,6 +90,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         criterion: args.creep_criterion,
         coordination_tolerance: args.coordination_tolerance,
         hold: args.hold,
+        all_holds: args.all_holds,
     };
     run_critical(&options).map_err(cli_error)
 }
