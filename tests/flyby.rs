@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{Random, temp_dir};
+use common::{Random, rubblepile, temp_dir};
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::scene::parse_scene;
 use rubblepile::ellipsoid::tide::TideTerm;
@@ -338,11 +338,7 @@ fn flyby_command_writes_the_planet_j2() {
             out,
         ];
         args.extend_from_slice(extra);
-        std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-            .args(&args)
-            .current_dir(&dir)
-            .output()
-            .unwrap()
+        rubblepile(&dir, &args)
     };
     let out = flyby(
         &[
@@ -381,14 +377,8 @@ fn flyby_command_writes_the_planet_j2() {
 fn analyze_command_handles_flyby_runs() {
     let flyby = "[physics.flyby]\nmass = 5.9722e25\nradius = 6.371e6\nq = 9.5e6\nv_inf = 3000.0\nt_perigee = 500.0";
     let (dir, _) = run(&pile_scene(flyby, 1000.0), "flyby-analyze");
-    let analyze = |extra: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-            .arg("analyze")
-            .arg(&dir)
-            .args(extra)
-            .output()
-            .unwrap()
-    };
+    let dir_arg = dir.to_str().unwrap();
+    let analyze = |extra: &[&str]| rubblepile(&dir, &[&["analyze", dir_arg], extra].concat());
     let first = analyze(&[]);
     assert!(first.status.success(), "{}", String::from_utf8_lossy(&first.stderr));
     assert!(String::from_utf8_lossy(&first.stdout).contains("flyby: "));
