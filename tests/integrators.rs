@@ -603,3 +603,42 @@ fn bs_start_with_zero_derivative() {
     assert!(max_abs_diff(&y, &[0.5, 1.0 / 6.0]) < 1e-12);
     assert!(b.rejections().stability < 10, "{:?}", b.rejections());
 }
+
+/// y' = 1e-16 from y(0) = 1: every step's increment is below half an ulp of y (1.1e-16), so an uncompensated
+/// `y += increment` returns y = 1 exactly, however long the run.
+struct CreepBelowUlp;
+impl OdeSystem for CreepBelowUlp {
+    fn dim(&self) -> usize {
+        1
+    }
+    fn rhs(&self, _t: f64, _y: &[f64], d: &mut [f64]) {
+        d[0] = 1e-16;
+    }
+}
+
+#[test]
+fn bs_compensated_summation_keeps_increments_below_half_an_ulp() {
+    // 1000 unit steps of 1e-16 each must add up to 1e-13; without Kahan compensation of the accepted increments
+    // the state never leaves 1.0. Output times every 10 steps check that the compensation carries across calls.
+    let mut b = bs(1e-12, 1e-12, 1);
+    b.set_h_max(1.0);
+    let (mut t, mut y) = (0.0, vec![1.0]);
+    for i in 1..=100 {
+        b.advance(&CreepBelowUlp, &mut t, &mut y, 10.0 * i as f64).unwrap();
+    }
+    let gained = y[0] - 1.0;
+    assert!(b.stats().steps_accepted >= 1000, "{:?}", b.stats());
+    assert!(
+        (gained - 1e-13).abs() <= 2.0 * f64::EPSILON,
+        "gained {gained:e}, exact 1e-13"
+    );
+    // A state changed by the caller between calls starts a new compensation (nothing stale is added to it).
+    let mut y2 = vec![1.0];
+    let t_end = t + 10.0;
+    b.advance(&CreepBelowUlp, &mut t, &mut y2, t_end).unwrap();
+    assert!(
+        (y2[0] - 1.0 - 1e-15).abs() <= 2.0 * f64::EPSILON,
+        "after a new state: {:e}",
+        y2[0] - 1.0
+    );
+}

@@ -20,7 +20,7 @@
 //! Aitken–Neville tableau
 //! `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) / ((n_j / n_{j−k})² − 1)`.
 //! `T_{j,j}` has order `2j`; the error estimate of column `j` is `‖T_{j,j} − T_{j,j−1}‖` in the
-//! scaled RMS norm of [`Tolerances`] with `sc_i = atol_i + rtol_i · max(|y_i|, |T_{j,j,i}|)`.
+//! scaled RMS norm of [`Tolerances`] with `sc_i = atol_i + rtol_i · max(|y_i|, |y_i + T_{j,j,i}|)` (the tableau holds increments, see below).
 //!
 //! # Step and order control (as in ODEX)
 //!
@@ -43,6 +43,17 @@
 //! `s · rtol`, and the final error follows `rtol` (`bench tolerance`). The optimal step uses the exponent
 //! `1/(2j − 2)` of the error per unit step. At high order this costs few steps (`(T/H)^{1/(2j−2)}`, about
 //! 1.3× for 100 steps of order 16).
+//!
+//! # Increments and compensated summation (deviation from ODEX)
+//!
+//! The midpoint rule and the tableau run on the increments `d_m = z_m − y` from the step's start, not on the
+//! states: the right-hand side is called at `y + d_m`, and the step ends with `y += T_{k,k}` summed with Kahan's
+//! compensation, which carries what that addition rounded away into the next step (and into the next
+//! [`Integrator::advance`] when the caller hands the returned state back unchanged; it is saved with
+//! [`Integrator::save_state`], so a resumed run is bit-identical). Written on the states, every substep and
+//! every tableau entry rounds at `ε |y|`, and the run's error stops following `rtol` near `1e-11`: on the outer
+//! Solar System at `rtol = 1e-12` the final error was 2.6e-11 with states, 1.2e-11 with increments and 9.3e-12
+//! with increments and compensation (`bench tolerance`).
 //!
 //! # Safeguards
 //!
@@ -159,6 +170,16 @@ pub struct BulirschStoer {
     dz: Vec<f64>,
     yh1: Vec<f64>,
     yh2: Vec<f64>,
+    /// The trial state `y + yh2` handed to the right-hand side.
+    ytrial: Vec<f64>,
+    /// Compensated summation of the accepted increments: the part of the true state that the last
+    /// `y += increment` rounded away (Kahan). Added to the next increment, so rounding does not accumulate over
+    /// many steps. Empty = zero.
+    comp: Vec<f64>,
+    /// The state handed back by the last [`Integrator::advance`]; the compensation only carries into the next
+    /// call if the caller passes that state back unchanged. `None` = trust the caller's state (fresh
+    /// integrator, or restored from a saved state).
+    y_out: Option<Vec<f64>>,
     dy: Vec<f64>,
     scal: Vec<f64>,
     tab: Vec<f64>,
@@ -214,6 +235,10 @@ pub struct BulirschStoerState {
     pub stats: SavedStats,
     /// Cumulative rejections by cause.
     pub rejections: Rejections,
+    /// What compensated summation carries into the next step (length `dim`, or empty = zero; states saved before
+    /// the compensation existed have none).
+    #[serde(default, with = "exact_f64_vec")]
+    pub compensation: Vec<f64>,
 }
 
 /// Rejected steps of a [`BulirschStoer`] by cause (cumulative); their sum is
@@ -297,6 +322,9 @@ impl BulirschStoer {
             dz: Vec::new(),
             yh1: Vec::new(),
             yh2: Vec::new(),
+            ytrial: Vec::new(),
+            comp: Vec::new(),
+            y_out: None,
             dy: Vec::new(),
             scal: Vec::new(),
             tab: Vec::new(),
@@ -357,6 +385,8 @@ impl BulirschStoer {
     /// Forgets the step-size and order history: the next step starts like the first one (initial
     /// step guess, initial column count). Use after a discontinuity in the state or equations.
     pub fn reset(&mut self) {
+        self.comp.clear();
+        self.y_out = None;
         self.h = 0.0;
         self.k = self.initial_columns();
         self.reject = false;
@@ -414,6 +444,7 @@ impl BulirschStoer {
         self.dz = vec![0.0; n];
         self.yh1 = vec![0.0; n];
         self.yh2 = vec![0.0; n];
+        self.ytrial = vec![0.0; n];
         self.dy = vec![0.0; n];
         self.scal = vec![0.0; n];
         self.tab = vec![0.0; self.km * n];
@@ -424,6 +455,17 @@ impl BulirschStoer {
         for (((sc, &yi), &a), &r) in self.scal.iter_mut().zip(y).zip(&self.tol.atol).zip(&self.tol.rtol) {
             *sc = (a + r * yi.abs()).max(f64::MIN_POSITIVE);
         }
+    }
+
+    /// `dy = f(t, y + yh2)`: the derivative at the trial state whose increment from the step's start `y` is in
+    /// `yh2`.
+    fn eval_at_increment(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64]) {
+        for ((z, &yi), &d) in self.ytrial.iter_mut().zip(y).zip(&self.yh2) {
+            *z = yi + d;
+        }
+        let z = std::mem::take(&mut self.ytrial);
+        self.eval(system, t, &z, Out::Dy);
+        self.ytrial = z;
     }
 
     fn eval(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], out: Out) {
@@ -483,20 +525,13 @@ impl BulirschStoer {
         let nsub = self.nj[j] as usize;
         let hj = h / self.nj[j];
         let two_hj = 2.0 * hj;
-        // z_0 = y (yh1), z_1 = y + hj f(t, y) (yh2).
-        for ((a, b), (&yi, &fi)) in self
-            .yh1
-            .iter_mut()
-            .zip(self.yh2.iter_mut())
-            .zip(y.iter().zip(self.dz.iter()))
-        {
-            *a = yi;
-            *b = yi + hj * fi;
+        // Increments from the step's start: d_0 = 0 (yh1), d_1 = hj f(t, y) (yh2); z_m = y + d_m.
+        for ((a, b), &fi) in self.yh1.iter_mut().zip(self.yh2.iter_mut()).zip(self.dz.iter()) {
+            *a = 0.0;
+            *b = hj * fi;
         }
         for m in 1..nsub {
-            let yh2 = std::mem::take(&mut self.yh2);
-            self.eval(system, t + hj * m as f64, &yh2, Out::Dy);
-            self.yh2 = yh2;
+            self.eval_at_increment(system, t + hj * m as f64, y);
             if m == 1 && j <= STABILITY_COLUMNS {
                 let (mut del1, mut del2) = (0.0, 0.0);
                 for i in 0..n {
@@ -517,9 +552,7 @@ impl BulirschStoer {
             std::mem::swap(&mut self.yh1, &mut self.yh2);
         }
         // Smoothing step.
-        let yh2 = std::mem::take(&mut self.yh2);
-        self.eval(system, t + h, &yh2, Out::Dy);
-        self.yh2 = yh2;
+        self.eval_at_increment(system, t + h, y);
         {
             let row = &mut self.tab[(j - 1) * n..j * n];
             for (((r, &a), &b), &d) in row
@@ -550,7 +583,8 @@ impl BulirschStoer {
         {
             let (r0, r1) = self.tab.split_at(n);
             for i in 0..n {
-                let sc = (self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max(r0[i].abs())).max(f64::MIN_POSITIVE);
+                let sc =
+                    (self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max((y[i] + r0[i]).abs())).max(f64::MIN_POSITIVE);
                 sum += ((r0[i] - r1[i]) / sc).powi(2);
             }
         }
@@ -586,7 +620,7 @@ impl BulirschStoer {
     }
 
     /// One step attempt from `(t, y)` with signed step `h`; `special` selects ODEX's handling of
-    /// the first and the last step. On acceptance the new state is in `tab[0..n]` and `self.h`,
+    /// the first and the last step. On acceptance the increment `T_{k,k}` is in `tab[0..n]` and `self.h`,
     /// `self.k` hold the proposal for the next step.
     fn attempt(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], h: f64, special: bool) -> Attempt {
         self.fill_scal(y);
@@ -723,41 +757,18 @@ fn validate_tolerances(tol: &Tolerances) -> Result<(), IntegrateError> {
     Ok(())
 }
 
-impl Integrator for BulirschStoer {
-    fn advance(
+impl BulirschStoer {
+    /// The stepping loop of [`Integrator::advance`], after its checks: `y`'s dimension is the workspace's and
+    /// the compensation is set up.
+    fn advance_steps(
         &mut self,
         system: &dyn OdeSystem,
         t: &mut f64,
         y: &mut [f64],
         t_target: f64,
     ) -> Result<(), IntegrateError> {
-        let n = system.dim();
-        if y.len() != n || self.tol.rtol.len() != n {
-            return Err(IntegrateError::Config(format!(
-                "dimension mismatch: system {n}, state {}, tolerances {}",
-                y.len(),
-                self.tol.rtol.len()
-            )));
-        }
-        if !t.is_finite() || !t_target.is_finite() {
-            return Err(IntegrateError::Config(format!(
-                "times must be finite (t = {}, t_target = {t_target})",
-                *t
-            )));
-        }
-        if t_target == *t {
-            return Ok(());
-        }
-        if n == 0 {
-            *t = t_target;
-            return Ok(());
-        }
-        if !all_finite(y) {
-            return Err(IntegrateError::NonFinite { t: *t });
-        }
-        self.ensure_workspace(n);
+        let n = self.n;
         let dir = if t_target > *t { 1.0 } else { -1.0 };
-
         self.eval(system, *t, y, Out::Dz);
         if !all_finite(&self.dz) {
             return Err(IntegrateError::NonFinite { t: *t });
@@ -813,7 +824,7 @@ impl Integrator for BulirschStoer {
                         }
                         continue;
                     }
-                    y.copy_from_slice(&self.tab[..n]);
+                    self.add_increment(y);
                     self.stats.steps_accepted += 1;
                     if !(last && h_abs < saved_h) {
                         // Steps shortened only to land on an output time say nothing about stiffness.
@@ -865,6 +876,63 @@ impl Integrator for BulirschStoer {
         }
     }
 
+    /// `y += T_kk` (the accepted increment), with compensated summation over the steps (Kahan).
+    fn add_increment(&mut self, y: &mut [f64]) {
+        for ((yi, &d), c) in y.iter_mut().zip(&self.tab[..self.n]).zip(self.comp.iter_mut()) {
+            let inc = d + *c;
+            let sum = *yi + inc;
+            *c = inc - (sum - *yi);
+            *yi = sum;
+        }
+    }
+}
+
+impl Integrator for BulirschStoer {
+    fn advance(
+        &mut self,
+        system: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_target: f64,
+    ) -> Result<(), IntegrateError> {
+        let n = system.dim();
+        if y.len() != n || self.tol.rtol.len() != n {
+            return Err(IntegrateError::Config(format!(
+                "dimension mismatch: system {n}, state {}, tolerances {}",
+                y.len(),
+                self.tol.rtol.len()
+            )));
+        }
+        if !t.is_finite() || !t_target.is_finite() {
+            return Err(IntegrateError::Config(format!(
+                "times must be finite (t = {}, t_target = {t_target})",
+                *t
+            )));
+        }
+        if t_target == *t {
+            return Ok(());
+        }
+        if n == 0 {
+            *t = t_target;
+            return Ok(());
+        }
+        if !all_finite(y) {
+            return Err(IntegrateError::NonFinite { t: *t });
+        }
+        self.ensure_workspace(n);
+        if self.comp.len() != n || self.y_out.as_ref().is_some_and(|prev| prev.as_slice() != &*y) {
+            // A new state from the caller (or a new dimension): what was rounded away belongs to another state.
+            self.comp.clear();
+            self.comp.resize(n, 0.0);
+        }
+        let result = self.advance_steps(system, t, y, t_target);
+        match &mut self.y_out {
+            Some(prev) if prev.len() == n => prev.copy_from_slice(y),
+            slot => *slot = Some(y.to_vec()),
+        }
+        result
+    }
+
     fn stats(&self) -> Stats {
         self.stats
     }
@@ -895,6 +963,7 @@ impl Integrator for BulirschStoer {
             w: self.w.clone(),
             stats: self.stats.into(),
             rejections: self.rejections,
+            compensation: self.comp.clone(),
         })
     }
 
@@ -952,8 +1021,18 @@ impl Integrator for BulirschStoer {
         self.started = s.started;
         self.hh.copy_from_slice(&s.hh);
         self.w.copy_from_slice(&s.w);
+        if !(s.compensation.is_empty() || s.compensation.len() == s.dim) || !all_finite(&s.compensation) {
+            return bad(format!(
+                "compensation must be empty or have {} finite entries, got {}",
+                s.dim,
+                s.compensation.len()
+            ));
+        }
         self.stats = s.stats.into();
         self.rejections = s.rejections;
+        self.comp.clone_from(&s.compensation);
+        // The saved state is the caller's: the compensation belongs to whatever state it passes next.
+        self.y_out = None;
         Ok(())
     }
 }
