@@ -267,6 +267,16 @@ fn output_files_follow_the_contract() {
         assert!(summary["scales"][format!("{s}_definition")].is_string());
     }
     assert!(summary["steps_accepted"].as_u64().unwrap() > 0);
+    // Bulirsch–Stoer's rejections by cause add up to the rejected steps.
+    let by_cause: u64 = ["error", "stability", "divergence", "nonfinite"]
+        .iter()
+        .map(|c| {
+            summary["rejections"][c]
+                .as_u64()
+                .unwrap_or_else(|| panic!("rejections.{c}: {summary}"))
+        })
+        .sum();
+    assert_eq!(by_cause, summary["steps_rejected"].as_u64().unwrap());
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -548,6 +548,10 @@ impl Engine for EllipsoidEngine {
             t_end: scene.t_end,
             steps_accepted: stats.steps_accepted,
             steps_rejected: stats.steps_rejected,
+            rejections: match self.integrator.save_state() {
+                IntegratorState::BulirschStoer(s) => Some(s.rejections),
+                _ => None,
+            },
             rhs_evaluations: stats.rhs_evaluations,
             smallest_step: stats.smallest_step.is_finite().then_some(stats.smallest_step),
             energy_error: self.tracker.energy / scales.energy,

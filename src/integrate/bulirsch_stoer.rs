@@ -20,7 +20,8 @@
 //! Aitken–Neville tableau
 //! `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) / ((n_j / n_{j−k})² − 1)`.
 //! `T_{j,j}` has order `2j`; the error estimate of column `j` is `‖T_{j,j} − T_{j,j−1}‖` in the
-//! scaled RMS norm of [`Tolerances`] with `sc_i = atol_i + rtol_i · max(|y_i|, |y_i + T_{j,j,i}|)` (the tableau holds increments, see below).
+//! scaled RMS norm of [`Tolerances`] with `sc_i = atol_i + rtol_i · max(|y_i|, |y_i + T_{j,j,i}|)` (the
+//! tableau holds increments, see below).
 //!
 //! # Step and order control (as in ODEX)
 //!
