@@ -458,12 +458,8 @@ impl BulirschStoer {
         }
     }
 
-    /// `dy = f(t, y + yh2)`: the derivative at the trial state whose increment from the step's start `y` is in
-    /// `yh2`.
-    fn eval_at_increment(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64]) {
-        for ((z, &yi), &d) in self.ytrial.iter_mut().zip(y).zip(&self.yh2) {
-            *z = yi + d;
-        }
+    /// `dy = f(t, ytrial)`, the derivative at the trial state `y + d_m` of the midpoint rule.
+    fn eval_trial(&mut self, system: &dyn OdeSystem, t: f64) {
         let z = std::mem::take(&mut self.ytrial);
         self.eval(system, t, &z, Out::Dy);
         self.ytrial = z;
@@ -526,13 +522,20 @@ impl BulirschStoer {
         let nsub = self.nj[j] as usize;
         let hj = h / self.nj[j];
         let two_hj = 2.0 * hj;
-        // Increments from the step's start: d_0 = 0 (yh1), d_1 = hj f(t, y) (yh2); z_m = y + d_m.
-        for ((a, b), &fi) in self.yh1.iter_mut().zip(self.yh2.iter_mut()).zip(self.dz.iter()) {
+        // Increments from the step's start: d_0 = 0 (yh1), d_1 = hj f(t, y) (yh2); the trial state z_1 = y + d_1.
+        for (((a, b), z), (&yi, &fi)) in self
+            .yh1
+            .iter_mut()
+            .zip(self.yh2.iter_mut())
+            .zip(self.ytrial.iter_mut())
+            .zip(y.iter().zip(self.dz.iter()))
+        {
             *a = 0.0;
             *b = hj * fi;
+            *z = yi + *b;
         }
         for m in 1..nsub {
-            self.eval_at_increment(system, t + hj * m as f64, y);
+            self.eval_trial(system, t + hj * m as f64);
             if m == 1 && j <= STABILITY_COLUMNS {
                 let (mut del1, mut del2) = (0.0, 0.0);
                 for i in 0..n {
@@ -546,14 +549,20 @@ impl BulirschStoer {
                     return Column::Shrink(Shrink::Stability);
                 }
             }
-            // z_{m+1} = z_{m-1} + 2 hj f(z_m), stored over z_{m-1}, then swap roles.
-            for (a, &d) in self.yh1.iter_mut().zip(self.dy.iter()) {
+            // d_{m+1} = d_{m-1} + 2 hj f(z_m), stored over d_{m-1} (then swap roles), and z_{m+1} = y + d_{m+1}.
+            for ((a, z), (&yi, &d)) in self
+                .yh1
+                .iter_mut()
+                .zip(self.ytrial.iter_mut())
+                .zip(y.iter().zip(self.dy.iter()))
+            {
                 *a += two_hj * d;
+                *z = yi + *a;
             }
             std::mem::swap(&mut self.yh1, &mut self.yh2);
         }
         // Smoothing step.
-        self.eval_at_increment(system, t + h, y);
+        self.eval_trial(system, t + h);
         {
             let row = &mut self.tab[(j - 1) * n..j * n];
             for (((r, &a), &b), &d) in row
