@@ -9,13 +9,34 @@ use std::path::Path;
 /// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
 /// with `t_end`, and a time series whose wall clock reads `wall` at the end; `summary` if finished.
 fn fake_run(dir: &Path, n: usize, t_last: f64, t_end: f64, wall: f64, finished: bool) {
-    let run = dir.join("path2");
+    fake_run_at(dir, "path2", n, t_last, t_end, wall, finished, None);
+}
+
+/// [`fake_run`] into `dir/path`; with `shed_below`, b/a drops by 0.02 once the period (5 h falling to 3 h) is below it
+/// (T_c,1 there).
+#[allow(clippy::too_many_arguments)]
+fn fake_run_at(
+    dir: &Path,
+    path: &str,
+    n: usize,
+    t_last: f64,
+    t_end: f64,
+    wall: f64,
+    finished: bool,
+    shed_below: Option<f64>,
+) {
+    let run = dir.join(path);
     std::fs::create_dir_all(run.join("snapshots")).unwrap();
     let mut csv = SPINUP_HEADER.to_string();
     let mut ts = "t,step,energy_residual,angular_momentum_error,max_overlap_fraction,wall_seconds\n".to_string();
     let mut t = 0.0;
     while t <= t_last {
         let period = 5.0 - 2.0 * t / 38300.0;
+        let b = if shed_below.is_some_and(|p| period < p) {
+            382.0
+        } else {
+            390.0
+        };
         let s = SpinupSample {
             t,
             path_period_h: period,
@@ -24,9 +45,9 @@ fn fake_run(dir: &Path, n: usize, t_last: f64, t_end: f64, wall: f64, finished: 
             body_particles: n,
             body_mass_fraction: 1.0,
             a: 400.0,
-            b: 390.0,
+            b,
             c: 350.0,
-            b_over_a: 0.975,
+            b_over_a: b / 400.0,
             c_over_a: 0.875,
             packing_fraction: 0.74,
             interior_particles: n / 2,
@@ -76,7 +97,7 @@ fn full_size_section_reads_a_run_still_going() {
     fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
     fake_run(&root.join("full/hcp"), 50, 12000.0, 38300.0, 9000.0, false);
     let out = root.join("out");
-    let report = write_report(&root.join("runs"), Some(&root.join("full")), &out, false).unwrap();
+    let report = write_report(&root.join("runs"), Some(&root.join("full")), None, &out, false).unwrap();
     let md = std::fs::read_to_string(&report).unwrap();
     let section = &md[md.find("## Full size").expect("a full-size section")..];
     let row = section
@@ -92,7 +113,7 @@ fn full_size_section_reads_a_run_still_going() {
     assert!(out.join("fig5_hcp_full.svg").is_file() || out.join("fig5_hcp_full.png").is_file());
     // the command line written into the report names --full, and a second write needs force
     assert!(md.contains("--full "), "{}", &md[..400]);
-    assert!(write_report(&root.join("runs"), Some(&root.join("full")), &out, false).is_err());
+    assert!(write_report(&root.join("runs"), Some(&root.join("full")), None, &out, false).is_err());
     let _ = std::fs::remove_dir_all(&root);
 }
 
@@ -113,7 +134,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     )
     .unwrap();
     let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, &out, false).unwrap()).unwrap();
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, &out, false).unwrap()).unwrap();
     assert!(
         !md.contains("by creep criterion"),
         "old critical.json: no criterion section"
@@ -133,7 +154,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
             "ours": {"t_c3_hours": 2.64, "friction_angle_deg": 45.2}}"#,
     )
     .unwrap();
-    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, &out, true).unwrap()).unwrap();
+    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, None, &out, true).unwrap()).unwrap();
     assert!(md2.ends_with(&format!("\n\n{notes}\n")), "{}", &md2[md2.len() - 300..]);
     let section = &md2[md2.find("## T_c,3 by creep criterion").expect("criterion section")..];
     let row = section.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
@@ -155,4 +176,70 @@ fn committed_report_ends_with_the_committed_notes() {
         report.ends_with(&expected),
         "REPORT.md does not end with NOTES.md as appended"
     );
+}
+
+/// `--paths`: the paths section shows paths 1 and 3 from their own directory and path 2 from the Table 3 runs, each
+/// with its own T_c,1, beside the paper's Table 6 for HCP.
+#[test]
+fn paths_section_sets_the_three_paths_beside_table_6() {
+    let root = std::env::temp_dir().join(format!("rp_report_paths_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run_at(
+        &root.join("runs/hcp"),
+        "path2",
+        30,
+        38300.0,
+        38300.0,
+        600.0,
+        true,
+        Some(3.6),
+    );
+    fake_run_at(
+        &root.join("paths/hcp"),
+        "path1",
+        30,
+        38300.0,
+        38300.0,
+        700.0,
+        true,
+        Some(3.3),
+    );
+    fake_run_at(
+        &root.join("paths/hcp"),
+        "path3",
+        30,
+        20000.0,
+        38300.0,
+        300.0,
+        false,
+        Some(4.2),
+    );
+    let out = root.join("out");
+    let md = std::fs::read_to_string(
+        write_report(&root.join("runs"), None, Some(&root.join("paths")), &out, false).unwrap(),
+    )
+    .unwrap();
+    assert!(md.contains("--paths "), "{}", &md[..400]);
+    let section = &md[md.find("## Spin-up paths").expect("a paths section")..];
+    let rows: Vec<&str> = section.lines().filter(|l| l.starts_with("| HCP |")).collect();
+    assert_eq!(rows.len(), 3, "{section}");
+    // the first sample below the shedding period: 5 - 2 t / 38300 sampled every 200 s
+    let first_below = |p: f64| {
+        let mut t: f64 = 0.0;
+        while 5.0 - 2.0 * t / 38300.0 >= p {
+            t += 200.0;
+        }
+        format!("| {:.3} |", 5.0 - 2.0 * t / 38300.0)
+    };
+    for (row, (path, shed, paper)) in rows.iter().zip([
+        ("| 1 |", 3.3, "2.38 / 2.36 / 2.40 (Table 6)"),
+        ("| 2 |", 3.6, "2.30 / 2.27 / 2.40 (Table 6)"),
+        ("| 3 |", 4.2, "2.26 / 2.26 / 2.40 (Table 6)"),
+    ]) {
+        assert!(row.contains(path), "{row}");
+        assert!(row.contains(&first_below(shed)), "T_c1 of {path}: {row}");
+        assert!(row.contains(paper), "{row}");
+    }
+    assert!(rows[2].contains("running"), "path 3 still going: {}", rows[2]);
+    let _ = std::fs::remove_dir_all(&root);
 }

@@ -13,6 +13,7 @@ pub mod report_richardson2011_tumbler;
 pub mod report_roig2003;
 pub mod report_roig2003_kappa;
 pub mod report_zhang2017;
+pub mod report_zhang2017_paths;
 pub use crate::ellipsoid::rigid_rotation;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;

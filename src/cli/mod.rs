@@ -146,6 +146,10 @@ pub struct ReportZhang2017Args {
     /// finished or still running.
     #[arg(long, value_name = "DIR")]
     pub full: Option<PathBuf>,
+    /// Directory of spin-up path 1 and 3 runs (`<model>/path1`, `<model>/path3`, e.g. runs/zhang2017_paths), read
+    /// into a "Spin-up paths" section beside the path-2 runs and the paper's Table 6.
+    #[arg(long, value_name = "DIR")]
+    pub paths: Option<PathBuf>,
     /// Where REPORT.md and the figures go.
     #[arg(long, value_name = "DIR", default_value = "analysis/zhang2017")]
     pub out: PathBuf,
@@ -392,8 +396,14 @@ impl From<crate::bench::BenchError> for CliError {
 }
 
 fn report_zhang2017(args: &ReportZhang2017Args) -> Result<(), CliError> {
-    let path = crate::analysis::report_zhang2017::write_report(&args.runs, args.full.as_deref(), &args.out, args.force)
-        .map_err(CliError::usage)?;
+    let path = crate::analysis::report_zhang2017::write_report(
+        &args.runs,
+        args.full.as_deref(),
+        args.paths.as_deref(),
+        &args.out,
+        args.force,
+    )
+    .map_err(CliError::usage)?;
     println!("wrote {}", path.display());
     Ok(())
 }
