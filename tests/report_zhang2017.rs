@@ -214,6 +214,16 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
         false,
         Some(4.2),
     );
+    // a T_c,3 search on path 3 only
+    let crit = root.join("paths/hcp/critical_path3");
+    std::fs::create_dir_all(&crit).unwrap();
+    std::fs::write(
+        crit.join("critical.json"),
+        r#"{"t_c3_hours": 2.52, "friction_angle_deg": 44.0, "runs": [],
+            "paper": {"t_c3_hours": 2.52, "friction_angle_deg": 44.0},
+            "ours": {"t_c3_hours": 2.48, "friction_angle_deg": 46.0}}"#,
+    )
+    .unwrap();
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(&root.join("runs"), None, Some(&root.join("paths")), &out, false).unwrap(),
@@ -241,5 +251,11 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
         assert!(row.contains(paper), "{row}");
     }
     assert!(rows[2].contains("running"), "path 3 still going: {}", rows[2]);
+    assert!(rows[2].contains("| 2.52 / 2.48 |"), "path 3's T_c,3: {}", rows[2]);
+    assert!(
+        rows[0].contains("| – (not searched) |"),
+        "path 1 has no search: {}",
+        rows[0]
+    );
     let _ = std::fs::remove_dir_all(&root);
 }

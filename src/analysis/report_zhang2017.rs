@@ -252,7 +252,8 @@ pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crat
     path_row(model_dir, "path2")
 }
 
-/// Reads the run `RUNS/<model>/<path>` (e.g. `path1`, `path3`) and the model's T_c,3 search.
+/// Reads the run `RUNS/<model>/<path>` (e.g. `path1`, `path3`) and the T_c,3 search on that path
+/// (`critical/` for path 2, `critical_<path>/` for the others).
 pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
     let model = model_dir
         .file_name()
@@ -285,7 +286,13 @@ pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSam
         &col(|s| s.packing_fraction),
         window,
     );
-    let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join("critical/critical.json"))
+    // the T_c,3 search of path 2 is `critical/`, that of another path `critical_<path>/`
+    let search = if path == "path2" {
+        "critical".to_string()
+    } else {
+        format!("critical_{path}")
+    };
+    let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join(search).join("critical.json"))
         .ok()
         .and_then(|s| serde_json::from_str(&s).ok());
     let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());

@@ -31,7 +31,8 @@ fn paper(model: &str, path: usize) -> String {
 }
 
 /// Appends the section: one row per path for every model under `paths` with a `path1` or `path3` run (path 2 is
-/// read from `runs/<model>/path2`, the run of the Table 3 section). A run still going is read as far as it got.
+/// read from `runs/<model>/path2`, the run of the Table 3 section), with the T_c,3 search of that path where one
+/// was made (`critical_path1/`, `critical/`, `critical_path3/`). A run still going is read as far as it got.
 pub fn write_paths_section(md: &mut String, runs: &Path, paths: &Path) -> Result<(), String> {
     let mut models: Vec<_> = std::fs::read_dir(paths)
         .map_err(|e| format!("{}: {e}", paths.display()))?
@@ -61,11 +62,11 @@ pub fn write_paths_section(md: &mut String, runs: &Path, paths: &Path) -> Result
     );
     let _ = writeln!(
         md,
-        "| model | path | T_c1 (h) | T_c2 (h) | smoothed T_c1/T_c2 | failure mode | status | simulated / t_end (s) | wall (s) | largest overlap / radius | paper T_c1 / T_c2 / T_c3 (h) |"
+        "| model | path | T_c1 (h) | T_c2 (h) | smoothed T_c1/T_c2 | T_c3 (h), paper's / our creep criterion | failure mode | status | simulated / t_end (s) | wall (s) | largest overlap / radius | paper T_c1 / T_c2 / T_c3 (h) |"
     );
     let _ = writeln!(
         md,
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     for m in &models {
         let name = m
@@ -80,13 +81,17 @@ pub fn write_paths_section(md: &mut String, runs: &Path, paths: &Path) -> Result
             let (r, _) = path_row(&dir, path).map_err(|e| e.to_string())?;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {}/{} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
+                "| {} | {} | {} | {} | {}/{} | {} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
                 name.to_uppercase(),
                 k + 1,
                 opt(r.limits.t_c1_hours, 3),
                 opt(r.limits.t_c2_hours, 3),
                 opt(r.limits_smoothed.t_c1_hours, 3),
                 opt(r.limits_smoothed.t_c2_hours, 3),
+                match r.t_c3_by_criterion {
+                    Some([paper, ours]) => format!("{} / {}", opt(paper.0, 2), opt(ours.0, 2)),
+                    None => "– (not searched)".into(),
+                },
                 mode(r.limits.failure_mode),
                 r.status,
                 r.final_time,
