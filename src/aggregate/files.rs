@@ -67,11 +67,14 @@ pub fn read_aggregate_csv(path: &Path) -> Result<Vec<Particle>, AggregateError> 
         .collect())
 }
 
-/// The bulk-density variant of the aggregate at `input_csv` (its report must be beside it): same positions and
-/// radii, masses scaled so that the bulk density becomes `bulk_density` (kg/m³). Returns the particles, the
-/// updated report and the mass factor.
+/// The bulk-density variant of the aggregate at `input_csv`: same positions, radii and velocities, masses scaled
+/// so that the bulk density becomes `bulk_density` (kg/m³). The body's shape volume comes from the aggregate's
+/// report, `report_json` or by default the `NAME.json` beside the CSV (a settled snapshot of an aggregate has
+/// none: name the report of the aggregate it was settled from). Returns the particles, the updated report and
+/// the mass factor.
 pub fn density_variant(
     input_csv: &Path,
+    report_json: Option<&Path>,
     bulk_density: f64,
 ) -> Result<(Vec<Particle>, AggregateReport, f64), AggregateError> {
     if !(bulk_density.is_finite() && bulk_density > 0.0) {
@@ -80,8 +83,9 @@ pub fn density_variant(
             format!("a positive density in kg/m³, got {bulk_density}"),
         ));
     }
-    let json_in = report_path(input_csv);
-    let bad = |e: String| input("--input", format!("{}: {e}", json_in.display()));
+    let json_in = report_json.map_or_else(|| report_path(input_csv), Path::to_path_buf);
+    let field = if report_json.is_some() { "--report" } else { "--input" };
+    let bad = |e: String| input(field, format!("{}: {e}", json_in.display()));
     let text = std::fs::read_to_string(&json_in).map_err(|e| bad(e.to_string()))?;
     let old: AggregateReport = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let mut particles = read_aggregate_csv(input_csv)?;
@@ -94,9 +98,10 @@ pub fn density_variant(
         total_mass_kg: total,
         bulk_density_kg_m3: total / old.shape_volume_m3,
         notes: format!(
-            "{}; bulk-density variant of {} (masses × {factor})",
+            "{}; bulk-density variant of {} (masses × {factor}){}",
             old.notes,
-            input_csv.display()
+            input_csv.display(),
+            report_json.map_or(String::new(), |r| format!("; shape volume from {}", r.display()))
         ),
         ..old
     };

@@ -68,9 +68,14 @@ pub struct BuildArgs {
 /// `rubblepile aggregate density`.
 #[derive(Debug, clap::Args)]
 pub struct DensityArgs {
-    /// An aggregate written by `aggregate build` (its NAME.json must be beside it).
+    /// An aggregate written by `aggregate build` (its NAME.json must be beside it), or a snapshot of one (with
+    /// `--report`).
     #[arg(long, value_name = "FILE.csv")]
     pub input: PathBuf,
+    /// The aggregate's report (`NAME.json` of `aggregate build`) when it is not beside `--input`, e.g. for a
+    /// settled snapshot: its shape volume sets the bulk density.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
     /// New bulk density (kg/m³).
     #[arg(long)]
     pub bulk_density: f64,
@@ -206,7 +211,8 @@ fn build_progress() -> impl FnMut(BuildProgress<'_>) {
 
 /// Runs `aggregate density`.
 pub fn density_cmd(args: &DensityArgs) -> Result<(), CliError> {
-    let (particles, report, factor) = density_variant(&args.input, args.bulk_density).map_err(cli_error)?;
+    let (particles, report, factor) =
+        density_variant(&args.input, args.report.as_deref(), args.bulk_density).map_err(cli_error)?;
     check_outputs(&args.out, args.force).map_err(cli_error)?;
     write_aggregate(&args.out, &particles, &report).map_err(cli_error)?;
     println!(
