@@ -214,6 +214,16 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
         false,
         Some(4.2),
     );
+    fake_run_at(
+        &root.join("paths/hcp_rho2309"),
+        "path3",
+        30,
+        38300.0,
+        38300.0,
+        300.0,
+        true,
+        Some(4.0),
+    );
     // a T_c,3 search on path 3 only
     let crit = root.join("paths/hcp/critical_path3");
     std::fs::create_dir_all(&crit).unwrap();
@@ -257,5 +267,11 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
         "path 1 has no search: {}",
         rows[0]
     );
+    // a density variant of HCP is set beside its own Table 6 row
+    let variant = section
+        .lines()
+        .find(|l| l.starts_with("| HCP_RHO2309 | 3 |"))
+        .expect("the 2309 kg/m³ variant's path 3");
+    assert!(variant.contains("2.26 / 2.26 / 2.29 (Table 6)"), "{variant}");
     let _ = std::fs::remove_dir_all(&root);
 }

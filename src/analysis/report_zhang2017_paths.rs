@@ -1,6 +1,6 @@
 //! The spin-up-path section of the Zhang17 report (Zhang et al. 2017, Table 5 paths, §4.3, Table 6): T_c,1 and
-//! T_c,2 of one model spun up along paths 1, 2 and 3, beside the paper's Table 6 (HCP at 2100 kg/m³; its other
-//! rows are density variants and PP2).
+//! T_c,2 of one model spun up along paths 1, 2 and 3, beside the paper's Table 6 (HCP at 2100, 2208 and
+//! 2309 kg/m³; its PP2 rows are not carried, PP2 is not built).
 //!
 //! The paths differ only in how fast the spin period is driven from its intermediate value `T_inter` to 2.26 h:
 //! path 1 (3 h, six stages with five rests of 7000 s, 320 000 s), path 2 (3 h → 2.26 h by 32 000 s) and path 3
@@ -15,14 +15,26 @@ use crate::analysis::report_zhang2017::{mode, opt, path_row, t_end_of};
 /// The spin-up paths, by the run directory's name.
 pub const PATHS: [&str; 3] = ["path1", "path2", "path3"];
 
-/// Zhang17 Table 6, HCP at ρ_B = 2100 kg/m³: T_c,1, T_c,2, T_c,3 (h) for paths 1, 2 and 3.
-pub const TABLE6_HCP_2100: [[f64; 3]; 3] = [[2.38, 2.36, 2.40], [2.30, 2.27, 2.40], [2.26, 2.26, 2.40]];
+/// Zhang17 Table 6 for HCP: the run directory's model name (`hcp` at 2100 kg/m³, `hcp_rho<ρ_B>` for the density
+/// variants) and T_c,1, T_c,2, T_c,3 (h) for paths 1, 2 and 3.
+pub const TABLE6_HCP: [(&str, [[f64; 3]; 3]); 3] = [
+    ("hcp", [[2.38, 2.36, 2.40], [2.30, 2.27, 2.40], [2.26, 2.26, 2.40]]),
+    (
+        "hcp_rho2208",
+        [[2.35, 2.28, 2.36], [2.26, 2.26, 2.36], [2.26, 2.26, 2.36]],
+    ),
+    (
+        "hcp_rho2309",
+        [[2.27, 2.26, 2.29], [2.26, 2.26, 2.29], [2.26, 2.26, 2.29]],
+    ),
+];
 
-/// The paper's values of one model and path: Table 6 for HCP; Table 3 (path 1 only) for the others.
+/// The paper's values of one model and path: Table 6 for HCP and its density variants; Table 3 (path 1 only) for
+/// the others.
 fn paper(model: &str, path: usize) -> String {
     let fmt = |v: [f64; 3]| format!("{:.2} / {:.2} / {:.2}", v[0], v[1], v[2]);
-    if model == "hcp" {
-        return format!("{} (Table 6)", fmt(TABLE6_HCP_2100[path]));
+    if let Some((_, rows)) = TABLE6_HCP.iter().find(|r| r.0 == model) {
+        return format!("{} (Table 6)", fmt(rows[path]));
     }
     match crate::analysis::report_zhang2017::TABLE3.iter().find(|r| r.0 == model) {
         Some(r) if path == 0 => format!("{} (Table 3)", fmt([r.3, r.4, r.5])),
