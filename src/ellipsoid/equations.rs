@@ -20,8 +20,8 @@ use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
 use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
-use crate::ellipsoid::gravity_tree::tree_gravity_forces;
 pub use crate::ellipsoid::gravity_tree::{GravityMethod, TREE_FROM};
+use crate::ellipsoid::gravity_tree::{frozen_tree_gravity_forces, tree_gravity_forces};
 use crate::ellipsoid::potential::{
     BodyGeometry, TAPER_WIDTH, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
     overlap, overlap_within_taper,
@@ -32,6 +32,7 @@ use crate::ellipsoid::quaternion::{
 };
 use crate::ellipsoid::tide::TideTerm;
 use crate::geometry::neighbours::sphere_pairs;
+use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::integrate::OdeSystem;
 use crate::math::{Mat4, Vec3, Vec4};
 use rayon::prelude::*;
@@ -273,6 +274,10 @@ pub struct EllipsoidSystem {
     pair_cache: std::sync::Mutex<Option<PairCache>>,
     /// Buffers reused by [`OdeSystem::rhs`] (an evaluation that finds them in use allocates its own).
     scratch: std::sync::Mutex<RhsScratch>,
+    /// Tree gravity's interaction lists, fixed at the state of the step being taken
+    /// ([`OdeSystem::begin_step`]) so that the tree's forces are smooth within the step; `None` (no integrator
+    /// calls `begin_step`, or no tree gravity): every evaluation walks a fresh tree.
+    gravity_lists: std::sync::Mutex<Option<FrozenOctree>>,
     /// Body masses (kg), contiguous for the gravity sums.
     masses: Vec<f64>,
     /// A planet on a prescribed orbit ([`EllipsoidSystem::with_tide`]); `None`: no tide computed.
@@ -335,6 +340,7 @@ impl EllipsoidSystem {
             cull_exp: max_cull_exponent(model.kappa, cutoff),
             pair_cache: std::sync::Mutex::new(None),
             scratch: std::sync::Mutex::new(RhsScratch::default()),
+            gravity_lists: std::sync::Mutex::new(None),
             masses: bodies.iter().map(|b| b.shape.mass).collect(),
             tide: None,
         }
@@ -377,8 +383,10 @@ impl EllipsoidSystem {
         self.rotation
     }
 
-    /// Whether the forces are smooth functions of the state: false when gravity is summed by the tree, whose
-    /// forces jump where an interaction list changes (see [`crate::ellipsoid::gravity_tree`]).
+    /// Whether the forces are smooth functions of the state under every integrator: false when gravity is
+    /// summed by the tree, whose forces jump where an interaction list changes (see
+    /// [`crate::ellipsoid::gravity_tree`]). Under an integrator that calls [`OdeSystem::begin_step`]
+    /// (Bulirsch–Stoer) the lists are fixed per step and the forces are smooth within each step.
     pub fn forces_are_smooth(&self) -> bool {
         let n = self.n_bodies();
         self.physics.gravity.is_none_or(|g| g.method.tree_theta(n).is_none())
@@ -822,6 +830,24 @@ impl OdeSystem for EllipsoidSystem {
         Some(units)
     }
 
+    /// With tree gravity: builds the tree at `y` and fixes its interaction lists for the step (see
+    /// [`FrozenOctree`]); the step's evaluations sum those lists, so its forces are smooth in the state and
+    /// the lists change only from one step to the next. The lists are a function of `y` alone, so a resumed
+    /// run repeats them.
+    fn begin_step(&self, _t: f64, y: &[f64]) {
+        let n = self.n_bodies();
+        let Some(theta) = self.physics.gravity.and_then(|gr| gr.method.tree_theta(n)) else {
+            return;
+        };
+        let positions: Vec<Vec3> = y
+            .chunks_exact(self.stride)
+            .take(n)
+            .map(|b| Vec3::new(b[0], b[1], b[2]))
+            .collect();
+        let frozen = Octree::build(&positions, &self.masses).freeze(theta);
+        *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(frozen);
+    }
+
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {
         let tide = self.tide.map(|tide| (tide, tide.planet_position(t)));
         let n = self.n_bodies();
@@ -898,7 +924,11 @@ impl OdeSystem for EllipsoidSystem {
         let mut gravity_pass = || match (blocked_gravity, tree_theta) {
             (Some(gr), Some(theta)) => {
                 gravity.resize_with(1, Vec::new);
-                tree_gravity_forces(gr.g, theta, positions, &self.masses, &mut gravity[0]);
+                let mut lists = self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner());
+                match lists.as_mut().filter(|t| t.len() == n) {
+                    Some(frozen) => frozen_tree_gravity_forces(gr.g, frozen, positions, &self.masses, &mut gravity[0]),
+                    None => tree_gravity_forces(gr.g, theta, positions, &self.masses, &mut gravity[0]),
+                };
             }
             (Some(gr), None) => gravity_blocks(gr.g, positions, &self.masses, gravity),
             (None, _) => gravity.clear(),

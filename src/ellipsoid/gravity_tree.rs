@@ -12,7 +12,7 @@
 //! there on: the threshold and [`DEFAULT_THETA`] are measured (`rubblepile bench rhs --gravity direct,tree`,
 //! and the RMS error test `tests/ellipsoid_gravity_tree.rs`).
 
-use crate::gravity::octree::Octree;
+use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::math::Vec3;
 
 /// Default opening angle θ (dimensionless): on a 2000-ellipsoid jittered lattice (`bench rhs`'s packing) the
@@ -23,9 +23,11 @@ pub const DEFAULT_THETA: f64 = 0.5;
 
 /// Bodies from which [`GravityMethod::Auto`] uses the tree. Below it the exact blocked pair sum costs at most
 /// about what the tree saves (2000 bodies: 49 ms against 43 ms per RHS; 10 000: 725 against 254 ms, see
-/// `analysis/n2000/REPORT.md`), and it keeps the forces smooth: the tree's jump where interaction lists change,
-/// which costs a run its error-per-unit-step control (see [`crate::ellipsoid::run`]). The N2000 impact at
-/// rtol 1e-6 broke its quaternion constraint with the tree and ran with the exact sum.
+/// `analysis/n2000/REPORT.md`), and it is exactly pairwise. The tree's forces jump where interaction lists
+/// change; under Bulirsch–Stoer the lists are fixed per step ([`crate::gravity::octree::FrozenOctree`]), so a
+/// tree run keeps its error-per-unit-step control, but at 2000 bodies the frozen tree, summed in double
+/// precision, was slower than the exact sum (18.6 s against 13.3 s of wall for the first 90 s of the N2000
+/// impact) and left an energy error of 1e-7 where the exact sum left 4e-12.
 pub const TREE_FROM: usize = 5000;
 
 /// Largest opening angle accepted (dimensionless): above `2/√3` a node could be used whole for a point inside
@@ -81,6 +83,22 @@ impl GravityMethod {
 /// in m, masses in kg.
 pub fn tree_gravity_forces(g: f64, theta: f64, positions: &[Vec3], masses: &[f64], forces: &mut Vec<Vec3>) -> f64 {
     let (acc, phi) = Octree::build(positions, masses).accelerations(theta, g);
+    forces.clear();
+    forces.extend(acc.iter().zip(masses).map(|(a, m)| a * *m));
+    0.5 * phi.iter().zip(masses).map(|(p, m)| p * m).sum::<f64>()
+}
+
+/// The same as [`tree_gravity_forces`] by the lists of a [`FrozenOctree`] (built from these bodies, in this
+/// order), summed at `positions` in double precision: smooth in the positions while the lists are kept (see
+/// [`crate::ellipsoid::equations::EllipsoidSystem`]'s `begin_step`).
+pub fn frozen_tree_gravity_forces(
+    g: f64,
+    tree: &mut FrozenOctree,
+    positions: &[Vec3],
+    masses: &[f64],
+    forces: &mut Vec<Vec3>,
+) -> f64 {
+    let (acc, phi) = tree.accelerations(positions, masses, g);
     forces.clear();
     forces.extend(acc.iter().zip(masses).map(|(a, m)| a * *m));
     0.5 * phi.iter().zip(masses).map(|(p, m)| p * m).sum::<f64>()

@@ -779,6 +779,7 @@ impl BulirschStoer {
     ) -> Result<(), IntegrateError> {
         let n = self.n;
         let dir = if t_target > *t { 1.0 } else { -1.0 };
+        system.begin_step(*t, y);
         self.eval(system, *t, y, Out::Dz);
         if !all_finite(&self.dz) {
             return Err(IntegrateError::NonFinite { t: *t });
@@ -852,6 +853,7 @@ impl BulirschStoer {
                     }
                     *t += dir * h_abs;
                     clean = true;
+                    system.begin_step(*t, y);
                     self.eval(system, *t, y, Out::Dz);
                     if !all_finite(&self.dz) {
                         return Err(IntegrateError::NonFinite { t: *t });
