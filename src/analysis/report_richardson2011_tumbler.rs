@@ -40,8 +40,16 @@ pub fn lining_froude(run: &TumblerRun) -> f64 {
     run.froude * (run.radius - 2.0 * run.particle_radius) / run.radius
 }
 
+/// The run's restitution, and "smooth drum" when no particle is stuck to the wall (Richardson11 §3.2's aside:
+/// the drum then drives the bed by its surface friction alone), so that such runs get series of their own.
 fn restitution_label(run: &TumblerRun) -> String {
-    format!("ε_n = {}, ε_t = {}", run.restitution.0, run.restitution.1)
+    drum_label(run.restitution, run.stuck)
+}
+
+/// [`restitution_label`] of restitution `(ε_n, ε_t)` with `stuck` particles on the wall.
+fn drum_label(restitution: (f64, f64), stuck: usize) -> String {
+    let drum = if stuck == 0 { ", smooth drum" } else { "" };
+    format!("ε_n = {}, ε_t = {}{drum}", restitution.0, restitution.1)
 }
 
 fn angle_chart(runs: &[TumblerRun]) -> LineChart {
@@ -219,4 +227,18 @@ pub fn write_tumbler_paper_report(args: &TumblerPaperArgs) -> Result<PathBuf, An
     std::fs::write(&path, tumbler_paper_markdown(&runs, &command))
         .map_err(|e| AnalysisError::Output(format!("{}: {e}", path.display())))?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::drum_label;
+
+    /// A smooth drum (no lining) at the same restitution is labelled apart, so the angle chart never pools it
+    /// with lined drums (their angles differ by 28°: NOTES row 20).
+    #[test]
+    fn smooth_drum_runs_are_not_pooled_with_lined_ones() {
+        assert_ne!(drum_label((0.8, 0.8), 0), drum_label((0.8, 0.8), 182));
+        assert_eq!(drum_label((0.8, 0.8), 182), drum_label((0.8, 0.8), 568));
+        assert!(drum_label((0.8, 0.8), 0).contains("smooth drum"));
+    }
 }
