@@ -45,7 +45,14 @@ fn every_zhang2017_scene_loads() {
         assert!(!scene.particles.is_empty(), "{name}");
     }
     // the targets that must be committed for the runs behind REPORT.md
-    for name in ["hcp_path2.toml", "rcp_path2.toml", "rcpc_path2.toml", "pp1_path2.toml"] {
+    for name in [
+        "hcp_path2.toml",
+        "rcp_path2.toml",
+        "rcpc_path2.toml",
+        "pp1_path2.toml",
+        "pp2_path2.toml",
+        "ppc_path2.toml",
+    ] {
         assert!(load(name).1, "{name}: its target is not in the repository");
     }
 }
