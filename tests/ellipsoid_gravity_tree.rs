@@ -276,9 +276,8 @@ fn frozen_tree_lists_let_bulirsch_stoer_keep_the_run_budget() {
         )
     };
     let (done, steps, energy) = run(&sys, 100_000);
-    // A system of its own: `sys` now holds the lists of the frozen run's last step.
-    let unfrozen = EllipsoidSystem::new(&s.bodies, s.model, s.physics);
-    let (fresh_done, fresh_steps, _) = run(&FreshWalks(&unfrozen), 10 * steps);
+    // After the advance `sys` holds no lists (`end_steps`), so the wrapper walks fresh trees.
+    let (fresh_done, fresh_steps, _) = run(&FreshWalks(&sys), 10 * steps);
     println!(
         "frozen lists: {steps} steps, energy error {energy:.2e}; fresh walks: {fresh_steps} steps, done {fresh_done}"
     );

@@ -275,8 +275,9 @@ pub struct EllipsoidSystem {
     /// Buffers reused by [`OdeSystem::rhs`] (an evaluation that finds them in use allocates its own).
     scratch: std::sync::Mutex<RhsScratch>,
     /// Tree gravity's interaction lists, fixed at the state of the step being taken
-    /// ([`OdeSystem::begin_step`]) so that the tree's forces are smooth within the step; `None` (no integrator
-    /// calls `begin_step`, or no tree gravity): every evaluation walks a fresh tree.
+    /// ([`OdeSystem::begin_step`]) so that the tree's forces are smooth within the step; `None` (outside an
+    /// integrator's advance, under an integrator that does not call `begin_step`, or without tree gravity):
+    /// every evaluation walks a fresh tree.
     gravity_lists: std::sync::Mutex<Option<FrozenOctree>>,
     /// Body masses (kg), contiguous for the gravity sums.
     masses: Vec<f64>,
@@ -846,6 +847,11 @@ impl OdeSystem for EllipsoidSystem {
             .collect();
         let frozen = Octree::build(&positions, &self.masses).freeze(theta);
         *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(frozen);
+    }
+
+    /// Drops the lists of [`OdeSystem::begin_step`]: later evaluations walk fresh trees until the next step.
+    fn end_steps(&self) {
+        *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = None;
     }
 
     fn rhs(&self, t: f64, y: &[f64], dydt: &mut [f64]) {

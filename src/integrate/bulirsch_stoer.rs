@@ -938,6 +938,7 @@ impl Integrator for BulirschStoer {
             self.comp.resize(n, 0.0);
         }
         let result = self.advance_steps(system, t, y, t_target);
+        system.end_steps();
         match &mut self.y_out {
             Some(prev) if prev.len() == n => prev.copy_from_slice(y),
             slot => *slot = Some(y.to_vec()),

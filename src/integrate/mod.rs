@@ -30,12 +30,17 @@ pub trait OdeSystem: Sync {
     fn state_units(&self) -> Option<Vec<f64>> {
         None
     }
-    /// Called by an integrator with the state `y` at time `t` from which it is about to take a step (and retry
-    /// it after a rejection), before that step's first evaluation. A system may fix here any discrete choice
-    /// its right-hand side makes (which tree nodes are used whole), so that `f` is a smooth function of the
-    /// state within the step and the choice changes only between steps. [`bulirsch_stoer`] calls it; the
-    /// `ode_solvers` methods cannot, and a system must then keep working without it. Default: nothing.
+    /// Called by an integrator with the state `y` at time `t` from which it is about to take a step, before
+    /// that step's first evaluation (once per step: retries after a rejection start from the same state and
+    /// keep the choice). A system may fix here any discrete choice its right-hand side makes (which tree nodes
+    /// are used whole), so that `f` is a smooth function of the state within the step and the choice changes
+    /// only between steps. [`bulirsch_stoer`] calls it; the `ode_solvers` methods cannot, and a system must
+    /// then keep working without it. Default: nothing.
     fn begin_step(&self, _t: f64, _y: &[f64]) {}
+    /// Called by an integrator that calls [`OdeSystem::begin_step`] when it returns from an advance (whether it
+    /// reached its target or failed): the system drops the choice, so that evaluations outside the integrator
+    /// (diagnostics, another integrator) do not keep it. Default: nothing.
+    fn end_steps(&self) {}
 }
 
 /// Which integrator runs a system (the scene's `[integrator] method`).
