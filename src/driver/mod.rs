@@ -30,6 +30,7 @@ pub mod convert;
 pub mod export;
 pub mod formats;
 pub mod kind;
+pub mod warm_pool;
 
 use std::fs::File;
 use std::io::{IsTerminal, Write};
@@ -577,19 +578,20 @@ fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> 
     std::fs::write(path, text + "\n")
 }
 
-/// The sampling loop shared by [`run`] and [`resume`].
 /// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
 /// worker). An engine's parallel passes are then forked from inside the pool; forked from outside it, every pass
 /// is injected into the pool and the caller sleeps until it ends, which cost 45 µs per right-hand side of the
-/// N200 impact on two threads (212 against 167 µs).
+/// N200 impact on two threads (212 against 167 µs). The pool's other workers stay awake for the run
+/// ([`warm_pool::with_warm_workers`]).
 fn on_pool<R: Send>(op: impl FnOnce() -> R + Send) -> R {
     if rayon::current_thread_index().is_some() {
-        op()
+        warm_pool::with_warm_workers(op)
     } else {
-        rayon::scope(|_| op())
+        rayon::scope(|_| warm_pool::with_warm_workers(op))
     }
 }
 
+/// The sampling loop shared by [`run`] and [`resume`].
 fn drive<E: Engine>(
     engine: &mut E,
     out_dir: &Path,
