@@ -899,12 +899,14 @@ impl OdeSystem for EllipsoidSystem {
             force,
             torque,
         } = scratch;
-        self.kinematics_into(y, self.needs_pairs(), kin);
-        let kin = &*kin;
+        // Gravity needs only the positions, read straight from the state, so its pass runs beside the
+        // kinematics and the pairs: the other worker sums gravity while this one computes the kinematics.
         positions.clear();
-        positions.extend(kin.iter().map(|k| k.r));
+        positions.extend((0..n).map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])));
         let mut dissipation_rate = 0.0;
         let mut pairs = || {
+            self.kinematics_into(y, self.needs_pairs(), kin);
+            let kin = &*kin;
             force.clear();
             force.resize(n, Vec3::zeros());
             torque.clear();
@@ -948,7 +950,7 @@ impl OdeSystem for EllipsoidSystem {
         if let (Some(gr), None) = (self.physics.gravity, blocked_gravity) {
             add_gravity_forces(gr.g, positions, &self.masses, force);
         }
-        let (force, torque, gravity) = (&*force, &*torque, &*gravity);
+        let (kin, force, torque, gravity) = (&*kin, &*force, &*torque, &*gravity);
         let stride = self.stride;
         let rotation = self.rotation;
         let body_rate = |(i, out): (usize, &mut [f64])| {
