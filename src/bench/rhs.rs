@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::BenchError as CliError;
+use crate::driver::warm_pool::with_warm_workers;
 use crate::ellipsoid::cloud::{CloudParams, random_cloud};
 use crate::ellipsoid::equations::{
     ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, PairCensus, Physics,
@@ -83,16 +84,19 @@ pub fn time_rhs(
         .map_err(|e| format!("cannot build a pool of {threads} threads: {e}"))?;
     let y = system.initial_state();
     let mut dydt = vec![0.0; system.dim()];
+    // Timed as a run evaluates it: on a pool whose other workers are kept polling (`with_warm_workers`).
     let mut samples = pool.install(|| {
-        system.rhs(0.0, &y, &mut dydt);
-        (0..repeats)
-            .map(|_| {
-                let start = Instant::now();
-                system.rhs(0.0, std::hint::black_box(&y), &mut dydt);
-                std::hint::black_box(&dydt);
-                start.elapsed().as_secs_f64() * 1e6
-            })
-            .collect::<Vec<f64>>()
+        with_warm_workers(|| {
+            system.rhs(0.0, &y, &mut dydt);
+            (0..repeats)
+                .map(|_| {
+                    let start = Instant::now();
+                    system.rhs(0.0, std::hint::black_box(&y), &mut dydt);
+                    std::hint::black_box(&dydt);
+                    start.elapsed().as_secs_f64() * 1e6
+                })
+                .collect::<Vec<f64>>()
+        })
     });
     samples.sort_by(f64::total_cmp);
     let n = samples.len();
