@@ -882,9 +882,10 @@ impl OdeSystem for EllipsoidSystem {
             }
             return;
         }
-        // Three parallel passes: the kinematics; the pair terms, summed per body in candidate order, beside the
-        // gravity blocks (both need only the kinematics); per body, the gravity blocks added in block order and the
-        // body's rates. The sums are those of a serial evaluation, whatever the number of threads.
+        // Two parallel branches, then one pass: the kinematics followed by the pair terms (summed per body in
+        // candidate order), beside the gravity blocks (which need only the positions); then per body, the gravity
+        // blocks added in block order and the body's rates. The sums are those of a serial evaluation, whatever
+        // the number of threads.
         let mut own = None;
         let mut guard = self.scratch.try_lock().ok();
         let scratch: &mut RhsScratch = match guard.as_deref_mut() {
@@ -899,8 +900,8 @@ impl OdeSystem for EllipsoidSystem {
             force,
             torque,
         } = scratch;
-        // Gravity needs only the positions, read straight from the state, so its pass runs beside the
-        // kinematics and the pairs: the other worker sums gravity while this one computes the kinematics.
+        // Read straight from the state, so that the gravity pass need not wait for the kinematics: the other
+        // worker sums gravity while this one computes the kinematics.
         positions.clear();
         positions.extend((0..n).map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])));
         let mut dissipation_rate = 0.0;
