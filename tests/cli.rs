@@ -482,7 +482,8 @@ fn bench_rhs_writes_csv_and_plot() {
 }
 
 /// `bench rhs --targets` times a relaxed pile (its N from the file, its κ from `FILE.json`) in rows labelled by
-/// the file's stem, and a target without its report is refused naming the flag.
+/// the file's stem, also with a Bulirsch–Stoer step's frozen tree lists (`tree-step`), and a target without its
+/// report is refused naming the flag.
 #[test]
 fn bench_rhs_times_relaxed_targets() {
     let dir = temp_dir("bench_targets");
@@ -498,15 +499,15 @@ fn bench_rhs_times_relaxed_targets() {
         "--threads",
         "1",
         "--gravity",
-        "auto,none",
+        "auto,none,tree-step",
         "--out",
         "b",
     ];
     assert_ok(&rubblepile(&dir, &args), "bench --targets");
     let csv = read(&dir.join("b/bench_rhs.csv"));
     let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
-    assert_eq!(rows.len(), 2, "{csv}");
-    for (row, gravity) in rows.iter().zip(["auto", "none"]) {
+    assert_eq!(rows.len(), 3, "{csv}");
+    for (row, gravity) in rows.iter().zip(["auto", "none", "tree-step"]) {
         assert_eq!(
             (row[0], row[1], row[4], row[5], row[6]),
             ("30", "1", "2", gravity, "N30_T4"),
@@ -520,6 +521,7 @@ fn bench_rhs_times_relaxed_targets() {
         );
     }
     assert_eq!(rows[0][7..], rows[1][7..], "{csv}");
+    assert_eq!(rows[0][7..], rows[2][7..], "{csv}");
     std::fs::copy(target, dir.join("lonely.csv")).unwrap();
     let out = rubblepile(&dir, &["bench", "rhs", "--targets", "lonely.csv", "--repeats", "1"]);
     assert_eq!(out.status.code(), Some(2));

@@ -42,9 +42,11 @@ pub struct RhsArgs {
     #[arg(long, value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Option<u64>,
     /// Gravity methods to time, comma-separated: `auto` (exact below 5000 bodies, tree from there on),
-    /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`), `none` (no gravity: contact and dissipation
-    /// only, so that the pair work is timed alone).
-    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree", "none"])]
+    /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`, walked afresh at every evaluation, as the
+    /// `ode_solvers` methods use it), `tree-step` (the same octree with its interaction lists fixed at the timed
+    /// state, as every evaluation of a Bulirsch–Stoer step sums them; the lists are found once per step, untimed),
+    /// `none` (no gravity: contact and dissipation only, so that the pair work is timed alone).
+    #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree", "tree-step", "none"])]
     pub gravity: Vec<String>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]).
     #[arg(long, default_value_t = crate::ellipsoid::gravity_tree::DEFAULT_THETA)]
@@ -72,11 +74,13 @@ pub struct RhsTiming {
 }
 
 /// Times `repeats` RHS evaluations of `system` at its initial state on a pool of `threads` threads
-/// (after one untimed warm-up evaluation).
+/// (after one untimed warm-up evaluation). With `step_lists`, the evaluations are those of one Bulirsch–Stoer
+/// step: [`OdeSystem::begin_step`] is called first (untimed), so tree gravity sums the step's frozen lists.
 pub fn time_rhs(
     system: &EllipsoidSystem,
     threads: usize,
     repeats: usize,
+    step_lists: bool,
 ) -> Result<RhsTiming, crate::bench::BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -87,15 +91,20 @@ pub fn time_rhs(
     // Timed as a run evaluates it: on a pool whose other workers are kept polling (`with_warm_workers`).
     let mut samples = pool.install(|| {
         with_warm_workers(|| {
+            if step_lists {
+                system.begin_step(0.0, &y);
+            }
             system.rhs(0.0, &y, &mut dydt);
-            (0..repeats)
+            let samples = (0..repeats)
                 .map(|_| {
                     let start = Instant::now();
                     system.rhs(0.0, std::hint::black_box(&y), &mut dydt);
                     std::hint::black_box(&dydt);
                     start.elapsed().as_secs_f64() * 1e6
                 })
-                .collect::<Vec<f64>>()
+                .collect::<Vec<f64>>();
+            system.end_steps();
+            samples
         })
     });
     samples.sort_by(f64::total_cmp);
@@ -220,7 +229,7 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         let theta = args.theta;
         let method = match gravity.as_str() {
             "direct" => Some(GravityMethod::Direct),
-            "tree" => Some(GravityMethod::Tree { theta }),
+            "tree" | "tree-step" => Some(GravityMethod::Tree { theta }),
             "none" => None,
             _ => Some(GravityMethod::Auto { theta }),
         };
@@ -252,7 +261,7 @@ pub fn rhs(args: &RhsArgs) -> Result<(), CliError> {
         );
         let mut row = Vec::new();
         for &threads in &counts {
-            let r = time_rhs(&system, threads, repeats).map_err(CliError::failed)?;
+            let r = time_rhs(&system, threads, repeats, gravity == "tree-step").map_err(CliError::failed)?;
             println!(
                 "  {:>3} thread{}: median {:.1} us per RHS (min {:.1} us)",
                 r.threads,

@@ -221,7 +221,10 @@ fn add_sources<T: Real, const N: usize>(sources: &[Source<T>], x: &[T; N], y: &[
         for l in 0..N {
             let (dx, dy, dz) = (xj - x[l], yj - y[l], zj - z[l]);
             let r2 = dx * dx + dy * dy + dz * dz;
-            let inv = if r2 > T::ZERO { one / r2.sqrt() } else { T::ZERO };
+            // A source at the point itself (r = 0) adds nothing. Computing 1/√r² first and then selecting
+            // (not branching) lets the lanes vectorise; for r > 0 the value is the same.
+            let inv = one / r2.sqrt();
+            let inv = if r2 > T::ZERO { inv } else { T::ZERO };
             let minv = mj * inv;
             let minv3 = minv * inv * inv;
             ax[l] += dx * minv3;
