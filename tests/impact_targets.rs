@@ -8,7 +8,8 @@ use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::geometry::ellipsoid_overlap::are_apart;
 use rubblepile::impact::projectile::{ProjectileSpec, set_up_impact};
 use rubblepile::impact::target::{
-    TargetSpec, build_target, build_target_resumable, draw_sizes, first_round_spin, place_fragments, set_rigid_rotation,
+    TargetSpec, build_target, build_target_resumable, draw_sizes, drop_detached, first_round_spin, place_fragments,
+    set_rigid_rotation,
 };
 use rubblepile::impact::target_checkpoint::BuildCheckpoint;
 use rubblepile::math::{Mat3, Vec3};
@@ -196,6 +197,63 @@ fn resumed_target_build_is_bit_identical() {
             .contains("checkpoint: it was written by a build with other inputs"),
         "{err}"
     );
+}
+
+/// `--drop-detached`: a relaxed pile (the committed N30_T4) is one clump, so nothing is removed; a fragment moved
+/// 1000 km out is removed, and only it, with its placement index dropped from `kept`. Without the option the
+/// spec's JSON has no `drop_detached` key, so the committed targets' files are unchanged.
+#[test]
+fn drop_detached_removes_only_fragments_outside_the_main_clump() {
+    let pile = rubblepile::impact::run::read_target(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/targets/N30_T4.csv"
+    )))
+    .unwrap();
+    let mut bodies = pile.clone();
+    let mut kept: Vec<usize> = (0..bodies.len()).collect();
+    assert_eq!(drop_detached(&mut bodies, &mut kept), 0);
+    assert_eq!(bodies, pile);
+    bodies[7].position += Vec3::new(1.0e6, 0.0, 0.0);
+    let lost = bodies[7].clone();
+    assert_eq!(drop_detached(&mut bodies, &mut kept), 1);
+    assert_eq!(bodies.len(), pile.len() - 1);
+    assert!(!bodies.contains(&lost));
+    assert_eq!(kept, (0..pile.len()).filter(|&i| i != 7).collect::<Vec<_>>());
+    let spec = TargetSpec::table1(30, 4.0, 1).unwrap();
+    assert!(!serde_json::to_string(&spec).unwrap().contains("drop_detached"));
+    let mut dropping = spec.clone();
+    dropping.drop_detached = true;
+    let back: TargetSpec = serde_json::from_str(&serde_json::to_string(&dropping).unwrap()).unwrap();
+    assert_eq!(back, dropping);
+}
+
+/// A checkpoint taken after fragments were dropped records which placement bodies remain (`kept`): its round
+/// starts from their shapes, it survives JSON, and a `kept` out of range or out of order is refused.
+#[test]
+fn checkpoint_after_dropping_fragments_keeps_their_shapes() {
+    let spec = small_spec();
+    let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
+    let mut saved: Option<BuildCheckpoint> = None;
+    let mut keep = |c: &BuildCheckpoint| {
+        saved.get_or_insert_with(|| c.clone());
+    };
+    let _ = build_target_resumable(&spec, None, &mut quiet, &mut keep).unwrap();
+    let first = saved.unwrap();
+    assert!(first.kept.is_none());
+    let (radii, _) = draw_sizes(&spec, &mut generator(spec.seed)).unwrap();
+    let placed = place_fragments(&spec, &radii, &mut generator(spec.seed)).0;
+    let all = first.round_start_bodies(&placed);
+    // the same round start without body 4
+    let kept: Vec<usize> = (0..spec.fragments).filter(|&i| i != 4).collect();
+    let start: Vec<_> = kept.iter().map(|&i| all[i].clone()).collect();
+    let cut = BuildCheckpoint::new(&spec, first.round, &start, &kept, 0.0, 0.0, first.state.clone());
+    let back: BuildCheckpoint = serde_json::from_str(&serde_json::to_string(&cut).unwrap()).unwrap();
+    assert_eq!(back, cut);
+    assert!(back.check(&spec).is_ok());
+    assert_eq!(back.round_start_bodies(&placed), start);
+    let mut bad = back.clone();
+    bad.kept = Some((1..spec.fragments).rev().collect());
+    assert!(bad.check(&spec).unwrap_err().to_string().contains("kept"));
 }
 
 /// The first round's spin keeps the placement sphere's equator bound: unchanged where `Ω² R_p³ ≤ G M` (Table 1's

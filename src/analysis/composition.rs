@@ -6,7 +6,7 @@
 //! * **Origin**: every body is tagged `target` or `projectile` by its index (the ranges in `impact.json`).
 //! * **Clump**: a connected set of bodies in contact, two bodies being in contact when their ellipsoids,
 //!   each semi-axis enlarged by [`CLUMP_MARGIN`], overlap (the overlap test of the contact model,
-//!   [`are_apart`]). Resting bodies sit in shallow overlap under the contact barrier; the margin also joins
+//!   [`crate::geometry::ellipsoid_overlap::are_apart`]; [`crate::ellipsoid::clumps`]). Resting bodies sit in shallow overlap under the contact barrier; the margin also joins
 //!   those a hair apart.
 //! * **Bound clump** (Eq. 43 with the clump as one body): `K_c = ½ M_c |V_c − V_sys|²` (barycentric frame of
 //!   the whole system) below `|U_c| = Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`.
@@ -19,7 +19,6 @@
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::geometry::ellipsoid_overlap::are_apart;
 use crate::math::{Mat3, Vec3};
 
 /// Relative enlargement of every semi-axis in the contact test that defines clumps (0.1 = 10 %).
@@ -134,48 +133,9 @@ impl Composition {
     }
 }
 
-/// World-frame shape matrix `Rᵀ diag(a², b², c²) R` with every semi-axis times `scale`.
-fn shape_matrix(b: &Body, scale: f64) -> Mat3 {
-    let r = rotation_matrix(&b.quaternion);
-    let axes = b.shape.axes * scale;
-    r.transpose() * Mat3::from_diagonal(&axes.component_mul(&axes)) * r
-}
-
 /// The clumps of `bodies`: connected components of the contact graph with [`CLUMP_MARGIN`], as body lists.
 pub fn find_clumps(bodies: &[Body]) -> Vec<Vec<usize>> {
-    let scale = 1.0 + CLUMP_MARGIN;
-    let sigmas: Vec<Mat3> = bodies.iter().map(|b| shape_matrix(b, scale)).collect();
-    // Union–find with path halving.
-    let mut parent: Vec<usize> = (0..bodies.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    for i in 0..bodies.len() {
-        for j in i + 1..bodies.len() {
-            let d = bodies[j].position - bodies[i].position;
-            if d.norm() < scale * (bodies[i].shape.axes.x + bodies[j].shape.axes.x)
-                && !are_apart(&d, &sigmas[i], &sigmas[j])
-            {
-                let (a, b) = (root(&mut parent, i), root(&mut parent, j));
-                parent[a.max(b)] = a.min(b);
-            }
-        }
-    }
-    let mut clumps: Vec<Vec<usize>> = Vec::new();
-    let mut slot = vec![usize::MAX; bodies.len()];
-    for i in 0..bodies.len() {
-        let r = root(&mut parent, i);
-        if slot[r] == usize::MAX {
-            slot[r] = clumps.len();
-            clumps.push(Vec::new());
-        }
-        clumps[slot[r]].push(i);
-    }
-    clumps
+    crate::ellipsoid::clumps::find_clumps(bodies, CLUMP_MARGIN)
 }
 
 /// Spin `ω` (world frame, rad/s) of the bodies `members` as one aggregate about their barycentre, with

@@ -127,6 +127,10 @@ pub struct BuildArgs {
     /// rotation is below this fraction of the total at two successive checks (dimensionless, in (0, 1)).
     #[arg(long, default_value_t = 1e-4)]
     pub rigidity: f64,
+    /// Remove the fragments outside the pile's main clump at the end of every relaxation round, before the spin
+    /// is reset (large N: fragments thrown onto wide orbits by the collapse; FILE.json counts them)
+    #[arg(long)]
+    pub drop_detached: bool,
     /// Overwrite FILE.csv / FILE.json (and a checkpoint) of an earlier build.
     #[arg(long)]
     pub force: bool,
@@ -202,6 +206,7 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
         )));
     }
     spec.rigidity = args.rigidity;
+    spec.drop_detached = args.drop_detached;
     if args.out.extension().is_none_or(|e| e != "csv") {
         return Err(CliError::usage(format!(
             "--out: expected a path ending in .csv, got {}",

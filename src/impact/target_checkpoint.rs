@@ -59,14 +59,19 @@ pub struct BuildCheckpoint {
     pub energy_error_before: f64,
     /// The round in progress.
     pub state: RoundState,
+    /// Each round-start body's index in the placement, when detached fragments were dropped
+    /// ([`TargetSpec::drop_detached`]); absent while all N remain.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kept: Option<Vec<usize>>,
 }
 
 impl BuildCheckpoint {
-    /// A checkpoint of round `round`, which began from `round_start`.
+    /// A checkpoint of round `round`, which began from `round_start`, the placement's bodies `kept`.
     pub fn new(
         spec: &TargetSpec,
         round: usize,
         round_start: &[Body],
+        kept: &[usize],
         time_before: f64,
         energy_error_before: f64,
         state: RoundState,
@@ -92,6 +97,7 @@ impl BuildCheckpoint {
             time_before,
             energy_error_before,
             state,
+            kept: (kept.len() < spec.fragments).then(|| kept.to_vec()),
         }
     }
 
@@ -117,12 +123,21 @@ impl BuildCheckpoint {
                     .into(),
             );
         }
-        if self.round == 0 || self.round_start.len() != PER_BODY * spec.fragments {
+        let bodies = self.kept.as_ref().map_or(spec.fragments, Vec::len);
+        if self.round == 0 || self.round_start.len() != PER_BODY * bodies {
             return refuse(format!(
                 "round {} with {} kinematic values; expected a round >= 1 and {} values",
                 self.round,
                 self.round_start.len(),
-                PER_BODY * spec.fragments
+                PER_BODY * bodies
+            ));
+        }
+        if let Some(kept) = &self.kept
+            && (kept.iter().any(|&i| i >= spec.fragments) || kept.windows(2).any(|w| w[0] >= w[1]))
+        {
+            return refuse(format!(
+                "kept: expected ascending body indices below {}",
+                spec.fragments
             ));
         }
         Ok(())
@@ -130,8 +145,12 @@ impl BuildCheckpoint {
 
     /// The bodies the round began from: the shapes of `placed`, the kinematics of the checkpoint.
     pub fn round_start_bodies(&self, placed: &[Body]) -> Vec<Body> {
-        placed
+        let all: Vec<usize> = (0..placed.len()).collect();
+        self.kept
+            .as_ref()
+            .unwrap_or(&all)
             .iter()
+            .map(|&i| &placed[i])
             .zip(self.round_start.chunks_exact(PER_BODY))
             .map(|(b, k)| Body {
                 shape: b.shape,
