@@ -1,6 +1,6 @@
-//! Clumps: connected sets of ellipsoids in contact. Used by the impact analysis (which bodies stick together,
-//! [`crate::analysis::composition`]) and by the target build (fragments that left the pile during its collapse,
-//! [`crate::impact::target`]).
+//! Clumps: connected sets of ellipsoids in contact. Used by the impact analysis (which bodies stick together, the
+//! `analysis::composition` module) and by the target build (fragments that left the pile during its collapse,
+//! `impact::target`).
 //!
 //! Two bodies are in contact when their ellipsoids, each semi-axis enlarged by a relative `margin`, overlap (the
 //! overlap test of the contact model, [`are_apart`]). Resting bodies sit in shallow overlap under the contact

@@ -192,7 +192,7 @@ fn is_zero_mass(m: &f64) -> bool {
 }
 
 /// Relative enlargement of the semi-axes in the contact test of [`drop_detached`] (as the impact analysis's
-/// clumps, [`crate::analysis::composition::CLUMP_MARGIN`]).
+/// clumps, `analysis::composition::CLUMP_MARGIN`).
 pub const DETACHED_MARGIN: f64 = 0.1;
 
 /// Removes from `bodies` every fragment outside their most massive clump (bodies in contact, semi-axes enlarged
