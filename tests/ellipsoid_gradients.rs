@@ -524,13 +524,13 @@ fn gravity_parallel_rows_match_serial_pairs_and_gradient() {
     assert!(rel_err((-f3[0]).as_slice(), &fd, 0.0) < 1e-6);
 }
 
-/// The right-hand side's force-only half loop (serial, or in blocks of equal work) equals the
-/// pairwise reference below and above the parallel threshold, adds to what is there, and conserves momentum to
-/// round-off.
+/// The right-hand side's force-only half loop (serial, or in blocks of equal work) equals the pairwise reference
+/// below and above the parallel threshold, adds to what is there, and conserves momentum to round-off. The
+/// sizes 65–67 and 131 put the blocks' row boundaries at odd places.
 #[test]
 fn gravity_force_only_rows_match_the_pair_sum() {
     let mut rng = Random::new(9);
-    for n in [1, 2, 7, 63, 64, 201, 300] {
+    for n in [1, 2, 7, 63, 64, 65, 66, 67, 131, 201, 300] {
         let pos: Vec<Vec3> = (0..n).map(|_| rng.vec3(1e5)).collect();
         let mass: Vec<f64> = (0..n).map(|_| rng.range(1e12, 1e15)).collect();
         let mut reference = vec![Vec3::zeros(); n];

@@ -365,8 +365,11 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
             (t_lo * 0.5..t_hi * 2.0).log_scale(),
         )
         .map_err(|e| err(&e))?;
+    // Few x labels: on a log axis plotters otherwise labels every 1000 up to 10 000, and they overlap.
     chart
         .configure_mesh()
+        .x_labels(4)
+        .x_label_formatter(&|n| format!("{n:.0}"))
         .x_desc("number of bodies N")
         .y_desc("median time per RHS (µs)")
         .draw()
@@ -390,8 +393,10 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
             .draw_series(points.into_iter().map(|p| Circle::new(p, 3, color.filled())))
             .map_err(|e| err(&e))?;
     }
+    // Upper left: the costs grow with N, so that corner is free of data.
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .draw()
