@@ -22,7 +22,7 @@ pub struct RenderArgs {
     /// Perspective camera with this field of view (degrees) instead of the orthographic one.
     #[arg(long, value_name = "DEGREES")]
     pub perspective: Option<f64>,
-    /// Half-width of the picture (m) about the first snapshot's centre [default: the first snapshot's bodies].
+    /// Half-width of the picture (m) about the first snapshot's centre of mass [default: the first snapshot's bodies].
     #[arg(long, value_name = "METRES")]
     pub extent: Option<f64>,
     /// File name of the animation in DIR/frames.

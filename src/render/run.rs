@@ -3,7 +3,8 @@
 //! the run's engine ([`crate::driver::export::visit_snapshots`]), so every engine's runs can be drawn.
 //!
 //! The camera does not move between frames: it frames the first snapshot (for an impact: the target and the
-//! incoming projectile), or a sphere of `extent` metres about the first snapshot's centre when given. Continuous
+//! incoming projectile), or a sphere of `extent` metres about the first snapshot's centre of mass when given (for
+//! an impact: the target, wherever the projectile starts). Continuous
 //! colour scales span 0 to the 95th percentile of the value over all frames, so one fast body (a projectile at
 //! 5 km/s) does not wash out the fragments' tens of m/s.
 
@@ -58,7 +59,8 @@ pub struct RenderRunOptions {
     pub height: u32,
     /// What colours the bodies.
     pub colour: ColourBy,
-    /// Half-width of the picture (m); `None`: framed on the first snapshot.
+    /// Half-width of the picture (m) about the first snapshot's centre of mass; `None`: framed on the whole first
+    /// snapshot.
     pub extent: Option<f64>,
     /// File name of the animation in `frames/`.
     pub gif_name: String,
@@ -137,6 +139,27 @@ fn values(view: &SnapshotView, colour: ColourBy, fields: Option<&FragmentFields>
     }
 }
 
+/// The camera's framing from the first snapshot: all its bodies, or a sphere of `extent` (m) about its centre of
+/// mass. The centre of mass, not the middle of the bodies' box: an impact's projectile starts hundreds of km out,
+/// which would put the target in a corner of a tight frame.
+fn first_framing(view: &SnapshotView, values: &[f64], extent: Option<f64>) -> Framing {
+    let all = Framing::enclosing(frame_bodies(view, values).iter());
+    let Some(half_extent) = extent else {
+        return all;
+    };
+    let mass: f64 = view.particles.iter().map(|p| p.mass).sum();
+    let centre = if mass > 0.0 {
+        view.particles
+            .iter()
+            .map(|p| p.position * p.mass)
+            .sum::<crate::math::Vec3>()
+            / mass
+    } else {
+        all.centre
+    };
+    Framing { centre, half_extent }
+}
+
 /// Renders every snapshot of the run in `dir` into `dir/frames/<k>.png` and `dir/frames/<gif_name>`.
 pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, RenderRunError> {
     if opts.width < 16 || opts.height < 16 || opts.width > 8192 || opts.height > 8192 {
@@ -176,12 +199,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     visit_snapshots(dir, &mut |_, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
         if framing.is_none() {
-            let bodies = frame_bodies(&view, &vals);
-            let mut f = Framing::enclosing(bodies.iter());
-            if let Some(e) = opts.extent {
-                f.half_extent = e;
-            }
-            framing = Some(f);
+            framing = Some(first_framing(&view, &vals, opts.extent));
         }
         all_values.extend(vals.into_iter().filter(|v| v.is_finite()));
         Ok(())
@@ -279,4 +297,49 @@ pub fn after_run(out: &Path, default_scene: bool, force: bool) -> Result<(String
         ));
     }
     Ok((before, after))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    fn view(particles: Vec<ParticleView>) -> SnapshotView {
+        SnapshotView {
+            spheres: true,
+            particles,
+            ..SnapshotView::default()
+        }
+    }
+
+    /// An impact's first snapshot: a heavy target at the origin and a light projectile 450 km out. Without an
+    /// extent the frame holds both; with one it is centred on the centre of mass (here 4.5 km from the target),
+    /// not halfway to the projectile.
+    #[test]
+    fn extent_frames_the_centre_of_mass_not_the_middle_of_the_bodies() {
+        let zero = Vec3::zeros();
+        let snapshot = view(vec![
+            ParticleView::sphere(0, 99.0, 90e3, zero, zero, zero),
+            ParticleView::sphere(1, 1.0, 20e3, Vec3::new(450e3, 0.0, 0.0), zero, zero),
+        ]);
+        let values = [0.0, 0.0];
+        let all = first_framing(&snapshot, &values, None);
+        assert!((all.centre.x - 0.5 * (-90e3 + 470e3)).abs() < 1e-6, "{:?}", all.centre);
+        let tight = first_framing(&snapshot, &values, Some(150e3));
+        assert!(
+            (tight.centre - Vec3::new(4.5e3, 0.0, 0.0)).norm() < 1e-6,
+            "{:?}",
+            tight.centre
+        );
+        assert_eq!(tight.half_extent, 150e3);
+        // Massless bodies (no masses written): the middle of the bodies, as without an extent.
+        let massless = view(
+            snapshot
+                .particles
+                .iter()
+                .map(|p| ParticleView { mass: 0.0, ..*p })
+                .collect(),
+        );
+        assert_eq!(first_framing(&massless, &values, Some(1.0)).centre, all.centre);
+    }
 }
