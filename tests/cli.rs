@@ -468,6 +468,12 @@ fn bench_rhs_writes_csv_and_plot() {
         svg.contains("<svg") && svg.contains("number of bodies N"),
         "plot lacks its axis label"
     );
+    // The x ticks are the benchmarked sizes (plotters' own log ticks vanish over less than a decade).
+    let texts: Vec<&str> = svg.lines().map(str::trim).collect();
+    assert!(
+        texts.contains(&"8") && texts.contains(&"30"),
+        "the sizes are not the x ticks"
+    );
     let again = rubblepile(&dir, &args);
     assert_eq!(again.status.code(), Some(2), "overwrote a benchmark without --force");
     assert_eq!(

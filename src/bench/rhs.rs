@@ -354,6 +354,9 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
         t_lo = t_lo.min(r.median_us);
         t_hi = t_hi.max(r.median_us);
     }
+    let mut sizes: Vec<f64> = results.iter().map(|(n, _, _)| *n as f64).collect();
+    sizes.sort_by(f64::total_cmp);
+    sizes.dedup();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut chart = ChartBuilder::on(root)
         .caption("rubblepile bench rhs: cost of one right-hand side", ("sans-serif", 18))
@@ -361,14 +364,14 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
         .x_label_area_size(40)
         .y_label_area_size(70)
         .build_cartesian_2d(
-            (n_lo * 0.8..n_hi * 1.25).log_scale(),
+            // The x ticks are the benchmarked N: plotters' own log ticks overlap from 1000 to 10 000 and vanish
+            // over less than a decade.
+            (n_lo * 0.8..n_hi * 1.25).log_scale().with_key_points(sizes),
             (t_lo * 0.5..t_hi * 2.0).log_scale(),
         )
         .map_err(|e| err(&e))?;
-    // Few x labels: on a log axis plotters otherwise labels every 1000 up to 10 000, and they overlap.
     chart
         .configure_mesh()
-        .x_labels(4)
         .x_label_formatter(&|n| format!("{n:.0}"))
         .x_desc("number of bodies N")
         .y_desc("median time per RHS (µs)")
@@ -388,7 +391,7 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
                 "{threads} thread{}, gravity {gravity}",
                 if threads == 1 { "" } else { "s" }
             ))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         chart
             .draw_series(points.into_iter().map(|p| Circle::new(p, 3, color.filled())))
             .map_err(|e| err(&e))?;
