@@ -6,8 +6,8 @@
 //! * **Origin**: every body is tagged `target` or `projectile` by its index (the ranges in `impact.json`).
 //! * **Clump**: a connected set of bodies in contact, two bodies being in contact when their ellipsoids,
 //!   each semi-axis enlarged by [`CLUMP_MARGIN`], overlap (the overlap test of the contact model,
-//!   [`crate::geometry::ellipsoid_overlap::are_apart`]; [`crate::ellipsoid::clumps`]). Resting bodies sit in shallow overlap under the contact barrier; the margin also joins
-//!   those a hair apart.
+//!   [`crate::geometry::ellipsoid_overlap::are_apart`], applied by [`crate::ellipsoid::clumps`]). Resting bodies
+//!   sit in shallow overlap under the contact barrier; the margin also joins those a hair apart.
 //! * **Bound clump** (Eq. 43 with the clump as one body): `K_c = ½ M_c |V_c − V_sys|²` (barycentric frame of
 //!   the whole system) below `|U_c| = Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`.
 //! * **Largest remnant**: the most massive clump. Its spin is `ω = I⁻¹ L` about its barycentre, with
