@@ -1,9 +1,9 @@
 //! Analysis of one impact run directory (Roig03 §4): per-fragment table and per-run results.
 //!
-//! Reads `summary.json` (κ), `scene.toml` (inertia model, G), `impact.json` (projectile) and the snapshots at
-//! t = 0 and at `t_at` (default 400 s, "a few minutes after the impact"); writes `analysis/fragments.csv` and
-//! `analysis/analysis.json` inside the run directory. Fits that cannot be made (too few fragments, say) are
-//! recorded with their reason instead of stopping the analysis.
+//! Reads `summary.json` (κ; from `scene.toml` while the run is still going), `scene.toml` (inertia model, G),
+//! `impact.json` (projectile) and the snapshots at t = 0 and at `t_at` (default 400 s, "a few minutes after the
+//! impact"); writes `analysis/fragments.csv` and `analysis/analysis.json` inside the run directory. Fits that
+//! cannot be made (too few fragments, say) are recorded with their reason instead of stopping the analysis.
 
 use std::path::{Path, PathBuf};
 
@@ -136,6 +136,26 @@ pub fn snapshot_path(dir: &Path, t: f64) -> Option<PathBuf> {
         .map(|(_, p)| p)
 }
 
+/// The κ the run in `dir` used: from its `summary.json`, or, while the run is still going (no summary yet, so that
+/// the snapshots it has already written can be analysed), resolved from its `scene.toml` as the engine resolved
+/// it at the start (given, or calibrated from the bodies by Roig03 Eq. 14).
+fn run_kappa(dir: &Path) -> Result<f64, AnalysisError> {
+    let summary_path = dir.join("summary.json");
+    if summary_path.exists() {
+        let summary = read_json(&summary_path)?;
+        return summary["kappa"].as_f64().ok_or_else(|| AnalysisError::Read {
+            path: summary_path,
+            reason: "no numeric `kappa`".into(),
+        });
+    }
+    let scene_path = dir.join("scene.toml");
+    let scene = crate::ellipsoid::scene::load_scene(&scene_path).map_err(|e| AnalysisError::Read {
+        path: scene_path,
+        reason: format!("no summary.json (run not finished), and κ could not be resolved from the scene: {e}"),
+    })?;
+    Ok(scene.model.kappa)
+}
+
 /// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
 /// (or `force`). Returns the per-run results and the per-fragment report.
 pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
@@ -144,11 +164,7 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
     if !force && (json_path.exists() || csv_path.exists()) {
         return Err(AnalysisError::Exists(out_dir));
     }
-    let summary = read_json(&dir.join("summary.json"))?;
-    let kappa = summary["kappa"].as_f64().ok_or_else(|| AnalysisError::Read {
-        path: dir.join("summary.json"),
-        reason: "no numeric `kappa`".into(),
-    })?;
+    let kappa = run_kappa(dir)?;
     let impact = read_json(&dir.join("impact.json"))?;
     let projectile = impact["projectile_index"].as_u64().ok_or_else(|| AnalysisError::Read {
         path: dir.join("impact.json"),
