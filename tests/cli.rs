@@ -474,6 +474,18 @@ fn bench_rhs_writes_csv_and_plot() {
         texts.contains(&"8") && texts.contains(&"30"),
         "the sizes are not the x ticks"
     );
+    // Every tick label is a plain number with one significant digit (y: 1–2–5 per decade, or 1–9 over a narrow
+    // range), not plotters' own crowded "9000.0" labels; the times of a few bodies' RHS are above 1 µs.
+    let numbers: Vec<f64> = texts.iter().filter_map(|t| t.parse::<f64>().ok()).collect();
+    assert!(numbers.len() >= 4, "too few tick labels: {numbers:?}");
+    for t in texts.iter().filter(|t| t.parse::<f64>().is_ok()) {
+        let v: f64 = t.parse().unwrap();
+        let mantissa = v / 10f64.powf(v.log10().floor());
+        assert!(
+            !t.contains('.') && (v == 30.0 || (mantissa - mantissa.round()).abs() < 1e-9),
+            "tick label {t} is not a plain round number"
+        );
+    }
     let again = rubblepile(&dir, &args);
     assert_eq!(again.status.code(), Some(2), "overwrote a benchmark without --force");
     assert_eq!(

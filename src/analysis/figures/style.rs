@@ -235,9 +235,61 @@ pub fn log_tick(v: &f64) -> String {
     }
 }
 
+/// Key points for a log axis over `lo..hi` (both > 0): the 1–2–5 values of every decade inside it, or, where
+/// that leaves fewer than three (a range under about a factor of 5), every integer multiple 1–9 of each decade.
+/// plotters' own log ticks crowd the top of a decade and repeat labels when the range is narrow.
+pub fn log_key_points(lo: f64, hi: f64) -> Vec<f64> {
+    let within = |mantissas: &[f64]| -> Vec<f64> {
+        let (d0, d1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+        (d0..=d1)
+            .flat_map(|d| mantissas.iter().map(move |m| m * 10f64.powi(d)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let coarse = within(&[1.0, 2.0, 5.0]);
+    if coarse.len() >= 3 {
+        coarse
+    } else {
+        within(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
+}
+
+/// Of the ascending `values`, those at least `min_ratio` (> 1) above the last one kept: key points of a log
+/// axis whose labels would otherwise print on top of each other (N = 2000 and 2001, say).
+pub fn spread_on_log_axis(values: &[f64], min_ratio: f64) -> Vec<f64> {
+    let mut kept: Vec<f64> = Vec::with_capacity(values.len());
+    for &v in values {
+        if kept.last().is_none_or(|&last| v >= last * min_ratio) {
+            kept.push(v);
+        }
+    }
+    kept
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_key_points_are_one_two_five_per_decade() {
+        assert_eq!(
+            log_key_points(300.0, 16_000.0),
+            vec![500.0, 1000.0, 2000.0, 5000.0, 10_000.0]
+        );
+        // under a factor of 5 the 1–2–5 values are too few: every multiple of the decade
+        assert_eq!(
+            log_key_points(2200.0, 7100.0),
+            vec![3000.0, 4000.0, 5000.0, 6000.0, 7000.0]
+        );
+    }
+
+    #[test]
+    fn spread_on_log_axis_drops_values_too_close_to_the_last_kept() {
+        assert_eq!(
+            spread_on_log_axis(&[200.0, 2000.0, 2001.0, 10_000.0], 1.1),
+            vec![200.0, 2000.0, 10_000.0]
+        );
+    }
 
     #[test]
     fn font_registers_and_measures_text() {
