@@ -49,5 +49,59 @@ fn bench_impact_rows_are_thread_independent_and_flags_checked() {
     let bad = rubblepile(&dir, &["bench", "impact", "--f0=-1", "--out", "c"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--f0: each must be >= 0"));
+    let bad = rubblepile(&dir, &["bench", "impact", "--rtol", "1e-6,2", "--out", "c"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--rtol: each must be in (0, 1), got 2"));
+    let bad = rubblepile(&dir, &["bench", "impact", "--goal", "0", "--out", "c"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--goal: must be > 0 s"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bench_impact_times_each_tolerance_and_draws_the_goal_it_is_given() {
+    let dir = temp_dir("bench-impact-rtol");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let args = [
+        "bench",
+        "impact",
+        "--target",
+        target.to_str().unwrap(),
+        "--projectile",
+        "P1",
+        "--t-end",
+        "100",
+        "--rtol",
+        "1e-6,1e-4",
+        "--threads",
+        "1",
+        "--goal",
+        "600",
+        "--out",
+        "b",
+    ];
+    let out = rubblepile(&dir, &args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(dir.join("b/bench_impact.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert_eq!((rows[0][4], rows[1][4]), ("1e-6", "1e-4"), "{csv}");
+    // the looser tolerance takes fewer RHS evaluations and makes a larger energy error
+    let (rhs, err) = (
+        |r: &Vec<&str>| r[11].parse::<u64>().unwrap(),
+        |r: &Vec<&str>| r[12].parse::<f64>().unwrap(),
+    );
+    assert!(rhs(&rows[1]) < rhs(&rows[0]), "{csv}");
+    assert!(err(&rows[1]) > err(&rows[0]), "{csv}");
+    let svg = std::fs::read_to_string(dir.join("b/bench_impact.svg")).unwrap();
+    assert!(
+        svg.contains("goal: 600 s on 2 cores"),
+        "the goal line is not labelled with --goal"
+    );
+    assert!(
+        svg.contains("rtol 1e-4") && svg.contains("rtol 1e-6") && svg.matches("F0 1e-6, 1 thr").count() == 2,
+        "bars not labelled by their configuration"
+    );
+    assert_eq!(svg.matches("dE/E ").count(), 2, "each bar carries its energy error");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,5 +1,6 @@
-//! `rubblepile bench impact`: the wall-clock time of whole impact runs (Roig03 §3), for the speed goal of the
-//! N200_T4 + P2, ζ = 45°, 10 000 s run at the impact default rtol (1e-6 over the run), across dissipation coefficients and thread counts.
+//! `rubblepile bench impact`: the wall-clock time of whole impact runs (Roig03 §3), for the speed goals of the
+//! N200_T4 + P2, ζ = 45°, 10 000 s run at the impact default rtol (1e-6 over the run; goal 60 s) and of the same
+//! impact on `targets/N2000_T4.csv` (goal 10 min), across tolerances, dissipation coefficients and thread counts.
 //!
 //! Each configuration is a complete [`run_impact`] into a scratch directory under `--out` (removed afterwards
 //! unless `--keep-runs`); the row reports its wall time beside its energy error, as every run does.
@@ -27,15 +28,18 @@ pub struct ImpactBenchArgs {
     /// End time of each run (s).
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
-    /// Bulirsch–Stoer tolerance (rtol = atol).
-    #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
-    pub rtol: f64,
+    /// Bulirsch–Stoer tolerances (rtol = atol, dimensionless, in (0, 1)), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1e-6")]
+    pub rtol: Vec<f64>,
     /// Dissipation coefficients F0 (s m⁻²), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1e-6")]
     pub f0: Vec<f64>,
     /// Thread counts, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Vec<u64>,
+    /// The wall-time goal drawn as a line on the plot (s): 60 for the N200 impact, 600 for the N2000 one.
+    #[arg(long, default_value_t = 60.0)]
+    pub goal: f64,
     /// Repeats of each configuration (the median and the minimum are reported).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
     pub repeats: u64,
@@ -53,6 +57,8 @@ pub struct ImpactBenchArgs {
 /// One configuration's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImpactTiming {
+    /// Bulirsch–Stoer rtol (= atol).
+    pub rtol: f64,
     /// F0 (s m⁻²).
     pub f0: f64,
     /// Threads.
@@ -77,6 +83,12 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     if let Some(bad) = args.f0.iter().find(|f| !(f.is_finite() && **f >= 0.0)) {
         return Err(CliError::usage(format!("--f0: each must be >= 0 s m^-2, got {bad}")));
     }
+    if let Some(bad) = args.rtol.iter().find(|r| !(**r > 0.0 && **r < 1.0)) {
+        return Err(CliError::usage(format!("--rtol: each must be in (0, 1), got {bad}")));
+    }
+    if !(args.goal.is_finite() && args.goal > 0.0) {
+        return Err(CliError::usage(format!("--goal: must be > 0 s, got {}", args.goal)));
+    }
     let (csv, svg) = (args.out.join("bench_impact.csv"), args.out.join("bench_impact.svg"));
     for p in [&csv, &svg] {
         if p.exists() && !args.force {
@@ -88,58 +100,64 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     }
     std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let mut results = Vec::new();
-    for &f0 in &args.f0 {
-        for &threads in &args.threads {
-            let mut cfg = ImpactConfig::new(args.target.clone(), projectile.clone());
-            cfg.angle_deg = args.angle;
-            cfg.t_end = args.t_end;
-            cfg.rtol = args.rtol;
-            cfg.f0 = f0;
-            cfg.snapshots = vec![0.0, args.t_end];
-            cfg.validate()
-                .map_err(|e| CliError::usage(format!("bench impact: {e}")))?;
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads as usize)
-                .build()
-                .map_err(|e| CliError::failed(format!("cannot build a pool of {threads} threads: {e}")))?;
-            let mut walls = Vec::new();
-            let mut last = None;
-            for k in 0..args.repeats {
-                let dir = args.out.join("runs").join(format!("f0_{f0:e}_threads_{threads}_{k}"));
-                let options = RunOptions {
-                    force: true,
-                    progress: false,
-                    ..RunOptions::default()
-                };
-                let summary = pool
-                    .install(|| run_impact(&cfg, &dir, &options))
-                    .map_err(|e| CliError::failed(format!("F0 = {f0:e}, {threads} threads: {e}")))?;
-                walls.push(summary.wall_seconds);
-                println!(
-                    "  F0 {f0:e} s m^-2, {threads} thread{}: wall {:.1} s, {} steps, {} RHS, energy error {:.1e}",
-                    if threads == 1 { "" } else { "s" },
-                    summary.wall_seconds,
-                    summary.steps_accepted,
-                    summary.rhs_evaluations,
-                    summary.energy_error
-                );
-                last = Some(summary);
-                if !args.keep_runs {
-                    let _ = std::fs::remove_dir_all(&dir);
-                }
+    for (&rtol, &f0, &threads) in args.rtol.iter().flat_map(|r| {
+        args.f0
+            .iter()
+            .flat_map(move |f| args.threads.iter().map(move |t| (r, f, t)))
+    }) {
+        let mut cfg = ImpactConfig::new(args.target.clone(), projectile.clone());
+        cfg.angle_deg = args.angle;
+        cfg.t_end = args.t_end;
+        cfg.rtol = rtol;
+        cfg.f0 = f0;
+        cfg.snapshots = vec![0.0, args.t_end];
+        cfg.validate()
+            .map_err(|e| CliError::usage(format!("bench impact: {e}")))?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads as usize)
+            .build()
+            .map_err(|e| CliError::failed(format!("cannot build a pool of {threads} threads: {e}")))?;
+        let mut walls = Vec::new();
+        let mut last = None;
+        for k in 0..args.repeats {
+            let dir = args
+                .out
+                .join("runs")
+                .join(format!("rtol_{rtol:e}_f0_{f0:e}_threads_{threads}_{k}"));
+            let options = RunOptions {
+                force: true,
+                progress: false,
+                ..RunOptions::default()
+            };
+            let summary = pool
+                .install(|| run_impact(&cfg, &dir, &options))
+                .map_err(|e| CliError::failed(format!("rtol = {rtol:e}, F0 = {f0:e}, {threads} threads: {e}")))?;
+            walls.push(summary.wall_seconds);
+            println!(
+                "  rtol {rtol:e}, F0 {f0:e} s m^-2, {threads} thread{}: wall {:.1} s, {} steps, {} RHS, energy error {:.1e}",
+                if threads == 1 { "" } else { "s" },
+                summary.wall_seconds,
+                summary.steps_accepted,
+                summary.rhs_evaluations,
+                summary.energy_error
+            );
+            last = Some(summary);
+            if !args.keep_runs {
+                let _ = std::fs::remove_dir_all(&dir);
             }
-            let s = last.expect("repeats >= 1");
-            let min = walls.iter().copied().fold(f64::INFINITY, f64::min);
-            results.push(ImpactTiming {
-                f0,
-                threads: threads as usize,
-                median_s: crate::math::median(&walls),
-                min_s: min,
-                steps: s.steps_accepted,
-                rhs_evaluations: s.rhs_evaluations,
-                energy_error: s.energy_error,
-            });
         }
+        let s = last.expect("repeats >= 1");
+        let min = walls.iter().copied().fold(f64::INFINITY, f64::min);
+        results.push(ImpactTiming {
+            rtol,
+            f0,
+            threads: threads as usize,
+            median_s: crate::math::median(&walls),
+            min_s: min,
+            steps: s.steps_accepted,
+            rhs_evaluations: s.rhs_evaluations,
+            energy_error: s.energy_error,
+        });
     }
     if !args.keep_runs {
         let _ = std::fs::remove_dir(args.out.join("runs"));
@@ -158,7 +176,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
                 args.projectile,
                 args.angle,
                 args.t_end,
-                args.rtol,
+                r.rtol,
                 r.f0,
                 r.threads,
                 r.median_s,
@@ -177,10 +195,13 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-/// Bars of the median wall time per (F0, threads), with the 60 s goal as a line.
+/// Bars of the median wall time per (rtol, F0, threads), each with its energy error above it, and the goal as a
+/// line.
 struct WallTimeBars<'a> {
     results: &'a [ImpactTiming],
     title: String,
+    /// The goal (s).
+    goal: f64,
 }
 
 impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
@@ -191,7 +212,9 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
         use plotters::prelude::*;
         let err = |e: &dyn std::fmt::Display| e.to_string();
         let results = self.results;
-        let top = results.iter().map(|r| r.median_s).fold(60.0, f64::max) * 1.2;
+        let goal = self.goal;
+        // room above the tallest bar for its three lines of text
+        let top = results.iter().map(|r| r.median_s).fold(goal, f64::max) * 1.35;
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, ("sans-serif", 18))
             .margin(12)
@@ -199,15 +222,18 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..results.len() as f64, 0.0..top)
             .map_err(|e| err(&e))?;
-        let labels: Vec<String> = results
-            .iter()
-            .map(|r| format!("F0 {:e}, {} thr", r.f0, r.threads))
-            .collect();
+        // Each bar is labelled above itself (plotters' ticks on a 0..n axis need not fall under every bar).
         chart
             .configure_mesh()
-            .x_labels(results.len())
-            .x_label_formatter(&|x| labels.get(x.floor() as usize).cloned().unwrap_or_default())
-            .x_desc("configuration (F0 in s m^-2, threads)")
+            .x_labels(0)
+            .y_label_formatter(&|t| {
+                if top >= 20.0 {
+                    format!("{t:.0}")
+                } else {
+                    format!("{t:.1}")
+                }
+            })
+            .x_desc("configuration: rtol, F0 (s m^-2), threads; relative energy error above each bar")
             .y_desc("wall-clock time (s)")
             .disable_x_mesh()
             .draw()
@@ -222,12 +248,32 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
             .map_err(|e| err(&e))?;
         chart
             .draw_series(LineSeries::new(
-                vec![(0.0, 60.0), (results.len() as f64, 60.0)],
+                vec![(0.0, goal), (results.len() as f64, goal)],
                 RED.stroke_width(2),
             ))
             .map_err(|e| err(&e))?
-            .label("goal: 60 s on 2 cores")
+            .label(format!("goal: {goal} s on 2 cores"))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        // Above each bar, its configuration and (every run's error beside its time) its relative energy error.
+        let lines = |r: &ImpactTiming| {
+            [
+                format!("rtol {:e}", r.rtol),
+                format!("F0 {:e}, {} thr", r.f0, r.threads),
+                format!("dE/E {:.1e}", r.energy_error),
+            ]
+        };
+        let line_height = 0.045 * top;
+        chart
+            .draw_series(results.iter().enumerate().flat_map(|(k, r)| {
+                lines(r).into_iter().enumerate().map(move |(i, text)| {
+                    Text::new(
+                        text,
+                        (k as f64 + 0.15, r.median_s + (3 - i) as f64 * line_height),
+                        ("sans-serif", 12),
+                    )
+                })
+            }))
+            .map_err(|e| err(&e))?;
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.8))
@@ -242,13 +288,13 @@ fn plot(results: &[ImpactTiming], args: &ImpactBenchArgs) -> Result<(), String> 
     let figure = WallTimeBars {
         results,
         title: format!(
-            "{} + {}, zeta = {} deg, {} s at rtol {:e}",
+            "{} + {}, zeta = {} deg, {} s",
             args.target.file_stem().and_then(|s| s.to_str()).unwrap_or("target"),
             args.projectile,
             args.angle,
             args.t_end,
-            args.rtol
         ),
+        goal: args.goal,
     };
     crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure)
         .map(|_| ())
