@@ -29,7 +29,7 @@ pub struct ImpactBenchArgs {
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
     /// Bulirsch–Stoer tolerances (rtol = atol, dimensionless, in (0, 1)), comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "1e-6")]
+    #[arg(long, value_delimiter = ',', default_values_t = [crate::impact::run::DEFAULT_RTOL])]
     pub rtol: Vec<f64>,
     /// Dissipation coefficients F0 (s m⁻²), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1e-6")]
@@ -49,7 +49,7 @@ pub struct ImpactBenchArgs {
     /// Overwrite an earlier `bench_impact.csv`/`.svg` in OUT.
     #[arg(long)]
     pub force: bool,
-    /// Keep the run directories (`OUT/runs/f0_<F0>_threads_<T>_<k>`).
+    /// Keep the run directories (`OUT/runs/rtol_<RTOL>_f0_<F0>_threads_<T>_<k>`).
     #[arg(long)]
     pub keep_runs: bool,
 }
