@@ -31,7 +31,7 @@ fn bench_impact_rows_are_thread_independent_and_flags_checked() {
     let rows: Vec<Vec<&str>> = csv.lines().map(|l| l.split(',').collect()).collect();
     assert_eq!(
         rows[0].join(","),
-        "target,projectile,angle_deg,t_end,rtol,f0,threads,median_s,min_s,repeats,steps,rhs_evaluations,energy_error"
+        "target,projectile,angle_deg,t_end,rtol,f0,threads,median_s,min_s,repeats,steps,rhs_evaluations,energy_error,method"
     );
     assert_eq!(rows.len(), 5, "{csv}");
     // steps, RHS evaluations and energy error do not depend on the thread count; F0 changes them
@@ -103,5 +103,69 @@ fn bench_impact_times_each_tolerance_and_draws_the_goal_it_is_given() {
         "bars not labelled by their configuration"
     );
     assert_eq!(svg.matches("dE/E ").count(), 2, "each bar carries its energy error");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bench_impact_times_each_method_and_names_it_in_the_csv_and_on_the_bars() {
+    let dir = temp_dir("bench-impact-method");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let target = target.to_str().unwrap();
+    let common = [
+        "bench",
+        "impact",
+        "--target",
+        target,
+        "--projectile",
+        "P1",
+        "--t-end",
+        "100",
+    ];
+    let args = [
+        &common[..],
+        &[
+            "--method",
+            "bulirsch-stoer,dop853:1e-8",
+            "--rtol",
+            "1e-6",
+            "--threads",
+            "1",
+            "--out",
+            "b",
+        ],
+    ]
+    .concat();
+    let out = rubblepile(&dir, &args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let csv = std::fs::read_to_string(dir.join("b/bench_impact.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",energy_error,method"), "{csv}");
+    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert_eq!((rows[0][13], rows[1][13]), ("bulirsch-stoer", "dop853"), "{csv}");
+    // A bare method runs at --rtol; `METHOD:RTOL` at its own.
+    assert_eq!((rows[0][4], rows[1][4]), ("1e-6", "1e-8"), "{csv}");
+    // Two different integrators: different step counts, both conserving energy (dissipation booked) to 1e-6.
+    assert_ne!(rows[0][10], rows[1][10], "{csv}");
+    for r in &rows {
+        assert!(r[12].parse::<f64>().unwrap() < 1e-6, "energy error: {csv}");
+    }
+    let svg = std::fs::read_to_string(dir.join("b/bench_impact.svg")).unwrap();
+    assert!(
+        svg.contains("BS rtol 1e-6") && svg.contains("dop853 rtol 1e-8"),
+        "bars not labelled by their method"
+    );
+    for (bad_arg, needle) in [
+        ("rk4", "each must be bulirsch-stoer, dop853 or dopri5"),
+        ("dop853:2", "tolerance after ':' must be in (0, 1), got 2"),
+        ("dop853:x", "tolerance after ':' must be a number"),
+    ] {
+        let bad = rubblepile(&dir, &[&common[..], &["--method", bad_arg, "--out", "c"]].concat());
+        assert_eq!(bad.status.code(), Some(2), "--method {bad_arg}");
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert!(
+            stderr.contains("--method") && stderr.contains(needle),
+            "--method {bad_arg}: {stderr}"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

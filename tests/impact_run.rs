@@ -91,6 +91,52 @@ fn short_impact_conserves_and_decelerates_the_projectile() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// `impact --method dop853`: the scene names the method, the run keeps the conservation of the Bulirsch–Stoer run
+/// above (dissipation booked) and projects the attitudes by default; rk4 is refused naming the field.
+#[test]
+fn impact_with_dop853_writes_its_method_and_conserves() {
+    let out = temp_dir("short-dop853");
+    let target = root().join("targets/N30_T4.csv");
+    let t = target.to_str().unwrap();
+    let common = [
+        "impact",
+        "--target",
+        t,
+        "--projectile",
+        "P1",
+        "--t-end",
+        "200",
+        "--snapshots",
+        "0,200",
+    ];
+    let dir = out.join("run");
+    let run = rubblepile(
+        &out,
+        &[&common[..], &["--method", "dop853", "--rtol", "1e-9", "--out", "run"]].concat(),
+    );
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        std::fs::read_to_string(dir.join("scene.toml"))
+            .unwrap()
+            .contains("method = \"dop853\"")
+    );
+    let summary = json(&dir.join("summary.json"));
+    assert_eq!(summary["integrator"], "dop853");
+    for key in ["energy_error", "linear_momentum_error", "angular_momentum_error"] {
+        let e = summary[key].as_f64().unwrap();
+        assert!(e <= 1e-6, "{key} = {e:e}");
+    }
+    let bad = rubblepile(&out, &[&common[..], &["--method", "rk4", "--out", "bad"]].concat());
+    assert_eq!(bad.status.code(), Some(2), "{}", String::from_utf8_lossy(&bad.stderr));
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        stderr.contains("method") && stderr.contains("rk4 has a fixed step"),
+        "{stderr}"
+    );
+    assert!(!out.join("bad").exists(), "a refused run leaves no directory");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
 /// Roig03 Table 1 for the committed targets: total mass and effective radius within 1 % of the paper,
 /// porosity 0.30–0.45, spin period within 10 % of 4 h / 12 h, rigid, and the CSV agrees with the JSON.
 #[test]

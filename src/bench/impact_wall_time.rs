@@ -12,6 +12,7 @@ use super::BenchError as CliError;
 use crate::driver::RunOptions;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, run_impact};
+use crate::integrate::Method;
 
 /// `rubblepile bench impact`.
 #[derive(Debug, clap::Args)]
@@ -28,7 +29,11 @@ pub struct ImpactBenchArgs {
     /// End time of each run (s).
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
-    /// Bulirsch–Stoer tolerances (rtol = atol, dimensionless, in (0, 1)), comma-separated.
+    /// Integrators, comma-separated: bulirsch-stoer (the impact default), dop853, dopri5. `METHOD:RTOL` runs that
+    /// method at that tolerance only (e.g. `bulirsch-stoer:1e-4,dop853:1e-8`); a bare METHOD runs every --rtol.
+    #[arg(long, value_delimiter = ',', default_value = "bulirsch-stoer", value_parser = parse_method_spec)]
+    pub method: Vec<MethodSpec>,
+    /// Tolerances (rtol = atol, dimensionless, in (0, 1)), comma-separated; each is run with each bare method.
     #[arg(long, value_delimiter = ',', default_values_t = [crate::impact::run::DEFAULT_RTOL])]
     pub rtol: Vec<f64>,
     /// Dissipation coefficients F0 (s m⁻²), comma-separated.
@@ -49,15 +54,49 @@ pub struct ImpactBenchArgs {
     /// Overwrite an earlier `bench_impact.csv`/`.svg` in OUT.
     #[arg(long)]
     pub force: bool,
-    /// Keep the run directories (`OUT/runs/rtol_<RTOL>_f0_<F0>_threads_<T>_<k>`).
+    /// Keep the run directories (`OUT/runs/<METHOD>_rtol_<RTOL>_f0_<F0>_threads_<T>_<k>`).
     #[arg(long)]
     pub keep_runs: bool,
+}
+
+/// A `--method` entry: an integrator, and the tolerance it runs at when it names one.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodSpec {
+    /// The integrator.
+    pub method: Method,
+    /// Its own tolerance (`METHOD:RTOL`); `None`: every `--rtol`.
+    pub rtol: Option<f64>,
+}
+
+/// Parses `METHOD` or `METHOD:RTOL` (bulirsch-stoer, dop853 or dopri5; RTOL in (0, 1)).
+fn parse_method_spec(text: &str) -> Result<MethodSpec, String> {
+    let (name, rtol) = match text.split_once(':') {
+        Some((name, rtol)) => {
+            let r: f64 = rtol
+                .parse()
+                .map_err(|_| format!("tolerance after ':' must be a number, got {rtol:?}"))?;
+            if !(r > 0.0 && r < 1.0) {
+                return Err(format!("tolerance after ':' must be in (0, 1), got {rtol}"));
+            }
+            (name, Some(r))
+        }
+        None => (text, None),
+    };
+    let method = <Method as clap::ValueEnum>::from_str(name, true)
+        .ok()
+        .filter(|m| *m != Method::Rk4)
+        .ok_or_else(|| {
+            format!("each must be bulirsch-stoer, dop853 or dopri5 (rk4 needs a fixed step), got {name:?}")
+        })?;
+    Ok(MethodSpec { method, rtol })
 }
 
 /// One configuration's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ImpactTiming {
-    /// Bulirsch–Stoer rtol (= atol).
+    /// Integrator.
+    pub method: Method,
+    /// rtol (= atol).
     pub rtol: f64,
     /// F0 (s m⁻²).
     pub f0: f64,
@@ -100,14 +139,24 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     }
     std::fs::create_dir_all(&args.out).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let mut results = Vec::new();
-    for (&rtol, &f0, &threads) in args.rtol.iter().flat_map(|r| {
+    let pairs: Vec<(Method, f64)> = args
+        .method
+        .iter()
+        .flat_map(|m| match m.rtol {
+            Some(r) => vec![(m.method, r)],
+            None => args.rtol.iter().map(|r| (m.method, *r)).collect(),
+        })
+        .collect();
+    let configurations = pairs.iter().flat_map(|&(m, r)| {
         args.f0
             .iter()
-            .flat_map(move |f| args.threads.iter().map(move |t| (r, f, t)))
-    }) {
+            .flat_map(move |f| args.threads.iter().map(move |t| (m, r, *f, *t)))
+    });
+    for (method, rtol, f0, threads) in configurations {
         let mut cfg = ImpactConfig::new(args.target.clone(), projectile.clone());
         cfg.angle_deg = args.angle;
         cfg.t_end = args.t_end;
+        cfg.method = method;
         cfg.rtol = rtol;
         cfg.f0 = f0;
         cfg.snapshots = vec![0.0, args.t_end];
@@ -123,18 +172,20 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
             let dir = args
                 .out
                 .join("runs")
-                .join(format!("rtol_{rtol:e}_f0_{f0:e}_threads_{threads}_{k}"));
+                .join(format!("{method}_rtol_{rtol:e}_f0_{f0:e}_threads_{threads}_{k}"));
             let options = RunOptions {
                 force: true,
                 progress: false,
                 ..RunOptions::default()
             };
-            let summary = pool
-                .install(|| run_impact(&cfg, &dir, &options))
-                .map_err(|e| CliError::failed(format!("rtol = {rtol:e}, F0 = {f0:e}, {threads} threads: {e}")))?;
+            let summary = pool.install(|| run_impact(&cfg, &dir, &options)).map_err(|e| {
+                CliError::failed(format!(
+                    "{method}, rtol = {rtol:e}, F0 = {f0:e}, {threads} threads: {e}"
+                ))
+            })?;
             walls.push(summary.wall_seconds);
             println!(
-                "  rtol {rtol:e}, F0 {f0:e} s m^-2, {threads} thread{}: wall {:.1} s, {} steps, {} RHS, energy error {:.1e}",
+                "  {method}, rtol {rtol:e}, F0 {f0:e} s m^-2, {threads} thread{}: wall {:.1} s, {} steps, {} RHS, energy error {:.1e}",
                 if threads == 1 { "" } else { "s" },
                 summary.wall_seconds,
                 summary.steps_accepted,
@@ -149,6 +200,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         let s = last.expect("repeats >= 1");
         let min = walls.iter().copied().fold(f64::INFINITY, f64::min);
         results.push(ImpactTiming {
+            method,
             rtol,
             f0,
             threads: threads as usize,
@@ -166,12 +218,12 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         let mut f = std::io::BufWriter::new(std::fs::File::create(&csv)?);
         writeln!(
             f,
-            "target,projectile,angle_deg,t_end,rtol,f0,threads,median_s,min_s,repeats,steps,rhs_evaluations,energy_error"
+            "target,projectile,angle_deg,t_end,rtol,f0,threads,median_s,min_s,repeats,steps,rhs_evaluations,energy_error,method"
         )?;
         for r in &results {
             writeln!(
                 f,
-                "{},{},{},{},{:e},{:e},{},{:.3},{:.3},{},{},{},{:e}",
+                "{},{},{},{},{:e},{:e},{},{:.3},{:.3},{},{},{},{:e},{}",
                 args.target.display(),
                 args.projectile,
                 args.angle,
@@ -184,7 +236,8 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
                 args.repeats,
                 r.steps,
                 r.rhs_evaluations,
-                r.energy_error
+                r.energy_error,
+                r.method
             )?;
         }
         f.flush()
@@ -213,8 +266,9 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
         let err = |e: &dyn std::fmt::Display| e.to_string();
         let results = self.results;
         let goal = self.goal;
-        // room above the tallest bar for its three lines of text
-        let top = results.iter().map(|r| r.median_s).fold(goal, f64::max) * 1.35;
+        // Room above the tallest bar for its three lines of text (to 0.76 of the height), and above those for
+        // the legend in the upper right corner.
+        let top = results.iter().map(|r| r.median_s).fold(goal, f64::max) * 1.6;
         let mut chart = ChartBuilder::on(root)
             .caption(&self.title, ("sans-serif", 18))
             .margin(12)
@@ -233,7 +287,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
                     format!("{t:.1}")
                 }
             })
-            .x_desc("configuration: rtol, F0 (s m^-2), threads; relative energy error above each bar")
+            .x_desc("configuration: method, rtol, F0 (s m^-2), threads; relative energy error above each bar")
             .y_desc("wall-clock time (s)")
             .disable_x_mesh()
             .draw()
@@ -257,7 +311,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
         // Above each bar, its configuration and (every run's error beside its time) its relative energy error.
         let lines = |r: &ImpactTiming| {
             [
-                format!("rtol {:e}", r.rtol),
+                format!("{} rtol {:e}", short_name(r.method), r.rtol),
                 format!("F0 {:e}, {} thr", r.f0, r.threads),
                 format!("dE/E {:.1e}", r.energy_error),
             ]
@@ -281,6 +335,14 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
             .draw()
             .map_err(|e| err(&e))?;
         Ok(())
+    }
+}
+
+/// The method as a bar label: "BS" for Bulirsch–Stoer, the `ode_solvers` names otherwise.
+fn short_name(method: Method) -> String {
+    match method {
+        Method::BulirschStoer => "BS".to_string(),
+        other => other.to_string(),
     }
 }
 

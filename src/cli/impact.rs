@@ -39,9 +39,13 @@ pub struct ImpactArgs {
     /// End time (s).
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
-    /// Relative (and absolute) tolerance of Bulirsch–Stoer.
+    /// Relative (and absolute) tolerance: of the whole run for Bulirsch–Stoer, of each step for Dop853/Dopri5.
     #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
     pub rtol: f64,
+    /// Integrator: bulirsch-stoer (Roig03's), dop853 or dopri5 (these project the attitudes onto |q| = 1 at
+    /// every output sample).
+    #[arg(long, default_value = "bulirsch-stoer")]
+    pub method: crate::integrate::Method,
     /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is Roig03's "F0 ≈ 1" in km and s, and the value
     /// closest to its outcomes in analysis/roig2003/F0_SCAN.md.
     #[arg(long, default_value_t = crate::impact::run::DEFAULT_F0)]
@@ -111,6 +115,7 @@ impl ImpactArgs {
             seed: self.seed,
             contact_time: self.contact_time,
             t_end: self.t_end,
+            method: self.method,
             rtol: self.rtol,
             f0: self.f0,
             beta: self.beta,

@@ -180,7 +180,7 @@ fn diagnostics_finite(d: &Diagnostics) -> bool {
 }
 
 /// What went wrong with a sampled state, if anything.
-fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
+fn check_state(t: f64, d: &Diagnostics, projected: bool) -> Option<String> {
     if !diagnostics_finite(d) {
         return Some(format!(
             "non-finite diagnostics at t = {t} s (energy {}, |P| {}, |L| {})",
@@ -191,8 +191,13 @@ fn check_state(t: f64, d: &Diagnostics) -> Option<String> {
     }
     if d.quaternion_norm_error > QUATERNION_NORM_LIMIT {
         return Some(format!(
-            "quaternion norm constraint broken at t = {t} s: max||q|-1| = {:.3e} > {QUATERNION_NORM_LIMIT:e}",
-            d.quaternion_norm_error
+            "quaternion norm constraint broken at t = {t} s: max||q|-1| = {:.3e} > {QUATERNION_NORM_LIMIT:e}{}",
+            d.quaternion_norm_error,
+            if projected {
+                " within one output interval: tighten integrator.rtol or shorten output.every"
+            } else {
+                "; integrator.project_attitudes = true pulls |q| back at every output sample"
+            }
         ));
     }
     None
@@ -252,6 +257,9 @@ pub struct EllipsoidEngine {
     last_good: (f64, Vec<f64>),
     barrier: BarrierMonitor,
     tracks: Option<(TracksWriter, PathBuf)>,
+    /// The largest `||q| − 1|` the last projection removed (0 without projection): the sample checks and
+    /// reports it, so projecting never hides a drift.
+    projected_drift: f64,
 }
 
 impl EllipsoidEngine {
@@ -291,6 +299,7 @@ impl EllipsoidEngine {
             tracker,
             barrier,
             tracks: None,
+            projected_drift: 0.0,
         })
     }
 
@@ -446,12 +455,16 @@ impl Engine for EllipsoidEngine {
             self.last_good = (self.t, self.y.clone());
             return Err(self.failure(format!("integrator error: {e}")));
         }
+        if self.scene.integrator.project_attitudes {
+            self.projected_drift = self.system.project_attitudes(&mut self.y);
+        }
         Ok(())
     }
 
     fn sample(&mut self, _to: &Sample, wall_seconds: f64) -> Result<String, SampleError> {
-        let d = self.system.diagnostics_at(self.t, &self.y);
-        if let Some(cause) = check_state(self.t, &d) {
+        let mut d = self.system.diagnostics_at(self.t, &self.y);
+        d.quaternion_norm_error = d.quaternion_norm_error.max(self.projected_drift);
+        if let Some(cause) = check_state(self.t, &d, self.scene.integrator.project_attitudes) {
             return Err(self.failure(cause).into());
         }
         self.tracker.update(&d);

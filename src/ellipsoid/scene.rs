@@ -254,6 +254,14 @@ pub struct IntegratorSection {
     /// adaptive methods (optional; by default they choose one).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
+    /// Whether to pull the attitudes back onto `|q| = 1` at every output sample (`true`/`false`; see
+    /// [`crate::ellipsoid::equations::EllipsoidSystem::project_attitudes`]). Default: `true` for `"dop853"`,
+    /// `"dopri5"` and `"rk4"`, whose error norm lets one fast-spinning body's `|q|` drift by 1e-3 within a few
+    /// hundred turns (the N2000 impact, `analysis/n2000/REPORT.md`); `false` for `"bulirsch-stoer"`, which keeps
+    /// the constraint without it (1.3e-6 over that impact) and whose runs stay as they were. The run's
+    /// `quaternion_norm_error` is the largest `||q| − 1|` before projection, and above 1e-3 it still stops the run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub project_attitudes: Option<bool>,
 }
 
 fn default_method() -> Method {
@@ -271,6 +279,7 @@ impl Default for IntegratorSection {
             rtol: default_tolerance(),
             atol: default_tolerance(),
             step: None,
+            project_attitudes: None,
         }
     }
 }
@@ -366,6 +375,9 @@ pub struct IntegratorSettings {
     pub atol: f64,
     /// Fixed (rk4) or initial step (s).
     pub step: Option<f64>,
+    /// Whether attitudes are projected onto `|q| = 1` at every output sample (resolved default: all methods but
+    /// Bulirsch–Stoer).
+    pub project_attitudes: bool,
 }
 
 /// Validated output settings.
@@ -596,6 +608,7 @@ impl Validator<'_> {
             rtol,
             atol,
             step,
+            project_attitudes: i.project_attitudes.unwrap_or(i.method != Method::BulirschStoer),
         })
     }
 

@@ -21,6 +21,7 @@ use crate::ellipsoid::output::{read_bodies_csv, write_snapshot};
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 use crate::impact::pile::{ProjectilePile, set_up_pile_impact};
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
+use crate::integrate::Method;
 use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
 
 /// Default end time (s).
@@ -70,7 +71,11 @@ pub struct ImpactConfig {
     pub contact_time: f64,
     /// End time (s, > 0; default 10 000).
     pub t_end: f64,
-    /// Relative and absolute tolerance of Bulirsch–Stoer (> 0; default 1e-6, of the whole run).
+    /// Integrator (default Bulirsch–Stoer, Roig03's; `Dop853` and `Dopri5` project the attitudes onto
+    /// `|q| = 1` at every sample, see [`crate::ellipsoid::scene::IntegratorSection::project_attitudes`]).
+    pub method: Method,
+    /// Relative and absolute tolerance (> 0; default 1e-6). Bulirsch–Stoer applies it to the whole run, the
+    /// Dormand–Prince methods to each step.
     pub rtol: f64,
     /// Dissipation coefficient F0 (s m⁻², ≥ 0; default 1e-6).
     pub f0: f64,
@@ -101,6 +106,7 @@ impl ImpactConfig {
             seed: DEFAULT_SEED,
             contact_time: DEFAULT_CONTACT_TIME,
             t_end: DEFAULT_T_END,
+            method: Method::BulirschStoer,
             rtol: DEFAULT_RTOL,
             f0: DEFAULT_F0,
             beta: DEFAULT_BETA,
@@ -153,6 +159,12 @@ impl ImpactConfig {
         }
         if !positive(self.t_end) {
             return invalid("t_end", format!("must be > 0 s and finite, got {}", self.t_end));
+        }
+        if self.method == Method::Rk4 {
+            return invalid(
+                "method",
+                "must be bulirsch-stoer, dop853 or dopri5 (rk4 has a fixed step, which an impact cannot choose)".into(),
+            );
         }
         let min_rtol = crate::io::scene_file::MIN_RTOL;
         if !(self.rtol.is_finite() && (min_rtol..1.0).contains(&self.rtol)) {
@@ -215,7 +227,7 @@ impl ImpactConfig {
              [scene]\nkind = \"ellipsoids\"\nt_end = {t_end:?}\nseed = {seed}\nbodies_file = \"initial_bodies.csv\"\n\n\
              [model]\ncalibrate = {{ beta = {beta:?}, v = {speed:?}, reading = \"{reading}\" }}\ninertia = \"{inertia}\"\n\n\
              [physics]\ngravity = {{}}\ncontact = {{}}\ndissipation = {{ F0 = {f0:?} }}\n\n\
-             [integrator]\nmethod = \"bulirsch-stoer\"\nrtol = {rtol:?}\natol = {rtol:?}\n\n\
+             [integrator]\nmethod = \"{method}\"\nrtol = {rtol:?}\natol = {rtol:?}\n\n\
              [output]\ntimes = [{times}]\nevery = {every:?}\ntrack = [{projectile_index}]\n",
             t_end = self.t_end,
             seed = self.seed,
@@ -223,6 +235,7 @@ impl ImpactConfig {
             reading = self.kappa_reading,
             speed = self.projectile.speed,
             f0 = self.f0,
+            method = self.method,
             rtol = self.rtol,
             times = times.join(", "),
             every = self.every,

@@ -55,7 +55,9 @@ fn default_seeds() -> Vec<u64> {
 pub struct ImpactSection {
     /// End time (s; default 10 000).
     pub t_end: Option<f64>,
-    /// Bulirsch–Stoer relative (= absolute) tolerance (default 1e-6, of the whole run).
+    /// Integrator: `"bulirsch-stoer"` (default), `"dop853"` or `"dopri5"`.
+    pub method: Option<crate::integrate::Method>,
+    /// Relative (= absolute) tolerance (default 1e-6; of the whole run for Bulirsch–Stoer, of each step otherwise).
     pub rtol: Option<f64>,
     /// Dissipation coefficient F0 (s m⁻²; default 1e-6).
     pub f0: Option<f64>,

@@ -15,7 +15,8 @@
 //!
 //! [impact]                         # optional; every key optional (defaults of `rubblepile impact`)
 //! t_end = 10000.0                  # end time (s; default 10000)
-//! rtol = 1e-6                      # Bulirsch-Stoer relative = absolute tolerance of the run (default 1e-6)
+//! method = "bulirsch-stoer"        # or "dop853", "dopri5" (default "bulirsch-stoer")
+//! rtol = 1e-6                      # relative = absolute tolerance (default 1e-6; of the run for Bulirsch-Stoer)
 //! f0 = 1e-6                        # dissipation coefficient F0 (s m^-2; default 1e-6)
 //! beta = 10.0                      # beta of Roig03 Eq. 14 for kappa (default 10)
 //! contact_time = 90.0              # time at which the surfaces first touch (s; default 90)

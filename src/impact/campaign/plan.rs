@@ -284,6 +284,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         for (pk, projectile) in projectiles.iter().enumerate() {
             let mut base = ImpactConfig::new(path.clone(), projectile.clone());
             base.t_end = t_end;
+            base.method = imp.method.unwrap_or(crate::integrate::Method::BulirschStoer);
             base.rtol = imp.rtol.unwrap_or(DEFAULT_RTOL);
             base.f0 = imp.f0.unwrap_or(DEFAULT_F0);
             base.beta = imp.beta.unwrap_or(DEFAULT_BETA);
