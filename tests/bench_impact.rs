@@ -154,6 +154,37 @@ fn bench_impact_times_each_method_and_names_it_in_the_csv_and_on_the_bars() {
         svg.contains("BS rtol 1e-6") && svg.contains("dop853 rtol 1e-8"),
         "bars not labelled by their method"
     );
+    // --replot draws the same bars again from the CSV, with the goal it is given, and runs nothing.
+    let before = std::fs::metadata(dir.join("b/bench_impact.csv"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    let replot = rubblepile(&dir, &["bench", "impact", "--replot", "--goal", "250", "--out", "b"]);
+    assert!(replot.status.success(), "{}", String::from_utf8_lossy(&replot.stderr));
+    let again = std::fs::read_to_string(dir.join("b/bench_impact.svg")).unwrap();
+    assert!(
+        again.contains("goal: 250 s on 2 cores") && again.contains("N30_T4 + P1"),
+        "replot title or goal"
+    );
+    assert!(
+        again.contains("BS rtol 1e-6") && again.contains("dop853 rtol 1e-8"),
+        "replot labels"
+    );
+    assert_eq!(
+        std::fs::metadata(dir.join("b/bench_impact.csv"))
+            .unwrap()
+            .modified()
+            .unwrap(),
+        before
+    );
+    let missing = rubblepile(&dir, &["bench", "impact", "--replot", "--out", "nothing_here"]);
+    assert_eq!(
+        missing.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&missing.stderr)
+    );
+    assert!(String::from_utf8_lossy(&missing.stderr).contains("bench_impact.csv"));
     for (bad_arg, needle) in [
         ("rk4", "each must be bulirsch-stoer, dop853 or dopri5"),
         ("dop853:2", "tolerance after ':' must be in (0, 1), got 2"),

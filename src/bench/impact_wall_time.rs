@@ -1,6 +1,6 @@
 //! `rubblepile bench impact`: the wall-clock time of whole impact runs (Roig03 §3), for the speed goals of the
 //! N200_T4 + P2, ζ = 45°, 10 000 s run at the impact default rtol (1e-6 over the run; goal 60 s) and of the same
-//! impact on `targets/N2000_T4.csv` (goal 10 min), across tolerances, dissipation coefficients and thread counts.
+//! impact on `targets/N2000_T4.csv` (goal 10 min), across integrators, tolerances, dissipation coefficients and thread counts.
 //!
 //! Each configuration is a complete [`run_impact`] into a scratch directory under `--out` (removed afterwards
 //! unless `--keep-runs`); the row reports its wall time beside its energy error, as every run does.
@@ -54,6 +54,10 @@ pub struct ImpactBenchArgs {
     /// Overwrite an earlier `bench_impact.csv`/`.svg` in OUT.
     #[arg(long)]
     pub force: bool,
+    /// Run nothing: redraw `bench_impact.svg` and `.png` from OUT/bench_impact.csv (its target, projectile, angle
+    /// and end time; `--goal` as given), overwriting the plot only.
+    #[arg(long)]
+    pub replot: bool,
     /// Keep the run directories (`OUT/runs/<METHOD>_rtol_<RTOL>_f0_<F0>_threads_<T>_<k>`).
     #[arg(long)]
     pub keep_runs: bool,
@@ -127,6 +131,9 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
     }
     if !(args.goal.is_finite() && args.goal > 0.0) {
         return Err(CliError::usage(format!("--goal: must be > 0 s, got {}", args.goal)));
+    }
+    if args.replot {
+        return replot(args);
     }
     let (csv, svg) = (args.out.join("bench_impact.csv"), args.out.join("bench_impact.svg"));
     for p in [&csv, &svg] {
@@ -243,7 +250,14 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         f.flush()
     };
     write().map_err(|e| CliError::failed(format!("{}: {e}", csv.display())))?;
-    plot(&results, args).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
+    let title = format!(
+        "{} + {}, zeta = {} deg, {} s",
+        args.target.file_stem().and_then(|s| s.to_str()).unwrap_or("target"),
+        args.projectile,
+        args.angle,
+        args.t_end,
+    );
+    plot(&results, title, args).map_err(|e| CliError::failed(format!("{}: {e}", svg.display())))?;
     println!("  wrote {}, {} and bench_impact.png", csv.display(), svg.display());
     Ok(())
 }
@@ -330,6 +344,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
             .map_err(|e| err(&e))?;
         chart
             .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
             .background_style(WHITE.mix(0.8))
             .border_style(BLACK)
             .draw()
@@ -346,16 +361,71 @@ fn short_name(method: Method) -> String {
     }
 }
 
-fn plot(results: &[ImpactTiming], args: &ImpactBenchArgs) -> Result<(), String> {
+/// `--replot`: the rows of OUT/bench_impact.csv drawn again (a CSV written before the `method` column reads as
+/// Bulirsch–Stoer throughout).
+fn replot(args: &ImpactBenchArgs) -> Result<(), CliError> {
+    let path = args.out.join("bench_impact.csv");
+    let fail = |e: String| CliError::failed(format!("{}: {e}", path.display()));
+    let mut reader = csv::Reader::from_path(&path).map_err(|e| fail(e.to_string()))?;
+    let headers = reader.headers().map_err(|e| fail(e.to_string()))?.clone();
+    let (mut results, mut title) = (Vec::new(), None);
+    for (k, record) in reader.records().enumerate() {
+        let record = record.map_err(|e| fail(e.to_string()))?;
+        let field = |name: &str| {
+            headers
+                .iter()
+                .position(|h| h == name)
+                .and_then(|i| record.get(i))
+                .ok_or_else(|| fail(format!("row {}: no column `{name}`", k + 1)))
+        };
+        let number = |name: &str| {
+            let text = field(name)?;
+            text.parse::<f64>()
+                .map_err(|_| fail(format!("row {}: `{name}` must be a number, got {text:?}", k + 1)))
+        };
+        let method = match headers.iter().any(|h| h == "method") {
+            false => Method::BulirschStoer,
+            true => {
+                parse_method_spec(field("method")?)
+                    .map_err(|e| fail(format!("row {}: `method`: {e}", k + 1)))?
+                    .method
+            }
+        };
+        title.get_or_insert(format!(
+            "{} + {}, zeta = {} deg, {} s",
+            std::path::Path::new(field("target")?)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("target"),
+            field("projectile")?,
+            field("angle_deg")?,
+            field("t_end")?,
+        ));
+        results.push(ImpactTiming {
+            method,
+            rtol: number("rtol")?,
+            f0: number("f0")?,
+            threads: number("threads")? as usize,
+            median_s: number("median_s")?,
+            min_s: number("min_s")?,
+            steps: number("steps")? as u64,
+            rhs_evaluations: number("rhs_evaluations")? as u64,
+            energy_error: number("energy_error")?,
+        });
+    }
+    let title = title.ok_or_else(|| fail("no rows to plot".to_string()))?;
+    plot(&results, title, args).map_err(fail)?;
+    println!(
+        "  redrew bench_impact.svg and bench_impact.png in {}",
+        args.out.display()
+    );
+    Ok(())
+}
+
+fn plot(results: &[ImpactTiming], title: String, args: &ImpactBenchArgs) -> Result<(), String> {
     let figure = WallTimeBars {
         results,
-        title: format!(
-            "{} + {}, zeta = {} deg, {} s",
-            args.target.file_stem().and_then(|s| s.to_str()).unwrap_or("target"),
-            args.projectile,
-            args.angle,
-            args.t_end,
-        ),
+        title,
         goal: args.goal,
     };
     crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure)

@@ -7,7 +7,9 @@
 //! those bodies' rows at every sample; `barrier_overruns.csv` (only when a pair overran its contact barrier, see
 //! [`crate::ellipsoid::barrier`]); `summary.json` as [`RunSummary`]. A sampled state with a non-finite diagnostic or a
 //! quaternion norm off by more than [`QUATERNION_NORM_LIMIT`] stops the run, as does an integrator error (step-size
-//! underflow, too many steps).
+//! underflow, too many steps). With `integrator.project_attitudes` (the default for the Dormand–Prince methods) the
+//! attitudes are pulled back onto `|q| = 1` after each advance to a sample
+//! ([`EllipsoidSystem::project_attitudes`]); the norm error checked and reported is the one found before that.
 
 use std::path::{Path, PathBuf};
 
