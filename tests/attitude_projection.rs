@@ -184,6 +184,7 @@ fn dop853_keeps_a_fast_tumbler_on_the_constraint_only_with_projection() {
         "with projection: max ||q|-1| before each projection {:e}, energy error {:e}, |dL| {:e}",
         s.quaternion_norm_error, s.energy_error, s.angular_momentum_error
     );
+    assert!(s.project_attitudes, "the summary says the attitudes were projected");
     assert!(s.quaternion_norm_error < 1e-4, "{:e}", s.quaternion_norm_error);
     // Projection keeps ω_b and the attitude's direction, so the world angular momentum R(q)ᵀ I ω_b, which the
     // free top conserves, is kept to round-off over its 100 projections (a wrong rescaling of p would move it by
@@ -192,6 +193,7 @@ fn dop853_keeps_a_fast_tumbler_on_the_constraint_only_with_projection() {
     // Bulirsch–Stoer keeps the constraint without it, so by default it does not project (its runs stay as they
     // were): the same turns end 1000 times further from the limit (measured 1.1e-6).
     let bs = run_tumbler(&tumbler_scene("bulirsch-stoer", RTOL, TURNS, None), "tumbler-bs").unwrap();
+    assert!(!bs.project_attitudes);
     assert!(bs.quaternion_norm_error < 1e-5, "{:e}", bs.quaternion_norm_error);
 }
 

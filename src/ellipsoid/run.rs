@@ -358,11 +358,16 @@ impl EllipsoidEngine {
         }
         lines.push(format!("  physics: {}", terms.join(", ")));
         lines.push(format!(
-            "  integrator: {} (rtol {:e}, atol {:e}{})",
+            "  integrator: {} (rtol {:e}, atol {:e}{}{})",
             s.integrator.method,
             s.integrator.rtol,
             s.integrator.atol,
-            s.integrator.step.map(|h| format!(", step {h} s")).unwrap_or_default()
+            s.integrator.step.map(|h| format!(", step {h} s")).unwrap_or_default(),
+            if s.integrator.project_attitudes {
+                "; attitudes projected onto |q| = 1 at every output sample"
+            } else {
+                ""
+            }
         ));
         lines.push(format!(
             "  output: every {} s, {} snapshots",
@@ -593,6 +598,7 @@ impl Engine for EllipsoidEngine {
             rtol: settings.rtol,
             atol: settings.atol,
             step: settings.step,
+            project_attitudes: settings.project_attitudes,
             n_bodies: self.system.n_bodies(),
             rotation_integrated: self.system.rotation_integrated(),
             physics: PhysicsSummary::from(&scene.physics),

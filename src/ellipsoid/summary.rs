@@ -121,6 +121,10 @@ pub struct RunSummary {
     pub atol: f64,
     /// Fixed (rk4) or initial step (s), if given.
     pub step: Option<f64>,
+    /// Whether the attitudes were projected onto `|q| = 1` at every output sample (`integrator.project_attitudes`;
+    /// false in summaries written before the option existed).
+    #[serde(default)]
+    pub project_attitudes: bool,
     /// Number of bodies.
     pub n_bodies: usize,
     /// Whether attitudes were integrated.
