@@ -327,7 +327,19 @@ fn bad_campaign_files_give_one_line_errors() {
             .iter()
             .all(|p| p.plan.scene_toml.contains("inertia = \"gaussian\""))
     );
-    let cases: [(String, &str); 11] = [
+    // impact.method reaches every run's scene; without rtol, Dop853 takes its per-step default 1e-8
+    let dop =
+        parse_campaign(&GRID.replace("rtol = 1e-8", "method = \"dop853\""), "c.toml", &dir).expect("method = dop853");
+    assert!(
+        dop.points
+            .iter()
+            .all(|p| p.plan.scene_toml.contains("method = \"dop853\"") && p.config.rtol == 1e-8)
+    );
+    let cases: [(String, &str); 12] = [
+        (
+            GRID.replace("rtol = 1e-8", "rtol = 1e-8\nmethod = \"leapfrog\""),
+            "c.toml: impact.method: unknown variant `leapfrog`",
+        ),
         (
             GRID.replace("rtol = 1e-8", "rtol = 1e-8\ninertia = \"hollow\""),
             "c.toml: impact.inertia: unknown variant `hollow`, expected `gaussian` or `uniform`",

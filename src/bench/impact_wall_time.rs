@@ -34,7 +34,8 @@ pub struct ImpactBenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "bulirsch-stoer", value_parser = parse_method_spec)]
     pub method: Vec<MethodSpec>,
     /// Tolerances (rtol = atol, dimensionless, in (0, 1)), comma-separated; each is run with each bare method.
-    #[arg(long, value_delimiter = ',', default_values_t = [crate::impact::run::DEFAULT_RTOL])]
+    /// Default: the impact's default of each method (1e-6 of the run for Bulirsch–Stoer, 1e-8 per step otherwise).
+    #[arg(long, value_delimiter = ',')]
     pub rtol: Vec<f64>,
     /// Dissipation coefficients F0 (s m⁻²), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "1e-6")]
@@ -151,6 +152,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         .iter()
         .flat_map(|m| match m.rtol {
             Some(r) => vec![(m.method, r)],
+            None if args.rtol.is_empty() => vec![(m.method, crate::impact::run::default_rtol(m.method))],
             None => args.rtol.iter().map(|r| (m.method, *r)).collect(),
         })
         .collect();

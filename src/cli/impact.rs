@@ -39,9 +39,10 @@ pub struct ImpactArgs {
     /// End time (s).
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
-    /// Relative (and absolute) tolerance: of the whole run for Bulirsch–Stoer, of each step for Dop853/Dopri5.
-    #[arg(long, default_value_t = crate::impact::run::DEFAULT_RTOL)]
-    pub rtol: f64,
+    /// Relative (and absolute) tolerance: of the whole run for Bulirsch–Stoer (default 1e-6), of each step for
+    /// Dop853/Dopri5 (default 1e-8).
+    #[arg(long)]
+    pub rtol: Option<f64>,
     /// Integrator: bulirsch-stoer (Roig03's), dop853 or dopri5 (these project the attitudes onto |q| = 1 at
     /// every output sample).
     #[arg(long, default_value = "bulirsch-stoer")]
@@ -116,7 +117,7 @@ impl ImpactArgs {
             contact_time: self.contact_time,
             t_end: self.t_end,
             method: self.method,
-            rtol: self.rtol,
+            rtol: self.rtol.unwrap_or(crate::impact::run::default_rtol(self.method)),
             f0: self.f0,
             beta: self.beta,
             kappa_reading: self.kappa_reading,

@@ -30,6 +30,19 @@ pub const DEFAULT_T_END: f64 = 10_000.0;
 /// same RHS evaluations as the per-step 1e-9 of earlier builds on the N200 impact and conserves energy better
 /// (7e-12 against 4.6e-11; analysis/work_precision/REPORT.md).
 pub const DEFAULT_RTOL: f64 = 1e-6;
+
+/// Default tolerance of the Dormand–Prince methods, which apply it to each step: at 1e-8, Dop853 runs the N2000 + P2
+/// impact to 10 000 s in 7 min 37 s on 2 cores with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
+pub const DEFAULT_RTOL_PER_STEP: f64 = 1e-8;
+
+/// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for Bulirsch–Stoer (of the whole run),
+/// [`DEFAULT_RTOL_PER_STEP`] for the others.
+pub fn default_rtol(method: Method) -> f64 {
+    match method {
+        Method::BulirschStoer => DEFAULT_RTOL,
+        _ => DEFAULT_RTOL_PER_STEP,
+    }
+}
 /// Default dissipation coefficient F0 (s m⁻²): Roig03 §2.4's "F0 ≈ 1" in its kilometres and seconds (1 s km⁻²);
 /// a scan made before that reading found 1e-6 reproduces the bound fraction, f_KE, spin–size exponent and best
 /// spin-histogram n most closely (analysis/roig2003/F0_SCAN.md).

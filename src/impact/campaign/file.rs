@@ -57,7 +57,8 @@ pub struct ImpactSection {
     pub t_end: Option<f64>,
     /// Integrator: `"bulirsch-stoer"` (default), `"dop853"` or `"dopri5"`.
     pub method: Option<crate::integrate::Method>,
-    /// Relative (= absolute) tolerance (default 1e-6; of the whole run for Bulirsch–Stoer, of each step otherwise).
+    /// Relative (= absolute) tolerance (of the whole run for Bulirsch–Stoer, default 1e-6; of each step otherwise,
+    /// default 1e-8).
     pub rtol: Option<f64>,
     /// Dissipation coefficient F0 (s m⁻²; default 1e-6).
     pub f0: Option<f64>,

@@ -16,7 +16,8 @@
 //! [impact]                         # optional; every key optional (defaults of `rubblepile impact`)
 //! t_end = 10000.0                  # end time (s; default 10000)
 //! method = "bulirsch-stoer"        # or "dop853", "dopri5" (default "bulirsch-stoer")
-//! rtol = 1e-6                      # relative = absolute tolerance (default 1e-6; of the run for Bulirsch-Stoer)
+//! rtol = 1e-6                      # relative = absolute tolerance (default: 1e-6 of the run for Bulirsch-Stoer,
+//!                                  # 1e-8 per step for dop853/dopri5)
 //! f0 = 1e-6                        # dissipation coefficient F0 (s m^-2; default 1e-6)
 //! beta = 10.0                      # beta of Roig03 Eq. 14 for kappa (default 10)
 //! contact_time = 90.0              # time at which the surfaces first touch (s; default 90)

@@ -7,8 +7,8 @@ use crate::ellipsoid::body::Body;
 use crate::impact::pile::ProjectilePile;
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{
-    DEFAULT_BETA, DEFAULT_CONTACT_TIME, DEFAULT_EVERY, DEFAULT_F0, DEFAULT_RTOL, DEFAULT_T_END, ImpactConfig,
-    ImpactError, ImpactPlan, default_snapshots, read_target,
+    DEFAULT_BETA, DEFAULT_CONTACT_TIME, DEFAULT_EVERY, DEFAULT_F0, DEFAULT_T_END, ImpactConfig, ImpactError,
+    ImpactPlan, default_rtol, default_snapshots, read_target,
 };
 
 use super::*;
@@ -285,7 +285,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             let mut base = ImpactConfig::new(path.clone(), projectile.clone());
             base.t_end = t_end;
             base.method = imp.method.unwrap_or(crate::integrate::Method::BulirschStoer);
-            base.rtol = imp.rtol.unwrap_or(DEFAULT_RTOL);
+            base.rtol = imp.rtol.unwrap_or(default_rtol(base.method));
             base.f0 = imp.f0.unwrap_or(DEFAULT_F0);
             base.beta = imp.beta.unwrap_or(DEFAULT_BETA);
             base.kappa_reading = imp.kappa_reading.unwrap_or_default();
