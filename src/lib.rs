@@ -13,7 +13,8 @@
 //! there is no import cycle and no engine sees the driver, the analysis or the command line. `tests/layers.rs` reads
 //! every `crate::` path in `src/` and checks this table (the table below is what it reads).
 //!
-//! - **L0**: `math`, `bits` — fixed-size linear algebra, bit-exact floats;
+//! - **L0**: `math`, `bits`, `phase` — fixed-size linear algebra, bit-exact floats, wall time per phase of the hot
+//!   loops (serial or parallel);
 //! - **L1**: `random` — seeded random numbers (`rand_pcg`; seeds live in scene files);
 //! - **L2**: `geometry`, `gravity`, `integrate`, `io` — shapes, walls and neighbour search; self-gravity; the ODE
 //!   solvers; the scene-file floor and lossless formatting;
@@ -43,5 +44,6 @@ pub mod impact;
 pub mod integrate;
 pub mod io;
 pub mod math;
+pub mod phase;
 pub mod random;
 pub mod render;

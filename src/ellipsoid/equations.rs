@@ -35,6 +35,7 @@ use crate::geometry::neighbours::sphere_pairs;
 use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::integrate::OdeSystem;
 use crate::math::{Mat4, Vec3, Vec4};
+use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -254,6 +255,16 @@ const CANDIDATES_PER_TASK: usize = 64;
 
 /// From this many bodies on, the per-body passes (kinematics, gravity blocks, body rates) run in parallel.
 const PARALLEL_BODIES: usize = 64;
+
+// Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).
+static PHASE_GATHER: Phase = Phase::new("ellipsoid.gather_positions", Kind::Serial);
+static PHASE_KINEMATICS: Phase = Phase::new("ellipsoid.kinematics", Kind::Parallel);
+static PHASE_CANDIDATES: Phase = Phase::new("ellipsoid.candidate_pairs", Kind::Serial);
+static PHASE_PAIR_FORCES: Phase = Phase::new("ellipsoid.pair_forces", Kind::Parallel);
+static PHASE_PAIR_SUM: Phase = Phase::new("ellipsoid.pair_sum", Kind::Serial);
+static PHASE_GRAVITY: Phase = Phase::new("ellipsoid.gravity", Kind::Parallel);
+static PHASE_SMALL_GRAVITY: Phase = Phase::new("ellipsoid.gravity_half_loop", Kind::Serial);
+static PHASE_RATES: Phase = Phase::new("ellipsoid.body_rates", Kind::Parallel);
 
 /// The N-ellipsoid system.
 pub struct EllipsoidSystem {
@@ -949,11 +960,14 @@ impl OdeSystem for EllipsoidSystem {
         } = scratch;
         // Read straight from the state, so that the gravity pass need not wait for the kinematics: the other
         // worker sums gravity while this one computes the kinematics.
-        positions.clear();
-        positions.extend((0..n).map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])));
+        PHASE_GATHER.time(|| {
+            positions.clear();
+            positions
+                .extend((0..n).map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])));
+        });
         let mut dissipation_rate = 0.0;
         let mut pairs = || {
-            self.kinematics_into(y, self.needs_pairs(), kin);
+            PHASE_KINEMATICS.time(|| self.kinematics_into(y, self.needs_pairs(), kin));
             let kin = &*kin;
             force.clear();
             force.resize(n, Vec3::zeros());
@@ -962,14 +976,17 @@ impl OdeSystem for EllipsoidSystem {
             if !self.needs_pairs() {
                 return;
             }
-            self.pair_forces_into(&self.candidate_pairs(kin), kin, blocks);
-            for t in blocks.iter().flatten() {
-                force[t.i] += t.force_i;
-                force[t.j] -= t.force_i;
-                torque[t.i] += t.torque_i;
-                torque[t.j] += t.torque_j;
-                dissipation_rate += t.dissipation;
-            }
+            let candidates = PHASE_CANDIDATES.time(|| self.candidate_pairs(kin));
+            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates, kin, blocks));
+            PHASE_PAIR_SUM.time(|| {
+                for t in blocks.iter().flatten() {
+                    force[t.i] += t.force_i;
+                    force[t.j] -= t.force_i;
+                    torque[t.i] += t.torque_i;
+                    torque[t.j] += t.torque_j;
+                    dissipation_rate += t.dissipation;
+                }
+            });
         };
         // From BLOCKED_FROM bodies on the gravity blocks, added per body below; small systems add the half loop.
         // The tree's forces (when the method asks for it at this N) are one block.
@@ -977,17 +994,21 @@ impl OdeSystem for EllipsoidSystem {
             .physics
             .gravity
             .filter(|_| n >= BLOCKED_FROM || tree_theta.is_some());
-        let mut gravity_pass = || match (blocked_gravity, tree_theta) {
-            (Some(gr), Some(theta)) => {
-                gravity.resize_with(1, Vec::new);
-                let mut lists = self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner());
-                match lists.as_mut().filter(|t| t.len() == n) {
-                    Some(frozen) => frozen_tree_gravity_forces(gr.g, frozen, positions, &self.masses, &mut gravity[0]),
-                    None => tree_gravity_forces(gr.g, theta, positions, &self.masses, &mut gravity[0]),
-                };
-            }
-            (Some(gr), None) => gravity_blocks(gr.g, positions, &self.masses, gravity),
-            (None, _) => gravity.clear(),
+        let mut gravity_pass = || {
+            PHASE_GRAVITY.time(|| match (blocked_gravity, tree_theta) {
+                (Some(gr), Some(theta)) => {
+                    gravity.resize_with(1, Vec::new);
+                    let mut lists = self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner());
+                    match lists.as_mut().filter(|t| t.len() == n) {
+                        Some(frozen) => {
+                            frozen_tree_gravity_forces(gr.g, frozen, positions, &self.masses, &mut gravity[0])
+                        }
+                        None => tree_gravity_forces(gr.g, theta, positions, &self.masses, &mut gravity[0]),
+                    };
+                }
+                (Some(gr), None) => gravity_blocks(gr.g, positions, &self.masses, gravity),
+                (None, _) => gravity.clear(),
+            })
         };
         if n >= PARALLEL_BODIES {
             rayon::join(pairs, gravity_pass);
@@ -996,7 +1017,7 @@ impl OdeSystem for EllipsoidSystem {
             gravity_pass();
         }
         if let (Some(gr), None) = (self.physics.gravity, blocked_gravity) {
-            add_gravity_forces(gr.g, positions, &self.masses, force);
+            PHASE_SMALL_GRAVITY.time(|| add_gravity_forces(gr.g, positions, &self.masses, force));
         }
         let (kin, force, torque, gravity) = (&*kin, &*force, &*torque, &*gravity);
         let stride = self.stride;
@@ -1029,11 +1050,13 @@ impl OdeSystem for EllipsoidSystem {
             }
         };
         let (bodies, rest) = dydt.split_at_mut(n * stride);
-        if n >= PARALLEL_BODIES {
-            bodies.par_chunks_mut(stride).enumerate().for_each(body_rate);
-        } else {
-            bodies.chunks_mut(stride).enumerate().for_each(body_rate);
-        }
+        PHASE_RATES.time(|| {
+            if n >= PARALLEL_BODIES {
+                bodies.par_chunks_mut(stride).enumerate().for_each(body_rate);
+            } else {
+                bodies.chunks_mut(stride).enumerate().for_each(body_rate);
+            }
+        });
         if let Some(slot) = rest.first_mut() {
             *slot = dissipation_rate;
         }
