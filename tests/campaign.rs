@@ -109,6 +109,7 @@ fn quiet() -> CampaignOptions {
             ..RunOptions::default()
         },
         parallel: None,
+        threads_per_run: None,
         verbose: false,
         shard: None,
     }

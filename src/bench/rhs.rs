@@ -138,7 +138,7 @@ fn lattice_system(n: usize, seed: u64, kappa: f64, method: Option<GravityMethod>
 
 /// The physics of every `bench rhs` system: gravity by `method` (`None`: no gravity), contact, dissipation
 /// (F0 = 1 s/m²).
-fn bench_physics(method: Option<GravityMethod>) -> Physics {
+pub fn bench_physics(method: Option<GravityMethod>) -> Physics {
     Physics {
         gravity: method.map(|method| GravityTerm { g: SI_G, method }),
         contact: Some(ContactTerm {

@@ -24,7 +24,9 @@ pub struct CampaignArgs {
     /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<crate::impact::campaign::Shard>,
-    /// Threads of each process's rayon pool [default: the node's cores over its MPI ranks; all cores without MPI].
+    /// Threads of this process [default: the node's cores over its MPI ranks; all cores without MPI]. The runs at
+    /// once share them: each run has its own pool of threads-per-rank / parallel threads, at least one, so
+    /// `--parallel 16 --threads-per-rank 1` runs 16 runs at once on one thread each.
     #[arg(long, value_name = "N")]
     pub threads_per_rank: Option<usize>,
     /// Runs at once (overrides `campaign.parallel`).
@@ -60,6 +62,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
     let options = CampaignOptions {
         run: args.checkpoints.options(!args.no_progress)?,
         parallel: args.parallel,
+        threads_per_run: None,
         verbose: true,
         shard: args.shard,
     };

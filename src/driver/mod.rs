@@ -385,7 +385,8 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
         checkpoints: 0,
         timeseries,
     };
-    on_pool(|| drive(&mut engine, out_dir, options, start, &identity))
+    let useful = engine.useful_threads();
+    on_pool(useful, || drive(&mut engine, out_dir, options, start, &identity))
 }
 
 /// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
@@ -551,7 +552,8 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         checkpoints: ckpt.checkpoints,
         timeseries,
     };
-    on_pool(|| drive(&mut engine, dir, options, start, &identity))
+    let useful = engine.useful_threads();
+    on_pool(useful, || drive(&mut engine, dir, options, start, &identity))
 }
 
 /// Writes `checkpoint` into `dir/checkpoint.json` atomically (temporary file, fsync, rename, directory fsync).
@@ -583,7 +585,15 @@ fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> 
 /// is injected into the pool and the caller sleeps until it ends, which cost 45 µs per right-hand side of the
 /// N200 impact on two threads (212 against 167 µs). The pool's other workers stay awake for the run
 /// ([`warm_pool::with_warm_workers`]).
-fn on_pool<R: Send>(op: impl FnOnce() -> R + Send) -> R {
+///
+/// With `useful` threads fewer than the pool has (see [`Engine::useful_threads`]), `op` runs on a pool of its own
+/// of `useful` threads instead: the run's parallel passes then fork over no more threads than pay for themselves.
+fn on_pool<R: Send>(useful: usize, op: impl FnOnce() -> R + Send) -> R {
+    if useful < rayon::current_num_threads()
+        && let Ok(pool) = rayon::ThreadPoolBuilder::new().num_threads(useful.max(1)).build()
+    {
+        return pool.install(|| warm_pool::with_warm_workers(op));
+    }
     if rayon::current_thread_index().is_some() {
         warm_pool::with_warm_workers(op)
     } else {
@@ -775,9 +785,20 @@ mod tests {
     #[test]
     fn runs_are_driven_from_a_pool_worker() {
         assert_eq!(rayon::current_thread_index(), None, "the test thread is not a worker");
-        assert!(on_pool(|| rayon::current_thread_index().is_some()));
+        assert!(on_pool(usize::MAX, || rayon::current_thread_index().is_some()));
         // already on a worker (of another pool): stays there
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        assert_eq!(pool.install(|| on_pool(rayon::current_thread_index)), Some(0));
+        assert_eq!(pool.install(|| on_pool(usize::MAX, rayon::current_thread_index)), Some(0));
+    }
+
+    /// A run that can use fewer threads than the pool has runs on a pool of that many (and no more than the pool
+    /// has when it could use more).
+    #[test]
+    fn a_small_run_forks_over_no_more_threads_than_it_can_use() {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
+        assert_eq!(pool.install(|| on_pool(2, rayon::current_num_threads)), 2);
+        assert_eq!(pool.install(|| on_pool(1, rayon::current_num_threads)), 1);
+        assert_eq!(pool.install(|| on_pool(64, rayon::current_num_threads)), 4);
+        assert_eq!(pool.install(|| on_pool(0, rayon::current_num_threads)), 1, "at least one thread");
     }
 }

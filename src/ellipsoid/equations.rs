@@ -256,6 +256,11 @@ const CANDIDATES_PER_TASK: usize = 64;
 /// From this many bodies on, the per-body passes (kinematics, gravity blocks, body rates) run in parallel.
 const PARALLEL_BODIES: usize = 64;
 
+/// Bodies per thread at least ([`EllipsoidSystem::useful_threads`]): with fewer, joining a parallel pass costs more
+/// than the thread's share of it. The N200 impact (201 bodies, ~8 per thread's pass on 16 threads) ran in 5.76 s on 8
+/// threads of a 16-core node and 7.19 s on all 16 (issue 39's measurement); 25 bodies per thread gives 8.
+pub const BODIES_PER_THREAD: usize = 25;
+
 // Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).
 static PHASE_GATHER: Phase = Phase::new("ellipsoid.gather_positions", Kind::Serial);
 static PHASE_KINEMATICS: Phase = Phase::new("ellipsoid.kinematics", Kind::Parallel);
@@ -312,21 +317,35 @@ struct PairCache {
 }
 
 impl PairCache {
-    fn build(centres: &[Vec3], radii: &[f64], candidate: impl Fn((usize, usize)) -> CandidatePair) -> Self {
+    fn build(centres: &[Vec3], radii: &[f64], candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send) -> Self {
         let skins: Vec<f64> = radii.iter().map(|r| PAIR_SKIN_FRACTION * r).collect();
         let grown: Vec<f64> = radii.iter().zip(&skins).map(|(r, s)| r + s).collect();
         PairCache {
             positions: centres.to_vec(),
             radii: radii.to_vec(),
-            candidates: Arc::new(sphere_pairs(centres, &grown).into_iter().map(candidate).collect()),
+            candidates: Arc::new(candidates_of(sphere_pairs(centres, &grown), candidate)),
             skins,
         }
     }
 
     fn covers(&self, centres: &[Vec3], radii: &[f64]) -> bool {
+        let holds = |i: usize| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i];
         centres.len() == self.positions.len()
-            && (0..centres.len())
-                .all(|i| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i])
+            && if centres.len() >= PARALLEL_BODIES {
+                (0..centres.len()).into_par_iter().with_min_len(PARALLEL_BODIES).all(holds)
+            } else {
+                (0..centres.len()).all(holds)
+            }
+    }
+}
+
+/// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential, and a
+/// rebuild of the N2000 pile's ~10⁵ candidates took milliseconds on one thread).
+fn candidates_of(pairs: Vec<(usize, usize)>, candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send) -> Vec<CandidatePair> {
+    if pairs.len() >= PARALLEL_CANDIDATES {
+        pairs.into_par_iter().with_min_len(CANDIDATES_PER_TASK).map(candidate).collect()
+    } else {
+        pairs.into_iter().map(candidate).collect()
     }
 }
 
@@ -449,6 +468,12 @@ impl EllipsoidSystem {
     pub fn forces_are_smooth(&self) -> bool {
         let n = self.n_bodies();
         self.physics.gravity.is_none_or(|g| g.method.tree_theta(n).is_none())
+    }
+
+    /// The most threads an evaluation uses well: one per [`BODIES_PER_THREAD`] bodies, at least one (the run
+    /// driver forks over no more; the bits do not depend on it).
+    pub fn useful_threads(&self) -> usize {
+        (self.n_bodies() / BODIES_PER_THREAD).max(1)
     }
 
     /// Number of bodies.
@@ -579,7 +604,7 @@ impl EllipsoidSystem {
         let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
         if !finite {
             // Not a state to remember (the integrator will reject it): the plain search.
-            return Arc::new(sphere_pairs(&centres, &radii).into_iter().map(candidate).collect());
+            return Arc::new(candidates_of(sphere_pairs(&centres, &radii), candidate));
         }
         match cache.as_ref() {
             Some(c) if c.covers(&centres, &radii) => Arc::clone(&c.candidates),

@@ -417,6 +417,10 @@ impl Engine for EllipsoidEngine {
         EllipsoidEngine::new(parse_scene(text, name, base_dir)?)
     }
 
+    fn useful_threads(&self) -> usize {
+        self.system.useful_threads()
+    }
+
     fn scene_source(&self) -> &str {
         &self.scene.source
     }

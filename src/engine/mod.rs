@@ -304,6 +304,14 @@ pub trait Engine: Sized + Send {
         false
     }
 
+    /// The most threads this run can use well: its work per parallel pass divided by the work a thread needs to
+    /// pay for joining the pass. The driver runs the engine on at most this many threads of the pool it is given
+    /// (a smaller pool of its own when needed), so that a small run does not get slower on a big node. The bits
+    /// do not depend on it. Default: no limit.
+    fn useful_threads(&self) -> usize {
+        usize::MAX
+    }
+
     /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64>;
 

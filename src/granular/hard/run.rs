@@ -325,6 +325,12 @@ impl Engine for HardEngine {
     type State = HardState;
     const KIND: &'static str = super::scene::KIND;
 
+    /// The event loop is serial (Richardson11 §2.1: one globally earliest event at a time): one thread, so that
+    /// no idle worker of the pool polls for work beside it.
+    fn useful_threads(&self) -> usize {
+        1
+    }
+
     fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError> {
         let base = base_dir.unwrap_or(Path::new("."));
         Ok(HardEngine::new(super::scene::parse_hard_scene(text, name, base)?))

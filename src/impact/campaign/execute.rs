@@ -27,6 +27,9 @@ pub struct CampaignOptions {
     pub run: RunOptions,
     /// Runs at once, overriding `campaign.parallel`.
     pub parallel: Option<usize>,
+    /// Threads of each run's own rayon pool; `None`: the threads of the calling pool shared among the runs at
+    /// once, at least one each (see [`threads_per_run`]).
+    pub threads_per_run: Option<usize>,
     /// Print one line per finished run on stdout.
     pub verbose: bool,
     /// Run only this shard of the grid ([`Shard`]); its index goes to its own file.
@@ -39,6 +42,7 @@ impl Default for CampaignOptions {
         CampaignOptions {
             run: RunOptions::default(),
             parallel: None,
+            threads_per_run: None,
             verbose: false,
             shard: None,
         }
@@ -222,6 +226,14 @@ impl Display {
     }
 }
 
+/// Threads of each run's pool when `parallel` runs go at once and the caller gives none: the calling pool's
+/// threads (rayon's current pool; the process's `--threads-per-rank`) shared among the runs, at least one each.
+/// Each run has its own pool, so `parallel` runs on one thread each really run at once: with one shared pool of
+/// one thread they took turns on it (`analysis/scaling/REPORT.md`, "Campaigns").
+pub fn threads_per_run(parallel: usize, given: Option<usize>) -> usize {
+    given.unwrap_or_else(|| rayon::current_num_threads() / parallel.max(1)).max(1)
+}
+
 /// Runs `campaign` (see the module docs): creates its directory, decides what to do with each grid point,
 /// writes `campaign.csv`, runs what needs running with `parallel` runs at once, rewriting `campaign.csv`
 /// whenever a run starts or ends. Failed runs are recorded, not returned: the error is only for the
@@ -290,6 +302,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         .unwrap_or(campaign.parallel)
         .max(1)
         .min(todo.len().max(1));
+    let run_threads = threads_per_run(parallel, options.threads_per_run);
 
     std::thread::scope(|s| {
         let ticker = display.as_ref().map(|d| {
@@ -303,6 +316,17 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         let workers: Vec<_> = (0..parallel)
             .map(|_| {
                 s.spawn(|| {
+                    // The worker's own pool: its runs fork their parallel passes over it alone.
+                    let pool = match rayon::ThreadPoolBuilder::new().num_threads(run_threads).build() {
+                        Ok(pool) => pool,
+                        Err(e) => {
+                            lock(&state).1.get_or_insert(CampaignError::Io {
+                                path: out.clone(),
+                                source: std::io::Error::other(format!("cannot build a pool of {run_threads} threads: {e}")),
+                            });
+                            return;
+                        }
+                    };
                     loop {
                         let k = next.fetch_add(1, Ordering::SeqCst);
                         let Some(&i) = todo.get(k) else { break };
@@ -318,7 +342,8 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
                         if let Some(d) = &display {
                             d.start(i, &point.name);
                         }
-                        let (status, stopped, numbers) = execute(point, &out.join(&point.name), &action, &options.run);
+                        let (status, stopped, numbers) =
+                            pool.install(|| execute(point, &out.join(&point.name), &action, &options.run));
                         let n = done_count.fetch_add(1, Ordering::SeqCst) + 1;
                         let line = match (&status, &numbers) {
                             (RunStatus::Completed, Some(x)) => format!(
