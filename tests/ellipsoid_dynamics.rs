@@ -319,7 +319,8 @@ fn rock_lattice(
 }
 
 /// The right-hand side of a system large enough for every parallel pass (144 bodies, thousands of candidate
-/// pairs) has the same bits on 1 and 2 threads, and when several threads evaluate the same system at once (the
+/// pairs) has the same bits on 1, 2, 3 and 4 threads (the per-body pair sums of several threads add in the serial
+/// scatter's order), and when several threads evaluate the same system at once (the
 /// evaluation reuses buffers held by the system; a caller that finds them in use must not disturb another).
 #[test]
 fn ellipsoid_rhs_bits_do_not_depend_on_threads_or_concurrent_callers() {
@@ -355,7 +356,9 @@ fn ellipsoid_rhs_bits_do_not_depend_on_threads_or_concurrent_callers() {
         system.diagnostics(&states[0]).potential_contact > 0.0,
         "the lattice has contacts"
     );
-    assert_eq!(on(2), reference, "1 and 2 threads");
+    for threads in [2, 3, 4] {
+        assert_eq!(on(threads), reference, "1 and {threads} threads");
+    }
     std::thread::scope(|scope| {
         let handles: Vec<_> = (0..3)
             .map(|_| scope.spawn(|| (0..5).flat_map(|_| states.iter().map(|y| eval(y))).collect::<Vec<_>>()))
@@ -372,6 +375,53 @@ fn ellipsoid_rhs_bits_do_not_depend_on_threads_or_concurrent_callers() {
             }
         }
     });
+}
+
+/// From 576 bodies on, the exact gravity's half loop is cut into more than 8 blocks (one per 64 bodies, so that
+/// 16 threads have work): the right-hand side of 648 bodies still has the same bits on 1 to 4 threads, and its
+/// gravity agrees with the row-wise exact sum of the diagnostics to round-off.
+#[test]
+fn many_gravity_blocks_keep_the_bits_of_one_thread() {
+    assert_eq!(rubblepile::ellipsoid::gravity::blocks(648), 10);
+    assert_eq!(rubblepile::ellipsoid::gravity::blocks(500), 8, "below 512 bodies: the blocks of every earlier run");
+    let mut rng = Random::new(91);
+    let (bodies, model, _) = rock_lattice(&mut rng, [9, 9, 8]);
+    let gravity_only = Physics {
+        gravity: Some(rubblepile::ellipsoid::equations::GravityTerm {
+            g: 6.674e-11,
+            method: rubblepile::ellipsoid::gravity_tree::GravityMethod::Direct,
+        }),
+        contact: None,
+        dissipation: None,
+    };
+    let system = EllipsoidSystem::new(&bodies, model, gravity_only);
+    let y = system.initial_state();
+    let on = |threads: usize| -> Vec<u64> {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        let mut d = vec![0.0; y.len()];
+        pool.install(|| system.rhs(0.0, &y, &mut d));
+        d.iter().map(|x| x.to_bits()).collect()
+    };
+    let reference = on(1);
+    for threads in [2, 3, 4] {
+        assert_eq!(on(threads), reference, "1 and {threads} threads");
+    }
+    // u̇ of body k against −∂U_G/∂r from the row-wise sum (gravity_forces, another order of the same terms)
+    let positions: Vec<Vec3> = bodies.iter().map(|b| b.position).collect();
+    let masses: Vec<f64> = bodies.iter().map(|b| b.shape.mass).collect();
+    let mut rows = vec![Vec3::zeros(); positions.len()];
+    rubblepile::ellipsoid::gravity::gravity_forces(6.674e-11, &positions, &masses, &mut rows);
+    let stride = y.len() / bodies.len();
+    let scale = rows.iter().map(|f| f.norm()).fold(0.0, f64::max);
+    for (k, f) in rows.iter().enumerate() {
+        let o = k * stride + 7;
+        let got = Vec3::new(
+            f64::from_bits(reference[o]),
+            f64::from_bits(reference[o + 1]),
+            f64::from_bits(reference[o + 2]),
+        );
+        assert!((got - f).norm() <= 1e-12 * scale, "body {k}: {got:?} against {f:?}");
+    }
 }
 
 /// The Verlet list of candidate pairs is a cache only: along a sequence of states where bodies move less and

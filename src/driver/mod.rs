@@ -3,7 +3,8 @@
 //!
 //! Files written in the output directory (engines add their own, e.g. `tracks.csv`, `spinup.csv`):
 //! - `scene.toml`: a copy of the scene text;
-//! - `timeseries.csv`: the engine's diagnostics row at every output sample, written and flushed row by row;
+//! - `timeseries.csv`: the engine's diagnostics row at every output sample (handed to the OS at least once a
+//!   second, see [`run_files`]);
 //! - `snapshots/<k>.csv`: the state at the k-th snapshot time (landed on exactly);
 //! - `summary.json`: the engine's summary (status, counters, conservation errors beside the wall time);
 //! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format, the cause named in
@@ -30,6 +31,7 @@ pub mod convert;
 pub mod export;
 pub mod formats;
 pub mod kind;
+pub mod run_files;
 pub mod warm_pool;
 
 use std::fs::File;
@@ -615,18 +617,23 @@ fn drive<E: Engine>(
         mut bytes,
         wall_before,
         mut checkpoints,
-        mut timeseries,
+        timeseries,
     } = start;
     let ts_path = out_dir.join("timeseries.csv");
+    let mut files = run_files::RunFiles::new(timeseries, &ts_path);
+    let file_err = |(path, source): run_files::FileError| RunError::Io { path, source };
     let t_end = engine.t_end();
     let started = Instant::now();
     let wall = || wall_before + started.elapsed().as_secs_f64();
     let pb = progress_bar(options.progress, t_end, engine.time());
 
-    // On failure: last good state + summary, then the error.
-    let fail = |engine: &E, failure: &crate::engine::Failure, rows: u64| -> RunError<E::Summary> {
+    // On failure: the rows so far, the last good state and the summary, then the error.
+    let fail = |engine: &E, failure: &crate::engine::Failure, rows: u64, files: &mut run_files::RunFiles| {
         if let Some(pb) = &pb {
             pb.abandon();
+        }
+        if let Err((path, source)) = files.flush() {
+            return RunError::Io { path, source };
         }
         let lgs = out_dir.join("last_good_state.csv");
         let t_good = match engine.write_last_good_state(&lgs) {
@@ -660,19 +667,20 @@ fn drive<E: Engine>(
             }
         };
         if let Err(failure) = engine.advance(index, sample, &mut progress) {
-            return Err(fail(engine, &failure, rows));
+            return Err(fail(engine, &failure, rows, &mut files));
         }
         let row = match engine.sample(sample, wall()) {
             Ok(row) => row,
-            Err(SampleError::Failed(failure)) => return Err(fail(engine, &failure, rows)),
+            Err(SampleError::Failed(failure)) => return Err(fail(engine, &failure, rows, &mut files)),
             Err(SampleError::Io { path, source }) => return Err(RunError::Io { path, source }),
         };
-        timeseries.write_all(row.as_bytes()).map_err(io_err(&ts_path))?;
+        files.write_row(&row).map_err(file_err)?;
         rows += 1;
         bytes += row.len() as u64;
         if let Some(k) = sample.snapshot {
             let p = out_dir.join("snapshots").join(format!("{k}.csv"));
             engine.write_snapshot(&p).map_err(io_err(&p))?;
+            files.snapshot_written(p);
             if !extra_formats.is_empty() {
                 let view = engine.view();
                 // Every snapshot up to this one (a resumed run's earlier ones included), for formats' run indexes.
@@ -695,8 +703,8 @@ fn drive<E: Engine>(
             .checkpoint_every_sim
             .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
         if (index as u64) + 1 < total && (due_wall || due_sim) {
-            // The rows the checkpoint counts must be on disk before it is.
-            timeseries.sync_all().map_err(io_err(&ts_path))?;
+            // The rows and snapshots the checkpoint counts must be on disk before it is.
+            files.sync().map_err(file_err)?;
             let state = engine.save().map_err(io_err(out_dir))?;
             checkpoints += 1;
             let ckpt = Checkpoint {
@@ -732,11 +740,13 @@ fn drive<E: Engine>(
             }
         }
     }
-    timeseries.sync_all().map_err(io_err(&ts_path))?;
+    // The wall time is the run's; the final flush to disk comes after it, before the summary says "completed".
+    let wall_seconds = wall();
+    files.sync().map_err(file_err)?;
     if let Some(pb) = &pb {
         pb.finish_and_clear();
     }
-    let summary = engine.summary(Outcome::Completed, rows, wall());
+    let summary = engine.summary(Outcome::Completed, rows, wall_seconds);
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;
     Ok(summary)

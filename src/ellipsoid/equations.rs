@@ -230,6 +230,9 @@ struct CandidatePair {
 /// Candidates per block of the pair pass: each block keeps its interacting pairs in its own reused buffer.
 const PAIR_BLOCK: usize = 64;
 
+/// The slot of a culled candidate (see `RhsScratch::slots`).
+const NO_TERMS: u32 = u32::MAX;
+
 /// Buffers of the right-hand side kept between evaluations, so that an evaluation allocates nothing once they
 /// have grown (fresh buffers of ~100 kB per evaluation cost page faults worth ~10 % of it).
 #[derive(Default)]
@@ -238,6 +241,9 @@ struct RhsScratch {
     positions: Vec<Vec3>,
     /// The interacting pairs of candidate block `b` (candidates `b·PAIR_BLOCK ..`), in candidate order.
     blocks: Vec<Vec<PairTerms>>,
+    /// Where candidate `k`'s terms are in its block (`blocks[k / PAIR_BLOCK][slots[k]]`), [`NO_TERMS`] when it was
+    /// culled.
+    slots: Vec<u32>,
     /// Per-block gravity forces ([`gravity_blocks`]).
     gravity: Vec<Vec<Vec3>>,
     /// Pair forces per body (N).
@@ -267,6 +273,7 @@ static PHASE_KINEMATICS: Phase = Phase::new("ellipsoid.kinematics", Kind::Parall
 static PHASE_CANDIDATES: Phase = Phase::new("ellipsoid.candidate_pairs", Kind::Serial);
 static PHASE_PAIR_FORCES: Phase = Phase::new("ellipsoid.pair_forces", Kind::Parallel);
 static PHASE_PAIR_SUM: Phase = Phase::new("ellipsoid.pair_sum", Kind::Serial);
+static PHASE_PAIR_SUM_PARALLEL: Phase = Phase::new("ellipsoid.pair_sum_per_body", Kind::Parallel);
 static PHASE_GRAVITY: Phase = Phase::new("ellipsoid.gravity", Kind::Parallel);
 static PHASE_SMALL_GRAVITY: Phase = Phase::new("ellipsoid.gravity_half_loop", Kind::Serial);
 static PHASE_RATES: Phase = Phase::new("ellipsoid.body_rates", Kind::Parallel);
@@ -313,7 +320,47 @@ struct PairCache {
     radii: Vec<f64>,
     skins: Vec<f64>,
     /// Shared with the evaluations that use it, so that none copies it or holds the lock while using it.
-    candidates: Arc<Vec<CandidatePair>>,
+    candidates: Arc<Candidates>,
+}
+
+/// The candidate pairs (sorted by `(i, j)`) and, per body, the candidates it takes part in.
+struct Candidates {
+    pairs: Vec<CandidatePair>,
+    /// Body `b`'s candidates are `members[start[b]..start[b + 1]]`, in candidate order: the pairs `(i, b)`, then the
+    /// pairs `(b, j)`. Summing a body's pair terms in this order adds them exactly as the serial scatter over the
+    /// candidates does, so the per-body sum can run in parallel with the same bits ([`sum_pair_terms`]).
+    start: Vec<u32>,
+    members: Vec<u32>,
+}
+
+impl Candidates {
+    /// The candidates of `n` bodies and their per-body lists (a counting sort: two passes over the pairs).
+    fn new(pairs: Vec<CandidatePair>, n: usize) -> Candidates {
+        let mut start = vec![0u32; n + 1];
+        for c in &pairs {
+            start[c.i + 1] += 1;
+            start[c.j + 1] += 1;
+        }
+        for b in 0..n {
+            start[b + 1] += start[b];
+        }
+        let mut next: Vec<u32> = start[..n].to_vec();
+        let mut members = vec![0u32; 2 * pairs.len()];
+        for (k, c) in pairs.iter().enumerate() {
+            for b in [c.i, c.j] {
+                members[next[b] as usize] = k as u32;
+                next[b] += 1;
+            }
+        }
+        Candidates { pairs, start, members }
+    }
+}
+
+impl std::ops::Deref for Candidates {
+    type Target = [CandidatePair];
+    fn deref(&self) -> &[CandidatePair] {
+        &self.pairs
+    }
 }
 
 impl PairCache {
@@ -323,7 +370,10 @@ impl PairCache {
         PairCache {
             positions: centres.to_vec(),
             radii: radii.to_vec(),
-            candidates: Arc::new(candidates_of(sphere_pairs(centres, &grown), candidate)),
+            candidates: Arc::new(Candidates::new(
+                candidates_of(sphere_pairs(centres, &grown), candidate),
+                centres.len(),
+            )),
             skins,
         }
     }
@@ -337,6 +387,49 @@ impl PairCache {
                 (0..centres.len()).all(holds)
             }
     }
+}
+
+/// The pair terms of `blocks` summed per body into `force` and `torque` (zeros on entry), in parallel over the
+/// bodies: each body adds its candidates' terms in candidate order ([`Candidates::members`]), which are the adds of
+/// the serial scatter over the candidates in the same order, so the bits are those of one thread. Returns the
+/// total dissipation rate, summed in candidate order beside the bodies' sums.
+fn sum_pair_terms(
+    candidates: &Candidates,
+    blocks: &[Vec<PairTerms>],
+    slots: &[u32],
+    force: &mut [Vec3],
+    torque: &mut [Vec3],
+) -> f64 {
+    let per_body = |(b, (f, tq)): (usize, (&mut Vec3, &mut Vec3))| {
+        let (lo, hi) = (candidates.start[b] as usize, candidates.start[b + 1] as usize);
+        for &k in &candidates.members[lo..hi] {
+            let k = k as usize;
+            let slot = slots[k];
+            if slot == NO_TERMS {
+                continue;
+            }
+            let t = &blocks[k / PAIR_BLOCK][slot as usize];
+            if t.i == b {
+                *f += t.force_i;
+                *tq += t.torque_i;
+            } else {
+                *f -= t.force_i;
+                *tq += t.torque_j;
+            }
+        }
+    };
+    let ((), dissipation) = rayon::join(
+        || {
+            force
+                .par_iter_mut()
+                .zip(torque.par_iter_mut())
+                .enumerate()
+                .with_min_len(PARALLEL_BODIES / 4)
+                .for_each(per_body)
+        },
+        || blocks.iter().flatten().fold(0.0, |sum, t| sum + t.dissipation),
+    );
+    dissipation
 }
 
 /// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential, and a
@@ -569,19 +662,40 @@ impl EllipsoidSystem {
 
     /// The interacting pairs among `candidates` with their forces, into one reused buffer per block of
     /// [`PAIR_BLOCK`] candidates (each block culled and evaluated by one task, in candidate order).
-    fn pair_forces_into(&self, candidates: &[CandidatePair], kin: &[Kinematics], blocks: &mut Vec<Vec<PairTerms>>) {
+    /// Each candidate's slot among its block's terms goes to `slots` (every slot is written).
+    fn pair_forces_into(
+        &self,
+        candidates: &[CandidatePair],
+        kin: &[Kinematics],
+        blocks: &mut Vec<Vec<PairTerms>>,
+        slots: &mut Vec<u32>,
+    ) {
         blocks.resize_with(candidates.len().div_ceil(PAIR_BLOCK), Vec::new);
-        let block = |(terms, cands): (&mut Vec<PairTerms>, &[CandidatePair])| {
+        slots.resize(candidates.len(), NO_TERMS);
+        let block = |((terms, slots), cands): ((&mut Vec<PairTerms>, &mut [u32]), &[CandidatePair])| {
             terms.clear();
-            terms.extend(cands.iter().filter_map(|c| self.pair_terms(c, kin, true)));
+            for (slot, c) in slots.iter_mut().zip(cands) {
+                *slot = match self.pair_terms(c, kin, true) {
+                    Some(t) => {
+                        terms.push(t);
+                        (terms.len() - 1) as u32
+                    }
+                    None => NO_TERMS,
+                };
+            }
         };
         if candidates.len() >= PARALLEL_CANDIDATES {
             blocks
                 .par_iter_mut()
+                .zip(slots.par_chunks_mut(PAIR_BLOCK))
                 .zip(candidates.par_chunks(PAIR_BLOCK))
                 .for_each(block);
         } else {
-            blocks.iter_mut().zip(candidates.chunks(PAIR_BLOCK)).for_each(block);
+            blocks
+                .iter_mut()
+                .zip(slots.chunks_mut(PAIR_BLOCK))
+                .zip(candidates.chunks(PAIR_BLOCK))
+                .for_each(block);
         }
     }
 
@@ -591,7 +705,7 @@ impl EllipsoidSystem {
 
     /// Candidate pairs of the bounding-sphere search (the cached Verlet list when it covers the state), with their
     /// constants; [`Self::pair_terms`] applies the exact cull.
-    fn candidate_pairs(&self, kin: &[Kinematics]) -> Arc<Vec<CandidatePair>> {
+    fn candidate_pairs(&self, kin: &[Kinematics]) -> Arc<Candidates> {
         let kappa = self.model.kappa;
         let centres: Vec<Vec3> = kin.iter().map(|k| k.r).collect();
         let radii: Vec<f64> = kin
@@ -604,7 +718,10 @@ impl EllipsoidSystem {
         let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
         if !finite {
             // Not a state to remember (the integrator will reject it): the plain search.
-            return Arc::new(candidates_of(sphere_pairs(&centres, &radii), candidate));
+            return Arc::new(Candidates::new(
+                candidates_of(sphere_pairs(&centres, &radii), candidate),
+                centres.len(),
+            ));
         }
         match cache.as_ref() {
             Some(c) if c.covers(&centres, &radii) => Arc::clone(&c.candidates),
@@ -979,6 +1096,7 @@ impl OdeSystem for EllipsoidSystem {
             kin,
             positions,
             blocks,
+            slots,
             gravity,
             force,
             torque,
@@ -1002,16 +1120,22 @@ impl OdeSystem for EllipsoidSystem {
                 return;
             }
             let candidates = PHASE_CANDIDATES.time(|| self.candidate_pairs(kin));
-            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates, kin, blocks));
-            PHASE_PAIR_SUM.time(|| {
-                for t in blocks.iter().flatten() {
-                    force[t.i] += t.force_i;
-                    force[t.j] -= t.force_i;
-                    torque[t.i] += t.torque_i;
-                    torque[t.j] += t.torque_j;
-                    dissipation_rate += t.dissipation;
-                }
-            });
+            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates, kin, blocks, slots));
+            dissipation_rate = if n >= PARALLEL_BODIES && rayon::current_num_threads() > 1 {
+                PHASE_PAIR_SUM_PARALLEL.time(|| sum_pair_terms(&candidates, blocks, slots, force, torque))
+            } else {
+                PHASE_PAIR_SUM.time(|| {
+                    let mut dissipation_rate = 0.0;
+                    for t in blocks.iter().flatten() {
+                        force[t.i] += t.force_i;
+                        force[t.j] -= t.force_i;
+                        torque[t.i] += t.torque_i;
+                        torque[t.j] += t.torque_j;
+                        dissipation_rate += t.dissipation;
+                    }
+                    dissipation_rate
+                })
+            };
         };
         // From BLOCKED_FROM bodies on the gravity blocks, added per body below; small systems add the half loop.
         // The tree's forces (when the method asks for it at this N) are one block.

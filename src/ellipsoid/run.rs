@@ -28,7 +28,6 @@ use crate::engine::{
     SnapshotView,
 };
 use crate::integrate::{Integrator, IntegratorState, Method, OdeSystem, Tolerances, make_integrator};
-use crate::io::fmt_f64;
 use crate::math::Vec3;
 
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
@@ -512,8 +511,15 @@ impl Engine for EllipsoidEngine {
             d.angular_momentum.z,
             wall_seconds,
         ];
-        let cells: Vec<String> = fields.iter().map(|&x| fmt_f64(x)).collect();
-        Ok(cells.join(",") + "\n")
+        let mut row = String::with_capacity(fields.len() * 24);
+        for (k, &x) in fields.iter().enumerate() {
+            if k > 0 {
+                row.push(',');
+            }
+            crate::io::push_f64(&mut row, x);
+        }
+        row.push('\n');
+        Ok(row)
     }
 
     fn write_snapshot(&self, path: &Path) -> std::io::Result<()> {
