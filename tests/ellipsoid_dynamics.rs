@@ -383,7 +383,11 @@ fn ellipsoid_rhs_bits_do_not_depend_on_threads_or_concurrent_callers() {
 #[test]
 fn many_gravity_blocks_keep_the_bits_of_one_thread() {
     assert_eq!(rubblepile::ellipsoid::gravity::blocks(648), 10);
-    assert_eq!(rubblepile::ellipsoid::gravity::blocks(500), 8, "below 512 bodies: the blocks of every earlier run");
+    assert_eq!(
+        rubblepile::ellipsoid::gravity::blocks(500),
+        8,
+        "below 512 bodies: the blocks of every earlier run"
+    );
     let mut rng = Random::new(91);
     let (bodies, model, _) = rock_lattice(&mut rng, [9, 9, 8]);
     let gravity_only = Physics {

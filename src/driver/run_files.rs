@@ -68,7 +68,10 @@ impl RunFiles {
     /// Flushes, then makes the time series and the snapshots written since the last sync durable (fsync).
     pub fn sync(&mut self) -> Result<(), FileError> {
         self.flush()?;
-        self.timeseries.get_ref().sync_all().map_err(|e| (self.path.clone(), e))?;
+        self.timeseries
+            .get_ref()
+            .sync_all()
+            .map_err(|e| (self.path.clone(), e))?;
         for p in self.unsynced.drain(..) {
             File::open(&p).and_then(|f| f.sync_all()).map_err(|e| (p.clone(), e))?;
         }
@@ -102,7 +105,11 @@ mod tests {
         assert_eq!(std::fs::read_to_string(&ts).unwrap(), "t\n0\n1\n");
         files.snapshot_written(dir.join("missing.csv"));
         let (path, _) = files.sync().unwrap_err();
-        assert!(path.ends_with("missing.csv"), "the failing file is named: {}", path.display());
+        assert!(
+            path.ends_with("missing.csv"),
+            "the failing file is named: {}",
+            path.display()
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
