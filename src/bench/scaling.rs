@@ -323,6 +323,8 @@ fn ssdem_case(
 /// The N30 campaign of `runs` impacts run `threads` at a time, one thread each, into `dir` (removed afterwards).
 fn campaign_case(root: &Path, dir: &Path, runs: usize, t_end: f64, threads: usize) -> Result<Measurement, BenchError> {
     let _ = std::fs::remove_dir_all(dir);
+    // The campaign resolves relative paths against `root`: give it absolute ones.
+    let dir = &std::path::absolute(dir).map_err(|e| BenchError::failed(format!("{}: {e}", dir.display())))?;
     let target = std::path::absolute(root.join("targets/N30_T4.csv"))
         .map_err(|e| BenchError::failed(format!("targets/N30_T4.csv: {e}")))?;
     // 3 projectiles × 11 angles × 2 seeds = 66 points, cut to `runs`.
