@@ -166,8 +166,16 @@ fn scaled(phases: Vec<phase::Total>, factor: f64) -> Vec<phase::Total> {
 /// The serial and parallel seconds of `phases` over a case's wall time `seconds`: the serial phases plus whatever
 /// no phase covers (the integrator, the driver: serial), and the parallel phases.
 fn split(phases: &[phase::Total], seconds: f64) -> (f64, f64) {
-    let serial: f64 = phases.iter().filter(|t| t.kind == Kind::Serial).map(|t| t.seconds).sum();
-    let parallel: f64 = phases.iter().filter(|t| t.kind == Kind::Parallel).map(|t| t.seconds).sum();
+    let serial: f64 = phases
+        .iter()
+        .filter(|t| t.kind == Kind::Serial)
+        .map(|t| t.seconds)
+        .sum();
+    let parallel: f64 = phases
+        .iter()
+        .filter(|t| t.kind == Kind::Parallel)
+        .map(|t| t.seconds)
+        .sum();
     let outside = (seconds - serial - parallel).max(0.0);
     (serial + outside, parallel)
 }
@@ -284,7 +292,13 @@ fn ssdem_case(
         }
         s.particles
             .iter()
-            .flat_map(|p| p.position.iter().chain(p.velocity.iter()).copied().collect::<Vec<f64>>())
+            .flat_map(|p| {
+                p.position
+                    .iter()
+                    .chain(p.velocity.iter())
+                    .copied()
+                    .collect::<Vec<f64>>()
+            })
             .collect::<Vec<f64>>()
     })?;
     let rate = rate?;
@@ -442,16 +456,48 @@ fn measure(args: &ScalingArgs, case: &str, threads: usize, cache: &mut Systems) 
     let scratch = args.out.join("scratch");
     let repeats = args.repeats as usize;
     match case {
-        "rhs-n2000" => rhs_case(case, cache.pile(root, "targets/N2000_T4.csv", false)?, threads, repeats, false),
-        "rhs-n10000" => rhs_case(case, cache.pile(root, "targets/N10000_T4.csv", false)?, threads, repeats, false),
-        "rhs-n10000-tree" => rhs_case(case, cache.pile(root, "targets/N10000_T4.csv", true)?, threads, repeats, true),
+        "rhs-n2000" => rhs_case(
+            case,
+            cache.pile(root, "targets/N2000_T4.csv", false)?,
+            threads,
+            repeats,
+            false,
+        ),
+        "rhs-n10000" => rhs_case(
+            case,
+            cache.pile(root, "targets/N10000_T4.csv", false)?,
+            threads,
+            repeats,
+            false,
+        ),
+        "rhs-n10000-tree" => rhs_case(
+            case,
+            cache.pile(root, "targets/N10000_T4.csv", true)?,
+            threads,
+            repeats,
+            true,
+        ),
         "impact-n2000" => {
             // Contact 2 s in, so that the window is nearly all contact.
-            let cfg = impact_config(root, "targets/N2000_T4.csv", Method::Dop853, 1e-8, 2.0, 2.0 + args.window);
+            let cfg = impact_config(
+                root,
+                "targets/N2000_T4.csv",
+                Method::Dop853,
+                1e-8,
+                2.0,
+                2.0 + args.window,
+            );
             impact_case(case, &cfg, &scratch.join(case), threads)
         }
         "impact-n200" => {
-            let cfg = impact_config(root, "targets/N200_T4.csv", Method::BulirschStoer, 1e-6, 90.0, args.n200_t_end);
+            let cfg = impact_config(
+                root,
+                "targets/N200_T4.csv",
+                Method::BulirschStoer,
+                1e-6,
+                90.0,
+                args.n200_t_end,
+            );
             impact_case(case, &cfg, &scratch.join(case), threads)
         }
         "ssdem-40k" | "ssdem-40k-tree10" | "ssdem-2k" => {
@@ -522,7 +568,11 @@ pub fn derived(rows: &[Measurement]) -> Vec<(f64, f64, Option<f64>)> {
                 .expect("the row itself");
             // Against the fewest threads timed, scaled as if it were one thread's time × its threads, per unit of
             // work (runs that did no work, e.g. no collision yet, compare their times).
-            let per_work = if base.work > 0.0 && r.work > 0.0 { r.work / base.work } else { 1.0 };
+            let per_work = if base.work > 0.0 && r.work > 0.0 {
+                r.work / base.work
+            } else {
+                1.0
+            };
             let t_1 = base.seconds * base.threads as f64 * per_work;
             karp_flatt(t_1, r.seconds, r.threads)
         })
@@ -552,7 +602,11 @@ fn write_csv(path: &Path, rows: &[Measurement]) -> std::io::Result<()> {
             kf.map_or(String::new(), |x| format!("{x:.4}")),
             r.serial_seconds,
             r.parallel_seconds,
-            if fraction.is_finite() { format!("{fraction:.4}") } else { String::new() },
+            if fraction.is_finite() {
+                format!("{fraction:.4}")
+            } else {
+                String::new()
+            },
             r.fingerprint
         )?;
     }
@@ -564,7 +618,16 @@ fn write_phases_csv(path: &Path, rows: &[Measurement]) -> std::io::Result<()> {
     writeln!(f, "case,threads,phase,kind,seconds,calls")?;
     for r in rows {
         for t in &r.phases {
-            writeln!(f, "{},{},{},{},{:e},{}", r.case, r.threads, t.name, t.kind.as_str(), t.seconds, t.calls)?;
+            writeln!(
+                f,
+                "{},{},{},{},{:e},{}",
+                r.case,
+                r.threads,
+                t.name,
+                t.kind.as_str(),
+                t.seconds,
+                t.calls
+            )?;
         }
     }
     f.flush()
@@ -614,7 +677,10 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
     {
         eprintln!("warning: timing {most} threads on {cores} cores: those rows measure oversubscription");
     }
-    println!("bench scaling: {} cases at threads {threads:?} ({cores} cores)", cases.len());
+    println!(
+        "bench scaling: {} cases at threads {threads:?} ({cores} cores)",
+        cases.len()
+    );
     let mut rows: Vec<Measurement> = Vec::new();
     let mut cache = Systems::default();
     for case in &cases {
@@ -634,14 +700,23 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
                 kf.map_or(String::new(), |x| format!("  Karp-Flatt {x:.3}")),
                 {
                     let f = r.serial_seconds / r.seconds;
-                    if f.is_finite() { format!("  serial (measured) {:.1} %", 100.0 * f) } else { String::new() }
+                    if f.is_finite() {
+                        format!("  serial (measured) {:.1} %", 100.0 * f)
+                    } else {
+                        String::new()
+                    }
                 }
             );
         }
         if mine.iter().any(|m| m.fingerprint != mine[0].fingerprint) {
-            eprintln!("warning: {case}: the results differ between thread counts (fingerprints {:?})", {
-                mine.iter().map(|m| (m.threads, m.fingerprint.clone())).collect::<Vec<_>>()
-            });
+            eprintln!(
+                "warning: {case}: the results differ between thread counts (fingerprints {:?})",
+                {
+                    mine.iter()
+                        .map(|m| (m.threads, m.fingerprint.clone()))
+                        .collect::<Vec<_>>()
+                }
+            );
         }
         print_phases(&mine);
         rows.extend(mine);
@@ -663,7 +738,10 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
 
 /// Where the time goes at the fewest and the most threads: the phases, largest first, serial ones marked.
 fn print_phases(rows: &[Measurement]) {
-    let (Some(lo), Some(hi)) = (rows.iter().min_by_key(|r| r.threads), rows.iter().max_by_key(|r| r.threads)) else {
+    let (Some(lo), Some(hi)) = (
+        rows.iter().min_by_key(|r| r.threads),
+        rows.iter().max_by_key(|r| r.threads),
+    ) else {
         return;
     };
     for r in [lo, hi] {
@@ -712,7 +790,10 @@ impl crate::analysis::figures::style::Figure for SpeedupPlot<'_> {
         let p_max = self.rows.iter().map(|r| r.threads).max().unwrap_or(1) as f64;
         let s_max = speedups.iter().map(|d| d.0).fold(p_max, f64::max);
         let mut chart = ChartBuilder::on(root)
-            .caption("rubblepile bench scaling: speed-up against threads", style::title_style())
+            .caption(
+                "rubblepile bench scaling: speed-up against threads",
+                style::title_style(),
+            )
             .margin(12)
             .x_label_area_size(44)
             .y_label_area_size(56)

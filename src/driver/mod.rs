@@ -788,7 +788,10 @@ mod tests {
         assert!(on_pool(usize::MAX, || rayon::current_thread_index().is_some()));
         // already on a worker (of another pool): stays there
         let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-        assert_eq!(pool.install(|| on_pool(usize::MAX, rayon::current_thread_index)), Some(0));
+        assert_eq!(
+            pool.install(|| on_pool(usize::MAX, rayon::current_thread_index)),
+            Some(0)
+        );
     }
 
     /// A run that can use fewer threads than the pool has runs on a pool of that many (and no more than the pool
@@ -799,6 +802,10 @@ mod tests {
         assert_eq!(pool.install(|| on_pool(2, rayon::current_num_threads)), 2);
         assert_eq!(pool.install(|| on_pool(1, rayon::current_num_threads)), 1);
         assert_eq!(pool.install(|| on_pool(64, rayon::current_num_threads)), 4);
-        assert_eq!(pool.install(|| on_pool(0, rayon::current_num_threads)), 1, "at least one thread");
+        assert_eq!(
+            pool.install(|| on_pool(0, rayon::current_num_threads)),
+            1,
+            "at least one thread"
+        );
     }
 }

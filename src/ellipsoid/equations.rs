@@ -317,7 +317,11 @@ struct PairCache {
 }
 
 impl PairCache {
-    fn build(centres: &[Vec3], radii: &[f64], candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send) -> Self {
+    fn build(
+        centres: &[Vec3],
+        radii: &[f64],
+        candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send,
+    ) -> Self {
         let skins: Vec<f64> = radii.iter().map(|r| PAIR_SKIN_FRACTION * r).collect();
         let grown: Vec<f64> = radii.iter().zip(&skins).map(|(r, s)| r + s).collect();
         PairCache {
@@ -329,10 +333,14 @@ impl PairCache {
     }
 
     fn covers(&self, centres: &[Vec3], radii: &[f64]) -> bool {
-        let holds = |i: usize| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i];
+        let holds =
+            |i: usize| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i];
         centres.len() == self.positions.len()
             && if centres.len() >= PARALLEL_BODIES {
-                (0..centres.len()).into_par_iter().with_min_len(PARALLEL_BODIES).all(holds)
+                (0..centres.len())
+                    .into_par_iter()
+                    .with_min_len(PARALLEL_BODIES)
+                    .all(holds)
             } else {
                 (0..centres.len()).all(holds)
             }
@@ -341,9 +349,16 @@ impl PairCache {
 
 /// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential, and a
 /// rebuild of the N2000 pile's ~10⁵ candidates took milliseconds on one thread).
-fn candidates_of(pairs: Vec<(usize, usize)>, candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send) -> Vec<CandidatePair> {
+fn candidates_of(
+    pairs: Vec<(usize, usize)>,
+    candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send,
+) -> Vec<CandidatePair> {
     if pairs.len() >= PARALLEL_CANDIDATES {
-        pairs.into_par_iter().with_min_len(CANDIDATES_PER_TASK).map(candidate).collect()
+        pairs
+            .into_par_iter()
+            .with_min_len(CANDIDATES_PER_TASK)
+            .map(candidate)
+            .collect()
     } else {
         pairs.into_iter().map(candidate).collect()
     }

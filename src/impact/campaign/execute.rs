@@ -231,7 +231,9 @@ impl Display {
 /// Each run has its own pool, so `parallel` runs on one thread each really run at once: with one shared pool of
 /// one thread they took turns on it (`analysis/scaling/REPORT.md`, "Campaigns").
 pub fn threads_per_run(parallel: usize, given: Option<usize>) -> usize {
-    given.unwrap_or_else(|| rayon::current_num_threads() / parallel.max(1)).max(1)
+    given
+        .unwrap_or_else(|| rayon::current_num_threads() / parallel.max(1))
+        .max(1)
 }
 
 /// Runs `campaign` (see the module docs): creates its directory, decides what to do with each grid point,
@@ -322,7 +324,9 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
                         Err(e) => {
                             lock(&state).1.get_or_insert(CampaignError::Io {
                                 path: out.clone(),
-                                source: std::io::Error::other(format!("cannot build a pool of {run_threads} threads: {e}")),
+                                source: std::io::Error::other(format!(
+                                    "cannot build a pool of {run_threads} threads: {e}"
+                                )),
                             });
                             return;
                         }
