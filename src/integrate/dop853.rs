@@ -278,7 +278,8 @@ const WEIGHTS: [(usize, f64); 8] = [
     (11, B12),
 ];
 
-/// The 5th-order error estimator `b_i − b̂_i` (0-based stage indices).
+/// The 5th-order error estimator `b_i − b̂_i` (0-based stage indices: the same stages as [`WEIGHTS`], in the
+/// same order).
 const ERROR5: [(usize, f64); 8] = [
     (0, ER1),
     (5, ER6),
@@ -289,6 +290,15 @@ const ERROR5: [(usize, f64); 8] = [
     (10, ER11),
     (11, ER12),
 ];
+
+// The final pass reads each of these stages once for both sums.
+const _: () = {
+    let mut t = 0;
+    while t < WEIGHTS.len() {
+        assert!(WEIGHTS[t].0 == ERROR5[t].0);
+        t += 1;
+    }
+};
 
 /// The published DOP853 tableau as full arrays, for tests of its order conditions: `(c, a, b, bhat5, bhat3)`
 /// with `c` and `b` of length 12, `a` 12 × 12 (strictly lower triangular), `bhat5 = b − e5` (the 5th-order
@@ -330,30 +340,23 @@ fn each_chunk(parallel: bool, out: &mut [f64], f: impl Fn(usize, &mut [f64]) + S
     }
 }
 
-/// Runs `f(lo, out_chunk, scratch_chunk)` on every [`CHUNK`] of `out` and `scratch` (same length), storing what
-/// it returns per chunk in `partials`, and returns the element-wise sums of `partials` added in chunk order.
+/// Runs `f(lo, out_chunk)` on every [`CHUNK`] of `out`, storing what it returns per chunk in `partials`, and
+/// returns the element-wise sums of `partials` added in chunk order.
 fn each_chunk_sums(
     parallel: bool,
     out: &mut [f64],
-    scratch: &mut [f64],
     partials: &mut [[f64; 3]],
-    f: impl Fn(usize, &mut [f64], &mut [f64]) -> [f64; 3] + Sync + Send,
+    f: impl Fn(usize, &mut [f64]) -> [f64; 3] + Sync + Send,
 ) -> [f64; 3] {
     let partials = &mut partials[..out.len().div_ceil(CHUNK)];
     if parallel {
         out.par_chunks_mut(CHUNK)
-            .zip(scratch.par_chunks_mut(CHUNK))
             .zip(partials.par_iter_mut())
             .enumerate()
-            .for_each(|(c, ((o, s), p))| *p = f(c * CHUNK, o, s));
+            .for_each(|(c, (o, p))| *p = f(c * CHUNK, o));
     } else {
-        for (c, ((o, s), p)) in out
-            .chunks_mut(CHUNK)
-            .zip(scratch.chunks_mut(CHUNK))
-            .zip(partials.iter_mut())
-            .enumerate()
-        {
-            *p = f(c * CHUNK, o, s);
+        for (c, (o, p)) in out.chunks_mut(CHUNK).zip(partials.iter_mut()).enumerate() {
+            *p = f(c * CHUNK, o);
         }
     }
     in_chunk_order(partials)
@@ -395,17 +398,35 @@ fn in_chunk_order(partials: &[[f64; 3]]) -> [f64; 3] {
     total
 }
 
-/// `acc = Σ_j w_j k_j[lo..lo + acc.len()]` over the terms `(j, w_j)` (in their order, one pass per term).
-fn weighted_sum(acc: &mut [f64], k: &[Vec<f64>], lo: usize, terms: &[(usize, f64)]) {
-    let hi = lo + acc.len();
-    let (&(j0, w0), rest) = terms.split_first().expect("at least one term");
-    for (a, &kv) in acc.iter_mut().zip(&k[j0][lo..hi]) {
-        *a = w0 * kv;
-    }
-    for &(j, w) in rest {
-        for (a, &kv) in acc.iter_mut().zip(&k[j][lo..hi]) {
-            *a += w * kv;
+/// One chunk of a stage's argument: `out = y + h Σ_j a_j k_j` over `lo..lo + out.len()`, with the `M` terms
+/// `(j, a_j)` summed left to right (each element's arithmetic is fixed, whichever thread does it).
+fn stage_chunk<const M: usize>(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize, terms: &[(usize, f64)]) {
+    let hi = lo + out.len();
+    let ks: [&[f64]; M] = std::array::from_fn(|t| &k[terms[t].0][lo..hi]);
+    let w: [f64; M] = std::array::from_fn(|t| terms[t].1);
+    let y = &y[lo..hi];
+    for (i, (z, &yi)) in out.iter_mut().zip(y).enumerate() {
+        let mut s = w[0] * ks[0][i];
+        for t in 1..M {
+            s += w[t] * ks[t][i];
         }
+        *z = yi + h * s;
+    }
+}
+
+/// [`stage_chunk`] for a row of [`STAGES`] (1 to 10 terms).
+fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize, terms: &[(usize, f64)]) {
+    match terms.len() {
+        1 => stage_chunk::<1>(out, y, h, k, lo, terms),
+        2 => stage_chunk::<2>(out, y, h, k, lo, terms),
+        3 => stage_chunk::<3>(out, y, h, k, lo, terms),
+        4 => stage_chunk::<4>(out, y, h, k, lo, terms),
+        5 => stage_chunk::<5>(out, y, h, k, lo, terms),
+        6 => stage_chunk::<6>(out, y, h, k, lo, terms),
+        7 => stage_chunk::<7>(out, y, h, k, lo, terms),
+        8 => stage_chunk::<8>(out, y, h, k, lo, terms),
+        9 => stage_chunk::<9>(out, y, h, k, lo, terms),
+        m => unreachable!("DOP853 has no stage with {m} terms"),
     }
 }
 
@@ -691,44 +712,40 @@ impl Dop853 {
             let (y, k) = (&self.y, &self.k);
             Self::timed(parallel, || {
                 each_chunk(parallel, &mut self.y_stage, |lo, o| {
-                    weighted_sum(o, k, lo, row.a);
-                    for (z, &yi) in o.iter_mut().zip(&y[lo..]) {
-                        *z = yi + h * *z;
-                    }
+                    stage_row_chunk(o, y, h, k, lo, row.a)
                 })
             });
             let ts = if row.c == 1.0 { t_end } else { t + row.c * h };
             self.eval(system, ts, s + 1, Arg::Stage);
         }
-        // The new state, both error estimators and their norms in one pass per chunk.
+        // The new state, both error estimators and their norms in one pass per chunk (WEIGHTS and ERROR5 use the
+        // same stages: k_1, k_6 … k_12).
         let (y, k, tol) = (&self.y, &self.k, &self.tol);
         let [e5, e3, bad] = Self::timed(parallel, || {
-            each_chunk_sums(
-                parallel,
-                &mut self.y_new,
-                &mut self.y_stage,
-                &mut self.partials,
-                |lo, yn, e| {
-                    let hi = lo + yn.len();
-                    weighted_sum(yn, k, lo, &WEIGHTS);
-                    weighted_sum(e, k, lo, &ERROR5);
-                    let (mut s5, mut s3, mut bad) = (0.0, 0.0, 0.0);
-                    for (i, (ynv, &e5)) in (lo..hi).zip(yn.iter_mut().zip(e.iter())) {
-                        let b = *ynv;
-                        let e3 = b - BHH1 * k[0][i] - BHH2 * k[8][i] - BHH3 * k[11][i];
-                        let yi = y[i];
-                        let v = yi + h * b;
-                        *ynv = v;
-                        if !v.is_finite() {
-                            bad += 1.0;
-                        }
-                        let sc = (tol.atol[i] + tol.rtol[i] * yi.abs().max(v.abs())).max(f64::MIN_POSITIVE);
-                        s5 += (e5 / sc).powi(2);
-                        s3 += (e3 / sc).powi(2);
+            each_chunk_sums(parallel, &mut self.y_new, &mut self.partials, |lo, yn| {
+                let hi = lo + yn.len();
+                let ks: [&[f64]; 8] = std::array::from_fn(|t| &k[WEIGHTS[t].0][lo..hi]);
+                let (y, atol, rtol) = (&y[lo..hi], &tol.atol[lo..hi], &tol.rtol[lo..hi]);
+                let (mut s5, mut s3, mut bad) = (0.0, 0.0, 0.0);
+                for (i, v) in yn.iter_mut().enumerate() {
+                    let mut b = WEIGHTS[0].1 * ks[0][i];
+                    let mut e5 = ERROR5[0].1 * ks[0][i];
+                    for t in 1..8 {
+                        b += WEIGHTS[t].1 * ks[t][i];
+                        e5 += ERROR5[t].1 * ks[t][i];
                     }
-                    [s5, s3, bad]
-                },
-            )
+                    let e3 = b - BHH1 * ks[0][i] - BHH2 * ks[4][i] - BHH3 * ks[7][i];
+                    let yi = y[i];
+                    *v = yi + h * b;
+                    if !v.is_finite() {
+                        bad += 1.0;
+                    }
+                    let sc = (atol[i] + rtol[i] * yi.abs().max(v.abs())).max(f64::MIN_POSITIVE);
+                    s5 += (e5 / sc).powi(2);
+                    s3 += (e3 / sc).powi(2);
+                }
+                [s5, s3, bad]
+            })
         });
         let mut deno = e5 + 0.01 * e3;
         if deno <= 0.0 {
