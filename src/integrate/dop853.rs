@@ -685,8 +685,8 @@ impl Dop853 {
         let [d2, _, _] = Self::timed(parallel, || {
             chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
                 let mut d2 = 0.0;
-                for i in lo..hi {
-                    d2 += ((k[1][i] - k[0][i]) / scale(i)).powi(2);
+                for (i, (&f1, &f0)) in (lo..hi).zip(k[1][lo..hi].iter().zip(&k[0][lo..hi])) {
+                    d2 += ((f1 - f0) / scale(i)).powi(2);
                 }
                 [d2, 0.0, 0.0]
             })
