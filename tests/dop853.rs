@@ -531,3 +531,93 @@ fn too_many_steps_keeps_the_last_accepted_state() {
     d.advance(&Arenstorf, &mut t, &mut y, Arenstorf::PERIOD).unwrap();
     assert!(max_abs_diff(&y, &Arenstorf.initial_state()) < 1e-5);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Measurement (not a check)
+
+/// `14 007` decoupled oscillators (28 014 components, about the N2000 impact's 28 015): a right-hand side far
+/// cheaper than the integrator's own vector work, so the wall time minus the RHS's is that work.
+struct Oscillators {
+    n: usize,
+}
+
+impl OdeSystem for Oscillators {
+    fn dim(&self) -> usize {
+        2 * self.n
+    }
+    fn rhs(&self, _t: f64, y: &[f64], d: &mut [f64]) {
+        for i in 0..self.n {
+            d[2 * i] = y[2 * i + 1];
+            d[2 * i + 1] = -(1.0 + (i % 13) as f64 * 0.1) * y[2 * i];
+        }
+    }
+}
+
+/// [`Oscillators`] timing its own evaluations (ns).
+struct TimedRhs {
+    inner: Oscillators,
+    nanos: AtomicU64,
+}
+
+impl OdeSystem for TimedRhs {
+    fn dim(&self) -> usize {
+        self.inner.dim()
+    }
+    fn rhs(&self, t: f64, y: &[f64], d: &mut [f64]) {
+        let start = std::time::Instant::now();
+        self.inner.rhs(t, y, d);
+        self.nanos
+            .fetch_add(start.elapsed().as_nanos() as u64, Ordering::Relaxed);
+    }
+}
+
+/// The integrator's own work per step (stage sums, new state, error norms, copies: the wall time outside the
+/// right-hand side) on a state of the N2000 impact's size, ours against the `ode_solvers` crate's Dop853 (whose
+/// adapter also rescales the state at every evaluation and stores every accepted state), on 1 and 2 threads,
+/// median of 5: `cargo test --release --test dop853 -- --ignored --nocapture overhead`.
+#[test]
+#[ignore = "a measurement: prints the integrators' overhead per step"]
+fn overhead_per_step_at_the_n2000_dimension() {
+    let sys = TimedRhs {
+        inner: Oscillators { n: 14_007 },
+        nanos: AtomicU64::new(0),
+    };
+    let n = sys.dim();
+    let y0: Vec<f64> = (0..n).map(|i| (i as f64 * 0.618).fract() + 0.5).collect();
+    // Scale-free-like tolerances: atol varies between components (the adapter then rescales the state).
+    let tolerances = Tolerances {
+        rtol: vec![1e-8; n],
+        atol: (0..n).map(|i| if i % 7 == 3 { 1e-5 } else { 1e-8 }).collect(),
+    };
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            for ours in [false, true] {
+                let mut per_step = Vec::new();
+                for _ in 0..5 {
+                    let mut integ: Box<dyn Integrator> = if ours {
+                        Box::new(Dop853::new(tolerances.clone(), None).unwrap())
+                    } else {
+                        Box::new(OdeSolversAdapter::new(Method::Dop853, tolerances.clone(), None).unwrap())
+                    };
+                    let (mut t, mut y) = (0.0, y0.clone());
+                    sys.nanos.store(0, Ordering::Relaxed);
+                    let start = std::time::Instant::now();
+                    for k in 1..=10 {
+                        integ.advance(&sys, &mut t, &mut y, 2.0 * k as f64).unwrap();
+                    }
+                    let outside = start.elapsed().as_secs_f64() - sys.nanos.load(Ordering::Relaxed) as f64 * 1e-9;
+                    let st = integ.stats();
+                    per_step.push(outside / (st.steps_accepted + st.steps_rejected) as f64);
+                }
+                per_step.sort_by(f64::total_cmp);
+                println!(
+                    "{threads} thread(s), {}: {:.0} us per step outside the RHS (median of 5; all {:.0?})",
+                    if ours { "ours" } else { "the crate's" },
+                    1e6 * per_step[2],
+                    per_step.iter().map(|s| 1e6 * s).collect::<Vec<_>>()
+                );
+            }
+        });
+    }
+}
