@@ -89,6 +89,8 @@ fn kepler_fixed_step_error(steps: u32) -> f64 {
     let st = d.stats();
     assert_eq!(st.steps_rejected, 0);
     assert_eq!(st.steps_accepted, steps as u64, "{st:?}");
+    // The derivative at the start, 11 stages per step, and FSAL's derivative after each step but the last.
+    assert_eq!(st.rhs_evaluations, 1 + 11 * steps as u64 + (steps as u64 - 1), "{st:?}");
     max_abs_diff(&y, &k.exact(t_end).unwrap())
 }
 

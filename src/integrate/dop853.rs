@@ -2,11 +2,11 @@
 //! estimators and the step-size control of Hairer's code DOP853.
 //!
 //! Source of the method: E. Hairer, S. P. Nørsett & G. Wanner, *Solving Ordinary Differential Equations I:
-//! Nonstiff Problems* (2nd ed., Springer 1993), §II.5 (the method, after Dormand & Prince 1980 and Prince & Dormand
-//! 1981) and §II.10 (the code DOP853: the combined error estimator, the step-size control, the initial step guess
-//! of §II.4). The coefficients below are the published ones of that code. This is an independent implementation
-//! written from that description; it replaces the `ode_solvers` crate's Dop853 (whose adapter,
-//! [`super::ode_solvers_adapter`], still runs it for cross-checks).
+//! Nonstiff Problems* (2nd ed., Springer 1993), §II.10 (the code DOP853: the order-8 method of Dormand & Prince,
+//! its error estimator "of order 8(5,3)" and its step-size control) and §II.4 (the initial step guess). The
+//! coefficients below are the published ones of that code. This is an independent implementation written from that
+//! description; it replaces the `ode_solvers` crate's Dop853 for `method = "dop853"` (the crate's still runs through
+//! [`super::ode_solvers_adapter`], for cross-checks).
 //!
 //! # The method
 //!
@@ -21,8 +21,7 @@
 //! err = |h| · E5 / sqrt(n · (E5 + 0.01 E3))
 //! ```
 //!
-//! which behaves as the 5th-order estimate for small `h` and as the 3rd-order one where that is larger (§II.10,
-//! "an error estimator of order 8(5,3)").
+//! which behaves as the 5th-order estimate for small `h` and as the 3rd-order one where that is larger.
 //!
 //! # Step-size control (DOP853's)
 //!
@@ -61,11 +60,18 @@
 //!
 //! # Failures
 //!
-//! As [`super::bulirsch_stoer`]: a non-finite stage (a NaN or infinite error estimate or new state) halves the
-//! step, and after [`Dop853::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
+//! As [`super::bulirsch_stoer`]: a non-finite stage (a NaN error estimate, or a non-finite new state) halves the
+//! step (an infinite estimate of finite values is an ordinary rejection, the step shrinking 3-fold), and after [`Dop853::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
 //! right after one, [`IntegrateError::NonFinite`] is returned; a non-finite derivative at an accepted state fails
 //! at once. A step below `max(h_min, 10 ε |t|)` gives [`IntegrateError::StepUnderflow`]. The caller's `t, y` are
 //! only ever set to accepted states: on error they hold the last one.
+//!
+//! # Statistics
+//!
+//! [`Integrator::stats`] counts every RHS call (the derivative at the start of each call, `hinit`'s extra one, 11
+//! per attempt and 1 per accepted step that does not end a call), every rejected attempt (error test and non-finite
+//! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
+//! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
 
 use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
 use crate::bits::{exact_f64, exact_f64_opt};
