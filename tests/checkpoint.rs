@@ -308,12 +308,52 @@ fn bulirsch_stoer_run_killed_and_resumed_twice_is_bit_identical() {
 
 #[test]
 fn dop853_run_killed_and_resumed_is_bit_identical() {
-    // Every `advance` of the ode_solvers adapter starts a fresh ode_solvers run from the carried
-    // step, so restoring that step and the counters is exact for Dop853 too. The scene reads its
-    // bodies from a relative bodies_file, and the resume runs from another directory.
+    // Every `advance` of Dop853 evaluates the derivative at its start afresh, so restoring the proposed step and
+    // the counters is exact. The scene reads its bodies from a relative bodies_file, and the resume runs from
+    // another directory.
     let cwd = temp_dir("cwd");
     let (a, b) = kill_and_resume("dop853", true, &[17], &cwd);
     assert_same_run(&a, &b, "dop853");
+}
+
+#[test]
+fn checkpoint_of_the_crates_dop853_is_refused_with_one_line() {
+    // A checkpoint written when "dop853" ran the ode_solvers crate (the same checkpoint version: only a new
+    // integrator state was added) holds an `ode-solvers` state; resuming it under our Dop853 would continue with
+    // another method's step history, so it is refused, naming why.
+    let dir = temp_dir("old-dop853");
+    std::fs::write(dir.join("scene.toml"), scene("dop853", false)).unwrap();
+    let out = rubblepile(
+        &dir,
+        &[
+            "run",
+            "scene.toml",
+            "--out",
+            "x",
+            "--no-progress",
+            "--checkpoint-every-sim",
+            "5",
+            "--stop-after-checkpoints",
+            "2",
+        ],
+    );
+    assert_one_line_error(&out, 3, "at t = 10 s", "stopped run");
+    let path = dir.join("x").join(CHECKPOINT_FILE);
+    let mut checkpoint: serde_json::Value = serde_json::from_str(&read(&path)).unwrap();
+    let integrator = &mut checkpoint["engine"]["integrator"];
+    assert_eq!(integrator["kind"], "dop853", "{integrator}");
+    let dim = integrator["dim"].as_u64().unwrap() as usize;
+    let old = OdeSolversAdapter::new(Method::Dop853, Tolerances::uniform(1e-10, 1e-10, dim), None).unwrap();
+    *integrator = serde_json::to_value(old.save_state()).unwrap();
+    assert_eq!(integrator["kind"], "ode-solvers");
+    std::fs::write(&path, serde_json::to_string_pretty(&checkpoint).unwrap()).unwrap();
+    let out = rubblepile(&dir, &["resume", "x", "--no-progress"]);
+    assert_one_line_error(&out, 2, "`ode_solvers` crate's Dop853", "old Dop853 checkpoint");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("re-run"),
+        "{}",
+        describe(&out)
+    );
 }
 
 #[test]
@@ -512,7 +552,8 @@ fn bulirsch_stoer_state_restores_exactly() {
 }
 
 #[test]
-fn ode_solvers_states_restore_exactly() {
+fn dop853_and_dopri5_states_restore_exactly() {
+    // Dop853 is ours (`integrate::dop853`), Dopri5 the ode_solvers crate's.
     for method in [Method::Dop853, Method::Dopri5] {
         assert_restore_is_exact(
             || make_integrator(method, Tolerances::uniform(1e-9, 1e-9, 4), None).unwrap(),

@@ -355,7 +355,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
     }
 }
 
-/// The method as a bar label: "BS" for Bulirsch–Stoer, the `ode_solvers` names otherwise.
+/// The method as a bar label: "BS" for Bulirsch–Stoer, the method's name otherwise.
 fn short_name(method: Method) -> String {
     match method {
         Method::BulirschStoer => "BS".to_string(),

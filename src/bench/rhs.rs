@@ -43,8 +43,9 @@ pub struct RhsArgs {
     pub threads: Option<u64>,
     /// Gravity methods to time, comma-separated: `auto` (exact below 5000 bodies, tree from there on),
     /// `direct` (exact pair sum), `tree` (octree at θ = `--theta`, walked afresh at every evaluation, as the
-    /// `ode_solvers` methods use it), `tree-step` (the same octree with its interaction lists fixed at the timed
-    /// state, as every evaluation of a Bulirsch–Stoer step sums them; the lists are found once per step, untimed),
+    /// `ode_solvers` methods, Dopri5 and Rk4, use it), `tree-step` (the same octree with its interaction lists fixed
+    /// at the timed state, as every evaluation of a Bulirsch–Stoer or Dop853 step sums them; the lists are found
+    /// once per step, untimed),
     /// `none` (no gravity: contact and dissipation only, so that the pair work is timed alone).
     #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree", "tree-step", "none"])]
     pub gravity: Vec<String>,

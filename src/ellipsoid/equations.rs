@@ -572,7 +572,7 @@ impl EllipsoidSystem {
     /// Whether the forces are smooth functions of the state under every integrator: false when gravity is
     /// summed by the tree, whose forces jump where an interaction list changes (see
     /// [`crate::ellipsoid::gravity_tree`]). Under an integrator that calls [`OdeSystem::begin_step`]
-    /// (Bulirsch–Stoer) the lists are fixed per step and the forces are smooth within each step.
+    /// (Bulirsch–Stoer, Dop853) the lists are fixed per step and the forces are smooth within each step.
     pub fn forces_are_smooth(&self) -> bool {
         let n = self.n_bodies();
         self.physics.gravity.is_none_or(|g| g.method.tree_theta(n).is_none())

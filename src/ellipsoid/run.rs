@@ -276,7 +276,7 @@ impl EllipsoidEngine {
         .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         // The error budget is the run's: rtol bounds the accumulated error, not each step's. Not with tree
         // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`;
-        // Bulirsch-Stoer does): freshly walked forces jump (by about the multipole error, 1e-4) wherever a
+        // Bulirsch-Stoer and Dop853 do; Dop853 controls each step's error anyway): freshly walked forces jump (by about the multipole error, 1e-4) wherever a
         // body's interaction list changes, a step's share h/T of rtol falls below those jumps on long runs, and
         // Bulirsch-Stoer without frozen lists accepted no 1 s step in a minute (N2000 impact,
         // analysis/n2000/REPORT.md). There each step's error is bounded by rtol (ODEX's rule).

@@ -748,7 +748,7 @@ enum Out {
     Dy,
 }
 
-fn validate_tolerances(tol: &Tolerances) -> Result<(), IntegrateError> {
+pub(super) fn validate_tolerances(tol: &Tolerances) -> Result<(), IntegrateError> {
     if tol.rtol.len() != tol.atol.len() {
         return Err(IntegrateError::Config(format!(
             "rtol has {} components but atol has {}",

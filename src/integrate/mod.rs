@@ -3,13 +3,17 @@
 //! One integrator per file behind the small [`Integrator`] trait (the REBOUND layout):
 //! - [`bulirsch_stoer`]: our own adaptive Gragg–Bulirsch–Stoer extrapolation integrator in the style of
 //!   Hairer's ODEX (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9), the method Roig03 §3 used;
-//! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dop853, Dopri5 and Rk4, for cross-checks;
+//! - [`dop853`]: our own DOP853 of Dormand & Prince (order 8 with Hairer's 5th- and 3rd-order error estimators
+//!   and step-size control, §II.10 of the same book), its vector work parallel and deterministic;
+//! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dopri5 and Rk4 (and its Dop853, for
+//!   cross-checks);
 //! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution).
 //!
 //! The canonical test problems and the work–precision measurements that exercise these solvers live in
 //! `bench`.
 
 pub mod bulirsch_stoer;
+pub mod dop853;
 pub mod elliptic;
 pub mod ode_solvers_adapter;
 
@@ -34,8 +38,8 @@ pub trait OdeSystem: Sync {
     /// that step's first evaluation (once per step: retries after a rejection start from the same state and
     /// keep the choice). A system may fix here any discrete choice its right-hand side makes (which tree nodes
     /// are used whole), so that `f` is a smooth function of the state within the step and the choice changes
-    /// only between steps. [`bulirsch_stoer`] calls it; the `ode_solvers` methods cannot, and a system must
-    /// then keep working without it. Default: nothing.
+    /// only between steps. [`bulirsch_stoer`] and [`dop853`] call it; the `ode_solvers` methods cannot, and a
+    /// system must then keep working without it. Default: nothing.
     fn begin_step(&self, _t: f64, _y: &[f64]) {}
     /// Called by an integrator that calls [`OdeSystem::begin_step`] when it returns from an advance (whether it
     /// reached its target or failed): the system drops the choice, so that evaluations outside the integrator
@@ -49,7 +53,7 @@ pub trait OdeSystem: Sync {
 pub enum Method {
     /// Adaptive Bulirsch–Stoer (ours), `"bulirsch-stoer"`.
     BulirschStoer,
-    /// Dormand–Prince 8(5,3) from `ode_solvers`, `"dop853"`.
+    /// Dormand–Prince 8(5,3) (ours, [`dop853::Dop853`]), `"dop853"`.
     Dop853,
     /// Dormand–Prince 5(4) from `ode_solvers`, `"dopri5"`.
     Dopri5,
@@ -182,8 +186,11 @@ impl From<SavedStats> for Stats {
 pub enum IntegratorState {
     /// State of a [`bulirsch_stoer::BulirschStoer`].
     BulirschStoer(bulirsch_stoer::BulirschStoerState),
-    /// State of an [`ode_solvers_adapter::OdeSolversAdapter`] (Dop853, Dopri5, Rk4).
+    /// State of an [`ode_solvers_adapter::OdeSolversAdapter`] (Dopri5, Rk4; Dop853 in checkpoints written before
+    /// [`dop853::Dop853`] ran `"dop853"`, which the latter refuses).
     OdeSolvers(ode_solvers_adapter::OdeSolversState),
+    /// State of a [`dop853::Dop853`].
+    Dop853(dop853::Dop853State),
 }
 
 impl IntegratorState {
@@ -192,6 +199,7 @@ impl IntegratorState {
         match self {
             IntegratorState::BulirschStoer(_) => Method::BulirschStoer,
             IntegratorState::OdeSolvers(s) => s.method,
+            IntegratorState::Dop853(_) => Method::Dop853,
         }
     }
 }
@@ -243,7 +251,7 @@ pub trait Integrator {
     /// Tells the integrator the span of the whole run (s), so that a method that can control the error per unit
     /// step does (Bulirsch–Stoer; see its module docs): the local errors of the run then add up to a share of
     /// the tolerance instead of one tolerance per step. A span that is not positive and finite switches it
-    /// off. The default does nothing (the `ode_solvers` methods control the error per step).
+    /// off. The default does nothing (the Dormand–Prince methods control the error per step).
     fn set_span(&mut self, _span: f64) {}
     /// Which method this is.
     fn method(&self) -> Method;
@@ -267,7 +275,8 @@ pub fn make_integrator(
 ) -> Result<Box<dyn Integrator + Send>, IntegrateError> {
     match method {
         Method::BulirschStoer => Ok(Box::new(bulirsch_stoer::BulirschStoer::new(tolerances, step)?)),
-        Method::Dop853 | Method::Dopri5 => Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(
+        Method::Dop853 => Ok(Box::new(dop853::Dop853::new(tolerances, step)?)),
+        Method::Dopri5 => Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(
             method, tolerances, step,
         )?)),
         Method::Rk4 => match step {

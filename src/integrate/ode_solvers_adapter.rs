@@ -1,5 +1,8 @@
 //! The `ode_solvers` crate's Dop853, Dopri5 and Rk4 behind our [`Integrator`] trait, for
-//! cross-checks against [`super::bulirsch_stoer`].
+//! cross-checks against [`super::bulirsch_stoer`]. [`super::make_integrator`] runs Dopri5 and Rk4 here; `"dop853"`
+//! runs our own [`super::dop853::Dop853`], and the crate's Dop853 stays reachable through
+//! [`OdeSolversAdapter::new`] to compare the two (and it reads the checkpoint states its runs wrote, which our
+//! Dop853 refuses).
 //!
 //! Notes on how the crate is driven (read from `ode_solvers` 0.6.2):
 //! * **Scalar tolerances.** `ode_solvers` accepts one `rtol` and one `atol` for all components. When `rtol`

@@ -1,0 +1,992 @@
+//! The explicit Runge–Kutta method DOP853 of Dormand & Prince: order 8, with the 5th- and 3rd-order error
+//! estimators and the step-size control of Hairer's code DOP853.
+//!
+//! Source of the method: E. Hairer, S. P. Nørsett & G. Wanner, *Solving Ordinary Differential Equations I:
+//! Nonstiff Problems* (2nd ed., Springer 1993), §II.10 (the code DOP853: the order-8 method of Dormand & Prince,
+//! its error estimator "of order 8(5,3)" and its step-size control) and §II.4 (the initial step guess). The
+//! coefficients below are the published ones of that code. This is an independent implementation written from that
+//! description; it replaces the `ode_solvers` crate's Dop853 for `method = "dop853"` (the crate's still runs through
+//! [`super::ode_solvers_adapter`], for cross-checks).
+//!
+//! # The method
+//!
+//! A step of size `h` from `(t, y)` evaluates twelve stages `k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)` and
+//! takes the 8th-order solution `y_new = y + h Σ b_i k_i` (FSAL: `f(t + h, y_new)` is the next step's `k_1`).
+//! The error of a step is measured with both of Hairer's estimators, in the scaled norm of [`Tolerances`]
+//! (`sc_i = atol_i + rtol_i · max(|y_i|, |y_new,i|)`, straight from the per-component tolerances):
+//!
+//! ```text
+//! E5 = Σ_i (e5_i / sc_i)²,  e5 = Σ_j (b_j − b̂_j) k_j          (the 5th-order estimator)
+//! E3 = Σ_i (e3_i / sc_i)²,  e3 = Σ_j b_j k_j − (b̃_1 k_1 + b̃_9 k_9 + b̃_12 k_12)   (the 3rd-order one)
+//! err = |h| · E5 / sqrt(n · (E5 + 0.01 E3))
+//! ```
+//!
+//! which behaves as the 5th-order estimate for small `h` and as the 3rd-order one where that is larger.
+//!
+//! # Step-size control (DOP853's)
+//!
+//! `h_new = h / fac`, `fac = clamp((err^{1/8}) / 0.9, 1/6, 1/0.333)` (safety 0.9, the step grows at most 6-fold
+//! and shrinks at most 3-fold); a step is accepted when `err ≤ 1`, and after a rejection the next accepted step
+//! does not grow. There is no β (Lund) stabilisation: DOP853's default is β = 0. The first step is Hairer's
+//! `hinit` (§II.4), with the norms of the error's scaled RMS norm and the exponent 1/8 of DOP853.
+//!
+//! # Landing, continuation, checkpoints
+//!
+//! Each [`Integrator::advance`] lands exactly on its target: the last step is shortened (when `1.01 h` reaches
+//! past the target, as in DOP853) and its end time is the target itself. The next call starts with the step the
+//! control proposed before that shortening (the "last full step"), so a sequence of output times does not restart
+//! the control. The derivative at the start of a call is always evaluated afresh (the caller may change the state
+//! between calls, e.g. project the attitudes), so nothing but the proposed step, the settings and the counters
+//! passes from one call to the next ([`Dop853State`]), and a restored integrator continues bit for bit.
+//!
+//! # Parallel, deterministic vector work
+//!
+//! Every loop over the state (the stage sums, the new state, the error norms, the initial-step guess) runs over
+//! fixed chunks of [`CHUNK`] components; from [`DEFAULT_PARALLEL_FROM`] components on the chunks run on rayon's
+//! current pool. The element-wise work does the same arithmetic whichever thread does it, and the norms' sums of
+//! squares are summed within each chunk in order and then over the chunks in chunk order (never with a reduction
+//! whose association depends on how rayon splits), so the results are bit-identical on any number of threads,
+//! and on the serial path. The twelve stages and the work vectors are allocated once per dimension; a step
+//! allocates nothing. The vector work is timed as the phases `integrate.dop853.vector` (parallel) and
+//! `integrate.dop853.vector_serial` ([`crate::phase`]).
+//!
+//! # The system's step hooks
+//!
+//! [`OdeSystem::begin_step`] is called with every state from which steps are attempted (the start of each call
+//! and each accepted state, before the derivative there), so a system that fixes a discrete choice per step (tree
+//! gravity's interaction lists) sees one choice per step; a rejected attempt retries from the same state and keeps
+//! it (the choice is a function of that state, so calling again would only repeat the work).
+//! [`OdeSystem::end_steps`] is called when the call returns, whether it succeeded or failed.
+//!
+//! # Failures
+//!
+//! As [`super::bulirsch_stoer`]: a non-finite stage (a NaN error estimate, or a non-finite new state) halves the
+//! step (an infinite estimate of finite values is an ordinary rejection, the step shrinking 3-fold), and after [`Dop853::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
+//! right after one, [`IntegrateError::NonFinite`] is returned; a non-finite derivative at an accepted state fails
+//! at once. A step below `max(h_min, 10 ε |t|)` gives [`IntegrateError::StepUnderflow`]. The caller's `t, y` are
+//! only ever set to accepted states: on error they hold the last one.
+//!
+//! # Statistics
+//!
+//! [`Integrator::stats`] counts every RHS call (the derivative at the start of each call, `hinit`'s extra one, 11
+//! per attempt and 1 per accepted step that does not end a call), every rejected attempt (error test and non-finite
+//! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
+//! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
+
+use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
+use crate::bits::{exact_f64, exact_f64_opt};
+use crate::phase::{Kind, Phase};
+use rayon::prelude::*;
+
+/// Components per chunk of every vector loop: the unit of parallel work and of the norms' partial sums (the
+/// summation order, hence the bits, depend on it and on nothing else).
+pub const CHUNK: usize = 2048;
+/// Default dimension from which the vector loops run on rayon's pool ([`Dop853::set_parallel_from`]).
+pub const DEFAULT_PARALLEL_FROM: usize = 16_384;
+/// Default maximum number of step attempts per call to [`Integrator::advance`].
+pub const DEFAULT_MAX_STEPS: u64 = super::bulirsch_stoer::DEFAULT_MAX_STEPS;
+/// Default number of consecutive non-finite rejections before giving up.
+pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = super::bulirsch_stoer::DEFAULT_MAX_NONFINITE_RETRIES;
+
+/// Safety factor of the step-size control.
+const SAFE: f64 = 0.9;
+/// Smallest step ratio `h_new / h` (DOP853's `fac1`).
+const FAC1: f64 = 0.333;
+/// Largest step ratio `h_new / h` (DOP853's `fac2`).
+const FAC2: f64 = 6.0;
+/// Exponent of the step-size control: 1/8 (β = 0).
+const EXPO: f64 = 1.0 / 8.0;
+/// Step reduction after a non-finite stage.
+const NONFINITE_SHRINK: f64 = 0.5;
+
+/// The vector work on the parallel path.
+static VECTOR: Phase = Phase::new("integrate.dop853.vector", Kind::Parallel);
+/// The vector work on the serial path (small systems).
+static VECTOR_SERIAL: Phase = Phase::new("integrate.dop853.vector_serial", Kind::Serial);
+
+/// The published coefficients of DOP853 (Hairer's code), 1-based names as there.
+#[allow(clippy::excessive_precision, clippy::unreadable_literal)]
+mod tableau {
+    pub const C2: f64 = 0.526001519587677318785587544488e-01;
+    pub const C3: f64 = 0.789002279381515978178381316732e-01;
+    pub const C4: f64 = 0.118350341907227396726757197510e+00;
+    pub const C5: f64 = 0.281649658092772603273242802490e+00;
+    pub const C6: f64 = 0.333333333333333333333333333333e+00;
+    pub const C7: f64 = 0.25e+00;
+    pub const C8: f64 = 0.307692307692307692307692307692e+00;
+    pub const C9: f64 = 0.651282051282051282051282051282e+00;
+    pub const C10: f64 = 0.6e+00;
+    pub const C11: f64 = 0.857142857142857142857142857142e+00;
+
+    pub const B1: f64 = 5.42937341165687622380535766363e-2;
+    pub const B6: f64 = 4.45031289275240888144113950566e0;
+    pub const B7: f64 = 1.89151789931450038304281599044e0;
+    pub const B8: f64 = -5.8012039600105847814672114227e0;
+    pub const B9: f64 = 3.1116436695781989440891606237e-1;
+    pub const B10: f64 = -1.52160949662516078556178806805e-1;
+    pub const B11: f64 = 2.01365400804030348374776537501e-1;
+    pub const B12: f64 = 4.47106157277725905176885569043e-2;
+
+    pub const BHH1: f64 = 0.244094488188976377952755905512e+00;
+    pub const BHH2: f64 = 0.733846688281611857341361741547e+00;
+    pub const BHH3: f64 = 0.220588235294117647058823529412e-01;
+
+    pub const ER1: f64 = 0.1312004499419488073250102996e-01;
+    pub const ER6: f64 = -0.1225156446376204440720569753e+01;
+    pub const ER7: f64 = -0.4957589496572501915214079952e+00;
+    pub const ER8: f64 = 0.1664377182454986536961530415e+01;
+    pub const ER9: f64 = -0.3503288487499736816886487290e+00;
+    pub const ER10: f64 = 0.3341791187130174790297318841e+00;
+    pub const ER11: f64 = 0.8192320648511571246570742613e-01;
+    pub const ER12: f64 = -0.2235530786388629525884427845e-01;
+
+    pub const A21: f64 = 5.26001519587677318785587544488e-2;
+    pub const A31: f64 = 1.97250569845378994544595329183e-2;
+    pub const A32: f64 = 5.91751709536136983633785987549e-2;
+    pub const A41: f64 = 2.95875854768068491816892993775e-2;
+    pub const A43: f64 = 8.87627564304205475450678981324e-2;
+    pub const A51: f64 = 2.41365134159266685502369798665e-1;
+    pub const A53: f64 = -8.84549479328286085344864962717e-1;
+    pub const A54: f64 = 9.24834003261792003115737966543e-1;
+    pub const A61: f64 = 3.7037037037037037037037037037e-2;
+    pub const A64: f64 = 1.70828608729473871279604482173e-1;
+    pub const A65: f64 = 1.25467687566822425016691814123e-1;
+    pub const A71: f64 = 3.7109375e-2;
+    pub const A74: f64 = 1.70252211019544039314978060272e-1;
+    pub const A75: f64 = 6.02165389804559606850219397283e-2;
+    pub const A76: f64 = -1.7578125e-2;
+    pub const A81: f64 = 3.70920001185047927108779319836e-2;
+    pub const A84: f64 = 1.70383925712239993810214054705e-1;
+    pub const A85: f64 = 1.07262030446373284651809199168e-1;
+    pub const A86: f64 = -1.53194377486244017527936158236e-2;
+    pub const A87: f64 = 8.27378916381402288758473766002e-3;
+    pub const A91: f64 = 6.24110958716075717114429577812e-1;
+    pub const A94: f64 = -3.36089262944694129406857109825e0;
+    pub const A95: f64 = -8.68219346841726006818189891453e-1;
+    pub const A96: f64 = 2.75920996994467083049415600797e1;
+    pub const A97: f64 = 2.01540675504778934086186788979e1;
+    pub const A98: f64 = -4.34898841810699588477366255144e1;
+    pub const A101: f64 = 4.77662536438264365890433908527e-1;
+    pub const A104: f64 = -2.48811461997166764192642586468e0;
+    pub const A105: f64 = -5.90290826836842996371446475743e-1;
+    pub const A106: f64 = 2.12300514481811942347288949897e1;
+    pub const A107: f64 = 1.52792336328824235832596922938e1;
+    pub const A108: f64 = -3.32882109689848629194453265587e1;
+    pub const A109: f64 = -2.03312017085086261358222928593e-2;
+    pub const A111: f64 = -9.3714243008598732571704021658e-1;
+    pub const A114: f64 = 5.18637242884406370830023853209e0;
+    pub const A115: f64 = 1.09143734899672957818500254654e0;
+    pub const A116: f64 = -8.14978701074692612513997267357e0;
+    pub const A117: f64 = -1.85200656599969598641566180701e1;
+    pub const A118: f64 = 2.27394870993505042818970056734e1;
+    pub const A119: f64 = 2.49360555267965238987089396762e0;
+    pub const A1110: f64 = -3.0467644718982195003823669022e0;
+    pub const A121: f64 = 2.27331014751653820792359768449e0;
+    pub const A124: f64 = -1.05344954667372501984066689879e1;
+    pub const A125: f64 = -2.00087205822486249909675718444e0;
+    pub const A126: f64 = -1.79589318631187989172765950534e1;
+    pub const A127: f64 = 2.79488845294199600508499808837e1;
+    pub const A128: f64 = -2.85899827713502369474065508674e0;
+    pub const A129: f64 = -8.87285693353062954433549289258e0;
+    pub const A1210: f64 = 1.23605671757943030647266201528e1;
+    pub const A1211: f64 = 6.43392746015763530355970484046e-1;
+}
+
+use tableau::*;
+
+/// One stage's sum: the node `c_i` and the nonzero `a_ij` with their stage indices `j` (0-based).
+struct StageRow {
+    c: f64,
+    a: &'static [(usize, f64)],
+}
+
+/// Stages 2–12 (index 0 is stage 2). Stages 2 and 3 do not use `k_4 … k_8`, stages 4 on do not use `k_2, k_3`.
+const STAGES: [StageRow; 11] = [
+    StageRow { c: C2, a: &[(0, A21)] },
+    StageRow {
+        c: C3,
+        a: &[(0, A31), (1, A32)],
+    },
+    StageRow {
+        c: C4,
+        a: &[(0, A41), (2, A43)],
+    },
+    StageRow {
+        c: C5,
+        a: &[(0, A51), (2, A53), (3, A54)],
+    },
+    StageRow {
+        c: C6,
+        a: &[(0, A61), (3, A64), (4, A65)],
+    },
+    StageRow {
+        c: C7,
+        a: &[(0, A71), (3, A74), (4, A75), (5, A76)],
+    },
+    StageRow {
+        c: C8,
+        a: &[(0, A81), (3, A84), (4, A85), (5, A86), (6, A87)],
+    },
+    StageRow {
+        c: C9,
+        a: &[(0, A91), (3, A94), (4, A95), (5, A96), (6, A97), (7, A98)],
+    },
+    StageRow {
+        c: C10,
+        a: &[
+            (0, A101),
+            (3, A104),
+            (4, A105),
+            (5, A106),
+            (6, A107),
+            (7, A108),
+            (8, A109),
+        ],
+    },
+    StageRow {
+        c: C11,
+        a: &[
+            (0, A111),
+            (3, A114),
+            (4, A115),
+            (5, A116),
+            (6, A117),
+            (7, A118),
+            (8, A119),
+            (9, A1110),
+        ],
+    },
+    StageRow {
+        c: 1.0,
+        a: &[
+            (0, A121),
+            (3, A124),
+            (4, A125),
+            (5, A126),
+            (6, A127),
+            (7, A128),
+            (8, A129),
+            (9, A1210),
+            (10, A1211),
+        ],
+    },
+];
+
+/// The weights `b_i` of the 8th-order solution (0-based stage indices).
+const WEIGHTS: [(usize, f64); 8] = [
+    (0, B1),
+    (5, B6),
+    (6, B7),
+    (7, B8),
+    (8, B9),
+    (9, B10),
+    (10, B11),
+    (11, B12),
+];
+
+/// The 5th-order error estimator `b_i − b̂_i` (0-based stage indices: the same stages as [`WEIGHTS`], in the
+/// same order).
+const ERROR5: [(usize, f64); 8] = [
+    (0, ER1),
+    (5, ER6),
+    (6, ER7),
+    (7, ER8),
+    (8, ER9),
+    (9, ER10),
+    (10, ER11),
+    (11, ER12),
+];
+
+// The final pass reads each of these stages once for both sums.
+const _: () = {
+    let mut t = 0;
+    while t < WEIGHTS.len() {
+        assert!(WEIGHTS[t].0 == ERROR5[t].0);
+        t += 1;
+    }
+};
+
+/// The published DOP853 tableau as full arrays, for tests of its order conditions: `(c, a, b, bhat5, bhat3)`
+/// with `c` and `b` of length 12, `a` 12 × 12 (strictly lower triangular), `bhat5 = b − e5` (the 5th-order
+/// embedded weights) and `bhat3` the 3rd-order weights on stages 1, 9 and 12.
+#[allow(clippy::type_complexity)]
+pub fn tableau() -> ([f64; 12], [[f64; 12]; 12], [f64; 12], [f64; 12], [f64; 12]) {
+    let mut c = [0.0; 12];
+    let mut a = [[0.0; 12]; 12];
+    for (s, row) in STAGES.iter().enumerate() {
+        c[s + 1] = row.c;
+        for &(j, v) in row.a {
+            a[s + 1][j] = v;
+        }
+    }
+    let mut b = [0.0; 12];
+    let mut b5 = [0.0; 12];
+    for &(j, v) in &WEIGHTS {
+        b[j] = v;
+        b5[j] = v;
+    }
+    for &(j, v) in &ERROR5 {
+        b5[j] -= v;
+    }
+    let mut b3 = [0.0; 12];
+    b3[0] = BHH1;
+    b3[8] = BHH2;
+    b3[11] = BHH3;
+    (c, a, b, b5, b3)
+}
+
+/// Runs `f(lo, chunk)` on every [`CHUNK`] of `out` (`lo`: the chunk's first index), on rayon's pool if `parallel`.
+fn each_chunk(parallel: bool, out: &mut [f64], f: impl Fn(usize, &mut [f64]) + Sync + Send) {
+    if parallel {
+        out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, o)| f(c * CHUNK, o));
+    } else {
+        for (c, o) in out.chunks_mut(CHUNK).enumerate() {
+            f(c * CHUNK, o);
+        }
+    }
+}
+
+/// Runs `f(lo, out_chunk)` on every [`CHUNK`] of `out`, storing what it returns per chunk in `partials`, and
+/// returns the element-wise sums of `partials` added in chunk order.
+fn each_chunk_sums(
+    parallel: bool,
+    out: &mut [f64],
+    partials: &mut [[f64; 3]],
+    f: impl Fn(usize, &mut [f64]) -> [f64; 3] + Sync + Send,
+) -> [f64; 3] {
+    let partials = &mut partials[..out.len().div_ceil(CHUNK)];
+    if parallel {
+        out.par_chunks_mut(CHUNK)
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (o, p))| *p = f(c * CHUNK, o));
+    } else {
+        for (c, (o, p)) in out.chunks_mut(CHUNK).zip(partials.iter_mut()).enumerate() {
+            *p = f(c * CHUNK, o);
+        }
+    }
+    in_chunk_order(partials)
+}
+
+/// Runs `f(lo, hi)` on the index range of every [`CHUNK`] of `0..n`, storing what it returns per chunk in
+/// `partials`, and returns the element-wise sums of `partials` added in chunk order.
+fn chunk_sums(
+    parallel: bool,
+    n: usize,
+    partials: &mut [[f64; 3]],
+    f: impl Fn(usize, usize) -> [f64; 3] + Sync + Send,
+) -> [f64; 3] {
+    let partials = &mut partials[..n.div_ceil(CHUNK)];
+    let range = |c: usize| (c * CHUNK, ((c + 1) * CHUNK).min(n));
+    if parallel {
+        partials.par_iter_mut().enumerate().for_each(|(c, p)| {
+            let (lo, hi) = range(c);
+            *p = f(lo, hi);
+        });
+    } else {
+        for (c, p) in partials.iter_mut().enumerate() {
+            let (lo, hi) = range(c);
+            *p = f(lo, hi);
+        }
+    }
+    in_chunk_order(partials)
+}
+
+/// The element-wise sums of per-chunk partial sums, added in chunk order (the order that makes the bits independent
+/// of the thread count).
+fn in_chunk_order(partials: &[[f64; 3]]) -> [f64; 3] {
+    let mut total = [0.0; 3];
+    for p in partials {
+        for (t, v) in total.iter_mut().zip(p) {
+            *t += v;
+        }
+    }
+    total
+}
+
+/// One chunk of a stage's argument: `out = y + h Σ_j a_j k_j` over `lo..lo + out.len()`, with the `M` terms
+/// `(j, a_j)` summed left to right (each element's arithmetic is fixed, whichever thread does it).
+fn stage_chunk<const M: usize>(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize, terms: &[(usize, f64)]) {
+    let hi = lo + out.len();
+    let ks: [&[f64]; M] = std::array::from_fn(|t| &k[terms[t].0][lo..hi]);
+    let w: [f64; M] = std::array::from_fn(|t| terms[t].1);
+    let y = &y[lo..hi];
+    for (i, (z, &yi)) in out.iter_mut().zip(y).enumerate() {
+        let mut s = w[0] * ks[0][i];
+        for t in 1..M {
+            s += w[t] * ks[t][i];
+        }
+        *z = yi + h * s;
+    }
+}
+
+/// [`stage_chunk`] for a row of [`STAGES`] (1 to 10 terms).
+fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize, terms: &[(usize, f64)]) {
+    match terms.len() {
+        1 => stage_chunk::<1>(out, y, h, k, lo, terms),
+        2 => stage_chunk::<2>(out, y, h, k, lo, terms),
+        3 => stage_chunk::<3>(out, y, h, k, lo, terms),
+        4 => stage_chunk::<4>(out, y, h, k, lo, terms),
+        5 => stage_chunk::<5>(out, y, h, k, lo, terms),
+        6 => stage_chunk::<6>(out, y, h, k, lo, terms),
+        7 => stage_chunk::<7>(out, y, h, k, lo, terms),
+        8 => stage_chunk::<8>(out, y, h, k, lo, terms),
+        9 => stage_chunk::<9>(out, y, h, k, lo, terms),
+        m => unreachable!("DOP853 has no stage with {m} terms"),
+    }
+}
+
+/// The DOP853 integrator (see the [module documentation](self)).
+///
+/// ```
+/// use rubblepile::integrate::{Integrator, Tolerances, dop853::Dop853};
+/// use rubblepile::bench::problems::{HarmonicOscillator, TestProblem};
+///
+/// let osc = HarmonicOscillator::new(1.0);
+/// let mut dop = Dop853::new(Tolerances::uniform(1e-10, 1e-10, 2), None).unwrap();
+/// let (mut t, mut y) = (0.0, osc.initial_state());
+/// for &t_out in &[0.5, 1.0, 2.5, 2.0 * std::f64::consts::PI] {
+///     dop.advance(&osc, &mut t, &mut y, t_out).unwrap();
+///     assert_eq!(t, t_out); // lands exactly on every output time
+/// }
+/// assert!((y[0] - 1.0).abs() < 1e-8 && y[1].abs() < 1e-8);
+/// ```
+#[derive(Debug, Clone)]
+pub struct Dop853 {
+    tol: Tolerances,
+    initial_step: Option<f64>,
+    max_steps: u64,
+    h_min: f64,
+    h_max: f64,
+    max_nonfinite_retries: u32,
+    parallel_from: usize,
+    /// Proposed `|h|` for the next step; 0 = unknown (initial guess needed).
+    h: f64,
+    stats: Stats,
+
+    // Work arrays (allocated once per dimension).
+    n: usize,
+    /// The stages `k_1 … k_12` (0-based); `k[0]` is the derivative at the step's start.
+    k: Vec<Vec<f64>>,
+    /// The last accepted state.
+    y: Vec<f64>,
+    /// The trial new state of a step.
+    y_new: Vec<f64>,
+    /// A stage's argument `y + h Σ a_ij k_j`, and scratch of the error pass.
+    y_stage: Vec<f64>,
+    /// Per-chunk partial sums of the norms.
+    partials: Vec<[f64; 3]>,
+}
+
+/// Everything a [`Dop853`] carries between [`Integrator::advance`] calls ([`Integrator::save_state`]): the
+/// proposed step, the settings and the counters. The tolerances are not saved: the integrator the state is
+/// restored into must be built with the same ones (only their length is checked). The derivative at the start of
+/// a call is recomputed by every call, so it is not part of the state; nor is the parallel threshold, on which no
+/// bit of the results depends.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Dop853State {
+    /// Length of the tolerance vectors (the system's dimension).
+    pub dim: usize,
+    /// The configured initial step (s), if any.
+    #[serde(with = "exact_f64_opt")]
+    pub initial_step: Option<f64>,
+    /// Maximum step attempts per `advance`.
+    pub max_steps: u64,
+    /// Smallest allowed step (s).
+    #[serde(with = "exact_f64")]
+    pub h_min: f64,
+    /// Largest allowed step (s).
+    #[serde(with = "exact_f64")]
+    pub h_max: f64,
+    /// Consecutive non-finite rejections retried.
+    pub max_nonfinite_retries: u32,
+    /// Proposed `|h|` for the next step (s); 0 = not yet known. After landing on an output time this is the
+    /// proposal from before the shortened last step.
+    #[serde(with = "exact_f64")]
+    pub h: f64,
+    /// Cumulative statistics.
+    pub stats: SavedStats,
+}
+
+/// The outcome of one step attempt.
+enum Attempt {
+    /// Accepted; the new state is in `y_new`.
+    Accepted,
+    /// Rejected by the error test.
+    Rejected,
+    /// A stage or the new state was not finite.
+    NonFinite,
+}
+
+impl Dop853 {
+    /// A new integrator with per-component `tolerances` and an optional initial step `step` (|step| is used for
+    /// the very first step only; `None` = Hairer's automatic guess from `f(t0, y0)` and one more evaluation).
+    ///
+    /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or contain negative
+    /// or non-finite values, if some component has `rtol = atol = 0`, or if `step` is not non-zero and finite.
+    /// The vectors' length must equal the dimension of the systems later passed to [`Integrator::advance`].
+    pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
+        super::bulirsch_stoer::validate_tolerances(&tolerances)?;
+        if let Some(h) = step
+            && !(h.is_finite() && h != 0.0)
+        {
+            return Err(IntegrateError::Config(format!(
+                "dop853 initial step must be non-zero and finite, got {h}"
+            )));
+        }
+        Ok(Dop853 {
+            tol: tolerances,
+            initial_step: step.map(f64::abs),
+            max_steps: DEFAULT_MAX_STEPS,
+            h_min: 0.0,
+            h_max: f64::INFINITY,
+            max_nonfinite_retries: DEFAULT_MAX_NONFINITE_RETRIES,
+            parallel_from: DEFAULT_PARALLEL_FROM,
+            h: 0.0,
+            stats: Stats {
+                smallest_step: f64::INFINITY,
+                ..Stats::default()
+            },
+            n: 0,
+            k: Vec::new(),
+            y: Vec::new(),
+            y_new: Vec::new(),
+            y_stage: Vec::new(),
+            partials: Vec::new(),
+        })
+    }
+
+    /// Sets the maximum number of step attempts (accepted + rejected) in one call to [`Integrator::advance`]
+    /// (default 10⁸); more gives [`IntegrateError::TooManySteps`].
+    pub fn set_max_steps(&mut self, max_steps: u64) {
+        self.max_steps = max_steps;
+    }
+
+    /// Sets the smallest allowed step size (default 0): a proposed `|h| < max(h_min, 10 ε |t|)` gives
+    /// [`IntegrateError::StepUnderflow`].
+    pub fn set_h_min(&mut self, h_min: f64) {
+        self.h_min = h_min.abs();
+    }
+
+    /// Sets the largest allowed step size (default ∞). With a loose tolerance it makes the method run at a
+    /// fixed step (the convergence tests use it so).
+    pub fn set_h_max(&mut self, h_max: f64) {
+        self.h_max = h_max.abs();
+        if self.h > self.h_max {
+            self.h = self.h_max;
+        }
+    }
+
+    /// Sets how many consecutive rejections caused by NaN/∞ stages are retried (each with a halved step) before
+    /// [`IntegrateError::NonFinite`] is returned (default 10).
+    pub fn set_max_nonfinite_retries(&mut self, retries: u32) {
+        self.max_nonfinite_retries = retries;
+    }
+
+    /// Sets the dimension from which the vector loops run on rayon's current pool (default
+    /// [`DEFAULT_PARALLEL_FROM`]); below it they run on the calling thread. No bit of the results depends on it.
+    pub fn set_parallel_from(&mut self, n: usize) {
+        self.parallel_from = n;
+    }
+
+    /// Forgets the step-size history: the next step starts like the first one. Use after a discontinuity in the
+    /// state or the equations.
+    pub fn reset(&mut self) {
+        self.h = 0.0;
+    }
+
+    /// The step size the next step will try (`None` before the first step or after [`Dop853::reset`]).
+    pub fn proposed_step(&self) -> Option<f64> {
+        (self.h > 0.0).then_some(self.h)
+    }
+
+    /// The tolerances in use.
+    pub fn tolerances(&self) -> &Tolerances {
+        &self.tol
+    }
+
+    fn ensure_workspace(&mut self, n: usize) {
+        if self.n == n && self.y.len() == n {
+            return;
+        }
+        self.n = n;
+        self.k = vec![vec![0.0; n]; 12];
+        self.y = vec![0.0; n];
+        self.y_new = vec![0.0; n];
+        self.y_stage = vec![0.0; n];
+        self.partials = vec![[0.0; 3]; n.div_ceil(CHUNK)];
+    }
+
+    fn parallel(&self) -> bool {
+        self.n >= self.parallel_from
+    }
+
+    /// Times `f` as the vector phase of the path in use.
+    fn timed<R>(parallel: bool, f: impl FnOnce() -> R) -> R {
+        if parallel {
+            VECTOR.time(f)
+        } else {
+            VECTOR_SERIAL.time(f)
+        }
+    }
+
+    /// `k[stage] = f(t, arg)`, counting the evaluation.
+    fn eval(&mut self, system: &dyn OdeSystem, t: f64, stage: usize, arg: Arg) {
+        self.stats.rhs_evaluations += 1;
+        let src = match arg {
+            Arg::State => &self.y,
+            Arg::Stage => &self.y_stage,
+        };
+        system.rhs(t, src, &mut self.k[stage]);
+    }
+
+    /// Whether stage `stage` holds only finite values (chunked, parallel on the parallel path).
+    fn finite(&mut self, stage: usize) -> bool {
+        let parallel = self.parallel();
+        let k = &self.k[stage];
+        let [bad, _, _] = Self::timed(parallel, || {
+            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
+                [k[lo..hi].iter().filter(|v| !v.is_finite()).count() as f64, 0.0, 0.0]
+            })
+        });
+        bad == 0.0
+    }
+
+    /// Hairer's initial step guess `hinit` (§II.4) with the error's scaled RMS norms, from `f(t, y)` in `k[0]` and
+    /// one more evaluation (into `k[1]`). Returns `|h|`.
+    fn initial_step_guess(&mut self, system: &dyn OdeSystem, t: f64, dir: f64, span: f64) -> f64 {
+        let n = self.n as f64;
+        let parallel = self.parallel();
+        let (y, k, tol) = (&self.y, &self.k, &self.tol);
+        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
+        let [dy, df, _] = Self::timed(parallel, || {
+            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
+                let (mut dy, mut df) = (0.0, 0.0);
+                for i in lo..hi {
+                    let sc = scale(i);
+                    dy += (y[i] / sc).powi(2);
+                    df += (k[0][i] / sc).powi(2);
+                }
+                [dy, df, 0.0]
+            })
+        });
+        let (d0, d1) = ((dy / n).sqrt(), (df / n).sqrt());
+        let mut h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+        h0 = h0.min(span).min(self.h_max);
+        if h0.is_nan() || h0 <= 0.0 {
+            return 1e-6f64.min(span).min(self.h_max);
+        }
+        // Explicit Euler step into y_stage, its derivative into k[1].
+        let (y, k) = (&self.y, &self.k);
+        Self::timed(parallel, || {
+            each_chunk(parallel, &mut self.y_stage, |lo, o| {
+                for ((z, &yi), &fi) in o.iter_mut().zip(&y[lo..]).zip(&k[0][lo..]) {
+                    *z = yi + dir * h0 * fi;
+                }
+            })
+        });
+        self.eval(system, t + dir * h0, 1, Arg::Stage);
+        let (y, k, tol) = (&self.y, &self.k, &self.tol);
+        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
+        let [d2, _, _] = Self::timed(parallel, || {
+            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
+                let mut d2 = 0.0;
+                for (i, (&f1, &f0)) in (lo..hi).zip(k[1][lo..hi].iter().zip(&k[0][lo..hi])) {
+                    d2 += ((f1 - f0) / scale(i)).powi(2);
+                }
+                [d2, 0.0, 0.0]
+            })
+        });
+        let d2 = (d2 / n).sqrt() / h0;
+        if !d2.is_finite() {
+            return h0;
+        }
+        let der = d1.max(d2);
+        let h1 = if der <= 1e-15 {
+            (h0 * 1e-3).max(1e-6)
+        } else {
+            (0.01 / der).powf(EXPO)
+        };
+        (100.0 * h0).min(h1).min(span).min(self.h_max)
+    }
+
+    /// One step attempt from `(t, self.y)` with `k[0] = f(t, y)` and signed step `h` ending at `t_end`. Returns
+    /// the outcome and the error estimate.
+    fn attempt(&mut self, system: &dyn OdeSystem, t: f64, h: f64, t_end: f64) -> (Attempt, f64) {
+        let parallel = self.parallel();
+        for (s, row) in STAGES.iter().enumerate() {
+            let (y, k) = (&self.y, &self.k);
+            Self::timed(parallel, || {
+                each_chunk(parallel, &mut self.y_stage, |lo, o| {
+                    stage_row_chunk(o, y, h, k, lo, row.a)
+                })
+            });
+            let ts = if row.c == 1.0 { t_end } else { t + row.c * h };
+            self.eval(system, ts, s + 1, Arg::Stage);
+        }
+        // The new state, both error estimators and their norms in one pass per chunk (WEIGHTS and ERROR5 use the
+        // same stages: k_1, k_6 … k_12).
+        let (y, k, tol) = (&self.y, &self.k, &self.tol);
+        let [e5, e3, bad] = Self::timed(parallel, || {
+            each_chunk_sums(parallel, &mut self.y_new, &mut self.partials, |lo, yn| {
+                let hi = lo + yn.len();
+                let ks: [&[f64]; 8] = std::array::from_fn(|t| &k[WEIGHTS[t].0][lo..hi]);
+                let (y, atol, rtol) = (&y[lo..hi], &tol.atol[lo..hi], &tol.rtol[lo..hi]);
+                let (mut s5, mut s3, mut bad) = (0.0, 0.0, 0.0);
+                for (i, v) in yn.iter_mut().enumerate() {
+                    let mut b = WEIGHTS[0].1 * ks[0][i];
+                    let mut e5 = ERROR5[0].1 * ks[0][i];
+                    for t in 1..8 {
+                        b += WEIGHTS[t].1 * ks[t][i];
+                        e5 += ERROR5[t].1 * ks[t][i];
+                    }
+                    let e3 = b - BHH1 * ks[0][i] - BHH2 * ks[4][i] - BHH3 * ks[7][i];
+                    let yi = y[i];
+                    *v = yi + h * b;
+                    if !v.is_finite() {
+                        bad += 1.0;
+                    }
+                    let sc = (atol[i] + rtol[i] * yi.abs().max(v.abs())).max(f64::MIN_POSITIVE);
+                    s5 += (e5 / sc).powi(2);
+                    s3 += (e3 / sc).powi(2);
+                }
+                [s5, s3, bad]
+            })
+        });
+        let mut deno = e5 + 0.01 * e3;
+        if deno <= 0.0 {
+            deno = 1.0;
+        }
+        let err = h.abs() * e5 * (1.0 / (self.n as f64 * deno)).sqrt();
+        if bad > 0.0 || err.is_nan() {
+            (Attempt::NonFinite, err)
+        } else if err <= 1.0 {
+            (Attempt::Accepted, err)
+        } else {
+            (Attempt::Rejected, err)
+        }
+    }
+
+    /// The stepping loop of [`Integrator::advance`], after its checks, on the state in `self.y`.
+    fn advance_steps(&mut self, system: &dyn OdeSystem, t: &mut f64, t_target: f64) -> Result<(), IntegrateError> {
+        let dir = if t_target > *t { 1.0 } else { -1.0 };
+        system.begin_step(*t, &self.y);
+        self.eval(system, *t, 0, Arg::State);
+        if !self.finite(0) {
+            return Err(IntegrateError::NonFinite { t: *t });
+        }
+        if self.h == 0.0 {
+            let span = (t_target - *t).abs();
+            self.h = match self.initial_step {
+                Some(h) => h.min(self.h_max),
+                None => self.initial_step_guess(system, *t, dir, span),
+            };
+        }
+        let mut attempts: u64 = 0;
+        let mut nonfinite_run: u32 = 0;
+        let mut reject = false; // the previous attempt was rejected (DOP853's REJECT)
+        let mut clean = true; // no rejection since the last accepted step
+        loop {
+            let remaining = (t_target - *t).abs();
+            let last = self.h * 1.01 >= remaining;
+            if !last {
+                let floor = self.h_min.max(10.0 * f64::EPSILON * t.abs());
+                if self.h.is_nan() || self.h < floor || self.h == 0.0 {
+                    return Err(if nonfinite_run > 0 {
+                        IntegrateError::NonFinite { t: *t }
+                    } else {
+                        IntegrateError::StepUnderflow { t: *t, h: dir * self.h }
+                    });
+                }
+            }
+            if attempts >= self.max_steps {
+                return Err(IntegrateError::TooManySteps {
+                    t: *t,
+                    max_steps: self.max_steps,
+                });
+            }
+            attempts += 1;
+            let h_abs = if last { remaining } else { self.h };
+            let proposed = self.h;
+            let t_end = if last { t_target } else { *t + dir * h_abs };
+            let (outcome, err) = self.attempt(system, *t, dir * h_abs, t_end);
+            match outcome {
+                Attempt::Accepted => {
+                    let fac = (err.powf(EXPO) / SAFE).clamp(1.0 / FAC2, 1.0 / FAC1);
+                    let mut h_new = (h_abs / fac).min(self.h_max);
+                    if reject {
+                        h_new = h_new.min(h_abs);
+                    }
+                    std::mem::swap(&mut self.y, &mut self.y_new);
+                    self.stats.steps_accepted += 1;
+                    if !(last && h_abs < proposed) {
+                        // Steps shortened only to land on an output time say nothing about the problem.
+                        self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
+                    }
+                    *t = t_end;
+                    if last {
+                        // Shortened to land on t_target: keep the proposal from before the shortening.
+                        self.h = if clean && h_abs < proposed {
+                            h_new.max(proposed)
+                        } else {
+                            h_new
+                        };
+                        return Ok(());
+                    }
+                    self.h = h_new;
+                    reject = false;
+                    clean = true;
+                    nonfinite_run = 0;
+                    system.begin_step(*t, &self.y);
+                    // FSAL: the derivative at the new state is the next step's first stage.
+                    self.eval(system, *t, 0, Arg::State);
+                    if !self.finite(0) {
+                        return Err(IntegrateError::NonFinite { t: *t });
+                    }
+                }
+                Attempt::Rejected => {
+                    self.stats.steps_rejected += 1;
+                    // err > 1: the step shrinks, by at most 1/FAC1.
+                    let fac = (err.powf(EXPO) / SAFE).min(1.0 / FAC1);
+                    self.h = h_abs / fac;
+                    reject = true;
+                    clean = false;
+                    nonfinite_run = 0;
+                }
+                Attempt::NonFinite => {
+                    self.stats.steps_rejected += 1;
+                    self.h = h_abs * NONFINITE_SHRINK;
+                    reject = true;
+                    clean = false;
+                    nonfinite_run += 1;
+                    if nonfinite_run > self.max_nonfinite_retries {
+                        return Err(IntegrateError::NonFinite { t: *t });
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Which vector a stage is evaluated at.
+#[derive(Clone, Copy)]
+enum Arg {
+    /// The last accepted state `y`.
+    State,
+    /// A stage's argument.
+    Stage,
+}
+
+impl Integrator for Dop853 {
+    fn advance(
+        &mut self,
+        system: &dyn OdeSystem,
+        t: &mut f64,
+        y: &mut [f64],
+        t_target: f64,
+    ) -> Result<(), IntegrateError> {
+        let n = system.dim();
+        if y.len() != n || self.tol.rtol.len() != n {
+            return Err(IntegrateError::Config(format!(
+                "dimension mismatch: system {n}, state {}, tolerances {}",
+                y.len(),
+                self.tol.rtol.len()
+            )));
+        }
+        if !t.is_finite() || !t_target.is_finite() {
+            return Err(IntegrateError::Config(format!(
+                "times must be finite (t = {}, t_target = {t_target})",
+                *t
+            )));
+        }
+        if t_target == *t {
+            return Ok(());
+        }
+        if n == 0 {
+            *t = t_target;
+            return Ok(());
+        }
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(IntegrateError::NonFinite { t: *t });
+        }
+        self.ensure_workspace(n);
+        let parallel = self.parallel();
+        let own = &mut self.y;
+        Self::timed(parallel, || {
+            each_chunk(parallel, own, |lo, o| o.copy_from_slice(&y[lo..lo + o.len()]))
+        });
+        let result = self.advance_steps(system, t, t_target);
+        system.end_steps();
+        // `self.y` is the last accepted state, whatever the result.
+        let own = &self.y;
+        Self::timed(parallel, || {
+            each_chunk(parallel, y, |lo, o| o.copy_from_slice(&own[lo..lo + o.len()]))
+        });
+        result
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats
+    }
+
+    fn method(&self) -> Method {
+        Method::Dop853
+    }
+
+    fn save_state(&self) -> IntegratorState {
+        IntegratorState::Dop853(Dop853State {
+            dim: self.tol.rtol.len(),
+            initial_step: self.initial_step,
+            max_steps: self.max_steps,
+            h_min: self.h_min,
+            h_max: self.h_max,
+            max_nonfinite_retries: self.max_nonfinite_retries,
+            h: self.h,
+            stats: self.stats.into(),
+        })
+    }
+
+    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
+        let s = match state {
+            IntegratorState::Dop853(s) => s,
+            IntegratorState::OdeSolvers(s) if s.method == Method::Dop853 => {
+                return Err(IntegrateError::Config(
+                    "the state was saved by the `ode_solvers` crate's Dop853, which rubblepile no longer runs for \
+                     method \"dop853\" (its own DOP853 has another step-size history): re-run from the start"
+                        .into(),
+                ));
+            }
+            other => {
+                return Err(IntegrateError::Config(format!(
+                    "cannot restore a {} state into dop853",
+                    other.method()
+                )));
+            }
+        };
+        let bad = |what: String| Err(IntegrateError::Config(format!("dop853 state: {what}")));
+        if s.dim != self.tol.rtol.len() {
+            return bad(format!(
+                "saved for dimension {}, tolerances have {}",
+                s.dim,
+                self.tol.rtol.len()
+            ));
+        }
+        if !(s.h.is_finite() && s.h >= 0.0) || s.h_min.is_nan() || s.h_max.is_nan() {
+            return bad(format!(
+                "bad step sizes (h = {}, h_min = {}, h_max = {})",
+                s.h, s.h_min, s.h_max
+            ));
+        }
+        if s.initial_step.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
+            return bad("bad initial step".into());
+        }
+        self.initial_step = s.initial_step;
+        self.max_steps = s.max_steps;
+        self.h_min = s.h_min;
+        self.h_max = s.h_max;
+        self.max_nonfinite_retries = s.max_nonfinite_retries;
+        self.h = s.h;
+        self.stats = s.stats.into();
+        Ok(())
+    }
+}
