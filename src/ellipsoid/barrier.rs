@@ -51,6 +51,7 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::Body;
@@ -265,6 +266,9 @@ pub fn pair_contact(
     contact.speed.is_finite().then_some(contact)
 }
 
+/// From this many bodies on, [`contacts`] sweeps in parallel.
+const PARALLEL_SWEEP_FROM: usize = 256;
+
 /// Every pair in contact (`x < κλ`), sorted by `(i, j)`: sort-and-sweep along x with a bound on each body's
 /// reach, then the exact test.
 pub fn contacts(model: &ModelConfig, settings: &BarrierSettings, bodies: &[Body]) -> Vec<PairContact> {
@@ -274,8 +278,10 @@ pub fn contacts(model: &ModelConfig, settings: &BarrierSettings, bodies: &[Body]
         .filter(|&k| bodies[k].position.x.is_finite())
         .collect();
     order.sort_by(|&a, &b| bodies[a].position.x.total_cmp(&bodies[b].position.x));
-    let mut out = Vec::new();
-    for (n, &a) in order.iter().enumerate() {
+    // The sweep from each body is independent of the others': in parallel for many bodies (it runs at every
+    // output sample), the pairs then sorted, so the result is the same on any number of threads.
+    let sweep = |(n, &a): (usize, &usize)| {
+        let mut found = Vec::new();
         let xa = bodies[a].position.x;
         for &b in &order[n + 1..] {
             if bodies[b].position.x - xa > reaches[a] + max_reach {
@@ -287,10 +293,16 @@ pub fn contacts(model: &ModelConfig, settings: &BarrierSettings, bodies: &[Body]
             }
             let (i, j) = (a.min(b), a.max(b));
             if let Some(c) = pair_contact(model, settings, bodies, i, j) {
-                out.push(c);
+                found.push(c);
             }
         }
-    }
+        found
+    };
+    let mut out: Vec<PairContact> = if order.len() >= PARALLEL_SWEEP_FROM {
+        order.par_iter().enumerate().flat_map_iter(sweep).collect()
+    } else {
+        order.iter().enumerate().flat_map(sweep).collect()
+    };
     out.sort_by_key(|c| (c.i, c.j));
     out
 }

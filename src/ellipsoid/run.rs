@@ -29,6 +29,7 @@ use crate::engine::{
 };
 use crate::integrate::{Integrator, IntegratorState, Method, OdeSystem, Tolerances, make_integrator};
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
 
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
@@ -407,6 +408,11 @@ impl RunReport for RunSummary {
     }
 }
 
+// The work at an output sample (`rubblepile bench scaling`, see [`crate::phase`]): the diagnostics (exact gravity
+// potential and pair terms, parallel) and the barrier monitor's contact sweep (parallel from 256 bodies).
+static PHASE_DIAGNOSTICS: Phase = Phase::new("ellipsoid.sample_diagnostics", Kind::Parallel);
+static PHASE_BARRIER: Phase = Phase::new("ellipsoid.sample_barrier", Kind::Parallel);
+
 impl Engine for EllipsoidEngine {
     type Summary = RunSummary;
     type State = EllipsoidState;
@@ -472,15 +478,15 @@ impl Engine for EllipsoidEngine {
     }
 
     fn sample(&mut self, _to: &Sample, wall_seconds: f64) -> Result<String, SampleError> {
-        let mut d = self.system.diagnostics_at(self.t, &self.y);
+        let mut d = PHASE_DIAGNOSTICS.time(|| self.system.diagnostics_at(self.t, &self.y));
         d.quaternion_norm_error = d.quaternion_norm_error.max(self.projected_drift);
         if let Some(cause) = check_state(self.t, &d, self.scene.integrator.project_attitudes) {
             return Err(self.failure(cause).into());
         }
         self.tracker.update(&d);
         let barrier_path = || PathBuf::from(OVERRUN_FILE);
-        self.barrier
-            .observe(self.t, &self.system, &self.y)
+        PHASE_BARRIER
+            .time(|| self.barrier.observe(self.t, &self.system, &self.y))
             .map_err(|source| SampleError::Io {
                 path: barrier_path(),
                 source,
