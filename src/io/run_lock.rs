@@ -120,15 +120,16 @@ impl DirLock {
         lock(dir, LOCK_FILE, dir.to_path_buf(), false)
     }
 
-    /// Locks `dir/<part>` (a subdirectory written separately from the rest, e.g. `frames`) exclusively, through
-    /// `dir/.rubblepile-<part>.lock`; `dir` must exist, `dir/<part>` need not. Errors as [`DirLock::acquire`],
-    /// naming `dir/<part>`.
+    /// Locks `dir/<part>` (a subdirectory or file written apart from the rest, e.g. `frames` or a shard's index)
+    /// exclusively, through `dir/.rubblepile-<part>.lock`; `dir` must exist, `dir/<part>` need not. Errors as
+    /// [`DirLock::acquire`], naming `dir/<part>`.
     pub fn acquire_part(dir: &Path, part: &str) -> Result<DirLock, LockError> {
         lock(dir, &part_lock_file(part), dir.join(part), false)
     }
 
     /// Locks the existing directory `dir` shared: other shared holders are let in, exclusive ones are refused (and
-    /// refuse it). Shared holders do not write their pid. Errors as [`DirLock::acquire`].
+    /// refuse it). Shared holders write no pid (an exclusive writer refused by them is told `pid unknown`). Errors as
+    /// [`DirLock::acquire`].
     pub fn acquire_shared(dir: &Path) -> Result<DirLock, LockError> {
         lock(dir, LOCK_FILE, dir.to_path_buf(), true)
     }
@@ -192,15 +193,14 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
     let attempt = if shared { file.try_lock_shared() } else { file.try_lock() };
     let file = match attempt {
         Ok(()) => {
-            if !shared {
-                // The pid first, the old tail cut after: a reader never sees an empty file between the two.
-                let pid = format!("{}\n", std::process::id());
-                file.seek(SeekFrom::Start(0))
-                    .and_then(|_| file.write_all(pid.as_bytes()))
-                    .and_then(|_| file.set_len(pid.len() as u64))
-                    .and_then(|_| file.flush())
-                    .map_err(io(&named))?;
-            }
+            // The pid first, the old tail cut after: a reader never sees an empty file between the two. Shared
+            // holders are several: they leave the file empty, so that no stale pid is named.
+            let pid = if shared { String::new() } else { format!("{}\n", std::process::id()) };
+            file.seek(SeekFrom::Start(0))
+                .and_then(|_| file.write_all(pid.as_bytes()))
+                .and_then(|_| file.set_len(pid.len() as u64))
+                .and_then(|_| file.flush())
+                .map_err(io(&named))?;
             Some(file)
         }
         Err(TryLockError::WouldBlock) => {
