@@ -123,11 +123,15 @@ fn read_csv(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// Every file under `dir` with its bytes and modification time.
+/// Every file under `dir` with its bytes and modification time, lock files aside (they name the last writer's pid and
+/// are rewritten by every writer, a campaign that skips everything included).
 fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>, SystemTime)> {
     let mut out = Vec::new();
     for entry in std::fs::read_dir(dir).unwrap() {
         let p = entry.unwrap().path();
+        if p.file_name().is_some_and(rubblepile::io::run_lock::is_lock_file) {
+            continue;
+        }
         if p.is_dir() {
             out.extend(tree(&p));
         } else {

@@ -172,11 +172,16 @@ enum Reached {
 fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf], ckpt: Option<&CheckpointFacts>) {
     let dir = report.dir.clone();
     let name = dir.join("scene.toml").display().to_string();
+    // The first base's error is the one to name: the others are guesses.
     let mut built = Err(String::new());
-    for base in bases {
-        built = E::from_scene_text(text, &name, Some(base)).map_err(|e| e.to_string());
-        if built.is_ok() {
-            break;
+    for (i, base) in bases.iter().enumerate() {
+        match E::from_scene_text(text, &name, Some(base)) {
+            Ok(e) => {
+                built = Ok(e);
+                break;
+            }
+            Err(e) if i == 0 => built = Err(e.to_string()),
+            Err(_) => {}
         }
     }
     report.note(format!("{}: a run of kind {:?} (scene.toml)", dir.display(), E::KIND));
@@ -225,38 +230,37 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
         }
     };
 
-    // The time series.
+    // The time series (when it is missing, the snapshots are still checked, as far as the summary says).
     let ts_path = dir.join("timeseries.csv");
     let ts = std::fs::read(&ts_path).ok();
     let rows = ts
         .as_ref()
         .map(|b| b.split(|&c| c == b'\n').filter(|l| !l.is_empty()).count().saturating_sub(1) as u64);
-    let Some(rows) = rows else {
-        report.problem(format!("{} is missing", ts_path.display()));
-        return;
-    };
-    report.note(match (ckpt, &reached) {
-        (Some(c), Reached::Checkpoint) => format!("timeseries.csv: {rows} rows, {} of them by the checkpoint", c.rows),
-        _ => format!("timeseries.csv: {rows} rows"),
-    });
     let summary_rows = summary.as_ref().and_then(|v| v.get("samples")?.as_u64());
-    if let (Some(n), Reached::Completed | Reached::Failed) = (summary_rows, &reached)
-        && n != rows
-    {
-        report.problem(format!(
-            "{}: {rows} rows, but summary.json counts {n} samples",
-            ts_path.display()
-        ));
-    }
-    if let (Some(c), Reached::Checkpoint) = (ckpt, &reached) {
-        let bytes = ts.as_ref().map_or(0, |b| b.len() as u64);
-        if rows < c.rows || bytes < c.bytes {
-            report.problem(format!(
-                "{}: {rows} rows ({bytes} bytes), fewer than the {} rows ({} bytes) written before the checkpoint",
-                ts_path.display(),
-                c.rows,
-                c.bytes
-            ));
+    match (rows, ckpt, &reached) {
+        (None, ..) => report.problem(format!("{} is missing", ts_path.display())),
+        (Some(rows), Some(c), Reached::Checkpoint) => {
+            report.note(format!("timeseries.csv: {rows} rows, {} of them by the checkpoint", c.rows));
+            let bytes = ts.as_ref().map_or(0, |b| b.len() as u64);
+            if rows < c.rows || bytes < c.bytes {
+                report.problem(format!(
+                    "{}: {rows} rows ({bytes} bytes), fewer than the {} rows ({} bytes) written before the checkpoint",
+                    ts_path.display(),
+                    c.rows,
+                    c.bytes
+                ));
+            }
+        }
+        (Some(rows), ..) => {
+            report.note(format!("timeseries.csv: {rows} rows"));
+            if let (Some(n), Reached::Completed | Reached::Failed) = (summary_rows, &reached)
+                && n != rows
+            {
+                report.problem(format!(
+                    "{}: {rows} rows, but summary.json counts {n} samples",
+                    ts_path.display()
+                ));
+            }
         }
     }
 
@@ -272,6 +276,7 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
     };
     let samples = engine.samples();
     let total = samples.len() as u64;
+    let rows = rows.or(summary_rows).unwrap_or(0);
     let (done, by) = match (&reached, ckpt) {
         (Reached::Completed, _) => {
             if rows != total {

@@ -203,11 +203,8 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
                 .map_err(io(&named))?;
             Some(file)
         }
-        Err(TryLockError::WouldBlock) => {
-            // A shared holder leaves the file as it found it: whatever pid it holds is stale.
-            let pid = if shared { None } else { holder_pid(&path) };
-            return Err(refused(pid));
-        }
+        // An exclusive holder has written its pid; shared holders have left the file empty.
+        Err(TryLockError::WouldBlock) => return Err(refused(holder_pid(&path))),
         Err(TryLockError::Error(e)) if e.kind() == std::io::ErrorKind::Unsupported => {
             eprintln!(
                 "warning: {}: this file system has no advisory file locks; nothing keeps a second rubblepile \
