@@ -57,7 +57,10 @@ fn describe(o: &Output) -> String {
 
 fn bin(cwd: &Path, args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_rubblepile"));
-    c.args(args).current_dir(cwd).stdout(Stdio::piped()).stderr(Stdio::piped());
+    c.args(args)
+        .current_dir(cwd)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
     c
 }
 
@@ -73,14 +76,16 @@ fn assert_refused(o: &Output, dir: &Path, what: &str) -> u32 {
     assert!(!stderr.contains("panicked"), "{what}: {stderr}");
     let lines: Vec<&str> = stderr.lines().collect();
     assert_eq!(lines.len(), 1, "{what}: not one line: {stderr}");
-    let prefix = format!("error: {} is being written by another rubblepile process (pid ", dir.display());
+    let prefix = format!(
+        "error: {} is being written by another rubblepile process (pid ",
+        dir.display()
+    );
     let rest = lines[0]
         .strip_prefix(&prefix)
         .unwrap_or_else(|| panic!("{what}: expected {prefix:?}…, got {stderr}"));
     let (pid, tail) = rest.split_once(')').unwrap_or_else(|| panic!("{what}: {stderr}"));
     assert!(tail.starts_with("; wait for it to end"), "{what}: {stderr}");
-    pid.parse()
-        .unwrap_or_else(|_| panic!("{what}: no pid in {stderr}"))
+    pid.parse().unwrap_or_else(|_| panic!("{what}: no pid in {stderr}"))
 }
 
 fn read(p: &Path) -> String {
@@ -93,7 +98,10 @@ fn snapshots(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .unwrap()
         .map(|e| {
             let p = e.unwrap().path();
-            (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap())
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
         })
         .collect();
     v.sort();
@@ -147,8 +155,18 @@ fn stopped_run(cwd: &Path, name: &str) -> PathBuf {
 /// The pid in `dir`'s lock file, once it names `pid` (the holder has locked the directory); panics after 60 s.
 fn wait_for_holder(dir: &Path, pid: u32) {
     let t0 = Instant::now();
-    while std::fs::read_to_string(dir.join(LOCK_FILE)).ok().as_deref().map(str::trim) != Some(&pid.to_string()) {
-        assert!(t0.elapsed() < Duration::from_secs(60), "{} never locked {}", pid, dir.display());
+    while std::fs::read_to_string(dir.join(LOCK_FILE))
+        .ok()
+        .as_deref()
+        .map(str::trim)
+        != Some(&pid.to_string())
+    {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60),
+            "{} never locked {}",
+            pid,
+            dir.display()
+        );
         std::thread::sleep(Duration::from_millis(1));
     }
 }
@@ -162,7 +180,9 @@ fn two_concurrent_resumes_one_refused_the_other_matches_an_uninterrupted_run() {
     let dir = temp_dir("two-resumes");
     std::fs::write(dir.join("scene.toml"), pile_scene(6000.0)).unwrap();
     let whole = dir.join("whole");
-    let o = bin(&dir, &["run", "scene.toml", "--out", s(&whole), "--no-progress"]).output().unwrap();
+    let o = bin(&dir, &["run", "scene.toml", "--out", s(&whole), "--no-progress"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "uninterrupted run: {}", describe(&o));
     let resume = |d: &Path| bin(&dir, &["resume", s(d), "--no-progress"]);
 
@@ -180,7 +200,11 @@ fn two_concurrent_resumes_one_refused_the_other_matches_an_uninterrupted_run() {
                 describe(&ob)
             ),
         };
-        assert!(String::from_utf8_lossy(&winner.stdout).starts_with("done: t = 6000 s"), "{}", describe(&winner));
+        assert!(
+            String::from_utf8_lossy(&winner.stdout).starts_with("done: t = 6000 s"),
+            "{}",
+            describe(&winner)
+        );
         assert_refused(&loser, &d, &format!("round {round}, race"));
         assert_same_run(&whole, &d, &format!("round {round}, race"));
 
@@ -191,7 +215,11 @@ fn two_concurrent_resumes_one_refused_the_other_matches_an_uninterrupted_run() {
         let second = resume(&d).output().unwrap();
         let first_pid = first.id();
         let first = first.wait_with_output().unwrap();
-        assert!(first.status.success(), "round {round}: first resume: {}", describe(&first));
+        assert!(
+            first.status.success(),
+            "round {round}: first resume: {}",
+            describe(&first)
+        );
         assert_eq!(assert_refused(&second, &d, "second resume"), first_pid);
         assert_same_run(&whole, &d, &format!("round {round}, second started late"));
     }
@@ -221,14 +249,20 @@ fn run_force_into_a_directory_being_written_is_refused_and_removes_nothing() {
     let summary = read(&out.join("summary.json"));
     let lock = DirLock::acquire(&out).unwrap();
     for args in [&["--force"][..], &[]] {
-        let o = rubblepile(&dir, &[&["run", "scene.toml", "--out", s(&out), "--no-progress"], args].concat());
+        let o = rubblepile(
+            &dir,
+            &[&["run", "scene.toml", "--out", s(&out), "--no-progress"], args].concat(),
+        );
         assert_eq!(assert_refused(&o, &out, "run --force"), std::process::id());
         assert!(String::from_utf8_lossy(&o.stderr).contains("or use another --out"));
     }
     assert_eq!(snapshots(&out), before, "nothing removed");
     assert_eq!(read(&out.join("summary.json")), summary);
     drop(lock);
-    let o = rubblepile(&dir, &["run", "scene.toml", "--out", s(&out), "--force", "--no-progress"]);
+    let o = rubblepile(
+        &dir,
+        &["run", "scene.toml", "--out", s(&out), "--force", "--no-progress"],
+    );
     assert!(o.status.success(), "once free: {}", describe(&o));
     assert!(out.join(LOCK_FILE).is_file(), "--force keeps the lock file");
     let _ = std::fs::remove_dir_all(&dir);
@@ -240,8 +274,22 @@ fn impact_and_flyby_into_a_directory_being_written_are_refused() {
     let dir = temp_dir("impact-locked");
     let target = root().join("targets/N30_T4.csv");
     for (name, args) in [
-        ("impact", vec!["impact", "--target", s(&target), "--t-end", "10", "--force", "--no-progress"]),
-        ("flyby", vec!["flyby", "--target", s(&target), "--q-m", "2e7", "--no-run", "--force"]),
+        (
+            "impact",
+            vec![
+                "impact",
+                "--target",
+                s(&target),
+                "--t-end",
+                "10",
+                "--force",
+                "--no-progress",
+            ],
+        ),
+        (
+            "flyby",
+            vec!["flyby", "--target", s(&target), "--q-m", "2e7", "--no-run", "--force"],
+        ),
     ] {
         let out = dir.join(name);
         std::fs::create_dir_all(&out).unwrap();
@@ -275,7 +323,10 @@ fn campaign_directory_being_written_is_refused() {
 
     let lock = DirLock::acquire(&camp).unwrap();
     assert_eq!(assert_refused(&campaign(&[]), &camp, "campaign"), std::process::id());
-    assert_eq!(assert_refused(&campaign(&["--shard", "0/2"]), &camp, "shard"), std::process::id());
+    assert_eq!(
+        assert_refused(&campaign(&["--shard", "0/2"]), &camp, "shard"),
+        std::process::id()
+    );
     std::fs::write(camp.join("campaign.source"), format!("{}\n", file.display())).unwrap();
     let merge = rubblepile(&dir, &["campaign", "merge", s(&camp)]);
     assert_eq!(assert_refused(&merge, &camp, "merge"), std::process::id());
@@ -305,7 +356,10 @@ fn campaign_directory_being_written_is_refused() {
     let o = campaign(&[]);
     assert_eq!(o.status.code(), Some(1), "{}", describe(&o));
     let index = read(&camp.join("campaign.csv"));
-    assert!(index.contains("is being written by another rubblepile process"), "{index}");
+    assert!(
+        index.contains("is being written by another rubblepile process"),
+        "{index}"
+    );
     assert!(!run.join("summary.json").exists());
     drop(lock);
     let _ = std::fs::remove_dir_all(&dir);
@@ -317,7 +371,13 @@ fn impact_run(tag: &str) -> PathBuf {
     let run = temp_dir(tag).join("run");
     let from = root().join("tests/data/n30_p1_z45");
     std::fs::create_dir_all(run.join("snapshots")).unwrap();
-    for f in ["scene.toml", "impact.json", "summary.json", "snapshots/0.csv", "snapshots/1.csv"] {
+    for f in [
+        "scene.toml",
+        "impact.json",
+        "summary.json",
+        "snapshots/0.csv",
+        "snapshots/1.csv",
+    ] {
         std::fs::copy(from.join(f), run.join(f)).unwrap();
     }
     // The scene's bodies file is the state at t = 0, which snapshot 0 holds in the same columns.
@@ -376,7 +436,11 @@ fn readers_and_part_writers_work_on_a_run_being_written() {
 #[test]
 fn a_killed_holder_releases_the_lock() {
     let dir = temp_dir("killed-holder");
-    std::fs::write(dir.join("scene.toml"), pile_scene(600_000.0).replace("every = 5.0", "every = 100.0")).unwrap();
+    std::fs::write(
+        dir.join("scene.toml"),
+        pile_scene(600_000.0).replace("every = 5.0", "every = 100.0"),
+    )
+    .unwrap();
     let out = dir.join("out");
     let mut child = bin(&dir, &["run", "scene.toml", "--out", s(&out), "--no-progress"])
         .stdout(Stdio::null())
@@ -392,8 +456,15 @@ fn a_killed_holder_releases_the_lock() {
     assert!(out.join(LOCK_FILE).is_file(), "the lock file stays");
     let lock = DirLock::acquire(&out).expect("the dead holder's lock is free");
     drop(lock);
-    std::fs::write(dir.join("short.toml"), read(&root().join("tests/bad_input/ellipsoids.toml"))).unwrap();
-    let o = rubblepile(&dir, &["run", "short.toml", "--out", s(&out), "--force", "--no-progress"]);
+    std::fs::write(
+        dir.join("short.toml"),
+        read(&root().join("tests/bad_input/ellipsoids.toml")),
+    )
+    .unwrap();
+    let o = rubblepile(
+        &dir,
+        &["run", "short.toml", "--out", s(&out), "--force", "--no-progress"],
+    );
     assert!(o.status.success(), "a new run after the killed one: {}", describe(&o));
     let _ = std::fs::remove_dir_all(&dir);
 }

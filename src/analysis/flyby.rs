@@ -298,7 +298,11 @@ pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };
     let o = analyze_flyby(&args.out).map_err(|e| {
-        let code = if matches!(e, FlybyAnalysisError::Locked(_)) { 2 } else { 1 };
+        let code = if matches!(e, FlybyAnalysisError::Locked(_)) {
+            2
+        } else {
+            1
+        };
         (e.to_string(), code)
     })?;
     Ok(vec![summary.one_line(), o.one_line()])

@@ -88,12 +88,19 @@ pub fn describe_missing(dir: &Path, missing: &[(usize, f64)], by: &str) -> Strin
     }
     let first = snapshot_path(dir, k);
     match missing.len() {
-        1 => format!("{} is missing (snapshot {k} at t = {t} s, written by {by})", first.display()),
+        1 => format!(
+            "{} is missing (snapshot {k} at t = {t} s, written by {by})",
+            first.display()
+        ),
         n => format!(
             "{} and {} more snapshots are missing (snapshots {} written by {by})",
             first.display(),
             n - 1,
-            missing.iter().map(|(k, _)| k.to_string()).collect::<Vec<_>>().join(", ")
+            missing
+                .iter()
+                .map(|(k, _)| k.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
         ),
     }
 }
@@ -117,7 +124,11 @@ fn read_checkpoint_facts(path: &Path) -> Result<CheckpointFacts, String> {
         next_sample: int("next_sample")?,
         rows: int("timeseries_rows")?,
         bytes: int("timeseries_bytes")?,
-        scene_hash: v.get("scene_hash").and_then(|x| x.as_str()).unwrap_or_default().to_string(),
+        scene_hash: v
+            .get("scene_hash")
+            .and_then(|x| x.as_str())
+            .unwrap_or_default()
+            .to_string(),
         scene_base_dir: v.get("scene_base_dir").and_then(|x| x.as_str()).map(PathBuf::from),
     })
 }
@@ -233,14 +244,20 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
     // The time series (when it is missing, the snapshots are still checked, as far as the summary says).
     let ts_path = dir.join("timeseries.csv");
     let ts = std::fs::read(&ts_path).ok();
-    let rows = ts
-        .as_ref()
-        .map(|b| b.split(|&c| c == b'\n').filter(|l| !l.is_empty()).count().saturating_sub(1) as u64);
+    let rows = ts.as_ref().map(|b| {
+        b.split(|&c| c == b'\n')
+            .filter(|l| !l.is_empty())
+            .count()
+            .saturating_sub(1) as u64
+    });
     let summary_rows = summary.as_ref().and_then(|v| v.get("samples")?.as_u64());
     match (rows, ckpt, &reached) {
         (None, ..) => report.problem(format!("{} is missing", ts_path.display())),
         (Some(rows), Some(c), Reached::Checkpoint) => {
-            report.note(format!("timeseries.csv: {rows} rows, {} of them by the checkpoint", c.rows));
+            report.note(format!(
+                "timeseries.csv: {rows} rows, {} of them by the checkpoint",
+                c.rows
+            ));
             let bytes = ts.as_ref().map_or(0, |b| b.len() as u64);
             if rows < c.rows || bytes < c.bytes {
                 report.problem(format!(

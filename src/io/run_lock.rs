@@ -190,12 +190,20 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
         .truncate(false)
         .open(&path)
         .map_err(io(&named))?;
-    let attempt = if shared { file.try_lock_shared() } else { file.try_lock() };
+    let attempt = if shared {
+        file.try_lock_shared()
+    } else {
+        file.try_lock()
+    };
     let file = match attempt {
         Ok(()) => {
             // The pid first, the old tail cut after: a reader never sees an empty file between the two. Shared
             // holders are several: they leave the file empty, so that no stale pid is named.
-            let pid = if shared { String::new() } else { format!("{}\n", std::process::id()) };
+            let pid = if shared {
+                String::new()
+            } else {
+                format!("{}\n", std::process::id())
+            };
             file.seek(SeekFrom::Start(0))
                 .and_then(|_| file.write_all(pid.as_bytes()))
                 .and_then(|_| file.set_len(pid.len() as u64))
@@ -248,9 +256,15 @@ mod tests {
         assert!(e.contains(&format!("pid {}", std::process::id())), "{e}");
         drop(a);
         // still held through `b`
-        assert!(std::thread::scope(|s| s.spawn(|| DirLock::acquire(&d).is_err()).join().unwrap()));
+        assert!(std::thread::scope(|s| s
+            .spawn(|| DirLock::acquire(&d).is_err())
+            .join()
+            .unwrap()));
         drop(b);
-        assert!(std::thread::scope(|s| s.spawn(|| DirLock::acquire(&d).is_ok()).join().unwrap()));
+        assert!(std::thread::scope(|s| s
+            .spawn(|| DirLock::acquire(&d).is_ok())
+            .join()
+            .unwrap()));
         let _ = std::fs::remove_dir_all(&d);
     }
 
