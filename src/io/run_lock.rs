@@ -5,7 +5,8 @@
 //! on a lock file at the top of the directory: `DIR/.rubblepile.lock` for the directory itself, and
 //! `DIR/.rubblepile-<part>.lock` for one part of it written separately (`frames`, `analysis`, a campaign shard's
 //! index), so that, for instance, `analyze` can write `DIR/analysis/` while the run is still writing `DIR`. The
-//! holder writes its process id into the file so that a refused writer can name it.
+//! holder writes its process id into the file right after locking it, so that a refused writer can name it (in the
+//! instant between the two, a refused writer reads the previous holder's pid).
 //!
 //! - A second writer is refused at once, never made to wait: [`LockError::Held`] names the directory and the
 //!   holder's pid (the command line prints it as one line, exit code 2).
