@@ -55,6 +55,9 @@ fn looks_finished(out: &Path) -> bool {
     std::fs::read_to_string(out.join("summary.json")).is_ok_and(|t| t.contains("\"status\": \"completed\""))
 }
 
+/// The lock a `hold-lock` damage holds while its case runs.
+static HELD: std::sync::Mutex<Option<rubblepile::io::run_lock::DirLock>> = std::sync::Mutex::new(None);
+
 /// Sets the case up in `dir`; returns an error text for a broken case (a replacement that matches nothing).
 fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
     let root_s = root().display().to_string();
@@ -121,6 +124,12 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
             "truncate-timeseries" => {
                 std::fs::write(out.join("timeseries.csv"), "t\n").map_err(|e| e.to_string())?;
             }
+            "delete-snapshots" => std::fs::remove_dir_all(out.join("snapshots")).map_err(|e| e.to_string())?,
+            // Another writer: this process holds the directory's lock until the case has run.
+            "hold-lock" => {
+                let lock = rubblepile::io::run_lock::DirLock::acquire(out).map_err(|e| e.to_string())?;
+                *HELD.lock().unwrap() = Some(lock);
+            }
             other => return Err(format!("unknown damage {other:?}")),
         }
     }
@@ -151,6 +160,7 @@ fn every_bad_input_gets_one_clear_error() {
             .map(|a| a.replace("SCENE", "scene.toml").replace("OUT", &out_s))
             .collect();
         let o = rubblepile(&dir, &args);
+        HELD.lock().unwrap().take();
         let stderr = String::from_utf8_lossy(&o.stderr);
         let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
         let problem = if o.status.code().is_none() {

@@ -124,11 +124,15 @@ fn read_csv(path: &Path) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// Every file under `dir` with its bytes and modification time.
+/// Every file under `dir` with its bytes and modification time, lock files aside (they name the last writer's pid and
+/// are rewritten by every writer, a campaign that skips everything included).
 fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>, SystemTime)> {
     let mut out = Vec::new();
     for entry in std::fs::read_dir(dir).unwrap() {
         let p = entry.unwrap().path();
+        if p.file_name().is_some_and(rubblepile::io::run_lock::is_lock_file) {
+            continue;
+        }
         if p.is_dir() {
             out.extend(tree(&p));
         } else {
@@ -787,5 +791,49 @@ fn a_rank_killed_mid_campaign_loses_nothing() {
         index_without_wall(&index),
         index_without_wall(&dir.join("out/campaign.csv"))
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Under MPI, a campaign directory another process writes: rank 0 is refused at once and sends the worker ranks
+/// home before it says so, so the job ends with the one-line refusal instead of hanging.
+#[cfg(feature = "mpi")]
+#[test]
+fn mpi_campaign_into_a_directory_being_written_is_refused_without_hanging() {
+    let (dir, file) = campaign_dir("mpi-locked", GRID);
+    let out = dir.join("mpi");
+    std::fs::create_dir_all(&out).unwrap();
+    let lock = rubblepile::io::run_lock::DirLock::acquire(&out).unwrap();
+    let mut child = mpirun(
+        3,
+        &[
+            "campaign",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--no-progress",
+        ],
+    )
+    .stdout(std::process::Stdio::piped())
+    .stderr(std::process::Stdio::piped())
+    .spawn()
+    .unwrap();
+    let t0 = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed().as_secs() > 120 {
+            let _ = child.kill();
+            panic!("mpirun hung on a refused campaign directory");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(!o.status.success(), "{}", stderr(&o));
+    let expected = format!(
+        "error: {} is being written by another rubblepile process (pid {})",
+        out.display(),
+        std::process::id()
+    );
+    assert!(stderr(&o).contains(&expected), "{}", stderr(&o));
+    assert!(!out.join("campaign.csv").exists(), "nothing written");
+    drop(lock);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -78,13 +78,18 @@ fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
-/// All files under `dir` with their contents (relative path -> bytes).
+/// All files under `dir` with their contents (relative path -> bytes), lock files aside (every writer, a refused one
+/// too, writes its pid into them).
 fn tree(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
     let mut out = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
+            let e = e.unwrap();
+            if rubblepile::io::run_lock::is_lock_file(&e.file_name()) {
+                continue;
+            }
+            let p = e.path();
             if p.is_dir() {
                 stack.push(p);
             } else {

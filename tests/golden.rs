@@ -10,6 +10,7 @@
 
 mod common;
 use common::{rubblepile, temp_dir};
+use rubblepile::io::run_lock::is_lock_file;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -98,7 +99,11 @@ fn check_case(name: &str, cwd: &Path, args: &[&str]) {
     let expected_dir = root().join("tests/golden").join(name).join("expected");
     let produced: Vec<PathBuf> = files(&out)
         .into_iter()
-        .filter(|p| p.file_name().is_some_and(|f| f != "checkpoint.json"))
+        // The checkpoint and the directory's lock files are no outputs of the physics.
+        .filter(|p| {
+            p.file_name()
+                .is_some_and(|f| f != "checkpoint.json" && !is_lock_file(f))
+        })
         .collect();
     if std::env::var_os("RUBBLEPILE_BLESS_GOLDEN").is_some() {
         if expected_dir.exists() {

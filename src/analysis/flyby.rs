@@ -74,6 +74,10 @@ pub struct FlybyOutcome {
 /// Why a run cannot be analysed.
 #[derive(Debug, thiserror::Error)]
 pub enum FlybyAnalysisError {
+    /// Another rubblepile process writes the run's `analysis/`
+    /// ([`crate::analysis::run_analysis::lock_analysis`]).
+    #[error(transparent)]
+    Locked(#[from] crate::io::run_lock::LockError),
     /// A file is missing or unreadable.
     #[error("{}: {message}", .path.display())]
     File {
@@ -230,8 +234,19 @@ fn snapshot_files(dir: &Path) -> Result<Vec<PathBuf>, FlybyAnalysisError> {
     Ok(files.into_iter().map(|(_, p)| p).collect())
 }
 
-/// Analyses the flyby run in `dir` (first vs last snapshot) and writes `dir/analysis/flyby.json`.
+/// Analyses the flyby run in `dir` (first vs last snapshot) and writes `dir/analysis/flyby.json`, holding the lock
+/// of `dir/analysis/` (refused at once, [`FlybyAnalysisError::Locked`], while another process writes it).
 pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
+    let _lock = match crate::analysis::run_analysis::lock_analysis(dir, "scene.toml") {
+        Ok(lock) => lock,
+        Err(crate::analysis::run_analysis::AnalysisError::Locked(e)) => return Err(e.into()),
+        Err(e) => {
+            return Err(FlybyAnalysisError::File {
+                path: dir.join("analysis"),
+                message: e.to_string(),
+            });
+        }
+    };
     let files = snapshot_files(dir)?;
     let scene = crate::ellipsoid::scene::load_scene(&dir.join("scene.toml")).ok();
     let (g, kappa_i) = scene.as_ref().map_or((G_SI, 2.5), |s| {
@@ -282,7 +297,14 @@ pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
     let Some(summary) = summary else {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };
-    let o = analyze_flyby(&args.out).map_err(|e| (e.to_string(), 1))?;
+    let o = analyze_flyby(&args.out).map_err(|e| {
+        let code = if matches!(e, FlybyAnalysisError::Locked(_)) {
+            2
+        } else {
+            1
+        };
+        (e.to_string(), code)
+    })?;
     Ok(vec![summary.one_line(), o.one_line()])
 }
 

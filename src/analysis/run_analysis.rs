@@ -4,6 +4,9 @@
 //! `impact.json` (projectile) and the snapshots at t = 0 and at `t_at` (default 400 s, "a few minutes after the
 //! impact"); writes `analysis/fragments.csv` and `analysis/analysis.json` inside the run directory. Fits that
 //! cannot be made (too few fragments, say) are recorded with their reason instead of stopping the analysis.
+//!
+//! The analysis locks what it writes, `analysis/` ([`lock_analysis`]), not the run directory, so a run still going
+//! can be analysed while it writes.
 
 use std::path::{Path, PathBuf};
 
@@ -11,10 +14,14 @@ use crate::analysis::composition::{Composition, Origin, composition};
 use crate::analysis::fits::{ExponentComparison, PowerLawFit, SpinFit, compare_exponents, fit_power_law, histogram};
 use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
 use crate::ellipsoid::equations::G_SI;
+use crate::io::run_lock::{DirLock, LockError};
 
 /// Why a run could not be analysed. One line, naming the file.
 #[derive(Debug, thiserror::Error)]
 pub enum AnalysisError {
+    /// Another rubblepile process writes the analysis directory ([`lock_analysis`]).
+    #[error(transparent)]
+    Locked(#[from] LockError),
     /// A file is missing or unreadable.
     #[error("{path}: {reason}")]
     Read {
@@ -156,9 +163,23 @@ fn run_kappa(dir: &Path) -> Result<f64, AnalysisError> {
     Ok(scene.model.kappa)
 }
 
+/// Locks `dir/analysis/` for this process until the guard is dropped ([`crate::io::run_lock`]; the lock file is
+/// `dir/.rubblepile-analysis.lock`), when `dir` holds `marker` (`scene.toml` for a run, `campaign.csv` for a
+/// campaign): another directory is left to the reading to refuse, without a lock file left in it.
+///
+/// Errors: [`AnalysisError::Locked`] at once when another rubblepile process writes `dir/analysis/`.
+pub fn lock_analysis(dir: &Path, marker: &str) -> Result<Option<DirLock>, AnalysisError> {
+    if !dir.join(marker).is_file() {
+        return Ok(None);
+    }
+    Ok(Some(DirLock::acquire_part(dir, "analysis")?))
+}
+
 /// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
-/// (or `force`). Returns the per-run results and the per-fragment report.
+/// (or `force`), holding the lock of `dir/analysis/` ([`lock_analysis`]). Returns the per-run results and the
+/// per-fragment report.
 pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
+    let _lock = lock_analysis(dir, "scene.toml")?;
     let out_dir = dir.join("analysis");
     let (json_path, csv_path) = (out_dir.join("analysis.json"), out_dir.join("fragments.csv"));
     if !force && (json_path.exists() || csv_path.exists()) {
@@ -467,6 +488,7 @@ pub fn analyze_campaign(
     force: bool,
     selection: &SpinSelection,
 ) -> Result<CampaignAnalysis, AnalysisError> {
+    let _lock = lock_analysis(dir, "campaign.csv")?;
     let out_dir = dir.join("analysis");
     let json_path = out_dir.join("campaign_analysis.json");
     if !force && json_path.exists() {
@@ -504,6 +526,8 @@ pub fn analyze_campaign(
             continue;
         }
         let run_dir = dir.join(&run);
+        // The run's analysis and its figures under one lock.
+        let _run_lock = lock_analysis(&run_dir, "scene.toml")?;
         let (a, report) = match analyze_run(&run_dir, t_at, force) {
             Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
             other => other?,

@@ -20,8 +20,10 @@ pub struct AnalyzeArgs {
     pub force: bool,
 }
 
-/// Runs `analyze`.
+/// Runs `analyze`, holding the lock of `DIR/analysis/` from the first check to the last figure (so a second
+/// `analyze` of the run is refused at once, while the run itself may still be writing `DIR`).
 pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
+    let _lock = crate::analysis::run_analysis::lock_analysis(&args.dir, "scene.toml").map_err(CliError::usage)?;
     if crate::analysis::flyby::is_flyby_run(&args.dir) {
         return analyze_flyby_run(args);
     }
@@ -184,7 +186,10 @@ fn analyze_flyby_run(args: &AnalyzeArgs) -> Result<(), CliError> {
             out.display()
         )));
     }
-    let o = crate::analysis::flyby::analyze_flyby(&args.dir).map_err(CliError::failed)?;
+    let o = crate::analysis::flyby::analyze_flyby(&args.dir).map_err(|e| match e {
+        crate::analysis::flyby::FlybyAnalysisError::Locked(_) => CliError::usage(e),
+        _ => CliError::failed(e),
+    })?;
     println!("{} (wrote {})", o.one_line(), out.display());
     Ok(())
 }

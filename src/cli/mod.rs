@@ -5,7 +5,9 @@
 //!   its outputs into DIR, with checkpoints as asked;
 //! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
 //!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::driver`]);
-//! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to;
+//! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to; `rubblepile check DIR` (a
+//!   directory): whether a run directory is whole ([`crate::driver::inspect`]), one line per finding, exit code 2
+//!   when it is not;
 //! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
 //! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
@@ -39,8 +41,19 @@
 //!   ([`crate::bench::stability`]): `stability.csv`, `stability.md` and one run directory per case.
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
-//! scene, bad arguments, existing output directory, nothing to resume) and 1 for a failed run; 3 when
+//! scene, bad arguments, existing output directory, nothing to resume, a run directory that is not whole, a
+//! directory another rubblepile process is writing) and 1 for a failed run; 3 when
 //! the hidden testing flag `--stop-after-checkpoints N` stopped a run after its N-th checkpoint.
+//!
+//! # One writer per directory
+//!
+//! Every command that writes a directory locks it first ([`crate::io::run_lock`]) and keeps the lock until it has
+//! written its last byte there: `run` (with `--force` too), `resume`, `impact` and `flyby` their run directory;
+//! `campaign` its campaign directory (a shard only its own index, beside the other shards) and each run directory;
+//! `campaign merge` the campaign directory; `export` the run directory (the run itself may write the same VTK and
+//! XYZ files); `render` and `run --render` the run's `frames/`; `analyze` the run's `analysis/` (so it can read a
+//! run still going). A second writer is refused at once with one line naming the directory and the holder's pid
+//! (exit code 2); readers (`check DIR`, and reading snapshots) take no lock.
 
 pub mod aggregate;
 pub mod analyze;
@@ -76,7 +89,8 @@ pub enum Command {
     Run(RunArgs),
     /// Continue an interrupted run in DIR from its checkpoint (DIR/checkpoint.json).
     Resume(ResumeArgs),
-    /// Validate a scene file and print what it resolves to (κ, bodies, output times).
+    /// Validate a scene file and print what it resolves to (κ, bodies, output times); of a run directory, say whether
+    /// it is whole (scene copy, status, snapshots, time series).
     Check(CheckArgs),
     /// Rubble-pile targets.
     #[command(subcommand)]
@@ -247,7 +261,7 @@ impl CheckpointArgs {
 /// `rubblepile check`.
 #[derive(Debug, clap::Args)]
 pub struct CheckArgs {
-    /// Scene file (TOML). Without it, the built-in default scene is checked.
+    /// Scene file (TOML), or a run directory (is it whole?). Without it, the built-in default scene is checked.
     pub scene: Option<PathBuf>,
     /// Print the built-in default scene's TOML instead (a starting point for your own scenes).
     #[arg(long, conflicts_with = "scene")]
@@ -334,6 +348,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 print!("{}", crate::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
             }
+            if let Some(dir) = args.scene.as_deref().filter(|p| p.is_dir()) {
+                return check_run_dir(dir);
+            }
             let (warnings, lines) = crate::driver::check_file(args.scene.as_deref()).map_err(CliError::usage)?;
             for w in warnings {
                 eprintln!("warning: {w}");
@@ -396,6 +413,31 @@ impl From<crate::bench::BenchError> for CliError {
             message: e.message,
             code: e.code,
         }
+    }
+}
+
+/// `rubblepile check DIR`: one line per finding on stdout (problems as `problem: …`); not whole is an error (exit
+/// code 2) naming the first problem.
+fn check_run_dir(dir: &std::path::Path) -> Result<(), CliError> {
+    let report = crate::driver::inspect::check_run_dir(dir);
+    for f in &report.findings {
+        println!("{}{}", if f.problem { "problem: " } else { "" }, f.line);
+    }
+    let problems: Vec<&str> = report.problems().map(|f| f.line.as_str()).collect();
+    match problems.as_slice() {
+        [] => {
+            println!("{} is whole", dir.display());
+            Ok(())
+        }
+        [first, rest @ ..] => Err(CliError::usage(format!(
+            "{} is not whole: {first}{}",
+            dir.display(),
+            match rest.len() {
+                0 => String::new(),
+                1 => " (and 1 more problem)".into(),
+                n => format!(" (and {n} more problems)"),
+            }
+        ))),
     }
 }
 

@@ -5,8 +5,10 @@
 //! until its own final period.
 //!
 //! The branch directory gets the new scene as `scene.toml`, the parent's `timeseries.csv` and `spinup.csv`
-//! (cut back to the checkpoint when the branch is resumed) and the parent's `checkpoint.json` with the scene
-//! hash of the new scene; [`crate::driver::resume_soft`] then carries it on. Whether the two
+//! (cut back to the checkpoint when the branch is resumed), the parent's snapshots from before the checkpoint (the
+//! grids agree up to it, so they are the branch's own; `resume` refuses a directory without them; a snapshot the new
+//! grid puts at the checkpoint's own sample is written from the checkpoint's state) and the parent's
+//! `checkpoint.json` with the scene hash of the new scene; [`crate::driver::resume_soft`] then carries it on. Whether the two
 //! scenes really agree up to the checkpoint is the caller's promise; what can be checked here is checked: the
 //! new scene must parse, hold the same number of particles, and put an output sample at the checkpoint's step
 //! with the same index.
@@ -15,7 +17,8 @@ use std::path::Path;
 
 use super::{CHECKPOINT_FILE, RunError};
 use crate::bits::fnv1a_hex;
-use crate::granular::soft::run::{SoftSummary, sample_steps};
+use crate::engine::{Engine, Resumed};
+use crate::granular::soft::run::{SoftEngine, SoftSummary, sample_steps};
 use crate::granular::soft::scene::parse_soft_scene;
 
 /// Errors of branching: those of a soft-sphere run.
@@ -74,6 +77,7 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
     ck["scene_hash"] = serde_json::Value::String(fnv1a_hex(scene_text.as_bytes()));
     ck["scene_base_dir"] = serde_json::Value::String(scene_dir.display().to_string());
     let io = |p: &Path, e: std::io::Error| bad(format!("{}: {e}", p.display()));
+    let snapshot = |k: usize| dir.join("snapshots").join(format!("{k}.csv"));
     std::fs::create_dir_all(dir.join("snapshots")).map_err(|e| io(dir, e))?;
     std::fs::write(dir.join("scene.toml"), scene_text).map_err(|e| io(&dir.join("scene.toml"), e))?;
     for f in ["timeseries.csv", "spinup.csv"] {
@@ -82,6 +86,35 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
             std::fs::copy(&from, dir.join(f)).map_err(|e| io(&from, e))?;
         }
     }
+    // The parent's snapshots from before the checkpoint are the branch's: the grids agree up to it.
+    let mut at_checkpoint = None;
+    for (i, k) in plan[..index]
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &(_, k))| Some((i, k?)))
+    {
+        let (from, to) = (parent.join("snapshots").join(format!("{k}.csv")), snapshot(k));
+        if i + 1 == index && !from.is_file() {
+            // The branch's grid may put a snapshot at the checkpoint's own sample, where the parent's has none.
+            at_checkpoint = Some(k);
+            continue;
+        }
+        std::fs::copy(&from, &to).map_err(|e| io(&from, e))?;
+    }
     let text = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
-    std::fs::write(dir.join(CHECKPOINT_FILE), text).map_err(|e| io(&dir.join(CHECKPOINT_FILE), e))
+    std::fs::write(dir.join(CHECKPOINT_FILE), text).map_err(|e| io(&dir.join(CHECKPOINT_FILE), e))?;
+    if let Some(k) = at_checkpoint {
+        // The checkpoint's state is that sample's state (a run writes a sample's snapshot, then checkpoints), so the
+        // engine restored from it writes the snapshot the branch's own run would have written there.
+        let c = super::read_checkpoint::<SoftEngine>(dir)?;
+        let mut engine =
+            SoftEngine::from_scene_text(scene_text, &name, Some(scene_dir)).map_err(|e| bad(e.to_string()))?;
+        let at = Resumed {
+            t: c.t,
+            samples_done: c.next_sample,
+        };
+        engine.restore(c.engine, dir, at).map_err(|e| bad(e.to_string()))?;
+        engine.write_snapshot(&snapshot(k)).map_err(|e| io(&snapshot(k), e))?;
+    }
+    Ok(())
 }

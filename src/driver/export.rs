@@ -41,6 +41,9 @@ pub enum ExportError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// Another rubblepile process writes the directory ([`crate::io::run_lock`]).
+    #[error(transparent)]
+    Locked(#[from] crate::io::run_lock::LockError),
     /// A caller's step failed (e.g. an analysis file could not be read).
     #[error("{0}")]
     Other(String),
@@ -161,7 +164,16 @@ pub struct ExportReport {
 
 /// Writes every snapshot of the run in `dir` in `formats`, with the per-body scalars `extra` gives for each view
 /// (e.g. an analysis' `bound`). Refuses to overwrite an existing `dir/<format>` output unless `force`.
+///
+/// Holds the run directory's lock while it writes ([`crate::io::run_lock`]): a run writes the same VTK and XYZ
+/// files, so a run still going is refused at once ([`ExportError::Locked`]), as is a second export.
 pub fn export(dir: &Path, formats: Formats, force: bool, extra: &ExtraFields<'_>) -> Result<ExportReport, ExportError> {
+    // A directory without a scene copy is no run: refused below without a lock file left in it.
+    let _lock = dir
+        .join("scene.toml")
+        .is_file()
+        .then(|| crate::io::run_lock::DirLock::acquire(dir))
+        .transpose()?;
     let selected = formats.selected();
     for f in &selected {
         if let Some(first) = f.files(dir).into_iter().next().filter(|_| !force) {

@@ -85,6 +85,11 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
                 None => EllipsoidEngine::default_scene(),
             }
             .map_err(|e| RunError::Setup(e.to_string()))?;
+            // The built-in scene's impact.json is written after the run: the directory stays locked until then.
+            let _lock = path
+                .is_none()
+                .then(|| super::lock_output_dir(out, options.force))
+                .transpose()?;
             let result = erase(super::run(engine, out, options));
             if path.is_none() && result.is_ok() {
                 // The built-in scene is an impact: its setup lets `rubblepile analyze` read the run.

@@ -30,6 +30,7 @@ pub mod branch;
 pub mod convert;
 pub mod export;
 pub mod formats;
+pub mod inspect;
 pub mod kind;
 pub mod run_files;
 pub mod warm_pool;
@@ -48,6 +49,7 @@ pub use crate::ellipsoid::summary::RunSummary;
 use crate::engine::{Engine, Outcome, Resumed, RunReport, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
+use crate::io::run_lock::{DirLock, LOCK_FILE, LockError, is_lock_file};
 
 pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
 
@@ -153,6 +155,9 @@ pub enum RunError<S> {
     /// file, truncated time series, …).
     #[error("cannot resume: {0}")]
     BadCheckpoint(String),
+    /// Another process (or thread) is writing the directory ([`crate::io::run_lock`]): refused at once.
+    #[error(transparent)]
+    Locked(#[from] LockError),
     /// The run stopped after a checkpoint as asked by [`RunOptions::stop_after_checkpoints`].
     #[error("stopped after checkpoint {checkpoints} at t = {t} s (--stop-after-checkpoints); continue with `rubblepile resume {}`", .dir.display())]
     Stopped {
@@ -177,6 +182,7 @@ impl<S> RunError<S> {
                 | RunError::NoCheckpoint { .. }
                 | RunError::AlreadyCompleted { .. }
                 | RunError::BadCheckpoint(_)
+                | RunError::Locked(_)
         )
     }
 
@@ -212,6 +218,7 @@ impl<S> RunError<S> {
             RunError::NoCheckpoint { dir } => RunError::NoCheckpoint { dir },
             RunError::AlreadyCompleted { dir, t } => RunError::AlreadyCompleted { dir, t },
             RunError::BadCheckpoint(m) => RunError::BadCheckpoint(m),
+            RunError::Locked(e) => RunError::Locked(e),
             RunError::Stopped { dir, t, checkpoints } => RunError::Stopped { dir, t, checkpoints },
         }
     }
@@ -238,43 +245,66 @@ const OUTPUT_FILES: [&str; 10] = [
     "impact.json",
 ];
 
-/// Checks `dir` is usable and creates it (and `snapshots/`). With `force`, a previous run's files are removed first
-/// (only those: other files are left alone).
-pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<(), RunError<S>> {
-    if dir.exists() {
-        if !dir.is_dir() {
-            return Err(RunError::NotADirectory { dir: dir.to_path_buf() });
+/// Checks `dir` is usable as an output directory, creates it and locks it for this process; the lock is held until
+/// the returned guard is dropped (keep it for as long as the directory is written). Nothing in `dir` is removed.
+///
+/// Errors: [`RunError::NotADirectory`]; [`RunError::OutputExists`] when `dir` holds files but no lock file (a
+/// directory rubblepile never wrote gets no lock file) and `force` is not given; [`RunError::Locked`] at once when
+/// another rubblepile process writes `dir`.
+pub fn lock_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunError<S>> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(RunError::NotADirectory { dir: dir.to_path_buf() });
+    }
+    std::fs::create_dir_all(dir).map_err(io_err(dir))?;
+    if !force && !dir.join(LOCK_FILE).exists() && holds_outputs(dir)? {
+        return Err(RunError::OutputExists { dir: dir.to_path_buf() });
+    }
+    Ok(DirLock::acquire(dir).map_err(|e| e.or("use another --out"))?)
+}
+
+/// Whether `dir` holds anything but lock files.
+fn holds_outputs<S>(dir: &Path) -> Result<bool, RunError<S>> {
+    let mut entries = std::fs::read_dir(dir).map_err(io_err(dir))?;
+    Ok(entries.any(|e| e.is_ok_and(|e| !is_lock_file(&e.file_name()))))
+}
+
+/// Checks `dir` is usable, creates it, locks it for this process ([`lock_output_dir`]) and creates `snapshots/`; the
+/// lock is held until the returned guard is dropped (keep it for as long as the directory is written). With `force`,
+/// a previous run's files are removed first (only those: other files are left alone, the lock file too).
+///
+/// Errors: [`RunError::NotADirectory`]; [`RunError::Locked`] at once when another rubblepile process writes `dir`
+/// (before anything in it is removed, `--force` or not); [`RunError::OutputExists`] when `dir` holds anything but
+/// lock files and `force` is not given.
+pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunError<S>> {
+    let lock = lock_output_dir(dir, force)?;
+    if holds_outputs(dir)? {
+        if !force {
+            return Err(RunError::OutputExists { dir: dir.to_path_buf() });
         }
-        let non_empty = std::fs::read_dir(dir).map_err(io_err(dir))?.next().is_some();
-        if non_empty {
-            if !force {
-                return Err(RunError::OutputExists { dir: dir.to_path_buf() });
+        for name in OUTPUT_FILES {
+            let p = dir.join(name);
+            if p.is_file() && name != "impact.json" {
+                std::fs::remove_file(&p).map_err(io_err(&p))?;
             }
-            for name in OUTPUT_FILES {
-                let p = dir.join(name);
-                if p.is_file() && name != "impact.json" {
-                    std::fs::remove_file(&p).map_err(io_err(&p))?;
-                }
-            }
-            let snaps = dir.join("snapshots");
-            if snaps.is_dir() {
-                for entry in std::fs::read_dir(&snaps).map_err(io_err(&snaps))? {
-                    let entry = entry.map_err(io_err(&snaps))?;
-                    let name = entry.file_name();
-                    let name = name.to_string_lossy();
-                    let is_snapshot = name
-                        .strip_suffix(".csv")
-                        .is_some_and(|stem| !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit()));
-                    if is_snapshot {
-                        std::fs::remove_file(entry.path()).map_err(io_err(&entry.path()))?;
-                    }
+        }
+        let snaps = dir.join("snapshots");
+        if snaps.is_dir() {
+            for entry in std::fs::read_dir(&snaps).map_err(io_err(&snaps))? {
+                let entry = entry.map_err(io_err(&snaps))?;
+                let name = entry.file_name();
+                let name = name.to_string_lossy();
+                let is_snapshot = name
+                    .strip_suffix(".csv")
+                    .is_some_and(|stem| !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit()));
+                if is_snapshot {
+                    std::fs::remove_file(entry.path()).map_err(io_err(&entry.path()))?;
                 }
             }
         }
     }
     let snaps = dir.join("snapshots");
     std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
-    Ok(())
+    Ok(lock)
 }
 
 /// A progress bar on stderr for a run from `t` to `t_end` (s), when `enabled` and stderr is a terminal.
@@ -363,11 +393,12 @@ fn absolute_base<S>(engine: &impl Engine) -> Result<Option<PathBuf>, RunError<S>
 
 /// Runs `engine` from its initial state, writing the outputs into `out_dir` (see the module docs).
 ///
-/// Refuses an existing non-empty `out_dir` unless `options.force`. When the engine fails (non-finite state, step
+/// Holds the lock of `out_dir` ([`prepare_output_dir`]) until it returns, and refuses an existing non-empty
+/// `out_dir` unless `options.force`. When the engine fails (non-finite state, step
 /// size underflow, a broken constraint), writes `last_good_state.csv` and `summary.json` (naming the cause) and
 /// returns [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunReport::one_line`].
 pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
-    prepare_output_dir(out_dir, options.force)?;
+    let _lock = prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
     std::fs::write(&scene_copy, engine.scene_source()).map_err(io_err(&scene_copy))?;
     let identity = Identity {
@@ -482,10 +513,17 @@ pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>>
 /// snapshots, time-series rows (after cutting those written after the checkpoint) and summary. `options.force` is
 /// ignored; the checkpoint options apply to the continued run.
 ///
-/// Errors: [`RunError::AlreadyCompleted`] when `dir/summary.json` says the run completed, [`RunError::NoCheckpoint`]
-/// without a checkpoint, [`RunError::BadCheckpoint`] when the checkpoint is corrupt or does not match the directory
-/// (scene copy, input files, time series); otherwise as [`run`].
+/// The directory is locked ([`crate::io::run_lock`]) from before it is read until the run ends, and nothing in it
+/// is changed before every check has passed.
+///
+/// Errors: [`RunError::Locked`] at once when another rubblepile process writes `dir`; [`RunError::AlreadyCompleted`]
+/// when `dir/summary.json` says the run completed, [`RunError::NoCheckpoint`] without a checkpoint,
+/// [`RunError::BadCheckpoint`] when the checkpoint is corrupt or does not match the directory (scene copy, input
+/// files, a snapshot written before the checkpoint missing, a time series shorter than at the checkpoint); otherwise
+/// as [`run`].
 pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    // A directory that does not exist is left to the checks below to name.
+    let _lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
     if let Some(t) = completed_run(dir) {
         return Err(RunError::AlreadyCompleted {
             dir: dir.to_path_buf(),
@@ -520,6 +558,27 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             ckpt.timeseries_rows, ckpt.next_sample
         )));
     }
+    // What the run wrote before the checkpoint must all be there: a resumed run never writes it again.
+    let missing = inspect::missing_snapshots(dir, &samples[..ckpt.next_sample as usize]);
+    if !missing.is_empty() {
+        return Err(bad(format!(
+            "{}; re-run the scene from the start",
+            inspect::describe_missing(dir, &missing, &format!("the checkpoint at t = {} s", ckpt.t))
+        )));
+    }
+    let ts_path = dir.join("timeseries.csv");
+    match std::fs::metadata(&ts_path) {
+        Err(e) => return Err(bad(format!("{}: {e}", ts_path.display()))),
+        Ok(m) if m.len() < ckpt.timeseries_bytes => {
+            return Err(bad(format!(
+                "{}: holds {} bytes, fewer than the {} written before the checkpoint; re-run the scene from the start",
+                ts_path.display(),
+                m.len(),
+                ckpt.timeseries_bytes
+            )));
+        }
+        Ok(_) => {}
+    }
     engine
         .restore(
             ckpt.engine,
@@ -540,7 +599,6 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
     }
     let snaps = dir.join("snapshots");
     std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
-    let ts_path = dir.join("timeseries.csv");
     let timeseries = reopen_truncated(&ts_path, ckpt.timeseries_bytes)?;
     let identity = Identity {
         scene_base_dir: ckpt.scene_base_dir.clone(),

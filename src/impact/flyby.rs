@@ -20,6 +20,7 @@ use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
 use crate::impact::run::{ImpactError, read_target};
+use crate::io::run_lock::DirLock;
 use crate::math::Vec3;
 
 /// Earth's mass (kg; IAU 2015 nominal GM 3.986004e14 m³ s⁻² over G = 6.674e-11).
@@ -194,8 +195,9 @@ fn target_kappa(target: &Path) -> Option<f64> {
     serde_json::from_str::<serde_json::Value>(&text).ok()?["kappa"].as_f64()
 }
 
-/// Validates `args`, writes the run directory (refused when not empty unless `force`) and returns the scene.
-pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), ImpactError> {
+/// Validates `args`, writes the run directory (refused when not empty unless `force`, or when another process writes
+/// it) and returns the scene, with the directory's lock ([`crate::io::run_lock`]: keep it until the run has ended).
+pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLock), ImpactError> {
     let positive = |x: f64| x.is_finite() && x > 0.0;
     for (field, x) in [
         ("planet_radius_m", args.planet_radius_m),
@@ -359,7 +361,7 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
         },
     );
     let out = &args.out;
-    prepare_output_dir(out, args.force)?;
+    let lock = prepare_output_dir(out, args.force)?;
     let io = |p: &Path| {
         let path = p.to_path_buf();
         move |source| ImpactError::Io { path, source }
@@ -372,12 +374,12 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup), Impa
     let scene_path = out.join("scene.toml");
     std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
     let scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
-    Ok((scene, setup))
+    Ok((scene, setup, lock))
 }
 
 /// Prepares and (unless `no_run`) runs the flyby of `args`; the run's summary, if run.
 pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<crate::driver::RunSummary>, ImpactError> {
-    let (scene, _) = prepare_flyby(args)?;
+    let (scene, _, _lock) = prepare_flyby(args)?;
     if args.no_run {
         return Ok(None);
     }

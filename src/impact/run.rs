@@ -22,6 +22,7 @@ use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 use crate::impact::pile::{ProjectilePile, set_up_pile_impact};
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::integrate::Method;
+use crate::io::run_lock::DirLock;
 use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
 
 /// Default end time (s).
@@ -340,12 +341,15 @@ pub struct ImpactPlan {
 }
 
 /// An impact whose run directory is written, ready for [`run_scene`].
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct PreparedImpact {
     /// The scene read back from the run directory's `scene.toml`.
     pub scene: LoadedScene,
     /// What was written.
     pub plan: ImpactPlan,
+    /// The run directory's lock ([`crate::io::run_lock`]): keep it until the run has ended, so that no other
+    /// process writes the directory between its preparation and the run.
+    pub lock: DirLock,
 }
 
 /// Why an impact could not be set up or run. Messages are one line.
@@ -430,11 +434,11 @@ pub fn read_target(path: &Path) -> Result<Vec<Body>, ImpactError> {
 
 /// Validates `cfg`, reads its target, prepares `out` ([`prepare_output_dir`]: refused when not empty unless
 /// `force`) and writes `initial_bodies.csv`, `impact.json` and `scene.toml` into it; returns the scene read
-/// back. Nothing is run.
+/// back, with the directory's lock. Nothing is run.
 pub fn prepare_impact(cfg: &ImpactConfig, out: &Path, force: bool) -> Result<PreparedImpact, ImpactError> {
     cfg.validate()?;
     let target = read_target(&cfg.target)?;
-    prepare_output_dir(out, force)?;
+    let lock = prepare_output_dir(out, force)?;
     let plan = cfg.plan(&target);
     let io = |p: &Path| {
         let path = p.to_path_buf();
@@ -456,7 +460,7 @@ pub fn prepare_impact(cfg: &ImpactConfig, out: &Path, force: bool) -> Result<Pre
     let scene_path = out.join("scene.toml");
     std::fs::write(&scene_path, &plan.scene_toml).map_err(io(&scene_path))?;
     let scene = parse_scene(&plan.scene_toml, &scene_path.display().to_string(), Some(out))?;
-    Ok(PreparedImpact { scene, plan })
+    Ok(PreparedImpact { scene, plan, lock })
 }
 
 /// Runs the impact `cfg` in `out`: [`prepare_impact`] (with `options.force`), then [`run_scene`] with the

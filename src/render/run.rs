@@ -19,6 +19,7 @@ use super::{
 use crate::analysis::run_analysis::FragmentFields;
 use crate::driver::export::{ExportError, visit_snapshots};
 use crate::engine::{ParticleView, SnapshotView};
+use crate::io::run_lock::DirLock;
 
 /// The scalar that colours the bodies.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -160,7 +161,9 @@ fn first_framing(view: &SnapshotView, values: &[f64], extent: Option<f64>) -> Fr
     Framing { centre, half_extent }
 }
 
-/// Renders every snapshot of the run in `dir` into `dir/frames/<k>.png` and `dir/frames/<gif_name>`.
+/// Renders every snapshot of the run in `dir` into `dir/frames/<k>.png` and `dir/frames/<gif_name>`, holding the lock
+/// of `dir/frames/` ([`crate::io::run_lock`]): a second render of the run is refused at once
+/// ([`ExportError::Locked`]); the run itself may still be going.
 pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, RenderRunError> {
     if opts.width < 16 || opts.height < 16 || opts.width > 8192 || opts.height > 8192 {
         return Err(RenderRunError::Option(format!(
@@ -188,6 +191,14 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
         _ => None,
     };
     let frames_dir = dir.join("frames");
+    // `frames/` is locked, not the run: a run still going can be drawn as far as it got. A directory without
+    // snapshots is refused below without a lock file left in it.
+    let _lock = dir
+        .join("snapshots")
+        .is_dir()
+        .then(|| DirLock::acquire_part(dir, "frames"))
+        .transpose()
+        .map_err(ExportError::Locked)?;
     if !opts.force && frames_dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
         return Err(ExportError::Exists(frames_dir).into());
     }

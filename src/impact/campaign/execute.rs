@@ -238,8 +238,10 @@ pub fn threads_per_run(parallel: usize, given: Option<usize>) -> usize {
 
 /// Runs `campaign` (see the module docs): creates its directory, decides what to do with each grid point,
 /// writes `campaign.csv`, runs what needs running with `parallel` runs at once, rewriting `campaign.csv`
-/// whenever a run starts or ends. Failed runs are recorded, not returned: the error is only for the
-/// campaign directory or `campaign.csv` that cannot be written.
+/// whenever a run starts or ends. The campaign directory is locked for as long ([`lock_campaign_dir`]), each run's
+/// directory by its run. Failed runs are recorded, not returned (a run directory another process writes is a failed
+/// run): the error is only for the campaign directory or `campaign.csv` that cannot be written, or that another
+/// process writes ([`CampaignError::Locked`], at once).
 pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<CampaignReport, CampaignError> {
     let started = Instant::now();
     let out = &campaign.out;
@@ -247,6 +249,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         path: out.clone(),
         source,
     })?;
+    let _lock = lock_campaign_dir(out, options.shard)?;
     if let Some(src) = &campaign.source {
         let pointer = out.join(CAMPAIGN_SOURCE);
         let line = format!("{}\n", src.display());

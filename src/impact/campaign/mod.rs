@@ -90,6 +90,8 @@ pub use shard::*;
 
 use std::path::PathBuf;
 
+use crate::io::run_lock::DirLock;
+
 /// Name of the campaign table in the campaign directory.
 pub const CAMPAIGN_CSV: &str = "campaign.csv";
 
@@ -143,6 +145,9 @@ pub enum CampaignError {
         /// What was expected and what was given.
         message: String,
     },
+    /// Another rubblepile process writes the campaign directory (or this shard's index).
+    #[error(transparent)]
+    Locked(#[from] crate::io::run_lock::LockError),
     /// Writing the campaign directory or `campaign.csv` failed.
     #[error("{}: {source}", .path.display())]
     Io {
@@ -158,9 +163,25 @@ impl CampaignError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CampaignError::Io { .. } => 1,
+            CampaignError::Locked(_) => 2,
             _ => 2,
         }
     }
+}
+
+/// Locks the campaign directory `out` for this process ([`crate::io::run_lock`]) until the guards are dropped: whole,
+/// or, for a shard, shared with the other shards (each writes its own runs) and with its own index exclusively. So two
+/// campaigns, a campaign and a shard, or one shard twice never write one campaign directory at once; each run
+/// directory is locked by its run besides. Errors: [`CampaignError::Locked`], at once.
+pub fn lock_campaign_dir(out: &std::path::Path, shard: Option<Shard>) -> Result<Vec<DirLock>, CampaignError> {
+    let advice = "use another --out";
+    Ok(match shard {
+        None => vec![DirLock::acquire(out).map_err(|e| e.or(advice))?],
+        Some(s) => vec![
+            DirLock::acquire_shared(out).map_err(|e| e.or(advice))?,
+            DirLock::acquire_part(out, &s.index_file()).map_err(|e| e.or(advice))?,
+        ],
+    })
 }
 
 pub(crate) fn one_line(s: &str) -> String {

@@ -3,7 +3,8 @@
 //!
 //! Rank 0 is the coordinator and runs no impact: it decides what each grid point needs (as the threaded runner
 //! does: skip, resume, start), hands the runs out one at a time to whichever rank asks (dynamic, so long runs do not
-//! hold short ones back), and is the only writer of `campaign.csv` (atomically, after every event). Ranks 1…K−1 run
+//! hold short ones back), and is the only writer of `campaign.csv` (atomically, after every event), holding the
+//! campaign directory's lock ([`lock_campaign_dir`]) while it coordinates. Ranks 1…K−1 run
 //! the runs they are given through the same [`execute`] as the threaded runner, so every run directory holds the
 //! same bytes whichever rank ran it. While waiting, rank 0 polls with short sleeps instead of MPI's busy-waiting
 //! receive, so it costs no core.
@@ -54,10 +55,34 @@ pub fn run_campaign_mpi(
     })?;
     let world = universe.world();
     if world.rank() == 0 {
+        // Rank 0 alone locks the campaign directory; each worker rank locks the run directory it writes (in
+        // `execute`). Refused, it sends the workers home before it says so: left waiting, they would hang the job.
+        let out = &campaign.out;
+        let locked = std::fs::create_dir_all(out)
+            .map_err(|source| CampaignError::Io {
+                path: out.clone(),
+                source,
+            })
+            .and_then(|_| lock_campaign_dir(out, options.shard));
+        let _lock = match locked {
+            Ok(lock) => lock,
+            Err(e) => {
+                dismiss(&world);
+                return Err(e);
+            }
+        };
         coordinate(&world, campaign, options).map(Some)
     } else {
         work(&world, campaign, options);
         Ok(None)
+    }
+}
+
+/// Answers every worker's first `ready` with `stop`, so that all ranks end when rank 0 cannot coordinate.
+fn dismiss(world: &::mpi::topology::SimpleCommunicator) {
+    for rank in 1..world.size() {
+        let _ = world.process_at_rank(rank).receive_vec_with_tag::<u8>(TAG);
+        send(world, rank, "stop");
     }
 }
 
@@ -84,10 +109,6 @@ fn coordinate(
 ) -> Result<CampaignReport, CampaignError> {
     let started = Instant::now();
     let out = &campaign.out;
-    std::fs::create_dir_all(out).map_err(|source| CampaignError::Io {
-        path: out.clone(),
-        source,
-    })?;
     let points = &campaign.points;
     let mut runs: Vec<RunRecord> = points
         .iter()

@@ -90,10 +90,13 @@ pub fn campaign_of_dir(dir: &Path) -> Result<Campaign, CampaignError> {
 }
 
 /// Rebuilds `campaign.csv` of the campaign directory `dir` from its run directories; returns the report (every
-/// run `Skip`ped, as nothing ran).
+/// run `Skip`ped, as nothing ran). Refused at once ([`CampaignError::Locked`]) while a campaign or one of its shards
+/// writes `dir`.
 pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
     let started = Instant::now();
     let campaign = campaign_of_dir(dir)?;
+    // The index is rewritten: not while a campaign or a shard writes the directory.
+    let _lock = lock_campaign_dir(dir, None)?;
     let runs: Vec<RunRecord> = campaign
         .points
         .iter()
