@@ -460,6 +460,13 @@ fn measure(args: &ScalingArgs, case: &str, threads: usize, cache: &mut Systems) 
     let scratch = args.out.join("scratch");
     let repeats = args.repeats as usize;
     match case {
+        "rhs-n200" => rhs_case(
+            case,
+            cache.pile(root, "targets/N200_T4.csv", false)?,
+            threads,
+            repeats,
+            false,
+        ),
         "rhs-n2000" => rhs_case(
             case,
             cache.pile(root, "targets/N2000_T4.csv", false)?,
