@@ -24,8 +24,9 @@ pub struct CampaignArgs {
     /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<crate::impact::campaign::Shard>,
-    /// Threads of each process's rayon pool [default: the node's cores over its MPI ranks; all cores without MPI].
-    #[arg(long, value_name = "N")]
+    /// Threads of each process's rayon pool, 1 to 4096 [default: the node's cores over its MPI ranks; all cores
+    /// without MPI].
+    #[arg(long, value_name = "N", value_parser = crate::io::scene_file::thread_count)]
     pub threads_per_rank: Option<usize>,
     /// Runs at once (overrides `campaign.parallel`).
     #[arg(long, value_name = "N")]
