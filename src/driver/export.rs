@@ -170,7 +170,7 @@ fn finite_view(dir: &Path, k: usize, view: &SnapshotView) -> Result<(), ExportEr
         ];
         if let Some((field, value)) = fields.iter().find(|(_, v)| !v.is_finite()) {
             return Err(ExportError::Other(format!(
-                "{}: body {} ({field}) is {value}, expected a finite number; not exported",
+                "{}: body {}: {field} is {value}, expected a finite number; not exported",
                 dir.join("snapshots").join(format!("{k}.csv")).display(),
                 p.id
             )));

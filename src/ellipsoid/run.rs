@@ -256,7 +256,7 @@ fn check_initial_state(scene: &LoadedScene, initial: &Diagnostics, y: &[f64]) ->
         file: scene.name.clone(),
         field: field.to_string(),
         message: format!(
-            "gives a non-finite energy or force at t = 0 with these bodies ({term} term: energy {energy:e} J{at});              the bodies' masses, sizes and separations overflow it"
+            "gives a non-finite energy or force at t = 0 with these bodies ({term} term: energy {energy:e} J{at}); the bodies' masses, sizes and separations overflow it"
         ),
     }))
 }
@@ -349,12 +349,23 @@ impl EllipsoidEngine {
     pub fn new(scene: LoadedScene) -> Result<Self, EngineError> {
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics).with_tide(scene.tide);
         let settings = scene.integrator;
-        let mut integrator = make_integrator(
-            settings.method,
-            Tolerances::scale_free(settings.rtol, settings.atol, &system),
-            settings.step,
-        )
-        .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
+        let tolerances = Tolerances::scale_free(settings.rtol, settings.atol, &system);
+        // atol is in user units (m, m/s, rad/s) and scaled by each body's mass and moment of inertia: a huge atol
+        // times a huge mass overflows, which is the scene's atol to name, not an integrator failure.
+        if let Some(k) = tolerances.atol.iter().position(|a| !a.is_finite()) {
+            return Err(EngineError::Scene(SceneError::Invalid {
+                file: scene.name.clone(),
+                field: "integrator.atol".into(),
+                message: format!(
+                    "times the scale of body[{}] (its mass, moment of inertia or the energy scale) is not finite, got \
+                     {:e}",
+                    k / (system.dim() / system.n_bodies().max(1)).max(1),
+                    settings.atol
+                ),
+            }));
+        }
+        let mut integrator = make_integrator(settings.method, tolerances, settings.step)
+            .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         // The error budget is the run's: rtol bounds the accumulated error, not each step's. Not with tree
         // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`;
         // Bulirsch-Stoer does): freshly walked forces jump (by about the multipole error, 1e-4) wherever a

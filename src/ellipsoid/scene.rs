@@ -495,6 +495,16 @@ pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
 /// an adaptive step resolves a spin turn or a contact in a few to a few tens of steps.
 pub const STEPS_PER_TIME_SCALE: f64 = 10.0;
 
+/// `|v|` without overflowing the squares of large components (`[1e200, 0, 0]` has the norm 1e200, not infinity).
+fn robust_norm(v: &Vec3) -> f64 {
+    let m = v.amax();
+    if m > 0.0 && m.is_finite() {
+        m * (v / m).norm()
+    } else {
+        m
+    }
+}
+
 /// `(A B C)^{1/3}` (m) without overflowing the product of three large axes.
 fn equivalent_radius(axes: &[f64; 3]) -> f64 {
     axes[0].cbrt() * axes[1].cbrt() * axes[2].cbrt()
@@ -670,7 +680,8 @@ impl Validator<'_> {
                     return Err(self.invalid(
                         field,
                         format!(
-                            "not used by method \"rk4\" (a fixed step has no error control; give `step` only), got {x}"
+                            "not used by method \"rk4\" (a fixed step has no error control; give `step` only), got {}",
+                            fmt_num(x)
                         ),
                     ));
                 }
@@ -900,8 +911,8 @@ impl Validator<'_> {
                     field,
                     format!(
                         "gives body[{k}] a non-finite contact energy at full overlap (U0 m^2 (kappa/pi)^(3/2) / \
-                         sqrt(det 2 Sigma) = e^{ln_u:.1} J with G = {g:e}, kappa = {kappa}, mass {m:e} kg, axes [{a:e}, \
-                         {bb:e}, {c:e}] m)"
+                         sqrt(det 2 Sigma) = e^{ln_u:.1} J with G = {g:e}, kappa = {kappa}, mass {m:e} kg, axes {} m)",
+                        fmt_list(&[a, bb, c])
                     ),
                 ));
             }
@@ -1151,7 +1162,7 @@ impl Validator<'_> {
         // Energies and momenta at t = 0 (finite inputs can still overflow: 1e300 m/s gives an infinite energy).
         let position = Vec3::new(b.position[0], b.position[1], b.position[2]);
         let velocity = Vec3::new(b.velocity[0], b.velocity[1], b.velocity[2]);
-        let speed = velocity.norm();
+        let speed = robust_norm(&velocity);
         if !(0.5 * mass * speed * speed).is_finite() || !(mass * speed).is_finite() {
             return Err(self.invalid(
                 f("velocity"),
@@ -1166,13 +1177,13 @@ impl Validator<'_> {
                 "gives a non-finite angular momentum at t = 0 (|r| |m v| overflows)",
             ));
         }
-        let w = spin_body.norm();
+        let w = robust_norm(&spin_body);
         if !(0.5 * i_max * w * w).is_finite() || !(i_max * w).is_finite() {
             return Err(self.invalid(
                 spin_field,
                 format!(
-                    "gives a non-finite rotational energy or spin angular momentum at t = 0 (|w| = {w:e} rad/s, \
-                     moments of inertia up to {i_max:e} kg m^2)"
+                    "gives a non-finite rotational energy or spin angular momentum at t = 0 (|w| = {w:.3e} rad/s, \
+                     moments of inertia up to {i_max:.3e} kg m^2)"
                 ),
             ));
         }

@@ -275,6 +275,15 @@ pub fn read_text_bounded(path: &Path) -> std::io::Result<String> {
     Ok(text)
 }
 
+/// Which factor of a product that overflows is to blame: the one of largest magnitude (its field is named). Used where
+/// a derived quantity (e.g. the potential energy `m |g| |x|`) is a product of fields.
+pub(crate) fn largest_factor<'a>(factors: &[(&'a str, f64)]) -> &'a str {
+    factors
+        .iter()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map_or("", |f| f.0)
+}
+
 /// Reads a scene file (a one-line [`SceneError::Read`] naming it if that fails).
 pub fn read_scene_text(path: &Path) -> Result<SceneText, SceneError> {
     let name = path.display().to_string();

@@ -475,12 +475,18 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     if let Some(g) = gravity {
         // The potential energy m g·x of every particle enters the energy book.
         for (k, p) in particles.iter().enumerate() {
-            if !(p.mass * g.norm() * p.position.norm()).is_finite() || !(g.norm() * dt).is_finite() {
+            let (m, gn, x) = (p.mass, g.norm(), p.position.norm());
+            if !(m * gn * x).is_finite() || !(gn * dt).is_finite() {
+                let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", gn), ("x", x)]) {
+                    "m" => format!("particle[{k}].mass"),
+                    "x" => format!("particle[{k}].position"),
+                    _ => "gravity.g".to_string(),
+                };
                 return Err(v.invalid(
-                    "gravity.g",
+                    field,
                     format!(
-                        "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at t = 0,                          got {:?}",
-                        g.as_slice()
+                        "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at t = 0 \
+                         (m = {m:e} kg, |g| = {gn:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
                     ),
                 ));
             }
@@ -671,7 +677,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
                     return Err(v.invalid(
                         f("oscillation.omega"),
                         format!(
-                            "must be finite with a finite wall speed amplitude x omega, got {} (amplitude {})",
+                            "must be finite with a finite wall speed amplitude x omega, got {:e} (amplitude {:e} m)",
                             o.omega, o.amplitude
                         ),
                     ));

@@ -437,12 +437,18 @@ impl V<'_> {
         let g = gravity.uniform.norm();
         if g > 0.0 {
             for (k, p) in particles.iter().enumerate() {
-                if !(p.mass * g * p.position.norm()).is_finite() || !(g * dt).is_finite() {
+                let (m, x) = (p.mass, p.position.norm());
+                if !(m * g * x).is_finite() || !(g * dt).is_finite() {
+                    let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", g), ("x", x)]) {
+                        "m" => format!("particle[{k}].mass"),
+                        "x" => format!("particle[{k}].position"),
+                        _ => "gravity.uniform".to_string(),
+                    };
                     return Err(self.invalid(
-                        "gravity.uniform",
+                        field,
                         format!(
                             "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at \
-                             t = 0, got |g| = {g:e} m/s^2"
+                             t = 0 (m = {m:e} kg, |g| = {g:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
                         ),
                     ));
                 }
@@ -735,12 +741,13 @@ impl V<'_> {
         let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
         let limit = crate::granular::soft::advise::stability_limit(material.k_n, m_min);
         if !(limit >= t_end * MIN_STEP_FRACTION) {
+            let lightest = particles.iter().position(|p| p.mass == m_min).unwrap_or(0);
             // No step can be both stable and at least t_end × 1e-12: the stiffness (or a tiny mass) is the cause.
             return Err(self.invalid(
                 "contact.k_n",
                 format!(
-                    "gives a leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:e} s (m_min = {m_min:e} kg), below \
-                     t_end x {MIN_STEP_FRACTION:e}: more than 1e12 steps, got {:e} N/m",
+                    "gives a leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:.3e} s (m_min = {m_min:.3e} kg, \
+                     particle[{lightest}]), below t_end x {MIN_STEP_FRACTION:e}: more than 1e12 steps, got {:e} N/m",
                     material.k_n
                 ),
             ));
