@@ -180,7 +180,7 @@ fn every_bad_input_gets_one_clear_error() {
     }
     let counts: Vec<String> = per_kind.iter().map(|(k, n)| format!("{k}: {n}")).collect();
     println!("{} cases ({})", corpus.case.len(), counts.join(", "));
-    assert!(corpus.case.len() >= 60, "the corpus must hold at least 60 cases");
+    assert!(corpus.case.len() >= 130, "the corpus must hold at least 130 cases");
     assert!(
         failures.is_empty(),
         "{} of {} cases failed:\n{}",
