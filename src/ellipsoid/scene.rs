@@ -898,7 +898,7 @@ impl Validator<'_> {
                 ("axes", 2.0 * std::f64::consts::LN_2 - (a.ln() + bb.ln() + c.ln()) / 3.0),
             ];
             let ln_u: f64 = parts.iter().map(|p| p.1).sum();
-            if !(ln_u < ln_max) {
+            if ln_u.is_nan() || ln_u >= ln_max {
                 let worst = parts.iter().max_by(|x, y| x.1.total_cmp(&y.1)).map_or("mass", |p| p.0);
                 let field = match worst {
                     "G" => "physics.gravity.G".to_string(),
@@ -918,7 +918,7 @@ impl Validator<'_> {
             }
             if let Some(d) = physics.dissipation
                 && d.f0 > 0.0
-                && !(d.f0.ln() + ln_u < ln_max)
+                && d.f0.ln() + ln_u >= ln_max
             {
                 return Err(self.invalid(
                     "physics.dissipation.F0",
@@ -1107,7 +1107,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        if !(i_min >= f64::MIN_POSITIVE) {
+        if i_min.is_nan() || i_min < f64::MIN_POSITIVE {
             return Err(self.invalid(
                 if small_sq >= f64::MIN_POSITIVE {
                     f("mass")

@@ -740,7 +740,7 @@ impl V<'_> {
         let mut warnings = Vec::new();
         let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
         let limit = crate::granular::soft::advise::stability_limit(material.k_n, m_min);
-        if !(limit >= t_end * MIN_STEP_FRACTION) {
+        if limit.is_nan() || limit < t_end * MIN_STEP_FRACTION {
             let lightest = particles.iter().position(|p| p.mass == m_min).unwrap_or(0);
             // No step can be both stable and at least t_end × 1e-12: the stiffness (or a tiny mass) is the cause.
             return Err(self.invalid(
