@@ -1,7 +1,8 @@
 //! The bad-input corpus (`tests/bad_input/cases.toml`): malformed scenes of the three engines, bodies and particles
 //! files, campaign files, aggregate and spin-up options, and damaged checkpoints, each run through the binary. Every
 //! case must end with a non-zero exit code (not a signal), a one-line `error: …` naming what it expects, no panic,
-//! and no output directory that a later run would take for a finished one.
+//! and no output directory that a later run would take for a finished one. `files` may name files in folders (the
+//! folders are created).
 
 mod common;
 use common::temp_dir;
@@ -74,7 +75,12 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
         std::fs::write(dir.join("scene.toml"), text.replace("ROOT", &root_s)).map_err(|e| e.to_string())?;
     }
     for (name, text) in &case.files {
-        std::fs::write(dir.join(name), text.replace("ROOT", &root_s)).map_err(|e| e.to_string())?;
+        // A name may hold folders (e.g. `run/snapshots/0.csv` for a damaged run directory).
+        let path = dir.join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| e.to_string())?;
+        }
+        std::fs::write(path, text.replace("ROOT", &root_s)).map_err(|e| e.to_string())?;
     }
     if case.prepare.as_deref() == Some("checkpoint") {
         let out_s = out.display().to_string();
@@ -184,7 +190,7 @@ fn every_bad_input_gets_one_clear_error() {
     }
     let counts: Vec<String> = per_kind.iter().map(|(k, n)| format!("{k}: {n}")).collect();
     println!("{} cases ({})", corpus.case.len(), counts.join(", "));
-    assert!(corpus.case.len() >= 60, "the corpus must hold at least 60 cases");
+    assert!(corpus.case.len() >= 130, "the corpus must hold at least 130 cases");
     assert!(
         failures.is_empty(),
         "{} of {} cases failed:\n{}",

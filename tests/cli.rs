@@ -405,11 +405,21 @@ fn snapshot_reread_as_bodies_file_is_lossless() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Needs the physics: two bodies at the same place make the gravitational energy non-finite.
+/// Needs the physics: two point masses falling head-on into each other (strong gravity, no contact term) drive
+/// the integrator to a step-size underflow at their collision. (Two bodies at the same place at t = 0 used to be
+/// this test's failure; since issue 38 such a start is refused before the run, exit 2, naming both bodies.)
 #[test]
 fn failed_run_writes_last_good_state_and_exits_1() {
     let dir = temp_dir("fail");
-    let broken = SCENE.replace("position = [5.5, 0.5, 0.0]", "position = [0.0, 0.0, 0.0]");
+    let coincident = SCENE.replace("position = [5.5, 0.5, 0.0]", "position = [0.0, 0.0, 0.0]");
+    let refused = run_scene_text(&dir, "coincident.toml", &coincident, "refused", &[]);
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("body[1].position: coincides with body[0]"), "{stderr}");
+    let broken = SCENE
+        .replace("gravity = {}", "gravity = { G = 1e-3 }")
+        .replace("contact = {}\ndissipation = { F0 = 0.01 }\n", "")
+        .replace("position = [5.5, 0.5, 0.0]", "position = [5.5, 0.0, 0.0]");
     let out = run_scene_text(&dir, "scene.toml", &broken, "out", &[]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");

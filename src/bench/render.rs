@@ -24,7 +24,7 @@ pub struct RenderBenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "30,200,2000")]
     pub bodies: Vec<usize>,
     /// Thread counts, comma-separated [default: 1 and all available].
-    #[arg(long, value_delimiter = ',')]
+    #[arg(long, value_delimiter = ',', value_parser = crate::io::scene_file::thread_count)]
     pub threads: Option<Vec<usize>>,
     /// Frame size (pixels, square).
     #[arg(long, default_value_t = 800)]

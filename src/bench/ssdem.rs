@@ -31,7 +31,7 @@ pub struct BenchSsdemArgs {
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub steps: u64,
     /// Thread counts to time (comma-separated).
-    #[arg(long, default_value = "1,2", value_delimiter = ',')]
+    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = crate::io::scene_file::thread_count)]
     pub threads: Vec<usize>,
     /// Write `bench_ssdem.csv` and `bench_ssdem.svg` here.
     #[arg(long, value_name = "DIR")]

@@ -24,10 +24,10 @@ pub struct CampaignArgs {
     /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<crate::impact::campaign::Shard>,
-    /// Threads of this process [default: the node's cores over its MPI ranks; all cores without MPI]. The runs at
-    /// once share them: each run has its own pool of threads-per-rank / parallel threads, at least one, so
-    /// `--parallel 16 --threads-per-rank 1` runs 16 runs at once on one thread each.
-    #[arg(long, value_name = "N")]
+    /// Threads of this process, 1 to 4096 [default: the node's cores over its MPI ranks; all cores without MPI].
+    /// The runs at once share them: each run has its own pool of threads-per-rank / parallel threads, at least
+    /// one, so `--parallel 16 --threads-per-rank 1` runs 16 runs at once on one thread each.
+    #[arg(long, value_name = "N", value_parser = crate::io::scene_file::thread_count)]
     pub threads_per_rank: Option<usize>,
     /// Runs at once (overrides `campaign.parallel`).
     #[arg(long, value_name = "N")]

@@ -155,6 +155,13 @@ fn csv_to_ss(input: &Path, output: &Path) -> Result<Converted, ConvertError> {
                 }
             })
             .collect();
+        // Nothing is written (sidecar included) for a file that would hold a non-finite value.
+        SsFile {
+            time: t,
+            particles: ps.clone(),
+        }
+        .check()
+        .map_err(|e| err(input, format!("{e}; nothing written")))?;
         let side = ss_sidecar(output);
         std::fs::copy(input, &side).map_err(|e| err(&side, e))?;
         let note = if ellipsoids {
@@ -189,8 +196,8 @@ fn csv_to_ss(input: &Path, output: &Path) -> Result<Converted, ConvertError> {
         (ps, "spheres, one to one".to_string())
     };
     let count = particles.len();
-    SsFile { time: t, particles }
-        .write(output)
-        .map_err(|e| err(output, e))?;
+    let ss = SsFile { time: t, particles };
+    ss.check().map_err(|e| err(input, format!("{e}; nothing written")))?;
+    ss.write(output).map_err(|e| err(output, e))?;
     Ok(Converted { count, note })
 }

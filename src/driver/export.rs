@@ -83,7 +83,8 @@ pub fn visit_snapshots(
     visit: &mut dyn FnMut(usize, SnapshotView) -> Result<(), ExportError>,
 ) -> Result<(), ExportError> {
     let scene_path = dir.join("scene.toml");
-    let text = std::fs::read_to_string(&scene_path).map_err(|_| ExportError::NotARun(dir.to_path_buf()))?;
+    let text =
+        crate::io::scene_file::read_text_bounded(&scene_path).map_err(|_| ExportError::NotARun(dir.to_path_buf()))?;
     let files = snapshot_files(dir)?;
     let base = scene_base_dir(dir);
     let name = scene_path.display().to_string();
@@ -140,7 +141,7 @@ pub fn visit_snapshots(
 /// Where the run's scene resolves its relative files: the directory recorded in its checkpoint, if any, else the
 /// run directory (where `rubblepile impact` puts the bodies file).
 fn scene_base_dir(dir: &Path) -> PathBuf {
-    std::fs::read_to_string(dir.join(CHECKPOINT_FILE))
+    crate::io::scene_file::read_text_bounded(&dir.join(CHECKPOINT_FILE))
         .ok()
         .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
         .and_then(|v| v.get("scene_base_dir")?.as_str().map(PathBuf::from))
@@ -150,6 +151,36 @@ fn scene_base_dir(dir: &Path) -> PathBuf {
 
 /// Per-body scalars added to a snapshot's view (name, one value per particle), or why they could not be had.
 pub type ExtraFields<'a> = dyn Fn(&SnapshotView) -> Result<Vec<(String, Vec<f64>)>, String> + 'a;
+
+/// Refuses a snapshot with a non-finite value (a damaged or hand-edited file), naming the snapshot, the body and the
+/// field, before anything of it is written: the formats would carry the NaN on to ParaView or OVITO.
+fn finite_view(dir: &Path, k: usize, view: &SnapshotView) -> Result<(), ExportError> {
+    for p in &view.particles {
+        let fields = [
+            ("mass", p.mass),
+            ("x", p.position.x),
+            ("y", p.position.y),
+            ("z", p.position.z),
+            ("vx", p.velocity.x),
+            ("vy", p.velocity.y),
+            ("vz", p.velocity.z),
+            ("wx", p.spin_world.x),
+            ("wy", p.spin_world.y),
+            ("wz", p.spin_world.z),
+            ("a", p.axes.x),
+            ("b", p.axes.y),
+            ("c", p.axes.z),
+        ];
+        if let Some((field, value)) = fields.iter().find(|(_, v)| !v.is_finite()) {
+            return Err(ExportError::Other(format!(
+                "{}: body {}: {field} is {value}, expected a finite number; not exported",
+                dir.join("snapshots").join(format!("{k}.csv")).display(),
+                p.id
+            )));
+        }
+    }
+    Ok(())
+}
 
 /// What [`export`] wrote.
 #[derive(Debug, Clone, PartialEq)]
@@ -184,6 +215,7 @@ pub fn export(dir: &Path, formats: Formats, force: bool, extra: &ExtraFields<'_>
     let mut written: Vec<(usize, f64)> = Vec::new();
     let mut count = 0;
     visit_snapshots(dir, &mut |k, mut view| {
+        finite_view(dir, k, &view)?;
         view.extra = extra(&view).map_err(ExportError::Other)?;
         written.push((k, view.t));
         for f in &selected {

@@ -38,7 +38,7 @@ impl SceneKind {
     /// The kind of the scene file at `path` (an unreadable file counts as an ellipsoid scene, whose loader reports
     /// the read error).
     pub fn of_file(path: &Path) -> SceneKind {
-        std::fs::read_to_string(path).map_or(SceneKind::Ellipsoids, |t| SceneKind::of_text(&t))
+        crate::io::scene_file::read_text_bounded(path).map_or(SceneKind::Ellipsoids, |t| SceneKind::of_text(&t))
     }
 
     /// The kind of the run in `dir` (from its `scene.toml` copy).
@@ -90,6 +90,9 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
                 .is_none()
                 .then(|| super::lock_output_dir(out, options.force))
                 .transpose()?;
+            for w in engine.scene_warnings() {
+                eprintln!("warning: {w}");
+            }
             let result = erase(super::run(engine, out, options));
             if path.is_none() && result.is_ok() {
                 // The built-in scene is an impact: its setup lets `rubblepile analyze` read the run.
@@ -110,6 +113,9 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
         SceneKind::HardSpheres => {
             let engine = HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
                 .map_err(|e| RunError::Setup(e.to_string()))?;
+            for w in engine.scene_warnings() {
+                eprintln!("warning: {w}");
+            }
             erase(super::run(engine, out, options))
         }
     }
@@ -132,11 +138,10 @@ pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), cra
             Some(p) => EllipsoidEngine::load(p),
             None => EllipsoidEngine::default_scene(),
         }
-        .map(|e| (Vec::new(), e.describe())),
+        .map(|e| (e.scene_warnings().to_vec(), e.describe())),
         SceneKind::SoftSpheres => SoftEngine::load(path.expect("a soft-sphere scene comes from a file"))
             .map(|e| (e.scene_warnings().to_vec(), e.describe())),
-        SceneKind::HardSpheres => {
-            HardEngine::load(path.expect("a hard-sphere scene comes from a file")).map(|e| (Vec::new(), e.describe()))
-        }
+        SceneKind::HardSpheres => HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
+            .map(|e| (e.scene_warnings().to_vec(), e.describe())),
     }
 }

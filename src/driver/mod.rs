@@ -444,12 +444,13 @@ fn read_checkpoint<E: Engine>(dir: &Path) -> Result<Checkpoint<E::State>, RunErr
             reason.split_whitespace().collect::<Vec<_>>().join(" ")
         ))
     };
-    let text = match std::fs::read_to_string(&path) {
+    let text = match crate::io::scene_file::read_text_bounded(&path) {
         Ok(t) => t,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             return Err(RunError::NoCheckpoint { dir: dir.to_path_buf() });
         }
-        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => return Err(corrupt("not UTF-8 text".into())),
+        // Not UTF-8, larger than MAX_INPUT_BYTES or a line longer than MAX_LINE_BYTES (the message says which).
+        Err(e) if e.kind() == std::io::ErrorKind::InvalidData => return Err(corrupt(e.to_string())),
         Err(source) => return Err(RunError::Io { path, source }),
     };
     let header: Header = serde_json::from_str(&text).map_err(|e| corrupt(e.to_string()))?;

@@ -178,7 +178,7 @@ pub fn read_bodies_csv(path: &Path) -> Result<Vec<BodyRecord>, BodiesFileError> 
     if crate::io::ss::is_ss(path) {
         return read_ss_bodies(path).map(|(_, records, _)| records);
     }
-    let file = File::open(path).map_err(|e| BodiesFileError::Read(e.to_string()))?;
+    let file = crate::io::scene_file::open_bounded(path).map_err(|e| BodiesFileError::Read(e.to_string()))?;
     read_bodies(file)
 }
 
@@ -234,6 +234,15 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
             message: one_line_csv(&e),
         })?;
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
+        if out.len() >= crate::io::scene_file::MAX_BODIES {
+            return Err(BodiesFileError::Format {
+                line,
+                message: format!(
+                    "more than {} bodies (MAX_BODIES, the most a scene may hold)",
+                    crate::io::scene_file::MAX_BODIES
+                ),
+            });
+        }
         let mut v = [0.0; 17];
         for (k, &pos) in index.iter().enumerate() {
             let s = rec.get(pos).unwrap_or("");

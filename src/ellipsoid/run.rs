@@ -18,7 +18,7 @@ use serde::{Deserialize, Serialize};
 use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
 use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
-use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem};
+use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem, Physics};
 use crate::ellipsoid::output::{TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
@@ -28,6 +28,7 @@ use crate::engine::{
     SnapshotView,
 };
 use crate::integrate::{Integrator, IntegratorState, Method, OdeSystem, Tolerances, make_integrator};
+use crate::io::scene_file::SceneError;
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
 
@@ -181,6 +182,84 @@ fn diagnostics_finite(d: &Diagnostics) -> bool {
         && d.angular_momentum.iter().all(|x| x.is_finite())
 }
 
+/// Refuses a scene whose state at t = 0 has a non-finite energy, momentum or right-hand side although every field
+/// passed validation (the terms combine bodies: a pair's force can overflow where each body alone is fine), as a
+/// scene error naming the term's parameter: each term on its own is evaluated in a system of its own (so the run's
+/// system and its caches are untouched), and the first whose energy or rates are not finite is named
+/// (`physics.gravity.G`, `model.kappa` or `model.calibrate`, `physics.dissipation.F0`, `physics.flyby`), with the
+/// first body whose rates are not finite.
+fn check_initial_state(scene: &LoadedScene, initial: &Diagnostics, y: &[f64]) -> Result<(), EngineError> {
+    let rates_finite = |system: &EllipsoidSystem| {
+        let mut dy = vec![0.0; y.len()];
+        system.rhs(0.0, y, &mut dy);
+        dy.iter()
+            .position(|x| !x.is_finite())
+            .map(|k| k / (y.len() / system.n_bodies().max(1)).max(1))
+    };
+    let whole = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics).with_tide(scene.tide);
+    let bad_body = rates_finite(&whole);
+    if diagnostics_finite(initial) && bad_body.is_none() {
+        return Ok(());
+    }
+    let p = scene.physics;
+    let none = Physics::default();
+    let kappa_field = match scene.kappa_source {
+        KappaSource::Given => "model.kappa",
+        KappaSource::Calibrated { .. } => "model.calibrate",
+    };
+    let terms = [
+        (
+            "gravity",
+            "physics.gravity.G",
+            p.gravity.is_some(),
+            Physics {
+                gravity: p.gravity,
+                ..none
+            },
+            None,
+        ),
+        (
+            "contact",
+            kappa_field,
+            p.contact.is_some(),
+            Physics {
+                contact: p.contact,
+                ..none
+            },
+            None,
+        ),
+        (
+            "dissipation",
+            "physics.dissipation.F0",
+            p.dissipation.is_some(),
+            Physics {
+                dissipation: p.dissipation,
+                ..none
+            },
+            None,
+        ),
+        ("flyby tide", "physics.flyby", scene.tide.is_some(), none, scene.tide),
+    ];
+    let (term, field, body, energy) = terms
+        .iter()
+        .filter(|t| t.2)
+        .find_map(|(term, field, _, physics, tide)| {
+            let system = EllipsoidSystem::new(&scene.bodies, scene.model, *physics).with_tide(*tide);
+            let d = system.diagnostics_at(0.0, y);
+            let body = rates_finite(&system);
+            (!diagnostics_finite(&d) || body.is_some()).then_some((*term, *field, body, d.energy()))
+        })
+        .unwrap_or(("combined", "physics", bad_body, initial.energy()));
+    let at = body.map_or(String::new(), |k| format!(", first non-finite rate on body[{k}]"));
+    Err(EngineError::Scene(SceneError::Invalid {
+        file: scene.name.clone(),
+        field: field.to_string(),
+        message: format!(
+            "gives a non-finite energy or force at t = 0 with these bodies ({term} term: energy {energy:e} J{at}); the bodies' masses, sizes and separations overflow it"
+        ),
+    }))
+}
+
 /// What went wrong with a sampled state, if anything.
 fn check_state(t: f64, d: &Diagnostics, projected: bool) -> Option<String> {
     if !diagnostics_finite(d) {
@@ -269,12 +348,23 @@ impl EllipsoidEngine {
     pub fn new(scene: LoadedScene) -> Result<Self, EngineError> {
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics).with_tide(scene.tide);
         let settings = scene.integrator;
-        let mut integrator = make_integrator(
-            settings.method,
-            Tolerances::scale_free(settings.rtol, settings.atol, &system),
-            settings.step,
-        )
-        .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
+        let tolerances = Tolerances::scale_free(settings.rtol, settings.atol, &system);
+        // atol is in user units (m, m/s, rad/s) and scaled by each body's mass and moment of inertia: a huge atol
+        // times a huge mass overflows, which is the scene's atol to name, not an integrator failure.
+        if let Some(k) = tolerances.atol.iter().position(|a| !a.is_finite()) {
+            return Err(EngineError::Scene(SceneError::Invalid {
+                file: scene.name.clone(),
+                field: "integrator.atol".into(),
+                message: format!(
+                    "times the scale of body[{}] (its mass, moment of inertia or the energy scale) is not finite, got \
+                     {:e}",
+                    k / (system.dim() / system.n_bodies().max(1)).max(1),
+                    settings.atol
+                ),
+            }));
+        }
+        let mut integrator = make_integrator(settings.method, tolerances, settings.step)
+            .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         // The error budget is the run's: rtol bounds the accumulated error, not each step's. Not with tree
         // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`;
         // Bulirsch-Stoer and Dop853 do; Dop853 controls each step's error anyway): freshly walked forces jump (by about the multipole error, 1e-4) wherever a
@@ -285,7 +375,9 @@ impl EllipsoidEngine {
             integrator.set_span(scene.t_end);
         }
         let y = system.initial_state();
-        let tracker = ErrorTracker::new(&system.diagnostics_at(0.0, &y));
+        let initial = system.diagnostics_at(0.0, &y);
+        check_initial_state(&scene, &initial, &y)?;
+        let tracker = ErrorTracker::new(&initial);
         let barrier = BarrierMonitor::new(
             BarrierSettings::for_kappa_source(&scene.kappa_source),
             scene.physics.contact.is_some(),
@@ -318,6 +410,11 @@ impl EllipsoidEngine {
     /// The scene being run.
     pub fn scene(&self) -> &LoadedScene {
         &self.scene
+    }
+
+    /// The scene's warnings ([`LoadedScene::warnings`]), printed by `rubblepile check` and before a run.
+    pub fn scene_warnings(&self) -> &[String] {
+        &self.scene.warnings
     }
 
     /// What the scene resolves to, for `rubblepile check` (κ, physics terms, integrator, outputs, bodies).

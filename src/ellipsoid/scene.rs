@@ -51,10 +51,10 @@ use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, Mod
 pub use crate::ellipsoid::tide::FlybySpec;
 use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
 use crate::integrate::Method;
+use crate::io::scene_file::{MAX_BODIES, MIN_MEANINGFUL, Validator, WORK_WARNING_STEPS, exact, fmt_list, fmt_num};
 pub use crate::io::scene_file::{
     MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
 };
-use crate::io::scene_file::{Validator, fmt_list};
 use crate::math::{Vec3, Vec4};
 
 /// Default contact cutoff (dimensionless): see [`ContactSpec::cutoff`].
@@ -235,7 +235,8 @@ pub struct DissipationSpec {
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
     /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
-    /// (adaptive Dormand–Prince) or `"rk4"` (fixed step; needs `step`). Default `"bulirsch-stoer"`.
+    /// (adaptive Dormand–Prince) or `"rk4"` (fixed step; needs `step`, and takes no `rtol` or `atol`). Default
+    /// `"bulirsch-stoer"`.
     #[serde(default = "default_method")]
     pub method: Method,
     /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
@@ -243,15 +244,17 @@ pub struct IntegratorSection {
     /// unit quaternion, dissipated energy relative to the initial energy scale), whatever its mass. With
     /// `"bulirsch-stoer"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
     /// quarter of it (error per unit step), so the final error follows `rtol`; the other methods apply it to each
-    /// step.
-    #[serde(default = "default_tolerance")]
-    pub rtol: f64,
-    /// Absolute tolerance (≥ 0). Default 1e-10. In the user units above: m for positions, m/s for velocities,
-    /// rad/s for spins (the integrator scales it by each body's mass and moment of inertia).
-    #[serde(default = "default_tolerance")]
-    pub atol: f64,
-    /// Step (s, > 0): the fixed step for `"rk4"` (required there), an initial step guess for the
-    /// adaptive methods (optional; by default they choose one).
+    /// step. In `[1e-15, 1)` ([`MIN_RTOL`]); only for the adaptive methods (refused with `"rk4"`, which has no
+    /// error control).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtol: Option<f64>,
+    /// Absolute tolerance (≥ 0, finite). Default 1e-10. In the user units above: m for positions, m/s for
+    /// velocities, rad/s for spins (the integrator scales it by each body's mass and moment of inertia). Only for the
+    /// adaptive methods (refused with `"rk4"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub atol: Option<f64>,
+    /// The fixed step of `"rk4"` (s, required there, ≥ `t_end × 1e-12` and ≥ 1e-300). Refused with the adaptive
+    /// methods, which choose their own steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub step: Option<f64>,
     /// Whether to pull the attitudes back onto `|q| = 1` at every output sample (`true`/`false`; see
@@ -276,8 +279,8 @@ impl Default for IntegratorSection {
     fn default() -> Self {
         IntegratorSection {
             method: default_method(),
-            rtol: default_tolerance(),
-            atol: default_tolerance(),
+            rtol: None,
+            atol: None,
             step: None,
             project_attitudes: None,
         }
@@ -310,32 +313,36 @@ pub struct OutputSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
-    /// Semi-axes `[A, B, C]` (m) along the body x, y, z axes, with `A ≥ B ≥ C > 0`. Required.
+    /// Semi-axes `[A, B, C]` (m) along the body x, y, z axes, with `A ≥ B ≥ C ≥ 1e-300` (exactly three). Required.
+    #[serde(deserialize_with = "exact::array")]
     pub axes: [f64; 3],
-    /// Mass (kg, > 0). Give exactly one of `mass` and `density`.
+    /// Mass (kg, finite, ≥ 1e-300). Give exactly one of `mass` and `density`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mass: Option<f64>,
-    /// Bulk density (kg/m³, > 0); then `mass = density · 4/3 π A B C`. Give exactly one of `mass`
-    /// and `density`.
+    /// Bulk density (kg/m³, finite, ≥ 1e-300); then `mass = density · 4/3 π A B C` (which must be finite and
+    /// ≥ 1e-300 too). Give exactly one of `mass` and `density`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub density: Option<f64>,
-    /// Centre-of-mass position `[x, y, z]` (m), world frame. Required.
+    /// Centre-of-mass position `[x, y, z]` (m, finite), world frame. Required. No two bodies' centres may lie
+    /// closer than [`MIN_CENTRE_SEPARATION`] times the smaller of their smallest semi-axes.
+    #[serde(deserialize_with = "exact::array")]
     pub position: [f64; 3],
-    /// Centre-of-mass velocity `[vx, vy, vz]` (m/s), world frame. Default `[0, 0, 0]`.
-    #[serde(default)]
+    /// Centre-of-mass velocity `[vx, vy, vz]` (m/s, finite, with a finite kinetic energy and momentum), world frame.
+    /// Default `[0, 0, 0]`.
+    #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
     /// Attitude quaternion `[α, β, γ, δ]` (vector part first, scalar last; Roig03 Eq. 19), whose
     /// rotation matrix R(q) (Eq. 21) maps world to body coordinates. Must have unit norm within 1e-6;
     /// it is then normalised. Default `[0, 0, 0, 1]` (body axes = world axes).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub quaternion: Option<[f64; 4]>,
-    /// Spin `[ω1, ω2, ω3]` (rad/s) about the body's principal axes (A, B, C). At most one of
-    /// `spin_body` and `spin_world`; default no spin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Spin `[ω1, ω2, ω3]` (rad/s, finite, with a finite rotational energy) about the body's principal axes
+    /// (A, B, C). At most one of `spin_body` and `spin_world`; default no spin.
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub spin_body: Option<[f64; 3]>,
     /// Spin `[ωx, ωy, ωz]` (rad/s) in the world frame; converted with `spin_body = R(q) · spin_world`.
     /// At most one of `spin_body` and `spin_world`; default no spin.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub spin_world: Option<[f64; 3]>,
 }
 
@@ -420,6 +427,10 @@ pub struct LoadedScene {
     pub integrator: IntegratorSettings,
     /// Output settings.
     pub output: OutputSettings,
+    /// Warnings about the scene, one line each naming the file (printed by `rubblepile check` and at the start of
+    /// `rubblepile run` as `warning: …`): the work estimate, when the scene's fastest time scale implies more than
+    /// [`WORK_WARNING_STEPS`] integrator steps.
+    pub warnings: Vec<String>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -469,6 +480,36 @@ struct RawBody {
     spin_world: Option<[f64; 3]>,
 }
 
+/// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
+/// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
+/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
+pub const MAX_KAPPA: f64 = 175.0;
+
+/// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
+/// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
+/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
+/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
+pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
+
+/// Integrator steps assumed per fastest time scale of a scene, for its work estimate (see [`LoadedScene::warnings`]):
+/// an adaptive step resolves a spin turn or a contact in a few to a few tens of steps.
+pub const STEPS_PER_TIME_SCALE: f64 = 10.0;
+
+/// `|v|` without overflowing the squares of large components (`[1e200, 0, 0]` has the norm 1e200, not infinity).
+fn robust_norm(v: &Vec3) -> f64 {
+    let m = v.amax();
+    if m > 0.0 && m.is_finite() {
+        m * (v / m).norm()
+    } else {
+        m
+    }
+}
+
+/// `(A B C)^{1/3}` (m) without overflowing the product of three large axes.
+fn equivalent_radius(axes: &[f64; 3]) -> f64 {
+    axes[0].cbrt() * axes[1].cbrt() * axes[2].cbrt()
+}
+
 impl Validator<'_> {
     /// Validates every section in order and builds the scene (each section's rules in its own function below).
     fn resolve(&self, text: &str, file: SceneFile, base_dir: Option<&Path>) -> Result<LoadedScene, SceneError> {
@@ -477,12 +518,17 @@ impl Validator<'_> {
         let physics = self.physics_section(&file.physics)?;
         let g = physics.gravity.map_or(SI_G, |g| g.g);
         let tide = file.physics.flyby.map(|f| resolve_flyby(self, &f, g)).transpose()?;
-        let integrator = self.integrator_section(&file.integrator)?;
+        let integrator = self.integrator_section(&file.integrator, t_end)?;
         let output = self.output_section(&file.output, t_end)?;
         let bodies = self.bodies_section(&file, base_dir)?;
         self.track_section(&output.track, bodies.len())?;
-        self.initial_state_finite(&bodies)?;
         let (model, kappa_source) = self.kappa_section(&file.model, &bodies, &physics)?;
+        self.separated(&bodies)?;
+        self.contact_amplitudes(&bodies, &model, &kappa_source, &physics)?;
+        let warnings = self
+            .work_estimate(&bodies, &model, &physics, t_end)
+            .into_iter()
+            .collect();
         Ok(LoadedScene {
             name: self.file.to_string(),
             source: text.to_string(),
@@ -497,6 +543,7 @@ impl Validator<'_> {
             tide,
             integrator,
             output,
+            warnings,
         })
     }
 
@@ -516,8 +563,8 @@ impl Validator<'_> {
         Ok(t_end)
     }
 
-    /// `[model]`: exactly one of `kappa` (> 1.5) or `calibrate` (β, v > 0); κ itself is computed after the bodies
-    /// ([`Validator::kappa_section`]), since calibration needs them.
+    /// `[model]`: exactly one of `kappa` (in (1.5, [`MAX_KAPPA`]]) or `calibrate` (β, v > 0); κ itself is computed
+    /// after the bodies ([`Validator::kappa_section`]), since calibration needs them.
     fn model_section(&self, m: &ModelSection) -> Result<(), SceneError> {
         match (m.kappa, m.calibrate) {
             (Some(_), Some(_)) => {
@@ -526,17 +573,31 @@ impl Validator<'_> {
             (None, None) => {
                 return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got neither"));
             }
-            (Some(k), None) => {
-                if !(k.is_finite() && k > 1.5) {
-                    return Err(self.invalid("model.kappa", format!("must be > 1.5 and finite, got {k}")));
-                }
-            }
+            (Some(k), None) => self.kappa_value("model.kappa", k)?,
             (None, Some(c)) => {
                 self.positive("model.calibrate.beta", c.beta)?;
                 self.positive("model.calibrate.v", c.v)?;
             }
         }
 
+        Ok(())
+    }
+
+    /// κ in (1.5, [`MAX_KAPPA`]].
+    fn kappa_value(&self, field: &str, k: f64) -> Result<(), SceneError> {
+        if !(k.is_finite() && k > 1.5) {
+            return Err(self.invalid(field, format!("must be > 1.5 and finite, got {k}")));
+        }
+        if k > MAX_KAPPA {
+            return Err(self.invalid(
+                field,
+                format!(
+                    "must be at most {MAX_KAPPA} (MAX_KAPPA: the contact amplitude holds e^(2 kappa), which overflows \
+                     beyond it), got {}",
+                    fmt_num(k)
+                ),
+            ));
+        }
         Ok(())
     }
 
@@ -564,7 +625,16 @@ impl Validator<'_> {
             Some(c) => {
                 let cutoff = c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF);
                 if !(cutoff.is_finite() && cutoff > 0.0 && cutoff < 1.0) {
-                    return Err(self.invalid("physics.contact.cutoff", format!("must be in (0, 1), got {cutoff}")));
+                    return Err(self.invalid(
+                        "physics.contact.cutoff",
+                        format!("must be in (0, 1), got {}", fmt_num(cutoff)),
+                    ));
+                }
+                if cutoff < MIN_MEANINGFUL {
+                    return Err(self.invalid(
+                        "physics.contact.cutoff",
+                        format!("is below the smallest meaningful value ({MIN_MEANINGFUL:e}), got {cutoff:e}"),
+                    ));
                 }
                 Some(ContactTerm { cutoff })
             }
@@ -583,9 +653,10 @@ impl Validator<'_> {
         })
     }
 
-    /// `[integrator]`: method, tolerances (`rtol` in [[`MIN_RTOL`], 1), `atol` finite and ≥ 0), fixed step.
-    fn integrator_section(&self, i: &IntegratorSection) -> Result<IntegratorSettings, SceneError> {
-        let rtol = i.rtol;
+    /// `[integrator]`: method, tolerances (`rtol` in [[`MIN_RTOL`], 1), `atol` finite and ≥ 0; adaptive methods
+    /// only), the fixed step of `"rk4"` (≥ `t_end ×` [`crate::io::scene_file::MIN_STEP_FRACTION`]; `"rk4"` only).
+    fn integrator_section(&self, i: &IntegratorSection, t_end: f64) -> Result<IntegratorSettings, SceneError> {
+        let rtol = i.rtol.unwrap_or_else(default_tolerance);
         if !(rtol.is_finite() && (MIN_RTOL..1.0).contains(&rtol)) {
             return Err(self.invalid(
                 "integrator.rtol",
@@ -595,13 +666,35 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let atol = self.non_negative("integrator.atol", i.atol)?;
+        let atol = self.non_negative("integrator.atol", i.atol.unwrap_or_else(default_tolerance))?;
         let step = match i.step {
-            Some(h) => Some(self.positive("integrator.step", h)?),
+            Some(h) => Some(self.step("integrator.step", h, t_end)?),
             None => None,
         };
-        if i.method == Method::Rk4 && step.is_none() {
-            return Err(self.invalid("integrator.step", "method \"rk4\" needs a fixed step: step = <s> (> 0)"));
+        if i.method == Method::Rk4 {
+            if step.is_none() {
+                return Err(self.invalid("integrator.step", "method \"rk4\" needs a fixed step: step = <s> (> 0)"));
+            }
+            for (field, given) in [("integrator.rtol", i.rtol), ("integrator.atol", i.atol)] {
+                if let Some(x) = given {
+                    return Err(self.invalid(
+                        field,
+                        format!(
+                            "not used by method \"rk4\" (a fixed step has no error control; give `step` only), got {}",
+                            fmt_num(x)
+                        ),
+                    ));
+                }
+            }
+        } else if let Some(h) = step {
+            return Err(self.invalid(
+                "integrator.step",
+                format!(
+                    "not used by method \"{}\" (an adaptive method chooses its own steps; `step` is the fixed step of \
+                     \"rk4\"): remove it, got {h}",
+                    i.method
+                ),
+            ));
         }
         Ok(IntegratorSettings {
             method: i.method,
@@ -614,32 +707,10 @@ impl Validator<'_> {
 
     /// `[output]`: time-series cadence `every` (s), snapshot times (s) in [0, t_end], tracked body ids.
     fn output_section(&self, o: &OutputSection, t_end: f64) -> Result<OutputSettings, SceneError> {
-        let every = self.positive("output.every", o.every)?;
-        if t_end / every > MAX_TIMESERIES_ROWS {
-            return Err(self.invalid(
-                "output.every",
-                format!(
-                    "too small for t_end = {t_end}: would write {:e} rows (at most 1e8), got {every}",
-                    t_end / every
-                ),
-            ));
-        }
+        let every = self.cadence("output.every", o.every, t_end)?;
         let times = match &o.times {
             Some(times) => {
-                for (k, &t) in times.iter().enumerate() {
-                    if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
-                        return Err(self.invalid(
-                            format!("output.times[{k}]"),
-                            format!("must be in [0, t_end = {t_end}], got {t}"),
-                        ));
-                    }
-                    if k > 0 && t <= times[k - 1] {
-                        return Err(self.invalid(
-                            "output.times",
-                            format!("must be strictly increasing, got {} then {t}", times[k - 1]),
-                        ));
-                    }
-                }
+                self.snapshot_times(times, t_end)?;
                 times.clone()
             }
             None => vec![0.0, t_end],
@@ -649,7 +720,8 @@ impl Validator<'_> {
         Ok(OutputSettings { times, every, track })
     }
 
-    /// The bodies: `[[body]]` tables or `scene.bodies_file`, each validated ([`Validator::body`]).
+    /// The bodies: `[[body]]` tables or `scene.bodies_file` (at most [`MAX_BODIES`]), each validated
+    /// ([`Validator::body`]).
     fn bodies_section(&self, file: &SceneFile, base_dir: Option<&Path>) -> Result<Vec<Body>, SceneError> {
         let raw = match (&file.scene.bodies_file, file.bodies.is_empty()) {
             (Some(_), false) => {
@@ -661,23 +733,25 @@ impl Validator<'_> {
             (None, true) => {
                 return Err(self.invalid("body", "no bodies: give [[body]] tables or scene.bodies_file"));
             }
-            (None, false) => file
-                .bodies
-                .iter()
-                .enumerate()
-                .map(|(k, b)| RawBody {
-                    label: format!("body[{k}]"),
-                    axes: b.axes,
-                    mass: b.mass,
-                    density: b.density,
-                    position: b.position,
-                    velocity: b.velocity,
-                    quaternion: b.quaternion,
-                    normalise_quaternion: true,
-                    spin_body: b.spin_body,
-                    spin_world: b.spin_world,
-                })
-                .collect::<Vec<_>>(),
+            (None, false) => {
+                self.count("body", file.bodies.len(), MAX_BODIES, "bodies (MAX_BODIES)")?;
+                file.bodies
+                    .iter()
+                    .enumerate()
+                    .map(|(k, b)| RawBody {
+                        label: format!("body[{k}]"),
+                        axes: b.axes,
+                        mass: b.mass,
+                        density: b.density,
+                        position: b.position,
+                        velocity: b.velocity,
+                        quaternion: b.quaternion,
+                        normalise_quaternion: true,
+                        spin_body: b.spin_body,
+                        spin_world: b.spin_world,
+                    })
+                    .collect::<Vec<_>>()
+            }
             (Some(rel), true) => self.read_bodies_file(rel, base_dir)?,
         };
         raw.iter().map(|b| self.body(b)).collect()
@@ -699,40 +773,6 @@ impl Validator<'_> {
                 return Err(self.invalid(
                     format!("output.track[{k}]"),
                     format!("body {id} is listed twice; give each body at most once"),
-                ));
-            }
-        }
-        Ok(())
-    }
-
-    /// Refuses a state whose energy or momentum is not finite at t = 0 (finite inputs can still overflow, e.g. a
-    /// velocity of 1e300 m/s gives an infinite kinetic energy), naming the body and the field.
-    fn initial_state_finite(&self, bodies: &[Body]) -> Result<(), SceneError> {
-        for (k, b) in bodies.iter().enumerate() {
-            let m = b.shape.mass;
-            let v2 = b.velocity.norm_squared();
-            if !(0.5 * m * v2).is_finite() || !(m * b.velocity.norm()).is_finite() {
-                return Err(self.invalid(
-                    format!("body[{k}].velocity"),
-                    format!(
-                        "gives a non-finite kinetic energy or momentum at t = 0 (mass {m:e} kg, |v| = {:e} m/s)",
-                        b.velocity.norm()
-                    ),
-                ));
-            }
-            let l = m * b.position.norm() * b.velocity.norm();
-            if !l.is_finite() {
-                return Err(self.invalid(
-                    format!("body[{k}].position"),
-                    "gives a non-finite angular momentum at t = 0 (|r| |m v| overflows)",
-                ));
-            }
-            let a2 = b.shape.axes.norm_squared();
-            let spin_energy = 0.5 * m * a2 * b.spin_body.norm_squared();
-            if !spin_energy.is_finite() {
-                return Err(self.invalid(
-                    format!("body[{k}].spin"),
-                    "gives a non-finite rotational energy at t = 0",
                 ));
             }
         }
@@ -774,6 +814,15 @@ impl Validator<'_> {
                 if !(k.is_finite() && k > 1.5) {
                     return Err(self.invalid("model.calibrate", format!("calibration gave kappa = {k}, need > 1.5")));
                 }
+                if k > MAX_KAPPA {
+                    return Err(self.invalid(
+                        "model.calibrate",
+                        format!(
+                            "calibration gave kappa = {k}, more than {MAX_KAPPA} (MAX_KAPPA: the contact amplitude \
+                             holds e^(2 kappa), which overflows beyond it); lower beta or v"
+                        ),
+                    ));
+                }
                 (
                     k,
                     KappaSource::Calibrated {
@@ -793,6 +842,160 @@ impl Validator<'_> {
             },
             kappa_source,
         ))
+    }
+
+    /// Refuses two bodies whose centres lie closer than [`MIN_CENTRE_SEPARATION`] times the smaller of their
+    /// smallest semi-axes (coincident or deeply overlapping at t = 0), naming both.
+    fn separated(&self, bodies: &[Body]) -> Result<(), SceneError> {
+        let centres: Vec<Vec3> = bodies.iter().map(|b| b.position).collect();
+        // Pairs closer than the mean of the two reaches contain every pair closer than the smaller one.
+        let reach: Vec<f64> = bodies
+            .iter()
+            .map(|b| 0.5 * MIN_CENTRE_SEPARATION * b.shape.axes.z)
+            .collect();
+        for (i, j) in crate::geometry::neighbours::sphere_pairs(&centres, &reach) {
+            let c = bodies[i].shape.axes.z.min(bodies[j].shape.axes.z);
+            let d = (centres[j] - centres[i]).norm();
+            if d < MIN_CENTRE_SEPARATION * c {
+                return Err(self.invalid(
+                    format!("body[{j}].position"),
+                    format!(
+                        "coincides with body[{i}] at t = 0: their centres are {d:e} m apart, less than \
+                         {MIN_CENTRE_SEPARATION} x the smaller smallest semi-axis ({c:e} m); bodies this deep inside \
+                         one another have a near-singular gravity and contact energy"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// With the contact or dissipation term on: every body's contact energy at full overlap with a copy of itself,
+    /// `U0 m² (κ/π)^{3/2} / √det(2Σ)` (Roig03 Eqs. 10–11), must be finite, and so must `F0` times it (the
+    /// dissipation, Eq. 41). A failure names the input that contributes most to the overflow: `G`, κ, the mass or
+    /// the axes (small axes make the Gaussian sharp), or `F0`.
+    fn contact_amplitudes(
+        &self,
+        bodies: &[Body],
+        model: &ModelConfig,
+        kappa_source: &KappaSource,
+        physics: &Physics,
+    ) -> Result<(), SceneError> {
+        if physics.contact.is_none() && physics.dissipation.is_none() {
+            return Ok(());
+        }
+        let ln_max = f64::MAX.ln();
+        let g = model.contact_g;
+        let kappa = model.kappa;
+        for (k, b) in bodies.iter().enumerate() {
+            let [a, bb, c] = [b.shape.axes.x, b.shape.axes.y, b.shape.axes.z];
+            let m = b.shape.mass;
+            // ln of U_full = ½ G (2R)² e^{2κ} / (2κ · 2^{3/2}) m² / (2√2 A B C), R = (ABC)^{1/3}, in its parts.
+            let parts = [
+                ("G", (0.5 * g).ln()),
+                ("kappa", 2.0 * kappa - (2.0 * kappa).ln() - 3.0 * std::f64::consts::LN_2),
+                ("mass", 2.0 * m.ln()),
+                ("axes", 2.0 * std::f64::consts::LN_2 - (a.ln() + bb.ln() + c.ln()) / 3.0),
+            ];
+            let ln_u: f64 = parts.iter().map(|p| p.1).sum();
+            if ln_u.is_nan() || ln_u >= ln_max {
+                let worst = parts.iter().max_by(|x, y| x.1.total_cmp(&y.1)).map_or("mass", |p| p.0);
+                let field = match worst {
+                    "G" => "physics.gravity.G".to_string(),
+                    "kappa" if *kappa_source == KappaSource::Given => "model.kappa".to_string(),
+                    "kappa" => "model.calibrate".to_string(),
+                    "axes" => format!("body[{k}].axes"),
+                    _ => format!("body[{k}].mass"),
+                };
+                return Err(self.invalid(
+                    field,
+                    format!(
+                        "gives body[{k}] a non-finite contact energy at full overlap (U0 m^2 (kappa/pi)^(3/2) / \
+                         sqrt(det 2 Sigma) = e^{ln_u:.1} J with G = {g:e}, kappa = {kappa}, mass {m:e} kg, axes {} m)",
+                        fmt_list(&[a, bb, c])
+                    ),
+                ));
+            }
+            if let Some(d) = physics.dissipation
+                && d.f0 > 0.0
+                && d.f0.ln() + ln_u >= ln_max
+            {
+                return Err(self.invalid(
+                    "physics.dissipation.F0",
+                    format!(
+                        "times the contact energy of body[{k}] at full overlap (e^{ln_u:.1} J) overflows: the \
+                         dissipation F0 U_C v^2 would be infinite, got {:e}",
+                        d.f0
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The scene's work estimate: [`STEPS_PER_TIME_SCALE`] steps per fastest time scale over `t_end`. The time
+    /// scales of each body: its spin period `2π/|ω|`; with contact between several bodies, the contact time
+    /// `2π √(R C² / (G m κ))` of two copies of it touching along their smallest semi-axis C (R its equivalent
+    /// radius) and the time `C / |v − v_cm|` to cross C; with dissipation, the damping time `4κR / (F0 G m)` at
+    /// contact. A warning (one line, naming the scale and its body) when the estimate exceeds
+    /// [`WORK_WARNING_STEPS`].
+    fn work_estimate(&self, bodies: &[Body], model: &ModelConfig, physics: &Physics, t_end: f64) -> Option<String> {
+        let several = bodies.len() > 1;
+        let total_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+        let v_cm: Vec3 = bodies.iter().map(|b| b.velocity * (b.shape.mass / total_mass)).sum();
+        let g = model.contact_g;
+        let kappa = model.kappa;
+        let mut fastest: Option<(f64, String)> = None;
+        let mut consider = |tau: f64, what: String| {
+            if tau.is_finite() && tau > 0.0 && fastest.as_ref().is_none_or(|f| tau < f.0) {
+                fastest = Some((tau, what));
+            }
+        };
+        for (k, b) in bodies.iter().enumerate() {
+            let w = b.spin_body.norm();
+            if w > 0.0 {
+                consider(
+                    std::f64::consts::TAU / w,
+                    format!("the spin period of body[{k}] (|w| = {w:e} rad/s)"),
+                );
+            }
+            if !several {
+                continue;
+            }
+            let c = b.shape.axes.z;
+            let m = b.shape.mass;
+            let r = equivalent_radius(&[b.shape.axes.x, b.shape.axes.y, c]);
+            if physics.contact.is_some() {
+                consider(
+                    std::f64::consts::TAU * (r * c * c / (g * m * kappa)).sqrt(),
+                    format!("the contact time of body[{k}] (smallest semi-axis {c:e} m, mass {m:e} kg, kappa {kappa})"),
+                );
+                let v = (b.velocity - v_cm).norm();
+                if v > 0.0 {
+                    consider(
+                        c / v,
+                        format!("the time body[{k}] takes to cross its smallest semi-axis ({c:e} m at {v:e} m/s)"),
+                    );
+                }
+            }
+            if let Some(d) = physics.dissipation
+                && d.f0 > 0.0
+            {
+                consider(
+                    4.0 * kappa * r / (d.f0 * g * m),
+                    format!("the damping time of body[{k}] in contact (F0 = {:e})", d.f0),
+                );
+            }
+        }
+        let (tau, what) = fastest?;
+        let steps = STEPS_PER_TIME_SCALE * t_end / tau;
+        (steps > WORK_WARNING_STEPS).then(|| {
+            format!(
+                "{}: the fastest time scale is {what}: {tau:.2e} s, so about {steps:.1e} integrator steps to t_end = \
+                 {t_end} s (more than {WORK_WARNING_STEPS:e}); the run may not end in useful time",
+                self.file
+            )
+        })
     }
 
     fn read_bodies_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<RawBody>, SceneError> {
@@ -834,6 +1037,9 @@ impl Validator<'_> {
             .collect())
     }
 
+    /// One body: every field finite and meaningful, and every quantity derived from it (volume, mass from density,
+    /// the bounds of its moments of inertia over κ in (1.5, [`MAX_KAPPA`]], its kinetic and rotational energies,
+    /// momentum and angular momentum) finite, each failure naming the field whose value caused it.
     fn body(&self, b: &RawBody) -> Result<Body, SceneError> {
         let f = |name: &str| format!("{}.{name}", b.label);
         let axes_field = f("axes");
@@ -842,14 +1048,36 @@ impl Validator<'_> {
         if !(a >= bb && bb >= c && c > 0.0) {
             return Err(self.invalid(axes_field, format!("need A >= B >= C > 0, got {}", fmt_list(&b.axes))));
         }
-        let volume = 4.0 / 3.0 * std::f64::consts::PI * a * bb * c;
+        if c < MIN_MEANINGFUL {
+            return Err(self.invalid(
+                axes_field,
+                format!(
+                    "C is below the smallest meaningful value ({MIN_MEANINGFUL:e}), got {}",
+                    fmt_list(&b.axes)
+                ),
+            ));
+        }
         let mass = match (b.mass, b.density) {
             (Some(m), None) => self.positive(&f("mass"), m)?,
             (None, Some(rho)) => {
                 let rho = self.positive(&f("density"), rho)?;
+                let volume = 4.0 / 3.0 * std::f64::consts::PI * a * bb * c;
+                if !(volume.is_finite() && volume >= MIN_MEANINGFUL) {
+                    return Err(self.invalid(
+                        axes_field,
+                        format!(
+                            "give a volume 4/3 pi A B C = {volume:e} m^3 outside [{MIN_MEANINGFUL:e}, finite] (needed \
+                             for the mass from the density), got {}",
+                            fmt_list(&b.axes)
+                        ),
+                    ));
+                }
                 let m = rho * volume;
-                if !(m.is_finite() && m > 0.0) {
-                    return Err(self.invalid(f("density"), format!("gives a mass of {m} kg, need > 0 and finite")));
+                if !(m.is_finite() && m >= MIN_MEANINGFUL) {
+                    return Err(self.invalid(
+                        f("density"),
+                        format!("gives a mass of {m:e} kg, need finite and >= {MIN_MEANINGFUL:e}"),
+                    ));
                 }
                 m
             }
@@ -860,6 +1088,39 @@ impl Validator<'_> {
                 return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got neither"));
             }
         };
+        // Moments of inertia m/(2κ) (B²+C², C²+A², A²+B²) (Roig03 Eq. 4): the smallest is at least
+        // m (B²+C²)/(2 MAX_KAPPA), the largest at most m (A²+B²)/3. Both must be normal numbers: the equations of
+        // motion divide by them.
+        let (small_sq, large_sq) = (bb * bb + c * c, a * a + bb * bb);
+        let (i_min, i_max) = (mass * small_sq / (2.0 * MAX_KAPPA), mass * large_sq / 3.0);
+        if !i_max.is_finite() {
+            return Err(self.invalid(
+                if large_sq.is_finite() {
+                    f("mass")
+                } else {
+                    axes_field.clone()
+                },
+                format!(
+                    "gives a moment of inertia m (A^2 + B^2)/(2 kappa) of up to {i_max:e} kg m^2, not finite (mass \
+                     {mass:e} kg, axes {})",
+                    fmt_list(&b.axes)
+                ),
+            ));
+        }
+        if i_min.is_nan() || i_min < f64::MIN_POSITIVE {
+            return Err(self.invalid(
+                if small_sq >= f64::MIN_POSITIVE {
+                    f("mass")
+                } else {
+                    axes_field.clone()
+                },
+                format!(
+                    "gives a moment of inertia m (B^2 + C^2)/(2 kappa) as small as {i_min:e} kg m^2, which underflows \
+                     (mass {mass:e} kg, axes {})",
+                    fmt_list(&b.axes)
+                ),
+            ));
+        }
         self.finite_vec(&f("position"), &b.position)?;
         self.finite_vec(&f("velocity"), &b.velocity)?;
 
@@ -880,7 +1141,7 @@ impl Validator<'_> {
             None => Vec4::new(0.0, 0.0, 0.0, 1.0),
         };
 
-        let spin_body = match (b.spin_body, b.spin_world) {
+        let (spin_body, spin_field) = match (b.spin_body, b.spin_world) {
             (Some(_), Some(_)) => {
                 return Err(self.invalid(
                     b.label.clone(),
@@ -889,22 +1150,51 @@ impl Validator<'_> {
             }
             (Some(w), None) => {
                 self.finite_vec(&f("spin_body"), &w)?;
-                Vec3::new(w[0], w[1], w[2])
+                (Vec3::new(w[0], w[1], w[2]), f("spin_body"))
             }
             (None, Some(w)) => {
                 self.finite_vec(&f("spin_world"), &w)?;
-                world_to_body(&q, &Vec3::new(w[0], w[1], w[2]))
+                (world_to_body(&q, &Vec3::new(w[0], w[1], w[2])), f("spin_world"))
             }
-            (None, None) => Vec3::zeros(),
+            (None, None) => (Vec3::zeros(), f("spin_body")),
         };
+
+        // Energies and momenta at t = 0 (finite inputs can still overflow: 1e300 m/s gives an infinite energy).
+        let position = Vec3::new(b.position[0], b.position[1], b.position[2]);
+        let velocity = Vec3::new(b.velocity[0], b.velocity[1], b.velocity[2]);
+        let speed = robust_norm(&velocity);
+        if !(0.5 * mass * speed * speed).is_finite() || !(mass * speed).is_finite() {
+            return Err(self.invalid(
+                f("velocity"),
+                format!(
+                    "gives a non-finite kinetic energy or momentum at t = 0 (mass {mass:e} kg, |v| = {speed:e} m/s)"
+                ),
+            ));
+        }
+        if !(mass * position.norm() * speed).is_finite() {
+            return Err(self.invalid(
+                f("position"),
+                "gives a non-finite angular momentum at t = 0 (|r| |m v| overflows)",
+            ));
+        }
+        let w = robust_norm(&spin_body);
+        if !(0.5 * i_max * w * w).is_finite() || !(i_max * w).is_finite() {
+            return Err(self.invalid(
+                spin_field,
+                format!(
+                    "gives a non-finite rotational energy or spin angular momentum at t = 0 (|w| = {w:.3e} rad/s, \
+                     moments of inertia up to {i_max:.3e} kg m^2)"
+                ),
+            ));
+        }
 
         Ok(Body {
             shape: Ellipsoid {
                 axes: Vec3::new(a, bb, c),
                 mass,
             },
-            position: Vec3::new(b.position[0], b.position[1], b.position[2]),
-            velocity: Vec3::new(b.velocity[0], b.velocity[1], b.velocity[2]),
+            position,
+            velocity,
             quaternion: q,
             spin_body,
         })

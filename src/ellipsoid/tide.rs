@@ -69,7 +69,7 @@ pub struct FlybySpec {
     /// inclination and argument of perigee, perifocal → frame `R_z(Ω) R_x(i) R_z(ω)`. Default `[0, 0, 0]`: the orbit
     /// in the x–y plane, anticlockwise about +z, the origin at `+q x̂` from the planet at perigee (the planet at
     /// `−q x̂` in the frame).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::io::scene_file::exact::array")]
     pub orientation_deg: [f64; 3],
     /// The planet's second zonal harmonic J2 (dimensionless, finite; Earth 1.0826e-3 with its equatorial radius
     /// 6378.137 km). Optional, default none (a point mass); needs `radius`, the reference radius of J2.
@@ -77,7 +77,11 @@ pub struct FlybySpec {
     pub j2: Option<f64>,
     /// The planet's spin axis (frame coordinates, any non-zero length; normalised), used with `j2`. Default
     /// `[0, 0, 1]`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        deserialize_with = "crate::io::scene_file::exact::option",
+        skip_serializing_if = "Option::is_none"
+    )]
     pub pole: Option<[f64; 3]>,
 }
 

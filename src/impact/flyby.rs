@@ -84,7 +84,7 @@ pub struct FlybyArgs {
     /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run.
     #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
-    /// Number of snapshots, evenly spaced from start to end (≥ 2).
+    /// Number of snapshots, evenly spaced from start to end (2 to 100000).
     #[arg(long, default_value_t = 9)]
     pub snapshots: usize,
     /// Output directory.
@@ -237,8 +237,12 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
             ),
         ));
     }
-    if args.snapshots < 2 {
-        return Err(invalid("snapshots", format!("need at least 2, got {}", args.snapshots)));
+    let max_snapshots = crate::io::scene_file::MAX_SNAPSHOTS;
+    if !(2..=max_snapshots).contains(&args.snapshots) {
+        return Err(invalid(
+            "snapshots",
+            format!("need 2 to {max_snapshots} (MAX_SNAPSHOTS), got {}", args.snapshots),
+        ));
     }
     let orientation = args.orientation_deg.clone().unwrap_or(vec![0.0; 3]);
     for (field, values) in [

@@ -56,10 +56,8 @@ pub fn read_particles(
     if crate::io::ss::is_ss(path) {
         return read_ss_particles(path, required, optional);
     }
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(|e| E::Read(format!("cannot read: {e}")))?;
+    let file = crate::io::scene_file::open_bounded(path).map_err(|e| E::Read(format!("cannot read: {e}")))?;
+    let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(file);
     let headers = reader
         .headers()
         .map_err(|e| E::Read(format!("bad header: {e}")))?
@@ -81,6 +79,12 @@ pub fn read_particles(
     for (k, record) in reader.records().enumerate() {
         let line = k + 2;
         let record = record.map_err(|e| E::Read(format!("line {line}: {e}")))?;
+        if rows.len() >= crate::io::scene_file::MAX_BODIES {
+            return Err(E::Read(format!(
+                "line {line}: more than {} particles (MAX_BODIES, the most a scene may hold)",
+                crate::io::scene_file::MAX_BODIES
+            )));
+        }
         let mut values = Vec::with_capacity(required.len());
         for (&i, &column) in idx.iter().zip(required) {
             let cell = record.get(i).unwrap_or("");

@@ -1,6 +1,13 @@
 //! The scene-file floor shared by every engine's scene parser: reading a scene file, TOML parsing into any schema
 //! with one-line errors that name the file, line and field ([`parse_toml_as`]), the [`SceneError`] type, the
 //! field checks of [`Validator`], and the physical constants and limits every engine's scene uses.
+//!
+//! The limits are one rule per engine-neutral concept, so the three engines agree (issue 38, "every input bounded,
+//! finite and named"): a positive size is at least [`MIN_MEANINGFUL`]; a time step or cadence at least
+//! `t_end ×` [`MIN_STEP_FRACTION`]; counts stay below [`MAX_TIMESERIES_ROWS`], [`MAX_SNAPSHOTS`], [`MAX_BODIES`],
+//! [`MAX_EVENTS_PER_STEP`] and [`MAX_THREADS`]; input files are read through [`BoundedReader`] ([`MAX_INPUT_BYTES`],
+//! [`MAX_LINE_BYTES`]); fixed-length arrays are read by [`exact`]; and a scene whose estimated work exceeds
+//! [`WORK_WARNING_STEPS`] is accepted with a warning.
 
 use std::path::{Path, PathBuf};
 
@@ -11,8 +18,64 @@ pub const SI_G: f64 = 6.674e-11;
 /// (f64 epsilon is 2.2e-16, and a Bulirsch–Stoer estimate sums many such terms).
 pub const MIN_RTOL: f64 = 1e-15;
 
-/// Most time-series rows a scene may ask for (`t_end / every`).
+/// Most time-series rows a scene may ask for (`t_end / every`): a row is ~200 bytes, so 1e8 rows are ~20 GB of
+/// `timeseries.csv`, far beyond any analysis here; a larger count is a typo (a cadence in the wrong unit).
 pub const MAX_TIMESERIES_ROWS: f64 = 1e8;
+
+/// The smallest meaningful magnitude (1e-300) of a positive physical size (a length, mass, density, time, spring
+/// constant, …). Below it the squares and products the engines form (a moment of inertia `m r²`, a volume `A B C`)
+/// underflow to zero or to subnormals that carry no precision, and a division by them gives infinities, so such a
+/// value is refused at validation rather than ending as a non-finite state that names no input. Committed scenes
+/// use sizes above 1e-12.
+pub const MIN_MEANINGFUL: f64 = 1e-300;
+
+/// Smallest time step or output cadence relative to the run's length: a step or cadence below `t_end × 1e-12`
+/// means more than 1e12 steps (or samples), years of wall-clock time at any speed this code reaches (the soft
+/// spheres advance ~1e7 particle-steps per second); it is a typo or a subnormal, never a run that ends.
+pub const MIN_STEP_FRACTION: f64 = 1e-12;
+
+/// Most snapshots a scene (or `rubblepile flyby --snapshots`) may ask for: each is a file of one row per body, so
+/// 1e5 snapshots of the smallest scene already fill a directory with 1e5 files; the committed runs write at most
+/// a few hundred.
+pub const MAX_SNAPSHOTS: usize = 100_000;
+
+/// Most bodies or particles a scene (its tables, its bodies or particles file) may hold: 1e7 bodies take a few GB
+/// of state and derivatives, beyond what one machine integrates in useful time (the largest committed pile has
+/// 1e4 ellipsoids, the largest soft-sphere runs ~1e5 spheres).
+pub const MAX_BODIES: usize = 10_000_000;
+
+/// Largest `stepping.max_events_per_step` of the hard spheres: the guard that names a stalled step is useless if
+/// it lets one step process more events than run in hours (~1e6 events per second).
+pub const MAX_EVENTS_PER_STEP: u64 = 1_000_000_000;
+
+/// Estimated steps (integrator steps of the ellipsoids, fixed steps of the spheres) above which a scene is
+/// reported with a `warning:` by `check` and at the start of `run`: at ~1e5 steps per second of the fastest
+/// scenes this is hours, and a run that crawls must not be silent. Big runs stay legitimate: it only warns.
+pub const WORK_WARNING_STEPS: f64 = 1e9;
+
+/// Largest input file read (bytes): 4 GiB, the size of a particles file of [`MAX_BODIES`] rows at ~400 bytes a
+/// row. Files are read through [`BoundedReader`], so a device like `/dev/zero` or a runaway file is refused
+/// instead of read until the allocator aborts.
+pub const MAX_INPUT_BYTES: u64 = 4 << 30;
+
+/// Longest line of a text input file (bytes): 16 MiB holds a `times = […]` list of [`MAX_SNAPSHOTS`] numbers on
+/// one line with room to spare, and a CSV row of the widest table is a few kB. A longer "line" is not a text file
+/// (e.g. `/dev/zero`, which has none), and is refused after reading 16 MiB instead of all memory.
+pub const MAX_LINE_BYTES: usize = 16 << 20;
+
+/// Most threads a command-line option may ask for (`--threads`, `--threads-per-rank`): the benches' bound.
+pub const MAX_THREADS: usize = 4096;
+
+/// Parses a thread count of the command line: a whole number in `1..=`[`MAX_THREADS`]. Zero is refused rather than
+/// passed on: rayon reads a pool of 0 threads as "all cores", which is not what was written.
+pub fn thread_count(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(n) if (1..=MAX_THREADS).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "must be a whole number of threads in 1..={MAX_THREADS}, got {s:?}"
+        )),
+    }
+}
 
 /// A bad scene. Display is always one line: `<file>: <field>: <what was expected>, got <value>`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -68,9 +131,19 @@ pub(crate) fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-/// Formats a list of numbers as `[1, 2, 3]`.
+/// Formats a number for a message: plainly in `[1e-4, 1e16)` (and 0), in scientific notation otherwise, so that
+/// `1e308` is not printed as 309 digits.
+pub(crate) fn fmt_num(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
+        format!("{x}")
+    } else {
+        format!("{x:e}")
+    }
+}
+
+/// Formats a list of numbers as `[1, 2, 3]` ([`fmt_num`] each).
 pub(crate) fn fmt_list(v: &[f64]) -> String {
-    let parts: Vec<String> = v.iter().map(|x| format!("{x}")).collect();
+    let parts: Vec<String> = v.iter().map(|&x| fmt_num(x)).collect();
     format!("[{}]", parts.join(", "))
 }
 
@@ -110,10 +183,118 @@ pub(crate) fn check_finite_motion(
     Ok(())
 }
 
+/// A reader that refuses input larger than [`MAX_INPUT_BYTES`] or with a line longer than [`MAX_LINE_BYTES`], with
+/// an [`std::io::ErrorKind::InvalidData`] error of one line (without the file name, which every caller adds).
+pub struct BoundedReader<R> {
+    inner: R,
+    /// Bytes read so far.
+    total: u64,
+    /// Bytes of the current line so far.
+    line: usize,
+    /// 1-based number of the current line.
+    line_no: u64,
+}
+
+impl<R: std::io::Read> BoundedReader<R> {
+    /// Wraps `inner`.
+    pub fn new(inner: R) -> Self {
+        BoundedReader {
+            inner,
+            total: 0,
+            line: 0,
+            line_no: 1,
+        }
+    }
+}
+
+/// An [`std::io::ErrorKind::InvalidData`] error with this one-line message.
+fn invalid_data(message: String) -> std::io::Error {
+    std::io::Error::new(std::io::ErrorKind::InvalidData, message)
+}
+
+impl<R: std::io::Read> std::io::Read for BoundedReader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.total += n as u64;
+        if self.total > MAX_INPUT_BYTES {
+            return Err(invalid_data(format!(
+                "larger than {} bytes (MAX_INPUT_BYTES, the largest input file read)",
+                MAX_INPUT_BYTES
+            )));
+        }
+        let chunk = &buf[..n];
+        match chunk.iter().rposition(|&b| b == b'\n') {
+            Some(last) => {
+                // The longest line ending in this chunk, and the line still open at its end.
+                let mut start = 0;
+                for (k, &b) in chunk.iter().enumerate() {
+                    if b == b'\n' {
+                        let len = if start == 0 { self.line + k } else { k - start };
+                        if len > MAX_LINE_BYTES {
+                            return Err(self.long_line());
+                        }
+                        self.line_no += 1;
+                        start = k + 1;
+                    }
+                }
+                self.line = n - last - 1;
+            }
+            None => self.line += n,
+        }
+        if self.line > MAX_LINE_BYTES {
+            return Err(self.long_line());
+        }
+        Ok(n)
+    }
+}
+
+impl<R> BoundedReader<R> {
+    fn long_line(&self) -> std::io::Error {
+        invalid_data(format!(
+            "line {} is longer than {} bytes (MAX_LINE_BYTES): not a text file",
+            self.line_no, MAX_LINE_BYTES
+        ))
+    }
+}
+
+/// Opens `path` for reading through a [`BoundedReader`]; a regular file larger than [`MAX_INPUT_BYTES`] is refused
+/// before reading anything.
+pub fn open_bounded(path: &Path) -> std::io::Result<BoundedReader<std::io::BufReader<std::fs::File>>> {
+    let file = std::fs::File::open(path)?;
+    let meta = file.metadata()?;
+    if meta.is_dir() {
+        return Err(std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a directory"));
+    }
+    if meta.is_file() && meta.len() > MAX_INPUT_BYTES {
+        return Err(invalid_data(format!(
+            "{} bytes, larger than {} (MAX_INPUT_BYTES, the largest input file read)",
+            meta.len(),
+            MAX_INPUT_BYTES
+        )));
+    }
+    Ok(BoundedReader::new(std::io::BufReader::new(file)))
+}
+
+/// Reads the text file at `path` through [`open_bounded`] (errors without the file name: the caller names it).
+pub fn read_text_bounded(path: &Path) -> std::io::Result<String> {
+    let mut text = String::new();
+    std::io::Read::read_to_string(&mut open_bounded(path)?, &mut text)?;
+    Ok(text)
+}
+
+/// Which factor of a product that overflows is to blame: the one of largest magnitude (its field is named). Used where
+/// a derived quantity (e.g. the potential energy `m |g| |x|`) is a product of fields.
+pub(crate) fn largest_factor<'a>(factors: &[(&'a str, f64)]) -> &'a str {
+    factors
+        .iter()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()))
+        .map_or("", |f| f.0)
+}
+
 /// Reads a scene file (a one-line [`SceneError::Read`] naming it if that fails).
 pub fn read_scene_text(path: &Path) -> Result<SceneText, SceneError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Read {
+    let text = read_text_bounded(path).map_err(|e| SceneError::Read {
         file: name.clone(),
         reason: one_line(&e.to_string()),
     })?;
@@ -261,11 +442,93 @@ impl Validator<'_> {
         }
     }
 
+    /// A positive physical size: finite, > 0 and at least [`MIN_MEANINGFUL`].
     pub(crate) fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x.is_finite() && x > 0.0 {
+        if x.is_finite() && x >= MIN_MEANINGFUL {
             Ok(x)
+        } else if x > 0.0 && x < MIN_MEANINGFUL {
+            Err(self.invalid(
+                field,
+                format!("is below the smallest meaningful value ({MIN_MEANINGFUL:e}), got {x:e}"),
+            ))
         } else {
-            Err(self.invalid(field, format!("must be > 0 and finite, got {x}")))
+            Err(self.invalid(field, format!("must be > 0 and finite, got {}", fmt_num(x))))
+        }
+    }
+
+    /// A time step or output cadence (s) of a run of length `t_end`: positive ([`Validator::positive`]) and at least
+    /// `t_end ×` [`MIN_STEP_FRACTION`] (at most 1e12 steps or samples).
+    pub(crate) fn step(&self, field: &str, x: f64, t_end: f64) -> Result<f64, SceneError> {
+        let x = self.positive(field, x)?;
+        let least = t_end * MIN_STEP_FRACTION;
+        if x < least {
+            return Err(self.invalid(
+                field,
+                format!(
+                    "must be at least t_end x {MIN_STEP_FRACTION:e} = {least:e} s (at most 1e12 steps for t_end = {t_end} s), got {x:e}"
+                ),
+            ));
+        }
+        Ok(x)
+    }
+
+    /// The time-series cadence `every` (s) of a run of length `t_end`: positive and giving at most
+    /// [`MAX_TIMESERIES_ROWS`] rows (so at least `t_end / 1e8`, stricter than a [`Validator::step`]'s `t_end × 1e-12`).
+    pub(crate) fn cadence(&self, field: &str, every: f64, t_end: f64) -> Result<f64, SceneError> {
+        let every = self.positive(field, every)?;
+        if t_end / every > MAX_TIMESERIES_ROWS {
+            return Err(self.invalid(
+                field,
+                format!(
+                    "too small for t_end = {t_end}: would write {:e} rows (at most {MAX_TIMESERIES_ROWS:e}), got {every}",
+                    t_end / every
+                ),
+            ));
+        }
+        Ok(every)
+    }
+
+    /// A count (snapshots, bodies, …) of at most `max`: `what` names what is counted.
+    pub(crate) fn count(&self, field: &str, n: usize, max: usize, what: &str) -> Result<usize, SceneError> {
+        if n > max {
+            return Err(self.invalid(field, format!("at most {max} {what}, got {n}")));
+        }
+        Ok(n)
+    }
+
+    /// The snapshot times `times` (s): at most [`MAX_SNAPSHOTS`], each finite in `[0, t_end]`, strictly increasing.
+    pub(crate) fn snapshot_times(&self, times: &[f64], t_end: f64) -> Result<(), SceneError> {
+        self.count(
+            "output.times",
+            times.len(),
+            MAX_SNAPSHOTS,
+            "snapshot times (MAX_SNAPSHOTS)",
+        )?;
+        for (k, &t) in times.iter().enumerate() {
+            if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
+                return Err(self.invalid(
+                    format!("output.times[{k}]"),
+                    format!("must be in [0, t_end = {t_end}], got {t}"),
+                ));
+            }
+            if k > 0 && t <= times[k - 1] {
+                return Err(self.invalid(
+                    "output.times",
+                    format!("must be strictly increasing, got {} then {t}", times[k - 1]),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A size that may be zero (a ring's radius, an amplitude): 0, or a [`Validator::positive`] size.
+    pub(crate) fn size_or_zero(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x == 0.0 {
+            Ok(0.0)
+        } else if x.is_finite() && x > 0.0 {
+            self.positive(field, x)
+        } else {
+            Err(self.invalid(field, format!("must be >= 0 and finite, got {x}")))
         }
     }
 
@@ -273,7 +536,7 @@ impl Validator<'_> {
         if x.is_finite() && x >= 0.0 {
             Ok(x)
         } else {
-            Err(self.invalid(field, format!("must be >= 0 and finite, got {x}")))
+            Err(self.invalid(field, format!("must be >= 0 and finite, got {}", fmt_num(x))))
         }
     }
 
@@ -283,5 +546,26 @@ impl Validator<'_> {
         } else {
             Err(self.invalid(field, format!("non-finite value, got {}", fmt_list(v))))
         }
+    }
+}
+
+/// Fixed-length number arrays of the scene files, read strictly: `#[serde(deserialize_with = "exact::array")]` on a
+/// `[f64; N]` field (`exact::option` on an `Option<[f64; N]>`) refuses an array of another length naming the
+/// field and the length expected. (TOML's reader fills a `[f64; 3]` from the first three numbers of a longer array
+/// and drops the rest, so four semi-axes would be read as three.)
+pub mod exact {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    /// A `[f64; N]` from an array of exactly `N` numbers.
+    pub fn array<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f64; N], D::Error> {
+        let v = Vec::<f64>::deserialize(d)?;
+        let len = v.len();
+        v.try_into()
+            .map_err(|_| D::Error::invalid_length(len, &format!("an array of {N} numbers").as_str()))
+    }
+
+    /// An `Option<[f64; N]>` from an array of exactly `N` numbers (absent: `None`, with `#[serde(default)]`).
+    pub fn option<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<Option<[f64; N]>, D::Error> {
+        array(d).map(Some)
     }
 }

@@ -188,6 +188,39 @@ impl SsFile {
         })
     }
 
+    /// Checks what [`SsFile::from_bytes`] requires of a file, before one is written: a finite time, and for every
+    /// particle finite values with a positive mass and radius. The error names the particle and the field.
+    pub fn check(&self) -> Result<(), SsError> {
+        if !self.time.is_finite() {
+            return Err(SsError::Value {
+                index: 0,
+                field: "the header's time",
+                value: self.time,
+                positive: "",
+            });
+        }
+        let names = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
+        for (index, p) in self.particles.iter().enumerate() {
+            let values = [p.mass, p.radius]
+                .into_iter()
+                .chain(p.position.iter().copied())
+                .chain(p.velocity.iter().copied())
+                .chain(p.spin.iter().copied());
+            for (k, (value, field)) in values.zip(names).enumerate() {
+                let positive = k < 2;
+                if !value.is_finite() || (positive && value <= 0.0) {
+                    return Err(SsError::Value {
+                        index,
+                        field,
+                        value,
+                        positive: if positive { " positive" } else { "" },
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The bytes of this file in `units`.
     pub fn to_bytes(&self, units: &Units) -> Vec<u8> {
         let mut out = Vec::with_capacity(HEADER_BYTES + RECORD_BYTES * self.particles.len());
@@ -210,14 +243,52 @@ impl SsFile {
         out
     }
 
-    /// Reads `path` (pkdgrav units) into SI.
+    /// Reads `path` (pkdgrav units) into SI. The header is read first and only the bytes its particle count
+    /// promises (at most [`crate::io::scene_file::MAX_INPUT_BYTES`]) after it, so a device or a runaway file is
+    /// refused at once rather than read into memory.
     pub fn read(path: &Path) -> Result<SsFile, SsError> {
-        let b = std::fs::read(path).map_err(|e| SsError::Io(e.to_string()))?;
+        use std::io::Read;
+        let io = |e: std::io::Error| SsError::Io(e.to_string());
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let meta = file.metadata().map_err(io)?;
+        let mut b = Vec::with_capacity(HEADER_BYTES);
+        (&mut file).take(HEADER_BYTES as u64).read_to_end(&mut b).map_err(io)?;
+        if b.len() < HEADER_BYTES {
+            return Err(SsError::Short(b.len()));
+        }
+        let n = i32_at(&b, 8);
+        let magic = i32_at(&b, 12);
+        if magic != MAGIC_STANDARD {
+            return Err(SsError::Magic(magic));
+        }
+        let expected = HEADER_BYTES as u64 + RECORD_BYTES as u64 * u64::from(n.max(0).unsigned_abs());
+        let actual = |read: usize| if meta.is_file() { meta.len() as usize } else { read };
+        if n < 0 || expected > crate::io::scene_file::MAX_INPUT_BYTES {
+            return Err(SsError::Length {
+                n: i64::from(n),
+                expected: expected as usize,
+                actual: actual(b.len()),
+            });
+        }
+        // One byte more than promised tells a longer file from an exact one.
+        (&mut file)
+            .take(expected - HEADER_BYTES as u64 + 1)
+            .read_to_end(&mut b)
+            .map_err(io)?;
+        if b.len() as u64 != expected {
+            return Err(SsError::Length {
+                n: i64::from(n),
+                expected: expected as usize,
+                actual: actual(b.len()),
+            });
+        }
         SsFile::from_bytes(&b, &Units::pkdgrav())
     }
 
-    /// Writes to `path` in pkdgrav units.
+    /// Writes to `path` in pkdgrav units; refuses (writing nothing) what [`SsFile::check`] refuses, so no file that
+    /// pkdgrav or [`SsFile::read`] would choke on is written.
     pub fn write(&self, path: &Path) -> Result<(), SsError> {
+        self.check()?;
         std::fs::write(path, self.to_bytes(&Units::pkdgrav())).map_err(|e| SsError::Io(e.to_string()))
     }
 }

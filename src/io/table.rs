@@ -79,11 +79,11 @@ pub fn read_table(path: &Path, cells: Cells) -> Result<Table, TableError> {
         path: path.to_path_buf(),
         source,
     };
+    let file = crate::io::scene_file::open_bounded(path).map_err(|e| read_err(e.into()))?;
     let mut reader = csv::ReaderBuilder::new()
         .flexible(cells == Cells::Lenient)
         .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(read_err)?;
+        .from_reader(file);
     let columns: Vec<String> = reader.headers().map_err(read_err)?.iter().map(str::to_string).collect();
     let mut rows = Vec::new();
     for record in reader.records() {
@@ -115,10 +115,8 @@ pub fn read_header(path: &Path) -> Result<Vec<String>, TableError> {
         path: path.to_path_buf(),
         source,
     };
-    let mut reader = csv::ReaderBuilder::new()
-        .trim(csv::Trim::All)
-        .from_path(path)
-        .map_err(read_err)?;
+    let file = crate::io::scene_file::open_bounded(path).map_err(|e| read_err(e.into()))?;
+    let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(file);
     Ok(reader.headers().map_err(read_err)?.iter().map(str::to_string).collect())
 }
 

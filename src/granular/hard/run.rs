@@ -303,6 +303,11 @@ impl HardEngine {
         Ok(HardEngine::new(super::scene::load_hard_scene(path)?))
     }
 
+    /// The scene's warnings ([`super::scene::HardScene::warnings`]), printed by `rubblepile check` and before a run.
+    pub fn scene_warnings(&self) -> &[String] {
+        &self.scene.warnings
+    }
+
     /// What the scene resolves to, for `rubblepile check`.
     pub fn describe(&self) -> Vec<String> {
         let s = &self.scene;

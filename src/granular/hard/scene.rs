@@ -49,7 +49,7 @@ use serde::{Deserialize, Serialize};
 use super::particle::{Attachment, Particle};
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
-use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError, parse_toml_as};
+use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WARNING_STEPS, exact, parse_toml_as};
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
@@ -119,13 +119,15 @@ pub struct HardSceneSection {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SteppingSection {
-    /// Kick–drift–kick step (s), > 0. Required. Steps are shortened to land on output times.
+    /// Kick–drift–kick step (s), at least `t_end × 1e-12` (at most 1e12 steps) and 1e-300. Required. Steps are
+    /// shortened to land on output times. More than 1e9 steps (`t_end/dt`) are run with a warning.
     pub dt: f64,
     /// Inelastic-collapse guard (m/s, ≥ 0): a collision whose normal approach speed is below this is elastic.
     /// Default 0 (off).
     #[serde(default)]
     pub collapse_speed: f64,
-    /// Most events one step may process (≥ 1); beyond it the run stops as stalled. Default 1e7.
+    /// Most events one step may process (in [1, 1e9], [`MAX_EVENTS_PER_STEP`]); beyond it the run stops as stalled.
+    /// Default 1e7.
     #[serde(default = "default_max_events")]
     pub max_events_per_step: u64,
     /// Neighbour-list skin in steps (dimensionless, ≥ 0): a particle's travel allowance is about
@@ -147,7 +149,8 @@ fn default_skin_steps() -> f64 {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform acceleration `[gx, gy, gz]` (m/s²). Required in the table.
+    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Required in the table.
+    #[serde(deserialize_with = "exact::array")]
     pub g: [f64; 3],
 }
 
@@ -177,10 +180,10 @@ impl Default for MaterialSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HardOutputSection {
-    /// Snapshot times (s), strictly increasing in `[0, t_end]`. Default `[0, t_end]`.
+    /// Snapshot times (s), strictly increasing in `[0, t_end]`, at most 1e5 ([`crate::io::scene_file::MAX_SNAPSHOTS`]). Default `[0, t_end]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub times: Option<Vec<f64>>,
-    /// Time-series cadence (s), > 0. Required.
+    /// Time-series cadence (s), at least `t_end × 1e-12` and `t_end / 1e8` (at most 1e8 rows). Required.
     pub every: f64,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
@@ -192,17 +195,19 @@ pub struct HardOutputSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Mass (kg), > 0.
+    /// Mass (kg), finite, ≥ 1e-300.
     pub mass: f64,
-    /// Radius (m), > 0.
+    /// Radius (m), finite, ≥ 1e-300.
     pub radius: f64,
-    /// Centre `[x, y, z]` (m).
+    /// Centre `[x, y, z]` (m, finite). At t = 0 it may overlap another sphere or a wall by at most
+    /// [`MAX_START_OVERLAP`] of its radius.
+    #[serde(deserialize_with = "exact::array")]
     pub position: [f64; 3],
-    /// Velocity (m/s). Default 0.
-    #[serde(default)]
+    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
-    /// Spin, world frame (rad/s). Default 0.
-    #[serde(default)]
+    /// Spin, world frame (rad/s, finite, with a finite rotational energy). Default 0.
+    #[serde(default, deserialize_with = "exact::array")]
     pub spin: [f64; 3],
     /// ε_n ∈ [0, 1]; default `material.eps_n`. A pair uses the mean of its two particles' values.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -220,15 +225,15 @@ pub struct ParticleSpec {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OscillationSpec {
-    /// Amplitude A (m), ≥ 0.
+    /// Amplitude A (m): 0 or in [1e-300, finite).
     pub amplitude: f64,
-    /// Angular frequency ω (rad/s).
+    /// Angular frequency ω (rad/s), finite, with a finite wall speed `A ω`.
     pub omega: f64,
     /// Phase φ (rad). Default 0.
     #[serde(default)]
     pub phase: f64,
     /// Direction d̂ (normalised; must not vanish). Default the wall axis.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub direction: Option<[f64; 3]>,
 }
 
@@ -241,20 +246,21 @@ pub struct WallSpec {
     pub kind: String,
     /// Reference point at t = 0 (m): a point of the plane, the centre of disk/ring, the centre of the cylinder's
     /// or line's axis segment. Default the origin.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::array")]
     pub origin: [f64; 3],
     /// Orientation: plane/disk/ring normal, cylinder/line axis (normalised; must not vanish). Default `[0, 0, 1]`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub axis: Option<[f64; 3]>,
-    /// Radius (m) of a disk (> 0), ring (≥ 0; 0 is a point) or cylinder (≥ 0; 0 is a line).
+    /// Radius (m) of a disk (≥ 1e-300), ring (0 or ≥ 1e-300; 0 is a point) or cylinder (0 or ≥ 1e-300; 0 is a
+    /// line).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
-    /// Length (m, ≥ 0) of a cylinder or line, centred on `origin`; absent = infinite. A cylinder of length 0 is a
-    /// ring.
+    /// Length (m, 0 or ≥ 1e-300) of a cylinder or line, centred on `origin`; absent = infinite. A cylinder of length
+    /// 0 is a ring.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
     /// Constant translation velocity (m/s). Default 0.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
     /// Sinusoidal oscillation. Optional.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -303,6 +309,9 @@ pub struct HardScene {
     pub times: Vec<f64>,
     /// Time-series cadence (s).
     pub every: f64,
+    /// Warnings, one line each naming the file (printed by `check` and before a run): more than
+    /// [`WORK_WARNING_STEPS`] steps.
+    pub warnings: Vec<String>,
 }
 
 use crate::io::scene_file::Validator as V;
@@ -349,11 +358,15 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         ));
     }
     let t_end = v.positive("scene.t_end", file.scene.t_end)?;
-    let dt = v.positive("stepping.dt", file.stepping.dt)?;
+    let dt = v.step("stepping.dt", file.stepping.dt, t_end)?;
     let collapse_speed = v.non_negative("stepping.collapse_speed", file.stepping.collapse_speed)?;
     let skin_steps = v.non_negative("stepping.skin_steps", file.stepping.skin_steps)?;
-    if file.stepping.max_events_per_step == 0 {
-        return Err(v.invalid("stepping.max_events_per_step", "must be >= 1, got 0"));
+    let max_events = file.stepping.max_events_per_step;
+    if !(1..=MAX_EVENTS_PER_STEP).contains(&max_events) {
+        return Err(v.invalid(
+            "stepping.max_events_per_step",
+            format!("must be in [1, {MAX_EVENTS_PER_STEP}] (MAX_EVENTS_PER_STEP), got {max_events}"),
+        ));
     }
     let gravity = match &file.gravity {
         Some(g) => Some(v.vec("gravity.g", g.g)?),
@@ -361,29 +374,10 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     };
     let eps_n = v.in_range("material.eps_n", file.material.eps_n, 0.0, 1.0)?;
     let eps_t = v.in_range("material.eps_t", file.material.eps_t, -1.0, 1.0)?;
-    let every = v.positive("output.every", file.output.every)?;
-    if t_end / every > MAX_TIMESERIES_ROWS {
-        return Err(v.invalid(
-            "output.every",
-            format!("too small for t_end = {t_end} (at most 1e8 rows), got {every}"),
-        ));
-    }
+    let every = v.cadence("output.every", file.output.every, t_end)?;
     let times = match &file.output.times {
         Some(ts) => {
-            for (k, &t) in ts.iter().enumerate() {
-                if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
-                    return Err(v.invalid(
-                        format!("output.times[{k}]"),
-                        format!("must be in [0, {t_end}], got {t}"),
-                    ));
-                }
-                if k > 0 && t <= ts[k - 1] {
-                    return Err(v.invalid(
-                        "output.times",
-                        format!("must be strictly increasing, got {} then {t}", ts[k - 1]),
-                    ));
-                }
-            }
+            v.snapshot_times(ts, t_end)?;
             ts.clone()
         }
         None => vec![0.0, t_end],
@@ -422,12 +416,16 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             ));
         }
         (None, false) => {
+            v.count("particle", file.particles.len(), MAX_BODIES, "particles (MAX_BODIES)")?;
             for (k, p) in file.particles.iter().enumerate() {
                 let f = |x: &str| format!("particle[{k}].{x}");
+                let mass = v.positive(&f("mass"), p.mass)?;
+                let radius = v.positive(&f("radius"), p.radius)?;
+                moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
-                    v.positive(&f("mass"), p.mass)?,
-                    v.positive(&f("radius"), p.radius)?,
+                    mass,
+                    radius,
                     v.vec(&f("position"), p.position)?,
                     v.vec(&f("velocity"), p.velocity)?,
                     v.vec(&f("spin"), p.spin)?,
@@ -448,10 +446,13 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             for (k, row) in rows.iter().enumerate() {
                 let r = &row.values;
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
+                let mass = v.positive(&f("mass"), r[2])?;
+                let radius = v.positive(&f("radius"), r[3])?;
+                moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
-                    v.positive(&f("mass"), r[2])?,
-                    v.positive(&f("radius"), r[3])?,
+                    mass,
+                    radius,
                     v.vec(&f("x,y,z"), [r[4], r[5], r[6]])?,
                     v.vec(&f("vx,vy,vz"), [r[7], r[8], r[9]])?,
                     v.vec(&f("wx,wy,wz"), [r[10], r[11], r[12]])?,
@@ -464,12 +465,41 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         }
     }
     reject_deep_overlaps(&v, &particles)?;
+    reject_wall_overlaps(&v, &particles, &walls)?;
     crate::io::scene_file::check_finite_motion(
         particles
             .iter()
             .map(|p| (p.mass, p.radius, p.position, p.velocity, p.spin)),
     )
     .map_err(|(field, message)| v.invalid(field, message))?;
+    if let Some(g) = gravity {
+        // The potential energy m g·x of every particle enters the energy book.
+        for (k, p) in particles.iter().enumerate() {
+            let (m, gn, x) = (p.mass, g.norm(), p.position.norm());
+            if !(m * gn * x).is_finite() || !(gn * dt).is_finite() {
+                let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", gn), ("x", x)]) {
+                    "m" => format!("particle[{k}].mass"),
+                    "x" => format!("particle[{k}].position"),
+                    _ => "gravity.g".to_string(),
+                };
+                return Err(v.invalid(
+                    field,
+                    format!(
+                        "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at t = 0 \
+                         (m = {m:e} kg, |g| = {gn:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
+                    ),
+                ));
+            }
+        }
+    }
+    let steps = t_end / dt;
+    let mut warnings = Vec::new();
+    if steps > WORK_WARNING_STEPS {
+        warnings.push(format!(
+            "{name}: stepping.dt = {dt:e} s means {steps:.1e} steps to t_end = {t_end} s (more than \
+             {WORK_WARNING_STEPS:e}); the run may not end in useful time"
+        ));
+    }
     Ok(HardScene {
         name: name.to_string(),
         source: text.to_string(),
@@ -487,8 +517,58 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         },
         times,
         every,
+        warnings,
         file,
     })
+}
+
+/// Refuses a sphere whose moment of inertia `2/5 m r²` is not a normal number (the collisions divide by it): a
+/// radius (or mass) so small that it underflows.
+fn moment_of_inertia(v: &V, f: &dyn Fn(&str) -> String, mass: f64, radius: f64) -> Result<(), SceneError> {
+    let inertia = 0.4 * mass * radius * radius;
+    if !(inertia.is_finite() && inertia >= f64::MIN_POSITIVE) {
+        let field = if !(radius * radius).is_finite() || radius * radius < f64::MIN_POSITIVE {
+            "radius"
+        } else {
+            "mass"
+        };
+        return Err(v.invalid(
+            f(field),
+            format!(
+                "gives a moment of inertia 2/5 m r^2 = {inertia:e} kg m^2, not a finite normal number (mass {mass:e} \
+                 kg, radius {radius:e} m)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a start where a sphere overlaps a wall by more than [`MAX_START_OVERLAP`] of its radius (as the
+/// soft-sphere engine does): the event loop would bounce it in place. A sphere stuck to that wall is exempt (a
+/// lining is placed against its wall).
+fn reject_wall_overlaps(v: &V, particles: &[Particle], walls: &[Wall]) -> Result<(), SceneError> {
+    for (k, w) in walls.iter().enumerate() {
+        let origin = w.origin_at(0.0);
+        for (i, p) in particles.iter().enumerate() {
+            if p.stuck.as_ref().is_some_and(|a| a.wall == k) {
+                continue;
+            }
+            let (dist, _) = w.nearest(&origin, &p.position);
+            let overlap = p.radius - dist;
+            if overlap > MAX_START_OVERLAP * p.radius {
+                return Err(v.invalid(
+                    format!("particle[{i}].position"),
+                    format!(
+                        "overlaps wall[{k}] ({}) by {overlap:e} m = {:.4} of its radius at the start; hard spheres may \
+                         overlap a wall by at most {MAX_START_OVERLAP} of it",
+                        w.shape.name(),
+                        overlap / p.radius
+                    ),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Largest initial overlap of two hard spheres accepted, as a fraction of the smaller radius. Touching and
@@ -522,13 +602,13 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     let f = |x: &str| format!("wall[{k}].{x}");
     let need_radius = |allow_zero: bool| -> Result<f64, SceneError> {
         match w.radius {
-            Some(r) if allow_zero => v.non_negative(&f("radius"), r),
+            Some(r) if allow_zero => v.size_or_zero(&f("radius"), r),
             Some(r) => v.positive(&f("radius"), r),
             None => Err(v.invalid(f("radius"), format!("required for a {}, got nothing", w.kind))),
         }
     };
     let length = match w.length {
-        Some(l) => Some(v.non_negative(&f("length"), l)?),
+        Some(l) => Some(v.size_or_zero(&f("length"), l)?),
         None => None,
     };
     let no = |field: &str, given: bool| -> Result<(), SceneError> {
@@ -590,10 +670,17 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
     let mut wall = Wall::new(shape, v.vec(&f("origin"), w.origin)?, axis);
     let oscillation = match &w.oscillation {
         Some(o) => Some(Oscillation {
-            amplitude: v.non_negative(&f("oscillation.amplitude"), o.amplitude)?,
+            amplitude: v.size_or_zero(&f("oscillation.amplitude"), o.amplitude)?,
             omega: {
-                if !o.omega.is_finite() {
-                    return Err(v.invalid(f("oscillation.omega"), format!("must be finite, got {}", o.omega)));
+                // The wall's speed A ω must be finite too: collisions take it as the surface velocity.
+                if !(o.omega.is_finite() && (o.amplitude * o.omega).is_finite()) {
+                    return Err(v.invalid(
+                        f("oscillation.omega"),
+                        format!(
+                            "must be finite with a finite wall speed amplitude x omega, got {:e} (amplitude {:e} m)",
+                            o.omega, o.amplitude
+                        ),
+                    ));
                 }
                 o.omega
             },

@@ -65,7 +65,25 @@ use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
 use crate::gravity::SelfGravity;
-use crate::io::scene_file::{SI_G, SceneError};
+use crate::io::scene_file::{
+    MAX_BODIES, MAX_SNAPSHOTS, MIN_MEANINGFUL, MIN_STEP_FRACTION, SI_G, SceneError, WORK_WARNING_STEPS, exact,
+};
+
+/// `wall.oscillation` read strictly (three amplitude components, no unknown keys) into the wall's [`Oscillation`].
+fn exact_oscillation<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Oscillation>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct Spec {
+        #[serde(deserialize_with = "exact::array")]
+        amplitude: [f64; 3],
+        frequency: f64,
+    }
+    let s = Spec::deserialize(d)?;
+    Ok(Some(Oscillation {
+        amplitude: s.amplitude,
+        frequency: s.frequency,
+    }))
+}
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
@@ -118,7 +136,8 @@ pub struct SoftSceneSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SoftIntegratorSection {
-    /// Fixed leapfrog step (s, > 0, at most the stability limit `2 √(μ_min/k_N)`).
+    /// Fixed leapfrog step (s, at most the stability limit `2 √(μ_min/k_N)` and `t_end`, at least `t_end × 1e-12`).
+    /// More than 1e9 steps are run with a warning.
     pub dt: f64,
 }
 
@@ -174,8 +193,8 @@ pub struct ContactSection {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform external field (m/s²). Default none.
-    #[serde(default)]
+    /// Uniform external field (m/s², finite). Default none.
+    #[serde(default, deserialize_with = "exact::option")]
     pub uniform: Option<[f64; 3]>,
     /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
     #[serde(default, rename = "self")]
@@ -196,9 +215,11 @@ pub struct GravitySection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SoftOutputSection {
-    /// Time-series cadence (s, > 0), rounded to a whole number of steps (at least one).
+    /// Time-series cadence (s, at least `t_end / 1e8`: at most 1e8 rows), rounded to a whole number of steps (at
+    /// least one).
     pub every: f64,
-    /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step. Default `[0, t_end]`.
+    /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step, at most 1e5. Default
+    /// `[0, t_end]`.
     #[serde(default)]
     pub times: Option<Vec<f64>>,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
@@ -214,19 +235,20 @@ pub struct WallSpec {
     /// `"plane"` or `"sphere"`.
     pub kind: String,
     /// Plane: a point on it (m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub point: Option<[f64; 3]>,
     /// Plane: normal towards the particles (any length > 0; normalised).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub normal: Option<[f64; 3]>,
     /// Sphere: centre (m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact::option")]
     pub centre: Option<[f64; 3]>,
-    /// Sphere: inner radius (m, > 0).
+    /// Sphere: inner radius (m, ≥ 1e-300).
     #[serde(default)]
     pub radius: Option<f64>,
-    /// Optional sinusoidal translation.
-    #[serde(default)]
+    /// Optional sinusoidal translation: `amplitude` (m, three finite numbers) and `frequency` (Hz, ≥ 1e-300), with a
+    /// finite wall speed `2π f |A|`.
+    #[serde(default, deserialize_with = "exact_oscillation")]
     pub oscillation: Option<Oscillation>,
 }
 
@@ -234,21 +256,22 @@ pub struct WallSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Radius (m, > 0).
+    /// Radius (m, finite, ≥ 1e-300).
     pub radius: f64,
-    /// Mass (kg, > 0); exactly one of `mass` and `density`.
+    /// Mass (kg, finite, ≥ 1e-300); exactly one of `mass` and `density`.
     #[serde(default)]
     pub mass: Option<f64>,
-    /// Grain density (kg/m³, > 0); then `mass = 4/3 π r³ density`.
+    /// Grain density (kg/m³, finite, ≥ 1e-300); then `mass = 4/3 π r³ density` (finite, ≥ 1e-300).
     #[serde(default)]
     pub density: Option<f64>,
-    /// Centre position (m).
+    /// Centre position (m, finite).
+    #[serde(deserialize_with = "exact::array")]
     pub position: [f64; 3],
-    /// Velocity (m/s). Default 0.
-    #[serde(default)]
+    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
-    /// Spin (rad/s). Default 0.
-    #[serde(default)]
+    /// Spin (rad/s, finite, with a finite rotational energy). Default 0.
+    #[serde(default, deserialize_with = "exact::array")]
     pub spin: [f64; 3],
 }
 
@@ -301,7 +324,7 @@ pub fn scene_kind(text: &str) -> Option<String> {
 
 /// Whether the file at `path` is a soft-sphere scene.
 pub fn is_soft_scene_file(path: &Path) -> bool {
-    std::fs::read_to_string(path).is_ok_and(|t| scene_kind(&t).as_deref() == Some(KIND))
+    crate::io::scene_file::read_text_bounded(path).is_ok_and(|t| scene_kind(&t).as_deref() == Some(KIND))
 }
 
 fn one_line(s: &str) -> String {
@@ -350,13 +373,38 @@ impl V<'_> {
 
     fn particle(&self, label: &str, s: &ParticleSpec) -> Result<Particle, SceneError> {
         let radius = self.positive(&format!("{label}.radius"), s.radius)?;
+        // r² and r³ enter the moment of inertia and the mass from the density: they must stay normal numbers.
+        let r3 = radius * radius * radius;
+        let radius_fault = !(r3.is_finite() && radius * radius >= f64::MIN_POSITIVE && r3 >= f64::MIN_POSITIVE);
         let mass = match (s.mass, s.density) {
             (Some(m), None) => self.positive(&format!("{label}.mass"), m)?,
             (None, Some(rho)) => {
-                self.positive(&format!("{label}.density"), rho)? * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3)
+                let m = self.positive(&format!("{label}.density"), rho)? * 4.0 / 3.0 * std::f64::consts::PI * r3;
+                if !(m.is_finite() && m >= MIN_MEANINGFUL) {
+                    let field = if radius_fault { "radius" } else { "density" };
+                    return Err(self.invalid(
+                        format!("{label}.{field}"),
+                        format!(
+                            "gives a mass 4/3 pi r^3 density = {m:e} kg (radius {radius:e} m, density {rho:e} kg/m^3), \
+                             need finite and >= {MIN_MEANINGFUL:e}"
+                        ),
+                    ));
+                }
+                m
             }
             _ => return Err(self.invalid(label, "give exactly one of `mass` (kg) and `density` (kg/m^3)")),
         };
+        let inertia = 0.4 * mass * radius * radius;
+        if !(inertia.is_finite() && inertia >= f64::MIN_POSITIVE) {
+            let field = if radius_fault { "radius" } else { "mass" };
+            return Err(self.invalid(
+                format!("{label}.{field}"),
+                format!(
+                    "gives a moment of inertia 2/5 m r^2 = {inertia:e} kg m^2, not a finite normal number (mass {mass:e} \
+                     kg, radius {radius:e} m)"
+                ),
+            ));
+        }
         Ok(Particle {
             mass,
             radius,
@@ -364,6 +412,49 @@ impl V<'_> {
             velocity: self.vector(&format!("{label}.velocity"), s.velocity)?,
             spin: self.vector(&format!("{label}.spin"), s.spin)?,
         })
+    }
+
+    /// The gravity terms at t = 0: with self-gravity, `G m_max² / r_min²` (the largest pair force between touching
+    /// spheres) and `G M² / r_min` must be finite; with a uniform field `g`, every `m |g| |x|` and `|g| dt`.
+    fn gravity_finite(&self, gravity: &Gravity, particles: &[Particle], dt: f64) -> Result<(), SceneError> {
+        if gravity.self_gravity.is_some() {
+            let m_max = particles.iter().map(|p| p.mass).fold(0.0, f64::max);
+            let m_total: f64 = particles.iter().map(|p| p.mass).sum();
+            let r_min = particles.iter().map(|p| p.radius).fold(f64::INFINITY, f64::min);
+            let force = gravity.g * m_max * m_max / (r_min * r_min);
+            let energy = gravity.g * m_total * m_total / r_min;
+            if !(force.is_finite() && energy.is_finite()) {
+                return Err(self.invalid(
+                    "gravity.G",
+                    format!(
+                        "gives a non-finite self-gravity at t = 0 (G m_max^2 / r_min^2 = {force:e} N, G M^2 / r_min = \
+                         {energy:e} J), got {:e}",
+                        gravity.g
+                    ),
+                ));
+            }
+        }
+        let g = gravity.uniform.norm();
+        if g > 0.0 {
+            for (k, p) in particles.iter().enumerate() {
+                let (m, x) = (p.mass, p.position.norm());
+                if !(m * g * x).is_finite() || !(g * dt).is_finite() {
+                    let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", g), ("x", x)]) {
+                        "m" => format!("particle[{k}].mass"),
+                        "x" => format!("particle[{k}].position"),
+                        _ => "gravity.uniform".to_string(),
+                    };
+                    return Err(self.invalid(
+                        field,
+                        format!(
+                            "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at \
+                             t = 0 (m = {m:e} kg, |g| = {g:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
+                        ),
+                    ));
+                }
+            }
+        }
+        Ok(())
     }
 
     fn read_particles_file(&self, rel: &str, base_dir: Option<&Path>) -> Result<Vec<Particle>, SceneError> {
@@ -408,8 +499,17 @@ impl V<'_> {
     fn wall(&self, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         let label = format!("wall[{k}]");
         if let Some(o) = &w.oscillation {
-            self.vector(&format!("{label}.oscillation.amplitude"), o.amplitude)?;
-            self.positive(&format!("{label}.oscillation.frequency"), o.frequency)?;
+            let a = self.vector(&format!("{label}.oscillation.amplitude"), o.amplitude)?;
+            let f = self.positive(&format!("{label}.oscillation.frequency"), o.frequency)?;
+            if !(std::f64::consts::TAU * f * a.norm()).is_finite() {
+                return Err(self.invalid(
+                    format!("{label}.oscillation.frequency"),
+                    format!(
+                        "gives a non-finite wall speed 2 pi f |A| (|A| = {:e} m), got {f:e}",
+                        a.norm()
+                    ),
+                ));
+            }
         }
         let need = |name: &str, present: bool| {
             if present {
@@ -468,7 +568,7 @@ impl V<'_> {
             return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
         }
         let t_end = self.positive("scene.t_end", file.scene.t_end)?;
-        let dt = self.positive("integrator.dt", file.integrator.dt)?;
+        let dt = self.step("integrator.dt", file.integrator.dt, t_end)?;
         let steps = (t_end / dt).round();
         if !(1.0..=1e12).contains(&steps) {
             return Err(self.invalid(
@@ -545,9 +645,15 @@ impl V<'_> {
             g,
         };
 
-        let every = self.positive("output.every", file.output.every)?;
+        let every = self.cadence("output.every", file.output.every, t_end)?;
         let every_steps = ((every / dt).round() as u64).max(1);
         let times = file.output.times.clone().unwrap_or_else(|| vec![0.0, t_end]);
+        self.count(
+            "output.times",
+            times.len(),
+            MAX_SNAPSHOTS,
+            "snapshot times (MAX_SNAPSHOTS)",
+        )?;
         let mut snapshot_steps: Vec<u64> = Vec::new();
         for (k, &t) in times.iter().enumerate() {
             if !(t.is_finite() && (0.0..=t_end).contains(&t)) {
@@ -593,6 +699,8 @@ impl V<'_> {
                 "need at least one [[particle]] table or scene.particles_file",
             ));
         }
+        self.count("particle", particles.len(), MAX_BODIES, "particles (MAX_BODIES)")?;
+        self.gravity_finite(&gravity, &particles, dt)?;
 
         // Initial overlaps.
         let centres: Vec<Vec3> = particles.iter().map(|p| p.position).collect();
@@ -632,6 +740,18 @@ impl V<'_> {
         let mut warnings = Vec::new();
         let m_min = particles.iter().map(|p| p.mass).fold(f64::INFINITY, f64::min);
         let limit = crate::granular::soft::advise::stability_limit(material.k_n, m_min);
+        if limit.is_nan() || limit < t_end * MIN_STEP_FRACTION {
+            let lightest = particles.iter().position(|p| p.mass == m_min).unwrap_or(0);
+            // No step can be both stable and at least t_end × 1e-12: the stiffness (or a tiny mass) is the cause.
+            return Err(self.invalid(
+                "contact.k_n",
+                format!(
+                    "gives a leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:.3e} s (m_min = {m_min:.3e} kg, \
+                     particle[{lightest}]), below t_end x {MIN_STEP_FRACTION:e}: more than 1e12 steps, got {:e} N/m",
+                    material.k_n
+                ),
+            ));
+        }
         if dt > limit {
             return Err(self.invalid(
                 "integrator.dt",
@@ -647,6 +767,13 @@ impl V<'_> {
         if dt > 10.0 * advised_dt {
             warnings.push(format!(
                 "{}: integrator.dt = {dt:e} s is more than 10 x the advised {advised_dt:e} s for contact.k_n (contacts resolved by fewer than 5 steps)",
+                self.file
+            ));
+        }
+        if n_steps as f64 > WORK_WARNING_STEPS {
+            warnings.push(format!(
+                "{}: integrator.dt = {dt:e} s means {n_steps} steps to t_end = {t_end} s (more than \
+                 {WORK_WARNING_STEPS:e}); the run may not end in useful time",
                 self.file
             ));
         }

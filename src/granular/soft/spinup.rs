@@ -93,8 +93,8 @@ pub struct SpinupSection {
     /// Length of each rest (s, ≥ 0; default 0); all rests together shorter than `t_final − t_inter`.
     #[serde(default)]
     pub rest_length: f64,
-    /// Spin axis, fixed in space (non-zero; default `[0, 0, 1]`).
-    #[serde(default)]
+    /// Spin axis, fixed in space (three finite numbers, non-zero; default `[0, 0, 1]`).
+    #[serde(default, deserialize_with = "crate::io::scene_file::exact::option")]
     pub axis: Option<[f64; 3]>,
     /// What the forcing holds on the path: `"period"` (default; the body's rotation period `2π I/L` equals `T(t)`
     /// after every step, Zhang17 §2.3.4: "strictly constrained to the spin-up path") or `"angular_momentum"`

@@ -53,7 +53,7 @@ pub struct Campaign {
 /// Reads and validates a campaign file; relative paths in it are resolved against its directory.
 pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| CampaignError::Read {
+    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| CampaignError::Read {
         file: name.clone(),
         reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
     })?;
