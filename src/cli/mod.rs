@@ -268,6 +268,8 @@ pub enum BenchCommand {
     Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(crate::bench::ssdem::BenchSsdemArgs),
+    /// Hard-sphere engine speed (collisions and steps per CPU second, time per stepper phase) on a scene.
+    Hsdem(crate::bench::hsdem::BenchHsdemArgs),
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
     /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
     Stability(stability::StabilityArgs),
@@ -370,6 +372,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             crate::bench::impact_wall_time::impact(&args).map_err(CliError::from)
         }
         Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
+        Command::Bench(BenchCommand::Hsdem(args)) => Ok(crate::bench::hsdem::bench(&args)?),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
         Command::Bench(BenchCommand::Tolerance(args)) => {

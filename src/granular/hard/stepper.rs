@@ -31,6 +31,26 @@ use super::particle::{Attachment, Particle};
 use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::walls::Wall;
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
+
+// Where a step's time goes (`rubblepile bench hsdem` prints the split; `crate::phase`). The phases are leaves: the
+// event loop is timed piece by piece so that re-listing inside it is not counted twice.
+/// Both half kicks, the stuck particles' secants and the finiteness check.
+static PHASE_KICK: Phase = Phase::new("hard.kick", Kind::Serial);
+/// The drift start's check of every particle against its neighbour-list allowance.
+static PHASE_LIST_CHECK: Phase = Phase::new("hard.list_check", Kind::Serial);
+/// Re-listing single particles (at drift starts and after collisions).
+static PHASE_RELIST: Phase = Phase::new("hard.relist", Kind::Serial);
+/// Full neighbour-list builds (the cell grid of all anchors).
+static PHASE_REBUILD: Phase = Phase::new("hard.rebuild", Kind::Serial);
+/// The drift start's predictions of every listed pair and wall contact.
+static PHASE_PREDICT_START: Phase = Phase::new("hard.predict_start", Kind::Serial);
+/// The event loop: popping events and applying collisions.
+static PHASE_EVENTS: Phase = Phase::new("hard.events", Kind::Serial);
+/// Re-predicting the particles of each processed event.
+static PHASE_REPREDICT: Phase = Phase::new("hard.repredict", Kind::Serial);
+/// Moving every particle to the end of the drift.
+static PHASE_ADVANCE: Phase = Phase::new("hard.advance", Kind::Serial);
 
 /// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 8, 16, 32 and 64 cost 3.7,
 /// 2.4, 2.0 and 1.9 s of CPU for 5000 steps against 8.8 s with a fresh list every step
@@ -180,6 +200,12 @@ pub struct NeighbourState {
     pub anchors: Vec<Vec3>,
     /// Travel allowances (m), one per particle.
     pub allowances: Vec<f64>,
+}
+
+/// An event the loop applied: its time and the particles it involved.
+struct Applied {
+    t: f64,
+    involved: [Option<usize>; 2],
 }
 
 /// Working state of one drift.
@@ -345,25 +371,29 @@ impl System {
     pub fn step(&mut self, h: f64) -> Result<(), StepError> {
         let t0 = self.t;
         let t1 = t0 + h;
-        self.kick(0.5 * h);
-        // Stuck particles follow their wall on the secant of this step.
-        for k in 0..self.particles.len() {
-            if let (true, Some(a)) = (self.particles[k].alive, self.particles[k].stuck) {
-                let end = self.attached_position(&a, t1);
-                let p = &mut self.particles[k];
-                p.velocity = (end - p.position) / h;
-                p.spin = self.walls[a.wall].axis * self.walls[a.wall].motion.spin;
+        PHASE_KICK.time(|| {
+            self.kick(0.5 * h);
+            // Stuck particles follow their wall on the secant of this step.
+            for k in 0..self.particles.len() {
+                if let (true, Some(a)) = (self.particles[k].alive, self.particles[k].stuck) {
+                    let end = self.attached_position(&a, t1);
+                    let p = &mut self.particles[k];
+                    p.velocity = (end - p.position) / h;
+                    p.spin = self.walls[a.wall].axis * self.walls[a.wall].motion.spin;
+                }
             }
-        }
+        });
         self.drift(t0, t1)?;
-        self.kick(0.5 * h);
-        self.t = t1;
-        for p in self.particles.iter().filter(|p| p.alive) {
-            if !(p.position.iter().all(|x| x.is_finite()) && p.velocity.iter().all(|x| x.is_finite())) {
-                return Err(StepError::NonFinite { id: p.id, t: t1 });
+        PHASE_KICK.time(|| {
+            self.kick(0.5 * h);
+            self.t = t1;
+            for p in self.particles.iter().filter(|p| p.alive) {
+                if !(p.position.iter().all(|x| x.is_finite()) && p.velocity.iter().all(|x| x.is_finite())) {
+                    return Err(StepError::NonFinite { id: p.id, t: t1 });
+                }
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 
     fn kick(&mut self, dt: f64) {
@@ -390,26 +420,73 @@ impl System {
             queue: EventQueue::new(),
             events: 0,
         };
-        let failing: Vec<usize> = if self.neighbours.built {
-            (0..self.particles.len())
-                .filter(|&k| !self.list_holds(k, t0, t1))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let failing: Vec<usize> = PHASE_LIST_CHECK.time(|| {
+            if self.neighbours.built {
+                (0..self.particles.len())
+                    .filter(|&k| !self.list_holds(k, t0, t1))
+                    .collect()
+            } else {
+                Vec::new()
+            }
+        });
         let local =
             self.settings.skin_steps > 0.0 && self.neighbours.built && failing.len() * 2 <= self.particles.len();
         if local {
-            for k in failing {
-                self.reanchor(k, t0, &d);
-            }
-            self.predict_all(&mut d, t0);
+            PHASE_RELIST.time(|| {
+                for k in failing {
+                    self.reanchor(k, t0, &d);
+                }
+            });
+            PHASE_PREDICT_START.time(|| self.predict_all(&mut d, t0));
         } else {
             self.rebuild(&mut d, t0);
         }
-        while let Some(e) = d.queue.pop() {
-            if e.t > t1 {
+        loop {
+            let next = PHASE_EVENTS.time(|| self.next_event(&mut d));
+            let Some(Applied { t, involved }) = next? else {
                 break;
+            };
+            let mut must_rebuild = false;
+            for k in involved.into_iter().flatten() {
+                self.gens[k] += 1;
+                if !self.list_holds(k, t, t1) {
+                    if self.settings.skin_steps > 0.0 {
+                        PHASE_RELIST.time(|| self.reanchor(k, t, &d));
+                    } else {
+                        must_rebuild = true;
+                    }
+                }
+            }
+            if must_rebuild {
+                self.rebuild(&mut d, t);
+            } else {
+                PHASE_REPREDICT.time(|| {
+                    for k in involved.into_iter().flatten() {
+                        self.predict(&mut d, k, t);
+                    }
+                });
+            }
+        }
+        PHASE_ADVANCE.time(|| {
+            for k in 0..self.particles.len() {
+                if !self.particles[k].alive {
+                    continue;
+                }
+                self.particles[k].advance(t1);
+                if let Some(a) = self.particles[k].stuck {
+                    self.particles[k].position = self.attached_position(&a, t1);
+                }
+            }
+        });
+        Ok(())
+    }
+
+    /// Pops events until a valid one within the drift, applies it and returns its time and the particles it
+    /// involved; `None` when the drift has no more events.
+    fn next_event(&mut self, d: &mut Drift) -> Result<Option<Applied>, StepError> {
+        while let Some(e) = d.queue.pop() {
+            if e.t > d.t1 {
+                return Ok(None);
             }
             if e.gen_i != self.gens[e.i] {
                 continue;
@@ -423,7 +500,7 @@ impl System {
             self.counters.events += 1;
             if d.events > self.settings.max_events_per_step {
                 return Err(StepError::Stalled {
-                    t: t1,
+                    t: d.t1,
                     limit: self.settings.max_events_per_step,
                 });
             }
@@ -433,39 +510,13 @@ impl System {
                     [Some(e.i), Some(j)]
                 }
                 Partner::Wall(w) => {
-                    self.collide_wall(&d, e.i, w, e.t);
+                    self.collide_wall(d, e.i, w, e.t);
                     [Some(e.i), None]
                 }
             };
-            let mut must_rebuild = false;
-            for k in involved.into_iter().flatten() {
-                self.gens[k] += 1;
-                if !self.list_holds(k, e.t, t1) {
-                    if self.settings.skin_steps > 0.0 {
-                        self.reanchor(k, e.t, &d);
-                    } else {
-                        must_rebuild = true;
-                    }
-                }
-            }
-            if must_rebuild {
-                self.rebuild(&mut d, e.t);
-            } else {
-                for k in involved.into_iter().flatten() {
-                    self.predict(&mut d, k, e.t);
-                }
-            }
+            return Ok(Some(Applied { t: e.t, involved }));
         }
-        for k in 0..self.particles.len() {
-            if !self.particles[k].alive {
-                continue;
-            }
-            self.particles[k].advance(t1);
-            if let Some(a) = self.particles[k].stuck {
-                self.particles[k].position = self.attached_position(&a, t1);
-            }
-        }
-        Ok(())
+        Ok(None)
     }
 
     /// Rebuilds the neighbour list at `t` with a fresh allowance and anchors (positions at `t`; the particles' states
@@ -493,9 +544,9 @@ impl System {
             vec![(2.0 * v_max * (d.t1 - t)).max(floor); n]
         };
         self.neighbours.anchors = self.particles.iter().map(|p| p.position_at(t)).collect();
-        self.neighbours.adjacency = self.candidate_pairs();
+        self.neighbours.adjacency = PHASE_REBUILD.time(|| self.candidate_pairs());
         self.neighbours.built = true;
-        self.predict_all(d, t);
+        PHASE_PREDICT_START.time(|| self.predict_all(d, t));
     }
 
     /// Empties the queue and predicts every listed pair and every wall contact from `t`.
