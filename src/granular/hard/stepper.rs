@@ -13,18 +13,34 @@
 //! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left). A
 //! particle that could leave its allowance is re-anchored alone at that instant: fresh anchor and allowance, its
 //! pairs found again against every other particle's (unchanged) anchor and allowance, which keeps the criterion
-//! exact for every pair. When more than half of the particles fail at a drift start, the whole list is built
-//! afresh instead (with skins spread over [0.5, 1.5) × `skin_steps` so that they do not all expire together). So no collision is ever missed, whatever the kicks and collisions do to the speeds.
+//! exact for every pair (the other anchors are filed in a cell grid, [`super::anchors`], so this costs the cells
+//! around the particle, not a pass over all particles). When more than half of the particles fail at a drift start,
+//! the whole list is built afresh instead (with skins spread over [0.5, 1.5) × `skin_steps` so that they do not all
+//! expire together). So no collision is ever missed, whatever the kicks and collisions do to the speeds.
 //! `L_k = max(min(skin_steps · |v_k| · h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))` (at least 1e-3 of the
 //! smallest radius), so a particle is re-listed about every `skin_steps` steps, slow particles in dense regions keep
-//! small allowances and no allowance exceeds a radius more than the drift needs (large skins only grow the lists). `skin_steps = 0` is the old scheme (one allowance `2 v_max h` for all and a fresh list at every step
-//! and whenever a particle fails), kept as the reference of the regression test `tests/hsdem_neighbours.rs`.
-//! Every kick changes every velocity, so all pairs of the list are re-predicted at each drift start.
+//! small allowances and no allowance exceeds a radius more than the drift needs (large skins only grow the lists).
+//! `skin_steps = 0` is the old scheme (one allowance `2 v_max h` for all and a fresh list at every step and whenever a
+//! particle fails), kept as the reference of the regression test `tests/hsdem_neighbours.rs`. The same allowance
+//! also lists each particle's near walls: a fixed wall farther than `R_k + L_k` from the anchor cannot be touched
+//! before the particle is re-listed, so only moving walls and near ones are predicted.
+//!
+//! What a drift start predicts. Every kick changes every velocity, so every wall contact is predicted afresh at each
+//! drift start (from the near walls). Pairs are not: a uniform kick changes no relative velocity, so a pair of free
+//! particles keeps a certificate across steps (the earliest time it can come within reach, [`super::certificates`])
+//! and is predicted afresh only when that comes due, at the first drift start after either particle collided or was
+//! re-listed (certified there unless a particle collided in the last drift: in a dense pile, where particles collide
+//! at every step, their pairs are simply predicted at every drift start, as before), or at every step when one is
+//! stuck (stuck particles are not kicked). Every event is still computed from the positions and
+//! velocities at the drift start or the collision, exactly as when every listed pair was predicted at every drift
+//! start (`certify_pairs = false`), so the certificates change no bit (`tests/hsdem_certificates.rs`).
 //!
 //! Overlap handling: a pair or a wall contact that touches or overlaps and approaches collides at once; no overlap is
 //! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
 //! secant over the step, landing exactly on the wall's law at the step end) and act as infinite masses.
 
+use super::anchors::AnchorGrid;
+use super::certificates::{self, Calendar, Due};
 use super::collision::{self, Body, Restitution};
 use super::events::{Event, EventQueue, Partner};
 use super::particle::{Attachment, Particle};
@@ -69,6 +85,10 @@ pub struct StepperSettings {
     /// Neighbour-list skin in steps (≥ 0): a particle's travel allowance is about `skin_steps · |v| · dt`, and it is
     /// re-listed when it could leave it. 0 = a fresh list for all at every step (the reference scheme).
     pub skin_steps: f64,
+    /// Keep pair certificates across steps ([`super::certificates`]; with `skin_steps > 0`): a drift start predicts
+    /// only the pairs whose certificates came due. `false` predicts every listed pair at every drift start (the
+    /// scheme before certificates), with the same results to the bit: the reference of `tests/hsdem_certificates.rs`.
+    pub certify_pairs: bool,
 }
 
 impl Default for StepperSettings {
@@ -78,6 +98,7 @@ impl Default for StepperSettings {
             collapse_speed: 0.0,
             max_events_per_step: 10_000_000,
             skin_steps: DEFAULT_SKIN_STEPS,
+            certify_pairs: true,
         }
     }
 }
@@ -176,6 +197,11 @@ pub struct System {
     /// Counters since t = 0.
     pub counters: Counters,
     gens: Vec<u64>,
+    /// Certificate generations: bumped when a particle collides or is re-listed, which ends its pairs'
+    /// certificates ([`super::certificates`]).
+    cert_gens: Vec<u64>,
+    /// The allowance floor, 1e-3 of the smallest alive radius, once computed (cleared when a particle dies).
+    floor: Option<f64>,
     neighbours: Neighbours,
 }
 
@@ -190,6 +216,30 @@ struct Neighbours {
     anchors: Vec<Vec3>,
     /// Travel allowances (m).
     allowances: Vec<f64>,
+    /// The anchors by cell, for re-listing one particle (empty for the reference scheme `skin_steps = 0`).
+    grid: AnchorGrid,
+    /// For each particle, the walls it may touch while it stays within its allowance (all moving walls).
+    near_walls: Vec<Vec<usize>>,
+    /// Certificates of the listed pairs of free particles ([`super::certificates`]).
+    calendar: Calendar,
+    /// Whether every listed pair of free particles without a queued event has a certificate in the calendar (false
+    /// after a build or a restore until everything has been predicted once).
+    certified: bool,
+    /// Particles whose pairs have no certificates (they collided or were re-listed since they last had a clean
+    /// drift start): the next drift start predicts all their pairs. Every listed pair of free particles has a valid
+    /// certificate in the calendar, an event in the queue, or a particle in this list.
+    pending: Vec<usize>,
+    /// Whether each particle is in `pending`.
+    uncertified: Vec<bool>,
+    /// Whether each particle collided in the current drift (its pairs are then predicted at the next drift start
+    /// without certificates: one that collides at every step, in a dense pile, would only fill the calendar).
+    dirty: Vec<bool>,
+    /// Calendar entries after its last compaction (stale entries are dropped when it grows well beyond that).
+    calendar_live: usize,
+    /// Scratch: the certificates that came due at a drift start.
+    due: Vec<Due>,
+    /// Scratch: which particles are in the drift start's `pending` list.
+    mark: Vec<bool>,
 }
 
 /// What a checkpoint needs of the neighbour list to continue bit for bit: the anchors and allowances of the current
@@ -228,6 +278,8 @@ impl System {
             t: 0.0,
             counters: Counters::default(),
             gens: vec![0; n],
+            cert_gens: vec![0; n],
+            floor: None,
             neighbours: Neighbours::default(),
         }
     }
@@ -259,7 +311,61 @@ impl System {
         self.neighbours.allowances = st.allowances;
         self.neighbours.adjacency = self.candidate_pairs();
         self.neighbours.built = true;
+        self.floor = None;
+        self.file_all();
         Ok(())
+    }
+
+    /// After a full build: files every anchor in the cell grid, finds every particle's near walls, and empties the
+    /// calendar (the next drift start predicts everything).
+    fn file_all(&mut self) {
+        let n = self.particles.len();
+        let nb = &mut self.neighbours;
+        nb.calendar.clear();
+        nb.calendar_live = 0;
+        nb.certified = false;
+        nb.pending.clear();
+        nb.uncertified = vec![false; n];
+        nb.dirty = vec![false; n];
+        nb.mark = vec![false; n];
+        if self.settings.skin_steps > 0.0 {
+            let reaches: Vec<f64> = (0..n)
+                .filter(|&k| self.particles[k].alive)
+                .map(|k| self.particles[k].radius + nb.allowances[k])
+                .collect();
+            nb.grid = AnchorGrid::new(n, AnchorGrid::reference_reach(&reaches));
+            for k in (0..n).filter(|&k| self.particles[k].alive) {
+                nb.grid
+                    .insert(k, &nb.anchors[k], self.particles[k].radius + nb.allowances[k]);
+            }
+        }
+        let mut near = std::mem::take(&mut self.neighbours.near_walls);
+        near.resize_with(n, Vec::new);
+        for (k, list) in near.iter_mut().enumerate() {
+            self.walls_near(k, list);
+        }
+        self.neighbours.near_walls = near;
+    }
+
+    /// The walls particle `k` may touch while it stays within its allowance of its anchor: every wall that moves,
+    /// and each fixed one within the particle's radius plus allowance of the anchor (plus a margin far above the
+    /// rounding of the distance), since a wall's distance changes no faster than the centre moves. Skipping the
+    /// others changes no prediction: their time of impact would be none.
+    fn walls_near(&self, k: usize, out: &mut Vec<usize>) {
+        out.clear();
+        let a = self.neighbours.anchors[k];
+        let reach = self.particles[k].radius + self.neighbours.allowances[k];
+        for (w, wall) in self.walls.iter().enumerate() {
+            let fixed = wall.motion.velocity == Vec3::zeros() && wall.motion.oscillation.is_none();
+            if fixed {
+                let (dist, _) = wall.nearest(&wall.origin, &a);
+                let margin = certificates::MARGIN_RELATIVE * reach + 1e-10 * (a - wall.origin).norm();
+                if dist > reach + margin {
+                    continue;
+                }
+            }
+            out.push(w);
+        }
     }
 
     /// Candidate partners from the anchors and the allowance of the current list.
@@ -300,41 +406,60 @@ impl System {
         skin.max(v * (t1 - t)).max(floor)
     }
 
-    /// 1e-3 of the smallest radius: keeps resting particles from being re-listed at every collision.
-    fn allowance_floor(&self) -> f64 {
+    /// 1e-3 of the smallest alive radius: keeps resting particles from being re-listed at every collision. Kept
+    /// until a particle dies (a pass over all particles at every re-listing cost more than the re-listing).
+    fn allowance_floor(&mut self) -> f64 {
+        if let Some(f) = self.floor {
+            return f;
+        }
         let r_min = self
             .particles
             .iter()
             .filter(|p| p.alive)
             .map(|p| p.radius)
             .fold(f64::INFINITY, f64::min);
-        if r_min.is_finite() { 1e-3 * r_min } else { 0.0 }
+        let f = if r_min.is_finite() { 1e-3 * r_min } else { 0.0 };
+        self.floor = Some(f);
+        f
     }
 
     /// Re-lists particle `k` alone at `t`: fresh anchor and allowance, its pairs found against every other alive
     /// particle's anchor and allowance (the criterion of [`sphere_pairs`], so the list stays what a full build from
-    /// the same anchors would give).
+    /// the same anchors would give; the candidates come from the cell grid of anchors, [`AnchorGrid`]), its near
+    /// walls found again, and its pairs' certificates ended.
     fn reanchor(&mut self, k: usize, t: f64, d: &Drift) {
         self.counters.reanchors += 1;
+        self.uncertify(k);
         let floor = self.allowance_floor();
         let l = self.allowance(k, t, d.t1, d.t1 - d.t0, floor, 1.0);
         let nb = &mut self.neighbours;
-        for j in std::mem::take(&mut nb.adjacency[k]) {
+        let mut mine = std::mem::take(&mut nb.adjacency[k]);
+        for &j in &mine {
             nb.adjacency[j].retain(|&x| x != k);
         }
+        mine.clear();
         nb.anchors[k] = self.particles[k].position_at(t);
         nb.allowances[k] = l;
         let rk = self.particles[k].radius + l;
-        for (j, q) in self.particles.iter().enumerate() {
+        nb.grid.insert(k, &nb.anchors[k], rk);
+        let (anchors, allowances, particles) = (&nb.anchors, &nb.allowances, &self.particles);
+        nb.grid.query(&anchors[k], rk, |j| {
+            let q = &particles[j];
             if j == k || !q.alive {
-                continue;
+                return;
             }
-            let reach = rk + q.radius + nb.allowances[j];
-            if (nb.anchors[j] - nb.anchors[k]).norm_squared() < reach * reach {
-                nb.adjacency[k].push(j);
-                nb.adjacency[j].push(k);
+            let reach = rk + q.radius + allowances[j];
+            if (anchors[j] - anchors[k]).norm_squared() < reach * reach {
+                mine.push(j);
             }
+        });
+        for &j in &mine {
+            nb.adjacency[j].push(k);
         }
+        nb.adjacency[k] = mine;
+        let mut near = std::mem::take(&mut self.neighbours.near_walls[k]);
+        self.walls_near(k, &mut near);
+        self.neighbours.near_walls[k] = near;
     }
 
     /// Energies and momenta of the free, alive particles.
@@ -375,7 +500,12 @@ impl System {
             self.kick(0.5 * h);
             // Stuck particles follow their wall on the secant of this step.
             for k in 0..self.particles.len() {
-                if let (true, Some(a)) = (self.particles[k].alive, self.particles[k].stuck) {
+                if let Particle {
+                    alive: true,
+                    stuck: Some(a),
+                    ..
+                } = self.particles[k]
+                {
                     let end = self.attached_position(&a, t1);
                     let p = &mut self.particles[k];
                     p.velocity = (end - p.position) / h;
@@ -387,8 +517,9 @@ impl System {
         PHASE_KICK.time(|| {
             self.kick(0.5 * h);
             self.t = t1;
-            for p in self.particles.iter().filter(|p| p.alive) {
-                if !(p.position.iter().all(|x| x.is_finite()) && p.velocity.iter().all(|x| x.is_finite())) {
+            let finite = |v: &Vec3| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
+            for p in &self.particles {
+                if p.alive && !(finite(&p.position) && finite(&p.velocity)) {
                     return Err(StepError::NonFinite { id: p.id, t: t1 });
                 }
             }
@@ -433,11 +564,15 @@ impl System {
             self.settings.skin_steps > 0.0 && self.neighbours.built && failing.len() * 2 <= self.particles.len();
         if local {
             PHASE_RELIST.time(|| {
-                for k in failing {
+                for &k in &failing {
                     self.reanchor(k, t0, &d);
                 }
             });
-            PHASE_PREDICT_START.time(|| self.predict_all(&mut d, t0));
+            if self.neighbours.certified && self.settings.certify_pairs {
+                PHASE_PREDICT_START.time(|| self.predict_start(&mut d, t0));
+            } else {
+                PHASE_PREDICT_START.time(|| self.predict_all(&mut d, t0));
+            }
         } else {
             self.rebuild(&mut d, t0);
         }
@@ -449,6 +584,8 @@ impl System {
             let mut must_rebuild = false;
             for k in involved.into_iter().flatten() {
                 self.gens[k] += 1;
+                self.uncertify(k);
+                self.neighbours.dirty[k] = true;
                 if !self.list_holds(k, t, t1) {
                     if self.settings.skin_steps > 0.0 {
                         PHASE_RELIST.time(|| self.reanchor(k, t, &d));
@@ -544,14 +681,25 @@ impl System {
             vec![(2.0 * v_max * (d.t1 - t)).max(floor); n]
         };
         self.neighbours.anchors = self.particles.iter().map(|p| p.position_at(t)).collect();
-        self.neighbours.adjacency = PHASE_REBUILD.time(|| self.candidate_pairs());
-        self.neighbours.built = true;
+        PHASE_REBUILD.time(|| {
+            self.neighbours.adjacency = self.candidate_pairs();
+            self.neighbours.built = true;
+            self.file_all();
+        });
         PHASE_PREDICT_START.time(|| self.predict_all(d, t));
     }
 
-    /// Empties the queue and predicts every listed pair and every wall contact from `t`.
+    /// Empties the queue and the calendar and predicts every listed pair and every wall contact from `t`,
+    /// certifying the pairs of free particles without an event in this drift when neither collided in the last one.
     fn predict_all(&mut self, d: &mut Drift, t: f64) {
         d.queue.clear();
+        let certify = self.settings.skin_steps > 0.0 && self.settings.certify_pairs;
+        let nb = &mut self.neighbours;
+        nb.calendar.clear();
+        nb.certified = certify;
+        for k in nb.pending.drain(..) {
+            nb.uncertified[k] = false;
+        }
         for k in 0..self.particles.len() {
             if !self.particles[k].alive {
                 continue;
@@ -559,11 +707,113 @@ impl System {
             for jx in 0..self.neighbours.adjacency[k].len() {
                 let j = self.neighbours.adjacency[k][jx];
                 if j > k {
-                    self.predict_pair(d, k, j, t);
+                    let clean = certify && !self.neighbours.dirty[k] && !self.neighbours.dirty[j];
+                    self.predict_pair(d, k, j, t, clean);
                 }
             }
             self.predict_walls(d, k, t);
         }
+        // The particles that collided in the last drift certify their pairs at their first clean drift start.
+        for k in 0..self.particles.len() {
+            if std::mem::take(&mut self.neighbours.dirty[k]) && certify {
+                self.uncertify(k);
+            }
+        }
+        self.neighbours.calendar_live = self.neighbours.calendar.len();
+    }
+
+    /// Ends particle `k`'s pairs' certificates and lists it for the next drift start.
+    fn uncertify(&mut self, k: usize) {
+        self.cert_gens[k] += 1;
+        let nb = &mut self.neighbours;
+        if nb.certified && !nb.uncertified[k] {
+            nb.uncertified[k] = true;
+            nb.pending.push(k);
+        }
+    }
+
+    /// The drift start's predictions when the calendar is complete: the same events as [`System::predict_all`]
+    /// from only the pairs that may have one (module doc). Predicted afresh at `t0`: every pair of a pending
+    /// particle (one that collided or was re-listed since its last clean drift start; certified unless either
+    /// particle collided in the last drift), the pairs whose certificates come due within the drift, every pair with
+    /// a stuck particle (not kicked, so its relative velocity changes at every step), and every free particle against
+    /// its near walls (the kicks change every velocity relative to the walls).
+    fn predict_start(&mut self, d: &mut Drift, t0: f64) {
+        d.queue.clear();
+        let pending = std::mem::take(&mut self.neighbours.pending);
+        for &k in &pending {
+            self.neighbours.mark[k] = true;
+        }
+        for &k in &pending {
+            if !self.particles[k].alive || self.particles[k].stuck.is_some() {
+                continue;
+            }
+            for jx in 0..self.neighbours.adjacency[k].len() {
+                let j = self.neighbours.adjacency[k][jx];
+                // A pair of two pending particles once; pairs with a stuck particle below.
+                if (self.neighbours.mark[j] && j < k) || self.particles[j].stuck.is_some() {
+                    continue;
+                }
+                let clean = !self.neighbours.dirty[k] && !self.neighbours.dirty[j];
+                self.predict_pair(d, k, j, t0, clean);
+            }
+        }
+        let mut still = Vec::new();
+        for &k in &pending {
+            let nb = &mut self.neighbours;
+            nb.mark[k] = false;
+            let p = &self.particles[k];
+            // One that collided in the last drift stays pending until a drift start finds it clean.
+            if std::mem::take(&mut nb.dirty[k]) && p.alive && p.stuck.is_none() {
+                still.push(k);
+            } else {
+                nb.uncertified[k] = false;
+            }
+        }
+        self.neighbours.pending = still;
+        let mut due = std::mem::take(&mut self.neighbours.due);
+        self.neighbours.calendar.take_due(d.t1, &mut due);
+        for c in &due {
+            if self.certificate_valid(c) {
+                self.predict_pair(d, c.i, c.j, t0, true);
+            }
+        }
+        self.neighbours.due = due;
+        for k in 0..self.particles.len() {
+            let p = &self.particles[k];
+            if !p.alive {
+                continue;
+            }
+            if p.stuck.is_some() {
+                for jx in 0..self.neighbours.adjacency[k].len() {
+                    let j = self.neighbours.adjacency[k][jx];
+                    self.predict_pair(d, k, j, t0, false);
+                }
+            } else {
+                self.predict_walls(d, k, t0);
+            }
+        }
+        // Stale certificates (a particle collided or was re-listed) wait in the calendar until they come due; when
+        // they outnumber the live ones, drop them.
+        let nb = &self.neighbours;
+        if nb.calendar.len() > 2 * nb.calendar_live + 8 * self.particles.len() + 1024 {
+            let mut calendar = std::mem::take(&mut self.neighbours.calendar);
+            calendar.retain(|c| self.certificate_valid(c));
+            self.neighbours.calendar_live = calendar.len();
+            self.neighbours.calendar = calendar;
+        }
+    }
+
+    /// Whether a certificate still speaks for its pair: neither particle collided or was re-listed since, both alive
+    /// and free.
+    fn certificate_valid(&self, c: &Due) -> bool {
+        let (pi, pj) = (&self.particles[c.i], &self.particles[c.j]);
+        c.gen_i == self.cert_gens[c.i]
+            && c.gen_j == self.cert_gens[c.j]
+            && pi.alive
+            && pj.alive
+            && pi.stuck.is_none()
+            && pj.stuck.is_none()
     }
 
     /// Re-predicts particle `k` against its neighbours and the walls at time `t`.
@@ -573,12 +823,14 @@ impl System {
         }
         for jx in 0..self.neighbours.adjacency[k].len() {
             let j = self.neighbours.adjacency[k][jx];
-            self.predict_pair(d, k, j, t);
+            self.predict_pair(d, k, j, t, false);
         }
         self.predict_walls(d, k, t);
     }
 
-    fn predict_pair(&self, d: &mut Drift, i: usize, j: usize, t: f64) {
+    /// Predicts the pair `(i, j)` from `t`: queues its collision if it falls within the drift, otherwise, when
+    /// `certify` (a drift start, both particles free and clean), files its certificate ([`super::certificates`]).
+    fn predict_pair(&mut self, d: &mut Drift, i: usize, j: usize, t: f64, certify: bool) {
         let (pi, pj) = (&self.particles[i], &self.particles[j]);
         if !pj.alive || (pi.stuck.is_some() && pj.stuck.is_some()) {
             return;
@@ -586,41 +838,56 @@ impl System {
         let r = pi.position_at(t) - pj.position_at(t);
         let v = pi.velocity - pj.velocity;
         let b = r.dot(&v);
-        if b >= 0.0 {
-            return;
-        }
         let s = pi.radius + pj.radius;
-        let c = r.norm_squared() - s * s;
-        let dt = if c <= 0.0 {
-            0.0
-        } else {
-            let disc = b * b - v.norm_squared() * c;
-            if disc < 0.0 {
+        if b < 0.0 {
+            let c = r.norm_squared() - s * s;
+            let dt = if c <= 0.0 {
+                Some(0.0)
+            } else {
+                let disc = b * b - v.norm_squared() * c;
+                // Cancellation-free smaller root (notes, "Particle–particle").
+                (disc >= 0.0).then(|| c / (-b + disc.sqrt()))
+            };
+            if let Some(te) = dt.map(|dt| t + dt)
+                && te <= d.t1
+            {
+                let (a, bb) = if i < j { (i, j) } else { (j, i) };
+                d.queue.push(Event {
+                    t: te,
+                    i: a,
+                    partner: Partner::Particle(bb),
+                    gen_i: self.gens[a],
+                    gen_j: self.gens[bb],
+                });
+                // Its event is processed or made stale within this drift, and either re-predicts the pair.
                 return;
             }
-            // Cancellation-free smaller root (notes, "Particle–particle").
-            c / (-b + disc.sqrt())
-        };
-        let te = t + dt;
-        if te <= d.t1 {
+        }
+        if certify && pi.stuck.is_none() && pj.stuck.is_none() {
+            let horizon = certificates::HORIZON_STEPS * (d.t1 - d.t0);
+            let g = self.settings.gravity.map_or(0.0, |g| g.norm());
+            let x = pi.position.norm() + pj.position.norm();
+            let speed = pi.velocity.norm() + pj.velocity.norm();
+            let reach = s + certificates::margin(s, x, speed, g, horizon);
             let (a, bb) = if i < j { (i, j) } else { (j, i) };
-            d.queue.push(Event {
-                t: te,
+            self.neighbours.calendar.push(Due {
+                t: certificates::safe_until(t, &r, &v, reach, horizon),
                 i: a,
-                partner: Partner::Particle(bb),
-                gen_i: self.gens[a],
-                gen_j: self.gens[bb],
+                j: bb,
+                gen_i: self.cert_gens[a],
+                gen_j: self.cert_gens[bb],
             });
         }
     }
 
     fn predict_walls(&self, d: &mut Drift, k: usize, t: f64) {
         let p = &self.particles[k];
-        if p.stuck.is_some() {
+        if p.stuck.is_some() || self.neighbours.near_walls[k].is_empty() {
             return;
         }
         let r = p.position_at(t);
-        for (w, wall) in self.walls.iter().enumerate() {
+        for &w in &self.neighbours.near_walls[k] {
+            let wall = &self.walls[w];
             let ws = d.walls[w];
             let origin_now = ws.origin0 + ws.velocity * (t - d.t0);
             if let Some(dt) = wall.time_of_impact(&origin_now, &ws.velocity, &r, &p.velocity, p.radius, d.t1 - t) {
@@ -727,6 +994,7 @@ impl System {
                 .unwrap_or(0.0);
             self.counters.energy_exchanged -= e_before + g_pot;
             self.counters.absorbed += 1;
+            self.floor = None;
             self.particles[i].alive = false;
             return;
         }
