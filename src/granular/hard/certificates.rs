@@ -17,9 +17,6 @@
 //! [`HORIZON_STEPS`] steps however far apart the pair stays, which bounds that rounding. The runs' bits are therefore
 //! those of re-predicting every pair at every drift start (`tests/hsdem_certificates.rs`).
 
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
-
 use crate::math::Vec3;
 
 /// A certificate expires after this many steps (so the rounding it must cover stays bounded).
@@ -74,65 +71,98 @@ pub struct Due {
     pub gen_j: u64,
 }
 
-impl Eq for Due {}
+/// Buckets in the calendar's ring: certificates last at most [`HORIZON_STEPS`] steps of one bucket width each.
+const BUCKETS: usize = 2 * HORIZON_STEPS as usize + 4;
 
-impl Ord for Due {
-    /// Reversed (the heap is a max-heap): the earliest is the greatest; ties by the pair, so the order is total.
-    fn cmp(&self, other: &Self) -> Ordering {
-        other
-            .t
-            .total_cmp(&self.t)
-            .then_with(|| other.i.cmp(&self.i))
-            .then_with(|| other.j.cmp(&self.j))
-            .then_with(|| other.gen_i.cmp(&self.gen_i))
-            .then_with(|| other.gen_j.cmp(&self.gen_j))
-    }
-}
-
-impl PartialOrd for Due {
-    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-/// Certificates, earliest expiry first (stale ones are dropped lazily, when they come due).
-#[derive(Debug, Clone, Default)]
+/// Certificates filed by expiry in a ring of buckets one step wide (a calendar queue, Brown 1988, Commun. ACM 31,
+/// 1220: filing and taking are O(1), where a heap cost a sift through thousands of entries). Stale certificates are
+/// dropped lazily, when their bucket comes due.
+#[derive(Debug, Clone)]
 pub struct Calendar {
-    heap: BinaryHeap<Due>,
+    /// Bucket width (s): the step length when the calendar was last cleared.
+    width: f64,
+    /// Absolute index (time / width) of the earliest bucket that may hold certificates; nothing is filed before it.
+    base: i64,
+    buckets: Vec<Vec<Due>>,
+    len: usize,
+}
+
+impl Default for Calendar {
+    fn default() -> Self {
+        Calendar {
+            width: 1.0,
+            base: 0,
+            buckets: vec![Vec::new(); BUCKETS],
+            len: 0,
+        }
+    }
 }
 
 impl Calendar {
-    /// Files a certificate.
-    pub fn push(&mut self, d: Due) {
-        self.heap.push(d);
+    /// The absolute bucket index of time `t`, never before the earliest bucket.
+    fn index(&self, t: f64) -> i64 {
+        let q = t / self.width;
+        // ⌊q⌋ (saturating), without the library call of `f64::floor`.
+        let i = q as i64;
+        let i = if (i as f64) > q { i - 1 } else { i };
+        i.max(self.base)
     }
 
-    /// Removes and returns every certificate that runs out at or before `t1`, in the calendar's order.
+    /// Files a certificate (one due beyond the ring goes in its last bucket and is filed again when that comes
+    /// due).
+    pub fn push(&mut self, d: Due) {
+        let idx = self.index(d.t).min(self.base + BUCKETS as i64 - 1);
+        self.buckets[idx.rem_euclid(BUCKETS as i64) as usize].push(d);
+        self.len += 1;
+    }
+
+    /// Moves into `out` every certificate that runs out at or before `t1` (in no particular order, the same on every
+    /// run); the others stay filed.
     pub fn take_due(&mut self, t1: f64, out: &mut Vec<Due>) {
         out.clear();
-        while self.heap.peek().is_some_and(|d| d.t <= t1) {
-            out.extend(self.heap.pop());
+        let last = self.index(t1);
+        let span = (last - self.base + 1).min(BUCKETS as i64);
+        let mut later = Vec::new();
+        for idx in self.base..self.base + span {
+            let bucket = &mut self.buckets[idx.rem_euclid(BUCKETS as i64) as usize];
+            for d in bucket.drain(..) {
+                if d.t <= t1 { out.push(d) } else { later.push(d) }
+            }
+        }
+        // The last bucket reached may hold certificates beyond t1: it stays the earliest.
+        self.base = last;
+        self.len -= out.len() + later.len();
+        for d in later {
+            self.push(d);
         }
     }
 
     /// Keeps only the certificates for which `keep` holds.
-    pub fn retain(&mut self, keep: impl FnMut(&Due) -> bool) {
-        self.heap.retain(keep);
+    pub fn retain(&mut self, mut keep: impl FnMut(&Due) -> bool) {
+        self.len = 0;
+        for b in &mut self.buckets {
+            b.retain(&mut keep);
+            self.len += b.len();
+        }
     }
 
-    /// Drops every certificate.
-    pub fn clear(&mut self) {
-        self.heap.clear();
+    /// Drops every certificate; buckets are `width` seconds wide (> 0) from time `t` on.
+    pub fn clear(&mut self, t: f64, width: f64) {
+        self.buckets.iter_mut().for_each(Vec::clear);
+        self.len = 0;
+        self.width = if width > 0.0 && width.is_finite() { width } else { 1.0 };
+        self.base = i64::MIN;
+        self.base = self.index(t);
     }
 
     /// Certificates filed (valid or stale).
     pub fn len(&self) -> usize {
-        self.heap.len()
+        self.len
     }
 
     /// Whether no certificate is filed.
     pub fn is_empty(&self) -> bool {
-        self.heap.is_empty()
+        self.len == 0
     }
 }
 
@@ -157,21 +187,39 @@ mod tests {
     }
 
     #[test]
-    fn calendar_takes_the_due_in_order() {
+    fn calendar_takes_the_due() {
         let mut c = Calendar::default();
-        for (t, i) in [(3.0, 0), (1.0, 5), (2.0, 1), (1.0, 2)] {
-            c.push(Due {
-                t,
-                i,
-                j: 9,
-                gen_i: 0,
-                gen_j: 0,
-            });
+        c.clear(0.0, 1.0);
+        let due = |t, i| Due {
+            t,
+            i,
+            j: 9,
+            gen_i: 0,
+            gen_j: 0,
+        };
+        for (t, i) in [(3.0, 0), (1.0, 5), (2.5, 1), (1.0, 2), (-1.0, 3), (1e6, 4)] {
+            c.push(due(t, i));
         }
         let mut out = Vec::new();
         c.take_due(2.0, &mut out);
-        let got: Vec<(f64, usize)> = out.iter().map(|d| (d.t, d.i)).collect();
-        assert_eq!(got, vec![(1.0, 2), (1.0, 5), (2.0, 1)]);
-        assert_eq!(c.len(), 1);
+        let mut got: Vec<usize> = out.iter().map(|d| d.i).collect();
+        got.sort();
+        assert_eq!(got, vec![2, 3, 5], "the due ones, including one filed late");
+        assert_eq!(c.len(), 3);
+        c.take_due(2.7, &mut out);
+        assert_eq!(
+            out.iter().map(|d| d.i).collect::<Vec<_>>(),
+            vec![1],
+            "same bucket, later time"
+        );
+        c.take_due(500.0, &mut out);
+        assert_eq!(out.iter().map(|d| d.i).collect::<Vec<_>>(), vec![0]);
+        c.take_due(2e6, &mut out);
+        assert_eq!(
+            out.iter().map(|d| d.i).collect::<Vec<_>>(),
+            vec![4],
+            "beyond the ring: refiled until due"
+        );
+        assert!(c.is_empty());
     }
 }

@@ -10,7 +10,9 @@
 //! `|a_i − a_j| < R_i + R_j + L_i + L_j` (found for all particles at once on a cell grid,
 //! [`crate::geometry::neighbours::sphere_pairs`]). A pair outside that list cannot meet while each particle stays
 //! within its allowance of its anchor. That is checked at the start of every drift (distance from the anchor plus
-//! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left). A
+//! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left); a bound
+//! on the travel under gravity gives each particle a time before which the drift-start check cannot fail, so only
+//! the particles past it are checked (`set_expiry`; the same decisions, fewer square roots). A
 //! particle that could leave its allowance is re-anchored alone at that instant: fresh anchor and allowance, its
 //! pairs found again against every other particle's (unchanged) anchor and allowance, which keeps the criterion
 //! exact for every pair (the other anchors are filed in a cell grid, [`super::anchors`], so this costs the cells
@@ -39,7 +41,7 @@
 //! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
 //! secant over the step, landing exactly on the wall's law at the step end) and act as infinite masses.
 
-use super::anchors::AnchorGrid;
+use super::anchors::{AnchorGrid, Entry};
 use super::certificates::{self, Calendar, Due};
 use super::collision::{self, Body, Restitution};
 use super::events::{Event, EventQueue, Partner};
@@ -220,6 +222,11 @@ struct Neighbours {
     grid: AnchorGrid,
     /// For each particle, the walls it may touch while it stays within its allowance (all moving walls).
     near_walls: Vec<Vec<usize>>,
+    /// The particles with near walls (any order), and where each is in that list (`usize::MAX`: absent).
+    near_list: Vec<usize>,
+    near_pos: Vec<usize>,
+    /// The particles stuck to walls (their pairs are predicted at every drift start).
+    stuck_list: Vec<usize>,
     /// Certificates of the listed pairs of free particles ([`super::certificates`]).
     calendar: Calendar,
     /// Whether every listed pair of free particles without a queued event has a certificate in the calendar (false
@@ -236,6 +243,11 @@ struct Neighbours {
     dirty: Vec<bool>,
     /// Calendar entries after its last compaction (stale entries are dropped when it grows well beyond that).
     calendar_live: usize,
+    /// For each particle, a time up to which it certainly stays within its allowance (see
+    /// [`System::set_expiry`]): a drift start ending no later skips its check. −∞ where unknown.
+    expiry: Vec<f64>,
+    /// The longest drift the expiries assume (s); a longer drift forgets them.
+    expiry_h: f64,
     /// Scratch: the certificates that came due at a drift start.
     due: Vec<Due>,
     /// Scratch: which particles are in the drift start's `pending` list.
@@ -321,30 +333,52 @@ impl System {
     fn file_all(&mut self) {
         let n = self.particles.len();
         let nb = &mut self.neighbours;
-        nb.calendar.clear();
+        nb.calendar.clear(0.0, 1.0);
         nb.calendar_live = 0;
         nb.certified = false;
         nb.pending.clear();
         nb.uncertified = vec![false; n];
         nb.dirty = vec![false; n];
         nb.mark = vec![false; n];
+        nb.expiry = vec![f64::NEG_INFINITY; n];
         if self.settings.skin_steps > 0.0 {
-            let reaches: Vec<f64> = (0..n)
-                .filter(|&k| self.particles[k].alive)
-                .map(|k| self.particles[k].radius + nb.allowances[k])
-                .collect();
-            nb.grid = AnchorGrid::new(n, AnchorGrid::reference_reach(&reaches));
-            for k in (0..n).filter(|&k| self.particles[k].alive) {
-                nb.grid
-                    .insert(k, &nb.anchors[k], self.particles[k].radius + nb.allowances[k]);
+            let particles = &self.particles;
+            let entries = (0..n).filter(|&k| particles[k].alive).map(|k| Entry {
+                anchor: nb.anchors[k],
+                radius: particles[k].radius,
+                allowance: nb.allowances[k],
+                k,
+            });
+            nb.grid = AnchorGrid::new(n, entries);
+        }
+        self.neighbours.near_walls.resize_with(n, Vec::new);
+        self.neighbours.near_list.clear();
+        self.neighbours.near_pos = vec![usize::MAX; n];
+        for k in 0..n {
+            self.update_near_walls(k);
+        }
+        self.neighbours.stuck_list = (0..n).filter(|&k| self.particles[k].stuck.is_some()).collect();
+    }
+
+    /// Finds particle `k`'s near walls again (from its anchor and allowance) and files it in the list of particles
+    /// with near walls accordingly.
+    fn update_near_walls(&mut self, k: usize) {
+        let mut near = std::mem::take(&mut self.neighbours.near_walls[k]);
+        self.walls_near(k, &mut near);
+        let nb = &mut self.neighbours;
+        let listed = nb.near_pos[k] != usize::MAX;
+        if !near.is_empty() && !listed {
+            nb.near_pos[k] = nb.near_list.len();
+            nb.near_list.push(k);
+        } else if near.is_empty() && listed {
+            let at = nb.near_pos[k];
+            nb.near_list.swap_remove(at);
+            if let Some(&moved) = nb.near_list.get(at) {
+                nb.near_pos[moved] = at;
             }
+            nb.near_pos[k] = usize::MAX;
         }
-        let mut near = std::mem::take(&mut self.neighbours.near_walls);
-        near.resize_with(n, Vec::new);
-        for (k, list) in near.iter_mut().enumerate() {
-            self.walls_near(k, list);
-        }
-        self.neighbours.near_walls = near;
+        nb.near_walls[k] = near;
     }
 
     /// The walls particle `k` may touch while it stays within its allowance of its anchor: every wall that moves,
@@ -358,7 +392,7 @@ impl System {
         for (w, wall) in self.walls.iter().enumerate() {
             let fixed = wall.motion.velocity == Vec3::zeros() && wall.motion.oscillation.is_none();
             if fixed {
-                let (dist, _) = wall.nearest(&wall.origin, &a);
+                let dist = wall.distance(&wall.origin, &a);
                 let margin = certificates::MARGIN_RELATIVE * reach + 1e-10 * (a - wall.origin).norm();
                 if dist > reach + margin {
                     continue;
@@ -393,6 +427,50 @@ impl System {
         !p.alive
             || (p.position_at(t) - self.neighbours.anchors[k]).norm() + p.velocity.norm() * (t1 - t)
                 <= self.neighbours.allowances[k]
+    }
+
+    /// Bounds when particle `k`, now at time `t` in a drift of length `h`, could first fail [`System::list_holds`]
+    /// at a drift start, assuming it does not collide (a collision sets a new bound) and no drift is longer than
+    /// `h` or the longest drift so far (a longer one forgets every bound). Between kicks a free particle moves on straight lines and the kicks add at most `|g|` times the time
+    /// elapsed plus one step to its velocity, so by a drift start whose drift ends `τ` after `t` it has moved at most
+    /// `|v| τ + |g| τ (τ/2 + h)` and the check adds at most `(|v| + |g| (τ + h)) h`; the check holds while the
+    /// distance from its anchor now plus `|g| τ² + (|v| + 2|g| h) τ + |v| h + 2|g| h²` (a little more) stays within
+    /// its allowance, less a margin far above the rounding of the positions. Capped at
+    /// [`certificates::HORIZON_STEPS`] steps so that the rounding stays bounded. Stuck particles (moved by their wall)
+    /// get −∞: they are checked at every drift start.
+    fn set_expiry(&mut self, k: usize, t: f64, h: f64) {
+        let p = &self.particles[k];
+        let nb = &self.neighbours;
+        // The longest drift seen (a landing step may be shorter than the next ones).
+        let h = h.max(nb.expiry_h);
+        let e = if !p.alive {
+            f64::INFINITY
+        } else if p.stuck.is_some() {
+            f64::NEG_INFINITY
+        } else {
+            let horizon = certificates::HORIZON_STEPS * h;
+            let v = p.velocity.norm();
+            let g = self.settings.gravity.map_or(0.0, |g| g.norm());
+            let here = p.position_at(t);
+            let l = nb.allowances[k];
+            let budget = l
+                - (here - nb.anchors[k]).norm()
+                - certificates::MARGIN_RELATIVE * l
+                - 1e-10 * (here.norm() + v * horizon + g * horizon * horizon);
+            let (a, b, c) = (g, v + 2.0 * g * h, v * h + 2.0 * g * h * h - budget);
+            let tau = if c > 0.0 {
+                f64::NEG_INFINITY
+            } else if a > 0.0 {
+                // The positive root of a τ² + b τ + c, in the form that does not cancel.
+                2.0 * (-c) / (b + (b * b - 4.0 * a * c).sqrt())
+            } else if b > 0.0 {
+                -c / b
+            } else {
+                horizon
+            };
+            t + tau.min(horizon)
+        };
+        self.neighbours.expiry[k] = e;
     }
 
     /// A fresh allowance for particle `k` listed at `t` in a drift ending at `t1` (module doc) with `skin_steps`
@@ -440,26 +518,27 @@ impl System {
         mine.clear();
         nb.anchors[k] = self.particles[k].position_at(t);
         nb.allowances[k] = l;
+        let me = Entry {
+            anchor: nb.anchors[k],
+            radius: self.particles[k].radius,
+            allowance: l,
+            k,
+        };
+        nb.grid.insert(me);
+        // The criterion of the full build, `|a_k − a_j| < (R_k + L_k) + R_j + L_j`, in the same arithmetic.
         let rk = self.particles[k].radius + l;
-        nb.grid.insert(k, &nb.anchors[k], rk);
-        let (anchors, allowances, particles) = (&nb.anchors, &nb.allowances, &self.particles);
-        nb.grid.query(&anchors[k], rk, |j| {
-            let q = &particles[j];
-            if j == k || !q.alive {
-                return;
-            }
-            let reach = rk + q.radius + allowances[j];
-            if (anchors[j] - anchors[k]).norm_squared() < reach * reach {
-                mine.push(j);
+        nb.grid.query(&me.anchor, rk, |e| {
+            let reach = rk + e.radius + e.allowance;
+            if e.k != k && (e.anchor - me.anchor).norm_squared() < reach * reach {
+                mine.push(e.k);
             }
         });
         for &j in &mine {
             nb.adjacency[j].push(k);
         }
         nb.adjacency[k] = mine;
-        let mut near = std::mem::take(&mut self.neighbours.near_walls[k]);
-        self.walls_near(k, &mut near);
-        self.neighbours.near_walls[k] = near;
+        self.update_near_walls(k);
+        self.set_expiry(k, t, d.t1 - d.t0);
     }
 
     /// Energies and momenta of the free, alive particles.
@@ -552,13 +631,26 @@ impl System {
             events: 0,
         };
         let failing: Vec<usize> = PHASE_LIST_CHECK.time(|| {
+            let mut failing = Vec::new();
             if self.neighbours.built {
-                (0..self.particles.len())
-                    .filter(|&k| !self.list_holds(k, t0, t1))
-                    .collect()
-            } else {
-                Vec::new()
+                let nb = &mut self.neighbours;
+                if t1 - t0 > nb.expiry_h {
+                    nb.expiry_h = t1 - t0;
+                    nb.expiry.iter_mut().for_each(|e| *e = f64::NEG_INFINITY);
+                }
+                for k in 0..self.particles.len() {
+                    // The exact check only where the bound of `set_expiry` does not already settle it.
+                    if t1 <= self.neighbours.expiry[k] {
+                        continue;
+                    }
+                    if self.list_holds(k, t0, t1) {
+                        self.set_expiry(k, t0, t1 - t0);
+                    } else {
+                        failing.push(k);
+                    }
+                }
             }
+            failing
         });
         let local =
             self.settings.skin_steps > 0.0 && self.neighbours.built && failing.len() * 2 <= self.particles.len();
@@ -592,6 +684,8 @@ impl System {
                     } else {
                         must_rebuild = true;
                     }
+                } else {
+                    self.set_expiry(k, t, t1 - t0);
                 }
             }
             if must_rebuild {
@@ -695,7 +789,7 @@ impl System {
         d.queue.clear();
         let certify = self.settings.skin_steps > 0.0 && self.settings.certify_pairs;
         let nb = &mut self.neighbours;
-        nb.calendar.clear();
+        nb.calendar.clear(t, d.t1 - d.t0);
         nb.certified = certify;
         for k in nb.pending.drain(..) {
             nb.uncertified[k] = false;
@@ -779,19 +873,18 @@ impl System {
             }
         }
         self.neighbours.due = due;
-        for k in 0..self.particles.len() {
-            let p = &self.particles[k];
-            if !p.alive {
-                continue;
-            }
-            if p.stuck.is_some() {
+        for sx in 0..self.neighbours.stuck_list.len() {
+            let k = self.neighbours.stuck_list[sx];
+            if self.particles[k].alive {
                 for jx in 0..self.neighbours.adjacency[k].len() {
                     let j = self.neighbours.adjacency[k][jx];
                     self.predict_pair(d, k, j, t0, false);
                 }
-            } else {
-                self.predict_walls(d, k, t0);
             }
+        }
+        for wx in 0..self.neighbours.near_list.len() {
+            let k = self.neighbours.near_list[wx];
+            self.predict_walls(d, k, t0);
         }
         // Stale certificates (a particle collided or was re-listed) wait in the calendar until they come due; when
         // they outnumber the live ones, drop them.
@@ -882,7 +975,7 @@ impl System {
 
     fn predict_walls(&self, d: &mut Drift, k: usize, t: f64) {
         let p = &self.particles[k];
-        if p.stuck.is_some() || self.neighbours.near_walls[k].is_empty() {
+        if !p.alive || p.stuck.is_some() || self.neighbours.near_walls[k].is_empty() {
             return;
         }
         let r = p.position_at(t);
@@ -995,6 +1088,7 @@ impl System {
             self.counters.energy_exchanged -= e_before + g_pot;
             self.counters.absorbed += 1;
             self.floor = None;
+            self.neighbours.grid.remove(i);
             self.particles[i].alive = false;
             return;
         }
@@ -1012,6 +1106,7 @@ impl System {
             };
             let end = self.attached_position(&att, d.t1);
             let axis_spin = wall.axis * wall.motion.spin;
+            self.neighbours.stuck_list.push(i);
             let p = &mut self.particles[i];
             p.stuck = Some(att);
             p.velocity = if d.t1 > t {
