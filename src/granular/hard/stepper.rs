@@ -35,7 +35,7 @@
 //! at every step, their pairs are simply predicted at every drift start, as before), or at every step when one is
 //! stuck (stuck particles are not kicked). Every event is still computed from the positions and
 //! velocities at the drift start or the collision, exactly as when every listed pair was predicted at every drift
-//! start (`certify_pairs = false`), so the certificates change no bit (`tests/hsdem_certificates.rs`).
+//! start (`prune_predictions = false`), so the certificates change no bit (`tests/hsdem_certificates.rs`).
 //!
 //! Overlap handling: a pair or a wall contact that touches or overlaps and approaches collides at once; no overlap is
 //! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
@@ -87,10 +87,11 @@ pub struct StepperSettings {
     /// Neighbour-list skin in steps (≥ 0): a particle's travel allowance is about `skin_steps · |v| · dt`, and it is
     /// re-listed when it could leave it. 0 = a fresh list for all at every step (the reference scheme).
     pub skin_steps: f64,
-    /// Keep pair certificates across steps ([`super::certificates`]; with `skin_steps > 0`): a drift start predicts
-    /// only the pairs whose certificates came due. `false` predicts every listed pair at every drift start (the
-    /// scheme before certificates), with the same results to the bit: the reference of `tests/hsdem_certificates.rs`.
-    pub certify_pairs: bool,
+    /// Predict only what may give an event (module doc): pair certificates kept across steps
+    /// ([`super::certificates`], with `skin_steps > 0`) and each particle's near walls. `false` predicts every listed
+    /// pair and every wall at every drift start (the scheme before), with the same results to the bit: the reference
+    /// of `tests/hsdem_certificates.rs`.
+    pub prune_predictions: bool,
 }
 
 impl Default for StepperSettings {
@@ -100,7 +101,7 @@ impl Default for StepperSettings {
             collapse_speed: 0.0,
             max_events_per_step: 10_000_000,
             skin_steps: DEFAULT_SKIN_STEPS,
-            certify_pairs: true,
+            prune_predictions: true,
         }
     }
 }
@@ -660,7 +661,7 @@ impl System {
                     self.reanchor(k, t0, &d);
                 }
             });
-            if self.neighbours.certified && self.settings.certify_pairs {
+            if self.neighbours.certified && self.settings.prune_predictions {
                 PHASE_PREDICT_START.time(|| self.predict_start(&mut d, t0));
             } else {
                 PHASE_PREDICT_START.time(|| self.predict_all(&mut d, t0));
@@ -787,7 +788,7 @@ impl System {
     /// certifying the pairs of free particles without an event in this drift when neither collided in the last one.
     fn predict_all(&mut self, d: &mut Drift, t: f64) {
         d.queue.clear();
-        let certify = self.settings.skin_steps > 0.0 && self.settings.certify_pairs;
+        let certify = self.settings.skin_steps > 0.0 && self.settings.prune_predictions;
         let nb = &mut self.neighbours;
         nb.calendar.clear(t, d.t1 - d.t0);
         nb.certified = certify;
@@ -975,11 +976,21 @@ impl System {
 
     fn predict_walls(&self, d: &mut Drift, k: usize, t: f64) {
         let p = &self.particles[k];
-        if !p.alive || p.stuck.is_some() || self.neighbours.near_walls[k].is_empty() {
+        if !p.alive
+            || p.stuck.is_some()
+            || (self.settings.prune_predictions && self.neighbours.near_walls[k].is_empty())
+        {
             return;
         }
         let r = p.position_at(t);
-        for &w in &self.neighbours.near_walls[k] {
+        let all: Vec<usize>;
+        let walls = if self.settings.prune_predictions {
+            &self.neighbours.near_walls[k]
+        } else {
+            all = (0..self.walls.len()).collect();
+            &all
+        };
+        for &w in walls {
             let wall = &self.walls[w];
             let ws = d.walls[w];
             let origin_now = ws.origin0 + ws.velocity * (t - d.t0);
