@@ -34,6 +34,10 @@ pub struct BenchHsdemArgs {
     /// Write this CSV (one row: the counts, times and rates, then one column of seconds per phase).
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
+    /// Time without the phase probes (they read the clock twice per event: about 10 % of a collision-dominated run
+    /// such as a dense drum, under 2 % of the model atmosphere).
+    #[arg(long)]
+    pub no_phases: bool,
 }
 
 /// What one timed stretch of a hard-sphere run did and cost.
@@ -99,8 +103,15 @@ fn step_to(system: &mut System, dt: f64, t: f64) -> Result<u64, BenchError> {
 }
 
 /// Runs the hard-sphere scene at `scene` on a pool of `threads` threads from t = 0 to `t_end` (default the scene's),
-/// timing the steps from `t_from` on, with the stepper's phase timers on.
-pub fn time_scene(scene: &Path, t_from: f64, t_end: Option<f64>, threads: usize) -> Result<HsdemTiming, BenchError> {
+/// timing the steps from `t_from` on, with the stepper's phase timers on if `phases` (then
+/// [`HsdemTiming::phases`] is filled; the probes cost a little, see [`BenchHsdemArgs::no_phases`]).
+pub fn time_scene(
+    scene: &Path,
+    t_from: f64,
+    t_end: Option<f64>,
+    threads: usize,
+    phases: bool,
+) -> Result<HsdemTiming, BenchError> {
     let sc = load_hard_scene(scene).map_err(|e| BenchError::usage(e.to_string()))?;
     let t_end = t_end.unwrap_or(sc.t_end);
     if !(t_from.is_finite() && t_from >= 0.0 && t_end.is_finite() && t_end > t_from) {
@@ -120,7 +131,7 @@ pub fn time_scene(scene: &Path, t_from: f64, t_end: Option<f64>, threads: usize)
         step_to(&mut system, sc.dt, t_from)?;
         let before = system.counters;
         let was_on = phase::enabled();
-        phase::enable(true);
+        phase::enable(phases);
         let hard_before: Vec<(&'static str, f64)> = phase::split("hard.")
             .0
             .into_iter()
@@ -139,6 +150,7 @@ pub fn time_scene(scene: &Path, t_from: f64, t_end: Option<f64>, threads: usize)
                 let earlier = hard_before.iter().find(|(n, _)| *n == t.name).map_or(0.0, |x| x.1);
                 (t.name, t.seconds - earlier)
             })
+            .filter(|(_, s)| phases && *s > 0.0)
             .collect();
         let c = system.counters;
         let collisions = |c: &crate::granular::hard::stepper::Counters| c.pair_collisions + c.wall_collisions;
@@ -158,15 +170,16 @@ pub fn time_scene(scene: &Path, t_from: f64, t_end: Option<f64>, threads: usize)
 }
 
 /// The model atmosphere's speed as the scaling benchmark wants it: `(collisions, steps, wall seconds)` of the whole
-/// run of the scene at `scene` to `t_end` (default the scene's) on `threads` threads.
+/// run of the scene at `scene` to `t_end` (default the scene's) on `threads` threads, phase timers as they are (off
+/// unless the caller turned them on with [`phase::enable`]).
 pub fn time_atmosphere(scene: &Path, t_end: Option<f64>, threads: usize) -> Result<(u64, u64, f64), BenchError> {
-    let t = time_scene(scene, 0.0, t_end, threads)?;
+    let t = time_scene(scene, 0.0, t_end, threads, phase::enabled())?;
     Ok((t.collisions, t.steps, t.wall_seconds))
 }
 
 /// `rubblepile bench hsdem`: times the scene, prints the rates and the phase split, writes the CSV.
 pub fn bench(args: &BenchHsdemArgs) -> Result<(), BenchError> {
-    let t = time_scene(&args.scene, args.from, args.t_end, args.threads)?;
+    let t = time_scene(&args.scene, args.from, args.t_end, args.threads, !args.no_phases)?;
     let cpu = t.cpu_seconds.map_or("unknown".to_string(), |c| format!("{c:.3} s"));
     println!(
         "{}: t = {} .. {} s, {} steps, {} collisions ({} pair), {} re-listings, {} list builds",

@@ -693,8 +693,13 @@ impl System {
                 self.rebuild(&mut d, t);
             } else {
                 PHASE_REPREDICT.time(|| {
-                    for k in involved.into_iter().flatten() {
-                        self.predict(&mut d, k, t);
+                    let [first, second] = involved;
+                    if let Some(i) = first {
+                        self.predict(&mut d, i, t, None);
+                    }
+                    if let Some(j) = second {
+                        // The pair itself was predicted from the first side (the same event, bit for bit).
+                        self.predict(&mut d, j, t, first);
                     }
                 });
             }
@@ -911,13 +916,16 @@ impl System {
     }
 
     /// Re-predicts particle `k` against its neighbours and the walls at time `t`.
-    fn predict(&mut self, d: &mut Drift, k: usize, t: f64) {
+    /// (The pair with `done`, already predicted from the other side, is skipped: it would queue the same event.)
+    fn predict(&mut self, d: &mut Drift, k: usize, t: f64, done: Option<usize>) {
         if !self.particles[k].alive {
             return;
         }
         for jx in 0..self.neighbours.adjacency[k].len() {
             let j = self.neighbours.adjacency[k][jx];
-            self.predict_pair(d, k, j, t, false);
+            if Some(j) != done {
+                self.predict_pair(d, k, j, t, false);
+            }
         }
         self.predict_walls(d, k, t);
     }
