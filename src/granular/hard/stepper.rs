@@ -72,7 +72,8 @@ static PHASE_ADVANCE: Phase = Phase::new("hard.advance", Kind::Serial);
 
 /// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 8, 16, 32 and 64 cost 3.7,
 /// 2.4, 2.0 and 1.9 s of CPU for 5000 steps against 8.8 s with a fresh list every step
-/// (`analysis/richardson2011/NOTES.md`); 16 keeps the lists shorter in dense piles.
+/// (`analysis/richardson2011/NOTES.md`, 22 Nov 2026, before the certificates and the anchor grid); 16 keeps the lists
+/// shorter in dense piles.
 pub const DEFAULT_SKIN_STEPS: f64 = 16.0;
 
 /// Settings of the stepper.
