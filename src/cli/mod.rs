@@ -285,6 +285,8 @@ pub enum BenchCommand {
     /// Strong scaling of every engine at 1, 2, 4, … threads: speed-up, efficiency, Karp–Flatt serial fraction,
     /// where the time goes (CSV + plot).
     Scaling(crate::bench::scaling::ScalingArgs),
+    /// Hard-sphere engine speed (collisions and steps per CPU second, time per stepper phase) on a scene.
+    Hsdem(crate::bench::hsdem::BenchHsdemArgs),
     /// Run the stability suite (impacts above the calibrated speed, needles and plates, mass ratio 1e-6,
     /// θ = 0, F0 = 100, κ sweep, cloud collapse, resting contact) and write stability.csv/.md.
     Stability(stability::StabilityArgs),
@@ -391,6 +393,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         }
         Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
         Command::Bench(BenchCommand::Scaling(args)) => Ok(crate::bench::scaling::scaling(&args)?),
+        Command::Bench(BenchCommand::Hsdem(args)) => Ok(crate::bench::hsdem::bench(&args)?),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
         Command::Bench(BenchCommand::Stability(args)) => stability::stability(&args),
         Command::Bench(BenchCommand::Tolerance(args)) => {

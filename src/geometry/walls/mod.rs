@@ -120,6 +120,27 @@ impl Shape {
         }
     }
 
+    /// Distance from `p` (wall frame) to the surface: the distance of [`Shape::nearest`] without its normal (a
+    /// neighbour list asks this of every wall at every re-listing, and the normal costs divisions).
+    pub fn distance(&self, p: &Vec3) -> f64 {
+        let rho = || (p.x * p.x + p.y * p.y).sqrt();
+        // √(a² + b²) without the library's `hypot` (no over- or underflow at the sizes of walls and particles).
+        let len = |a: f64, b: f64| if b == 0.0 { a.abs() } else { (a * a + b * b).sqrt() };
+        // Axial distance beyond a finite length.
+        let beyond = |length: Option<f64>| length.map_or(0.0, |l| (p.z.abs() - 0.5 * l).max(0.0));
+        match *self {
+            Shape::Plane => p.z.abs(),
+            Shape::Disk { radius } => {
+                let r = rho();
+                if r <= radius { p.z.abs() } else { len(r - radius, p.z) }
+            }
+            Shape::Cylinder { radius, length } => len(rho() - radius, beyond(length)),
+            Shape::Ring { radius } => len(rho() - radius, p.z),
+            Shape::Point => p.norm(),
+            Shape::Line { length } => len(rho(), beyond(length)),
+        }
+    }
+
     /// First time in `(0, t_max]` at which a sphere of radius `s` at `p + d t` (wall frame) touches the surface
     /// coming from outside it.
     pub fn toi(&self, p: &Vec3, d: &Vec3, s: f64, t_max: f64) -> Option<f64> {
@@ -203,6 +224,12 @@ impl Wall {
         (dist, self.to_world(&n))
     }
 
+    /// Distance (m) from the world point `r` to the surface when the reference point is at `origin_now` (that of
+    /// [`Wall::nearest`], without the normal).
+    pub fn distance(&self, origin_now: &Vec3, r: &Vec3) -> f64 {
+        self.shape.distance(&self.to_local(&(r - origin_now)))
+    }
+
     /// Time (s, in `[0, t_max]`) until a sphere of radius `s` at `r` with velocity `v` touches the wall whose
     /// reference point is now at `origin_now` and moves with `wall_velocity`; `None` if not within `t_max`.
     /// A sphere already touching (gap ≤ [`TOUCH_TOLERANCE`]·s) or overlapping and approaching gives 0.
@@ -232,5 +259,45 @@ impl Wall {
     /// is at `origin_now` and translates with `wall_velocity`: translation plus the spin `Ω â × ρ`.
     pub fn surface_velocity(&self, origin_now: &Vec3, wall_velocity: &Vec3, x: &Vec3) -> Vec3 {
         wall_velocity + self.axis.cross(&(x - origin_now)) * self.motion.spin
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `distance` is the distance of `nearest` for every primitive, inside and outside, on and off the axis.
+    #[test]
+    fn distance_matches_nearest() {
+        let shapes = [
+            Shape::Plane,
+            Shape::Disk { radius: 0.7 },
+            Shape::Cylinder {
+                radius: 0.8,
+                length: None,
+            },
+            Shape::Cylinder {
+                radius: 0.8,
+                length: Some(1.3),
+            },
+            Shape::Ring { radius: 0.6 },
+            Shape::Point,
+            Shape::Line { length: None },
+            Shape::Line { length: Some(0.9) },
+        ];
+        let mut seed = 99u64;
+        let mut rnd = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0
+        };
+        for shape in shapes {
+            let mut points: Vec<Vec3> = (0..500).map(|_| Vec3::new(rnd(), rnd(), rnd())).collect();
+            points.extend([Vec3::zeros(), Vec3::new(0.0, 0.0, 1.5), Vec3::new(0.6, 0.0, 0.0)]);
+            for p in points {
+                let (d, _) = shape.nearest(&p);
+                let e = shape.distance(&p);
+                assert!((d - e).abs() <= 1e-14 * (1.0 + d), "{shape:?} at {p:?}: {e} vs {d}");
+            }
+        }
     }
 }

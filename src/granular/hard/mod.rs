@@ -3,6 +3,8 @@
 //! primitives ([`crate::geometry::walls`]), kick–drift–kick stepping with predicted collisions inside each drift.
 //!
 //! - [`particle`]: the sphere state;
+//! - [`anchors`]: the cell grid of the neighbour list's anchors (re-listing one particle);
+//! - [`certificates`]: pair certificates kept across steps (which pairs a drift start must predict);
 //! - [`collision`]: collision resolution (particle–particle and particle–wall) and the inelastic-collapse guard;
 //! - [`events`]: the priority queue of predicted collisions;
 //! - [`stepper`]: the stepping and event loop;
@@ -28,8 +30,11 @@
 //!
 //! **Stepping (§2.1).** Kick–drift–kick leapfrog with uniform gravity in the kicks only, so that drifts are straight
 //! lines; within a drift the globally earliest predicted event is processed and only the particles it involved are
-//! re-predicted, until the step ends.
+//! re-predicted, until the step ends. Since a uniform kick changes no relative velocity, pairs of free particles
+//! keep certificates across steps and a drift start re-predicts only those that came due ([`certificates`]).
 
+pub mod anchors;
+pub mod certificates;
 pub mod collision;
 pub mod events;
 pub mod particle;

@@ -514,6 +514,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             collapse_speed,
             max_events_per_step: file.stepping.max_events_per_step,
             skin_steps,
+            prune_predictions: true,
         },
         times,
         every,

@@ -10,31 +10,70 @@
 //! `|a_i − a_j| < R_i + R_j + L_i + L_j` (found for all particles at once on a cell grid,
 //! [`crate::geometry::neighbours::sphere_pairs`]). A pair outside that list cannot meet while each particle stays
 //! within its allowance of its anchor. That is checked at the start of every drift (distance from the anchor plus
-//! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left). A
+//! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left); a bound
+//! on the travel under gravity gives each particle a time before which the drift-start check cannot fail, so only
+//! the particles past it are checked (`set_expiry`; the same decisions, fewer square roots). A
 //! particle that could leave its allowance is re-anchored alone at that instant: fresh anchor and allowance, its
 //! pairs found again against every other particle's (unchanged) anchor and allowance, which keeps the criterion
-//! exact for every pair. When more than half of the particles fail at a drift start, the whole list is built
-//! afresh instead (with skins spread over [0.5, 1.5) × `skin_steps` so that they do not all expire together). So no collision is ever missed, whatever the kicks and collisions do to the speeds.
+//! exact for every pair (the other anchors are filed in a cell grid, [`super::anchors`], so this costs the cells
+//! around the particle, not a pass over all particles). When more than half of the particles fail at a drift start,
+//! the whole list is built afresh instead (with skins spread over [0.5, 1.5) × `skin_steps` so that they do not all
+//! expire together). So no collision is ever missed, whatever the kicks and collisions do to the speeds.
 //! `L_k = max(min(skin_steps · |v_k| · h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))` (at least 1e-3 of the
 //! smallest radius), so a particle is re-listed about every `skin_steps` steps, slow particles in dense regions keep
-//! small allowances and no allowance exceeds a radius more than the drift needs (large skins only grow the lists). `skin_steps = 0` is the old scheme (one allowance `2 v_max h` for all and a fresh list at every step
-//! and whenever a particle fails), kept as the reference of the regression test `tests/hsdem_neighbours.rs`.
-//! Every kick changes every velocity, so all pairs of the list are re-predicted at each drift start.
+//! small allowances and no allowance exceeds a radius more than the drift needs (large skins only grow the lists).
+//! `skin_steps = 0` is the old scheme (one allowance `2 v_max h` for all and a fresh list at every step and whenever a
+//! particle fails), kept as the reference of the regression test `tests/hsdem_neighbours.rs`. The same allowance
+//! also lists each particle's near walls: a fixed wall farther than `R_k + L_k` from the anchor cannot be touched
+//! before the particle is re-listed, so only moving walls and near ones are predicted.
+//!
+//! What a drift start predicts. Every kick changes every velocity, so every wall contact is predicted afresh at each
+//! drift start (from the near walls). Pairs are not: a uniform kick changes no relative velocity, so a pair of free
+//! particles keeps a certificate across steps (the earliest time it can come within reach, [`super::certificates`])
+//! and is predicted afresh only when that comes due, at the first drift start after either particle collided or was
+//! re-listed (certified there unless a particle collided in the last drift: in a dense pile, where particles collide
+//! at every step, their pairs are simply predicted at every drift start, as before), or at every step when one is
+//! stuck (stuck particles are not kicked). Every event is still computed from the positions and
+//! velocities at the drift start or the collision, exactly as when every listed pair was predicted at every drift
+//! start (`prune_predictions = false`), so the certificates change no bit (`tests/hsdem_certificates.rs`).
 //!
 //! Overlap handling: a pair or a wall contact that touches or overlaps and approaches collides at once; no overlap is
 //! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
 //! secant over the step, landing exactly on the wall's law at the step end) and act as infinite masses.
 
+use super::anchors::{AnchorGrid, Entry};
+use super::certificates::{self, Calendar, Due};
 use super::collision::{self, Body, Restitution};
 use super::events::{Event, EventQueue, Partner};
 use super::particle::{Attachment, Particle};
 use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::walls::Wall;
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
+
+// Where a step's time goes (`rubblepile bench hsdem` prints the split; `crate::phase`). The phases are leaves: the
+// event loop is timed piece by piece so that re-listing inside it is not counted twice.
+/// Both half kicks, the stuck particles' secants and the finiteness check.
+static PHASE_KICK: Phase = Phase::new("hard.kick", Kind::Serial);
+/// The drift start's check of every particle against its neighbour-list allowance.
+static PHASE_LIST_CHECK: Phase = Phase::new("hard.list_check", Kind::Serial);
+/// Re-listing single particles (at drift starts and after collisions).
+static PHASE_RELIST: Phase = Phase::new("hard.relist", Kind::Serial);
+/// Full neighbour-list builds (the cell grid of all anchors).
+static PHASE_REBUILD: Phase = Phase::new("hard.rebuild", Kind::Serial);
+/// The drift start's predictions of every listed pair and wall contact.
+static PHASE_PREDICT_START: Phase = Phase::new("hard.predict_start", Kind::Serial);
+/// The event loop: popping events and applying collisions.
+static PHASE_EVENTS: Phase = Phase::new("hard.events", Kind::Serial);
+/// Re-predicting the particles of each processed event.
+static PHASE_REPREDICT: Phase = Phase::new("hard.repredict", Kind::Serial);
+/// Moving every particle to the end of the drift.
+static PHASE_ADVANCE: Phase = Phase::new("hard.advance", Kind::Serial);
 
 /// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 8, 16, 32 and 64 cost 3.7,
 /// 2.4, 2.0 and 1.9 s of CPU for 5000 steps against 8.8 s with a fresh list every step
-/// (`analysis/richardson2011/NOTES.md`); 16 keeps the lists shorter in dense piles.
+/// (`analysis/richardson2011/NOTES.md`, 22 Nov 2026, before the certificates and the anchor grid); 16 keeps the lists
+/// shorter in dense piles.
 pub const DEFAULT_SKIN_STEPS: f64 = 16.0;
 
 /// Settings of the stepper.
@@ -49,6 +88,11 @@ pub struct StepperSettings {
     /// Neighbour-list skin in steps (≥ 0): a particle's travel allowance is about `skin_steps · |v| · dt`, and it is
     /// re-listed when it could leave it. 0 = a fresh list for all at every step (the reference scheme).
     pub skin_steps: f64,
+    /// Predict only what may give an event (module doc): pair certificates kept across steps
+    /// ([`super::certificates`], with `skin_steps > 0`) and each particle's near walls. `false` predicts every listed
+    /// pair and every wall at every drift start (the scheme before), with the same results to the bit: the reference
+    /// of `tests/hsdem_certificates.rs`.
+    pub prune_predictions: bool,
 }
 
 impl Default for StepperSettings {
@@ -58,6 +102,7 @@ impl Default for StepperSettings {
             collapse_speed: 0.0,
             max_events_per_step: 10_000_000,
             skin_steps: DEFAULT_SKIN_STEPS,
+            prune_predictions: true,
         }
     }
 }
@@ -156,6 +201,11 @@ pub struct System {
     /// Counters since t = 0.
     pub counters: Counters,
     gens: Vec<u64>,
+    /// Certificate generations: bumped when a particle collides or is re-listed, which ends its pairs'
+    /// certificates ([`super::certificates`]).
+    cert_gens: Vec<u64>,
+    /// The allowance floor, 1e-3 of the smallest alive radius, once computed (cleared when a particle dies).
+    floor: Option<f64>,
     neighbours: Neighbours,
 }
 
@@ -170,6 +220,40 @@ struct Neighbours {
     anchors: Vec<Vec3>,
     /// Travel allowances (m).
     allowances: Vec<f64>,
+    /// The anchors by cell, for re-listing one particle (empty for the reference scheme `skin_steps = 0`).
+    grid: AnchorGrid,
+    /// For each particle, the walls it may touch while it stays within its allowance (all moving walls).
+    near_walls: Vec<Vec<usize>>,
+    /// The particles with near walls (any order), and where each is in that list (`usize::MAX`: absent).
+    near_list: Vec<usize>,
+    near_pos: Vec<usize>,
+    /// The particles stuck to walls (their pairs are predicted at every drift start).
+    stuck_list: Vec<usize>,
+    /// Certificates of the listed pairs of free particles ([`super::certificates`]).
+    calendar: Calendar,
+    /// Whether every listed pair of free particles without a queued event has a certificate in the calendar (false
+    /// after a build or a restore until everything has been predicted once).
+    certified: bool,
+    /// Particles whose pairs have no certificates (they collided or were re-listed since they last had a clean
+    /// drift start): the next drift start predicts all their pairs. Every listed pair of free particles has a valid
+    /// certificate in the calendar, an event in the queue, or a particle in this list.
+    pending: Vec<usize>,
+    /// Whether each particle is in `pending`.
+    uncertified: Vec<bool>,
+    /// Whether each particle collided in the current drift (its pairs are then predicted at the next drift start
+    /// without certificates: one that collides at every step, in a dense pile, would only fill the calendar).
+    dirty: Vec<bool>,
+    /// Calendar entries after its last compaction (stale entries are dropped when it grows well beyond that).
+    calendar_live: usize,
+    /// For each particle, a time up to which it certainly stays within its allowance (see
+    /// [`System::set_expiry`]): a drift start ending no later skips its check. −∞ where unknown.
+    expiry: Vec<f64>,
+    /// The longest drift the expiries assume (s); a longer drift forgets them.
+    expiry_h: f64,
+    /// Scratch: the certificates that came due at a drift start.
+    due: Vec<Due>,
+    /// Scratch: which particles are in the drift start's `pending` list.
+    mark: Vec<bool>,
 }
 
 /// What a checkpoint needs of the neighbour list to continue bit for bit: the anchors and allowances of the current
@@ -180,6 +264,12 @@ pub struct NeighbourState {
     pub anchors: Vec<Vec3>,
     /// Travel allowances (m), one per particle.
     pub allowances: Vec<f64>,
+}
+
+/// An event the loop applied: its time and the particles it involved.
+struct Applied {
+    t: f64,
+    involved: [Option<usize>; 2],
 }
 
 /// Working state of one drift.
@@ -202,6 +292,8 @@ impl System {
             t: 0.0,
             counters: Counters::default(),
             gens: vec![0; n],
+            cert_gens: vec![0; n],
+            floor: None,
             neighbours: Neighbours::default(),
         }
     }
@@ -233,7 +325,83 @@ impl System {
         self.neighbours.allowances = st.allowances;
         self.neighbours.adjacency = self.candidate_pairs();
         self.neighbours.built = true;
+        self.floor = None;
+        self.file_all();
         Ok(())
+    }
+
+    /// After a full build: files every anchor in the cell grid, finds every particle's near walls, and empties the
+    /// calendar (the next drift start predicts everything).
+    fn file_all(&mut self) {
+        let n = self.particles.len();
+        let nb = &mut self.neighbours;
+        nb.calendar.clear(0.0, 1.0);
+        nb.calendar_live = 0;
+        nb.certified = false;
+        nb.pending.clear();
+        nb.uncertified = vec![false; n];
+        nb.dirty = vec![false; n];
+        nb.mark = vec![false; n];
+        nb.expiry = vec![f64::NEG_INFINITY; n];
+        if self.settings.skin_steps > 0.0 {
+            let particles = &self.particles;
+            let entries = (0..n).filter(|&k| particles[k].alive).map(|k| Entry {
+                anchor: nb.anchors[k],
+                radius: particles[k].radius,
+                allowance: nb.allowances[k],
+                k,
+            });
+            nb.grid = AnchorGrid::new(n, entries);
+        }
+        self.neighbours.near_walls.resize_with(n, Vec::new);
+        self.neighbours.near_list.clear();
+        self.neighbours.near_pos = vec![usize::MAX; n];
+        for k in 0..n {
+            self.update_near_walls(k);
+        }
+        self.neighbours.stuck_list = (0..n).filter(|&k| self.particles[k].stuck.is_some()).collect();
+    }
+
+    /// Finds particle `k`'s near walls again (from its anchor and allowance) and files it in the list of particles
+    /// with near walls accordingly.
+    fn update_near_walls(&mut self, k: usize) {
+        let mut near = std::mem::take(&mut self.neighbours.near_walls[k]);
+        self.walls_near(k, &mut near);
+        let nb = &mut self.neighbours;
+        let listed = nb.near_pos[k] != usize::MAX;
+        if !near.is_empty() && !listed {
+            nb.near_pos[k] = nb.near_list.len();
+            nb.near_list.push(k);
+        } else if near.is_empty() && listed {
+            let at = nb.near_pos[k];
+            nb.near_list.swap_remove(at);
+            if let Some(&moved) = nb.near_list.get(at) {
+                nb.near_pos[moved] = at;
+            }
+            nb.near_pos[k] = usize::MAX;
+        }
+        nb.near_walls[k] = near;
+    }
+
+    /// The walls particle `k` may touch while it stays within its allowance of its anchor: every wall that moves,
+    /// and each fixed one within the particle's radius plus allowance of the anchor (plus a margin far above the
+    /// rounding of the distance), since a wall's distance changes no faster than the centre moves. Skipping the
+    /// others changes no prediction: their time of impact would be none.
+    fn walls_near(&self, k: usize, out: &mut Vec<usize>) {
+        out.clear();
+        let a = self.neighbours.anchors[k];
+        let reach = self.particles[k].radius + self.neighbours.allowances[k];
+        for (w, wall) in self.walls.iter().enumerate() {
+            let fixed = wall.motion.velocity == Vec3::zeros() && wall.motion.oscillation.is_none();
+            if fixed {
+                let dist = wall.distance(&wall.origin, &a);
+                let margin = certificates::MARGIN_RELATIVE * reach + 1e-10 * (a - wall.origin).norm();
+                if dist > reach + margin {
+                    continue;
+                }
+            }
+            out.push(w);
+        }
     }
 
     /// Candidate partners from the anchors and the allowance of the current list.
@@ -263,6 +431,50 @@ impl System {
                 <= self.neighbours.allowances[k]
     }
 
+    /// Bounds when particle `k`, now at time `t` in a drift of length `h`, could first fail [`System::list_holds`]
+    /// at a drift start, assuming it does not collide (a collision sets a new bound) and no drift is longer than
+    /// `h` or the longest drift so far (a longer one forgets every bound). Between kicks a free particle moves on straight lines and the kicks add at most `|g|` times the time
+    /// elapsed plus one step to its velocity, so by a drift start whose drift ends `τ` after `t` it has moved at most
+    /// `|v| τ + |g| τ (τ/2 + h)` and the check adds at most `(|v| + |g| (τ + h)) h`; the check holds while the
+    /// distance from its anchor now plus `|g| τ² + (|v| + 2|g| h) τ + |v| h + 2|g| h²` (a little more) stays within
+    /// its allowance, less a margin far above the rounding of the positions. Capped at
+    /// [`certificates::HORIZON_STEPS`] steps so that the rounding stays bounded. Stuck particles (moved by their wall)
+    /// get −∞: they are checked at every drift start.
+    fn set_expiry(&mut self, k: usize, t: f64, h: f64) {
+        let p = &self.particles[k];
+        let nb = &self.neighbours;
+        // The longest drift seen (a landing step may be shorter than the next ones).
+        let h = h.max(nb.expiry_h);
+        let e = if !p.alive {
+            f64::INFINITY
+        } else if p.stuck.is_some() {
+            f64::NEG_INFINITY
+        } else {
+            let horizon = certificates::HORIZON_STEPS * h;
+            let v = p.velocity.norm();
+            let g = self.settings.gravity.map_or(0.0, |g| g.norm());
+            let here = p.position_at(t);
+            let l = nb.allowances[k];
+            let budget = l
+                - (here - nb.anchors[k]).norm()
+                - certificates::MARGIN_RELATIVE * l
+                - 1e-10 * (here.norm() + v * horizon + g * horizon * horizon);
+            let (a, b, c) = (g, v + 2.0 * g * h, v * h + 2.0 * g * h * h - budget);
+            let tau = if c > 0.0 {
+                f64::NEG_INFINITY
+            } else if a > 0.0 {
+                // The positive root of a τ² + b τ + c, in the form that does not cancel.
+                2.0 * (-c) / (b + (b * b - 4.0 * a * c).sqrt())
+            } else if b > 0.0 {
+                -c / b
+            } else {
+                horizon
+            };
+            t + tau.min(horizon)
+        };
+        self.neighbours.expiry[k] = e;
+    }
+
     /// A fresh allowance for particle `k` listed at `t` in a drift ending at `t1` (module doc) with `skin_steps`
     /// scaled by `stagger`, at least `floor`.
     fn allowance(&self, k: usize, t: f64, t1: f64, h: f64, floor: f64, stagger: f64) -> f64 {
@@ -274,41 +486,61 @@ impl System {
         skin.max(v * (t1 - t)).max(floor)
     }
 
-    /// 1e-3 of the smallest radius: keeps resting particles from being re-listed at every collision.
-    fn allowance_floor(&self) -> f64 {
+    /// 1e-3 of the smallest alive radius: keeps resting particles from being re-listed at every collision. Kept
+    /// until a particle dies (a pass over all particles at every re-listing cost more than the re-listing).
+    fn allowance_floor(&mut self) -> f64 {
+        if let Some(f) = self.floor {
+            return f;
+        }
         let r_min = self
             .particles
             .iter()
             .filter(|p| p.alive)
             .map(|p| p.radius)
             .fold(f64::INFINITY, f64::min);
-        if r_min.is_finite() { 1e-3 * r_min } else { 0.0 }
+        let f = if r_min.is_finite() { 1e-3 * r_min } else { 0.0 };
+        self.floor = Some(f);
+        f
     }
 
     /// Re-lists particle `k` alone at `t`: fresh anchor and allowance, its pairs found against every other alive
     /// particle's anchor and allowance (the criterion of [`sphere_pairs`], so the list stays what a full build from
-    /// the same anchors would give).
+    /// the same anchors would give; the candidates come from the cell grid of anchors, [`AnchorGrid`]), its near
+    /// walls found again, and its pairs' certificates ended.
     fn reanchor(&mut self, k: usize, t: f64, d: &Drift) {
         self.counters.reanchors += 1;
+        self.uncertify(k);
         let floor = self.allowance_floor();
         let l = self.allowance(k, t, d.t1, d.t1 - d.t0, floor, 1.0);
         let nb = &mut self.neighbours;
-        for j in std::mem::take(&mut nb.adjacency[k]) {
+        let mut mine = std::mem::take(&mut nb.adjacency[k]);
+        for &j in &mine {
             nb.adjacency[j].retain(|&x| x != k);
         }
+        mine.clear();
         nb.anchors[k] = self.particles[k].position_at(t);
         nb.allowances[k] = l;
+        let me = Entry {
+            anchor: nb.anchors[k],
+            radius: self.particles[k].radius,
+            allowance: l,
+            k,
+        };
+        nb.grid.insert(me);
+        // The criterion of the full build, `|a_k − a_j| < (R_k + L_k) + R_j + L_j`, in the same arithmetic.
         let rk = self.particles[k].radius + l;
-        for (j, q) in self.particles.iter().enumerate() {
-            if j == k || !q.alive {
-                continue;
+        nb.grid.query(&me.anchor, rk, |e| {
+            let reach = rk + e.radius + e.allowance;
+            if e.k != k && (e.anchor - me.anchor).norm_squared() < reach * reach {
+                mine.push(e.k);
             }
-            let reach = rk + q.radius + nb.allowances[j];
-            if (nb.anchors[j] - nb.anchors[k]).norm_squared() < reach * reach {
-                nb.adjacency[k].push(j);
-                nb.adjacency[j].push(k);
-            }
+        });
+        for &j in &mine {
+            nb.adjacency[j].push(k);
         }
+        nb.adjacency[k] = mine;
+        self.update_near_walls(k);
+        self.set_expiry(k, t, d.t1 - d.t0);
     }
 
     /// Energies and momenta of the free, alive particles.
@@ -345,25 +577,35 @@ impl System {
     pub fn step(&mut self, h: f64) -> Result<(), StepError> {
         let t0 = self.t;
         let t1 = t0 + h;
-        self.kick(0.5 * h);
-        // Stuck particles follow their wall on the secant of this step.
-        for k in 0..self.particles.len() {
-            if let (true, Some(a)) = (self.particles[k].alive, self.particles[k].stuck) {
-                let end = self.attached_position(&a, t1);
-                let p = &mut self.particles[k];
-                p.velocity = (end - p.position) / h;
-                p.spin = self.walls[a.wall].axis * self.walls[a.wall].motion.spin;
+        PHASE_KICK.time(|| {
+            self.kick(0.5 * h);
+            // Stuck particles follow their wall on the secant of this step.
+            for k in 0..self.particles.len() {
+                if let Particle {
+                    alive: true,
+                    stuck: Some(a),
+                    ..
+                } = self.particles[k]
+                {
+                    let end = self.attached_position(&a, t1);
+                    let p = &mut self.particles[k];
+                    p.velocity = (end - p.position) / h;
+                    p.spin = self.walls[a.wall].axis * self.walls[a.wall].motion.spin;
+                }
             }
-        }
+        });
         self.drift(t0, t1)?;
-        self.kick(0.5 * h);
-        self.t = t1;
-        for p in self.particles.iter().filter(|p| p.alive) {
-            if !(p.position.iter().all(|x| x.is_finite()) && p.velocity.iter().all(|x| x.is_finite())) {
-                return Err(StepError::NonFinite { id: p.id, t: t1 });
+        PHASE_KICK.time(|| {
+            self.kick(0.5 * h);
+            self.t = t1;
+            let finite = |v: &Vec3| v.x.is_finite() && v.y.is_finite() && v.z.is_finite();
+            for p in &self.particles {
+                if p.alive && !(finite(&p.position) && finite(&p.velocity)) {
+                    return Err(StepError::NonFinite { id: p.id, t: t1 });
+                }
             }
-        }
-        Ok(())
+            Ok(())
+        })
     }
 
     fn kick(&mut self, dt: f64) {
@@ -390,26 +632,99 @@ impl System {
             queue: EventQueue::new(),
             events: 0,
         };
-        let failing: Vec<usize> = if self.neighbours.built {
-            (0..self.particles.len())
-                .filter(|&k| !self.list_holds(k, t0, t1))
-                .collect()
-        } else {
-            Vec::new()
-        };
+        let failing: Vec<usize> = PHASE_LIST_CHECK.time(|| {
+            let mut failing = Vec::new();
+            if self.neighbours.built {
+                let nb = &mut self.neighbours;
+                if t1 - t0 > nb.expiry_h {
+                    nb.expiry_h = t1 - t0;
+                    nb.expiry.iter_mut().for_each(|e| *e = f64::NEG_INFINITY);
+                }
+                for k in 0..self.particles.len() {
+                    // The exact check only where the bound of `set_expiry` does not already settle it.
+                    if t1 <= self.neighbours.expiry[k] {
+                        continue;
+                    }
+                    if self.list_holds(k, t0, t1) {
+                        self.set_expiry(k, t0, t1 - t0);
+                    } else {
+                        failing.push(k);
+                    }
+                }
+            }
+            failing
+        });
         let local =
             self.settings.skin_steps > 0.0 && self.neighbours.built && failing.len() * 2 <= self.particles.len();
         if local {
-            for k in failing {
-                self.reanchor(k, t0, &d);
+            PHASE_RELIST.time(|| {
+                for &k in &failing {
+                    self.reanchor(k, t0, &d);
+                }
+            });
+            if self.neighbours.certified && self.settings.prune_predictions {
+                PHASE_PREDICT_START.time(|| self.predict_start(&mut d, t0));
+            } else {
+                PHASE_PREDICT_START.time(|| self.predict_all(&mut d, t0));
             }
-            self.predict_all(&mut d, t0);
         } else {
             self.rebuild(&mut d, t0);
         }
-        while let Some(e) = d.queue.pop() {
-            if e.t > t1 {
+        loop {
+            let next = PHASE_EVENTS.time(|| self.next_event(&mut d));
+            let Some(Applied { t, involved }) = next? else {
                 break;
+            };
+            let mut must_rebuild = false;
+            for k in involved.into_iter().flatten() {
+                self.gens[k] += 1;
+                self.uncertify(k);
+                self.neighbours.dirty[k] = true;
+                if !self.list_holds(k, t, t1) {
+                    if self.settings.skin_steps > 0.0 {
+                        PHASE_RELIST.time(|| self.reanchor(k, t, &d));
+                    } else {
+                        must_rebuild = true;
+                    }
+                } else {
+                    self.set_expiry(k, t, t1 - t0);
+                }
+            }
+            if must_rebuild {
+                self.rebuild(&mut d, t);
+            } else {
+                PHASE_REPREDICT.time(|| {
+                    let [first, second] = involved;
+                    if let Some(i) = first {
+                        self.predict(&mut d, i, t, None);
+                    }
+                    if let Some(j) = second {
+                        // The pair itself was predicted from the first side (the same event, bit for bit).
+                        self.predict(&mut d, j, t, first);
+                    }
+                });
+            }
+        }
+        PHASE_ADVANCE.time(|| {
+            for k in 0..self.particles.len() {
+                if !self.particles[k].alive {
+                    continue;
+                }
+                self.particles[k].advance(t1);
+                if let Some(a) = self.particles[k].stuck {
+                    self.particles[k].position = self.attached_position(&a, t1);
+                }
+            }
+        });
+        Ok(())
+    }
+
+    /// Pops events until a valid one within the drift, applies it and returns its time and the particles it
+    /// involved; `None` when the drift has no more events.
+    fn next_event(&mut self, d: &mut Drift) -> Result<Option<Applied>, StepError> {
+        while let Some(e) = d.queue.pop() {
+            if e.t > d.t1 {
+                return Ok(None);
             }
             if e.gen_i != self.gens[e.i] {
                 continue;
@@ -423,7 +738,7 @@ impl System {
             self.counters.events += 1;
             if d.events > self.settings.max_events_per_step {
                 return Err(StepError::Stalled {
-                    t: t1,
+                    t: d.t1,
                     limit: self.settings.max_events_per_step,
                 });
             }
@@ -433,39 +748,13 @@ impl System {
                     [Some(e.i), Some(j)]
                 }
                 Partner::Wall(w) => {
-                    self.collide_wall(&d, e.i, w, e.t);
+                    self.collide_wall(d, e.i, w, e.t);
                     [Some(e.i), None]
                 }
             };
-            let mut must_rebuild = false;
-            for k in involved.into_iter().flatten() {
-                self.gens[k] += 1;
-                if !self.list_holds(k, e.t, t1) {
-                    if self.settings.skin_steps > 0.0 {
-                        self.reanchor(k, e.t, &d);
-                    } else {
-                        must_rebuild = true;
-                    }
-                }
-            }
-            if must_rebuild {
-                self.rebuild(&mut d, e.t);
-            } else {
-                for k in involved.into_iter().flatten() {
-                    self.predict(&mut d, k, e.t);
-                }
-            }
+            return Ok(Some(Applied { t: e.t, involved }));
         }
-        for k in 0..self.particles.len() {
-            if !self.particles[k].alive {
-                continue;
-            }
-            self.particles[k].advance(t1);
-            if let Some(a) = self.particles[k].stuck {
-                self.particles[k].position = self.attached_position(&a, t1);
-            }
-        }
-        Ok(())
+        Ok(None)
     }
 
     /// Rebuilds the neighbour list at `t` with a fresh allowance and anchors (positions at `t`; the particles' states
@@ -493,14 +782,25 @@ impl System {
             vec![(2.0 * v_max * (d.t1 - t)).max(floor); n]
         };
         self.neighbours.anchors = self.particles.iter().map(|p| p.position_at(t)).collect();
-        self.neighbours.adjacency = self.candidate_pairs();
-        self.neighbours.built = true;
-        self.predict_all(d, t);
+        PHASE_REBUILD.time(|| {
+            self.neighbours.adjacency = self.candidate_pairs();
+            self.neighbours.built = true;
+            self.file_all();
+        });
+        PHASE_PREDICT_START.time(|| self.predict_all(d, t));
     }
 
-    /// Empties the queue and predicts every listed pair and every wall contact from `t`.
+    /// Empties the queue and the calendar and predicts every listed pair and every wall contact from `t`,
+    /// certifying the pairs of free particles without an event in this drift when neither collided in the last one.
     fn predict_all(&mut self, d: &mut Drift, t: f64) {
         d.queue.clear();
+        let certify = self.settings.skin_steps > 0.0 && self.settings.prune_predictions;
+        let nb = &mut self.neighbours;
+        nb.calendar.clear(t, d.t1 - d.t0);
+        nb.certified = certify;
+        for k in nb.pending.drain(..) {
+            nb.uncertified[k] = false;
+        }
         for k in 0..self.particles.len() {
             if !self.particles[k].alive {
                 continue;
@@ -508,26 +808,132 @@ impl System {
             for jx in 0..self.neighbours.adjacency[k].len() {
                 let j = self.neighbours.adjacency[k][jx];
                 if j > k {
-                    self.predict_pair(d, k, j, t);
+                    let clean = certify && !self.neighbours.dirty[k] && !self.neighbours.dirty[j];
+                    self.predict_pair(d, k, j, t, clean);
                 }
             }
             self.predict_walls(d, k, t);
         }
+        // The particles that collided in the last drift certify their pairs at their first clean drift start.
+        for k in 0..self.particles.len() {
+            if std::mem::take(&mut self.neighbours.dirty[k]) && certify {
+                self.uncertify(k);
+            }
+        }
+        self.neighbours.calendar_live = self.neighbours.calendar.len();
+    }
+
+    /// Ends particle `k`'s pairs' certificates and lists it for the next drift start.
+    fn uncertify(&mut self, k: usize) {
+        self.cert_gens[k] += 1;
+        let nb = &mut self.neighbours;
+        if nb.certified && !nb.uncertified[k] {
+            nb.uncertified[k] = true;
+            nb.pending.push(k);
+        }
+    }
+
+    /// The drift start's predictions when the calendar is complete: the same events as [`System::predict_all`]
+    /// from only the pairs that may have one (module doc). Predicted afresh at `t0`: every pair of a pending
+    /// particle (one that collided or was re-listed since its last clean drift start; certified unless either
+    /// particle collided in the last drift), the pairs whose certificates come due within the drift, every pair with
+    /// a stuck particle (not kicked, so its relative velocity changes at every step), and every free particle against
+    /// its near walls (the kicks change every velocity relative to the walls).
+    fn predict_start(&mut self, d: &mut Drift, t0: f64) {
+        d.queue.clear();
+        let pending = std::mem::take(&mut self.neighbours.pending);
+        for &k in &pending {
+            self.neighbours.mark[k] = true;
+        }
+        for &k in &pending {
+            if !self.particles[k].alive || self.particles[k].stuck.is_some() {
+                continue;
+            }
+            for jx in 0..self.neighbours.adjacency[k].len() {
+                let j = self.neighbours.adjacency[k][jx];
+                // A pair of two pending particles once; pairs with a stuck particle below.
+                if (self.neighbours.mark[j] && j < k) || self.particles[j].stuck.is_some() {
+                    continue;
+                }
+                let clean = !self.neighbours.dirty[k] && !self.neighbours.dirty[j];
+                self.predict_pair(d, k, j, t0, clean);
+            }
+        }
+        let mut still = Vec::new();
+        for &k in &pending {
+            let nb = &mut self.neighbours;
+            nb.mark[k] = false;
+            let p = &self.particles[k];
+            // One that collided in the last drift stays pending until a drift start finds it clean.
+            if std::mem::take(&mut nb.dirty[k]) && p.alive && p.stuck.is_none() {
+                still.push(k);
+            } else {
+                nb.uncertified[k] = false;
+            }
+        }
+        self.neighbours.pending = still;
+        let mut due = std::mem::take(&mut self.neighbours.due);
+        self.neighbours.calendar.take_due(d.t1, &mut due);
+        for c in &due {
+            if self.certificate_valid(c) {
+                self.predict_pair(d, c.i, c.j, t0, true);
+            }
+        }
+        self.neighbours.due = due;
+        for sx in 0..self.neighbours.stuck_list.len() {
+            let k = self.neighbours.stuck_list[sx];
+            if self.particles[k].alive {
+                for jx in 0..self.neighbours.adjacency[k].len() {
+                    let j = self.neighbours.adjacency[k][jx];
+                    self.predict_pair(d, k, j, t0, false);
+                }
+            }
+        }
+        for wx in 0..self.neighbours.near_list.len() {
+            let k = self.neighbours.near_list[wx];
+            self.predict_walls(d, k, t0);
+        }
+        // Stale certificates (a particle collided or was re-listed) wait in the calendar until they come due; when
+        // they outnumber the live ones, drop them.
+        let nb = &self.neighbours;
+        if nb.calendar.len() > 2 * nb.calendar_live + 8 * self.particles.len() + 1024 {
+            let mut calendar = std::mem::take(&mut self.neighbours.calendar);
+            calendar.retain(|c| self.certificate_valid(c));
+            self.neighbours.calendar_live = calendar.len();
+            self.neighbours.calendar = calendar;
+        }
+    }
+
+    /// Whether a certificate still speaks for its pair: neither particle collided or was re-listed since, both alive
+    /// and free.
+    fn certificate_valid(&self, c: &Due) -> bool {
+        let (pi, pj) = (&self.particles[c.i], &self.particles[c.j]);
+        c.gen_i == self.cert_gens[c.i]
+            && c.gen_j == self.cert_gens[c.j]
+            && pi.alive
+            && pj.alive
+            && pi.stuck.is_none()
+            && pj.stuck.is_none()
     }
 
     /// Re-predicts particle `k` against its neighbours and the walls at time `t`.
-    fn predict(&mut self, d: &mut Drift, k: usize, t: f64) {
+    /// (The pair with `done`, already predicted from the other side, is skipped: it would queue the same event.)
+    fn predict(&mut self, d: &mut Drift, k: usize, t: f64, done: Option<usize>) {
         if !self.particles[k].alive {
             return;
         }
         for jx in 0..self.neighbours.adjacency[k].len() {
             let j = self.neighbours.adjacency[k][jx];
-            self.predict_pair(d, k, j, t);
+            if Some(j) != done {
+                self.predict_pair(d, k, j, t, false);
+            }
         }
         self.predict_walls(d, k, t);
     }
 
-    fn predict_pair(&self, d: &mut Drift, i: usize, j: usize, t: f64) {
+    /// Predicts the pair `(i, j)` from `t`: queues its collision if it falls within the drift, otherwise, when
+    /// `certify` (a drift start, both particles free and clean), files its certificate ([`super::certificates`]).
+    fn predict_pair(&mut self, d: &mut Drift, i: usize, j: usize, t: f64, certify: bool) {
         let (pi, pj) = (&self.particles[i], &self.particles[j]);
         if !pj.alive || (pi.stuck.is_some() && pj.stuck.is_some()) {
             return;
@@ -535,41 +941,66 @@ impl System {
         let r = pi.position_at(t) - pj.position_at(t);
         let v = pi.velocity - pj.velocity;
         let b = r.dot(&v);
-        if b >= 0.0 {
-            return;
-        }
         let s = pi.radius + pj.radius;
-        let c = r.norm_squared() - s * s;
-        let dt = if c <= 0.0 {
-            0.0
-        } else {
-            let disc = b * b - v.norm_squared() * c;
-            if disc < 0.0 {
+        if b < 0.0 {
+            let c = r.norm_squared() - s * s;
+            let dt = if c <= 0.0 {
+                Some(0.0)
+            } else {
+                let disc = b * b - v.norm_squared() * c;
+                // Cancellation-free smaller root (notes, "Particle–particle").
+                (disc >= 0.0).then(|| c / (-b + disc.sqrt()))
+            };
+            if let Some(te) = dt.map(|dt| t + dt)
+                && te <= d.t1
+            {
+                let (a, bb) = if i < j { (i, j) } else { (j, i) };
+                d.queue.push(Event {
+                    t: te,
+                    i: a,
+                    partner: Partner::Particle(bb),
+                    gen_i: self.gens[a],
+                    gen_j: self.gens[bb],
+                });
+                // Its event is processed or made stale within this drift, and either re-predicts the pair.
                 return;
             }
-            // Cancellation-free smaller root (notes, "Particle–particle").
-            c / (-b + disc.sqrt())
-        };
-        let te = t + dt;
-        if te <= d.t1 {
+        }
+        if certify && pi.stuck.is_none() && pj.stuck.is_none() {
+            let horizon = certificates::HORIZON_STEPS * (d.t1 - d.t0);
+            let g = self.settings.gravity.map_or(0.0, |g| g.norm());
+            let x = pi.position.norm() + pj.position.norm();
+            let speed = pi.velocity.norm() + pj.velocity.norm();
+            let reach = s + certificates::margin(s, x, speed, g, horizon);
             let (a, bb) = if i < j { (i, j) } else { (j, i) };
-            d.queue.push(Event {
-                t: te,
+            self.neighbours.calendar.push(Due {
+                t: certificates::safe_until(t, &r, &v, reach, horizon),
                 i: a,
-                partner: Partner::Particle(bb),
-                gen_i: self.gens[a],
-                gen_j: self.gens[bb],
+                j: bb,
+                gen_i: self.cert_gens[a],
+                gen_j: self.cert_gens[bb],
             });
         }
     }
 
     fn predict_walls(&self, d: &mut Drift, k: usize, t: f64) {
         let p = &self.particles[k];
-        if p.stuck.is_some() {
+        if !p.alive
+            || p.stuck.is_some()
+            || (self.settings.prune_predictions && self.neighbours.near_walls[k].is_empty())
+        {
             return;
         }
         let r = p.position_at(t);
-        for (w, wall) in self.walls.iter().enumerate() {
+        let all: Vec<usize>;
+        let walls = if self.settings.prune_predictions {
+            &self.neighbours.near_walls[k]
+        } else {
+            all = (0..self.walls.len()).collect();
+            &all
+        };
+        for &w in walls {
+            let wall = &self.walls[w];
             let ws = d.walls[w];
             let origin_now = ws.origin0 + ws.velocity * (t - d.t0);
             if let Some(dt) = wall.time_of_impact(&origin_now, &ws.velocity, &r, &p.velocity, p.radius, d.t1 - t) {
@@ -676,6 +1107,8 @@ impl System {
                 .unwrap_or(0.0);
             self.counters.energy_exchanged -= e_before + g_pot;
             self.counters.absorbed += 1;
+            self.floor = None;
+            self.neighbours.grid.remove(i);
             self.particles[i].alive = false;
             return;
         }
@@ -693,6 +1126,7 @@ impl System {
             };
             let end = self.attached_position(&att, d.t1);
             let axis_spin = wall.axis * wall.motion.spin;
+            self.neighbours.stuck_list.push(i);
             let p = &mut self.particles[i];
             p.stuck = Some(att);
             p.velocity = if d.t1 > t {
