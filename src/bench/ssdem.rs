@@ -44,6 +44,10 @@ pub struct BenchSsdemArgs {
     /// (`analysis/ssdem_perf/`).
     #[arg(long, value_name = "FILE")]
     pub dump_particles: Option<PathBuf>,
+    /// Also time every phase of the step ([`crate::phase`]) and print, per thread count, each phase's share of
+    /// the timed steps and the serial fraction (the phase timers cost two clock reads per phase and step).
+    #[arg(long)]
+    pub phases: bool,
 }
 
 /// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly, self-gravity (if
@@ -83,6 +87,10 @@ pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, B
     let dt = std::f64::consts::PI * (0.5 * s.particles[0].mass / s.material.k_n).sqrt() / 50.0;
     let elapsed = pool.install(|| {
         leapfrog::step(&mut s, 0.0, dt);
+        // the phase totals (when timing is on) are those of the timed steps only
+        if crate::phase::enabled() {
+            crate::phase::reset();
+        }
         let start = Instant::now();
         for k in 1..=steps {
             leapfrog::step(&mut s, k as f64 * dt, dt);
@@ -119,11 +127,17 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
         if t == 0 {
             return Err(BenchError::usage("--threads: each count must be >= 1, got 0"));
         }
+        crate::phase::enable(args.phases);
         let rate = time_steps(&sys, t, args.steps)?;
+        crate::phase::enable(false);
         println!(
             "N = {}, gravity {} (interval {}), {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
             args.particles, args.gravity, args.gravity_interval, sys.stats.pair_contacts
         );
+        if args.phases {
+            let wall = sys.particles.len() as f64 * args.steps as f64 / rate;
+            print!("{}", phase_table(wall, args.steps));
+        }
         rows.push((t, rate));
     }
     if let Some(dir) = &args.out {
@@ -141,6 +155,37 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
         plot(&dir.join("bench_ssdem.svg"), &rows, &args.gravity, args.particles).map_err(BenchError::failed)?;
     }
     Ok(())
+}
+
+/// The phases of the soft-sphere step and of the tree (`soft.*`, `gravity.*`) timed since the last reset, as a
+/// table: seconds, milliseconds per step and share of the timed wall time `wall` (s) of `steps` steps, then the
+/// serial and parallel sums and the serial fraction `serial / (serial + parallel)`.
+pub fn phase_table(wall: f64, steps: u64) -> String {
+    let mut text = String::new();
+    let (mut serial, mut parallel) = (0.0, 0.0);
+    for prefix in ["soft.", "gravity."] {
+        let (mine, s, p) = crate::phase::split(prefix);
+        serial += s;
+        parallel += p;
+        for t in mine.iter().filter(|t| t.calls > 0) {
+            text += &format!(
+                "  {:<26} {:<8} {:>9.4} s {:>9.4} ms/step {:>6.2} %  ({} calls)\n",
+                t.name,
+                t.kind.as_str(),
+                t.seconds,
+                1e3 * t.seconds / steps as f64,
+                100.0 * t.seconds / wall,
+                t.calls
+            );
+        }
+    }
+    text += &format!(
+        "  timed {wall:.4} s; phases: serial {serial:.4} s, parallel {parallel:.4} s, unaccounted {:.4} s; \
+         serial fraction {:.2} %\n",
+        wall - serial - parallel,
+        100.0 * serial / (serial + parallel).max(f64::MIN_POSITIVE)
+    );
+    text
 }
 
 fn plot(path: &Path, rows: &[(usize, f64)], gravity: &str, n: u64) -> Result<(), String> {

@@ -54,7 +54,15 @@
 //! stay in double precision.
 
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
+
+// Where a tree evaluation's time goes (see [`crate::phase`]).
+static PHASE_KEYS: Phase = Phase::new("gravity.tree_keys", Kind::Parallel);
+static PHASE_SUBDIVIDE: Phase = Phase::new("gravity.tree_subdivide", Kind::Serial);
+static PHASE_MOMENTS: Phase = Phase::new("gravity.tree_moments", Kind::Parallel);
+static PHASE_WALK: Phase = Phase::new("gravity.tree_walk_sum", Kind::Parallel);
+static PHASE_UNSORT: Phase = Phase::new("gravity.tree_unsort", Kind::Serial);
 use std::ops::{Add, AddAssign, Div, Mul, Sub, SubAssign};
 
 /// Most particles in a leaf, except at the deepest level.
@@ -303,45 +311,55 @@ impl Octree {
         let cells = (1u64 << KEY_BITS) as f64;
         let scale = cells / (2.0 * half);
         let quantise = |x: f64, c: f64| (((x - c) * scale).max(0.0) as u64).min((1 << KEY_BITS) - 1);
-        let mut keyed: Vec<(u64, u32)> = positions
-            .par_iter()
-            .with_min_len(1024)
-            .enumerate()
-            .map(|(i, p)| {
-                let key = spread(quantise(p.x, corner.x))
-                    | spread(quantise(p.y, corner.y)) << 1
-                    | spread(quantise(p.z, corner.z)) << 2;
-                (key, i as u32)
-            })
-            .collect();
-        // Pairs are distinct (the index breaks ties), so the order does not depend on the sort's scheduling.
-        keyed.par_sort_unstable();
-        let keys: Vec<u64> = keyed.iter().map(|k| k.0).collect();
-        let order: Vec<u32> = keyed.iter().map(|k| k.1).collect();
-        let mut tree = Octree {
-            particles: order
-                .iter()
-                .map(|&i| {
-                    let p = positions[i as usize];
-                    [p.x, p.y, p.z, masses[i as usize]]
+        let keyed: Vec<(u64, u32)> = PHASE_KEYS.time(|| {
+            let mut keyed: Vec<(u64, u32)> = positions
+                .par_iter()
+                .with_min_len(1024)
+                .enumerate()
+                .map(|(i, p)| {
+                    let key = spread(quantise(p.x, corner.x))
+                        | spread(quantise(p.y, corner.y)) << 1
+                        | spread(quantise(p.z, corner.z)) << 2;
+                    (key, i as u32)
                 })
-                .collect(),
-            order,
-            far_leaves: n >= FAR_LEAVES_FROM,
-            ..Octree::default()
-        };
-        // Cubes (centre, side) of the nodes, in node order; moments are filled afterwards.
-        let mut cubes: Vec<(Vec3, f64)> = Vec::new();
-        tree.subdivide(&keys, 0, n, centre, half, 0, false, &mut cubes);
-        tree.moments = (0..cubes.len())
-            .into_par_iter()
-            .with_min_len(32)
-            .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, cubes[k].0))
-            .collect();
-        for (m, (cube, side)) in tree.moments.iter().zip(cubes) {
-            tree.side.push(side);
-            tree.delta.push((Vec3::new(m[0], m[1], m[2]) - cube).norm());
-        }
+                .collect();
+            // Pairs are distinct (the index breaks ties), so the order does not depend on the sort's scheduling.
+            keyed.par_sort_unstable();
+            keyed
+        });
+        let (mut tree, cubes) = PHASE_SUBDIVIDE.time(|| {
+            let keys: Vec<u64> = keyed.iter().map(|k| k.0).collect();
+            let order: Vec<u32> = keyed.iter().map(|k| k.1).collect();
+            let mut tree = Octree {
+                particles: order
+                    .iter()
+                    .map(|&i| {
+                        let p = positions[i as usize];
+                        [p.x, p.y, p.z, masses[i as usize]]
+                    })
+                    .collect(),
+                order,
+                far_leaves: n >= FAR_LEAVES_FROM,
+                ..Octree::default()
+            };
+            // Cubes (centre, side) of the nodes, in node order; moments are filled afterwards.
+            let mut cubes: Vec<(Vec3, f64)> = Vec::new();
+            tree.subdivide(&keys, 0, n, centre, half, 0, false, &mut cubes);
+            (tree, cubes)
+        });
+        tree.moments = PHASE_MOMENTS.time(|| {
+            (0..cubes.len())
+                .into_par_iter()
+                .with_min_len(32)
+                .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, cubes[k].0))
+                .collect()
+        });
+        PHASE_SUBDIVIDE.time(|| {
+            for (m, (cube, side)) in tree.moments.iter().zip(cubes) {
+                tree.side.push(side);
+                tree.delta.push((Vec3::new(m[0], m[1], m[2]) - cube).norm());
+            }
+        });
         tree
     }
 
@@ -584,12 +602,14 @@ impl Octree {
         // Sorted-order results, one disjoint chunk per bucket (buckets cover the sorted particles in order).
         let mut sorted = vec![[0.0; 4]; n];
         let open = Walk::Open(self.reach2(theta));
-        if self.single_precision() {
-            self.sum_buckets::<f32, 8, 4>(&open, g, &mut sorted);
-        } else {
-            self.sum_buckets::<f64, 4, 2>(&open, g, &mut sorted);
-        }
-        self.unsort(&sorted)
+        PHASE_WALK.time(|| {
+            if self.single_precision() {
+                self.sum_buckets::<f32, 8, 4>(&open, g, &mut sorted);
+            } else {
+                self.sum_buckets::<f64, 4, 2>(&open, g, &mut sorted);
+            }
+        });
+        PHASE_UNSORT.time(|| self.unsort(&sorted))
     }
 
     /// Per-particle results in sorted order back in input order: accelerations and potentials.

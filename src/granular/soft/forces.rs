@@ -16,7 +16,19 @@ use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs,
 use crate::granular::soft::particle::Particle;
 use crate::gravity::{SelfGravity, accelerations};
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
+
+// Where a force evaluation's time goes (`rubblepile bench ssdem --phases`, `bench scaling`; see [`crate::phase`]).
+static PHASE_BASE: Phase = Phase::new("soft.base_forces", Kind::Serial);
+static PHASE_VERLET_CHECK: Phase = Phase::new("soft.verlet_check", Kind::Serial);
+static PHASE_VERLET_PAIRS: Phase = Phase::new("soft.verlet_pairs", Kind::Parallel);
+static PHASE_VERLET_MERGE: Phase = Phase::new("soft.verlet_merge", Kind::Serial);
+static PHASE_PAIR_EVAL: Phase = Phase::new("soft.pair_eval", Kind::Parallel);
+static PHASE_PAIR_SUM: Phase = Phase::new("soft.pair_sum", Kind::Serial);
+static PHASE_COMBINE: Phase = Phase::new("soft.combine", Kind::Serial);
+static PHASE_WALLS: Phase = Phase::new("soft.walls", Kind::Parallel);
+static PHASE_WALL_SUM: Phase = Phase::new("soft.wall_sum", Kind::Serial);
 
 /// Gravity settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -329,33 +341,39 @@ impl SoftSystem {
     }
 
     fn refresh_verlet(&mut self) {
-        let stale = self.verlet_origin.len() != self.particles.len()
-            || self
-                .particles
-                .iter()
-                .zip(&self.verlet_origin)
-                .any(|(p, o)| (p.position - o).norm_squared() > 0.25 * self.skin * self.skin);
+        let stale = PHASE_VERLET_CHECK.time(|| {
+            self.verlet_origin.len() != self.particles.len()
+                || self
+                    .particles
+                    .iter()
+                    .zip(&self.verlet_origin)
+                    .any(|(p, o)| (p.position - o).norm_squared() > 0.25 * self.skin * self.skin)
+        });
         if stale {
             let centres: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
             let reach: Vec<f64> = self.particles.iter().map(|p| p.radius + 0.5 * self.skin).collect();
-            let pairs = sphere_pairs(&centres, &reach);
-            // Carry the springs of touching pairs over: both lists are sorted by key, and every touching pair
-            // is in the new list (it holds every pair closer than the sum of radii plus the skin).
-            let mut old = self
-                .verlet
-                .iter()
-                .zip(&self.pair_slots)
-                .filter(|(_, slot)| slot.get().is_some())
-                .peekable();
-            let pairs: Vec<PairKey> = pairs.into_iter().map(pair_key).collect();
-            let mut slots = Vec::with_capacity(pairs.len());
-            for key in &pairs {
-                while old.next_if(|(k, _)| *k < key).is_some() {}
-                slots.push(
-                    old.next_if(|(k, _)| *k == key)
-                        .map_or_else(Slot::empty, |(_, slot)| *slot),
-                );
-            }
+            let pairs = PHASE_VERLET_PAIRS.time(|| sphere_pairs(&centres, &reach));
+            let merge = PHASE_VERLET_MERGE.time(|| {
+                // Carry the springs of touching pairs over: both lists are sorted by key, and every touching pair
+                // is in the new list (it holds every pair closer than the sum of radii plus the skin).
+                let mut old = self
+                    .verlet
+                    .iter()
+                    .zip(&self.pair_slots)
+                    .filter(|(_, slot)| slot.get().is_some())
+                    .peekable();
+                let pairs: Vec<PairKey> = pairs.into_iter().map(pair_key).collect();
+                let mut slots = Vec::with_capacity(pairs.len());
+                for key in &pairs {
+                    while old.next_if(|(k, _)| *k < key).is_some() {}
+                    slots.push(
+                        old.next_if(|(k, _)| *k == key)
+                            .map_or_else(Slot::empty, |(_, slot)| *slot),
+                    );
+                }
+                (pairs, slots)
+            });
+            let (pairs, slots) = merge;
             self.verlet = pairs;
             self.pair_slots = slots;
             self.pair_hits.clear();
@@ -368,28 +386,34 @@ impl SoftSystem {
         let particles = &self.particles;
         if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
             self.pair_hits.resize(self.verlet.len(), None);
-            self.verlet
-                .par_chunks(PAIR_CHUNK)
-                .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
-                .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
-                .for_each(|((keys, slots), hits)| {
-                    for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
-                        *hit = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt);
+            PHASE_PAIR_EVAL.time(|| {
+                self.verlet
+                    .par_chunks(PAIR_CHUNK)
+                    .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
+                    .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
+                    .for_each(|((keys, slots), hits)| {
+                        for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
+                            *hit = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt);
+                        }
+                    })
+            });
+            PHASE_PAIR_SUM.time(|| {
+                for (&key, hit) in self.verlet.iter().zip(&self.pair_hits) {
+                    if let Some(hit) = hit {
+                        let (i, j) = pair_indices(key);
+                        sums.add_pair(i, j, hit);
                     }
-                });
-            for (&key, hit) in self.verlet.iter().zip(&self.pair_hits) {
-                if let Some(hit) = hit {
-                    let (i, j) = pair_indices(key);
-                    sums.add_pair(i, j, hit);
                 }
-            }
+            });
         } else {
-            for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
-                if let Some(hit) = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt) {
-                    let (i, j) = pair_indices(key);
-                    sums.add_pair(i, j, &hit);
+            PHASE_PAIR_EVAL.time(|| {
+                for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
+                    if let Some(hit) = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt) {
+                        let (i, j) = pair_indices(key);
+                        sums.add_pair(i, j, &hit);
+                    }
                 }
-            }
+            });
         }
     }
 
@@ -412,21 +436,23 @@ impl SoftSystem {
         // With r-RESPA the self-gravity is the slow force, kept apart (`respa.rs`); here only the fast ones.
         match self.gravity.self_gravity {
             Some(mode) if n > 1 && !self.split_gravity() => {
-                let positions: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
-                let masses: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
+                let (positions, masses): (Vec<Vec3>, Vec<f64>) =
+                    PHASE_BASE.time(|| self.particles.iter().map(|p| (p.position, p.mass)).unzip());
                 let (acc, potentials) = accelerations(mode, &positions, &masses, self.gravity.g);
-                for k in 0..n {
-                    let m = masses[k];
-                    forces.push((acc[k] + uniform) * m);
-                    stats.gravitational_energy += 0.5 * m * potentials[k] - m * uniform.dot(&positions[k]);
-                }
+                PHASE_BASE.time(|| {
+                    for k in 0..n {
+                        let m = masses[k];
+                        forces.push((acc[k] + uniform) * m);
+                        stats.gravitational_energy += 0.5 * m * potentials[k] - m * uniform.dot(&positions[k]);
+                    }
+                });
             }
-            _ => {
+            _ => PHASE_BASE.time(|| {
                 for p in &self.particles {
                     forces.push(uniform * p.mass);
                     stats.gravitational_energy += 0.0 - p.mass * uniform.dot(&p.position);
                 }
-            }
+            }),
         }
         let mut records = std::mem::take(&mut self.records);
         records.clear();
@@ -435,8 +461,10 @@ impl SoftSystem {
         self.refresh_verlet();
         let law = Law::new(&self.material);
         let mut load = std::mem::take(&mut self.pair_load);
-        load.clear();
-        load.resize(n, (Vec3::zeros(), Vec3::zeros()));
+        PHASE_COMBINE.time(|| {
+            load.clear();
+            load.resize(n, (Vec3::zeros(), Vec3::zeros()));
+        });
         let mut sums = Sums {
             load: &mut load,
             stats: &mut stats,
@@ -452,11 +480,13 @@ impl SoftSystem {
         }
         let mut dissipated = sums.dissipated;
         let mut torques = std::mem::take(&mut self.torques);
-        torques.clear();
-        torques.extend(load.iter().map(|l| l.1));
-        for (f, l) in forces.iter_mut().zip(&load) {
-            *f += l.0;
-        }
+        PHASE_COMBINE.time(|| {
+            torques.clear();
+            torques.extend(load.iter().map(|l| l.1));
+            for (f, l) in forces.iter_mut().zip(&load) {
+                *f += l.0;
+            }
+        });
         self.pair_load = load;
 
         // Wall contacts.
@@ -464,57 +494,60 @@ impl SoftSystem {
         let mut wall_work = 0.0;
         if !self.walls.is_empty() {
             let old = &self.wall_springs;
-            let per_particle: Vec<Vec<WallHit>> = self
-                .particles
-                .par_iter()
-                .with_min_len(PAR_MIN)
-                .enumerate()
-                .map(|(i, p)| {
-                    let mut hits = Vec::new();
-                    for (w, wall) in self.walls.iter().enumerate() {
-                        let Some(touch) = wall.touch(&p.position, p.radius, t) else {
-                            continue;
-                        };
-                        let nrm = touch.normal;
-                        let li = p.radius - touch.overlap;
-                        let kin = Kinematics {
-                            normal: nrm,
-                            overlap: touch.overlap,
-                            lever_i: li,
-                            lever_j: f64::INFINITY,
-                            relative_velocity: touch.wall_velocity - p.velocity - p.spin.cross(&nrm) * li,
-                            spin_i: p.spin,
-                            spin_j: Vec3::zeros(),
-                            r_eff: p.radius,
-                            mass_eff: p.mass,
-                        };
-                        let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
-                        let out = evaluate_law(&law, &kin, &mut springs, dt);
-                        hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
+            let per_particle: Vec<Vec<WallHit>> = PHASE_WALLS.time(|| {
+                self.particles
+                    .par_iter()
+                    .with_min_len(PAR_MIN)
+                    .enumerate()
+                    .map(|(i, p)| {
+                        let mut hits = Vec::new();
+                        for (w, wall) in self.walls.iter().enumerate() {
+                            let Some(touch) = wall.touch(&p.position, p.radius, t) else {
+                                continue;
+                            };
+                            let nrm = touch.normal;
+                            let li = p.radius - touch.overlap;
+                            let kin = Kinematics {
+                                normal: nrm,
+                                overlap: touch.overlap,
+                                lever_i: li,
+                                lever_j: f64::INFINITY,
+                                relative_velocity: touch.wall_velocity - p.velocity - p.spin.cross(&nrm) * li,
+                                spin_i: p.spin,
+                                spin_j: Vec3::zeros(),
+                                r_eff: p.radius,
+                                mass_eff: p.mass,
+                            };
+                            let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
+                            let out = evaluate_law(&law, &kin, &mut springs, dt);
+                            hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
+                        }
+                        hits
+                    })
+                    .collect()
+            });
+            PHASE_WALL_SUM.time(|| {
+                for (i, hits) in per_particle.into_iter().enumerate() {
+                    for (w, springs, overlap, wall_velocity, out) in hits {
+                        forces[i] += out.force_i;
+                        torques[i] += out.torque_i;
+                        stats.spring_energy += out.stored_energy;
+                        dissipated += out.dissipated;
+                        wall_work += out.force_i.dot(&wall_velocity) * dt;
+                        stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / self.particles[i].radius);
+                        stats.wall_contacts += 1;
+                        if self.keep_records {
+                            records.push(ContactRecord {
+                                i,
+                                j: n + w,
+                                overlap,
+                                output: out,
+                            });
+                        }
+                        wall_springs.push(((i, w), springs));
                     }
-                    hits
-                })
-                .collect();
-            for (i, hits) in per_particle.into_iter().enumerate() {
-                for (w, springs, overlap, wall_velocity, out) in hits {
-                    forces[i] += out.force_i;
-                    torques[i] += out.torque_i;
-                    stats.spring_energy += out.stored_energy;
-                    dissipated += out.dissipated;
-                    wall_work += out.force_i.dot(&wall_velocity) * dt;
-                    stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / self.particles[i].radius);
-                    stats.wall_contacts += 1;
-                    if self.keep_records {
-                        records.push(ContactRecord {
-                            i,
-                            j: n + w,
-                            overlap,
-                            output: out,
-                        });
-                    }
-                    wall_springs.push(((i, w), springs));
                 }
-            }
+            });
         }
         self.wall_springs = wall_springs;
         self.forces = forces;

@@ -8,12 +8,18 @@
 
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::respa::{close_block, open_block};
+use crate::phase::{Kind, Phase};
+
+static PHASE_KICK: Phase = Phase::new("soft.kick", Kind::Serial);
+static PHASE_DRIFT: Phase = Phase::new("soft.drift", Kind::Serial);
 
 fn kick(sys: &mut SoftSystem, half_dt: f64) {
-    for ((p, f), tau) in sys.particles.iter_mut().zip(&sys.forces).zip(&sys.torques) {
-        p.velocity += f * (half_dt / p.mass);
-        p.spin += tau * (half_dt / p.inertia());
-    }
+    PHASE_KICK.time(|| {
+        for ((p, f), tau) in sys.particles.iter_mut().zip(&sys.forces).zip(&sys.torques) {
+            p.velocity += f * (half_dt / p.mass);
+            p.spin += tau * (half_dt / p.inertia());
+        }
+    })
 }
 
 /// Advances `sys` from time `t` (s) by one step `dt` (s). The forces of `sys` must be those at `t`
@@ -21,9 +27,11 @@ fn kick(sys: &mut SoftSystem, half_dt: f64) {
 pub fn step(sys: &mut SoftSystem, t: f64, dt: f64) {
     open_block(sys, dt);
     kick(sys, 0.5 * dt);
-    for p in sys.particles.iter_mut() {
-        p.position += p.velocity * dt;
-    }
+    PHASE_DRIFT.time(|| {
+        for p in sys.particles.iter_mut() {
+            p.position += p.velocity * dt;
+        }
+    });
     sys.compute_forces(t + dt, dt);
     kick(sys, 0.5 * dt);
     close_block(sys, dt);

@@ -20,6 +20,11 @@
 use crate::granular::soft::forces::SoftSystem;
 use crate::gravity::accelerations;
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
+
+static PHASE_SLOW_GATHER: Phase = Phase::new("soft.slow_gather", Kind::Serial);
+static PHASE_SLOW_ENERGY: Phase = Phase::new("soft.slow_energy", Kind::Serial);
+static PHASE_SLOW_KICK: Phase = Phase::new("soft.slow_kick", Kind::Serial);
 
 impl SoftSystem {
     /// Whether self-gravity is on and split off as the slow force (`gravity_interval > 1`).
@@ -33,13 +38,14 @@ impl SoftSystem {
         let n = self.particles.len();
         let (acc, pot) = match self.gravity.self_gravity {
             Some(mode) if n > 1 => {
-                let positions: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
-                let masses: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
+                let (positions, masses): (Vec<Vec3>, Vec<f64>) =
+                    PHASE_SLOW_GATHER.time(|| self.particles.iter().map(|p| (p.position, p.mass)).unzip());
                 accelerations(mode, &positions, &masses, self.gravity.g)
             }
             _ => (vec![Vec3::zeros(); n], vec![0.0; n]),
         };
-        let energy: f64 = self.particles.iter().zip(&pot).map(|(p, phi)| 0.5 * p.mass * phi).sum();
+        let energy: f64 =
+            PHASE_SLOW_ENERGY.time(|| self.particles.iter().zip(&pot).map(|(p, phi)| 0.5 * p.mass * phi).sum());
         self.stats.gravitational_energy += energy - self.slow_energy;
         self.slow_energy = energy;
         self.slow_accelerations = acc;
@@ -47,9 +53,11 @@ impl SoftSystem {
 
     /// `v += a_slow τ` for every sphere (τ in s).
     fn slow_kick(&mut self, tau: f64) {
-        for (p, a) in self.particles.iter_mut().zip(&self.slow_accelerations) {
-            p.velocity += a * tau;
-        }
+        PHASE_SLOW_KICK.time(|| {
+            for (p, a) in self.particles.iter_mut().zip(&self.slow_accelerations) {
+                p.velocity += a * tau;
+            }
+        })
     }
 }
 
