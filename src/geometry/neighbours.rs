@@ -142,14 +142,88 @@ impl Grid {
 /// assert_eq!(sphere_pairs(&c, &[1.0, 1.0, 1.0]), vec![(0, 1)]);
 /// ```
 pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
+    let rows = sphere_pair_rows(centres, radii);
+    let mut pairs = Vec::with_capacity(rows.upper.len());
+    for i in 0..centres.len() {
+        pairs.extend(rows.upper(i).iter().map(|&j| (i, j as usize)));
+    }
+    pairs
+}
+
+/// The pairs of [`sphere_pairs`] in compressed rows, by each of their two bodies: body `i`'s partners of higher
+/// index (its "row") and of lower index (its "column"), both ascending. Indices are 32-bit (a system of 2³²
+/// bodies would not fit in memory anyway).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PairRows {
+    /// `upper_start[i]..upper_start[i + 1]` is the range of `upper` holding body `i`'s partners `j > i`
+    /// (`n + 1` entries).
+    pub upper_start: Vec<usize>,
+    /// The partners `j > i` of every body `i`, row after row, each row ascending.
+    pub upper: Vec<u32>,
+    /// `lower_start[j]..lower_start[j + 1]` is the range of `lower` holding body `j`'s partners `i < j`.
+    pub lower_start: Vec<usize>,
+    /// The partners `i < j` of every body `j`, column after column, each ascending.
+    pub lower: Vec<u32>,
+}
+
+impl PairRows {
+    /// Body `i`'s partners of higher index, ascending.
+    pub fn upper(&self, i: usize) -> &[u32] {
+        &self.upper[self.upper_start[i]..self.upper_start[i + 1]]
+    }
+
+    /// Body `j`'s partners of lower index, ascending.
+    pub fn lower(&self, j: usize) -> &[u32] {
+        &self.lower[self.lower_start[j]..self.lower_start[j + 1]]
+    }
+
+    /// Rows from per-body lists (each sorted here), flattened in parallel.
+    fn from_lists(mut upper: Vec<Vec<u32>>, mut lower: Vec<Vec<u32>>) -> Self {
+        upper.par_iter_mut().for_each(|r| r.sort_unstable());
+        lower.par_iter_mut().for_each(|r| r.sort_unstable());
+        let starts = |rows: &[Vec<u32>]| -> Vec<usize> {
+            let mut start = Vec::with_capacity(rows.len() + 1);
+            start.push(0);
+            let mut total = 0;
+            for r in rows {
+                total += r.len();
+                start.push(total);
+            }
+            start
+        };
+        PairRows {
+            upper_start: starts(&upper),
+            lower_start: starts(&lower),
+            upper: upper.par_iter().flatten().copied().collect(),
+            lower: lower.par_iter().flatten().copied().collect(),
+        }
+    }
+}
+
+/// [`sphere_pairs`] as [`PairRows`], built in parallel; the result does not depend on the number of threads.
+///
+/// ```
+/// use rubblepile::geometry::neighbours::sphere_pair_rows;
+/// use rubblepile::math::Vec3;
+/// let c = [Vec3::zeros(), Vec3::new(1.5, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0)];
+/// let rows = sphere_pair_rows(&c, &[1.0, 1.0, 1.0]);
+/// assert_eq!((rows.upper(0), rows.upper(1), rows.lower(2)), (&[1][..], &[2][..], &[1][..]));
+/// ```
+pub fn sphere_pair_rows(centres: &[Vec3], radii: &[f64]) -> PairRows {
     let n = centres.len();
+    assert!(n < u32::MAX as usize, "{n} bodies: indices must fit in 32 bits");
     let finite =
         centres.iter().all(|c| c.iter().all(|x| x.is_finite())) && radii.iter().all(|r| r.is_finite() && *r > 0.0);
     if n < BRUTE_FORCE_BELOW || !finite {
-        return brute_force_pairs(centres, radii);
+        let (mut upper, mut lower) = (vec![Vec::new(); n], vec![Vec::new(); n]);
+        for (i, j) in brute_force_pairs(centres, radii) {
+            upper[i].push(j as u32);
+            lower[j].push(i as u32);
+        }
+        return PairRows::from_lists(upper, lower);
     }
     let mut sorted = radii.to_vec();
-    sorted.sort_unstable_by(f64::total_cmp);
+    sorted.par_sort_unstable_by(f64::total_cmp);
     let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
     let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
     let mut grid = Grid {
@@ -160,46 +234,47 @@ pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
         ids: Vec::new(),
         dense: None,
     };
-    let mut binned: Vec<([i64; 3], usize)> = regular.iter().map(|&i| (grid.key(&centres[i]), i)).collect();
-    binned.sort_unstable();
+    let mut binned: Vec<([i64; 3], usize)> = regular.par_iter().map(|&i| (grid.key(&centres[i]), i)).collect();
+    // (key, index) pairs are distinct, so the order does not depend on the sort's scheduling
+    binned.par_sort_unstable();
     grid.keys = binned.iter().map(|b| b.0).collect();
     grid.ids = binned.iter().map(|b| b.1).collect();
     grid.centres = grid.ids.iter().map(|&i| centres[i]).collect();
     grid.radii = grid.ids.iter().map(|&i| radii[i]).collect();
     grid.dense = DenseStarts::new(&grid.keys, DENSE_CELLS_PER_BODY * grid.keys.len().max(1));
 
-    // Regular–regular pairs: each body lists its partners of higher index.
-    let row_of = |i: usize| -> Vec<usize> {
-        let mut row = Vec::new();
+    // Regular–regular pairs: each body lists its partners of higher and of lower index.
+    let lists_of = |i: usize| -> (Vec<u32>, Vec<u32>) {
+        let (mut up, mut down) = (Vec::new(), Vec::new());
         if radii[i] <= r_ref {
-            grid.query(&centres[i], radii[i], r_ref, |j| {
-                if j > i {
-                    row.push(j)
-                }
+            grid.query(&centres[i], radii[i], r_ref, |j| match j.cmp(&i) {
+                std::cmp::Ordering::Greater => up.push(j as u32),
+                std::cmp::Ordering::Less => down.push(j as u32),
+                std::cmp::Ordering::Equal => {}
             });
         }
-        row
+        (up, down)
     };
-    let mut rows: Vec<Vec<usize>> = if n >= PARALLEL_FROM {
-        (0..n).into_par_iter().map(row_of).collect()
+    let (mut upper, mut lower): (Vec<Vec<u32>>, Vec<Vec<u32>>) = if n >= PARALLEL_FROM {
+        (0..n).into_par_iter().map(lists_of).unzip()
     } else {
-        (0..n).map(row_of).collect()
+        (0..n).map(lists_of).unzip()
     };
     // Pairs with a large body: large–regular through the grid, large–large directly.
+    let mut add = |a: usize, b: usize| {
+        let (i, j) = (a.min(b), a.max(b));
+        upper[i].push(j as u32);
+        lower[j].push(i as u32);
+    };
     for (a, &l) in large.iter().enumerate() {
-        grid.query(&centres[l], radii[l], r_ref, |j| rows[l.min(j)].push(l.max(j)));
+        grid.query(&centres[l], radii[l], r_ref, |j| add(l, j));
         for &m in &large[a + 1..] {
             if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
-                rows[l.min(m)].push(l.max(m));
+                add(l, m);
             }
         }
     }
-    let mut pairs = Vec::with_capacity(rows.iter().map(Vec::len).sum());
-    for (i, mut row) in rows.into_iter().enumerate() {
-        row.sort_unstable();
-        pairs.extend(row.into_iter().map(|j| (i, j)));
-    }
-    pairs
+    PairRows::from_lists(upper, lower)
 }
 
 /// The O(N²) reference search.
@@ -244,6 +319,28 @@ mod tests {
             let brute = brute_force_pairs(&centres, &radii);
             assert!(!brute.is_empty());
             assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
+        }
+    }
+
+    /// The rows' columns are their transpose, on the grid (with large bodies) and on the brute-force path.
+    #[test]
+    fn lower_rows_are_the_transpose_of_the_upper_rows() {
+        let mut next = uniform(3);
+        for n in [17, 1500] {
+            let centres: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(next(), next(), next()) * 2.5 * (n as f64).cbrt())
+                .collect();
+            let radii: Vec<f64> = (0..n).map(|_| 0.5 + 4.0 * next().powi(8) * 8.0).collect();
+            let rows = sphere_pair_rows(&centres, &radii);
+            let mut from_lower: Vec<(usize, usize)> = (0..n)
+                .flat_map(|j| rows.lower(j).iter().map(move |&i| (i as usize, j)))
+                .collect();
+            from_lower.sort_unstable();
+            let brute = brute_force_pairs(&centres, &radii);
+            assert!(brute.len() > n / 2, "n = {n}: too few pairs to test");
+            assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
+            assert_eq!(from_lower, brute, "n = {n}");
+            assert!((0..n).all(|j| rows.lower(j).windows(2).all(|w| w[0] < w[1])));
         }
     }
 

@@ -6,19 +6,29 @@
 //! conserves total linear and angular momentum up to rounding. With `gravity_interval = k > 1` self-gravity
 //! is kicked separately once per block of `k` steps ([`crate::granular::soft::respa`]).
 
-use crate::granular::soft::forces::SoftSystem;
+//!
+//! Every kick and drift is a loop over the spheres, each sphere on its own: they run in parallel (tasks of
+//! [`SUM_CHUNK`] spheres) with the same bits on any number of threads.
+
+use crate::granular::soft::forces::{SUM_CHUNK, SoftSystem};
 use crate::granular::soft::respa::{close_block, open_block};
 use crate::phase::{Kind, Phase};
+use rayon::prelude::*;
 
-static PHASE_KICK: Phase = Phase::new("soft.kick", Kind::Serial);
-static PHASE_DRIFT: Phase = Phase::new("soft.drift", Kind::Serial);
+static PHASE_KICK: Phase = Phase::new("soft.kick", Kind::Parallel);
+static PHASE_DRIFT: Phase = Phase::new("soft.drift", Kind::Parallel);
 
 fn kick(sys: &mut SoftSystem, half_dt: f64) {
     PHASE_KICK.time(|| {
-        for ((p, f), tau) in sys.particles.iter_mut().zip(&sys.forces).zip(&sys.torques) {
-            p.velocity += f * (half_dt / p.mass);
-            p.spin += tau * (half_dt / p.inertia());
-        }
+        sys.particles
+            .par_iter_mut()
+            .zip(&sys.forces)
+            .zip(&sys.torques)
+            .with_min_len(SUM_CHUNK)
+            .for_each(|((p, f), tau)| {
+                p.velocity += f * (half_dt / p.mass);
+                p.spin += tau * (half_dt / p.inertia());
+            })
     })
 }
 
@@ -28,9 +38,10 @@ pub fn step(sys: &mut SoftSystem, t: f64, dt: f64) {
     open_block(sys, dt);
     kick(sys, 0.5 * dt);
     PHASE_DRIFT.time(|| {
-        for p in sys.particles.iter_mut() {
-            p.position += p.velocity * dt;
-        }
+        sys.particles
+            .par_iter_mut()
+            .with_min_len(SUM_CHUNK)
+            .for_each(|p| p.position += p.velocity * dt)
     });
     sys.compute_forces(t + dt, dt);
     kick(sys, 0.5 * dt);

@@ -17,14 +17,15 @@
 //! velocities already carry the opening kick and the gravitational energy is that of the block's start, so
 //! energies are exact only at block ends (`SoftSystem::gravity_phase == 0`).
 
-use crate::granular::soft::forces::SoftSystem;
+use crate::granular::soft::forces::{SUM_CHUNK, SoftSystem, ordered_sum};
 use crate::gravity::accelerations;
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
+use rayon::prelude::*;
 
-static PHASE_SLOW_GATHER: Phase = Phase::new("soft.slow_gather", Kind::Serial);
-static PHASE_SLOW_ENERGY: Phase = Phase::new("soft.slow_energy", Kind::Serial);
-static PHASE_SLOW_KICK: Phase = Phase::new("soft.slow_kick", Kind::Serial);
+static PHASE_SLOW_GATHER: Phase = Phase::new("soft.slow_gather", Kind::Parallel);
+static PHASE_SLOW_ENERGY: Phase = Phase::new("soft.slow_energy", Kind::Parallel);
+static PHASE_SLOW_KICK: Phase = Phase::new("soft.slow_kick", Kind::Parallel);
 
 impl SoftSystem {
     /// Whether self-gravity is on and split off as the slow force (`gravity_interval > 1`).
@@ -39,13 +40,14 @@ impl SoftSystem {
         let (acc, pot) = match self.gravity.self_gravity {
             Some(mode) if n > 1 => {
                 let (positions, masses): (Vec<Vec3>, Vec<f64>) =
-                    PHASE_SLOW_GATHER.time(|| self.particles.iter().map(|p| (p.position, p.mass)).unzip());
+                    PHASE_SLOW_GATHER.time(|| self.particles.par_iter().map(|p| (p.position, p.mass)).unzip());
                 accelerations(mode, &positions, &masses, self.gravity.g)
             }
             _ => (vec![Vec3::zeros(); n], vec![0.0; n]),
         };
-        let energy: f64 =
-            PHASE_SLOW_ENERGY.time(|| self.particles.iter().zip(&pot).map(|(p, phi)| 0.5 * p.mass * phi).sum());
+        // summed in fixed chunks: the same bits on any number of threads
+        let ps = &self.particles;
+        let energy = PHASE_SLOW_ENERGY.time(|| ordered_sum(n, |k| 0.5 * ps[k].mass * pot[k]));
         self.stats.gravitational_energy += energy - self.slow_energy;
         self.slow_energy = energy;
         self.slow_accelerations = acc;
@@ -54,9 +56,11 @@ impl SoftSystem {
     /// `v += a_slow τ` for every sphere (τ in s).
     fn slow_kick(&mut self, tau: f64) {
         PHASE_SLOW_KICK.time(|| {
-            for (p, a) in self.particles.iter_mut().zip(&self.slow_accelerations) {
-                p.velocity += a * tau;
-            }
+            self.particles
+                .par_iter_mut()
+                .zip(&self.slow_accelerations)
+                .with_min_len(SUM_CHUNK)
+                .for_each(|(p, a)| p.velocity += a * tau)
         })
     }
 }
