@@ -8,7 +8,7 @@
 
 //!
 //! Every kick and drift is a loop over the spheres, each sphere on its own: they run in parallel (tasks of
-//! [`SUM_CHUNK`] spheres) with the same bits on any number of threads.
+//! `SUM_CHUNK` spheres) with the same bits on any number of threads.
 
 use crate::granular::soft::forces::{SUM_CHUNK, SoftSystem};
 use crate::granular::soft::respa::{close_block, open_block};
