@@ -8,8 +8,8 @@ use std::time::Instant;
 use super::BenchError;
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::{Gravity, SoftSystem};
-use crate::granular::soft::leapfrog;
 use crate::granular::soft::packing::fcc_ball;
+use crate::granular::soft::run::checked_step;
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::SI_G;
 use crate::math::Vec3;
@@ -74,29 +74,32 @@ pub fn bench_system(n: usize, gravity: Option<SelfGravity>, gravity_interval: u6
     sys
 }
 
-/// Particle-steps per second of `steps` leapfrog steps on `threads` threads, as the steps of a run between output
-/// samples: the dissipation is summed at every step, the springs' stored energy is not (runs sum it only at samples).
+/// Particle-steps per second of `steps` leapfrog steps on `threads` threads (a pool of its own), as a run takes
+/// its steps between output samples ([`checked_step`]: the state before each step kept for `last_good_state.csv`,
+/// the new state checked, the dissipation summed at every step, the springs' stored energy not, as runs sum it
+/// only at samples). One untimed step comes first; when phase timing is on ([`crate::phase`]) its totals are reset
+/// after it, so that they hold the timed steps only.
 pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| format!("cannot build a pool of {threads} threads: {e}"))?;
     let mut s = sys.clone();
-    // as in a run between output samples: the pair springs' stored energy is not summed (the dissipation is)
     s.spring_energy_wanted = false;
     let dt = std::f64::consts::PI * (0.5 * s.particles[0].mass / s.material.k_n).sqrt() / 50.0;
-    let elapsed = pool.install(|| {
-        leapfrog::step(&mut s, 0.0, dt);
-        // the phase totals (when timing is on) are those of the timed steps only
+    let mut before = Vec::new();
+    let elapsed = pool.install(|| -> Result<f64, String> {
+        checked_step(&mut s, &mut before, 0, dt, |_, _| ())?;
         if crate::phase::enabled() {
             crate::phase::reset();
         }
         let start = Instant::now();
         for k in 1..=steps {
-            leapfrog::step(&mut s, k as f64 * dt, dt);
+            checked_step(&mut s, &mut before, k, dt, |_, _| ())?;
         }
-        start.elapsed().as_secs_f64()
+        Ok(start.elapsed().as_secs_f64())
     });
+    let elapsed = elapsed.map_err(|e| BenchError::failed(format!("the benchmark system broke: {e}")))?;
     Ok(s.particles.len() as f64 * steps as f64 / elapsed)
 }
 

@@ -324,9 +324,9 @@ impl crate::io::scene_file::Validator<'_> {
 }
 
 /// Membership of the central body: the largest-mass set of particles connected by the pair contacts `contacts`
-/// (`(i, j)` keys, as `granular::soft::forces::SoftSystem::pair_springs` after a force evaluation); ties go
+/// (`(i, j)` keys, as `granular::soft::forces::SoftSystem::touching_pairs` after a force evaluation); ties go
 /// to the set holding the lowest index.
-pub fn central_body<'a>(particles: &[Particle], contacts: impl Iterator<Item = &'a (usize, usize)>) -> Vec<bool> {
+pub fn central_body(particles: &[Particle], contacts: impl IntoIterator<Item = (usize, usize)>) -> Vec<bool> {
     let n = particles.len();
     let mut parent: Vec<usize> = (0..n).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -336,7 +336,7 @@ pub fn central_body<'a>(particles: &[Particle], contacts: impl Iterator<Item = &
         }
         i
     }
-    for &(i, j) in contacts {
+    for (i, j) in contacts {
         if i < n && j < n {
             let (a, b) = (root(&mut parent, i), root(&mut parent, j));
             if a != b {
@@ -602,7 +602,7 @@ mod tests {
         let ps = [p(1.0), p(1.0), p(1.0), p(5.0), p(1.0)];
         let contacts = [(0, 1), (1, 2), (3, 4)];
         assert_eq!(
-            central_body(&ps, contacts.iter()),
+            central_body(&ps, contacts.iter().copied()),
             vec![false, false, false, true, true]
         );
     }
