@@ -9,6 +9,8 @@
 //! holds at most [`DENSE_CELLS_PER_BODY`] cells per body, a dense table of where each cell's run starts finds a
 //! run in O(1); otherwise (sparse clouds, far debris) a binary search over the sorted keys does. The output is
 //! sorted `(i, j)` with `i < j` and does not depend on the number of threads, so runs are deterministic.
+//! [`sphere_pair_rows`] gives the same pairs as compressed rows by both indices (a Verlet list and its
+//! transpose), built in parallel by tasks of consecutive bodies that each fill their own buffers.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
@@ -177,30 +179,72 @@ impl PairRows {
         &self.lower[self.lower_start[j]..self.lower_start[j + 1]]
     }
 
-    /// Rows from per-body lists (each sorted here), flattened in parallel.
-    fn from_lists(mut upper: Vec<Vec<u32>>, mut lower: Vec<Vec<u32>>) -> Self {
-        upper.par_iter_mut().for_each(|r| r.sort_unstable());
-        lower.par_iter_mut().for_each(|r| r.sort_unstable());
-        let starts = |rows: &[Vec<u32>]| -> Vec<usize> {
-            let mut start = Vec::with_capacity(rows.len() + 1);
+    /// Rows from blocks of consecutive bodies, each block's rows back to back (`Block`), in block order.
+    fn from_blocks(blocks: Vec<Block>) -> Self {
+        let n: usize = blocks.iter().map(|b| b.upper_len.len()).sum();
+        let starts = |lens: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
+            let mut start = Vec::with_capacity(n + 1);
             start.push(0);
             let mut total = 0;
-            for r in rows {
-                total += r.len();
+            for l in lens {
+                total += l;
                 start.push(total);
             }
             start
         };
+        let upper_start = starts(&mut blocks.iter().flat_map(|b| b.upper_len.iter().map(|&l| l as usize)));
+        let lower_start = starts(&mut blocks.iter().flat_map(|b| b.lower_len.iter().map(|&l| l as usize)));
+        let mut upper = Vec::with_capacity(upper_start[n]);
+        let mut lower = Vec::with_capacity(lower_start[n]);
+        for b in &blocks {
+            upper.extend_from_slice(&b.upper);
+            lower.extend_from_slice(&b.lower);
+        }
         PairRows {
-            upper_start: starts(&upper),
-            lower_start: starts(&lower),
-            upper: upper.par_iter().flatten().copied().collect(),
-            lower: lower.par_iter().flatten().copied().collect(),
+            upper_start,
+            upper,
+            lower_start,
+            lower,
         }
     }
 }
 
-/// [`sphere_pairs`] as [`PairRows`], built in parallel; the result does not depend on the number of threads.
+/// The rows of a block of consecutive bodies: partners back to back, and each row's length.
+#[derive(Default)]
+struct Block {
+    upper: Vec<u32>,
+    upper_len: Vec<u32>,
+    lower: Vec<u32>,
+    lower_len: Vec<u32>,
+}
+
+impl Block {
+    /// Appends the next body's row and column (sorted here) from its partners `partners` (in any order) and the
+    /// extra partners of higher and lower index `up`, `down`.
+    fn push(&mut self, i: u32, partners: &mut Vec<u32>, up: &[u32], down: &[u32]) {
+        let (u0, l0) = (self.upper.len(), self.lower.len());
+        for &j in partners.iter() {
+            if j > i {
+                self.upper.push(j);
+            } else if j < i {
+                self.lower.push(j);
+            }
+        }
+        partners.clear();
+        self.upper.extend_from_slice(up);
+        self.lower.extend_from_slice(down);
+        self.upper[u0..].sort_unstable();
+        self.lower[l0..].sort_unstable();
+        self.upper_len.push((self.upper.len() - u0) as u32);
+        self.lower_len.push((self.lower.len() - l0) as u32);
+    }
+}
+
+/// Bodies per parallel task of the neighbour search.
+const BODIES_PER_TASK: usize = 256;
+
+/// [`sphere_pairs`] as [`PairRows`], built in parallel (tasks of consecutive bodies, each filling its own
+/// buffers); the result does not depend on the number of threads.
 ///
 /// ```
 /// use rubblepile::geometry::neighbours::sphere_pair_rows;
@@ -214,67 +258,80 @@ pub fn sphere_pair_rows(centres: &[Vec3], radii: &[f64]) -> PairRows {
     assert!(n < u32::MAX as usize, "{n} bodies: indices must fit in 32 bits");
     let finite =
         centres.iter().all(|c| c.iter().all(|x| x.is_finite())) && radii.iter().all(|r| r.is_finite() && *r > 0.0);
+    // Pairs found outside the grid (all of them on the brute-force path; those of large bodies otherwise), as
+    // (i, j) and (j, i) lists sorted by their first index.
+    let mut extra: Vec<(u32, u32)> = Vec::new();
+    let mut grid = None;
     if n < BRUTE_FORCE_BELOW || !finite {
-        let (mut upper, mut lower) = (vec![Vec::new(); n], vec![Vec::new(); n]);
-        for (i, j) in brute_force_pairs(centres, radii) {
-            upper[i].push(j as u32);
-            lower[j].push(i as u32);
-        }
-        return PairRows::from_lists(upper, lower);
-    }
-    let mut sorted = radii.to_vec();
-    sorted.par_sort_unstable_by(f64::total_cmp);
-    let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
-    let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
-    let mut grid = Grid {
-        cell: r_ref,
-        keys: Vec::new(),
-        centres: Vec::new(),
-        radii: Vec::new(),
-        ids: Vec::new(),
-        dense: None,
-    };
-    let mut binned: Vec<([i64; 3], usize)> = regular.par_iter().map(|&i| (grid.key(&centres[i]), i)).collect();
-    // (key, index) pairs are distinct, so the order does not depend on the sort's scheduling
-    binned.par_sort_unstable();
-    grid.keys = binned.iter().map(|b| b.0).collect();
-    grid.ids = binned.iter().map(|b| b.1).collect();
-    grid.centres = grid.ids.iter().map(|&i| centres[i]).collect();
-    grid.radii = grid.ids.iter().map(|&i| radii[i]).collect();
-    grid.dense = DenseStarts::new(&grid.keys, DENSE_CELLS_PER_BODY * grid.keys.len().max(1));
-
-    // Regular–regular pairs: each body lists its partners of higher and of lower index.
-    let lists_of = |i: usize| -> (Vec<u32>, Vec<u32>) {
-        let (mut up, mut down) = (Vec::new(), Vec::new());
-        if radii[i] <= r_ref {
-            grid.query(&centres[i], radii[i], r_ref, |j| match j.cmp(&i) {
-                std::cmp::Ordering::Greater => up.push(j as u32),
-                std::cmp::Ordering::Less => down.push(j as u32),
-                std::cmp::Ordering::Equal => {}
-            });
-        }
-        (up, down)
-    };
-    let (mut upper, mut lower): (Vec<Vec<u32>>, Vec<Vec<u32>>) = if n >= PARALLEL_FROM {
-        (0..n).into_par_iter().map(lists_of).unzip()
+        extra = brute_force_pairs(centres, radii)
+            .into_iter()
+            .map(|(i, j)| (i as u32, j as u32))
+            .collect();
     } else {
-        (0..n).map(lists_of).unzip()
-    };
-    // Pairs with a large body: large–regular through the grid, large–large directly.
-    let mut add = |a: usize, b: usize| {
-        let (i, j) = (a.min(b), a.max(b));
-        upper[i].push(j as u32);
-        lower[j].push(i as u32);
-    };
-    for (a, &l) in large.iter().enumerate() {
-        grid.query(&centres[l], radii[l], r_ref, |j| add(l, j));
-        for &m in &large[a + 1..] {
-            if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
-                add(l, m);
+        let mut sorted = radii.to_vec();
+        sorted.par_sort_unstable_by(f64::total_cmp);
+        let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
+        let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
+        let mut g = Grid {
+            cell: r_ref,
+            keys: Vec::new(),
+            centres: Vec::new(),
+            radii: Vec::new(),
+            ids: Vec::new(),
+            dense: None,
+        };
+        let mut binned: Vec<([i64; 3], usize)> = regular.par_iter().map(|&i| (g.key(&centres[i]), i)).collect();
+        // (key, index) pairs are distinct, so the order does not depend on the sort's scheduling
+        binned.par_sort_unstable();
+        g.keys = binned.iter().map(|b| b.0).collect();
+        g.ids = binned.iter().map(|b| b.1).collect();
+        g.centres = g.ids.iter().map(|&i| centres[i]).collect();
+        g.radii = g.ids.iter().map(|&i| radii[i]).collect();
+        g.dense = DenseStarts::new(&g.keys, DENSE_CELLS_PER_BODY * g.keys.len().max(1));
+        // Pairs with a large body: large–regular through the grid, large–large directly.
+        for (a, &l) in large.iter().enumerate() {
+            g.query(&centres[l], radii[l], r_ref, |j| {
+                extra.push((l.min(j) as u32, l.max(j) as u32))
+            });
+            for &m in &large[a + 1..] {
+                if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
+                    extra.push((l as u32, m as u32));
+                }
             }
         }
+        grid = Some((g, r_ref));
     }
-    PairRows::from_lists(upper, lower)
+    let mut extra_down: Vec<(u32, u32)> = extra.iter().map(|&(i, j)| (j, i)).collect();
+    extra.sort_unstable();
+    extra_down.sort_unstable();
+    let partners_of = |list: &[(u32, u32)], i: u32| -> Vec<u32> {
+        let a = list.partition_point(|e| e.0 < i);
+        let b = list.partition_point(|e| e.0 <= i);
+        list[a..b].iter().map(|e| e.1).collect()
+    };
+    // Each body's regular partners from the grid (a regular body lists every regular body near it), then its extra
+    // partners.
+    let block = |k: usize| -> Block {
+        let mut out = Block::default();
+        let mut partners = Vec::new();
+        for i in k * BODIES_PER_TASK..((k + 1) * BODIES_PER_TASK).min(n) {
+            if let Some((g, r_ref)) = &grid
+                && radii[i] <= *r_ref
+            {
+                g.query(&centres[i], radii[i], *r_ref, |j| partners.push(j as u32));
+            }
+            let (up, down) = (partners_of(&extra, i as u32), partners_of(&extra_down, i as u32));
+            out.push(i as u32, &mut partners, &up, &down);
+        }
+        out
+    };
+    let tasks = n.div_ceil(BODIES_PER_TASK);
+    let blocks: Vec<Block> = if n >= PARALLEL_FROM {
+        (0..tasks).into_par_iter().map(block).collect()
+    } else {
+        (0..tasks).map(block).collect()
+    };
+    PairRows::from_blocks(blocks)
 }
 
 /// The O(N²) reference search.

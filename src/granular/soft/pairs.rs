@@ -267,6 +267,28 @@ fn pair_contact<const SIZES: bool, const STORED: bool>(
     })
 }
 
+/// A vector laid out in rows (`start[i]..start[i + 1]` is row `i`), every entry `value` until `fill(i, row)` fills
+/// row `i`; rows are filled in parallel, in tasks of [`ROWS_PER_BLOCK`] rows.
+fn fill_rows<T: Copy + Send + Sync>(start: &[usize], value: T, fill: impl Fn(usize, &mut [T]) + Sync) -> Vec<T> {
+    let rows = start.len().saturating_sub(1);
+    let mut out = vec![value; start.last().copied().unwrap_or(0)];
+    let mut pieces = Vec::with_capacity(rows.div_ceil(ROWS_PER_BLOCK));
+    let mut rest = &mut out[..];
+    for first in (0..rows).step_by(ROWS_PER_BLOCK) {
+        let end = (first + ROWS_PER_BLOCK).min(rows);
+        let (piece, tail) = std::mem::take(&mut rest).split_at_mut(start[end] - start[first]);
+        pieces.push((first..end, piece));
+        rest = tail;
+    }
+    pieces.into_par_iter().for_each(|(block, piece)| {
+        let offset = start[block.start];
+        for i in block {
+            fill(i, &mut piece[start[i] - offset..start[i + 1] - offset]);
+        }
+    });
+    out
+}
+
 /// The list and what an evaluation needs of it.
 struct Rows<'a> {
     particles: &'a [Particle],
@@ -422,74 +444,54 @@ impl PairList {
         let rows = sphere_pair_rows(&centres, &reach);
         // Carry the springs of touching pairs over, row by row: old and new rows are both ascending.
         let old_rows = self.row_start.len().saturating_sub(1);
-        let slots: Vec<Slot> = (0..n)
-            .into_par_iter()
-            .with_min_len(256)
-            .flat_map_iter(|i| {
-                let (old_cols, old_slots) = if i < old_rows {
-                    let r = self.row_start[i]..self.row_start[i + 1];
-                    (&self.cols[r.clone()], &self.slots[r])
-                } else {
-                    (&[][..], &[][..])
-                };
-                let mut k = 0;
-                rows.upper(i).iter().map(move |&j| {
-                    while k < old_cols.len() && old_cols[k] < j {
-                        k += 1;
-                    }
-                    if k < old_cols.len() && old_cols[k] == j {
-                        old_slots[k]
-                    } else {
-                        Slot::empty()
-                    }
-                })
-            })
-            .collect();
-        // Per sphere p, the entries (k, p) with k in an earlier block than p's: by block from the nearest to the
-        // first, ascending k in each.
-        let entry = |k: usize, p: usize| {
-            let row = rows.upper(k);
-            let at = row
-                .binary_search(&(p as u32))
-                .expect("the columns are the rows' transpose");
-            (rows.upper_start[k] + at) as u32
-        };
+        let slots = fill_rows(&rows.upper_start, Slot::empty(), |i, out| {
+            if i >= old_rows {
+                return;
+            }
+            let r = self.row_start[i]..self.row_start[i + 1];
+            let (old_cols, old_slots) = (&self.cols[r.clone()], &self.slots[r]);
+            let mut k = 0;
+            for (slot, &j) in out.iter_mut().zip(rows.upper(i)) {
+                while k < old_cols.len() && old_cols[k] < j {
+                    k += 1;
+                }
+                if k < old_cols.len() && old_cols[k] == j {
+                    *slot = old_slots[k];
+                }
+            }
+        });
+        // Per sphere p, the entries (k, p) with k in an earlier block than p's, in the order they are added: by
+        // block from the nearest to the first, ascending k in each.
         let crossing = |p: usize| {
             let lower = rows.lower(p);
             &lower[..lower.partition_point(|&k| (k as usize) < p / ROWS_PER_BLOCK * ROWS_PER_BLOCK)]
         };
-        let in_adding_order = |ks: &[u32]| {
-            let mut out = Vec::with_capacity(ks.len());
+        let mut cross_start = Vec::with_capacity(n + 1);
+        cross_start.push(0);
+        let mut total = 0;
+        for p in 0..n {
+            total += crossing(p).len();
+            cross_start.push(total);
+        }
+        let cross = fill_rows(&cross_start, 0u32, |p, out| {
+            let ks = crossing(p);
+            let mut filled = 0;
             let mut end = ks.len();
             while end > 0 {
                 let block = ks[end - 1] as usize / ROWS_PER_BLOCK;
                 let start = ks[..end].partition_point(|&k| (k as usize) / ROWS_PER_BLOCK < block);
-                out.extend_from_slice(&ks[start..end]);
+                for &k in &ks[start..end] {
+                    let k = k as usize;
+                    let at = rows
+                        .upper(k)
+                        .binary_search(&(p as u32))
+                        .expect("the columns are the rows' transpose");
+                    out[filled] = (rows.upper_start[k] + at) as u32;
+                    filled += 1;
+                }
                 end = start;
             }
-            out
-        };
-        let counts: Vec<usize> = (0..n)
-            .into_par_iter()
-            .with_min_len(1024)
-            .map(|p| crossing(p).len())
-            .collect();
-        let mut cross_start = Vec::with_capacity(n + 1);
-        cross_start.push(0);
-        let mut total = 0;
-        for c in counts {
-            total += c;
-            cross_start.push(total);
-        }
-        let cross: Vec<u32> = (0..n)
-            .into_par_iter()
-            .with_min_len(256)
-            .flat_map_iter(|p| {
-                in_adding_order(crossing(p))
-                    .into_iter()
-                    .map(move |k| entry(k as usize, p))
-            })
-            .collect();
+        });
         self.row_start = rows.upper_start;
         self.cols = rows.upper;
         self.slots = slots;
