@@ -103,13 +103,36 @@ const PAR_MIN: usize = 64;
 pub(crate) const SUM_CHUNK: usize = 1024;
 
 /// `Σ term(k)` over `k < n`, summed in chunks of [`SUM_CHUNK`] (each in order, in parallel) and the chunks'
-/// totals in order: the same bits on any number of threads.
+/// totals in order: the same bits on any number of threads (and, up to `SUM_CHUNK` terms, those of a plain
+/// loop from 0).
 pub(crate) fn ordered_sum(n: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
-    let chunks: Vec<f64> = (0..n.div_ceil(SUM_CHUNK))
+    ordered_reduce(n, 0.0, |s, k| *s += term(k), |s, c| *s += c)
+}
+
+/// A reduction over `k < n` in the order of [`ordered_sum`]: each chunk of [`SUM_CHUNK`] starts from `zero` and
+/// takes `add_term(acc, k)` for its `k` in order (chunks in parallel); the chunks' results are then combined by
+/// `add(total, chunk)` in order, starting from `zero`.
+pub(crate) fn ordered_reduce<T: Copy + Send + Sync>(
+    n: usize,
+    zero: T,
+    add_term: impl Fn(&mut T, usize) + Sync,
+    add: impl Fn(&mut T, T),
+) -> T {
+    let chunks: Vec<T> = (0..n.div_ceil(SUM_CHUNK))
         .into_par_iter()
-        .map(|c| (c * SUM_CHUNK..((c + 1) * SUM_CHUNK).min(n)).fold(0.0, |s, k| s + term(k)))
+        .map(|c| {
+            let mut acc = zero;
+            for k in c * SUM_CHUNK..((c + 1) * SUM_CHUNK).min(n) {
+                add_term(&mut acc, k);
+            }
+            acc
+        })
         .collect();
-    chunks.into_iter().fold(0.0, |s, c| s + c)
+    let mut total = zero;
+    for c in chunks {
+        add(&mut total, c);
+    }
+    total
 }
 
 /// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
@@ -158,6 +181,11 @@ impl SoftSystem {
     /// The pairs `(i, j)`, `i < j`, that touched at the last evaluation, in key order (no allocation).
     pub fn touching_pairs(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         self.pairs.touching()
+    }
+
+    /// Calls `f(i, j)` for every pair that touched at the last evaluation, in parallel and in no particular order.
+    pub fn for_each_touching_pair(&self, f: impl Fn(usize, usize) + Sync) {
+        self.pairs.for_each_touching(f)
     }
 
     /// Replaces the pair spring histories by `springs` (as from [`SoftSystem::pair_springs`], e.g. on

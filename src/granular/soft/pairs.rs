@@ -391,6 +391,21 @@ impl PairList {
         })
     }
 
+    /// Calls `f(i, j)` for every pair that touched at the last evaluation, in parallel (blocks of rows), in no
+    /// particular order.
+    pub fn for_each_touching(&self, f: impl Fn(usize, usize) + Sync) {
+        let rows = self.row_start.len().saturating_sub(1);
+        (0..rows.div_ceil(ROWS_PER_BLOCK)).into_par_iter().for_each(|b| {
+            for i in b * ROWS_PER_BLOCK..((b + 1) * ROWS_PER_BLOCK).min(rows) {
+                for q in self.row_start[i]..self.row_start[i + 1] {
+                    if self.slots[q].get().is_some() {
+                        f(i, self.cols[q] as usize);
+                    }
+                }
+            }
+        });
+    }
+
     /// The spring histories of the pairs that touched at the last evaluation, in key order `(i, j)`.
     pub fn springs(&self) -> Vec<((usize, usize), Springs)> {
         self.rows()

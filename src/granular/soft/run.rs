@@ -39,7 +39,7 @@ use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene::{SoftScene, load_soft_scene, parse_soft_scene};
-use crate::granular::soft::spinup::{SpinupDriver, central_body};
+use crate::granular::soft::spinup::{SpinupDriver, central_body, central_body_par};
 use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
@@ -302,9 +302,9 @@ impl SpinRun {
     fn after_step(&self, sys: &mut SoftSystem, t: f64) {
         if !self.driver.released {
             PHASE_SPINUP.time(|| {
-                // the touching pairs straight from the list: a copy of every spring would cost ~20 MB a step at
-                // 40 000 spheres
-                let member = central_body(&sys.particles, sys.touching_pairs());
+                // the touching pairs straight from the list, joined in parallel: a copy of every spring would cost
+                // ~20 MB a step at 40 000 spheres
+                let member = central_body_par(&sys.particles, |union| sys.for_each_touching_pair(union));
                 let inc = self.driver.apply(&mut sys.particles, &member, t);
                 sys.forcing_work += inc.work;
                 sys.forcing_angular_impulse += inc.angular_impulse;
