@@ -19,6 +19,8 @@ use rayon::prelude::*;
 
 // Where a force evaluation's time goes (`rubblepile bench ssdem --phases`, `bench scaling`; see [`crate::phase`]).
 static PHASE_BASE: Phase = Phase::new("soft.base_forces", Kind::Parallel);
+static PHASE_OPEN: Phase = Phase::new("soft.kick_drift", Kind::Parallel);
+static PHASE_CLOSE: Phase = Phase::new("soft.kick", Kind::Parallel);
 static PHASE_WALLS: Phase = Phase::new("soft.walls", Kind::Parallel);
 static PHASE_WALL_SUM: Phase = Phase::new("soft.wall_sum", Kind::Serial);
 
@@ -212,22 +214,19 @@ impl SoftSystem {
             _ => None,
         };
         let particles = &self.particles;
-        let gravitational_energy = PHASE_BASE.time(|| match &every_step {
-            Some((_, potentials)) => ordered_sum(n, |k| {
-                let p = &particles[k];
-                0.5 * p.mass * potentials[k] - p.mass * uniform.dot(&p.position)
-            }),
-            None => ordered_sum(n, |k| 0.0 - particles[k].mass * uniform.dot(&particles[k].position)),
-        });
-        let mut stats = ForceStats {
-            gravitational_energy: self.slow_energy + gravitational_energy,
-            ..ForceStats::default()
+        // The non-contact force on sphere k and its potential energy, added to its contact force as the pairs'
+        // sums are finished; the energies are summed there in the chunks of `ordered_sum`.
+        let base = |k: usize| {
+            let p = &particles[k];
+            match &every_step {
+                Some((acc, potentials)) => (
+                    (acc[k] + uniform) * p.mass,
+                    0.5 * p.mass * potentials[k] - p.mass * uniform.dot(&p.position),
+                ),
+                None => (uniform * p.mass, 0.0 - p.mass * uniform.dot(&p.position)),
+            }
         };
-        // The non-contact force on sphere k, added to its contact force as the pairs' sums are finished.
-        let base = |k: usize| match &every_step {
-            Some((acc, _)) => (acc[k] + uniform) * particles[k].mass,
-            None => uniform * particles[k].mass,
-        };
+        let mut stats = ForceStats::default();
 
         // Pair contacts. The force and torque buffers are reused from step to step: per-step arrays of a
         // 40 000-sphere system cost page faults and cache space.
@@ -242,6 +241,7 @@ impl SoftSystem {
             (false, true) => pairs.evaluate::<false, true>(particles, &law, dt, base, &mut forces, &mut torques),
             (false, false) => pairs.evaluate::<false, false>(particles, &law, dt, base, &mut forces, &mut torques),
         };
+        stats.gravitational_energy = self.slow_energy + totals.base_energy;
         stats.spring_energy = totals.spring_energy;
         stats.max_overlap_fraction = totals.max_overlap_fraction;
         stats.pair_contacts = totals.contacts;
@@ -315,6 +315,71 @@ impl SoftSystem {
         self.dissipated += dissipated;
         self.wall_work += wall_work;
         self.records = records;
+    }
+
+    /// The first half of a leapfrog step in one pass over the spheres (each sphere on its own, so the bits are
+    /// those of separate passes): copies the state into `before` (resized to the spheres) if given, gives the
+    /// slow kick `v += a_slow τ` if `slow` is `Some(τ)` (r-RESPA, `respa.rs`), kicks `v += F/m h`, `ω += τ/I h`
+    /// and drifts `x += v dt`; and tells the pair list whether a sphere has moved far enough to rebuild it, so that
+    /// the force evaluation that must follow needs no pass of its own for that.
+    pub(crate) fn open_step(&mut self, before: Option<&mut Vec<Particle>>, slow: Option<f64>, h: f64, dt: f64) {
+        let (forces, torques, slow_acc, pairs) = (&self.forces, &self.torques, &self.slow_accelerations, &self.pairs);
+        let one = |c: usize, ps: &mut [Particle], keep: Option<&mut [Particle]>| -> bool {
+            if let Some(keep) = keep {
+                keep.copy_from_slice(ps);
+            }
+            let mut moved = false;
+            for (k, p) in ps.iter_mut().enumerate() {
+                let i = c * SUM_CHUNK + k;
+                if let Some(tau) = slow {
+                    p.velocity += slow_acc[i] * tau;
+                }
+                p.velocity += forces[i] * (h / p.mass);
+                p.spin += torques[i] * (h / p.inertia());
+                p.position += p.velocity * dt;
+                moved |= pairs.moved_too_far(i, &p.position);
+            }
+            moved
+        };
+        let moved = PHASE_OPEN.time(|| match before {
+            Some(before) => {
+                before.resize(self.particles.len(), Particle::default());
+                self.particles
+                    .par_chunks_mut(SUM_CHUNK)
+                    .zip(before.par_chunks_mut(SUM_CHUNK))
+                    .enumerate()
+                    .map(|(c, (ps, keep))| one(c, ps, Some(keep)))
+                    .reduce(|| false, |a, b| a || b)
+            }
+            None => self
+                .particles
+                .par_chunks_mut(SUM_CHUNK)
+                .enumerate()
+                .map(|(c, ps)| one(c, ps, None))
+                .reduce(|| false, |a, b| a || b),
+        });
+        self.pairs.set_checked(moved);
+    }
+
+    /// The second half of a leapfrog step in one pass: kicks `v += F/m h`, `ω += τ/I h`, then gives the slow
+    /// kick `v += a_slow τ` if `slow` is `Some(τ)`.
+    pub(crate) fn close_step(&mut self, slow: Option<f64>, h: f64) {
+        let (forces, torques, slow_acc) = (&self.forces, &self.torques, &self.slow_accelerations);
+        PHASE_CLOSE.time(|| {
+            self.particles
+                .par_chunks_mut(SUM_CHUNK)
+                .enumerate()
+                .for_each(|(c, ps)| {
+                    for (k, p) in ps.iter_mut().enumerate() {
+                        let i = c * SUM_CHUNK + k;
+                        p.velocity += forces[i] * (h / p.mass);
+                        p.spin += torques[i] * (h / p.inertia());
+                        if let Some(tau) = slow {
+                            p.velocity += slow_acc[i] * tau;
+                        }
+                    }
+                })
+        })
     }
 
     /// Kinetic energy, translational plus rotational (J).

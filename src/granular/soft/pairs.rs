@@ -27,6 +27,7 @@
 
 use crate::geometry::neighbours::sphere_pair_rows;
 use crate::granular::soft::contact::{Kinematics, Law, Output, Springs, evaluate_inner};
+use crate::granular::soft::forces::SUM_CHUNK;
 use crate::granular::soft::particle::Particle;
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
@@ -109,6 +110,8 @@ pub struct PairTotals {
     pub contacts: usize,
     /// Per-contact records, in key order `(i, j)` (when asked for).
     pub records: Vec<ContactRecord>,
+    /// `Σ base(p).1` over the spheres ([`PairList::evaluate`]; J).
+    pub base_energy: f64,
 }
 
 impl PairTotals {
@@ -357,6 +360,9 @@ pub struct PairList {
     load: Vec<(Vec3, Vec3)>,
     /// The centres at the last build.
     origin: Vec<Vec3>,
+    /// Whether the list is stale, as found by a pass that already compared every sphere's current position with
+    /// `origin` ([`PairList::moved_too_far`]); taken by the next evaluation instead of checking again.
+    checked: Option<bool>,
 }
 
 impl PairList {
@@ -438,14 +444,17 @@ impl PairList {
     /// not those of the last build).
     fn refresh(&mut self, particles: &[Particle]) {
         let limit = 0.25 * self.skin * self.skin;
-        let stale = PHASE_CHECK.time(|| {
-            self.origin.len() != particles.len()
-                || particles
-                    .par_iter()
-                    .with_min_len(4096)
-                    .zip(&self.origin)
-                    .any(|(p, o)| (p.position - o).norm_squared() > limit)
-        });
+        let checked = self.checked.take();
+        let stale = self.origin.len() != particles.len()
+            || checked.unwrap_or_else(|| {
+                PHASE_CHECK.time(|| {
+                    particles
+                        .par_iter()
+                        .with_min_len(4096)
+                        .zip(&self.origin)
+                        .any(|(p, o)| (p.position - o).norm_squared() > limit)
+                })
+            });
         if stale {
             PHASE_REBUILD.time(|| self.rebuild(particles));
         }
@@ -515,16 +524,33 @@ impl PairList {
         self.origin = centres;
     }
 
+    /// Whether sphere `k`, now at `position` (m), has moved more than half the skin since the last build (true
+    /// for a sphere the list has not seen). A pass that asks this of every sphere at its final position hands the
+    /// answer on with [`PairList::set_checked`], which saves the evaluation a pass over the spheres.
+    #[inline(always)]
+    pub fn moved_too_far(&self, k: usize, position: &Vec3) -> bool {
+        self.origin
+            .get(k)
+            .is_none_or(|o| (position - o).norm_squared() > 0.25 * self.skin * self.skin)
+    }
+
+    /// Hands on whether any sphere has moved too far ([`PairList::moved_too_far`]); valid until the positions
+    /// change, which the caller guarantees (the next evaluation takes it).
+    pub fn set_checked(&mut self, stale: bool) {
+        self.checked = Some(stale);
+    }
+
     /// Evaluates every listed pair for a step of `dt` (s) with the constants `law`, refreshing the list first:
-    /// sets `forces[p] = base(p) + (contact force on p)` and `torques[p]` (the contact torque) for every sphere, and
-    /// returns the scalar sums. `SIZES`: the outputs' `|M_R|`, `|M_T|` and per-contact records (only samples want
+    /// sets `forces[p] = base(p).0 + (contact force on p)` and `torques[p]` (the contact torque) for every sphere,
+    /// and returns the scalar sums, with `Σ base(p).1` (the non-contact potential energy) summed by
+    /// `ordered_sum`'s chunks in `PairTotals::base_energy`. `SIZES`: the outputs' `|M_R|`, `|M_T|` and per-contact records (only samples want
     /// them); `STORED`: the springs' stored energy.
     pub fn evaluate<const SIZES: bool, const STORED: bool>(
         &mut self,
         particles: &[Particle],
         law: &Law,
         dt: f64,
-        base: impl Fn(usize) -> Vec3 + Sync,
+        base: impl Fn(usize) -> (Vec3, f64) + Sync,
         forces: &mut Vec<Vec3>,
         torques: &mut Vec<Vec3>,
     ) -> PairTotals {
@@ -581,31 +607,43 @@ impl PairList {
                 partial
             }
         });
-        PHASE_FINISH.time(|| {
+        let base_energy = PHASE_FINISH.time(|| {
             forces.resize(n, Vec3::zeros());
             torques.resize(n, Vec3::zeros());
             let (load, shares, cross_start, cross) = (&self.load, &self.shares, &self.cross_start, &self.cross);
-            forces
-                .par_iter_mut()
-                .zip(torques.par_iter_mut())
+            // chunks of SUM_CHUNK spheres, so that the energy is summed as `ordered_sum` sums
+            let chunks: Vec<f64> = forces
+                .par_chunks_mut(SUM_CHUNK)
+                .zip(torques.par_chunks_mut(SUM_CHUNK))
                 .enumerate()
-                .with_min_len(1024)
-                .for_each(|(p, (f, t))| {
-                    let (mut force, mut torque) = load[p];
-                    if parallel {
-                        // the pairs (k, p) of earlier blocks: the end of p's order
-                        for &q in &cross[cross_start[p]..cross_start[p + 1]] {
-                            let s = &shares[q as usize];
-                            force -= s.force;
-                            torque += s.torque;
+                .map(|(c, (fs, ts))| {
+                    let mut energy = 0.0;
+                    for (k, (f, t)) in fs.iter_mut().zip(ts).enumerate() {
+                        let p = c * SUM_CHUNK + k;
+                        let (mut force, mut torque) = load[p];
+                        if parallel {
+                            // the pairs (k, p) of earlier blocks: the end of p's order
+                            for &q in &cross[cross_start[p]..cross_start[p + 1]] {
+                                let s = &shares[q as usize];
+                                force -= s.force;
+                                torque += s.torque;
+                            }
                         }
+                        let (b, e) = base(p);
+                        *f = b + force;
+                        *t = torque;
+                        energy += e;
                     }
-                    *f = base(p) + force;
-                    *t = torque;
-                });
+                    energy
+                })
+                .collect();
+            chunks.into_iter().fold(0.0, |s, c| s + c)
         });
         PHASE_TOTALS.time(|| {
-            let mut totals = PairTotals::default();
+            let mut totals = PairTotals {
+                base_energy,
+                ..PairTotals::default()
+            };
             for p in &mut partial {
                 totals.spring_energy += p.spring_energy;
                 totals.dissipated += p.dissipated;

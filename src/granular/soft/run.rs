@@ -48,14 +48,13 @@ use rayon::prelude::*;
 /// Overlap (fraction of the smaller radius) above which the run is declared broken.
 pub const BROKEN_OVERLAP: f64 = 0.5;
 
-static PHASE_KEEP: Phase = Phase::new("soft.keep_state", Kind::Parallel);
 static PHASE_CHECK_STATE: Phase = Phase::new("soft.check_state", Kind::Parallel);
 static PHASE_SPINUP: Phase = Phase::new("soft.spinup_forcing", Kind::Serial);
 
 /// One step of a run from step number `step` (time `step dt`, s) by `dt` (s), as the run driver takes it between
 /// samples and as `rubblepile bench ssdem` times it: keeps the state before the step in `before` (for
-/// `last_good_state.csv`), takes the leapfrog step, calls `after` (the spin-up forcing, if any) with the system
-/// and the time at the step's end, and checks the new state. The copy and the check run in parallel. An error
+/// `last_good_state.csv`, copied in the step's first pass), takes the leapfrog step, calls `after` (the spin-up
+/// forcing, if any) with the system and the time at the step's end, and checks the new state (in parallel). An error
 /// names a non-finite particle or an overlap above [`BROKEN_OVERLAP`].
 pub fn checked_step(
     sys: &mut SoftSystem,
@@ -64,15 +63,7 @@ pub fn checked_step(
     dt: f64,
     after: impl FnOnce(&mut SoftSystem, f64),
 ) -> Result<(), String> {
-    PHASE_KEEP.time(|| {
-        before.resize(sys.particles.len(), sys.particles.first().copied().unwrap_or(EMPTY));
-        before
-            .par_iter_mut()
-            .zip(&sys.particles)
-            .with_min_len(crate::granular::soft::forces::SUM_CHUNK)
-            .for_each(|(b, p)| *b = *p);
-    });
-    leapfrog::step(sys, step as f64 * dt, dt);
+    leapfrog::step_keeping(sys, step as f64 * dt, dt, Some(before));
     after(sys, (step + 1) as f64 * dt);
     let bad = PHASE_CHECK_STATE.time(|| {
         sys.particles
@@ -91,15 +82,6 @@ pub fn checked_step(
     }
     Ok(())
 }
-
-/// A placeholder particle (overwritten at once).
-const EMPTY: Particle = Particle {
-    mass: 0.0,
-    radius: 0.0,
-    position: Vec3::new(0.0, 0.0, 0.0),
-    velocity: Vec3::new(0.0, 0.0, 0.0),
-    spin: Vec3::new(0.0, 0.0, 0.0),
-};
 
 const TIMESERIES_HEADER: &str = "t,step,kinetic_energy,gravitational_energy,spring_energy,dissipated_energy,wall_work,energy_residual,momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,forcing_work,wall_seconds\n";
 
