@@ -8,8 +8,8 @@ use std::time::Instant;
 use super::BenchError;
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::{Gravity, SoftSystem};
-use crate::granular::soft::leapfrog;
 use crate::granular::soft::packing::fcc_ball;
+use crate::granular::soft::run::checked_step;
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::SI_G;
 use crate::math::Vec3;
@@ -44,6 +44,10 @@ pub struct BenchSsdemArgs {
     /// (`analysis/ssdem_perf/`).
     #[arg(long, value_name = "FILE")]
     pub dump_particles: Option<PathBuf>,
+    /// Also time every phase of the step ([`crate::phase`]) and print, per thread count, each phase's share of
+    /// the timed steps and the serial fraction (the phase timers cost two clock reads per phase and step).
+    #[arg(long)]
+    pub phases: bool,
 }
 
 /// The benchmark system: `n` spheres on an FCC ball compressed by 0.5 %, spinning slowly, self-gravity (if
@@ -70,25 +74,32 @@ pub fn bench_system(n: usize, gravity: Option<SelfGravity>, gravity_interval: u6
     sys
 }
 
-/// Particle-steps per second of `steps` leapfrog steps on `threads` threads, as the steps of a run between output
-/// samples: the dissipation is summed at every step, the springs' stored energy is not (runs sum it only at samples).
+/// Particle-steps per second of `steps` leapfrog steps on `threads` threads (a pool of its own), as a run takes
+/// its steps between output samples ([`checked_step`]: the state before each step kept for `last_good_state.csv`,
+/// the new state checked, the dissipation summed at every step, the springs' stored energy not, as runs sum it
+/// only at samples). One untimed step comes first; when phase timing is on ([`crate::phase`]) its totals are reset
+/// after it, so that they hold the timed steps only.
 pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .map_err(|e| format!("cannot build a pool of {threads} threads: {e}"))?;
     let mut s = sys.clone();
-    // as in a run between output samples: the pair springs' stored energy is not summed (the dissipation is)
     s.spring_energy_wanted = false;
     let dt = std::f64::consts::PI * (0.5 * s.particles[0].mass / s.material.k_n).sqrt() / 50.0;
-    let elapsed = pool.install(|| {
-        leapfrog::step(&mut s, 0.0, dt);
+    let mut before = Vec::new();
+    let elapsed = pool.install(|| -> Result<f64, String> {
+        checked_step(&mut s, &mut before, 0, dt, |_, _| ())?;
+        if crate::phase::enabled() {
+            crate::phase::reset();
+        }
         let start = Instant::now();
         for k in 1..=steps {
-            leapfrog::step(&mut s, k as f64 * dt, dt);
+            checked_step(&mut s, &mut before, k, dt, |_, _| ())?;
         }
-        start.elapsed().as_secs_f64()
+        Ok(start.elapsed().as_secs_f64())
     });
+    let elapsed = elapsed.map_err(|e| BenchError::failed(format!("the benchmark system broke: {e}")))?;
     Ok(s.particles.len() as f64 * steps as f64 / elapsed)
 }
 
@@ -119,11 +130,17 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
         if t == 0 {
             return Err(BenchError::usage("--threads: each count must be >= 1, got 0"));
         }
+        crate::phase::enable(args.phases);
         let rate = time_steps(&sys, t, args.steps)?;
+        crate::phase::enable(false);
         println!(
             "N = {}, gravity {} (interval {}), {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
             args.particles, args.gravity, args.gravity_interval, sys.stats.pair_contacts
         );
+        if args.phases {
+            let wall = sys.particles.len() as f64 * args.steps as f64 / rate;
+            print!("{}", phase_table(wall, args.steps));
+        }
         rows.push((t, rate));
     }
     if let Some(dir) = &args.out {
@@ -141,6 +158,37 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
         plot(&dir.join("bench_ssdem.svg"), &rows, &args.gravity, args.particles).map_err(BenchError::failed)?;
     }
     Ok(())
+}
+
+/// The phases of the soft-sphere step and of the tree (`soft.*`, `gravity.*`) timed since the last reset, as a
+/// table: seconds, milliseconds per step and share of the timed wall time `wall` (s) of `steps` steps, then the
+/// serial and parallel sums and the serial fraction `serial / (serial + parallel)`.
+pub fn phase_table(wall: f64, steps: u64) -> String {
+    let mut text = String::new();
+    let (mut serial, mut parallel) = (0.0, 0.0);
+    for prefix in ["soft.", "gravity."] {
+        let (mine, s, p) = crate::phase::split(prefix);
+        serial += s;
+        parallel += p;
+        for t in mine.iter().filter(|t| t.calls > 0) {
+            text += &format!(
+                "  {:<26} {:<8} {:>9.4} s {:>9.4} ms/step {:>6.2} %  ({} calls)\n",
+                t.name,
+                t.kind.as_str(),
+                t.seconds,
+                1e3 * t.seconds / steps as f64,
+                100.0 * t.seconds / wall,
+                t.calls
+            );
+        }
+    }
+    text += &format!(
+        "  timed {wall:.4} s; phases: serial {serial:.4} s, parallel {parallel:.4} s, unaccounted {:.4} s; \
+         serial fraction {:.2} %\n",
+        wall - serial - parallel,
+        100.0 * serial / (serial + parallel).max(f64::MIN_POSITIVE)
+    );
+    text
 }
 
 fn plot(path: &Path, rows: &[(usize, f64)], gravity: &str, n: u64) -> Result<(), String> {

@@ -9,6 +9,8 @@
 //! holds at most [`DENSE_CELLS_PER_BODY`] cells per body, a dense table of where each cell's run starts finds a
 //! run in O(1); otherwise (sparse clouds, far debris) a binary search over the sorted keys does. The output is
 //! sorted `(i, j)` with `i < j` and does not depend on the number of threads, so runs are deterministic.
+//! [`sphere_pair_rows`] gives the same pairs as compressed rows by both indices (a Verlet list and its
+//! transpose), built in parallel by tasks of consecutive bodies that each fill their own buffers.
 
 use crate::math::Vec3;
 use rayon::prelude::*;
@@ -142,64 +144,194 @@ impl Grid {
 /// assert_eq!(sphere_pairs(&c, &[1.0, 1.0, 1.0]), vec![(0, 1)]);
 /// ```
 pub fn sphere_pairs(centres: &[Vec3], radii: &[f64]) -> Vec<(usize, usize)> {
-    let n = centres.len();
-    let finite =
-        centres.iter().all(|c| c.iter().all(|x| x.is_finite())) && radii.iter().all(|r| r.is_finite() && *r > 0.0);
-    if n < BRUTE_FORCE_BELOW || !finite {
-        return brute_force_pairs(centres, radii);
-    }
-    let mut sorted = radii.to_vec();
-    sorted.sort_unstable_by(f64::total_cmp);
-    let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
-    let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
-    let mut grid = Grid {
-        cell: r_ref,
-        keys: Vec::new(),
-        centres: Vec::new(),
-        radii: Vec::new(),
-        ids: Vec::new(),
-        dense: None,
-    };
-    let mut binned: Vec<([i64; 3], usize)> = regular.iter().map(|&i| (grid.key(&centres[i]), i)).collect();
-    binned.sort_unstable();
-    grid.keys = binned.iter().map(|b| b.0).collect();
-    grid.ids = binned.iter().map(|b| b.1).collect();
-    grid.centres = grid.ids.iter().map(|&i| centres[i]).collect();
-    grid.radii = grid.ids.iter().map(|&i| radii[i]).collect();
-    grid.dense = DenseStarts::new(&grid.keys, DENSE_CELLS_PER_BODY * grid.keys.len().max(1));
-
-    // Regular–regular pairs: each body lists its partners of higher index.
-    let row_of = |i: usize| -> Vec<usize> {
-        let mut row = Vec::new();
-        if radii[i] <= r_ref {
-            grid.query(&centres[i], radii[i], r_ref, |j| {
-                if j > i {
-                    row.push(j)
-                }
-            });
-        }
-        row
-    };
-    let mut rows: Vec<Vec<usize>> = if n >= PARALLEL_FROM {
-        (0..n).into_par_iter().map(row_of).collect()
-    } else {
-        (0..n).map(row_of).collect()
-    };
-    // Pairs with a large body: large–regular through the grid, large–large directly.
-    for (a, &l) in large.iter().enumerate() {
-        grid.query(&centres[l], radii[l], r_ref, |j| rows[l.min(j)].push(l.max(j)));
-        for &m in &large[a + 1..] {
-            if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
-                rows[l.min(m)].push(l.max(m));
-            }
-        }
-    }
-    let mut pairs = Vec::with_capacity(rows.iter().map(Vec::len).sum());
-    for (i, mut row) in rows.into_iter().enumerate() {
-        row.sort_unstable();
-        pairs.extend(row.into_iter().map(|j| (i, j)));
+    let rows = sphere_pair_rows(centres, radii);
+    let mut pairs = Vec::with_capacity(rows.upper.len());
+    for i in 0..centres.len() {
+        pairs.extend(rows.upper(i).iter().map(|&j| (i, j as usize)));
     }
     pairs
+}
+
+/// The pairs of [`sphere_pairs`] in compressed rows, by each of their two bodies: body `i`'s partners of higher
+/// index (its "row") and of lower index (its "column"), both ascending. Indices are 32-bit (a system of 2³²
+/// bodies would not fit in memory anyway).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PairRows {
+    /// `upper_start[i]..upper_start[i + 1]` is the range of `upper` holding body `i`'s partners `j > i`
+    /// (`n + 1` entries).
+    pub upper_start: Vec<usize>,
+    /// The partners `j > i` of every body `i`, row after row, each row ascending.
+    pub upper: Vec<u32>,
+    /// `lower_start[j]..lower_start[j + 1]` is the range of `lower` holding body `j`'s partners `i < j`.
+    pub lower_start: Vec<usize>,
+    /// The partners `i < j` of every body `j`, column after column, each ascending.
+    pub lower: Vec<u32>,
+}
+
+impl PairRows {
+    /// Body `i`'s partners of higher index, ascending.
+    pub fn upper(&self, i: usize) -> &[u32] {
+        &self.upper[self.upper_start[i]..self.upper_start[i + 1]]
+    }
+
+    /// Body `j`'s partners of lower index, ascending.
+    pub fn lower(&self, j: usize) -> &[u32] {
+        &self.lower[self.lower_start[j]..self.lower_start[j + 1]]
+    }
+
+    /// Rows from blocks of consecutive bodies, each block's rows back to back (`Block`), in block order.
+    fn from_blocks(blocks: Vec<Block>) -> Self {
+        let n: usize = blocks.iter().map(|b| b.upper_len.len()).sum();
+        let starts = |lens: &mut dyn Iterator<Item = usize>| -> Vec<usize> {
+            let mut start = Vec::with_capacity(n + 1);
+            start.push(0);
+            let mut total = 0;
+            for l in lens {
+                total += l;
+                start.push(total);
+            }
+            start
+        };
+        let upper_start = starts(&mut blocks.iter().flat_map(|b| b.upper_len.iter().map(|&l| l as usize)));
+        let lower_start = starts(&mut blocks.iter().flat_map(|b| b.lower_len.iter().map(|&l| l as usize)));
+        let mut upper = Vec::with_capacity(upper_start[n]);
+        let mut lower = Vec::with_capacity(lower_start[n]);
+        for b in &blocks {
+            upper.extend_from_slice(&b.upper);
+            lower.extend_from_slice(&b.lower);
+        }
+        PairRows {
+            upper_start,
+            upper,
+            lower_start,
+            lower,
+        }
+    }
+}
+
+/// The rows of a block of consecutive bodies: partners back to back, and each row's length.
+#[derive(Default)]
+struct Block {
+    upper: Vec<u32>,
+    upper_len: Vec<u32>,
+    lower: Vec<u32>,
+    lower_len: Vec<u32>,
+}
+
+impl Block {
+    /// Appends the next body's row and column (sorted here) from its partners `partners` (in any order) and the
+    /// extra partners of higher and lower index `up`, `down`.
+    fn push(&mut self, i: u32, partners: &mut Vec<u32>, up: &[u32], down: &[u32]) {
+        let (u0, l0) = (self.upper.len(), self.lower.len());
+        for &j in partners.iter() {
+            if j > i {
+                self.upper.push(j);
+            } else if j < i {
+                self.lower.push(j);
+            }
+        }
+        partners.clear();
+        self.upper.extend_from_slice(up);
+        self.lower.extend_from_slice(down);
+        self.upper[u0..].sort_unstable();
+        self.lower[l0..].sort_unstable();
+        self.upper_len.push((self.upper.len() - u0) as u32);
+        self.lower_len.push((self.lower.len() - l0) as u32);
+    }
+}
+
+/// Bodies per parallel task of the neighbour search.
+const BODIES_PER_TASK: usize = 256;
+
+/// [`sphere_pairs`] as [`PairRows`], built in parallel (tasks of consecutive bodies, each filling its own
+/// buffers); the result does not depend on the number of threads.
+///
+/// ```
+/// use rubblepile::geometry::neighbours::sphere_pair_rows;
+/// use rubblepile::math::Vec3;
+/// let c = [Vec3::zeros(), Vec3::new(1.5, 0.0, 0.0), Vec3::new(3.0, 0.0, 0.0)];
+/// let rows = sphere_pair_rows(&c, &[1.0, 1.0, 1.0]);
+/// assert_eq!((rows.upper(0), rows.upper(1), rows.lower(2)), (&[1][..], &[2][..], &[1][..]));
+/// ```
+pub fn sphere_pair_rows(centres: &[Vec3], radii: &[f64]) -> PairRows {
+    let n = centres.len();
+    assert!(n < u32::MAX as usize, "{n} bodies: indices must fit in 32 bits");
+    let finite =
+        centres.iter().all(|c| c.iter().all(|x| x.is_finite())) && radii.iter().all(|r| r.is_finite() && *r > 0.0);
+    // Pairs found outside the grid (all of them on the brute-force path; those of large bodies otherwise), as
+    // (i, j) and (j, i) lists sorted by their first index.
+    let mut extra: Vec<(u32, u32)> = Vec::new();
+    let mut grid = None;
+    if n < BRUTE_FORCE_BELOW || !finite {
+        extra = brute_force_pairs(centres, radii)
+            .into_iter()
+            .map(|(i, j)| (i as u32, j as u32))
+            .collect();
+    } else {
+        let mut sorted = radii.to_vec();
+        sorted.par_sort_unstable_by(f64::total_cmp);
+        let r_ref = sorted[n - 1].min(2.0 * sorted[n / 2]);
+        let (regular, large): (Vec<usize>, Vec<usize>) = (0..n).partition(|&i| radii[i] <= r_ref);
+        let mut g = Grid {
+            cell: r_ref,
+            keys: Vec::new(),
+            centres: Vec::new(),
+            radii: Vec::new(),
+            ids: Vec::new(),
+            dense: None,
+        };
+        let mut binned: Vec<([i64; 3], usize)> = regular.par_iter().map(|&i| (g.key(&centres[i]), i)).collect();
+        // (key, index) pairs are distinct, so the order does not depend on the sort's scheduling
+        binned.par_sort_unstable();
+        g.keys = binned.iter().map(|b| b.0).collect();
+        g.ids = binned.iter().map(|b| b.1).collect();
+        g.centres = g.ids.iter().map(|&i| centres[i]).collect();
+        g.radii = g.ids.iter().map(|&i| radii[i]).collect();
+        g.dense = DenseStarts::new(&g.keys, DENSE_CELLS_PER_BODY * g.keys.len().max(1));
+        // Pairs with a large body: large–regular through the grid, large–large directly.
+        for (a, &l) in large.iter().enumerate() {
+            g.query(&centres[l], radii[l], r_ref, |j| {
+                extra.push((l.min(j) as u32, l.max(j) as u32))
+            });
+            for &m in &large[a + 1..] {
+                if (centres[l] - centres[m]).norm() < radii[l] + radii[m] {
+                    extra.push((l as u32, m as u32));
+                }
+            }
+        }
+        grid = Some((g, r_ref));
+    }
+    let mut extra_down: Vec<(u32, u32)> = extra.iter().map(|&(i, j)| (j, i)).collect();
+    extra.sort_unstable();
+    extra_down.sort_unstable();
+    let partners_of = |list: &[(u32, u32)], i: u32| -> Vec<u32> {
+        let a = list.partition_point(|e| e.0 < i);
+        let b = list.partition_point(|e| e.0 <= i);
+        list[a..b].iter().map(|e| e.1).collect()
+    };
+    // Each body's regular partners from the grid (a regular body lists every regular body near it), then its extra
+    // partners.
+    let block = |k: usize| -> Block {
+        let mut out = Block::default();
+        let mut partners = Vec::new();
+        for i in k * BODIES_PER_TASK..((k + 1) * BODIES_PER_TASK).min(n) {
+            if let Some((g, r_ref)) = &grid
+                && radii[i] <= *r_ref
+            {
+                g.query(&centres[i], radii[i], *r_ref, |j| partners.push(j as u32));
+            }
+            let (up, down) = (partners_of(&extra, i as u32), partners_of(&extra_down, i as u32));
+            out.push(i as u32, &mut partners, &up, &down);
+        }
+        out
+    };
+    let tasks = n.div_ceil(BODIES_PER_TASK);
+    let blocks: Vec<Block> = if n >= PARALLEL_FROM {
+        (0..tasks).into_par_iter().map(block).collect()
+    } else {
+        (0..tasks).map(block).collect()
+    };
+    PairRows::from_blocks(blocks)
 }
 
 /// The O(N²) reference search.
@@ -244,6 +376,28 @@ mod tests {
             let brute = brute_force_pairs(&centres, &radii);
             assert!(!brute.is_empty());
             assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
+        }
+    }
+
+    /// The rows' columns are their transpose, on the grid (with large bodies) and on the brute-force path.
+    #[test]
+    fn lower_rows_are_the_transpose_of_the_upper_rows() {
+        let mut next = uniform(3);
+        for n in [17, 1500] {
+            let centres: Vec<Vec3> = (0..n)
+                .map(|_| Vec3::new(next(), next(), next()) * 2.5 * (n as f64).cbrt())
+                .collect();
+            let radii: Vec<f64> = (0..n).map(|_| 0.5 + 4.0 * next().powi(8) * 8.0).collect();
+            let rows = sphere_pair_rows(&centres, &radii);
+            let mut from_lower: Vec<(usize, usize)> = (0..n)
+                .flat_map(|j| rows.lower(j).iter().map(move |&i| (i as usize, j)))
+                .collect();
+            from_lower.sort_unstable();
+            let brute = brute_force_pairs(&centres, &radii);
+            assert!(brute.len() > n / 2, "n = {n}: too few pairs to test");
+            assert_eq!(sphere_pairs(&centres, &radii), brute, "n = {n}");
+            assert_eq!(from_lower, brute, "n = {n}");
+            assert!((0..n).all(|j| rows.lower(j).windows(2).all(|w| w[0] < w[1])));
         }
     }
 

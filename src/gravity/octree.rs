@@ -54,8 +54,17 @@
 //! stay in double precision.
 
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
 use std::ops::{Add, AddAssign, Div, Mul, Sub, SubAssign};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+// Where a tree evaluation's time goes (see [`crate::phase`]).
+static PHASE_KEYS: Phase = Phase::new("gravity.tree_keys", Kind::Parallel);
+static PHASE_SUBDIVIDE: Phase = Phase::new("gravity.tree_subdivide", Kind::Parallel);
+static PHASE_MOMENTS: Phase = Phase::new("gravity.tree_moments", Kind::Parallel);
+static PHASE_WALK: Phase = Phase::new("gravity.tree_walk_sum", Kind::Parallel);
+static PHASE_UNSORT: Phase = Phase::new("gravity.tree_unsort", Kind::Parallel);
 
 /// Most particles in a leaf, except at the deepest level.
 pub const LEAF_SIZE: usize = 32;
@@ -138,6 +147,8 @@ fn power_of_two_near(x: f64) -> f64 {
 pub struct Octree {
     /// Input index of each sorted particle.
     order: Vec<u32>,
+    /// Sorted index of each input particle (the inverse of `order`).
+    rank: Vec<u32>,
     /// Sorted particles.
     particles: Vec<Source>,
     /// Nodes in depth-first order: moments.
@@ -276,6 +287,90 @@ fn bounding_box(points: &[Source]) -> (Vec3, Vec3) {
     (lo, hi)
 }
 
+/// The nodes of a subtree in depth-first order, as [`Octree`] stores them, with node indices (`next`, `buckets`)
+/// counted from the subtree's root.
+#[derive(Debug, Default)]
+struct Nodes {
+    start: Vec<u32>,
+    end: Vec<u32>,
+    next: Vec<u32>,
+    leaf: Vec<bool>,
+    /// Cube (centre, side) of each node.
+    cubes: Vec<(Vec3, f64)>,
+    buckets: Vec<u32>,
+}
+
+/// Nodes of at least this many particles build their children's subtrees in parallel (and append them in
+/// octant order, so the layout is the serial one).
+const PARALLEL_NODE: usize = 2048;
+
+impl Nodes {
+    /// The subtree of sorted particles `s..e` (cube `centre ± half`, at `level`); its root is a bucket unless it
+    /// lies `in_bucket` already.
+    fn subtree(keys: &[u64], s: usize, e: usize, centre: Vec3, half: f64, level: u32, in_bucket: bool) -> Nodes {
+        let mut nodes = Nodes::default();
+        nodes.add(keys, s, e, centre, half, level, in_bucket);
+        nodes
+    }
+
+    /// Appends `other`, shifting its node indices past ours.
+    fn append(&mut self, other: Nodes) {
+        let offset = self.start.len() as u32;
+        self.start.extend(other.start);
+        self.end.extend(other.end);
+        self.next.extend(other.next.into_iter().map(|k| k + offset));
+        self.leaf.extend(other.leaf);
+        self.cubes.extend(other.cubes);
+        self.buckets.extend(other.buckets.into_iter().map(|k| k + offset));
+    }
+
+    /// Adds the node of sorted particles `s..e` (cube `centre ± half`, at `level`) and its subtree; the node
+    /// is a bucket unless it lies `in_bucket` already.
+    #[allow(clippy::too_many_arguments)]
+    fn add(&mut self, keys: &[u64], s: usize, e: usize, centre: Vec3, half: f64, level: u32, in_bucket: bool) {
+        let idx = self.start.len();
+        self.start.push(s as u32);
+        self.end.push(e as u32);
+        self.next.push(0);
+        let is_leaf = e - s <= LEAF_SIZE || level >= KEY_BITS;
+        self.leaf.push(is_leaf);
+        self.cubes.push((centre, 2.0 * half));
+        let is_bucket = !in_bucket && (e - s <= BUCKET_SIZE || is_leaf);
+        if is_bucket {
+            self.buckets.push(idx as u32);
+        }
+        if !is_leaf {
+            // The three key bits of this level give the octant (bit 0: x, bit 1: y, bit 2: z).
+            let shift = 3 * (KEY_BITS - 1 - level);
+            let mut children = Vec::with_capacity(8);
+            let mut lo = s;
+            for octant in 0..8u64 {
+                let hi = lo + keys[lo..e].partition_point(|&k| (k >> shift) & 7 <= octant);
+                if hi > lo {
+                    let sign = |bit: u64| if octant & bit != 0 { 0.5 } else { -0.5 };
+                    children.push((lo, hi, centre + Vec3::new(sign(1), sign(2), sign(4)) * half));
+                }
+                lo = hi;
+            }
+            let inside = in_bucket || is_bucket;
+            if e - s >= PARALLEL_NODE {
+                let subtrees: Vec<Nodes> = children
+                    .into_par_iter()
+                    .map(|(lo, hi, c)| Nodes::subtree(keys, lo, hi, c, 0.5 * half, level + 1, inside))
+                    .collect();
+                for t in subtrees {
+                    self.append(t);
+                }
+            } else {
+                for (lo, hi, c) in children {
+                    self.add(keys, lo, hi, c, 0.5 * half, level + 1, inside);
+                }
+            }
+        }
+        self.next[idx] = self.start.len() as u32;
+    }
+}
+
 /// Where each bucket's interaction lists come from when the tree is summed.
 enum Walk<'a> {
     /// A fresh walk at the current positions, with these `(l/θ + δ)²` ([`Octree::reach2`]).
@@ -291,100 +386,94 @@ impl Octree {
         if n == 0 {
             return Octree::default();
         }
-        let mut lo = positions[0];
-        let mut hi = positions[0];
-        for p in positions {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
+        let (lo, hi) = PHASE_KEYS.time(|| {
+            positions
+                .par_iter()
+                .with_min_len(4096)
+                .fold(|| (positions[0], positions[0]), |(lo, hi), p| (lo.inf(p), hi.sup(p)))
+                .reduce(|| (positions[0], positions[0]), |a, b| (a.0.inf(&b.0), a.1.sup(&b.1)))
+        });
         let centre = (lo + hi) * 0.5;
         let half = ((hi - lo).max() * 0.5).max(f64::MIN_POSITIVE) * (1.0 + 1e-12);
         let corner = centre - Vec3::repeat(half);
         let cells = (1u64 << KEY_BITS) as f64;
         let scale = cells / (2.0 * half);
         let quantise = |x: f64, c: f64| (((x - c) * scale).max(0.0) as u64).min((1 << KEY_BITS) - 1);
-        let mut keyed: Vec<(u64, u32)> = positions
-            .par_iter()
-            .with_min_len(1024)
-            .enumerate()
-            .map(|(i, p)| {
-                let key = spread(quantise(p.x, corner.x))
-                    | spread(quantise(p.y, corner.y)) << 1
-                    | spread(quantise(p.z, corner.z)) << 2;
-                (key, i as u32)
-            })
-            .collect();
-        // Pairs are distinct (the index breaks ties), so the order does not depend on the sort's scheduling.
-        keyed.par_sort_unstable();
-        let keys: Vec<u64> = keyed.iter().map(|k| k.0).collect();
-        let order: Vec<u32> = keyed.iter().map(|k| k.1).collect();
-        let mut tree = Octree {
-            particles: order
-                .iter()
+        let keyed: Vec<(u64, u32)> = PHASE_KEYS.time(|| {
+            let mut keyed: Vec<(u64, u32)> = positions
+                .par_iter()
+                .with_min_len(1024)
+                .enumerate()
+                .map(|(i, p)| {
+                    let key = spread(quantise(p.x, corner.x))
+                        | spread(quantise(p.y, corner.y)) << 1
+                        | spread(quantise(p.z, corner.z)) << 2;
+                    (key, i as u32)
+                })
+                .collect();
+            // Pairs are distinct (the index breaks ties), so the order does not depend on the sort's scheduling.
+            keyed.par_sort_unstable();
+            keyed
+        });
+        let (mut tree, cubes) = PHASE_SUBDIVIDE.time(|| {
+            let keys: Vec<u64> = keyed.par_iter().with_min_len(4096).map(|k| k.0).collect();
+            let order: Vec<u32> = keyed.par_iter().with_min_len(4096).map(|k| k.1).collect();
+            let rank: Vec<AtomicU32> = (0..n)
+                .into_par_iter()
+                .with_min_len(4096)
+                .map(|_| AtomicU32::new(0))
+                .collect();
+            order
+                .par_iter()
+                .with_min_len(4096)
+                .enumerate()
+                .for_each(|(k, &i)| rank[i as usize].store(k as u32, Ordering::Relaxed));
+            let particles = order
+                .par_iter()
+                .with_min_len(4096)
                 .map(|&i| {
                     let p = positions[i as usize];
                     [p.x, p.y, p.z, masses[i as usize]]
                 })
-                .collect(),
-            order,
-            far_leaves: n >= FAR_LEAVES_FROM,
-            ..Octree::default()
-        };
-        // Cubes (centre, side) of the nodes, in node order; moments are filled afterwards.
-        let mut cubes: Vec<(Vec3, f64)> = Vec::new();
-        tree.subdivide(&keys, 0, n, centre, half, 0, false, &mut cubes);
-        tree.moments = (0..cubes.len())
-            .into_par_iter()
-            .with_min_len(32)
-            .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, cubes[k].0))
-            .collect();
-        for (m, (cube, side)) in tree.moments.iter().zip(cubes) {
-            tree.side.push(side);
-            tree.delta.push((Vec3::new(m[0], m[1], m[2]) - cube).norm());
-        }
+                .collect();
+            // the nodes, built in parallel from the top (their layout is the serial one)
+            let nodes = Nodes::subtree(&keys, 0, n, centre, half, 0, false);
+            let tree = Octree {
+                particles,
+                order,
+                rank: rank
+                    .into_par_iter()
+                    .with_min_len(4096)
+                    .map(AtomicU32::into_inner)
+                    .collect(),
+                start: nodes.start,
+                end: nodes.end,
+                next: nodes.next,
+                leaf: nodes.leaf,
+                buckets: nodes.buckets,
+                far_leaves: n >= FAR_LEAVES_FROM,
+                ..Octree::default()
+            };
+            (tree, nodes.cubes)
+        });
+        tree.moments = PHASE_MOMENTS.time(|| {
+            (0..cubes.len())
+                .into_par_iter()
+                .with_min_len(32)
+                .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, cubes[k].0))
+                .collect()
+        });
+        PHASE_MOMENTS.time(|| {
+            tree.side = cubes.par_iter().with_min_len(1024).map(|c| c.1).collect();
+            tree.delta = tree
+                .moments
+                .par_iter()
+                .zip(&cubes)
+                .with_min_len(1024)
+                .map(|(m, (cube, _))| (Vec3::new(m[0], m[1], m[2]) - cube).norm())
+                .collect();
+        });
         tree
-    }
-
-    /// Adds the node of sorted particles `s..e` (cube `centre ± half`, at `level`) and its subtree; the node
-    /// is a bucket unless it lies `in_bucket` already.
-    #[allow(clippy::too_many_arguments)]
-    fn subdivide(
-        &mut self,
-        keys: &[u64],
-        s: usize,
-        e: usize,
-        centre: Vec3,
-        half: f64,
-        level: u32,
-        in_bucket: bool,
-        cubes: &mut Vec<(Vec3, f64)>,
-    ) {
-        let idx = self.start.len();
-        self.start.push(s as u32);
-        self.end.push(e as u32);
-        self.next.push(0);
-        let is_leaf = e - s <= LEAF_SIZE || level >= KEY_BITS;
-        self.leaf.push(is_leaf);
-        cubes.push((centre, 2.0 * half));
-        let is_bucket = !in_bucket && (e - s <= BUCKET_SIZE || is_leaf);
-        if is_bucket {
-            self.buckets.push(idx as u32);
-        }
-        if !is_leaf {
-            // The three key bits of this level give the octant (bit 0: x, bit 1: y, bit 2: z).
-            let shift = 3 * (KEY_BITS - 1 - level);
-            let mut lo = s;
-            for octant in 0..8u64 {
-                let hi = lo + keys[lo..e].partition_point(|&k| (k >> shift) & 7 <= octant);
-                if hi > lo {
-                    let sign = |bit: u64| if octant & bit != 0 { 0.5 } else { -0.5 };
-                    let c = centre + Vec3::new(sign(1), sign(2), sign(4)) * half;
-                    self.subdivide(keys, lo, hi, c, 0.5 * half, level + 1, in_bucket || is_bucket, cubes);
-                }
-                lo = hi;
-            }
-        }
-        self.next[idx] = self.start.len() as u32;
     }
 
     /// Moments of sorted particles `s..e` (`fallback` as centre if massless).
@@ -414,8 +503,9 @@ impl Octree {
     /// `(l/θ + δ)²` of every node: a node is used whole beyond this squared distance.
     fn reach2(&self, theta: f64) -> Vec<f64> {
         self.side
-            .iter()
+            .par_iter()
             .zip(&self.delta)
+            .with_min_len(1024)
             .map(|(l, d)| (l / theta + d).powi(2))
             .collect()
     }
@@ -556,7 +646,7 @@ impl Octree {
         let (mut a, mut phi) = (Vec3::new(out[0][0], out[0][1], out[0][2]), out[0][3]);
         // A particle at `p` itself was skipped by the sums; `skip` elsewhere was included: remove its direct
         // term (exact when its leaf was summed directly, as it is whenever `p` lies near it).
-        if let Some(sorted) = skip.and_then(|i| self.order.iter().position(|&o| o as usize == i)) {
+        if let Some(sorted) = skip.filter(|&i| i < self.rank.len()).map(|i| self.rank[i] as usize) {
             let [xj, yj, zj, mj] = self.particles[sorted];
             let d = Vec3::new(xj, yj, zj) - p;
             let r = d.norm();
@@ -584,24 +674,26 @@ impl Octree {
         // Sorted-order results, one disjoint chunk per bucket (buckets cover the sorted particles in order).
         let mut sorted = vec![[0.0; 4]; n];
         let open = Walk::Open(self.reach2(theta));
-        if self.single_precision() {
-            self.sum_buckets::<f32, 8, 4>(&open, g, &mut sorted);
-        } else {
-            self.sum_buckets::<f64, 4, 2>(&open, g, &mut sorted);
-        }
-        self.unsort(&sorted)
+        PHASE_WALK.time(|| {
+            if self.single_precision() {
+                self.sum_buckets::<f32, 8, 4>(&open, g, &mut sorted);
+            } else {
+                self.sum_buckets::<f64, 4, 2>(&open, g, &mut sorted);
+            }
+        });
+        PHASE_UNSORT.time(|| self.unsort(&sorted))
     }
 
-    /// Per-particle results in sorted order back in input order: accelerations and potentials.
+    /// Per-particle results in sorted order back in input order: accelerations and potentials (in parallel).
     fn unsort(&self, sorted: &[[f64; 4]]) -> (Vec<Vec3>, Vec<f64>) {
-        let n = self.order.len();
-        let mut acc = vec![Vec3::zeros(); n];
-        let mut pot = vec![0.0; n];
-        for (&input, r) in self.order.iter().zip(sorted) {
-            acc[input as usize] = Vec3::new(r[0], r[1], r[2]);
-            pot[input as usize] = r[3];
-        }
-        (acc, pot)
+        self.rank
+            .par_iter()
+            .with_min_len(4096)
+            .map(|&k| {
+                let r = &sorted[k as usize];
+                (Vec3::new(r[0], r[1], r[2]), r[3])
+            })
+            .unzip()
     }
 
     /// Fills `sorted` (per sorted particle: acceleration, potential) bucket by bucket, summing in `T`, `W`
@@ -709,11 +801,15 @@ impl FrozenOctree {
     /// nodes' moments recomputed there; `g` is the gravitational constant.
     pub fn accelerations(&mut self, positions: &[Vec3], masses: &[f64], g: f64) -> (Vec<Vec3>, Vec<f64>) {
         let tree = &mut self.tree;
-        for (p, &i) in tree.particles.iter_mut().zip(&tree.order) {
-            let (x, m) = (positions[i as usize], masses[i as usize]);
-            *p = [x.x, x.y, x.z, m];
-        }
-        let fallbacks: Vec<Vec3> = tree.moments.iter().map(|m| Vec3::new(m[0], m[1], m[2])).collect();
+        tree.particles
+            .par_iter_mut()
+            .zip(&tree.order)
+            .with_min_len(4096)
+            .for_each(|(p, &i)| {
+                let (x, m) = (positions[i as usize], masses[i as usize]);
+                *p = [x.x, x.y, x.z, m];
+            });
+        let fallbacks: Vec<Vec3> = tree.moments.par_iter().map(|m| Vec3::new(m[0], m[1], m[2])).collect();
         let tree = &*tree;
         let moments: Vec<Moments> = (0..tree.start.len())
             .into_par_iter()

@@ -2,21 +2,27 @@
 //! field, and the contact law ([`crate::granular::soft::contact`]) for every touching pair and every
 //! sphere–wall contact.
 //!
-//! Contacts are found from a Verlet list built on the cell grid of [`crate::geometry::neighbours`] with
-//! reach `r + skin/2`, rebuilt when any sphere has moved more than `skin/2` since the last build. The pair
-//! list is sorted by key `(i, j)`, `i < j`, and the pair spring histories live in an array parallel to it
-//! (no look-up; carried over by a merge on key when the list is rebuilt); wall histories live in a vector
-//! sorted by `(i, wall)`. Forces are accumulated in key order: on one thread in the same pass that evaluates
-//! the contacts, on several threads after a parallel pass that stores each pair's output. Both orders are the
-//! same, so the forces depend neither on the number of threads nor on when the Verlet list was rebuilt.
+//! The pair contacts (Verlet list, springs, evaluation in a fixed order on any number of threads) are in
+//! [`crate::granular::soft::pairs`]. Wall histories live in a vector sorted by `(i, wall)`. Every per-sphere
+//! pass runs in parallel, and the scalar sums over the spheres (gravitational energy) are taken in fixed chunks
+//! (`ordered_sum`), so the results do not depend on the number of threads.
 
-use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::walls::soft::Wall;
-use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_inner, evaluate_law};
+use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_law};
+pub use crate::granular::soft::pairs::ContactRecord;
+use crate::granular::soft::pairs::PairList;
 use crate::granular::soft::particle::Particle;
 use crate::gravity::{SelfGravity, accelerations};
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
+
+// Where a force evaluation's time goes (`rubblepile bench ssdem --phases`, `bench scaling`; see [`crate::phase`]).
+static PHASE_BASE: Phase = Phase::new("soft.base_forces", Kind::Parallel);
+static PHASE_OPEN: Phase = Phase::new("soft.kick_drift", Kind::Parallel);
+static PHASE_CLOSE: Phase = Phase::new("soft.kick", Kind::Parallel);
+static PHASE_WALLS: Phase = Phase::new("soft.walls", Kind::Parallel);
+static PHASE_WALL_SUM: Phase = Phase::new("soft.wall_sum", Kind::Serial);
 
 /// Gravity settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -27,19 +33,6 @@ pub struct Gravity {
     pub self_gravity: Option<SelfGravity>,
     /// Gravitational constant (m³ kg⁻¹ s⁻²).
     pub g: f64,
-}
-
-/// A pair contact's record at the last force evaluation (for tests and diagnostics).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ContactRecord {
-    /// Particle `i`.
-    pub i: usize,
-    /// Partner: particle index, or `n_particles + wall index` for a wall.
-    pub j: usize,
-    /// Overlap (m).
-    pub overlap: f64,
-    /// The law's output.
-    pub output: Output,
 }
 
 /// Diagnostics of the last force evaluation.
@@ -102,169 +95,47 @@ pub struct SoftSystem {
     pub slow_accelerations: Vec<Vec3>,
     /// Self-gravity potential energy (J) of the last slow evaluation (0 when `gravity_interval = 1`).
     pub slow_energy: f64,
-    skin: f64,
-    /// Candidate pairs `(i, j)`, `i < j`, sorted.
-    verlet: Vec<PairKey>,
-    /// Per entry of `verlet`: the springs if the pair touched at the last evaluation.
-    pair_slots: Vec<Slot>,
-    /// Per entry of `verlet`: this evaluation's outcome (only filled when pairs are evaluated in parallel).
-    pair_hits: Vec<Option<PairHit>>,
-    /// Per sphere: the pair contacts' force and torque of the evaluation under way.
-    pair_load: Vec<(Vec3, Vec3)>,
-    verlet_origin: Vec<Vec3>,
+    /// The pair contacts: Verlet list and springs.
+    pairs: PairList,
 }
 
-/// A Verlet-list pair `(i, j)`, `i < j`, as 32-bit indices: half the bytes of `(usize, usize)`, which with
-/// [`Slot`] keeps the contact data of 40 000 spheres (~240 000 contacts) inside a 32 MiB cache.
-type PairKey = (u32, u32);
-
-/// `(i, j)` as a [`PairKey`]. A system of 2³² spheres would need far more memory than any machine holds, so
-/// the indices always fit.
-fn pair_key((i, j): (usize, usize)) -> PairKey {
-    (i as u32, j as u32)
-}
-
-/// `key` as particle indices.
-fn pair_indices((i, j): PairKey) -> (usize, usize) {
-    (i as usize, j as usize)
-}
-
-/// A Verlet-list entry's springs, or none (the pair did not touch at the last evaluation). "None" is a NaN
-/// twist angle rather than an `Option`, so that a slot is 80 and not 88 bytes; a touching pair's twist is
-/// always finite (a NaN anywhere in the state stops the run first).
-#[derive(Debug, Clone, Copy)]
-struct Slot(Springs);
-
-impl Slot {
-    /// The empty slot.
-    fn empty() -> Self {
-        Slot(Springs {
-            twist: f64::NAN,
-            ..Springs::default()
-        })
-    }
-
-    /// A slot holding `springs`.
-    fn full(springs: Springs) -> Self {
-        Slot(springs)
-    }
-
-    /// The springs, if any.
-    #[inline(always)]
-    fn get(&self) -> Option<Springs> {
-        (!self.0.twist.is_nan()).then_some(self.0)
-    }
-}
-
-/// What one touching pair contributes at one evaluation.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct PairHit {
-    /// Overlap (m).
-    overlap: f64,
-    /// The smaller radius (m).
-    r_small: f64,
-    /// The law's output.
-    out: Output,
-}
-
-/// Running sums of one evaluation, added to in key order.
-struct Sums<'a> {
-    /// Per sphere: contact force and torque side by side (one cache line for a random partner `j`).
-    load: &'a mut [(Vec3, Vec3)],
-    stats: &'a mut ForceStats,
-    dissipated: f64,
-    records: Option<&'a mut Vec<ContactRecord>>,
-}
-
-impl Sums<'_> {
-    /// Adds pair `(i, j)`'s contribution (the one place that does, so that the serial and the parallel paths
-    /// add the same numbers in the same order).
-    #[inline(always)]
-    fn add_pair(&mut self, i: usize, j: usize, hit: &PairHit) {
-        let out = &hit.out;
-        self.load[i].0 += out.force_i;
-        self.load[j].0 -= out.force_i;
-        self.load[i].1 += out.torque_i;
-        self.load[j].1 += out.torque_j;
-        self.stats.spring_energy += out.stored_energy;
-        self.dissipated += out.dissipated;
-        // max(m, x/r) with the division only when x/r may exceed m (rounding of m r is far below 1e-12).
-        let max = &mut self.stats.max_overlap_fraction;
-        if hit.overlap >= *max * hit.r_small * (1.0 - 1e-12) {
-            *max = max.max(hit.overlap / hit.r_small);
-        }
-        self.stats.pair_contacts += 1;
-        if let Some(records) = self.records.as_deref_mut() {
-            records.push(ContactRecord {
-                i,
-                j,
-                overlap: hit.overlap,
-                output: *out,
-            });
-        }
-    }
-}
-
-/// The kinematics of pair `(i, j)` if the spheres overlap.
-#[inline(always)]
-fn pair_kinematics(particles: &[Particle], i: usize, j: usize) -> Option<Kinematics> {
-    let (a, b) = (&particles[i], &particles[j]);
-    let d = b.position - a.position;
-    let reach = a.radius + b.radius;
-    let dist2 = d.norm_squared();
-    if dist2 >= reach * reach {
-        return None;
-    }
-    let dist = dist2.sqrt();
-    let overlap = reach - dist;
-    if overlap <= 0.0 || dist <= 0.0 {
-        return None;
-    }
-    let n = d * (1.0 / dist);
-    let (li, lj) = (a.radius - 0.5 * overlap, b.radius - 0.5 * overlap);
-    let inv = 1.0 / (reach * (a.mass + b.mass));
-    let u = b.velocity - a.velocity - b.spin.cross(&n) * lj - a.spin.cross(&n) * li;
-    Some(Kinematics {
-        normal: n,
-        overlap,
-        lever_i: li,
-        lever_j: lj,
-        relative_velocity: u,
-        spin_i: a.spin,
-        spin_j: b.spin,
-        // R = r_i r_j/(r_i + r_j) and μ = m_i m_j/(m_i + m_j) with one division.
-        r_eff: a.radius * b.radius * (a.mass + b.mass) * inv,
-        mass_eff: a.mass * b.mass * reach * inv,
-    })
-}
-
-/// Evaluates pair `(i, j)` with the springs of its slot, and updates the slot (emptied if they do not touch).
-#[inline(always)]
-fn pair_contact<const SIZES: bool, const STORED: bool>(
-    particles: &[Particle],
-    law: &Law,
-    key: PairKey,
-    slot: &mut Slot,
-    dt: f64,
-) -> Option<PairHit> {
-    let (i, j) = pair_indices(key);
-    let Some(kin) = pair_kinematics(particles, i, j) else {
-        *slot = Slot::empty();
-        return None;
-    };
-    let mut springs = slot.get().unwrap_or_else(|| Springs::new(kin.normal));
-    let out = evaluate_inner::<SIZES, STORED>(law, &kin, &mut springs, dt);
-    *slot = Slot::full(springs);
-    Some(PairHit {
-        overlap: kin.overlap,
-        r_small: particles[i].radius.min(particles[j].radius),
-        out,
-    })
-}
-
+/// From this many spheres per task on, the wall contacts are evaluated in parallel.
 const PAR_MIN: usize = 64;
-/// Pairs per parallel task.
-const PAIR_CHUNK: usize = 1024;
+/// Spheres per partial sum of [`ordered_sum`], and per parallel task of the per-sphere passes.
+pub(crate) const SUM_CHUNK: usize = 1024;
+
+/// `Σ term(k)` over `k < n`, summed in chunks of [`SUM_CHUNK`] (each in order, in parallel) and the chunks'
+/// totals in order: the same bits on any number of threads (and, up to `SUM_CHUNK` terms, those of a plain
+/// loop from 0).
+pub(crate) fn ordered_sum(n: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
+    ordered_reduce(n, 0.0, |s, k| *s += term(k), |s, c| *s += c)
+}
+
+/// A reduction over `k < n` in the order of [`ordered_sum`]: each chunk of [`SUM_CHUNK`] starts from `zero` and
+/// takes `add_term(acc, k)` for its `k` in order (chunks in parallel); the chunks' results are then combined by
+/// `add(total, chunk)` in order, starting from `zero`.
+pub(crate) fn ordered_reduce<T: Copy + Send + Sync>(
+    n: usize,
+    zero: T,
+    add_term: impl Fn(&mut T, usize) + Sync,
+    add: impl Fn(&mut T, T),
+) -> T {
+    let chunks: Vec<T> = (0..n.div_ceil(SUM_CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut acc = zero;
+            for k in c * SUM_CHUNK..((c + 1) * SUM_CHUNK).min(n) {
+                add_term(&mut acc, k);
+            }
+            acc
+        })
+        .collect();
+    let mut total = zero;
+    for c in chunks {
+        add(&mut total, c);
+    }
+    total
+}
 
 /// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
 type WallHit = (usize, Springs, f64, Vec3, Output);
@@ -299,98 +170,30 @@ impl SoftSystem {
             gravity_phase: 0,
             slow_accelerations: Vec::new(),
             slow_energy: 0.0,
-            skin: if r_min.is_finite() { 0.1 * r_min } else { 0.0 },
-            verlet: Vec::new(),
-            pair_slots: Vec::new(),
-            pair_hits: Vec::new(),
-            pair_load: Vec::new(),
-            verlet_origin: Vec::new(),
+            pairs: PairList::new(if r_min.is_finite() { 0.1 * r_min } else { 0.0 }),
         }
     }
 
     /// The spring histories of the pairs that touched at the last evaluation, sorted by `(i, j)`
     /// (for checkpoints).
     pub fn pair_springs(&self) -> Vec<((usize, usize), Springs)> {
-        self.verlet
-            .iter()
-            .zip(&self.pair_slots)
-            .filter_map(|(&key, slot)| slot.get().map(|s| (pair_indices(key), s)))
-            .collect()
+        self.pairs.springs()
+    }
+
+    /// The pairs `(i, j)`, `i < j`, that touched at the last evaluation, in key order (no allocation).
+    pub fn touching_pairs(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        self.pairs.touching()
+    }
+
+    /// Calls `f(i, j)` for every pair that touched at the last evaluation, in parallel and in no particular order.
+    pub fn for_each_touching_pair(&self, f: impl Fn(usize, usize) + Sync) {
+        self.pairs.for_each_touching(f)
     }
 
     /// Replaces the pair spring histories by `springs` (as from [`SoftSystem::pair_springs`], e.g. on
     /// resuming a checkpoint); the next evaluation rebuilds the Verlet list and carries them over.
-    pub fn set_pair_springs(&mut self, mut springs: Vec<((usize, usize), Springs)>) {
-        springs.sort_by_key(|e| e.0);
-        springs.dedup_by_key(|e| e.0);
-        self.verlet = springs.iter().map(|e| pair_key(e.0)).collect();
-        self.pair_slots = springs.into_iter().map(|e| Slot::full(e.1)).collect();
-        self.verlet_origin.clear();
-    }
-
-    fn refresh_verlet(&mut self) {
-        let stale = self.verlet_origin.len() != self.particles.len()
-            || self
-                .particles
-                .iter()
-                .zip(&self.verlet_origin)
-                .any(|(p, o)| (p.position - o).norm_squared() > 0.25 * self.skin * self.skin);
-        if stale {
-            let centres: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
-            let reach: Vec<f64> = self.particles.iter().map(|p| p.radius + 0.5 * self.skin).collect();
-            let pairs = sphere_pairs(&centres, &reach);
-            // Carry the springs of touching pairs over: both lists are sorted by key, and every touching pair
-            // is in the new list (it holds every pair closer than the sum of radii plus the skin).
-            let mut old = self
-                .verlet
-                .iter()
-                .zip(&self.pair_slots)
-                .filter(|(_, slot)| slot.get().is_some())
-                .peekable();
-            let pairs: Vec<PairKey> = pairs.into_iter().map(pair_key).collect();
-            let mut slots = Vec::with_capacity(pairs.len());
-            for key in &pairs {
-                while old.next_if(|(k, _)| *k < key).is_some() {}
-                slots.push(
-                    old.next_if(|(k, _)| *k == key)
-                        .map_or_else(Slot::empty, |(_, slot)| *slot),
-                );
-            }
-            self.verlet = pairs;
-            self.pair_slots = slots;
-            self.pair_hits.clear();
-            self.verlet_origin = centres;
-        }
-    }
-
-    /// Evaluates every pair of the Verlet list and adds the touching ones to `sums` in key order.
-    fn pair_pass<const SIZES: bool, const STORED: bool>(&mut self, law: &Law, dt: f64, sums: &mut Sums<'_>) {
-        let particles = &self.particles;
-        if rayon::current_num_threads() > 1 && self.verlet.len() > PAIR_CHUNK {
-            self.pair_hits.resize(self.verlet.len(), None);
-            self.verlet
-                .par_chunks(PAIR_CHUNK)
-                .zip(self.pair_slots.par_chunks_mut(PAIR_CHUNK))
-                .zip(self.pair_hits.par_chunks_mut(PAIR_CHUNK))
-                .for_each(|((keys, slots), hits)| {
-                    for ((&key, slot), hit) in keys.iter().zip(slots).zip(hits) {
-                        *hit = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt);
-                    }
-                });
-            for (&key, hit) in self.verlet.iter().zip(&self.pair_hits) {
-                if let Some(hit) = hit {
-                    let (i, j) = pair_indices(key);
-                    sums.add_pair(i, j, hit);
-                }
-            }
-        } else {
-            for (&key, slot) in self.verlet.iter().zip(self.pair_slots.iter_mut()) {
-                if let Some(hit) = pair_contact::<SIZES, STORED>(particles, law, key, slot, dt) {
-                    let (i, j) = pair_indices(key);
-                    sums.add_pair(i, j, &hit);
-                }
-            }
-        }
+    pub fn set_pair_springs(&mut self, springs: Vec<((usize, usize), Springs)>) {
+        self.pairs.set_springs(self.particles.len(), springs);
     }
 
     /// Evaluates all forces and torques at time `t` (s) for a step of `dt` (s) (the springs advance by the
@@ -400,121 +203,110 @@ impl SoftSystem {
         if self.split_gravity() && self.slow_accelerations.len() != n {
             self.update_slow_gravity();
         }
-        let mut stats = ForceStats {
-            gravitational_energy: self.slow_energy,
-            ..ForceStats::default()
-        };
-        // The force buffer is reused from step to step: per-step arrays of a 40 000-sphere system cost page
-        // faults and cache space.
-        let mut forces = std::mem::take(&mut self.forces);
-        forces.clear();
         let uniform = self.gravity.uniform;
         // With r-RESPA the self-gravity is the slow force, kept apart (`respa.rs`); here only the fast ones.
-        match self.gravity.self_gravity {
+        let every_step = match self.gravity.self_gravity {
             Some(mode) if n > 1 && !self.split_gravity() => {
-                let positions: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
-                let masses: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
-                let (acc, potentials) = accelerations(mode, &positions, &masses, self.gravity.g);
-                for k in 0..n {
-                    let m = masses[k];
-                    forces.push((acc[k] + uniform) * m);
-                    stats.gravitational_energy += 0.5 * m * potentials[k] - m * uniform.dot(&positions[k]);
-                }
+                let (positions, masses): (Vec<Vec3>, Vec<f64>) =
+                    PHASE_BASE.time(|| self.particles.par_iter().map(|p| (p.position, p.mass)).unzip());
+                Some(accelerations(mode, &positions, &masses, self.gravity.g))
             }
-            _ => {
-                for p in &self.particles {
-                    forces.push(uniform * p.mass);
-                    stats.gravitational_energy += 0.0 - p.mass * uniform.dot(&p.position);
-                }
-            }
-        }
-        let mut records = std::mem::take(&mut self.records);
-        records.clear();
-
-        // Pair contacts.
-        self.refresh_verlet();
-        let law = Law::new(&self.material);
-        let mut load = std::mem::take(&mut self.pair_load);
-        load.clear();
-        load.resize(n, (Vec3::zeros(), Vec3::zeros()));
-        let mut sums = Sums {
-            load: &mut load,
-            stats: &mut stats,
-            dissipated: 0.0,
-            records: self.keep_records.then_some(&mut records),
+            _ => None,
         };
+        let particles = &self.particles;
+        // The non-contact force on sphere k and its potential energy, added to its contact force as the pairs'
+        // sums are finished; the energies are summed there in the chunks of `ordered_sum`.
+        let base = |k: usize| {
+            let p = &particles[k];
+            match &every_step {
+                Some((acc, potentials)) => (
+                    (acc[k] + uniform) * p.mass,
+                    0.5 * p.mass * potentials[k] - p.mass * uniform.dot(&p.position),
+                ),
+                None => (uniform * p.mass, 0.0 - p.mass * uniform.dot(&p.position)),
+            }
+        };
+        let mut stats = ForceStats::default();
+
+        // Pair contacts. The force and torque buffers are reused from step to step: per-step arrays of a
+        // 40 000-sphere system cost page faults and cache space.
+        let mut forces = std::mem::take(&mut self.forces);
+        let mut torques = std::mem::take(&mut self.torques);
+        let law = Law::new(&self.material);
         // Contact records want |M_R| and |M_T|; the force loop alone does not. Records always come with the
         // stored energy.
-        match (self.keep_records, self.spring_energy_wanted) {
-            (true, _) => self.pair_pass::<true, true>(&law, dt, &mut sums),
-            (false, true) => self.pair_pass::<false, true>(&law, dt, &mut sums),
-            (false, false) => self.pair_pass::<false, false>(&law, dt, &mut sums),
-        }
-        let mut dissipated = sums.dissipated;
-        let mut torques = std::mem::take(&mut self.torques);
-        torques.clear();
-        torques.extend(load.iter().map(|l| l.1));
-        for (f, l) in forces.iter_mut().zip(&load) {
-            *f += l.0;
-        }
-        self.pair_load = load;
+        let pairs = &mut self.pairs;
+        let totals = match (self.keep_records, self.spring_energy_wanted) {
+            (true, _) => pairs.evaluate::<true, true>(particles, &law, dt, base, &mut forces, &mut torques),
+            (false, true) => pairs.evaluate::<false, true>(particles, &law, dt, base, &mut forces, &mut torques),
+            (false, false) => pairs.evaluate::<false, false>(particles, &law, dt, base, &mut forces, &mut torques),
+        };
+        stats.gravitational_energy = self.slow_energy + totals.base_energy;
+        stats.spring_energy = totals.spring_energy;
+        stats.max_overlap_fraction = totals.max_overlap_fraction;
+        stats.pair_contacts = totals.contacts;
+        let mut dissipated = totals.dissipated;
+        let mut records = totals.records;
 
         // Wall contacts.
         let mut wall_springs = Vec::new();
         let mut wall_work = 0.0;
         if !self.walls.is_empty() {
             let old = &self.wall_springs;
-            let per_particle: Vec<Vec<WallHit>> = self
-                .particles
-                .par_iter()
-                .with_min_len(PAR_MIN)
-                .enumerate()
-                .map(|(i, p)| {
-                    let mut hits = Vec::new();
-                    for (w, wall) in self.walls.iter().enumerate() {
-                        let Some(touch) = wall.touch(&p.position, p.radius, t) else {
-                            continue;
-                        };
-                        let nrm = touch.normal;
-                        let li = p.radius - touch.overlap;
-                        let kin = Kinematics {
-                            normal: nrm,
-                            overlap: touch.overlap,
-                            lever_i: li,
-                            lever_j: f64::INFINITY,
-                            relative_velocity: touch.wall_velocity - p.velocity - p.spin.cross(&nrm) * li,
-                            spin_i: p.spin,
-                            spin_j: Vec3::zeros(),
-                            r_eff: p.radius,
-                            mass_eff: p.mass,
-                        };
-                        let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
-                        let out = evaluate_law(&law, &kin, &mut springs, dt);
-                        hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
+            let per_particle: Vec<Vec<WallHit>> = PHASE_WALLS.time(|| {
+                self.particles
+                    .par_iter()
+                    .with_min_len(PAR_MIN)
+                    .enumerate()
+                    .map(|(i, p)| {
+                        let mut hits = Vec::new();
+                        for (w, wall) in self.walls.iter().enumerate() {
+                            let Some(touch) = wall.touch(&p.position, p.radius, t) else {
+                                continue;
+                            };
+                            let nrm = touch.normal;
+                            let li = p.radius - touch.overlap;
+                            let kin = Kinematics {
+                                normal: nrm,
+                                overlap: touch.overlap,
+                                lever_i: li,
+                                lever_j: f64::INFINITY,
+                                relative_velocity: touch.wall_velocity - p.velocity - p.spin.cross(&nrm) * li,
+                                spin_i: p.spin,
+                                spin_j: Vec3::zeros(),
+                                r_eff: p.radius,
+                                mass_eff: p.mass,
+                            };
+                            let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
+                            let out = evaluate_law(&law, &kin, &mut springs, dt);
+                            hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
+                        }
+                        hits
+                    })
+                    .collect()
+            });
+            PHASE_WALL_SUM.time(|| {
+                for (i, hits) in per_particle.into_iter().enumerate() {
+                    for (w, springs, overlap, wall_velocity, out) in hits {
+                        forces[i] += out.force_i;
+                        torques[i] += out.torque_i;
+                        stats.spring_energy += out.stored_energy;
+                        dissipated += out.dissipated;
+                        wall_work += out.force_i.dot(&wall_velocity) * dt;
+                        stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / self.particles[i].radius);
+                        stats.wall_contacts += 1;
+                        if self.keep_records {
+                            records.push(ContactRecord {
+                                i,
+                                j: n + w,
+                                overlap,
+                                output: out,
+                            });
+                        }
+                        wall_springs.push(((i, w), springs));
                     }
-                    hits
-                })
-                .collect();
-            for (i, hits) in per_particle.into_iter().enumerate() {
-                for (w, springs, overlap, wall_velocity, out) in hits {
-                    forces[i] += out.force_i;
-                    torques[i] += out.torque_i;
-                    stats.spring_energy += out.stored_energy;
-                    dissipated += out.dissipated;
-                    wall_work += out.force_i.dot(&wall_velocity) * dt;
-                    stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / self.particles[i].radius);
-                    stats.wall_contacts += 1;
-                    if self.keep_records {
-                        records.push(ContactRecord {
-                            i,
-                            j: n + w,
-                            overlap,
-                            output: out,
-                        });
-                    }
-                    wall_springs.push(((i, w), springs));
                 }
-            }
+            });
         }
         self.wall_springs = wall_springs;
         self.forces = forces;
@@ -523,6 +315,71 @@ impl SoftSystem {
         self.dissipated += dissipated;
         self.wall_work += wall_work;
         self.records = records;
+    }
+
+    /// The first half of a leapfrog step in one pass over the spheres (each sphere on its own, so the bits are
+    /// those of separate passes): copies the state into `before` (resized to the spheres) if given, gives the
+    /// slow kick `v += a_slow τ` if `slow` is `Some(τ)` (r-RESPA, `respa.rs`), kicks `v += F/m h`, `ω += τ/I h`
+    /// and drifts `x += v dt`; and tells the pair list whether a sphere has moved far enough to rebuild it, so that
+    /// the force evaluation that must follow needs no pass of its own for that.
+    pub(crate) fn open_step(&mut self, before: Option<&mut Vec<Particle>>, slow: Option<f64>, h: f64, dt: f64) {
+        let (forces, torques, slow_acc, pairs) = (&self.forces, &self.torques, &self.slow_accelerations, &self.pairs);
+        let one = |c: usize, ps: &mut [Particle], keep: Option<&mut [Particle]>| -> bool {
+            if let Some(keep) = keep {
+                keep.copy_from_slice(ps);
+            }
+            let mut moved = false;
+            for (k, p) in ps.iter_mut().enumerate() {
+                let i = c * SUM_CHUNK + k;
+                if let Some(tau) = slow {
+                    p.velocity += slow_acc[i] * tau;
+                }
+                p.velocity += forces[i] * (h / p.mass);
+                p.spin += torques[i] * (h / p.inertia());
+                p.position += p.velocity * dt;
+                moved |= pairs.moved_too_far(i, &p.position);
+            }
+            moved
+        };
+        let moved = PHASE_OPEN.time(|| match before {
+            Some(before) => {
+                before.resize(self.particles.len(), Particle::default());
+                self.particles
+                    .par_chunks_mut(SUM_CHUNK)
+                    .zip(before.par_chunks_mut(SUM_CHUNK))
+                    .enumerate()
+                    .map(|(c, (ps, keep))| one(c, ps, Some(keep)))
+                    .reduce(|| false, |a, b| a || b)
+            }
+            None => self
+                .particles
+                .par_chunks_mut(SUM_CHUNK)
+                .enumerate()
+                .map(|(c, ps)| one(c, ps, None))
+                .reduce(|| false, |a, b| a || b),
+        });
+        self.pairs.set_checked(moved);
+    }
+
+    /// The second half of a leapfrog step in one pass: kicks `v += F/m h`, `ω += τ/I h`, then gives the slow
+    /// kick `v += a_slow τ` if `slow` is `Some(τ)`.
+    pub(crate) fn close_step(&mut self, slow: Option<f64>, h: f64) {
+        let (forces, torques, slow_acc) = (&self.forces, &self.torques, &self.slow_accelerations);
+        PHASE_CLOSE.time(|| {
+            self.particles
+                .par_chunks_mut(SUM_CHUNK)
+                .enumerate()
+                .for_each(|(c, ps)| {
+                    for (k, p) in ps.iter_mut().enumerate() {
+                        let i = c * SUM_CHUNK + k;
+                        p.velocity += forces[i] * (h / p.mass);
+                        p.spin += torques[i] * (h / p.inertia());
+                        if let Some(tau) = slow {
+                            p.velocity += slow_acc[i] * tau;
+                        }
+                    }
+                })
+        })
     }
 
     /// Kinetic energy, translational plus rotational (J).

@@ -5,26 +5,30 @@
 //! For central pair forces and the contact law's equal and opposite forces and torques, every kick and drift
 //! conserves total linear and angular momentum up to rounding. With `gravity_interval = k > 1` self-gravity
 //! is kicked separately once per block of `k` steps ([`crate::granular::soft::respa`]).
+//!
+//! Every kick and drift is a loop over the spheres, each sphere on its own, so they run in parallel with the
+//! same bits on any number of threads. The passes of a step are fused (each sphere gets the same operations in
+//! the same order as in separate passes): one pass for the opening slow kick, the kick, the drift and the Verlet
+//! list's staleness check (and, for a run, the copy of the state before the step); the force evaluation; one
+//! pass for the closing kick and slow kick. Fewer passes mean fewer fork–joins per step on many threads and less
+//! memory traffic on one.
 
 use crate::granular::soft::forces::SoftSystem;
+use crate::granular::soft::particle::Particle;
 use crate::granular::soft::respa::{close_block, open_block};
-
-fn kick(sys: &mut SoftSystem, half_dt: f64) {
-    for ((p, f), tau) in sys.particles.iter_mut().zip(&sys.forces).zip(&sys.torques) {
-        p.velocity += f * (half_dt / p.mass);
-        p.spin += tau * (half_dt / p.inertia());
-    }
-}
 
 /// Advances `sys` from time `t` (s) by one step `dt` (s). The forces of `sys` must be those at `t`
 /// (from [`SoftSystem::compute_forces`] or the previous step).
 pub fn step(sys: &mut SoftSystem, t: f64, dt: f64) {
-    open_block(sys, dt);
-    kick(sys, 0.5 * dt);
-    for p in sys.particles.iter_mut() {
-        p.position += p.velocity * dt;
-    }
+    step_keeping(sys, t, dt, None);
+}
+
+/// [`step`], also copying the state before the step into `before` (resized to the spheres), in the step's first
+/// pass (a run keeps it for `last_good_state.csv`).
+pub fn step_keeping(sys: &mut SoftSystem, t: f64, dt: f64, before: Option<&mut Vec<Particle>>) {
+    let slow = open_block(sys, dt);
+    sys.open_step(before, slow, 0.5 * dt, dt);
     sys.compute_forces(t + dt, dt);
-    kick(sys, 0.5 * dt);
-    close_block(sys, dt);
+    let slow = close_block(sys, dt);
+    sys.close_step(slow, 0.5 * dt);
 }

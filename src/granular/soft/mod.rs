@@ -3,7 +3,8 @@
 //! self-gravity by octree or direct summation, walls, and a kick–drift–kick leapfrog with a fixed step.
 //!
 //! - [`particle`]: the spheres; [`contact`]: the contact law (Eqs. 1–12); [`spring_frame`]: springs carried
-//!   with the contact frame; [`forces`]: the force loop; [`leapfrog`]: the integrator; [`respa`]: self-gravity
+//!   with the contact frame; [`forces`]: the forces of a step; [`pairs`]: the pair contacts (Verlet list,
+//!   springs, the same sums on any number of threads); [`leapfrog`]: the integrator; [`respa`]: self-gravity
 //!   every `k` steps (multiple time stepping);
 //! - [`advise`]: `k_N` and the step for a requested maximum overlap; [`packing`]: lattice aggregates;
 //!   [`scene`]: the `kind = "soft-spheres"`
@@ -16,6 +17,7 @@ pub mod contact;
 pub mod forces;
 pub mod leapfrog;
 pub mod packing;
+pub mod pairs;
 pub mod particle;
 pub mod respa;
 pub mod run;

@@ -4,7 +4,7 @@
 use crate::math::Vec3;
 
 /// One sphere: mass (kg), radius (m), centre position (m), velocity (m/s) and spin (rad/s), world frame.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Particle {
     /// Mass (kg, > 0).
     pub mass: f64,

@@ -17,9 +17,14 @@
 //! velocities already carry the opening kick and the gravitational energy is that of the block's start, so
 //! energies are exact only at block ends (`SoftSystem::gravity_phase == 0`).
 
-use crate::granular::soft::forces::SoftSystem;
+use crate::granular::soft::forces::{SoftSystem, ordered_sum};
 use crate::gravity::accelerations;
 use crate::math::Vec3;
+use crate::phase::{Kind, Phase};
+use rayon::prelude::*;
+
+static PHASE_SLOW_GATHER: Phase = Phase::new("soft.slow_gather", Kind::Parallel);
+static PHASE_SLOW_ENERGY: Phase = Phase::new("soft.slow_energy", Kind::Parallel);
 
 impl SoftSystem {
     /// Whether self-gravity is on and split off as the slow force (`gravity_interval > 1`).
@@ -33,47 +38,46 @@ impl SoftSystem {
         let n = self.particles.len();
         let (acc, pot) = match self.gravity.self_gravity {
             Some(mode) if n > 1 => {
-                let positions: Vec<Vec3> = self.particles.iter().map(|p| p.position).collect();
-                let masses: Vec<f64> = self.particles.iter().map(|p| p.mass).collect();
+                let (positions, masses): (Vec<Vec3>, Vec<f64>) =
+                    PHASE_SLOW_GATHER.time(|| self.particles.par_iter().map(|p| (p.position, p.mass)).unzip());
                 accelerations(mode, &positions, &masses, self.gravity.g)
             }
             _ => (vec![Vec3::zeros(); n], vec![0.0; n]),
         };
-        let energy: f64 = self.particles.iter().zip(&pot).map(|(p, phi)| 0.5 * p.mass * phi).sum();
+        // summed in fixed chunks: the same bits on any number of threads
+        let ps = &self.particles;
+        let energy = PHASE_SLOW_ENERGY.time(|| ordered_sum(n, |k| 0.5 * ps[k].mass * pot[k]));
         self.stats.gravitational_energy += energy - self.slow_energy;
         self.slow_energy = energy;
         self.slow_accelerations = acc;
     }
-
-    /// `v += a_slow τ` for every sphere (τ in s).
-    fn slow_kick(&mut self, tau: f64) {
-        for (p, a) in self.particles.iter_mut().zip(&self.slow_accelerations) {
-            p.velocity += a * tau;
-        }
-    }
 }
 
-/// The opening slow kick of a block, before the fast step from time `t`; evaluates the slow force first if
-/// it is missing (a system set up without [`SoftSystem::compute_forces`]).
-pub(crate) fn open_block(sys: &mut SoftSystem, dt: f64) {
+/// The opening slow kick of a block, before the fast step from time `t`: its `τ` (s) if the step opens a block
+/// (the caller gives the kick, in the step's first pass), evaluating the slow force first if it is missing (a
+/// system set up without [`SoftSystem::compute_forces`]).
+pub(crate) fn open_block(sys: &mut SoftSystem, dt: f64) -> Option<f64> {
     if !sys.split_gravity() || sys.gravity_phase != 0 {
-        return;
+        return None;
     }
     if sys.slow_accelerations.len() != sys.particles.len() {
         sys.update_slow_gravity();
     }
-    sys.slow_kick(0.5 * sys.gravity_interval as f64 * dt);
+    Some(0.5 * sys.gravity_interval as f64 * dt)
 }
 
-/// Counts the fast step just taken; at the block's end evaluates the slow force and gives the closing kick.
-pub(crate) fn close_block(sys: &mut SoftSystem, dt: f64) {
+/// Counts the fast step just taken (its forces evaluated, its closing fast kick not yet given); at the block's
+/// end evaluates the slow force (positions only: the fast kick does not change it) and returns the closing slow
+/// kick's `τ` (s), which the caller gives after the fast kick.
+pub(crate) fn close_block(sys: &mut SoftSystem, dt: f64) -> Option<f64> {
     if !sys.split_gravity() {
-        return;
+        return None;
     }
     sys.gravity_phase += 1;
     if sys.gravity_phase >= sys.gravity_interval {
         sys.update_slow_gravity();
-        sys.slow_kick(0.5 * sys.gravity_interval as f64 * dt);
         sys.gravity_phase = 0;
+        return Some(0.5 * sys.gravity_interval as f64 * dt);
     }
+    None
 }

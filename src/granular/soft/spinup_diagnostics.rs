@@ -331,8 +331,7 @@ pub fn diagnose(
 ) -> Diagnosis {
     let ps = &sys.particles;
     let n = ps.len();
-    let springs = sys.pair_springs();
-    let member = central_body(ps, springs.iter().map(|(k, _)| k));
+    let member = central_body(ps, sys.touching_pairs());
     let rot = body_rotation(ps, &member, axis);
     let total_mass: f64 = ps.iter().map(|p| p.mass).sum();
     let centres: Vec<Vec3> = ps.iter().map(|p| p.position).collect();
