@@ -294,14 +294,14 @@ pub struct EllipsoidSystem {
     cull_exp: f64,
     /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
     /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
-    pair_cache: std::sync::Mutex<Option<PairCache>>,
+    pair_cache: std::sync::Mutex<Option<Arc<PairCache>>>,
     /// Buffers reused by [`OdeSystem::rhs`] (an evaluation that finds them in use allocates its own).
     scratch: std::sync::Mutex<RhsScratch>,
     /// Tree gravity's interaction lists, fixed at the state of the step being taken
     /// ([`OdeSystem::begin_step`]) so that the tree's forces are smooth within the step; `None` (outside an
     /// integrator's advance, under an integrator that does not call `begin_step`, or without tree gravity):
     /// every evaluation walks a fresh tree.
-    gravity_lists: std::sync::Mutex<Option<FrozenOctree>>,
+    gravity_lists: std::sync::Mutex<Option<Arc<FrozenOctree>>>,
     /// Body masses (kg), contiguous for the gravity sums.
     masses: Vec<f64>,
     /// A planet on a prescribed orbit ([`EllipsoidSystem::with_tide`]); `None`: no tide computed.
@@ -728,8 +728,6 @@ impl EllipsoidSystem {
             .map(|k| interaction_radius(kappa, k.geometry.as_ref().expect("geometry"), self.cull_exp))
             .collect();
         let candidate = |(i, j): (usize, usize)| self.candidate_pair(i, j);
-        // A poisoned lock only means another thread panicked mid-update: rebuild.
-        let mut cache = self.pair_cache.lock().unwrap_or_else(|e| e.into_inner());
         let finite = centres.iter().all(|c| c.iter().all(|x| x.is_finite()));
         if !finite {
             // Not a state to remember (the integrator will reject it): the plain search.
@@ -738,12 +736,18 @@ impl EllipsoidSystem {
                 centres.len(),
             ));
         }
-        match cache.as_ref() {
+        // The lock is held only to copy or replace the cache's handle, never across the parallel check or build:
+        // a rayon worker blocked on it could be waiting for a job of its own (another caller's evaluation stolen
+        // while this one's build runs), and every worker so blocked is a deadlock. A poisoned lock only means
+        // another thread panicked mid-update.
+        let cache = || self.pair_cache.lock().unwrap_or_else(|e| e.into_inner());
+        let cached = cache().clone();
+        match cached {
             Some(c) if c.covers(&centres, &radii) => Arc::clone(&c.candidates),
             _ => {
-                let fresh = PairCache::build(&centres, &radii, candidate);
+                let fresh = Arc::new(PairCache::build(&centres, &radii, candidate));
                 let candidates = Arc::clone(&fresh.candidates);
-                *cache = Some(fresh);
+                *cache() = Some(fresh);
                 candidates
             }
         }
@@ -1061,7 +1065,7 @@ impl OdeSystem for EllipsoidSystem {
             .map(|b| Vec3::new(b[0], b[1], b[2]))
             .collect();
         let frozen = Octree::build(&positions, &self.masses).freeze(theta);
-        *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(frozen);
+        *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(Arc::new(frozen));
     }
 
     /// Drops the lists of [`OdeSystem::begin_step`]: later evaluations walk fresh trees until the next step.
@@ -1162,8 +1166,9 @@ impl OdeSystem for EllipsoidSystem {
             PHASE_GRAVITY.time(|| match (blocked_gravity, tree_theta) {
                 (Some(gr), Some(theta)) => {
                     gravity.resize_with(1, Vec::new);
-                    let mut lists = self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner());
-                    match lists.as_mut().filter(|t| t.len() == n) {
+                    // The handle is copied out: no lock is held across the parallel sums (see `candidate_pairs`).
+                    let lists = self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                    match lists.as_deref().filter(|t| t.len() == n) {
                         Some(frozen) => {
                             frozen_tree_gravity_forces(gr.g, frozen, positions, &self.masses, &mut gravity[0])
                         }

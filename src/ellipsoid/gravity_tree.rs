@@ -93,7 +93,7 @@ pub fn tree_gravity_forces(g: f64, theta: f64, positions: &[Vec3], masses: &[f64
 /// [`crate::ellipsoid::equations::EllipsoidSystem`]'s `begin_step`).
 pub fn frozen_tree_gravity_forces(
     g: f64,
-    tree: &mut FrozenOctree,
+    tree: &FrozenOctree,
     positions: &[Vec3],
     masses: &[f64],
     forces: &mut Vec<Vec3>,

@@ -752,7 +752,7 @@ impl Octree {
 /// use rubblepile::math::Vec3;
 /// let x: Vec<Vec3> = (0..1200).map(|k| Vec3::new((k % 11) as f64, (k / 11 % 11) as f64, (k / 121) as f64)).collect();
 /// let m = vec![1.0; x.len()];
-/// let mut frozen = Octree::build(&x, &m).freeze(0.5);
+/// let frozen = Octree::build(&x, &m).freeze(0.5);
 /// // a small motion: the frozen lists still give the field to the tree's accuracy
 /// let moved: Vec<Vec3> = x.iter().map(|p| p + Vec3::new(0.01, -0.02, 0.005)).collect();
 /// let (tree, _) = frozen.accelerations(&moved, &m, 1.0);
@@ -798,9 +798,12 @@ impl FrozenOctree {
 
     /// Accelerations (m/s²) and potentials (J/kg) of every particle, in input order, at `positions` (m) with
     /// `masses` (kg), both in the input order of the build and of its length, by the frozen lists with the
-    /// nodes' moments recomputed there; `g` is the gravitational constant.
-    pub fn accelerations(&mut self, positions: &[Vec3], masses: &[f64], g: f64) -> (Vec<Vec3>, Vec<f64>) {
-        let tree = &mut self.tree;
+    /// nodes' moments recomputed there; `g` is the gravitational constant. The frozen tree is only read (the
+    /// particles and moments at `positions` go into a copy of the tree's arrays, O(N), beside the lists' O(N log N)
+    /// sums), so that several evaluations may share it without a lock held across their parallel work (a rayon
+    /// worker blocked on such a lock can wait for a job of its own; issue 39).
+    pub fn accelerations(&self, positions: &[Vec3], masses: &[f64], g: f64) -> (Vec<Vec3>, Vec<f64>) {
+        let mut tree = self.tree.clone();
         tree.particles
             .par_iter_mut()
             .zip(&tree.order)
@@ -809,18 +812,22 @@ impl FrozenOctree {
                 let (x, m) = (positions[i as usize], masses[i as usize]);
                 *p = [x.x, x.y, x.z, m];
             });
-        let fallbacks: Vec<Vec3> = tree.moments.par_iter().map(|m| Vec3::new(m[0], m[1], m[2])).collect();
-        let tree = &*tree;
-        let moments: Vec<Moments> = (0..tree.start.len())
+        // A node without mass keeps the centre it had when the tree was built (the moments are otherwise
+        // those of the particles alone).
+        let built = &self.tree.moments;
+        let current = &tree;
+        let moments: Vec<Moments> = (0..current.start.len())
             .into_par_iter()
             .with_min_len(32)
-            .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, fallbacks[k]))
+            .map(|k| {
+                let fallback = Vec3::new(built[k][0], built[k][1], built[k][2]);
+                current.node_moments(current.start[k] as usize, current.end[k] as usize, fallback)
+            })
             .collect();
-        self.tree.moments = moments;
+        tree.moments = moments;
         let mut sorted = vec![[0.0; 4]; self.len()];
-        self.tree
-            .sum_buckets::<f64, 4, 2>(&Walk::Frozen(&self.lists), g, &mut sorted);
-        self.tree.unsort(&sorted)
+        tree.sum_buckets::<f64, 4, 2>(&Walk::Frozen(&self.lists), g, &mut sorted);
+        tree.unsort(&sorted)
     }
 }
 
@@ -881,7 +888,7 @@ mod tests {
         let v: Vec<Vec3> = (0..x.len()).map(|_| point_in_ball(&mut rng, 1e-3)).collect();
         let m: Vec<f64> = (0..x.len()).map(|k| 1.0 + (k % 3) as f64).collect();
         let at = |s: f64| -> Vec<Vec3> { x.iter().zip(&v).map(|(p, d)| p + d * s).collect() };
-        let mut frozen = Octree::build(&x, &m).freeze(0.5);
+        let frozen = Octree::build(&x, &m).freeze(0.5);
         let fresh = |p: &[Vec3]| {
             let tree = Octree::build(p, &m);
             tree.unsort(&sums::<f64, 4, 2>(&tree, 0.5)).0
