@@ -15,6 +15,21 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// `take()` retried for up to 2 s while the lock is held: right after this test drops a lock, a child process that
+/// another test of this binary is just spawning may still share the lock file's descriptor (inherited at `fork`,
+/// closed at `exec`), so the OS lock can outlive the guard by a moment. The retry guards against that race of the
+/// test harness, not against a real second writer (those are refused and asserted above and below).
+fn acquire_soon(take: impl Fn() -> Result<DirLock, rubblepile::io::run_lock::LockError>) -> DirLock {
+    let start = Instant::now();
+    loop {
+        match take() {
+            Ok(lock) => return lock,
+            Err(e) if start.elapsed() > Duration::from_secs(2) => panic!("lock still held after 2 s: {e}"),
+            Err(_) => std::thread::sleep(Duration::from_millis(10)),
+        }
+    }
+}
+
 /// The 30-fragment pile at rest for `t_end` seconds: ~1.5 s of wall time at 6000 s on two cores, long enough for a
 /// second process to start while the first one holds the lock.
 fn pile_scene(t_end: f64) -> String {
@@ -334,8 +349,8 @@ fn campaign_directory_being_written_is_refused() {
     drop(lock);
 
     // Shards share the directory (each holds it shared, and its own index alone).
-    let shard0 = DirLock::acquire_part(&camp, "campaign.shard-0-of-2.csv").unwrap();
-    let shared = DirLock::acquire_shared(&camp).unwrap();
+    let shard0 = acquire_soon(|| DirLock::acquire_part(&camp, "campaign.shard-0-of-2.csv"));
+    let shared = acquire_soon(|| DirLock::acquire_shared(&camp));
     let o = campaign(&["--shard", "0/2"]);
     assert_refused(&o, &camp.join("campaign.shard-0-of-2.csv"), "the same shard twice");
     let o = campaign(&["--shard", "1/2"]); // an empty shard of the one-run grid: runs nothing
@@ -398,13 +413,13 @@ fn render_export_and_analyze_are_refused_while_their_output_is_written() {
     assert!(!run.join("frames").exists(), "render wrote nothing");
     drop(frames);
 
-    let whole = DirLock::acquire(&run).unwrap();
+    let whole = acquire_soon(|| DirLock::acquire(&run));
     let o = rubblepile(cwd, &["export", "vtk", s(&run)]);
     assert_eq!(assert_refused(&o, &run, "export"), std::process::id());
     assert!(!run.join("vtk").exists(), "export wrote nothing");
     drop(whole);
 
-    let analysis = DirLock::acquire_part(&run, "analysis").unwrap();
+    let analysis = acquire_soon(|| DirLock::acquire_part(&run, "analysis"));
     let o = rubblepile(cwd, &["analyze", s(&run), "--at", "200"]);
     assert_eq!(assert_refused(&o, &run.join("analysis"), "analyze"), std::process::id());
     assert!(!run.join("analysis").exists(), "analyze wrote nothing");
