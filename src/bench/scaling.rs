@@ -310,8 +310,7 @@ fn ssdem_case(
     let rate = rate?;
     let particles = sys.particles.len() as f64;
     let seconds = particles * steps as f64 / rate;
-    // `time_steps` times the steps after one untimed step; the phases cover all of them.
-    let phases = scaled(phases, steps as f64 / (steps + 1) as f64);
+    // `time_steps` resets the phase totals after its untimed first step, so they cover the timed steps only.
     let (serial_seconds, parallel_seconds) = split(&phases, seconds);
     Ok(Measurement {
         case: case.into(),
@@ -711,10 +710,12 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
         }
         print_phases(&mine);
         rows.extend(mine);
+        // Rewritten after every case, so a run cut short (a time limit, a lent machine taken back) keeps the
+        // cases it finished.
+        write_csv(&files[0], &rows).map_err(|e| BenchError::failed(format!("{}: {e}", files[0].display())))?;
+        write_phases_csv(&files[1], &rows).map_err(|e| BenchError::failed(format!("{}: {e}", files[1].display())))?;
     }
     let _ = std::fs::remove_dir_all(args.out.join("scratch"));
-    write_csv(&files[0], &rows).map_err(|e| BenchError::failed(format!("{}: {e}", files[0].display())))?;
-    write_phases_csv(&files[1], &rows).map_err(|e| BenchError::failed(format!("{}: {e}", files[1].display())))?;
     crate::analysis::figures::style::write_figure(&args.out, "scaling", &SpeedupPlot { rows: &rows })
         .map_err(|e| BenchError::failed(format!("{}: {e}", files[2].display())))?;
     println!(
