@@ -192,3 +192,28 @@ fn skipping_the_spring_energy_between_samples_changes_nothing_else() {
     run(&mut lazy, 1, 30, 1, dt);
     assert_same(&lazy, &every, "the sample step");
 }
+
+/// A soft-sphere run forks over one thread per `SPHERES_PER_THREAD` spheres at most (at least one): the grain
+/// below which more threads were not measured to help (issue 39). Guards the rule, not a timing.
+#[test]
+fn a_small_soft_sphere_run_uses_one_thread_per_125_spheres() {
+    use rubblepile::engine::Engine;
+    use rubblepile::granular::soft::run::{SPHERES_PER_THREAD, SoftEngine};
+    assert_eq!(SPHERES_PER_THREAD, 125);
+    let scene = |n: usize| {
+        let mut text = String::from(
+            "[scene]\nkind = \"soft-spheres\"\nt_end = 1e-4\n[integrator]\ndt = 1e-5\n[contact]\nk_n = 1e5\n",
+        );
+        for k in 0..n {
+            // A row of unit spheres 3 m apart: no contacts, nothing to refuse.
+            text.push_str(&format!(
+                "[[particle]]\nradius = 1.0\nmass = 1.0\nposition = [{}.0, 0.0, 0.0]\n",
+                3 * k
+            ));
+        }
+        SoftEngine::from_scene_text(&text, "row.toml", None).unwrap()
+    };
+    for (n, threads) in [(1, 1), (124, 1), (250, 2), (2000, 16)] {
+        assert_eq!(scene(n).useful_threads(), threads, "{n} spheres");
+    }
+}

@@ -48,6 +48,12 @@ use rayon::prelude::*;
 /// Overlap (fraction of the smaller radius) above which the run is declared broken.
 pub const BROKEN_OVERLAP: f64 = 0.5;
 
+/// Spheres per thread at least ([`SoftEngine`]'s `useful_threads`): the smallest grain measured still to gain from
+/// more threads. The 2000-sphere ball of `bench scaling` (`ssdem-2k`, 125 spheres per thread on 16 threads) went
+/// from 2.71× at 8 threads to 3.38× at 16 on a 16-core node (issue 39, `analysis/scaling/REPORT.md`); below that
+/// grain nothing was measured, so a smaller run forks over no more threads than this gives.
+pub const SPHERES_PER_THREAD: usize = 125;
+
 static PHASE_CHECK_STATE: Phase = Phase::new("soft.check_state", Kind::Parallel);
 static PHASE_SPINUP: Phase = Phase::new("soft.spinup_forcing", Kind::Serial);
 
@@ -583,6 +589,11 @@ impl Engine for SoftEngine {
 
     fn from_scene_text(text: &str, name: &str, base_dir: Option<&Path>) -> Result<Self, EngineError> {
         Ok(SoftEngine::new(parse_soft_scene(text, name, base_dir)?))
+    }
+
+    /// One thread per [`SPHERES_PER_THREAD`] spheres, at least one (the bits do not depend on it).
+    fn useful_threads(&self) -> usize {
+        (self.sys.particles.len() / SPHERES_PER_THREAD).max(1)
     }
 
     fn scene_source(&self) -> &str {
