@@ -256,6 +256,11 @@ struct RhsScratch {
 /// thread pool.
 const PARALLEL_CANDIDATES: usize = 512;
 
+/// From this many bodies the pair cache's check (one distance per body, ~1 ns each) runs in parallel: below it a
+/// fork–join (tens of µs on a 16-core node with sleeping workers) costs more than the whole check, and the N200
+/// impact makes one check per evaluation.
+const PARALLEL_COVERS: usize = 8192;
+
 /// Candidates per parallel task at least (a culled candidate costs a few ns, a kept one ~100 ns).
 const CANDIDATES_PER_TASK: usize = 64;
 
@@ -386,10 +391,10 @@ impl PairCache {
         let holds =
             |i: usize| (centres[i] - self.positions[i]).norm() + (radii[i] - self.radii[i]).max(0.0) <= self.skins[i];
         centres.len() == self.positions.len()
-            && if centres.len() >= PARALLEL_BODIES {
+            && if centres.len() >= PARALLEL_COVERS {
                 (0..centres.len())
                     .into_par_iter()
-                    .with_min_len(PARALLEL_BODIES)
+                    .with_min_len(PARALLEL_COVERS)
                     .all(holds)
             } else {
                 (0..centres.len()).all(holds)
