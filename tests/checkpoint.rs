@@ -4,7 +4,7 @@
 //! one-line errors; integrator states restore exactly.
 
 mod common;
-use common::{rubblepile, temp_dir};
+use common::{rubblepile, snapshots, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -114,22 +114,6 @@ fn assert_one_line_error(out: &Output, code: i32, needle: &str, what: &str) {
 
 fn read(path: &Path) -> String {
     std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
-/// Snapshot files (name -> bytes), sorted.
-fn snapshots(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("snapshots"))
-        .unwrap()
-        .map(|e| {
-            let p = e.unwrap().path();
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
 }
 
 /// The time series without its last (wall_seconds) column.

@@ -4,7 +4,7 @@
 //! holder's lock released by the OS, and readers never blocked.
 
 mod common;
-use common::{rubblepile, temp_dir};
+use common::{rubblepile, snapshots, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -105,22 +105,6 @@ fn assert_refused(o: &Output, dir: &Path, what: &str) -> u32 {
 
 fn read(p: &Path) -> String {
     std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
-}
-
-/// Snapshot files (name -> bytes), sorted.
-fn snapshots(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("snapshots"))
-        .unwrap()
-        .map(|e| {
-            let p = e.unwrap().path();
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
 }
 
 /// Asserts that the run in `b` ended exactly like the uninterrupted run in `a`: snapshots, time series without its

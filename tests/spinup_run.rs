@@ -3,7 +3,7 @@
 //! resumes bit for bit with the driver's state, and bad `[spinup]` input gives a one-line error naming the field.
 
 mod common;
-use common::{rubblepile, temp_dir};
+use common::{rubblepile, snapshots, temp_dir};
 use rubblepile::analysis::spinup_diagnostics::read_spinup_csv;
 use rubblepile::geometry::lattice::hcp_centres;
 use std::path::Path;
@@ -288,22 +288,6 @@ fn assert_same_snapshots(a: &Path, b: &Path, close: &[&str], skip: &[&str]) {
             }
         }
     }
-}
-
-/// Snapshot files (name -> bytes), sorted.
-fn snapshots(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("snapshots"))
-        .unwrap()
-        .map(|e| {
-            let p = e.unwrap().path();
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect();
-    v.sort();
-    v
 }
 
 /// `spinup critical --branch`: a hold run branched off the shared path run gives the same `spinup.csv` and the

@@ -73,7 +73,9 @@
 //!   derivative at an *accepted* point fails at once (no step size can cure it).
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
-use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
+use super::{
+    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
+};
 use crate::bits::{exact_f64, exact_f64_opt, exact_f64_vec};
 
 /// Step-size factor bound parameter (ODEX `fac1`).
@@ -908,28 +910,8 @@ impl Integrator for BulirschStoer {
         t_target: f64,
     ) -> Result<(), IntegrateError> {
         let n = system.dim();
-        if y.len() != n || self.tol.rtol.len() != n {
-            return Err(IntegrateError::Config(format!(
-                "dimension mismatch: system {n}, state {}, tolerances {}",
-                y.len(),
-                self.tol.rtol.len()
-            )));
-        }
-        if !t.is_finite() || !t_target.is_finite() {
-            return Err(IntegrateError::Config(format!(
-                "times must be finite (t = {}, t_target = {t_target})",
-                *t
-            )));
-        }
-        if t_target == *t {
+        if !begin_advance(n, self.tol.rtol.len(), t, y, t_target)? {
             return Ok(());
-        }
-        if n == 0 {
-            *t = t_target;
-            return Ok(());
-        }
-        if !all_finite(y) {
-            return Err(IntegrateError::NonFinite { t: *t });
         }
         self.ensure_workspace(n);
         if self.comp.len() != n || self.y_out.as_ref().is_some_and(|prev| prev.as_slice() != &*y) {

@@ -73,7 +73,9 @@
 //! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
 //! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
 
-use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
+use super::{
+    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
+};
 use crate::bits::{exact_f64, exact_f64_opt};
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
@@ -886,28 +888,8 @@ impl Integrator for Dop853 {
         t_target: f64,
     ) -> Result<(), IntegrateError> {
         let n = system.dim();
-        if y.len() != n || self.tol.rtol.len() != n {
-            return Err(IntegrateError::Config(format!(
-                "dimension mismatch: system {n}, state {}, tolerances {}",
-                y.len(),
-                self.tol.rtol.len()
-            )));
-        }
-        if !t.is_finite() || !t_target.is_finite() {
-            return Err(IntegrateError::Config(format!(
-                "times must be finite (t = {}, t_target = {t_target})",
-                *t
-            )));
-        }
-        if t_target == *t {
+        if !begin_advance(n, self.tol.rtol.len(), t, y, t_target)? {
             return Ok(());
-        }
-        if n == 0 {
-            *t = t_target;
-            return Ok(());
-        }
-        if !y.iter().all(|v| v.is_finite()) {
-            return Err(IntegrateError::NonFinite { t: *t });
         }
         self.ensure_workspace(n);
         let parallel = self.parallel();

@@ -287,3 +287,39 @@ pub fn make_integrator(
         },
     }
 }
+
+/// The checks every [`Integrator::advance`] makes before its first step, for a system of dimension `n` with
+/// `n_tol` tolerances: the state and tolerances have the system's dimension, the times are finite, the state is
+/// finite. Returns whether there is anything to integrate (`false` when `t_target == t`, or for an empty system,
+/// whose time is then set to `t_target`).
+pub(crate) fn begin_advance(
+    n: usize,
+    n_tol: usize,
+    t: &mut f64,
+    y: &[f64],
+    t_target: f64,
+) -> Result<bool, IntegrateError> {
+    if y.len() != n || n_tol != n {
+        return Err(IntegrateError::Config(format!(
+            "dimension mismatch: system {n}, state {}, tolerances {n_tol}",
+            y.len()
+        )));
+    }
+    if !t.is_finite() || !t_target.is_finite() {
+        return Err(IntegrateError::Config(format!(
+            "times must be finite (t = {}, t_target = {t_target})",
+            *t
+        )));
+    }
+    if t_target == *t {
+        return Ok(false);
+    }
+    if n == 0 {
+        *t = t_target;
+        return Ok(false);
+    }
+    if !y.iter().all(|v| v.is_finite()) {
+        return Err(IntegrateError::NonFinite { t: *t });
+    }
+    Ok(true)
+}

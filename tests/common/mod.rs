@@ -207,3 +207,19 @@ pub fn spinning_aggregate_particles() -> Vec<rubblepile::granular::soft::particl
     }
     particles
 }
+
+/// The files of `dir/snapshots` (name -> bytes), sorted by name.
+pub fn snapshots(dir: &std::path::Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir.join("snapshots"))
+        .unwrap()
+        .map(|e| {
+            let p = e.unwrap().path();
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
