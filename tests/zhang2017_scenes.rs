@@ -52,6 +52,7 @@ fn every_zhang2017_scene_loads() {
         "pp1_path2.toml",
         "pp2_path2.toml",
         "ppc_path2.toml",
+        "rcp_8k_path2.toml",
     ] {
         assert!(load(name).1, "{name}: its target is not in the repository");
     }
@@ -101,4 +102,30 @@ fn path_scenes_follow_table_5_and_differ_from_path_2_only_in_the_path() {
             assert_eq!(scene.particles, base.particles, "{name}");
         }
     }
+}
+
+/// The resolution ladder's RCP rungs (issue 40) differ from the 2083-grain scene only in the grains and in what
+/// scales with the grain radius r: k_N ∝ r (the static-load rule), dt ∝ r (a fixed fraction of the contact time
+/// π √(m/2/k_N) ∝ r), the same gravity interval, path and outputs; and the target is the same body (bulk density,
+/// equivalent size).
+#[test]
+fn the_rcp_ladder_scales_stiffness_and_step_with_the_grain_radius() {
+    let (base, _) = load("rcp_path2.toml");
+    let (rung, present) = load("rcp_8k_path2.toml");
+    assert!(present, "rcp_8k.csv is committed");
+    let radius = |s: &SoftScene| s.particles.iter().map(|p| p.radius).sum::<f64>() / s.particles.len() as f64;
+    let mass = |s: &SoftScene| s.particles.iter().map(|p| p.mass).sum::<f64>();
+    let ratio = radius(&rung) / radius(&base);
+    assert!(rung.particles.len() > 3 * base.particles.len(), "a finer rung");
+    for (what, got) in [
+        ("k_N / r", rung.material.k_n / base.material.k_n / ratio),
+        ("dt / r", rung.dt / base.dt / ratio),
+        ("total mass", mass(&rung) / mass(&base)),
+    ] {
+        assert!((got - 1.0).abs() < 0.02, "{what}: ratio {got} to the 2083-grain scene");
+    }
+    assert_eq!(rung.gravity_interval, base.gravity_interval);
+    assert_eq!(rung.every_steps as f64 * rung.dt, base.every_steps as f64 * base.dt);
+    assert_eq!(rung.spinup.as_ref().unwrap().path, base.spinup.as_ref().unwrap().path);
+    assert_eq!(rung.t_end, base.t_end);
 }
