@@ -48,7 +48,9 @@ pub type PaperRow = (&'static str, f64, f64, f64, f64, f64, Option<f64>, &'stati
 pub const TABLE3: [PaperRow; 6] = [
     ("hcp", 0.739, 43.0, 2.38, 2.36, 2.40, Some(0.946), "surface shedding"),
     ("rcp", 0.641, 30.0, 2.51, 2.53, 2.83, Some(0.806), "internal failure"),
-    ("rcpc", 0.695, 32.0, 2.46, 2.46, 2.76, None, "internal failure"),
+    // Zhang17 §4.1 names RCPC the exception: its shell sheds while the body deforms (T_c1 = T_c2), neither of the
+    // two modes alone.
+    ("rcpc", 0.695, 32.0, 2.46, 2.46, 2.76, None, "shedding with deformation"),
     ("pp1", 0.820, 39.0, 2.41, 2.44, 2.53, Some(0.902), "internal failure"),
     ("pp2", 0.750, 38.0, 2.41, 2.44, 2.54, None, "internal failure"),
     ("ppc", 0.820, 39.0, 2.46, 2.41, 2.49, None, "surface shedding"),
