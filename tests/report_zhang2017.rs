@@ -163,7 +163,8 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
 }
 
 /// The committed `analysis/zhang2017/REPORT.md` ends with the committed `NOTES.md` exactly as the generator
-/// appends it, so that the hand-written part and the report cannot drift apart between regenerations.
+/// appends it (its tally marker replaced by the counted tally), so that the hand-written part and the report
+/// cannot drift apart between regenerations.
 #[test]
 fn committed_report_ends_with_the_committed_notes() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/zhang2017");
@@ -171,7 +172,14 @@ fn committed_report_ends_with_the_committed_notes() {
     let notes = std::fs::read_to_string(dir.join("NOTES.md")).unwrap();
     let mut expected = String::new();
     rubblepile::analysis::report_notes::append_notes(&mut expected, &dir);
-    assert_eq!(expected, format!("\n{notes}\n"));
+    assert_eq!(
+        expected,
+        format!("\n{}\n", rubblepile::analysis::report_notes::with_tally(&notes))
+    );
+    assert!(
+        notes.contains(rubblepile::analysis::report_notes::TALLY_MARKER),
+        "NOTES.md's tally is computed, not typed"
+    );
     assert!(
         report.ends_with(&expected),
         "REPORT.md does not end with NOTES.md as appended"
