@@ -4,7 +4,7 @@
 //! progress or damaged (exit code 0 when whole, 2 when not).
 
 mod common;
-use common::{rubblepile, temp_dir};
+use common::{describe, rubblepile, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -12,14 +12,6 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn describe(o: &Output) -> String {
-    format!(
-        "exit {:?}\nstdout: {}\nstderr: {}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()

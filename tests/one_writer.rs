@@ -4,7 +4,7 @@
 //! holder's lock released by the OS, and readers never blocked.
 
 mod common;
-use common::{rubblepile, snapshots, temp_dir};
+use common::{describe, rubblepile, snapshots, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -61,14 +61,6 @@ every = 5.0
     )
 }
 
-fn describe(o: &Output) -> String {
-    format!(
-        "exit {:?}\nstdout: {}\nstderr: {}",
-        o.status.code(),
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 fn bin(cwd: &Path, args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_rubblepile"));
