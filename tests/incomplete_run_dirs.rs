@@ -12,7 +12,6 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }

@@ -61,7 +61,6 @@ every = 5.0
     )
 }
 
-
 fn bin(cwd: &Path, args: &[&str]) -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_rubblepile"));
     c.args(args)
