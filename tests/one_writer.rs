@@ -15,6 +15,16 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Held by every test of this file for its whole run: a lock file's descriptor that this process holds is
+/// inherited by any child another thread is forking at that moment (until the child's `exec` closes it), so
+/// the OS lock can outlive the guard by a moment. With one test at a time, no other thread forks while a test
+/// drops a lock and then starts a process that takes it.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    SERIAL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
 /// `take()` retried for up to 2 s while the lock is held: right after this test drops a lock, a child process that
 /// another test of this binary is just spawning may still share the lock file's descriptor (inherited at `fork`,
 /// closed at `exec`), so the OS lock can outlive the guard by a moment. The retry guards against that race of the
@@ -167,6 +177,7 @@ fn wait_for_holder(dir: &Path, pid: u32) {
 /// holds the lock); last, the test itself holds the lock as a first writer would.
 #[test]
 fn two_concurrent_resumes_one_refused_the_other_matches_an_uninterrupted_run() {
+    let _serial = one_at_a_time();
     let dir = temp_dir("two-resumes");
     std::fs::write(dir.join("scene.toml"), pile_scene(6000.0)).unwrap();
     let whole = dir.join("whole");
@@ -230,6 +241,7 @@ fn two_concurrent_resumes_one_refused_the_other_matches_an_uninterrupted_run() {
 /// `run --force` into a directory another process writes is refused before anything in it is removed.
 #[test]
 fn run_force_into_a_directory_being_written_is_refused_and_removes_nothing() {
+    let _serial = one_at_a_time();
     let dir = temp_dir("force-locked");
     std::fs::copy(root().join("tests/bad_input/ellipsoids.toml"), dir.join("scene.toml")).unwrap();
     let out = dir.join("out");
@@ -261,6 +273,7 @@ fn run_force_into_a_directory_being_written_is_refused_and_removes_nothing() {
 /// `impact` and `flyby` into a directory another process writes: refused, the directory left as it was.
 #[test]
 fn impact_and_flyby_into_a_directory_being_written_are_refused() {
+    let _serial = one_at_a_time();
     let dir = temp_dir("impact-locked");
     let target = root().join("targets/N30_T4.csv");
     for (name, args) in [
@@ -303,6 +316,7 @@ fn impact_and_flyby_into_a_directory_being_written_are_refused() {
 /// a run directory another process writes is a failed run of the campaign, not a broken campaign.
 #[test]
 fn campaign_directory_being_written_is_refused() {
+    let _serial = one_at_a_time();
     let dir = temp_dir("campaign-locked");
     let text = read(&root().join("tests/bad_input/campaign.toml")).replace("ROOT", s(&root()));
     let file = dir.join("campaign.toml");
@@ -379,6 +393,7 @@ fn impact_run(tag: &str) -> PathBuf {
 /// `frames/`, the run directory itself (a run writes the same VTK and XYZ files), the run's `analysis/`.
 #[test]
 fn render_export_and_analyze_are_refused_while_their_output_is_written() {
+    let _serial = one_at_a_time();
     let run = impact_run("visual-locked");
     let cwd = run.parent().unwrap();
 
@@ -406,6 +421,7 @@ fn render_export_and_analyze_are_refused_while_their_output_is_written() {
 /// its `analysis/` and `render` its `frames/` (README: "`analyze` also works on a run that is still going").
 #[test]
 fn readers_and_part_writers_work_on_a_run_being_written() {
+    let _serial = one_at_a_time();
     let run = impact_run("readers");
     let cwd = run.parent().unwrap();
     let _lock = DirLock::acquire(&run).unwrap();
@@ -425,6 +441,7 @@ fn readers_and_part_writers_work_on_a_run_being_written() {
 /// so the next writer goes ahead at once.
 #[test]
 fn a_killed_holder_releases_the_lock() {
+    let _serial = one_at_a_time();
     let dir = temp_dir("killed-holder");
     std::fs::write(
         dir.join("scene.toml"),
