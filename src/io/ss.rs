@@ -118,6 +118,24 @@ pub enum SsError {
     },
 }
 
+/// The values of particle `index`'s record in file order (mass, radius, position, velocity, spin): all finite,
+/// mass and radius positive; the error names the particle and the field.
+fn check_record(index: usize, values: [f64; 11]) -> Result<(), SsError> {
+    const NAMES: [&str; 11] = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
+    for (k, (value, field)) in values.into_iter().zip(NAMES).enumerate() {
+        let positive = k < 2;
+        if !value.is_finite() || (positive && value <= 0.0) {
+            return Err(SsError::Value {
+                index,
+                field,
+                value,
+                positive: if positive { " positive" } else { "" },
+            });
+        }
+    }
+    Ok(())
+}
+
 fn f64_at(b: &[u8], at: usize) -> f64 {
     f64::from_be_bytes(b[at..at + 8].try_into().expect("8 bytes"))
 }
@@ -160,18 +178,7 @@ impl SsFile {
         for index in 0..n as usize {
             let r = &b[HEADER_BYTES + RECORD_BYTES * index..HEADER_BYTES + RECORD_BYTES * (index + 1)];
             let x: [f64; 11] = std::array::from_fn(|k| f64_at(r, 8 * k));
-            let names = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
-            for (k, (&value, field)) in x.iter().zip(names).enumerate() {
-                let positive = k < 2;
-                if !value.is_finite() || (positive && value <= 0.0) {
-                    return Err(SsError::Value {
-                        index,
-                        field,
-                        value,
-                        positive: if positive { " positive" } else { "" },
-                    });
-                }
-            }
+            check_record(index, x)?;
             particles.push(SsParticle {
                 mass: x[0] * units.mass,
                 radius: x[1] * units.length,
@@ -199,24 +206,9 @@ impl SsFile {
                 positive: "",
             });
         }
-        let names = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
         for (index, p) in self.particles.iter().enumerate() {
-            let values = [p.mass, p.radius]
-                .into_iter()
-                .chain(p.position.iter().copied())
-                .chain(p.velocity.iter().copied())
-                .chain(p.spin.iter().copied());
-            for (k, (value, field)) in values.zip(names).enumerate() {
-                let positive = k < 2;
-                if !value.is_finite() || (positive && value <= 0.0) {
-                    return Err(SsError::Value {
-                        index,
-                        field,
-                        value,
-                        positive: if positive { " positive" } else { "" },
-                    });
-                }
-            }
+            let (r, v, w) = (p.position, p.velocity, p.spin);
+            check_record(index, [p.mass, p.radius, r.x, r.y, r.z, v.x, v.y, v.z, w.x, w.y, w.z])?;
         }
         Ok(())
     }
