@@ -58,6 +58,7 @@ fn fake_run_at(
             s_max: 1.0,
             p_max: 2.0,
             theta_max_deg: 20.0,
+            coordination_loaded: 8.5,
         };
         csv += &s.csv_row();
         ts += &format!(

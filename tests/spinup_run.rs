@@ -76,6 +76,11 @@ fn forced_body_follows_the_path_and_resumes_bit_identically() {
         );
         assert_eq!(r.body_particles, rows[0].body_particles, "the ball lost members");
         assert!(r.rves >= 2 && r.coordination_number > 3.0, "{r:?}");
+        // force-floored contacts are a subset of all contacts; in a settled ball nearly all of them carry load
+        assert!(
+            r.coordination_loaded <= r.coordination_number && r.coordination_loaded > 0.9 * r.coordination_number,
+            "{r:?}"
+        );
     }
     // the path itself: T_start until t_start, linear to T_inter, then to T_final, then held
     let at = |t: f64| rows.iter().find(|r| (r.t - t).abs() < 1e-6).unwrap().path_period_h;

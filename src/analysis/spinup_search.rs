@@ -153,6 +153,16 @@ pub struct CriticalSearch {
     pub ours: CriterionResult,
 }
 
+/// The coordination number the creep test judges: the force-floored `coordination_loaded` where the run has it,
+/// else (files from before it) the raw count.
+fn coordination_judged(s: &SpinupSample) -> f64 {
+    if s.coordination_loaded.is_finite() {
+        s.coordination_loaded
+    } else {
+        s.coordination_number
+    }
+}
+
 /// Judges the hold (samples at or after `t_final`, s) of one run of T_final = `t_final_hours` in `dir` by both
 /// criteria; `selected` fills [`HoldVerdict::stable`] and [`HoldVerdict::drifting`].
 pub fn judge_hold(
@@ -172,7 +182,7 @@ pub fn judge_hold(
         &col(|s| s.t),
         &theta,
         &col(|s| s.packing_fraction),
-        &col(|s| s.coordination_number),
+        &col(coordination_judged),
     );
     let theta_max_deg = theta.iter().cloned().fold(f64::NAN, f64::max);
     let verdict = |c: &CreepCriterion| {
@@ -704,6 +714,7 @@ mod tests {
             packing_fraction: eta,
             interior_particles: 50,
             coordination_number: coord,
+            coordination_loaded: f64::NAN,
             fraction_0_contacts: 0.0,
             fraction_1_contact: 0.0,
             rves: 5,

@@ -40,7 +40,7 @@ use crate::granular::soft::leapfrog;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene::{SoftScene, load_soft_scene, parse_soft_scene};
 use crate::granular::soft::spinup::{SpinupDriver, central_body, central_body_par};
-use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, diagnose_run};
+use crate::granular::soft::spinup_diagnostics::{SPINUP_HEADER, SPINUP_HEADER_LEGACY, diagnose_run};
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
@@ -278,11 +278,24 @@ struct SpinupCheckpoint {
     bytes: u64,
 }
 
+/// The first line of the text file at `path` (without its newline), if it can be read.
+fn first_line(path: &Path) -> Option<String> {
+    use std::io::BufRead;
+    let mut line = String::new();
+    std::io::BufReader::new(File::open(path).ok()?)
+        .read_line(&mut line)
+        .ok()?;
+    Some(line.trim_end().to_string())
+}
+
 /// A spin-up run's driver and its open `spinup.csv`.
 struct SpinRun {
     driver: SpinupDriver,
     csv: BufWriter<File>,
     bytes: u64,
+    /// The file was started with [`SPINUP_HEADER_LEGACY`] (a run resumed from before `coordination_loaded`):
+    /// its rows keep those columns.
+    legacy: bool,
 }
 
 impl SpinRun {
@@ -302,7 +315,7 @@ impl SpinRun {
     /// The diagnostics row at an output sample (time `t`, s), then the release check.
     fn sample(&mut self, sys: &SoftSystem, t: f64) -> std::io::Result<()> {
         let d = diagnose_run(sys, &self.driver, t).sample;
-        let line = d.csv_row();
+        let line = if self.legacy { d.csv_row_legacy() } else { d.csv_row() };
         self.csv.write_all(line.as_bytes())?;
         self.csv.flush()?;
         self.bytes += line.len() as u64;
@@ -642,6 +655,7 @@ impl Engine for SoftEngine {
                 driver,
                 csv,
                 bytes: SPINUP_HEADER.len() as u64,
+                legacy: false,
             });
             self.book = Book::new(&self.sys);
         }
@@ -851,12 +865,14 @@ impl SoftEngine {
             (Some(settings), Some(sc)) => {
                 let mut driver = SpinupDriver::new(*settings, &scene.particles);
                 driver.restore(&sc.state).ok_or("malformed spin-up state")?;
-                let f =
-                    crate::engine::reopen_truncated(&dir.join("spinup.csv"), sc.bytes).map_err(|e| e.to_string())?;
+                let path = dir.join("spinup.csv");
+                let legacy = first_line(&path).is_some_and(|h| h == SPINUP_HEADER_LEGACY.trim_end());
+                let f = crate::engine::reopen_truncated(&path, sc.bytes).map_err(|e| e.to_string())?;
                 Some(SpinRun {
                     driver,
                     csv: BufWriter::new(f),
                     bytes: sc.bytes,
+                    legacy,
                 })
             }
             (None, None) => None,

@@ -35,6 +35,14 @@
 //! sphere size) for an open one, whose cell measures only the starting cube. Contacts with walls carry no branch
 //! vector here and are left out of the stresses (spin-up scenes have no walls).
 //!
+//! **Coordination number.** `coordination_number` counts every touching pair of the force evaluation, however
+//! little it carries; `coordination_loaded` counts only contacts whose normal force is at least
+//! [`CONTACT_FORCE_FLOOR`] times the mean normal force of all sphere contacts of that evaluation. A contact at a
+//! grazing overlap opens and closes from step to step as the pile breathes and moves the raw count by a few
+//! hundredths of a contact per particle at a sample; the floor leaves out those that carry under 1 % of the mean
+//! (in a self-gravitating pile the outermost layer's contacts carry a few tenths of the mean, so they stay counted).
+//! The creep test judges `coordination_loaded` where a run has it (issue 40, item 3).
+//!
 //! **Reductions.** `s_max` is the largest deviatoric stress `(σ₁ − σ₃)/2`, `p_max` the largest compressive
 //! pressure `−(σ₁ + σ₂ + σ₃)/3` (reported positive, Pa), `θ_max` the largest mobilized friction angle (degrees)
 //! over the RVEs.
@@ -50,7 +58,15 @@ use crate::granular::soft::stress::{StressState, particle_stress, rve_stress, st
 use crate::math::{Mat3, Vec3};
 
 /// The `spinup.csv` header.
-pub const SPINUP_HEADER: &str = "t,path_period_h,period_h,forcing,body_particles,body_mass_fraction,a,b,c,b_over_a,c_over_a,packing_fraction,interior_particles,coordination_number,fraction_0_contacts,fraction_1_contact,rves,s_max,p_max,theta_max_deg\n";
+pub const SPINUP_HEADER: &str = "t,path_period_h,period_h,forcing,body_particles,body_mass_fraction,a,b,c,b_over_a,c_over_a,packing_fraction,interior_particles,coordination_number,fraction_0_contacts,fraction_1_contact,rves,s_max,p_max,theta_max_deg,coordination_loaded\n";
+
+/// The header of `spinup.csv` files written before 27 Nov 2026 (no `coordination_loaded`): still read, with
+/// `coordination_loaded` NaN, and a run started with it is resumed in it.
+pub const SPINUP_HEADER_LEGACY: &str = "t,path_period_h,period_h,forcing,body_particles,body_mass_fraction,a,b,c,b_over_a,c_over_a,packing_fraction,interior_particles,coordination_number,fraction_0_contacts,fraction_1_contact,rves,s_max,p_max,theta_max_deg\n";
+
+/// The force floor of "in contact" for `coordination_loaded`, as a fraction of the mean normal force of all
+/// sphere–sphere contacts of the force evaluation (dimensionless): contacts carrying less are not counted.
+pub const CONTACT_FORCE_FLOOR: f64 = 1e-2;
 
 /// One row of `spinup.csv`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -95,11 +111,22 @@ pub struct SpinupSample {
     pub p_max: f64,
     /// Largest mobilized friction angle over the RVEs (degrees; NaN if none is defined).
     pub theta_max_deg: f64,
+    /// Mean contacts per particle (all particles) counting only contacts that carry at least
+    /// [`CONTACT_FORCE_FLOOR`] of the mean normal force; NaN when read from a file without it.
+    pub coordination_loaded: f64,
 }
 
 impl SpinupSample {
-    /// The CSV row (with newline).
+    /// The CSV row (with newline), in the columns of [`SPINUP_HEADER`].
     pub fn csv_row(&self) -> String {
+        let mut row = self.csv_row_legacy();
+        row.pop();
+        row.push_str(&format!(",{}\n", self.coordination_loaded));
+        row
+    }
+
+    /// The CSV row (with newline) in the columns of [`SPINUP_HEADER_LEGACY`], for resuming a run started with it.
+    pub fn csv_row_legacy(&self) -> String {
         format!(
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n",
             self.t,
@@ -126,11 +153,13 @@ impl SpinupSample {
     }
 }
 
-/// Reads a `spinup.csv` (header [`SPINUP_HEADER`], 20 numbers a row); errors name the file, line and column.
+/// Reads a `spinup.csv` (header [`SPINUP_HEADER`], 21 numbers a row, or [`SPINUP_HEADER_LEGACY`], 20); errors
+/// name the file, line and column.
 pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, crate::io::table::TableError> {
     use crate::io::table::{Cells, TableError, read_table};
     let table = read_table(path, Cells::Strict)?;
-    if table.columns.join(",") != SPINUP_HEADER.trim() {
+    let header = table.columns.join(",");
+    if header != SPINUP_HEADER.trim() && header != SPINUP_HEADER_LEGACY.trim() {
         return Err(TableError::Header {
             path: path.to_path_buf(),
             expected: SPINUP_HEADER.trim().to_string(),
@@ -159,6 +188,7 @@ pub fn read_spinup_csv(path: &Path) -> Result<Vec<SpinupSample>, crate::io::tabl
             s_max: v[17],
             p_max: v[18],
             theta_max_deg: v[19],
+            coordination_loaded: v.get(20).copied().unwrap_or(f64::NAN),
         });
     }
     Ok(out)
@@ -311,6 +341,32 @@ pub fn contact_counts(records: &[ContactRecord], n: usize) -> Vec<u32> {
     count
 }
 
+/// [`contact_counts`] of the contacts whose normal force is at least `floor` times the mean normal force of the
+/// sphere–sphere contacts in `records` (wall contacts are counted by the same floor but do not enter the mean).
+///
+/// ```
+/// use rubblepile::granular::soft::contact::Output;
+/// use rubblepile::granular::soft::forces::ContactRecord;
+/// use rubblepile::granular::soft::spinup_diagnostics::loaded_contact_counts;
+/// let rec = |i, j, f| ContactRecord { i, j, overlap: 1e-3, output: Output { normal_force: f, ..Default::default() } };
+/// // mean force 100.5 N: the 1 N contact is under 1 % of it and is not counted
+/// let counts = loaded_contact_counts(&[rec(0, 1, 200.0), rec(1, 2, 1.0)], 3, 1e-2);
+/// assert_eq!(counts, vec![1, 1, 0]);
+/// ```
+pub fn loaded_contact_counts(records: &[ContactRecord], n: usize, floor: f64) -> Vec<u32> {
+    let pairs = records.iter().filter(|r| r.j < n);
+    let (sum, k) = pairs.fold((0.0, 0usize), |(s, k), r| (s + r.output.normal_force, k + 1));
+    let threshold = if k > 0 { floor * sum / k as f64 } else { 0.0 };
+    let mut count = vec![0u32; n];
+    for r in records.iter().filter(|r| r.output.normal_force >= threshold) {
+        count[r.i] += 1;
+        if r.j < n {
+            count[r.j] += 1;
+        }
+    }
+    count
+}
+
 /// The coordination number of Zhang17 §4.1.1 (Fig. 5, bottom frame; the creep test of §3.3.3): the mean number
 /// of contacts per particle over all spheres, from [`contact_counts`] (0 for no spheres).
 pub fn mean_coordination(counts: &[u32]) -> f64 {
@@ -413,6 +469,7 @@ pub fn diagnose(
         s_max,
         p_max,
         theta_max_deg: theta_max,
+        coordination_loaded: mean_coordination(&loaded_contact_counts(&sys.records, n, CONTACT_FORCE_FLOOR)),
     };
     Diagnosis { sample, rves: stresses }
 }
@@ -434,6 +491,76 @@ pub fn diagnose_run(sys: &SoftSystem, driver: &SpinupDriver, t: f64) -> Diagnosi
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn sample(coordination_loaded: f64) -> SpinupSample {
+        SpinupSample {
+            t: 100.0,
+            path_period_h: 3.0,
+            period_h: 3.01,
+            forcing: true,
+            body_particles: 10,
+            body_mass_fraction: 1.0,
+            a: 3.0,
+            b: 2.0,
+            c: 1.0,
+            b_over_a: 2.0 / 3.0,
+            c_over_a: 1.0 / 3.0,
+            packing_fraction: 0.64,
+            interior_particles: 4,
+            coordination_number: 5.5,
+            fraction_0_contacts: 0.1,
+            fraction_1_contact: 0.0,
+            rves: 1,
+            s_max: 10.0,
+            p_max: 20.0,
+            theta_max_deg: 30.0,
+            coordination_loaded,
+        }
+    }
+
+    #[test]
+    fn spinup_csv_reads_back_its_rows_and_the_legacy_columns_with_no_loaded_coordination() {
+        let dir = std::env::temp_dir().join(format!("rubblepile-spinup-csv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (new, old) = (dir.join("new.csv"), dir.join("old.csv"));
+        std::fs::write(&new, format!("{SPINUP_HEADER}{}", sample(5.25).csv_row())).unwrap();
+        std::fs::write(&old, format!("{SPINUP_HEADER_LEGACY}{}", sample(5.25).csv_row_legacy())).unwrap();
+        assert_eq!(read_spinup_csv(&new).unwrap(), vec![sample(5.25)]);
+        let legacy = read_spinup_csv(&old).unwrap();
+        assert!(legacy[0].coordination_loaded.is_nan());
+        assert_eq!(
+            SpinupSample {
+                coordination_loaded: 5.25,
+                ..legacy[0]
+            },
+            sample(5.25)
+        );
+        // a legacy header over new rows (a run resumed in the wrong columns) is refused
+        std::fs::write(&old, format!("{SPINUP_HEADER_LEGACY}{}", sample(5.25).csv_row())).unwrap();
+        assert!(read_spinup_csv(&old).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn force_floor_drops_grazing_contacts_and_walls_take_the_same_floor() {
+        use crate::granular::soft::contact::Output;
+        let rec = |i, j, f| ContactRecord {
+            i,
+            j,
+            overlap: 1e-3,
+            output: Output {
+                normal_force: f,
+                ..Default::default()
+            },
+        };
+        // pair forces 300, 100, 2 N: mean 134 N, floor 1.34 N keeps 2 N; at floor 0.02 (2.68 N) it goes.
+        // the wall contact (j = 4 >= n) of 1 N is under both floors and does not enter the mean.
+        let records = [rec(0, 1, 300.0), rec(1, 2, 100.0), rec(2, 3, 2.0), rec(3, 4, 1.0)];
+        assert_eq!(contact_counts(&records, 4), vec![1, 2, 2, 2]);
+        assert_eq!(loaded_contact_counts(&records, 4, 1e-2), vec![1, 2, 2, 1]);
+        assert_eq!(loaded_contact_counts(&records, 4, 2e-2), vec![1, 2, 1, 0]);
+        assert_eq!(mean_coordination(&loaded_contact_counts(&records, 4, 2e-2)), 1.0);
+    }
 
     #[test]
     fn rve_tree_gives_similar_sizes_covering_every_member_once() {
