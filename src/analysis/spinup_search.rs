@@ -126,14 +126,16 @@ impl HoldVerdict {
 }
 
 /// T_c,3 and φ under one criterion.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CriterionResult {
     /// The criterion and its tolerances.
     pub criterion: CreepCriterion,
-    /// T_c,3 (h): the first T_final stable under it.
+    /// T_c,3 (h): the shortest T_final from which every slower hold searched is stable under it.
     pub t_c3_hours: Option<f64>,
     /// φ (degrees): the largest θ_max over the holds within ±0.01 h of that T_c,3.
     pub friction_angle_deg: Option<f64>,
+    /// Stable holds (T_final, h) below a creeping one, set aside by the monotone rule ([`set_aside`]).
+    pub set_aside_hours: Vec<f64>,
 }
 
 /// `critical.json`.
@@ -211,10 +213,18 @@ pub fn judge_hold(
     }
 }
 
-/// Reduces judged runs to T_c,3 and φ under criterion `kind`: the first T_final stable under it, and the largest
-/// θ_max over the holds within ±0.01 h of it (Zhang17 §3.3.3).
+/// Index of the first run of the trailing block of holds stable under `kind` (runs by increasing T_final): the
+/// shortest T_final from which every slower hold searched is stable. `None` when the slowest hold creeps.
+fn stable_from(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Option<usize> {
+    let start = runs.iter().rposition(|r| !r.verdict(kind).stable).map_or(0, |i| i + 1);
+    (start < runs.len()).then_some(start)
+}
+
+/// Reduces judged runs (by increasing T_final) to T_c,3 and φ under criterion `kind`. T_c,3 is the shortest T_final
+/// from which every slower hold is stable (the verdict made monotone: a stable hold below a creeping one does not
+/// count, see [`set_aside`]); φ the largest θ_max over the holds within ±0.01 h of it (Zhang17 §3.3.3).
 pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) -> (Option<f64>, Option<f64>) {
-    let t_c3 = runs.iter().find(|r| r.verdict(kind).stable).map(|r| r.t_final_hours);
+    let t_c3 = stable_from(runs, kind).map(|i| runs[i].t_final_hours);
     let phi = t_c3.and_then(|t| {
         let m = runs
             .iter()
@@ -226,14 +236,24 @@ pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) ->
     (t_c3, phi)
 }
 
-/// Whether the search may stop after `runs`: every criterion has a stable hold and a judged hold after it (φ looks
-/// ±0.01 h around T_c,3).
+/// The T_final (h) of holds stable under `kind` that lie below a creeping or disrupted one: where the verdict is
+/// not monotone in the spin. [`critical_from_verdicts`] sets them aside; a search with `--step 0.01` between them
+/// and the next creeping hold says whether they were luck.
+pub fn set_aside(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Vec<f64> {
+    let last_unstable = runs.iter().rposition(|r| !r.verdict(kind).stable);
+    runs.iter()
+        .enumerate()
+        .filter(|(i, r)| last_unstable.is_some_and(|u| *i < u) && r.verdict(kind).stable)
+        .map(|(_, r)| r.t_final_hours)
+        .collect()
+}
+
+/// Whether the search may stop after `runs`: under every criterion the slowest two holds are stable (T_c,3 and a
+/// judged hold after it, since φ looks ±0.01 h around T_c,3).
 pub fn search_done(runs: &[HoldVerdict]) -> bool {
-    CreepCriterionKind::ALL.iter().all(|&k| {
-        runs.iter()
-            .position(|r| r.verdict(k).stable)
-            .is_some_and(|f| runs.len() > f + 1)
-    })
+    CreepCriterionKind::ALL
+        .iter()
+        .all(|&k| stable_from(runs, k).is_some_and(|f| runs.len() > f + 1))
 }
 
 /// Whether the search stops after `runs`: when it is done ([`search_done`]), unless `all_holds` asks for the whole
@@ -408,12 +428,13 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             criterion,
             t_c3_hours,
             friction_angle_deg,
+            set_aside_hours: set_aside(&runs, criterion.kind),
         }
     };
     let (paper, ours) = (result(paper), result(ours));
     let selected = match args.criterion {
-        CreepCriterionKind::Paper => paper,
-        CreepCriterionKind::Ours => ours,
+        CreepCriterionKind::Paper => paper.clone(),
+        CreepCriterionKind::Ours => ours.clone(),
     };
     let (t_c3_hours, friction_angle_deg) = (selected.t_c3_hours, selected.friction_angle_deg);
     let csv = args.out.join("critical.csv");
@@ -429,6 +450,14 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.ours] {
+        if let (Some(&first), Some(t)) = (r.set_aside_hours.first(), r.t_c3_hours) {
+            println!(
+                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside; refine with \
+                 --from {first:.2} --to {t:.2} --step 0.01",
+                r.criterion.kind.name(),
+                r.set_aside_hours
+            );
+        }
         match (r.t_c3_hours, r.friction_angle_deg) {
             (Some(t), Some(p)) => println!(
                 "{} criterion: T_c3 = {t:.2} h, phi = {p:.1} deg",
@@ -739,7 +768,8 @@ mod tests {
     }
 
     /// The creep criteria on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps
-    /// under both; T_c,3 is the first stable T_final and φ the largest θ_max within ±0.01 h of it.
+    /// under both; T_c,3 is the first stable T_final (every slower one stable too) and φ the largest θ_max within
+    /// ±0.01 h of it.
     #[test]
     fn hold_verdicts_give_t_c3_and_phi() {
         let flat = |v: f64| move |_: f64| v;
@@ -779,6 +809,40 @@ mod tests {
             "{}",
             verdict_line(&v)
         );
+    }
+
+    /// The verdict made monotone: a hold that happens to be stable below a creeping one is set aside, T_c,3 is where
+    /// the trailing run of stable holds begins, and the search is not done while the slowest hold creeps.
+    #[test]
+    fn a_stable_hold_below_a_creeping_one_is_set_aside() {
+        let flat = |v: f64| move |_: f64| v;
+        let rising = |x: f64| 40.0 + 2.0 * x;
+        let kinds = [
+            (2.40, false),
+            (2.45, true), // lucky: stable below a creeping hold
+            (2.50, false),
+            (2.55, true),
+            (2.60, true),
+        ];
+        let runs: Vec<HoldVerdict> = kinds
+            .iter()
+            .map(|&(tf, stable)| {
+                let s = if stable {
+                    hold(flat(38.0), flat(0.74), flat(9.0))
+                } else {
+                    hold(rising, flat(0.74), flat(9.0))
+                };
+                verdict(tf, &s, CreepCriterionKind::Paper)
+            })
+            .collect();
+        for k in CreepCriterionKind::ALL {
+            assert_eq!(critical_from_verdicts(&runs, k), (Some(2.55), Some(38.0)));
+            assert_eq!(set_aside(&runs, k), vec![2.45]);
+            // after the hold at 2.50 h the search is not done although 2.45 h was stable with one hold after it
+            assert!(!search_done(&runs[..3]) && !search_done(&runs[..4]) && search_done(&runs));
+            // the slowest hold creeping: no T_c,3 at all
+            assert_eq!(critical_from_verdicts(&runs[..3], k), (None, None));
+        }
     }
 
     /// Both T_c,3 values from one search: holds at 2.55–2.58 h lose 0.2 contacts per particle over the hold with
