@@ -837,3 +837,91 @@ fn mpi_campaign_into_a_directory_being_written_is_refused_without_hanging() {
     drop(lock);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `campaign slurm` with every scheduler option: each lands on its own `#SBATCH` line, the array carries the
+/// throttle, the tasks run the named binary; without them none of those lines is written; a bad value is refused
+/// naming its option, before anything is written.
+#[test]
+fn slurm_script_carries_the_scheduler_options() {
+    let (dir, file) = campaign_dir("slurm-options", GRID);
+    let f = file.to_str().unwrap();
+    let o = bin(&[
+        "campaign",
+        "slurm",
+        f,
+        "--tasks",
+        "8",
+        "--threads-per-task",
+        "4",
+        "--time",
+        "1-02:30:00",
+        "--partition",
+        "short",
+        "--account",
+        "proj-42",
+        "--mem",
+        "16G",
+        "--throttle",
+        "3",
+        "--binary",
+        "/opt/rp/bin/rubblepile",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let script = std::fs::read_to_string(dir.join("out/campaign.slurm")).unwrap();
+    let sbatch: Vec<&str> = script.lines().filter(|l| l.starts_with("#SBATCH")).collect();
+    let out = dir.join("out");
+    let expected = [
+        "#SBATCH --job-name=rubblepile-campaign".to_string(),
+        "#SBATCH --array=0-7%3".to_string(),
+        "#SBATCH --ntasks=1".to_string(),
+        "#SBATCH --cpus-per-task=4".to_string(),
+        "#SBATCH --time=1-02:30:00".to_string(),
+        "#SBATCH --partition=short".to_string(),
+        "#SBATCH --account=proj-42".to_string(),
+        "#SBATCH --mem=16G".to_string(),
+        format!("#SBATCH --output={}/slurm-%A_%a.out", out.display()),
+    ];
+    assert_eq!(
+        sbatch,
+        expected.iter().map(String::as_str).collect::<Vec<_>>(),
+        "{script}"
+    );
+    let srun: Vec<&str> = script.lines().filter(|l| l.starts_with("srun ")).collect();
+    assert_eq!(srun.len(), 1, "{script}");
+    assert!(srun[0].starts_with("srun /opt/rp/bin/rubblepile campaign "), "{script}");
+    assert!(srun[0].contains("--shard $SLURM_ARRAY_TASK_ID/8"), "{script}");
+    assert!(
+        script.contains("--wrap \"/opt/rp/bin/rubblepile campaign merge"),
+        "{script}"
+    );
+
+    // Without the options: the plain array, the scheduler's defaults, this binary by its absolute path.
+    let o = bin(&["campaign", "slurm", f, "--tasks", "2", "--out", out.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let plain = std::fs::read_to_string(out.join("campaign.slurm")).unwrap();
+    assert!(plain.contains("#SBATCH --array=0-1\n"), "{plain}");
+    for opt in ["--time", "--partition", "--account", "--mem"] {
+        assert!(!plain.contains(&format!("#SBATCH {opt}")), "{opt}: {plain}");
+    }
+    let exe = std::fs::canonicalize(env!("CARGO_BIN_EXE_rubblepile")).unwrap();
+    assert!(plain.contains(&format!("srun {} campaign", exe.display())), "{plain}");
+
+    std::fs::remove_file(out.join("campaign.slurm")).unwrap();
+    for (opt, value) in [
+        ("--time", "2 hours"),
+        ("--time", "1-"),
+        ("--mem", "16GB"),
+        ("--partition", "a;rm -rf"),
+        ("--account", ""),
+        ("--throttle", "0"),
+    ] {
+        let o = bin(&["campaign", "slurm", f, "--tasks", "2", opt, value]);
+        assert_eq!(o.status.code(), Some(2), "{opt} {value}: {}", stderr(&o));
+        assert!(stderr(&o).contains(opt), "{opt} {value}: {}", stderr(&o));
+        assert!(
+            !out.join("campaign.slurm").exists(),
+            "{opt} {value}: a script was written"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -84,6 +84,40 @@ fn a_hand_built_two_particle_file_is_read_in_si() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Older pkdgrav wrote a header pad of 0 where the magic number −1 now stands; the records are the same standard
+/// format, so a hand-written pad-0 file converts to the very bytes of its magic −1 twin.
+#[test]
+fn a_file_whose_header_pad_is_zero_is_read_as_the_standard_format() {
+    let dir = temp_dir("ss-pad0");
+    let p = [
+        [1e-12, 1e-9, 1.0, -2.0, 0.5, 0.01, 0.0, -0.02, 3.0, 0.0, -1.0],
+        [2e-13, 5e-10, 1.0 + 1e-8, -2.0, 0.5, 0.01, 1e-3, -0.02, 0.0, 0.5, 0.0],
+    ];
+    let old = hand_built(&p, 0.25, 0);
+    assert_eq!(&old[12..16], &[0, 0, 0, 0], "the pad word");
+    std::fs::write(dir.join("old.ss"), old).unwrap();
+    std::fs::write(dir.join("new.ss"), hand_built(&p, 0.25, -1)).unwrap();
+    for stem in ["old", "new"] {
+        let o = rubblepile(
+            &dir,
+            &[
+                "convert",
+                &format!("{stem}.ss"),
+                "--to",
+                &format!("{stem}.csv"),
+                "--spheres",
+            ],
+        );
+        assert!(o.status.success(), "{stem}: {}", String::from_utf8_lossy(&o.stderr));
+    }
+    let old_csv = std::fs::read(dir.join("old.csv")).unwrap();
+    assert_eq!(old_csv, std::fs::read(dir.join("new.csv")).unwrap());
+    let (_, rows) = csv_rows(&dir.join("old.csv"));
+    assert_eq!(rows.len(), 2);
+    assert!((rows[1][2] - 2e-13 * GM / G).abs() <= 1e-14 * rows[1][2]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn bad_files_get_one_clear_error() {
     let dir = temp_dir("ss-bad");

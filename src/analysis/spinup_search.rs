@@ -398,6 +398,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             checkpoint_every_sim: None,
             formats: crate::driver::formats::Formats::NONE,
             stop_after_checkpoints: None,
+            ..RunOptions::default()
         };
         let t_final = branches.as_ref().map_or(settings.path.t_final, |b| b[k]);
         if !completed {
@@ -624,6 +625,7 @@ fn prepare_branches(
                 checkpoint_every_sim: Some(t_ck - t_here - 0.5 * dt),
                 formats: crate::driver::formats::Formats::NONE,
                 stop_after_checkpoints: Some(1),
+                ..RunOptions::default()
             };
             eprintln!(
                 "spinup critical: base run to t = {t_ck} s (T_final = {tf} h starts at {} s)",

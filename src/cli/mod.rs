@@ -208,7 +208,8 @@ pub struct ResumeArgs {
     pub checkpoints: CheckpointArgs,
 }
 
-/// When `run` and `resume` write `DIR/checkpoint.json` (always at an output sample).
+/// When `run` and `resume` write `DIR/checkpoint.json` (always at an output sample), and how often a batch log
+/// gets a progress line.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CheckpointArgs {
     /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never).
@@ -222,6 +223,10 @@ pub struct CheckpointArgs {
     /// repeat for several.
     #[arg(long, value_name = "NAME")]
     pub format: Vec<String>,
+    /// When stderr is not a terminal (a batch log): a progress line (t, %, ETA, the energy error) every SECONDS
+    /// of wall-clock time, 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the bar is shown.
+    #[arg(long, value_name = "SECONDS")]
+    pub progress_every: Option<f64>,
     /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after_checkpoints: Option<u64>,
@@ -247,12 +252,31 @@ impl CheckpointArgs {
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
+        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
+        let progress_every = match (self.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
+            (Some(s), _) if ok(s) => s,
+            (Some(s), _) => {
+                return Err(CliError::usage(format!(
+                    "--progress-every must be a finite number of seconds >= 0, got {s}"
+                )));
+            }
+            (None, Ok(text)) => match text.trim().parse::<f64>() {
+                Ok(s) if ok(s) => s,
+                _ => {
+                    return Err(CliError::usage(format!(
+                        "{PROGRESS_EVERY_ENV} must be a finite number of seconds >= 0, got {text:?}"
+                    )));
+                }
+            },
+            (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
+        };
         Ok(RunOptions {
             force: false,
             progress,
             checkpoint_every: (self.checkpoint_every > 0.0).then_some(self.checkpoint_every),
             checkpoint_every_sim: self.checkpoint_every_sim,
             formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
+            progress_every,
             stop_after_checkpoints: self.stop_after_checkpoints,
         })
     }

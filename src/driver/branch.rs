@@ -55,6 +55,8 @@ fn read_checkpoint(dir: &Path) -> Result<serde_json::Value, BranchError> {
 /// grid has no sample at the checkpoint's step with the checkpoint's index.
 pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path) -> Result<(), BranchError> {
     let mut ck = read_checkpoint(parent)?;
+    // The branch's scene copy stands alone as a run's does (crate::io::standalone).
+    let scene_text = &crate::io::standalone::with_absolute_inputs(scene_text, scene_dir);
     let name = dir.join("scene.toml").display().to_string();
     let scene = parse_soft_scene(scene_text, &name, Some(scene_dir)).map_err(|e| bad(e.to_string()))?;
     let n_state = ck["engine"]["state"].as_array().map_or(0, Vec::len);

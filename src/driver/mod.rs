@@ -32,6 +32,7 @@ pub mod export;
 pub mod formats;
 pub mod inspect;
 pub mod kind;
+pub mod progress;
 pub mod run_files;
 pub mod warm_pool;
 
@@ -79,6 +80,9 @@ pub struct RunOptions {
     pub checkpoint_every_sim: Option<f64>,
     /// Extra snapshot formats to write beside the engine's CSV snapshots ([`formats`]).
     pub formats: formats::Formats,
+    /// Wall-clock seconds between progress lines when `progress` is on and stderr is not a terminal (a batch log);
+    /// 0 = no lines. Default [`progress::DEFAULT_PROGRESS_EVERY`] (60 s).
+    pub progress_every: f64,
     /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many checkpoints
     /// (as if the process had been killed then).
     pub stop_after_checkpoints: Option<u64>,
@@ -94,6 +98,7 @@ impl Default for RunOptions {
             checkpoint_every: Some(DEFAULT_CHECKPOINT_EVERY),
             checkpoint_every_sim: None,
             formats: formats::Formats::NONE,
+            progress_every: progress::DEFAULT_PROGRESS_EVERY,
             stop_after_checkpoints: None,
         }
     }
@@ -391,6 +396,23 @@ fn absolute_base<S>(engine: &impl Engine) -> Result<Option<PathBuf>, RunError<S>
     }
 }
 
+/// The scene text a run keeps as `out_dir/scene.toml`: the engine's own, with its relative input files written by
+/// their absolute paths ([`crate::io::standalone`]) unless the scene's directory is the run directory itself
+/// (`impact`, `flyby` and campaigns keep their `initial_bodies.csv` there, so the directory can move as a whole).
+fn standalone_scene(engine: &impl Engine, out_dir: &Path) -> String {
+    let text = engine.scene_source();
+    match engine.scene_base_dir() {
+        Some(base) if !same_dir(base, out_dir) => crate::io::standalone::with_absolute_inputs(text, base),
+        _ => text.to_string(),
+    }
+}
+
+/// Whether `a` and `b` name the same existing directory.
+fn same_dir(a: &Path, b: &Path) -> bool {
+    let canon = |p: &Path| std::fs::canonicalize(if p.as_os_str().is_empty() { Path::new(".") } else { p });
+    matches!((canon(a), canon(b)), (Ok(x), Ok(y)) if x == y)
+}
+
 /// Runs `engine` from its initial state, writing the outputs into `out_dir` (see the module docs).
 ///
 /// Holds the lock of `out_dir` ([`prepare_output_dir`]) until it returns, and refuses an existing non-empty
@@ -400,10 +422,11 @@ fn absolute_base<S>(engine: &impl Engine) -> Result<Option<PathBuf>, RunError<S>
 pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
     let _lock = prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
-    std::fs::write(&scene_copy, engine.scene_source()).map_err(io_err(&scene_copy))?;
+    let scene_text = standalone_scene(&engine, out_dir);
+    std::fs::write(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
     let identity = Identity {
         scene_base_dir: absolute_base(&engine)?,
-        scene_hash: fnv1a_hex(engine.scene_source().as_bytes()),
+        scene_hash: fnv1a_hex(scene_text.as_bytes()),
     };
     let ts_path = out_dir.join("timeseries.csv");
     let mut timeseries = File::create(&ts_path).map_err(io_err(&ts_path))?;
@@ -684,13 +707,11 @@ fn drive<E: Engine>(
     let t_end = engine.t_end();
     let started = Instant::now();
     let wall = || wall_before + started.elapsed().as_secs_f64();
-    let pb = progress_bar(options.progress, t_end, engine.time());
+    let shown = progress::Progress::new(options.progress, options.progress_every, t_end, engine.time());
 
     // On failure: the rows so far, the last good state and the summary, then the error.
     let fail = |engine: &E, failure: &crate::engine::Failure, rows: u64, files: &mut run_files::RunFiles| {
-        if let Some(pb) = &pb {
-            pb.abandon();
-        }
+        shown.abandon();
         if let Err((path, source)) = files.flush() {
             return RunError::Io { path, source };
         }
@@ -720,11 +741,9 @@ fn drive<E: Engine>(
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
     for (index, sample) in samples.iter().enumerate().skip(next_sample as usize) {
-        let mut progress = |t: f64| {
-            if let Some(pb) = &pb {
-                show_progress(pb, t, t_end);
-            }
-        };
+        // The error of the last sample: the engine is busy while it advances.
+        let error = engine.error_so_far();
+        let mut progress = |t: f64| shown.show(t, t_end, error);
         if let Err(failure) = engine.advance(index, sample, &mut progress) {
             return Err(fail(engine, &failure, rows, &mut files));
         }
@@ -753,7 +772,7 @@ fn drive<E: Engine>(
             }
         }
         let t = engine.time();
-        progress(t);
+        shown.show(t, t_end, engine.error_so_far());
 
         let due_wall = options
             .checkpoint_every
@@ -788,9 +807,7 @@ fn drive<E: Engine>(
             last_checkpoint_t = t;
             checkpoints_here += 1;
             if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
-                if let Some(pb) = &pb {
-                    pb.abandon();
-                }
+                shown.abandon();
                 return Err(RunError::Stopped {
                     dir: out_dir.to_path_buf(),
                     t,
@@ -802,9 +819,7 @@ fn drive<E: Engine>(
     // The wall time is the run's; the final flush to disk comes after it, before the summary says "completed".
     let wall_seconds = wall();
     files.sync().map_err(file_err)?;
-    if let Some(pb) = &pb {
-        pb.finish_and_clear();
-    }
+    shown.finish();
     let summary = engine.summary(Outcome::Completed, rows, wall_seconds);
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;

@@ -527,6 +527,10 @@ impl Engine for EllipsoidEngine {
         &self.scene.source
     }
 
+    fn error_so_far(&self) -> Option<(&'static str, f64)> {
+        Some(("energy error", self.tracker.energy / self.tracker.scales().energy))
+    }
+
     fn scene_base_dir(&self) -> Option<&Path> {
         self.scene.base_dir.as_deref()
     }

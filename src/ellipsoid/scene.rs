@@ -295,6 +295,11 @@ pub struct OutputSection {
     /// exactly and writes `snapshots/<k>.csv` for the k-th time. Default `[0, t_end]`; `[]` = no snapshots.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub times: Option<Vec<f64>>,
+    /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
+    /// `t_end` (each `k × snapshot_every`, the last exactly `t_end`), at most 1e5. Give `times` or this, not both.
+    /// Default: none (`times` decides).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshot_every: Option<f64>,
     /// Time-series cadence (s, > 0): a row of `timeseries.csv` every `every` seconds from 0 to
     /// `t_end` inclusive (plus one at each snapshot time). Required. At most 1e8 rows.
     pub every: f64,
@@ -705,16 +710,11 @@ impl Validator<'_> {
         })
     }
 
-    /// `[output]`: time-series cadence `every` (s), snapshot times (s) in [0, t_end], tracked body ids.
+    /// `[output]`: time-series cadence `every` (s), snapshot times (s) in [0, t_end] (a list or a cadence), tracked
+    /// body ids.
     fn output_section(&self, o: &OutputSection, t_end: f64) -> Result<OutputSettings, SceneError> {
         let every = self.cadence("output.every", o.every, t_end)?;
-        let times = match &o.times {
-            Some(times) => {
-                self.snapshot_times(times, t_end)?;
-                times.clone()
-            }
-            None => vec![0.0, t_end],
-        };
+        let times = self.output_times(o.times.as_deref(), o.snapshot_every, t_end)?;
         let track = o.track.clone().unwrap_or_default();
 
         Ok(OutputSettings { times, every, track })

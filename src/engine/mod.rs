@@ -312,6 +312,13 @@ pub trait Engine: Sized + Send {
         usize::MAX
     }
 
+    /// The run's error measure up to its last sample, for the progress lines of a batch log: its name and value
+    /// (the relative energy error its summary reports, or the bookkeeping residual where energy is exchanged on
+    /// purpose). Default: none.
+    fn error_so_far(&self) -> Option<(&'static str, f64)> {
+        None
+    }
+
     /// Writes the last good state (after a [`Failure`]) in the snapshot format; returns its time (s).
     fn write_last_good_state(&self, path: &Path) -> std::io::Result<f64>;
 

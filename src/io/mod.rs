@@ -1,16 +1,18 @@
 //! The engine-independent floor of file input and output: lossless float formatting ([`fmt_f64`]), the checkpoint
 //! file names ([`checkpoint`]), the scene-file reading, parsing and field checks every engine's scene uses
-//! ([`scene_file`]), and the one-writer lock of the directories rubblepile writes ([`run_lock`]). Each engine's own
+//! ([`scene_file`]), the run's stand-alone scene copy ([`standalone`]), and the one-writer lock of the directories rubblepile writes ([`run_lock`]). Each engine's own
 //! output formats live with the engine (e.g. `ellipsoid::output`).
 //!
 //! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific notation), so a
 //! snapshot re-read as an input file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
+pub mod output_times;
 pub mod particles;
 pub mod run_lock;
 pub mod scene_file;
 pub mod ss;
+pub mod standalone;
 pub mod table;
 pub mod vtk;
 

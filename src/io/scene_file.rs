@@ -521,6 +521,47 @@ impl Validator<'_> {
         Ok(())
     }
 
+    /// The snapshot times of an `[output]` table: the list `times` (checked by [`Validator::snapshot_times`]) or the
+    /// cadence `snapshot_every` (s, positive, giving at most [`MAX_SNAPSHOTS`] times: `0, every, 2·every, …` and
+    /// `t_end`, by [`crate::io::output_times::cadence_times`]); at most one of the two. Neither: `[0, t_end]`.
+    pub(crate) fn output_times(
+        &self,
+        times: Option<&[f64]>,
+        snapshot_every: Option<f64>,
+        t_end: f64,
+    ) -> Result<Vec<f64>, SceneError> {
+        use crate::io::output_times::{cadence_count, cadence_times};
+        match (times, snapshot_every) {
+            (Some(_), Some(every)) => Err(self.invalid(
+                "output.snapshot_every",
+                format!(
+                    "give either `times` (the list of snapshot times) or `snapshot_every` (their cadence), not both; \
+                     got snapshot_every = {} beside times",
+                    fmt_num(every)
+                ),
+            )),
+            (Some(times), None) => {
+                self.snapshot_times(times, t_end)?;
+                Ok(times.to_vec())
+            }
+            (None, Some(every)) => {
+                let every = self.positive("output.snapshot_every", every)?;
+                let n = cadence_count(t_end, every);
+                if n > MAX_SNAPSHOTS as f64 {
+                    return Err(self.invalid(
+                        "output.snapshot_every",
+                        format!(
+                            "too small for t_end = {t_end}: would write {n:e} snapshots (at most {MAX_SNAPSHOTS}, \
+                             MAX_SNAPSHOTS), got {every:e}"
+                        ),
+                    ));
+                }
+                Ok(cadence_times(t_end, every))
+            }
+            (None, None) => Ok(vec![0.0, t_end]),
+        }
+    }
+
     /// A size that may be zero (a ring's radius, an amplitude): 0, or a [`Validator::positive`] size.
     pub(crate) fn size_or_zero(&self, field: &str, x: f64) -> Result<f64, SceneError> {
         if x == 0.0 {

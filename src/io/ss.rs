@@ -1,7 +1,8 @@
 //! pkdgrav's `.ss` particle files (its `ssio` library), so rubble piles move between pkdgrav and rubblepile.
 //!
 //! The format is XDR, i.e. big-endian: a 16-byte header — time (f64), number of particles `n_data` (i32), magic
-//! number (i32; −1 marks the standard format, the only one read here) — then `n_data` records of 96 bytes: mass,
+//! number (i32; −1 marks the standard format, the only one read here; files of older pkdgrav versions, whose header
+//! had a pad of 0 in its place, are that same standard format and are read too) — then `n_data` records of 96 bytes: mass,
 //! radius, position (3), velocity (3), spin (3), all f64, then colour (i32) and original index (i32).
 //!
 //! pkdgrav works in units with G = 1: length 1 AU, mass 1 solar mass, time 1 yr/2π (so that the Earth's mean
@@ -22,6 +23,9 @@ pub const AU_M: f64 = 1.495978707e11;
 pub const GM_SUN: f64 = 1.32712440018e20;
 /// The standard format's magic number.
 pub const MAGIC_STANDARD: i32 = -1;
+/// The header's fourth word in files of older pkdgrav versions: an unused pad, written as 0, before the magic
+/// number took its place; their records are the standard format's.
+pub const MAGIC_OLD_PAD: i32 = 0;
 /// Bytes of the header.
 pub const HEADER_BYTES: usize = 16;
 /// Bytes of one particle record.
@@ -92,7 +96,9 @@ pub enum SsError {
     #[error("{0} bytes: shorter than the 16-byte header of a pkdgrav .ss file")]
     Short(usize),
     /// Not the standard format.
-    #[error("magic number {0}: expected -1 (pkdgrav's standard .ss format; reduced formats are not read)")]
+    #[error(
+        "magic number {0}: expected -1 (pkdgrav's standard .ss format) or 0 (the pad of older pkdgrav versions); reduced formats are not read"
+    )]
     Magic(i32),
     /// The length does not match `n_data`.
     #[error("header says {n} particles ({expected} bytes), the file has {actual} bytes")]
@@ -144,6 +150,16 @@ fn i32_at(b: &[u8], at: usize) -> i32 {
     i32::from_be_bytes(b[at..at + 4].try_into().expect("4 bytes"))
 }
 
+/// Accepts the header's fourth word of a standard-format file: [`MAGIC_STANDARD`] or an older pkdgrav's pad
+/// ([`MAGIC_OLD_PAD`]).
+fn standard_format(magic: i32) -> Result<(), SsError> {
+    if magic == MAGIC_STANDARD || magic == MAGIC_OLD_PAD {
+        Ok(())
+    } else {
+        Err(SsError::Magic(magic))
+    }
+}
+
 impl SsFile {
     /// Parses the bytes of a `.ss` file.
     pub fn from_bytes(b: &[u8], units: &Units) -> Result<SsFile, SsError> {
@@ -152,10 +168,7 @@ impl SsFile {
         }
         let time = f64_at(b, 0);
         let n = i32_at(b, 8);
-        let magic = i32_at(b, 12);
-        if magic != MAGIC_STANDARD {
-            return Err(SsError::Magic(magic));
-        }
+        standard_format(i32_at(b, 12))?;
         let expected = HEADER_BYTES + RECORD_BYTES * n.max(0) as usize;
         if n < 0 || b.len() != expected {
             return Err(SsError::Length {
@@ -249,10 +262,7 @@ impl SsFile {
             return Err(SsError::Short(b.len()));
         }
         let n = i32_at(&b, 8);
-        let magic = i32_at(&b, 12);
-        if magic != MAGIC_STANDARD {
-            return Err(SsError::Magic(magic));
-        }
+        standard_format(i32_at(&b, 12))?;
         let expected = HEADER_BYTES as u64 + RECORD_BYTES as u64 * u64::from(n.max(0).unsigned_abs());
         let actual = |read: usize| if meta.is_file() { meta.len() as usize } else { read };
         if n < 0 || expected > crate::io::scene_file::MAX_INPUT_BYTES {

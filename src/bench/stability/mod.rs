@@ -292,6 +292,7 @@ pub fn run_case(case: &Case, runs_dir: &Path, force: bool) -> Result<CaseResult,
         checkpoint_every_sim: None,
         formats: crate::driver::formats::Formats::NONE,
         stop_after_checkpoints: None,
+        ..RunOptions::default()
     };
     let started = Instant::now();
     let (summary, failure) = match run_scene(&scene, &dir, &options) {

@@ -183,6 +183,10 @@ pub struct HardOutputSection {
     /// Snapshot times (s), strictly increasing in `[0, t_end]`, at most 1e5 ([`crate::io::scene_file::MAX_SNAPSHOTS`]). Default `[0, t_end]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub times: Option<Vec<f64>>,
+    /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
+    /// `t_end` (the last exactly `t_end`), at most 1e5. Give `times` or this, not both. Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshot_every: Option<f64>,
     /// Time-series cadence (s), at least `t_end × 1e-12` and `t_end / 1e8` (at most 1e8 rows). Required.
     pub every: f64,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
@@ -375,13 +379,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     let eps_n = v.in_range("material.eps_n", file.material.eps_n, 0.0, 1.0)?;
     let eps_t = v.in_range("material.eps_t", file.material.eps_t, -1.0, 1.0)?;
     let every = v.cadence("output.every", file.output.every, t_end)?;
-    let times = match &file.output.times {
-        Some(ts) => {
-            v.snapshot_times(ts, t_end)?;
-            ts.clone()
-        }
-        None => vec![0.0, t_end],
-    };
+    let times = v.output_times(file.output.times.as_deref(), file.output.snapshot_every, t_end)?;
 
     let mut walls = Vec::new();
     for (k, w) in file.walls.iter().enumerate() {

@@ -613,6 +613,10 @@ impl Engine for SoftEngine {
         &self.scene.source
     }
 
+    fn error_so_far(&self) -> Option<(&'static str, f64)> {
+        Some(("energy error", self.book.max_energy))
+    }
+
     fn scene_base_dir(&self) -> Option<&Path> {
         self.scene.base_dir.as_deref()
     }

@@ -222,6 +222,11 @@ pub struct SoftOutputSection {
     /// `[0, t_end]`.
     #[serde(default)]
     pub times: Option<Vec<f64>>,
+    /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
+    /// `t_end`, each at the nearest step and at least one step apart, at most 1e5. Give `times` or this, not both.
+    /// Default: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub snapshot_every: Option<f64>,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
@@ -647,17 +652,22 @@ impl V<'_> {
 
         let every = self.cadence("output.every", file.output.every, t_end)?;
         let every_steps = ((every / dt).round() as u64).max(1);
-        let times = file.output.times.clone().unwrap_or_else(|| vec![0.0, t_end]);
-        self.snapshot_times(&times, t_end)?;
+        let times = self.output_times(file.output.times.as_deref(), file.output.snapshot_every, t_end)?;
         let mut snapshot_steps: Vec<u64> = Vec::new();
         for (k, &t) in times.iter().enumerate() {
             // Distinct times may still round to one step.
             let s = ((t / dt).round() as u64).min(n_steps);
             if snapshot_steps.last().is_some_and(|&p| s <= p) {
-                return Err(self.invalid(
-                    format!("output.times[{k}]"),
-                    format!("must be increasing and at least one step (dt = {dt} s) after the previous, got {t}"),
-                ));
+                return Err(match file.output.snapshot_every {
+                    Some(every) => self.invalid(
+                        "output.snapshot_every",
+                        format!("must be at least one step (dt = {dt} s) between snapshots, got {every}"),
+                    ),
+                    None => self.invalid(
+                        format!("output.times[{k}]"),
+                        format!("must be increasing and at least one step (dt = {dt} s) after the previous, got {t}"),
+                    ),
+                });
             }
             snapshot_steps.push(s);
         }

@@ -72,6 +72,8 @@ pub struct ImpactSection {
     pub every: Option<f64>,
     /// Snapshot times (s; default 0, 100, 400, 1000, 10 000 cut to `t_end`, plus `t_end`).
     pub snapshots: Option<Vec<f64>>,
+    /// Snapshot cadence (s, > 0), instead of `snapshots`: 0, S, 2S, … and `t_end` (at most 1e5 snapshots).
+    pub snapshot_every: Option<f64>,
     /// Impact speed of P1–P3 and of custom projectiles without their own (km/s; default 5).
     pub speed_km_s: Option<f64>,
     /// Inertia model of the ellipsoids: `"gaussian"` (Roig03 Eq. 4, default) or `"uniform"`.

@@ -23,6 +23,7 @@
 //! contact_time = 90.0              # time at which the surfaces first touch (s; default 90)
 //! every = 10.0                     # time-series cadence (s; default 10)
 //! snapshots = [0.0, 100.0]         # snapshot times (s; default 0, 100, 400, 1000, 10000 cut at t_end, + t_end)
+//! # snapshot_every = 100.0          # or their cadence (s): 0, 100, 200, ... and t_end; not both
 //! speed_km_s = 5.0                 # impact speed of P1-P3 and of custom projectiles without one (km/s; default 5)
 //! inertia = "gaussian"             # "gaussian" (Roig03 Eq. 4, default) or "uniform" (homogeneous ellipsoids)
 //!

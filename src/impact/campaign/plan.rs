@@ -278,6 +278,36 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         }
     }
 
+    let snapshots = match (&imp.snapshots, imp.snapshot_every) {
+        (Some(_), Some(every)) => {
+            return Err(invalid(
+                "impact.snapshot_every".into(),
+                format!(
+                    "give either `snapshots` (the list) or `snapshot_every` (their cadence), not both; got {every}"
+                ),
+            ));
+        }
+        (Some(times), None) => times.clone(),
+        (None, Some(every)) => {
+            use crate::io::output_times::{cadence_count, cadence_times};
+            use crate::io::scene_file::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
+            if !(every.is_finite() && every >= MIN_MEANINGFUL) {
+                return Err(invalid(
+                    "impact.snapshot_every".into(),
+                    format!("must be > 0 s and finite, got {every}"),
+                ));
+            }
+            if !(t_end.is_finite() && t_end > 0.0) || cadence_count(t_end, every) > MAX_SNAPSHOTS as f64 {
+                return Err(invalid(
+                    "impact.snapshot_every".into(),
+                    format!("too small for t_end = {t_end}: at most {MAX_SNAPSHOTS} snapshots, got {every}"),
+                ));
+            }
+            cadence_times(t_end, every)
+        }
+        (None, None) => default_snapshots(t_end),
+    };
+
     // The grid; each configuration validated (an error names the campaign's field).
     let mut points = Vec::new();
     for (stem, path, bodies) in &targets {
@@ -292,7 +322,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.contact_time = imp.contact_time.unwrap_or(DEFAULT_CONTACT_TIME);
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();
-            base.snapshots = imp.snapshots.clone().unwrap_or_else(|| default_snapshots(t_end));
+            base.snapshots = snapshots.clone();
             base.pile = piles
                 .iter()
                 .find(|(id, _)| *id == projectile.id)

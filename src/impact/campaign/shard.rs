@@ -118,14 +118,109 @@ pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
     })
 }
 
-/// A Slurm job-array script running `campaign` as `tasks` shards, one array task each, with `threads` cores per
-/// task; `binary` is the rubblepile executable the tasks call.
-pub fn slurm_script(campaign: &Campaign, campaign_file: &Path, tasks: usize, threads: usize, binary: &Path) -> String {
+/// What the Slurm script of `campaign slurm` asks of the scheduler and which binary it runs (options named as
+/// `sbatch`'s).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SlurmJob {
+    /// Array tasks (shards), at least 1.
+    pub tasks: usize,
+    /// Cores per task, at least 1.
+    pub threads: usize,
+    /// `--time` (wall-clock limit per task: `MINUTES`, `HH:MM:SS`, `D-HH:MM`, …); `None`: the partition's default.
+    pub time: Option<String>,
+    /// `--partition`; `None`: the cluster's default.
+    pub partition: Option<String>,
+    /// `--account` charged; `None`: the user's default.
+    pub account: Option<String>,
+    /// `--mem` per node (e.g. `4G`, `500M`; a bare number is MB); `None`: the partition's default.
+    pub mem: Option<String>,
+    /// Most array tasks running at once (`--array=0-(N-1)%K`); `None`: no limit.
+    pub throttle: Option<usize>,
+    /// The rubblepile executable the tasks run.
+    pub binary: PathBuf,
+}
+
+impl SlurmJob {
+    /// Checks the options as `sbatch` would read them, naming the option at fault: counts at least 1, a time of
+    /// digits with `-` and `:` in one of Slurm's forms, memory as digits with an optional K/M/G/T unit, and
+    /// partition and account names of letters, digits and `_ . - ,` (nothing the shell would read).
+    pub fn check(&self) -> Result<(), (String, String)> {
+        let bad = |opt: &str, why: &str, got: &str| Err((format!("--{opt}"), format!("{why}, got {got:?}")));
+        if self.tasks == 0 {
+            return bad("tasks", "must be at least 1", "0");
+        }
+        if self.threads == 0 {
+            return bad("threads-per-task", "must be at least 1", "0");
+        }
+        if self.throttle == Some(0) {
+            return bad("throttle", "must be at least 1 (array tasks at once)", "0");
+        }
+        if let Some(t) = &self.time
+            && !slurm_time(t)
+        {
+            return bad(
+                "time",
+                "must be a Slurm time limit: MINUTES, MINUTES:SECONDS, HOURS:MINUTES:SECONDS, DAYS-HOURS, \
+                 DAYS-HOURS:MINUTES or DAYS-HOURS:MINUTES:SECONDS",
+                t,
+            );
+        }
+        if let Some(m) = &self.mem {
+            let digits = m.trim_end_matches(['K', 'M', 'G', 'T']);
+            if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) || m.len() > digits.len() + 1 {
+                return bad(
+                    "mem",
+                    "must be a whole number with an optional unit K, M, G or T (e.g. 4G)",
+                    m,
+                );
+            }
+        }
+        for (opt, value) in [("partition", &self.partition), ("account", &self.account)] {
+            if let Some(v) = value
+                && (v.is_empty() || !v.bytes().all(|b| b.is_ascii_alphanumeric() || b"_.-,".contains(&b)))
+            {
+                return bad(opt, "must be a name of letters, digits, '_', '.', '-' or ','", v);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether `t` is one of Slurm's time-limit forms (`sbatch --time`).
+fn slurm_time(t: &str) -> bool {
+    let numbers = |s: &str, most: usize| {
+        let parts: Vec<&str> = s.split(':').collect();
+        parts.len() <= most
+            && parts
+                .iter()
+                .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
+    };
+    match t.split_once('-') {
+        Some((days, rest)) => numbers(days, 1) && numbers(rest, 3),
+        None => numbers(t, 3),
+    }
+}
+
+/// A Slurm job-array script running `campaign` as `job.tasks` shards, one array task each, with `job.threads`
+/// cores per task and the scheduler options of `job`; its tasks call `job.binary`.
+pub fn slurm_script(campaign: &Campaign, campaign_file: &Path, job: &SlurmJob) -> String {
     let out = campaign.out.display();
     let name = campaign_file
         .file_stem()
         .map_or("campaign".into(), |s| s.to_string_lossy().into_owned());
     let runs = campaign.points.len();
+    let tasks = job.tasks;
+    let mut options = String::new();
+    for (opt, value) in [
+        ("time", &job.time),
+        ("partition", &job.partition),
+        ("account", &job.account),
+        ("mem", &job.mem),
+    ] {
+        if let Some(v) = value {
+            options.push_str(&format!("#SBATCH --{opt}={v}\n"));
+        }
+    }
     format!(
         "#!/bin/bash\n\
          # {runs} impact runs of {file} in {tasks} shards (written by `rubblepile campaign slurm`).\n\
@@ -133,16 +228,19 @@ pub fn slurm_script(campaign: &Campaign, campaign_file: &Path, tasks: usize, thr
          # Then:    sbatch --dependency=afterany:$jobid --wrap \"{bin} campaign merge {out}\"\n\
          # A task that dies leaves its finished runs and checkpoints; resubmitting the array resumes them.\n\
          #SBATCH --job-name=rubblepile-{name}\n\
-         #SBATCH --array=0-{last}\n\
+         #SBATCH --array=0-{last}{throttle}\n\
          #SBATCH --ntasks=1\n\
          #SBATCH --cpus-per-task={threads}\n\
+         {options}\
          #SBATCH --output={out}/slurm-%A_%a.out\n\
          set -euo pipefail\n\
          export RAYON_NUM_THREADS=$SLURM_CPUS_PER_TASK\n\
          srun {bin} campaign {file} --out {out} --shard $SLURM_ARRAY_TASK_ID/{tasks} --parallel 1 --no-progress\n",
         file = campaign_file.display(),
-        bin = binary.display(),
+        bin = job.binary.display(),
         last = tasks - 1,
+        threads = job.threads,
+        throttle = job.throttle.map_or(String::new(), |k| format!("%{k}")),
     )
 }
 
@@ -172,6 +270,25 @@ pub enum CampaignAction {
         /// Cores per task (each task runs one impact at a time on them).
         #[arg(long, value_name = "N", default_value_t = 2)]
         threads_per_task: usize,
+        /// Wall-clock limit per array task (`sbatch --time`: MINUTES, HH:MM:SS, D-HH:MM, …) [default: the
+        /// partition's].
+        #[arg(long, value_name = "LIMIT")]
+        time: Option<String>,
+        /// Slurm partition (`sbatch --partition`) [default: the cluster's].
+        #[arg(long, value_name = "NAME")]
+        partition: Option<String>,
+        /// Account charged (`sbatch --account`) [default: the user's].
+        #[arg(long, value_name = "NAME")]
+        account: Option<String>,
+        /// Memory per task's node (`sbatch --mem`, e.g. 4G; a bare number is MB) [default: the partition's].
+        #[arg(long, value_name = "SIZE")]
+        mem: Option<String>,
+        /// Most array tasks running at once (the array's `%K`) [default: no limit].
+        #[arg(long, value_name = "K")]
+        throttle: Option<usize>,
+        /// The rubblepile executable the tasks run [default: this one, by its absolute path].
+        #[arg(long, value_name = "PATH")]
+        binary: Option<PathBuf>,
     },
 }
 
@@ -195,22 +312,37 @@ impl CampaignAction {
                 out,
                 tasks,
                 threads_per_task,
+                time,
+                partition,
+                account,
+                mem,
+                throttle,
+                binary,
             } => {
-                let invalid = |field: &str, message: String| CampaignError::Invalid {
-                    file: file.display().to_string(),
-                    field: field.into(),
-                    message,
+                let job = SlurmJob {
+                    tasks: *tasks,
+                    threads: *threads_per_task,
+                    time: time.clone(),
+                    partition: partition.clone(),
+                    account: account.clone(),
+                    mem: mem.clone(),
+                    throttle: *throttle,
+                    binary: binary
+                        .clone()
+                        .or_else(|| std::env::current_exe().ok())
+                        .unwrap_or_else(|| PathBuf::from("rubblepile")),
                 };
-                if *tasks == 0 || *threads_per_task == 0 {
-                    return Err(invalid("--tasks/--threads-per-task", "must be at least 1".into()));
-                }
+                job.check().map_err(|(field, message)| CampaignError::Invalid {
+                    file: file.display().to_string(),
+                    field,
+                    message,
+                })?;
                 let mut campaign = load_campaign(file)?;
                 if let Some(o) = out {
                     campaign.out = std::path::absolute(o).unwrap_or_else(|_| o.clone());
                 }
                 let abs_file = campaign.source.clone().unwrap_or_else(|| file.clone());
-                let binary = std::env::current_exe().unwrap_or_else(|_| PathBuf::from("rubblepile"));
-                let text = slurm_script(&campaign, &abs_file, *tasks, *threads_per_task, &binary);
+                let text = slurm_script(&campaign, &abs_file, &job);
                 let path = slurm_script_path(&campaign);
                 let io = |source| CampaignError::Io {
                     path: path.clone(),

@@ -1,0 +1,149 @@
+//! How a run shows its progress on stderr: the indicatif bar on a terminal, and on anything else (a batch job's log,
+//! a pipe) one plain line every few seconds of wall clock — simulated time, per cent done, ETA and the engine's
+//! error so far — so a log is not silent until `done:` (issue 41).
+
+use std::cell::Cell;
+use std::io::IsTerminal;
+use std::time::{Duration, Instant};
+
+/// Default wall-clock seconds between progress lines on a non-terminal ([`super::RunOptions::progress_every`]).
+pub const DEFAULT_PROGRESS_EVERY: f64 = 60.0;
+
+/// The environment variable that sets the seconds between progress lines when `--progress-every` is not given.
+pub const PROGRESS_EVERY_ENV: &str = "RUBBLEPILE_PROGRESS_EVERY";
+
+/// A progress display for a run from `t` to `t_end` (s).
+pub enum Progress {
+    /// Nothing shown (`--no-progress`, or lines turned off with a cadence of 0).
+    Off,
+    /// The bar, on a terminal.
+    Bar(indicatif::ProgressBar),
+    /// Plain lines on a non-terminal.
+    Lines(Lines),
+}
+
+/// The state of the plain progress lines.
+pub struct Lines {
+    every: Duration,
+    started: Instant,
+    // A cell: the run's failure path and its progress callback both hold the display.
+    last: Cell<Instant>,
+    t_start: f64,
+}
+
+impl Progress {
+    /// The bar when `enabled` and stderr is a terminal; lines every `every` wall-clock seconds when `enabled`,
+    /// stderr is not a terminal and `every > 0`; otherwise nothing.
+    pub fn new(enabled: bool, every: f64, t_end: f64, t: f64) -> Progress {
+        if !enabled {
+            Progress::Off
+        } else if std::io::stderr().is_terminal() {
+            super::progress_bar(true, t_end, t).map_or(Progress::Off, Progress::Bar)
+        } else if every.is_finite() && every > 0.0 {
+            let now = Instant::now();
+            Progress::Lines(Lines {
+                every: Duration::from_secs_f64(every),
+                started: now,
+                last: Cell::new(now),
+                t_start: t,
+            })
+        } else {
+            Progress::Off
+        }
+    }
+
+    /// Shows simulated time `t` of `t_end` (s); `error` is the engine's error measure so far (name, value), for the
+    /// lines. A line is printed only when `every` seconds have passed since the last (or the start).
+    pub fn show(&self, t: f64, t_end: f64, error: Option<(&str, f64)>) {
+        match self {
+            Progress::Off => {}
+            Progress::Bar(pb) => super::show_progress(pb, t, t_end),
+            Progress::Lines(lines) => {
+                if lines.last.get().elapsed() >= lines.every {
+                    lines.last.set(Instant::now());
+                    eprintln!(
+                        "{}",
+                        progress_line(t, t_end, lines.t_start, lines.started.elapsed(), error)
+                    );
+                }
+            }
+        }
+    }
+
+    /// Clears the bar at the end of a completed run (the summary line follows); nothing for lines.
+    pub fn finish(&self) {
+        if let Progress::Bar(pb) = self {
+            pb.finish_and_clear();
+        }
+    }
+
+    /// Leaves the bar as it is (a failed run); nothing for lines.
+    pub fn abandon(&self) {
+        if let Progress::Bar(pb) = self {
+            pb.abandon();
+        }
+    }
+}
+
+/// One progress line: `progress: t = 120 of 600 s (20.0 %), wall 1m 0s, ETA 4m 0s, energy error 3.1e-12`. The ETA
+/// assumes the rest runs as fast as the simulated time from `t_start` did over `wall`.
+pub fn progress_line(t: f64, t_end: f64, t_start: f64, wall: Duration, error: Option<(&str, f64)>) -> String {
+    let done = if t_end > 0.0 { 100.0 * t / t_end } else { 100.0 };
+    let w = wall.as_secs_f64();
+    let eta = if t > t_start && t_end > t {
+        clock(w * (t_end - t) / (t - t_start))
+    } else if t >= t_end {
+        "0s".to_string()
+    } else {
+        "unknown".to_string()
+    };
+    let mut line = format!(
+        "progress: t = {} of {t_end} s ({done:.1} %), wall {}, ETA {eta}",
+        // Four decimals are plenty for a log; an adaptive step's time has sixteen.
+        (t * 1e4).round() / 1e4,
+        clock(w)
+    );
+    if let Some((name, value)) = error {
+        line.push_str(&format!(", {name} {value:.1e}"));
+    }
+    line
+}
+
+/// Seconds as `2h 5m 3s`, `5m 3s` or `3s` (whole seconds).
+fn clock(s: f64) -> String {
+    let s = s.max(0.0).round() as u64;
+    match (s / 3600, (s % 3600) / 60, s % 60) {
+        (0, 0, sec) => format!("{sec}s"),
+        (0, m, sec) => format!("{m}m {sec}s"),
+        (h, m, sec) => format!("{h}h {m}m {sec}s"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_line_says_time_share_eta_and_error() {
+        let line = progress_line(
+            150.0,
+            600.0,
+            0.0,
+            Duration::from_secs(60),
+            Some(("energy error", 3.14e-12)),
+        );
+        // 150 s of simulated time took 60 s: the other 450 s take 180 s.
+        assert_eq!(
+            line,
+            "progress: t = 150 of 600 s (25.0 %), wall 1m 0s, ETA 3m 0s, energy error 3.1e-12"
+        );
+        // A resumed run measures its speed from where it resumed.
+        let line = progress_line(400.0, 600.0, 300.0, Duration::from_secs(7300), None);
+        assert_eq!(
+            line,
+            "progress: t = 400 of 600 s (66.7 %), wall 2h 1m 40s, ETA 4h 3m 20s"
+        );
+        let line = progress_line(0.0, 600.0, 0.0, Duration::from_secs(5), None);
+        assert!(line.ends_with("ETA unknown"), "{line}");
+    }
+}
