@@ -119,6 +119,45 @@ fn a_sphere_behind_a_translucent_wall_is_visible_and_tinted_and_one_in_front_is_
     assert_eq!(seen.get(100, 50), over(once, z_face_shade()));
 }
 
+/// Walls reaching from in front of a perspective eye to behind it (a floor under it, a side wall beside it): every
+/// pixel is what its own ray gives, layer by layer — the culling of polygons to screen rectangles loses none.
+#[test]
+fn walls_reaching_behind_a_perspective_eye_are_drawn_wherever_their_rays_cross_them() {
+    let framing = Framing {
+        centre: Vec3::zeros(),
+        half_extent: 1.0,
+    };
+    let camera = Camera::new(View::Iso, Projection::Perspective { fov_deg: 60.0 }, framing, 120, 90);
+    // The eye is 2 m from the centre along (1, 1, 1): z = x = 1.155 m.
+    let floor = square(0.5, 10.0);
+    let side: Vec<Vec3> = floor.iter().map(|p| Vec3::new(1.0, p.x, p.y)).collect();
+    let walls = [WallPolygon::new(floor).unwrap(), WallPolygon::new(side).unwrap()];
+    let image = render_scene(&[], &walls, &camera, BG);
+    let light = (-camera.right() + camera.up() - 1.2 * camera.forward()).normalize();
+    let mut tinted = 0;
+    for y in 0..camera.height() {
+        for x in 0..camera.width() {
+            let ray = camera.ray(x, y);
+            let mut layers: Vec<(f64, f64)> = walls
+                .iter()
+                .filter_map(|w| {
+                    w.hit(&ray, 0.0)
+                        .map(|t| (t, 0.25 + 0.75 * w.normal().dot(&light).abs()))
+                })
+                .collect();
+            layers.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let mut c = BG.map(f64::from);
+            for (_, shade) in layers {
+                c = std::array::from_fn(|k| WALL_ALPHA * f64::from(WALL_COLOUR[k]) * shade + (1.0 - WALL_ALPHA) * c[k]);
+            }
+            let expected = c.map(|v| v.round() as u8);
+            tinted += usize::from(expected != BG);
+            assert_eq!(image.get(x, y), expected, "pixel ({x}, {y})");
+        }
+    }
+    assert!(tinted > 1000, "{tinted} pixels see a wall");
+}
+
 /// The longest horizontal run of `colour` in the image (pixels).
 fn longest_run(image: &RgbImage, colour: [u8; 3]) -> u32 {
     let mut best = 0;

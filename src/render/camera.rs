@@ -348,36 +348,53 @@ impl Camera {
     }
 
     /// The pixel rectangle that holds the projection of the convex polygon through `points` (m), with one pixel of
-    /// slack; `None` when it is wholly off screen or behind a perspective eye, the whole image when it reaches from
-    /// in front of a perspective eye to behind it.
+    /// slack; `None` when it is wholly off screen or behind a perspective eye. A perspective camera sees only the
+    /// part in front of its eye: the polygon is clipped to depths of at least a billionth of the framing's
+    /// half-width first (Sutherland & Hodgman 1974, against one plane), so a wall reaching past the eye keeps a
+    /// bounded rectangle.
     pub(crate) fn screen_box_of_points(&self, points: &[Vec3]) -> Option<ScreenBox> {
+        let clipped;
+        let points = match self.projection {
+            Projection::Orthographic => points,
+            Projection::Perspective { .. } => {
+                let near = 1e-9 * self.framing.half_extent;
+                let depth = |p: &Vec3| (p - self.eye).dot(&self.forward) - near;
+                if points.iter().all(|p| depth(p) > 0.0) {
+                    points
+                } else {
+                    let mut kept = Vec::with_capacity(points.len() + 1);
+                    for (k, a) in points.iter().enumerate() {
+                        let b = &points[(k + 1) % points.len()];
+                        let (da, db) = (depth(a), depth(b));
+                        if da > 0.0 {
+                            kept.push(*a);
+                        }
+                        if (da > 0.0) != (db > 0.0) {
+                            // Where the edge crosses the near plane, nudged to its front side.
+                            let s = (da / (da - db)).clamp(0.0, 1.0);
+                            let cross = a + s * (b - a);
+                            kept.push(cross + (near - (cross - self.eye).dot(&self.forward)).max(0.0) * self.forward);
+                        }
+                    }
+                    clipped = kept;
+                    &clipped
+                }
+            }
+        };
         let mut lo = (f64::INFINITY, f64::INFINITY);
         let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        let mut behind = 0;
         for p in points {
-            match self.project(p) {
-                Some((x, y)) => {
-                    lo = (lo.0.min(x), lo.1.min(y));
-                    hi = (hi.0.max(x), hi.1.max(y));
-                }
-                None => behind += 1,
-            }
+            let (x, y) = self.project(p)?;
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
         }
-        if behind == points.len() {
+        if points.is_empty() {
             return None;
-        }
-        if behind > 0 {
-            return Some(ScreenBox {
-                x0: 0,
-                x1: self.width - 1,
-                y0: 0,
-                y1: self.height - 1,
-            });
         }
         let range = |lo: f64, hi: f64, n: u32| -> Option<(u32, u32)> {
             // Pixel k covers [k, k + 1): the pixels whose centres may be covered, plus one of slack.
             let (a, b) = ((lo - 1.0).floor(), (hi + 1.0).ceil());
-            if !(a.is_finite() && b.is_finite()) || b < 0.0 || a > f64::from(n - 1) {
+            if a.is_nan() || b.is_nan() || b < 0.0 || a > f64::from(n - 1) {
                 return None;
             }
             Some((a.max(0.0) as u32, b.min(f64::from(n - 1)) as u32))

@@ -122,7 +122,8 @@ impl Triad {
     }
 
     /// Draws the arrows, farthest first so a nearer one lies on top: a shaft of `thickness` pixels and a head; an
-    /// axis seen end-on (shorter than a quarter of the length on screen) as a ring about the foot.
+    /// axis seen end-on (shorter than a quarter of the length on screen) as a ring about the foot, dotted when it
+    /// points at the viewer and crossed when it points away.
     pub fn draw(&self, image: &mut RgbImage, thickness: f64) {
         let mut order: Vec<&Arrow> = self.arrows.iter().collect();
         order.sort_by(|a, b| b.depth.total_cmp(&a.depth));
@@ -130,9 +131,20 @@ impl Triad {
             let (dx, dy) = (a.tip.0 - self.origin.0, a.tip.1 - self.origin.1);
             let len = dx.hypot(dy);
             if len < 0.25 * self.length {
+                // Seen end-on: a ring, with a dot in it when the axis points at the viewer (⊙) and a cross when it
+                // points away (⊗), as field lines are drawn.
                 let r = 0.25 * self.length;
+                let (ox, oy) = self.origin;
+                let towards = a.depth < 0.0;
                 fill(image, a.colour, self.origin, r + thickness, |x, y| {
-                    ((x - self.origin.0).hypot(y - self.origin.1) - r).abs() <= 0.5 * thickness
+                    let (px, py) = (x - ox, y - oy);
+                    let ring = (px.hypot(py) - r).abs() <= 0.5 * thickness;
+                    let mark = if towards {
+                        px.hypot(py) <= thickness
+                    } else {
+                        px.hypot(py) <= r && ((px - py).abs().min((px + py).abs()) <= 0.5 * thickness * 1.5)
+                    };
+                    ring || mark
                 });
                 continue;
             }

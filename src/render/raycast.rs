@@ -216,13 +216,16 @@ pub fn render_scene(bodies: &[RenderBody], walls: &[WallPolygon], camera: &Camer
                         colour.map(|c| f64::from(c) * k)
                     };
                     layers.clear();
+                    // One ray per pixel, made only when some wall's rectangle holds the pixel.
+                    let mut ray: Option<Ray> = None;
                     for &i in wall_members {
                         let b = &wall_boxes[i as usize];
                         if y < b.y0 || y > b.y1 || (xi as u32) < b.x0 || (xi as u32) > b.x1 {
                             continue;
                         }
                         let (wall, shade) = shown_walls[i as usize];
-                        if let Some(t) = wall.hit(&camera.ray(xi as u32, y), t_min)
+                        let ray = ray.get_or_insert_with(|| camera.ray(xi as u32, y));
+                        if let Some(t) = wall.hit(ray, t_min)
                             && t < depth[xi]
                         {
                             layers.push((t, shade));

@@ -182,19 +182,29 @@ pub fn reach_98(particles: &[ParticleView]) -> (crate::math::Vec3, f64) {
 
 /// The framing of each frame from each snapshot's [`reach_98`] `(centre, reach)`: centred on the snapshot's centre,
 /// with half-width `extent` when given, else the largest reach so far plus [`Framing::MARGIN`] (never shrinking;
-/// 1 m while every reach is zero).
+/// 1 m while every reach is zero). Frame by frame: [`Follower`].
 pub fn following_framings(reaches: &[(crate::math::Vec3, f64)], extent: Option<f64>) -> Vec<Framing> {
-    let mut widest = 0.0_f64;
-    reaches
-        .iter()
-        .map(|&(centre, reach)| {
-            if reach.is_finite() {
-                widest = widest.max(reach * (1.0 + Framing::MARGIN));
-            }
-            let half_extent = extent.unwrap_or(if widest > 0.0 { widest } else { 1.0 });
-            Framing { centre, half_extent }
-        })
-        .collect()
+    let mut follower = Follower::default();
+    reaches.iter().map(|r| follower.frame(*r, extent)).collect()
+}
+
+/// The camera of [`following_framings`], one frame at a time (a run still being written may gain snapshots while
+/// it is drawn).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Follower {
+    /// The widest half-width so far (m; 0 before any).
+    widest: f64,
+}
+
+impl Follower {
+    /// The framing of the next frame, whose snapshot has `reach` = `(centre, reach)` ([`reach_98`]).
+    pub fn frame(&mut self, (centre, reach): (crate::math::Vec3, f64), extent: Option<f64>) -> Framing {
+        if reach.is_finite() {
+            self.widest = self.widest.max(reach * (1.0 + Framing::MARGIN));
+        }
+        let half_extent = extent.unwrap_or(if self.widest > 0.0 { self.widest } else { 1.0 });
+        Framing { centre, half_extent }
+    }
 }
 
 /// Renders every snapshot of the run in `dir` into `<frames>/<k>.png` and `<frames>/<gif_name>`, `<frames>` being
@@ -262,16 +272,13 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     }
     let start = Instant::now();
 
-    // Pass 1: each snapshot's centre and reach, and the colour range (all snapshots).
-    let mut reaches = Vec::new();
+    // Pass 1: the colour range (all snapshots).
     let mut all_values: Vec<f64> = Vec::new();
     visit_snapshots(dir, &mut |_, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
-        reaches.push(reach_98(&view.particles));
         all_values.extend(vals.into_iter().filter(|v| v.is_finite()));
         Ok(())
     })?;
-    let framings = following_framings(&reaches, opts.extent);
     let scale = colour_scale(opts.colour, &mut all_values);
 
     // Pass 2: draw and write.
@@ -286,13 +293,11 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     };
     let mut gif = GifWriter::create_with(&gif_path, opts.width, opts.height, opts.gif_delay_centiseconds, options)?;
     let mut frame_ms = Vec::new();
+    let mut follower = Follower::default();
     let mut fail: Option<RenderError> = None;
     visit_snapshots(dir, &mut |k, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
-        let framing = framings.get(frame_ms.len()).copied().unwrap_or(Framing {
-            centre: crate::math::Vec3::zeros(),
-            half_extent: 1.0,
-        });
+        let framing = follower.frame(reach_98(&view.particles), opts.extent);
         let camera = Camera::new(opts.view, opts.projection, framing, opts.width, opts.height);
         let t0 = Instant::now();
         let drawn = render_frame_with_walls(

@@ -54,7 +54,7 @@ impl WallPolygon {
             newell += a.cross(&points[(k + 1) % points.len()]);
         }
         let area2 = newell.norm();
-        if !(area2 > 0.0) {
+        if area2.is_nan() || area2 <= 0.0 {
             return None;
         }
         let centre = points.iter().sum::<Vec3>() / points.len() as f64;
@@ -85,7 +85,7 @@ impl WallPolygon {
             return None;
         }
         let t = self.normal.dot(&(self.points[0] - ray.origin)) / along;
-        if !(t > t_min) {
+        if t.is_nan() || t <= t_min {
             return None;
         }
         let p = ray.origin + t * ray.direction;
