@@ -451,3 +451,63 @@ fn out_puts_a_second_view_elsewhere_and_an_existing_one_is_kept_without_force() 
     assert!(dir.join("soft/frames/run.gif").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A spherical container (radius 1 m) swinging ±0.5 m along x at 1 Hz around a ball at rest, drawn at t = 0.25 s
+/// and 0.75 s (offsets +0.5 m and −0.5 m) looking down z, 400 px across ±3 m: the container's left edge on the
+/// middle row lies at 200 px + (offset − 1 m) × 66.7 px/m in each frame.
+#[test]
+fn a_moving_wall_is_drawn_where_it_was_at_each_snapshot() {
+    let dir = temp_dir("render-moving-wall");
+    std::fs::write(
+        dir.join("scene.toml"),
+        r#"[scene]
+kind = "soft-spheres"
+t_end = 1.0
+
+[integrator]
+dt = 1e-3
+
+[contact]
+k_n = 1e3
+
+[output]
+every = 0.25
+times = [0.25, 0.75]
+
+[[wall]]
+kind = "sphere"
+centre = [0.0, 0.0, 0.0]
+radius = 1.0
+oscillation = { amplitude = [0.5, 0.0, 0.0], frequency = 1.0 }
+
+[[particle]]
+radius = 0.1
+density = 2000.0
+position = [0.0, 0.0, 0.0]
+"#,
+    )
+    .unwrap();
+    ok(&rubblepile(
+        &dir,
+        &["run", "scene.toml", "--out", "run", "--no-progress"],
+    ));
+    ok(&rubblepile(
+        &dir,
+        &[
+            "render", "run", "--view", "z", "--size", "400x400", "--extent", "3", "--out", "views",
+        ],
+    ));
+    let ppm = 200.0 / 3.0;
+    for (k, offset) in [(0, 0.5), (1, -0.5)] {
+        let frame = read_png(&dir.join(format!("views/{k:04}.png")));
+        let left = (0..frame.width)
+            .find(|&x| frame.get(x, frame.height / 2) != BACKGROUND)
+            .unwrap();
+        let expected = 200.0 + (offset - 1.0) * ppm;
+        assert!(
+            (f64::from(left) + 0.5 - expected).abs() <= 1.0,
+            "frame {k}: edge at pixel {left}, expected {expected:.1}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
