@@ -303,13 +303,16 @@ impl Camera {
     }
 
     /// Screen coordinates (each in [−1, 1] across the shorter side, y up) of the centre of pixel `(x, y)`.
+    #[inline]
     fn screen(&self, x: f64, y: f64) -> (f64, f64) {
         let sx = (x + 0.5 - 0.5 * f64::from(self.width)) / self.half_short_px;
         let sy = (0.5 * f64::from(self.height) - (y + 0.5)) / self.half_short_px;
         (sx, sy)
     }
 
-    /// The primary ray through the centre of pixel `(x, y)` (`(0, 0)` = top left).
+    /// The primary ray through the centre of pixel `(x, y)` (`(0, 0)` = top left). Inlined: the renderer's inner
+    /// loop asks it of every pixel of every body's rectangle, and a call there costs as much as the ray itself.
+    #[inline]
     pub fn ray(&self, x: u32, y: u32) -> Ray {
         let (sx, sy) = self.screen(f64::from(x), f64::from(y));
         match self.projection {
