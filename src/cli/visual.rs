@@ -62,7 +62,7 @@ pub fn render_cmd(args: &RenderArgs) -> Result<(), CliError> {
     println!(
         "rendered {} frames into {} in {:.1} s (median {:.0} ms per frame drawn); animation: {}",
         r.frames,
-        args.dir.join("frames").display(),
+        r.frames_dir.display(),
         r.seconds,
         r.median_frame_ms,
         r.gif.display()

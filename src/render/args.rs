@@ -22,13 +22,17 @@ pub struct RenderArgs {
     /// Perspective camera with this field of view (degrees) instead of the orthographic one.
     #[arg(long, value_name = "DEGREES")]
     pub perspective: Option<f64>,
-    /// Half-width of the picture (m) about the first snapshot's centre of mass [default: the first snapshot's bodies].
+    /// Fixed half-width of the picture (m) about each snapshot's centre of mass [default: follows the bodies,
+    /// growing to hold 98 % of them and never shrinking].
     #[arg(long, value_name = "METRES")]
     pub extent: Option<f64>,
-    /// File name of the animation in DIR/frames.
+    /// File name of the animation in the frames directory.
     #[arg(long, default_value = "run.gif")]
     pub gif: String,
-    /// Overwrite an earlier DIR/frames.
+    /// Directory of the frames and the animation, so a second view need not overwrite the first [default: DIR/frames].
+    #[arg(long, value_name = "FRAMES_DIR")]
+    pub out: Option<PathBuf>,
+    /// Overwrite an earlier frames directory.
     #[arg(long)]
     pub force: bool,
 }
@@ -62,6 +66,7 @@ impl RenderArgs {
             colour,
             extent: self.extent,
             gif_name: self.gif.clone(),
+            out: self.out.clone(),
             force: self.force,
             ..RenderRunOptions::default()
         })

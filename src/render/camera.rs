@@ -261,6 +261,41 @@ impl Camera {
         }
     }
 
+    /// Pixels per metre at the depth of the framing centre: the orthographic scale, or for a perspective camera the
+    /// scale of the plane through the framing centre facing the camera (nearer things look bigger, farther smaller).
+    pub fn pixels_per_metre_at_centre(&self) -> f64 {
+        match self.projection {
+            Projection::Orthographic => self.half_short_px / self.scale,
+            Projection::Perspective { .. } => {
+                let depth = (self.framing.centre - self.eye).dot(&self.forward);
+                self.half_short_px / (self.scale * depth)
+            }
+        }
+    }
+
+    /// Where the world point `p` (m) lands on the image: fractional pixel coordinates `(x, y)` of the pixel grid
+    /// (`(0.5, 0.5)` is the centre of the top-left pixel, y down), or `None` for a point at or behind a perspective
+    /// eye. The inverse of [`Camera::ray`]: the ray of pixel `(i, j)` passes through points that project to
+    /// `(i + 0.5, j + 0.5)`.
+    pub fn project(&self, p: &Vec3) -> Option<(f64, f64)> {
+        let d = p - self.eye;
+        let (cx, cy) = (d.dot(&self.right), d.dot(&self.up));
+        let (sx, sy) = match self.projection {
+            Projection::Orthographic => (cx / self.scale, cy / self.scale),
+            Projection::Perspective { .. } => {
+                let cz = d.dot(&self.forward);
+                if cz <= 0.0 {
+                    return None;
+                }
+                (cx / (cz * self.scale), cy / (cz * self.scale))
+            }
+        };
+        Some((
+            0.5 * f64::from(self.width) + sx * self.half_short_px,
+            0.5 * f64::from(self.height) - sy * self.half_short_px,
+        ))
+    }
+
     /// Whether rays are lines rather than half-lines: orthographic rays start on an arbitrary plane, so a body
     /// behind that plane is still seen (the nearest intersection along the whole line counts).
     pub(crate) fn rays_are_lines(&self) -> bool {
@@ -268,13 +303,16 @@ impl Camera {
     }
 
     /// Screen coordinates (each in [−1, 1] across the shorter side, y up) of the centre of pixel `(x, y)`.
+    #[inline]
     fn screen(&self, x: f64, y: f64) -> (f64, f64) {
         let sx = (x + 0.5 - 0.5 * f64::from(self.width)) / self.half_short_px;
         let sy = (0.5 * f64::from(self.height) - (y + 0.5)) / self.half_short_px;
         (sx, sy)
     }
 
-    /// The primary ray through the centre of pixel `(x, y)` (`(0, 0)` = top left).
+    /// The primary ray through the centre of pixel `(x, y)` (`(0, 0)` = top left). Inlined: the renderer's inner
+    /// loop asks it of every pixel of every body's rectangle, and a call there costs as much as the ray itself.
+    #[inline]
     pub fn ray(&self, x: u32, y: u32) -> Ray {
         let (sx, sy) = self.screen(f64::from(x), f64::from(y));
         match self.projection {
@@ -310,6 +348,63 @@ impl Camera {
             return None;
         }
         Some((lo.max(0.0) as u32, hi.min(f64::from(n - 1)) as u32))
+    }
+
+    /// The pixel rectangle that holds the projection of the convex polygon through `points` (m), with one pixel of
+    /// slack; `None` when it is wholly off screen or behind a perspective eye. A perspective camera sees only the
+    /// part in front of its eye: the polygon is clipped to depths of at least a billionth of the framing's
+    /// half-width first (Sutherland & Hodgman 1974, against one plane), so a wall reaching past the eye keeps a
+    /// bounded rectangle.
+    pub(crate) fn screen_box_of_points(&self, points: &[Vec3]) -> Option<ScreenBox> {
+        let clipped;
+        let points = match self.projection {
+            Projection::Orthographic => points,
+            Projection::Perspective { .. } => {
+                let near = 1e-9 * self.framing.half_extent;
+                let depth = |p: &Vec3| (p - self.eye).dot(&self.forward) - near;
+                if points.iter().all(|p| depth(p) > 0.0) {
+                    points
+                } else {
+                    let mut kept = Vec::with_capacity(points.len() + 1);
+                    for (k, a) in points.iter().enumerate() {
+                        let b = &points[(k + 1) % points.len()];
+                        let (da, db) = (depth(a), depth(b));
+                        if da > 0.0 {
+                            kept.push(*a);
+                        }
+                        if (da > 0.0) != (db > 0.0) {
+                            // Where the edge crosses the near plane, nudged to its front side.
+                            let s = (da / (da - db)).clamp(0.0, 1.0);
+                            let cross = a + s * (b - a);
+                            kept.push(cross + (near - (cross - self.eye).dot(&self.forward)).max(0.0) * self.forward);
+                        }
+                    }
+                    clipped = kept;
+                    &clipped
+                }
+            }
+        };
+        let mut lo = (f64::INFINITY, f64::INFINITY);
+        let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        for p in points {
+            let (x, y) = self.project(p)?;
+            lo = (lo.0.min(x), lo.1.min(y));
+            hi = (hi.0.max(x), hi.1.max(y));
+        }
+        if points.is_empty() {
+            return None;
+        }
+        let range = |lo: f64, hi: f64, n: u32| -> Option<(u32, u32)> {
+            // Pixel k covers [k, k + 1): the pixels whose centres may be covered, plus one of slack.
+            let (a, b) = ((lo - 1.0).floor(), (hi + 1.0).ceil());
+            if a.is_nan() || b.is_nan() || b < 0.0 || a > f64::from(n - 1) {
+                return None;
+            }
+            Some((a.max(0.0) as u32, b.min(f64::from(n - 1)) as u32))
+        };
+        let (x0, x1) = range(lo.0, hi.0, self.width)?;
+        let (y0, y1) = range(lo.1, hi.1, self.height)?;
+        Some(ScreenBox { x0, x1, y0, y1 })
     }
 
     /// The pixel rectangle that holds the projection of the sphere (`centre`, `radius`), or `None` when the sphere

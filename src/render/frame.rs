@@ -14,7 +14,9 @@ use crate::math::{Mat3, Vec3};
 use super::RenderError;
 use super::camera::{BoundingSphere, Camera};
 use super::colour::{ColourScale, ScaleKind};
-use super::raycast::{RenderBody, render_bodies};
+use super::overlay::{BAR_COLOUR, ScaleBar, Triad, draw_scale_bar};
+use super::raycast::{RenderBody, render_scene};
+use super::walls::WallPolygon;
 
 /// Frame background: a dark blue-grey, so that both ends of viridis and the white text read on it.
 pub const BACKGROUND: [u8; 3] = [24, 26, 34];
@@ -86,9 +88,21 @@ impl BoundingSphere for FrameBody {
 }
 
 /// Renders one frame: `bodies` coloured by `scale` and ray-cast through `camera` on [`BACKGROUND`], then a colour
-/// bar with the scale's label and range at the right edge and `caption` (e.g. "t = 123.4 s") at the top left.
+/// bar with the scale's label and range at the right edge, `caption` (e.g. "t = 123.4 s") at the top left, and at
+/// the bottom left an axis triad and a scale bar ([`super::overlay`]).
 pub fn render_frame(
     bodies: &[FrameBody],
+    scale: &ColourScale,
+    camera: &Camera,
+    caption: &str,
+) -> Result<RgbImage, RenderError> {
+    render_frame_with_walls(bodies, &[], scale, camera, caption)
+}
+
+/// [`render_frame`] with translucent `walls` ([`super::walls`]) in the scene.
+pub fn render_frame_with_walls(
+    bodies: &[FrameBody],
+    walls: &[WallPolygon],
     scale: &ColourScale,
     camera: &Camera,
     caption: &str,
@@ -102,12 +116,45 @@ pub fn render_frame(
             colour: scale.colour(b.value),
         })
         .collect();
-    let mut image = render_bodies(&coloured, camera, BACKGROUND);
+    let mut image = render_scene(&coloured, walls, camera, BACKGROUND);
     let layout = Layout::new(image.width, image.height);
     draw_bar(&mut image, scale, &layout);
-    draw_text(&mut image, scale, &layout, caption)?;
+    let mut labels = Vec::new();
+    let triad = layout.triad(camera);
+    triad.draw(&mut image, f64::from(layout.line));
+    for a in &triad.arrows {
+        let (dx, dy) = (a.tip.0 - triad.origin.0, a.tip.1 - triad.origin.1);
+        let len = dx.hypot(dy);
+        // Beyond the tip, or beside the ring of an axis seen end-on.
+        let (ux, uy) = if len < 0.25 * triad.length {
+            (0.7, -0.7)
+        } else {
+            (dx / len, dy / len)
+        };
+        let reach = if len < 0.25 * triad.length {
+            0.45 * triad.length
+        } else {
+            len + 0.6 * f64::from(layout.font)
+        };
+        let at = (triad.origin.0 + reach * ux, triad.origin.1 + reach * uy);
+        labels.push((a.label.to_string(), (at.0 as i32, at.1 as i32), a.colour, VPos::Center));
+    }
+    if let Some(bar) = ScaleBar::for_camera(camera) {
+        let (x0, y0) = layout.scale_bar_at();
+        if x0 + bar.pixels < image.width.saturating_sub(layout.margin as u32) {
+            draw_scale_bar(&mut image, &bar, x0, y0, layout.line);
+            let centre = (x0 + bar.pixels / 2) as i32;
+            // Above the end ticks, which rise one bar thickness.
+            let above = y0 as i32 - 2 * layout.line as i32 - 2;
+            labels.push((bar.label.clone(), (centre, above), BAR_COLOUR, VPos::Bottom));
+        }
+    }
+    draw_text(&mut image, scale, &layout, caption, &labels)?;
     Ok(image)
 }
+
+/// A piece of text on a frame: what, where (pixels), its colour and its vertical anchor.
+type Label = (String, (i32, i32), [u8; 3], VPos);
 
 /// Sizes and places of the overlays, in pixels, scaled with the image.
 struct Layout {
@@ -117,6 +164,10 @@ struct Layout {
     bar_x1: i32,
     bar_y0: i32,
     bar_y1: i32,
+    /// Thickness of the scale bar and the triad's shafts (pixels).
+    line: u32,
+    /// Image height (pixels).
+    height: u32,
 }
 
 impl Layout {
@@ -134,7 +185,30 @@ impl Layout {
             // Room above the bar for the label.
             bar_y0: h / 5,
             bar_y1: h - h / 5,
+            line: (short / 200).max(2) as u32,
+            height,
         }
+    }
+
+    /// Length of the triad's arrows (pixels).
+    fn triad_length(&self) -> f64 {
+        f64::from(self.font) * 2.5
+    }
+
+    /// The triad in the bottom-left corner, room left for its labels.
+    fn triad(&self, camera: &Camera) -> Triad {
+        let len = self.triad_length();
+        let pad = f64::from(self.margin) + len + 1.2 * f64::from(self.font);
+        Triad::new(camera, (pad, f64::from(camera.height()) - pad), len)
+    }
+
+    /// Left end and top row of the scale bar: right of the triad, level with its foot.
+    fn scale_bar_at(&self) -> (u32, u32) {
+        let pad = f64::from(self.margin) + self.triad_length() + 1.2 * f64::from(self.font);
+        (
+            (2.0 * pad).round() as u32,
+            (f64::from(self.height) - pad).round() as u32,
+        )
     }
 }
 
@@ -162,7 +236,15 @@ fn draw_bar(image: &mut RgbImage, scale: &ColourScale, l: &Layout) {
 }
 
 /// Draws the caption and the colour bar's label and values with plotters on the image's own buffer.
-fn draw_text(image: &mut RgbImage, scale: &ColourScale, l: &Layout, caption: &str) -> Result<(), RenderError> {
+/// `labels`: further text, each centred across its point, placed up and down by its `VPos`, in its colour (the
+/// triad's and the scale bar's).
+fn draw_text(
+    image: &mut RgbImage,
+    scale: &ColourScale,
+    l: &Layout,
+    caption: &str,
+    labels: &[Label],
+) -> Result<(), RenderError> {
     ensure_font().map_err(|e| RenderError::Text(e.to_string()))?;
     let text_err = |e: DrawingAreaErrorKind<_>| RenderError::Text(e.to_string());
     let (w, h) = (image.width, image.height);
@@ -209,6 +291,13 @@ fn draw_text(image: &mut RgbImage, scale: &ColourScale, l: &Layout, caption: &st
                 .map_err(text_err)?;
             }
         }
+    }
+    for (text, at, colour, v_pos) in labels {
+        let rgb = RGBColor(colour[0], colour[1], colour[2]);
+        let style = TextStyle::from((FONT_FAMILY, l.font))
+            .color(&rgb)
+            .pos(Pos::new(HPos::Center, *v_pos));
+        root.draw(&Text::new(text.as_str(), *at, style)).map_err(text_err)?;
     }
     root.present().map_err(text_err)?;
     Ok(())

@@ -10,8 +10,10 @@ use rayon::prelude::*;
 
 use crate::math::{Mat3, Vec3};
 
+use super::camera::ScreenBox;
 use super::camera::{BoundingSphere, Camera, Ray};
 use super::frame::RgbImage;
+use super::walls::{WallPolygon, composite, wall_shade};
 
 /// One body to draw: an ellipsoid with its colour.
 #[derive(Clone, Debug, PartialEq)]
@@ -102,22 +104,34 @@ pub fn intersect_ellipsoid(ray: &Ray, centre: &Vec3, rotation: &Mat3, axes: &Vec
 }
 
 /// Ambient share of the light: faces turned away from the light still show their colour at this fraction.
-const AMBIENT: f64 = 0.25;
+pub const AMBIENT: f64 = 0.25;
 /// Diffuse share of the light (ambient + diffuse = 1, so a face turned to the light shows its full colour).
-const DIFFUSE: f64 = 0.75;
+pub const DIFFUSE: f64 = 0.75;
 /// Rows per band: bands are the unit of parallel work and of body bucketing. Small enough for load balance
 /// over many threads, big enough that the per-band body lists stay short.
 const BAND_ROWS: u32 = 8;
 
+/// The unit direction towards the light of `camera`'s pictures: from the upper left, in front of the scene (camera
+/// space), so shapes and orientations read well whatever the view.
+pub fn light_direction(camera: &Camera) -> Vec3 {
+    (-camera.right() + camera.up() - 1.2 * camera.forward()).normalize()
+}
+
 /// Renders `bodies` seen by `camera` on a `background`: each pixel takes the shaded colour of its nearest hit.
 ///
-/// Shading: `colour · (0.25 + 0.75·max(0, n·l))` with `l` a fixed light from the upper left, in front of the scene
-/// (camera space), so the shapes and orientations read well whatever the view. Parallel over row bands with
+/// Shading: `colour · (0.25 + 0.75·max(0, n·l))` with `l` the [`light_direction`]. Parallel over row bands with
 /// rayon's global pool.
 pub fn render_bodies(bodies: &[RenderBody], camera: &Camera, background: [u8; 3]) -> RgbImage {
+    render_scene(bodies, &[], camera, background)
+}
+
+/// Renders `bodies` as [`render_bodies`] does, seen through the translucent `walls` ([`super::walls`]): along each
+/// pixel's ray the nearest body is opaque and every wall polygon crossed before it (or before the background)
+/// blends over it with [`super::walls::WALL_ALPHA`].
+pub fn render_scene(bodies: &[RenderBody], walls: &[WallPolygon], camera: &Camera, background: [u8; 3]) -> RgbImage {
     let (width, height) = (camera.width(), camera.height());
     let mut image = RgbImage::new(width, height, background);
-    let light = (-camera.right() + camera.up() - 1.2 * camera.forward()).normalize();
+    let light = light_direction(camera);
     let t_min = if camera.rays_are_lines() {
         f64::NEG_INFINITY
     } else {
@@ -140,12 +154,19 @@ pub fn render_bodies(bodies: &[RenderBody], camera: &Camera, background: [u8; 3]
 
     // Which bodies each band must test.
     let n_bands = height.div_ceil(BAND_ROWS) as usize;
-    let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
-    for (i, b) in boxes.iter().enumerate() {
-        for band in &mut bands[(b.y0 / BAND_ROWS) as usize..=(b.y1 / BAND_ROWS) as usize] {
-            band.push(i as u32);
+    let bands = bucket(&boxes, n_bands);
+    // The walls on screen, bucketed the same way, each with its shading factor.
+    let mut wall_boxes = Vec::new();
+    let mut shown_walls = Vec::new();
+    for w in walls {
+        if let Some(b) = camera.screen_box_of_points(w.points()) {
+            wall_boxes.push(b);
+            shown_walls.push((w, wall_shade(camera, &w.normal())));
         }
     }
+    let wall_bands = bucket(&wall_boxes, n_bands);
+    // Two facets' hits this close along a ray are one crossing of their shared edge.
+    let merge = 1e-9 * camera.framing().half_extent;
 
     let row_bytes = width as usize * 3;
     image
@@ -154,9 +175,11 @@ pub fn render_bodies(bodies: &[RenderBody], camera: &Camera, background: [u8; 3]
         .enumerate()
         .for_each(|(band, chunk)| {
             let members = &bands[band];
-            if members.is_empty() {
+            let wall_members = &wall_bands[band];
+            if members.is_empty() && wall_members.is_empty() {
                 return;
             }
+            let mut layers: Vec<(f64, f64)> = Vec::new();
             let mut depth = vec![f64::INFINITY; width as usize];
             let mut winner = vec![u32::MAX; width as usize];
             let mut unit_hit = vec![Vec3::zeros(); width as usize];
@@ -184,17 +207,52 @@ pub fn render_bodies(bodies: &[RenderBody], camera: &Camera, background: [u8; 3]
                 }
                 // Shade winners only: overdrawn hits cost no normal or lighting.
                 for (xi, &w) in winner.iter().enumerate() {
-                    if w == u32::MAX {
+                    let mut shaded = if w == u32::MAX {
+                        background.map(f64::from)
+                    } else {
+                        let (body, colour) = &prepared[w as usize];
+                        let n = body.normal(&unit_hit[xi]);
+                        let k = AMBIENT + DIFFUSE * n.dot(&light).max(0.0);
+                        colour.map(|c| f64::from(c) * k)
+                    };
+                    layers.clear();
+                    // One ray per pixel, made only when some wall's rectangle holds the pixel.
+                    let mut ray: Option<Ray> = None;
+                    for &i in wall_members {
+                        let b = &wall_boxes[i as usize];
+                        if y < b.y0 || y > b.y1 || (xi as u32) < b.x0 || (xi as u32) > b.x1 {
+                            continue;
+                        }
+                        let (wall, shade) = shown_walls[i as usize];
+                        let ray = ray.get_or_insert_with(|| camera.ray(xi as u32, y));
+                        if let Some(t) = wall.hit(ray, t_min)
+                            && t < depth[xi]
+                        {
+                            layers.push((t, shade));
+                        }
+                    }
+                    if w == u32::MAX && layers.is_empty() {
                         continue;
                     }
-                    let (body, colour) = &prepared[w as usize];
-                    let n = body.normal(&unit_hit[xi]);
-                    let k = AMBIENT + DIFFUSE * n.dot(&light).max(0.0);
+                    if !layers.is_empty() {
+                        shaded = composite(shaded, &mut layers, merge);
+                    }
                     for c in 0..3 {
-                        row[xi * 3 + c] = (f64::from(colour[c]) * k).round().clamp(0.0, 255.0) as u8;
+                        row[xi * 3 + c] = shaded[c].round().clamp(0.0, 255.0) as u8;
                     }
                 }
             }
         });
     image
+}
+
+/// For each of `n_bands` row bands, the indices of the `boxes` that reach into it.
+fn bucket(boxes: &[ScreenBox], n_bands: usize) -> Vec<Vec<u32>> {
+    let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
+    for (i, b) in boxes.iter().enumerate() {
+        for band in &mut bands[(b.y0 / BAND_ROWS) as usize..=(b.y1 / BAND_ROWS) as usize] {
+            band.push(i as u32);
+        }
+    }
+    bands
 }

@@ -1,20 +1,22 @@
-//! A whole run in pictures (`rubblepile render RUN_DIR`): one PNG per snapshot in `RUN_DIR/frames/` and an
-//! animated GIF of them, each frame with the simulated time and a colour bar. The snapshots are read back through
-//! the run's engine ([`crate::driver::export::visit_snapshots`]), so every engine's runs can be drawn.
+//! A whole run in pictures (`rubblepile render RUN_DIR`): one PNG per snapshot in `RUN_DIR/frames/` (or `--out
+//! DIR`) and an animated GIF of them, each frame with the simulated time, a colour bar, a scale bar and an axis
+//! triad, the run's walls drawn translucent where they were at that time. The snapshots are read back through the
+//! run's engine ([`crate::driver::export::visit_snapshots`]), so every engine's runs can be drawn.
 //!
-//! The camera does not move between frames: it frames the first snapshot (for an impact: the target and the
-//! incoming projectile), or a sphere of `extent` metres about the first snapshot's centre of mass when given (for
-//! an impact: the target, wherever the projectile starts). Continuous
-//! colour scales span 0 to the 95th percentile of the value over all frames, so one fast body (a projectile at
-//! 5 km/s) does not wash out the fragments' tens of m/s.
+//! The camera follows the bodies ([`following_framings`]): each frame is centred on its snapshot's centre of mass
+//! (the middle of the bodies when no masses are written), and its half-width is the largest [`reach_98`] of the
+//! snapshots so far — it grows as a pile expands and never shrinks, so nothing that was in the picture is cropped
+//! and the picture does not zoom in and out. `extent` fixes the half-width instead. Continuous colour scales span 0
+//! to the 95th percentile of the value over all frames, so one fast body (a projectile at 5 km/s) does not wash
+//! out the fragments' tens of m/s.
 
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::time::Instant;
 
 use super::{
-    Camera, ColourScale, FrameBody, Framing, GifOptions, GifWriter, Projection, RenderError, View, render_frame,
-    write_png,
+    Camera, ColourScale, FrameBody, Framing, GifOptions, GifWriter, Projection, RenderError, View,
+    render_frame_with_walls, wall_polygons, write_png,
 };
 use crate::analysis::run_analysis::FragmentFields;
 use crate::driver::export::{ExportError, visit_snapshots};
@@ -60,14 +62,16 @@ pub struct RenderRunOptions {
     pub height: u32,
     /// What colours the bodies.
     pub colour: ColourBy,
-    /// Half-width of the picture (m) about the first snapshot's centre of mass; `None`: framed on the whole first
-    /// snapshot.
+    /// Half-width of the picture (m) about each snapshot's centre of mass; `None`: following the bodies
+    /// ([`following_framings`]).
     pub extent: Option<f64>,
-    /// File name of the animation in `frames/`.
+    /// File name of the animation in the frames directory.
     pub gif_name: String,
     /// Time each GIF frame is shown (1/100 s).
     pub gif_delay_centiseconds: u16,
-    /// Overwrite an earlier `frames/`.
+    /// Directory of the frames and the animation; `None`: `RUN_DIR/frames`.
+    pub out: Option<PathBuf>,
+    /// Overwrite an earlier frames directory.
     pub force: bool,
 }
 
@@ -83,6 +87,7 @@ impl Default for RenderRunOptions {
             extent: None,
             gif_name: "run.gif".into(),
             gif_delay_centiseconds: 10,
+            out: None,
             force: false,
         }
     }
@@ -113,6 +118,8 @@ pub struct RenderReport {
     pub seconds: f64,
     /// The animation.
     pub gif: PathBuf,
+    /// The directory the frames were written to.
+    pub frames_dir: PathBuf,
 }
 
 fn frame_bodies(view: &SnapshotView, values: &[f64]) -> Vec<FrameBody> {
@@ -140,30 +147,70 @@ fn values(view: &SnapshotView, colour: ColourBy, fields: Option<&FragmentFields>
     }
 }
 
-/// The camera's framing from the first snapshot: all its bodies, or a sphere of `extent` (m) about its centre of
-/// mass. The centre of mass, not the middle of the bodies' box: an impact's projectile starts hundreds of km out,
-/// which would put the target in a corner of a tight frame.
-fn first_framing(view: &SnapshotView, values: &[f64], extent: Option<f64>) -> Framing {
-    let all = Framing::enclosing(frame_bodies(view, values).iter());
-    let Some(half_extent) = extent else {
-        return all;
-    };
-    let mass: f64 = view.particles.iter().map(|p| p.mass).sum();
-    let centre = if mass > 0.0 {
-        view.particles
-            .iter()
-            .map(|p| p.position * p.mass)
-            .sum::<crate::math::Vec3>()
-            / mass
+/// Share of the bodies [`reach_98`] holds.
+pub const REACH_QUANTILE: f64 = 0.98;
+
+/// The centre of mass of `particles` (the middle of their bounding box when they have no mass) and their robust
+/// reach about it (m): the smallest radius that holds the whole of at least 98 % of the bodies (nearest-rank
+/// percentile of each body's centre distance plus its largest semi-axis; up to 49 bodies that is all of them). One
+/// fragment flying off does not widen the picture; a pile expanding does.
+pub fn reach_98(particles: &[ParticleView]) -> (crate::math::Vec3, f64) {
+    use crate::math::Vec3;
+    if particles.is_empty() {
+        return (Vec3::zeros(), 0.0);
+    }
+    let mass: f64 = particles.iter().map(|p| p.mass).sum();
+    let centre = if mass > 0.0 && mass.is_finite() {
+        particles.iter().map(|p| p.position * p.mass).sum::<Vec3>() / mass
     } else {
-        all.centre
+        let lo = particles
+            .iter()
+            .fold(Vec3::repeat(f64::INFINITY), |a, p| a.inf(&p.position));
+        let hi = particles
+            .iter()
+            .fold(Vec3::repeat(f64::NEG_INFINITY), |a, p| a.sup(&p.position));
+        0.5 * (lo + hi)
     };
-    Framing { centre, half_extent }
+    let mut reach: Vec<f64> = particles
+        .iter()
+        .map(|p| (p.position - centre).norm() + p.axes.max())
+        .collect();
+    reach.sort_by(f64::total_cmp);
+    let rank = (REACH_QUANTILE * reach.len() as f64).ceil() as usize;
+    (centre, reach[rank.clamp(1, reach.len()) - 1])
 }
 
-/// Renders every snapshot of the run in `dir` into `dir/frames/<k>.png` and `dir/frames/<gif_name>`, holding the lock
-/// of `dir/frames/` ([`crate::io::run_lock`]): a second render of the run is refused at once
-/// ([`ExportError::Locked`]); the run itself may still be going.
+/// The framing of each frame from each snapshot's [`reach_98`] `(centre, reach)`: centred on the snapshot's centre,
+/// with half-width `extent` when given, else the largest reach so far plus [`Framing::MARGIN`] (never shrinking;
+/// 1 m while every reach is zero). Frame by frame: [`Follower`].
+pub fn following_framings(reaches: &[(crate::math::Vec3, f64)], extent: Option<f64>) -> Vec<Framing> {
+    let mut follower = Follower::default();
+    reaches.iter().map(|r| follower.frame(*r, extent)).collect()
+}
+
+/// The camera of [`following_framings`], one frame at a time (a run still being written may gain snapshots while
+/// it is drawn).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Follower {
+    /// The widest half-width so far (m; 0 before any).
+    widest: f64,
+}
+
+impl Follower {
+    /// The framing of the next frame, whose snapshot has `reach` = `(centre, reach)` ([`reach_98`]).
+    pub fn frame(&mut self, (centre, reach): (crate::math::Vec3, f64), extent: Option<f64>) -> Framing {
+        if reach.is_finite() {
+            self.widest = self.widest.max(reach * (1.0 + Framing::MARGIN));
+        }
+        let half_extent = extent.unwrap_or(if self.widest > 0.0 { self.widest } else { 1.0 });
+        Framing { centre, half_extent }
+    }
+}
+
+/// Renders every snapshot of the run in `dir` into `<frames>/<k>.png` and `<frames>/<gif_name>`, `<frames>` being
+/// `opts.out` or `dir/frames`. Holds the lock of the frames directory ([`crate::io::run_lock`], a lock file beside
+/// it): a second render into it is refused at once ([`ExportError::Locked`]); the run itself may still be going. A
+/// frames directory that exists and is not empty is refused ([`ExportError::Exists`]) unless `opts.force`.
 pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, RenderRunError> {
     if opts.width < 16 || opts.height < 16 || opts.width > 8192 || opts.height > 8192 {
         return Err(RenderRunError::Option(format!(
@@ -190,13 +237,34 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
         ),
         _ => None,
     };
-    let frames_dir = dir.join("frames");
-    // `frames/` is locked, not the run: a run still going can be drawn as far as it got. A directory without
-    // snapshots is refused below without a lock file left in it.
-    let _lock = dir
-        .join("snapshots")
-        .is_dir()
-        .then(|| DirLock::acquire_part(dir, "frames"))
+    // The frames directory is locked through a file beside it (in its parent), not the run: a run still going can
+    // be drawn as far as it got. A directory without snapshots is refused below without a lock file left anywhere.
+    let (frames_dir, parent, part) = match &opts.out {
+        None => (dir.join("frames"), dir.to_path_buf(), "frames".to_string()),
+        Some(out) => {
+            let name = out.file_name().and_then(|n| n.to_str()).filter(|n| *n != "..");
+            let Some(name) = name else {
+                return Err(RenderRunError::Option(format!(
+                    "--out: expected a directory path ending in a name, got {:?}",
+                    out.display().to_string()
+                )));
+            };
+            let parent = out
+                .parent()
+                .filter(|p| !p.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            (out.clone(), parent.to_path_buf(), name.to_string())
+        }
+    };
+    let has_snapshots = dir.join("snapshots").is_dir();
+    if has_snapshots && !parent.is_dir() {
+        std::fs::create_dir_all(&parent).map_err(|source| RenderError::Io {
+            path: parent.clone(),
+            source,
+        })?;
+    }
+    let _lock = has_snapshots
+        .then(|| DirLock::acquire_part(&parent, &part))
         .transpose()
         .map_err(ExportError::Locked)?;
     if !opts.force && frames_dir.read_dir().is_ok_and(|mut d| d.next().is_some()) {
@@ -204,21 +272,13 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     }
     let start = Instant::now();
 
-    // Pass 1: the framing (first snapshot) and the colour range (all snapshots).
-    let mut framing: Option<Framing> = None;
+    // Pass 1: the colour range (all snapshots).
     let mut all_values: Vec<f64> = Vec::new();
     visit_snapshots(dir, &mut |_, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
-        if framing.is_none() {
-            framing = Some(first_framing(&view, &vals, opts.extent));
-        }
         all_values.extend(vals.into_iter().filter(|v| v.is_finite()));
         Ok(())
     })?;
-    let framing = framing.unwrap_or(Framing {
-        centre: crate::math::Vec3::zeros(),
-        half_extent: 1.0,
-    });
     let scale = colour_scale(opts.colour, &mut all_values);
 
     // Pass 2: draw and write.
@@ -226,7 +286,6 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
         path: frames_dir.clone(),
         source,
     })?;
-    let camera = Camera::new(opts.view, opts.projection, framing, opts.width, opts.height);
     let gif_path = frames_dir.join(&opts.gif_name);
     let options = GifOptions {
         speed: 10,
@@ -234,11 +293,20 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     };
     let mut gif = GifWriter::create_with(&gif_path, opts.width, opts.height, opts.gif_delay_centiseconds, options)?;
     let mut frame_ms = Vec::new();
+    let mut follower = Follower::default();
     let mut fail: Option<RenderError> = None;
     visit_snapshots(dir, &mut |k, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
+        let framing = follower.frame(reach_98(&view.particles), opts.extent);
+        let camera = Camera::new(opts.view, opts.projection, framing, opts.width, opts.height);
         let t0 = Instant::now();
-        let drawn = render_frame(&frame_bodies(&view, &vals), &scale, &camera, &caption(view.t));
+        let drawn = render_frame_with_walls(
+            &frame_bodies(&view, &vals),
+            &wall_polygons(view.surfaces.iter().map(|s| &s.mesh)),
+            &scale,
+            &camera,
+            &caption(view.t),
+        );
         frame_ms.push(t0.elapsed().as_secs_f64() * 1e3);
         let written = drawn.and_then(|image| {
             write_png(&frames_dir.join(format!("{k:04}.png")), &image)?;
@@ -257,6 +325,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
         median_frame_ms: crate::math::median(&frame_ms),
         seconds: start.elapsed().as_secs_f64(),
         gif: gif_path,
+        frames_dir,
     })
 }
 
@@ -308,49 +377,4 @@ pub fn after_run(out: &Path, default_scene: bool, force: bool) -> Result<(String
         ));
     }
     Ok((before, after))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::math::Vec3;
-
-    fn view(particles: Vec<ParticleView>) -> SnapshotView {
-        SnapshotView {
-            spheres: true,
-            particles,
-            ..SnapshotView::default()
-        }
-    }
-
-    /// An impact's first snapshot: a heavy target at the origin and a light projectile 450 km out. Without an
-    /// extent the frame holds both; with one it is centred on the centre of mass (here 4.5 km from the target),
-    /// not halfway to the projectile.
-    #[test]
-    fn extent_frames_the_centre_of_mass_not_the_middle_of_the_bodies() {
-        let zero = Vec3::zeros();
-        let snapshot = view(vec![
-            ParticleView::sphere(0, 99.0, 90e3, zero, zero, zero),
-            ParticleView::sphere(1, 1.0, 20e3, Vec3::new(450e3, 0.0, 0.0), zero, zero),
-        ]);
-        let values = [0.0, 0.0];
-        let all = first_framing(&snapshot, &values, None);
-        assert!((all.centre.x - 0.5 * (-90e3 + 470e3)).abs() < 1e-6, "{:?}", all.centre);
-        let tight = first_framing(&snapshot, &values, Some(150e3));
-        assert!(
-            (tight.centre - Vec3::new(4.5e3, 0.0, 0.0)).norm() < 1e-6,
-            "{:?}",
-            tight.centre
-        );
-        assert_eq!(tight.half_extent, 150e3);
-        // Massless bodies (no masses written): the middle of the bodies, as without an extent.
-        let massless = view(
-            snapshot
-                .particles
-                .iter()
-                .map(|p| ParticleView { mass: 0.0, ..*p })
-                .collect(),
-        );
-        assert_eq!(first_framing(&massless, &values, Some(1.0)).centre, all.centre);
-    }
 }
