@@ -342,7 +342,16 @@ impl ClumpReport {
         let Some(lr) = self.largest() else {
             return "clumps: none (no bodies)".into();
         };
-        let period = |p: Option<f64>| p.map_or("none".into(), |p| format!("{p:.3} h"));
+        // a spin left by rounding alone gives an astronomical period: scientific notation keeps it short
+        let period = |p: Option<f64>| {
+            p.map_or("none".into(), |p| {
+                if p < 1e4 {
+                    format!("{p:.3} h")
+                } else {
+                    format!("{p:.3e} h")
+                }
+            })
+        };
         let second = self.second().map_or("none".into(), |s| {
             format!("{:.4} of the mass ({} bodies)", s.mass_fraction, s.n_members)
         });
