@@ -520,6 +520,9 @@ pub struct CampaignRun {
     pub escaping: usize,
     /// Fraction of the target mass that stays bound (Fig. 5).
     pub bound_mass_fraction: f64,
+    /// Mass of the largest remnant (the most massive clump, [`crate::analysis::clumps`]) over the mass of all
+    /// bodies; `None` when the snapshot has no bodies.
+    pub largest_remnant_fraction: Option<f64>,
     /// Post-impact fragment kinetic energy over the projectile's.
     pub f_ke: f64,
     /// Rotational share of that energy.
@@ -711,6 +714,7 @@ pub fn analyze_campaign(
             fragments: s.n_fragments,
             escaping: s.n_escaping,
             bound_mass_fraction: s.bound_mass_fraction,
+            largest_remnant_fraction: a.clumps.largest_remnant.as_ref().map(|r| r.mass_fraction),
             f_ke: s.f_ke,
             rotational_share: s.rotational_share,
             ejection_speed_median: s.ejection_speed_median,
