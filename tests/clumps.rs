@@ -199,12 +199,8 @@ fn axis_ratios_of_a_clump_of_known_inertia() {
     let report = analyse_clumps(&pair, 0.1, None, uniform);
     let c = &report.clumps[0];
     let expected = [0.8 * m * r * r, 2.8 * m * r * r, 2.8 * m * r * r];
-    for k in 0..3 {
-        assert!(
-            close(c.principal_moments_kg_m2[k], expected[k], 1e-14),
-            "{:?}",
-            c.principal_moments_kg_m2
-        );
+    for (got, want) in c.principal_moments_kg_m2.iter().zip(expected) {
+        assert!(close(*got, want, 1e-14), "{:?}", c.principal_moments_kg_m2);
     }
     let ratio = 1.0 / 6f64.sqrt();
     assert!(

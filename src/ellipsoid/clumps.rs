@@ -118,13 +118,13 @@ pub fn find_clumps_among(bodies: &[Body], ids: &[usize], linking: Linking) -> Ve
     }
     let mut clumps: Vec<Vec<usize>> = Vec::new();
     let mut slot = vec![usize::MAX; ids.len()];
-    for p in 0..ids.len() {
+    for (p, &id) in ids.iter().enumerate() {
         let r = root(&mut parent, p);
         if slot[r] == usize::MAX {
             slot[r] = clumps.len();
             clumps.push(Vec::new());
         }
-        clumps[slot[r]].push(ids[p]);
+        clumps[slot[r]].push(id);
     }
     clumps
 }
