@@ -446,6 +446,7 @@ fn campaign_run(
         fragments: 0,
         escaping: 0,
         bound_mass_fraction: 1.0,
+        largest_remnant_fraction: Some(1.0),
         f_ke: 0.0,
         rotational_share: 0.0,
         ejection_speed_median: 0.0,

@@ -154,7 +154,19 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     for r in runs {
         let b = r["bound_mass_fraction"].as_f64().unwrap();
         assert!((0.0..=1.0).contains(&b));
+        // beside it, the largest remnant (of the whole mass), also in campaign_runs.csv and in Fig. 5
+        let lr = r["largest_remnant_fraction"].as_f64().unwrap();
+        assert!(lr > 0.0 && lr <= 1.0, "largest remnant {lr}");
     }
+    let table = std::fs::read_to_string(dir.join("c/analysis/campaign_runs.csv")).unwrap();
+    assert!(
+        table
+            .lines()
+            .next()
+            .unwrap()
+            .contains(",bound_mass_fraction,largest_remnant_fraction,"),
+        "{table}"
+    );
     assert!(a["q_star_d"].get("ok").is_some() || a["q_star_d"].get("failed").is_some());
     assert!(
         a["bound_fraction_vs_q"].get("ok").is_some(),
@@ -163,7 +175,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     );
     // Figs. 5 and 7, SVG and PNG
     let svg = std::fs::read_to_string(dir.join("c/analysis/bound_fraction_vs_q.svg")).unwrap();
-    assert!(svg.contains("specific impact energy Q (erg/g)"));
+    assert!(svg.contains("specific impact energy Q (erg/g)") && svg.contains("largest remnant / total mass (2 runs)"));
     assert_png(&dir.join("c/analysis/bound_fraction_vs_q.png"));
     let svg = std::fs::read_to_string(dir.join("c/analysis/spin_distributions.svg")).unwrap();
     assert!(svg.contains("spin rate x (rad/s)") && svg.contains("P1 (Q = ") && svg.contains("P3 (Q = "));

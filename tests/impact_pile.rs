@@ -6,7 +6,8 @@ mod common;
 use common::temp_dir;
 use std::path::{Path, PathBuf};
 
-use rubblepile::analysis::composition::{CLUMP_MARGIN, Origin, clump_spin, composition};
+use rubblepile::analysis::clumps::clump_spin;
+use rubblepile::analysis::composition::{CLUMP_MARGIN, Origin, composition};
 use rubblepile::driver::RunOptions;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::ellipsoid::quaternion::rotation_matrix;

@@ -17,9 +17,10 @@
 //! * **Mixing** of the other bound clumps: their mass-weighted projectile fraction
 //!   `Σ_c m_c^proj / Σ_c M_c`, and how many hold bodies of both origins.
 
+use crate::analysis::clumps::clump_spin;
 use crate::ellipsoid::body::Body;
-use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::math::{Mat3, Vec3};
+use crate::ellipsoid::clumps::{Linking, find_clumps};
+use crate::math::Vec3;
 
 /// Relative enlargement of every semi-axis in the contact test that defines clumps (0.1 = 10 %).
 pub const CLUMP_MARGIN: f64 = 0.1;
@@ -133,38 +134,6 @@ impl Composition {
     }
 }
 
-/// The clumps of `bodies`: connected components of the contact graph with [`CLUMP_MARGIN`], as body lists.
-pub fn find_clumps(bodies: &[Body]) -> Vec<Vec<usize>> {
-    crate::ellipsoid::clumps::find_clumps(bodies, CLUMP_MARGIN)
-}
-
-/// Spin `ω` (world frame, rad/s) of the bodies `members` as one aggregate about their barycentre, with
-/// `moments(body)` the principal moments of each body (kg m²); zero when the inertia tensor is singular (one
-/// point mass).
-pub fn clump_spin(bodies: &[Body], members: &[usize], moments: impl Fn(&Body) -> Vec3) -> Vec3 {
-    let mass: f64 = members.iter().map(|&i| bodies[i].shape.mass).sum();
-    let centre = members
-        .iter()
-        .map(|&i| bodies[i].position * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / mass;
-    let velocity = members
-        .iter()
-        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / mass;
-    let (mut inertia, mut l) = (Mat3::zeros(), Vec3::zeros());
-    for &i in members {
-        let b = &bodies[i];
-        let r = rotation_matrix(&b.quaternion);
-        let own = r.transpose() * Mat3::from_diagonal(&moments(b)) * r;
-        let (d, u) = (b.position - centre, b.velocity - velocity);
-        inertia += own + b.shape.mass * (Mat3::identity() * d.norm_squared() - d * d.transpose());
-        l += b.shape.mass * d.cross(&u) + own * (r.transpose() * b.spin_body);
-    }
-    inertia.try_inverse().map_or_else(Vec3::zeros, |inv| inv * l)
-}
-
 /// The composition of `bodies` (one snapshot) whose projectile bodies are `projectile` (a range of indices);
 /// `moments` gives each body's principal moments (kg m²), `g` the gravitational constant (SI). `None` when the
 /// range is empty, out of bounds or covers every body.
@@ -198,7 +167,7 @@ pub fn composition(
     let projectile_mass = mass_of(&mut (0..n), Some(Origin::Projectile));
     let v_sys = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / total;
 
-    let mut clumps: Vec<Clump> = find_clumps(bodies)
+    let mut clumps: Vec<Clump> = find_clumps(bodies, Linking::ScaledAxes(CLUMP_MARGIN))
         .into_iter()
         .map(|ids| {
             let mass = mass_of(&mut ids.iter().copied(), None);

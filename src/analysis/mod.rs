@@ -1,6 +1,7 @@
 //! Post-processing of states and runs.
 
 pub mod atmosphere;
+pub mod clumps;
 pub mod composition;
 pub mod creep;
 pub mod figures;

@@ -649,9 +649,9 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     let _ = writeln!(w, "## Appendix: every run\n");
     let _ = writeln!(
         w,
-        "| run | Q (erg/g) | bound | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | energy error | barrier overruns | wall (s) |"
+        "| run | Q (erg/g) | bound | largest remnant | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | energy error | barrier overruns | wall (s) |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut overrun_runs = (0, 0);
     for r in runs {
         let overruns = overrun_pairs(&inputs.campaign_dir.join(&r.run));
@@ -661,10 +661,11 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         }
         let _ = writeln!(
             w,
-            "| `{}` | {:.3e} | {:.3} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
+            "| `{}` | {:.3e} | {:.3} | {} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
             r.run,
             r.q_erg_per_g,
             r.bound_mass_fraction,
+            opt(r.largest_remnant_fraction, &|x| format!("{x:.3}")),
             r.escaping,
             r.fragments,
             pct(r.f_ke),
@@ -880,6 +881,7 @@ mod tests {
             fragments: 200,
             escaping: 3,
             bound_mass_fraction: bound,
+            largest_remnant_fraction: Some(bound),
             f_ke: 0.02,
             rotational_share: 0.05,
             ejection_speed_median: 40.0,

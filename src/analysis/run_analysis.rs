@@ -10,6 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::clumps::{ClumpReport, ClumpSummary, DEFAULT_GAP_FRACTION, analyse_clumps};
 use crate::analysis::composition::{Composition, Origin, composition};
 use crate::analysis::fits::{ExponentComparison, PowerLawFit, SpinFit, compare_exponents, fit_power_law, histogram};
 use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
@@ -96,6 +97,27 @@ pub struct RunAnalysis {
     /// ([`crate::analysis::composition`]); its per-body table is `analysis/composition.csv`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub composition: Option<Composition>,
+    /// The clumps of the analysed snapshot: the largest and second remnants and the counts
+    /// ([`crate::analysis::clumps`]); the per-clump table is `analysis/clumps.csv`.
+    #[serde(flatten)]
+    pub clumps: ClumpSummary,
+    /// Every clump (for `clumps.csv` and the size–frequency figure; not in `analysis.json`).
+    #[serde(skip)]
+    pub clump_report: ClumpReport,
+}
+
+/// `analysis.json` of a run that is not an impact (any ellipsoid run, soft or hard spheres): the clumps of one
+/// snapshot.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ClumpRunAnalysis {
+    /// Time of the analysed snapshot (s).
+    pub t_at: f64,
+    /// The largest and second remnants and the counts ([`crate::analysis::clumps`]).
+    #[serde(flatten)]
+    pub clumps: ClumpSummary,
+    /// Every clump (for `clumps.csv` and the size–frequency figure; not in `analysis.json`).
+    #[serde(skip)]
+    pub clump_report: ClumpReport,
 }
 
 fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
@@ -230,6 +252,11 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         })
     };
     let (initial, at) = (read(&p0)?, read(&pat)?);
+    let kappa_i = scene.model.inertia.inertia_kappa(kappa);
+    let self_gravity = scene.physics.gravity.as_ref().map(|s| s.g.unwrap_or(G_SI));
+    let clump_report = analyse_clumps(&at, DEFAULT_GAP_FRACTION, self_gravity, |b| {
+        b.shape.principal_moments(kappa_i)
+    });
     let params = FragmentParams {
         kappa,
         inertia: scene.model.inertia,
@@ -260,6 +287,8 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
             let kappa_i = scene.model.inertia.inertia_kappa(kappa);
             composition(&at, r, g, |b| b.shape.principal_moments(kappa_i))
         }),
+        clumps: clump_report.summary(),
+        clump_report,
     };
     std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
         path: out_dir.clone(),
@@ -269,12 +298,126 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
     if let Some(c) = &analysis.composition {
         write_composition_csv(&out_dir.join("composition.csv"), c)?;
     }
+    write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
     let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
     std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
         path: json_path.clone(),
         reason: e.to_string(),
     })?;
     Ok((analysis, report))
+}
+
+fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
+    std::fs::write(path, text).map_err(|e| AnalysisError::Write {
+        path: path.to_path_buf(),
+        reason: e.to_string(),
+    })
+}
+
+/// Whether `dir` holds an impact run (its `impact.json`, from `rubblepile impact`, a campaign or `run` of the
+/// default scene), which [`analyze_run`] analyses in full; any other run gets [`analyze_clumps_run`].
+pub fn is_impact_run(dir: &Path) -> bool {
+    dir.join("impact.json").is_file()
+}
+
+/// The bodies of a snapshot of the run in `dir`, whatever its engine, with the gravitational constant of its
+/// self-gravity (`None` without: a scene without gravity, a soft-sphere scene without `[gravity] self`, hard
+/// spheres) and each body's principal moments (the run's inertia model for ellipsoids; uniform solid spheres,
+/// `2/5 m r²`, for spheres, whose snapshots give the world-frame spin, kept as the body spin of an unrotated
+/// body).
+fn run_snapshot_bodies(
+    dir: &Path,
+    snapshot: &Path,
+) -> Result<(Vec<crate::ellipsoid::body::Body>, Option<f64>, f64), AnalysisError> {
+    use crate::driver::kind::SceneKind;
+    let scene_path = dir.join("scene.toml");
+    let read_err = |path: &Path, reason: String| AnalysisError::Read {
+        path: path.to_path_buf(),
+        reason,
+    };
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| read_err(&scene_path, e.to_string()))?;
+    match SceneKind::of_text(&text) {
+        SceneKind::Ellipsoids => {
+            let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
+                .map_err(|e| read_err(&scene_path, e.to_string()))?;
+            let kappa_i = scene.model.inertia.inertia_kappa(run_kappa(dir)?);
+            let g = scene.physics.gravity.as_ref().map(|s| s.g.unwrap_or(G_SI));
+            let bodies = read_snapshot_bodies(snapshot).map_err(|e| read_err(snapshot, e.to_string()))?;
+            Ok((bodies, g, kappa_i))
+        }
+        kind => {
+            let table: toml::Table = text.parse().map_err(|e| read_err(&scene_path, format!("{e}")))?;
+            let gravity = table.get("gravity");
+            let g = (kind == SceneKind::SoftSpheres && gravity.and_then(|g| g.get("self")).is_some()).then(|| {
+                gravity
+                    .and_then(|g| g.get("G"))
+                    .and_then(toml::Value::as_float)
+                    .unwrap_or(G_SI)
+            });
+            let columns = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
+            let rows = crate::io::particles::read_particles(snapshot, &columns, &[])
+                .map_err(|e| read_err(snapshot, e.to_string()))?;
+            let bodies = rows
+                .iter()
+                .map(|r| {
+                    let v = &r.values;
+                    crate::ellipsoid::body::Body {
+                        shape: crate::ellipsoid::body::Ellipsoid {
+                            axes: crate::math::Vec3::repeat(v[1]),
+                            mass: v[0],
+                        },
+                        position: crate::math::Vec3::new(v[2], v[3], v[4]),
+                        velocity: crate::math::Vec3::new(v[5], v[6], v[7]),
+                        quaternion: crate::math::Vec4::new(0.0, 0.0, 0.0, 1.0),
+                        spin_body: crate::math::Vec3::new(v[8], v[9], v[10]),
+                    }
+                })
+                .collect();
+            Ok((bodies, g, 2.5))
+        }
+    }
+}
+
+/// Analyses the clumps of the run in `dir` (any engine; [`crate::analysis::clumps`]) at its snapshot at `t_at`
+/// (s; `None`: its last snapshot): writes `dir/analysis/{clumps.csv, analysis.json}` unless `analysis.json`
+/// exists (or `force`), holding the lock of `dir/analysis/` ([`lock_analysis`]). The size–frequency figure is
+/// left to the caller ([`crate::analysis::figures::sfd`]).
+pub fn analyze_clumps_run(dir: &Path, t_at: Option<f64>, force: bool) -> Result<ClumpRunAnalysis, AnalysisError> {
+    let _lock = lock_analysis(dir, "scene.toml")?;
+    let out_dir = dir.join("analysis");
+    let json_path = out_dir.join("analysis.json");
+    if !force && json_path.exists() {
+        return Err(AnalysisError::Exists(out_dir));
+    }
+    let times = snapshot_times(dir)?;
+    let found = match t_at {
+        Some(t) => times.iter().find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0)),
+        None => times.last(),
+    };
+    let Some((t, snapshot)) = found.cloned() else {
+        return Err(AnalysisError::NoSnapshot {
+            dir: dir.to_path_buf(),
+            t: t_at.unwrap_or(f64::NAN),
+            available: times.iter().map(|x| x.0).collect(),
+        });
+    };
+    let (bodies, g, kappa_i) = run_snapshot_bodies(dir, &snapshot)?;
+    let report = analyse_clumps(&bodies, DEFAULT_GAP_FRACTION, g, |b| b.shape.principal_moments(kappa_i));
+    let analysis = ClumpRunAnalysis {
+        t_at: t,
+        clumps: report.summary(),
+        clump_report: report,
+    };
+    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Write {
+        path: out_dir.clone(),
+        reason: e.to_string(),
+    })?;
+    write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
+    write_text(
+        &json_path,
+        &(serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n"),
+    )?;
+    Ok(analysis)
 }
 
 /// `composition.csv`: one row per body: its origin, its clump (0 = the largest remnant) and whether that is bound.
@@ -377,6 +520,9 @@ pub struct CampaignRun {
     pub escaping: usize,
     /// Fraction of the target mass that stays bound (Fig. 5).
     pub bound_mass_fraction: f64,
+    /// Mass of the largest remnant (the most massive clump, [`crate::analysis::clumps`]) over the mass of all
+    /// bodies; `None` when the snapshot has no bodies.
+    pub largest_remnant_fraction: Option<f64>,
     /// Post-impact fragment kinetic energy over the projectile's.
     pub f_ke: f64,
     /// Rotational share of that energy.
@@ -568,6 +714,7 @@ pub fn analyze_campaign(
             fragments: s.n_fragments,
             escaping: s.n_escaping,
             bound_mass_fraction: s.bound_mass_fraction,
+            largest_remnant_fraction: a.clumps.largest_remnant.as_ref().map(|r| r.mass_fraction),
             f_ke: s.f_ke,
             rotational_share: s.rotational_share,
             ejection_speed_median: s.ejection_speed_median,

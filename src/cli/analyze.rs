@@ -10,11 +10,12 @@ use crate::cli::CliError;
 #[derive(Debug, clap::Args)]
 pub struct AnalyzeArgs {
     /// An impact run directory (from `rubblepile impact` or a campaign), or a flyby run (`rubblepile flyby`, or any
-    /// scene with `[physics.flyby]`).
+    /// scene with `[physics.flyby]`), or any other run (ellipsoids, soft or hard spheres: its clumps only).
     pub dir: PathBuf,
-    /// Time of the post-impact snapshot to analyse (s); there must be a snapshot at that time.
-    #[arg(long, default_value_t = 400.0)]
-    pub at: f64,
+    /// Time of the snapshot to analyse (s); there must be a snapshot at that time. Default: 400 s for an impact
+    /// run, the last snapshot for any other run.
+    #[arg(long)]
+    pub at: Option<f64>,
     /// Overwrite an earlier analysis in DIR/analysis.
     #[arg(long)]
     pub force: bool,
@@ -27,10 +28,20 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     if crate::analysis::flyby::is_flyby_run(&args.dir) {
         return analyze_flyby_run(args);
     }
-    if !(args.at.is_finite() && args.at > 0.0) {
-        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+    if let Some(at) = args.at
+        && !(at.is_finite() && at >= 0.0)
+    {
+        return Err(CliError::usage(format!("--at: must be a time >= 0 s, got {at}")));
     }
-    let (a, report) = analyze_run(&args.dir, args.at, args.force).map_err(|e| match e {
+    if !crate::analysis::run_analysis::is_impact_run(&args.dir) {
+        return analyze_clumps_of_run(args);
+    }
+    if args.at == Some(0.0) {
+        return Err(CliError::usage(
+            "--at: an impact run is analysed after the impact: must be a time > 0 s, got 0",
+        ));
+    }
+    let (a, report) = analyze_run(&args.dir, args.at.unwrap_or(400.0), args.force).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
@@ -65,9 +76,30 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         args.dir.join("analysis").display(),
         figures.join(", ")
     );
+    println!("{}", a.clump_report.summary_line());
     if let Some(c) = &a.composition {
         println!("{}", c.summary_line());
     }
+    Ok(())
+}
+
+/// `analyze` of a run that is not an impact (no `impact.json`): the clumps of one snapshot
+/// (`analysis/clumps.csv`, `analysis.json`, the size–frequency figure `analysis/sfd.svg`).
+fn analyze_clumps_of_run(args: &AnalyzeArgs) -> Result<(), CliError> {
+    let a =
+        crate::analysis::run_analysis::analyze_clumps_run(&args.dir, args.at, args.force).map_err(CliError::usage)?;
+    let figure = crate::analysis::figures::sfd::SizeFrequency::of(&a.clump_report, a.t_at);
+    let drawn = crate::analysis::figures::style::write_figure(&args.dir.join("analysis"), "sfd", &figure);
+    if let Err(why) = &drawn {
+        eprintln!("warning: figure not drawn: sfd: {why}");
+    }
+    println!(
+        "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",
+        a.t_at,
+        a.clump_report.summary_line(),
+        args.dir.join("analysis").display(),
+        if drawn.is_ok() { ", sfd.svg, sfd.png" } else { "" }
+    );
     Ok(())
 }
 

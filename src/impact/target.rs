@@ -202,7 +202,8 @@ pub const DETACHED_MARGIN: f64 = 0.1;
 /// distance would keep `K_rel/K` rising forever (N = 10 000: 18 fragments beyond 180 km, `analysis/n2000`).
 /// Returns how many were removed.
 pub fn drop_detached(bodies: &mut Vec<Body>, kept: &mut Vec<usize>) -> usize {
-    let clumps = crate::ellipsoid::clumps::find_clumps(bodies, DETACHED_MARGIN);
+    let clumps =
+        crate::ellipsoid::clumps::find_clumps(bodies, crate::ellipsoid::clumps::Linking::ScaledAxes(DETACHED_MARGIN));
     let mass = |c: &Vec<usize>| c.iter().map(|&i| bodies[i].shape.mass).sum::<f64>();
     let Some(main) = clumps.iter().max_by(|a, b| mass(a).total_cmp(&mass(b))) else {
         return 0;

@@ -3,7 +3,7 @@
 //!
 //! | file stem | Roig03 | content |
 //! |---|---|---|
-//! | `bound_fraction_vs_q` | Fig. 5 | bound mass fraction vs Q: runs, per-projectile means with max-excursion bars, fit, paper's line, Q*_D |
+//! | `bound_fraction_vs_q` | Fig. 5 | bound mass fraction vs Q: runs, per-projectile means with max-excursion bars, fit, paper's line, Q*_D; beside it each run's largest remnant over the total mass |
 //! | `spin_distributions` | Fig. 7 | Eq. 45-normalised best fits `a xⁿ exp(−x²/b²)` of the spin histograms, one per projectile |
 //!
 //! Fig. 5 groups the runs by projectile: all runs with one projectile have (nearly) the same Q — the targets'
@@ -33,6 +33,9 @@ pub struct BoundFractionVsQ {
     pub title: String,
     /// `(group label, Q (erg/g), bound mass fraction)` per run; runs are grouped by label.
     pub runs: Vec<(String, f64, f64)>,
+    /// `(Q (erg/g), largest remnant over the mass of all bodies)` per run ([`crate::analysis::clumps`]), drawn
+    /// beside the bound fractions.
+    pub largest_remnant: Vec<(f64, f64)>,
     /// The least-squares line through all runs.
     pub fit: Option<LineFit>,
     /// Where that line crosses 0.5 (Q*_D, erg/g).
@@ -104,7 +107,7 @@ impl Figure for BoundFractionVsQ {
         chart
             .configure_mesh()
             .x_desc("specific impact energy Q (erg/g)")
-            .y_desc("bound fraction of the target mass (dimensionless)")
+            .y_desc("bound fraction of the target mass; largest remnant (dimensionless)")
             .axis_desc_style(label_style())
             .label_style(small_style())
             .x_label_formatter(&|v| format!("{v:.1e}"))
@@ -163,6 +166,26 @@ impl Figure for BoundFractionVsQ {
             .map_err(draw_err)?
             .label(format!("runs ({})", runs.len()))
             .legend(|(x, y)| Circle::new((x + 10, y), 3, DATA_COLOUR.mix(0.45).filled()));
+        let remnants: Vec<(f64, f64)> = self
+            .largest_remnant
+            .iter()
+            .copied()
+            .filter(|p| p.0.is_finite() && p.1.is_finite())
+            .collect();
+        if !remnants.is_empty() {
+            let colour = SERIES_COLOURS[2];
+            let marker = move |(x, y): (i32, i32)| {
+                PathElement::new(
+                    vec![(x - 4, y + 3), (x + 4, y + 3), (x, y - 4), (x - 4, y + 3)],
+                    colour.stroke_width(2),
+                )
+            };
+            chart
+                .draw_series(remnants.iter().map(|&p| EmptyElement::at(p) + marker((0, 0))))
+                .map_err(draw_err)?
+                .label(format!("largest remnant / total mass ({} runs)", remnants.len()))
+                .legend(move |(x, y)| marker((x + 10, y)));
+        }
         let groups = self.groups();
         let bar = BLACK.stroke_width(2);
         chart
@@ -344,6 +367,11 @@ pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) 
             .iter()
             .map(|r| (r.projectile.clone(), r.q_erg_per_g, r.bound_mass_fraction))
             .collect(),
+        largest_remnant: analysis
+            .runs
+            .iter()
+            .filter_map(|r| Some((r.q_erg_per_g, r.largest_remnant_fraction?)))
+            .collect(),
         fit: match &analysis.bound_fraction_vs_q {
             Fit::Ok(l) => Some(*l),
             Fit::Failed(_) => None,
@@ -421,6 +449,7 @@ mod tests {
                 ("P3".into(), 3.54e9, 0.31),
                 ("P3".into(), 3.50e9, 0.35),
             ],
+            largest_remnant: vec![(0.44e9, 0.99), (1.49e9, 0.62)],
             fit: crate::analysis::fits::fit_line(&[0.44e9, 1.49e9, 3.54e9], &[0.95, 0.74, 0.33]).ok(),
             q_star_d: Some(LineCrossing { x: 2.6e9, sigma_x: 1e8 }),
         };
@@ -435,10 +464,11 @@ mod tests {
             "bound_fraction_vs_q",
             &[
                 "specific impact energy Q (erg/g)",
-                "bound fraction of the target mass (dimensionless)",
+                "bound fraction of the target mass; largest remnant (dimensionless)",
             ],
         );
         assert!(svg.contains("Q*_D = 2.60e9") && svg.contains("1.04 − 0.2×10⁻⁹ Q"));
+        assert!(svg.contains("largest remnant / total mass (2 runs)"));
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -2,8 +2,9 @@
 //! and PNG with titled, unit-labelled axes and a legend.
 //!
 //! * [`run_figures`]: one run — Fig. 2 `energy_partition`, Fig. 3 `velocity_field`, Fig. 4
-//!   `ejection_vs_size`, Fig. 6 `spin_histogram`, Fig. 8 `spin_vs_size`, Fig. 9 `rotation_mode_vs_size`.
+//!   `ejection_vs_size`, Fig. 6 `spin_histogram`, Fig. 8 `spin_vs_size`, Fig. 9 `rotation_mode_vs_size`, and `sfd` (below).
 //! * [`campaign_figures`]: a campaign — Fig. 5 `bound_fraction_vs_q`, Fig. 7 `spin_distributions`.
+//! * [`sfd`]: the cumulative mass distribution of a snapshot's clumps (`sfd`).
 //! * [`spinup_figures`]: Zhang17 Fig. 5-style time series of a spin-up run.
 //! * [`energy`]: the data of Fig. 2 (energies and momentum drift over time from `timeseries.csv` and
 //!   `tracks.csv`).
@@ -17,6 +18,7 @@ pub mod campaign_figures;
 pub mod energy;
 pub mod lines;
 pub mod run_figures;
+pub mod sfd;
 pub mod spinup_figures;
 pub mod style;
 

@@ -9,6 +9,7 @@
 //! | `spin_histogram` | Fig. 6 | histogram of corrected spin rates with the n = 0.5 and n = 2 fits of Eq. 44 |
 //! | `spin_vs_size` | Fig. 8 | corrected spin rate vs size, power-law fit, −5/2 reference |
 //! | `rotation_mode_vs_size` | Fig. 9 | SAM/LAM measure vs size |
+//! | `sfd` | — | cumulative mass distribution of the clumps, all and escaping ([`super::sfd`]) |
 //!
 //! Only target fragments are plotted (the projectile is excluded, as in every target quantity of
 //! [`crate::analysis::fragments`]). Sizes are the fragments' equivalent radii over the parent body's effective
@@ -659,6 +660,9 @@ pub fn write_run_figures(
             Ok(write_figure(&dir, "energy_partition", &fig)?)
         });
     record("energy_partition", fig2);
+
+    let sfd = super::sfd::SizeFrequency::of(&analysis.clump_report, t_at);
+    record("sfd", write_figure(&dir, "sfd", &sfd).map_err(String::from));
 
     let fig3 = VelocityField {
         title: format!("Fragment ejection velocities relative to the target barycentre, t = {t_at} s"),
