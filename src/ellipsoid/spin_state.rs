@@ -139,11 +139,11 @@ pub fn principal_axes(inertia: &Mat3) -> ([f64; 3], Mat3) {
     (moments, axes)
 }
 
-/// Angle between two vectors (degrees), or between two lines when `as_lines` (0–90).
+/// Angle between two vectors (degrees), or between two lines when `as_lines` (0–90); by `atan2`, accurate near 0.
 fn angle_deg(u: &Vec3, v: &Vec3, as_lines: bool) -> f64 {
-    let c = u.dot(v) / (u.norm() * v.norm());
+    let c = u.dot(v);
     let c = if as_lines { c.abs() } else { c };
-    c.clamp(-1.0, 1.0).acos().to_degrees()
+    u.cross(v).norm().atan2(c).to_degrees()
 }
 
 /// The rotation state of inertia tensor `inertia` (kg m²) with angular momentum `l` (kg m² s⁻¹).

@@ -165,6 +165,17 @@ pub struct FlybySetup {
     pub settling: Option<SettleReport>,
 }
 
+/// The frame origin's hyperbolic orbit about a planet of `gm` (m³ s⁻²) with perigee `q` (m) and speed at infinity
+/// `v_inf` (m/s), and the time (s) from `start_q · q` on the way in to perigee: half the run's duration.
+pub fn flyby_orbit(gm: f64, q: f64, v_inf: f64, start_q: f64) -> Result<(KeplerOrbit, f64), ImpactError> {
+    let rot = orientation_matrix(0.0, 0.0, 0.0);
+    let orbit = KeplerOrbit::hyperbolic(gm, q, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let t_perigee = orbit
+        .time_from_perigee_at_distance(start_q * q)
+        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
+    Ok((orbit, t_perigee))
+}
+
 /// Subfolder of a flyby run directory that holds its control run (the same pile and time, no planet).
 pub const CONTROL_DIR: &str = "control";
 
@@ -347,12 +358,8 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         .unwrap_or(F0_REFERENCE * (F0_REFERENCE_RADIUS_M / radius).powi(2));
     let gm = G_SI * args.planet_mass;
     let v_inf = args.v_inf_km_s * 1e3;
-    let rot = orientation_matrix(0.0, 0.0, 0.0);
-    let orbit = KeplerOrbit::hyperbolic(gm, args.q_m, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let (orbit, t_perigee) = flyby_orbit(gm, args.q_m, v_inf, args.start_q)?;
     let start_distance = args.start_q * args.q_m;
-    let t_perigee = orbit
-        .time_from_perigee_at_distance(start_distance)
-        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
     let t_end = 2.0 * t_perigee;
     let times: Vec<String> = output_times(t_end, args.snapshots)
         .iter()
