@@ -19,3 +19,8 @@ one() { # name, extra args...
 }
 one settled
 one principal --settle-to-principal
+# The spin change depends on where the pile's long axis points at perigee: the same pass with the orbit turned in
+# its plane (argument of perigee 45, 90, 135 deg; same duration, so the control of `settled` serves them all).
+for w in 45 90 135; do
+  one "settled_w$w" --orientation-deg "0,0,$w" --no-control
+done
