@@ -509,3 +509,68 @@ fn tidal_torque_impulse_is_reported_apart_from_the_angular_momentum_residual() {
     let (_, plain) = run(&pile_scene("", 500.0), "flyby-no-impulse");
     assert_eq!(plain.tidal_torque_impulse, None);
 }
+
+/// The settling's cap is kept and said (a warning line, `settling.capped` in `flyby.json`), and `--no-control`
+/// runs no control: no `control/`, and the outcome says its changes are the run's own.
+#[test]
+fn capped_settling_is_reported_and_no_control_skips_the_control() {
+    let dir = temp_dir("flyby-capped");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let out = rubblepile(
+        &dir,
+        &[
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--radius-m",
+            "170",
+            "--period-hours",
+            "30.5",
+            "--q-m",
+            "3.8e7",
+            "--v-inf-km-s",
+            "12",
+            "--settle-max-hours",
+            "0.5",
+            "--no-control",
+            "--snapshots",
+            "2",
+            "--out",
+            "run",
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        stdout.contains("warning: settling stopped at its cap of 0.50 h"),
+        "{stdout}"
+    );
+    let setup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/flyby.json")).unwrap()).unwrap();
+    assert_eq!(setup["settling"]["capped"], true, "{setup}");
+    assert_eq!(setup["settling"]["time"].as_f64(), Some(1800.0), "{setup}");
+    assert_eq!(setup["control"], false);
+    assert!(!dir.join("run/control").exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/analysis/flyby.json")).unwrap()).unwrap();
+    assert_eq!(json["tide"]["from_control"], false, "{json}");
+    assert!(json["control"].is_null());
+    // A cap that is not a positive time is refused, naming the flag's field.
+    let bad = rubblepile(
+        &dir,
+        &[
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--q-m",
+            "3.8e7",
+            "--settle-max-hours",
+            "0",
+            "--no-run",
+            "--out",
+            "bad",
+        ],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("settle_max_hours"));
+}
