@@ -51,10 +51,12 @@ pub struct FlybyArgs {
     /// Target bodies file (snapshot columns, e.g. from `rubblepile target build`).
     #[arg(long)]
     pub target: PathBuf,
-    /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A) [default: as built].
+    /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A); a rescaled pile is
+    /// settled before the run [default: as built].
     #[arg(long)]
     pub radius_m: Option<f64>,
-    /// Set the pile into rigid rotation about its z axis with this period (hours) [default: the target's spins].
+    /// Set the pile into rigid rotation about its z axis with this period (hours); a re-spun pile is settled before
+    /// the run [default: the target's spins].
     #[arg(long)]
     pub period_hours: Option<f64>,
     /// Planet mass (kg; 0 for a control run without tide, the frame then moves straight at v∞) [default: Earth].
@@ -89,7 +91,7 @@ pub struct FlybyArgs {
     /// Dissipation F0 (s m⁻²) [default: 1e-6 (100 km/R)², R the pile's apparent radius].
     #[arg(long)]
     pub f0: Option<f64>,
-    /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run.
+    /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run (and over the settling).
     #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
     /// Number of snapshots, evenly spaced from start to end (2 to 100000).
