@@ -391,3 +391,186 @@ fn analyze_command_handles_flyby_runs() {
     assert!(String::from_utf8_lossy(&again.stderr).contains("--force"));
     assert!(analyze(&["--force"]).status.success());
 }
+
+/// `flyby --snapshots N` wrote `t_end·k/(N − 1)`, whose last value rounds one ulp above `t_end` for some N (147 of
+/// N = 2…1201 at q = 6 R_E, v∞ = 12 km/s), and the scene check refused the run. The output times are clamped: every
+/// one lies in `[0, t_end]`, increasing, the last exactly `t_end` (and the unclamped formula does fail here, so the
+/// case is one that catches the bug).
+#[test]
+fn flyby_output_times_never_pass_t_end() {
+    use rubblepile::impact::flyby::{DEFAULT_START_Q, EARTH_MASS_KG, EARTH_RADIUS_M, flyby_orbit, output_times};
+    let gm = rubblepile::ellipsoid::equations::G_SI * EARTH_MASS_KG;
+    let (_, t_perigee) = flyby_orbit(gm, 6.0 * EARTH_RADIUS_M, 12_000.0, DEFAULT_START_Q).unwrap();
+    let t_end = 2.0 * t_perigee;
+    let mut unclamped_over = 0;
+    for n in 2..=1201usize {
+        let times = output_times(t_end, n);
+        assert_eq!(times.len(), n);
+        assert_eq!(times[0], 0.0);
+        assert_eq!(times[n - 1], t_end, "N = {n}");
+        assert!(times.windows(2).all(|w| w[0] < w[1]), "N = {n}: not increasing");
+        if (0..n).any(|k| t_end * k as f64 / (n - 1) as f64 > t_end) {
+            unclamped_over += 1;
+        }
+    }
+    assert!(
+        unclamped_over > 0,
+        "the unclamped times never passed t_end: the case no longer tests the clamp"
+    );
+}
+
+/// A control flyby (planet mass 0) of a rescaled, re-spun pile is classed unaffected (issue 41's acceptance): the
+/// pile is settled first, the tide's effect (run minus control) is below the thresholds, and so are the run's own
+/// changes of period and shape (before the settling existed this case printed "reshaped: P 30.5 → 28.2 h, b/a
+/// 0.924 → 0.856").
+#[test]
+fn control_flyby_is_classed_unaffected() {
+    use rubblepile::analysis::flyby::{RESHAPE_THRESHOLD, SPIN_CHANGE_THRESHOLD};
+    let dir = temp_dir("flyby-control-acceptance");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let out = rubblepile(
+        &dir,
+        &[
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--radius-m",
+            "170",
+            "--period-hours",
+            "30.5",
+            "--q-m",
+            "3.8e7",
+            "--planet-mass",
+            "0",
+            "--out",
+            "run",
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("settled in"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/analysis/flyby.json")).unwrap()).unwrap();
+    assert_eq!(json["class"], "unaffected", "{json}");
+    assert_eq!(json["rbl98_class"], "N");
+    assert_eq!(json["tide"]["from_control"], true);
+    assert_eq!(json["settling"]["capped"], false, "{json}");
+    let p_before = json["before"]["spin"]["invariant_period_hours"].as_f64().unwrap();
+    for (what, source) in [("tide", &json["tide"]), ("run", &json)] {
+        let (dp, db) = match what {
+            "tide" => (
+                source["delta_invariant_period_hours"].as_f64().unwrap(),
+                source["delta_b_over_a"].as_f64().unwrap(),
+            ),
+            _ => (
+                source["after"]["spin"]["invariant_period_hours"].as_f64().unwrap() - p_before,
+                source["after"]["b_over_a"].as_f64().unwrap() - source["before"]["b_over_a"].as_f64().unwrap(),
+            ),
+        };
+        assert!(
+            (dp / p_before).abs() < SPIN_CHANGE_THRESHOLD,
+            "{what}: dP {dp} h of {p_before} h"
+        );
+        assert!(db.abs() < RESHAPE_THRESHOLD, "{what}: d(b/a) {db}");
+    }
+    // The control ran beside the run: same duration, its own summary.
+    let control: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/control/summary.json")).unwrap()).unwrap();
+    assert_eq!(control["status"], "completed");
+    assert!(dir.join("run/prepared_bodies.csv").is_file());
+}
+
+/// The tide's torque changes L by much more than the integration's error: the summary reports its impulse
+/// `|∫τ dt|` apart, and the angular-momentum error is the residual `|L − L0 − ∫τ dt|`, at the tolerance's level.
+#[test]
+fn tidal_torque_impulse_is_reported_apart_from_the_angular_momentum_residual() {
+    let flyby = "[physics.flyby]\nmass = 5.9722e25\nradius = 6.371e6\nq = 9.5e6\nv_inf = 3000.0\nt_perigee = 1500.0";
+    let (dir, s) = run(&pile_scene(flyby, 3000.0), "flyby-torque-impulse");
+    let impulse = s
+        .tidal_torque_impulse
+        .expect("a flyby reports the tidal torque impulse");
+    assert!(s.tidal_impulse.is_some());
+    let rows =
+        rubblepile::io::particles::read_particles(&dir.join("timeseries.csv"), &["lx", "ly", "lz"], &[]).unwrap();
+    let l = |r: &rubblepile::io::particles::ParticleRecord| Vec3::new(r.values[0], r.values[1], r.values[2]);
+    let raw = (l(&rows[rows.len() - 1]) - l(&rows[0])).norm() / s.scales.angular_momentum;
+    assert!(
+        raw > 1e-4,
+        "the tide hardly changed L ({raw:e}): the case tests nothing"
+    );
+    assert!(
+        s.angular_momentum_error < 1e-4 * raw,
+        "residual {:e} vs raw change {raw:e}",
+        s.angular_momentum_error
+    );
+    // The impulse is the largest |∫τ dt| over the run; at the end it equals the change of L up to the residual.
+    assert!(impulse >= raw * (1.0 - 1e-6), "impulse {impulse:e}, raw change {raw:e}");
+    // Without a planet there is no impulse to report.
+    let (_, plain) = run(&pile_scene("", 500.0), "flyby-no-impulse");
+    assert_eq!(plain.tidal_torque_impulse, None);
+}
+
+/// The settling's cap is kept and said (a warning line, `settling.capped` in `flyby.json`), and `--no-control`
+/// runs no control: no `control/`, and the outcome says its changes are the run's own.
+#[test]
+fn capped_settling_is_reported_and_no_control_skips_the_control() {
+    let dir = temp_dir("flyby-capped");
+    let target = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("targets/N30_T4.csv");
+    let out = rubblepile(
+        &dir,
+        &[
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--radius-m",
+            "170",
+            "--period-hours",
+            "30.5",
+            "--q-m",
+            "3.8e7",
+            "--v-inf-km-s",
+            "12",
+            "--settle-max-hours",
+            "0.5",
+            "--no-control",
+            "--snapshots",
+            "2",
+            "--out",
+            "run",
+        ],
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        stdout.contains("warning: settling stopped at its cap of 0.50 h"),
+        "{stdout}"
+    );
+    let setup: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/flyby.json")).unwrap()).unwrap();
+    assert_eq!(setup["settling"]["capped"], true, "{setup}");
+    assert_eq!(setup["settling"]["time"].as_f64(), Some(1800.0), "{setup}");
+    assert_eq!(setup["control"], false);
+    assert!(!dir.join("run/control").exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/analysis/flyby.json")).unwrap()).unwrap();
+    assert_eq!(json["tide"]["from_control"], false, "{json}");
+    assert!(json["control"].is_null());
+    // A cap that is not a positive time is refused, naming the flag's field.
+    let bad = rubblepile(
+        &dir,
+        &[
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--q-m",
+            "3.8e7",
+            "--settle-max-hours",
+            "0",
+            "--no-run",
+            "--out",
+            "bad",
+        ],
+    );
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("settle_max_hours"));
+}

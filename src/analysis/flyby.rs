@@ -9,11 +9,19 @@
 //! - **Shape**: the semi-axes `a ≥ b ≥ c` of the uniform ellipsoid with the remnant's inertia tensor (fragments as
 //!   uniform solids of their own axes, κ = 5/2): with principal moments `I₁ ≤ I₂ ≤ I₃`,
 //!   `a² = 5 (I₂ + I₃ − I₁)/(2M)` etc.; reported as `b/a`, `c/a`.
-//! - **Class** (our thresholds, after RBL98's S / B / M / N classes, which are by the fraction of mass shed):
-//!   `disrupted` (RBL98 "S", Shoemaker–Levy-9-like): the remnant keeps < 50 % of the mass; `mass loss` (RBL98 "B"
-//!   for 10–50 % lost, "M" below 10 %): any fragment lost; `reshaped` (RBL98 "N" with a shape change): no mass lost
-//!   but `b/a` or `c/a` changed by ≥ [`RESHAPE_THRESHOLD`]; `unaffected` otherwise (the spin change is reported in
-//!   every class).
+//! - **Spin state** ([`crate::ellipsoid::spin_state`]): principal-axis or tumbling (L–ω angle, `L²/2E` against the
+//!   principal moments, the precession and rotation periods of the free tumble), before and after.
+//! - **The tide's effect** (issue 41): a run of `rubblepile flyby` has a control run (`DIR/control/`, the same pile
+//!   over the same time without the planet); every change below is the run's minus the control's, so that what the
+//!   pile does by itself (settling, the cycle of a tumbler) cancels. Without a control the run's own changes are
+//!   used, and the outcome says so (`tide.from_control = false`).
+//! - **Class** (our thresholds, after RBL98's S / B / M / N classes, which are by the fraction of mass shed), from
+//!   the tide's effect: `disrupted` (RBL98 "S", Shoemaker–Levy-9-like): the tide took ≥ 50 % of the mass from the
+//!   remnant; `mass loss` (RBL98 "B" for 10–50 % lost, "M" below 10 %): the tide took any fragment; `reshaped`
+//!   (RBL98 "N" with a shape change): no mass lost but `b/a` or `c/a` changed by ≥ [`RESHAPE_THRESHOLD`];
+//!   `spin changed`: shape kept but the invariant period `π|L|/E` changed by ≥ [`SPIN_CHANGE_THRESHOLD`] of its
+//!   value before; `unaffected` otherwise. `π|L|/E` is `2π/|ω|` for principal-axis rotation and a constant of free
+//!   tumbling, so the phase of a tumbler's cycle (over which `2π/|ω|` of a snapshot varies) does not enter.
 
 use std::path::{Path, PathBuf};
 
@@ -22,12 +30,18 @@ use serde::Serialize;
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::impact::flyby::{FlybyArgs, run_flyby};
+use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
+use crate::ellipsoid::spin_state::{SpinState, spin_state_of_fit};
+use crate::impact::flyby::{CONTROL_DIR, FlybyArgs, run_flyby};
 use crate::impact::run::read_target;
+use crate::impact::settle::SettleReport;
 use crate::math::{Mat3, Vec3};
 
-/// Change of `b/a` or `c/a` (absolute) from which a pile that lost no mass counts as reshaped.
+/// Change of `b/a` or `c/a` (absolute, run minus control) from which a pile that lost no mass counts as reshaped.
 pub const RESHAPE_THRESHOLD: f64 = 0.02;
+/// Change of the invariant period `π|L|/E` (run minus control, relative to its value before) from which a pile
+/// that kept its mass and shape counts as `spin changed`.
+pub const SPIN_CHANGE_THRESHOLD: f64 = 0.01;
 /// Fraction of the mass the remnant must lose for a `disrupted` class (RBL98 "S": < 50 % retained).
 pub const DISRUPTED_LOST_FRACTION: f64 = 0.5;
 /// RBL98's boundary between "B" (break-up) and "M" (mild) mass loss.
@@ -52,9 +66,43 @@ pub struct Remnant {
     pub c_over_a: f64,
     /// Semi-major axis `a` of the equivalent ellipsoid (m).
     pub a_m: f64,
+    /// Rotation state of the remnant read as a rigid body.
+    pub spin: SpinState,
 }
 
-/// `analysis/flyby.json`: before (first snapshot) and after (last snapshot).
+/// One run's remnant before and after (the run with the planet, or its control).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct RunRemnants {
+    /// Largest remnant at the first snapshot.
+    pub before: Remnant,
+    /// Largest remnant at the last snapshot.
+    pub after: Remnant,
+    /// Mass lost from the largest remnant, `1 − M_after/M_total` (fraction).
+    pub mass_lost: f64,
+    /// `P_after − P_before` (h), `P = 2π/|ω|`.
+    pub delta_period_hours: f64,
+}
+
+/// The tide's effect: the run's changes minus the control's (module docs).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TideEffect {
+    /// Whether a control run was subtracted (false: the run's own changes).
+    pub from_control: bool,
+    /// Mass fraction lost from the remnant.
+    pub mass_lost: f64,
+    /// Fragments lost from the remnant (the control's remnant's count minus the run's, at the end).
+    pub fragments_lost: i64,
+    /// Change of `2π/|ω|` (h).
+    pub delta_period_hours: f64,
+    /// Change of the invariant period `π|L|/E` (h).
+    pub delta_invariant_period_hours: f64,
+    /// Change of `b/a`.
+    pub delta_b_over_a: f64,
+    /// Change of `c/a`.
+    pub delta_c_over_a: f64,
+}
+
+/// `analysis/flyby.json`: before (first snapshot) and after (last snapshot), of the run and of its control.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FlybyOutcome {
     /// Largest remnant at the first snapshot.
@@ -65,7 +113,14 @@ pub struct FlybyOutcome {
     pub mass_lost: f64,
     /// `P_after − P_before` (h).
     pub delta_period_hours: f64,
-    /// `disrupted`, `mass loss`, `reshaped` or `unaffected` (module docs).
+    /// The control run's remnants (`DIR/control/`), when there is one.
+    pub control: Option<RunRemnants>,
+    /// The tide's effect: run minus control.
+    pub tide: TideEffect,
+    /// How the pile was settled before the run (from `flyby.json`), when it was.
+    pub settling: Option<SettleReport>,
+    /// `disrupted`, `mass loss`, `reshaped`, `spin changed` or `unaffected`, from [`FlybyOutcome::tide`] (module
+    /// docs).
     pub class: String,
     /// RBL98's letter: S, B, M or N.
     pub rbl98_class: String,
@@ -150,21 +205,9 @@ pub fn remnant(t: f64, g: f64, bodies: &[Body], kappa_i: f64) -> Remnant {
         .map(|&i| bodies[i].position * bodies[i].shape.mass)
         .sum::<Vec3>()
         / m;
-    let v = ids
-        .iter()
-        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / m;
-    let mut l = Vec3::zeros();
-    for &i in &ids {
-        let b = &bodies[i];
-        let rot = rotation_matrix(&b.quaternion.normalize());
-        l += b.shape.mass * (b.position - r).cross(&(b.velocity - v));
-        l += rot.transpose() * b.shape.principal_moments(kappa_i).component_mul(&b.spin_body);
-    }
-    let omega = inertia_tensor(bodies, &ids, &r, kappa_i)
-        .try_inverse()
-        .map_or(Vec3::zeros(), |inv| inv * l);
+    let members: Vec<Body> = ids.iter().map(|&i| bodies[i].clone()).collect();
+    let moments: Vec<Vec3> = members.iter().map(|b| b.shape.principal_moments(kappa_i)).collect();
+    let fit = fit_rigid_rotation(&members, &moments);
     let shape = inertia_tensor(bodies, &ids, &r, 2.5);
     let mut moments: Vec<f64> = shape.symmetric_eigen().eigenvalues.iter().copied().collect();
     moments.sort_by(f64::total_cmp);
@@ -177,33 +220,73 @@ pub fn remnant(t: f64, g: f64, bodies: &[Body], kappa_i: f64) -> Remnant {
         fragments: ids.len(),
         mass: m,
         mass_fraction: m / total,
-        period_hours: 2.0 * std::f64::consts::PI / omega.norm() / 3600.0,
+        period_hours: fit.period() / 3600.0,
         b_over_a: (b2 / a2).sqrt(),
         c_over_a: (c2.max(0.0) / a2).sqrt(),
         a_m: a2.sqrt(),
+        spin: spin_state_of_fit(&fit),
     }
 }
 
-/// Classifies a flyby from the two remnants (module docs).
-pub fn classify(before: &Remnant, after: &Remnant) -> (String, String) {
-    let lost = 1.0 - after.mass_fraction;
+/// The tide's effect from the run's remnants and, when there is one, the control's (module docs).
+pub fn tide_effect(run: &RunRemnants, control: Option<&RunRemnants>) -> TideEffect {
+    let change = |r: &RunRemnants| {
+        (
+            r.mass_lost,
+            r.after.fragments as i64,
+            r.delta_period_hours,
+            r.after.spin.invariant_period_hours - r.before.spin.invariant_period_hours,
+            r.after.b_over_a - r.before.b_over_a,
+            r.after.c_over_a - r.before.c_over_a,
+        )
+    };
+    let (lost, n, dp, dpi, db, dc) = change(run);
+    match control {
+        Some(c) => {
+            let (lost_c, n_c, dp_c, dpi_c, db_c, dc_c) = change(c);
+            TideEffect {
+                from_control: true,
+                mass_lost: lost - lost_c,
+                fragments_lost: n_c - n,
+                delta_period_hours: dp - dp_c,
+                delta_invariant_period_hours: dpi - dpi_c,
+                delta_b_over_a: db - db_c,
+                delta_c_over_a: dc - dc_c,
+            }
+        }
+        None => TideEffect {
+            from_control: false,
+            mass_lost: lost,
+            fragments_lost: run.before.fragments as i64 - n,
+            delta_period_hours: dp,
+            delta_invariant_period_hours: dpi,
+            delta_b_over_a: db,
+            delta_c_over_a: dc,
+        },
+    }
+}
+
+/// Classifies the tide's effect `tide` on a pile whose invariant period before was `period_before_hours` (module
+/// docs): the class and RBL98's letter.
+pub fn classify(tide: &TideEffect, period_before_hours: f64) -> (String, String) {
+    let lost = tide.mass_lost;
     let letter = if lost >= DISRUPTED_LOST_FRACTION {
         "S"
     } else if lost >= RBL98_B_LOST_FRACTION {
         "B"
-    } else if after.fragments < before.fragments {
+    } else if tide.fragments_lost > 0 {
         "M"
     } else {
         "N"
     };
     let class = if lost >= DISRUPTED_LOST_FRACTION {
         "disrupted"
-    } else if after.fragments < before.fragments {
+    } else if tide.fragments_lost > 0 {
         "mass loss"
-    } else if (after.b_over_a - before.b_over_a).abs() >= RESHAPE_THRESHOLD
-        || (after.c_over_a - before.c_over_a).abs() >= RESHAPE_THRESHOLD
-    {
+    } else if tide.delta_b_over_a.abs() >= RESHAPE_THRESHOLD || tide.delta_c_over_a.abs() >= RESHAPE_THRESHOLD {
         "reshaped"
+    } else if (tide.delta_invariant_period_hours / period_before_hours).abs() >= SPIN_CHANGE_THRESHOLD {
+        "spin changed"
     } else {
         "unaffected"
     };
@@ -234,19 +317,8 @@ fn snapshot_files(dir: &Path) -> Result<Vec<PathBuf>, FlybyAnalysisError> {
     Ok(files.into_iter().map(|(_, p)| p).collect())
 }
 
-/// Analyses the flyby run in `dir` (first vs last snapshot) and writes `dir/analysis/flyby.json`, holding the lock
-/// of `dir/analysis/` (refused at once, [`FlybyAnalysisError::Locked`], while another process writes it).
-pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
-    let _lock = match crate::analysis::run_analysis::lock_analysis(dir, "scene.toml") {
-        Ok(lock) => lock,
-        Err(crate::analysis::run_analysis::AnalysisError::Locked(e)) => return Err(e.into()),
-        Err(e) => {
-            return Err(FlybyAnalysisError::File {
-                path: dir.join("analysis"),
-                message: e.to_string(),
-            });
-        }
-    };
+/// The largest remnant at the first and last snapshots of the run in `dir`.
+pub fn run_remnants(dir: &Path) -> Result<RunRemnants, FlybyAnalysisError> {
     let files = snapshot_files(dir)?;
     let scene = crate::ellipsoid::scene::load_scene(&dir.join("scene.toml")).ok();
     let (g, kappa_i) = scene.as_ref().map_or((G_SI, 2.5), |s| {
@@ -270,12 +342,49 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
     let (t1, last) = read(&files[files.len() - 1])?;
     let before = remnant(t0, g, &first, kappa_i);
     let after = remnant(t1, g, &last, kappa_i);
-    let (class, rbl98_class) = classify(&before, &after);
-    let outcome = FlybyOutcome {
+    Ok(RunRemnants {
         mass_lost: 1.0 - after.mass_fraction,
         delta_period_hours: after.period_hours - before.period_hours,
         before,
         after,
+    })
+}
+
+/// Analyses the flyby run in `dir` (first vs last snapshot) and writes `dir/analysis/flyby.json`, holding the lock
+/// of `dir/analysis/` (refused at once, [`FlybyAnalysisError::Locked`], while another process writes it).
+pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
+    let _lock = match crate::analysis::run_analysis::lock_analysis(dir, "scene.toml") {
+        Ok(lock) => lock,
+        Err(crate::analysis::run_analysis::AnalysisError::Locked(e)) => return Err(e.into()),
+        Err(e) => {
+            return Err(FlybyAnalysisError::File {
+                path: dir.join("analysis"),
+                message: e.to_string(),
+            });
+        }
+    };
+    // Read field by field: a control's flyby.json holds `"eccentricity": null` (infinite without a planet).
+    let setup: serde_json::Value = std::fs::read_to_string(dir.join("flyby.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok())
+        .unwrap_or_default();
+    let settling: Option<SettleReport> = serde_json::from_value(setup["settling"].clone()).ok();
+    let run = run_remnants(dir)?;
+    let control = if setup["control"].as_bool() == Some(true) && dir.join(CONTROL_DIR).join("snapshots").is_dir() {
+        Some(run_remnants(&dir.join(CONTROL_DIR))?)
+    } else {
+        None
+    };
+    let tide = tide_effect(&run, control.as_ref());
+    let (class, rbl98_class) = classify(&tide, run.before.spin.invariant_period_hours);
+    let outcome = FlybyOutcome {
+        mass_lost: run.mass_lost,
+        delta_period_hours: run.delta_period_hours,
+        before: run.before,
+        after: run.after,
+        control,
+        tide,
+        settling,
         class,
         rbl98_class,
     };
@@ -293,8 +402,8 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
 /// `rubblepile flyby`: prepares and runs the flyby of `args` ([`run_flyby`]), then analyses it ([`analyze_flyby`]);
 /// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request).
 pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
-    let summary = run_flyby(args, &crate::driver::RunOptions::default()).map_err(|e| (e.to_string(), e.exit_code()))?;
-    let Some(summary) = summary else {
+    let runs = run_flyby(args, &crate::driver::RunOptions::default()).map_err(|e| (e.to_string(), e.exit_code()))?;
+    let Some(runs) = runs else {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };
     let o = analyze_flyby(&args.out).map_err(|e| {
@@ -305,17 +414,59 @@ pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
         };
         (e.to_string(), code)
     })?;
-    Ok(vec![summary.one_line(), o.one_line()])
+    let mut lines = Vec::new();
+    lines.extend(runs.setup.settling.as_ref().map(settling_line));
+    lines.push(format!("run: {}", runs.run.one_line()));
+    if let Some(c) = &runs.control {
+        lines.push(format!("control ({}): {}", CONTROL_DIR, c.one_line()));
+    }
+    lines.extend(o.lines());
+    Ok(lines)
+}
+
+/// One line on the settling: its time, `K_rel/K`, the period, and a warning when the cap was reached.
+pub fn settling_line(s: &SettleReport) -> String {
+    let head = if s.capped {
+        format!(
+            "warning: settling stopped at its cap of {:.2} h before K_rel/K fell below {:e}",
+            s.max_time / 3600.0,
+            crate::impact::settle::SETTLE_NON_RIGID_FRACTION
+        )
+    } else {
+        format!("settled in {:.2} h", s.time / 3600.0)
+    };
+    format!(
+        "{head}: K_rel/K {:.1e} -> {:.1e}, P {:.3} h -> {:.3} h{}",
+        s.non_rigid_fraction_start,
+        s.non_rigid_fraction,
+        s.period_hours[0],
+        s.period_hours[1],
+        if s.set_to_principal {
+            ", then set into principal-axis rotation about the largest moment"
+        } else {
+            ""
+        }
+    )
 }
 
 impl FlybyOutcome {
-    /// One line for the terminal: class, mass lost, period and axis ratios before and after.
+    /// One line for the terminal: class, the tide's effect, and the run's period and axis ratios before and after.
     pub fn one_line(&self) -> String {
+        let t = &self.tide;
         format!(
-            "flyby: {} (RBL98 {}): mass lost {:.4}, P {:.3} h -> {:.3} h, b/a {:.3} -> {:.3}, c/a {:.3} -> {:.3}",
+            "flyby: {} (RBL98 {}), tide ({}): mass lost {:.4}, dP {:+.3} h (pi|L|/E {:+.3} h), d(b/a) {:+.4}, d(c/a) {:+.4}; run: P {:.3} h -> {:.3} h, b/a {:.3} -> {:.3}, c/a {:.3} -> {:.3}",
             self.class,
             self.rbl98_class,
-            self.mass_lost,
+            if t.from_control {
+                "run - control"
+            } else {
+                "run alone, no control"
+            },
+            t.mass_lost,
+            t.delta_period_hours,
+            t.delta_invariant_period_hours,
+            t.delta_b_over_a,
+            t.delta_c_over_a,
             self.before.period_hours,
             self.after.period_hours,
             self.before.b_over_a,
@@ -323,6 +474,15 @@ impl FlybyOutcome {
             self.before.c_over_a,
             self.after.c_over_a
         )
+    }
+
+    /// The lines for the terminal: the spin state before and after, then [`FlybyOutcome::one_line`].
+    pub fn lines(&self) -> Vec<String> {
+        vec![
+            format!("before: {}", self.before.spin.describe()),
+            format!("after: {}", self.after.spin.describe()),
+            self.one_line(),
+        ]
     }
 }
 

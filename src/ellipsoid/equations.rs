@@ -154,6 +154,11 @@ pub struct Diagnostics {
     pub energy_scale: f64,
     /// max over bodies of ||q| − 1|.
     pub quaternion_norm_error: f64,
+    /// Impulse of the flyby tide's net force `∫ Σ F_tide dt` so far (kg m/s); 0 without a tide (or a massless
+    /// planet). Integrated as state components ([`EllipsoidSystem::tide_impulse_index`]).
+    pub tidal_impulse: Vec3,
+    /// Impulse of the tide's torque about the origin `∫ Σ r × F_tide dt` so far (kg m²/s); 0 without a tide.
+    pub tidal_torque_impulse: Vec3,
 }
 
 impl Diagnostics {
@@ -614,6 +619,30 @@ impl EllipsoidSystem {
         self.physics.dissipation.map(|_| self.n_bodies() * self.stride)
     }
 
+    /// Index of the first of the six state components holding the tide's impulses (`∫ Σ F_tide dt`, then
+    /// `∫ Σ r × F_tide dt`), after the bodies and the dissipation integral; `None` without a tide or with a massless
+    /// planet (whose run stays bit-identical to one without `[physics.flyby]`). They let the run tell the momentum
+    /// the tide gave from the integration's error: `|L − L0 − ∫τ dt|` is an error, `∫τ dt` is physics.
+    pub fn tide_impulse_index(&self) -> Option<usize> {
+        self.tide
+            .filter(|t| t.gm != 0.0)
+            .map(|_| self.n_bodies() * self.stride + usize::from(self.physics.dissipation.is_some()))
+    }
+
+    /// Adds `Σ m a_tide` and `Σ r × m a_tide` at time `t` for `positions` to `rates[0..6]` (the impulses' rates).
+    fn add_tide_impulse_rates(&self, t: f64, positions: &[Vec3], rates: &mut [f64]) {
+        let Some(tide) = &self.tide else { return };
+        let planet = tide.planet_position(t);
+        let (mut force, mut torque) = (Vec3::zeros(), Vec3::zeros());
+        for (r, m) in positions.iter().zip(&self.masses) {
+            let f = tide.acceleration(r, &planet) * *m;
+            force += f;
+            torque += r.cross(&f);
+        }
+        rates[0..3].copy_from_slice(force.as_slice());
+        rates[3..6].copy_from_slice(torque.as_slice());
+    }
+
     fn kinematics(&self, i: usize, y: &[f64], with_geometry: bool) -> Kinematics {
         let s = &y[i * self.stride..(i + 1) * self.stride];
         let r = Vec3::new(s[0], s[1], s[2]);
@@ -956,6 +985,10 @@ impl EllipsoidSystem {
         if let Some(idx) = self.dissipation_index() {
             d.dissipated = 2.0 * y[idx];
         }
+        if let Some(idx) = self.tide_impulse_index() {
+            d.tidal_impulse = Vec3::new(y[idx], y[idx + 1], y[idx + 2]);
+            d.tidal_torque_impulse = Vec3::new(y[idx + 3], y[idx + 4], y[idx + 5]);
+        }
         d.energy_scale =
             d.kinetic_translational + d.kinetic_rotational + d.potential_contact.abs() + d.potential_gravity.abs();
         d
@@ -1028,14 +1061,17 @@ pub fn constrained_momentum_rate_closed_form(q: &Vec4, g: &Vec4, m_inv_q: &Vec4,
 
 impl OdeSystem for EllipsoidSystem {
     fn dim(&self) -> usize {
-        self.n_bodies() * self.stride + usize::from(self.physics.dissipation.is_some())
+        self.n_bodies() * self.stride
+            + usize::from(self.physics.dissipation.is_some())
+            + if self.tide_impulse_index().is_some() { 6 } else { 0 }
     }
 
     /// User units of the state blocks (see [`OdeSystem::state_units`]): `r` 1 (m), `q` 1 (an attitude error of
     /// `δq` is about `2 δq` rad), `u` the body's mass `m` (kg, so the norm sees m/s), `p` twice the mean principal
     /// moment `2 (I₁ + I₂ + I₃)/3` (kg m², since `p = 2 W(q)ᵀ (I ω, 0)` has `|p| ≈ 2 I |ω|`: the norm sees rad/s),
     /// and `∫F dt` the initial energy scale `K + |U_C| + |U_G|` (J, so the dissipated energy is judged relative
-    /// to the system's energy; 1 J if that is zero).
+    /// to the system's energy; 1 J if that is zero); the tide's impulses the total mass `M` (kg: the norm sees
+    /// m/s) and `M R²` (kg m², `R` the largest body distance from the origin plus its major semi-axis: rad/s).
     fn state_units(&self) -> Option<Vec<f64>> {
         let mut units = vec![1.0; self.dim()];
         for (i, chunk) in units.chunks_exact_mut(self.stride).enumerate() {
@@ -1051,6 +1087,16 @@ impl OdeSystem for EllipsoidSystem {
         if let Some(idx) = self.dissipation_index() {
             let scale = self.diagnostics(&self.initial_state()).energy_scale;
             units[idx] = if scale.is_finite() && scale > 0.0 { scale } else { 1.0 };
+        }
+        if let Some(idx) = self.tide_impulse_index() {
+            let mass: f64 = self.masses.iter().sum();
+            let reach = self
+                .initial
+                .iter()
+                .map(|b| b.position.norm() + b.shape.axes.x)
+                .fold(0.0, f64::max);
+            units[idx..idx + 3].fill(mass);
+            units[idx + 3..idx + 6].fill(mass * reach * reach);
         }
         Some(units)
     }
@@ -1103,6 +1149,12 @@ impl OdeSystem for EllipsoidSystem {
                         *o += fk;
                     }
                 }
+            }
+            if let Some(idx) = self.tide_impulse_index() {
+                let positions: Vec<Vec3> = (0..n)
+                    .map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]))
+                    .collect();
+                self.add_tide_impulse_rates(t, &positions, &mut dydt[idx..idx + 6]);
             }
             return;
         }
@@ -1231,8 +1283,14 @@ impl OdeSystem for EllipsoidSystem {
                 bodies.chunks_mut(stride).enumerate().for_each(body_rate);
             }
         });
-        if let Some(slot) = rest.first_mut() {
+        if self.physics.dissipation.is_some()
+            && let Some(slot) = rest.first_mut()
+        {
             *slot = dissipation_rate;
+        }
+        if let Some(idx) = self.tide_impulse_index() {
+            let at = idx - n * stride;
+            self.add_tide_impulse_rates(t, positions, &mut rest[at..at + 6]);
         }
     }
 }

@@ -95,10 +95,18 @@ pub struct RunSummary {
     pub smallest_step: Option<f64>,
     /// max |H(t) − H0 − dissipated(t)| / energy scale (dissipated = 2∫F dt since t = 0).
     pub energy_error: f64,
-    /// max |P(t) − P0| / momentum scale.
+    /// max |P(t) − P0 − ∫F_tide dt| / momentum scale (the tide's impulse, in a flyby, is not an error).
     pub linear_momentum_error: f64,
-    /// max |L(t) − L0| / angular-momentum scale.
+    /// max |L(t) − L0 − ∫τ_tide dt| / angular-momentum scale (τ_tide the flyby tide's torque about the origin).
     pub angular_momentum_error: f64,
+    /// In a flyby (planet mass > 0): max |∫F_tide dt| / momentum scale, the momentum the tide gave the pile
+    /// (physics, not an error); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tidal_impulse: Option<f64>,
+    /// In a flyby: max |∫τ_tide dt| / angular-momentum scale, the angular momentum the tide's torque gave the pile
+    /// (physics, not an error); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tidal_torque_impulse: Option<f64>,
     /// max over sampled times and bodies of ||q| − 1|.
     pub quaternion_norm_error: f64,
     /// Scales of the three relative errors and their definitions.
@@ -166,8 +174,12 @@ impl RunSummary {
     /// `done: t = 200 s, wall 1.23 s, steps 456 (12 rejected), RHS 7890, energy error 3.1e-11, |dP| 1e-16, |dL| 2e-15, max||q|-1| 1e-12`.
     pub fn one_line(&self) -> String {
         let head = if self.completed() { "done" } else { "stopped" };
+        let tide = match (self.tidal_impulse, self.tidal_torque_impulse) {
+            (Some(p), Some(l)) => format!(" (tide's impulse, not errors: |int F dt| {p:.1e}, |int tau dt| {l:.1e})"),
+            _ => String::new(),
+        };
         format!(
-            "{head}: t = {} s, wall {:.2} s, steps {} ({} rejected), RHS {}, energy error {:.1e}, |dP| {:.1e}, |dL| {:.1e}, max||q|-1| {:.1e}",
+            "{head}: t = {} s, wall {:.2} s, steps {} ({} rejected), RHS {}, energy error {:.1e}, |dP| {:.1e}, |dL| {:.1e}, max||q|-1| {:.1e}{tide}",
             self.final_time,
             self.wall_seconds,
             self.steps_accepted,

@@ -7,6 +7,13 @@
 //! run directory `initial_bodies.csv`, `flyby.json` ([`FlybySetup`]) and `scene.toml` (gravity, contact,
 //! dissipation, the flyby; Bulirsch–Stoer). The run starts with the planet at `start_q · q` on the way in and ends
 //! at the same distance on the way out. The same run again: `rubblepile run DIR/scene.toml --out OTHER`.
+//!
+//! **A fair flyby** (issue 41): a pile that was rescaled or re-spun is first settled without tide
+//! ([`crate::impact::settle`]; the pile as prepared is kept as `prepared_bodies.csv`, the settled one is
+//! `initial_bodies.csv`, the run's "before"), optionally put into principal-axis rotation about its largest moment
+//! (`--settle-to-principal`), and a control run of the same pile over the same time without the planet (mass 0)
+//! goes into `DIR/control/` unless `--no-control`: the tide's effect is the run minus the control
+//! ([`crate::analysis::flyby`]).
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +27,7 @@ use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
 use crate::impact::run::{ImpactError, read_target};
+use crate::impact::settle::{SETTLE_MAX_FREE_FALLS, SettleReport, free_fall_time, set_principal_axis_rotation, settle};
 use crate::io::run_lock::DirLock;
 use crate::math::Vec3;
 
@@ -43,10 +51,12 @@ pub struct FlybyArgs {
     /// Target bodies file (snapshot columns, e.g. from `rubblepile target build`).
     #[arg(long)]
     pub target: PathBuf,
-    /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A) [default: as built].
+    /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A); a rescaled pile is
+    /// settled before the run [default: as built].
     #[arg(long)]
     pub radius_m: Option<f64>,
-    /// Set the pile into rigid rotation about its z axis with this period (hours) [default: the target's spins].
+    /// Set the pile into rigid rotation about its z axis with this period (hours); a re-spun pile is settled before
+    /// the run [default: the target's spins].
     #[arg(long)]
     pub period_hours: Option<f64>,
     /// Planet mass (kg; 0 for a control run without tide, the frame then moves straight at v∞) [default: Earth].
@@ -81,7 +91,7 @@ pub struct FlybyArgs {
     /// Dissipation F0 (s m⁻²) [default: 1e-6 (100 km/R)², R the pile's apparent radius].
     #[arg(long)]
     pub f0: Option<f64>,
-    /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run.
+    /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run (and over the settling).
     #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
     /// Number of snapshots, evenly spaced from start to end (2 to 100000).
@@ -93,9 +103,19 @@ pub struct FlybyArgs {
     /// Overwrite an earlier run in DIR.
     #[arg(long)]
     pub force: bool,
-    /// Write the run directory (scene, bodies) but do not run it.
+    /// Write the run directory (scene, bodies) but do not run it (the pile is still settled when it would be).
     #[arg(long)]
     pub no_run: bool,
+    /// Skip the control run without the planet (by default it runs into DIR/control over the same time).
+    #[arg(long)]
+    pub no_control: bool,
+    /// After settling, put the pile into rigid rotation about its axis of largest moment with the same |L|
+    /// (settles an as-built pile too).
+    #[arg(long)]
+    pub settle_to_principal: bool,
+    /// Cap on the settling time (hours) [default: 100 free-fall times √(3π/(32 G ρ)) of the pile].
+    #[arg(long)]
+    pub settle_max_hours: Option<f64>,
 }
 
 /// What `flyby.json` records about a flyby run (SI units).
@@ -139,6 +159,41 @@ pub struct FlybySetup {
     /// The planet's spin axis in the frame (with `j2`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pole: Option<[f64; 3]>,
+    /// Whether a control run without the planet goes into `control/` (absent in older runs: none).
+    #[serde(default)]
+    pub control: bool,
+    /// How the pile was settled before the run (absent: it was not).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub settling: Option<SettleReport>,
+}
+
+/// The frame origin's hyperbolic orbit about a planet of `gm` (m³ s⁻²) with perigee `q` (m) and speed at infinity
+/// `v_inf` (m/s), and the time (s) from `start_q · q` on the way in to perigee: half the run's duration.
+pub fn flyby_orbit(gm: f64, q: f64, v_inf: f64, start_q: f64) -> Result<(KeplerOrbit, f64), ImpactError> {
+    let rot = orientation_matrix(0.0, 0.0, 0.0);
+    let orbit = KeplerOrbit::hyperbolic(gm, q, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let t_perigee = orbit
+        .time_from_perigee_at_distance(start_q * q)
+        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
+    Ok((orbit, t_perigee))
+}
+
+/// Subfolder of a flyby run directory that holds its control run (the same pile and time, no planet).
+pub const CONTROL_DIR: &str = "control";
+
+/// `n ≥ 2` output times evenly spaced over `[0, t_end]` (s), the last exactly `t_end`: `t_end·k/(n − 1)` can round
+/// one ulp above `t_end`, which the scene check refuses, so every time is clamped to `t_end`.
+pub fn output_times(t_end: f64, n: usize) -> Vec<f64> {
+    let last = n.saturating_sub(1).max(1);
+    (0..n)
+        .map(|k| {
+            if k == last {
+                t_end
+            } else {
+                (t_end * k as f64 / last as f64).min(t_end)
+            }
+        })
+        .collect()
 }
 
 fn invalid(field: &str, message: String) -> ImpactError {
@@ -208,6 +263,7 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         ("period_hours", args.period_hours.unwrap_or(1.0)),
         ("kappa", args.kappa.unwrap_or(2.0)),
         ("f0", args.f0.unwrap_or(1.0)),
+        ("settle_max_hours", args.settle_max_hours.unwrap_or(1.0)),
     ] {
         if !positive(x) {
             return Err(invalid(field, format!("must be > 0 and finite, got {x}")));
@@ -304,15 +360,12 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         .unwrap_or(F0_REFERENCE * (F0_REFERENCE_RADIUS_M / radius).powi(2));
     let gm = G_SI * args.planet_mass;
     let v_inf = args.v_inf_km_s * 1e3;
-    let rot = orientation_matrix(0.0, 0.0, 0.0);
-    let orbit = KeplerOrbit::hyperbolic(gm, args.q_m, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let (orbit, t_perigee) = flyby_orbit(gm, args.q_m, v_inf, args.start_q)?;
     let start_distance = args.start_q * args.q_m;
-    let t_perigee = orbit
-        .time_from_perigee_at_distance(start_distance)
-        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
     let t_end = 2.0 * t_perigee;
-    let times: Vec<String> = (0..args.snapshots)
-        .map(|k| format!("{:?}", t_end * k as f64 / (args.snapshots - 1) as f64))
+    let times: Vec<String> = output_times(t_end, args.snapshots)
+        .iter()
+        .map(|t| format!("{t:?}"))
         .collect();
     let setup = FlybySetup {
         target: args.target.display().to_string(),
@@ -333,6 +386,8 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         f0,
         j2: args.planet_j2,
         pole,
+        control: !args.no_control,
+        settling: None,
     };
     let title = format!(
         "Flyby of {} (R = {radius:.1} m) at q = {:.4e} m ({:.2} planet radii), v_inf = {} km/s",
@@ -341,8 +396,9 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         args.q_m / args.planet_radius_m,
         args.v_inf_km_s
     );
-    let scene_toml = format!(
-        "# {title}\n# Generated by `rubblepile flyby`; the same run: `rubblepile run scene.toml --out OTHER_DIR`.\n\
+    let scene_text = |planet_mass: f64, title: &str| {
+        format!(
+            "# {title}\n# Generated by `rubblepile flyby`; the same run: `rubblepile run scene.toml --out OTHER_DIR`.\n\
          [scene]\nkind = \"ellipsoids\"\nt_end = {t_end:?}\nbodies_file = \"initial_bodies.csv\"\n\n\
          [model]\nkappa = {kappa:?}\n\n\
          [physics]\ngravity = {{}}\ncontact = {{}}\ndissipation = {{ F0 = {f0:?} }}\n\n\
@@ -350,20 +406,22 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
          orientation_deg = [{o0:?}, {o1:?}, {o2:?}]\n{zonal}\n\
          [integrator]\nmethod = \"bulirsch-stoer\"\nrtol = {rtol:?}\natol = {rtol:?}\n\n\
          [output]\ntimes = [{times}]\nevery = {every:?}\n",
-        mass = args.planet_mass,
-        pr = args.planet_radius_m,
-        q = args.q_m,
-        o0 = orientation[0],
-        o1 = orientation[1],
-        o2 = orientation[2],
-        rtol = args.rtol,
-        times = times.join(", "),
-        every = t_end / 400.0,
-        zonal = match (args.planet_j2, pole) {
-            (Some(j2), Some([x, y, z])) => format!("j2 = {j2:?}\npole = [{x:?}, {y:?}, {z:?}]\n"),
-            _ => String::new(),
-        },
-    );
+            mass = planet_mass,
+            pr = args.planet_radius_m,
+            q = args.q_m,
+            o0 = orientation[0],
+            o1 = orientation[1],
+            o2 = orientation[2],
+            rtol = args.rtol,
+            times = times.join(", "),
+            every = t_end / 400.0,
+            zonal = match (args.planet_j2, pole) {
+                (Some(j2), Some([x, y, z])) => format!("j2 = {j2:?}\npole = [{x:?}, {y:?}, {z:?}]\n"),
+                _ => String::new(),
+            },
+        )
+    };
+    let scene_toml = scene_text(args.planet_mass, &title);
     let out = &args.out;
     let lock = prepare_output_dir(out, args.force)?;
     let io = |p: &Path| {
@@ -372,18 +430,70 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     };
     let bodies_path = out.join("initial_bodies.csv");
     write_snapshot(&bodies_path, 0.0, &bodies).map_err(io(&bodies_path))?;
+    let scene_path = out.join("scene.toml");
+    std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
+    let mut scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
+    let mut setup = setup;
+    if args.radius_m.is_some() || args.period_hours.is_some() || args.settle_to_principal {
+        let prepared_path = out.join("prepared_bodies.csv");
+        write_snapshot(&prepared_path, 0.0, &bodies).map_err(io(&prepared_path))?;
+        let max_time = args.settle_max_hours.map_or_else(
+            || SETTLE_MAX_FREE_FALLS * free_fall_time(setup.mass, radius),
+            |h| h * 3600.0,
+        );
+        let (mut settled, mut report) = settle(&scene.bodies, scene.model, scene.physics, args.rtol, max_time)
+            .map_err(|e| ImpactError::Run(crate::driver::RunError::Setup(format!("settling the pile: {e}"))))?;
+        if args.settle_to_principal {
+            let moments: Vec<Vec3> = settled
+                .iter()
+                .map(|b| b.shape.principal_moments(scene.model.inertia.inertia_kappa(kappa)))
+                .collect();
+            set_principal_axis_rotation(&mut settled, &moments);
+            report.set_to_principal = true;
+        }
+        write_snapshot(&bodies_path, 0.0, &settled).map_err(io(&bodies_path))?;
+        scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
+        setup.settling = Some(report);
+    }
     let json_path = out.join("flyby.json");
     let json = serde_json::to_string_pretty(&setup).unwrap_or_default() + "\n";
     std::fs::write(&json_path, json).map_err(io(&json_path))?;
-    let scene_path = out.join("scene.toml");
-    std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
-    let scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
+    if !args.no_control {
+        let dir = out.join(CONTROL_DIR);
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        let control_bodies = dir.join("initial_bodies.csv");
+        std::fs::copy(&bodies_path, &control_bodies).map_err(io(&control_bodies))?;
+        let control_toml = scene_text(
+            0.0,
+            "Control of the flyby in the directory above: the same pile and duration, no planet (mass 0)",
+        );
+        let control_path = dir.join("scene.toml");
+        std::fs::write(&control_path, &control_toml).map_err(io(&control_path))?;
+    }
     Ok((scene, setup, lock))
 }
 
-/// Prepares and (unless `no_run`) runs the flyby of `args`; the run's summary, if run.
-pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<crate::driver::RunSummary>, ImpactError> {
-    let (scene, _, _lock) = prepare_flyby(args)?;
+/// The control run's scene of the flyby directory `dir` (written by [`prepare_flyby`]).
+pub fn control_scene(dir: &Path) -> Result<LoadedScene, ImpactError> {
+    Ok(crate::ellipsoid::scene::load_scene(
+        &dir.join(CONTROL_DIR).join("scene.toml"),
+    )?)
+}
+
+/// The summaries of a flyby run and of its control (when run).
+#[derive(Debug, Clone)]
+pub struct FlybyRuns {
+    /// The run with the planet.
+    pub run: crate::driver::RunSummary,
+    /// The control run without it, in `DIR/control/`.
+    pub control: Option<crate::driver::RunSummary>,
+    /// What `flyby.json` records.
+    pub setup: FlybySetup,
+}
+
+/// Prepares and (unless `no_run`) runs the flyby of `args`, then its control (unless `no_control`).
+pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<FlybyRuns>, ImpactError> {
+    let (scene, setup, _lock) = prepare_flyby(args)?;
     if args.no_run {
         return Ok(None);
     }
@@ -391,5 +501,16 @@ pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<crate:
         force: true,
         ..*options
     };
-    Ok(Some(crate::driver::run_scene(&scene, &args.out, &options)?))
+    let run = crate::driver::run_scene(&scene, &args.out, &options)?;
+    let control = if setup.control {
+        let control = control_scene(&args.out)?;
+        Some(crate::driver::run_scene(
+            &control,
+            &args.out.join(CONTROL_DIR),
+            &options,
+        )?)
+    } else {
+        None
+    };
+    Ok(Some(FlybyRuns { run, control, setup }))
 }

@@ -13,5 +13,6 @@ pub mod flyby;
 pub mod pile;
 pub mod projectile;
 pub mod run;
+pub mod settle;
 pub mod target;
 pub mod target_checkpoint;

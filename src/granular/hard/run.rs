@@ -73,15 +73,32 @@ pub struct HardRunSummary {
     pub energy_initial: f64,
     /// Total energy at the end (J).
     pub energy_final: f64,
-    /// Largest |E − E0| / scale over the samples (scale = max(|E0|, kinetic at t = 0)).
+    /// The error: largest |E − E0 − exchanged| / scale over the samples (scale = max(|E0|, kinetic at t = 0)), the
+    /// bookkeeping residual once the energy lost to restitution, the walls' work and what sticking and absorbed
+    /// particles took away are accounted for.
     pub energy_error: f64,
-    /// Largest |E − E0 − exchanged| / scale: the integration error once the energy changed by inelastic
-    /// collisions, moving walls, sticking and absorption is accounted for.
-    pub energy_residual: f64,
-    /// Energy exchanged in collisions, sticking and absorption (J).
+    /// Largest |E − E0| / scale: how much the energy changed (physics, not an error, with restitution < 1 or moving
+    /// walls).
+    pub energy_change: f64,
+    /// Energy exchanged in collisions, sticking and absorption (J): `energy_restitution + energy_walls +
+    /// energy_removed`.
     pub energy_exchanged: f64,
-    /// Largest |P − P0| (kg m/s).
+    /// Energy lost to restitution (J, ≤ 0 for restitution ≤ 1), in the frame of each contact.
+    pub energy_restitution: f64,
+    /// Work done by moving walls on the free particles (J).
+    pub energy_walls: f64,
+    /// Energy taken out with particles that stuck or were absorbed (J).
+    pub energy_removed: f64,
+    /// The error: largest |P − P0 − J_walls − J_field| (kg m/s), the momentum residual once the walls' and the
+    /// gravity field's impulses are accounted for.
     pub momentum_error: f64,
+    /// Largest |P − P0| (kg m/s): how much the momentum changed (physics, not an error, with walls or gravity).
+    pub momentum_change: f64,
+    /// |J_walls| at the end (kg m/s): momentum the walls gave the free particles (bounces, stuck particles'
+    /// contacts, minus what sticking and absorbed particles took away).
+    pub wall_impulse: f64,
+    /// |J_field| at the end (kg m/s): momentum the uniform gravity field gave the free particles.
+    pub field_impulse: f64,
     /// Collisions applied (pairs + walls).
     pub collisions: u64,
     /// Particle–particle collisions.
@@ -143,6 +160,9 @@ pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<
     w.flush()
 }
 
+/// Numbers in a checkpoint's bookkeeping ([`HardState`]'s `book`).
+const BOOK_LEN: usize = 20;
+
 /// Numbers per particle in a checkpoint.
 const PARTICLE_STATE: usize = 16;
 
@@ -151,9 +171,10 @@ const PARTICLE_STATE: usize = 16;
 struct Book {
     e0: f64,
     scale: f64,
-    energy_error: f64,
+    energy_change: f64,
     energy_residual: f64,
     momentum_error: f64,
+    momentum_change: f64,
     p0: Vec3,
 }
 
@@ -212,14 +233,19 @@ impl HardRunSummary {
     /// One line for the terminal.
     pub fn one_line(&self) -> String {
         format!(
-            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy residual {:.2e} (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
+            "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy error {:.2e} (change {:.2e}: restitution {:.2e} J, walls {:.2e} J, removed {:.2e} J), momentum error {:.2e} kg m/s (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
             self.status,
             self.t_reached,
             self.steps,
             self.collisions,
             self.events_per_second,
-            self.energy_residual,
             self.energy_error,
+            self.energy_change,
+            self.energy_restitution,
+            self.energy_walls,
+            self.energy_removed,
+            self.momentum_error,
+            self.momentum_change,
             self.max_overlap,
             self.absorbed,
             self.wall_seconds
@@ -248,7 +274,9 @@ pub struct HardState {
     allowances: Vec<f64>,
     /// pair, wall, events, guarded, rebuilds, re-anchors, absorbed.
     counts: [u64; 7],
-    /// max_overlap, energy_exchanged, then the run's book: E0, scale, energy error, residual, momentum error, P0.
+    /// max_overlap, energy_exchanged, then the run's book: E0, scale, energy change, residual, momentum error, P0;
+    /// then the energy lost to restitution, the walls' work, the energy removed, the walls' and the field's
+    /// impulses and the largest momentum change.
     #[serde(with = "exact_f64_vec")]
     book: Vec<f64>,
     /// Counters at the last time-series row: collisions, pair, wall, events.
@@ -280,9 +308,10 @@ impl HardEngine {
         let book = Book {
             e0: d0.energy(),
             scale: d0.energy().abs().max(d0.kinetic + d0.rotational).max(f64::MIN_POSITIVE),
-            energy_error: 0.0,
+            energy_change: 0.0,
             energy_residual: 0.0,
             momentum_error: 0.0,
+            momentum_change: 0.0,
             p0: d0.momentum,
         };
         HardEngine {
@@ -398,11 +427,14 @@ impl Engine for HardEngine {
         let d: Diagnostics = system.diagnostics();
         let c = system.counters;
         let e = d.energy();
-        book.energy_error = book.energy_error.max((e - book.e0).abs() / book.scale);
+        book.energy_change = book.energy_change.max((e - book.e0).abs() / book.scale);
         book.energy_residual = book
             .energy_residual
             .max((e - book.e0 - c.energy_exchanged).abs() / book.scale);
-        book.momentum_error = book.momentum_error.max((d.momentum - book.p0).norm());
+        book.momentum_change = book.momentum_change.max((d.momentum - book.p0).norm());
+        book.momentum_error = book
+            .momentum_error
+            .max((d.momentum - book.p0 - c.wall_impulse - c.field_impulse).norm());
         let [last_coll, last_pair, last_wall, last_events] = self.last_counts;
         let coll = c.pair_collisions + c.wall_collisions;
         let eps = if wall > self.last_wall_clock {
@@ -500,10 +532,16 @@ impl Engine for HardEngine {
             wall_seconds,
             energy_initial: book.e0,
             energy_final: d.energy(),
-            energy_error: book.energy_error,
-            energy_residual: book.energy_residual,
+            energy_error: book.energy_residual,
+            energy_change: book.energy_change,
             energy_exchanged: c.energy_exchanged,
+            energy_restitution: c.energy_restitution,
+            energy_walls: c.energy_walls,
+            energy_removed: c.energy_removed,
             momentum_error: book.momentum_error,
+            momentum_change: book.momentum_change,
+            wall_impulse: c.wall_impulse.norm(),
+            field_impulse: c.field_impulse.norm(),
             collisions: c.pair_collisions + c.wall_collisions,
             pair_collisions: c.pair_collisions,
             wall_collisions: c.wall_collisions,
@@ -549,12 +587,22 @@ impl Engine for HardEngine {
                 c.energy_exchanged,
                 book.e0,
                 book.scale,
-                book.energy_error,
+                book.energy_change,
                 book.energy_residual,
                 book.momentum_error,
                 book.p0.x,
                 book.p0.y,
                 book.p0.z,
+                c.energy_restitution,
+                c.energy_walls,
+                c.energy_removed,
+                c.wall_impulse.x,
+                c.wall_impulse.y,
+                c.wall_impulse.z,
+                c.field_impulse.x,
+                c.field_impulse.y,
+                c.field_impulse.z,
+                book.momentum_change,
             ],
             last_counts: self.last_counts,
             last_wall_clock: self.last_wall_clock,
@@ -581,9 +629,14 @@ impl HardEngine {
             n => return Err(format!("{n} anchor numbers for {} particles", system.particles.len())),
         };
         system.restore_neighbours(anchors)?;
-        if ck.book.len() != 10 {
-            return Err("malformed bookkeeping".into());
+        if ck.book.len() != BOOK_LEN {
+            return Err(format!(
+                "malformed bookkeeping: {} numbers, expected {BOOK_LEN} (a checkpoint from before the energy and \
+                 momentum exchanges were split cannot be resumed)",
+                ck.book.len()
+            ));
         }
+        let v3 = |k: usize| Vec3::new(ck.book[k], ck.book[k + 1], ck.book[k + 2]);
         let [pair, wall, events, guarded, rebuilds, reanchors, absorbed] = ck.counts;
         system.counters = Counters {
             pair_collisions: pair,
@@ -595,14 +648,20 @@ impl HardEngine {
             absorbed,
             max_overlap: ck.book[0],
             energy_exchanged: ck.book[1],
+            energy_restitution: ck.book[10],
+            energy_walls: ck.book[11],
+            energy_removed: ck.book[12],
+            wall_impulse: v3(13),
+            field_impulse: v3(16),
         };
         self.book = Book {
             e0: ck.book[2],
             scale: ck.book[3],
-            energy_error: ck.book[4],
+            energy_change: ck.book[4],
             energy_residual: ck.book[5],
             momentum_error: ck.book[6],
-            p0: Vec3::new(ck.book[7], ck.book[8], ck.book[9]),
+            momentum_change: ck.book[19],
+            p0: v3(7),
         };
         self.steps = ck.steps;
         self.last_counts = ck.last_counts;

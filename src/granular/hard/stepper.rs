@@ -150,8 +150,22 @@ pub struct Counters {
     /// Largest overlap seen at a collision, relative to the smaller radius.
     pub max_overlap: f64,
     /// Energy (J) changed by collisions, sticking and absorption (so that `E − E0 − exchanged` is the integration
-    /// error).
+    /// error): the sum of `energy_restitution`, `energy_walls` and `energy_removed`.
     pub energy_exchanged: f64,
+    /// Energy (J) the collisions lost in the frame of the contact (restitution: ≤ 0 for restitution ≤ 1): the
+    /// kinetic energy change minus the walls' work.
+    pub energy_restitution: f64,
+    /// Work (J) of moving walls on the free particles: each wall collision's impulse `J = m Δv` times the wall's
+    /// surface velocity at the contact (also for contacts with particles stuck to a wall).
+    pub energy_walls: f64,
+    /// Energy (J) that sticking and absorbed particles took out of the free particles' total (≤ 0 when it was
+    /// positive).
+    pub energy_removed: f64,
+    /// Momentum (kg m/s) the walls gave the free particles: bounces, contacts with stuck particles, and minus the
+    /// momentum of particles that stuck or were absorbed.
+    pub wall_impulse: Vec3,
+    /// Momentum (kg m/s) the uniform gravity field gave the free particles (its kicks).
+    pub field_impulse: Vec3,
 }
 
 /// Energies and momenta of the free particles (stuck particles belong to their wall).
@@ -610,9 +624,12 @@ impl System {
 
     fn kick(&mut self, dt: f64) {
         if let Some(g) = self.settings.gravity {
+            let mut kicked = 0.0;
             for p in self.particles.iter_mut().filter(|p| p.alive && p.stuck.is_none()) {
                 p.velocity += g * dt;
+                kicked += p.mass;
             }
+            self.counters.field_impulse += g * (dt * kicked);
         }
     }
 
@@ -1036,6 +1053,7 @@ impl System {
         let collapse = self.settings.collapse_speed;
         let e_before = pi.kinetic_energy() * f64::from(pi.stuck.is_none() as u8)
             + pj.kinetic_energy() * f64::from(pj.stuck.is_none() as u8);
+        let mut wall_work = 0.0;
         let outcome = match (pi.stuck, pj.stuck) {
             (None, None) => {
                 let r = Restitution {
@@ -1068,6 +1086,9 @@ impl System {
                 };
                 let mut b = Self::body(pf);
                 let o = collision::resolve_wall(&mut b, &n, &surface, r, collapse);
+                let impulse = (b.velocity - pf.velocity) * pf.mass;
+                self.counters.wall_impulse += impulse;
+                wall_work = impulse.dot(&surface);
                 self.particles[free].velocity = b.velocity;
                 self.particles[free].spin = b.spin;
                 o
@@ -1081,6 +1102,8 @@ impl System {
         let e_after = pi.kinetic_energy() * f64::from(pi.stuck.is_none() as u8)
             + pj.kinetic_energy() * f64::from(pj.stuck.is_none() as u8);
         self.counters.energy_exchanged += e_after - e_before;
+        self.counters.energy_walls += wall_work;
+        self.counters.energy_restitution += e_after - e_before - wall_work;
     }
 
     fn collide_wall(&mut self, d: &Drift, i: usize, w: usize, t: f64) {
@@ -1106,6 +1129,8 @@ impl System {
                 .map(|g| -p.mass * g.dot(&p.position))
                 .unwrap_or(0.0);
             self.counters.energy_exchanged -= e_before + g_pot;
+            self.counters.energy_removed -= e_before + g_pot;
+            self.counters.wall_impulse -= p.velocity * p.mass;
             self.counters.absorbed += 1;
             self.floor = None;
             self.neighbours.grid.remove(i);
@@ -1119,6 +1144,8 @@ impl System {
                 .map(|g| -p.mass * g.dot(&p.position))
                 .unwrap_or(0.0);
             self.counters.energy_exchanged -= e_before + g_pot;
+            self.counters.energy_removed -= e_before + g_pot;
+            self.counters.wall_impulse -= p.velocity * p.mass;
             let att = Attachment {
                 wall: w,
                 offset: wall.to_local(&(p.position - origin_now)),
@@ -1144,9 +1171,15 @@ impl System {
         let mut b = Self::body(p);
         let o = collision::resolve_wall(&mut b, &n, &surface, r, self.settings.collapse_speed);
         self.counters.guarded += u64::from(o.guarded);
+        let impulse = (b.velocity - p.velocity) * p.mass;
+        let wall_work = impulse.dot(&surface);
         let p = &mut self.particles[i];
         p.velocity = b.velocity;
         p.spin = b.spin;
-        self.counters.energy_exchanged += p.kinetic_energy() - e_before;
+        let change = p.kinetic_energy() - e_before;
+        self.counters.energy_exchanged += change;
+        self.counters.energy_walls += wall_work;
+        self.counters.energy_restitution += change - wall_work;
+        self.counters.wall_impulse += impulse;
     }
 }
