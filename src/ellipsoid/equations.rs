@@ -614,6 +614,11 @@ impl EllipsoidSystem {
         &self.moments
     }
 
+    /// State components per body (14 with rotation: position, momentum, quaternion and its momentum; 6 without).
+    pub fn stride(&self) -> usize {
+        self.stride
+    }
+
     /// Index of the `∫F dt` component in the state, when dissipation is on.
     pub fn dissipation_index(&self) -> Option<usize> {
         self.physics.dissipation.map(|_| self.n_bodies() * self.stride)

@@ -206,9 +206,10 @@ fn check_initial_state(scene: &LoadedScene, initial: &Diagnostics, y: &[f64]) ->
     let rates_finite = |system: &EllipsoidSystem| {
         let mut dy = vec![0.0; y.len()];
         system.rhs(0.0, y, &mut dy);
+        // components past the bodies' (the dissipation integral, the tide's impulses) are charged to the last body
         dy.iter()
             .position(|x| !x.is_finite())
-            .map(|k| k / (y.len() / system.n_bodies().max(1)).max(1))
+            .map(|k| (k / system.stride()).min(system.n_bodies().saturating_sub(1)))
     };
     let whole = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics).with_tide(scene.tide);
     let bad_body = rates_finite(&whole);
