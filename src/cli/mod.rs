@@ -101,8 +101,8 @@ pub enum Command {
     Flyby(Box<crate::impact::flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(campaign::CampaignArgs),
-    /// Analyse an impact run: per-fragment table and per-run results (Roig03 §4) in DIR/analysis; a flyby run: its
-    /// largest remnant before and after (DIR/analysis/flyby.json).
+    /// Analyse a run: clumps of any run (largest and second remnant, clumps.csv, sfd.svg); of an impact run also the
+    /// per-fragment table and per-run results (Roig03 §4); of a flyby run its state before and after (flyby.json).
     Analyze(analyze::AnalyzeArgs),
     /// Analyse every completed run of a campaign; bound fraction vs Q and Q*_D (Roig03 Fig. 5).
     AnalyzeCampaign(analyze::AnalyzeCampaignArgs),
