@@ -55,5 +55,6 @@ pub mod quaternion;
 pub mod rigid_rotation;
 pub mod run;
 pub mod scene;
+pub mod scene_fields;
 pub mod summary;
 pub mod tide;
