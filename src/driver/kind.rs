@@ -47,6 +47,36 @@ impl SceneKind {
     }
 }
 
+impl SceneKind {
+    /// Every kind, in the order `rubblepile check --explain` prints them.
+    pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
+
+    /// The kind named `name` (the `scene.kind` string), if there is one.
+    pub fn of_name(name: &str) -> Option<SceneKind> {
+        SceneKind::ALL.into_iter().find(|k| k.reference().kind == name)
+    }
+
+    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
+    pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
+        match self {
+            SceneKind::Ellipsoids => &crate::ellipsoid::scene_fields::REFERENCE,
+            SceneKind::SoftSpheres => &crate::granular::soft::scene_fields::REFERENCE,
+            SceneKind::HardSpheres => &crate::granular::hard::scene_fields::REFERENCE,
+        }
+    }
+}
+
+/// The text of `rubblepile check --explain [KIND]`: the field reference of one kind's scene file, or of all three
+/// (`None`), one after the other.
+pub fn explain(kind: Option<SceneKind>) -> String {
+    let kinds: Vec<SceneKind> = kind.map_or(SceneKind::ALL.to_vec(), |k| vec![k]);
+    kinds
+        .iter()
+        .map(|k| crate::io::scene_fields::explain_text(k.reference()))
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Any engine's summary as the command line reports it: its one line and its warnings.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct AnyReport {
