@@ -576,6 +576,18 @@ fn check_explain_prints_the_reference() {
             .any(|l| l.starts_with("physics.dissipation.F0 ") && l.contains("s m^-2"))
     );
 
+    // Each kind by its `scene.kind` name.
+    for kind in SceneKind::ALL {
+        let name = kind.reference().kind;
+        let out = rubblepile(&["check", "--explain", name]);
+        assert!(out.status.success(), "{name}");
+        assert!(
+            String::from_utf8(out.stdout)
+                .unwrap()
+                .starts_with(&format!("# kind = \"{name}\"\n"))
+        );
+    }
+
     // An unknown kind is bad input: exit code 2, the kinds named.
     let out = rubblepile(&["check", "--explain", "rigid-bodies"]);
     assert_eq!(out.status.code(), Some(2));

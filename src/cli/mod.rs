@@ -291,17 +291,9 @@ pub struct CheckArgs {
     /// Print the built-in default scene's TOML instead (a starting point for your own scenes).
     #[arg(long, conflicts_with = "scene")]
     pub print_default: bool,
-    /// Print every key of a scene file of this kind (all three kinds without one): its unit, default, allowed
-    /// range and meaning, from the tables the scene validator reads its bounds from.
-    #[arg(
-        long,
-        value_name = "KIND",
-        num_args = 0..=1,
-        default_missing_value = "all",
-        value_parser = ["all", "ellipsoids", "soft-spheres", "hard-spheres"],
-        conflicts_with_all = ["scene", "print_default"]
-    )]
-    pub explain: Option<String>,
+    /// Print every key of a KIND scene file (all kinds without one): its unit, default, allowed range and meaning.
+    #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"])]
+    pub explain: Option<Option<crate::driver::SceneKind>>,
 }
 
 /// `rubblepile bench …`.
@@ -382,8 +374,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             report(crate::driver::resume_dir(&args.dir, &options))
         }
         Command::Check(args) => {
-            if let Some(kind) = args.explain.as_deref() {
-                print!("{}", crate::driver::explain(crate::driver::SceneKind::of_name(kind)));
+            if let Some(kind) = args.explain {
+                print!("{}", crate::driver::explain(kind));
                 return Ok(());
             }
             if args.print_default {

@@ -9,8 +9,8 @@ use crate::engine::{Engine, RunReport};
 use crate::granular::hard::run::HardEngine;
 use crate::granular::soft::run::SoftEngine;
 
-/// The engines a scene file can name in `scene.kind`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The engines a scene file can name in `scene.kind` (on the command line by the same names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SceneKind {
     /// `kind = "ellipsoids"` (also a scene without `kind`): interacting ellipsoids (Roig03).
     Ellipsoids,
@@ -50,11 +50,6 @@ impl SceneKind {
 impl SceneKind {
     /// Every kind, in the order `rubblepile check --explain` prints them.
     pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
-
-    /// The kind named `name` (the `scene.kind` string), if there is one.
-    pub fn of_name(name: &str) -> Option<SceneKind> {
-        SceneKind::ALL.into_iter().find(|k| k.reference().kind == name)
-    }
 
     /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
     pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {

@@ -604,7 +604,14 @@ impl Validator<'_> {
                 ),
             ))
         } else {
-            Err(self.invalid(field, format!("must be in {}, got {}", fields::KAPPA.range, fmt_num(k))))
+            Err(self.invalid(
+                field,
+                format!(
+                    "must be > 1.5 and finite, in {}, got {}",
+                    fields::KAPPA.range,
+                    fmt_num(k)
+                ),
+            ))
         }
     }
 
