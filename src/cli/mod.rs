@@ -7,7 +7,8 @@
 //!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::driver`]);
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to; `rubblepile check DIR` (a
 //!   directory): whether a run directory is whole ([`crate::driver::inspect`]), one line per finding, exit code 2
-//!   when it is not;
+//!   when it is not; `rubblepile check --explain [KIND]`: every key of a scene file with its unit, default and
+//!   allowed range ([`crate::driver::explain`]);
 //! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
 //! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
@@ -290,6 +291,9 @@ pub struct CheckArgs {
     /// Print the built-in default scene's TOML instead (a starting point for your own scenes).
     #[arg(long, conflicts_with = "scene")]
     pub print_default: bool,
+    /// Print every key of a KIND scene file (all kinds without one): its unit, default, allowed range and meaning.
+    #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"])]
+    pub explain: Option<Option<crate::driver::SceneKind>>,
 }
 
 /// `rubblepile bench …`.
@@ -370,6 +374,10 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             report(crate::driver::resume_dir(&args.dir, &options))
         }
         Command::Check(args) => {
+            if let Some(kind) = args.explain {
+                print!("{}", crate::driver::explain(kind));
+                return Ok(());
+            }
             if args.print_default {
                 print!("{}", crate::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());

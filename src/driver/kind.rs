@@ -9,8 +9,8 @@ use crate::engine::{Engine, RunReport};
 use crate::granular::hard::run::HardEngine;
 use crate::granular::soft::run::SoftEngine;
 
-/// The engines a scene file can name in `scene.kind`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The engines a scene file can name in `scene.kind` (on the command line by the same names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum SceneKind {
     /// `kind = "ellipsoids"` (also a scene without `kind`): interacting ellipsoids (Roig03).
     Ellipsoids,
@@ -45,6 +45,31 @@ impl SceneKind {
     pub fn of_run_dir(dir: &Path) -> SceneKind {
         SceneKind::of_file(&dir.join("scene.toml"))
     }
+}
+
+impl SceneKind {
+    /// Every kind, in the order `rubblepile check --explain` prints them.
+    pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
+
+    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
+    pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
+        match self {
+            SceneKind::Ellipsoids => &crate::ellipsoid::scene_fields::REFERENCE,
+            SceneKind::SoftSpheres => &crate::granular::soft::scene_fields::REFERENCE,
+            SceneKind::HardSpheres => &crate::granular::hard::scene_fields::REFERENCE,
+        }
+    }
+}
+
+/// The text of `rubblepile check --explain [KIND]`: the field reference of one kind's scene file, or of all three
+/// (`None`), one after the other.
+pub fn explain(kind: Option<SceneKind>) -> String {
+    let kinds: Vec<SceneKind> = kind.map_or(SceneKind::ALL.to_vec(), |k| vec![k]);
+    kinds
+        .iter()
+        .map(|k| crate::io::scene_fields::explain_text(k.reference()))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 /// Any engine's summary as the command line reports it: its one line and its warnings.

@@ -52,7 +52,7 @@ use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
 use crate::io::run_lock::{DirLock, LOCK_FILE, LockError, is_lock_file};
 
-pub use kind::{AnyReport, SceneKind, check_file, resume_dir, run_file};
+pub use kind::{AnyReport, SceneKind, check_file, explain, resume_dir, run_file};
 
 pub use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 /// The `format` tag of a checkpoint.

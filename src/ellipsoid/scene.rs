@@ -48,6 +48,7 @@ use serde::{Deserialize, Serialize};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
+use crate::ellipsoid::scene_fields as fields;
 pub use crate::ellipsoid::tide::FlybySpec;
 use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
 use crate::integrate::Method;
@@ -563,7 +564,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let t_end = self.positive("scene.t_end", file.scene.t_end)?;
+        let t_end = self.field(&fields::T_END, file.scene.t_end)?;
 
         Ok(t_end)
     }
@@ -580,8 +581,8 @@ impl Validator<'_> {
             }
             (Some(k), None) => self.kappa_value("model.kappa", k)?,
             (None, Some(c)) => {
-                self.positive("model.calibrate.beta", c.beta)?;
-                self.positive("model.calibrate.v", c.v)?;
+                self.field(&fields::CALIBRATE_BETA, c.beta)?;
+                self.field(&fields::CALIBRATE_V, c.v)?;
             }
         }
 
@@ -590,33 +591,38 @@ impl Validator<'_> {
 
     /// κ in (1.5, [`MAX_KAPPA`]].
     fn kappa_value(&self, field: &str, k: f64) -> Result<(), SceneError> {
-        if !(k.is_finite() && k > 1.5) {
-            return Err(self.invalid(field, format!("must be > 1.5 and finite, got {k}")));
-        }
-        if k > MAX_KAPPA {
-            return Err(self.invalid(
+        if fields::KAPPA.range.contains(k) {
+            Ok(())
+        } else if k.is_finite() && k > MAX_KAPPA {
+            Err(self.invalid(
                 field,
                 format!(
-                    "must be at most {MAX_KAPPA} (MAX_KAPPA: the contact amplitude holds e^(2 kappa), which overflows \
-                     beyond it), got {}",
+                    "must be at most {MAX_KAPPA}, in {} (MAX_KAPPA: the contact amplitude holds e^(2 kappa), which \
+                     overflows beyond it), got {}",
+                    fields::KAPPA.range,
                     fmt_num(k)
                 ),
-            ));
+            ))
+        } else {
+            Err(self.invalid(
+                field,
+                format!(
+                    "must be > 1.5 and finite, in {}, got {}",
+                    fields::KAPPA.range,
+                    fmt_num(k)
+                ),
+            ))
         }
-        Ok(())
     }
 
     /// `[physics]`: each term optional (absent = not computed).
     fn physics_section(&self, p: &PhysicsSection) -> Result<Physics, SceneError> {
         let gravity = match p.gravity {
             Some(g) => {
-                use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod, MAX_THETA};
-                let theta = g.theta.unwrap_or(DEFAULT_THETA);
-                if !(theta > 0.0 && theta <= MAX_THETA) {
-                    return Err(self.invalid("physics.gravity.theta", format!("must be in (0, 1], got {theta}")));
-                }
+                use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
+                let theta = self.field(&fields::GRAVITY_THETA, g.theta.unwrap_or(DEFAULT_THETA))?;
                 Some(GravityTerm {
-                    g: self.positive("physics.gravity.G", g.g.unwrap_or(SI_G))?,
+                    g: self.field(&fields::GRAVITY_G, g.g.unwrap_or(SI_G))?,
                     method: match g.method.unwrap_or_default() {
                         GravityMethodSpec::Direct => GravityMethod::Direct,
                         GravityMethodSpec::Tree => GravityMethod::Tree { theta },
@@ -629,12 +635,7 @@ impl Validator<'_> {
         let contact = match p.contact {
             Some(c) => {
                 let cutoff = c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF);
-                if !(cutoff.is_finite() && cutoff > 0.0 && cutoff < 1.0) {
-                    return Err(self.invalid(
-                        "physics.contact.cutoff",
-                        format!("must be in (0, 1), got {}", fmt_num(cutoff)),
-                    ));
-                }
+                let cutoff = self.field(&fields::CONTACT_CUTOFF, cutoff)?;
                 if cutoff < MIN_MEANINGFUL {
                     return Err(self.invalid(
                         "physics.contact.cutoff",
@@ -647,7 +648,7 @@ impl Validator<'_> {
         };
         let dissipation = match p.dissipation {
             Some(d) => Some(DissipationTerm {
-                f0: self.non_negative("physics.dissipation.F0", d.f0)?,
+                f0: self.field(&fields::DISSIPATION_F0, d.f0)?,
             }),
             None => None,
         };
@@ -662,16 +663,17 @@ impl Validator<'_> {
     /// only), the fixed step of `"rk4"` (≥ `t_end ×` [`crate::io::scene_file::MIN_STEP_FRACTION`]; `"rk4"` only).
     fn integrator_section(&self, i: &IntegratorSection, t_end: f64) -> Result<IntegratorSettings, SceneError> {
         let rtol = i.rtol.unwrap_or_else(default_tolerance);
-        if !(rtol.is_finite() && (MIN_RTOL..1.0).contains(&rtol)) {
+        if !fields::RTOL.range.contains(rtol) {
             return Err(self.invalid(
-                "integrator.rtol",
+                fields::RTOL.key,
                 format!(
-                    "must be in [{MIN_RTOL:e}, 1), got {rtol:e}: a relative tolerance of 1 or more controls nothing, \
-                     and below {MIN_RTOL:e} the integrators' error estimates are round-off (f64 epsilon is 2.2e-16)"
+                    "must be in {}, got {rtol:e}: a relative tolerance of 1 or more controls nothing, \
+                     and below {MIN_RTOL:e} the integrators' error estimates are round-off (f64 epsilon is 2.2e-16)",
+                    fields::RTOL.range
                 ),
             ));
         }
-        let atol = self.non_negative("integrator.atol", i.atol.unwrap_or_else(default_tolerance))?;
+        let atol = self.field(&fields::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
         let step = match i.step {
             Some(h) => Some(self.step("integrator.step", h, t_end)?),
             None => None,
@@ -1058,9 +1060,9 @@ impl Validator<'_> {
             ));
         }
         let mass = match (b.mass, b.density) {
-            (Some(m), None) => self.positive(&f("mass"), m)?,
+            (Some(m), None) => self.within(&fields::BODY_MASS, &f("mass"), m)?,
             (None, Some(rho)) => {
-                let rho = self.positive(&f("density"), rho)?;
+                let rho = self.within(&fields::BODY_DENSITY, &f("density"), rho)?;
                 let volume = 4.0 / 3.0 * std::f64::consts::PI * a * bb * c;
                 if !(volume.is_finite() && volume >= MIN_MEANINGFUL) {
                     return Err(self.invalid(

@@ -172,11 +172,12 @@ impl TideTerm {
 
 /// Validates `physics.flyby` (errors name the field) and resolves it with the scene's `G` (m³ kg⁻¹ s⁻²).
 pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<TideTerm, SceneError> {
-    let mass = v.non_negative("physics.flyby.mass", spec.mass)?;
+    use crate::ellipsoid::scene_fields as fields;
+    let mass = v.field(&fields::FLYBY_MASS, spec.mass)?;
     let gm = g * mass;
-    let q = v.positive("physics.flyby.q", spec.q)?;
+    let q = v.field(&fields::FLYBY_Q, spec.q)?;
     let radius = match spec.radius {
-        Some(r) => Some(v.positive("physics.flyby.radius", r)?),
+        Some(r) => Some(v.field(&fields::FLYBY_RADIUS, r)?),
         None => None,
     };
     if let Some(r) = radius
@@ -210,7 +211,7 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
             ));
         }
         (Some(vi), None) => {
-            let vi = v.positive("physics.flyby.v_inf", vi)?;
+            let vi = v.field(&fields::FLYBY_V_INF, vi)?;
             KeplerOrbit::hyperbolic(gm, q, vi, spec.t_perigee, rotation)
                 .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
         }

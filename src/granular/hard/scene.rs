@@ -47,6 +47,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::particle::{Attachment, Particle};
+use super::scene_fields as fields;
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
 use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WARNING_STEPS, exact, parse_toml_as};
@@ -321,13 +322,6 @@ pub struct HardScene {
 use crate::io::scene_file::Validator as V;
 
 impl V<'_> {
-    fn in_range(&self, field: &str, x: f64, lo: f64, hi: f64) -> Result<f64, SceneError> {
-        if (lo..=hi).contains(&x) {
-            Ok(x)
-        } else {
-            Err(self.invalid(field, format!("must be in [{lo}, {hi}], got {x}")))
-        }
-    }
     fn vec(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
         if v.iter().all(|x| x.is_finite()) {
             Ok(Vec3::from(v))
@@ -361,14 +355,15 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             format!("must be \"{KIND}\" here, got {:?}", file.scene.kind),
         ));
     }
-    let t_end = v.positive("scene.t_end", file.scene.t_end)?;
+    let t_end = v.field(&fields::T_END, file.scene.t_end)?;
     let dt = v.step("stepping.dt", file.stepping.dt, t_end)?;
-    let collapse_speed = v.non_negative("stepping.collapse_speed", file.stepping.collapse_speed)?;
-    let skin_steps = v.non_negative("stepping.skin_steps", file.stepping.skin_steps)?;
+    let collapse_speed = v.field(&fields::COLLAPSE_SPEED, file.stepping.collapse_speed)?;
+    let skin_steps = v.field(&fields::SKIN_STEPS, file.stepping.skin_steps)?;
     let max_events = file.stepping.max_events_per_step;
-    if !(1..=MAX_EVENTS_PER_STEP).contains(&max_events) {
+    // A count above 2^53 rounds as an f64, but every such count is far beyond the range's upper end (1e9).
+    if !fields::MAX_EVENTS.range.contains(max_events as f64) {
         return Err(v.invalid(
-            "stepping.max_events_per_step",
+            fields::MAX_EVENTS.key,
             format!("must be in [1, {MAX_EVENTS_PER_STEP}] (MAX_EVENTS_PER_STEP), got {max_events}"),
         ));
     }
@@ -376,8 +371,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         Some(g) => Some(v.vec("gravity.g", g.g)?),
         None => None,
     };
-    let eps_n = v.in_range("material.eps_n", file.material.eps_n, 0.0, 1.0)?;
-    let eps_t = v.in_range("material.eps_t", file.material.eps_t, -1.0, 1.0)?;
+    let eps_n = v.field(&fields::MATERIAL_EPS_N, file.material.eps_n)?;
+    let eps_t = v.field(&fields::MATERIAL_EPS_T, file.material.eps_t)?;
     let every = v.cadence("output.every", file.output.every, t_end)?;
     let times = v.output_times(file.output.times.as_deref(), file.output.snapshot_every, t_end)?;
 
@@ -417,8 +412,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             v.count("particle", file.particles.len(), MAX_BODIES, "particles (MAX_BODIES)")?;
             for (k, p) in file.particles.iter().enumerate() {
                 let f = |x: &str| format!("particle[{k}].{x}");
-                let mass = v.positive(&f("mass"), p.mass)?;
-                let radius = v.positive(&f("radius"), p.radius)?;
+                let mass = v.within(&fields::PARTICLE_MASS, &f("mass"), p.mass)?;
+                let radius = v.within(&fields::PARTICLE_RADIUS, &f("radius"), p.radius)?;
                 moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
@@ -428,8 +423,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
                     v.vec(&f("velocity"), p.velocity)?,
                     v.vec(&f("spin"), p.spin)?,
                 );
-                q.eps_n = v.in_range(&f("eps_n"), p.eps_n.unwrap_or(eps_n), 0.0, 1.0)?;
-                q.eps_t = v.in_range(&f("eps_t"), p.eps_t.unwrap_or(eps_t), -1.0, 1.0)?;
+                q.eps_n = v.within(&fields::PARTICLE_EPS_N, &f("eps_n"), p.eps_n.unwrap_or(eps_n))?;
+                q.eps_t = v.within(&fields::PARTICLE_EPS_T, &f("eps_t"), p.eps_t.unwrap_or(eps_t))?;
                 q.stuck = attach(f("stuck_to"), p.stuck_to, &q)?;
                 particles.push(q);
             }
@@ -444,8 +439,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             for (k, row) in rows.iter().enumerate() {
                 let r = &row.values;
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
-                let mass = v.positive(&f("mass"), r[2])?;
-                let radius = v.positive(&f("radius"), r[3])?;
+                let mass = v.within(&fields::PARTICLE_MASS, &f("mass"), r[2])?;
+                let radius = v.within(&fields::PARTICLE_RADIUS, &f("radius"), r[3])?;
                 moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
@@ -705,11 +700,11 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         spin: w.spin,
     };
     wall.eps_n = match w.eps_n {
-        Some(e) => Some(v.in_range(&f("eps_n"), e, 0.0, 1.0)?),
+        Some(e) => Some(v.within(&fields::WALL_EPS_N, &f("eps_n"), e)?),
         None => None,
     };
     wall.eps_t = match w.eps_t {
-        Some(e) => Some(v.in_range(&f("eps_t"), e, -1.0, 1.0)?),
+        Some(e) => Some(v.within(&fields::WALL_EPS_T, &f("eps_t"), e)?),
         None => None,
     };
     if w.sticky && w.absorbing {

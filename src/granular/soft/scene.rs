@@ -64,6 +64,7 @@ use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, ad
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
+use crate::granular::soft::scene_fields as fields;
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::{
     MAX_BODIES, MIN_MEANINGFUL, MIN_STEP_FRACTION, SI_G, SceneError, WORK_WARNING_STEPS, exact,
@@ -361,13 +362,6 @@ pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Resu
 use crate::io::scene_file::Validator as V;
 
 impl V<'_> {
-    fn restitution(&self, field: &str, x: f64) -> Result<f64, SceneError> {
-        if x > 0.0 && x <= 1.0 {
-            Ok(x)
-        } else {
-            Err(self.invalid(field, format!("must be in (0, 1], got {x}")))
-        }
-    }
     fn vector(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
         if v.iter().all(|x| x.is_finite()) {
             Ok(Vec3::from(v))
@@ -377,14 +371,16 @@ impl V<'_> {
     }
 
     fn particle(&self, label: &str, s: &ParticleSpec) -> Result<Particle, SceneError> {
-        let radius = self.positive(&format!("{label}.radius"), s.radius)?;
+        let radius = self.within(&fields::PARTICLE_RADIUS, &format!("{label}.radius"), s.radius)?;
         // r² and r³ enter the moment of inertia and the mass from the density: they must stay normal numbers.
         let r3 = radius * radius * radius;
         let radius_fault = !(r3.is_finite() && radius * radius >= f64::MIN_POSITIVE && r3 >= f64::MIN_POSITIVE);
         let mass = match (s.mass, s.density) {
-            (Some(m), None) => self.positive(&format!("{label}.mass"), m)?,
+            (Some(m), None) => self.within(&fields::PARTICLE_MASS, &format!("{label}.mass"), m)?,
             (None, Some(rho)) => {
-                let m = self.positive(&format!("{label}.density"), rho)? * 4.0 / 3.0 * std::f64::consts::PI * r3;
+                let m = self.within(&fields::PARTICLE_DENSITY, &format!("{label}.density"), rho)? * 4.0 / 3.0
+                    * std::f64::consts::PI
+                    * r3;
                 if !(m.is_finite() && m >= MIN_MEANINGFUL) {
                     let field = if radius_fault { "radius" } else { "density" };
                     return Err(self.invalid(
@@ -505,7 +501,11 @@ impl V<'_> {
         let label = format!("wall[{k}]");
         if let Some(o) = &w.oscillation {
             let a = self.vector(&format!("{label}.oscillation.amplitude"), o.amplitude)?;
-            let f = self.positive(&format!("{label}.oscillation.frequency"), o.frequency)?;
+            let f = self.within(
+                &fields::OSCILLATION_FREQUENCY,
+                &format!("{label}.oscillation.frequency"),
+                o.frequency,
+            )?;
             if !(std::f64::consts::TAU * f * a.norm()).is_finite() {
                 return Err(self.invalid(
                     format!("{label}.oscillation.frequency"),
@@ -557,7 +557,11 @@ impl V<'_> {
                 unused("normal", w.normal.is_some())?;
                 Ok(Wall::Sphere(SphereContainer {
                     centre: self.vector(&format!("{label}.centre"), w.centre.unwrap_or_default())?,
-                    radius: self.positive(&format!("{label}.radius"), w.radius.unwrap_or_default())?,
+                    radius: self.within(
+                        &fields::WALL_RADIUS,
+                        &format!("{label}.radius"),
+                        w.radius.unwrap_or_default(),
+                    )?,
                     oscillation: w.oscillation,
                 }))
             }
@@ -572,7 +576,7 @@ impl V<'_> {
         if file.scene.kind != KIND {
             return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
         }
-        let t_end = self.positive("scene.t_end", file.scene.t_end)?;
+        let t_end = self.field(&fields::T_END, file.scene.t_end)?;
         let dt = self.step("integrator.dt", file.integrator.dt, t_end)?;
         let steps = (t_end / dt).round();
         if !(1.0..=1e12).contains(&steps) {
@@ -585,19 +589,19 @@ impl V<'_> {
 
         let c = &file.contact;
         let material = Material {
-            k_n: self.positive("contact.k_n", c.k_n)?,
-            eps_n: self.restitution("contact.eps_n", c.eps_n)?,
-            eps_t: self.restitution("contact.eps_t", c.eps_t)?,
-            mu_s: self.non_negative("contact.mu_s", c.mu_s)?,
-            mu_t: self.non_negative("contact.mu_t", c.mu_t)?,
-            mu_r: self.non_negative("contact.mu_r", c.mu_r)?,
-            beta: self.non_negative("contact.beta", c.beta)?,
+            k_n: self.field(&fields::K_N, c.k_n)?,
+            eps_n: self.field(&fields::EPS_N, c.eps_n)?,
+            eps_t: self.field(&fields::EPS_T, c.eps_t)?,
+            mu_s: self.field(&fields::MU_S, c.mu_s)?,
+            mu_t: self.field(&fields::MU_T, c.mu_t)?,
+            mu_r: self.field(&fields::MU_R, c.mu_r)?,
+            beta: self.field(&fields::BETA, c.beta)?,
         };
-        let max_start = self.non_negative("contact.max_start_overlap", c.max_start_overlap)?;
+        let max_start = self.field(&fields::MAX_START_OVERLAP, c.max_start_overlap)?;
 
         let gs = &file.gravity;
         let g = match gs.g {
-            Some(g) => self.positive("gravity.G", g)?,
+            Some(g) => self.field(&fields::GRAVITY_G, g)?,
             None => SI_G,
         };
         let self_gravity = match gs.self_gravity.as_deref() {
@@ -614,10 +618,7 @@ impl V<'_> {
                 Some(SelfGravity::Direct)
             }
             Some("tree") => {
-                let theta = gs.theta.unwrap_or(0.5);
-                if !(theta > 0.0 && theta <= 1.0) {
-                    return Err(self.invalid("gravity.theta", format!("must be in (0, 1], got {theta}")));
-                }
+                let theta = self.field(&fields::GRAVITY_THETA, gs.theta.unwrap_or(0.5))?;
                 Some(SelfGravity::Tree { theta })
             }
             Some(other) => {

@@ -232,25 +232,26 @@ pub struct SpinupSettings {
 impl crate::io::scene_file::Validator<'_> {
     /// Checks a `[spinup]` table; errors name the field (`spinup.T_final`, …) and the expected value.
     pub(crate) fn spinup(&self, s: &SpinupSection) -> Result<SpinupSettings, SceneError> {
-        let ts = self.positive("spinup.T_start", s.period_start_h)?;
-        let ti = self.positive("spinup.T_inter", s.period_inter_h)?;
-        let tf = self.positive("spinup.T_final", s.period_final_h)?;
+        use crate::granular::soft::scene_fields as fields;
+        let ts = self.field(&fields::SPINUP_T_START, s.period_start_h)?;
+        let ti = self.field(&fields::SPINUP_T_INTER, s.period_inter_h)?;
+        let tf = self.field(&fields::SPINUP_T_FINAL, s.period_final_h)?;
         if ti > ts {
             return Err(self.invalid("spinup.T_inter", format!("must be <= T_start = {ts} h, got {ti}")));
         }
         if tf > ti {
             return Err(self.invalid("spinup.T_final", format!("must be <= T_inter = {ti} h, got {tf}")));
         }
-        let t0 = self.non_negative("spinup.t_start", s.t_start)?;
-        let t1 = self.non_negative("spinup.t_inter", s.t_inter)?;
-        let t2 = self.non_negative("spinup.t_final", s.t_final)?;
+        let t0 = self.field(&fields::SPINUP_TIME_START, s.t_start)?;
+        let t1 = self.field(&fields::SPINUP_TIME_INTER, s.t_inter)?;
+        let t2 = self.field(&fields::SPINUP_TIME_FINAL, s.t_final)?;
         if t1 < t0 {
             return Err(self.invalid("spinup.t_inter", format!("must be >= t_start = {t0} s, got {t1}")));
         }
         if t2 < t1 {
             return Err(self.invalid("spinup.t_final", format!("must be >= t_inter = {t1} s, got {t2}")));
         }
-        let rest = self.non_negative("spinup.rest_length", s.rest_length)?;
+        let rest = self.field(&fields::SPINUP_REST_LENGTH, s.rest_length)?;
         if s.rests as f64 * rest >= t2 - t1 && s.rests > 0 {
             return Err(self.invalid(
                 "spinup.rest_length",
@@ -287,9 +288,9 @@ impl crate::io::scene_file::Validator<'_> {
                 return Err(self.invalid("spinup.interior_ramp", "needs spinup.interior_depth (m, >= 0)"));
             }
             (Some(d), ramp) => {
-                let depth = self.non_negative("spinup.interior_depth", d)?;
+                let depth = self.field(&fields::SPINUP_INTERIOR_DEPTH, d)?;
                 let ramp = match ramp {
-                    Some(w) => self.positive("spinup.interior_ramp", w)?,
+                    Some(w) => self.field(&fields::SPINUP_INTERIOR_RAMP, w)?,
                     None if depth > 0.0 => depth,
                     None => {
                         return Err(self.invalid(
@@ -317,8 +318,8 @@ impl crate::io::scene_file::Validator<'_> {
             },
             axis: axis.normalize(),
             target,
-            release_axis_ratio: self.positive("spinup.release_axis_ratio", s.release_axis_ratio)?,
-            release_packing: self.positive("spinup.release_packing", s.release_packing)?,
+            release_axis_ratio: self.field(&fields::SPINUP_RELEASE_AXIS_RATIO, s.release_axis_ratio)?,
+            release_packing: self.field(&fields::SPINUP_RELEASE_PACKING, s.release_packing)?,
             release_samples: s.release_samples,
             rve_particles: s.rve_particles,
             interior,
