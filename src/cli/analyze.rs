@@ -88,18 +88,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
 fn analyze_clumps_of_run(args: &AnalyzeArgs) -> Result<(), CliError> {
     let a =
         crate::analysis::run_analysis::analyze_clumps_run(&args.dir, args.at, args.force).map_err(CliError::usage)?;
-    let figure = crate::analysis::figures::sfd::SizeFrequency::of(&a.clump_report, a.t_at);
-    let drawn = crate::analysis::figures::style::write_figure(&args.dir.join("analysis"), "sfd", &figure);
-    if let Err(why) = &drawn {
-        eprintln!("warning: figure not drawn: sfd: {why}");
-    }
-    println!(
-        "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",
-        a.t_at,
-        a.clump_report.summary_line(),
-        args.dir.join("analysis").display(),
-        if drawn.is_ok() { ", sfd.svg, sfd.png" } else { "" }
-    );
+    println!("{}", a.write_figure_and_describe(&args.dir));
     Ok(())
 }
 

@@ -126,7 +126,10 @@ impl ImpactArgs {
             kappa_reading: self.kappa_reading,
             snapshots: match (&self.snapshots, self.snapshot_every) {
                 (Some(times), _) => times.clone(),
-                (None, Some(every)) => cadence_snapshots(self.t_end, every)?,
+                (None, Some(every)) => {
+                    crate::io::output_times::checked_cadence_times(self.t_end, every, "--snapshot-every", "--t-end")
+                        .map_err(CliError::usage)?
+                }
                 (None, None) => crate::impact::run::default_snapshots(self.t_end),
             },
             every: self.every,
@@ -140,32 +143,6 @@ impl ImpactArgs {
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)
     }
-}
-
-/// The snapshot times of `--snapshot-every S` for a run of `t_end` (s): `0, S, 2S, …` and `t_end`
-/// ([`crate::io::output_times::cadence_times`]), refused when `S` is not positive or gives more than
-/// [`crate::io::scene_file::MAX_SNAPSHOTS`] snapshots.
-fn cadence_snapshots(t_end: f64, every: f64) -> Result<Vec<f64>, CliError> {
-    use crate::io::output_times::{cadence_count, cadence_times};
-    use crate::io::scene_file::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
-    if !(every.is_finite() && every >= MIN_MEANINGFUL) {
-        return Err(CliError::usage(format!(
-            "--snapshot-every: must be > 0 s and finite, got {every}"
-        )));
-    }
-    if !(t_end.is_finite() && t_end > 0.0) {
-        return Err(CliError::usage(format!(
-            "--t-end: must be > 0 s and finite, got {t_end}"
-        )));
-    }
-    let n = cadence_count(t_end, every);
-    if n > MAX_SNAPSHOTS as f64 {
-        return Err(CliError::usage(format!(
-            "--snapshot-every: too small for --t-end {t_end}: would write {n:e} snapshots (at most {MAX_SNAPSHOTS}), \
-             got {every}"
-        )));
-    }
-    Ok(cadence_times(t_end, every))
 }
 
 /// The command-line flag of an [`ImpactConfig`] field named in an error.

@@ -181,19 +181,11 @@ pub fn flyby_orbit(gm: f64, q: f64, v_inf: f64, start_q: f64) -> Result<(KeplerO
 /// Subfolder of a flyby run directory that holds its control run (the same pile and time, no planet).
 pub const CONTROL_DIR: &str = "control";
 
-/// `n ≥ 2` output times evenly spaced over `[0, t_end]` (s), the last exactly `t_end`: `t_end·k/(n − 1)` can round
-/// one ulp above `t_end`, which the scene check refuses, so every time is clamped to `t_end`.
+/// `n ≥ 2` output times evenly spaced over `[0, t_end]` (s), the last exactly `t_end` and none above it
+/// ([`crate::io::output_times::evenly_spaced`]; `t_end·k/(n − 1)` can round one ulp above `t_end`, which the scene
+/// check refuses).
 pub fn output_times(t_end: f64, n: usize) -> Vec<f64> {
-    let last = n.saturating_sub(1).max(1);
-    (0..n)
-        .map(|k| {
-            if k == last {
-                t_end
-            } else {
-                (t_end * k as f64 / last as f64).min(t_end)
-            }
-        })
-        .collect()
+    crate::io::output_times::evenly_spaced(t_end, n)
 }
 
 fn invalid(field: &str, message: String) -> ImpactError {

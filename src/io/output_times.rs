@@ -46,6 +46,26 @@ pub fn evenly_spaced(t_end: f64, n: usize) -> Vec<f64> {
     }
 }
 
+/// The snapshot times of a cadence `every` (s) for a run of `t_end` (s), [`cadence_times`], after checking both:
+/// the error names `every_field` or `t_end_field` (e.g. `--snapshot-every`, `--t-end`) and the expected value.
+pub fn checked_cadence_times(t_end: f64, every: f64, every_field: &str, t_end_field: &str) -> Result<Vec<f64>, String> {
+    use crate::io::scene_file::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
+    if !(every.is_finite() && every >= MIN_MEANINGFUL) {
+        return Err(format!("{every_field}: must be > 0 s and finite, got {every}"));
+    }
+    if !(t_end.is_finite() && t_end > 0.0) {
+        return Err(format!("{t_end_field}: must be > 0 s and finite, got {t_end}"));
+    }
+    let n = cadence_count(t_end, every);
+    if n > MAX_SNAPSHOTS as f64 {
+        return Err(format!(
+            "{every_field}: too small for {t_end_field} {t_end}: would write {n:e} snapshots (at most {MAX_SNAPSHOTS}), \
+             got {every}"
+        ));
+    }
+    Ok(cadence_times(t_end, every))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
