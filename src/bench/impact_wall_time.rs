@@ -359,6 +359,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
 fn short_name(method: Method) -> String {
     match method {
         Method::BulirschStoer => "BS".to_string(),
+        Method::BulirschStoerImplicit => "BS-implicit".to_string(),
         other => other.to_string(),
     }
 }

@@ -56,6 +56,8 @@ type Mat12 = SMatrix<f64, 12, 12>;
 
 /// Relative residual (in the `M_V⁻¹` norm) at which conjugate gradients stop.
 const CG_TOLERANCE: f64 = 1e-14;
+/// Conjugate-gradient iterations without the residual halving after which the iteration has stagnated.
+const STALL_ITERATIONS: usize = 10;
 
 /// One body's maps between momenta and velocities at the linearisation point.
 #[derive(Debug, Clone)]
@@ -301,7 +303,19 @@ impl StiffSolve for DissipationJacobian {
         let mut ap = vec![Vec6::zeros(); n];
         let max_iterations = 12 * n + 50;
         let mut it = 0;
-        while it < max_iterations && rz.is_finite() && rz > 0.0 && mass_norm2(&r) > target {
+        // Stagnation: round-off (about ε times the condition 1 + h|D|/m) can keep the residual above the target;
+        // then stop once it has not halved in STALL_ITERATIONS iterations.
+        let (mut best, mut best_at) = (f64::INFINITY, 0);
+        loop {
+            let res = mass_norm2(&r);
+            if res <= target || it >= max_iterations || !rz.is_finite() || rz <= 0.0 {
+                break;
+            }
+            if res < 0.25 * best {
+                (best, best_at) = (res, it);
+            } else if it - best_at >= STALL_ITERATIONS {
+                break;
+            }
             apply_a(self, &dir, &mut ap, &mut scratch);
             let pap = dot(&dir, &ap);
             if !(pap > 0.0) {

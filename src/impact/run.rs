@@ -36,11 +36,11 @@ pub const DEFAULT_RTOL: f64 = 1e-6;
 /// impact to 10 000 s in 7 min 37 s on 2 cores with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
 pub const DEFAULT_RTOL_PER_STEP: f64 = 1e-8;
 
-/// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for Bulirsch–Stoer (of the whole run),
+/// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for the Bulirsch–Stoer methods (of the whole run),
 /// [`DEFAULT_RTOL_PER_STEP`] for the others.
 pub fn default_rtol(method: Method) -> f64 {
     match method {
-        Method::BulirschStoer => DEFAULT_RTOL,
+        Method::BulirschStoer | Method::BulirschStoerImplicit => DEFAULT_RTOL,
         _ => DEFAULT_RTOL_PER_STEP,
     }
 }
