@@ -139,15 +139,16 @@ fn dissipation_jacobian_matches_finite_differences() {
 }
 
 /// A stiff pile settling: four overlapping ellipsoids (gravity, contact, F0 = 100 s m⁻², damping rates up to
-/// ~1e5 s⁻¹) integrated for 20 s by the implicit method. Total linear and angular momentum are conserved to
-/// 1e-13 of their scales (the dissipation and its linearly implicit solve conserve both), the energy balance
+/// ~1e5 s⁻¹) integrated for 20 s by the implicit method. Total linear momentum is conserved to 1e-13 of its scale
+/// and angular momentum to 2e-13 (the dissipation and its linearly implicit solve conserve both), the energy balance
 /// `H − H0 − 2∫F` holds, and the bodies come to rest relative to each other.
 #[test]
 fn stiff_pile_settles_conserving_momenta() {
     let bodies = overlapping_four(11);
     let sys = EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(6.0), Physics::impact(100.0));
-    // At rtol = 1e-10: angular momentum is conserved only at the rate level (a quadratic invariant; its error
-    // follows the tolerance: 8e-12 at rtol = 1e-8), so the 1e-13 bound needs the tight tolerance.
+    // Angular momentum is conserved only at the rate level (a quadratic invariant; its error follows the tolerance:
+    // 8e-12 at rtol = 1e-8) down to its round-off floor of about 1e-13 of its scale (1.0e-13 at rtol = 1e-11,
+    // 0.6–1.2e-13 at 1e-10 depending on the rounding of the solve): the bound on it is 2e-13.
     let t_end = 20.0;
     let rtol = 1e-10;
     let mut integ = make_integrator(
@@ -175,7 +176,7 @@ fn stiff_pile_settles_conserving_momenta() {
         stats.steps_accepted, stats.steps_rejected, stats.rhs_evaluations, -d.dissipated, d0.kinetic_translational
     );
     assert!(dp <= 1e-13, "linear momentum error {dp:e}");
-    assert!(dl <= 1e-13, "angular momentum error {dl:e}");
+    assert!(dl <= 2e-13, "angular momentum error {dl:e}");
     assert!(de <= 1e-8, "energy balance error {de:e}");
     assert!(-d.dissipated > 0.5 * d0.kinetic_translational, "the pile did not dissipate its relative motion");
     assert!(stats.steps_accepted < 5000, "{} steps: the damping is not handled implicitly", stats.steps_accepted);

@@ -43,6 +43,8 @@
 //! about the origin (`F` vanishes for every common rigid motion, so `D` annihilates them and its forces do no work
 //! on them): the solve changes neither total momentum.
 
+use std::ops::{AddAssign, SubAssign};
+
 use nalgebra::{DVector, SMatrix, SVector};
 
 use crate::ellipsoid::potential::{BodyGeometry, Overlap};
@@ -104,37 +106,62 @@ impl BodyLinear {
     }
 }
 
-/// One pair's `D_ij` (12 × 12 over `(ṙ_i, ω_i, ṙ_j, ω_j)`; kg/s, kg m/s, kg m²/s by block).
+/// One pair's `D_ij = c (H_ijᵀ Q' H_ij + G_ijᵀ G_ij)` in factored form (`c = 2 F0 U_C`, kg/s;
+/// `Q' = Q/(2κ)`; the offsets `d_i`, `d_j` of `G_ij`): its product with the velocities costs a
+/// quarter of the dense 12 × 12 block's and reads an eighth of the memory.
 #[derive(Debug, Clone)]
 pub struct PairLinear {
     i: usize,
     j: usize,
-    d: Mat12,
+    c: f64,
+    d_i: Vec3,
+    d_j: Vec3,
+    q: Mat3,
 }
 
 impl PairLinear {
     /// `D_ij` of bodies `i < j` overlapping as `ov` (its `potential` the tapered `U_C`), with dissipation
     /// coefficient `f0` (s m⁻²) and κ.
     pub fn new(f0: f64, kappa: f64, i: usize, j: usize, ov: &Overlap, gi: &BodyGeometry, gj: &BodyGeometry) -> Self {
-        let d_i = -(gi.sigma * ov.y);
-        let d_j = gj.sigma * ov.y;
         let p = gi.sigma * ov.g_inv * gj.sigma;
         let q = Mat3::identity() * p.trace() - p;
-        let mut g = SMatrix::<f64, 3, 12>::zeros();
-        g.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
-        g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-d_i.cross_matrix()));
-        g.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-Mat3::identity()));
-        g.fixed_view_mut::<3, 3>(0, 9).copy_from(&d_j.cross_matrix());
-        let mut hq = SMatrix::<f64, 3, 12>::zeros();
-        hq.fixed_view_mut::<3, 3>(0, 3).copy_from(&Mat3::identity());
-        hq.fixed_view_mut::<3, 3>(0, 9).copy_from(&(-Mat3::identity()));
-        let d = (hq.transpose() * q * hq / (2.0 * kappa) + g.transpose() * g) * (2.0 * f0 * ov.potential);
-        // Exactly symmetric, as conjugate gradients assume (P is symmetric up to rounding).
         PairLinear {
             i,
             j,
-            d: (d + d.transpose()) * 0.5,
+            c: 2.0 * f0 * ov.potential,
+            d_i: -(gi.sigma * ov.y),
+            d_j: gj.sigma * ov.y,
+            // Exactly symmetric, as conjugate gradients assume (P is symmetric up to rounding).
+            q: (q + q.transpose()) / (4.0 * kappa),
         }
+    }
+
+    /// `D_ij (V_i, V_j)` added to `out_i`, `out_j` (forces, then torques).
+    fn apply(&self, vi: &Vec6, vj: &Vec6, out_i: &mut Vec6, out_j: &mut Vec6) {
+        let (ti, ri) = (vi.fixed_rows::<3>(0), vi.fixed_rows::<3>(3));
+        let (tj, rj) = (vj.fixed_rows::<3>(0), vj.fixed_rows::<3>(3));
+        let v0 = ti - tj - self.d_i.cross(&ri) + self.d_j.cross(&rj);
+        let qw = self.q * (ri - rj);
+        let force = v0 * self.c;
+        let torque_i = (qw + self.d_i.cross(&v0)) * self.c;
+        let torque_j = (-qw - self.d_j.cross(&v0)) * self.c;
+        out_i.fixed_rows_mut::<3>(0).add_assign(&force);
+        out_i.fixed_rows_mut::<3>(3).add_assign(&torque_i);
+        out_j.fixed_rows_mut::<3>(0).sub_assign(&force);
+        out_j.fixed_rows_mut::<3>(3).add_assign(&torque_j);
+    }
+
+    /// The dense `D_ij` (12 × 12 over `(ṙ_i, ω_i, ṙ_j, ω_j)`).
+    fn block(&self) -> Mat12 {
+        let mut g = SMatrix::<f64, 3, 12>::zeros();
+        g.fixed_view_mut::<3, 3>(0, 0).copy_from(&Mat3::identity());
+        g.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-self.d_i.cross_matrix()));
+        g.fixed_view_mut::<3, 3>(0, 6).copy_from(&(-Mat3::identity()));
+        g.fixed_view_mut::<3, 3>(0, 9).copy_from(&self.d_j.cross_matrix());
+        let mut hw = SMatrix::<f64, 3, 12>::zeros();
+        hw.fixed_view_mut::<3, 3>(0, 3).copy_from(&Mat3::identity());
+        hw.fixed_view_mut::<3, 3>(0, 9).copy_from(&(-Mat3::identity()));
+        (hw.transpose() * self.q * hw + g.transpose() * g) * self.c
     }
 }
 
@@ -146,6 +173,8 @@ pub struct DissipationJacobian {
     stride: usize,
     bodies: Vec<BodyLinear>,
     pairs: Vec<PairLinear>,
+    /// `Σ` of the pairs' diagonal 6 × 6 blocks of `D` per body (for the preconditioner).
+    diagonal: Vec<Mat6>,
     /// Conjugate-gradient iterations over all solves (for benchmarks).
     iterations: u64,
 }
@@ -154,10 +183,17 @@ impl DissipationJacobian {
     /// The Jacobian of bodies `bodies` (state `stride` components each, the momenta `u, p` at 7..14) coupled by
     /// `pairs`.
     pub fn new(stride: usize, bodies: Vec<BodyLinear>, pairs: Vec<PairLinear>) -> Self {
+        let mut diagonal = vec![Mat6::zeros(); bodies.len()];
+        for pr in &pairs {
+            let d = pr.block();
+            diagonal[pr.i] += d.fixed_view::<6, 6>(0, 0);
+            diagonal[pr.j] += d.fixed_view::<6, 6>(6, 6);
+        }
         DissipationJacobian {
             stride,
             bodies,
             pairs,
+            diagonal,
             iterations: 0,
         }
     }
@@ -176,12 +212,10 @@ impl DissipationJacobian {
     fn apply_d(&self, v: &[Vec6], out: &mut [Vec6]) {
         out.fill(Vec6::zeros());
         for pr in &self.pairs {
-            let mut x = SVector::<f64, 12>::zeros();
-            x.fixed_rows_mut::<6>(0).copy_from(&v[pr.i]);
-            x.fixed_rows_mut::<6>(6).copy_from(&v[pr.j]);
-            let y = pr.d * x;
-            out[pr.i] += y.fixed_rows::<6>(0);
-            out[pr.j] += y.fixed_rows::<6>(6);
+            let (mut oi, mut oj) = (out[pr.i], out[pr.j]);
+            pr.apply(&v[pr.i], &v[pr.j], &mut oi, &mut oj);
+            out[pr.i] = oi;
+            out[pr.j] = oj;
         }
     }
 
@@ -246,22 +280,17 @@ impl StiffSolve for DissipationJacobian {
             *r = Vec6::new(m[0], m[1], m[2], w.x, w.y, w.z);
         }
         // Block-Jacobi preconditioner: the 6 × 6 diagonal blocks of M_V + h D.
-        let mut diag: Vec<Mat6> = self
+        let chol: Vec<Option<nalgebra::Cholesky<f64, nalgebra::Const<6>>>> = self
             .bodies
             .iter()
-            .map(|body| {
-                let mut m = Mat6::zeros();
-                m.fixed_view_mut::<3, 3>(0, 0).copy_from(&(Mat3::identity() * body.mass));
-                m.fixed_view_mut::<3, 3>(3, 3).copy_from(&body.inertia_world);
-                m
+            .zip(&self.diagonal)
+            .map(|(body, d)| {
+                let mut m = d * h;
+                m.fixed_view_mut::<3, 3>(0, 0).add_assign(&(Mat3::identity() * body.mass));
+                m.fixed_view_mut::<3, 3>(3, 3).add_assign(&body.inertia_world);
+                m.cholesky()
             })
             .collect();
-        for pr in &self.pairs {
-            diag[pr.i] += pr.d.fixed_view::<6, 6>(0, 0) * h;
-            diag[pr.j] += pr.d.fixed_view::<6, 6>(6, 6) * h;
-        }
-        let chol: Vec<Option<nalgebra::Cholesky<f64, nalgebra::Const<6>>>> =
-            diag.into_iter().map(|m| m.cholesky()).collect();
         let precondition = |r: &[Vec6], z: &mut [Vec6]| {
             for ((zi, ri), c) in z.iter_mut().zip(r).zip(&chol) {
                 *zi = match c {
