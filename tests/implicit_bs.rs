@@ -27,7 +27,10 @@ fn stiff_oscillator_error_follows_the_tolerance() {
         let (err, steps) = oscillator_error(tol);
         eprintln!("tol {tol:e}: error {err:e} ({:.2} x tol), {steps} steps", err / tol);
         assert!(err <= 10.0 * tol, "error {err:e} at tolerance {tol:e}");
-        assert!(err < previous, "error {err:e} not below {previous:e} of the looser tolerance");
+        assert!(
+            err < previous,
+            "error {err:e} not below {previous:e} of the looser tolerance"
+        );
         assert!(steps < 1000, "{steps} steps: the stiff mode is not handled implicitly");
         previous = err;
     }
@@ -45,7 +48,12 @@ use rubblepile::integrate::linearly_implicit::StiffSolve;
 /// every neighbouring pair overlaps.
 fn overlapping_four(seed: u64) -> Vec<Body> {
     let mut rng = Random::new(seed);
-    let centres = [[0.0, 0.0, 0.0], [1000.0, 100.0, 0.0], [400.0, 900.0, 100.0], [500.0, 400.0, 850.0]];
+    let centres = [
+        [0.0, 0.0, 0.0],
+        [1000.0, 100.0, 0.0],
+        [400.0, 900.0, 100.0],
+        [500.0, 400.0, 850.0],
+    ];
     centres
         .iter()
         .map(|&c| {
@@ -105,8 +113,15 @@ fn dissipation_jacobian_matches_finite_differences() {
         }
     }
     eprintln!("largest |J| entry {scale:e} 1/s, largest |J - J_fd| {worst:e}");
-    assert!(scale > 1e-3, "the dissipation is not stiff enough to test ({scale:e} 1/s)");
-    assert!(worst <= 1e-8 * scale, "J differs from finite differences by {:e} relative", worst / scale);
+    assert!(
+        scale > 1e-3,
+        "the dissipation is not stiff enough to test ({scale:e} 1/s)"
+    );
+    assert!(
+        worst <= 1e-8 * scale,
+        "J differs from finite differences by {:e} relative",
+        worst / scale
+    );
 
     // The solve: (I − h J) x = b with the dense J, and total momentum unchanged.
     let mut solver = sys.dissipation_jacobian(&y).unwrap();
@@ -119,7 +134,12 @@ fn dissipation_jacobian_matches_finite_differences() {
         // stiffness), so they agree to ε (1 + h |J|) of |x|.
         let a = nalgebra::DMatrix::<f64>::identity(n, n) - &dense * h;
         let x_lu = a.lu().solve(&nalgebra::DVector::from_column_slice(&b)).unwrap();
-        let diff = x_lu.iter().zip(&x).zip(&units).map(|((p, q), u)| ((p - q) / u).abs()).fold(0.0, f64::max);
+        let diff = x_lu
+            .iter()
+            .zip(&x)
+            .zip(&units)
+            .map(|((p, q), u)| ((p - q) / u).abs())
+            .fold(0.0, f64::max);
         let size = x.iter().zip(&units).map(|(p, u)| (p / u).abs()).fold(0.0, f64::max);
         let bound = 1e-14 * (1.0 + h * scale) * size;
         eprintln!("h = {h:e}: |x_cg - x_lu| {diff:e}, bound {bound:e} (user units)");
@@ -127,13 +147,24 @@ fn dissipation_jacobian_matches_finite_differences() {
         // The residual of (I − h J) x = b itself, where h J is small.
         if h * scale < 1e3 {
             let back = apply_dense(&dense, h, &x);
-            let resid = back.iter().zip(&b).zip(&units).map(|((p, q), u)| ((p - q) / u).abs()).fold(0.0, f64::max);
-            assert!(resid <= 1e-13 * (1.0 + h * scale) * size, "residual {resid:e} at h = {h}");
+            let resid = back
+                .iter()
+                .zip(&b)
+                .zip(&units)
+                .map(|((p, q), u)| ((p - q) / u).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                resid <= 1e-13 * (1.0 + h * scale) * size,
+                "residual {resid:e} at h = {h}"
+            );
         }
         let sum = |v: &[f64], c: usize| (0..bodies.len()).map(|i| v[i * 14 + 7 + c]).sum::<f64>();
         let p_scale: f64 = (0..bodies.len()).map(|i| units[i * 14 + 7]).sum();
         for c in 0..3 {
-            assert!((sum(&x, c) - sum(&b, c)).abs() <= 1e-14 * p_scale, "momentum changed by the solve");
+            assert!(
+                (sum(&x, c) - sum(&b, c)).abs() <= 1e-14 * p_scale,
+                "momentum changed by the solve"
+            );
         }
     }
 }
@@ -169,7 +200,8 @@ fn stiff_pile_settles_conserving_momenta() {
         de = de.max((d.energy() - d0.energy() - d.dissipated).abs() / d0.energy_scale);
     }
     let d = sys.diagnostics(&y);
-    let relative_ke = d.kinetic_translational - 0.5 * d.momentum.norm_squared() / bodies.iter().map(|b| b.shape.mass).sum::<f64>();
+    let relative_ke =
+        d.kinetic_translational - 0.5 * d.momentum.norm_squared() / bodies.iter().map(|b| b.shape.mass).sum::<f64>();
     let stats = integ.stats();
     eprintln!(
         "steps {} ({} rejected), RHS {}: |dP| {dp:e}, |dL| {dl:e}, energy {de:e}, dissipated {:e} J, KE left in relative motion {relative_ke:e} J of {:e}",
@@ -178,6 +210,13 @@ fn stiff_pile_settles_conserving_momenta() {
     assert!(dp <= 1e-13, "linear momentum error {dp:e}");
     assert!(dl <= 2e-13, "angular momentum error {dl:e}");
     assert!(de <= 1e-8, "energy balance error {de:e}");
-    assert!(-d.dissipated > 0.5 * d0.kinetic_translational, "the pile did not dissipate its relative motion");
-    assert!(stats.steps_accepted < 5000, "{} steps: the damping is not handled implicitly", stats.steps_accepted);
+    assert!(
+        -d.dissipated > 0.5 * d0.kinetic_translational,
+        "the pile did not dissipate its relative motion"
+    );
+    assert!(
+        stats.steps_accepted < 5000,
+        "{} steps: the damping is not handled implicitly",
+        stats.steps_accepted
+    );
 }

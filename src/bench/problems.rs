@@ -17,8 +17,8 @@
 //! are in [`super::ellipsoid_problems`].
 
 use crate::integrate::OdeSystem;
-use crate::integrate::linearly_implicit::{DenseStiff, StiffSolve};
 use crate::integrate::elliptic::{incomplete_f, jacobi_sn_cn_dn};
+use crate::integrate::linearly_implicit::{DenseStiff, StiffSolve};
 use std::f64::consts::PI;
 
 /// A test problem: an [`OdeSystem`] with an initial state, a natural end time and (optionally)

@@ -286,7 +286,8 @@ impl StiffSolve for DissipationJacobian {
             .zip(&self.diagonal)
             .map(|(body, d)| {
                 let mut m = d * h;
-                m.fixed_view_mut::<3, 3>(0, 0).add_assign(&(Mat3::identity() * body.mass));
+                m.fixed_view_mut::<3, 3>(0, 0)
+                    .add_assign(&(Mat3::identity() * body.mass));
                 m.fixed_view_mut::<3, 3>(3, 3).add_assign(&body.inertia_world);
                 m.cholesky()
             })
@@ -347,7 +348,7 @@ impl StiffSolve for DissipationJacobian {
             }
             apply_a(self, &dir, &mut ap, &mut scratch);
             let pap = dot(&dir, &ap);
-            if !(pap > 0.0) {
+            if pap.is_nan() || pap <= 0.0 {
                 break;
             }
             let alpha = rz / pap;

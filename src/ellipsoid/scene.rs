@@ -712,9 +712,10 @@ impl Validator<'_> {
             rtol,
             atol,
             step,
-            project_attitudes: i
-                .project_attitudes
-                .unwrap_or(!matches!(i.method, Method::BulirschStoer | Method::BulirschStoerImplicit)),
+            project_attitudes: i.project_attitudes.unwrap_or(!matches!(
+                i.method,
+                Method::BulirschStoer | Method::BulirschStoerImplicit
+            )),
         })
     }
 

@@ -240,7 +240,11 @@ impl LinearlyImplicit {
         let rtol = tolerances.rtol.iter().copied().fold(f64::INFINITY, f64::min);
         // SEULEX's initial column count from the tolerance: about one order per decade of it.
         let k0 = (-(rtol + f64::EPSILON).log10() * 0.6 + 1.5).floor();
-        let k = if k0.is_finite() { (k0.max(0.0) as usize).clamp(2, km - 1) } else { 2 };
+        let k = if k0.is_finite() {
+            (k0.max(0.0) as usize).clamp(2, km - 1)
+        } else {
+            2
+        };
         Ok(LinearlyImplicit {
             tol: tolerances,
             km,
@@ -318,7 +322,11 @@ impl LinearlyImplicit {
         let d0 = self.norm(y);
         let d1 = self.norm(&self.f0);
         let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
-        if h0.is_finite() && h0 > 0.0 { h0.min(span) } else { 1e-6f64.min(span) }
+        if h0.is_finite() && h0 > 0.0 {
+            h0.min(span)
+        } else {
+            1e-6f64.min(span)
+        }
     }
 
     /// Column `j` of the tableau for the step `(t, y) → t + h` with the stiff part `stiff`.
@@ -427,7 +435,12 @@ impl LinearlyImplicit {
         h: f64,
         special: bool,
     ) -> Attempt {
-        for ((sc, &yi), (&a, &r)) in self.scal.iter_mut().zip(y).zip(self.tol.atol.iter().zip(&self.tol.rtol)) {
+        for ((sc, &yi), (&a, &r)) in self
+            .scal
+            .iter_mut()
+            .zip(y)
+            .zip(self.tol.atol.iter().zip(&self.tol.rtol))
+        {
             *sc = (a + r * yi.abs()).max(f64::MIN_POSITIVE);
         }
         let k = self.k;
@@ -492,6 +505,8 @@ impl LinearlyImplicit {
             }
             kopt
         };
+        // Accepted in column km (one past the target k = km − 1): the target stays below km.
+        let kopt = kopt.min(km - 1);
         // The tableau's answer is column kc: put T_{kc,kc} in row 0 (it is there already).
         if self.reject {
             self.k = kopt.min(kc);
@@ -537,7 +552,10 @@ impl LinearlyImplicit {
         }
         let mut stiff = system.stiff_part(*t, y).unwrap_or_else(|| Box::new(NoStiffPart));
         if self.h == 0.0 {
-            for (sc, (&yi, (&a, &r))) in self.scal.iter_mut().zip(y.iter().zip(self.tol.atol.iter().zip(&self.tol.rtol)))
+            for (sc, (&yi, (&a, &r))) in self
+                .scal
+                .iter_mut()
+                .zip(y.iter().zip(self.tol.atol.iter().zip(&self.tol.rtol)))
             {
                 *sc = (a + r * yi.abs()).max(f64::MIN_POSITIVE);
             }
@@ -698,7 +716,11 @@ impl Integrator for LinearlyImplicit {
         };
         let bad = |what: String| Err(IntegrateError::Config(format!("bulirsch-stoer-implicit state: {what}")));
         if s.dim != self.tol.rtol.len() {
-            return bad(format!("saved for dimension {}, tolerances have {}", s.dim, self.tol.rtol.len()));
+            return bad(format!(
+                "saved for dimension {}, tolerances have {}",
+                s.dim,
+                self.tol.rtol.len()
+            ));
         }
         if s.km != self.km || !(2..s.km).contains(&s.k) {
             return bad(format!("columns {} of {} (expected at most {})", s.k, s.km, self.km));
@@ -709,7 +731,8 @@ impl Integrator for LinearlyImplicit {
         if !(s.h.is_finite() && s.h >= 0.0) || s.span.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
             return bad(format!("bad step size {} or span {:?}", s.h, s.span));
         }
-        if !(s.compensation.is_empty() || s.compensation.len() == s.dim) || !s.compensation.iter().all(|c| c.is_finite())
+        if !(s.compensation.is_empty() || s.compensation.len() == s.dim)
+            || !s.compensation.iter().all(|c| c.is_finite())
         {
             return bad(format!("compensation must be empty or {} finite entries", s.dim));
         }
