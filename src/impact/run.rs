@@ -177,7 +177,9 @@ impl ImpactConfig {
         if self.method == Method::Rk4 {
             return invalid(
                 "method",
-                "must be bulirsch-stoer, dop853 or dopri5 (rk4 has a fixed step, which an impact cannot choose)".into(),
+                "must be bulirsch-stoer, dop853 or dopri5, or bulirsch-stoer-implicit (rk4 has a fixed step, which an \
+                 impact cannot choose)"
+                    .into(),
             );
         }
         let min_rtol = crate::io::scene_file::MIN_RTOL;

@@ -205,10 +205,9 @@ impl Case {
     /// `[integrator] method` line replaced.
     pub fn with_method(self, method: crate::integrate::Method) -> Case {
         Case {
-            scene_toml: self.scene_toml.replace(
-                "method = \"bulirsch-stoer\"\n",
-                &format!("method = \"{method}\"\n"),
-            ),
+            scene_toml: self
+                .scene_toml
+                .replace("method = \"bulirsch-stoer\"\n", &format!("method = \"{method}\"\n")),
             ..self
         }
     }
