@@ -230,9 +230,15 @@ fn stability_cases_take_another_method() {
         let id = case.id.clone();
         let after = case.with_method(Method::BulirschStoerImplicit).scene_toml;
         assert!(before.contains("method = \"bulirsch-stoer\"\n"), "{id}: no method line");
-        assert!(after.contains("method = \"bulirsch-stoer-implicit\"\n"), "{id}: method not replaced");
+        assert!(
+            after.contains("method = \"bulirsch-stoer-implicit\"\n"),
+            "{id}: method not replaced"
+        );
         assert_eq!(
-            after.replace("method = \"bulirsch-stoer-implicit\"\n", "method = \"bulirsch-stoer\"\n"),
+            after.replace(
+                "method = \"bulirsch-stoer-implicit\"\n",
+                "method = \"bulirsch-stoer\"\n"
+            ),
             before,
             "{id}: more than the method line changed"
         );
