@@ -291,6 +291,15 @@ fn bulirsch_stoer_run_killed_and_resumed_twice_is_bit_identical() {
 }
 
 #[test]
+fn implicit_bulirsch_stoer_run_killed_and_resumed_is_bit_identical() {
+    // The linearly implicit method restores its step, column count and compensation; its Jacobian is rebuilt from
+    // the state at every step, so nothing else carries over.
+    let cwd = temp_dir("cwd");
+    let (a, b) = kill_and_resume("bulirsch-stoer-implicit", false, &[15, 5], &cwd);
+    assert_same_run(&a, &b, "bulirsch-stoer-implicit");
+}
+
+#[test]
 fn dop853_run_killed_and_resumed_is_bit_identical() {
     // Every `advance` of Dop853 evaluates the derivative at its start afresh, so restoring the proposed step and
     // the counters is exact. The scene reads its bodies from a relative bodies_file, and the resume runs from

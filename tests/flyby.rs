@@ -574,3 +574,54 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("settle_max_hours"));
 }
+
+/// Spheres under gravity alone take the packed right-hand side; with a planet the state also carries the tide's six
+/// impulse components after the bodies, which that path once walked as a body of its own (an index panic). The
+/// pair's momentum residual must be an error (the tide's impulse reported apart), and the run must complete.
+#[test]
+fn spheres_under_gravity_alone_pass_a_planet() {
+    let text = r#"[scene]
+kind = "ellipsoids"
+t_end = 3000.0
+[model]
+kappa = 10.0
+[physics]
+gravity = {}
+[physics.flyby]
+mass = 5.9722e25
+radius = 6.371e6
+q = 9.5e6
+v_inf = 3000.0
+t_perigee = 1500.0
+[integrator]
+method = "bulirsch-stoer"
+rtol = 1e-10
+atol = 1e-10
+[output]
+times = [0.0, 3000.0]
+every = 500.0
+[[body]]
+axes = [40.0, 40.0, 40.0]
+density = 2000.0
+position = [-300.0, 0.0, 0.0]
+velocity = [0.0, -0.01, 0.0]
+[[body]]
+axes = [30.0, 30.0, 30.0]
+density = 2000.0
+position = [300.0, 0.0, 0.0]
+velocity = [0.0, 0.02, 0.0]
+"#;
+    let (_, s) = run(text, "flyby-point-masses");
+    assert_eq!(s.status, "completed");
+    assert!(s.energy_error < 1e-8, "energy error {:e}", s.energy_error);
+    assert!(
+        s.linear_momentum_error < 1e-8,
+        "momentum residual {:e}",
+        s.linear_momentum_error
+    );
+    assert!(
+        s.tidal_impulse.is_some_and(|j| j > 1e3 * s.linear_momentum_error),
+        "{:?}",
+        s.tidal_impulse
+    );
+}

@@ -29,7 +29,7 @@ pub struct ImpactBenchArgs {
     /// End time of each run (s).
     #[arg(long, default_value_t = 10_000.0)]
     pub t_end: f64,
-    /// Integrators, comma-separated: bulirsch-stoer (the impact default), dop853, dopri5. `METHOD:RTOL` runs that
+    /// Integrators, comma-separated: bulirsch-stoer (the impact default), dop853, dopri5, bulirsch-stoer-implicit. `METHOD:RTOL` runs that
     /// method at that tolerance only (e.g. `bulirsch-stoer:1e-4,dop853:1e-8`); a bare METHOD runs every --rtol.
     #[arg(long, value_delimiter = ',', default_value = "bulirsch-stoer", value_parser = parse_method_spec)]
     pub method: Vec<MethodSpec>,
@@ -73,7 +73,7 @@ pub struct MethodSpec {
     pub rtol: Option<f64>,
 }
 
-/// Parses `METHOD` or `METHOD:RTOL` (bulirsch-stoer, dop853 or dopri5; RTOL in (0, 1)).
+/// Parses `METHOD` or `METHOD:RTOL` (bulirsch-stoer, dop853, dopri5 or bulirsch-stoer-implicit; RTOL in (0, 1)).
 fn parse_method_spec(text: &str) -> Result<MethodSpec, String> {
     let (name, rtol) = match text.split_once(':') {
         Some((name, rtol)) => {
@@ -91,7 +91,10 @@ fn parse_method_spec(text: &str) -> Result<MethodSpec, String> {
         .ok()
         .filter(|m| *m != Method::Rk4)
         .ok_or_else(|| {
-            format!("each must be bulirsch-stoer, dop853 or dopri5 (rk4 needs a fixed step), got {name:?}")
+            format!(
+                "each must be bulirsch-stoer, dop853 or dopri5, or bulirsch-stoer-implicit (rk4 needs a fixed step), \
+                 got {name:?}"
+            )
         })?;
     Ok(MethodSpec { method, rtol })
 }
@@ -359,6 +362,7 @@ impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
 fn short_name(method: Method) -> String {
     match method {
         Method::BulirschStoer => "BS".to_string(),
+        Method::BulirschStoerImplicit => "BS-implicit".to_string(),
         other => other.to_string(),
     }
 }

@@ -10,6 +10,7 @@
 //! | [`Kepler`] | 4 | exact solution via Kepler's equation, energy and angular momentum |
 //! | [`Arenstorf`] | 4 | periodic orbit of the restricted three-body problem (hard step control) |
 //! | [`ExponentialDecay`] | 1 | mildly stiff linear decay, stability of explicit methods |
+//! | [`StiffDampedOscillator`] | 2 | overdamped oscillator, stiffness ratio ~4ζ²: exact solution, stiff integrators (with its exact Jacobian) |
 //! | [`RigidBody`] | 3 | Euler's equations of a free rigid body: exact solution ([`torque_free_spin`], Jacobi elliptic functions), energy and angular momentum |
 //!
 //! The problems of the ellipsoid model itself (a free top, a bouncing pair, the N30 target, N-body tests)
@@ -17,6 +18,7 @@
 
 use crate::integrate::OdeSystem;
 use crate::integrate::elliptic::{incomplete_f, jacobi_sn_cn_dn};
+use crate::integrate::linearly_implicit::{DenseStiff, StiffSolve};
 use std::f64::consts::PI;
 
 /// A test problem: an [`OdeSystem`] with an initial state, a natural end time and (optionally)
@@ -289,6 +291,75 @@ impl TestProblem for ExponentialDecay {
     }
     fn exact(&self, t: f64) -> Option<Vec<f64>> {
         Some(vec![(-self.lambda * t).exp()])
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+/// The overdamped oscillator `x'' + 2 ζ ω x' + ω² x = 0` (ζ > 1), state `[x, v]`, started at `x = 1, v = 0`: the
+/// contact of two bodies under strong linear damping, reduced to one coordinate.
+///
+/// Its modes decay at `λ_fast = −ω (ζ + s)` and `λ_slow = −ω/(ζ + s)` (`s = √(ζ² − 1)`, the second written so that
+/// it does not cancel): a stiffness ratio of about `4 ζ²`. Exact solution
+/// `x = A e^{λ_slow t} + B e^{λ_fast t}` with `A = λ_fast/(λ_fast − λ_slow)`, `B = 1 − A`. It supplies its exact
+/// (constant) Jacobian `[[0, 1], [−ω², −2ζω]]` as its stiff part. The natural end time is `1/|λ_slow|`, one
+/// e-folding of the slow mode; an explicit method needs about `|λ_fast|/|λ_slow| ≈ 4 ζ²` steps to get there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StiffDampedOscillator {
+    /// Undamped angular frequency ω (rad per unit time, > 0).
+    pub omega: f64,
+    /// Damping ratio ζ (> 1: overdamped).
+    pub zeta: f64,
+}
+
+impl Default for StiffDampedOscillator {
+    /// ω = 1, ζ = 1000 (stiffness ratio 4e6).
+    fn default() -> Self {
+        StiffDampedOscillator {
+            omega: 1.0,
+            zeta: 1000.0,
+        }
+    }
+}
+
+impl StiffDampedOscillator {
+    /// The decay rates `(λ_slow, λ_fast)` (both negative).
+    pub fn rates(&self) -> (f64, f64) {
+        let s = (self.zeta * self.zeta - 1.0).sqrt();
+        (-self.omega / (self.zeta + s), -self.omega * (self.zeta + s))
+    }
+}
+
+impl OdeSystem for StiffDampedOscillator {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn rhs(&self, _t: f64, y: &[f64], dydt: &mut [f64]) {
+        dydt[0] = y[1];
+        dydt[1] = -self.omega * self.omega * y[0] - 2.0 * self.zeta * self.omega * y[1];
+    }
+    fn stiff_part(&self, _t: f64, _y: &[f64]) -> Option<Box<dyn StiffSolve + '_>> {
+        let jacobian = vec![0.0, 1.0, -self.omega * self.omega, -2.0 * self.zeta * self.omega];
+        Some(Box::new(DenseStiff::new(2, jacobian)))
+    }
+}
+
+impl TestProblem for StiffDampedOscillator {
+    fn name(&self) -> &'static str {
+        "stiff-damped-oscillator"
+    }
+    fn initial_state(&self) -> Vec<f64> {
+        vec![1.0, 0.0]
+    }
+    fn t_end(&self) -> f64 {
+        -1.0 / self.rates().0
+    }
+    fn exact(&self, t: f64) -> Option<Vec<f64>> {
+        let (slow, fast) = self.rates();
+        let a = fast / (fast - slow);
+        let b = 1.0 - a;
+        let (es, ef) = ((slow * t).exp(), (fast * t).exp());
+        Some(vec![a * es + b * ef, a * slow * es + b * fast * ef])
     }
 }
 

@@ -327,6 +327,7 @@ fn method_colour(method: Method) -> RGBColor {
         Method::Dop853 => RGBColor(0x1f, 0x77, 0xb4),
         Method::Dopri5 => RGBColor(0x2c, 0xa0, 0x2c),
         Method::Rk4 => RGBColor(0x94, 0x67, 0xbd),
+        Method::BulirschStoerImplicit => RGBColor(0xff, 0x7f, 0x0e),
     }
 }
 

@@ -124,14 +124,8 @@ impl ImpactArgs {
             f0: self.f0,
             beta: self.beta,
             kappa_reading: self.kappa_reading,
-            snapshots: match (&self.snapshots, self.snapshot_every) {
-                (Some(times), _) => times.clone(),
-                (None, Some(every)) => {
-                    crate::io::output_times::checked_cadence_times(self.t_end, every, "--snapshot-every", "--t-end")
-                        .map_err(CliError::usage)?
-                }
-                (None, None) => crate::impact::run::default_snapshots(self.t_end),
-            },
+            snapshots: crate::impact::run::snapshot_times(self.t_end, self.snapshots.as_deref(), self.snapshot_every)
+                .map_err(CliError::usage)?,
             every: self.every,
             inertia: if self.inertia == "uniform" {
                 crate::ellipsoid::body::InertiaModel::Uniform

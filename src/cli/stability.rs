@@ -23,6 +23,10 @@ pub struct StabilityArgs {
     /// Run only the cases whose id contains one of these strings (comma-separated), e.g. `--only a2,f-kappa`.
     #[arg(long, value_delimiter = ',')]
     pub only: Vec<String>,
+    /// The integrator every case runs with (its tolerances unchanged), e.g. `bulirsch-stoer-implicit` to compare
+    /// the stiff rows.
+    #[arg(long, value_enum, default_value_t = crate::integrate::Method::BulirschStoer)]
+    pub method: crate::integrate::Method,
 }
 
 /// Runs `bench stability`; exits with code 1 when a case fails.
@@ -30,6 +34,7 @@ pub fn stability(args: &StabilityArgs) -> Result<(), CliError> {
     let cases: Vec<_> = all_cases(args.quick)
         .into_iter()
         .filter(|c| args.only.is_empty() || args.only.iter().any(|s| c.id.contains(s.as_str())))
+        .map(|c| c.with_method(args.method))
         .collect();
     if cases.is_empty() {
         return Err(CliError::usage(format!(

@@ -17,6 +17,7 @@
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{lambda, pair_prefactor};
 use crate::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
+use crate::ellipsoid::dissipation_jacobian::{BodyLinear, DissipationJacobian, PairLinear};
 use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
@@ -34,6 +35,7 @@ use crate::ellipsoid::tide::TideTerm;
 use crate::geometry::neighbours::sphere_pairs;
 use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::integrate::OdeSystem;
+use crate::integrate::linearly_implicit::StiffSolve;
 use crate::math::{Mat4, Vec3, Vec4};
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
@@ -619,6 +621,40 @@ impl EllipsoidSystem {
         self.stride
     }
 
+    /// The dissipation's Jacobian in the momenta at state `y` ([`DissipationJacobian`], the stiff part the linearly
+    /// implicit integrator solves with), over the pairs whose dissipation the right-hand side computes; `None`
+    /// without dissipation.
+    pub fn dissipation_jacobian(&self, y: &[f64]) -> Option<DissipationJacobian> {
+        let f0 = self.physics.dissipation?.f0;
+        if !self.rotation {
+            return None;
+        }
+        let kappa = self.model.kappa;
+        let kin = self.all_kinematics(y, true);
+        let candidates = self.candidate_pairs(&kin);
+        let pairs = candidates
+            .iter()
+            .filter_map(|c| {
+                let (gi, gj) = (kin[c.i].geometry.as_ref()?, kin[c.j].geometry.as_ref()?);
+                let delta = kin[c.i].r - kin[c.j].r;
+                if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
+                    return None;
+                }
+                let ov = overlap_within_taper(c.prefactor, kappa, &delta, gi, gj, &c.taper)?;
+                Some(PairLinear::new(f0, kappa, c.i, c.j, &ov, gi, gj))
+            })
+            .collect();
+        let bodies = kin
+            .iter()
+            .enumerate()
+            .map(|(i, k)| {
+                let g = k.geometry.as_ref().expect("geometry computed above");
+                BodyLinear::new(self.shapes[i].mass, &self.moments[i], &self.inertia_ext[i], g)
+            })
+            .collect();
+        Some(DissipationJacobian::new(self.stride, bodies, pairs))
+    }
+
     /// Index of the `∫F dt` component in the state, when dissipation is on.
     pub fn dissipation_index(&self) -> Option<usize> {
         self.physics.dissipation.map(|_| self.n_bodies() * self.stride)
@@ -1079,7 +1115,8 @@ impl OdeSystem for EllipsoidSystem {
     /// m/s) and `M R²` (kg m², `R` the largest body distance from the origin plus its major semi-axis: rad/s).
     fn state_units(&self) -> Option<Vec<f64>> {
         let mut units = vec![1.0; self.dim()];
-        for (i, chunk) in units.chunks_exact_mut(self.stride).enumerate() {
+        let bodies = self.n_bodies() * self.stride;
+        for (i, chunk) in units[..bodies].chunks_exact_mut(self.stride).enumerate() {
             let m = self.shapes[i].mass;
             if self.rotation {
                 let moments = self.moments[i];
@@ -1124,6 +1161,11 @@ impl OdeSystem for EllipsoidSystem {
         *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(Arc::new(frozen));
     }
 
+    /// The dissipation's Jacobian in the momenta ([`EllipsoidSystem::dissipation_jacobian`]).
+    fn stiff_part(&self, _t: f64, y: &[f64]) -> Option<Box<dyn StiffSolve + '_>> {
+        self.dissipation_jacobian(y).map(|j| Box::new(j) as Box<dyn StiffSolve>)
+    }
+
     /// Drops the lists of [`OdeSystem::begin_step`]: later evaluations walk fresh trees until the next step.
     fn end_steps(&self) {
         *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = None;
@@ -1136,7 +1178,8 @@ impl OdeSystem for EllipsoidSystem {
         if !self.rotation && !self.needs_pairs() && n < BLOCKED_FROM && tree_theta.is_none() {
             // Spheres under gravity alone (e.g. planetary N-body problems): ṙ = u/m, u̇ = F_G, straight from
             // the packed state, nothing allocated.
-            for (i, out) in dydt.chunks_exact_mut(self.stride).enumerate() {
+            // the bodies' components only: the tide's impulses follow them when a planet is there
+            for (i, out) in dydt[..n * self.stride].chunks_exact_mut(self.stride).enumerate() {
                 let m = self.shapes[i].mass;
                 for k in 0..3 {
                     out[k] = y[i * self.stride + 3 + k] / m;
@@ -1147,7 +1190,7 @@ impl OdeSystem for EllipsoidSystem {
                 add_gravity_forces_packed(gr.g, y, self.stride, &self.masses, dydt, 3);
             }
             if let Some((tide, planet)) = &tide {
-                for (i, out) in dydt.chunks_exact_mut(self.stride).enumerate() {
+                for (i, out) in dydt[..n * self.stride].chunks_exact_mut(self.stride).enumerate() {
                     let r = Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]);
                     let f = tide.acceleration(&r, planet) * self.masses[i];
                     for (o, fk) in out[3..6].iter_mut().zip(f.iter()) {

@@ -7,6 +7,7 @@
 //! - [`gravity`]: monopole gravity (Eq. 6);
 //! - [`gravity_tree`]: the same by a Barnes–Hut octree for large N, and the choice between the two;
 //! - [`dissipation`]: the point dissipation function (Eqs. 40–41);
+//! - [`dissipation_jacobian`]: its analytic Jacobian in the momenta and the solve the stiff integrator needs;
 //! - [`clumps`]: connected sets of bodies in contact;
 //! - [`barrier`]: the contact-barrier overrun detector (calibration of Eqs. 13–14 checked during a run);
 //! - [`tide`]: a planet on a prescribed Kepler orbit (the `[physics.flyby]` term);
@@ -46,6 +47,7 @@ pub mod calibration;
 pub mod cloud;
 pub mod clumps;
 pub mod dissipation;
+pub mod dissipation_jacobian;
 pub mod equations;
 pub mod gravity;
 pub mod gravity_tree;

@@ -386,7 +386,9 @@ impl EllipsoidEngine {
         // body's interaction list changes, a step's share h/T of rtol falls below those jumps on long runs, and
         // Bulirsch-Stoer without frozen lists accepted no 1 s step in a minute (N2000 impact,
         // analysis/n2000/REPORT.md). There each step's error is bounded by rtol (ODEX's rule).
-        if system.forces_are_smooth() || settings.method == Method::BulirschStoer {
+        if system.forces_are_smooth()
+            || matches!(settings.method, Method::BulirschStoer | Method::BulirschStoerImplicit)
+        {
             integrator.set_span(scene.t_end);
         }
         let y = system.initial_state();
@@ -703,6 +705,7 @@ impl Engine for EllipsoidEngine {
             steps_rejected: stats.steps_rejected,
             rejections: match self.integrator.save_state() {
                 IntegratorState::BulirschStoer(s) => Some(s.rejections),
+                IntegratorState::LinearlyImplicit(s) => Some(s.rejections),
                 _ => None,
             },
             rhs_evaluations: stats.rhs_evaluations,

@@ -236,14 +236,24 @@ pub struct DissipationSpec {
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
     /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
-    /// (adaptive Dormand–Prince) or `"rk4"` (fixed step; needs `step`, and takes no `rtol` or `atol`). Default
+    /// (adaptive Dormand–Prince), `"rk4"` (fixed step; needs `step`, and takes no `rtol` or `atol`) or
+    /// `"bulirsch-stoer-implicit"` (linearly implicit Euler extrapolation, [`crate::integrate::linearly_implicit`],
+    /// with the dissipation's analytic Jacobian, [`crate::ellipsoid::dissipation_jacobian`]). Default
     /// `"bulirsch-stoer"`.
+    ///
+    /// **When to use the implicit method.** The dissipation damps a touching pair at the rate
+    /// `2 F0 U_C / μ` (s⁻¹; `μ` the reduced mass, `U_C` the pair's contact energy, about
+    /// `G m_i m_j / (2κλ (R_i + R_j))` at contact by Roig03 Eq. 11), and an explicit method must resolve that time
+    /// scale. Once it exceeds the contact's own frequency (the pair is overdamped: sticking regimes, large `F0`)
+    /// the implicit method's steps follow the motion instead; below it (soft contacts, Roig03's F0 = 1e-6 s m⁻²)
+    /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
+    /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
     #[serde(default = "default_method")]
     pub method: Method,
     /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
     /// is judged in the units a user thinks in (position in m, velocity in m/s, spin in rad/s, attitude as a
     /// unit quaternion, dissipated energy relative to the initial energy scale), whatever its mass. With
-    /// `"bulirsch-stoer"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
+    /// `"bulirsch-stoer"` and `"bulirsch-stoer-implicit"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
     /// quarter of it (error per unit step), so the final error follows `rtol`; the other methods apply it to each
     /// step. In `[1e-15, 1)` ([`MIN_RTOL`]); only for the adaptive methods (refused with `"rk4"`, which has no
     /// error control).
@@ -262,7 +272,8 @@ pub struct IntegratorSection {
     /// [`crate::ellipsoid::equations::EllipsoidSystem::project_attitudes`]). Default: `true` for `"dop853"`,
     /// `"dopri5"` and `"rk4"`, whose error norm lets one fast-spinning body's `|q|` drift by 1e-3 within a few
     /// hundred turns (the N2000 impact, `analysis/n2000/REPORT.md`); `false` for `"bulirsch-stoer"`, which keeps
-    /// the constraint without it (1.3e-6 over that impact) and whose runs stay as they were. The run's
+    /// the constraint without it (1.3e-6 over that impact) and whose runs stay as they were, and for
+    /// `"bulirsch-stoer-implicit"`, which controls the error in the same run-wide norm. The run's
     /// `quaternion_norm_error` is the largest `||q| − 1|` before projection, and above 1e-3 it still stops the run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub project_attitudes: Option<bool>,
@@ -389,7 +400,7 @@ pub struct IntegratorSettings {
     /// Fixed (rk4) or initial step (s).
     pub step: Option<f64>,
     /// Whether attitudes are projected onto `|q| = 1` at every output sample (resolved default: all methods but
-    /// Bulirsch–Stoer).
+    /// the two Bulirsch–Stoer ones).
     pub project_attitudes: bool,
 }
 
@@ -708,7 +719,10 @@ impl Validator<'_> {
             rtol,
             atol,
             step,
-            project_attitudes: i.project_attitudes.unwrap_or(i.method != Method::BulirschStoer),
+            project_attitudes: i.project_attitudes.unwrap_or(!matches!(
+                i.method,
+                Method::BulirschStoer | Method::BulirschStoerImplicit
+            )),
         })
     }
 

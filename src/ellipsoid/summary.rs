@@ -85,7 +85,7 @@ pub struct RunSummary {
     pub steps_accepted: u64,
     /// Rejected integrator steps.
     pub steps_rejected: u64,
-    /// Bulirsch–Stoer's rejected steps by cause (error test, stability check, divergence, non-finite values);
+    /// The Bulirsch–Stoer methods' rejected steps by cause (error test, stability check, divergence, non-finite values);
     /// absent for the other methods. Tells whether a run's step was set by accuracy or by stiffness.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rejections: Option<crate::integrate::bulirsch_stoer::Rejections>,

@@ -36,11 +36,11 @@ pub const DEFAULT_RTOL: f64 = 1e-6;
 /// impact to 10 000 s in 7 min 37 s on 2 cores with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
 pub const DEFAULT_RTOL_PER_STEP: f64 = 1e-8;
 
-/// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for Bulirsch–Stoer (of the whole run),
+/// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for the Bulirsch–Stoer methods (of the whole run),
 /// [`DEFAULT_RTOL_PER_STEP`] for the others.
 pub fn default_rtol(method: Method) -> f64 {
     match method {
-        Method::BulirschStoer => DEFAULT_RTOL,
+        Method::BulirschStoer | Method::BulirschStoerImplicit => DEFAULT_RTOL,
         _ => DEFAULT_RTOL_PER_STEP,
     }
 }
@@ -67,6 +67,19 @@ pub fn default_snapshots(t_end: f64) -> Vec<f64> {
     let mut times: Vec<f64> = DEFAULT_SNAPSHOTS.iter().copied().filter(|&t| t < t_end).collect();
     times.push(t_end);
     times
+}
+
+/// The snapshot times of an impact to `t_end` (s): the `list` when given, else those of a cadence `every` (s,
+/// checked: [`crate::io::output_times::checked_cadence_times`], errors naming `--snapshot-every` and `--t-end`),
+/// else [`default_snapshots`].
+pub fn snapshot_times(t_end: f64, list: Option<&[f64]>, every: Option<f64>) -> Result<Vec<f64>, String> {
+    match (list, every) {
+        (Some(times), _) => Ok(times.to_vec()),
+        (None, Some(every)) => {
+            crate::io::output_times::checked_cadence_times(t_end, every, "--snapshot-every", "--t-end")
+        }
+        (None, None) => Ok(default_snapshots(t_end)),
+    }
 }
 
 /// Everything that defines one impact run. SI units unless the name says otherwise; the defaults (of
@@ -177,7 +190,9 @@ impl ImpactConfig {
         if self.method == Method::Rk4 {
             return invalid(
                 "method",
-                "must be bulirsch-stoer, dop853 or dopri5 (rk4 has a fixed step, which an impact cannot choose)".into(),
+                "must be bulirsch-stoer, dop853 or dopri5, or bulirsch-stoer-implicit (rk4 has a fixed step, which an \
+                 impact cannot choose)"
+                    .into(),
             );
         }
         let min_rtol = crate::io::scene_file::MIN_RTOL;

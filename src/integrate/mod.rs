@@ -7,6 +7,8 @@
 //!   and step-size control, §II.10 of the same book), its vector work parallel and deterministic;
 //! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dopri5 and Rk4 (and its Dop853, for
 //!   cross-checks);
+//! - [`linearly_implicit`]: linearly implicit Euler extrapolation (SEULEX of Hairer & Wanner, *Solving ODEs II*,
+//!   §IV.9) for stiff systems, using the stiff part a system supplies ([`OdeSystem::stiff_part`]);
 //! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution).
 //!
 //! The canonical test problems and the work–precision measurements that exercise these solvers live in
@@ -15,6 +17,7 @@
 pub mod bulirsch_stoer;
 pub mod dop853;
 pub mod elliptic;
+pub mod linearly_implicit;
 pub mod ode_solvers_adapter;
 
 use std::fmt;
@@ -45,6 +48,13 @@ pub trait OdeSystem: Sync {
     /// reached its target or failed): the system drops the choice, so that evaluations outside the integrator
     /// (diagnostics, another integrator) do not keep it. Default: nothing.
     fn end_steps(&self) {}
+    /// The stiff part `J ≈ ∂f/∂y` at `(t, y)`, as a solver of `(I − h J) x = b`, for the linearly implicit
+    /// methods ([`linearly_implicit`]), which call it at the start of every step and keep it for the step. Any
+    /// matrix gives a correct method of the same order (a W-method); the closer it is to the stiff part of the
+    /// true Jacobian, the longer the stable steps. Default `None`: no stiff part (`J = 0`).
+    fn stiff_part(&self, _t: f64, _y: &[f64]) -> Option<Box<dyn linearly_implicit::StiffSolve + '_>> {
+        None
+    }
 }
 
 /// Which integrator runs a system (the scene's `[integrator] method`).
@@ -59,6 +69,9 @@ pub enum Method {
     Dopri5,
     /// Classical fixed-step Runge–Kutta 4 from `ode_solvers`, `"rk4"` (needs a step).
     Rk4,
+    /// Linearly implicit Euler extrapolation for stiff systems (ours, [`linearly_implicit::LinearlyImplicit`]),
+    /// `"bulirsch-stoer-implicit"`.
+    BulirschStoerImplicit,
 }
 
 impl fmt::Display for Method {
@@ -68,6 +81,7 @@ impl fmt::Display for Method {
             Method::Dop853 => "dop853",
             Method::Dopri5 => "dopri5",
             Method::Rk4 => "rk4",
+            Method::BulirschStoerImplicit => "bulirsch-stoer-implicit",
         };
         f.write_str(s)
     }
@@ -191,6 +205,8 @@ pub enum IntegratorState {
     OdeSolvers(ode_solvers_adapter::OdeSolversState),
     /// State of a [`dop853::Dop853`].
     Dop853(dop853::Dop853State),
+    /// State of a [`linearly_implicit::LinearlyImplicit`].
+    LinearlyImplicit(linearly_implicit::LinearlyImplicitState),
 }
 
 impl IntegratorState {
@@ -200,6 +216,7 @@ impl IntegratorState {
             IntegratorState::BulirschStoer(_) => Method::BulirschStoer,
             IntegratorState::OdeSolvers(s) => s.method,
             IntegratorState::Dop853(_) => Method::Dop853,
+            IntegratorState::LinearlyImplicit(_) => Method::BulirschStoerImplicit,
         }
     }
 }
@@ -267,7 +284,7 @@ pub trait Integrator {
 }
 
 /// Builds the integrator for `method`. `step` is the fixed step (s) for `Rk4`, or an optional
-/// initial step for the adaptive methods.
+/// initial step for the adaptive methods (`BulirschStoerImplicit` chooses its own).
 pub fn make_integrator(
     method: Method,
     tolerances: Tolerances,
@@ -276,6 +293,7 @@ pub fn make_integrator(
     match method {
         Method::BulirschStoer => Ok(Box::new(bulirsch_stoer::BulirschStoer::new(tolerances, step)?)),
         Method::Dop853 => Ok(Box::new(dop853::Dop853::new(tolerances, step)?)),
+        Method::BulirschStoerImplicit => Ok(Box::new(linearly_implicit::LinearlyImplicit::new(tolerances)?)),
         Method::Dopri5 => Ok(Box::new(ode_solvers_adapter::OdeSolversAdapter::new(
             method, tolerances, step,
         )?)),

@@ -200,6 +200,19 @@ pub struct Case {
     pub check: Check,
 }
 
+impl Case {
+    /// The same case run by `method` instead of the suite's Bulirsch–Stoer (same tolerances): its scene's
+    /// `[integrator] method` line replaced.
+    pub fn with_method(self, method: crate::integrate::Method) -> Case {
+        Case {
+            scene_toml: self
+                .scene_toml
+                .replace("method = \"bulirsch-stoer\"\n", &format!("method = \"{method}\"\n")),
+            ..self
+        }
+    }
+}
+
 impl std::fmt::Debug for Case {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Case")
