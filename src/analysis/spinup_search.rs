@@ -451,10 +451,10 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.ours] {
-        if let (Some(&first), Some(t)) = (r.set_aside_hours.first(), r.t_c3_hours) {
+        if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {
             println!(
-                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside; refine with \
-                 --from {first:.2} --to {t:.2} --step 0.01",
+                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
+                 monotone there: refine with --step 0.01 from {first:.2} h to the next creeping hold above {last:.2} h)",
                 r.criterion.kind.name(),
                 r.set_aside_hours
             );
