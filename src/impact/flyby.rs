@@ -13,7 +13,7 @@
 //! `initial_bodies.csv`, the run's "before"), optionally put into principal-axis rotation about its largest moment
 //! (`--settle-to-principal`), and a control run of the same pile over the same time without the planet (mass 0)
 //! goes into `DIR/control/` unless `--no-control`: the tide's effect is the run minus the control
-//! ([`crate::analysis::flyby`]).
+//! (reported by the flyby analysis one layer up).
 
 use std::path::{Path, PathBuf};
 

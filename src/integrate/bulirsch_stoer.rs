@@ -73,6 +73,7 @@
 //!   derivative at an *accepted* point fails at once (no step size can cure it).
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
+use super::compensated::Compensation;
 use super::{
     IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
 };
@@ -175,14 +176,9 @@ pub struct BulirschStoer {
     yh2: Vec<f64>,
     /// The trial state `y + yh2` handed to the right-hand side.
     ytrial: Vec<f64>,
-    /// Compensated summation of the accepted increments: the part of the true state that the last
-    /// `y += increment` rounded away (Kahan). Added to the next increment, so rounding does not accumulate over
-    /// many steps. Empty = zero.
-    comp: Vec<f64>,
-    /// The state handed back by the last [`Integrator::advance`]; the compensation only carries into the next
-    /// call if the caller passes that state back unchanged. `None` = trust the caller's state (fresh
-    /// integrator, or restored from a saved state).
-    y_out: Option<Vec<f64>>,
+    /// Compensated summation of the accepted increments ([`Compensation`]): carried into the next call only if
+    /// the caller passes back the state the last `advance` returned.
+    comp: Compensation,
     dy: Vec<f64>,
     scal: Vec<f64>,
     tab: Vec<f64>,
@@ -326,8 +322,7 @@ impl BulirschStoer {
             yh1: Vec::new(),
             yh2: Vec::new(),
             ytrial: Vec::new(),
-            comp: Vec::new(),
-            y_out: None,
+            comp: Compensation::default(),
             dy: Vec::new(),
             scal: Vec::new(),
             tab: Vec::new(),
@@ -388,8 +383,7 @@ impl BulirschStoer {
     /// Forgets the step-size and order history: the next step starts like the first one (initial
     /// step guess, initial column count). Use after a discontinuity in the state or equations.
     pub fn reset(&mut self) {
-        self.comp.clear();
-        self.y_out = None;
+        self.comp = Compensation::default();
         self.h = 0.0;
         self.k = self.initial_columns();
         self.reject = false;
@@ -837,7 +831,7 @@ impl BulirschStoer {
                         }
                         continue;
                     }
-                    self.add_increment(y);
+                    self.comp.add(y, &self.tab[..self.n]);
                     self.stats.steps_accepted += 1;
                     if !(last && h_abs < saved_h) {
                         // Steps shortened only to land on an output time say nothing about stiffness.
@@ -889,16 +883,6 @@ impl BulirschStoer {
             }
         }
     }
-
-    /// `y += T_kk` (the accepted increment), with compensated summation over the steps (Kahan).
-    fn add_increment(&mut self, y: &mut [f64]) {
-        for ((yi, &d), c) in y.iter_mut().zip(&self.tab[..self.n]).zip(self.comp.iter_mut()) {
-            let inc = d + *c;
-            let sum = *yi + inc;
-            *c = inc - (sum - *yi);
-            *yi = sum;
-        }
-    }
 }
 
 impl Integrator for BulirschStoer {
@@ -914,17 +898,10 @@ impl Integrator for BulirschStoer {
             return Ok(());
         }
         self.ensure_workspace(n);
-        if self.comp.len() != n || self.y_out.as_ref().is_some_and(|prev| prev.as_slice() != &*y) {
-            // A new state from the caller (or a new dimension): what was rounded away belongs to another state.
-            self.comp.clear();
-            self.comp.resize(n, 0.0);
-        }
+        self.comp.begin(y);
         let result = self.advance_steps(system, t, y, t_target);
         system.end_steps();
-        match &mut self.y_out {
-            Some(prev) if prev.len() == n => prev.copy_from_slice(y),
-            slot => *slot = Some(y.to_vec()),
-        }
+        self.comp.end(y);
         result
     }
 
@@ -958,7 +935,7 @@ impl Integrator for BulirschStoer {
             w: self.w.clone(),
             stats: self.stats.into(),
             rejections: self.rejections,
-            compensation: self.comp.clone(),
+            compensation: self.comp.carry.clone(),
         })
     }
 
@@ -1025,9 +1002,9 @@ impl Integrator for BulirschStoer {
         }
         self.stats = s.stats.into();
         self.rejections = s.rejections;
-        self.comp.clone_from(&s.compensation);
+        self.comp.carry.clone_from(&s.compensation);
         // The saved state is the caller's: the compensation belongs to whatever state it passes next.
-        self.y_out = None;
+        self.comp.forget_output();
         Ok(())
     }
 }

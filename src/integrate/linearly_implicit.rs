@@ -38,6 +38,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::bulirsch_stoer::{RUN_BUDGET, Rejections, validate_tolerances};
+use super::compensated::Compensation;
 use super::{
     IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
 };
@@ -153,10 +154,8 @@ pub struct LinearlyImplicit {
     scal: Vec<f64>,
     /// The tableau, `km` rows of `n` (increments from the step's start).
     tab: Vec<f64>,
-    /// Kahan compensation of the accepted increments (see [`super::bulirsch_stoer`]).
-    comp: Vec<f64>,
-    /// The state handed back by the last advance (the compensation carries only into that state).
-    y_out: Option<Vec<f64>>,
+    /// Compensated summation of the accepted increments ([`Compensation`]).
+    comp: Compensation,
     stats: Stats,
     rejections: Rejections,
     solves: u64,
@@ -266,8 +265,7 @@ impl LinearlyImplicit {
             trial: Vec::new(),
             scal: Vec::new(),
             tab: Vec::new(),
-            comp: Vec::new(),
-            y_out: None,
+            comp: Compensation::default(),
             stats: Stats {
                 smallest_step: f64::INFINITY,
                 ..Stats::default()
@@ -587,12 +585,7 @@ impl LinearlyImplicit {
             self.started = true;
             match self.attempt(system, stiff.as_mut(), *t, y, dir * h_abs, special) {
                 Attempt::Accepted => {
-                    for ((yi, &d), c) in y.iter_mut().zip(&self.tab[..n]).zip(self.comp.iter_mut()) {
-                        let inc = d + *c;
-                        let sum = *yi + inc;
-                        *c = inc - (sum - *yi);
-                        *yi = sum;
-                    }
+                    self.comp.add(y, &self.tab[..n]);
                     self.stats.steps_accepted += 1;
                     if !(last && h_abs < saved_h) {
                         self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
@@ -660,16 +653,10 @@ impl Integrator for LinearlyImplicit {
             return Ok(());
         }
         self.ensure_workspace(n);
-        if self.comp.len() != n || self.y_out.as_ref().is_some_and(|prev| prev.as_slice() != &*y) {
-            self.comp.clear();
-            self.comp.resize(n, 0.0);
-        }
+        self.comp.begin(y);
         let result = self.advance_steps(system, t, y, t_target);
         system.end_steps();
-        match &mut self.y_out {
-            Some(prev) if prev.len() == n => prev.copy_from_slice(y),
-            slot => *slot = Some(y.to_vec()),
-        }
+        self.comp.end(y);
         result
     }
 
@@ -700,7 +687,7 @@ impl Integrator for LinearlyImplicit {
             stats: self.stats.into(),
             rejections: self.rejections,
             solves: self.solves,
-            compensation: self.comp.clone(),
+            compensation: self.comp.carry.clone(),
         })
     }
 
@@ -747,8 +734,8 @@ impl Integrator for LinearlyImplicit {
         self.stats = s.stats.into();
         self.rejections = s.rejections;
         self.solves = s.solves;
-        self.comp.clone_from(&s.compensation);
-        self.y_out = None;
+        self.comp.carry.clone_from(&s.compensation);
+        self.comp.forget_output();
         Ok(())
     }
 }

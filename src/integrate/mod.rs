@@ -15,6 +15,7 @@
 //! `bench`.
 
 pub mod bulirsch_stoer;
+pub mod compensated;
 pub mod dop853;
 pub mod elliptic;
 pub mod linearly_implicit;
