@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::analysis::fragments::read_snapshot_bodies;
-use crate::analysis::report_roig2003::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
+use crate::studies::roig2003::report::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
 use crate::analysis::run_analysis::{CampaignAnalysis, CampaignRun, Fit};
 use crate::ellipsoid::barrier::calibrated_speed;
 use crate::ellipsoid::body::Body;
@@ -46,7 +46,7 @@ pub struct KappaEvidence {
 /// for no bodies.
 ///
 /// ```
-/// use rubblepile::analysis::report_roig2003_kappa::kappa_evidence;
+/// use rubblepile::studies::roig2003::kappa::kappa_evidence;
 /// use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 /// use rubblepile::math::{Vec3, Vec4};
 /// // Roig03 Table 1, N200: smallest fragment 7 km, largest 59 km (equivalent radii), 3 g/cm³
