@@ -9,6 +9,7 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::kappa::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
 use crate::analysis::run_analysis::{
     AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_campaign,
 };
@@ -47,10 +48,6 @@ pub const EJECTION_RELATIVE: Published = Published { low: 1e-4, high: 5e-4 };
 pub const Q_STAR_D: f64 = 2.6e9;
 /// Roig03 Fig. 5: bound fraction ≈ 1.04 − 0.2e-9 Q (Q in erg/g).
 pub const BOUND_LINE: (f64, f64) = (1.04, -0.2e-9);
-/// Roig03 Fig. 4 (N200_T4, ζ = 45°): ejection-speed–size exponents for P1, P2, P3 (its caption).
-pub const FIG4_EXPONENTS: [(&str, f64); 3] = [("P1", -0.42), ("P2", -0.28), ("P3", -0.32)];
-/// Roig03 Fig. 8 (N200_T4, ζ = 45°): spin–size exponents for P1, P2, P3.
-pub const FIG8_EXPONENTS: [(&str, f64); 3] = [("P1", -1.09), ("P2", -1.11), ("P3", -1.13)];
 
 /// What the report needs besides the campaign analysis.
 #[derive(Debug, Clone)]
@@ -838,14 +835,6 @@ fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
         "\nMedian over the cells of the seed standard deviation (the error bar of one run): {}.\n",
         typical.join(", ")
     );
-}
-
-/// The number of contact-barrier overrun pairs a run recorded (`barrier.overrun_pairs` of its `summary.json`), or
-/// `None` when the run has no such record (it predates the detector, or its summary is missing).
-pub(crate) fn overrun_pairs(run_dir: &Path) -> Option<u64> {
-    let text = std::fs::read_to_string(run_dir.join("summary.json")).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
-    v.get("barrier")?.get("overrun_pairs")?.as_u64()
 }
 
 /// Median raw and corrected spin rates of the target fragments of an analysed run (from its
