@@ -5,10 +5,10 @@
 
 mod common;
 use common::temp_dir;
+use rubblepile::analysis::tumbler::{analyse_tumbler_run, repose_fit};
 use rubblepile::studies::richardson2011::tumbler_paper::{
     TumblerPaperArgs, lining_froude, tumbler_paper_markdown, write_tumbler_paper_report,
 };
-use rubblepile::analysis::tumbler::{analyse_tumbler_run, repose_fit};
 use std::fmt::Write as _;
 
 /// The paper's scale: particle radius 0.53 mm, wall at 31.06 mm, so the lining's inner edge is at 30 mm.

@@ -2,8 +2,8 @@
 //! time against the scene's t_end, wall time so far from `timeseries.csv`, residuals so far), next to the
 //! scaled runs' Table 3.
 
-use rubblepile::studies::zhang2017::report::write_report;
 use rubblepile::analysis::spinup_diagnostics::{SPINUP_HEADER, SpinupSample};
+use rubblepile::studies::zhang2017::report::write_report;
 use std::path::Path;
 
 /// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
