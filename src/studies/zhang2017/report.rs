@@ -8,9 +8,9 @@
 //! printed beside ours for HCP, RCP, RCPC, PP1, PP2 and PPC.
 //!
 //! Per model: N and the particle radii (the radius scaling against the paper's sizes), T_c,1 and T_c,2 from the
-//! forced part after `t_start` ([`critical_limits`]), the failure mode, T_c,3 and φ, κ₃ of Eq. 22 with
-//! `ρ_B = 2100 M/M_P` (Zhang17 §4.2, M_P = 5.23e11 kg), the largest overlap, the largest departure of the spin
-//! period from the path while forced, and the run's wall time.
+//! forced part after `t_start` ([`crate::analysis::spinup::critical_limits`]), the failure mode, T_c,3 and φ, κ₃
+//! of Eq. 22 with `ρ_B = 2100 M/M_P` (Zhang17 §4.2, M_P = 5.23e11 kg), the largest overlap, the largest departure
+//! of the spin period from the path while forced, and the run's wall time.
 //!
 //! Bulk-density variants (Zhang17 §4.2, Fig. 19, Table 4) are runs of the same target with scaled masses, in
 //! directories named `<model>_rho<ρ_B>` (e.g. `rcp_rho1800`): they are left out of the Table 3 rows and go, with
