@@ -23,8 +23,10 @@
 //!   schema, equations, outputs and [`engine::Engine`] implementation;
 //! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
 //! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
-//! - **L7**: `analysis` — science on finished runs (the three papers' reports, fragment statistics, figures);
-//! - **L8**: `render` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF;
+//! - **L7**: `analysis` — science on finished runs that any run needs (fragment statistics, fits, clumps, spin-up
+//!   diagnostics and searches, figures);
+//! - **L8**: `render`, `studies` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF;
+//!   the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of `analysis`;
 //! - **L9**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
 //!   problems shared by tests;
 //! - **L10**: `cli` — argument parsing and dispatch.
@@ -47,3 +49,4 @@ pub mod math;
 pub mod phase;
 pub mod random;
 pub mod render;
+pub mod studies;

@@ -1,14 +1,14 @@
-//! The paper-scale tumbler report (Richardson11 §3.2, Fig. 10; `src/analysis/report_richardson2011_tumbler.rs`)
+//! The paper-scale tumbler report (Richardson11 §3.2, Fig. 10; `src/studies/richardson2011/tumbler_paper.rs`)
 //! on synthetic run directories whose answers are known: a packed bed whose surface is tilted at a known angle, a
 //! run stopped before its end (no `summary.json`, read from its time series), the slope's fit error against the
 //! closed form of least squares, and the Froude number taken with the lining's inner edge.
 
 mod common;
 use common::temp_dir;
-use rubblepile::analysis::report_richardson2011_tumbler::{
+use rubblepile::analysis::tumbler::{analyse_tumbler_run, repose_fit};
+use rubblepile::studies::richardson2011::tumbler_paper::{
     TumblerPaperArgs, lining_froude, tumbler_paper_markdown, write_tumbler_paper_report,
 };
-use rubblepile::analysis::tumbler::{analyse_tumbler_run, repose_fit};
 use std::fmt::Write as _;
 
 /// The paper's scale: particle radius 0.53 mm, wall at 31.06 mm, so the lining's inner edge is at 30 mm.

@@ -2,8 +2,8 @@
 //! time against the scene's t_end, wall time so far from `timeseries.csv`, residuals so far), next to the
 //! scaled runs' Table 3.
 
-use rubblepile::analysis::report_zhang2017::write_report;
 use rubblepile::analysis::spinup_diagnostics::{SPINUP_HEADER, SpinupSample};
+use rubblepile::studies::zhang2017::report::write_report;
 use std::path::Path;
 
 /// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
@@ -119,7 +119,7 @@ fn full_size_section_reads_a_run_still_going() {
 }
 
 /// The hand-written `NOTES.md` in the output directory is appended verbatim at the end of REPORT.md (the hook
-/// shared with the Richardson11 report, `analysis::report_notes`); without it the report ends with the figures.
+/// shared with the Richardson11 report, `studies::report_notes`); without it the report ends with the figures.
 /// A `critical.json` that records T_c,3 by both creep criteria adds a section with both beside Table 3; one from
 /// before the paper's criterion came in (only the top-level T_c,3) adds nothing.
 #[test]
@@ -172,13 +172,13 @@ fn committed_report_ends_with_the_committed_notes() {
     let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     let notes = std::fs::read_to_string(dir.join("NOTES.md")).unwrap();
     let mut expected = String::new();
-    rubblepile::analysis::report_notes::append_notes(&mut expected, &dir);
+    rubblepile::studies::report_notes::append_notes(&mut expected, &dir);
     assert_eq!(
         expected,
-        format!("\n{}\n", rubblepile::analysis::report_notes::with_tally(&notes))
+        format!("\n{}\n", rubblepile::studies::report_notes::with_tally(&notes))
     );
     assert!(
-        notes.contains(rubblepile::analysis::report_notes::TALLY_MARKER),
+        notes.contains(rubblepile::studies::report_notes::TALLY_MARKER),
         "NOTES.md's tally is computed, not typed"
     );
     assert!(

@@ -1,4 +1,6 @@
-//! Post-processing of states and runs.
+//! Post-processing of states and runs: what any run needs (fragments, fits, clumps, composition, flyby outcome,
+//! spin-up diagnostics and searches, creep, the model atmosphere and tumbler measurements, figures). The three
+//! papers' reports are one layer up, in `src/studies/` (nothing here names them).
 
 pub mod atmosphere;
 pub mod clumps;
@@ -8,13 +10,6 @@ pub mod figures;
 pub mod fits;
 pub mod flyby;
 pub mod fragments;
-pub mod report_notes;
-pub mod report_richardson2011;
-pub mod report_richardson2011_tumbler;
-pub mod report_roig2003;
-pub mod report_roig2003_kappa;
-pub mod report_zhang2017;
-pub mod report_zhang2017_paths;
 pub use crate::ellipsoid::rigid_rotation;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;

@@ -22,7 +22,8 @@
 //! - `rubblepile spinup density-fit --points RHO:T,RHO:T,… [--period 2.26]`: κ of Eq. 22 by least squares
 //!   through the origin from (bulk density kg/m³, critical period h) pairs, its standard error, and the critical
 //!   bulk density for the given period.
-//! - `rubblepile report zhang2017 RUNS --out DIR [--force]`: see [`crate::analysis::report_zhang2017`].
+//! - `rubblepile report zhang2017 RUNS --out DIR [--force]`: the report on these searches' runs, written
+//!   one layer up (`src/studies/zhang2017/report.rs`).
 
 use std::path::{Path, PathBuf};
 

@@ -178,13 +178,13 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
             report.display()
         )));
     }
-    let dirs = crate::analysis::report_roig2003::CampaignDirs {
+    let dirs = crate::studies::roig2003::report::CampaignDirs {
         campaign: &args.campaign,
         uniform: args.uniform.as_deref(),
         other_kappa: args.other_kappa.as_deref(),
     };
     let (path, campaign) =
-        crate::analysis::report_roig2003::regenerate(&dirs, args.at, &args.out).map_err(|e| match e {
+        crate::studies::roig2003::report::regenerate(&dirs, args.at, &args.out).map_err(|e| match e {
             AnalysisError::Fragments(_) | AnalysisError::Write { .. } => CliError::failed(e),
             _ => CliError::usage(e),
         })?;

@@ -149,7 +149,7 @@ pub enum ReportCommand {
     /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
     Richardson2011(report_richardson2011::ReportRichardson2011Args),
     /// Read Richardson11 tumbler runs at the paper's scale; write analysis/richardson2011/TUMBLER_PAPER.md.
-    Richardson2011Tumbler(crate::analysis::report_richardson2011_tumbler::TumblerPaperArgs),
+    Richardson2011Tumbler(crate::studies::richardson2011::tumbler_paper::TumblerPaperArgs),
 }
 
 /// `rubblepile report zhang2017`.
@@ -410,7 +410,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             report_richardson2011::report(&args)
         }
         Command::Report(ReportCommand::Richardson2011Tumbler(a)) => {
-            let path = crate::analysis::report_richardson2011_tumbler::write_tumbler_paper_report(&a);
+            let path = crate::studies::richardson2011::tumbler_paper::write_tumbler_paper_report(&a);
             println!("wrote {}", path.map_err(CliError::usage)?.display());
             Ok(())
         }
@@ -477,7 +477,7 @@ fn check_run_dir(dir: &std::path::Path) -> Result<(), CliError> {
 }
 
 fn report_zhang2017(args: &ReportZhang2017Args) -> Result<(), CliError> {
-    let path = crate::analysis::report_zhang2017::write_report(
+    let path = crate::studies::zhang2017::report::write_report(
         &args.runs,
         args.full.as_deref(),
         args.paths.as_deref(),

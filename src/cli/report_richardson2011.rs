@@ -1,9 +1,9 @@
-//! `rubblepile report richardson2011`: the options, and the call into [`crate::analysis::report_richardson2011`].
+//! `rubblepile report richardson2011`: the options, and the call into [`crate::studies::richardson2011::report`].
 
 use std::path::PathBuf;
 
 use super::CliError;
-use crate::analysis::report_richardson2011::{Richardson2011Inputs, write_report};
+use crate::studies::richardson2011::report::{Richardson2011Inputs, write_report};
 
 /// `rubblepile report richardson2011`.
 #[derive(Debug, clap::Args)]

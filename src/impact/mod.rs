@@ -9,6 +9,7 @@
 //! - [`flyby`]: a tidal flyby of a pile past a planet (`rubblepile flyby`).
 
 pub mod campaign;
+pub mod error;
 pub mod flyby;
 pub mod pile;
 pub mod projectile;
@@ -16,3 +17,4 @@ pub mod run;
 pub mod settle;
 pub mod target;
 pub mod target_checkpoint;
+pub mod target_spec;

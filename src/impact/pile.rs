@@ -14,8 +14,9 @@ use std::path::{Path, PathBuf};
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::{from_unit_quaternion, rotation_matrix, to_unit_quaternion};
+use crate::impact::error::{ImpactError, read_target};
+pub use crate::impact::projectile::PileRecord;
 use crate::impact::projectile::{ERG_PER_G_PER_J_PER_KG, ImpactSetup, ProjectileSpec, first_contact_distance};
-use crate::impact::run::{ImpactError, read_target};
 use crate::impact::target::to_centre_of_mass_frame;
 use crate::math::Vec3;
 use crate::random::{generator, random_quaternion};
@@ -62,24 +63,6 @@ pub fn as_field(field: &str) -> impl Fn(ImpactError) -> ImpactError + '_ {
         field: field.to_string(),
         message: e.to_string(),
     }
-}
-
-/// Where the bodies of an impact with a rubble-pile projectile come from (in `impact.json` as
-/// `"projectile_pile"`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct PileRecord {
-    /// The projectile pile's bodies file.
-    pub file: String,
-    /// Number of bodies of the projectile pile `N_p`.
-    pub n: usize,
-    /// Total mass of the projectile pile (kg).
-    pub mass_kg: f64,
-    /// Whether it was turned by the seeded random attitude.
-    pub random_attitude: bool,
-    /// Body indices of the target: `[0, N_t)` (start, end).
-    pub target_bodies: [usize; 2],
-    /// Body indices of the projectile pile: `[N_t, N_t + N_p)` (start, end).
-    pub projectile_bodies: [usize; 2],
 }
 
 impl ProjectilePile {

@@ -87,9 +87,9 @@ pub struct ImpactSetup {
     /// Index of the projectile among the bodies (the last one); for a rubble-pile projectile, its first body.
     pub projectile_index: usize,
     /// The rubble-pile projectile (file, N, mass, which bodies are whose), when there is one
-    /// ([`crate::impact::pile`]); absent for a single ellipsoid.
+    /// (`pile.rs`); absent for a single ellipsoid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub projectile_pile: Option<crate::impact::pile::PileRecord>,
+    pub projectile_pile: Option<PileRecord>,
 }
 
 /// Adds the projectile to `target` (bodies of the target, any frame) and returns the whole system in its
@@ -180,4 +180,22 @@ pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) ->
         if touching(mid) { lo = mid } else { hi = mid }
     }
     hi
+}
+
+/// Where the bodies of an impact with a rubble-pile projectile come from (in `impact.json` as
+/// `"projectile_pile"`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PileRecord {
+    /// The projectile pile's bodies file.
+    pub file: String,
+    /// Number of bodies of the projectile pile `N_p`.
+    pub n: usize,
+    /// Total mass of the projectile pile (kg).
+    pub mass_kg: f64,
+    /// Whether it was turned by the seeded random attitude.
+    pub random_attitude: bool,
+    /// Body indices of the target: `[0, N_t)` (start, end).
+    pub target_bodies: [usize; 2],
+    /// Body indices of the projectile pile: `[N_t, N_t + N_p)` (start, end).
+    pub projectile_bodies: [usize; 2],
 }

@@ -13,17 +13,18 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::driver::{RunError, RunOptions, RunSummary, prepare_output_dir, run_scene};
+use crate::driver::{RunOptions, RunSummary, prepare_output_dir, run_scene};
 use crate::ellipsoid::body::{Body, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::G_SI;
-use crate::ellipsoid::output::{read_bodies_csv, write_snapshot};
+use crate::ellipsoid::output::write_snapshot;
 use crate::ellipsoid::scene::{LoadedScene, parse_scene};
+pub use crate::impact::error::{ImpactError, read_target};
 use crate::impact::pile::{ProjectilePile, set_up_pile_impact};
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
 use crate::integrate::Method;
 use crate::io::run_lock::DirLock;
-use crate::io::scene_file::{MAX_TIMESERIES_ROWS, SceneError};
+use crate::io::scene_file::MAX_TIMESERIES_ROWS;
 
 /// Default end time (s).
 pub const DEFAULT_T_END: f64 = 10_000.0;
@@ -365,86 +366,6 @@ pub struct PreparedImpact {
     /// The run directory's lock ([`crate::io::run_lock`]): keep it until the run has ended, so that no other
     /// process writes the directory between its preparation and the run.
     pub lock: DirLock,
-}
-
-/// Why an impact could not be set up or run. Messages are one line.
-#[derive(Debug, thiserror::Error)]
-pub enum ImpactError {
-    /// A configuration value out of range; `field` as in [`ImpactConfig`].
-    #[error("{field}: {message}")]
-    Invalid {
-        /// The field, e.g. `angle_deg`.
-        field: String,
-        /// What was expected and what was given.
-        message: String,
-    },
-    /// The target bodies file cannot be read or holds bad bodies.
-    #[error("{}: {message}", .path.display())]
-    Target {
-        /// The file.
-        path: PathBuf,
-        /// Why.
-        message: String,
-    },
-    /// The generated scene was refused (e.g. too many time-series rows).
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// Writing a file of the run directory failed.
-    #[error("{}: {source}", .path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The OS error.
-        source: std::io::Error,
-    },
-    /// The run itself (or the preparation of its directory) failed.
-    #[error(transparent)]
-    Run(#[from] RunError<RunSummary>),
-}
-
-impl ImpactError {
-    /// The command line's exit code: 2 for bad input, 1 for a failed run, 3 for a run stopped on request.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            ImpactError::Invalid { .. } | ImpactError::Target { .. } | ImpactError::Scene(_) => 2,
-            ImpactError::Io { .. } => 1,
-            ImpactError::Run(e) => e.exit_code(),
-        }
-    }
-}
-
-/// Reads a target bodies file into bodies (quaternions normalised): at least one body, finite values,
-/// mass > 0 and `A >= B >= C > 0`.
-pub fn read_target(path: &Path) -> Result<Vec<Body>, ImpactError> {
-    let target_error = |message: String| ImpactError::Target {
-        path: path.to_path_buf(),
-        message,
-    };
-    let records = read_bodies_csv(path).map_err(|e| target_error(e.to_string()))?;
-    if records.is_empty() {
-        return Err(target_error("no bodies".into()));
-    }
-    records
-        .iter()
-        .map(|r| {
-            let ok = r.mass > 0.0 && r.axes[2] > 0.0 && r.axes[0] >= r.axes[1] && r.axes[1] >= r.axes[2];
-            let finite = [r.mass]
-                .iter()
-                .chain(&r.axes)
-                .chain(&r.position)
-                .chain(&r.velocity)
-                .chain(&r.spin_body)
-                .chain(&r.quaternion)
-                .all(|v| v.is_finite());
-            if !(ok && finite) {
-                return Err(target_error(format!(
-                    "line {}: need finite values, mass > 0 and A >= B >= C > 0",
-                    r.line
-                )));
-            }
-            Ok(r.to_body())
-        })
-        .collect()
 }
 
 /// Validates `cfg`, reads its target, prepares `out` ([`prepare_output_dir`]: refused when not empty unless

@@ -17,13 +17,14 @@
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
+use crate::ellipsoid::calibration::calibrate_kappa;
 use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
 use crate::impact::target_checkpoint::{BuildCheckpoint, RoundState};
-use crate::integrate::{IntegrateError, Method, Tolerances, make_integrator};
+pub use crate::impact::target_spec::{TargetError, TargetSpec};
+use crate::integrate::{Method, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};
 use crate::random::{Generator, generator, point_in_ball, random_quaternion, uniform};
 use std::f64::consts::PI;
@@ -31,98 +32,6 @@ use std::f64::consts::PI;
 /// `(ABC)^{1/3} / A` for the axis ratios 1 : 0.7 : 0.5.
 fn equivalent_to_major(b_over_a: f64, c_over_a: f64) -> f64 {
     (b_over_a * c_over_a).cbrt()
-}
-
-/// What to build. Lengths in m, masses in kg, times in s unless the name says otherwise.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct TargetSpec {
-    /// Number of fragments N (≥ 2).
-    pub fragments: usize,
-    /// Spin period of the pile (hours; converted at the edge).
-    pub period_hours: f64,
-    /// Seed of every random choice.
-    pub seed: u64,
-    /// Equivalent radius of the largest fragment (m).
-    pub r_largest: f64,
-    /// Equivalent radius of the smallest fragment (m).
-    pub r_smallest: f64,
-    /// Total mass aimed at (kg).
-    pub total_mass: f64,
-    /// Relative tolerance on the total mass (dimensionless).
-    pub mass_tolerance: f64,
-    /// Fragment density (kg m⁻³).
-    pub density: f64,
-    /// Axis ratios B/A and C/A.
-    pub axis_ratios: [f64; 2],
-    /// Exponent of the cumulative size distribution `N(>R) ∝ R^−slope`.
-    pub slope: f64,
-    /// β and v (m/s) of Roig03 Eq. 14 for κ.
-    pub calibrate: [f64; 2],
-    /// Dissipation coefficient F0 used while relaxing (s m⁻²).
-    pub f0: f64,
-    /// Relative tolerance of the relaxation run (Bulirsch–Stoer).
-    pub rtol: f64,
-    /// Rigidity criterion: `K_rel / K` below this ends a relaxation round.
-    pub rigidity: f64,
-    /// Largest simulated relaxation time per round (s) before giving up.
-    pub max_relax_time: f64,
-    /// Whether fragments outside the pile's main clump are removed at the end of every round (before the spin is
-    /// reset; see [`drop_detached`]). Off for the committed targets, whose bits it would change; absent from
-    /// their files.
-    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
-    pub drop_detached: bool,
-}
-
-impl TargetSpec {
-    /// The Roig03 Table 1 target with `fragments` ∈ {30, 100, 200} (64→16, 60→10, 59→7 km), or `None`.
-    pub fn table1(fragments: usize, period_hours: f64, seed: u64) -> Option<Self> {
-        let (r_largest, r_smallest) = match fragments {
-            30 => (64e3, 16e3),
-            100 => (60e3, 10e3),
-            200 => (59e3, 7e3),
-            _ => return None,
-        };
-        Some(TargetSpec {
-            fragments,
-            period_hours,
-            seed,
-            r_largest,
-            r_smallest,
-            total_mass: 1.0e19,
-            mass_tolerance: 0.005,
-            density: 3000.0,
-            axis_ratios: [0.7, 0.5],
-            slope: 2.5,
-            calibrate: [10.0, 5000.0],
-            f0: 1e-4,
-            rtol: 1e-8,
-            rigidity: 1e-4,
-            max_relax_time: 2e5,
-            drop_detached: false,
-        })
-    }
-}
-
-/// Why a target could not be built.
-#[derive(Debug, thiserror::Error)]
-pub enum TargetError {
-    /// An input out of range (one line naming it).
-    #[error("{0}")]
-    Invalid(String),
-    /// κ could not be calibrated.
-    #[error(transparent)]
-    Calibration(#[from] CalibrationError),
-    /// The relaxation run failed.
-    #[error("relaxation failed: {0}")]
-    Integration(#[from] IntegrateError),
-    /// The pile did not become rigid in time.
-    #[error("the pile did not become rigid within {time:.0} s of relaxation (K_rel/K = {fraction:e})")]
-    NotRigid {
-        /// Simulated time spent (s).
-        time: f64,
-        /// Last `K_rel / K`.
-        fraction: f64,
-    },
 }
 
 /// The Table 1 quantities of a target, plus how it was made (written as `NAME.json`).

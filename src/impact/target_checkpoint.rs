@@ -1,4 +1,4 @@
-//! Checkpoints of a target build (Roig03 §3's relaxation, see [`crate::impact::target`]): where a build stands
+//! Checkpoints of a target build (Roig03 §3's relaxation of `target.rs`): where a build stands
 //! between two rigidity checks, so that a relaxation of hours (N = 2000 fragments) survives a stopped process.
 //!
 //! The sizes, the placement and κ are redone on resume (they are seeded and take seconds); the checkpoint holds
@@ -8,7 +8,7 @@
 
 use crate::bits::{exact_f64, exact_f64_vec};
 use crate::ellipsoid::body::Body;
-use crate::impact::target::{TargetError, TargetSpec};
+use crate::impact::target_spec::{TargetError, TargetSpec};
 use crate::integrate::IntegratorState;
 use crate::math::{Vec3, Vec4};
 

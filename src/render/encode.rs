@@ -9,7 +9,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::RenderError;
-use super::frame::RgbImage;
+use super::image::RgbImage;
 
 fn io_error(path: &Path, source: std::io::Error) -> RenderError {
     RenderError::Io {

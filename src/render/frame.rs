@@ -1,6 +1,5 @@
 //! One finished frame: the bodies coloured by a [`ColourScale`] and ray-cast ([`render_frame`]), with a vertical
-//! colour bar (label and end values, or category names) at the right edge and a caption at the top left; and the
-//! image type every step passes along ([`RgbImage`]).
+//! colour bar (label and end values, or category names) at the right edge and a caption at the top left.
 //!
 //! Text is drawn with plotters on the frame's own pixel buffer, in the embedded font the figures use, so frames
 //! need no system fonts.
@@ -14,6 +13,7 @@ use crate::math::{Mat3, Vec3};
 use super::RenderError;
 use super::camera::{BoundingSphere, Camera};
 use super::colour::{ColourScale, ScaleKind};
+use super::image::RgbImage;
 use super::overlay::{BAR_COLOUR, ScaleBar, Triad, draw_scale_bar};
 use super::raycast::{RenderBody, render_scene};
 use super::walls::WallPolygon;
@@ -22,51 +22,6 @@ use super::walls::WallPolygon;
 pub const BACKGROUND: [u8; 3] = [24, 26, 34];
 /// Colour of the caption and colour-bar text.
 const TEXT_COLOUR: RGBColor = RGBColor(235, 235, 235);
-
-/// An RGB image, 8 bits per channel.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct RgbImage {
-    /// Width (pixels).
-    pub width: u32,
-    /// Height (pixels).
-    pub height: u32,
-    /// RGB triplets, row-major, top row first (`3·width·height` bytes).
-    pub pixels: Vec<u8>,
-}
-
-impl RgbImage {
-    /// A `width × height` image filled with `fill`.
-    pub fn new(width: u32, height: u32, fill: [u8; 3]) -> RgbImage {
-        let n = width as usize * height as usize;
-        let mut pixels = Vec::with_capacity(3 * n);
-        for _ in 0..n {
-            pixels.extend_from_slice(&fill);
-        }
-        RgbImage { width, height, pixels }
-    }
-
-    /// Colour of pixel `(x, y)` (`(0, 0)` = top left). Panics outside the image.
-    pub fn get(&self, x: u32, y: u32) -> [u8; 3] {
-        let i = self.index(x, y);
-        [self.pixels[i], self.pixels[i + 1], self.pixels[i + 2]]
-    }
-
-    /// Sets pixel `(x, y)`. Panics outside the image.
-    pub fn set(&mut self, x: u32, y: u32, colour: [u8; 3]) {
-        let i = self.index(x, y);
-        self.pixels[i..i + 3].copy_from_slice(&colour);
-    }
-
-    fn index(&self, x: u32, y: u32) -> usize {
-        assert!(
-            x < self.width && y < self.height,
-            "pixel ({x}, {y}) outside {}×{}",
-            self.width,
-            self.height
-        );
-        3 * (y as usize * self.width as usize + x as usize)
-    }
-}
 
 /// One body of a frame: an ellipsoid and the scalar that colours it.
 #[derive(Clone, Debug, PartialEq)]

@@ -9,7 +9,7 @@
 use crate::math::Vec3;
 
 use super::camera::Camera;
-use super::frame::RgbImage;
+use super::image::RgbImage;
 
 /// Colour of the x arrow.
 pub const X_COLOUR: [u8; 3] = [235, 85, 75];

@@ -12,7 +12,7 @@ use crate::math::{Mat3, Vec3};
 
 use super::camera::ScreenBox;
 use super::camera::{BoundingSphere, Camera, Ray};
-use super::frame::RgbImage;
+use super::image::RgbImage;
 use super::walls::{WallPolygon, composite, wall_shade};
 
 /// One body to draw: an ellipsoid with its colour.

@@ -12,12 +12,25 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::analysis::fragments::read_snapshot_bodies;
-use crate::analysis::report_roig2003::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
 use crate::analysis::run_analysis::{CampaignAnalysis, CampaignRun, Fit};
 use crate::ellipsoid::barrier::calibrated_speed;
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::summary::read_summary;
+
+/// Roig03 Fig. 4 (N200_T4, ζ = 45°): ejection-speed–size exponents for P1, P2, P3 (its caption; the report
+/// prints them too).
+pub const FIG4_EXPONENTS: [(&str, f64); 3] = [("P1", -0.42), ("P2", -0.28), ("P3", -0.32)];
+/// Roig03 Fig. 8 (N200_T4, ζ = 45°): spin–size exponents for P1, P2, P3.
+pub const FIG8_EXPONENTS: [(&str, f64); 3] = [("P1", -1.09), ("P2", -1.11), ("P3", -1.13)];
+
+/// The number of contact-barrier overrun pairs a run recorded (`barrier.overrun_pairs` of its `summary.json`), or
+/// `None` when the run has no such record (it predates the detector, or its summary is missing).
+pub(crate) fn overrun_pairs(run_dir: &Path) -> Option<u64> {
+    let text = std::fs::read_to_string(run_dir.join("summary.json")).ok()?;
+    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    v.get("barrier")?.get("overrun_pairs")?.as_u64()
+}
 
 /// Roig03 §4.3: "κ ≃ 10 in all our examples".
 pub const PAPER_KAPPA: f64 = 10.0;
@@ -46,7 +59,7 @@ pub struct KappaEvidence {
 /// for no bodies.
 ///
 /// ```
-/// use rubblepile::analysis::report_roig2003_kappa::kappa_evidence;
+/// use rubblepile::studies::roig2003::kappa::kappa_evidence;
 /// use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 /// use rubblepile::math::{Vec3, Vec4};
 /// // Roig03 Table 1, N200: smallest fragment 7 km, largest 59 km (equivalent radii), 3 g/cm³

@@ -459,7 +459,7 @@ pub fn write_report(args: &Richardson2011Inputs) -> Result<(PathBuf, usize), Rep
     for f in figures.iter().filter(|f| f.ends_with(".png")) {
         let _ = writeln!(md, "![{f}](figures/{f})");
     }
-    crate::analysis::report_notes::append_notes(&mut md, &args.out);
+    crate::studies::report_notes::append_notes(&mut md, &args.out);
     let path = args.out.join("REPORT.md");
     std::fs::write(&path, md).map_err(|e| ReportError::Output(format!("{}: {e}", path.display())))?;
     Ok((path, figures.len()))

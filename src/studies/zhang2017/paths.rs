@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::report_zhang2017::{mode, opt, path_row, t_end_of};
+use crate::studies::zhang2017::rows::{TABLE3, mode, opt, path_row, t_end_of};
 
 /// The spin-up paths, by the run directory's name.
 pub const PATHS: [&str; 3] = ["path1", "path2", "path3"];
@@ -36,7 +36,7 @@ fn paper(model: &str, path: usize) -> String {
     if let Some((_, rows)) = TABLE6_HCP.iter().find(|r| r.0 == model) {
         return format!("{} (Table 6)", fmt(rows[path]));
     }
-    match crate::analysis::report_zhang2017::TABLE3.iter().find(|r| r.0 == model) {
+    match TABLE3.iter().find(|r| r.0 == model) {
         Some(r) if path == 0 => format!("{} (Table 3)", fmt([r.3, r.4, r.5])),
         _ => "– (no Table 6 row)".into(),
     }

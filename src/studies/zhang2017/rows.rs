@@ -1,0 +1,362 @@
+//! The rows of the Zhang17 report: the paper's Tables 1, 3 and 4, and one spin-up run read into a [`ModelRow`]
+//! (its critical limits, T_c,3 by both creep criteria, sizes, overlap, path error, wall time), shared by the report
+//! (`report.rs`) and its spin-up-path section (`paths.rs`), which both read rows from here and not each other.
+//! Zhang et al. (2017, Icarus 294), Tables 1, 3 and 4, §4.2.
+
+use crate::io::table::{Cells, read_header, read_table};
+use std::path::Path;
+
+use crate::analysis::spinup::{
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, dynamical_time, first_departure,
+    fit_density, smoothed_critical_limits,
+};
+use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use crate::io::scene_file::SI_G;
+
+/// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
+pub const DIDYMOS_MASS: f64 = 5.23e11;
+
+/// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
+pub type LimitAndAngle = (Option<f64>, Option<f64>);
+
+/// One row of [`TABLE3`]: model, η, φ (°), T_c1, T_c2, T_c3 (h), κ₃, failure mode.
+pub type PaperRow = (&'static str, f64, f64, f64, f64, f64, Option<f64>, &'static str);
+
+/// Zhang17 Table 3 (nominal material, path 1) and the κ₃ of §4.2.
+pub const TABLE3: [PaperRow; 6] = [
+    ("hcp", 0.739, 43.0, 2.38, 2.36, 2.40, Some(0.946), "surface shedding"),
+    ("rcp", 0.641, 30.0, 2.51, 2.53, 2.83, Some(0.806), "internal failure"),
+    // Zhang17 §4.1 names RCPC the exception: its shell sheds while the body deforms (T_c1 = T_c2), neither of the
+    // two modes alone.
+    ("rcpc", 0.695, 32.0, 2.46, 2.46, 2.76, None, "shedding with deformation"),
+    ("pp1", 0.820, 39.0, 2.41, 2.44, 2.53, Some(0.902), "internal failure"),
+    ("pp2", 0.750, 38.0, 2.41, 2.44, 2.54, None, "internal failure"),
+    ("ppc", 0.820, 39.0, 2.46, 2.41, 2.49, None, "surface shedding"),
+];
+
+/// One row of [`TABLE4`]: model and, for limits 1, 2, 3, the critical bulk density (kg/m³) and κ.
+pub type Table4Row = (&'static str, [(f64, f64); 3]);
+
+/// Zhang17 Table 4: critical bulk densities at the Didymos period and κ of Eq. 22, per limit.
+pub const TABLE4: [Table4Row; 6] = [
+    ("hcp", [(2349.0, 0.953), (2269.0, 0.970), (2383.0, 0.946)]),
+    ("rcp", [(2583.0, 0.909), (2662.0, 0.895), (3284.0, 0.806)]),
+    ("rcpc", [(2478.0, 0.928), (2478.0, 0.928), (3077.0, 0.833)]),
+    ("pp1", [(2388.0, 0.945), (2443.0, 0.935), (2626.0, 0.902)]),
+    ("pp2", [(2419.0, 0.939), (2457.0, 0.932), (2662.0, 0.895)]),
+    ("ppc", [(2469.0, 0.930), (2378.0, 0.947), (2519.0, 0.920)]),
+];
+
+/// Zhang17: the observed spin period of the Didymos primary (h), at which critical bulk densities are given.
+pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
+
+/// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`).
+///
+/// ```
+/// use rubblepile::studies::zhang2017::rows::base_model;
+/// assert_eq!(base_model("rcp_rho1800"), "rcp");
+/// assert_eq!(base_model("hcp"), "hcp");
+/// ```
+pub fn base_model(name: &str) -> &str {
+    name.split("_rho").next().unwrap_or(name)
+}
+
+/// One model over its bulk densities: the points (ρ_B in kg/m³, T_c1, T_c2, T_c3 in h where found) and the
+/// Eq. 22 fit of each limit over the points that have it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DensitySeries {
+    /// Model name.
+    pub model: String,
+    /// (ρ_B, [T_c1, T_c2, T_c3]) by increasing density.
+    pub points: Vec<(f64, [Option<f64>; 3])>,
+    /// Fit of limit i (κ_i ± σ, critical bulk density at [`DIDYMOS_PERIOD_HOURS`]) over at least 2 densities.
+    pub fits: [Option<DensityFit>; 3],
+}
+
+/// The bulk density of a row (kg/m³): `ρ_B = 2100 M/M_P` (Zhang17 §4.2).
+fn bulk_density(row: &ModelRow) -> f64 {
+    2100.0 * row.mass / DIDYMOS_MASS
+}
+
+/// The models run at two or more bulk densities, with their Eq. 22 fits (Zhang17 Fig. 19, Table 4).
+pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
+    let mut models: Vec<&str> = rows.iter().map(|r| base_model(&r.model)).collect();
+    models.sort();
+    models.dedup();
+    let mut out = Vec::new();
+    for m in models {
+        let mut points: Vec<(f64, [Option<f64>; 3])> = rows
+            .iter()
+            .filter(|r| base_model(&r.model) == m && r.mass.is_finite())
+            .map(|r| (bulk_density(r), [r.limits.t_c1_hours, r.limits.t_c2_hours, r.t_c3]))
+            .collect();
+        if points.len() < 2 {
+            continue;
+        }
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let fits = [0, 1, 2].map(|i| {
+            let xy: Vec<(f64, f64)> = points.iter().filter_map(|(rho, t)| t[i].map(|t| (*rho, t))).collect();
+            (xy.len() >= 2)
+                .then(|| fit_density(&xy, SI_G, DIDYMOS_PERIOD_HOURS))
+                .flatten()
+        });
+        out.push(DensitySeries {
+            model: m.to_string(),
+            points,
+            fits,
+        });
+    }
+    out
+}
+
+/// RMS of the successive differences of `values` over √2 (the standard deviation of white noise; a slow trend
+/// adds little); 0 with fewer than two values.
+pub fn successive_scatter(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let sum: f64 = values.windows(2).map(|w| (w[1] - w[0]).powi(2)).sum();
+    (sum / (values.len() - 1) as f64 / 2.0).sqrt()
+}
+
+/// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
+/// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
+/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
+/// the scaled runs with the rotation-free open test resolve (sample scatter 2.6e-5 to 1.0e-4, 23 Nov 2026).
+pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
+    let samples = (window / spacing).max(1.0);
+    noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
+}
+
+/// One model's row.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ModelRow {
+    /// Model name (directory).
+    pub model: String,
+    /// Particles.
+    pub n: usize,
+    /// Smallest and largest particle radius (m).
+    pub radius_range: (f64, f64),
+    /// Total mass (kg).
+    pub mass: f64,
+    /// η_B at t_start.
+    pub packing: f64,
+    /// T_c1, T_c2 and the failure mode from the samples themselves (the paper's rule as written).
+    pub limits: CriticalLimits,
+    /// The same from b/a, c/a and η_B averaged over the body's dynamical time ([`smoothed_critical_limits`]):
+    /// a check on the sampled values, biased towards longer periods by the window's look-ahead.
+    pub limits_smoothed: CriticalLimits,
+    /// Sample-to-sample scatter of η_B while forced and before the shape changes: the RMS of successive
+    /// differences over √2 (for white noise, its standard deviation).
+    pub packing_noise: f64,
+    /// Whether that scatter of single samples is below half the T_c,2 threshold, so that T_c,2 measures the
+    /// packing and not the scatter ([`t_c2_resolved`] with a window of one sample).
+    pub t_c2_resolved: bool,
+    /// T_c,3 (h) and φ (°) from `critical.json`.
+    pub t_c3: Option<f64>,
+    /// See `t_c3`.
+    pub phi: Option<f64>,
+    /// T_c,3 (h) and φ (°) by the paper's creep criterion and by ours, from a `critical.json` that records both
+    /// (searches made after the paper's criterion came in; [`crate::analysis::creep`]); `None` for older ones.
+    pub t_c3_by_criterion: Option<[LimitAndAngle; 2]>,
+    /// κ₃ of Eq. 22.
+    pub kappa3: Option<f64>,
+    /// Largest |T/T_path − 1| while forced.
+    pub path_error: f64,
+    /// Largest |T/T_path − 1| while forced and before T_c,1 (before the shape changes; the angular-momentum
+    /// rule lets a body that has started to expand spin slower than the path, see `granular::soft::spinup`).
+    pub path_error_before_t_c1: f64,
+    /// Time the forcing was released (s), if it was.
+    pub release_time: Option<f64>,
+    /// Largest overlap / radius.
+    pub max_overlap: f64,
+    /// Largest energy and angular-momentum residuals of the run (`summary.json`), forcing work and torque
+    /// booked; `None` for runs made before the forcing was booked (their residuals include the forcing).
+    pub residuals: Option<(f64, f64)>,
+    /// Wall time (s), simulated time (s), status.
+    pub wall_seconds: f64,
+    /// See `wall_seconds`.
+    pub final_time: f64,
+    /// See `wall_seconds`.
+    pub status: String,
+}
+
+fn t_start_of(dir: &Path) -> f64 {
+    std::fs::read_to_string(dir.join("scene.toml"))
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .and_then(|t| t.get("spinup")?.get("t_start")?.as_float())
+        .unwrap_or(0.0)
+}
+
+/// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0.
+fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
+    let table = read_table(&dir.join("snapshots/0.csv"), Cells::Lenient).ok()?;
+    let (km, kr) = (table.column("mass")?, table.column("radius")?);
+    let (mut lo, mut hi, mut m, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
+    for v in table.rows.iter().filter(|v| v.len() > km.max(kr)) {
+        m += v[km];
+        lo = lo.min(v[kr]);
+        hi = hi.max(v[kr]);
+        n += 1;
+    }
+    (m > 0.0).then_some((lo, hi, m, n))
+}
+
+/// The `wall_seconds` of the last row of the run's `timeseries.csv` (cumulative over resumes): the wall time
+/// so far of a run that has not finished.
+fn last_wall_seconds(run: &Path) -> Option<f64> {
+    let table = read_table(&run.join("timeseries.csv"), Cells::Lenient).ok()?;
+    let col = table.column("wall_seconds")?;
+    table.rows.last()?.get(col).copied().filter(|x| x.is_finite())
+}
+
+/// The scene's `t_end` (s) of a run directory.
+pub(crate) fn t_end_of(dir: &Path) -> Option<f64> {
+    std::fs::read_to_string(dir.join("scene.toml"))
+        .ok()?
+        .parse::<toml::Table>()
+        .ok()?
+        .get("scene")?
+        .get("t_end")?
+        .as_float()
+}
+
+/// Whether the run's `timeseries.csv` books the spin-up forcing (has the `forcing_work` column).
+fn books_forcing(run: &Path) -> bool {
+    read_header(&run.join("timeseries.csv")).is_ok_and(|h| h.iter().any(|c| c == "forcing_work"))
+}
+
+/// Reads one model's runs under `RUNS/<model>`: its path-2 run and its T_c,3 search.
+pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+    path_row(model_dir, "path2")
+}
+
+/// Reads the run `RUNS/<model>/<path>` (e.g. `path1`, `path3`) and the T_c,3 search on that path
+/// (`critical/` for path 2, `critical_<path>/` for the others).
+pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+    let model = model_dir
+        .file_name()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
+    let run = model_dir.join(path);
+    let samples = read_spinup_csv(&run.join("spinup.csv")).map_err(|e| e.to_string())?;
+    let summary: serde_json::Value = std::fs::read_to_string(run.join("summary.json"))
+        .ok()
+        .and_then(|s| serde_json::from_str(&s).ok())
+        .unwrap_or(serde_json::Value::Null);
+    let t_start = t_start_of(&run);
+    let forced: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_start && s.forcing).collect();
+    let col = |f: fn(&SpinupSample) -> f64| forced.iter().map(|s| f(s)).collect::<Vec<f64>>();
+    let limits = critical_limits(
+        &col(|s| s.period_h),
+        &col(|s| s.b_over_a),
+        &col(|s| s.c_over_a),
+        &col(|s| s.packing_fraction),
+    );
+    let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
+    let rho_b = 2100.0 * mass / DIDYMOS_MASS;
+    // the smoothing window of the check on the limits
+    let window = dynamical_time(SI_G, rho_b);
+    let limits_smoothed = smoothed_critical_limits(
+        &col(|s| s.t),
+        &col(|s| s.period_h),
+        &col(|s| s.b_over_a),
+        &col(|s| s.c_over_a),
+        &col(|s| s.packing_fraction),
+        window,
+    );
+    // the T_c,3 search of path 2 is `critical/`, that of another path `critical_<path>/`
+    let search = if path == "path2" {
+        "critical".to_string()
+    } else {
+        format!("critical_{path}")
+    };
+    let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join(search).join("critical.json"))
+        .ok()
+        .and_then(|s| serde_json::from_str(&s).ok());
+    let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
+    let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
+    let t_c3_by_criterion = critical.as_ref().and_then(|c| {
+        let get = |k: &str| {
+            c.get(k)
+                .map(|r| (r["t_c3_hours"].as_f64(), r["friction_angle_deg"].as_f64()))
+        };
+        Some([get("paper")?, get("ours")?])
+    });
+    let kappa3 = t_c3.and_then(|t| fit_density(&[(rho_b, t)], SI_G, t)).map(|f| f.kappa);
+    let path_error = samples
+        .iter()
+        .filter(|s| s.forcing)
+        .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
+        .fold(0.0, f64::max);
+    let shape_change = [
+        first_departure(&col(|s| s.b_over_a), AXIS_RATIO_THRESHOLD),
+        first_departure(&col(|s| s.c_over_a), AXIS_RATIO_THRESHOLD),
+    ]
+    .into_iter()
+    .flatten()
+    .min()
+    .unwrap_or(forced.len());
+    let before: Vec<f64> = forced[..shape_change].iter().map(|s| s.packing_fraction).collect();
+    let packing_noise = successive_scatter(&before);
+    let spacing = match (forced.first(), forced.get(1)) {
+        (Some(a), Some(b)) => b.t - a.t,
+        _ => window,
+    };
+    // the limits are read from single samples: the window of the resolution test is one sample
+    let resolved = t_c2_resolved(packing_noise, spacing, spacing);
+    let path_error_before_t_c1 = forced[..shape_change]
+        .iter()
+        .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
+        .fold(0.0, f64::max);
+    let release_time = samples.iter().find(|s| !s.forcing).map(|s| s.t);
+    let row = ModelRow {
+        path_error_before_t_c1,
+        model,
+        n,
+        radius_range: (lo, hi),
+        mass,
+        packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
+        limits,
+        limits_smoothed,
+        packing_noise,
+        t_c2_resolved: resolved,
+        t_c3,
+        phi,
+        t_c3_by_criterion,
+        kappa3,
+        path_error,
+        release_time,
+        max_overlap: summary["max_overlap_fraction"].as_f64().unwrap_or(f64::NAN),
+        residuals: books_forcing(&run)
+            .then(|| {
+                summary["energy_error"]
+                    .as_f64()
+                    .zip(summary["angular_momentum_error"].as_f64())
+            })
+            .flatten(),
+        wall_seconds: summary["wall_seconds"]
+            .as_f64()
+            .or_else(|| last_wall_seconds(&run))
+            .unwrap_or(f64::NAN),
+        final_time: samples.last().map(|s| s.t).unwrap_or(0.0),
+        status: summary["status"]
+            .as_str()
+            .unwrap_or("running (no summary.json)")
+            .to_string(),
+    };
+    Ok((row, samples))
+}
+
+pub(crate) fn opt(x: Option<f64>, digits: usize) -> String {
+    x.map(|v| format!("{v:.digits$}")).unwrap_or_else(|| "–".into())
+}
+
+pub(crate) fn mode(m: Option<FailureMode>) -> &'static str {
+    match m {
+        Some(FailureMode::SurfaceShedding) => "surface shedding",
+        Some(FailureMode::InternalFailure) => "internal failure",
+        None => "–",
+    }
+}
