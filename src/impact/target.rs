@@ -17,7 +17,7 @@
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::ellipsoid::calibration::{CalibrationError, calibrate_kappa};
+use crate::ellipsoid::calibration::{CalibrationError, KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
@@ -71,6 +71,15 @@ pub struct TargetSpec {
     /// their files.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub drop_detached: bool,
+    /// Which kinetic energy Roig03 Eq. 13's barrier is β times when κ is calibrated over the target's smallest
+    /// and largest fragments ([`KappaReading`]). Printed (the default) for the committed targets, absent from
+    /// their files; `reduced` relaxes the pile at the κ of the impacts (`analysis/roig2003/campaign.toml`).
+    #[serde(default, skip_serializing_if = "is_printed")]
+    pub kappa_reading: KappaReading,
+}
+
+fn is_printed(reading: &KappaReading) -> bool {
+    *reading == KappaReading::Printed
 }
 
 impl TargetSpec {
@@ -99,6 +108,7 @@ impl TargetSpec {
             rigidity: 1e-4,
             max_relax_time: 2e5,
             drop_detached: false,
+            kappa_reading: KappaReading::Printed,
         })
     }
 }
@@ -466,12 +476,12 @@ pub fn build_target_resumable(
     let (mut bodies, placement_radius) = place_fragments(spec, &radii, &mut rng);
     let small = bodies.last().unwrap().shape;
     let large = bodies[0].shape;
-    let kappa = calibrate_kappa(
+    let kappa = calibrate_kappa_read(
+        spec.kappa_reading,
         spec.calibrate[0],
         spec.calibrate[1],
-        small.equivalent_radius(),
-        small.mass,
-        large.equivalent_radius(),
+        (small.equivalent_radius(), small.mass),
+        (large.equivalent_radius(), large.mass),
         G_SI,
     )?;
     let model = ModelConfig::gaussian_si(kappa);
