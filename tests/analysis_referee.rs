@@ -100,7 +100,10 @@ fn small_fragments_from_the_impact_side_give_a_correlation_of_minus_one() {
     }
     frags.push(fragment(9, 0.01, 5000.0, true, 1.0, true));
     let sites = ejected_sites(&frags, 10.0);
-    assert_eq!((sites.fast_fragments, sites.impact_side, sites.antipodal_side), (6, 3, 3));
+    assert_eq!(
+        (sites.fast_fragments, sites.impact_side, sites.antipodal_side),
+        (6, 3, 3)
+    );
     assert_eq!(sites.impact_side_median_size, Some(0.05));
     assert_eq!(sites.antipodal_side_median_size, Some(0.2));
     let r = sites.size_cosine_correlation.unwrap();
@@ -165,7 +168,11 @@ fn a_rigidly_turning_target_has_all_its_rotational_energy_from_before() {
         .sum();
     assert!((split.rotational - expected).abs() < 1e-12 * expected);
     assert!((split.rotational_initial - expected).abs() < 1e-12 * expected);
-    assert!(split.added_spin_frame < 1e-20 * expected, "added {}", split.added_spin_frame);
+    assert!(
+        split.added_spin_frame < 1e-20 * expected,
+        "added {}",
+        split.added_spin_frame
+    );
     assert!(split.added_per_fragment < 1e-20 * expected);
     assert!((split.pre_existing_fraction() - 1.0).abs() < 1e-12);
     assert!((split.initial_spin_rate - OMEGA).abs() < 1e-15);
@@ -192,7 +199,11 @@ fn the_targets_recoil_is_translational_energy_only_in_the_systems_frame() {
     // a non-spinning target of two bodies recoiling at u, a projectile carrying the opposite momentum
     let u = Vec3::new(3.0, 0.0, 0.0);
     let body = |m: f64, x: f64, v: Vec3| ellipsoid(m, [1.0, 1.0, 1.0], Vec3::new(x, 0.0, 0.0), v, 0.0, Vec3::zeros());
-    let initial = vec![body(2.0, 0.0, Vec3::zeros()), body(1.0, 10.0, Vec3::zeros()), body(1.0, 50.0, Vec3::zeros())];
+    let initial = vec![
+        body(2.0, 0.0, Vec3::zeros()),
+        body(1.0, 10.0, Vec3::zeros()),
+        body(1.0, 50.0, Vec3::zeros()),
+    ];
     let later = vec![body(2.0, 0.0, u), body(1.0, 10.0, u), body(1.0, 50.0, -3.0 * u)];
     let split = rotational_split(&initial, &later, KAPPA, |i| i < 2).unwrap();
     assert!((split.translational_system - 0.5 * 3.0 * u.norm_squared()).abs() < 1e-12);
@@ -214,7 +225,16 @@ fn a_rigidly_turning_pile_has_not_drifted() {
 #[test]
 fn one_moved_body_of_four_drifts_by_three_quarters_and_the_others_by_a_quarter() {
     let d = 100.0;
-    let still = |x: f64| ellipsoid(1.0e12, [1.0e3, 1.0e3, 1.0e3], Vec3::new(x, 1.0e4, 0.0), Vec3::zeros(), 0.0, Vec3::zeros());
+    let still = |x: f64| {
+        ellipsoid(
+            1.0e12,
+            [1.0e3, 1.0e3, 1.0e3],
+            Vec3::new(x, 1.0e4, 0.0),
+            Vec3::zeros(),
+            0.0,
+            Vec3::zeros(),
+        )
+    };
     let initial: Vec<Body> = (0..4).map(|k| still(1.0e4 * k as f64)).collect();
     let mut later = initial.clone();
     later[1].position.x += d;
@@ -226,11 +246,20 @@ fn one_moved_body_of_four_drifts_by_three_quarters_and_the_others_by_a_quarter()
 
 #[test]
 fn run_names_give_target_projectile_and_seed() {
-    let parse = |s: &str| parse_run_name(s).map(|(t, p, s)| (t, p, s));
+    let parse = parse_run_name;
     assert_eq!(parse("N200_T4_P2_z45_s3"), Some(("N200_T4".into(), "P2".into(), 3)));
-    assert_eq!(parse("N200_T4_s2_P1_z45_s1"), Some(("N200_T4_s2".into(), "P1".into(), 1)));
-    assert_eq!(parse("N200_T4_P2_z45_s2_f3e-7"), Some(("N200_T4".into(), "P2".into(), 2)));
-    assert_eq!(parse("N200_T4_reduced_P3_z45_s1"), Some(("N200_T4_reduced".into(), "P3".into(), 3 - 2)));
+    assert_eq!(
+        parse("N200_T4_s2_P1_z45_s1"),
+        Some(("N200_T4_s2".into(), "P1".into(), 1))
+    );
+    assert_eq!(
+        parse("N200_T4_P2_z45_s2_f3e-7"),
+        Some(("N200_T4".into(), "P2".into(), 2))
+    );
+    assert_eq!(
+        parse("N200_T4_reduced_P3_z45_s1"),
+        Some(("N200_T4_reduced".into(), "P3".into(), 1))
+    );
     assert_eq!(parse("P2_z45_s1"), None);
     assert_eq!(parse("N200_T4_printed"), None);
 }

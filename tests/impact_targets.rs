@@ -353,12 +353,23 @@ fn the_kappa_reading_sets_the_relaxation_kappa() {
     let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
     let (bodies, report) = build_target(&spec, &mut quiet).unwrap();
     let by_mass = |pick: fn(f64, f64) -> bool| {
-        let b = bodies.iter().reduce(|a, b| if pick(b.shape.mass, a.shape.mass) { b } else { a }).unwrap();
+        let b = bodies
+            .iter()
+            .reduce(|a, b| if pick(b.shape.mass, a.shape.mass) { b } else { a })
+            .unwrap();
         (b.shape.equivalent_radius(), b.shape.mass)
     };
     let (small, large) = (by_mass(|a, b| a < b), by_mass(|a, b| a > b));
     let expected = calibrate_kappa_read(KappaReading::Reduced, 10.0, 5000.0, small, large, G_SI).unwrap();
-    assert!((report.kappa - expected).abs() < 1e-12 * expected, "{} vs {expected}", report.kappa);
+    assert!(
+        (report.kappa - expected).abs() < 1e-12 * expected,
+        "{} vs {expected}",
+        report.kappa
+    );
     let printed = calibrate_kappa_read(KappaReading::Printed, 10.0, 5000.0, small, large, G_SI).unwrap();
-    assert!(report.kappa < printed - 1.0, "reduced {} against printed {printed}", report.kappa);
+    assert!(
+        report.kappa < printed - 1.0,
+        "reduced {} against printed {printed}",
+        report.kappa
+    );
 }

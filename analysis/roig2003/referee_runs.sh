@@ -49,6 +49,10 @@ for part in "${parts[@]}"; do
         for f0 in 1e-5 1e-6 5e-7 4e-7 3e-7 1e-7 3e-8 1e-8; do
             for s in 1 2 3; do impact "$OUT/f0/N200_T4_P2_z45_s${s}_f$f0" targets/N200_T4.csv P2 "$s" "$f0"; done
         done
+        # the Fig. 4/8 cells P1 and P3 at the F0 where f_KE of the Fig. 2 cell is still inside 1-5 %
+        for p in P1 P3; do
+            for s in 1 2 3; do impact "$OUT/f0/N200_T4_${p}_z45_s${s}_f5e-7" targets/N200_T4.csv "$p" "$s" 5e-7; done
+        done
         ;;
     inertia) # item 1: Gaussian (Eq. 4) and uniform moments on the Fig. 2/4/8 cells, 3 seeds
         for p in P1 P2 P3; do

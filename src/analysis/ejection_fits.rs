@@ -55,7 +55,9 @@ pub fn fit_selected(sizes: &[f64], speeds: &[f64], keep: &[bool]) -> Result<Powe
 /// `Δv = c size^α` fitted to the pairs with `speed > floor` (m/s).
 pub fn fit_above_floor(sizes: &[f64], speeds: &[f64], floor: f64) -> Result<PowerLawFit, FitError> {
     if !floor.is_finite() {
-        return Err(FitError::InvalidInput(format!("floor: expected a finite speed (m/s), got {floor}")));
+        return Err(FitError::InvalidInput(format!(
+            "floor: expected a finite speed (m/s), got {floor}"
+        )));
     }
     let keep: Vec<bool> = speeds.iter().map(|v| *v > floor).collect();
     fit_selected(sizes, speeds, &keep)

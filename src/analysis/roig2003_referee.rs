@@ -33,7 +33,7 @@ use crate::ellipsoid::body::Body;
 use crate::ellipsoid::equations::G_SI;
 
 /// The Δv floor of the Fig. 4 fits (m/s): above the largest ejection speed a fragment of a 4 h pile gets from
-/// the pile's turning alone over 400 s, `2 sin(Ω t/2) Ω R ≈ 7.6 m/s` at the apparent radius 110 km.
+/// the pile's turning alone over 400 s, `2 sin(Ω t/2) Ω R ≈ 8.5 m/s` at the apparent radius 110 km.
 pub const FLOOR: f64 = 10.0;
 
 /// The analysis time of every run (s): Roig03's 400 s, ≈ 300 s after the impact.
@@ -183,7 +183,10 @@ fn alpha(fit: &Result<PowerLawFit, crate::analysis::fits::FitError>) -> (f64, f6
 
 /// The [`RefereeRun`] of the analysed impact run in `dir`, in `group`.
 pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError> {
-    let name = dir.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
     let (target, projectile, seed) = parse_run_name(&name)
         .ok_or_else(|| AnalysisError::Input(format!("{}: not a TARGET_Pk_zANGLE_sSEED run name", dir.display())))?;
     let summary_path = dir.join("summary.json");
@@ -279,7 +282,10 @@ pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError>
 /// The [`EquilibriumRow`]s (one per snapshot after `t = 0`) of a target run alone in `dir`, named
 /// `TARGET_READING`.
 pub fn collect_equilibrium(dir: &Path) -> Result<Vec<EquilibriumRow>, AnalysisError> {
-    let name = dir.file_name().map(|n| n.to_string_lossy().to_string()).unwrap_or_default();
+    let name = dir
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_default();
     let (target, reading) = name
         .rsplit_once('_')
         .ok_or_else(|| AnalysisError::Input(format!("{}: not a TARGET_READING name", dir.display())))?;
@@ -375,7 +381,7 @@ fn column(rows: &[&RefereeRun], f: impl Fn(&RefereeRun) -> f64, scale: f64, digi
 const PAPER_EJECTION: [(&str, f64); 3] = [("P1", -0.42), ("P2", -0.28), ("P3", -0.32)];
 const PAPER_SPIN: [(&str, f64); 3] = [("P1", -1.09), ("P2", -1.11), ("P3", -1.13)];
 
-fn select<'a>(runs: &'a [RefereeRun], keep: impl Fn(&RefereeRun) -> bool) -> Vec<&'a RefereeRun> {
+fn select(runs: &[RefereeRun], keep: impl Fn(&RefereeRun) -> bool) -> Vec<&RefereeRun> {
     runs.iter().filter(|r| keep(r)).collect()
 }
 
@@ -388,7 +394,8 @@ fn realisation_rows<'a>(runs: &'a [RefereeRun], projectile: &str) -> Vec<&'a Ref
 }
 
 fn f0_table(runs: &[RefereeRun], md: &mut String) {
-    let mut f0s: Vec<f64> = select(runs, |r| r.group == "f0").iter().map(|r| r.f0).collect();
+    let fig2 = |r: &RefereeRun| r.group == "f0" && r.projectile == "P2";
+    let mut f0s: Vec<f64> = select(runs, fig2).iter().map(|r| r.f0).collect();
     f0s.sort_by(|a, b| b.total_cmp(a));
     f0s.dedup();
     md.push_str(
@@ -397,7 +404,7 @@ fn f0_table(runs: &[RefereeRun], md: &mut String) {
          |---|---|---|---|---|---|---|---|---|---|\n",
     );
     for f0 in f0s {
-        let rows = select(runs, |r| r.group == "f0" && r.f0 == f0);
+        let rows = select(runs, |r| fig2(r) && r.f0 == f0);
         let _ = writeln!(
             md,
             "| {f0:.0e} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
@@ -447,25 +454,29 @@ fn split_table(runs: &[RefereeRun], md: &mut String) {
     }
 }
 
-fn variant_table(runs: &[RefereeRun], groups: [&str; 2], md: &mut String) {
+/// A variant: its label and which runs belong to it.
+type Variant<'a> = (&'a str, &'a dyn Fn(&RefereeRun) -> bool);
+
+fn variant_table(runs: &[RefereeRun], variants: [Variant<'_>; 2], md: &mut String) {
     md.push_str(
-        "| projectile | runs | f_KE (%) | rot. share (%) | bound fraction | ejection α | spin α | κ |\n\
-         |---|---|---|---|---|---|---|---|\n",
+        "| projectile | runs | f_KE (%) | rot. share (%) | bound fraction | ejection α | ejection α, escaping only | \
+         spin α | κ |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for (p, _) in PAPER_EJECTION {
-        for group in groups {
-            let rows = select(runs, |r| r.group == group && r.projectile == p);
+        for (label, keep) in variants {
+            let rows = select(runs, |r| keep(r) && r.projectile == p);
             if rows.is_empty() {
                 continue;
             }
             let _ = writeln!(
                 md,
-                "| {p}, {group} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {p}, {label} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 rows.len(),
                 column(&rows, |r| r.f_ke, 100.0, 2),
                 column(&rows, |r| r.rot_share, 100.0, 1),
                 column(&rows, |r| r.bound_fraction, 1.0, 3),
                 column(&rows, |r| r.alpha_all, 1.0, 2),
+                column(&rows, |r| r.alpha_escaping, 1.0, 2),
                 column(&rows, |r| r.spin_alpha, 1.0, 2),
                 column(&rows, |r| r.kappa, 1.0, 2),
             );
@@ -564,7 +575,9 @@ fn scatter_table(runs: &[RefereeRun], md: &mut String) {
 }
 
 fn spin_table(runs: &[RefereeRun], md: &mut String) {
-    md.push_str("| projectile | paper | N200_T4 (3 seeds) | 3 targets × 3 seeds | mean fit σ |\n|---|---|---|---|---|\n");
+    md.push_str(
+        "| projectile | paper | N200_T4 (3 seeds) | 3 targets × 3 seeds | mean fit σ |\n|---|---|---|---|---|\n",
+    );
     for (p, paper) in PAPER_SPIN {
         let all = realisation_rows(runs, p);
         let committed: Vec<&RefereeRun> = all.iter().copied().filter(|r| r.group == "gaussian").collect();
@@ -601,9 +614,10 @@ fn sites_table(runs: &[RefereeRun], md: &mut String) {
     }
 }
 
-/// The rotational share and f_KE against F0 (Fig. 2 cell), with the paper's ranges.
+/// The rotational share and f_KE of the Fig. 2 cell against 1/F0 (weaker dissipation to the right, so that the
+/// legend sits over the small values), with the paper's ranges.
 fn f0_figure(runs: &[RefereeRun]) -> LineChart {
-    let rows = select(runs, |r| r.group == "f0");
+    let rows = select(runs, |r| r.group == "f0" && r.projectile == "P2");
     let mut f0s: Vec<f64> = rows.iter().map(|r| r.f0).collect();
     f0s.sort_by(f64::total_cmp);
     f0s.dedup();
@@ -612,43 +626,35 @@ fn f0_figure(runs: &[RefereeRun]) -> LineChart {
             .map(|&f0| {
                 let v: Vec<f64> = rows.iter().filter(|r| r.f0 == f0).map(|r| 100.0 * f(r)).collect();
                 let (m, s) = mean_std(&v);
-                ((f0, m), s)
+                ((1.0 / f0, m), s)
             })
             .unzip()
     };
-    let (share, share_e) = stats(|r| r.rot_share);
-    let (fke, fke_e) = stats(|r| r.f_ke);
-    let band = |y: f64| vec![(f0s[0], y), (f0s[f0s.len() - 1], y)];
-    let line = |label: &str, points, colour, mark| Series {
+    let points = |label: &str, (points, errors): (Vec<(f64, f64)>, Vec<f64>), colour| Series {
         label: label.into(),
         points,
+        errors,
+        colour,
+        mark: Mark::Points,
+    };
+    let band = |label: &str, y: f64, colour| Series {
+        label: label.into(),
+        points: vec![(1.0 / f0s[f0s.len() - 1], y), (1.0 / f0s[0], y)],
         errors: vec![],
         colour,
-        mark,
+        mark: Mark::Dashed,
     };
     LineChart {
-        title: "N200_T4 + P2, ζ = 45°, 400 s: 3 seeds per F0".into(),
-        x_label: "F0 (s m⁻²)".into(),
+        title: "N200_T4 + P2, ζ = 45°, 400 s: mean ± sd of 3 seeds per F0".into(),
+        x_label: "1 / F0 (m² s⁻¹); the campaign: 1e6".into(),
         y_label: "per cent".into(),
         series: vec![
-            Series {
-                label: "rotational share of the fragment KE".into(),
-                points: share,
-                errors: share_e,
-                colour: 0,
-                mark: Mark::Points,
-            },
-            Series {
-                label: "f_KE".into(),
-                points: fke,
-                errors: fke_e,
-                colour: 1,
-                mark: Mark::Points,
-            },
-            line("paper: rotational share 10–20 %", band(10.0), 0, Mark::Dashed),
-            line("", band(20.0), 0, Mark::Dashed),
-            line("paper: f_KE 1–5 %", band(1.0), 1, Mark::Dashed),
-            line("", band(5.0), 1, Mark::Dashed),
+            points("rotational share of the fragment KE", stats(|r| r.rot_share), 0),
+            points("f_KE", stats(|r| r.f_ke), 1),
+            band("paper: rotational share 20 %", 20.0, 0),
+            band("paper: rotational share 10 %", 10.0, 0),
+            band("paper: f_KE 5 %", 5.0, 1),
+            band("paper: f_KE 1 %", 1.0, 1),
         ],
         log_x: true,
     }
@@ -673,14 +679,40 @@ pub fn write_report(out: &Path) -> Result<std::path::PathBuf, AnalysisError> {
     f0_table(&runs, &mut md);
     md.push_str(
         "\nRoig03: f_KE 1–5 %, rotational share 10–20 %, bound fraction ≈ 1.04 − 0.2 × 1.5 = 0.74 at this Q, \
-         ejection α −0.28, spin α −1.11.\n\n![rotational share and f_KE against F0](figures/referee_f0.png)\n\n",
+         ejection α −0.28, spin α −1.11.\n\n![rotational share and f_KE against 1/F0](figures/referee_f0.png)\n\n",
     );
     md.push_str("## 2. Whose rotation: K_R split into the targets' own spin and the impact's (F0 = 1e-6)\n\n");
     split_table(&runs, &mut md);
     md.push_str("\n## 3. Gaussian (Eq. 4) against uniform moments of inertia (committed N200_T4, 3 seeds)\n\n");
-    variant_table(&runs, ["gaussian", "uniform"], &mut md);
-    md.push_str("\n## 4. The committed target against one relaxed at the impact's κ (seed 1 pile, 3 projectile seeds)\n\n");
-    variant_table(&runs, ["gaussian", "relaxed"], &mut md);
+    let gaussian = |r: &RefereeRun| r.group == "gaussian";
+    variant_table(
+        &runs,
+        [
+            ("Gaussian", &gaussian),
+            ("uniform", &|r: &RefereeRun| r.group == "uniform"),
+        ],
+        &mut md,
+    );
+    md.push_str(
+        "\n## 4. The committed target against one relaxed at the impact's κ (seed 1 pile, 3 projectile seeds)\n\n",
+    );
+    variant_table(
+        &runs,
+        [
+            ("committed", &gaussian),
+            ("relaxed at κ = 11.44", &|r: &RefereeRun| r.group == "relaxed"),
+        ],
+        &mut md,
+    );
+    md.push_str("\n## 4b. The Fig. 2/4/8 cells at F0 = 1e-6 and 5e-7 s m⁻² (committed N200_T4, 3 seeds)\n\n");
+    variant_table(
+        &runs,
+        [
+            ("F0 = 1e-6", &gaussian),
+            ("F0 = 5e-7", &|r: &RefereeRun| r.group == "f0" && r.f0 == 5e-7),
+        ],
+        &mut md,
+    );
     md.push_str("\n## 5. The targets alone for 400 s at the impact's κ and at their own (F0 = 1e-6)\n\n");
     equilibrium_table(&equilibrium, &mut md);
     md.push_str(
