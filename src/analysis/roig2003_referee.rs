@@ -83,6 +83,8 @@ pub struct RefereeRun {
     pub alpha_all: f64,
     /// Standard error of `alpha_all`.
     pub se_all: f64,
+    /// Fragments in that fit.
+    pub n_all: usize,
     /// Exponent over the fragments with `Δv > FLOOR`.
     pub alpha_floor: f64,
     /// Its standard error.
@@ -231,7 +233,7 @@ pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError>
         .map(|f| (initial[f.index].position - centre).norm() / s.target_radius)
         .collect();
     let ln_sizes: Vec<f64> = sizes.iter().map(|x| x.ln()).collect();
-    let ((a_all, se_all, _), (a_fl, se_fl, n_fl), (a_h, se_h, n_h), (a_e, se_e, _), (a_s, se_s, _)) = (
+    let ((a_all, se_all, n_all), (a_fl, se_fl, n_fl), (a_h, se_h, n_h), (a_e, se_e, _), (a_s, se_s, _)) = (
         alpha(&fits.all),
         alpha(&fits.above_floor),
         alpha(&half),
@@ -258,6 +260,7 @@ pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError>
         pre_existing_per_fragment: split.pre_existing_fraction_per_fragment(),
         alpha_all: a_all,
         se_all,
+        n_all,
         alpha_floor: a_fl,
         se_floor: se_fl,
         n_floor: n_fl,
@@ -506,9 +509,29 @@ fn equilibrium_table(rows: &[EquilibriumRow], md: &mut String) {
     }
 }
 
+/// `mean ± sd [σ mean fit error] (mean points)` of one fit over `rows`.
+fn fit_cell(
+    rows: &[&RefereeRun],
+    alpha: fn(&RefereeRun) -> f64,
+    sigma: fn(&RefereeRun) -> f64,
+    points: fn(&RefereeRun) -> f64,
+) -> String {
+    let sigmas: Vec<f64> = rows.iter().map(|r| sigma(r)).filter(|x| x.is_finite()).collect();
+    let mean_sigma = if sigmas.is_empty() {
+        "–".to_string()
+    } else {
+        format!("{:.2}", mean_std(&sigmas).0)
+    };
+    format!(
+        "{} [σ {mean_sigma}] ({})",
+        column(rows, alpha, 1.0, 2),
+        column(rows, points, 1.0, 0)
+    )
+}
+
 fn fig4_table(runs: &[RefereeRun], md: &mut String) {
     md.push_str(
-        "| projectile | target | runs | paper | all fragments | Δv > 10 m/s (n) | Δv > v_esc/2 (n) | escaping only (n) |\n\
+        "| projectile | target | runs | paper | all fragments | Δv > 10 m/s | Δv > v_esc/2 | escaping only |\n\
          |---|---|---|---|---|---|---|---|\n",
     );
     for (p, paper) in PAPER_EJECTION {
@@ -521,19 +544,19 @@ fn fig4_table(runs: &[RefereeRun], md: &mut String) {
             .collect();
         blocks.push(("**all three**".into(), all.clone()));
         for (t, rows) in blocks {
-            let n = |f: fn(&RefereeRun) -> f64| column(&rows, f, 1.0, 0);
             let _ = writeln!(
                 md,
-                "| {p} | {t} | {} | {paper:.2} | {} (fit σ {}) | {} ({}) | {} ({}) | {} ({}) |",
+                "| {p} | {t} | {} | {paper:.2} | {} | {} | {} | {} |",
                 rows.len(),
-                column(&rows, |r| r.alpha_all, 1.0, 2),
-                column(&rows, |r| r.se_all, 1.0, 2),
-                column(&rows, |r| r.alpha_floor, 1.0, 2),
-                n(|r| r.n_floor as f64),
-                column(&rows, |r| r.alpha_half_escape, 1.0, 2),
-                n(|r| r.n_half_escape as f64),
-                column(&rows, |r| r.alpha_escaping, 1.0, 2),
-                n(|r| r.n_escaping as f64),
+                fit_cell(&rows, |r| r.alpha_all, |r| r.se_all, |r| r.n_all as f64),
+                fit_cell(&rows, |r| r.alpha_floor, |r| r.se_floor, |r| r.n_floor as f64),
+                fit_cell(
+                    &rows,
+                    |r| r.alpha_half_escape,
+                    |r| r.se_half_escape,
+                    |r| r.n_half_escape as f64
+                ),
+                fit_cell(&rows, |r| r.alpha_escaping, |r| r.se_escaping, |r| r.n_escaping as f64),
             );
         }
     }
@@ -718,8 +741,8 @@ pub fn write_report(out: &Path) -> Result<std::path::PathBuf, AnalysisError> {
     md.push_str(
         "\n## 6. Fig. 4: ejection speed–size exponents by which fragments are fitted (3 targets × 3 seeds)\n\n\
          Targets: the committed N200_T4 and two realisations built with `target build --seed 2` and `--seed 3`. \
-         Each cell is mean ± sd over the runs of α, fitted by least squares in (ln size, ln Δv); n is the mean \
-         number of fragments in the fit.\n\n",
+         Each cell is the mean ± sd over the runs of α, fitted by least squares in (ln size, ln Δv), then [σ the \
+         mean standard error of one run's fit] and (the mean number of fragments in the fit).\n\n",
     );
     fig4_table(&runs, &mut md);
     md.push_str("\n## 7. Fig. 8: spin–size exponents with the target in the scatter\n\n");
