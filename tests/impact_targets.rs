@@ -336,3 +336,40 @@ fn projectiles_have_table2_energies_and_impact_geometry() {
         }
     }
 }
+
+/// `kappa_reading` sets the κ the pile is relaxed with: Eq. 14 under that reading over the pile's smallest and
+/// largest fragments; the printed default stays out of the spec's JSON (the committed targets' files) and is
+/// what a spec without the key reads as.
+#[test]
+fn the_kappa_reading_sets_the_relaxation_kappa() {
+    use rubblepile::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
+    let mut spec = small_spec();
+    let printed = serde_json::to_value(&spec).unwrap();
+    assert!(printed.get("kappa_reading").is_none());
+    let back: TargetSpec = serde_json::from_value(printed).unwrap();
+    assert_eq!(back.kappa_reading, KappaReading::Printed);
+    spec.kappa_reading = KappaReading::Reduced;
+    assert_eq!(serde_json::to_value(&spec).unwrap()["kappa_reading"], "reduced");
+    let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
+    let (bodies, report) = build_target(&spec, &mut quiet).unwrap();
+    let by_mass = |pick: fn(f64, f64) -> bool| {
+        let b = bodies
+            .iter()
+            .reduce(|a, b| if pick(b.shape.mass, a.shape.mass) { b } else { a })
+            .unwrap();
+        (b.shape.equivalent_radius(), b.shape.mass)
+    };
+    let (small, large) = (by_mass(|a, b| a < b), by_mass(|a, b| a > b));
+    let expected = calibrate_kappa_read(KappaReading::Reduced, 10.0, 5000.0, small, large, G_SI).unwrap();
+    assert!(
+        (report.kappa - expected).abs() < 1e-12 * expected,
+        "{} vs {expected}",
+        report.kappa
+    );
+    let printed = calibrate_kappa_read(KappaReading::Printed, 10.0, 5000.0, small, large, G_SI).unwrap();
+    assert!(
+        report.kappa < printed - 1.0,
+        "reduced {} against printed {printed}",
+        report.kappa
+    );
+}

@@ -130,7 +130,7 @@ pub enum Command {
     Spinup(spinup::SpinupCommand),
     /// Old spelling of `report zhang2017`.
     #[command(hide = true)]
-    ReportZhang2017(ReportZhang2017Args),
+    ReportZhang2017(crate::studies::zhang2017::report::ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
     Export(crate::driver::export::ExportArgs),
     /// Convert pkdgrav `.ss` files to and from bodies/particles CSV (units converted at the edge).
@@ -145,32 +145,14 @@ pub enum ReportCommand {
     /// Re-analyse the Roig03 campaign (and its uniform-inertia partner) and write analysis/roig2003/REPORT.md.
     Roig2003(analyze::ReportRoig2003Args),
     /// Read spin-up runs (RUNS/<model>/path2, RUNS/<model>/critical) and write REPORT.md and Fig. 5-style figures.
-    Zhang2017(ReportZhang2017Args),
+    Zhang2017(crate::studies::zhang2017::report::ReportZhang2017Args),
     /// Re-analyse the Richardson11 model-atmosphere and tumbler runs and write analysis/richardson2011/REPORT.md.
     Richardson2011(report_richardson2011::ReportRichardson2011Args),
     /// Read Richardson11 tumbler runs at the paper's scale; write analysis/richardson2011/TUMBLER_PAPER.md.
     Richardson2011Tumbler(crate::studies::richardson2011::tumbler_paper::TumblerPaperArgs),
-}
-
-/// `rubblepile report zhang2017`.
-#[derive(Debug, clap::Args)]
-pub struct ReportZhang2017Args {
-    /// Directory of the runs (e.g. runs/zhang2017).
-    pub runs: PathBuf,
-    /// Directory of full-size runs (`<model>/path2`, e.g. runs/zhang2017_full), read into a "Full size" section,
-    /// finished or still running.
-    #[arg(long, value_name = "DIR")]
-    pub full: Option<PathBuf>,
-    /// Directory of spin-up path 1 and 3 runs (`<model>/path1`, `<model>/path3`, e.g. runs/zhang2017_paths), read
-    /// into a "Spin-up paths" section beside the path-2 runs and the paper's Table 6.
-    #[arg(long, value_name = "DIR")]
-    pub paths: Option<PathBuf>,
-    /// Where REPORT.md and the figures go.
-    #[arg(long, value_name = "DIR", default_value = "analysis/zhang2017")]
-    pub out: PathBuf,
-    /// Overwrite an existing REPORT.md.
-    #[arg(long)]
-    pub force: bool,
+    /// Roig03 after the referee: the runs of referee_runs.sh into compact CSVs, the CSVs into REFEREE.md.
+    #[command(subcommand)]
+    Roig2003Referee(crate::studies::roig2003::referee::RefereeArgs),
 }
 
 /// `rubblepile run`.
@@ -410,11 +392,14 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             report_richardson2011::report(&args)
         }
         Command::Report(ReportCommand::Richardson2011Tumbler(a)) => {
-            let path = crate::studies::richardson2011::tumbler_paper::write_tumbler_paper_report(&a);
-            println!("wrote {}", path.map_err(CliError::usage)?.display());
-            Ok(())
+            crate::studies::richardson2011::tumbler_paper::tumbler_paper_command(&a).map_err(CliError::usage)
         }
-        Command::Report(ReportCommand::Zhang2017(args)) | Command::ReportZhang2017(args) => report_zhang2017(&args),
+        Command::Report(ReportCommand::Roig2003Referee(a)) => {
+            crate::studies::roig2003::referee::referee_command(&a).map_err(CliError::usage)
+        }
+        Command::Report(ReportCommand::Zhang2017(args)) | Command::ReportZhang2017(args) => {
+            crate::studies::zhang2017::report::report_command(&args).map_err(CliError::usage)
+        }
         Command::Bench(BenchCommand::Rhs(args)) => crate::bench::rhs::rhs(&args).map_err(CliError::from),
         Command::Bench(BenchCommand::WorkPrecision(args)) => {
             crate::bench::work_precision_sweep::work_precision(&args).map_err(CliError::from)
@@ -474,19 +459,6 @@ fn check_run_dir(dir: &std::path::Path) -> Result<(), CliError> {
             }
         ))),
     }
-}
-
-fn report_zhang2017(args: &ReportZhang2017Args) -> Result<(), CliError> {
-    let path = crate::studies::zhang2017::report::write_report(
-        &args.runs,
-        args.full.as_deref(),
-        args.paths.as_deref(),
-        &args.out,
-        args.force,
-    )
-    .map_err(CliError::usage)?;
-    println!("wrote {}", path.display());
-    Ok(())
 }
 
 /// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on stderr, e.g.

@@ -131,6 +131,9 @@ pub struct BuildArgs {
     /// is reset (large N: fragments thrown onto wide orbits by the collapse; FILE.json counts them)
     #[arg(long)]
     pub drop_detached: bool,
+    /// Which K of Roig03 Eq. 13 sets κ: printed, impactor or reduced (the impacts' κ; see `rubblepile impact`)
+    #[arg(long, default_value = "printed")]
+    pub kappa_reading: crate::ellipsoid::calibration::KappaReading,
     /// Overwrite FILE.csv / FILE.json (and a checkpoint) of an earlier build.
     #[arg(long)]
     pub force: bool,
@@ -207,6 +210,7 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
     }
     spec.rigidity = args.rigidity;
     spec.drop_detached = args.drop_detached;
+    spec.kappa_reading = args.kappa_reading;
     if args.out.extension().is_none_or(|e| e != "csv") {
         return Err(CliError::usage(format!(
             "--out: expected a path ending in .csv, got {}",

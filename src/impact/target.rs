@@ -17,7 +17,7 @@
 //!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::ellipsoid::calibration::calibrate_kappa;
+use crate::ellipsoid::calibration::calibrate_kappa_read;
 use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
@@ -375,12 +375,12 @@ pub fn build_target_resumable(
     let (mut bodies, placement_radius) = place_fragments(spec, &radii, &mut rng);
     let small = bodies.last().unwrap().shape;
     let large = bodies[0].shape;
-    let kappa = calibrate_kappa(
+    let kappa = calibrate_kappa_read(
+        spec.kappa_reading,
         spec.calibrate[0],
         spec.calibrate[1],
-        small.equivalent_radius(),
-        small.mass,
-        large.equivalent_radius(),
+        (small.equivalent_radius(), small.mass),
+        (large.equivalent_radius(), large.mass),
         G_SI,
     )?;
     let model = ModelConfig::gaussian_si(kappa);

@@ -2,7 +2,7 @@
 //! ([`TargetError`]): below both the build (`target.rs`) and its checkpoints (`target_checkpoint.rs`), which both
 //! use them, so that neither imports the other for them (Roig et al. 2003, §3 and Table 1).
 
-use crate::ellipsoid::calibration::CalibrationError;
+use crate::ellipsoid::calibration::{CalibrationError, KappaReading};
 use crate::integrate::IntegrateError;
 
 /// What to build. Lengths in m, masses in kg, times in s unless the name says otherwise.
@@ -43,6 +43,15 @@ pub struct TargetSpec {
     /// their files.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub drop_detached: bool,
+    /// Which kinetic energy Roig03 Eq. 13's barrier is β times when κ is calibrated over the target's smallest
+    /// and largest fragments ([`KappaReading`]). Printed (the default) for the committed targets, absent from
+    /// their files; `reduced` relaxes the pile at the κ of the impacts (`analysis/roig2003/campaign.toml`).
+    #[serde(default, skip_serializing_if = "is_printed")]
+    pub kappa_reading: KappaReading,
+}
+
+fn is_printed(reading: &KappaReading) -> bool {
+    *reading == KappaReading::Printed
 }
 
 impl TargetSpec {
@@ -71,6 +80,7 @@ impl TargetSpec {
             rigidity: 1e-4,
             max_relax_time: 2e5,
             drop_detached: false,
+            kappa_reading: KappaReading::Printed,
         })
     }
 }

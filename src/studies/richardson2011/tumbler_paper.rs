@@ -199,6 +199,12 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
     md
 }
 
+/// `report richardson2011-tumbler`: [`write_tumbler_paper_report`], saying where it wrote.
+pub fn tumbler_paper_command(args: &TumblerPaperArgs) -> Result<(), AnalysisError> {
+    println!("wrote {}", write_tumbler_paper_report(args)?.display());
+    Ok(())
+}
+
 /// Analyses the runs, writes `TUMBLER_PAPER.md` and its two figures into `args.out`; returns the report's path.
 pub fn write_tumbler_paper_report(args: &TumblerPaperArgs) -> Result<PathBuf, AnalysisError> {
     let mut runs = Vec::new();

@@ -399,6 +399,40 @@ fn write_density_section(md: &mut String, rows: &[ModelRow]) {
     }
 }
 
+/// `rubblepile report zhang2017`.
+#[derive(Debug, clap::Args)]
+pub struct ReportZhang2017Args {
+    /// Directory of the runs (e.g. runs/zhang2017).
+    pub runs: std::path::PathBuf,
+    /// Directory of full-size runs (`<model>/path2`, e.g. runs/zhang2017_full), read into a "Full size" section,
+    /// finished or still running.
+    #[arg(long, value_name = "DIR")]
+    pub full: Option<std::path::PathBuf>,
+    /// Directory of spin-up path 1 and 3 runs (`<model>/path1`, `<model>/path3`, e.g. runs/zhang2017_paths), read
+    /// into a "Spin-up paths" section beside the path-2 runs and the paper's Table 6.
+    #[arg(long, value_name = "DIR")]
+    pub paths: Option<std::path::PathBuf>,
+    /// Where REPORT.md and the figures go.
+    #[arg(long, value_name = "DIR", default_value = "analysis/zhang2017")]
+    pub out: std::path::PathBuf,
+    /// Overwrite an existing REPORT.md.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `rubblepile report zhang2017`: [`write_report`] from the arguments, saying where it wrote.
+pub fn report_command(args: &ReportZhang2017Args) -> Result<(), String> {
+    let path = write_report(
+        &args.runs,
+        args.full.as_deref(),
+        args.paths.as_deref(),
+        &args.out,
+        args.force,
+    )?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
