@@ -98,7 +98,7 @@ fn full_size_section_reads_a_run_still_going() {
     fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
     fake_run(&root.join("full/hcp"), 50, 12000.0, 38300.0, 9000.0, false);
     let out = root.join("out");
-    let report = write_report(&root.join("runs"), Some(&root.join("full")), None, &out, false).unwrap();
+    let report = write_report(&root.join("runs"), Some(&root.join("full")), None, None, &out, false).unwrap();
     let md = std::fs::read_to_string(&report).unwrap();
     let section = &md[md.find("## Full size").expect("a full-size section")..];
     let row = section
@@ -114,7 +114,7 @@ fn full_size_section_reads_a_run_still_going() {
     assert!(out.join("fig5_hcp_full.svg").is_file() || out.join("fig5_hcp_full.png").is_file());
     // the command line written into the report names --full, and a second write needs force
     assert!(md.contains("--full "), "{}", &md[..400]);
-    assert!(write_report(&root.join("runs"), Some(&root.join("full")), None, &out, false).is_err());
+    assert!(write_report(&root.join("runs"), Some(&root.join("full")), None, None, &out, false).is_err());
     let _ = std::fs::remove_dir_all(&root);
 }
 
@@ -135,7 +135,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     )
     .unwrap();
     let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, &out, false).unwrap()).unwrap();
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, &out, false).unwrap()).unwrap();
     assert!(
         !md.contains("by creep criterion"),
         "old critical.json: no criterion section"
@@ -155,7 +155,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
             "ours": {"t_c3_hours": 2.64, "friction_angle_deg": 45.2}}"#,
     )
     .unwrap();
-    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, None, &out, true).unwrap()).unwrap();
+    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, &out, true).unwrap()).unwrap();
     assert!(md2.ends_with(&format!("\n\n{notes}\n")), "{}", &md2[md2.len() - 300..]);
     let section = &md2[md2.find("## T_c,3 by creep criterion").expect("criterion section")..];
     let row = section.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
@@ -245,7 +245,7 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
     .unwrap();
     let out = root.join("out");
     let md = std::fs::read_to_string(
-        write_report(&root.join("runs"), None, Some(&root.join("paths")), &out, false).unwrap(),
+        write_report(&root.join("runs"), None, Some(&root.join("paths")), None, &out, false).unwrap(),
     )
     .unwrap();
     assert!(md.contains("--paths "), "{}", &md[..400]);
@@ -282,5 +282,92 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
         .find(|l| l.starts_with("| HCP_RHO2309 | 3 |"))
         .expect("the 2309 kg/m³ variant's path 3");
     assert!(variant.contains("2.26 / 2.26 / 2.29 (Table 6)"), "{variant}");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// `--ladder`: one row per rung sorted by grain count; a compact rung (no snapshots, `particles.json` instead)
+/// gives its grains, radius and mass from that file; of two searches the finer one that found T_c,3 is shown;
+/// the paper's RCP row closes the table and the figure is written.
+#[test]
+fn ladder_section_takes_compact_rungs_and_the_finest_search() {
+    let root = std::env::temp_dir().join(format!("rp_report_ladder_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run(&root.join("runs/rcp"), 30, 38300.0, 38300.0, 600.0, true);
+    fake_run_at(
+        &root.join("ladder/rcp_big"),
+        "path2",
+        80,
+        38300.0,
+        38300.0,
+        900.0,
+        true,
+        Some(2.6),
+    );
+    fake_run_at(
+        &root.join("ladder/rcp_small"),
+        "path2",
+        40,
+        38300.0,
+        38300.0,
+        300.0,
+        true,
+        Some(2.5),
+    );
+    // the big rung as a compact copy: the first snapshot replaced by its summary
+    let big = root.join("ladder/rcp_big/path2");
+    std::fs::remove_dir_all(big.join("snapshots")).unwrap();
+    std::fs::write(
+        big.join("particles.json"),
+        r#"{"n": 80, "radius_min_m": 6.5, "radius_max_m": 6.5, "mass_kg": 8e8}"#,
+    )
+    .unwrap();
+    let search = |dir: &str, t: &[f64], t_c3: Option<f64>| {
+        let d = root.join(dir);
+        std::fs::create_dir_all(&d).unwrap();
+        let runs: Vec<String> = t.iter().map(|x| format!("{{\"t_final_h\": {x}}}")).collect();
+        let t_c3 = t_c3.map_or("null".to_string(), |x| x.to_string());
+        std::fs::write(
+            d.join("critical.json"),
+            format!(
+                "{{\"t_c3_hours\": {t_c3}, \"friction_angle_deg\": 50.0, \"runs\": [{}], \
+                 \"paper\": {{\"t_c3_hours\": {t_c3}, \"friction_angle_deg\": 50.0}}, \
+                 \"ours\": {{\"t_c3_hours\": 2.61, \"friction_angle_deg\": 48.0}}}}",
+                runs.join(",")
+            ),
+        )
+        .unwrap();
+    };
+    search("ladder/rcp_big/critical", &[2.5, 2.55, 2.6], Some(2.55));
+    search("ladder/rcp_big/critical_fine", &[2.51, 2.52, 2.53], Some(2.52));
+    search("ladder/rcp_small/critical", &[2.5, 2.55], None);
+    let out = root.join("out");
+    let md = std::fs::read_to_string(
+        write_report(&root.join("runs"), None, None, Some(&root.join("ladder")), &out, false).unwrap(),
+    )
+    .unwrap();
+    let section = &md[md.find("## Resolution ladder").expect("a ladder section")..];
+    let rows: Vec<&str> = section.lines().filter(|l| l.starts_with("| rcp_")).collect();
+    println!("{}", rows.join("\n"));
+    assert_eq!(rows.len(), 2, "{section}");
+    assert!(rows[0].starts_with("| rcp_small | 40 | 10.00 |"), "{}", rows[0]);
+    assert!(
+        rows[1].starts_with("| rcp_big | 80 | 6.50 |"),
+        "grains and radius from particles.json: {}",
+        rows[1]
+    );
+    assert!(
+        rows[1].contains("| 2.52 h, 50.0° |"),
+        "the fine search's T_c3: {}",
+        rows[1]
+    );
+    assert!(rows[1].contains("`critical_fine`: 0.01 h, 3"), "{}", rows[1]);
+    assert!(
+        rows[0].contains("| – h, 50.0° |"),
+        "no T_c3 found by the paper's criterion: {}",
+        rows[0]
+    );
+    assert!(section.contains("| paper (RCP) | 36 523 |"), "{section}");
+    assert!(md.contains("--ladder "), "the command line names --ladder");
+    assert!(out.join("ladder.svg").is_file(), "the figure");
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -3,6 +3,7 @@
 //! runs into the rows of [`rows`]. The searches that make its runs are generic and live in
 //! [`crate::analysis::spinup_search`].
 
+pub mod ladder;
 pub mod paths;
 pub mod report;
 pub mod rows;

@@ -189,8 +189,24 @@ fn t_start_of(dir: &Path) -> f64 {
         .unwrap_or(0.0)
 }
 
-/// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0.
+/// The file of a compact run directory (no snapshots; `analysis/zhang2017/compact.py`) that keeps what
+/// [`radii_and_mass`] reads from the first snapshot: `n`, `radius_min_m`, `radius_max_m`, `mass_kg`.
+pub const PARTICLES_SUMMARY: &str = "particles.json";
+
+/// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0: from the first snapshot,
+/// or from [`PARTICLES_SUMMARY`] in a compact run directory that keeps no snapshots.
 fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
+    if !dir.join("snapshots/0.csv").is_file() {
+        let text = std::fs::read_to_string(dir.join(PARTICLES_SUMMARY)).ok()?;
+        let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+        let n = usize::try_from(v["n"].as_u64()?).ok()?;
+        return Some((
+            v["radius_min_m"].as_f64()?,
+            v["radius_max_m"].as_f64()?,
+            v["mass_kg"].as_f64()?,
+            n,
+        ));
+    }
     let table = read_table(&dir.join("snapshots/0.csv"), Cells::Lenient).ok()?;
     let (km, kr) = (table.column("mass")?, table.column("radius")?);
     let (mut lo, mut hi, mut m, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
@@ -359,4 +375,16 @@ pub(crate) fn mode(m: Option<FailureMode>) -> &'static str {
         Some(FailureMode::InternalFailure) => "internal failure",
         None => "–",
     }
+}
+
+/// The model directories under `runs`: those with a `path2/spinup.csv`, sorted by name.
+pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
+    let mut models: Vec<_> = std::fs::read_dir(runs)
+        .map_err(|e| format!("{}: {e}", runs.display()))?
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.join("path2/spinup.csv").is_file())
+        .collect();
+    models.sort();
+    Ok(models)
 }
