@@ -244,6 +244,19 @@ fn bad_problem_names_the_flag_and_the_choices() {
     );
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--rtol"));
+    // --f0 belongs to the stiff problems only, and must be >= 0.
+    for (problem, f0) in [("top", "--f0=1e-4"), ("pile", "--f0=-1")] {
+        let o = rubblepile(
+            &dir,
+            &["bench", "work-precision", "--problem", problem, f0, "--out", "x"],
+        );
+        assert_eq!(o.status.code(), Some(2), "{problem} --f0 {f0}");
+        assert!(
+            String::from_utf8_lossy(&o.stderr).contains("--f0"),
+            "{problem} --f0 {f0}"
+        );
+    }
+    assert!(!dir.join("x").exists());
     let o = rubblepile(
         &dir,
         &[

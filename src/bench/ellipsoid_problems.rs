@@ -9,6 +9,8 @@
 //! | [`WorkPrecisionProblem::Pair`] | 2 ellipsoids, G = 1, one bounce | gravity + contact | another method at 1e-14 |
 //! | [`WorkPrecisionProblem::PairDissipative`] | the same | + dissipation, F0 = 0.1 | another method at 1e-14 |
 //! | [`WorkPrecisionProblem::N30`] | `targets/N30_T4.csv` + projectile P1 | SI gravity + contact + dissipation | another method at 1e-14 |
+//! | [`WorkPrecisionProblem::StiffPair`] | 2 overlapping ellipsoids, G = 1 | gravity + contact + dissipation, F0 = 1e4 (damping 1000× faster than the contact period) | tight explicit BS, else tight implicit |
+//! | [`WorkPrecisionProblem::Pile`] | `targets/N30_T4.csv` squeezed to 0.9 of its size | SI gravity + contact + dissipation, F0 = 1e-6, 1e-4 or 1e-2 | tight explicit BS, else tight implicit |
 //! | [`NBodyProblem::Pythagorean`] | 3 point masses (tiny spheres), G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
 //! | [`NBodyProblem::OuterSolar`] | Sun + 4 giants, G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
 //!
@@ -55,16 +57,24 @@ pub enum WorkPrecisionProblem {
     /// The N200_T4 target hit by projectile P2 (5 km/s, 45°) as in the Roig03 campaign (F0 = 1e-6 s m⁻²), to
     /// 400 s: the impact and the first 310 s of ejection.
     N200,
+    /// A stiff damped pair: two overlapping ellipsoids (G = 1) whose contact damping (F0 = 1e4) is about 1000×
+    /// faster than their contact oscillation, settling into one another ([`stiff_pair`]).
+    StiffPair,
+    /// An overdamped pile: the N30_T4 target squeezed to 0.9 of its size about its centre of mass, relaxing
+    /// under contact, gravity and dissipation (F0 = 1e-2 s m⁻² unless `--f0`; [`squeezed_pile`]).
+    Pile,
 }
 
 impl WorkPrecisionProblem {
     /// All problems, in `--problem` order.
-    pub const ALL: [WorkPrecisionProblem; 5] = [
+    pub const ALL: [WorkPrecisionProblem; 7] = [
         WorkPrecisionProblem::Top,
         WorkPrecisionProblem::Pair,
         WorkPrecisionProblem::PairDissipative,
         WorkPrecisionProblem::N30,
         WorkPrecisionProblem::N200,
+        WorkPrecisionProblem::StiffPair,
+        WorkPrecisionProblem::Pile,
     ];
 
     /// The `--problem` value, e.g. `"pair-dissipative"`.
@@ -75,12 +85,31 @@ impl WorkPrecisionProblem {
             WorkPrecisionProblem::PairDissipative => "pair-dissipative",
             WorkPrecisionProblem::N30 => "n30",
             WorkPrecisionProblem::N200 => "n200",
+            WorkPrecisionProblem::StiffPair => "stiff-pair",
+            WorkPrecisionProblem::Pile => "pile",
+        }
+    }
+
+    /// Whether the problem has dissipation whose F0 `--f0` may set.
+    pub fn takes_f0(self) -> bool {
+        matches!(self, WorkPrecisionProblem::StiffPair | WorkPrecisionProblem::Pile)
+    }
+
+    /// Builds the problem with its F0 replaced by `f0` (s m⁻² in the problem's units; only where
+    /// [`Self::takes_f0`], otherwise `None` is expected and the problem is built as it is).
+    pub fn setup_with_f0(self, f0: Option<f64>) -> ProblemSetup {
+        match (self, f0) {
+            (WorkPrecisionProblem::StiffPair, f0) => stiff_pair(f0.unwrap_or(STIFF_PAIR_F0)),
+            (WorkPrecisionProblem::Pile, f0) => squeezed_pile(f0.unwrap_or(PILE_F0)),
+            (other, _) => other.setup(),
         }
     }
 
     /// Builds the problem.
     pub fn setup(self) -> ProblemSetup {
         match self {
+            WorkPrecisionProblem::StiffPair => stiff_pair(STIFF_PAIR_F0),
+            WorkPrecisionProblem::Pile => squeezed_pile(PILE_F0),
             WorkPrecisionProblem::Top => free_top(),
             WorkPrecisionProblem::Pair => bouncing_pair(None),
             WorkPrecisionProblem::PairDissipative => bouncing_pair(Some(PAIR_F0)),
@@ -126,6 +155,9 @@ pub enum ReferenceKind {
     Analytic,
     /// A tight run of a different method.
     Numerical,
+    /// A stiff problem: one reference for every method, a tight explicit Bulirsch–Stoer run where it finishes
+    /// within its time limit, else a tight linearly implicit run ([`crate::bench::work_precision::References`]).
+    Stiff,
 }
 
 /// A built problem: the system, its initial bodies, the time span and what the benchmarks need.
@@ -338,6 +370,107 @@ pub fn n30_impact() -> ProblemSetup {
         rk4_steps: vec![0.2, 0.1, 0.05, 0.02, 0.01, 0.005],
     };
     setup.build()
+}
+
+/// F0 of [`stiff_pair`] by default (s m⁻² in G = 1 units).
+pub const STIFF_PAIR_F0: f64 = 100.0;
+
+/// The stiff damped pair: the [`bouncing_pair`]'s two ellipsoids (G = 1, κ = 10, Gaussian moments) placed with
+/// their centres 1.2 apart (overlapping: their equivalent radii add up to 1.47), approaching at 0.1 and spinning,
+/// with gravity, contact and dissipation at `f0`; centre-of-mass frame; t = 0..10. With the formulas of
+/// `targets/README.md` ("Choosing κ and F0") the contact oscillates with a period of about 2 (time units) and a
+/// relative velocity decays in `τ_v = μ/(2 F0 U_C(d)) ≈ 20/F0`: at the default F0 = 1e4 the damping is about
+/// 1000× faster than the oscillation, an overdamped contact that an explicit method must follow at its damping
+/// rate (steps ~ τ_v) while the solution itself creeps on the slow time scale.
+pub fn stiff_pair(f0: f64) -> ProblemSetup {
+    let mut bodies = vec![
+        body(
+            [1.0, 0.8, 0.6],
+            1.0,
+            [0.0; 3],
+            [0.0; 3],
+            Vec4::new(0.1, 0.2, -0.3, 0.9),
+            [0.05, -0.1, 0.2],
+        ),
+        body(
+            [0.8, 0.6, 0.5],
+            0.6,
+            [1.2, 0.1, 0.05],
+            [-0.1, 0.03, 0.0],
+            Vec4::new(-0.4, 0.1, 0.2, 0.8),
+            [0.0, 0.15, -0.1],
+        ),
+    ];
+    to_centre_of_mass_frame(&mut bodies);
+    let model = ModelConfig {
+        kappa: 10.0,
+        inertia: InertiaModel::Gaussian,
+        contact_g: 1.0,
+    };
+    let physics = Physics {
+        gravity: Some(GravityTerm::new(1.0)),
+        contact: Some(ContactTerm::default()),
+        dissipation: Some(DissipationTerm { f0 }),
+    };
+    let system = EllipsoidSystem::new(&bodies, model, physics);
+    ProblemSetup {
+        name: "stiff-pair",
+        description: format!(
+            "stiff damped pair: ellipsoids (1, 0.8, 0.6) m=1 and (0.8, 0.6, 0.5) m=0.6 overlapping (centres 1.2 \
+             apart), G = 1, kappa = 10, gravity + contact + dissipation F0 = {f0:e}, t = 0..10"
+        ),
+        bodies,
+        system,
+        t_end: 10.0,
+        energy_samples: 10,
+        rk4_steps: Vec::new(),
+        reference: ReferenceKind::Stiff,
+    }
+}
+
+/// F0 of [`squeezed_pile`] by default (s m⁻²).
+pub const PILE_F0: f64 = 1e-2;
+/// The factor by which [`squeezed_pile`] shrinks the N30_T4 target's positions about its centre of mass.
+pub const PILE_SQUEEZE: f64 = 0.9;
+/// End time of [`squeezed_pile`] (s).
+pub const PILE_T_END: f64 = 100.0;
+
+/// The overdamped pile: the N30_T4 target ([`N30_T4_CSV`], 30 ellipsoids of 25–90 km) with its positions squeezed
+/// to [`PILE_SQUEEZE`] about its centre of mass (velocities and spins as in the file), so its contacts overlap
+/// more deeply than at rest and push it apart against the damping; κ as in [`n30_impact`] (calibrated for P1, the
+/// N30 problems' κ), SI gravity + contact + dissipation at `f0`; t = 0..[`PILE_T_END`]. The damping rates grow
+/// like F0 `U_C`: at F0 = 1e-6 s m⁻² (the impact default) the pile is not stiff, at 1e-4 the damping is the
+/// fastest time scale of the deepest contacts, at 1e-2 of every contact (overdamped: the pile creeps apart).
+/// 30 bodies, 420 state components (431 with the dissipation integral).
+pub fn squeezed_pile(f0: f64) -> ProblemSetup {
+    let mut bodies: Vec<Body> = crate::ellipsoid::output::read_bodies(N30_T4_CSV.as_bytes())
+        .expect("the embedded target parses")
+        .iter()
+        .map(crate::ellipsoid::output::BodyRecord::to_body)
+        .collect();
+    let projectile = ProjectileSpec::preset("P1").expect("a preset projectile");
+    let cfg = crate::impact::run::ImpactConfig::new("targets/N30_T4.csv".into(), projectile);
+    let kappa = cfg.kappa(&bodies).expect("the target and projectile calibrate");
+    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let centre = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    for b in &mut bodies {
+        b.position = centre + (b.position - centre) * PILE_SQUEEZE;
+    }
+    let system = EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), Physics::impact(f0));
+    ProblemSetup {
+        name: "pile",
+        description: format!(
+            "overdamped pile: targets/N30_T4.csv squeezed to {PILE_SQUEEZE} of its size, SI, kappa = {kappa:.4}, \
+             gravity + contact + dissipation F0 = {f0:e} s/m^2, {} bodies, t = 0..{PILE_T_END} s",
+            bodies.len()
+        ),
+        bodies,
+        system,
+        t_end: PILE_T_END,
+        energy_samples: 10,
+        rk4_steps: Vec::new(),
+        reference: ReferenceKind::Stiff,
+    }
 }
 
 /// End time of the N200 impact (s).

@@ -1,9 +1,10 @@
 //! `rubblepile bench tolerance`: tolerance proportionality of the adaptive integrators — does the final-state
 //! error follow `rtol`? On the canonical problems (the free top with its analytic reference; the bouncing pair,
 //! conservative and dissipative; the N30 impact; the N200 impact to 400 s; the Pythagorean three-body problem; the
-//! outer Solar System), each
+//! outer Solar System; the stiff damped pair and the overdamped pile, F0 = 1e-2 s m⁻²), each
 //! method runs once per `rtol = atol` from 1e-6 to 1e-12 and the error (as in `bench work-precision`, against a
-//! reference by a different method at 1e-14) is divided by `rtol`. A tolerance means what it says when
+//! reference by a different method at 1e-14; for the two stiff problems one reference for every method, tight
+//! explicit Bulirsch–Stoer where it finishes, else tight implicit) is divided by `rtol`. A tolerance means what it says when
 //! `error_over_tol` stays of order one, at most 100, and the error falls monotonically as `rtol` does.
 //! Writes `tolerance.csv` and prints, per problem and method, the worst `error_over_tol` at `rtol ≥ 1e-11` and
 //! whether the error is monotone.
@@ -25,10 +26,11 @@ pub struct ToleranceArgs {
     /// Overwrite an earlier tolerance.csv in DIR.
     #[arg(long)]
     pub force: bool,
-    /// Methods, comma-separated (default bulirsch-stoer,dop853).
+    /// Methods, comma-separated (default bulirsch-stoer,dop853; bulirsch-stoer-implicit for the stiff problems).
     #[arg(long, value_enum, value_delimiter = ',', value_name = "METHOD")]
     pub methods: Option<Vec<Method>>,
-    /// Problems, comma-separated, from top, pair, pair-dissipative, n30, n200, pythagorean, outer-solar (default all).
+    /// Problems, comma-separated, from top, pair, pair-dissipative, n30, n200, pythagorean, outer-solar, stiff-pair,
+    /// pile (default all).
     #[arg(long, value_delimiter = ',', value_name = "PROBLEM")]
     pub problems: Option<Vec<String>>,
 }
@@ -49,6 +51,8 @@ pub fn problems() -> Vec<NamedProblem> {
         ("n200", || WorkPrecisionProblem::N200.setup()),
         ("pythagorean", || NBodyProblem::Pythagorean.setup()),
         ("outer-solar", || NBodyProblem::OuterSolar.setup()),
+        ("stiff-pair", || WorkPrecisionProblem::StiffPair.setup()),
+        ("pile", || WorkPrecisionProblem::Pile.setup()),
     ]
 }
 

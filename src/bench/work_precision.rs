@@ -220,39 +220,146 @@ pub fn measure(
 /// The reference states of a problem with a numerical reference.
 #[derive(Debug, Clone, PartialEq)]
 pub struct References {
-    /// Tolerance of both reference runs.
+    /// Tolerance of the reference runs.
     pub tolerance: f64,
-    /// Dop853 at `tolerance`: the reference of Bulirsch–Stoer.
-    pub dop853: Vec<f64>,
-    /// Bulirsch–Stoer at `tolerance`: the reference of every other method.
-    pub bulirsch_stoer: Vec<f64>,
-    /// Block-norm distance between the two (a floor under the measurable error).
-    pub difference: f64,
-    /// Wall time of the two reference runs (s): Dop853, Bulirsch–Stoer.
-    pub wall_seconds: [f64; 2],
+    /// The reference runs: Dop853 and Bulirsch–Stoer ([`ReferenceKind::Numerical`]: each method is measured
+    /// against the other method's run), or the one run every method is measured against ([`ReferenceKind::Stiff`]).
+    pub runs: Vec<ReferenceRun>,
+    /// Block-norm distance between the two runs of a [`ReferenceKind::Numerical`] problem (a floor under the
+    /// measurable error); `None` with one run.
+    pub difference: Option<f64>,
+    /// Why the explicit reference of a stiff problem was given up (its time limit), when it was.
+    pub explicit_given_up: Option<String>,
+}
+
+/// One reference run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReferenceRun {
+    /// The method.
+    pub method: Method,
+    /// Its state at `t_end`.
+    pub state: Vec<f64>,
+    /// Wall time of the run (s).
+    pub wall_seconds: f64,
+}
+
+/// Wall-clock limit (s) of a stiff problem's explicit reference run: past it the tight implicit run is the reference.
+pub const STIFF_REFERENCE_EXPLICIT_SECONDS: f64 = 60.0;
+
+/// Integrates `problem` to `t_end` with `method` at `rtol = atol = tolerance` in 100 pieces, giving up (`Ok(None)`)
+/// once the wall time passes `limit_seconds`.
+fn run_limited(
+    problem: &ProblemSetup,
+    method: Method,
+    tolerance: f64,
+    limit_seconds: f64,
+) -> Result<Option<ReferenceRun>, IntegrateError> {
+    let system = &problem.system;
+    let mut y = problem.initial_state();
+    let mut integ = make_integrator(method, Tolerances::scale_free(tolerance, tolerance, system), None)?;
+    integ.set_span(problem.t_end);
+    let start = Instant::now();
+    let mut t = 0.0;
+    let pieces = 100;
+    for k in 1..=pieces {
+        let target = if k == pieces {
+            problem.t_end
+        } else {
+            problem.t_end * k as f64 / pieces as f64
+        };
+        integ.advance(system, &mut t, &mut y, target)?;
+        if k < pieces && start.elapsed().as_secs_f64() > limit_seconds {
+            return Ok(None);
+        }
+    }
+    Ok(Some(ReferenceRun {
+        method,
+        state: y,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    }))
 }
 
 impl References {
-    /// Computes both reference runs at `tolerance`.
+    /// Computes the reference runs at `tolerance`: for a [`ReferenceKind::Numerical`] problem Dop853 and
+    /// Bulirsch–Stoer; for a [`ReferenceKind::Stiff`] one explicit Bulirsch–Stoer, or where that takes more than
+    /// [`STIFF_REFERENCE_EXPLICIT_SECONDS`], the linearly implicit method.
     pub fn compute(problem: &ProblemSetup, tolerance: f64) -> Result<Self, IntegrateError> {
+        if problem.reference == ReferenceKind::Stiff {
+            let limit = STIFF_REFERENCE_EXPLICIT_SECONDS;
+            if let Some(run) = run_limited(problem, Method::BulirschStoer, tolerance, limit)? {
+                return Ok(References {
+                    tolerance,
+                    runs: vec![run],
+                    difference: None,
+                    explicit_given_up: None,
+                });
+            }
+            let run =
+                run_limited(problem, Method::BulirschStoerImplicit, tolerance, f64::INFINITY)?.expect("no time limit");
+            return Ok(References {
+                tolerance,
+                runs: vec![run],
+                difference: None,
+                explicit_given_up: Some(format!(
+                    "bulirsch-stoer at rtol {tolerance:e} did not finish within {limit} s"
+                )),
+            });
+        }
         let d = run_once(problem, &Setting::adaptive(Method::Dop853, tolerance))?;
         let b = run_once(problem, &Setting::adaptive(Method::BulirschStoer, tolerance))?;
         Ok(References {
             tolerance,
-            difference: problem.state_error(&b.y, &d.y),
-            dop853: d.y,
-            bulirsch_stoer: b.y,
-            wall_seconds: [d.wall_seconds, b.wall_seconds],
+            difference: Some(problem.state_error(&b.y, &d.y)),
+            runs: vec![
+                ReferenceRun {
+                    method: Method::Dop853,
+                    state: d.y,
+                    wall_seconds: d.wall_seconds,
+                },
+                ReferenceRun {
+                    method: Method::BulirschStoer,
+                    state: b.y,
+                    wall_seconds: b.wall_seconds,
+                },
+            ],
+            explicit_given_up: None,
         })
     }
 
-    /// The reference state for runs of `method`.
-    pub fn for_method(&self, method: Method) -> &[f64] {
-        if method == Method::BulirschStoer {
-            &self.dop853
-        } else {
-            &self.bulirsch_stoer
+    /// The reference run for runs of `method`: the only one, or the other method's (Dop853 for Bulirsch–Stoer,
+    /// Bulirsch–Stoer for every other method).
+    pub fn run_for(&self, method: Method) -> &ReferenceRun {
+        if self.runs.len() == 1 {
+            return &self.runs[0];
         }
+        let wanted = if method == Method::BulirschStoer {
+            Method::Dop853
+        } else {
+            Method::BulirschStoer
+        };
+        self.runs.iter().find(|r| r.method == wanted).unwrap_or(&self.runs[0])
+    }
+
+    /// The reference state for runs of `method` ([`Self::run_for`]).
+    pub fn for_method(&self, method: Method) -> &[f64] {
+        &self.run_for(method).state
+    }
+
+    /// One line saying what the references are, how long they took and, for two, how far they differ.
+    pub fn describe(&self) -> String {
+        let runs: Vec<String> = self
+            .runs
+            .iter()
+            .map(|r| format!("{} at rtol {:e} ({:.2} s)", r.method, self.tolerance, r.wall_seconds))
+            .collect();
+        let mut line = format!("reference: {}", runs.join(" and "));
+        if let Some(d) = self.difference {
+            line += &format!("; the two differ by {d:.2e} (block norm)");
+        }
+        if let Some(why) = &self.explicit_given_up {
+            line += &format!("; the implicit run, because {why}");
+        }
+        line
     }
 }
 
@@ -292,16 +399,13 @@ pub fn sweep(
 ) -> Result<Sweep, IntegrateError> {
     let references = match problem.reference {
         ReferenceKind::Analytic => None,
-        ReferenceKind::Numerical => {
+        ReferenceKind::Numerical | ReferenceKind::Stiff => {
             progress(&format!(
-                "reference runs (dop853 and bulirsch-stoer at rtol = atol = {:e}) ...",
+                "reference runs at rtol = atol = {:e} ...",
                 config.reference_tolerance
             ));
             let r = References::compute(problem, config.reference_tolerance)?;
-            progress(&format!(
-                "  done in {:.2} s + {:.2} s; the two references differ by {:.2e} (block norm)",
-                r.wall_seconds[0], r.wall_seconds[1], r.difference
-            ));
+            progress(&format!("  {}", r.describe()));
             Some(r)
         }
     };

@@ -446,7 +446,8 @@ pub struct LoadedScene {
     pub output: OutputSettings,
     /// Warnings about the scene, one line each naming the file (printed by `rubblepile check` and at the start of
     /// `rubblepile run` as `warning: …`): the work estimate, when the scene's fastest time scale implies more than
-    /// [`WORK_WARNING_STEPS`] integrator steps.
+    /// [`WORK_WARNING_STEPS`] integrator steps; the advice to use `bulirsch-stoer-implicit` when the contact damping
+    /// is more than [`STIFF_ADVICE_RATIO`] times faster than the contact ([`contact_stiffness`]).
     pub warnings: Vec<String>,
 }
 
@@ -512,6 +513,52 @@ pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
 /// an adaptive step resolves a spin turn or a contact in a few to a few tens of steps.
 pub const STEPS_PER_TIME_SCALE: f64 = 10.0;
 
+/// The ratio of contact period to damping time above which `rubblepile check` advises
+/// `integrator.method = "bulirsch-stoer-implicit"` ([`contact_stiffness`]). At 10 an explicit method spends at least
+/// ten times the steps the contact needs; the stiff work–precision diagrams (`analysis/work_precision/REPORT.md`)
+/// show the implicit method ahead at the pile's F0 = 1e-2 and not at 1e-6.
+pub const STIFF_ADVICE_RATIO: f64 = 10.0;
+
+/// The stiffest body of a scene's contacts ([`contact_stiffness`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactStiffness {
+    /// Index of the body.
+    pub body: usize,
+    /// Period of two copies of it touching at rest, `2π √(R C² / (G m κ))` (s).
+    pub contact_period: f64,
+    /// Damping time of that contact, `4κR / (F0 G m)` (s).
+    pub damping_time: f64,
+    /// `contact_period / damping_time`: how many times faster the damping is than the contact.
+    pub ratio: f64,
+}
+
+/// The body whose contact is stiffest (largest contact period over damping time, see [`ContactStiffness`]), or
+/// `None` without several bodies, contact and a positive F0.
+pub fn contact_stiffness(bodies: &[Body], model: &ModelConfig, physics: &Physics) -> Option<ContactStiffness> {
+    let f0 = physics.dissipation.map_or(0.0, |d| d.f0);
+    if bodies.len() < 2 || physics.contact.is_none() || f0 <= 0.0 {
+        return None;
+    }
+    let (g, kappa) = (model.contact_g, model.kappa);
+    bodies
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let (c, m) = (b.shape.axes.z, b.shape.mass);
+            let r = equivalent_radius(&[b.shape.axes.x, b.shape.axes.y, c]);
+            let contact_period = std::f64::consts::TAU * (r * c * c / (g * m * kappa)).sqrt();
+            let damping_time = 4.0 * kappa * r / (f0 * g * m);
+            ContactStiffness {
+                body: k,
+                contact_period,
+                damping_time,
+                ratio: contact_period / damping_time,
+            }
+        })
+        .filter(|s| s.ratio.is_finite())
+        .max_by(|a, b| a.ratio.total_cmp(&b.ratio))
+}
+
 /// `|v|` without overflowing the squares of large components (`[1e200, 0, 0]` has the norm 1e200, not infinity).
 fn robust_norm(v: &Vec3) -> f64 {
     let m = v.amax();
@@ -545,6 +592,7 @@ impl Validator<'_> {
         let warnings = self
             .work_estimate(&bodies, &model, &physics, t_end)
             .into_iter()
+            .chain(self.stiffness_advice(&bodies, &model, &physics, integrator.method))
             .collect();
         Ok(LoadedScene {
             name: self.file.to_string(),
@@ -1010,6 +1058,30 @@ impl Validator<'_> {
                 "{}: the fastest time scale is {what}: {tau:.2e} s, so about {steps:.1e} integrator steps to t_end = \
                  {t_end} s (more than {WORK_WARNING_STEPS:e}); the run may not end in useful time",
                 self.file
+            )
+        })
+    }
+
+    /// Advice to use `bulirsch-stoer-implicit` when the dissipation is stiff: for each body, two copies of it
+    /// touching at rest (as in [`Self::work_estimate`]) have the contact period `T = 2π √(R C² / (G m κ))` and the
+    /// damping time `τ = 4κR / (F0 G m)` (`targets/README.md`, "Choosing κ and F0"); when `T/τ` exceeds
+    /// [`STIFF_ADVICE_RATIO`] for some body and the method is an explicit one, one line naming the body, both times
+    /// and the ratio. Deeper overlaps (impacts) raise the contact weight `U_C` and with it the ratio, so a scene
+    /// below the threshold at rest may still be stiff during an impact (the N200 impact at F0 = 1e-4 s m⁻²).
+    fn stiffness_advice(
+        &self,
+        bodies: &[Body],
+        model: &ModelConfig,
+        physics: &Physics,
+        method: Method,
+    ) -> Option<String> {
+        let stiffness = contact_stiffness(bodies, model, physics)?;
+        (stiffness.ratio > STIFF_ADVICE_RATIO && method != Method::BulirschStoerImplicit).then(|| {
+            format!(
+                "{}: physics.dissipation.F0 makes the damping stiff: body[{}] in contact damps in {:.2e} s, {:.0}x \
+                 faster than its contact period {:.2e} s (above {STIFF_ADVICE_RATIO}); an explicit method steps at \
+                 the damping time, integrator.method = \"bulirsch-stoer-implicit\" at the contact's",
+                self.file, stiffness.body, stiffness.damping_time, stiffness.ratio, stiffness.contact_period
             )
         })
     }

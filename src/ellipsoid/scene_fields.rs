@@ -307,8 +307,10 @@ pub const FIELDS: &[FieldDoc] = &[
         key: "integrator.method",
         unit: "text",
         default: "\"bulirsch-stoer\"",
-        range: Range::Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\""),
-        meaning: "adaptive Gragg-Bulirsch-Stoer, Dormand-Prince 8(5,3) or 5(4), or fixed-step RK4",
+        range: Range::Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""),
+        meaning: "adaptive Gragg-Bulirsch-Stoer, Dormand-Prince 8(5,3) or 5(4), fixed-step RK4, or linearly implicit \
+                  extrapolation for stiff dissipation (contact damping time well below the contact period; `check` \
+                  advises it)",
     },
     RTOL,
     ATOL,
