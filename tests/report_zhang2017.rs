@@ -324,7 +324,7 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     let search = |dir: &str, t: &[f64], t_c3: Option<f64>| {
         let d = root.join(dir);
         std::fs::create_dir_all(&d).unwrap();
-        let runs: Vec<String> = t.iter().map(|x| format!("{{\"t_final_h\": {x}}}")).collect();
+        let runs: Vec<String> = t.iter().map(|x| format!("{{\"t_final_hours\": {x}}}")).collect();
         let t_c3 = t_c3.map_or("null".to_string(), |x| x.to_string());
         std::fs::write(
             d.join("critical.json"),

@@ -310,6 +310,73 @@ pub fn critical_csv(runs: &[HoldVerdict]) -> String {
     out
 }
 
+/// Reads a `critical.csv` ([`critical_csv`]) back into judged holds (the run directories are not in it: `dir`
+/// is empty; the selected criterion is the paper's), so that T_c,3 and φ can be re-derived by
+/// [`critical_from_verdicts`] from a committed copy without the runs. A malformed row is an error naming its
+/// line and column.
+pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
+    const NAMES: [&str; 3] = ["theta_max", "packing_fraction", "coordination_number"];
+    let mut lines = text.lines();
+    if lines.next().map(str::trim) != Some(CRITICAL_CSV_HEADER.trim()) {
+        return Err(format!(
+            "not a critical.csv: the header must be {}",
+            CRITICAL_CSV_HEADER.trim()
+        ));
+    }
+    let mut out = Vec::new();
+    for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let at = |col: &str| format!("line {}: column {col}", k + 2);
+        let c: Vec<&str> = line.split(',').collect();
+        if c.len() != 10 {
+            return Err(format!("line {}: {} columns, expected 10", k + 2, c.len()));
+        }
+        let num = |i: usize, col: &str| {
+            c[i].trim()
+                .parse::<f64>()
+                .map_err(|_| format!("{}: not a number", at(col)))
+        };
+        let flag = |i: usize, col: &str| {
+            c[i].trim()
+                .parse::<bool>()
+                .map_err(|_| format!("{}: not true/false", at(col)))
+        };
+        let names = |i: usize, col: &str| -> Result<Vec<&'static str>, String> {
+            c[i].split(';')
+                .filter(|n| !n.is_empty())
+                .map(|n| {
+                    NAMES
+                        .into_iter()
+                        .find(|m| *m == n)
+                        .ok_or_else(|| format!("{}: unknown {n}", at(col)))
+                })
+                .collect()
+        };
+        let paper = CriterionVerdict {
+            stable: flag(6, "paper_stable")?,
+            drifting: names(7, "paper_drifting")?,
+        };
+        out.push(HoldVerdict {
+            t_final_hours: num(0, "t_final_h")?,
+            dir: PathBuf::new(),
+            released: flag(1, "released")?,
+            drift: HoldDrift {
+                theta_max_deg: num(3, "drift_theta_max_deg")?,
+                packing: num(4, "drift_packing")?,
+                coordination: num(5, "drift_coordination")?,
+            },
+            theta_max_deg: num(2, "theta_max_deg")?,
+            drifting: paper.drifting.clone(),
+            stable: paper.stable,
+            paper,
+            ours: CriterionVerdict {
+                stable: flag(8, "ours_stable")?,
+                drifting: names(9, "ours_drifting")?,
+            },
+        });
+    }
+    Ok(out)
+}
+
 /// The paper's criterion with the coordination tolerance `tol` (contacts per particle; `None`: the default), or
 /// a usage error naming `--coordination-tolerance` when it is not a positive number.
 pub fn paper_criterion(tol: Option<f64>) -> Result<CreepCriterion, SearchError> {

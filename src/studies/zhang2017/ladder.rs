@@ -14,7 +14,7 @@ use std::path::Path;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
 
-use super::rows::{ModelRow, TABLE3, base_model, mode, model_dirs, model_row, opt};
+use super::rows::{ModelRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.
@@ -32,14 +32,14 @@ pub struct RungSearch {
     pub holds: usize,
 }
 
-/// Reads one `critical.json` of `rubblepile spinup critical`; `None` if it is absent or unreadable.
+/// Reads one search of `rubblepile spinup critical` ([`read_critical`]: its `critical.json` or `critical.csv`);
+/// `None` if neither is there or readable.
 pub fn read_search(dir: &Path) -> Option<RungSearch> {
-    let text = std::fs::read_to_string(dir.join("critical.json")).ok()?;
-    let v: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let v = read_critical(dir)?;
     let mut t: Vec<f64> = v["runs"]
         .as_array()?
         .iter()
-        .filter_map(|r| r["t_final_h"].as_f64())
+        .filter_map(|r| r["t_final_hours"].as_f64())
         .collect();
     t.sort_by(f64::total_cmp);
     let step_hours = t.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
@@ -96,7 +96,7 @@ fn pair(p: (Option<f64>, Option<f64>)) -> String {
 }
 
 /// Writes the "Resolution ladder" section of the rungs under `ladder` and its figure `out/ladder.{svg,png}`
-/// (T_c,1, smoothed T_c,2 and T_c,3 against the grain count, the paper's values as dashed lines).
+/// (T_c,1, smoothed T_c,2 and T_c,3 by both criteria against the grain count, the paper's values as dashed lines).
 pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Result<(), String> {
     let rungs = rungs(ladder)?;
     if rungs.is_empty() {
@@ -197,6 +197,12 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
                 2,
                 Mark::Points,
                 of(&|r| chosen_search(&r.searches).and_then(|s| s.paper.0)),
+            ),
+            series(
+                "T_c3 (our criterion)",
+                3,
+                Mark::Points,
+                of(&|r| chosen_search(&r.searches).and_then(|s| s.ours.0)),
             ),
         ],
         log_x: true,

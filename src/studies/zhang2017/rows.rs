@@ -288,9 +288,7 @@ pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSam
     } else {
         format!("critical_{path}")
     };
-    let critical: Option<serde_json::Value> = std::fs::read_to_string(model_dir.join(search).join("critical.json"))
-        .ok()
-        .and_then(|s| serde_json::from_str(&s).ok());
+    let critical = read_critical(&model_dir.join(search));
     let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
     let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
     let t_c3_by_criterion = critical.as_ref().and_then(|c| {
@@ -387,4 +385,30 @@ pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
         .collect();
     models.sort();
     Ok(models)
+}
+
+/// The result of a T_c,3 search directory: its `critical.json`, or, in a compact copy that keeps only
+/// `critical.csv` (the searches committed before the JSON was kept), the same fields re-derived from the judged
+/// holds by [`crate::analysis::spinup_search::critical_from_verdicts`]: `t_c3_hours` and `friction_angle_deg` (the
+/// paper's criterion, the search's default), `paper`, `ours`, and `runs` (their `t_final_hours`). `None` when
+/// neither file is there or readable.
+pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
+    use crate::analysis::creep::CreepCriterionKind;
+    use crate::analysis::spinup_search::{critical_from_verdicts, read_critical_csv};
+    if let Ok(text) = std::fs::read_to_string(search_dir.join("critical.json")) {
+        return serde_json::from_str(&text).ok();
+    }
+    let holds = read_critical_csv(&std::fs::read_to_string(search_dir.join("critical.csv")).ok()?).ok()?;
+    let of = |kind| {
+        let (t, phi) = critical_from_verdicts(&holds, kind);
+        serde_json::json!({ "t_c3_hours": t, "friction_angle_deg": phi })
+    };
+    let paper = of(CreepCriterionKind::Paper);
+    Some(serde_json::json!({
+        "t_c3_hours": paper["t_c3_hours"],
+        "friction_angle_deg": paper["friction_angle_deg"],
+        "paper": paper,
+        "ours": of(CreepCriterionKind::Ours),
+        "runs": holds.iter().map(|h| serde_json::json!({ "t_final_hours": h.t_final_hours })).collect::<Vec<_>>(),
+    }))
 }
