@@ -614,8 +614,6 @@ const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
     ("src/integrate/linearly_implicit.rs", "src/integrate/mod.rs"),
     ("src/integrate/ode_solvers_adapter.rs", "src/integrate/dop853.rs"),
     ("src/integrate/ode_solvers_adapter.rs", "src/integrate/mod.rs"),
-    ("src/io/scene_file.rs", "src/io/output_times.rs"),
-    ("src/io/schema_keys.rs", "src/io/scene_fields.rs"),
     ("src/render/camera.rs", "src/render/mod.rs"),
     ("src/render/encode.rs", "src/render/mod.rs"),
     ("src/render/frame.rs", "src/render/mod.rs"),
