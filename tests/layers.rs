@@ -598,8 +598,6 @@ const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
     ("src/geometry/walls/point.rs", "src/geometry/walls/mod.rs"),
     ("src/geometry/walls/ring.rs", "src/geometry/walls/mod.rs"),
     ("src/geometry/walls/roots.rs", "src/geometry/walls/mod.rs"),
-    ("src/granular/hard/scene_fields.rs", "src/granular/hard/scene.rs"),
-    ("src/granular/hard/stepper.rs", "src/granular/hard/anchors.rs"),
     ("src/granular/soft/pairs.rs", "src/granular/soft/forces.rs"),
     ("src/granular/soft/respa.rs", "src/granular/soft/advise.rs"),
     ("src/granular/soft/respa.rs", "src/granular/soft/forces.rs"),
