@@ -598,7 +598,6 @@ const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
     ("src/geometry/walls/point.rs", "src/geometry/walls/mod.rs"),
     ("src/geometry/walls/ring.rs", "src/geometry/walls/mod.rs"),
     ("src/geometry/walls/roots.rs", "src/geometry/walls/mod.rs"),
-    ("src/impact/settle.rs", "src/impact/flyby.rs"),
     ("src/integrate/bulirsch_stoer.rs", "src/integrate/mod.rs"),
     ("src/integrate/dop853.rs", "src/integrate/mod.rs"),
     ("src/integrate/linearly_implicit.rs", "src/integrate/mod.rs"),
