@@ -587,11 +587,6 @@ const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
     ("src/integrate/linearly_implicit.rs", "src/integrate/mod.rs"),
     ("src/integrate/ode_solvers_adapter.rs", "src/integrate/dop853.rs"),
     ("src/integrate/ode_solvers_adapter.rs", "src/integrate/mod.rs"),
-    ("src/render/camera.rs", "src/render/mod.rs"),
-    ("src/render/encode.rs", "src/render/mod.rs"),
-    ("src/render/frame.rs", "src/render/mod.rs"),
-    ("src/render/overlay.rs", "src/render/frame.rs"),
-    ("src/render/walls.rs", "src/render/raycast.rs"),
 ];
 
 /// Edges that, taken out of `graph`, leave it without a cycle: for each cycle found, the edge into a `mod.rs`
