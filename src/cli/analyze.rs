@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::analysis::run_analysis::{AnalysisError, Fit, analyze_run};
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 
 /// `rubblepile analyze`.
 #[derive(Debug, clap::Args)]
