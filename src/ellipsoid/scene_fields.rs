@@ -1,8 +1,8 @@
-//! The field reference of the `kind = "ellipsoids"` scene file (Roig03's interacting ellipsoids): one row per key
-//! of `ellipsoid::scene::SceneFile` (which reads its bounds from here), printed by `rubblepile check --explain ellipsoids`. The rows the
-//! validator checks a plain range with are named constants, and the validator reads its bounds from them
-//! ([`crate::io::scene_file::Validator::within`]); the rest state the rule the validator's own code applies. The
-//! meanings restate the rustdoc of the schema structs in one line each.
+//! The field reference of the `kind = "ellipsoids"` scene file (Roig03's interacting ellipsoids): one row per key of
+//! `ellipsoid::scene::SceneFile` (which reads its bounds from here), printed by `rubblepile check --explain
+//! ellipsoids`. The rows the validator checks a plain range with are named constants, and the validator reads its
+//! bounds from them ([`crate::io::scene_file::Validator::within`]); the rest state the rule the validator's own code
+//! applies. The meanings restate the rustdoc of the schema structs in one line each.
 
 use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, MAX_THETA, TREE_FROM};
 use crate::io::scene_fields::{FieldDoc, Range, SceneReference, TableDoc};
