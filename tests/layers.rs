@@ -554,7 +554,6 @@ const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
     ("src/integrate/bulirsch_stoer.rs", "src/integrate/mod.rs"),
     ("src/integrate/dop853.rs", "src/integrate/mod.rs"),
     ("src/integrate/linearly_implicit.rs", "src/integrate/mod.rs"),
-    ("src/integrate/ode_solvers_adapter.rs", "src/integrate/dop853.rs"),
     ("src/integrate/ode_solvers_adapter.rs", "src/integrate/mod.rs"),
 ];
 
