@@ -120,6 +120,7 @@ pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), cra
     }
 }
 
+/// [`RunReport`] of any engine, for code that runs whichever engine a scene names.
 impl RunReport for AnyReport {
     fn one_line(&self) -> String {
         self.line.clone()

@@ -796,8 +796,6 @@ pub fn resume_soft(dir: &Path, options: &RunOptions) -> Result<SoftSummary, RunE
     resume::<SoftEngine>(dir, options)
 }
 
-/// [`RunReport`] of any engine, for code that runs whichever engine a scene names.
-
 #[cfg(test)]
 mod tests {
     use super::on_pool;
