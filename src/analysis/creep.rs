@@ -23,7 +23,7 @@
 //!   contacts, not the creep that precedes failure.
 //!
 //! Either way a hold whose forcing was released (global disruption) is not stable; that is the search's business
-//! ([`crate::analysis::spinup_search`]).
+//! (`analysis::spinup_search`, which uses these criteria).
 
 use serde::Serialize;
 

@@ -3,6 +3,7 @@
 //! papers' reports are one layer up, in `src/studies/` (nothing here names them).
 
 pub mod atmosphere;
+pub mod campaign_analysis;
 pub mod clumps;
 pub mod composition;
 pub mod creep;

@@ -68,7 +68,8 @@ pub enum Fit<T> {
 }
 
 impl<T> Fit<T> {
-    fn from<E: std::fmt::Display>(r: Result<T, E>) -> Self {
+    /// The fit of `r`, or its error's text.
+    pub(crate) fn from<E: std::fmt::Display>(r: Result<T, E>) -> Self {
         match r {
             Ok(v) => Fit::Ok(v),
             Err(e) => Fit::Failed(e.to_string()),
@@ -120,26 +121,7 @@ pub struct ClumpRunAnalysis {
     pub clump_report: ClumpReport,
 }
 
-impl ClumpRunAnalysis {
-    /// Draws the size–frequency figure into `dir/analysis` (`sfd.svg`, `sfd.png`) and returns the line `analyze`
-    /// prints; a figure that cannot be drawn is a warning on stderr, not an error (the tables are written).
-    pub fn write_figure_and_describe(&self, dir: &Path) -> String {
-        let figure = crate::analysis::figures::sfd::SizeFrequency::of(&self.clump_report, self.t_at);
-        let drawn = crate::analysis::figures::style::write_figure(&dir.join("analysis"), "sfd", &figure);
-        if let Err(why) = &drawn {
-            eprintln!("warning: figure not drawn: sfd: {why}");
-        }
-        format!(
-            "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",
-            self.t_at,
-            self.clump_report.summary_line(),
-            dir.join("analysis").display(),
-            if drawn.is_ok() { ", sfd.svg, sfd.png" } else { "" }
-        )
-    }
-}
-
-fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
+pub(crate) fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
     let err = |reason: String| AnalysisError::Read {
         path: path.to_path_buf(),
         reason,
@@ -400,7 +382,7 @@ fn run_snapshot_bodies(
 /// Analyses the clumps of the run in `dir` (any engine; [`crate::analysis::clumps`]) at its snapshot at `t_at`
 /// (s; `None`: its last snapshot): writes `dir/analysis/{clumps.csv, analysis.json}` unless `analysis.json`
 /// exists (or `force`), holding the lock of `dir/analysis/` ([`lock_analysis`]). The size–frequency figure is
-/// left to the caller ([`crate::analysis::figures::sfd`]).
+/// left to the caller (`ClumpRunAnalysis::write_figure_and_describe`, in `analysis::figures::sfd`).
 pub fn analyze_clumps_run(dir: &Path, t_at: Option<f64>, force: bool) -> Result<ClumpRunAnalysis, AnalysisError> {
     let _lock = lock_analysis(dir, "scene.toml")?;
     let out_dir = dir.join("analysis");
@@ -639,166 +621,6 @@ impl Default for SpinSelection {
             target: "N200_T12".into(),
             angle_deg: 45.0,
         }
-    }
-}
-
-/// Analyses every completed run listed in `CAMPAIGN_DIR/campaign.csv` at `t_at` (each run's own
-/// `analysis/` is written or, with `force`, rewritten, figures included) and writes
-/// `CAMPAIGN_DIR/analysis/campaign_analysis.json`, `campaign_runs.csv` and the campaign figures (Roig03 Figs. 5
-/// and 7, [`crate::analysis::figures::write_campaign_figures`]; a figure that cannot be drawn is a warning on
-/// stderr).
-pub fn analyze_campaign(
-    dir: &Path,
-    t_at: f64,
-    force: bool,
-    selection: &SpinSelection,
-) -> Result<CampaignAnalysis, AnalysisError> {
-    let _lock = lock_analysis(dir, "campaign.csv")?;
-    let out_dir = dir.join("analysis");
-    let json_path = out_dir.join("campaign_analysis.json");
-    if !force && json_path.exists() {
-        return Err(AnalysisError::Exists(out_dir));
-    }
-    let index = dir.join("campaign.csv");
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: index.clone(),
-        reason: e.to_string(),
-    };
-    let mut rdr = csv::Reader::from_path(&index).map_err(|e| err(&e))?;
-    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
-    let col = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| err(&format!("no `{name}` column")))
-    };
-    let (c_run, c_target, c_proj, c_angle, c_q, c_status) = (
-        col("run")?,
-        col("target")?,
-        col("projectile")?,
-        col("angle_deg")?,
-        col("q_erg_per_g")?,
-        col("status")?,
-    );
-    let mut runs = Vec::new();
-    let mut spins: Vec<Vec<f64>> = Vec::new();
-    let mut skipped = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| err(&e))?;
-        let run = rec[c_run].to_string();
-        if &rec[c_status] != "completed" {
-            skipped.push(run);
-            continue;
-        }
-        let run_dir = dir.join(&run);
-        // The run's analysis and its figures under one lock.
-        let _run_lock = lock_analysis(&run_dir, "scene.toml")?;
-        let (a, report) = match analyze_run(&run_dir, t_at, force) {
-            Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
-            other => other?,
-        };
-        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, &a, &report);
-        for why in &not_drawn {
-            eprintln!("warning: {run}: figure not drawn: {why}");
-        }
-        spins.push(
-            report
-                .fragments
-                .iter()
-                .filter(|f| !f.is_projectile)
-                .map(|f| f.spin_rate_corrected)
-                .collect(),
-        );
-        let num = |c: usize| rec[c].parse::<f64>().map_err(|e| err(&format!("{run}: {e}")));
-        let run_summary = read_json(&run_dir.join("summary.json")).ok();
-        let from_summary = |key: &str| run_summary.as_ref().and_then(|v| v[key].as_f64());
-        let (ej, sp) = (fit_ok(&a.ejection_speed_vs_size), fit_ok(&a.spin_vs_size));
-        let (best_n, maxwell) = match &a.spin_fits {
-            Fit::Ok(c) => {
-                let rss = |n: f64| c.fixed.iter().find(|f| f.n == n).map(|f| f.rss);
-                let ratio = match (rss(2.0), rss(c.best_n)) {
-                    (Some(m), Some(b)) if b > 0.0 => Some(m / b),
-                    _ => None,
-                };
-                (Some(c.best_n), ratio)
-            }
-            Fit::Failed(_) => (None, None),
-        };
-        let s = &a.summary;
-        runs.push(CampaignRun {
-            target: rec[c_target].to_string(),
-            projectile: rec[c_proj].to_string(),
-            angle_deg: num(c_angle)?,
-            q_erg_per_g: num(c_q)?,
-            fragments: s.n_fragments,
-            escaping: s.n_escaping,
-            bound_mass_fraction: s.bound_mass_fraction,
-            largest_remnant_fraction: a.clumps.largest_remnant.as_ref().map(|r| r.mass_fraction),
-            f_ke: s.f_ke,
-            rotational_share: s.rotational_share,
-            ejection_speed_median: s.ejection_speed_median,
-            ejection_speed_median_relative: s.ejection_speed_median_relative,
-            ejection_exponent: ej.map(|f| f.alpha),
-            ejection_exponent_sigma: ej.map(|f| f.sigma_alpha),
-            spin_exponent: sp.map(|f| f.alpha),
-            spin_exponent_sigma: sp.map(|f| f.sigma_alpha),
-            best_n,
-            maxwellian_residual_ratio: maxwell,
-            size_site_correlation: s.ejection_sites.size_cosine_correlation,
-            impact_side_median_size: s.ejection_sites.impact_side_median_size,
-            antipodal_side_median_size: s.ejection_sites.antipodal_side_median_size,
-            energy_error: from_summary("energy_error"),
-            wall_seconds: from_summary("wall_seconds"),
-            run,
-        });
-    }
-    let q: Vec<f64> = runs.iter().map(|r| r.q_erg_per_g).collect();
-    let bound: Vec<f64> = runs.iter().map(|r| r.bound_mass_fraction).collect();
-    let line = crate::analysis::fits::fit_line(&q, &bound);
-    let q_star_d = match &line {
-        Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
-        Err(e) => Fit::Failed(e.to_string()),
-    };
-    let spin_distributions = spin_distributions(&runs, &spins, selection);
-    let analysis = CampaignAnalysis {
-        t_at,
-        runs,
-        skipped,
-        bound_fraction_vs_q: Fit::from(line),
-        q_star_d,
-        spin_distributions,
-    };
-    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
-        path: out_dir.clone(),
-        reason: e.to_string(),
-    })?;
-    let csv_path = out_dir.join("campaign_runs.csv");
-    let werr = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: csv_path.clone(),
-        reason: e.to_string(),
-    };
-    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| werr(&e))?;
-    for r in &analysis.runs {
-        w.serialize(r).map_err(|e| werr(&e))?;
-    }
-    w.flush().map_err(|e| werr(&e))?;
-    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
-        path: json_path.clone(),
-        reason: e.to_string(),
-    })?;
-    // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them
-    let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
-    for why in &not_drawn {
-        eprintln!("warning: figure not drawn: {why}");
-    }
-    Ok(analysis)
-}
-
-fn fit_ok(f: &Fit<PowerLawFit>) -> Option<&PowerLawFit> {
-    match f {
-        Fit::Ok(p) => Some(p),
-        Fit::Failed(_) => None,
     }
 }
 

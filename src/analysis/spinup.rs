@@ -1,6 +1,6 @@
-//! Post-processing of spin-up runs (Zhang17 §3): the first two critical spin limits detected in time series
-//! (the creep criterion behind the third is [`crate::analysis::creep`]), stresses (Eqs. 15–16), principal stresses and the Mohr–Coulomb measures
-//! (Eqs. 20–21), and the fit of Eq. 22 over bulk densities.
+//! Post-processing of spin-up runs (Zhang17 §3): the first two critical spin limits detected in time series (the creep
+//! criterion behind the third is in `analysis::creep`, which reads the packing threshold here), stresses (Eqs. 15–16),
+//! principal stresses and the Mohr–Coulomb measures (Eqs. 20–21), and the fit of Eq. 22 over bulk densities.
 //!
 //! Conventions: stresses are in Pa with compression negative (as the paper); periods in hours at the edges
 //! (function names say so), SI inside.

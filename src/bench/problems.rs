@@ -14,7 +14,7 @@
 //! | [`RigidBody`] | 3 | Euler's equations of a free rigid body: exact solution ([`torque_free_spin`], Jacobi elliptic functions), energy and angular momentum |
 //!
 //! The problems of the ellipsoid model itself (a free top, a bouncing pair, the N30 target, N-body tests)
-//! are in [`super::ellipsoid_problems`].
+//! are in `bench::ellipsoid_problems`, built on these.
 
 use crate::integrate::OdeSystem;
 use crate::integrate::elliptic::{incomplete_f, jacobi_sn_cn_dn};

@@ -8,7 +8,7 @@ use crate::aggregate::files::{check_outputs, density_variant, write_aggregate};
 use crate::aggregate::random_packing::{BuildProgress, Recipe};
 use crate::aggregate::shape::Shape;
 use crate::aggregate::{BuildSpec, Grains, Model, build_with_progress};
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 
 /// `rubblepile aggregate …`.
 #[derive(Debug, clap::Subcommand)]

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::analysis::run_analysis::{AnalysisError, Fit, analyze_run};
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 
 /// `rubblepile analyze`.
 #[derive(Debug, clap::Args)]
@@ -120,7 +120,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
     };
-    let a = crate::analysis::run_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection).map_err(
+    let a = crate::analysis::campaign_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection).map_err(
         |e| match e {
             AnalysisError::Fragments(_) => CliError::failed(e),
             _ => CliError::usage(e),

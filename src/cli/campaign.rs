@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::cli::{CheckpointArgs, CliError};
+use crate::cli::common::{CheckpointArgs, CliError};
 use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign_anywhere};
 
 /// `rubblepile campaign`.

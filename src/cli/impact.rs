@@ -7,7 +7,7 @@
 
 use std::path::PathBuf;
 
-use crate::cli::{CheckpointArgs, CliError, report};
+use crate::cli::common::{CheckpointArgs, CliError, report};
 use crate::driver::{RunOptions, run_scene};
 use crate::impact::projectile::ProjectileSpec;
 use crate::impact::run::{ImpactConfig, ImpactError, prepare_impact};

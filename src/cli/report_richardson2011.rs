@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use super::CliError;
+use super::common::CliError;
 use crate::studies::richardson2011::report::{Richardson2011Inputs, write_report};
 
 /// `rubblepile report richardson2011`.

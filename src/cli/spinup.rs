@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use crate::analysis::creep::CreepCriterionKind;
 use crate::analysis::spinup_search::{CriticalOptions, SearchError, critical as run_critical, density_fit as fit};
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 
 /// `rubblepile spinup …`.
 #[derive(Debug, clap::Subcommand)]

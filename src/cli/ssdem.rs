@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 use crate::granular::soft::advise::{Advice, DEFAULT_MAX_OVERLAP, advise_for_grains};
 use crate::granular::soft::scene::load_soft_scene;
 

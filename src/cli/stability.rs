@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use crate::bench::stability::cases::all_cases;
 use crate::bench::stability::{StabilityRow, Verdict, prepare_out, result_paths, run_case, write_csv, write_markdown};
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 
 /// `rubblepile bench stability`.
 #[derive(Debug, clap::Args)]

@@ -3,7 +3,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 use crate::driver::DEFAULT_CHECKPOINT_EVERY;
 use crate::ellipsoid::output::write_snapshot;
 use crate::impact::target::{TargetSpec, build_target_resumable};

@@ -2,7 +2,7 @@
 //! (PNG frames and an animated GIF) and `rubblepile convert FILE --to FILE` (pkdgrav `.ss` files).
 
 use crate::analysis::run_analysis::FragmentFields;
-use crate::cli::CliError;
+use crate::cli::common::CliError;
 use crate::driver::export::{ExportError, export};
 use crate::driver::formats::Formats;
 use crate::render::args::RenderArgs;

@@ -8,18 +8,19 @@
 //! (cut back to the checkpoint when the branch is resumed), the parent's snapshots from before the checkpoint (the
 //! grids agree up to it, so they are the branch's own; `resume` refuses a directory without them; a snapshot the new
 //! grid puts at the checkpoint's own sample is written from the checkpoint's state) and the parent's
-//! `checkpoint.json` with the scene hash of the new scene; [`crate::driver::resume_soft`] then carries it on. Whether the two
+//! `checkpoint.json` with the scene hash of the new scene; [`crate::driver::runner::resume_soft`] then carries it on. Whether the two
 //! scenes really agree up to the checkpoint is the caller's promise; what can be checked here is checked: the
 //! new scene must parse, hold the same number of particles, and put an output sample at the checkpoint's step
 //! with the same index.
 
 use std::path::Path;
 
-use super::{CHECKPOINT_FILE, RunError};
+use super::runner::RunError;
 use crate::bits::fnv1a_hex;
 use crate::engine::{Engine, Resumed};
 use crate::granular::soft::run::{SoftEngine, SoftSummary, sample_steps};
 use crate::granular::soft::scene::parse_soft_scene;
+use crate::io::checkpoint::CHECKPOINT_FILE;
 
 /// Errors of branching: those of a soft-sphere run.
 type BranchError = RunError<SoftSummary>;
@@ -108,7 +109,7 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
     if let Some(k) = at_checkpoint {
         // The checkpoint's state is that sample's state (a run writes a sample's snapshot, then checkpoints), so the
         // engine restored from it writes the snapshot the branch's own run would have written there.
-        let c = super::read_checkpoint::<SoftEngine>(dir)?;
+        let c = super::runner::read_checkpoint::<SoftEngine>(dir)?;
         let mut engine =
             SoftEngine::from_scene_text(scene_text, &name, Some(scene_dir)).map_err(|e| bad(e.to_string()))?;
         let at = Resumed {

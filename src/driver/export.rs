@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::formats::Formats;
-use super::kind::SceneKind;
+use super::scene_kind::SceneKind;
 use crate::ellipsoid::run::EllipsoidEngine;
 use crate::engine::{Engine, EngineError, SnapshotView};
 use crate::granular::hard::run::HardEngine;

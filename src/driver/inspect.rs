@@ -1,4 +1,4 @@
-//! Whether a run directory is whole: `rubblepile check DIR` ([`check_run_dir`]), and the snapshots [`super::resume`]
+//! Whether a run directory is whole: `rubblepile check DIR` ([`check_run_dir`]), and the snapshots the runner's `resume`
 //! makes sure of before it continues a run ([`missing_snapshots`]).
 //!
 //! A run directory is whole when everything its own record says was written is there: the scene copy; every
@@ -10,7 +10,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::kind::SceneKind;
+use super::scene_kind::SceneKind;
 use crate::bits::fnv1a_hex;
 use crate::ellipsoid::run::EllipsoidEngine;
 use crate::engine::{Engine, Sample};

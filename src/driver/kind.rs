@@ -3,63 +3,12 @@
 
 use std::path::Path;
 
-use super::{RunError, RunOptions};
+use super::runner::{RunError, RunOptions};
+pub use super::scene_kind::SceneKind;
 use crate::ellipsoid::run::EllipsoidEngine;
-use crate::engine::{Engine, RunReport};
+use crate::engine::RunReport;
 use crate::granular::hard::run::HardEngine;
 use crate::granular::soft::run::SoftEngine;
-
-/// The engines a scene file can name in `scene.kind` (on the command line by the same names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum SceneKind {
-    /// `kind = "ellipsoids"` (also a scene without `kind`): interacting ellipsoids (Roig03).
-    Ellipsoids,
-    /// `kind = "soft-spheres"`: soft-sphere DEM (Zhang17).
-    SoftSpheres,
-    /// `kind = "hard-spheres"`: hard spheres with predicted collisions (Richardson11).
-    HardSpheres,
-}
-
-impl SceneKind {
-    /// The kind a scene text names. A text that is not TOML, has no `scene.kind` or names an unknown kind is taken
-    /// as an ellipsoid scene, whose parser then reports exactly what is wrong with it.
-    pub fn of_text(text: &str) -> SceneKind {
-        let kind = text
-            .parse::<toml::Table>()
-            .ok()
-            .and_then(|t| t.get("scene")?.get("kind")?.as_str().map(str::to_string));
-        match kind.as_deref() {
-            Some(SoftEngine::KIND) => SceneKind::SoftSpheres,
-            Some(HardEngine::KIND) => SceneKind::HardSpheres,
-            _ => SceneKind::Ellipsoids,
-        }
-    }
-
-    /// The kind of the scene file at `path` (an unreadable file counts as an ellipsoid scene, whose loader reports
-    /// the read error).
-    pub fn of_file(path: &Path) -> SceneKind {
-        crate::io::scene_file::read_text_bounded(path).map_or(SceneKind::Ellipsoids, |t| SceneKind::of_text(&t))
-    }
-
-    /// The kind of the run in `dir` (from its `scene.toml` copy).
-    pub fn of_run_dir(dir: &Path) -> SceneKind {
-        SceneKind::of_file(&dir.join("scene.toml"))
-    }
-}
-
-impl SceneKind {
-    /// Every kind, in the order `rubblepile check --explain` prints them.
-    pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
-
-    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
-    pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
-        match self {
-            SceneKind::Ellipsoids => &crate::ellipsoid::scene_fields::REFERENCE,
-            SceneKind::SoftSpheres => &crate::granular::soft::scene_fields::REFERENCE,
-            SceneKind::HardSpheres => &crate::granular::hard::scene_fields::REFERENCE,
-        }
-    }
-}
 
 /// The text of `rubblepile check --explain [KIND]`: the field reference of one kind's scene file, or of all three
 /// (`None`), one after the other.
@@ -113,12 +62,12 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             // The built-in scene's impact.json is written after the run: the directory stays locked until then.
             let _lock = path
                 .is_none()
-                .then(|| super::lock_output_dir(out, options.force))
+                .then(|| super::runner::lock_output_dir(out, options.force))
                 .transpose()?;
             for w in engine.scene_warnings() {
                 eprintln!("warning: {w}");
             }
-            let result = erase(super::run(engine, out, options));
+            let result = erase(super::runner::run(engine, out, options));
             if path.is_none() && result.is_ok() {
                 // The built-in scene is an impact: its setup lets `rubblepile analyze` read the run.
                 let json = out.join("impact.json");
@@ -133,7 +82,7 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             for w in engine.scene_warnings() {
                 eprintln!("warning: {w}");
             }
-            erase(super::run(engine, out, options))
+            erase(super::runner::run(engine, out, options))
         }
         SceneKind::HardSpheres => {
             let engine = HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
@@ -141,17 +90,17 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             for w in engine.scene_warnings() {
                 eprintln!("warning: {w}");
             }
-            erase(super::run(engine, out, options))
+            erase(super::runner::run(engine, out, options))
         }
     }
 }
 
-/// Continues the run in `dir` from its checkpoint with the engine its `scene.toml` names ([`super::resume`]).
+/// Continues the run in `dir` from its checkpoint with the engine its `scene.toml` names ([`super::runner::resume`]).
 pub fn resume_dir(dir: &Path, options: &RunOptions) -> AnyResult {
     match SceneKind::of_run_dir(dir) {
-        SceneKind::Ellipsoids => erase(super::resume::<EllipsoidEngine>(dir, options)),
-        SceneKind::SoftSpheres => erase(super::resume::<SoftEngine>(dir, options)),
-        SceneKind::HardSpheres => erase(super::resume::<HardEngine>(dir, options)),
+        SceneKind::Ellipsoids => erase(super::runner::resume::<EllipsoidEngine>(dir, options)),
+        SceneKind::SoftSpheres => erase(super::runner::resume::<SoftEngine>(dir, options)),
+        SceneKind::HardSpheres => erase(super::runner::resume::<HardEngine>(dir, options)),
     }
 }
 
@@ -168,5 +117,15 @@ pub fn check_file(path: Option<&Path>) -> Result<(Vec<String>, Vec<String>), cra
             .map(|e| (e.scene_warnings().to_vec(), e.describe())),
         SceneKind::HardSpheres => HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
             .map(|e| (e.scene_warnings().to_vec(), e.describe())),
+    }
+}
+
+/// [`RunReport`] of any engine, for code that runs whichever engine a scene names.
+impl RunReport for AnyReport {
+    fn one_line(&self) -> String {
+        self.line.clone()
+    }
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
     }
 }

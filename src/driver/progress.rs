@@ -6,7 +6,7 @@ use std::cell::Cell;
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
 
-/// Default wall-clock seconds between progress lines on a non-terminal ([`super::RunOptions::progress_every`]).
+/// Default wall-clock seconds between progress lines on a non-terminal (the runner's `RunOptions::progress_every`).
 pub const DEFAULT_PROGRESS_EVERY: f64 = 60.0;
 
 /// The environment variable that sets the seconds between progress lines when `--progress-every` is not given.
@@ -38,7 +38,7 @@ impl Progress {
         if !enabled {
             Progress::Off
         } else if std::io::stderr().is_terminal() {
-            super::progress_bar(true, t_end, t).map_or(Progress::Off, Progress::Bar)
+            progress_bar(true, t_end, t).map_or(Progress::Off, Progress::Bar)
         } else if every.is_finite() && every > 0.0 {
             let now = Instant::now();
             Progress::Lines(Lines {
@@ -57,7 +57,7 @@ impl Progress {
     pub fn show(&self, t: f64, t_end: f64, error: Option<(&str, f64)>) {
         match self {
             Progress::Off => {}
-            Progress::Bar(pb) => super::show_progress(pb, t, t_end),
+            Progress::Bar(pb) => show_progress(pb, t, t_end),
             Progress::Lines(lines) => {
                 if lines.last.get().elapsed() >= lines.every {
                     lines.last.set(Instant::now());
@@ -117,6 +117,28 @@ fn clock(s: f64) -> String {
         (0, m, sec) => format!("{m}m {sec}s"),
         (h, m, sec) => format!("{h}h {m}m {sec}s"),
     }
+}
+
+/// A progress bar on stderr for a run from `t` to `t_end` (s), when `enabled` and stderr is a terminal.
+pub fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::ProgressBar> {
+    if !enabled || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let pb = indicatif::ProgressBar::with_draw_target(Some(1_000_000), indicatif::ProgressDrawTarget::stderr());
+    let style = indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg} ETA {eta}")
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    pb.set_style(style);
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.reset_eta();
+    pb.set_message(format!("t = {t}/{t_end} s"));
+    pb.enable_steady_tick(Duration::from_millis(250));
+    Some(pb)
+}
+
+/// Moves `pb` to simulated time `t` of `t_end` (s).
+pub fn show_progress(pb: &indicatif::ProgressBar, t: f64, t_end: f64) {
+    pb.set_position((t / t_end * 1e6) as u64);
+    pb.set_message(format!("t = {t:.4}/{t_end} s"));
 }
 
 #[cfg(test)]

@@ -171,7 +171,7 @@ impl PairLinear {
     }
 }
 
-/// The dissipation's Jacobian at one state ([`crate::ellipsoid::equations::EllipsoidSystem::dissipation_jacobian`]),
+/// The dissipation's Jacobian at one state (`EllipsoidSystem::dissipation_jacobian` of `ellipsoid::equations`),
 /// a [`StiffSolve`] for the linearly implicit integrator.
 #[derive(Debug, Clone)]
 pub struct DissipationJacobian {

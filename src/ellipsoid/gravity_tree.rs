@@ -90,7 +90,7 @@ pub fn tree_gravity_forces(g: f64, theta: f64, positions: &[Vec3], masses: &[f64
 
 /// The same as [`tree_gravity_forces`] by the lists of a [`FrozenOctree`] (built from these bodies, in this
 /// order), summed at `positions` in double precision: smooth in the positions while the lists are kept (see
-/// [`crate::ellipsoid::equations::EllipsoidSystem`]'s `begin_step`).
+/// `begin_step` of the ellipsoid system in `ellipsoid::equations`).
 pub fn frozen_tree_gravity_forces(
     g: f64,
     tree: &FrozenOctree,

@@ -13,7 +13,26 @@ pub const SNAPSHOT_COLUMNS: [&str; 19] = [
     "t", "id", "mass", "a", "b", "c", "x", "y", "z", "vx", "vy", "vz", "qa", "qb", "qc", "qd", "wx", "wy", "wz",
 ];
 
-pub use crate::ellipsoid::run::TIMESERIES_COLUMNS;
+/// Columns of `timeseries.csv`: time (s); energies (J): translational and rotational kinetic, contact and
+/// gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
+/// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum about the origin
+/// (kg m²/s); wall-clock seconds since the run started.
+pub const TIMESERIES_COLUMNS: [&str; 14] = [
+    "t",
+    "kinetic_translational",
+    "kinetic_rotational",
+    "potential_contact",
+    "potential_gravity",
+    "dissipated",
+    "energy_residual",
+    "px",
+    "py",
+    "pz",
+    "lx",
+    "ly",
+    "lz",
+    "wall_seconds",
+];
 
 fn csv_to_io(e: ::csv::Error) -> std::io::Error {
     match e.into_kind() {

@@ -35,26 +35,7 @@ use crate::phase::{Kind, Phase};
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
 
-/// Columns of `timeseries.csv`: time (s); energies (J): translational and rotational kinetic, contact and
-/// gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
-/// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum about the origin
-/// (kg m²/s); wall-clock seconds since the run started.
-pub const TIMESERIES_COLUMNS: [&str; 14] = [
-    "t",
-    "kinetic_translational",
-    "kinetic_rotational",
-    "potential_contact",
-    "potential_gravity",
-    "dissipated",
-    "energy_residual",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-    "wall_seconds",
-];
+pub use crate::ellipsoid::output::TIMESERIES_COLUMNS;
 
 /// Running maxima of the conservation errors (absolute; made relative at the end), as stored in checkpoints.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -498,16 +498,7 @@ struct RawBody {
     spin_world: Option<[f64; 3]>,
 }
 
-/// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
-/// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
-/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
-pub const MAX_KAPPA: f64 = 175.0;
-
-/// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
-/// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
-/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
-/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
-pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
+pub use crate::ellipsoid::scene_fields::{MAX_KAPPA, MIN_CENTRE_SEPARATION};
 
 /// Integrator steps assumed per fastest time scale of a scene, for its work estimate (see [`LoadedScene::warnings`]):
 /// an adaptive step resolves a spin turn or a contact in a few to a few tens of steps.

@@ -1,13 +1,23 @@
-//! The field reference of the `kind = "ellipsoids"` scene file (Roig03's interacting ellipsoids): one row per key
-//! of [`crate::ellipsoid::scene::SceneFile`], printed by `rubblepile check --explain ellipsoids`. The rows the
-//! validator checks a plain range with are named constants, and the validator reads its bounds from them
-//! ([`crate::io::scene_file::Validator::within`]); the rest state the rule the validator's own code applies. The
-//! meanings restate the rustdoc of the schema structs in one line each.
+//! The field reference of the `kind = "ellipsoids"` scene file (Roig03's interacting ellipsoids): one row per key of
+//! `ellipsoid::scene::SceneFile` (which reads its bounds from here), printed by `rubblepile check --explain
+//! ellipsoids`. The rows the validator checks a plain range with are named constants, and the validator reads its
+//! bounds from them ([`crate::io::scene_file::Validator::within`]); the rest state the rule the validator's own code
+//! applies. The meanings restate the rustdoc of the schema structs in one line each.
 
 use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, MAX_THETA, TREE_FROM};
-use crate::ellipsoid::scene::{MAX_KAPPA, MIN_CENTRE_SEPARATION};
 use crate::io::scene_fields::{FieldDoc, Range, SceneReference, TableDoc};
 use crate::io::scene_file::MIN_RTOL;
+
+/// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
+/// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
+/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
+pub const MAX_KAPPA: f64 = 175.0;
+
+/// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
+/// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
+/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
+/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
+pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
 
 /// `scene.t_end`.
 pub const T_END: FieldDoc = FieldDoc {

@@ -195,14 +195,8 @@ fn invalid(field: &str, message: String) -> ImpactError {
     }
 }
 
-/// Apparent radius (m): max over bodies of `|r − r_cm| + A`.
-pub fn apparent_radius(bodies: &[Body]) -> f64 {
-    let (cm, _) = centre_of_mass(bodies);
-    bodies
-        .iter()
-        .map(|b| (b.position - cm).norm() + b.shape.axes.x)
-        .fold(0.0, f64::max)
-}
+/// Apparent radius (m) of a pile; it lives with the settling that reads it.
+pub use crate::impact::settle::apparent_radius;
 
 /// Centre-of-mass position (m) and velocity (m/s).
 fn centre_of_mass(bodies: &[Body]) -> (Vec3, Vec3) {

@@ -67,7 +67,7 @@ pub fn settle(
     max_time: f64,
 ) -> Result<(Vec<Body>, SettleReport), IntegrateError> {
     let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let t_ff = free_fall_time(mass, crate::impact::flyby::apparent_radius(bodies));
+    let t_ff = free_fall_time(mass, apparent_radius(bodies));
     let system = EllipsoidSystem::new(bodies, model, physics);
     let moments = system.principal_moments().to_vec();
     let mut y = system.initial_state();
@@ -123,4 +123,15 @@ pub fn set_principal_axis_rotation(bodies: &mut [Body], moments: &[Vec3]) -> Vec
     let omega = axis * (sign * l.norm() / principal[2]);
     set_rigid_rotation(bodies, &omega);
     omega
+}
+
+/// Apparent radius (m): max over bodies of `|r − r_cm| + A`, the size the free-fall time of the settling is taken
+/// at (and the flyby's reach of the pile).
+pub fn apparent_radius(bodies: &[Body]) -> f64 {
+    let m: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let cm = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / m;
+    bodies
+        .iter()
+        .map(|b| (b.position - cm).norm() + b.shape.axes.x)
+        .fold(0.0, f64::max)
 }

@@ -1,6 +1,6 @@
 //! The `ode_solvers` crate's Dop853, Dopri5 and Rk4 behind our [`Integrator`] trait, for
 //! cross-checks against [`super::bulirsch_stoer`]. [`super::make_integrator`] runs Dopri5 and Rk4 here; `"dop853"`
-//! runs our own [`super::dop853::Dop853`], and the crate's Dop853 stays reachable through
+//! runs our own `dop853::Dop853`, and the crate's Dop853 stays reachable through
 //! [`OdeSolversAdapter::new`] to compare the two (and it reads the checkpoint states its runs wrote, which our
 //! Dop853 refuses).
 //!

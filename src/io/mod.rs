@@ -7,6 +7,7 @@
 //! snapshot re-read as an input file gives the same `f64`s bit for bit.
 
 pub mod checkpoint;
+pub mod limits;
 pub mod output_times;
 pub mod particles;
 pub mod run_lock;

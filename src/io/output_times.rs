@@ -49,7 +49,7 @@ pub fn evenly_spaced(t_end: f64, n: usize) -> Vec<f64> {
 /// The snapshot times of a cadence `every` (s) for a run of `t_end` (s), [`cadence_times`], after checking both:
 /// the error names `every_field` or `t_end_field` (e.g. `--snapshot-every`, `--t-end`) and the expected value.
 pub fn checked_cadence_times(t_end: f64, every: f64, every_field: &str, t_end_field: &str) -> Result<Vec<f64>, String> {
-    use crate::io::scene_file::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
+    use crate::io::limits::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
     if !(every.is_finite() && every >= MIN_MEANINGFUL) {
         return Err(format!("{every_field}: must be > 0 s and finite, got {every}"));
     }

@@ -1,7 +1,7 @@
 //! The keys a scene schema accepts, read from its `serde::Deserialize` impl itself: [`schema_keys`] runs the impl
-//! against a recording deserializer that answers each `deserialize_struct` with the field names serde passes it
-//! (the `fields` list of the derive, renames applied) and recurses into every table, optional table and array of
-//! tables. It is how the field reference ([`crate::io::scene_fields`]) is tested against what the TOML parser
+//! against a recording deserializer that answers each `deserialize_struct` with the field names serde passes it (the
+//! `fields` list of the derive, renames applied) and recurses into every table, optional table and array of tables. It
+//! is how the field reference (`io::scene_fields`, whose test reads this walk) is tested against what the TOML parser
 //! really takes: a key added to a schema without a row, or a row the parser does not know, fails that test.
 //!
 //! Values are made up (0, `""`, `false`, one-element arrays), so a field whose own deserializer refuses them (a

@@ -9,7 +9,7 @@ use std::str::FromStr;
 
 use crate::math::Vec3;
 
-use super::RenderError;
+use super::error::RenderError;
 
 /// Direction a picture is taken from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

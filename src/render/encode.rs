@@ -8,7 +8,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use super::RenderError;
+use super::error::RenderError;
 use super::image::RgbImage;
 
 fn io_error(path: &Path, source: std::io::Error) -> RenderError {

@@ -10,9 +10,9 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use crate::analysis::figures::style::{FONT_FAMILY, ensure_font};
 use crate::math::{Mat3, Vec3};
 
-use super::RenderError;
 use super::camera::{BoundingSphere, Camera};
 use super::colour::{ColourScale, ScaleKind};
+use super::error::RenderError;
 use super::image::RgbImage;
 use super::overlay::{BAR_COLOUR, ScaleBar, Triad, draw_scale_bar};
 use super::raycast::{RenderBody, render_scene};

@@ -3,8 +3,8 @@
 //! world x, y and z directions as the camera sees them, each a labelled arrow).
 //!
 //! Both are filled pixel by pixel (no anti-aliasing), so a test can measure them; their labels are drawn with the
-//! frame's text ([`super::frame`]). The conventions are those of map and microscope scale bars and of CAD view
-//! triads (x red, y green, z blue).
+//! frame's text (by `render::frame`, which places these marks). The conventions are those of map and microscope scale
+//! bars and of CAD view triads (x red, y green, z blue).
 
 use crate::math::Vec3;
 

@@ -13,6 +13,7 @@ use crate::math::{Mat3, Vec3};
 use super::camera::ScreenBox;
 use super::camera::{BoundingSphere, Camera, Ray};
 use super::image::RgbImage;
+pub use super::light::{AMBIENT, DIFFUSE, light_direction};
 use super::walls::{WallPolygon, composite, wall_shade};
 
 /// One body to draw: an ellipsoid with its colour.
@@ -103,19 +104,9 @@ pub fn intersect_ellipsoid(ray: &Ray, centre: &Vec3, rotation: &Mat3, axes: &Vec
     })
 }
 
-/// Ambient share of the light: faces turned away from the light still show their colour at this fraction.
-pub const AMBIENT: f64 = 0.25;
-/// Diffuse share of the light (ambient + diffuse = 1, so a face turned to the light shows its full colour).
-pub const DIFFUSE: f64 = 0.75;
 /// Rows per band: bands are the unit of parallel work and of body bucketing. Small enough for load balance
 /// over many threads, big enough that the per-band body lists stay short.
 const BAND_ROWS: u32 = 8;
-
-/// The unit direction towards the light of `camera`'s pictures: from the upper left, in front of the scene (camera
-/// space), so shapes and orientations read well whatever the view.
-pub fn light_direction(camera: &Camera) -> Vec3 {
-    (-camera.right() + camera.up() - 1.2 * camera.forward()).normalize()
-}
 
 /// Renders `bodies` seen by `camera` on a `background`: each pixel takes the shaded colour of its nearest hit.
 ///

@@ -16,7 +16,7 @@ use crate::geometry::mesh::SurfaceMesh;
 use crate::math::Vec3;
 
 use super::camera::{BoundingSphere, Camera, Ray};
-use super::raycast::{AMBIENT, DIFFUSE, light_direction};
+use super::light::{AMBIENT, DIFFUSE, light_direction};
 
 /// Colour of walls before shading: a pale blue-grey, apart from viridis and the category colours.
 pub const WALL_COLOUR: [u8; 3] = [190, 205, 225];

@@ -104,6 +104,25 @@ impl Figure for SizeFrequency {
     }
 }
 
+impl crate::analysis::run_analysis::ClumpRunAnalysis {
+    /// Draws the size–frequency figure into `dir/analysis` (`sfd.svg`, `sfd.png`) and returns the line `analyze`
+    /// prints; a figure that cannot be drawn is a warning on stderr, not an error (the tables are written).
+    pub fn write_figure_and_describe(&self, dir: &std::path::Path) -> String {
+        let figure = SizeFrequency::of(&self.clump_report, self.t_at);
+        let drawn = crate::analysis::figures::style::write_figure(&dir.join("analysis"), "sfd", &figure);
+        if let Err(why) = &drawn {
+            eprintln!("warning: figure not drawn: sfd: {why}");
+        }
+        format!(
+            "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",
+            self.t_at,
+            self.clump_report.summary_line(),
+            dir.join("analysis").display(),
+            if drawn.is_ok() { ", sfd.svg, sfd.png" } else { "" }
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

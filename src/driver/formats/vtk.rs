@@ -22,7 +22,7 @@
 
 use std::path::Path;
 
-use super::SnapshotFormat;
+use super::format::{SnapshotFormat, files_with_extension};
 use crate::engine::SnapshotView;
 use crate::io::vtk::{Cells, CollectionEntry, DataArray, PolyData, write_collection};
 
@@ -60,8 +60,8 @@ impl SnapshotFormat for Vtk {
 
     fn files(&self, dir: &Path) -> Vec<std::path::PathBuf> {
         let vtk_dir = dir.join("vtk");
-        let mut out = super::files_with_extension(&vtk_dir, "vtp");
-        out.extend(super::files_with_extension(&vtk_dir, "pvd"));
+        let mut out = files_with_extension(&vtk_dir, "vtp");
+        out.extend(files_with_extension(&vtk_dir, "pvd"));
         out
     }
 }

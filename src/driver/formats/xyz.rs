@@ -6,7 +6,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::SnapshotFormat;
+use super::format::{SnapshotFormat, files_with_extension};
 use crate::engine::SnapshotView;
 use crate::io::fmt_f64;
 
@@ -47,6 +47,6 @@ impl SnapshotFormat for ExtendedXyz {
     }
 
     fn files(&self, dir: &Path) -> Vec<std::path::PathBuf> {
-        super::files_with_extension(&dir.join("snapshots"), "xyz")
+        files_with_extension(&dir.join("snapshots"), "xyz")
     }
 }

@@ -1,8 +1,9 @@
 //! Cylinder wall about the wall axis, radius R_c, infinite or of length L centred on the origin, open-ended
-//! (Richardson11 §2.2, ≈Eqs. 10–12; derivations in [`crate::geometry::walls`], "Infinite cylinder", "Finite cylinder"). Both
-//! faces are walls: from inside the sphere hits `ρ = R_c − s` (ρ increasing; the larger root), from outside
-//! `ρ = R_c + s` (ρ decreasing; the smaller root). A finite cylinder accepts a side hit only where `|z| ≤ L/2`; its
-//! ends are rings. The degenerate cases (R_c = 0: a line, L = 0: a ring) are mapped to those primitives by the scene.
+//! (Richardson11 §2.2, ≈Eqs. 10–12; derivations in the docs of `geometry::walls`, "Infinite cylinder", "Finite
+//! cylinder"). Both faces are walls: from inside the sphere hits `ρ = R_c − s` (ρ increasing; the larger root), from
+//! outside `ρ = R_c + s` (ρ decreasing; the smaller root). A finite cylinder accepts a side hit only where `|z| ≤ L/2`;
+//! its ends are rings. The degenerate cases (R_c = 0: a line, L = 0: a ring) are mapped to those primitives by the
+//! scene.
 
 use super::ring;
 use super::roots::quadratic;

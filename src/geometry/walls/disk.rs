@@ -1,5 +1,5 @@
-//! Finite thin disk wall of radius R in the wall frame's z = 0 plane (Richardson11 §2.2; derivations in
-//! [`crate::geometry::walls`], "Finite disk"): a plane hit accepted only inside the disk, else the rim (a ring).
+//! Finite thin disk wall of radius R in the wall frame's z = 0 plane (Richardson11 §2.2; derivations in the docs of
+//! `geometry::walls`, "Finite disk"): a plane hit accepted only inside the disk, else the rim (a ring).
 
 use super::{plane, ring};
 use crate::math::Vec3;

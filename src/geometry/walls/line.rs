@@ -1,5 +1,6 @@
 //! Line wall along the wall axis, infinite or a segment of length L centred on the origin (Richardson11 §2.2;
-//! derivations in [`crate::geometry::walls`]: a cylinder of zero radius, which has no inner face; a segment's ends are points).
+//! derivations in the docs of `geometry::walls`: a cylinder of zero radius, which has no inner face; a segment's ends
+//! are points).
 
 use super::point;
 use super::roots::quadratic;

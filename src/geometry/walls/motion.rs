@@ -1,5 +1,5 @@
 //! Prescribed wall motion (Richardson11 §2.2: walls may translate, oscillate and, for cylinders, spin; derivations in
-//! [`crate::geometry::walls`], "Particle–wall").
+//! the docs of `geometry::walls`, "Particle–wall").
 //!
 //! The wall's reference point is `o(t) = origin + V t + A (sin(ω t + φ) − sin φ) d̂`, so `origin` is where the wall
 //! is at t = 0 whatever the phase. Within one step `[t0, t1]` the wall moves on the straight secant from `o(t0)` to

@@ -1,5 +1,5 @@
-//! Infinite thin plane wall, two-sided (Richardson11 §2.2, ≈Eq. 9; derivations in [`crate::geometry::walls`], "Infinite
-//! plane"). In the wall frame the plane is z = 0; a sphere of radius s touches it when |z| = s.
+//! Infinite thin plane wall, two-sided (Richardson11 §2.2, ≈Eq. 9; derivations in the docs of `geometry::walls`,
+//! "Infinite plane"). In the wall frame the plane is z = 0; a sphere of radius s touches it when |z| = s.
 
 use crate::math::Vec3;
 

@@ -1,5 +1,5 @@
-//! Point wall (Richardson11 §2.2; derivations in [`crate::geometry::walls`]: a cylinder with zero radius and length, or a ring
-//! of zero radius). A sphere of radius s touches it when `|p| = s`: the particle–particle quadratic.
+//! Point wall (Richardson11 §2.2; derivations in the docs of `geometry::walls`: a cylinder with zero radius and length,
+//! or a ring of zero radius). A sphere of radius s touches it when `|p| = s`: the particle–particle quadratic.
 
 use super::roots::quadratic;
 use crate::math::Vec3;

@@ -1,5 +1,5 @@
-//! Thin ring wall of radius R in the wall frame's z = 0 plane, centred on the origin (Richardson11 §2.2, ≈Eqs.
-//! 13–21 and 25; derivations in [`crate::geometry::walls`], "Ring"). It is also the rim of a disk and the end of a finite
+//! Thin ring wall of radius R in the wall frame's z = 0 plane, centred on the origin (Richardson11 §2.2, ≈Eqs. 13–21
+//! and 25; derivations in the docs of `geometry::walls`, "Ring"). It is also the rim of a disk and the end of a finite
 //! cylinder.
 //!
 //! A sphere of radius s touches the ring when its centre is on the torus of tube radius s about it. With

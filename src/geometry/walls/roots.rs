@@ -1,5 +1,5 @@
-//! Real roots of the low-degree polynomials of the time-of-impact problems (Richardson11 §2.2; derivations in
-//! [`crate::geometry::walls`], "Particle–wall").
+//! Real roots of the low-degree polynomials of the time-of-impact problems (Richardson11 §2.2; derivations in the docs
+//! of `geometry::walls`, "Particle–wall").
 //!
 //! Quadratics use the cancellation-free form `q = −(B + sgn(B)√Δ)/2`, roots `q/A` and `C/q`, so that a root next
 //! to zero (a particle that has just touched a wall) keeps full relative precision. Higher degrees (the ring's torus

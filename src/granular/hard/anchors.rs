@@ -1,7 +1,7 @@
 //! A cell grid of the neighbour list's anchors, kept up to date as single particles are re-listed, so that re-listing
 //! one particle costs the cells around it instead of a pass over every particle (the cell method of molecular
 //! dynamics, e.g. Rapaport, *The Art of Molecular Dynamics Simulation*, §3.4; Richardson11 §2.1 uses a tree for the
-//! same search). Used by [`super::stepper`] for the Verlet list with skins.
+//! same search). Used by the stepper (`hard::stepper`) for the Verlet list with skins.
 //!
 //! Every particle k has a reach `ρ_k = R_k + L_k` (radius plus travel allowance) around its anchor `a_k`; a pair is a
 //! candidate when `|a_i − a_j| < ρ_i + ρ_j`. Particles with `ρ ≤ ρ_ref` are filed in cubic cells of side at least

@@ -569,6 +569,9 @@ fn reject_wall_overlaps(v: &V, particles: &[Particle], walls: &[Wall]) -> Result
 /// round-off overlaps are resolved at once by the event loop; a sphere placed deep inside another would bounce in
 /// place forever and stall it, so such a start is refused.
 pub const MAX_START_OVERLAP: f64 = 1e-3;
+// The field reference writes this number into a rule (`scene_fields`, "overlaps <= 1e-3 of the radius"); held here,
+// where the reference is read, so that the reference need not name this file.
+const _: () = assert!(MAX_START_OVERLAP == 1e-3);
 
 /// Refuses a start where two spheres, not both stuck to walls, overlap by more than [`MAX_START_OVERLAP`].
 fn reject_deep_overlaps(v: &V, particles: &[Particle]) -> Result<(), SceneError> {

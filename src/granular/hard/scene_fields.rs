@@ -1,5 +1,5 @@
 //! The field reference of the `kind = "hard-spheres"` scene file (Richardson11's hard spheres with predicted
-//! collisions, §2): one row per key of [`crate::granular::hard::scene::HardSceneFile`], printed by
+//! collisions, §2): one row per key of `hard::scene::HardSceneFile` (which reads its bounds from here), printed by
 //! `rubblepile check --explain hard-spheres`. The rows the validator checks a plain range with are named
 //! constants it reads its bounds from ([`crate::io::scene_file::Validator::within`]); the rest state the rule the
 //! validator's own code applies.
@@ -371,5 +371,4 @@ pub const REFERENCE: SceneReference = SceneReference {
 };
 
 // The numbers written into the words above, held to the constants they restate.
-const _: () = assert!(crate::granular::hard::scene::MAX_START_OVERLAP == 1e-3);
 const _: () = assert!(crate::granular::hard::stepper::DEFAULT_SKIN_STEPS == 16.0);

@@ -10,7 +10,7 @@
 //! - The step resolves the shortest contact, `T_c = π √(μ_min/k_N)` with `μ_min = m_min/2`, in 50 steps:
 //!   `dt = T_c/50`. Leapfrog is unstable for a spring of that frequency above `dt = 2 √(μ_min/k_N)`, the
 //!   stability limit reported (and enforced by the scene check).
-//! - Self-gravity every `k` steps ([`crate::granular::soft::respa`]): the body's dynamical time
+//! - Self-gravity every `k` steps (r-RESPA, `soft::respa`): the body's dynamical time
 //!   `t_dyn = 1/√(Gρ)` (ρ the bulk density) must hold at least 100 gravity blocks, `k dt ≤ t_dyn/100`, and a
 //!   block must stay well below half a contact oscillation, where the impulse method resonates:
 //!   `k dt ≤ T_c/5`. So `k = max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`: 10 at the advised step

@@ -9,6 +9,7 @@
 
 use crate::geometry::walls::soft::Wall;
 use crate::granular::soft::contact::{Kinematics, Law, Material, Output, Springs, evaluate_law};
+use crate::granular::soft::ordered_sum::SUM_CHUNK;
 pub use crate::granular::soft::pairs::ContactRecord;
 use crate::granular::soft::pairs::PairList;
 use crate::granular::soft::particle::Particle;
@@ -73,7 +74,7 @@ pub struct SoftSystem {
     pub dissipated: f64,
     /// Work done on the spheres by moving walls so far (J).
     pub wall_work: f64,
-    /// Work done on the spheres by an external spin-up forcing so far (J; [`crate::granular::soft::spinup`]).
+    /// Work done on the spheres by an external spin-up forcing so far (J; the spin-up of `soft::spinup`).
     pub forcing_work: f64,
     /// Angular momentum given to the spheres by that forcing so far (kg m²/s, about the origin).
     pub forcing_angular_impulse: Vec3,
@@ -87,7 +88,7 @@ pub struct SoftSystem {
     /// dissipation is summed either way.
     pub spring_energy_wanted: bool,
     /// Self-gravity is evaluated once every this many steps (steps, ≥ 1; r-RESPA, see
-    /// [`crate::granular::soft::respa`]); 1 = with the contacts, every step.
+    /// `soft::respa`); 1 = with the contacts, every step.
     pub gravity_interval: u64,
     /// Steps taken in the current block of `gravity_interval` steps.
     pub gravity_phase: u64,
@@ -101,42 +102,6 @@ pub struct SoftSystem {
 
 /// From this many spheres per task on, the wall contacts are evaluated in parallel.
 const PAR_MIN: usize = 64;
-/// Spheres per partial sum of [`ordered_sum`], and per parallel task of the per-sphere passes.
-pub(crate) const SUM_CHUNK: usize = 1024;
-
-/// `Σ term(k)` over `k < n`, summed in chunks of [`SUM_CHUNK`] (each in order, in parallel) and the chunks'
-/// totals in order: the same bits on any number of threads (and, up to `SUM_CHUNK` terms, those of a plain
-/// loop from 0).
-pub(crate) fn ordered_sum(n: usize, term: impl Fn(usize) -> f64 + Sync) -> f64 {
-    ordered_reduce(n, 0.0, |s, k| *s += term(k), |s, c| *s += c)
-}
-
-/// A reduction over `k < n` in the order of [`ordered_sum`]: each chunk of [`SUM_CHUNK`] starts from `zero` and
-/// takes `add_term(acc, k)` for its `k` in order (chunks in parallel); the chunks' results are then combined by
-/// `add(total, chunk)` in order, starting from `zero`.
-pub(crate) fn ordered_reduce<T: Copy + Send + Sync>(
-    n: usize,
-    zero: T,
-    add_term: impl Fn(&mut T, usize) + Sync,
-    add: impl Fn(&mut T, T),
-) -> T {
-    let chunks: Vec<T> = (0..n.div_ceil(SUM_CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            let mut acc = zero;
-            for k in c * SUM_CHUNK..((c + 1) * SUM_CHUNK).min(n) {
-                add_term(&mut acc, k);
-            }
-            acc
-        })
-        .collect();
-    let mut total = zero;
-    for c in chunks {
-        add(&mut total, c);
-    }
-    total
-}
-
 /// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
 type WallHit = (usize, Springs, f64, Vec3, Output);
 

@@ -16,6 +16,7 @@ pub mod advise;
 pub mod contact;
 pub mod forces;
 pub mod leapfrog;
+pub mod ordered_sum;
 pub mod packing;
 pub mod pairs;
 pub mod particle;

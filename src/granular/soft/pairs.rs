@@ -27,7 +27,7 @@
 
 use crate::geometry::neighbours::sphere_pair_rows;
 use crate::granular::soft::contact::{Kinematics, Law, Output, Springs, evaluate_inner};
-use crate::granular::soft::forces::SUM_CHUNK;
+use crate::granular::soft::ordered_sum::SUM_CHUNK;
 use crate::granular::soft::particle::Particle;
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};

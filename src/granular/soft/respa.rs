@@ -17,7 +17,8 @@
 //! velocities already carry the opening kick and the gravitational energy is that of the block's start, so
 //! energies are exact only at block ends (`SoftSystem::gravity_phase == 0`).
 
-use crate::granular::soft::forces::{SoftSystem, ordered_sum};
+use crate::granular::soft::forces::SoftSystem;
+use crate::granular::soft::ordered_sum::ordered_sum;
 use crate::gravity::accelerations;
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};

@@ -1,8 +1,8 @@
-//! The field reference of the `kind = "soft-spheres"` scene file (Zhang17's soft-sphere DEM, §2; nominal material
-//! of §2.3.3): one row per key of [`crate::granular::soft::scene::SoftSceneFile`] (with `[spinup]`,
-//! [`crate::granular::soft::spinup::SpinupSection`]), printed by `rubblepile check --explain soft-spheres`. The
-//! rows the validator checks a plain range with are named constants it reads its bounds from
-//! ([`crate::io::scene_file::Validator::within`]); the rest state the rule the validator's own code applies.
+//! The field reference of the `kind = "soft-spheres"` scene file (Zhang17's soft-sphere DEM, §2; nominal material of
+//! §2.3.3): one row per key of `soft::scene::SoftSceneFile` (with `[spinup]`, `soft::spinup::SpinupSection`; both read
+//! their bounds from here), printed by `rubblepile check --explain soft-spheres`. The rows the validator checks a plain
+//! range with are named constants it reads its bounds from ([`crate::io::scene_file::Validator::within`]); the rest
+//! state the rule the validator's own code applies.
 
 use crate::io::scene_fields::{FieldDoc, Range, SceneReference, TableDoc};
 

@@ -51,7 +51,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::granular::soft::forces::{SUM_CHUNK, ordered_reduce, ordered_sum};
+use crate::granular::soft::ordered_sum::{SUM_CHUNK, ordered_reduce, ordered_sum};
 use crate::granular::soft::particle::Particle;
 use crate::io::scene_file::SceneError;
 use crate::math::Vec3;
@@ -459,7 +459,7 @@ impl BodyRotation {
 }
 
 /// [`BodyRotation`] of the members of `particles` about unit `axis`. The sums over the members run in parallel
-/// in fixed chunks of particles (`forces::ordered_reduce`): the same bits on any number of threads.
+/// in fixed chunks of particles (`ordered_sum::ordered_reduce`): the same bits on any number of threads.
 pub fn body_rotation(particles: &[Particle], member: &[bool], axis: &Vec3) -> BodyRotation {
     let n = particles.len().min(member.len());
     let (m, mx, mv) = ordered_reduce(

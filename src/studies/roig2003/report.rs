@@ -10,9 +10,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::kappa::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
-use crate::analysis::run_analysis::{
-    AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_campaign,
-};
+use crate::analysis::campaign_analysis::analyze_campaign;
+use crate::analysis::run_analysis::{AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection};
 
 /// A published outcome of Roig03 as a closed interval (with the paper's words).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,0 +1,61 @@
+//! Which engine a scene is for ([`SceneKind`]), from one read of its `scene.kind`, and the field reference of each
+//! kind. Below the choice of engine (`driver::kind`), the run-directory check (`driver::inspect`) and the export,
+//! which all read it.
+
+use std::path::Path;
+
+use crate::engine::Engine;
+use crate::granular::hard::run::HardEngine;
+use crate::granular::soft::run::SoftEngine;
+
+/// The engines a scene file can name in `scene.kind` (on the command line by the same names).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum SceneKind {
+    /// `kind = "ellipsoids"` (also a scene without `kind`): interacting ellipsoids (Roig03).
+    Ellipsoids,
+    /// `kind = "soft-spheres"`: soft-sphere DEM (Zhang17).
+    SoftSpheres,
+    /// `kind = "hard-spheres"`: hard spheres with predicted collisions (Richardson11).
+    HardSpheres,
+}
+
+impl SceneKind {
+    /// The kind a scene text names. A text that is not TOML, has no `scene.kind` or names an unknown kind is taken
+    /// as an ellipsoid scene, whose parser then reports exactly what is wrong with it.
+    pub fn of_text(text: &str) -> SceneKind {
+        let kind = text
+            .parse::<toml::Table>()
+            .ok()
+            .and_then(|t| t.get("scene")?.get("kind")?.as_str().map(str::to_string));
+        match kind.as_deref() {
+            Some(SoftEngine::KIND) => SceneKind::SoftSpheres,
+            Some(HardEngine::KIND) => SceneKind::HardSpheres,
+            _ => SceneKind::Ellipsoids,
+        }
+    }
+
+    /// The kind of the scene file at `path` (an unreadable file counts as an ellipsoid scene, whose loader reports
+    /// the read error).
+    pub fn of_file(path: &Path) -> SceneKind {
+        crate::io::scene_file::read_text_bounded(path).map_or(SceneKind::Ellipsoids, |t| SceneKind::of_text(&t))
+    }
+
+    /// The kind of the run in `dir` (from its `scene.toml` copy).
+    pub fn of_run_dir(dir: &Path) -> SceneKind {
+        SceneKind::of_file(&dir.join("scene.toml"))
+    }
+}
+
+impl SceneKind {
+    /// Every kind, in the order `rubblepile check --explain` prints them.
+    pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
+
+    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
+    pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
+        match self {
+            SceneKind::Ellipsoids => &crate::ellipsoid::scene_fields::REFERENCE,
+            SceneKind::SoftSpheres => &crate::granular::soft::scene_fields::REFERENCE,
+            SceneKind::HardSpheres => &crate::granular::hard::scene_fields::REFERENCE,
+        }
+    }
+}
