@@ -156,7 +156,7 @@ pub enum ReferenceKind {
     /// A tight run of a different method.
     Numerical,
     /// A stiff problem: one reference for every method, a tight explicit Bulirsch–Stoer run where it finishes
-    /// within its time limit, else a tight linearly implicit run ([`crate::bench::work_precision::References`]).
+    /// within its time limit, else a tight linearly implicit run (the work–precision bench's `References`).
     Stiff,
 }
 
