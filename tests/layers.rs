@@ -4,7 +4,7 @@
 //!
 //! Inside the rooms, the same between files: the graph of file → file dependencies of `src/` (paths in code and
 //! intra-doc links, `use` groups split, `super::`/`self::` resolved, re-exports counted as the `mod.rs` that makes
-//! them) has no cycle but those closed by the edges of [`STANDING_CYCLE_EDGES`], a list that may only shrink.
+//! them) has no cycle.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -547,16 +547,6 @@ fn cycles(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<(Vec<String>, Vec<S
     out
 }
 
-/// The file edges that close the import cycles still standing: each is one arrow to turn round (move the shared
-/// item down, or into a small file both use). The list may only shrink: an edge here that no longer exists fails
-/// [`no_import_cycle_between_files_of_src`] until it is deleted, and any cycle not closed by one of these fails it.
-const STANDING_CYCLE_EDGES: &[(&str, &str)] = &[
-    ("src/integrate/bulirsch_stoer.rs", "src/integrate/mod.rs"),
-    ("src/integrate/dop853.rs", "src/integrate/mod.rs"),
-    ("src/integrate/linearly_implicit.rs", "src/integrate/mod.rs"),
-    ("src/integrate/ode_solvers_adapter.rs", "src/integrate/mod.rs"),
-];
-
 /// Edges that, taken out of `graph`, leave it without a cycle: for each cycle found, the edge into a `mod.rs`
 /// (a child using its parent) if there is one, else the walk's last edge; repeated until none is left.
 fn cycle_closing_edges(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<(String, String)> {
@@ -590,20 +580,7 @@ fn no_import_cycle_between_files_of_src() {
         graph.entry(from.clone()).or_default().insert(to.clone());
         at.entry((from, to)).or_insert(where_);
     }
-    let gone: Vec<String> = STANDING_CYCLE_EDGES
-        .iter()
-        .filter(|(from, to)| !graph.get(*from).is_some_and(|t| t.contains(*to)))
-        .map(|(from, to)| format!("{from} -> {to}"))
-        .collect();
-    assert!(
-        gone.is_empty(),
-        "untied (delete from STANDING_CYCLE_EDGES):\n{}",
-        gone.join("\n")
-    );
     let whole = graph.clone();
-    for (from, to) in STANDING_CYCLE_EDGES {
-        graph.get_mut(*from).unwrap().remove(*to);
-    }
     let found = cycles(&graph);
     let shown: Vec<String> = found
         .iter()

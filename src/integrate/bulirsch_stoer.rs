@@ -73,11 +73,9 @@
 //!   derivative at an *accepted* point fails at once (no step size can cure it).
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
+pub use super::common::{BulirschStoerState, Rejections};
+use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances, begin_advance};
 use super::compensated::Compensation;
-use super::{
-    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
-};
-use crate::bits::{exact_f64, exact_f64_opt, exact_f64_vec};
 
 /// Step-size factor bound parameter (ODEX `fac1`).
 const FAC1: f64 = 0.02;
@@ -185,74 +183,6 @@ pub struct BulirschStoer {
 
     stats: Stats,
     rejections: Rejections,
-}
-
-/// Everything a [`BulirschStoer`] carries between [`Integrator::advance`] calls
-/// ([`Integrator::save_state`]): the step-size and column control, the per-column proposals and
-/// work of the last attempt, the counters and the settings. The work arrays are not saved: every
-/// call recomputes them before reading them. The tolerances are not saved either: the integrator
-/// the state is restored into must be built with the same ones (only their length is checked).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BulirschStoerState {
-    /// Length of the tolerance vectors (the system's dimension).
-    pub dim: usize,
-    /// Maximum number of columns `km`.
-    pub km: usize,
-    /// Maximum step attempts per `advance`.
-    pub max_steps: u64,
-    /// Smallest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_min: f64,
-    /// Largest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_max: f64,
-    /// Consecutive non-finite rejections retried.
-    pub max_nonfinite_retries: u32,
-    /// The configured initial step (s), if any.
-    #[serde(with = "exact_f64_opt")]
-    pub initial_step: Option<f64>,
-    /// The run's span for error-per-unit-step control (s), if set.
-    #[serde(with = "exact_f64_opt")]
-    pub span: Option<f64>,
-    /// Proposed `|H|` for the next step (s); 0 = not yet known. After landing on an output time
-    /// this is the un-shortened proposal.
-    #[serde(with = "exact_f64")]
-    pub h: f64,
-    /// Target column count `k`.
-    pub k: usize,
-    /// The previous attempt was rejected.
-    pub reject: bool,
-    /// At least one step has been attempted.
-    pub started: bool,
-    /// Optimal step per column of the last attempt (index 0 unused, length `km + 1`).
-    #[serde(with = "exact_f64_vec")]
-    pub hh: Vec<f64>,
-    /// Work per unit step per column of the last attempt (index 0 unused, length `km + 1`).
-    #[serde(with = "exact_f64_vec")]
-    pub w: Vec<f64>,
-    /// Cumulative statistics.
-    pub stats: SavedStats,
-    /// Cumulative rejections by cause.
-    pub rejections: Rejections,
-    /// What compensated summation carries into the next step (length `dim`, or empty = zero; states saved before
-    /// the compensation existed have none).
-    #[serde(default, with = "exact_f64_vec")]
-    pub compensation: Vec<f64>,
-}
-
-/// Rejected steps of a [`BulirschStoer`] by cause (cumulative); their sum is
-/// [`Stats::steps_rejected`].
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub struct Rejections {
-    /// Error estimate too large (ordinary step-size control, including the convergence monitor).
-    pub error: u64,
-    /// The stability check in the first substep of columns 1–2 failed (step halved).
-    pub stability: u64,
-    /// The error estimate diverged with the column index (`err_j ≥ max(4 err_{j−1}, 1)`), or was huge
-    /// (step halved).
-    pub divergence: u64,
-    /// NaN/∞ in a trial value or derivative (step halved).
-    pub nonfinite: u64,
 }
 
 /// Why a step has to be retried with a halved step.

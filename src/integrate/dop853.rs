@@ -73,10 +73,8 @@
 //! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
 //! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
 
-use super::{
-    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
-};
-use crate::bits::{exact_f64, exact_f64_opt};
+pub use super::common::Dop853State;
+use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances, begin_advance};
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
 
@@ -478,36 +476,6 @@ pub struct Dop853 {
     y_stage: Vec<f64>,
     /// Per-chunk partial sums of the norms.
     partials: Vec<[f64; 3]>,
-}
-
-/// Everything a [`Dop853`] carries between [`Integrator::advance`] calls ([`Integrator::save_state`]): the
-/// proposed step, the settings and the counters. The tolerances are not saved: the integrator the state is
-/// restored into must be built with the same ones (only their length is checked). The derivative at the start of
-/// a call is recomputed by every call, so it is not part of the state; nor is the parallel threshold, on which no
-/// bit of the results depends.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Dop853State {
-    /// Length of the tolerance vectors (the system's dimension).
-    pub dim: usize,
-    /// The configured initial step (s), if any.
-    #[serde(with = "exact_f64_opt")]
-    pub initial_step: Option<f64>,
-    /// Maximum step attempts per `advance`.
-    pub max_steps: u64,
-    /// Smallest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_min: f64,
-    /// Largest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_max: f64,
-    /// Consecutive non-finite rejections retried.
-    pub max_nonfinite_retries: u32,
-    /// Proposed `|h|` for the next step (s); 0 = not yet known. After landing on an output time this is the
-    /// proposal from before the shortened last step.
-    #[serde(with = "exact_f64")]
-    pub h: f64,
-    /// Cumulative statistics.
-    pub stats: SavedStats,
 }
 
 /// The outcome of one step attempt.

@@ -37,20 +37,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::bulirsch_stoer::{RUN_BUDGET, Rejections, validate_tolerances};
-use super::compensated::Compensation;
-use super::{
-    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances, begin_advance,
+use super::bulirsch_stoer::{RUN_BUDGET, validate_tolerances};
+use super::common::{
+    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Rejections, Stats, Tolerances, begin_advance,
 };
-use crate::bits::{exact_f64, exact_f64_opt, exact_f64_vec};
-
-/// The stiff part `J` of a system at the start of a step, as the solver of `(I − h J) x = b` that the linearly
-/// implicit methods need ([`OdeSystem::stiff_part`]).
-pub trait StiffSolve {
-    /// Overwrites `b` with the solution `x` of `(I − h J) x = b` (`h` in s; `b` of the system's dimension).
-    /// `J` is the same for every call on one value.
-    fn solve(&mut self, h: f64, b: &mut [f64]);
-}
+pub use super::common::{LinearlyImplicitState, StiffSolve};
+use super::compensated::Compensation;
 
 /// A dense `J` (row-major `n × n`) solved by LU, refactorised when `h` changes: for small systems and tests.
 #[derive(Debug, Clone)]
@@ -159,45 +151,6 @@ pub struct LinearlyImplicit {
     stats: Stats,
     rejections: Rejections,
     solves: u64,
-}
-
-/// Everything a [`LinearlyImplicit`] carries between [`Integrator::advance`] calls, for checkpoints (the tolerances
-/// are not saved: the integrator it is restored into must be built with the same ones).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct LinearlyImplicitState {
-    /// The system's dimension.
-    pub dim: usize,
-    /// Maximum number of columns.
-    pub km: usize,
-    /// Maximum step attempts per advance.
-    pub max_steps: u64,
-    /// The run's span for error-per-unit-step control (s), if set.
-    #[serde(with = "exact_f64_opt")]
-    pub span: Option<f64>,
-    /// Proposed `|H|` for the next step (s); 0 = not yet known.
-    #[serde(with = "exact_f64")]
-    pub h: f64,
-    /// Target column count.
-    pub k: usize,
-    /// The previous attempt was rejected.
-    pub reject: bool,
-    /// At least one step has been attempted.
-    pub started: bool,
-    /// Optimal step per column of the last attempt (s; index 0 unused, `km + 1` entries).
-    #[serde(with = "exact_f64_vec")]
-    pub hh: Vec<f64>,
-    /// Work per unit step per column of the last attempt (index 0 unused, `km + 1` entries).
-    #[serde(with = "exact_f64_vec")]
-    pub w: Vec<f64>,
-    /// Cumulative statistics.
-    pub stats: SavedStats,
-    /// Cumulative rejections by cause.
-    pub rejections: Rejections,
-    /// Linear solves so far.
-    pub solves: u64,
-    /// What the compensated summation carries into the next step (`dim` entries, or empty = zero).
-    #[serde(with = "exact_f64_vec")]
-    pub compensation: Vec<f64>,
 }
 
 enum Column {

@@ -1,5 +1,5 @@
 //! The `ode_solvers` crate's Dop853, Dopri5 and Rk4 behind our [`Integrator`] trait, for
-//! cross-checks against [`super::bulirsch_stoer`]. [`super::make_integrator`] runs Dopri5 and Rk4 here; `"dop853"`
+//! cross-checks against [`super::bulirsch_stoer`]. `make_integrator` runs Dopri5 and Rk4 here; `"dop853"`
 //! runs our own `dop853::Dop853`, and the crate's Dop853 stays reachable through
 //! [`OdeSolversAdapter::new`] to compare the two (and it reads the checkpoint states its runs wrote, which our
 //! Dop853 refuses).
@@ -41,8 +41,8 @@
 //! * **Failure**: on error `t, y` are left at the last accepted state (the start of the call if no
 //!   step was accepted), never at a trial state.
 
-use super::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, SavedStats, Stats, Tolerances};
-use crate::bits::{exact_f64, exact_f64_opt};
+pub use super::common::OdeSolversState;
+use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances};
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dop853, Dopri5, OutputType, Rk4, System};
 use std::cell::{Cell, RefCell};
@@ -130,35 +130,6 @@ pub struct OdeSolversAdapter {
     max_steps: u64,
     chunk_steps: Option<usize>,
     stats: Stats,
-}
-
-/// Everything an [`OdeSolversAdapter`] carries between [`Integrator::advance`] calls
-/// ([`Integrator::save_state`]). The scalar tolerances are saved only to check that the adapter the
-/// state is restored into was built with the same ones.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct OdeSolversState {
-    /// Dop853, Dopri5 or Rk4.
-    pub method: Method,
-    /// Length of the tolerance vectors (the system's dimension).
-    pub dim: usize,
-    /// Scalar relative tolerance in use.
-    #[serde(with = "exact_f64")]
-    pub rtol: f64,
-    /// Scalar absolute tolerance in use.
-    #[serde(with = "exact_f64")]
-    pub atol: f64,
-    /// Rk4's fixed step or the adaptive methods' configured initial step (s).
-    #[serde(with = "exact_f64_opt")]
-    pub step: Option<f64>,
-    /// The step the next `advance` starts with (adaptive methods; 0 = automatic).
-    #[serde(with = "exact_f64")]
-    pub h_next: f64,
-    /// Maximum steps per `advance`.
-    pub max_steps: u64,
-    /// Steps per `ode_solvers` run (`None` = automatic).
-    pub chunk_steps: Option<usize>,
-    /// Cumulative statistics.
-    pub stats: SavedStats,
 }
 
 impl OdeSolversAdapter {
