@@ -297,6 +297,28 @@ pub const PAIR_F0: f64 = 0.1;
 /// just before the second collision: over longer spans the tumbling pair is so chaotic that two 1e-13 runs of
 /// different methods part at 1e-9 by t = 20 and at O(1) by t = 60). With `f0`, dissipation is on (`F0 = f0`).
 pub fn bouncing_pair(f0: Option<f64>) -> ProblemSetup {
+    let (bodies, system) = two_ellipsoids([5.0, 0.0, 0.3], [-0.1, 0.2, 0.02], f0);
+    let dissipative = f0.is_some();
+    ProblemSetup {
+        name: if dissipative { "pair-dissipative" } else { "pair" },
+        description: format!(
+            "bouncing pair: ellipsoids (1, 0.8, 0.6) m=1 and (0.8, 0.6, 0.5) m=0.6, G = 1, kappa = 10, gravity + \
+             contact{}, bound orbit with pericentre inside contact (one bounce), t = 0..15",
+            f0.map(|f| format!(" + dissipation F0 = {f}")).unwrap_or_default()
+        ),
+        bodies,
+        system,
+        t_end: 15.0,
+        energy_samples: 15,
+        rk4_steps: vec![0.05, 0.02, 0.01, 0.005, 0.002, 0.001],
+        reference: ReferenceKind::Numerical,
+    }
+}
+
+/// The two ellipsoids of [`bouncing_pair`] and [`stiff_pair`]: (1, 0.8, 0.6) of mass 1 at rest at the origin and
+/// (0.8, 0.6, 0.5) of mass 0.6 at `position` with `velocity`, small fixed spins and attitudes, moved to their
+/// centre-of-mass frame; G = 1, κ = 10, Gaussian moments, gravity + contact, and dissipation at `f0` if given.
+fn two_ellipsoids(position: [f64; 3], velocity: [f64; 3], f0: Option<f64>) -> (Vec<Body>, EllipsoidSystem) {
     let mut bodies = vec![
         body(
             [1.0, 0.8, 0.6],
@@ -309,8 +331,8 @@ pub fn bouncing_pair(f0: Option<f64>) -> ProblemSetup {
         body(
             [0.8, 0.6, 0.5],
             0.6,
-            [5.0, 0.0, 0.3],
-            [-0.1, 0.2, 0.02],
+            position,
+            velocity,
             Vec4::new(-0.4, 0.1, 0.2, 0.8),
             [0.0, 0.15, -0.1],
         ),
@@ -327,21 +349,7 @@ pub fn bouncing_pair(f0: Option<f64>) -> ProblemSetup {
         dissipation: f0.map(|f0| DissipationTerm { f0 }),
     };
     let system = EllipsoidSystem::new(&bodies, model, physics);
-    let dissipative = f0.is_some();
-    ProblemSetup {
-        name: if dissipative { "pair-dissipative" } else { "pair" },
-        description: format!(
-            "bouncing pair: ellipsoids (1, 0.8, 0.6) m=1 and (0.8, 0.6, 0.5) m=0.6, G = 1, kappa = 10, gravity + \
-             contact{}, bound orbit with pericentre inside contact (one bounce), t = 0..15",
-            f0.map(|f| format!(" + dissipation F0 = {f}")).unwrap_or_default()
-        ),
-        bodies,
-        system,
-        t_end: 15.0,
-        energy_samples: 15,
-        rk4_steps: vec![0.05, 0.02, 0.01, 0.005, 0.002, 0.001],
-        reference: ReferenceKind::Numerical,
-    }
+    (bodies, system)
 }
 
 /// End time of the N30 impact (s).
@@ -383,36 +391,7 @@ pub const STIFF_PAIR_F0: f64 = 100.0;
 /// 1000× faster than the oscillation, an overdamped contact that an explicit method must follow at its damping
 /// rate (steps ~ τ_v) while the solution itself creeps on the slow time scale.
 pub fn stiff_pair(f0: f64) -> ProblemSetup {
-    let mut bodies = vec![
-        body(
-            [1.0, 0.8, 0.6],
-            1.0,
-            [0.0; 3],
-            [0.0; 3],
-            Vec4::new(0.1, 0.2, -0.3, 0.9),
-            [0.05, -0.1, 0.2],
-        ),
-        body(
-            [0.8, 0.6, 0.5],
-            0.6,
-            [1.2, 0.1, 0.05],
-            [-0.1, 0.03, 0.0],
-            Vec4::new(-0.4, 0.1, 0.2, 0.8),
-            [0.0, 0.15, -0.1],
-        ),
-    ];
-    to_centre_of_mass_frame(&mut bodies);
-    let model = ModelConfig {
-        kappa: 10.0,
-        inertia: InertiaModel::Gaussian,
-        contact_g: 1.0,
-    };
-    let physics = Physics {
-        gravity: Some(GravityTerm::new(1.0)),
-        contact: Some(ContactTerm::default()),
-        dissipation: Some(DissipationTerm { f0 }),
-    };
-    let system = EllipsoidSystem::new(&bodies, model, physics);
+    let (bodies, system) = two_ellipsoids([1.2, 0.1, 0.05], [-0.1, 0.03, 0.0], Some(f0));
     ProblemSetup {
         name: "stiff-pair",
         description: format!(
