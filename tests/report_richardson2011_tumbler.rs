@@ -1,4 +1,4 @@
-//! The paper-scale tumbler report (Richardson11 §3.2, Fig. 10; `src/studies/richardson2011/tumbler_paper.rs`)
+//! The paper-scale tumbler report (Richardson11 §3.2, Fig. 8; `src/studies/richardson2011/tumbler_paper.rs`)
 //! on synthetic run directories whose answers are known: a packed bed whose surface is tilted at a known angle, a
 //! run stopped before its end (no `summary.json`, read from its time series), the slope's fit error against the
 //! closed form of least squares, and the Froude number taken with the lining's inner edge.
@@ -118,11 +118,22 @@ fn a_stopped_run_of_a_bed_tilted_at_35_degrees_reports_35_degrees_and_its_time_s
     assert!((run.radius_ratio() - 0.030 / R_PART).abs() < 1e-9);
     // The report: one table row with the interrupted status and the angle, and both figures.
     let out = root.join("out");
+    let compact = root.join("compact");
     let path = write_tumbler_paper_report(&TumblerPaperArgs {
         runs: vec![run_dir.clone()],
         out: out.clone(),
+        compact: Some(compact.clone()),
     })
     .unwrap();
+    // The compact copy analyses to the same run (its directory aside), so the report regenerates from it.
+    let mut again = analyse_tumbler_run(&compact.join("run")).unwrap();
+    assert_eq!(again.dir, compact.join("run"));
+    again.dir = run.dir.clone();
+    assert_eq!(format!("{again:?}"), format!("{run:?}"));
+    assert!(
+        std::fs::read_dir(compact.join("run")).unwrap().count() == 2,
+        "two CSV files, no snapshots"
+    );
     let md = std::fs::read_to_string(&path).unwrap();
     assert_eq!(
         md,

@@ -16,6 +16,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::analysis::AnalysisError;
 use crate::analysis::atmosphere::{RunFiles, mean, mean_std, read_run_files};
 use crate::analysis::fits::fit_line;
 use crate::granular::hard::scene::{ParticleRow, read_particles_csv};
@@ -227,8 +228,74 @@ impl TumblerRun {
     }
 }
 
-/// Reads a tumbler run: `scene.toml` (wall 0 the drum: its radius and spin; gravity), `summary.json`, snapshots.
-pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::AnalysisError> {
+/// One snapshot of a tumbler run, reduced to what the reports read: a row of a compact copy's
+/// [`COMPACT_SNAPSHOTS`] file.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TumblerSnapshot {
+    /// Time (s).
+    pub t: f64,
+    /// Surface angle ([`repose_fit`], degrees); NaN when the snapshot has no fit.
+    pub angle_deg: f64,
+    /// Its fit error (degrees); NaN when the snapshot has no fit.
+    pub fit_error_deg: f64,
+    /// [`Centrifuging::co_rotating`].
+    pub co_rotating: f64,
+    /// [`Centrifuging::spin_ratio`].
+    pub spin_ratio: f64,
+    /// [`Centrifuging::above_axis`].
+    pub above_axis: f64,
+}
+
+/// The run-level facts of a tumbler run: the one row of a compact copy's [`COMPACT_FACTS`] file.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct TumblerFacts {
+    /// Froude number `ω² R / g` with the wall radius.
+    pub froude: f64,
+    /// Drum spin (rad/s).
+    pub omega: f64,
+    /// Drum wall radius (m).
+    pub radius: f64,
+    /// Free particles' radius (m).
+    pub particle_radius: f64,
+    /// Free particles (last snapshot).
+    pub free: usize,
+    /// Stuck (lining) particles (last snapshot).
+    pub stuck: usize,
+    /// Normal restitution from `[material]` (NaN when absent).
+    pub eps_n: f64,
+    /// Tangential restitution from `[material]` (NaN when absent).
+    pub eps_t: f64,
+    /// [`initial_fill`] of the first snapshot.
+    pub fill: f64,
+    /// Run status (`completed`, `interrupted`, …).
+    pub status: String,
+    /// Time reached (s).
+    pub t_reached: f64,
+    /// Events per wall-clock second.
+    pub events_per_second: f64,
+    /// Wall-clock seconds.
+    pub wall_seconds: f64,
+    /// Collisions applied.
+    pub collisions: u64,
+}
+
+/// File of a compact copy holding [`TumblerFacts`] (one row).
+pub const COMPACT_FACTS: &str = "tumbler_run.csv";
+/// File of a compact copy holding one [`TumblerSnapshot`] per snapshot.
+pub const COMPACT_SNAPSHOTS: &str = "tumbler_snapshots.csv";
+
+/// The facts and per-snapshot measures of the tumbler run in `dir`: a run directory (`scene.toml` — wall 0 the
+/// drum: its radius and spin; gravity —, `summary.json` or the time series, snapshots) or a compact copy written by
+/// [`write_tumbler_compact`] (its two CSV files, a few kB instead of the snapshots' tens of MB).
+pub fn read_tumbler_parts(dir: &Path) -> Result<(TumblerFacts, Vec<TumblerSnapshot>), AnalysisError> {
+    if !dir.join("scene.toml").exists() && dir.join(COMPACT_SNAPSHOTS).exists() {
+        let facts: Vec<TumblerFacts> = read_compact_csv(&dir.join(COMPACT_FACTS))?;
+        let facts = facts
+            .into_iter()
+            .next()
+            .ok_or_else(|| AnalysisError::Input(format!("{}: no data row", dir.join(COMPACT_FACTS).display())))?;
+        return Ok((facts, read_compact_csv(&dir.join(COMPACT_SNAPSHOTS))?));
+    }
     let RunFiles {
         scene: v,
         g,
@@ -245,11 +312,7 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
     let radius = num(drum, "radius").ok_or_else(|| format!("{}: wall[0].radius missing", sp.display()))?;
     let omega = num(drum, "spin").unwrap_or(0.0);
     let material = |k: &str| v.get("material").and_then(|m| num(m, k)).unwrap_or(f64::NAN);
-    let t_reached = summary["t_reached"].as_f64().unwrap_or(f64::NAN);
-    let mut angles = Vec::new();
-    let mut fit_errors = Vec::new();
-    let mut history = Vec::new();
-    let mut measures = Vec::new();
+    let mut snapshots = Vec::new();
     let (mut free, mut stuck, mut r, mut first) = (0, 0, f64::NAN, None);
     for path in &files {
         let rows = read_particles_csv(path).map_err(|e| format!("{}: {e}", path.display()))?;
@@ -260,7 +323,7 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
             .map(|r| (r.values[4], r.values[6]))
             .collect();
         let particles = drum_particles(&rows);
-        measures.push((t, centrifuging(&particles, omega)));
+        let c = centrifuging(&particles, omega);
         first.get_or_insert(particles);
         free = centres.len();
         stuck = rows.len() - free;
@@ -268,15 +331,95 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
             .iter()
             .find(|r| r.stuck_to.is_none())
             .map_or(f64::NAN, |r| r.values[3]);
-        if centres.is_empty() {
+        let fit = if centres.is_empty() {
+            None
+        } else {
+            repose_fit(&surface_points(&centres, r), -0.8 * radius, 0.0)
+        };
+        let (angle_deg, fit_error_deg) = fit.unwrap_or((f64::NAN, f64::NAN));
+        snapshots.push(TumblerSnapshot {
+            t,
+            angle_deg,
+            fit_error_deg,
+            co_rotating: c.co_rotating,
+            spin_ratio: c.spin_ratio,
+            above_axis: c.above_axis,
+        });
+    }
+    let facts = TumblerFacts {
+        froude: omega * omega * radius / g,
+        omega,
+        radius,
+        particle_radius: r,
+        free,
+        stuck,
+        eps_n: material("eps_n"),
+        eps_t: material("eps_t"),
+        fill: initial_fill(first.as_deref().unwrap_or_default(), radius, r),
+        status: summary["status"].as_str().unwrap_or("?").to_string(),
+        t_reached: summary["t_reached"].as_f64().unwrap_or(f64::NAN),
+        events_per_second: summary["events_per_second"].as_f64().unwrap_or(f64::NAN),
+        wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
+        collisions: summary["collisions"].as_u64().unwrap_or(0),
+    };
+    Ok((facts, snapshots))
+}
+
+fn read_compact_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, AnalysisError> {
+    let err = |e: String| AnalysisError::Input(format!("{}: {e}", path.display()));
+    let mut r = csv::Reader::from_path(path).map_err(|e| err(e.to_string()))?;
+    r.deserialize().map(|row| row.map_err(|e| err(e.to_string()))).collect()
+}
+
+/// Writes the compact copy of the tumbler run `run_dir` (a run directory or a compact copy) into `out`
+/// ([`COMPACT_FACTS`] and [`COMPACT_SNAPSHOTS`]): everything [`analyse_tumbler_run`] reads, so that a report
+/// regenerates from committed files. Refuses to write into a run directory.
+pub fn write_tumbler_compact(run_dir: &Path, out: &Path) -> Result<(), AnalysisError> {
+    if out.join("scene.toml").exists() {
+        return Err(AnalysisError::Output(format!(
+            "{}: is a run directory; a compact copy goes to a directory of its own",
+            out.display()
+        )));
+    }
+    let (facts, snapshots) = read_tumbler_parts(run_dir)?;
+    std::fs::create_dir_all(out).map_err(|e| AnalysisError::Output(format!("{}: {e}", out.display())))?;
+    write_compact_csv(&out.join(COMPACT_FACTS), std::slice::from_ref(&facts))?;
+    write_compact_csv(&out.join(COMPACT_SNAPSHOTS), &snapshots)
+}
+
+fn write_compact_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<(), AnalysisError> {
+    let err = |e: String| AnalysisError::Output(format!("{}: {e}", path.display()));
+    let mut w = csv::Writer::from_path(path).map_err(|e| err(e.to_string()))?;
+    for row in rows {
+        w.serialize(row).map_err(|e| err(e.to_string()))?;
+    }
+    w.flush().map_err(|e| err(e.to_string()))
+}
+
+/// Reads and analyses the tumbler run in `dir` (a run directory or a compact copy, [`read_tumbler_parts`]).
+pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, AnalysisError> {
+    let (facts, snapshots) = read_tumbler_parts(dir)?;
+    let t_reached = facts.t_reached;
+    let mut angles = Vec::new();
+    let mut fit_errors = Vec::new();
+    let mut history = Vec::new();
+    let mut measures = Vec::new();
+    for s in &snapshots {
+        measures.push((
+            s.t,
+            Centrifuging {
+                co_rotating: s.co_rotating,
+                spin_ratio: s.spin_ratio,
+                above_axis: s.above_axis,
+            },
+        ));
+        if s.angle_deg.is_nan() {
             continue;
         }
-        if let Some((a, e)) = repose_fit(&surface_points(&centres, r), -0.8 * radius, 0.0) {
-            history.push((t, a, e));
-            if t >= 0.5 * t_reached {
-                angles.push((t, a));
-                fit_errors.push(e);
-            }
+        history.push((s.t, s.angle_deg, s.fit_error_deg));
+        if s.t >= 0.5 * t_reached {
+            angles.push((s.t, s.angle_deg));
+            fit_errors.push(s.fit_error_deg);
         }
     }
     let a: Vec<f64> = angles.iter().map(|p| p.1).collect();
@@ -292,30 +435,29 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, crate::analysis::An
             .collect();
         mean_centrifuging(&m)
     };
-    let fill = initial_fill(first.as_deref().unwrap_or_default(), radius, r);
     Ok(TumblerRun {
         dir: dir.to_path_buf(),
-        froude: omega * omega * radius / g,
-        omega,
-        radius,
-        particle_radius: r,
-        free,
-        stuck,
+        froude: facts.froude,
+        omega: facts.omega,
+        radius: facts.radius,
+        particle_radius: facts.particle_radius,
+        free: facts.free,
+        stuck: facts.stuck,
         angle: mean_std(&a),
         angles,
         angle_fit_errors: fit_errors,
         angle_history: history,
-        restitution: (material("eps_n"), material("eps_t")),
-        fill,
-        threshold: centrifuging_threshold(fill, radius, r),
+        restitution: (facts.eps_n, facts.eps_t),
+        fill: facts.fill,
+        threshold: centrifuging_threshold(facts.fill, facts.radius, facts.particle_radius),
         late: between(0.5, 1.0),
         late_halves: [between(0.5, 0.75), between(0.75, 1.0)],
         centrifuging: measures,
-        status: summary["status"].as_str().unwrap_or("?").to_string(),
+        status: facts.status,
         t_reached,
-        events_per_second: summary["events_per_second"].as_f64().unwrap_or(f64::NAN),
-        wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
-        collisions: summary["collisions"].as_u64().unwrap_or(0),
+        events_per_second: facts.events_per_second,
+        wall_seconds: facts.wall_seconds,
+        collisions: facts.collisions,
     })
 }
 
