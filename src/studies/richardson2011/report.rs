@@ -73,7 +73,7 @@ fn atmosphere_figures(run: &AtmosphereRun, tag: &str, fig_dir: &Path) -> Result<
     }
     let chart = LineChart {
         title: format!(
-            "Model atmosphere, cylinder radius {}: mean heights (cf. Richardson11 Fig. 7)",
+            "Model atmosphere, cylinder radius {}: mean heights (cf. Richardson11 Fig. 5)",
             run.cylinder_radius
         ),
         x_label: "time (system units)".into(),
@@ -116,7 +116,7 @@ fn atmosphere_figures(run: &AtmosphereRun, tag: &str, fig_dir: &Path) -> Result<
     });
     let chart = LineChart {
         title: format!(
-            "KS curves at t = {:.0} (cf. Richardson11 Fig. 8)",
+            "KS curves at t = {:.0} (cf. Richardson11 Fig. 6)",
             run.ks.last().map_or(0.0, |k| k.t)
         ),
         x_label: "height / mean height of the species".into(),
@@ -297,7 +297,7 @@ fn angle_chart(groups: &[(f64, Vec<&TumblerRun>)], r_over_d: f64) -> LineChart {
         })
         .collect();
     LineChart {
-        title: "Tumbler: dynamic angle of repose vs Froude number (cf. Richardson11 Fig. 10)".into(),
+        title: "Tumbler: dynamic angle of repose vs Froude number (cf. Richardson11 Fig. 8)".into(),
         x_label: "Fr = ω² R / g".into(),
         y_label: "dynamic angle of repose (deg)".into(),
         series,
