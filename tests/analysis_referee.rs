@@ -10,7 +10,7 @@ use rubblepile::analysis::pile_equilibrium::pile_drift;
 use rubblepile::analysis::rotational_split::rotational_split;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::math::{Vec3, Vec4};
-use rubblepile::studies::roig2003::referee::parse_run_name;
+use rubblepile::studies::roig2003::referee::{RefereeRun, merge_with_committed, parse_run_name, read_csv, write_csvs};
 
 /// A target fragment (or the projectile) with only the fields the fits and the site measure read.
 fn fragment(index: usize, size: f64, speed: f64, escaping: bool, cosine: f64, is_projectile: bool) -> FragmentAnalysis {
@@ -262,4 +262,51 @@ fn run_names_give_target_projectile_and_seed() {
     );
     assert_eq!(parse("P2_z45_s1"), None);
     assert_eq!(parse("N200_T4_printed"), None);
+}
+
+/// Guards `report roig2003-referee collect` against dropping committed rows: collecting one new group (here a
+/// `per_n` row) keeps every other group's committed rows in their order, and a collected group replaces its
+/// own committed rows.
+#[test]
+fn collecting_one_group_keeps_the_committed_rows_of_the_others() {
+    let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/roig2003");
+    let rows: Vec<RefereeRun> = read_csv(&committed.join("referee_runs.csv")).unwrap();
+    let equilibrium: Vec<rubblepile::studies::roig2003::referee::EquilibriumRow> =
+        read_csv(&committed.join("referee_equilibrium.csv")).unwrap();
+    let committed_only: Vec<RefereeRun> = rows.iter().filter(|r| r.group != "per_n").cloned().collect();
+    let dir = std::env::temp_dir().join(format!("rubblepile-referee-merge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    write_csvs(&dir, &committed_only, &equilibrium).unwrap();
+
+    let (same, eq) = merge_with_committed(&dir, Vec::new(), Vec::new()).unwrap();
+    // Debug text, not `==`: the rows hold NaN where a fit had too few points.
+    let text = |rows: &[RefereeRun]| format!("{rows:?}");
+    assert!(
+        text(&same) == text(&committed_only),
+        "nothing collected: the committed rows, unchanged and in order"
+    );
+    assert_eq!(eq.len(), equilibrium.len());
+
+    let mut new = committed_only[0].clone();
+    new.group = "per_n".into();
+    new.run = "N30_T4_P1_z45_s1".into();
+    new.target = "N30_T4".into();
+    let (merged, _) = merge_with_committed(&dir, vec![new.clone()], Vec::new()).unwrap();
+    assert_eq!(merged.len(), committed_only.len() + 1);
+    assert!(
+        text(&merged[merged.len() - 1..]) == text(&[new]),
+        "per_n sorts after the committed groups"
+    );
+
+    let mut replaced = committed_only[0].clone();
+    replaced.f_ke = 0.5;
+    let group = replaced.group.clone();
+    let (merged, _) = merge_with_committed(&dir, vec![replaced.clone()], Vec::new()).unwrap();
+    let in_group: Vec<&RefereeRun> = merged.iter().filter(|r| r.group == group).collect();
+    assert_eq!(
+        in_group,
+        vec![&replaced],
+        "a collected group replaces its committed rows"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -3,7 +3,7 @@
 # N200_T4-type, to t = 400 s with the campaign's settings (campaign.toml: rtol 1e-6, beta 10, reduced reading,
 # contact at 90 s), analysed at 400 s. Runs go to runs/referee/ (not committed); a run that exists is kept.
 #
-#   analysis/roig2003/referee_runs.sh [PART ...]     # parts: targets f0 inertia realisations relaxed equilibrium
+#   analysis/roig2003/referee_runs.sh [PART ...]     # parts: targets f0 inertia realisations relaxed equilibrium per_n
 #   analysis/roig2003/referee_tables.sh              # collect the compact CSVs and write REFEREE.md
 #
 # About 5 min of CPU on one core in all: 75 impacts of 0.5-5 s, the piles alone under 1 s each, three target
@@ -14,7 +14,7 @@ BIN=${BIN:-./target/release/rubblepile}
 OUT=runs/referee
 export RAYON_NUM_THREADS=1
 parts=("$@")
-[ ${#parts[@]} -eq 0 ] && parts=(targets f0 inertia realisations relaxed equilibrium)
+[ ${#parts[@]} -eq 0 ] && parts=(targets f0 inertia realisations relaxed equilibrium per_n)
 
 # One impact + its analysis: impact DIR TARGET PROJECTILE SEED F0 [extra impact options...]
 impact() {
@@ -30,11 +30,15 @@ impact() {
     fi
 }
 
-target() { # target NAME SEED [extra build options...]
-    local name=$1 seed=$2
+target() { # target NAME SEED [extra build options...]; N200 unless --fragments is given first
+    local name=$1 seed=$2 fragments=200
     shift 2
-    [ -f "$OUT/targets/$name.csv" ] || nice "$BIN" target build --fragments 200 --period-hours 4 --seed "$seed" \
-        --out "$OUT/targets/$name.csv" "$@" | tail -1
+    if [ "${1:-}" = --fragments ]; then
+        fragments=$2
+        shift 2
+    fi
+    [ -f "$OUT/targets/$name.csv" ] || nice "$BIN" target build --fragments "$fragments" --period-hours 4 \
+        --seed "$seed" --out "$OUT/targets/$name.csv" "$@" | tail -1
 }
 
 for part in "${parts[@]}"; do
@@ -110,8 +114,21 @@ EOF
             done
         done
         ;;
+    per_n) # item 3: the seed scatter with the target included at N = 30 and 100 (Table 1's recipe, seeds
+        # 2 and 3 beside the committed seed-1 target), P1-P3 at zeta = 45 deg, 3 projectile seeds each
+        mkdir -p "$OUT/targets" "$OUT/per_n"
+        for n in 30 100; do
+            target "N${n}_T4_s2" 2 --fragments "$n"
+            target "N${n}_T4_s3" 3 --fragments "$n"
+            for t in "targets/N${n}_T4.csv" "$OUT/targets/N${n}_T4_s2.csv" "$OUT/targets/N${n}_T4_s3.csv"; do
+                for p in P1 P2 P3; do
+                    for s in 1 2 3; do impact "$OUT/per_n/$(basename "$t" .csv)_${p}_z45_s$s" "$t" "$p" "$s" 1e-6; done
+                done
+            done
+        done
+        ;;
     *)
-        echo "unknown part $part (targets f0 inertia realisations relaxed equilibrium)" >&2
+        echo "unknown part $part (targets f0 inertia realisations relaxed equilibrium per_n)" >&2
         exit 2
         ;;
     esac

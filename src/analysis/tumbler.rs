@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 use crate::analysis::AnalysisError;
 use crate::analysis::atmosphere::{RunFiles, mean, mean_std, read_run_files};
+use crate::analysis::csv_rows::{read_rows, write_rows};
 use crate::analysis::fits::fit_line;
 use crate::granular::hard::scene::{ParticleRow, read_particles_csv};
 use crate::math::Vec3;
@@ -289,12 +290,12 @@ pub const COMPACT_SNAPSHOTS: &str = "tumbler_snapshots.csv";
 /// [`write_tumbler_compact`] (its two CSV files, a few kB instead of the snapshots' tens of MB).
 pub fn read_tumbler_parts(dir: &Path) -> Result<(TumblerFacts, Vec<TumblerSnapshot>), AnalysisError> {
     if !dir.join("scene.toml").exists() && dir.join(COMPACT_SNAPSHOTS).exists() {
-        let facts: Vec<TumblerFacts> = read_compact_csv(&dir.join(COMPACT_FACTS))?;
+        let facts: Vec<TumblerFacts> = read_rows(&dir.join(COMPACT_FACTS))?;
         let facts = facts
             .into_iter()
             .next()
             .ok_or_else(|| AnalysisError::Input(format!("{}: no data row", dir.join(COMPACT_FACTS).display())))?;
-        return Ok((facts, read_compact_csv(&dir.join(COMPACT_SNAPSHOTS))?));
+        return Ok((facts, read_rows(&dir.join(COMPACT_SNAPSHOTS))?));
     }
     let RunFiles {
         scene: v,
@@ -365,12 +366,6 @@ pub fn read_tumbler_parts(dir: &Path) -> Result<(TumblerFacts, Vec<TumblerSnapsh
     Ok((facts, snapshots))
 }
 
-fn read_compact_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, AnalysisError> {
-    let err = |e: String| AnalysisError::Input(format!("{}: {e}", path.display()));
-    let mut r = csv::Reader::from_path(path).map_err(|e| err(e.to_string()))?;
-    r.deserialize().map(|row| row.map_err(|e| err(e.to_string()))).collect()
-}
-
 /// Writes the compact copy of the tumbler run `run_dir` (a run directory or a compact copy) into `out`
 /// ([`COMPACT_FACTS`] and [`COMPACT_SNAPSHOTS`]): everything [`analyse_tumbler_run`] reads, so that a report
 /// regenerates from committed files. Refuses to write into a run directory.
@@ -383,17 +378,8 @@ pub fn write_tumbler_compact(run_dir: &Path, out: &Path) -> Result<(), AnalysisE
     }
     let (facts, snapshots) = read_tumbler_parts(run_dir)?;
     std::fs::create_dir_all(out).map_err(|e| AnalysisError::Output(format!("{}: {e}", out.display())))?;
-    write_compact_csv(&out.join(COMPACT_FACTS), std::slice::from_ref(&facts))?;
-    write_compact_csv(&out.join(COMPACT_SNAPSHOTS), &snapshots)
-}
-
-fn write_compact_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<(), AnalysisError> {
-    let err = |e: String| AnalysisError::Output(format!("{}: {e}", path.display()));
-    let mut w = csv::Writer::from_path(path).map_err(|e| err(e.to_string()))?;
-    for row in rows {
-        w.serialize(row).map_err(|e| err(e.to_string()))?;
-    }
-    w.flush().map_err(|e| err(e.to_string()))
+    write_rows(&out.join(COMPACT_FACTS), std::slice::from_ref(&facts))?;
+    write_rows(&out.join(COMPACT_SNAPSHOTS), &snapshots)
 }
 
 /// Reads and analyses the tumbler run in `dir` (a run directory or a compact copy, [`read_tumbler_parts`]).

@@ -21,6 +21,7 @@ use std::path::Path;
 
 use crate::analysis::AnalysisError;
 use crate::analysis::atmosphere::mean_std;
+use crate::analysis::csv_rows::{read_rows, write_rows};
 use crate::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor};
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
@@ -40,12 +41,16 @@ pub const FLOOR: f64 = 10.0;
 pub const T_AT: f64 = 400.0;
 
 /// The run groups of `referee_runs.sh`, in the order the tables use.
-pub const GROUPS: [&str; 5] = ["f0", "gaussian", "uniform", "relaxed", "realisations"];
+pub const GROUPS: [&str; 6] = ["f0", "gaussian", "uniform", "relaxed", "realisations", "per_n"];
+
+/// The smaller piles whose seed scatter group `per_n` measures with the target included (Table 1's N30_T4 and
+/// N100_T4 beside their `--seed 2` and `--seed 3` realisations).
+pub const PER_N_TARGETS: [&str; 2] = ["N30_T4", "N100_T4"];
 
 /// One analysed run: its coordinates and the measures the tables need. NaN where a fit had too few points.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RefereeRun {
-    /// The group (directory under `runs/referee/`): f0, gaussian, uniform, relaxed or realisations.
+    /// The group (directory under `runs/referee/`): f0, gaussian, uniform, relaxed, realisations or per_n.
     pub group: String,
     /// The run's directory name.
     pub run: String,
@@ -344,25 +349,15 @@ pub fn collect(runs: &Path) -> Result<(Vec<RefereeRun>, Vec<EquilibriumRow>), An
     Ok((out, equilibrium))
 }
 
-fn write_csv<T: serde::Serialize>(path: &Path, rows: &[T]) -> Result<(), AnalysisError> {
-    let err = |e: String| AnalysisError::Output(format!("{}: {e}", path.display()));
-    let mut w = csv::Writer::from_path(path).map_err(|e| err(e.to_string()))?;
-    for r in rows {
-        w.serialize(r).map_err(|e| err(e.to_string()))?;
-    }
-    w.flush().map_err(|e| err(e.to_string()))
-}
-
-fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, AnalysisError> {
-    let err = |e: String| AnalysisError::Input(format!("{}: {e}", path.display()));
-    let mut r = csv::Reader::from_path(path).map_err(|e| err(e.to_string()))?;
-    r.deserialize().map(|row| row.map_err(|e| err(e.to_string()))).collect()
+/// Reads one of the two compact CSVs (rows of `T`).
+pub fn read_csv<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, AnalysisError> {
+    read_rows(path)
 }
 
 /// Writes `out/referee_runs.csv` and `out/referee_equilibrium.csv`.
 pub fn write_csvs(out: &Path, runs: &[RefereeRun], equilibrium: &[EquilibriumRow]) -> Result<(), AnalysisError> {
-    write_csv(&out.join("referee_runs.csv"), runs)?;
-    write_csv(&out.join("referee_equilibrium.csv"), equilibrium)
+    write_rows(&out.join("referee_runs.csv"), runs)?;
+    write_rows(&out.join("referee_equilibrium.csv"), equilibrium)
 }
 
 /// `mean ± sd` of the finite values with `digits` decimals (`–` when none).
@@ -574,7 +569,8 @@ fn scatter(rows: &[&RefereeRun], f: &dyn Fn(&RefereeRun) -> f64) -> (f64, f64, f
     (mean_std(&within).0, mean_std(&means).1, mean_std(&all).1)
 }
 
-fn scatter_table(runs: &[RefereeRun], md: &mut String) {
+/// The seed-scatter table: for each projectile, the rows `rows_of(projectile)` (3 targets × 3 seeds).
+fn scatter_table<'a>(rows_of: impl Fn(&str) -> Vec<&'a RefereeRun>, md: &mut String) {
     md.push_str(
         "| projectile | quantity | sd over the projectile's seeds (mean over 3 targets) | sd of the 3 targets' means | \
          sd over all 9 runs |\n|---|---|---|---|---|\n",
@@ -589,11 +585,45 @@ fn scatter_table(runs: &[RefereeRun], md: &mut String) {
         ("spin α", |r| r.spin_alpha, 2),
     ];
     for (p, _) in PAPER_EJECTION {
-        let rows = realisation_rows(runs, p);
+        let rows = rows_of(p);
         for (name, f, d) in quantities {
             let (w, b, a) = scatter(&rows, &f);
             let _ = writeln!(md, "| {p} | {name} | {w:.d$} | {b:.d$} | {a:.d$} |");
         }
+    }
+}
+
+/// Whether a target-name suffix after the base name marks the base target itself or one of its seed
+/// realisations (`""`, `"_s2"`, `"_s3"`…), so that `N30_T4` does not also take `N30_T4_reduced`.
+fn is_realisation(suffix: &str) -> bool {
+    suffix.is_empty() || suffix.strip_prefix("_s").is_some_and(|s| s.parse::<u64>().is_ok())
+}
+
+/// One line per (target, projectile) cell of a per-N group: the outcome means ± sd over the seeds, so the
+/// reader sees which target moves which number.
+fn variant_summary(rows: &[&RefereeRun], md: &mut String) {
+    let mut cells: BTreeMap<(&str, &str), Vec<&RefereeRun>> = BTreeMap::new();
+    for r in rows {
+        cells
+            .entry((r.projectile.as_str(), r.target.as_str()))
+            .or_default()
+            .push(r);
+    }
+    md.push_str(
+        "\n| projectile | target | runs | bound fraction | f_KE (%) | rot. share (%) | ejection α | spin α |\n\
+         |---|---|---|---|---|---|---|---|\n",
+    );
+    for ((p, t), cell) in &cells {
+        let _ = writeln!(
+            md,
+            "| {p} | {t} | {} | {} | {} | {} | {} | {} |",
+            cell.len(),
+            column(cell, |r| r.bound_fraction, 1.0, 3),
+            column(cell, |r| r.f_ke, 100.0, 2),
+            column(cell, |r| r.rot_share, 100.0, 1),
+            column(cell, |r| r.alpha_all, 1.0, 2),
+            column(cell, |r| r.spin_alpha, 1.0, 2),
+        );
     }
 }
 
@@ -695,7 +725,7 @@ pub fn write_report(out: &Path) -> Result<std::path::PathBuf, AnalysisError> {
          Generated by `analysis/roig2003/referee_tables.sh` from `referee_runs.csv` (one row per run) and \
          `referee_equilibrium.csv`, which it collects from the runs of `analysis/roig2003/referee_runs.sh` \
          (`runs/referee/`, not committed). Do not edit by hand: the verdicts are in `DISCUSSION.md`. Every run is \
-         N200_T4-type at ζ = 45°, κ from the reduced reading of Eq. 13, rtol 1e-6, analysed at t = 400 s; mean ± \
+         N200_T4-type (§8's second and third tables: N30_T4- and N100_T4-type) at ζ = 45°, κ from the reduced reading of Eq. 13, rtol 1e-6, analysed at t = 400 s; mean ± \
          sample standard deviation over the runs of a row.\n\n",
     );
     md.push_str("## 1. The rotational share against F0 (Fig. 2 cell: N200_T4 + P2, ζ = 45°, seeds 1–3)\n\n");
@@ -748,7 +778,29 @@ pub fn write_report(out: &Path) -> Result<std::path::PathBuf, AnalysisError> {
     md.push_str("\n## 7. Fig. 8: spin–size exponents with the target in the scatter\n\n");
     spin_table(&runs, &mut md);
     md.push_str("\n## 8. Seed scatter: the projectile's attitude against the target realisation\n\n");
-    scatter_table(&runs, &mut md);
+    scatter_table(|p| realisation_rows(&runs, p), &mut md);
+    for base in PER_N_TARGETS {
+        let rows_of = |p: &str| {
+            select(&runs, |r| {
+                r.group == "per_n" && r.projectile == p && r.target.strip_prefix(base).is_some_and(is_realisation)
+            })
+        };
+        if rows_of("P1").is_empty() {
+            continue;
+        }
+        let _ = writeln!(
+            md,
+            "\n### {base} and its two realisations (`target build --fragments {n} --seed 2`, `--seed 3`), ζ = 45°\n",
+            n = base.trim_start_matches('N').split('_').next().unwrap_or(base)
+        );
+        scatter_table(rows_of, &mut md);
+        variant_summary(
+            &select(&runs, |r| {
+                r.group == "per_n" && r.target.strip_prefix(base).is_some_and(is_realisation)
+            }),
+            &mut md,
+        );
+    }
     md.push_str(
         "\n## 9. §4.2: where the ejected fragments started (3 targets × 3 seeds)\n\n\
          Site cosine: the cosine between a fragment's position at t = 0 and the projectile's, both from the \
@@ -760,6 +812,34 @@ pub fn write_report(out: &Path) -> Result<std::path::PathBuf, AnalysisError> {
     let path = out.join("REFEREE.md");
     std::fs::write(&path, md).map_err(|e| AnalysisError::Output(format!("{}: {e}", path.display())))?;
     Ok(path)
+}
+
+/// The collected rows with the committed CSVs' rows of every group that `rows` lacks (and the committed
+/// equilibrium rows when none were collected), so that collecting one new group of runs keeps the others'
+/// rows instead of dropping them. Groups present in `rows` replace their committed rows.
+pub fn merge_with_committed(
+    out: &Path,
+    mut rows: Vec<RefereeRun>,
+    equilibrium: Vec<EquilibriumRow>,
+) -> Result<(Vec<RefereeRun>, Vec<EquilibriumRow>), AnalysisError> {
+    let runs_csv = out.join("referee_runs.csv");
+    if runs_csv.exists() {
+        let fresh: std::collections::BTreeSet<String> = rows.iter().map(|r| r.group.clone()).collect();
+        let kept: Vec<RefereeRun> = read_csv::<RefereeRun>(&runs_csv)?
+            .into_iter()
+            .filter(|r| !fresh.contains(&r.group))
+            .collect();
+        rows.extend(kept);
+        let order = |g: &str| GROUPS.iter().position(|x| *x == g).unwrap_or(GROUPS.len());
+        rows.sort_by(|a, b| (order(&a.group), &a.run).cmp(&(order(&b.group), &b.run)));
+    }
+    let equilibrium_csv = out.join("referee_equilibrium.csv");
+    let equilibrium = if equilibrium.is_empty() && equilibrium_csv.exists() {
+        read_csv(&equilibrium_csv)?
+    } else {
+        equilibrium
+    };
+    Ok((rows, equilibrium))
 }
 
 /// `rubblepile report roig2003-referee …`: the two steps of this module.
@@ -785,6 +865,7 @@ pub fn referee_command(args: &RefereeArgs) -> Result<(), AnalysisError> {
     match args {
         RefereeArgs::Collect { runs, out } => {
             let (rows, equilibrium) = collect(runs)?;
+            let (rows, equilibrium) = merge_with_committed(out, rows, equilibrium)?;
             write_csvs(out, &rows, &equilibrium)?;
             println!(
                 "collected {} runs and {} equilibrium rows into {}",
