@@ -51,11 +51,16 @@ fn tilted_bed(theta_deg: f64) -> Vec<(f64, f64)> {
 }
 
 fn write_run(dir: &std::path::Path, theta_deg: f64) {
+    write_run_at(dir, theta_deg, OMEGA);
+}
+
+/// [`write_run`] with the drum's spin `omega` (rad/s).
+fn write_run_at(dir: &std::path::Path, theta_deg: f64, omega: f64) {
     std::fs::write(
         dir.join("scene.toml"),
         format!(
             "[gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 0.5\neps_t = 0.3\n[[wall]]\ntype = \"cylinder\"\n\
-             radius = {R_WALL:?}\nspin = {OMEGA:?}\n"
+             radius = {R_WALL:?}\nspin = {omega:?}\n"
         ),
     )
     .unwrap();
@@ -202,4 +207,36 @@ fn every_richardson2011_scene_loads_and_the_smooth_drum_lacks_only_the_lining() 
     assert_eq!(stuck(&smooth), 0);
     assert_eq!(smooth.particles.len(), lined.particles.len() - stuck(&lined));
     assert_eq!(smooth.walls.len(), lined.walls.len());
+}
+
+/// Guards the Fig. 8 comparison against centrifuging runs: at Fr ≥ 1 the paper estimates no slope, so the table
+/// prints none (a line through a bed spread round the lining is not a dynamic angle of repose) while a subcritical
+/// run keeps its angle.
+#[test]
+fn a_centrifuging_run_gets_no_slope_in_the_table() {
+    let root = temp_dir("tumbler_paper_centrifuging");
+    let (slow, fast) = (root.join("slow"), root.join("fast"));
+    for d in [&slow, &fast] {
+        std::fs::create_dir_all(d).unwrap();
+    }
+    write_run(&slow, 30.0);
+    // Fr = ω² R / g = 1.2 with R = 30 mm.
+    write_run_at(&fast, 30.0, (1.2f64 * 9.81 / 0.030).sqrt());
+    let out = root.join("out");
+    let path = write_tumbler_paper_report(&TumblerPaperArgs {
+        runs: vec![slow, fast],
+        out,
+        compact: None,
+    })
+    .unwrap();
+    let md = std::fs::read_to_string(&path).unwrap();
+    let row = |fr: &str| {
+        md.lines()
+            .find(|l| l.starts_with(&format!("| {fr} |")))
+            .unwrap()
+            .to_string()
+    };
+    assert!(row("1.200").contains("— (Fr ≥ 1: no slope)"), "{}", row("1.200"));
+    assert!(!row("0.049").contains("no slope"), "{}", row("0.049"));
+    std::fs::remove_dir_all(&root).unwrap();
 }

@@ -20,6 +20,17 @@ use crate::analysis::tumbler::{TumblerRun, analyse_tumbler_run, write_tumbler_co
 /// few degrees of our expected results" at their Froude number (whose value was lost in extraction).
 pub const POHLMAN_ANGLE_DEG: f64 = 16.9;
 
+/// The Froude number from which the bed centrifuges (Richardson11 §3.2: "for Fr = 1.0 … centrifuging has begun").
+/// The paper estimates a slope only for the subcritical cases, so runs at or above it get no angle in the table or
+/// in the Fig. 8 chart (a line fitted to a bed spread round the lining is not a slope), only the centrifuging
+/// measures.
+pub const CENTRIFUGING_FROUDE: f64 = 1.0;
+
+/// Whether a run is subcritical (`Fr < CENTRIFUGING_FROUDE`), i.e. has a slope to compare with Fig. 8.
+pub fn has_slope(run: &TumblerRun) -> bool {
+    lining_froude(run) < CENTRIFUGING_FROUDE - 1e-9
+}
+
 /// The report's file name in the output directory.
 pub const TUMBLER_PAPER_FILE: &str = "TUMBLER_PAPER.md";
 
@@ -59,7 +70,7 @@ fn drum_label(restitution: (f64, f64), stuck: usize) -> String {
 fn angle_chart(runs: &[TumblerRun]) -> LineChart {
     let mut labels: Vec<String> = Vec::new();
     let mut series: Vec<Series> = Vec::new();
-    for run in runs.iter().filter(|r| !r.angles.is_empty()) {
+    for run in runs.iter().filter(|r| !r.angles.is_empty() && has_slope(r)) {
         let label = format!("this work, R/r = {:.0}, {}", run.radius_ratio(), restitution_label(run));
         let k = labels.iter().position(|l| *l == label).unwrap_or_else(|| {
             labels.push(label.clone());
@@ -151,16 +162,24 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
     }
     let _ = writeln!(
         md,
-        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | last snapshot: t (s), angle ± fit error (deg) | above axis | collisions | events/s | wall (s) |"
+        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | last snapshot: t (s), angle ± fit error (deg) | above axis | co-rotating | collisions | events/s | wall (s) |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for run in runs {
         let a: Vec<f64> = run.angles.iter().map(|p| p.1).collect();
         let half = a.len() / 2;
         let (first_half, second_half) = (mean_std(&a[..half]).0, mean_std(&a[half..]).0);
+        let angle = if has_slope(run) {
+            format!("{:.1} ± {:.1}", run.angle.0, run.angle.1)
+        } else {
+            format!("— (Fr ≥ {CENTRIFUGING_FROUDE}: no slope)")
+        };
         let _ = writeln!(
             md,
-            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {:.1} ± {:.1} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {} | {:.2e} | {:.0} |",
+            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {:.2} | {} | {:.2e} | {:.0} |",
             lining_froude(run),
             run.restitution.0,
             run.restitution.1,
@@ -168,8 +187,6 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
             run.status,
             run.t_reached,
             run.t_reached * run.omega / std::f64::consts::TAU,
-            run.angle.0,
-            run.angle.1,
             a.len(),
             mean_std(&run.angle_fit_errors).0,
             first_half,
@@ -178,6 +195,7 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
                 .last()
                 .map_or("—".to_string(), |h| format!("{:.3}, {:.1} ± {:.1}", h.0, h.1, h.2)),
             run.late.above_axis,
+            run.late.co_rotating,
             run.collisions,
             run.events_per_second,
             run.wall_seconds
