@@ -588,7 +588,15 @@ fn scatter_table<'a>(rows_of: impl Fn(&str) -> Vec<&'a RefereeRun>, md: &mut Str
         let rows = rows_of(p);
         for (name, f, d) in quantities {
             let (w, b, a) = scatter(&rows, &f);
-            let _ = writeln!(md, "| {p} | {name} | {w:.d$} | {b:.d$} | {a:.d$} |");
+            // A fit with too few points in some run (no escaping fragment) leaves no spread to show.
+            let cell = |x: f64| {
+                if x.is_finite() {
+                    format!("{x:.d$}")
+                } else {
+                    "–".into()
+                }
+            };
+            let _ = writeln!(md, "| {p} | {name} | {} | {} | {} |", cell(w), cell(b), cell(a));
         }
     }
 }
