@@ -59,7 +59,7 @@ fn write_run_at(dir: &std::path::Path, theta_deg: f64, omega: f64) {
     std::fs::write(
         dir.join("scene.toml"),
         format!(
-            "[gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 0.5\neps_t = 0.3\n[[wall]]\ntype = \"cylinder\"\n\
+            "[stepping]\ndt = 5e-4\n[gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 0.5\neps_t = 0.3\n[[wall]]\ntype = \"cylinder\"\n\
              radius = {R_WALL:?}\nspin = {omega:?}\n"
         ),
     )
@@ -67,7 +67,7 @@ fn write_run_at(dir: &std::path::Path, theta_deg: f64, omega: f64) {
     // Stopped at t = 0.4 s: no summary.json; the time series holds per-row collision counts and the wall clock.
     std::fs::write(
         dir.join("timeseries.csv"),
-        "t,kinetic,collisions,wall_seconds\n0e0,0,0,0.5\n2e-1,1,100,5\n4e-1,1,300,12\n",
+        "t,kinetic,energy_residual,collisions,wall_seconds\n0e0,0,0,0,0.5\n2e-1,1,-3e-3,100,5\n4e-1,1,2e-3,300,12\n",
     )
     .unwrap();
     std::fs::create_dir_all(dir.join("snapshots")).unwrap();
@@ -120,6 +120,9 @@ fn a_stopped_run_of_a_bed_tilted_at_35_degrees_reports_35_degrees_and_its_time_s
     );
     // Fr with R = 31.06 − 2 × 0.53 = 30 mm, and R/r = 30 / 0.53.
     assert!((lining_froude(&run) - OMEGA * OMEGA * 0.030 / 9.81).abs() < 1e-12);
+    // The step from the scene and, for a stopped run, the largest |energy_residual| of the time series.
+    assert_eq!(run.dt, 5e-4);
+    assert_eq!(run.energy_error, 3e-3);
     assert!((run.radius_ratio() - 0.030 / R_PART).abs() < 1e-9);
     // The report: one table row with the interrupted status and the angle, and both figures.
     let out = root.join("out");

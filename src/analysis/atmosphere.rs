@@ -197,27 +197,36 @@ pub struct RunFiles {
 
 /// The summary of a run that has no `summary.json` (stopped before its end), from its `timeseries.csv`:
 /// `status = "interrupted"`, `t_reached` and `wall_seconds` of the last row, `collisions` the sum of the per-row
-/// counts, `events_per_second` their ratio. `None` without a time series or with no data row.
+/// counts, `events_per_second` their ratio, `energy_error` the largest |energy_residual| of the rows (when the
+/// column is there). `None` without a time series or with no data row.
 pub fn interrupted_summary(dir: &Path) -> Option<serde_json::Value> {
     let text = std::fs::read_to_string(dir.join("timeseries.csv")).ok()?;
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next()?.split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name);
     let (it, ic, iw) = (col("t")?, col("collisions")?, col("wall_seconds")?);
-    let (mut t, mut collisions, mut wall) = (None, 0.0, f64::NAN);
+    let ie = col("energy_residual");
+    let (mut t, mut collisions, mut wall, mut residual) = (None, 0.0, f64::NAN, None::<f64>);
     for line in lines.filter(|l| !l.trim().is_empty()) {
         let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap_or(f64::NAN)).collect();
         t = Some(*v.get(it)?);
         collisions += v.get(ic).copied().unwrap_or(0.0);
         wall = v.get(iw).copied().unwrap_or(f64::NAN);
+        if let Some(e) = ie.and_then(|k| v.get(k)).filter(|e| e.is_finite()) {
+            residual = Some(residual.map_or(e.abs(), |r| r.max(e.abs())));
+        }
     }
-    Some(serde_json::json!({
+    let mut summary = serde_json::json!({
         "status": "interrupted",
         "t_reached": t?,
         "wall_seconds": wall,
         "collisions": collisions as u64,
         "events_per_second": collisions / wall,
-    }))
+    });
+    if let Some(e) = residual {
+        summary["energy_error"] = serde_json::json!(e);
+    }
+    Some(summary)
 }
 
 /// Reads [`RunFiles`]; errors (one line, naming the file) when a file is missing or gravity does not point down. A

@@ -220,6 +220,12 @@ pub struct TumblerRun {
     pub wall_seconds: f64,
     /// Collisions applied.
     pub collisions: u64,
+    /// The scene's step `stepping.dt` (s; NaN when absent).
+    pub dt: f64,
+    /// The run's energy residual (`energy_error` of the summary, or the largest |energy_residual| of a stopped
+    /// run's time series; NaN when neither is there): the integration error once restitution and the walls' work
+    /// are booked.
+    pub energy_error: f64,
 }
 
 impl TumblerRun {
@@ -278,6 +284,10 @@ pub struct TumblerFacts {
     pub wall_seconds: f64,
     /// Collisions applied.
     pub collisions: u64,
+    /// [`TumblerRun::dt`].
+    pub dt: f64,
+    /// [`TumblerRun::energy_error`].
+    pub energy_error: f64,
 }
 
 /// File of a compact copy holding [`TumblerFacts`] (one row).
@@ -362,6 +372,8 @@ pub fn read_tumbler_parts(dir: &Path) -> Result<(TumblerFacts, Vec<TumblerSnapsh
         events_per_second: summary["events_per_second"].as_f64().unwrap_or(f64::NAN),
         wall_seconds: summary["wall_seconds"].as_f64().unwrap_or(f64::NAN),
         collisions: summary["collisions"].as_u64().unwrap_or(0),
+        dt: v.get("stepping").and_then(|s| num(s, "dt")).unwrap_or(f64::NAN),
+        energy_error: summary["energy_error"].as_f64().unwrap_or(f64::NAN),
     };
     Ok((facts, snapshots))
 }
@@ -444,6 +456,8 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, AnalysisError> {
         events_per_second: facts.events_per_second,
         wall_seconds: facts.wall_seconds,
         collisions: facts.collisions,
+        dt: facts.dt,
+        energy_error: facts.energy_error,
     })
 }
 

@@ -162,11 +162,11 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
     }
     let _ = writeln!(
         md,
-        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | last snapshot: t (s), angle ± fit error (deg) | above axis | co-rotating | collisions | events/s | wall (s) |"
+        "| Fr | ε_n | ε_t | ω (rad/s) | status | t reached (s) | turns | angle (deg) | snapshots | fit error of one angle (deg) | angle, 1st / 2nd half of window (deg) | last snapshot: t (s), angle ± fit error (deg) | above axis | co-rotating | dt (s) | energy residual | collisions | events/s | wall (s) |"
     );
     let _ = writeln!(
         md,
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
     );
     for run in runs {
         let a: Vec<f64> = run.angles.iter().map(|p| p.1).collect();
@@ -179,7 +179,7 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
         };
         let _ = writeln!(
             md,
-            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {:.2} | {} | {:.2e} | {:.0} |",
+            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {:.2} | {:.3e} | {:.1e} | {} | {:.2e} | {:.0} |",
             lining_froude(run),
             run.restitution.0,
             run.restitution.1,
@@ -196,6 +196,8 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
                 .map_or("—".to_string(), |h| format!("{:.3}, {:.1} ± {:.1}", h.0, h.1, h.2)),
             run.late.above_axis,
             run.late.co_rotating,
+            run.dt,
+            run.energy_error,
             run.collisions,
             run.events_per_second,
             run.wall_seconds
