@@ -240,6 +240,11 @@ fn a_centrifuging_run_gets_no_slope_in_the_table() {
             .to_string()
     };
     assert!(row("1.200").contains("— (Fr ≥ 1: no slope)"), "{}", row("1.200"));
+    assert!(
+        !row("1.200").contains(" / "),
+        "no halves of a slope either: {}",
+        row("1.200")
+    );
     assert!(!row("0.049").contains("no slope"), "{}", row("0.049"));
     std::fs::remove_dir_all(&root).unwrap();
 }

@@ -172,14 +172,25 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
         let a: Vec<f64> = run.angles.iter().map(|p| p.1).collect();
         let half = a.len() / 2;
         let (first_half, second_half) = (mean_std(&a[..half]).0, mean_std(&a[half..]).0);
-        let angle = if has_slope(run) {
-            format!("{:.1} ± {:.1}", run.angle.0, run.angle.1)
+        // Past the centrifuging threshold every angle cell is a dash: the fitted lines are not slopes.
+        let (angle, halves, last) = if has_slope(run) {
+            (
+                format!("{:.1} ± {:.1}", run.angle.0, run.angle.1),
+                format!("{first_half:.1} / {second_half:.1}"),
+                run.angle_history
+                    .last()
+                    .map_or("—".to_string(), |h| format!("{:.3}, {:.1} ± {:.1}", h.0, h.1, h.2)),
+            )
         } else {
-            format!("— (Fr ≥ {CENTRIFUGING_FROUDE}: no slope)")
+            (
+                format!("— (Fr ≥ {CENTRIFUGING_FROUDE}: no slope)"),
+                "—".into(),
+                "—".into(),
+            )
         };
         let _ = writeln!(
             md,
-            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {:.1} / {:.1} | {} | {:.2} | {:.2} | {:.3e} | {:.1e} | {} | {:.2e} | {:.0} |",
+            "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {halves} | {last} | {:.2} | {:.2} | {:.3e} | {:.1e} | {} | {:.2e} | {:.0} |",
             lining_froude(run),
             run.restitution.0,
             run.restitution.1,
@@ -189,11 +200,6 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
             run.t_reached * run.omega / std::f64::consts::TAU,
             a.len(),
             mean_std(&run.angle_fit_errors).0,
-            first_half,
-            second_half,
-            run.angle_history
-                .last()
-                .map_or("—".to_string(), |h| format!("{:.3}, {:.1} ± {:.1}", h.0, h.1, h.2)),
             run.late.above_axis,
             run.late.co_rotating,
             run.dt,
