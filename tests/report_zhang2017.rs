@@ -98,7 +98,16 @@ fn full_size_section_reads_a_run_still_going() {
     fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
     fake_run(&root.join("full/hcp"), 50, 12000.0, 38300.0, 9000.0, false);
     let out = root.join("out");
-    let report = write_report(&root.join("runs"), Some(&root.join("full")), None, None, &out, false).unwrap();
+    let report = write_report(
+        &root.join("runs"),
+        Some(&root.join("full")),
+        None,
+        None,
+        None,
+        &out,
+        false,
+    )
+    .unwrap();
     let md = std::fs::read_to_string(&report).unwrap();
     let section = &md[md.find("## Full size").expect("a full-size section")..];
     let row = section
@@ -114,7 +123,18 @@ fn full_size_section_reads_a_run_still_going() {
     assert!(out.join("fig5_hcp_full.svg").is_file() || out.join("fig5_hcp_full.png").is_file());
     // the command line written into the report names --full, and a second write needs force
     assert!(md.contains("--full "), "{}", &md[..400]);
-    assert!(write_report(&root.join("runs"), Some(&root.join("full")), None, None, &out, false).is_err());
+    assert!(
+        write_report(
+            &root.join("runs"),
+            Some(&root.join("full")),
+            None,
+            None,
+            None,
+            &out,
+            false
+        )
+        .is_err()
+    );
     let _ = std::fs::remove_dir_all(&root);
 }
 
@@ -135,7 +155,8 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     )
     .unwrap();
     let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, &out, false).unwrap()).unwrap();
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
+        .unwrap();
     assert!(
         !md.contains("by creep criterion"),
         "old critical.json: no criterion section"
@@ -155,7 +176,8 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
             "ours": {"t_c3_hours": 2.64, "friction_angle_deg": 45.2}}"#,
     )
     .unwrap();
-    let md2 = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, &out, true).unwrap()).unwrap();
+    let md2 =
+        std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, true).unwrap()).unwrap();
     assert!(md2.ends_with(&format!("\n\n{notes}\n")), "{}", &md2[md2.len() - 300..]);
     let section = &md2[md2.find("## T_c,3 by creep criterion").expect("criterion section")..];
     let row = section.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
@@ -245,7 +267,16 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
     .unwrap();
     let out = root.join("out");
     let md = std::fs::read_to_string(
-        write_report(&root.join("runs"), None, Some(&root.join("paths")), None, &out, false).unwrap(),
+        write_report(
+            &root.join("runs"),
+            None,
+            Some(&root.join("paths")),
+            None,
+            None,
+            &out,
+            false,
+        )
+        .unwrap(),
     )
     .unwrap();
     assert!(md.contains("--paths "), "{}", &md[..400]);
@@ -342,7 +373,16 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     search("ladder/rcp_small/critical", &[2.5, 2.55], None);
     let out = root.join("out");
     let md = std::fs::read_to_string(
-        write_report(&root.join("runs"), None, None, Some(&root.join("ladder")), &out, false).unwrap(),
+        write_report(
+            &root.join("runs"),
+            None,
+            None,
+            Some(&root.join("ladder")),
+            None,
+            &out,
+            false,
+        )
+        .unwrap(),
     )
     .unwrap();
     let section = &md[md.find("## Resolution ladder").expect("a ladder section")..];
@@ -369,5 +409,122 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     assert!(section.contains("| paper (RCP) | 36 523 |"), "{section}");
     assert!(md.contains("--ladder "), "the command line names --ladder");
     assert!(out.join("ladder.svg").is_file(), "the figure");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Writes a search's `critical.csv`: one hold per `(T_final, released, ours stable, paper stable)`.
+fn critical_csv(dir: &Path, holds: &[(f64, bool, bool, bool)]) {
+    std::fs::create_dir_all(dir).unwrap();
+    let mut csv = "t_final_h,released,theta_max_deg,drift_theta_max_deg,drift_packing,drift_coordination,\
+                   paper_stable,paper_drifting,ours_stable,ours_drifting\n"
+        .to_string();
+    for &(t, released, ours, paper) in holds {
+        let theta = 100.0 - 20.0 * t;
+        csv += &format!(
+            "{t:.2},{released},{theta:.3},0.1,-0.00001,-0.09,{paper},{},{ours},{}\n",
+            if paper { "" } else { "coordination_number" },
+            if ours { "" } else { "theta_max" }
+        );
+    }
+    std::fs::write(dir.join("critical.csv"), csv).unwrap();
+}
+
+/// `--ordering`: the variants' T_c,3 of HCP and RCP side by side with RCP − HCP (positive: the paper's order), a
+/// search without a stable hold as "> its slowest hold", the nominal row from RUNS; and the Fig. 22 analogue:
+/// every search with a `holds.csv` gets its hold table (with the density a hold stands for at 2.26 h) and figure,
+/// the φ of a search being the θ_max of its T_c,3 hold, not of the released hold beside it.
+#[test]
+fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
+    let root = std::env::temp_dir().join(format!("rp_report_ordering_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    fake_run(&root.join("runs/rcp"), 30, 38300.0, 38300.0, 600.0, true);
+    critical_csv(
+        &root.join("runs/hcp/critical"),
+        &[
+            (2.60, true, false, false),
+            (2.64, false, true, false),
+            (2.68, false, true, false),
+        ],
+    );
+    critical_csv(
+        &root.join("runs/rcp/critical"),
+        &[
+            (2.55, true, false, false),
+            (2.60, false, true, true),
+            (2.65, false, true, true),
+        ],
+    );
+    // β = 0: RCP never stable up to 3.00 h, HCP at 2.70 h; the paper's order
+    critical_csv(
+        &root.join("ordering/rcp_beta0"),
+        &[
+            (2.80, true, false, false),
+            (2.90, false, false, false),
+            (3.00, true, false, false),
+        ],
+    );
+    critical_csv(
+        &root.join("ordering/hcp_beta0"),
+        &[
+            (2.66, true, false, false),
+            (2.70, false, true, false),
+            (2.74, false, true, false),
+        ],
+    );
+    // the nominal RCP's holds, as compact.py writes them
+    let mut holds = "t_final_h,t_hold_s,period_h,body_mass_fraction,packing_fraction,coordination_number,\
+                     coordination_loaded,theta_max_deg\n"
+        .to_string();
+    for t in ["2.55", "2.60", "2.65"] {
+        for k in 0..20 {
+            holds += &format!("{t},{},{t},1.0,0.64,{},,50.0\n", 200 * k, 4.0 + 0.01 * k as f64);
+        }
+    }
+    std::fs::write(root.join("runs/rcp/critical/holds.csv"), &holds).unwrap();
+    let beta0 = holds
+        .replace("2.65", "3.00")
+        .replace("2.60", "2.90")
+        .replace("2.55", "2.80");
+    std::fs::write(root.join("ordering/rcp_beta0/holds.csv"), beta0).unwrap();
+    let out = root.join("out");
+    let md = std::fs::read_to_string(
+        write_report(
+            &root.join("runs"),
+            None,
+            None,
+            None,
+            Some(&root.join("ordering")),
+            &out,
+            false,
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let section = &md[md.find("## Packing ordering").expect("an ordering section")..];
+    let row = |start: &str| {
+        section
+            .lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no row {start}: {section}"))
+            .to_string()
+    };
+    let nominal = row("| Zhang17 Eqs. 11–12");
+    assert!(
+        nominal.contains("| 2.64 h, 47.2° | > 2.68 h | 2.60 h, 48.0° | 2.60 h, 48.0° | -0.04 |"),
+        "{nominal}"
+    );
+    let beta0 = row("| β = 0");
+    assert!(
+        beta0.contains("| 2.70 h, 46.0° | > 2.74 h | > 3.00 h | > 3.00 h | – |"),
+        "{beta0}"
+    );
+    assert!(row("| paper (Table 3").ends_with("| +0.43 |"));
+    assert!(!section.contains("caps × 2"), "variants not run get no row");
+    // the holds: the figures come from the ladder's and the ordering's searches (not RUNS'), here the β = 0 one
+    let holds_md = &md[md.find("## Holds").expect("a holds section")..];
+    assert!(holds_md.contains("### contact law rcp_beta0"), "{holds_md}");
+    assert!(holds_md.contains("| 3.00 | "), "{holds_md}");
+    assert!(out.join("fig22_contact_law_rcp_beta0.png").is_file());
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -3,7 +3,8 @@
 spinup.csv, timeseries.csv, summary.json and scene.toml as they are, and particles.json in place of the snapshots
 (n, radius_min_m, radius_max_m, mass_kg of the first snapshot: what `rubblepile report zhang2017` reads from
 snapshots/0.csv when a run keeps its snapshots). Searches: critical.json and critical.csv of a `spinup critical`
-directory.
+directory, and holds.csv: every hold's samples from its start (the scene's `spinup.t_final`) to its end, the state
+variables that Zhang17 Fig. 22 follows (θ_max, η_B, the coordination number) with the period and the bound mass.
 
 Usage: python3 analysis/zhang2017/compact.py RUN_DIR OUT_DIR          # a run
        python3 analysis/zhang2017/compact.py --search SEARCH_DIR OUT_DIR   # a T_c3 search
@@ -23,6 +24,35 @@ def copy(src, dst, force):
     shutil.copyfile(src, dst)
 
 
+HOLD_COLUMNS = ["period_h", "body_mass_fraction", "packing_fraction", "coordination_number", "coordination_loaded",
+                "theta_max_deg"]
+
+
+def write_holds(search_dir, dst, force):
+    """One row per sample of every hold in critical.json's `runs`, from the hold's start on: t_final_h (the hold's
+    period), t_hold_s (seconds since the hold began) and HOLD_COLUMNS (empty where a run lacks the column)."""
+    import tomllib
+    if os.path.exists(dst) and not force:
+        sys.exit(f"{dst} exists (use --force to overwrite it)")
+    with open(os.path.join(search_dir, "critical.json")) as f:
+        runs = json.load(f)["runs"]
+    rows = []
+    for run in runs:
+        hold = os.path.join(search_dir, os.path.basename(run["dir"]))
+        with open(os.path.join(hold, "scene.toml"), "rb") as f:
+            t0 = tomllib.load(f)["spinup"]["t_final"]
+        with open(os.path.join(hold, "spinup.csv")) as f:
+            for r in csv.DictReader(f):
+                t = float(r["t"])
+                if t + 1e-6 < t0:
+                    continue
+                rows.append([f"{run['t_final_hours']:.2f}", f"{t - t0:.1f}"] + [r.get(c, "") for c in HOLD_COLUMNS])
+    with open(dst, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["t_final_h", "t_hold_s"] + HOLD_COLUMNS)
+        w.writerows(rows)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("src")
@@ -38,6 +68,7 @@ def main():
             sys.exit(f"{src}: missing (a run still going has no summary.json: wait for it)")
         copy(src, os.path.join(a.out, name), a.force)
     if a.search:
+        write_holds(a.src, os.path.join(a.out, "holds.csv"), a.force)
         return
     with open(os.path.join(a.src, "snapshots", "0.csv")) as f:
         rows = list(csv.DictReader(f))

@@ -8,7 +8,7 @@
 //!   the second half of the hold is creep; `C` is the largest fall of the coordination number let pass, default
 //!   0.05) and ours (θ_max or η_B moving either way; the coordination number not judged). A hold is stable under a
 //!   criterion when the forcing was never released and nothing drifts by it. T_c,3 under a criterion is its first
-//!   stable T_final, and φ the largest θ_max over the holds within ±0.01 h of it. The search goes on until both
+//!   stable T_final, and φ the largest θ_max of that hold (the critical state's). The search goes on until both
 //!   criteria have a stable hold and one step beyond it (for φ), or to `--to`. `critical.json` ([`CriticalSearch`])
 //!   holds both T_c,3 values (`paper`, `ours`), the measured drifts and both verdicts per hold; its top-level
 //!   `t_c3_hours` and `friction_angle_deg` are those of `--creep-criterion` (default `paper`). `critical.csv` is
@@ -133,7 +133,7 @@ pub struct CriterionResult {
     pub criterion: CreepCriterion,
     /// T_c,3 (h): the shortest T_final from which every slower hold searched is stable under it.
     pub t_c3_hours: Option<f64>,
-    /// φ (degrees): the largest θ_max over the holds within ±0.01 h of that T_c,3.
+    /// φ (degrees): the largest θ_max of the hold at that T_c,3.
     pub friction_angle_deg: Option<f64>,
     /// Stable holds (T_final, h) below a creeping one, set aside by the monotone rule ([`set_aside`]).
     pub set_aside_hours: Vec<f64>,
@@ -223,18 +223,15 @@ fn stable_from(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Option<usize> 
 
 /// Reduces judged runs (by increasing T_final) to T_c,3 and φ under criterion `kind`. T_c,3 is the shortest T_final
 /// from which every slower hold is stable (the verdict made monotone: a stable hold below a creeping one does not
-/// count, see [`set_aside`]); φ the largest θ_max over the holds within ±0.01 h of it (Zhang17 §3.3.3).
+/// count, see [`set_aside`]); φ the largest θ_max of the hold at T_c,3: Zhang17 §3.3.3 takes φ as the largest
+/// mobilized angle *at the critical state*, the stable hold. (Until 28 Nov 2026 φ was the largest θ_max within
+/// ±0.01 h of T_c,3, which on a 0.01 h grid took the disrupted hold's θ_max, a post-failure value.)
 pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) -> (Option<f64>, Option<f64>) {
-    let t_c3 = stable_from(runs, kind).map(|i| runs[i].t_final_hours);
-    let phi = t_c3.and_then(|t| {
-        let m = runs
-            .iter()
-            .filter(|r| (r.t_final_hours - t).abs() <= 0.01 + 1e-9)
-            .map(|r| r.theta_max_deg)
-            .fold(f64::NAN, f64::max);
-        m.is_finite().then_some(m)
-    });
-    (t_c3, phi)
+    let Some(i) = stable_from(runs, kind) else {
+        return (None, None);
+    };
+    let phi = runs[i].theta_max_deg;
+    (Some(runs[i].t_final_hours), phi.is_finite().then_some(phi))
 }
 
 /// The T_final (h) of holds stable under `kind` that lie below a creeping or disrupted one: where the verdict is
@@ -250,7 +247,7 @@ pub fn set_aside(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Vec<f64> {
 }
 
 /// Whether the search may stop after `runs`: under every criterion the slowest two holds are stable (T_c,3 and a
-/// judged hold after it, since φ looks ±0.01 h around T_c,3).
+/// judged hold after it: a T_c,3 is only trusted with a slower stable hold beside it).
 pub fn search_done(runs: &[HoldVerdict]) -> bool {
     CreepCriterionKind::ALL
         .iter()
@@ -838,8 +835,8 @@ mod tests {
     }
 
     /// The creep criteria on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps
-    /// under both; T_c,3 is the first stable T_final (every slower one stable too) and φ the largest θ_max within
-    /// ±0.01 h of it.
+    /// under both; T_c,3 is the first stable T_final (every slower one stable too) and φ the largest θ_max of
+    /// that hold, not of the creeping one beside it.
     #[test]
     fn hold_verdicts_give_t_c3_and_phi() {
         let flat = |v: f64| move |_: f64| v;
@@ -864,7 +861,7 @@ mod tests {
         assert_eq!(runs[0].ours.drifting, vec!["theta_max"]);
         assert!(runs[1].stable && runs[2].stable);
         for k in CreepCriterionKind::ALL {
-            assert_eq!(critical_from_verdicts(&runs, k), (Some(2.41), Some(42.0)));
+            assert_eq!(critical_from_verdicts(&runs, k), (Some(2.41), Some(39.0)));
         }
         assert!(search_done(&runs) && !search_done(&runs[..2]));
         // `--all-holds` never stops early; the default stops exactly when the search is done
@@ -942,7 +939,7 @@ mod tests {
         assert_eq!(t_ours, Some(2.55));
         assert_eq!(t_paper, Some(2.59));
         assert!((phi_ours.unwrap() - 50.0).abs() < 1e-9);
-        assert!((phi_paper.unwrap() - (50.0 - 10.0 * 0.03)).abs() < 1e-9);
+        assert!((phi_paper.unwrap() - (50.0 - 10.0 * 0.04)).abs() < 1e-9);
         assert!(!search_done(&runs[..4]) && !search_done(&runs[..5]) && search_done(&runs));
         let csv = critical_csv(&runs);
         assert!(csv.starts_with(CRITICAL_CSV_HEADER));

@@ -91,7 +91,7 @@ impl Figure for LineChart {
                 .x_label_formatter(&super::style::log_tick)
                 .draw()
                 .map_err(draw_err)?;
-            self.draw_series(&mut c, &ok)?;
+            draw_series(&mut c, &self.series, &ok)?;
             draw_legend(&mut c, SeriesLabelPosition::UpperLeft)
         } else {
             let xr = padded(x0, x1, 0.02);
@@ -103,57 +103,56 @@ impl Figure for LineChart {
                 .label_style(small_style())
                 .draw()
                 .map_err(draw_err)?;
-            self.draw_series(&mut c, &ok)?;
+            draw_series(&mut c, &self.series, &ok)?;
             draw_legend(&mut c, SeriesLabelPosition::UpperRight)
         }
     }
 }
 
-impl LineChart {
-    fn draw_series<'a, DB: DrawingBackend + 'a, CT>(
-        &self,
-        chart: &mut ChartContext<'a, DB, CT>,
-        ok: &dyn Fn(&(f64, f64)) -> bool,
-    ) -> PlotResult
-    where
-        CT: CoordTranslate<From = (f64, f64)>,
-    {
-        for s in &self.series {
-            let colour = SERIES_COLOURS[s.colour % SERIES_COLOURS.len()];
-            let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(ok).collect();
-            let anno = match s.mark {
-                Mark::Line => chart
-                    .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
-                    .map_err(draw_err)?,
-                Mark::Dashed => chart
-                    .draw_series(DashedLineSeries::new(pts, 6, 4, colour.stroke_width(1)))
-                    .map_err(draw_err)?,
-                Mark::Points => {
-                    let bars: Vec<_> = s
-                        .points
-                        .iter()
-                        .zip(&s.errors)
-                        .filter(|(p, e)| ok(p) && e.is_finite() && **e > 0.0)
-                        .map(|(&(x, y), &e)| PathElement::new(vec![(x, y - e), (x, y + e)], colour.stroke_width(1)))
-                        .collect();
-                    chart.draw_series(bars).map_err(draw_err)?;
-                    chart
-                        .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
-                        .map_err(draw_err)?
-                }
+/// Draws `series` on `chart` as their [`Mark`]s say, the points that pass `ok` only, each labelled for the legend.
+pub(crate) fn draw_series<'a, DB: DrawingBackend + 'a, CT>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    series: &[Series],
+    ok: &dyn Fn(&(f64, f64)) -> bool,
+) -> PlotResult
+where
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    for s in series {
+        let colour = SERIES_COLOURS[s.colour % SERIES_COLOURS.len()];
+        let pts: Vec<(f64, f64)> = s.points.iter().copied().filter(ok).collect();
+        let anno = match s.mark {
+            Mark::Line => chart
+                .draw_series(LineSeries::new(pts, colour.stroke_width(2)))
+                .map_err(draw_err)?,
+            Mark::Dashed => chart
+                .draw_series(DashedLineSeries::new(pts, 6, 4, colour.stroke_width(1)))
+                .map_err(draw_err)?,
+            Mark::Points => {
+                let bars: Vec<_> = s
+                    .points
+                    .iter()
+                    .zip(&s.errors)
+                    .filter(|(p, e)| ok(p) && e.is_finite() && **e > 0.0)
+                    .map(|(&(x, y), &e)| PathElement::new(vec![(x, y - e), (x, y + e)], colour.stroke_width(1)))
+                    .collect();
+                chart.draw_series(bars).map_err(draw_err)?;
+                chart
+                    .draw_series(pts.into_iter().map(|p| Circle::new(p, 4, colour.filled())))
+                    .map_err(draw_err)?
+            }
+        };
+        let dashed = s.mark == Mark::Dashed;
+        anno.label(&s.label).legend(move |(x, y)| {
+            let style = if dashed {
+                colour.stroke_width(1)
+            } else {
+                colour.stroke_width(2)
             };
-            let dashed = s.mark == Mark::Dashed;
-            anno.label(&s.label).legend(move |(x, y)| {
-                let style = if dashed {
-                    colour.stroke_width(1)
-                } else {
-                    colour.stroke_width(2)
-                };
-                PathElement::new(vec![(x, y), (x + 20, y)], style)
-            });
-        }
-        Ok(())
+            PathElement::new(vec![(x, y), (x + 20, y)], style)
+        });
     }
+    Ok(())
 }
 
 #[cfg(test)]

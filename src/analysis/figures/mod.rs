@@ -6,6 +6,7 @@
 //! * [`campaign_figures`]: a campaign — Fig. 5 `bound_fraction_vs_q`, Fig. 7 `spin_distributions`.
 //! * [`sfd`]: the cumulative mass distribution of a snapshot's clumps (`sfd`).
 //! * [`spinup_figures`]: Zhang17 Fig. 5-style time series of a spin-up run.
+//! * [`stacked`]: panels of lines over one x axis (Zhang17 Fig. 22: the holds of a T_c,3 search).
 //! * [`energy`]: the data of Fig. 2 (energies and momentum drift over time from `timeseries.csv` and
 //!   `tracks.csv`).
 //! * [`style`]: the embedded font, the common look, and [`style::write_figure`], which renders each figure
@@ -20,6 +21,7 @@ pub mod lines;
 pub mod run_figures;
 pub mod sfd;
 pub mod spinup_figures;
+pub mod stacked;
 pub mod style;
 
 pub use campaign_figures::{write_campaign_figures, write_spin_distributions};

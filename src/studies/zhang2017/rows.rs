@@ -74,7 +74,7 @@ pub struct DensitySeries {
 }
 
 /// The bulk density of a row (kg/m³): `ρ_B = 2100 M/M_P` (Zhang17 §4.2).
-fn bulk_density(row: &ModelRow) -> f64 {
+pub(crate) fn bulk_density(row: &ModelRow) -> f64 {
     2100.0 * row.mass / DIDYMOS_MASS
 }
 
@@ -387,18 +387,19 @@ pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
     Ok(models)
 }
 
-/// The result of a T_c,3 search directory: its `critical.json`, or, in a compact copy that keeps only
-/// `critical.csv` (the searches committed before the JSON was kept), the same fields re-derived from the judged
-/// holds by [`crate::analysis::spinup_search::critical_from_verdicts`]: `t_c3_hours` and `friction_angle_deg` (the
-/// paper's criterion, the search's default), `paper`, `ours`, and `runs` (their `t_final_hours`). `None` when
-/// neither file is there or readable.
+/// The result of a T_c,3 search directory, re-derived from its judged holds (`critical.csv`) by
+/// [`crate::analysis::spinup_search::critical_from_verdicts`], so that every search is read by today's rule
+/// whenever it ran: `t_c3_hours` and `friction_angle_deg` (the paper's criterion, the search's default), `paper`,
+/// `ours`, and `runs` (their `t_final_hours`). A directory with only `critical.json` is read as written. `None`
+/// when neither file is there or readable.
 pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
     use crate::analysis::creep::CreepCriterionKind;
     use crate::analysis::spinup_search::{critical_from_verdicts, read_critical_csv};
-    if let Ok(text) = std::fs::read_to_string(search_dir.join("critical.json")) {
+    let Some(csv) = std::fs::read_to_string(search_dir.join("critical.csv")).ok() else {
+        let text = std::fs::read_to_string(search_dir.join("critical.json")).ok()?;
         return serde_json::from_str(&text).ok();
-    }
-    let holds = read_critical_csv(&std::fs::read_to_string(search_dir.join("critical.csv")).ok()?).ok()?;
+    };
+    let holds = read_critical_csv(&csv).ok()?;
     let of = |kind| {
         let (t, phi) = critical_from_verdicts(&holds, kind);
         serde_json::json!({ "t_c3_hours": t, "friction_angle_deg": phi })

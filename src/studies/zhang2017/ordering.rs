@@ -1,0 +1,178 @@
+//! Does the paper's packing ordering of T_c,3 (Zhang17 Table 3: HCP strongest at 2.40 h, RCP weakest at 2.83 h)
+//! depend on the contact law? The HCP and RCP models' T_c,3 searches with the twisting and rolling resistance of
+//! Zhang17 Eqs. 11–12 changed (issue 40: the measured reason the ordering is or is not reproduced).
+//!
+//! Layout read: `ORDERING/<model>_<variant>/critical.{json,csv}` (compact copies of `rubblepile spinup critical`
+//! directories), `<variant>` one of [`VARIANTS`]; the nominal material's searches are the Table 3 ones,
+//! `RUNS/<model>/critical`. A search that found no stable hold is shown as "> its slowest hold".
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::ladder::{RungSearch, read_search};
+use super::rows::{TABLE3, opt};
+
+/// The contact-law variants, strongest rolling and twisting resistance first: directory suffix and what changes
+/// against Zhang17 §2.3.3's nominal material (β = 0.5, μ_T = 1.3, μ_R = 1.05).
+pub const VARIANTS: [(&str, &str); 4] = [
+    ("caps_x2", "twisting and rolling caps × 2 (μ_T 2.6, μ_R 2.1)"),
+    ("nominal", "Zhang17 Eqs. 11–12 as written (β 0.5, μ_T 1.3, μ_R 1.05)"),
+    ("caps_half", "twisting and rolling caps × ½ (μ_T 0.65, μ_R 0.525)"),
+    ("beta0", "β = 0: no twisting or rolling resistance"),
+];
+
+/// The two models whose order the paper's Table 3 sets apart most (T_c,3 2.40 h and 2.83 h).
+pub const MODELS: [&str; 2] = ["hcp", "rcp"];
+
+/// One variant's searches: per model of [`MODELS`], the search if it was run.
+#[derive(Debug, Clone)]
+pub struct VariantRow {
+    /// Directory suffix of [`VARIANTS`].
+    pub variant: &'static str,
+    /// What the variant changes.
+    pub what: &'static str,
+    /// The HCP and RCP searches, in [`MODELS`] order.
+    pub searches: [Option<(RungSearch, f64)>; 2],
+}
+
+/// T_c,3 by our criterion as a cell: the value and φ, or "> slowest hold" when no hold was stable.
+fn cell(s: &Option<(RungSearch, f64)>, paper_criterion: bool) -> String {
+    match s {
+        None => "not run".into(),
+        Some((search, slowest)) => {
+            let (t, phi) = if paper_criterion { search.paper } else { search.ours };
+            match t {
+                Some(t) => format!("{t:.2} h, {}°", opt(phi, 1)),
+                None => format!("> {slowest:.2} h"),
+            }
+        }
+    }
+}
+
+/// RCP's T_c,3 minus HCP's (h) by our criterion, when both searches found one: positive is the paper's order.
+pub fn rcp_minus_hcp(row: &VariantRow) -> Option<f64> {
+    let t = |k: usize| row.searches[k].as_ref().and_then(|(s, _)| s.ours.0);
+    Some(t(1)? - t(0)?)
+}
+
+/// Reads the variants' searches: nominal from `runs/<model>/critical`, the others from `ordering/<model>_<variant>`.
+pub fn read_variants(runs: &Path, ordering: &Path) -> Vec<VariantRow> {
+    VARIANTS
+        .iter()
+        .map(|&(variant, what)| {
+            let dir = |model: &str| {
+                if variant == "nominal" {
+                    runs.join(model).join("critical")
+                } else {
+                    ordering.join(format!("{model}_{variant}"))
+                }
+            };
+            let searches = MODELS.map(|m| {
+                let d = dir(m);
+                let search = read_search(&d)?;
+                Some((search.clone(), slowest_hold(&d).unwrap_or(f64::NAN)))
+            });
+            VariantRow {
+                variant,
+                what,
+                searches,
+            }
+        })
+        .collect()
+}
+
+/// The slowest T_final (h) a search ran.
+fn slowest_hold(dir: &Path) -> Option<f64> {
+    let v = super::rows::read_critical(dir)?;
+    v["runs"]
+        .as_array()?
+        .iter()
+        .filter_map(|r| r["t_final_hours"].as_f64())
+        .reduce(f64::max)
+}
+
+/// Writes the "Packing ordering and the contact law" section.
+pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
+    let rows = read_variants(runs, ordering);
+    let paper = |m: &str| TABLE3.iter().find(|p| p.0 == m).map(|p| (p.5, p.2));
+    let _ = writeln!(md, "\n## Packing ordering and the contact law\n");
+    let _ = writeln!(
+        md,
+        "Zhang17 Table 3 orders the models by strength, HCP strongest (T_c3 2.40 h) and RCP weakest (2.83 h). The \
+         scaled HCP (3033 grains) and RCP (2083 grains) searched with the twisting and rolling resistance of Eqs. \
+         11–12 changed, everything else as in Table 3 above (searches under `{}`, the nominal ones under `{}`; \
+         holds of 16 000 s branched off one path-2 run each). T_c3 by our creep criterion (θ_max and η_B) and by \
+         the paper's (also the coordination number); \"> X\" when no hold up to X h was stable. The last column is \
+         RCP's T_c3 minus HCP's by ours: positive is the paper's order.\n",
+        ordering.display(),
+        runs.display()
+    );
+    let _ = writeln!(
+        md,
+        "| contact law | HCP: ours | HCP: paper's criterion | RCP: ours | RCP: paper's criterion | RCP − HCP (h) |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- |");
+    for r in &rows {
+        if r.searches.iter().all(Option::is_none) {
+            continue;
+        }
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {} | {} | {} |",
+            r.what,
+            cell(&r.searches[0], false),
+            cell(&r.searches[0], true),
+            cell(&r.searches[1], false),
+            cell(&r.searches[1], true),
+            rcp_minus_hcp(r).map_or("–".into(), |d| format!("{d:+.2}")),
+        );
+    }
+    if let (Some(h), Some(c)) = (paper("hcp"), paper("rcp")) {
+        let _ = writeln!(
+            md,
+            "| paper (Table 3, full size) | {:.2} h, {:.0}° | | {:.2} h, {:.0}° | | {:+.2} |",
+            h.0,
+            h.1,
+            c.0,
+            c.1,
+            c.0 - h.0
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn search(ours: Option<f64>) -> Option<(RungSearch, f64)> {
+        Some((
+            RungSearch {
+                name: "critical".into(),
+                step_hours: 0.05,
+                paper: (None, None),
+                ours: (ours, Some(45.0)),
+                holds: 5,
+            },
+            2.9,
+        ))
+    }
+
+    #[test]
+    fn the_ordering_is_rcp_minus_hcp_and_needs_both() {
+        let row = |h, r| VariantRow {
+            variant: "nominal",
+            what: "",
+            searches: [search(h), search(r)],
+        };
+        assert_eq!(
+            rcp_minus_hcp(&row(Some(2.40), Some(2.83))).map(|d| (d * 100.0).round()),
+            Some(43.0)
+        );
+        assert!(rcp_minus_hcp(&row(Some(2.64), Some(2.60))).unwrap() < 0.0);
+        assert_eq!(rcp_minus_hcp(&row(None, Some(2.6))), None);
+        assert_eq!(cell(&search(None), false), "> 2.90 h");
+        assert_eq!(cell(&search(Some(2.6)), false), "2.60 h, 45.0°");
+        assert_eq!(cell(&search(Some(2.6)), true), "> 2.90 h");
+        assert_eq!(cell(&None, true), "not run");
+    }
+}
