@@ -430,7 +430,8 @@ fn critical_csv(dir: &Path, holds: &[(f64, bool, bool, bool)]) {
 }
 
 /// `--ordering`: the variants' T_c,3 of HCP and RCP side by side with RCP − HCP (positive: the paper's order), a
-/// search without a stable hold as "> its slowest hold", the nominal row from RUNS; and the Fig. 22 analogue:
+/// search without a stable hold as "> its slowest hold", the nominal row from RUNS, a variant's coarse and fine
+/// searches judged as one; and the Fig. 22 analogue:
 /// every search with a `holds.csv` gets its hold table (with the density a hold stands for at 2.26 h) and figure,
 /// the φ of a search being the θ_max of its T_c,3 hold, not of the released hold beside it.
 #[test]
@@ -464,13 +465,14 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
             (3.00, true, false, false),
         ],
     );
+    // HCP's in two searches, judged together: the fine one's 2.70 h hold makes T_c,3
     critical_csv(
-        &root.join("ordering/hcp_beta0"),
-        &[
-            (2.66, true, false, false),
-            (2.70, false, true, false),
-            (2.74, false, true, false),
-        ],
+        &root.join("ordering/hcp_beta0/critical"),
+        &[(2.66, true, false, false), (2.74, false, true, false)],
+    );
+    critical_csv(
+        &root.join("ordering/hcp_beta0/critical_fine"),
+        &[(2.70, false, true, false)],
     );
     // the nominal RCP's holds, as compact.py writes them
     let mut holds = "t_final_h,t_hold_s,period_h,body_mass_fraction,packing_fraction,coordination_number,\

@@ -129,3 +129,51 @@ fn the_rcp_ladder_scales_stiffness_and_step_with_the_grain_radius() {
     assert_eq!(rung.spinup.as_ref().unwrap().path, base.spinup.as_ref().unwrap().path);
     assert_eq!(rung.t_end, base.t_end);
 }
+
+/// The contact-law variants of `contact_check/` (the packing-ordering searches of REPORT.md) load, and each differs
+/// from the nominal scene of its model (`<model>_path2.toml`) only in the twisting and rolling law: β, μ_T, μ_R.
+/// Regression guard: a variant that also changed the path, the step or k_N would not measure the contact law.
+#[test]
+fn contact_law_variants_differ_from_their_nominal_scene_only_in_beta_and_the_caps() {
+    let d = dir().join("contact_check");
+    let mut names: Vec<String> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 5, "{names:?}");
+    let table = |path: &Path| -> toml::Table { toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap() };
+    for name in &names {
+        let model = name.split('_').next().unwrap();
+        let mut variant = table(&d.join(name));
+        let mut nominal = table(&dir().join(format!("{model}_path2.toml")));
+        let text = std::fs::read_to_string(d.join(name)).unwrap();
+        parse_soft_scene(&text, name, Some(Path::new(&d))).unwrap_or_else(|e| panic!("{name}: {e}"));
+        // the same target file, seen from one directory deeper
+        let file = |t: &toml::Table| t["scene"]["particles_file"].as_str().unwrap().to_string();
+        assert_eq!(file(&variant), format!("../{}", file(&nominal)), "{name}");
+        let mut changed = Vec::new();
+        for t in [&mut variant, &mut nominal] {
+            t["scene"].as_table_mut().unwrap().remove("particles_file");
+        }
+        let contact = |t: &mut toml::Table| t["contact"].as_table_mut().unwrap().clone();
+        let (vc, nc) = (contact(&mut variant), contact(&mut nominal));
+        for key in ["beta", "mu_t", "mu_r"] {
+            if vc.get(key) != nc.get(key) {
+                changed.push(key);
+            }
+        }
+        assert!(!changed.is_empty(), "{name} changes nothing");
+        for t in [&mut variant, &mut nominal] {
+            let c = t["contact"].as_table_mut().unwrap();
+            for key in ["beta", "mu_t", "mu_r"] {
+                c.remove(key);
+            }
+        }
+        assert_eq!(
+            variant, nominal,
+            "{name} differs from {model}_path2.toml beyond {changed:?}"
+        );
+    }
+}

@@ -2,14 +2,19 @@
 //! depend on the contact law? The HCP and RCP models' T_c,3 searches with the twisting and rolling resistance of
 //! Zhang17 Eqs. 11–12 changed (issue 40: the measured reason the ordering is or is not reproduced).
 //!
-//! Layout read: `ORDERING/<model>_<variant>/critical.{json,csv}` (compact copies of `rubblepile spinup critical`
-//! directories), `<variant>` one of [`VARIANTS`]; the nominal material's searches are the Table 3 ones,
-//! `RUNS/<model>/critical`. A search that found no stable hold is shown as "> its slowest hold".
+//! Layout read: `ORDERING/<model>_<variant>/critical*/critical.csv` (compact copies of `rubblepile spinup critical`
+//! directories: a coarse search and, where it bracketed T_c,3, a finer one), `<variant>` one of [`VARIANTS`]; the
+//! nominal material's searches are the Table 3 ones, `RUNS/<model>/critical`. The holds of all of a variant's
+//! searches are judged together ([`union_search`]: every hold branches off the same path, so a fine search only adds
+//! holds). A variant that found no stable hold is shown as "> its slowest hold".
 
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::ladder::{RungSearch, read_search};
+use crate::analysis::creep::CreepCriterionKind;
+use crate::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
+
+use super::ladder::RungSearch;
 use super::rows::{TABLE3, opt};
 
 /// The contact-law variants, strongest rolling and twisting resistance first: directory suffix and what changes
@@ -67,28 +72,59 @@ pub fn read_variants(runs: &Path, ordering: &Path) -> Vec<VariantRow> {
                     ordering.join(format!("{model}_{variant}"))
                 }
             };
-            let searches = MODELS.map(|m| {
-                let d = dir(m);
-                let search = read_search(&d)?;
-                Some((search.clone(), slowest_hold(&d).unwrap_or(f64::NAN)))
-            });
             VariantRow {
                 variant,
                 what,
-                searches,
+                searches: MODELS.map(|m| union_search(&dir(m))),
             }
         })
         .collect()
 }
 
-/// The slowest T_final (h) a search ran.
-fn slowest_hold(dir: &Path) -> Option<f64> {
-    let v = super::rows::read_critical(dir)?;
-    v["runs"]
-        .as_array()?
-        .iter()
-        .filter_map(|r| r["t_final_hours"].as_f64())
-        .reduce(f64::max)
+/// The search directories of a variant: its `critical*` subdirectories, or `dir` itself when it has none.
+pub fn search_dirs(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut subs: Vec<_> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_dir()
+                && p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("critical"))
+        })
+        .collect();
+    subs.sort();
+    if subs.is_empty() { vec![dir.to_path_buf()] } else { subs }
+}
+
+/// All holds of the searches under `dir` ([`search_dirs`]) judged together: by increasing T_final, a hold run twice
+/// kept once (the later search's); T_c,3 and φ by both criteria from [`critical_from_verdicts`], and the slowest
+/// hold (h). `None` without any readable `critical.csv`.
+pub fn union_search(dir: &Path) -> Option<(RungSearch, f64)> {
+    let mut holds: Vec<HoldVerdict> = Vec::new();
+    for d in search_dirs(dir) {
+        let Ok(text) = std::fs::read_to_string(d.join("critical.csv")) else {
+            continue;
+        };
+        for h in read_critical_csv(&text).ok()? {
+            holds.retain(|k| (k.t_final_hours - h.t_final_hours).abs() > 1e-9);
+            holds.push(h);
+        }
+    }
+    holds.sort_by(|a, b| a.t_final_hours.total_cmp(&b.t_final_hours));
+    let slowest = holds.last()?.t_final_hours;
+    let step_hours = holds
+        .windows(2)
+        .map(|w| w[1].t_final_hours - w[0].t_final_hours)
+        .fold(f64::INFINITY, f64::min);
+    let search = RungSearch {
+        name: dir.file_name()?.to_string_lossy().into_owned(),
+        step_hours,
+        paper: critical_from_verdicts(&holds, CreepCriterionKind::Paper),
+        ours: critical_from_verdicts(&holds, CreepCriterionKind::Ours),
+        holds: holds.len(),
+    };
+    Some((search, slowest))
 }
 
 /// Writes the "Packing ordering and the contact law" section.

@@ -332,9 +332,17 @@ fn hold_searches(
             out.push((format!("ladder {} {}", name(&rung), name(&s)), s, rho));
         }
     }
-    for s in ordering.map(subdirs).unwrap_or_default() {
-        let model = name(&s).split('_').next().unwrap_or_default().to_string();
-        out.push((format!("contact law {}", name(&s)), s, rho(&runs.join(model))));
+    for variant in ordering.map(subdirs).unwrap_or_default() {
+        let model = name(&variant).split('_').next().unwrap_or_default().to_string();
+        let rho = rho(&runs.join(model));
+        for s in crate::studies::zhang2017::ordering::search_dirs(&variant) {
+            let label = if s == variant {
+                format!("contact law {}", name(&variant))
+            } else {
+                format!("contact law {} {}", name(&variant), name(&s))
+            };
+            out.push((label, s, rho));
+        }
     }
     out
 }
