@@ -456,23 +456,23 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
             (2.65, false, true, true),
         ],
     );
-    // β = 0: RCP never stable up to 3.00 h, HCP at 2.70 h; the paper's order
+    // β = 0: RCP stops failing at 3.00 h, HCP at 2.70 h (the paper's order), though HCP's slowest hold creeps
     critical_csv(
         &root.join("ordering/rcp_beta0"),
         &[
             (2.80, true, false, false),
             (2.90, false, false, false),
-            (3.00, true, false, false),
+            (3.00, false, true, false),
         ],
     );
-    // HCP's in two searches, judged together: the fine one's 2.70 h hold makes T_c,3
+    // HCP's in two searches, judged together: the fine one's 2.70 h hold is where it stops failing
     critical_csv(
         &root.join("ordering/hcp_beta0/critical"),
         &[(2.66, true, false, false), (2.74, false, true, false)],
     );
     critical_csv(
         &root.join("ordering/hcp_beta0/critical_fine"),
-        &[(2.70, false, true, false)],
+        &[(2.70, false, true, false), (2.78, false, false, false)],
     );
     // the nominal RCP's holds, as compact.py writes them
     let mut holds = "t_final_h,t_hold_s,period_h,body_mass_fraction,packing_fraction,coordination_number,\
@@ -484,11 +484,11 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
         }
     }
     std::fs::write(root.join("runs/rcp/critical/holds.csv"), &holds).unwrap();
-    let beta0 = holds
+    let beta0_holds = holds
         .replace("2.65", "3.00")
         .replace("2.60", "2.90")
         .replace("2.55", "2.80");
-    std::fs::write(root.join("ordering/rcp_beta0/holds.csv"), beta0).unwrap();
+    std::fs::write(root.join("ordering/rcp_beta0/holds.csv"), beta0_holds).unwrap();
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(
@@ -513,12 +513,18 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
     };
     let nominal = row("| Zhang17 Eqs. 11–12");
     assert!(
-        nominal.contains("| 2.64 h, 47.2° | > 2.68 h | 2.60 h, 48.0° | 2.60 h, 48.0° | -0.04 |"),
+        nominal.contains(
+            "| 2.64 h, 47.2° | > 2.68 h | 2.64 h | R 2.60, S 2.64, S 2.68 \
+             | 2.60 h, 48.0° | 2.60 h, 48.0° | 2.60 h | R 2.55, S 2.60, S 2.65 | -0.04 |"
+        ),
         "{nominal}"
     );
     let beta0 = row("| β = 0");
     assert!(
-        beta0.contains("| 2.70 h, 46.0° | > 2.74 h | > 3.00 h | > 3.00 h | – |"),
+        beta0.contains(
+            "| > 2.78 h | > 2.78 h | 2.70 h | R 2.66, S 2.70, S 2.74, C 2.78 \
+             | 3.00 h, 40.0° | > 3.00 h | 3.00 h | R 2.80, C 2.90, S 3.00 | +0.30 |"
+        ),
         "{beta0}"
     );
     assert!(row("| paper (Table 3").ends_with("| +0.43 |"));

@@ -18,16 +18,33 @@ use super::ladder::RungSearch;
 use super::rows::{TABLE3, opt};
 
 /// The contact-law variants, strongest rolling and twisting resistance first: directory suffix and what changes
-/// against Zhang17 §2.3.3's nominal material (β = 0.5, μ_T = 1.3, μ_R = 1.05).
-pub const VARIANTS: [(&str, &str); 4] = [
+/// against Zhang17 §2.3.3's nominal material (β = 0.5, μ_T = 1.3, μ_R = 1.05) and our k_N (`kn5`: the stiffness
+/// check of item 4, scenes `<model>_path2_kn5.toml`).
+pub const VARIANTS: [(&str, &str); 5] = [
     ("caps_x2", "twisting and rolling caps × 2 (μ_T 2.6, μ_R 2.1)"),
     ("nominal", "Zhang17 Eqs. 11–12 as written (β 0.5, μ_T 1.3, μ_R 1.05)"),
+    ("kn5", "as written, k_N × 5 and dt / √5 (overlaps ≲ 1 %)"),
     ("caps_half", "twisting and rolling caps × ½ (μ_T 0.65, μ_R 0.525)"),
     ("beta0", "β = 0: no twisting or rolling resistance"),
 ];
 
 /// The two models whose order the paper's Table 3 sets apart most (T_c,3 2.40 h and 2.83 h).
 pub const MODELS: [&str; 2] = ["hcp", "rcp"];
+
+/// All holds of one model under one variant, judged together ([`union_search`]).
+#[derive(Debug, Clone)]
+pub struct VariantSearch {
+    /// T_c,3 and φ by both criteria, the finest step and the number of holds.
+    pub search: RungSearch,
+    /// The slowest hold (h).
+    pub slowest_hours: f64,
+    /// The shortest period above every released hold whose hold is stable by our criterion (h): where the pile
+    /// stops failing, whatever slower holds do (a θ_max that keeps falling by more than 0.5° over a slow hold's
+    /// second half makes our criterion reject it, and the trailing-run rule then every faster hold too).
+    pub after_release_hours: Option<f64>,
+    /// The holds by our criterion, fastest first: `R` released, `S` stable, `C` creeping, with the periods.
+    pub holds: String,
+}
 
 /// One variant's searches: per model of [`MODELS`], the search if it was run.
 #[derive(Debug, Clone)]
@@ -37,26 +54,27 @@ pub struct VariantRow {
     /// What the variant changes.
     pub what: &'static str,
     /// The HCP and RCP searches, in [`MODELS`] order.
-    pub searches: [Option<(RungSearch, f64)>; 2],
+    pub searches: [Option<VariantSearch>; 2],
 }
 
-/// T_c,3 by our criterion as a cell: the value and φ, or "> slowest hold" when no hold was stable.
-fn cell(s: &Option<(RungSearch, f64)>, paper_criterion: bool) -> String {
+/// T_c,3 as a cell: the value and φ, or "> slowest hold" when no hold was stable.
+fn cell(s: &Option<VariantSearch>, paper_criterion: bool) -> String {
     match s {
         None => "not run".into(),
-        Some((search, slowest)) => {
-            let (t, phi) = if paper_criterion { search.paper } else { search.ours };
+        Some(v) => {
+            let (t, phi) = if paper_criterion { v.search.paper } else { v.search.ours };
             match t {
                 Some(t) => format!("{t:.2} h, {}°", opt(phi, 1)),
-                None => format!("> {slowest:.2} h"),
+                None => format!("> {:.2} h", v.slowest_hours),
             }
         }
     }
 }
 
-/// RCP's T_c,3 minus HCP's (h) by our criterion, when both searches found one: positive is the paper's order.
+/// RCP's minus HCP's shortest stable period above their last released hold (h), when both have one: positive is
+/// the paper's order.
 pub fn rcp_minus_hcp(row: &VariantRow) -> Option<f64> {
-    let t = |k: usize| row.searches[k].as_ref().and_then(|(s, _)| s.ours.0);
+    let t = |k: usize| row.searches[k].as_ref().and_then(|v| v.after_release_hours);
     Some(t(1)? - t(0)?)
 }
 
@@ -98,9 +116,9 @@ pub fn search_dirs(dir: &Path) -> Vec<std::path::PathBuf> {
 }
 
 /// All holds of the searches under `dir` ([`search_dirs`]) judged together: by increasing T_final, a hold run twice
-/// kept once (the later search's); T_c,3 and φ by both criteria from [`critical_from_verdicts`], and the slowest
-/// hold (h). `None` without any readable `critical.csv`.
-pub fn union_search(dir: &Path) -> Option<(RungSearch, f64)> {
+/// kept once (the later search's); T_c,3 and φ by both criteria from [`critical_from_verdicts`]. `None` without
+/// any readable `critical.csv`.
+pub fn union_search(dir: &Path) -> Option<VariantSearch> {
     let mut holds: Vec<HoldVerdict> = Vec::new();
     for d in search_dirs(dir) {
         let Ok(text) = std::fs::read_to_string(d.join("critical.csv")) else {
@@ -112,19 +130,38 @@ pub fn union_search(dir: &Path) -> Option<(RungSearch, f64)> {
         }
     }
     holds.sort_by(|a, b| a.t_final_hours.total_cmp(&b.t_final_hours));
-    let slowest = holds.last()?.t_final_hours;
+    let slowest_hours = holds.last()?.t_final_hours;
     let step_hours = holds
         .windows(2)
         .map(|w| w[1].t_final_hours - w[0].t_final_hours)
         .fold(f64::INFINITY, f64::min);
-    let search = RungSearch {
-        name: dir.file_name()?.to_string_lossy().into_owned(),
-        step_hours,
-        paper: critical_from_verdicts(&holds, CreepCriterionKind::Paper),
-        ours: critical_from_verdicts(&holds, CreepCriterionKind::Ours),
-        holds: holds.len(),
+    let last_release = holds.iter().rposition(|h| h.released).map_or(0, |k| k + 1);
+    let after_release_hours = holds[last_release..]
+        .iter()
+        .find(|h| h.ours.stable)
+        .map(|h| h.t_final_hours);
+    let letter = |h: &HoldVerdict| match (h.released, h.ours.stable) {
+        (true, _) => 'R',
+        (false, true) => 'S',
+        (false, false) => 'C',
     };
-    Some((search, slowest))
+    let summary = holds
+        .iter()
+        .map(|h| format!("{} {:.2}", letter(h), h.t_final_hours))
+        .collect::<Vec<_>>()
+        .join(", ");
+    Some(VariantSearch {
+        search: RungSearch {
+            name: dir.file_name()?.to_string_lossy().into_owned(),
+            step_hours,
+            paper: critical_from_verdicts(&holds, CreepCriterionKind::Paper),
+            ours: critical_from_verdicts(&holds, CreepCriterionKind::Ours),
+            holds: holds.len(),
+        },
+        slowest_hours,
+        after_release_hours,
+        holds: summary,
+    })
 }
 
 /// Writes the "Packing ordering and the contact law" section.
@@ -138,35 +175,48 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
          scaled HCP (3033 grains) and RCP (2083 grains) searched with the twisting and rolling resistance of Eqs. \
          11–12 changed, everything else as in Table 3 above (searches under `{}`, the nominal ones under `{}`; \
          holds of 16 000 s branched off one path-2 run each). T_c3 by our creep criterion (θ_max and η_B) and by \
-         the paper's (also the coordination number); \"> X\" when no hold up to X h was stable. The last column is \
-         RCP's T_c3 minus HCP's by ours: positive is the paper's order.\n",
+         the paper's (also the coordination number), each where the trailing run of stable holds begins; \"> X\" \
+         when the slowest hold, X h, is not stable. 'Stops failing' is the shortest period above every released \
+         hold whose hold is stable by ours (it differs from T_c3 where slow holds relax, θ_max falling by more than \
+         0.5°). Holds: R released, S stable, C creeping, by ours. The last column is RCP's 'stops failing' minus \
+         HCP's: positive is the paper's order.\n",
         ordering.display(),
         runs.display()
     );
     let _ = writeln!(
         md,
-        "| contact law | HCP: ours | HCP: paper's criterion | RCP: ours | RCP: paper's criterion | RCP − HCP (h) |"
+        "| contact law | HCP: ours | HCP: paper's criterion | HCP: stops failing | HCP holds | RCP: ours | RCP: paper's criterion | RCP: stops failing | RCP holds | RCP − HCP (h) |"
     );
-    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- |");
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    let stops = |s: &Option<VariantSearch>| {
+        s.as_ref()
+            .and_then(|v| v.after_release_hours)
+            .map_or("–".into(), |t| format!("{t:.2} h"))
+    };
+    let holds = |s: &Option<VariantSearch>| s.as_ref().map_or("–".into(), |v| v.holds.clone());
     for r in &rows {
         if r.searches.iter().all(Option::is_none) {
             continue;
         }
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.what,
             cell(&r.searches[0], false),
             cell(&r.searches[0], true),
+            stops(&r.searches[0]),
+            holds(&r.searches[0]),
             cell(&r.searches[1], false),
             cell(&r.searches[1], true),
+            stops(&r.searches[1]),
+            holds(&r.searches[1]),
             rcp_minus_hcp(r).map_or("–".into(), |d| format!("{d:+.2}")),
         );
     }
     if let (Some(h), Some(c)) = (paper("hcp"), paper("rcp")) {
         let _ = writeln!(
             md,
-            "| paper (Table 3, full size) | {:.2} h, {:.0}° | | {:.2} h, {:.0}° | | {:+.2} |",
+            "| paper (Table 3, full size) | {:.2} h, {:.0}° | | | | {:.2} h, {:.0}° | | | | {:+.2} |",
             h.0,
             h.1,
             c.0,
@@ -180,17 +230,19 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
 mod tests {
     use super::*;
 
-    fn search(ours: Option<f64>) -> Option<(RungSearch, f64)> {
-        Some((
-            RungSearch {
+    fn search(ours: Option<f64>) -> Option<VariantSearch> {
+        Some(VariantSearch {
+            search: RungSearch {
                 name: "critical".into(),
                 step_hours: 0.05,
                 paper: (None, None),
                 ours: (ours, Some(45.0)),
                 holds: 5,
             },
-            2.9,
-        ))
+            slowest_hours: 2.9,
+            after_release_hours: ours,
+            holds: String::new(),
+        })
     }
 
     #[test]
