@@ -42,6 +42,8 @@ pub struct VariantSearch {
     /// stops failing, whatever slower holds do (a θ_max that keeps falling by more than 0.5° over a slow hold's
     /// second half makes our criterion reject it, and the trailing-run rule then every faster hold too).
     pub after_release_hours: Option<f64>,
+    /// Whether any hold was released: without one, `after_release_hours` is only an upper bound.
+    pub bracketed: bool,
     /// The holds by our criterion, fastest first: `R` released, `S` stable, `C` creeping, with the periods.
     pub holds: String,
 }
@@ -71,10 +73,15 @@ fn cell(s: &Option<VariantSearch>, paper_criterion: bool) -> String {
     }
 }
 
-/// RCP's minus HCP's shortest stable period above their last released hold (h), when both have one: positive is
-/// the paper's order.
+/// RCP's minus HCP's shortest stable period above their last released hold (h), when both have one and both
+/// searches reached a released hold (else it is only a bound): positive is the paper's order.
 pub fn rcp_minus_hcp(row: &VariantRow) -> Option<f64> {
-    let t = |k: usize| row.searches[k].as_ref().and_then(|v| v.after_release_hours);
+    let t = |k: usize| {
+        row.searches[k]
+            .as_ref()
+            .filter(|v| v.bracketed)
+            .and_then(|v| v.after_release_hours)
+    };
     Some(t(1)? - t(0)?)
 }
 
@@ -160,6 +167,7 @@ pub fn union_search(dir: &Path) -> Option<VariantSearch> {
         },
         slowest_hours,
         after_release_hours,
+        bracketed: holds.iter().any(|h| h.released),
         holds: summary,
     })
 }
@@ -190,8 +198,8 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
     let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     let stops = |s: &Option<VariantSearch>| {
         s.as_ref()
-            .and_then(|v| v.after_release_hours)
-            .map_or("–".into(), |t| format!("{t:.2} h"))
+            .and_then(|v| v.after_release_hours.map(|t| (t, v.bracketed)))
+            .map_or("–".into(), |(t, b)| format!("{}{t:.2} h", if b { "" } else { "≤ " }))
     };
     let holds = |s: &Option<VariantSearch>| s.as_ref().map_or("–".into(), |v| v.holds.clone());
     for r in &rows {
@@ -241,6 +249,7 @@ mod tests {
             },
             slowest_hours: 2.9,
             after_release_hours: ours,
+            bracketed: true,
             holds: String::new(),
         })
     }
@@ -262,5 +271,9 @@ mod tests {
         assert_eq!(cell(&search(Some(2.6)), false), "2.60 h, 45.0°");
         assert_eq!(cell(&search(Some(2.6)), true), "> 2.90 h");
         assert_eq!(cell(&None, true), "not run");
+        // an unbracketed search is only a bound: no difference
+        let mut r = row(Some(2.40), Some(2.83));
+        r.searches[0].as_mut().unwrap().bracketed = false;
+        assert_eq!(rcp_minus_hcp(&r), None);
     }
 }
