@@ -38,9 +38,9 @@ pub struct VariantSearch {
     pub search: RungSearch,
     /// The slowest hold (h).
     pub slowest_hours: f64,
-    /// The shortest period above every released hold whose hold is stable by our criterion (h): where the pile
-    /// stops failing, whatever slower holds do (a θ_max that keeps falling by more than 0.5° over a slow hold's
-    /// second half makes our criterion reject it, and the trailing-run rule then every faster hold too).
+    /// The shortest period above every released hold (h): where the pile stops failing, whatever either creep
+    /// criterion says of the holds (a θ_max that keeps falling by more than 0.5° over a slow hold's second half
+    /// makes ours reject it, a loss of contacts the paper's, and the trailing-run rule then every faster hold too).
     pub after_release_hours: Option<f64>,
     /// Whether any hold was released: without one, `after_release_hours` is only an upper bound.
     pub bracketed: bool,
@@ -73,7 +73,7 @@ fn cell(s: &Option<VariantSearch>, paper_criterion: bool) -> String {
     }
 }
 
-/// RCP's minus HCP's shortest stable period above their last released hold (h), when both have one and both
+/// RCP's minus HCP's shortest period above their last released hold (h), when both have one and both
 /// searches reached a released hold (else it is only a bound): positive is the paper's order.
 pub fn rcp_minus_hcp(row: &VariantRow) -> Option<f64> {
     let t = |k: usize| {
@@ -143,10 +143,7 @@ pub fn union_search(dir: &Path) -> Option<VariantSearch> {
         .map(|w| w[1].t_final_hours - w[0].t_final_hours)
         .fold(f64::INFINITY, f64::min);
     let last_release = holds.iter().rposition(|h| h.released).map_or(0, |k| k + 1);
-    let after_release_hours = holds[last_release..]
-        .iter()
-        .find(|h| h.ours.stable)
-        .map(|h| h.t_final_hours);
+    let after_release_hours = holds.get(last_release).map(|h| h.t_final_hours);
     let letter = |h: &HoldVerdict| match (h.released, h.ours.stable) {
         (true, _) => 'R',
         (false, true) => 'S',
@@ -184,9 +181,9 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
          11–12 changed, everything else as in Table 3 above (searches under `{}`, the nominal ones under `{}`; \
          holds of 16 000 s branched off one path-2 run each). T_c3 by our creep criterion (θ_max and η_B) and by \
          the paper's (also the coordination number), each where the trailing run of stable holds begins; \"> X\" \
-         when the slowest hold, X h, is not stable. 'Stops failing' is the shortest period above every released \
-         hold whose hold is stable by ours (it differs from T_c3 where slow holds relax, θ_max falling by more than \
-         0.5°). Holds: R released, S stable, C creeping, by ours. The last column is RCP's 'stops failing' minus \
+         when the slowest hold, X h, is not stable. 'Stops failing' is the shortest period held above every \
+         released hold, whatever the creep criteria say (they differ from it where slow holds relax, θ_max falling \
+         by more than 0.5°, or lose contacts); '≤' when no hold was released. Holds: R released, S stable, C creeping, by ours. The last column is RCP's 'stops failing' minus \
          HCP's: positive is the paper's order.\n",
         ordering.display(),
         runs.display()
