@@ -401,13 +401,14 @@ fn write_density_section(md: &mut String, rows: &[ModelRow]) {
          scaled (`rubblepile aggregate density`, ρ_B = 2100 M/M_P; runs `<model>_rho<ρ_B>`), path 2 and T_c,3 \
          searches as for the nominal run. Fit of Ω_c = κ √(4πGρ_B/3) through the origin by least squares over the \
          densities (± its standard error), and the critical bulk density ρ_B^c at which Ω_c is the Didymos spin \
-         (P = {DIDYMOS_PERIOD_HOURS} h).\n"
+         (P = {DIDYMOS_PERIOD_HOURS} h). T_c,3 by the paper's creep criterion and by ours (section \"T_c,3 by \
+         creep criterion\"); the paper's κ₃ stands beside both.\n"
     );
     for s in &series {
         let _ = writeln!(md, "### {}\n", s.model.to_uppercase());
         let _ = writeln!(
             md,
-            "| ρ_B (kg/m³) | T_c1 (h) | T_c2 (h) | T_c3 (h) | κ₁ | κ₂ | κ₃ (single point) |"
+            "| ρ_B (kg/m³) | T_c1 (h) | T_c2 (h) | T_c3 (h), paper's / ours | κ₁ | κ₂ | κ₃ (single point), paper's / ours |"
         );
         let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
         for (rho, t) in &s.points {
@@ -417,13 +418,15 @@ fn write_density_section(md: &mut String, rows: &[ModelRow]) {
             };
             let _ = writeln!(
                 md,
-                "| {rho:.0} | {} | {} | {} | {} | {} | {} |",
+                "| {rho:.0} | {} | {} | {} / {} | {} | {} | {} / {} |",
                 opt(t[0], 3),
                 opt(t[1], 3),
                 opt(t[2], 2),
+                opt(t[3], 2),
                 opt(kappa(t[0]), 3),
                 opt(kappa(t[1]), 3),
-                opt(kappa(t[2]), 3)
+                opt(kappa(t[2]), 3),
+                opt(kappa(t[3]), 3)
             );
         }
         let paper = TABLE4.iter().find(|p| p.0 == s.model);
@@ -439,8 +442,15 @@ fn write_density_section(md: &mut String, rows: &[ModelRow]) {
                 .map_or("– (fewer than 2 densities) | –".to_string(), |f: &DensityFit| {
                     format!("{:.3} ± {:.3} | {:.0}", f.kappa, f.sigma_kappa, f.critical_density)
                 });
-            let p = paper.map_or("–".to_string(), |p| format!("{:.3}, {:.0}", p.1[i].1, p.1[i].0));
-            let _ = writeln!(md, "| T_c,{} | {n} | {fitted} | {p} |", i + 1);
+            // the paper has one κ₃, set beside both of ours
+            let k = i.min(2);
+            let p = paper.map_or("–".to_string(), |p| format!("{:.3}, {:.0}", p.1[k].1, p.1[k].0));
+            let name = match i {
+                0..=1 => format!("T_c,{}", i + 1),
+                2 => "T_c,3 (paper's criterion)".to_string(),
+                _ => "T_c,3 (ours)".to_string(),
+            };
+            let _ = writeln!(md, "| {name} | {n} | {fitted} | {p} |");
         }
         let _ = writeln!(md);
     }
@@ -548,7 +558,10 @@ mod tests {
                 1800.0,
                 [period(0.9, 1800.0), period(0.85, 1800.0), period(0.8, 1800.0)],
             ),
-            row("rcp_rho2400", 2400.0, [period(0.9, 2400.0), period(0.85, 2400.0), None]),
+            ModelRow {
+                t_c3_by_criterion: Some([(None, None), (Some(2.30), Some(45.0))]),
+                ..row("rcp_rho2400", 2400.0, [period(0.9, 2400.0), period(0.85, 2400.0), None])
+            },
             row("hcp", 2100.0, [Some(2.4), None, None]),
         ];
         let series = density_series(&rows);
@@ -570,7 +583,10 @@ mod tests {
         write_density_section(&mut md, &rows);
         assert!(md.contains("### RCP") && !md.contains("### HCP"));
         // κ₃ from 2 of the 3 densities
-        assert!(md.contains("| T_c,3 | 2 | 0.800 ± 0.000"), "{md}");
+        assert!(md.contains("| T_c,3 (paper's criterion) | 2 | 0.800 ± 0.000"), "{md}");
+        // ours: only the 2400 kg/m³ run records both criteria, one point, no fit
+        assert!(md.contains("| T_c,3 (ours) | 1 | – (fewer than 2 densities)"), "{md}");
+        assert!(md.contains("| – / 2.30 |"), "{md}");
     }
 
     /// The scatter estimate sees white noise and not a slow trend; the resolution rule separates the scaled RCP

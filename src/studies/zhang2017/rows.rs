@@ -61,16 +61,19 @@ pub fn base_model(name: &str) -> &str {
     name.split("_rho").next().unwrap_or(name)
 }
 
-/// One model over its bulk densities: the points (ρ_B in kg/m³, T_c1, T_c2, T_c3 in h where found) and the
-/// Eq. 22 fit of each limit over the points that have it.
+/// The limits fitted over bulk densities: T_c,1, T_c,2, T_c,3 by the paper's creep criterion and by ours.
+pub const DENSITY_LIMITS: usize = 4;
+
+/// One model over its bulk densities: the points (ρ_B in kg/m³, T_c1, T_c2, T_c3 by the paper's creep criterion
+/// and T_c3 by ours, in h where found) and the Eq. 22 fit of each limit over the points that have it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DensitySeries {
     /// Model name.
     pub model: String,
-    /// (ρ_B, [T_c1, T_c2, T_c3]) by increasing density.
-    pub points: Vec<(f64, [Option<f64>; 3])>,
+    /// (ρ_B, [T_c1, T_c2, T_c3 paper's criterion, T_c3 ours]) by increasing density.
+    pub points: Vec<(f64, [Option<f64>; DENSITY_LIMITS])>,
     /// Fit of limit i (κ_i ± σ, critical bulk density at [`DIDYMOS_PERIOD_HOURS`]) over at least 2 densities.
-    pub fits: [Option<DensityFit>; 3],
+    pub fits: [Option<DensityFit>; DENSITY_LIMITS],
 }
 
 /// The bulk density of a row (kg/m³): `ρ_B = 2100 M/M_P` (Zhang17 §4.2).
@@ -85,16 +88,22 @@ pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
     models.dedup();
     let mut out = Vec::new();
     for m in models {
-        let mut points: Vec<(f64, [Option<f64>; 3])> = rows
+        let mut points: Vec<(f64, [Option<f64>; DENSITY_LIMITS])> = rows
             .iter()
             .filter(|r| base_model(&r.model) == m && r.mass.is_finite())
-            .map(|r| (bulk_density(r), [r.limits.t_c1_hours, r.limits.t_c2_hours, r.t_c3]))
+            .map(|r| {
+                let ours = r.t_c3_by_criterion.and_then(|[_, ours]| ours.0);
+                (
+                    bulk_density(r),
+                    [r.limits.t_c1_hours, r.limits.t_c2_hours, r.t_c3, ours],
+                )
+            })
             .collect();
         if points.len() < 2 {
             continue;
         }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let fits = [0, 1, 2].map(|i| {
+        let fits = std::array::from_fn(|i| {
             let xy: Vec<(f64, f64)> = points.iter().filter_map(|(rho, t)| t[i].map(|t| (*rho, t))).collect();
             (xy.len() >= 2)
                 .then(|| fit_density(&xy, SI_G, DIDYMOS_PERIOD_HOURS))
