@@ -14,7 +14,7 @@ use std::path::Path;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
 
-use super::rows::{ModelRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical};
+use super::rows::{ModelRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical, search_subdirs};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.
@@ -75,15 +75,7 @@ fn rungs(ladder: &Path) -> Result<Vec<Rung>, String> {
     let mut out = Vec::new();
     for dir in model_dirs(ladder)? {
         let (row, _) = model_row(&dir).map_err(|e| e.to_string())?;
-        let mut subdirs: Vec<_> = std::fs::read_dir(&dir)
-            .map_err(|e| format!("{}: {e}", dir.display()))?
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| {
-                p.file_name()
-                    .is_some_and(|n| n.to_string_lossy().starts_with("critical"))
-            })
-            .collect();
-        subdirs.sort();
+        let subdirs = search_subdirs(&dir);
         let searches = subdirs.iter().filter_map(|d| read_search(d)).collect();
         out.push(Rung { row, searches });
     }

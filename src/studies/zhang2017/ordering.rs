@@ -15,7 +15,7 @@ use crate::analysis::creep::CreepCriterionKind;
 use crate::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
 
 use super::ladder::RungSearch;
-use super::rows::{TABLE3, opt};
+use super::rows::{TABLE3, opt, search_subdirs};
 
 /// The contact-law variants, strongest rolling and twisting resistance first: directory suffix and what changes
 /// against Zhang17 §2.3.3's nominal material (β = 0.5, μ_T = 1.3, μ_R = 1.05) and our k_N (`kn5`: the stiffness
@@ -108,17 +108,7 @@ pub fn read_variants(runs: &Path, ordering: &Path) -> Vec<VariantRow> {
 
 /// The search directories of a variant: its `critical*` subdirectories, or `dir` itself when it has none.
 pub fn search_dirs(dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut subs: Vec<_> = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            p.is_dir()
-                && p.file_name()
-                    .is_some_and(|n| n.to_string_lossy().starts_with("critical"))
-        })
-        .collect();
-    subs.sort();
+    let subs = search_subdirs(dir);
     if subs.is_empty() { vec![dir.to_path_buf()] } else { subs }
 }
 

@@ -328,7 +328,7 @@ fn hold_searches(
     let mut out = Vec::new();
     for rung in ladder.map(subdirs).unwrap_or_default() {
         let rho = rho(&rung);
-        for s in subdirs(&rung).into_iter().filter(|s| name(s).starts_with("critical")) {
+        for s in search_subdirs(&rung) {
             out.push((format!("ladder {} {}", name(&rung), name(&s)), s, rho));
         }
     }

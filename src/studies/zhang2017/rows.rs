@@ -396,6 +396,23 @@ pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
     Ok(models)
 }
 
+/// The `critical*` subdirectories of `dir` (the T_c,3 searches of a run or variant: a coarse one, a finer one, …),
+/// sorted by name; empty when there are none or `dir` cannot be read.
+pub fn search_subdirs(dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut subs: Vec<_> = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.is_dir()
+                && p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("critical"))
+        })
+        .collect();
+    subs.sort();
+    subs
+}
+
 /// The result of a T_c,3 search directory, re-derived from its judged holds (`critical.csv`) by
 /// [`crate::analysis::spinup_search::critical_from_verdicts`], so that every search is read by today's rule
 /// whenever it ran: `t_c3_hours` and `friction_angle_deg` (the paper's criterion, the search's default), `paper`,
