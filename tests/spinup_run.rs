@@ -345,6 +345,11 @@ fn branched_hold_equals_the_hold_run_from_the_start() {
     assert_eq!(a.len(), b.len());
     assert_eq!(a, b);
     assert_same_snapshots(&hold, &dir.join("h"), &[], &[]);
+    // The base run reached the hold's start (1560 s) in checkpointed legs of an eighth of its span, each a resume
+    // of the last, and still gives the bit-identical hold above: a search stopped on the way loses one leg only.
+    let base: serde_json::Value = serde_json::from_str(&read(&dir.join("crit/base/checkpoint.json"))).unwrap();
+    assert!(base["checkpoints"].as_u64().unwrap() >= 6, "{base:#}");
+    assert_eq!(base["t_seconds"].as_f64(), Some(1560.0));
     let json = read(&dir.join("crit/critical.json"));
     assert!(json.contains("\"t_final_hours\": 6.0"), "{json}");
     // both creep criteria are judged and recorded per hold, the paper's selected by default (Zhang17 §3.3.3)

@@ -559,6 +559,31 @@ pub fn path_time_at_period(p: &crate::granular::soft::spinup::SpinupPath, period
     Some(p.t_inter + (hi - x) / (hi - lo) * (p.t_final - p.t_inter))
 }
 
+/// How many checkpointed legs the base run of `--branch` is cut into over its whole span (a stopped search loses
+/// at most one leg of the path: about 15 min of a full-size base run on two cores).
+const BASE_LEGS: u64 = 8;
+
+/// The output-sample steps at which the base run stops and checkpoints on its way from step `from` to `to` (an
+/// output sample): legs of at most `leg_steps` steps where the samples allow (a leg shorter than the sample spacing
+/// ends at the next sample), the last one at `to`; empty when `from >= to`.
+fn base_legs(samples: &[u64], from: u64, to: u64, leg_steps: u64) -> Vec<u64> {
+    let mut legs = Vec::new();
+    let mut at = from;
+    while at < to {
+        let reach = at.saturating_add(leg_steps.max(1)).min(to);
+        let next = samples
+            .iter()
+            .copied()
+            .filter(|&s| s > at && s <= reach)
+            .max()
+            .or_else(|| samples.iter().copied().filter(|&s| s > at && s <= to).min())
+            .unwrap_or(to);
+        legs.push(next);
+        at = next;
+    }
+    legs
+}
+
 /// `--branch`: runs the scene's path once in `OUT/base`, stopping at the output sample at or before each hold's
 /// start `t_X` (the time the path passes X = T_final, latest first), and writes the hold run `OUT/T<X>` there as
 /// a branch ([`crate::granular::soft::branch`]) whose scene follows the same path to X at `t_X` and holds it for
@@ -648,6 +673,8 @@ fn prepare_branches(
     }
     let failed =
         |e: crate::driver::RunError<crate::granular::soft::run::SoftSummary>| SearchError::failed(e.to_string());
+    let sample_list: Vec<u64> = plan.iter().map(|p| p.0).collect();
+    let leg_steps = sample_list.last().copied().unwrap_or(0).div_ceil(BASE_LEGS).max(1);
     // latest hold first: the base run only moves forward
     let mut order: Vec<usize> = (0..grid.len()).collect();
     order.sort_by(|&a, &b| starts[a].total_cmp(&starts[b]));
@@ -681,19 +708,24 @@ fn prepare_branches(
                 base_dir.display()
             )));
         }
-        if here != Some(s_ck) {
+        // The base run advances in legs, each ending in a checkpoint, so that one stopped before this hold's
+        // start (a full-size path takes hours) resumes from its last leg, not from the previous hold's start. A
+        // resumed run continues bit for bit (`crate::driver`), so the legs change no result.
+        let mut here = here;
+        for s_leg in base_legs(&sample_list, here.unwrap_or(0), s_ck, leg_steps) {
             let t_here = here.map_or(0.0, |h| h as f64 * dt);
+            let t_leg = s_leg as f64 * dt;
             let options = RunOptions {
                 force: true,
                 progress: false,
                 checkpoint_every: None,
-                checkpoint_every_sim: Some(t_ck - t_here - 0.5 * dt),
+                checkpoint_every_sim: Some(t_leg - t_here - 0.5 * dt),
                 formats: crate::driver::formats::Formats::NONE,
                 stop_after_checkpoints: Some(1),
                 ..RunOptions::default()
             };
             eprintln!(
-                "spinup critical: base run to t = {t_ck} s (T_final = {tf} h starts at {} s)",
+                "spinup critical: base run to t = {t_leg} s of {t_ck} s (T_final = {tf} h starts at {} s)",
                 starts[k]
             );
             let result = match here {
@@ -705,11 +737,12 @@ fn prepare_branches(
                 Err(e) => return Err(failed(e)),
                 Ok(_) => {
                     return Err(SearchError::failed(format!(
-                        "{}: the base run ended before t = {t_ck} s",
+                        "{}: the base run ended before t = {t_leg} s",
                         base_dir.display()
                     )));
                 }
             }
+            here = Some(s_leg);
         }
         let mut hold_table = table.clone();
         hold_table["spinup"]["T_final"] = toml::Value::Float(tf);
@@ -955,6 +988,18 @@ mod tests {
 
     /// Regression guard: a bad `--coordination-tolerance` is refused with the option's name and the expected
     /// value, before any run starts.
+    #[test]
+    fn base_run_legs_end_on_samples_and_reach_the_hold_start() {
+        let samples: Vec<u64> = (0..=20).map(|k| k * 10).collect();
+        // 0 → 200 in legs of at most 45 steps: the last sample within each reach
+        assert_eq!(base_legs(&samples, 0, 200, 45), [40, 80, 120, 160, 200]);
+        // a resumed base run starts from its checkpoint
+        assert_eq!(base_legs(&samples, 120, 200, 45), [160, 200]);
+        // legs shorter than the sample spacing still advance, one sample at a time
+        assert_eq!(base_legs(&samples, 0, 30, 3), [10, 20, 30]);
+        assert!(base_legs(&samples, 200, 200, 45).is_empty());
+    }
+
     #[test]
     fn coordination_tolerance_must_be_positive() {
         for bad in [0.0, -0.1, f64::NAN] {
