@@ -537,3 +537,78 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
     assert!(out.join("fig22_contact_law_rcp_beta0.png").is_file());
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// Table 7 (Zhang17 §4.4): a material variant `<model>_beta<β>_mus<μ_s>` gets its own row beside the paper's (the
+/// pile it was spun up from, T_c3 by both criteria, where it stops failing, φ, and κ₃ and the critical bulk density
+/// of Eq. 22 from its one density), is not a Table 3 row, and is not taken for a second bulk density of its model;
+/// Table 3 gives T_c3 by both criteria.
+#[test]
+fn material_section_sets_each_material_beside_table_7() {
+    let root = std::env::temp_dir().join(format!("rp_report_materials_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    critical_csv(
+        &root.join("runs/hcp/critical"),
+        &[(2.60, true, false, false), (2.64, false, true, false)],
+    );
+    let weak = root.join("runs/hcp_beta0.3_mus0.5");
+    fake_run(&weak, 30, 38300.0, 38300.0, 600.0, true);
+    std::fs::write(
+        weak.join("path2/scene.toml"),
+        "[scene]\nt_end = 38300.0\nparticles_file = \"../../targets/zhang2017/hcp_settled_beta0.3_mus0.5.csv\"\n\n\
+         [spinup]\nt_start = 700.0\n",
+    )
+    .unwrap();
+    critical_csv(
+        &weak.join("critical"),
+        &[
+            (2.50, true, false, false),
+            (2.56, false, true, false),
+            (2.62, false, true, true),
+        ],
+    );
+    let out = root.join("out");
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
+        .unwrap();
+    let table3 = &md[..md.find("## T_c,3 by creep criterion").expect("criterion section")];
+    let hcp = table3.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
+    assert!(
+        hcp.contains("| – / 2.64 | – / 47.2 |"),
+        "both criteria in Table 3: {hcp}"
+    );
+    assert!(
+        !table3.contains("| HCP_BETA"),
+        "a material is not a Table 3 row: {table3}"
+    );
+    assert!(!md.contains("### HCP"), "nor a second bulk density of HCP");
+    let section = &md[md.find("## Material").expect("a Table 7 section")..];
+    let row = |start: &str| {
+        section
+            .lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("no row {start}: {section}"))
+            .to_string()
+    };
+    // Eq. 22 by hand for the weak material's T_c3 (ours) of 2.56 h at this fake body's bulk density
+    let rho = 2100.0 * 30.0 * 1e7 / rubblepile::studies::zhang2017::rows::DIDYMOS_MASS;
+    let omega = 2.0 * std::f64::consts::PI / (2.56 * 3600.0);
+    let kappa = omega / (4.0 * std::f64::consts::PI * 6.674e-11 * rho / 3.0).sqrt();
+    let rho_c = rho * (2.56f64 / 2.26).powi(2);
+    assert_eq!(
+        row("| HCP | 0.3, 0.5 |"),
+        format!(
+            "| HCP | 0.3, 0.5 | `hcp_settled_beta0.3_mus0.5.csv` | – / – | 2.62 / 2.56 | 2.56 | 48.8 | \
+             {kappa:.3}, {rho_c:.0} | 0.937, 2430, 42° |"
+        )
+    );
+    assert!(
+        row("| HCP | 0.5, 1.0 |").contains("| 2.64 | 47.2 |"),
+        "the nominal row is Table 3's"
+    );
+    assert!(row("| HCP | 0.6, 1.3 |").contains("| not run |"));
+    assert!(
+        !section.contains("| PP2 |"),
+        "a model without a Table 3 run gets no rows"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

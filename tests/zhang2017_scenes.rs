@@ -53,6 +53,12 @@ fn every_zhang2017_scene_loads() {
         "pp2_path2.toml",
         "ppc_path2.toml",
         "rcp_8k_path2.toml",
+        "rcpc_rho2400_path2.toml",
+        "pp1_rho2400_path2.toml",
+        "pp2_rho2400_path2.toml",
+        "ppc_rho2400_path2.toml",
+        "hcp_beta0.3_mus0.5_path2.toml",
+        "hcp_beta0.6_mus1.3_path2.toml",
     ] {
         assert!(load(name).1, "{name}: its target is not in the repository");
     }
@@ -175,5 +181,79 @@ fn contact_law_variants_differ_from_their_nominal_scene_only_in_beta_and_the_cap
             variant, nominal,
             "{name} differs from {model}_path2.toml beyond {changed:?}"
         );
+    }
+}
+
+/// The bulk-density variants `<model>_rho<ρ_B>_path2.toml` (Table 4) differ from their nominal scene only in the
+/// target, whose masses are scaled to that bulk density (and in the self-gravity interval, which follows the contact
+/// time); the material variants `<model>_beta<β>_mus<μ_s>_path2.toml`
+/// (Table 7) only in β and μ_s as named and in the target, a pile settled with that material by
+/// `<model>_settle_beta<β>_mus<μ_s>.toml`, which in turn differs from the nominal settling scene only in β and μ_s.
+/// Regression guard: a variant that also changed the path, the step or k_N would not measure what it varies.
+#[test]
+fn density_and_material_variants_differ_from_their_nominal_scene_only_in_what_they_vary() {
+    let table = |name: &str| -> toml::Table {
+        toml::from_str(&std::fs::read_to_string(dir().join(name)).unwrap()).unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
+    let without = |mut t: toml::Table, scene_keys: &[&str], contact_keys: &[&str]| {
+        for k in scene_keys {
+            t["scene"].as_table_mut().unwrap().remove(*k);
+        }
+        for k in contact_keys {
+            t["contact"].as_table_mut().unwrap().remove(*k);
+        }
+        t
+    };
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+        .filter(|n| n.ends_with("_path2.toml") && (n.contains("_rho") || n.contains("_mus")))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 9, "{names:?}");
+    for name in &names {
+        let model = name.split('_').next().unwrap();
+        let (variant, nominal) = (table(name), table(&format!("{model}_path2.toml")));
+        let file = variant["scene"]["particles_file"].as_str().unwrap();
+        if let Some(rho) = name
+            .strip_prefix(&format!("{model}_rho"))
+            .and_then(|r| r.strip_suffix("_path2.toml"))
+        {
+            assert!(file.ends_with(&format!("{model}_rho{rho}.csv")), "{name}: {file}");
+            // the self-gravity interval follows the contact time, which scales as √m (`ssdem advise`)
+            let drop_interval = |mut t: toml::Table| {
+                t["gravity"].as_table_mut().unwrap().remove("interval_steps");
+                without(t, &["particles_file"], &[])
+            };
+            assert_eq!(drop_interval(variant), drop_interval(nominal), "{name}");
+            continue;
+        }
+        let material = name
+            .strip_prefix(&format!("{model}_"))
+            .unwrap()
+            .strip_suffix("_path2.toml")
+            .unwrap();
+        let (beta, mu_s) = material
+            .strip_prefix("beta")
+            .and_then(|m| m.split_once("_mus"))
+            .unwrap_or_else(|| panic!("{name}: not <model>_beta<β>_mus<μ_s>_path2.toml"));
+        let contact = &variant["contact"];
+        assert_eq!(contact["beta"].as_float(), beta.parse().ok(), "{name}");
+        assert_eq!(contact["mu_s"].as_float(), mu_s.parse().ok(), "{name}");
+        assert!(
+            file.ends_with(&format!("{model}_settled_{material}.csv")),
+            "{name}: {file}"
+        );
+        let keys = ["beta", "mu_s"];
+        assert_eq!(
+            without(variant, &["particles_file"], &keys),
+            without(nominal, &["particles_file"], &keys),
+            "{name}"
+        );
+        let settle = format!("{model}_settle_{material}.toml");
+        let (s, s0) = (table(&settle), table(&format!("{model}_settle.toml")));
+        assert_eq!(s["contact"]["beta"].as_float(), beta.parse().ok(), "{settle}");
+        assert_eq!(s["contact"]["mu_s"].as_float(), mu_s.parse().ok(), "{settle}");
+        assert_eq!(without(s, &[], &keys), without(s0, &[], &keys), "{settle}");
     }
 }

@@ -1,11 +1,13 @@
 //! Zhang et al. (2017, Icarus 294): the report on Table 3's critical spin limits ([`report`]), its spin-up-path
 //! section after Table 6 ([`paths`]), the resolution ladder ([`ladder`]), the packing ordering under changed contact
-//! laws ([`ordering`]) and the Fig. 22 analogue of the searches' holds ([`holds`]), all reading runs into the rows
+//! laws ([`ordering`]), Table 7's materials ([`materials`]) and the Fig. 22 analogue of the searches' holds ([`holds`]),
+//! all reading runs into the rows
 //! of [`rows`]. The searches that make its runs are generic and live in
 //! [`crate::analysis::spinup_search`].
 
 pub mod holds;
 pub mod ladder;
+pub mod materials;
 pub mod ordering;
 pub mod paths;
 pub mod report;

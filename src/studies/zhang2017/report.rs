@@ -182,13 +182,13 @@ pub fn write_report(
          check that the limits are not set by one sample; its look-ahead of half a window moves them to longer \
          periods by up to ≈ 0.05 h on path 2. η_B counts closed Voronoi cells by the rotation-free test \
          (`VoronoiCell::reaches`; the axis-aligned test used before 23 Nov 2026 made η_B wiggle by ±5e-4 with a \
-         quarter of the spin period). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`), κ₃ of \
-         Eq. 22 with ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, \
+         quarter of the spin period). T_c3/φ from `critical/critical.json` (`rubblepile spinup critical`) by the \
+         paper's creep criterion and by ours (section below), κ₃ of Eq. 22 from each with ρ_B = 2100 M/M_P. Paper: Table 3 (path 1, full size; §4.3: T_c3 does not depend on the path, \
          T_c1 and T_c2 do — faster paths give shorter ones).\n"
     );
     let _ = writeln!(
         md,
-        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h) | φ (°) | κ₃ | failure mode | smoothed T_c1/T_c2, mode | paper η, φ, T_c1/2/3, κ₃, mode |"
+        "| model | N | radius (m) | η_B | T_c1 (h) | T_c2 (h) | T_c3 (h), paper's / ours | φ (°), paper's / ours | κ₃, paper's / ours | failure mode | smoothed T_c1/T_c2, mode | paper η, φ, T_c1/2/3, κ₃, mode |"
     );
     let _ = writeln!(
         md,
@@ -212,6 +212,19 @@ pub fn write_report(
                 )
             })
             .unwrap_or_else(|| "–".into());
+        // T_c3 by our creep criterion where the search recorded both (`critical.json` or `critical.csv`)
+        let ours = r.t_c3_by_criterion.map_or((None, None), |[_, ours]| ours);
+        let kappa3_ours = ours
+            .0
+            .and_then(|t| fit_density(&[(bulk_density(r), t)], SI_G, t))
+            .map(|f| f.kappa);
+        let both = |a: Option<f64>, b: Option<f64>, digits: usize| {
+            if a.is_none() && b.is_none() {
+                "–".to_string()
+            } else {
+                format!("{} / {}", opt(a, digits), opt(b, digits))
+            }
+        };
         let radius = if (r.radius_range.1 - r.radius_range.0).abs() < 1e-9 * r.radius_range.1 {
             format!("{:.1}", r.radius_range.0)
         } else {
@@ -233,9 +246,9 @@ pub fn write_report(
                     r.packing_noise
                 )
             },
-            opt(r.t_c3, 2),
-            opt(r.phi, 1),
-            opt(r.kappa3, 3),
+            both(r.t_c3, ours.0, 2),
+            both(r.phi, ours.1, 1),
+            both(r.kappa3, kappa3_ours, 3),
             if r.t_c2_resolved {
                 mode(r.limits.failure_mode)
             } else {
@@ -278,6 +291,7 @@ pub fn write_report(
         );
     }
     write_density_section(&mut md, &rows);
+    crate::studies::zhang2017::materials::write_materials_section(&mut md, runs, &rows);
     if let Some(full) = full {
         write_full_section(&mut md, full, out)?;
     }
@@ -581,6 +595,7 @@ mod tests {
         }
         let mut md = String::new();
         write_density_section(&mut md, &rows);
+        crate::studies::zhang2017::materials::write_materials_section(&mut md, runs, &rows);
         assert!(md.contains("### RCP") && !md.contains("### HCP"));
         // κ₃ from 2 of the 3 densities
         assert!(md.contains("| T_c,3 (paper's criterion) | 2 | 0.800 ± 0.000"), "{md}");

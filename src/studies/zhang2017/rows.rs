@@ -50,15 +50,22 @@ pub const TABLE4: [Table4Row; 6] = [
 /// Zhang17: the observed spin period of the Didymos primary (h), at which critical bulk densities are given.
 pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
 
-/// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`).
+/// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`,
+/// material variants `<model>_beta<β>_mus<μ_s>`, [`super::materials`]).
 ///
 /// ```
 /// use rubblepile::studies::zhang2017::rows::base_model;
 /// assert_eq!(base_model("rcp_rho1800"), "rcp");
+/// assert_eq!(base_model("hcp_beta0.3_mus0.5"), "hcp");
 /// assert_eq!(base_model("hcp"), "hcp");
 /// ```
 pub fn base_model(name: &str) -> &str {
-    name.split("_rho").next().unwrap_or(name)
+    let name = name.split("_rho").next().unwrap_or(name);
+    if super::materials::is_material_variant(name) {
+        name.split("_beta").next().unwrap_or(name)
+    } else {
+        name
+    }
 }
 
 /// The limits fitted over bulk densities: T_c,1, T_c,2, T_c,3 by the paper's creep criterion and by ours.
@@ -81,8 +88,13 @@ pub(crate) fn bulk_density(row: &ModelRow) -> f64 {
     2100.0 * row.mass / DIDYMOS_MASS
 }
 
-/// The models run at two or more bulk densities, with their Eq. 22 fits (Zhang17 Fig. 19, Table 4).
+/// The models run at two or more bulk densities, with their Eq. 22 fits (Zhang17 Fig. 19, Table 4); material
+/// variants ([`super::materials`]) are another material, not another density, and are left out.
 pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
+    let rows: Vec<&ModelRow> = rows
+        .iter()
+        .filter(|r| !super::materials::is_material_variant(&r.model))
+        .collect();
     let mut models: Vec<&str> = rows.iter().map(|r| base_model(&r.model)).collect();
     models.sort();
     models.dedup();
