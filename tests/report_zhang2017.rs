@@ -612,3 +612,35 @@ fn material_section_sets_each_material_beside_table_7() {
     );
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// The Runs table gives, beside the run's largest overlap, the largest sampled one up to the failure (the sample of
+/// the later of T_c,1 and T_c,2): the part of the run that sets them, without the failure's collisions.
+#[test]
+fn overlap_before_failure_leaves_out_the_collisions_after_it() {
+    let root = std::env::temp_dir().join(format!("rp_report_overlap_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let model = root.join("runs/hcp");
+    // b/a drops once the period is below 4 h: the sample at t = 19 200 s gives T_c,1, and no T_c,2
+    fake_run_at(&model, "path2", 30, 38300.0, 38300.0, 600.0, true, Some(4.0));
+    let ts = model.join("path2/timeseries.csv");
+    let text = std::fs::read_to_string(&ts).unwrap();
+    let mut out = String::new();
+    for (k, line) in text.lines().enumerate() {
+        let mut cells: Vec<String> = line.split(',').map(String::from).collect();
+        if k > 0 {
+            let t: f64 = cells[0].parse().unwrap();
+            cells[4] = if t <= 19200.0 { "0.005" } else { "0.03" }.into();
+        }
+        out += &cells.join(",");
+        out.push('\n');
+    }
+    std::fs::write(&ts, out).unwrap();
+    let md = std::fs::read_to_string(
+        write_report(&root.join("runs"), None, None, None, None, &root.join("out"), false).unwrap(),
+    )
+    .unwrap();
+    let runs = &md[md.find("## Runs").expect("runs table")..];
+    let row = runs.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
+    assert!(row.contains("| 4.00e-3, 5.00e-3 |"), "{row}");
+    let _ = std::fs::remove_dir_all(&root);
+}

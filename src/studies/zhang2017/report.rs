@@ -269,18 +269,19 @@ pub fn write_report(
     let _ = writeln!(md, "## Runs\n");
     let _ = writeln!(
         md,
-        "| model | status | simulated (s) | wall (s) | largest overlap / radius | largest \\|T/T_path − 1\\| while forced: before T_c1 / all | forcing released at (s) | energy / L residual |"
+        "| model | status | simulated (s) | wall (s) | largest overlap / radius: run, sampled before failure | largest \\|T/T_path − 1\\| while forced: before T_c1 / all | forcing released at (s) | energy / L residual |"
     );
     let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- |");
     for r in &rows {
         let _ = writeln!(
             md,
-            "| {} | {} | {:.0} | {:.0} | {:.2e} | {:.1e} / {:.1e} | {} | {} |",
+            "| {} | {} | {:.0} | {:.0} | {:.2e}, {} | {:.1e} / {:.1e} | {} | {} |",
             r.model.to_uppercase(),
             r.status,
             r.final_time,
             r.wall_seconds,
             r.max_overlap,
+            r.max_overlap_before_failure.map_or("–".into(), |o| format!("{o:.2e}")),
             r.path_error_before_t_c1,
             r.path_error,
             opt(r.release_time, 0),
@@ -546,6 +547,7 @@ mod tests {
             path_error_before_t_c1: 0.0,
             release_time: None,
             max_overlap: 0.0,
+            max_overlap_before_failure: None,
             residuals: None,
             wall_seconds: 0.0,
             final_time: 0.0,

@@ -191,6 +191,10 @@ pub struct ModelRow {
     pub release_time: Option<f64>,
     /// Largest overlap / radius.
     pub max_overlap: f64,
+    /// Largest sampled overlap / radius (`timeseries.csv`) up to the sample at which the later of T_c,1 and T_c,2
+    /// was found (all forced samples when neither was): the overlaps of the part of the run that sets them, before
+    /// the failure's collisions (Zhang17 §2.3.3 keeps overlaps under 1 % of the smallest radius).
+    pub max_overlap_before_failure: Option<f64>,
     /// Largest energy and angular-momentum residuals of the run (`summary.json`), forcing work and torque
     /// booked; `None` for runs made before the forcing was booked (their residuals include the forcing).
     pub residuals: Option<(f64, f64)>,
@@ -257,6 +261,19 @@ pub(crate) fn t_end_of(dir: &Path) -> Option<f64> {
         .get("scene")?
         .get("t_end")?
         .as_float()
+}
+
+/// The largest `max_overlap_fraction` of the run's `timeseries.csv` rows at `t ≤ t_max` (s).
+fn sampled_max_overlap(run: &Path, t_max: f64) -> Option<f64> {
+    let table = read_table(&run.join("timeseries.csv"), Cells::Lenient).ok()?;
+    let (t, o) = (table.column("t")?, table.column("max_overlap_fraction")?);
+    table
+        .rows
+        .iter()
+        .filter(|v| v.get(t).is_some_and(|&x| x <= t_max))
+        .filter_map(|v| v.get(o).copied())
+        .filter(|x| x.is_finite())
+        .reduce(f64::max)
 }
 
 /// Whether the run's `timeseries.csv` books the spin-up forcing (has the `forcing_work` column).
@@ -346,7 +363,17 @@ pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSam
         .map(|s| (s.period_h / s.path_period_h - 1.0).abs())
         .fold(0.0, f64::max);
     let release_time = samples.iter().find(|s| !s.forcing).map(|s| s.t);
+    let last_limit = [limits.t_c1_hours, limits.t_c2_hours]
+        .into_iter()
+        .flatten()
+        .reduce(f64::min);
+    let t_failure = match last_limit {
+        Some(p) => forced.iter().find(|s| s.period_h <= p).map(|s| s.t),
+        None => forced.last().map(|s| s.t),
+    };
+    let max_overlap_before_failure = t_failure.and_then(|t| sampled_max_overlap(&run, t));
     let row = ModelRow {
+        max_overlap_before_failure,
         path_error_before_t_c1,
         model,
         n,
