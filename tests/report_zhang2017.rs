@@ -644,3 +644,34 @@ fn overlap_before_failure_leaves_out_the_collisions_after_it() {
     assert!(row.contains("| 4.00e-3, 5.00e-3 |"), "{row}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// The Fig. 22 analogue shows the paper's own model, PP2, at every bulk density run under RUNS (Table 3's run and
+/// the Eq. 22 variants), each hold with the density it stands for at 2.26 h; other models' Table 3 searches are
+/// not shown there.
+#[test]
+fn holds_section_shows_pp2_at_each_density_run() {
+    let root = std::env::temp_dir().join(format!("rp_report_pp2_holds_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    for m in ["pp2", "pp2_rho2400", "hcp"] {
+        fake_run(&root.join("runs").join(m), 30, 38300.0, 38300.0, 600.0, true);
+        let search = root.join("runs").join(m).join("critical");
+        critical_csv(&search, &[(2.50, true, false, false), (2.60, false, true, true)]);
+        let mut holds = "t_final_h,t_hold_s,period_h,body_mass_fraction,packing_fraction,coordination_number,\
+                         coordination_loaded,theta_max_deg\n"
+            .to_string();
+        for t in ["2.50", "2.60"] {
+            for k in 0..10 {
+                holds += &format!("{t},{},{t},1.0,0.69,{},,40.0\n", 400 * k, 5.0 + 0.01 * k as f64);
+            }
+        }
+        std::fs::write(search.join("holds.csv"), holds).unwrap();
+    }
+    let out = root.join("out");
+    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
+        .unwrap();
+    let holds_md = &md[md.find("## Holds").expect("a holds section")..];
+    assert!(holds_md.contains("### runs pp2 critical"), "{holds_md}");
+    assert!(holds_md.contains("### runs pp2_rho2400 critical"), "{holds_md}");
+    assert!(!holds_md.contains("### runs hcp"), "{holds_md}");
+    let _ = std::fs::remove_dir_all(&root);
+}

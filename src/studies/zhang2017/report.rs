@@ -316,7 +316,8 @@ pub fn write_report(
     Ok(report)
 }
 
-/// The searches whose holds the Fig. 22 analogue may show: every `critical*` search of the ladder's rungs and every
+/// The searches whose holds the Fig. 22 analogue may show: PP2's T_c,3 searches under `runs` (the paper's model, at
+/// each bulk density run), every `critical*` search of the ladder's rungs and every
 /// search under the ordering directory (`<model>_<variant>`), labelled by their directories, with the bulk density
 /// (kg/m³, `ρ_B = 2100 M/M_P`) of the rung's path-2 run or of the model's run under `runs`.
 fn hold_searches(
@@ -341,6 +342,17 @@ fn hold_searches(
             .unwrap_or_default()
     };
     let mut out = Vec::new();
+    // Fig. 22's own model, PP2, at each bulk density run (Table 3's run and the Eq. 22 variants)
+    for model_dir in subdirs(runs) {
+        let n = name(&model_dir);
+        if base_model(&n) == "pp2" && !crate::studies::zhang2017::materials::is_material_variant(&n) {
+            out.push((
+                format!("runs {n} critical"),
+                model_dir.join("critical"),
+                rho(&model_dir),
+            ));
+        }
+    }
     for rung in ladder.map(subdirs).unwrap_or_default() {
         let rho = rho(&rung);
         for s in search_subdirs(&rung) {
