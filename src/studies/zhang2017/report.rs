@@ -609,7 +609,6 @@ mod tests {
         }
         let mut md = String::new();
         write_density_section(&mut md, &rows);
-        crate::studies::zhang2017::materials::write_materials_section(&mut md, runs, &rows);
         assert!(md.contains("### RCP") && !md.contains("### HCP"));
         // κ₃ from 2 of the 3 densities
         assert!(md.contains("| T_c,3 (paper's criterion) | 2 | 0.800 ± 0.000"), "{md}");
