@@ -155,8 +155,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     )
     .unwrap();
     let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
-        .unwrap();
+    let md = report_of_runs(&root);
     assert!(
         !md.contains("by creep criterion"),
         "old critical.json: no criterion section"
@@ -505,13 +504,7 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
     )
     .unwrap();
     let section = &md[md.find("## Packing ordering").expect("an ordering section")..];
-    let row = |start: &str| {
-        section
-            .lines()
-            .find(|l| l.starts_with(start))
-            .unwrap_or_else(|| panic!("no row {start}: {section}"))
-            .to_string()
-    };
+    let row = |start: &str| line_starting(section, start);
     let nominal = row("| Zhang17 Eqs. 11–12");
     assert!(
         nominal.contains(
@@ -538,14 +531,35 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
     let _ = std::fs::remove_dir_all(&root);
 }
 
+/// The first line of a report section that starts with `start` (a table row), or a panic showing the section.
+fn line_starting(section: &str, start: &str) -> String {
+    section
+        .lines()
+        .find(|l| l.starts_with(start))
+        .unwrap_or_else(|| panic!("no row {start}: {section}"))
+        .to_string()
+}
+
+/// A fresh scratch directory for one test.
+fn fresh_root(tag: &str) -> std::path::PathBuf {
+    let root = std::env::temp_dir().join(format!("rp_report_{tag}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    root
+}
+
+/// The report of `root/runs` alone (no optional sections), written to `root/out`.
+fn report_of_runs(root: &Path) -> String {
+    let path = write_report(&root.join("runs"), None, None, None, None, &root.join("out"), false).unwrap();
+    std::fs::read_to_string(path).unwrap()
+}
+
 /// Table 7 (Zhang17 §4.4): a material variant `<model>_beta<β>_mus<μ_s>` gets its own row beside the paper's (the
 /// pile it was spun up from, T_c3 by both criteria, where it stops failing, φ, and κ₃ and the critical bulk density
 /// of Eq. 22 from its one density), is not a Table 3 row, and is not taken for a second bulk density of its model;
 /// Table 3 gives T_c3 by both criteria.
 #[test]
 fn material_section_sets_each_material_beside_table_7() {
-    let root = std::env::temp_dir().join(format!("rp_report_materials_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = fresh_root("materials");
     fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
     critical_csv(
         &root.join("runs/hcp/critical"),
@@ -567,9 +581,7 @@ fn material_section_sets_each_material_beside_table_7() {
             (2.62, false, true, true),
         ],
     );
-    let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
-        .unwrap();
+    let md = report_of_runs(&root);
     let table3 = &md[..md.find("## T_c,3 by creep criterion").expect("criterion section")];
     let hcp = table3.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
     assert!(
@@ -582,13 +594,7 @@ fn material_section_sets_each_material_beside_table_7() {
     );
     assert!(!md.contains("### HCP"), "nor a second bulk density of HCP");
     let section = &md[md.find("## Material").expect("a Table 7 section")..];
-    let row = |start: &str| {
-        section
-            .lines()
-            .find(|l| l.starts_with(start))
-            .unwrap_or_else(|| panic!("no row {start}: {section}"))
-            .to_string()
-    };
+    let row = |start: &str| line_starting(section, start);
     // Eq. 22 by hand for the weak material's T_c3 (ours) of 2.56 h at this fake body's bulk density
     let rho = 2100.0 * 30.0 * 1e7 / rubblepile::studies::zhang2017::rows::DIDYMOS_MASS;
     let omega = 2.0 * std::f64::consts::PI / (2.56 * 3600.0);
@@ -617,8 +623,7 @@ fn material_section_sets_each_material_beside_table_7() {
 /// the later of T_c,1 and T_c,2): the part of the run that sets them, without the failure's collisions.
 #[test]
 fn overlap_before_failure_leaves_out_the_collisions_after_it() {
-    let root = std::env::temp_dir().join(format!("rp_report_overlap_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = fresh_root("overlap");
     let model = root.join("runs/hcp");
     // b/a drops once the period is below 4 h: the sample at t = 19 200 s gives T_c,1, and no T_c,2
     fake_run_at(&model, "path2", 30, 38300.0, 38300.0, 600.0, true, Some(4.0));
@@ -635,10 +640,7 @@ fn overlap_before_failure_leaves_out_the_collisions_after_it() {
         out.push('\n');
     }
     std::fs::write(&ts, out).unwrap();
-    let md = std::fs::read_to_string(
-        write_report(&root.join("runs"), None, None, None, None, &root.join("out"), false).unwrap(),
-    )
-    .unwrap();
+    let md = report_of_runs(&root);
     let runs = &md[md.find("## Runs").expect("runs table")..];
     let row = runs.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
     assert!(row.contains("| 4.00e-3, 5.00e-3 |"), "{row}");
@@ -650,8 +652,7 @@ fn overlap_before_failure_leaves_out_the_collisions_after_it() {
 /// not shown there.
 #[test]
 fn holds_section_shows_pp2_at_each_density_run() {
-    let root = std::env::temp_dir().join(format!("rp_report_pp2_holds_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&root);
+    let root = fresh_root("pp2_holds");
     for m in ["pp2", "pp2_rho2400", "hcp"] {
         fake_run(&root.join("runs").join(m), 30, 38300.0, 38300.0, 600.0, true);
         let search = root.join("runs").join(m).join("critical");
@@ -666,9 +667,7 @@ fn holds_section_shows_pp2_at_each_density_run() {
         }
         std::fs::write(search.join("holds.csv"), holds).unwrap();
     }
-    let out = root.join("out");
-    let md = std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, false).unwrap())
-        .unwrap();
+    let md = report_of_runs(&root);
     let holds_md = &md[md.find("## Holds").expect("a holds section")..];
     assert!(holds_md.contains("### runs pp2 critical"), "{holds_md}");
     assert!(holds_md.contains("### runs pp2_rho2400 critical"), "{holds_md}");
