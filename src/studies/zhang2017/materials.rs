@@ -4,7 +4,7 @@
 //!
 //! Layout read: `RUNS/<model>_beta<β>_mus<μ_s>/path2` and `…/critical` ([`variant_dir`]), the nominal material's
 //! run being the Table 3 one, `RUNS/<model>`. Such directories are neither Table 3 rows nor bulk-density points
-//! ([`is_material_variant`]). Per material: T_c,1/T_c,2 of path 2, T_c,3 by both creep criteria and where the
+//! ([`super::rows::is_material_variant`]). Per material: T_c,1/T_c,2 of path 2, T_c,3 by both creep criteria and where the
 //! pile stops failing ([`super::ordering::union_search`]), φ, and the single-density κ₃ and critical bulk density
 //! at the Didymos period (Eq. 22, as Table 7 gives them) beside the paper's.
 
@@ -15,7 +15,7 @@ use crate::analysis::spinup::fit_density;
 use crate::io::scene_file::SI_G;
 
 use super::ordering::union_search;
-use super::rows::{DIDYMOS_PERIOD_HOURS, ModelRow, bulk_density, opt};
+use super::rows::{DIDYMOS_PERIOD_HOURS, ModelRow, bulk_density, is_material_variant, opt};
 
 /// Zhang17 Table 7: model, β, μ_s, and the paper's ρ_B^{c,3} (kg/m³), κ₃ and φ (°) (full size, path 1); the
 /// nominal material's column repeats Table 4.
@@ -45,17 +45,6 @@ pub fn variant_dir(model: &str, beta: f64, mu_s: f64) -> String {
     } else {
         format!("{model}_beta{beta:?}_mus{mu_s:?}")
     }
-}
-
-/// Whether a run directory's name is a material variant ([`variant_dir`]).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::materials::is_material_variant;
-/// assert!(is_material_variant("pp2_beta0.6_mus1.3"));
-/// assert!(!is_material_variant("rcp_rho1800"));
-/// ```
-pub fn is_material_variant(name: &str) -> bool {
-    name.split_once("_beta").is_some_and(|(_, rest)| rest.contains("_mus"))
 }
 
 /// The particle file a run started from (`particles_file` of its `scene.toml`, file name only): which settled

@@ -345,7 +345,7 @@ fn hold_searches(
     // Fig. 22's own model, PP2, at each bulk density run (Table 3's run and the Eq. 22 variants)
     for model_dir in subdirs(runs) {
         let n = name(&model_dir);
-        if base_model(&n) == "pp2" && !crate::studies::zhang2017::materials::is_material_variant(&n) {
+        if base_model(&n) == "pp2" && !is_material_variant(&n) {
             out.push((
                 format!("runs {n} critical"),
                 model_dir.join("critical"),

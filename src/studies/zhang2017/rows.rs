@@ -51,7 +51,7 @@ pub const TABLE4: [Table4Row; 6] = [
 pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
 
 /// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`,
-/// material variants `<model>_beta<β>_mus<μ_s>`, [`super::materials`]).
+/// material variants `<model>_beta<β>_mus<μ_s>`, Table 7).
 ///
 /// ```
 /// use rubblepile::studies::zhang2017::rows::base_model;
@@ -61,11 +61,22 @@ pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
 /// ```
 pub fn base_model(name: &str) -> &str {
     let name = name.split("_rho").next().unwrap_or(name);
-    if super::materials::is_material_variant(name) {
+    if is_material_variant(name) {
         name.split("_beta").next().unwrap_or(name)
     } else {
         name
     }
+}
+
+/// Whether a run directory's name is a material variant (`<model>_beta<β>_mus<μ_s>`, Zhang17 Table 7).
+///
+/// ```
+/// use rubblepile::studies::zhang2017::rows::is_material_variant;
+/// assert!(is_material_variant("pp2_beta0.6_mus1.3"));
+/// assert!(!is_material_variant("rcp_rho1800"));
+/// ```
+pub fn is_material_variant(name: &str) -> bool {
+    name.split_once("_beta").is_some_and(|(_, rest)| rest.contains("_mus"))
 }
 
 /// The limits fitted over bulk densities: T_c,1, T_c,2, T_c,3 by the paper's creep criterion and by ours.
@@ -89,12 +100,9 @@ pub(crate) fn bulk_density(row: &ModelRow) -> f64 {
 }
 
 /// The models run at two or more bulk densities, with their Eq. 22 fits (Zhang17 Fig. 19, Table 4); material
-/// variants ([`super::materials`]) are another material, not another density, and are left out.
+/// variants ([`is_material_variant`]) are another material, not another density, and are left out.
 pub fn density_series(rows: &[ModelRow]) -> Vec<DensitySeries> {
-    let rows: Vec<&ModelRow> = rows
-        .iter()
-        .filter(|r| !super::materials::is_material_variant(&r.model))
-        .collect();
+    let rows: Vec<&ModelRow> = rows.iter().filter(|r| !is_material_variant(&r.model)).collect();
     let mut models: Vec<&str> = rows.iter().map(|r| base_model(&r.model)).collect();
     models.sort();
     models.dedup();
