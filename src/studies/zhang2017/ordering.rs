@@ -42,6 +42,8 @@ pub struct VariantSearch {
     /// criterion says of the holds (a θ_max that keeps falling by more than 0.5° over a slow hold's second half
     /// makes ours reject it, a loss of contacts the paper's, and the trailing-run rule then every faster hold too).
     pub after_release_hours: Option<f64>,
+    /// θ_max (°) of that hold: the friction angle mobilized where the pile stops failing.
+    pub after_release_theta_deg: Option<f64>,
     /// Whether any hold was released: without one, `after_release_hours` is only an upper bound.
     pub bracketed: bool,
     /// The holds by our criterion, fastest first: `R` released, `S` stable, `C` creeping, with the periods.
@@ -134,6 +136,7 @@ pub fn union_search(dir: &Path) -> Option<VariantSearch> {
         .fold(f64::INFINITY, f64::min);
     let last_release = holds.iter().rposition(|h| h.released).map_or(0, |k| k + 1);
     let after_release_hours = holds.get(last_release).map(|h| h.t_final_hours);
+    let after_release_theta_deg = holds.get(last_release).map(|h| h.theta_max_deg);
     let letter = |h: &HoldVerdict| match (h.released, h.ours.stable) {
         (true, _) => 'R',
         (false, true) => 'S',
@@ -154,6 +157,7 @@ pub fn union_search(dir: &Path) -> Option<VariantSearch> {
         },
         slowest_hours,
         after_release_hours,
+        after_release_theta_deg,
         bracketed: holds.iter().any(|h| h.released),
         holds: summary,
     })
@@ -236,6 +240,7 @@ mod tests {
             },
             slowest_hours: 2.9,
             after_release_hours: ours,
+            after_release_theta_deg: Some(45.0),
             bracketed: true,
             holds: String::new(),
         })
