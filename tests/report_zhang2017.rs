@@ -315,9 +315,10 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
     let _ = std::fs::remove_dir_all(&root);
 }
 
-/// `--ladder`: one row per rung sorted by grain count; a compact rung (no snapshots, `particles.json` instead)
-/// gives its grains, radius and mass from that file; of two searches the finer one that found T_c,3 is shown;
-/// the paper's RCP row closes the table and the figure is written.
+/// `--ladder`: one row per rung, by model and then by grain count; a compact rung (no snapshots, `particles.json`
+/// instead) gives its grains, radius and mass from that file; of two searches the finer one that found T_c,3 is
+/// shown; each model's rows are closed by the paper's row at its Table 2 grain count, and the three figures (T_c,3,
+/// φ, T_c,1/T_c,2) carry each model's paper value.
 #[test]
 fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     let root = std::env::temp_dir().join(format!("rp_report_ladder_{}", std::process::id()));
@@ -370,6 +371,18 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     search("ladder/rcp_big/critical", &[2.5, 2.55, 2.6], Some(2.55));
     search("ladder/rcp_big/critical_fine", &[2.51, 2.52, 2.53], Some(2.52));
     search("ladder/rcp_small/critical", &[2.5, 2.55], None);
+    // a rung of another model in the same ladder
+    fake_run_at(
+        &root.join("ladder/hcp_full"),
+        "path2",
+        120,
+        38300.0,
+        38300.0,
+        1200.0,
+        true,
+        Some(2.5),
+    );
+    search("ladder/hcp_full/critical", &[2.5, 2.55, 2.6], Some(2.6));
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(
@@ -406,8 +419,43 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
         rows[0]
     );
     assert!(section.contains("| paper (RCP) | 36 523 |"), "{section}");
+    // each model's rungs, then its paper row: HCP's block before RCP's
+    let order: Vec<&str> = section
+        .lines()
+        .filter(|l| l.starts_with("| hcp_") || l.starts_with("| rcp_") || l.starts_with("| paper ("))
+        .map(|l| l.split(" | ").next().unwrap())
+        .collect();
+    assert_eq!(
+        order,
+        [
+            "| hcp_full",
+            "| paper (HCP)",
+            "| rcp_small",
+            "| rcp_big",
+            "| paper (RCP)"
+        ],
+        "{section}"
+    );
+    assert!(section.contains("| paper (HCP) | 42 062 |"), "{section}");
+    assert!(
+        section.contains("| hcp_full | 120 |") && section.contains("| 2.60 h, 50.0° |"),
+        "{section}"
+    );
     assert!(md.contains("--ladder "), "the command line names --ladder");
-    assert!(out.join("ladder.svg").is_file(), "the figure");
+    for (figure, paper) in [
+        ("ladder", ["HCP paper (Table 3): 2.4", "RCP paper (Table 3): 2.83"]),
+        ("ladder_phi", ["HCP paper (Table 3): 43", "RCP paper (Table 3): 30"]),
+        (
+            "ladder_limits",
+            ["HCP paper (Table 3): 2.38", "RCP paper (Table 3): 2.51"],
+        ),
+    ] {
+        let svg = std::fs::read_to_string(out.join(format!("{figure}.svg"))).expect(figure);
+        for line in paper {
+            assert!(svg.contains(line), "{figure}.svg lacks the paper's line {line}");
+        }
+        assert!(section.contains(&format!("({figure}.png)")), "{figure} in the section");
+    }
     let _ = std::fs::remove_dir_all(&root);
 }
 

@@ -1,7 +1,8 @@
 //! The resolution ladder (issue 40): one model's path-2 run and T_c,3 search at several grain counts, the same
 //! body and material with lengths scaled by the grain radius (`analysis/zhang2017/ladder/README.md`), against
-//! the paper's value at its own count (Zhang17 Table 3: RCP, 36 523 grains of ≈ 10 m). Does the packing
-//! dependence of T_c,3 appear as N grows?
+//! the paper's value at its own count (Zhang17 Tables 2 and 3: RCP, 36 523 grains of ≈ 10 m; HCP, 42 062). Does
+//! the packing dependence of T_c,3 appear as N grows? Rungs of several models (`rcp_8k`, `hcp_full`) share one
+//! ladder directory; a rung's model is its name up to the first `_`.
 //!
 //! Each rung is a directory `<rung>/path2` (a run, or its compact copy: `spinup.csv`, `timeseries.csv`,
 //! `summary.json`, `scene.toml`, `particles.json`) with zero or more searches `<rung>/critical*/critical.json`.
@@ -14,7 +15,9 @@ use std::path::Path;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
 
-use super::rows::{ModelRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical, search_subdirs};
+use super::rows::{
+    ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical, search_subdirs,
+};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.
@@ -65,21 +68,47 @@ pub fn chosen_search(searches: &[RungSearch]) -> Option<&RungSearch> {
         .or_else(|| searches.iter().min_by(by_step))
 }
 
-/// A rung: its path-2 row and its searches.
+/// Zhang17 Table 2's grain counts of the models a ladder climbs: the rung the paper ran.
+pub const PAPER_GRAINS: [(&str, usize); 2] = [("hcp", 42_062), ("rcp", 36_523)];
+
+/// The model a rung belongs to: its directory name up to the first `_` (`rcp_8k` → `rcp`, `hcp_full` → `hcp`).
+///
+/// ```
+/// use rubblepile::studies::zhang2017::ladder::rung_model;
+/// assert_eq!(rung_model("rcp_8k"), "rcp");
+/// assert_eq!(rung_model("hcp_full"), "hcp");
+/// ```
+pub fn rung_model(rung: &str) -> String {
+    base_model(rung).split('_').next().unwrap_or("").to_lowercase()
+}
+
+/// A rung: its model, its path-2 row and its searches.
 struct Rung {
+    model: String,
     row: ModelRow,
     searches: Vec<RungSearch>,
 }
 
+impl Rung {
+    fn chosen(&self) -> Option<&RungSearch> {
+        chosen_search(&self.searches)
+    }
+}
+
+/// The rungs under `ladder`, by model and then by grain count.
 fn rungs(ladder: &Path) -> Result<Vec<Rung>, String> {
     let mut out = Vec::new();
     for dir in model_dirs(ladder)? {
         let (row, _) = model_row(&dir).map_err(|e| e.to_string())?;
         let subdirs = search_subdirs(&dir);
         let searches = subdirs.iter().filter_map(|d| read_search(d)).collect();
-        out.push(Rung { row, searches });
+        out.push(Rung {
+            model: rung_model(&row.model),
+            row,
+            searches,
+        });
     }
-    out.sort_by_key(|r| r.row.n);
+    out.sort_by(|a, b| a.model.cmp(&b.model).then(a.row.n.cmp(&b.row.n)));
     Ok(out)
 }
 
@@ -87,8 +116,42 @@ fn pair(p: (Option<f64>, Option<f64>)) -> String {
     format!("{} h, {}°", opt(p.0, 2), opt(p.1, 1))
 }
 
-/// Writes the "Resolution ladder" section of the rungs under `ladder` and its figure `out/ladder.{svg,png}`
-/// (T_c,1, smoothed T_c,2 and T_c,3 by both criteria against the grain count, the paper's values as dashed lines).
+/// The paper's row of a model's rungs: Zhang17 Table 3 at the grain count of Table 2.
+fn paper_row(model: &str) -> Option<String> {
+    let p = TABLE3.iter().find(|p| p.0 == model)?;
+    let grains = PAPER_GRAINS
+        .iter()
+        .find(|g| g.0 == model)
+        .map_or("–".to_string(), |g| thousands(g.1));
+    Some(format!(
+        "| paper ({}) | {grains} | ≈ 10 | {:.3} | {:.2} / {:.2} | | {} | {:.2} h, {:.0}° | | | < 1e-2 | |",
+        model.to_uppercase(),
+        p.1,
+        p.3,
+        p.4,
+        p.7,
+        p.5,
+        p.2
+    ))
+}
+
+/// `42062` → `42 062` (the paper's grain counts as the tables print them).
+fn thousands(n: usize) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// Writes the "Resolution ladder" section of the rungs under `ladder` (a table per model, closed by the paper's
+/// row) and its figures in `out`: `ladder.{svg,png}` (T_c,3 by both criteria against the grain count),
+/// `ladder_phi.{svg,png}` (φ) and `ladder_limits.{svg,png}` (T_c,1 and the smoothed T_c,2), each model in its
+/// colours with the paper's value (Zhang17 Table 3) as a dashed line.
 pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Result<(), String> {
     let rungs = rungs(ladder)?;
     if rungs.is_empty() {
@@ -100,7 +163,9 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
         "Rungs under `{}`: the same body, material and path 2 at several grain counts (lengths scaled with the grain \
          radius). T_c,1/T_c,2 by the rule of Table 3 above (sampled, then smoothed); T_c,3 and φ from the rung's finest \
          search that found one (`critical*/critical.json`), by the paper's criterion and by ours. The paper's row is \
-         Table 3 (path 1; its T_c,3 does not depend on the path, §4.3).\n",
+         Table 3 (path 1; its T_c,3 does not depend on the path, §4.3) at the grain count of its Table 2. In the figures \
+         each model has its colours, the paper's value is the dashed line, and the points of our criterion sit 4 % to \
+         the right of the rung's grain count so that they do not hide the paper's criterion's.\n",
         ladder.display()
     );
     let _ = writeln!(
@@ -111,107 +176,127 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
         md,
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
-    for r in &rungs {
-        let s = chosen_search(&r.searches);
-        let _ = writeln!(
-            md,
-            "| {} | {} | {:.2} | {:.4} | {} / {} | {} / {} | {} | {} | {} | {} | {:.2e} | {:.0} |",
-            r.row.model,
-            r.row.n,
-            r.row.radius_range.1,
-            r.row.packing,
-            opt(r.row.limits.t_c1_hours, 3),
-            opt(r.row.limits.t_c2_hours, 3),
-            opt(r.row.limits_smoothed.t_c1_hours, 3),
-            opt(r.row.limits_smoothed.t_c2_hours, 3),
-            mode(r.row.limits.failure_mode),
-            s.map_or("not searched".into(), |s| pair(s.paper)),
-            s.map_or("–".into(), |s| pair(s.ours)),
-            s.map_or("–".into(), |s| format!(
-                "`{}`: {:.2} h, {}",
-                s.name, s.step_hours, s.holds
-            )),
-            r.row.max_overlap,
-            r.row.wall_seconds,
-        );
+    let mut models: Vec<String> = rungs.iter().map(|r| r.model.clone()).collect();
+    models.dedup();
+    for model in &models {
+        for r in rungs.iter().filter(|r| &r.model == model) {
+            let s = r.chosen();
+            let _ = writeln!(
+                md,
+                "| {} | {} | {:.2} | {:.4} | {} / {} | {} / {} | {} | {} | {} | {} | {:.2e} | {:.0} |",
+                r.row.model,
+                r.row.n,
+                r.row.radius_range.1,
+                r.row.packing,
+                opt(r.row.limits.t_c1_hours, 3),
+                opt(r.row.limits.t_c2_hours, 3),
+                opt(r.row.limits_smoothed.t_c1_hours, 3),
+                opt(r.row.limits_smoothed.t_c2_hours, 3),
+                mode(r.row.limits.failure_mode),
+                s.map_or("not searched".into(), |s| pair(s.paper)),
+                s.map_or("–".into(), |s| pair(s.ours)),
+                s.map_or("–".into(), |s| format!(
+                    "`{}`: {:.2} h, {}",
+                    s.name, s.step_hours, s.holds
+                )),
+                r.row.max_overlap,
+                r.row.wall_seconds,
+            );
+        }
+        if let Some(row) = paper_row(model) {
+            let _ = writeln!(md, "{row}");
+        }
     }
-    let model = base_model(&rungs[0].row.model)
-        .split('_')
-        .next()
-        .unwrap_or("")
-        .to_string();
-    let paper = TABLE3.iter().find(|p| p.0 == model);
-    if let Some(p) = paper {
-        let _ = writeln!(
-            md,
-            "| paper ({}) | {} | ≈ 10 | {:.3} | {:.2} / {:.2} | | {} | {:.2} h, {:.0}° | | | < 1e-2 | |",
-            p.0.to_uppercase(),
-            if p.0 == "rcp" { "36 523" } else { "–" },
-            p.1,
-            p.3,
-            p.4,
-            p.7,
-            p.5,
-            p.2
-        );
-    }
+    let most = rungs
+        .iter()
+        .map(|r| r.row.n)
+        .chain(PAPER_GRAINS.iter().map(|g| g.1))
+        .max();
     let n_range = (
-        rungs[0].row.n as f64 * 0.8,
-        rungs[rungs.len() - 1].row.n.max(36_523) as f64 * 1.25,
+        rungs.iter().map(|r| r.row.n).min().unwrap_or(1) as f64 * 0.8,
+        most.unwrap_or(1) as f64 * 1.25,
     );
-    let series = |label: &str, colour, mark, points: Vec<(f64, f64)>| Series {
-        label: label.into(),
-        errors: vec![],
-        points,
-        colour,
-        mark,
+    // one figure per quantity: each model's rungs as points, the paper's value as a dashed line of its colour
+    type Of<'a> = &'a dyn Fn(&Rung) -> Option<f64>;
+    type Paper = Option<fn(&PaperRow) -> f64>;
+    let figure = |name: &str, title: &str, y_label: &str, quantities: &[(&str, Of, Paper)]| {
+        let mut series = Vec::new();
+        for (m, model) in models.iter().enumerate() {
+            let paper = TABLE3.iter().find(|p| p.0 == model);
+            for (q, (label, of, paper_value)) in quantities.iter().enumerate() {
+                let colour = m * quantities.len() + q;
+                let points = rungs
+                    .iter()
+                    .filter(|r| &r.model == model)
+                    // the second criterion's points sit 4 % to the right, so that equal values stay visible
+                    .filter_map(|r| of(r).map(|y| (r.row.n as f64 * (1.0 + 0.04 * q as f64), y)))
+                    .collect();
+                series.push(Series {
+                    label: format!("{} {label}", model.to_uppercase()),
+                    errors: vec![],
+                    points,
+                    colour,
+                    mark: Mark::Points,
+                });
+                if let (Some(p), Some(value)) = (paper, paper_value) {
+                    let v = value(p);
+                    series.push(Series {
+                        label: format!("{} paper (Table 3): {v}", model.to_uppercase()),
+                        errors: vec![],
+                        points: vec![(n_range.0, v), (n_range.1, v)],
+                        colour,
+                        mark: Mark::Dashed,
+                    });
+                }
+            }
+        }
+        let chart = LineChart {
+            title: title.into(),
+            x_label: "grains".into(),
+            y_label: y_label.into(),
+            series,
+            log_x: true,
+        };
+        write_figure(out, name, &chart).map_err(|e| e.to_string())
     };
-    let of = |f: &dyn Fn(&Rung) -> Option<f64>| -> Vec<(f64, f64)> {
-        rungs.iter().filter_map(|r| f(r).map(|y| (r.row.n as f64, y))).collect()
-    };
-    let mut chart = LineChart {
-        title: format!(
-            "{}: critical spins against the grain count (path 2)",
-            model.to_uppercase()
-        ),
-        x_label: "grains".into(),
-        y_label: "spin period (h)".into(),
-        series: vec![
-            series("T_c1 (sampled)", 0, Mark::Points, of(&|r| r.row.limits.t_c1_hours)),
-            series(
-                "T_c2 (smoothed)",
-                1,
-                Mark::Points,
-                of(&|r| r.row.limits_smoothed.t_c2_hours),
-            ),
-            series(
+    // the paper's value is drawn once per model: beside the paper's criterion (Table 3 gives one T_c,3 and φ)
+    figure(
+        "ladder",
+        "T_c3 against the grain count (path 2)",
+        "T_c3 (h)",
+        &[
+            (
                 "T_c3 (paper's criterion)",
-                2,
-                Mark::Points,
-                of(&|r| chosen_search(&r.searches).and_then(|s| s.paper.0)),
+                &|r| r.chosen().and_then(|s| s.paper.0),
+                Some(|p| p.5),
             ),
-            series(
-                "T_c3 (our criterion)",
-                3,
-                Mark::Points,
-                of(&|r| chosen_search(&r.searches).and_then(|s| s.ours.0)),
-            ),
+            ("T_c3 (our criterion)", &|r| r.chosen().and_then(|s| s.ours.0), None),
         ],
-        log_x: true,
-    };
-    if let Some(p) = paper {
-        let line = |v: f64| vec![(n_range.0, v), (n_range.1, v)];
-        chart
-            .series
-            .push(series(&format!("paper T_c1 {:.2} h", p.3), 0, Mark::Dashed, line(p.3)));
-        chart
-            .series
-            .push(series(&format!("paper T_c2 {:.2} h", p.4), 1, Mark::Dashed, line(p.4)));
-        chart
-            .series
-            .push(series(&format!("paper T_c3 {:.2} h", p.5), 2, Mark::Dashed, line(p.5)));
-    }
-    write_figure(out, "ladder", &chart).map_err(|e| e.to_string())?;
-    let _ = writeln!(md, "\n![ladder](ladder.png)");
+    )?;
+    figure(
+        "ladder_phi",
+        "Friction angle at T_c3 against the grain count (path 2)",
+        "phi (deg)",
+        &[
+            (
+                "phi (paper's criterion)",
+                &|r| r.chosen().and_then(|s| s.paper.1),
+                Some(|p| p.2),
+            ),
+            ("phi (our criterion)", &|r| r.chosen().and_then(|s| s.ours.1), None),
+        ],
+    )?;
+    figure(
+        "ladder_limits",
+        "T_c1 and T_c2 against the grain count (path 2)",
+        "spin period (h)",
+        &[
+            ("T_c1 (sampled)", &|r| r.row.limits.t_c1_hours, Some(|p| p.3)),
+            ("T_c2 (smoothed)", &|r| r.row.limits_smoothed.t_c2_hours, Some(|p| p.4)),
+        ],
+    )?;
+    let _ = writeln!(md, "\n![ladder: T_c3](ladder.png)\n");
+    let _ = writeln!(md, "![ladder: φ](ladder_phi.png)\n");
+    let _ = writeln!(md, "![ladder: T_c1 and T_c2](ladder_limits.png)");
     Ok(())
 }
