@@ -20,6 +20,7 @@ fn spec(model: Model, shape: Shape, grains: Grains, bulk_density: f64) -> BuildS
         seed: 7,
         core_radius: None,
         recipe: Recipe::default(),
+        orientation: Default::default(),
     }
 }
 
@@ -131,7 +132,7 @@ fn core_variants_have_the_requested_density_ratio_and_structure() {
     let total: f64 = ps.iter().map(|p| p.mass).sum();
     assert!((total / volume / 2100.0 - 1.0).abs() < 1e-12);
 
-    let core = hcp_core(r, 40.0);
+    let core = hcp_core(r, 40.0, &rubblepile::math::Mat3::identity());
     assert!(core.centres.iter().all(|c| c.norm() <= 40.0));
     for c in core.centres.iter().filter(|c| c.norm() < 40.0 - 2.5 * r) {
         let touching = core

@@ -16,6 +16,7 @@ fn spec(model: Model, shape: Shape, grains: Grains, seed: u64) -> BuildSpec {
         seed,
         core_radius: None,
         recipe: Recipe::default(),
+        orientation: Default::default(),
     }
 }
 

@@ -357,6 +357,7 @@ fn branched_hold_equals_the_hold_run_from_the_start() {
     assert_eq!(v["criterion"]["kind"], "paper", "{json}");
     assert_eq!(v["paper"]["criterion"]["kind"], "paper", "{json}");
     assert_eq!(v["ours"]["criterion"]["kind"], "ours", "{json}");
+    assert_eq!(v["paper_tolerance"]["criterion"]["kind"], "paper-tolerance", "{json}");
     let run = &v["runs"][0];
     assert!(run["drift"]["coordination"].is_f64(), "{json}");
     assert!(
@@ -365,13 +366,17 @@ fn branched_hold_equals_the_hold_run_from_the_start() {
     );
     assert_eq!(run["stable"], run["paper"]["stable"], "{json}");
     let out = String::from_utf8_lossy(&c.stdout);
-    assert!(out.contains("T_final = 6.00 h: paper "), "{out}");
+    assert!(out.contains("T_final = 6.00 h (600 s judged): paper "), "{out}");
     let csv = read(&dir.join("crit/critical.csv"));
-    assert!(csv.starts_with("t_final_h,released,theta_max_deg,"), "{csv}");
+    assert!(
+        csv.starts_with("t_final_h,hold_s,released,release_s,theta_max_deg,"),
+        "{csv}"
+    );
     assert!(csv.lines().nth(1).unwrap().starts_with("6.00,"), "{csv}");
 }
 
-/// `--creep-criterion` takes `paper` or `ours`; anything else is refused with the expected values.
+/// `--creep-criterion` takes `paper`, `paper-tolerance` or `ours`; anything else is refused with the expected
+/// values.
 #[test]
 fn creep_criterion_option_names_the_expected_values() {
     let dir = temp_dir("spinup-criterion");
@@ -395,7 +400,10 @@ fn creep_criterion_option_names_the_expected_values() {
     );
     assert!(!c.status.success());
     let err = String::from_utf8_lossy(&c.stderr);
-    assert!(err.contains("expected `paper` or `ours`, got `Paper`"), "{err}");
+    assert!(
+        err.contains("expected `paper`, `paper-tolerance` or `ours`, got `Paper`"),
+        "{err}"
+    );
     assert!(!dir.join("crit").exists(), "nothing is written for a refused option");
 }
 
@@ -417,4 +425,139 @@ fn branch_refuses_a_path_with_rests() {
     assert!(!c.status.success());
     let err = String::from_utf8_lossy(&c.stderr);
     assert!(err.contains("spinup.rests = 1"), "{err}");
+}
+
+/// Files of a search directory that must not depend on how its holds were scheduled: `critical.json` and
+/// `critical.csv` (the run directories' paths aside) and every hold's `spinup.csv` and snapshots.
+fn search_outputs(dir: &Path) -> Vec<(String, String)> {
+    let mut out = vec![
+        ("critical.csv".to_string(), read(&dir.join("critical.csv"))),
+        (
+            "critical.json".to_string(),
+            read(&dir.join("critical.json")).replace(&dir.display().to_string(), "DIR"),
+        ),
+    ];
+    let mut holds: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir() && p.file_name().unwrap().to_string_lossy().starts_with('T'))
+        .collect();
+    holds.sort();
+    for h in holds {
+        let name = h.file_name().unwrap().to_string_lossy().to_string();
+        out.push((format!("{name}/spinup.csv"), read(&h.join("spinup.csv"))));
+        for (f, bytes) in snapshots(&h) {
+            out.push((
+                format!("{name}/snapshots/{f}"),
+                String::from_utf8_lossy(&bytes).to_string(),
+            ));
+        }
+    }
+    out
+}
+
+/// Acceptance (issue 55, item 4): the holds of a search run two at once (`--parallel 2`), or as two shards of a job
+/// array judged afterwards, give the same `critical.csv`, `critical.json` and hold runs as one after another.
+#[test]
+fn parallel_and_sharded_searches_equal_the_sequential_one() {
+    let dir = temp_dir("spinup-parallel");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let search = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "spinup",
+            "critical",
+            "--scene",
+            "s.toml",
+            "--from",
+            "5.7",
+            "--to",
+            "6.0",
+            "--step",
+            "0.1",
+            "--branch",
+            "--hold",
+            "600",
+            "--all-holds",
+            "--out",
+            out,
+        ];
+        args.extend_from_slice(extra);
+        let c = rubblepile(&dir, &args);
+        assert!(c.status.success(), "{out}: {}", String::from_utf8_lossy(&c.stderr));
+        String::from_utf8_lossy(&c.stdout).to_string()
+    };
+    let seq = search("seq", &[]);
+    let par = search("par", &["--parallel", "2", "--threads-per-hold", "1"]);
+    assert_eq!(seq.replace("seq/", ""), par.replace("par/", ""));
+    for shard in ["0/2", "1/2"] {
+        let out = search("sh", &["--shard", shard]);
+        assert!(out.contains(&format!("shard {shard} ran 2 of 4 holds")), "{out}");
+    }
+    assert!(!dir.join("sh/critical.json").exists(), "a shard judges nothing");
+    search("sh", &[]);
+    let reference = search_outputs(&dir.join("seq"));
+    assert_eq!(reference.len(), 2 + 4 * (1 + snapshots(&dir.join("seq/T6.00")).len()));
+    for other in ["par", "sh"] {
+        let o = search_outputs(&dir.join(other));
+        assert_eq!(o.len(), reference.len());
+        for ((na, a), (nb, b)) in reference.iter().zip(&o) {
+            assert_eq!(na, nb);
+            assert!(a == &b.replace(&format!("{other}/"), "seq/"), "{other}: {na} differs");
+        }
+    }
+}
+
+/// A hold whose forcing is released stops at the next release check (2000 simulated seconds) instead of running
+/// to its end, and is judged released; `--finish-released` runs it to the end with the same verdict. The release
+/// thresholds are set so low that every sample after t_start trips them, and 12 consecutive samples (1440 s) are
+/// asked for, so the path reaches the hold's start (1560 s) forced and the release comes inside the hold.
+#[test]
+fn a_released_hold_stops_early_unless_asked_to_finish() {
+    let dir = temp_dir("spinup-release-stop");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0").replace(
+        "rve_particles = 30",
+        "rve_particles = 30\nrelease_packing = 1e-12\nrelease_axis_ratio = 1e-12\nrelease_samples = 12",
+    );
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let search = |out: &str, extra: &[&str]| {
+        let mut args = vec![
+            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "6000",
+            "--out", out,
+        ];
+        args.extend_from_slice(extra);
+        let c = rubblepile(&dir, &args);
+        assert!(c.status.success(), "{out}: {}", String::from_utf8_lossy(&c.stderr));
+    };
+    search("early", &[]);
+    search("full", &["--finish-released"]);
+    let last_t = |d: &str| {
+        read_spinup_csv(&dir.join(d).join("T6.00/spinup.csv"))
+            .unwrap()
+            .last()
+            .unwrap()
+            .t
+    };
+    // the hold branches off the base run at 1560 s (its t_final is 1600 s) and releases inside it; the first leg
+    // ends at the first sample at least 2000 s on (3600 s), where the hold stops; the full hold ends at 7600 s
+    let released = read_spinup_csv(&dir.join("full/T6.00/spinup.csv")).unwrap();
+    let release_t = released.iter().find(|r| !r.forcing).unwrap().t;
+    assert!(release_t > 1560.0 && release_t < 3560.0, "{release_t}");
+    assert!((last_t("early") - 3600.0).abs() < 1.0, "{}", last_t("early"));
+    assert!((last_t("full") - 7600.0).abs() < 1.0, "{}", last_t("full"));
+    for d in ["early", "full"] {
+        let csv = read(&dir.join(d).join("critical.csv"));
+        assert!(csv.lines().nth(1).unwrap().starts_with("6.00,"), "{csv}");
+        assert_eq!(
+            csv.lines().nth(1).unwrap().split(',').nth(2),
+            Some("true"),
+            "{d}: {csv}"
+        );
+    }
+    // the early rows are the full run's up to the stop, bit for bit
+    let (a, b) = (
+        read(&dir.join("early/T6.00/spinup.csv")),
+        read(&dir.join("full/T6.00/spinup.csv")),
+    );
+    assert!(b.starts_with(&a), "the stopped hold is a prefix of the finished one");
 }

@@ -30,7 +30,8 @@ HOLD_COLUMNS = ["period_h", "body_mass_fraction", "packing_fraction", "coordinat
 
 def write_holds(search_dir, dst, force):
     """One row per sample of every hold in critical.json's `runs`, from the hold's start on: t_final_h (the hold's
-    period), t_hold_s (seconds since the hold began) and HOLD_COLUMNS (empty where a run lacks the column)."""
+    period), t_hold_s (seconds since the hold began), HOLD_COLUMNS (empty where a run lacks the column) and
+    forcing (1 while the spin-up forcing acts, 0 once it was released)."""
     import tomllib
     if os.path.exists(dst) and not force:
         sys.exit(f"{dst} exists (use --force to overwrite it)")
@@ -46,10 +47,13 @@ def write_holds(search_dir, dst, force):
                 t = float(r["t"])
                 if t + 1e-6 < t0:
                     continue
-                rows.append([f"{run['t_final_hours']:.2f}", f"{t - t0:.1f}"] + [r.get(c, "") for c in HOLD_COLUMNS])
+                forcing = r.get("forcing", "")
+                forcing = {"true": "1", "false": "0"}.get(forcing, forcing)
+                rows.append([f"{run['t_final_hours']:.2f}", f"{t - t0:.1f}"] + [r.get(c, "") for c in HOLD_COLUMNS]
+                            + [forcing])
     with open(dst, "w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(["t_final_h", "t_hold_s"] + HOLD_COLUMNS)
+        w.writerow(["t_final_h", "t_hold_s"] + HOLD_COLUMNS + ["forcing"])
         w.writerows(rows)
 
 

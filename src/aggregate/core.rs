@@ -3,9 +3,10 @@
 //! with centres inside a 200 m core have 1.5 times the grain density of the rest. The paper's core radius is
 //! 200 m in a body of volume-equivalent radius 390 m; [`default_core_radius`] keeps that proportion.
 
+use crate::aggregate::hcp::rotate;
 use crate::aggregate::random_packing::Insert;
 use crate::geometry::lattice::hcp_centres;
-use crate::math::Vec3;
+use crate::math::{Mat3, Vec3};
 
 /// Zhang17's core radius relative to the body's volume-equivalent radius, 200 m / 390 m.
 pub const CORE_FRACTION: f64 = 200.0 / 390.0;
@@ -18,9 +19,13 @@ pub fn default_core_radius(d_eq: f64) -> f64 {
 }
 
 /// The HCP core of RCPC: lattice sites (a site at the origin) within `core_radius` (m) for grains of radius `r`;
-/// the random heap's grains inside `core_radius` or touching the core are removed before settling.
-pub fn hcp_core(r: f64, core_radius: f64) -> Insert {
-    let centres: Vec<Vec3> = hcp_centres(r, core_radius);
+/// the random heap's grains inside `core_radius` or touching the core are removed before settling. The lattice is
+/// turned by `rotation` (lattice → body; [`crate::aggregate::lattice_orientation`]).
+pub fn hcp_core(r: f64, core_radius: f64, rotation: &Mat3) -> Insert {
+    let centres: Vec<Vec3> = hcp_centres(r, core_radius)
+        .into_iter()
+        .map(|p| rotate(rotation, p))
+        .collect();
     Insert {
         radii: vec![r; centres.len()],
         centres,

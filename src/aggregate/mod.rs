@@ -2,9 +2,10 @@
 //! PP1, PP2 and PPC, carved from a shape, with masses set by a bulk density, written in the soft-sphere
 //! particle-file format so spin-up scenes can load them.
 //!
-//! - [`shape`]: sphere, ellipsoid, Didymos-like top, OBJ model (`contains`, volume);
+//! - [`shape`]: sphere, ellipsoid, Didymos-like top, [`triaxial_top`] (Naidu et al. 2020's Didymos), OBJ model
+//!   (`contains`, volume);
 //! - [`size_distribution`]: `dN/dr ∝ r⁻³` radii;
-//! - [`hcp`]: lattice carving; [`random_packing`]: the collapse → shaking → settling recipe on the SSDEM engine;
+//! - [`hcp`]: lattice carving, turned as [`lattice_orientation`] says; [`random_packing`]: the collapse → shaking → settling recipe on the SSDEM engine;
 //! - [`core`]: RCPC's HCP core and PPC's denser core; [`density`]: masses from a bulk density and its variants;
 //! - [`report`]: the JSON report.
 //!
@@ -15,11 +16,14 @@ pub mod core;
 pub mod density;
 pub mod files;
 pub mod hcp;
+pub mod lattice_orientation;
 pub mod random_packing;
 pub mod report;
 pub mod shape;
 pub mod size_distribution;
+pub mod triaxial_top;
 
+use crate::aggregate::lattice_orientation::LatticeOrientation;
 use crate::aggregate::random_packing::{BuildProgress, Recipe, random_heap};
 use crate::aggregate::report::{AggregateReport, measure};
 use crate::aggregate::shape::Shape;
@@ -127,6 +131,8 @@ pub struct BuildSpec {
     pub core_radius: Option<f64>,
     /// Random-packing recipe.
     pub recipe: Recipe,
+    /// How the lattice of HCP (and of RCPC's core) is turned before carving; default: layers ⟂ the spin axis.
+    pub orientation: LatticeOrientation,
 }
 
 /// Why a build was refused or failed.
@@ -254,13 +260,21 @@ pub fn build_with_progress(
         }
         _ => None,
     };
+    let has_lattice = matches!(spec.model, Model::Hcp | Model::Rcpc);
+    if !has_lattice && spec.orientation != LatticeOrientation::default() {
+        return Err(input(
+            "--lattice-orientation",
+            format!("only hcp and rcpc have a lattice to turn, not {}", spec.model.name()),
+        ));
+    }
+    let rotation = spec.orientation.rotation(spec.seed);
     let mut rng = generator(spec.seed);
     // Grains before carving: centres about the shape's origin, radii, density weights.
     let mut heap_n = None;
     let mut stages = Vec::new();
     let (centres, radii): (Vec<Vec3>, Vec<f64>) = if spec.model == Model::Hcp {
         let r = radius.expect("monodisperse");
-        let c = hcp::hcp_carve(&spec.shape, r);
+        let c = hcp::hcp_carve_oriented(&spec.shape, r, &rotation);
         let n = c.len();
         (c, vec![r; n])
     } else {
@@ -276,7 +290,7 @@ pub fn build_with_progress(
             _ => unreachable!("grain_sizes gives a radius or a law"),
         };
         let insert = match (spec.model, core_radius) {
-            (Model::Rcpc, Some(c)) => Some(core::hcp_core(radius.expect("monodisperse"), c)),
+            (Model::Rcpc, Some(c)) => Some(core::hcp_core(radius.expect("monodisperse"), c, &rotation)),
             _ => None,
         };
         let rho_build = spec.bulk_density / expected_packing(spec.model);
@@ -337,6 +351,10 @@ pub fn build_with_progress(
         report.recipe = Some(spec.recipe);
         report.heap_n = heap_n;
         notes.push_str("; carved from the settled heap, centred on its centre of mass");
+    }
+    if has_lattice {
+        report.lattice_orientation = Some(spec.orientation.name(spec.seed));
+        report.lattice_tilt_deg = Some(spec.orientation.stacking_axis_tilt_deg(spec.seed));
     }
     report.stages = stages;
     report.notes = notes;

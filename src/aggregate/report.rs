@@ -78,6 +78,14 @@ pub struct AggregateReport {
     pub heap_n: Option<usize>,
     /// Free text: how the radii were chosen (scaling relative to the paper).
     pub notes: String,
+    /// How the lattice (HCP, RCPC's core) was turned before carving: `perpendicular`, `parallel`, `tilt:DEG` or
+    /// `random:SEED` ([`crate::aggregate::lattice_orientation`]); absent for models without a lattice and in
+    /// reports written before it was recorded (those lattices are `perpendicular`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice_orientation: Option<String>,
+    /// Angle (degrees, 0–90) between the lattice's stacking axis and the spin axis z.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lattice_tilt_deg: Option<f64>,
 }
 
 /// Largest pairwise overlap over the smaller radius (0 if none).
@@ -149,5 +157,7 @@ pub fn measure(particles: &[Particle], shape: &Shape) -> AggregateReport {
         stages: Vec::new(),
         heap_n: None,
         notes: String::new(),
+        lattice_orientation: None,
+        lattice_tilt_deg: None,
     }
 }

@@ -2,11 +2,14 @@
 //! model; a particle is kept when its centre is inside, so grains stick out of the surface by up to a radius, as
 //! in the paper's Fig. 4).
 //!
-//! One enum, [`Shape`], with `contains(p)` and an exact volume: a sphere, a triaxial ellipsoid, a Didymos-like
-//! "top" ([`Top`]), and any closed triangulated OBJ model ([`crate::geometry::polyhedron::Polyhedron`]).
+//! One enum, [`Shape`], with `contains(p)` and an exact volume: a sphere, a triaxial ellipsoid, the Didymos primary
+//! with Naidu et al. (2020)'s extents ([`TriaxialTop`], the nominal shape of the Zhang17 scenes), the axisymmetric
+//! Didymos-like "top" ([`Top`], the shape of our Zhang17 runs before Dec 2026), and any closed triangulated OBJ
+//! model ([`crate::geometry::polyhedron::Polyhedron`]).
 
 use std::path::Path;
 
+use crate::aggregate::triaxial_top::TriaxialTop;
 use crate::geometry::polyhedron::Polyhedron;
 use crate::math::Vec3;
 
@@ -130,6 +133,8 @@ pub enum Shape {
     },
     /// The Didymos-like top ([`Top`]).
     Top(Top),
+    /// A triaxial top with a given volume ([`TriaxialTop`]; Naidu et al. 2020's Didymos by default).
+    TriaxialTop(TriaxialTop),
     /// A closed triangulated model, with the path it was read from.
     Polyhedron {
         /// The model (m).
@@ -146,7 +151,9 @@ pub struct ShapeSpecError(pub String);
 
 impl Shape {
     /// Parses `sphere:R`, `ellipsoid:A,B,C` (semi-axes), `top` or `top:D_EQ` (volume-equivalent diameter,
-    /// default 780 m), or `obj:PATH` (coordinates multiplied by `obj_scale`, e.g. 1000 for km); lengths in m.
+    /// default 780 m), `didymos` or `didymos:LX,LY,LZ,D_EQ` (a [`TriaxialTop`] of full extents LX, LY, LZ and
+    /// volume-equivalent diameter D_EQ; default Naidu et al. 2020's 832, 838, 786 and 780 m), or `obj:PATH`
+    /// (coordinates multiplied by `obj_scale`, e.g. 1000 for km); lengths in m.
     ///
     /// ```
     /// use rubblepile::aggregate::shape::Shape;
@@ -185,6 +192,13 @@ impl Shape {
             }
             "top" if arg.is_empty() => Ok(Shape::Top(Top::didymos(780.0))),
             "top" => Ok(Shape::Top(Top::didymos(numbers(1, "EQUIVALENT_DIAMETER")?[0]))),
+            "didymos" if arg.is_empty() => Ok(Shape::TriaxialTop(TriaxialTop::didymos_naidu2020())),
+            "didymos" => {
+                let v = numbers(4, "LX,LY,LZ,EQUIVALENT_DIAMETER")?;
+                TriaxialTop::new([v[0], v[1], v[2]], v[3])
+                    .map(Shape::TriaxialTop)
+                    .map_err(|e| ShapeSpecError(format!("`{spec}`: {e}")))
+            }
             "obj" => {
                 if arg.is_empty() {
                     return Err(ShapeSpecError(format!("`{spec}`: expected obj:PATH")));
@@ -209,7 +223,7 @@ impl Shape {
                 })
             }
             _ => Err(ShapeSpecError(format!(
-                "unknown shape `{spec}`; expected sphere:R, ellipsoid:A,B,C, top[:D_EQ] or obj:PATH"
+                "unknown shape `{spec}`; expected sphere:R, ellipsoid:A,B,C, top[:D_EQ], didymos[:LX,LY,LZ,D_EQ] or obj:PATH"
             ))),
         }
     }
@@ -220,6 +234,7 @@ impl Shape {
             Shape::Sphere { radius } => p.norm_squared() <= radius * radius,
             Shape::Ellipsoid { axes } => (0..3).map(|k| (p[k] / axes[k]).powi(2)).sum::<f64>() <= 1.0,
             Shape::Top(t) => t.contains(p),
+            Shape::TriaxialTop(t) => t.contains(p),
             Shape::Polyhedron { model, .. } => model.contains(p),
         }
     }
@@ -231,6 +246,7 @@ impl Shape {
             Shape::Sphere { radius } => ball * radius.powi(3),
             Shape::Ellipsoid { axes } => ball * axes[0] * axes[1] * axes[2],
             Shape::Top(t) => t.volume(),
+            Shape::TriaxialTop(t) => t.volume(),
             Shape::Polyhedron { model, .. } => model.volume(),
         }
     }
@@ -241,6 +257,7 @@ impl Shape {
             Shape::Sphere { radius } => *radius,
             Shape::Ellipsoid { axes } => axes.iter().cloned().fold(0.0, f64::max),
             Shape::Top(t) => t.ridge_radius.max(t.polar),
+            Shape::TriaxialTop(t) => t.semi_extents.iter().cloned().fold(0.0, f64::max),
             Shape::Polyhedron { model, .. } => model.vertices.iter().map(|v| v.norm()).fold(0.0, f64::max),
         }
     }
@@ -258,6 +275,14 @@ impl Shape {
             Shape::Top(t) => format!(
                 "top (oblate spheroid a_s {:.3} m, c {:.3} m, with an equatorial ridge A {:.3} m, cone apex h {:.3} m)",
                 t.spheroid_equatorial, t.polar, t.ridge_radius, t.cone_height
+            ),
+            Shape::TriaxialTop(t) => format!(
+                "triaxial top (extents {} × {} × {} m, ridge excess {:.4}, volume-equivalent diameter {:.3} m)",
+                2.0 * t.semi_extents[0],
+                2.0 * t.semi_extents[1],
+                2.0 * t.semi_extents[2],
+                t.ridge_excess(),
+                t.equivalent_diameter()
             ),
             Shape::Polyhedron { model, source } => format!("obj {source} ({} triangles)", model.triangles.len()),
         }

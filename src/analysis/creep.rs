@@ -6,21 +6,23 @@
 //! fraction η_B and of the coordination number (mean contacts per particle). Its stable example (Fig. 22, PP2 at
 //! 2811 kg/m³) shows η_B and the coordination number *rising* a little once the acceleration stops (the pile
 //! re-compacts) and then levelling off; that is not creep. T_c,3 is the shortest T_final whose hold does not creep.
-//! The paper gives no numbers for "gradual", and its sentence can be read as "η_B and the coordination number both
-//! fall"; we read each of the three as a sign of creep on its own, because the paper lists them as indicators
-//! and a hold in which any one of them keeps degrading has not settled.
+//! The paper gives no tolerance: any persistent weakening trend is creep.
 //!
-//! **The two criteria here** ([`CreepCriterionKind`]) judge the same thing, the change over the second half of the
-//! hold of a least-squares line through each diagnostic ([`second_half_drift`]; the first half is left to the
+//! **The criteria here** ([`CreepCriterionKind`]) look at the second half of the hold (the first half is left to the
 //! transient that follows the end of the acceleration, so that "gradual" means a trend that persists):
-//! - [`CreepCriterionKind::Paper`]: one-sided, as the paper words it, coordination number included: creep when θ_max
-//!   rises by more than 0.5°, η_B falls by more than 0.0005 or the coordination number falls by more than 0.05
-//!   (tolerances ours; the paper gives none);
-//! - [`CreepCriterionKind::Ours`]: the criterion of the runs behind `analysis/zhang2017/REPORT.md` (23 Nov 2026):
-//!   two-sided on θ_max (0.5°) and η_B (0.0005, half the T_c,2 threshold), the coordination number not judged. We
-//!   dropped it because in our scaled RCP holds it fell by about 0.1 over the second half at every held period from
-//!   2.74 h to 3.00 h (θ_max 25° at 3.00 h, far from yield) with θ_max and η_B flat: a slow loss of marginal
-//!   contacts, not the creep that precedes failure.
+//! - [`CreepCriterionKind::Paper`] (the default): the paper's one-sided rule with zero tolerance, judged by *rates*.
+//!   Each diagnostic's least-squares slope over the second half is given per 1000 s with its standard error
+//!   ([`RateFit`]; the error widened for the serial correlation of the samples); a diagnostic creeps when its
+//!   weakening rate (θ_max up, η_B down, contacts down) exceeds [`DEFAULT_SIGNIFICANCE`] standard errors. Nothing
+//!   here depends on the hold's length except through the error of the rate, so a longer hold can only sharpen a
+//!   verdict, not move a threshold.
+//! - [`CreepCriterionKind::PaperTolerance`]: the same one-sided reading with tolerances on the *change* over the
+//!   second half (θ_max +0.5°, η_B −0.0005, contacts −0.05 per particle; ours, the paper gives none): the default
+//!   of the searches made before Dec 2026, kept to read them and as the documented alternative.
+//! - [`CreepCriterionKind::Ours`]: two-sided on θ_max (0.5°) and η_B (0.0005) over the second half, the
+//!   coordination number not judged: the criterion of the runs behind the 23 Nov 2026 report. We dropped the
+//!   coordination number then because our scaled RCP holds lost about 0.1 contacts per particle per half-hold at
+//!   every period from 2.74 to 3.00 h with θ_max near 25°; by the paper's rule all of those creep.
 //!
 //! Either way a hold whose forcing was released (global disruption) is not stable; that is the search's business
 //! (`analysis::spinup_search`, which uses these criteria).
@@ -31,22 +33,29 @@ use crate::analysis::spinup::PACKING_THRESHOLD;
 
 /// Which reading of the creep test of Zhang17 §3.3.3 judges a hold (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "kebab-case")]
 pub enum CreepCriterionKind {
-    /// The paper's: a rising θ_max, a falling η_B or a falling coordination number is creep.
+    /// The paper's, zero tolerance: a significantly rising θ_max, falling η_B or falling coordination number.
     Paper,
-    /// Ours (REPORT.md's T_c,3): θ_max or η_B moving either way is creep; the coordination number is not judged.
+    /// The paper's one-sided reading with tolerances on the second-half change (before Dec 2026).
+    PaperTolerance,
+    /// Ours: θ_max or η_B moving either way beyond a tolerance; the coordination number not judged.
     Ours,
 }
 
 impl CreepCriterionKind {
-    /// Both kinds, the paper's first.
-    pub const ALL: [CreepCriterionKind; 2] = [CreepCriterionKind::Paper, CreepCriterionKind::Ours];
+    /// All kinds, the default (the paper's) first.
+    pub const ALL: [CreepCriterionKind; 3] = [
+        CreepCriterionKind::Paper,
+        CreepCriterionKind::PaperTolerance,
+        CreepCriterionKind::Ours,
+    ];
 
-    /// The name used on the command line and in `critical.json`: `paper` or `ours`.
+    /// The name used on the command line and in `critical.json`: `paper`, `paper-tolerance` or `ours`.
     pub fn name(self) -> &'static str {
         match self {
             CreepCriterionKind::Paper => "paper",
+            CreepCriterionKind::PaperTolerance => "paper-tolerance",
             CreepCriterionKind::Ours => "ours",
         }
     }
@@ -54,38 +63,42 @@ impl CreepCriterionKind {
 
 impl std::str::FromStr for CreepCriterionKind {
     type Err = String;
-    /// Parses `paper` or `ours`; anything else is an error naming the expected values.
+    /// Parses `paper`, `paper-tolerance` or `ours`; anything else is an error naming the expected values.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "paper" => Ok(CreepCriterionKind::Paper),
-            "ours" => Ok(CreepCriterionKind::Ours),
-            _ => Err(format!("creep criterion: expected `paper` or `ours`, got `{s}`")),
-        }
+        CreepCriterionKind::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("creep criterion: expected `paper`, `paper-tolerance` or `ours`, got `{s}`"))
     }
 }
 
 /// Largest change of the coordination number (contacts per particle) over the second half of a hold that the
-/// paper's criterion lets pass by default. Ours, the paper gives no number: the tolerance of our first search
-/// with the coordination number judged (Nov 2026), about 1 % of a coordination number of 5–6.
+/// paper-tolerance criterion lets pass by default: about 1 % of a coordination number of 5–6 (ours).
 pub const PAPER_COORDINATION_TOLERANCE: f64 = 0.05;
 
-/// A creep criterion: its kind and its tolerances, each the largest change over the second half of the hold of
-/// the least-squares line through a diagnostic that still counts as settled.
+/// Standard errors by which a weakening rate must exceed zero for the paper's criterion to call it creep: 2, a
+/// one-sided false-alarm probability of 2.3 % per diagnostic for a hold that has settled.
+pub const DEFAULT_SIGNIFICANCE: f64 = 2.0;
+
+/// A creep criterion: its kind and its thresholds.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct CreepCriterion {
-    /// Which reading: one-sided with the coordination number (paper) or two-sided without it (ours).
+    /// Which reading (see [`CreepCriterionKind`]).
     pub kind: CreepCriterionKind,
-    /// Largest allowed change of θ_max (degrees).
+    /// Largest allowed change of θ_max over the second half (degrees); 0 for the paper's (rates).
     pub theta_max_deg: f64,
-    /// Largest allowed change of η_B (dimensionless).
+    /// Largest allowed change of η_B (dimensionless); 0 for the paper's.
     pub packing: f64,
     /// Largest allowed change of the coordination number (contacts per particle), or `None` where it is not
     /// judged (ours).
     pub coordination: Option<f64>,
+    /// The paper's: standard errors a weakening rate must exceed ([`DEFAULT_SIGNIFICANCE`]); `None` for the
+    /// tolerance criteria.
+    pub significance: Option<f64>,
 }
 
 /// The signed changes over the second half of a hold of the least-squares lines through θ_max (degrees), η_B and
-/// the coordination number (contacts per particle) ([`second_half_drift`]): what both criteria judge.
+/// the coordination number (contacts per particle) ([`second_half_drift`]): what the tolerance criteria judge.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct HoldDrift {
     /// Change of θ_max (degrees; positive: rising).
@@ -114,6 +127,21 @@ pub fn second_half_drift(t: &[f64], y: &[f64]) -> f64 {
     if t.len() < 3 {
         return 0.0;
     }
+    let fit = line_fit(t, y);
+    if fit.stt == 0.0 {
+        return 0.0;
+    }
+    fit.slope * (t[t.len() - 1] - t[0])
+}
+
+/// Least squares of `y` on `t`: slope, Σ(t − t̄)², residuals.
+struct LineFit {
+    slope: f64,
+    stt: f64,
+    residuals: Vec<f64>,
+}
+
+fn line_fit(t: &[f64], y: &[f64]) -> LineFit {
     let m = t.len() as f64;
     let (tm, ym) = (t.iter().sum::<f64>() / m, y.iter().sum::<f64>() / m);
     let (mut sty, mut stt) = (0.0, 0.0);
@@ -121,21 +149,118 @@ pub fn second_half_drift(t: &[f64], y: &[f64]) -> f64 {
         sty += (a - tm) * (b - ym);
         stt += (a - tm) * (a - tm);
     }
-    if stt == 0.0 {
-        return 0.0;
+    let slope = if stt == 0.0 { 0.0 } else { sty / stt };
+    let residuals = t.iter().zip(y).map(|(a, b)| b - ym - slope * (a - tm)).collect();
+    LineFit { slope, stt, residuals }
+}
+
+/// The rate of one diagnostic over the second half of a hold: the least-squares slope per 1000 s and its
+/// standard error. The ordinary error `s / √Σ(t − t̄)²` assumes independent samples; the diagnostics of a pile
+/// sampled every 200 s are not, so it is widened by `√((n − 2)/(n_eff − 2))` with the effective count
+/// `n_eff = n (1 − ρ₁)/(1 + ρ₁)` of an AR(1) series of lag-1 autocorrelation ρ₁ (of the residuals, clamped to
+/// [0, 0.9]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RateFit {
+    /// Slope (unit of the diagnostic per 1000 s).
+    pub rate_per_ks: f64,
+    /// Its standard error (same unit); infinite with fewer than 4 samples.
+    pub se_per_ks: f64,
+    /// Samples in the fit.
+    pub samples: usize,
+}
+
+impl RateFit {
+    /// The rate of `y` sampled at `t` (s) over the second half of the samples.
+    pub fn second_half(t: &[f64], y: &[f64]) -> Self {
+        let n = t.len().min(y.len());
+        RateFit::of(&t[n / 2..n], &y[n / 2..n])
     }
-    sty / stt * (t[t.len() - 1] - t[0])
+
+    /// The rate of `y` sampled at `t` (s) over all the samples given.
+    pub fn of(t: &[f64], y: &[f64]) -> Self {
+        let n = t.len().min(y.len());
+        let (t, y) = (&t[..n], &y[..n]);
+        if n < 4 || t.iter().chain(y).any(|v| !v.is_finite()) {
+            return RateFit {
+                rate_per_ks: if n >= 2 { line_fit(t, y).slope * 1e3 } else { 0.0 },
+                se_per_ks: f64::INFINITY,
+                samples: n,
+            };
+        }
+        let fit = line_fit(t, y);
+        if fit.stt == 0.0 {
+            return RateFit {
+                rate_per_ks: 0.0,
+                se_per_ks: f64::INFINITY,
+                samples: n,
+            };
+        }
+        let ss: f64 = fit.residuals.iter().map(|r| r * r).sum();
+        let lag: f64 = fit.residuals.windows(2).map(|w| w[0] * w[1]).sum();
+        let rho = if ss > 0.0 { (lag / ss).clamp(0.0, 0.9) } else { 0.0 };
+        let nf = n as f64;
+        let n_eff = nf * (1.0 - rho) / (1.0 + rho);
+        let se_ols = (ss / (nf - 2.0) / fit.stt).sqrt();
+        let se = se_ols * ((nf - 2.0) / (n_eff - 2.0).max(1.0)).sqrt();
+        RateFit {
+            rate_per_ks: fit.slope * 1e3,
+            se_per_ks: se * 1e3,
+            samples: n,
+        }
+    }
+
+    /// Whether the rate is beyond `z` standard errors in the direction `sign` (+1: rising, −1: falling).
+    pub fn significant(&self, sign: f64, z: f64) -> bool {
+        sign * self.rate_per_ks > z * self.se_per_ks
+    }
+}
+
+/// The rates of θ_max (°/ks), η_B (1/ks) and the coordination number (contacts per particle per ks) over the second
+/// half of a hold: what the paper's criterion judges.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct HoldRates {
+    /// θ_max.
+    pub theta_max_deg: RateFit,
+    /// η_B.
+    pub packing: RateFit,
+    /// Coordination number.
+    pub coordination: RateFit,
+}
+
+impl HoldRates {
+    /// The rates of the three series sampled at times `t` (s), over their second half.
+    pub fn of(t: &[f64], theta_max_deg: &[f64], packing: &[f64], coordination: &[f64]) -> Self {
+        HoldRates {
+            theta_max_deg: RateFit::second_half(t, theta_max_deg),
+            packing: RateFit::second_half(t, packing),
+            coordination: RateFit::second_half(t, coordination),
+        }
+    }
 }
 
 impl CreepCriterion {
-    /// The paper's criterion with our tolerances: θ_max rising by > 0.5°, η_B falling by > 0.0005 (half the
-    /// T_c,2 threshold) or the coordination number falling by > `coordination` (contacts per particle).
-    pub fn paper(coordination: f64) -> Self {
+    /// The paper's criterion (the default): zero tolerance, a weakening rate beyond `significance` standard errors
+    /// is creep ([`DEFAULT_SIGNIFICANCE`] by default).
+    pub fn paper(significance: f64) -> Self {
         CreepCriterion {
             kind: CreepCriterionKind::Paper,
+            theta_max_deg: 0.0,
+            packing: 0.0,
+            coordination: Some(0.0),
+            significance: Some(significance),
+        }
+    }
+
+    /// The paper's reading with tolerances: θ_max rising by > 0.5°, η_B falling by > 0.0005 (half the T_c,2
+    /// threshold) or the coordination number falling by > `coordination` (contacts per particle) over the second
+    /// half.
+    pub fn paper_tolerance(coordination: f64) -> Self {
+        CreepCriterion {
+            kind: CreepCriterionKind::PaperTolerance,
             theta_max_deg: 0.5,
             packing: 0.5 * PACKING_THRESHOLD,
             coordination: Some(coordination),
+            significance: None,
         }
     }
 
@@ -146,22 +271,39 @@ impl CreepCriterion {
             theta_max_deg: 0.5,
             packing: 0.5 * PACKING_THRESHOLD,
             coordination: None,
+            significance: None,
         }
     }
 
-    /// The criterion of `kind` with its default tolerances ([`PAPER_COORDINATION_TOLERANCE`] for the paper's).
+    /// The criterion of `kind` with its default thresholds.
     pub fn of_kind(kind: CreepCriterionKind) -> Self {
         match kind {
-            CreepCriterionKind::Paper => CreepCriterion::paper(PAPER_COORDINATION_TOLERANCE),
+            CreepCriterionKind::Paper => CreepCriterion::paper(DEFAULT_SIGNIFICANCE),
+            CreepCriterionKind::PaperTolerance => CreepCriterion::paper_tolerance(PAPER_COORDINATION_TOLERANCE),
             CreepCriterionKind::Ours => CreepCriterion::ours(),
         }
     }
 
-    /// The diagnostics whose drift this criterion calls creep (`theta_max`, `packing_fraction`,
-    /// `coordination_number`; empty: the hold has settled).
-    pub fn judge(&self, d: &HoldDrift) -> Vec<&'static str> {
-        // the paper's reading counts only the direction that weakens the pile (more shear, looser, fewer contacts)
-        let one_sided = self.kind == CreepCriterionKind::Paper;
+    /// The diagnostics whose trend this criterion calls creep (`theta_max`, `packing_fraction`,
+    /// `coordination_number`; empty: the hold has settled), from the second-half changes `d` (tolerance criteria)
+    /// or rates `r` (the paper's).
+    pub fn judge(&self, d: &HoldDrift, r: &HoldRates) -> Vec<&'static str> {
+        let mut out = Vec::new();
+        if let Some(z) = self.significance {
+            // the weakening directions: more shear, looser, fewer contacts
+            if r.theta_max_deg.significant(1.0, z) {
+                out.push("theta_max");
+            }
+            if r.packing.significant(-1.0, z) {
+                out.push("packing_fraction");
+            }
+            if r.coordination.significant(-1.0, z) {
+                out.push("coordination_number");
+            }
+            return out;
+        }
+        // the paper's reading counts only the direction that weakens the pile
+        let one_sided = self.kind == CreepCriterionKind::PaperTolerance;
         let beyond = |weakening: f64, tol: f64| {
             if one_sided {
                 weakening > tol
@@ -169,7 +311,6 @@ impl CreepCriterion {
                 weakening.abs() > tol
             }
         };
-        let mut out = Vec::new();
         if beyond(d.theta_max_deg, self.theta_max_deg) {
             out.push("theta_max");
         }
@@ -190,7 +331,10 @@ impl CreepCriterion {
         packing: &[f64],
         coordination: &[f64],
     ) -> Vec<&'static str> {
-        self.judge(&HoldDrift::of(t, theta_max_deg, packing, coordination))
+        self.judge(
+            &HoldDrift::of(t, theta_max_deg, packing, coordination),
+            &HoldRates::of(t, theta_max_deg, packing, coordination),
+        )
     }
 }
 
@@ -218,7 +362,7 @@ mod tests {
 
     fn both(t: &[f64], theta: &[f64], eta: &[f64], cn: &[f64]) -> (Vec<&'static str>, Vec<&'static str>) {
         (
-            CreepCriterion::of_kind(CreepCriterionKind::Paper).drifting(t, theta, eta, cn),
+            CreepCriterion::of_kind(CreepCriterionKind::PaperTolerance).drifting(t, theta, eta, cn),
             CreepCriterion::of_kind(CreepCriterionKind::Ours).drifting(t, theta, eta, cn),
         )
     }
@@ -304,7 +448,7 @@ mod tests {
         // ramp over the whole hold by 2c changes by c·(N/2 − 1)/(N − 1) ≈ c over the second half
         let half = (N / 2 - 1) as f64 / (N - 1) as f64;
         assert!((second_half_drift(&t, &ramp(5.5, -0.2)) + 0.2 * half).abs() < 1e-12);
-        let paper = CreepCriterion::paper(0.05);
+        let paper = CreepCriterion::paper_tolerance(0.05);
         let flat = vec![0.65; N];
         let theta = vec![30.0; N];
         let under = ramp(5.5, -0.049 / half);
@@ -313,7 +457,7 @@ mod tests {
         assert_eq!(paper.drifting(&t, &theta, &flat, &over), vec!["coordination_number"]);
         // a looser tolerance lets the same fall pass
         assert!(
-            CreepCriterion::paper(0.06)
+            CreepCriterion::paper_tolerance(0.06)
                 .drifting(&t, &theta, &flat, &over)
                 .is_empty()
         );
@@ -327,11 +471,94 @@ mod tests {
             assert_eq!(serde_json::to_value(k).unwrap(), serde_json::json!(k.name()));
         }
         let e = "Paper".parse::<CreepCriterionKind>().unwrap_err();
-        assert!(e.contains("expected `paper` or `ours`, got `Paper`"), "{e}");
+        assert!(
+            e.contains("expected `paper`, `paper-tolerance` or `ours`, got `Paper`"),
+            "{e}"
+        );
         let j = serde_json::to_value(CreepCriterion::ours()).unwrap();
         assert_eq!(j["kind"], "ours");
         assert!(j["coordination"].is_null());
-        let j = serde_json::to_value(CreepCriterion::of_kind(CreepCriterionKind::Paper)).unwrap();
+        let j = serde_json::to_value(CreepCriterion::of_kind(CreepCriterionKind::PaperTolerance)).unwrap();
         assert_eq!(j["coordination"], PAPER_COORDINATION_TOLERANCE);
+        let j = serde_json::to_value(CreepCriterion::of_kind(CreepCriterionKind::Paper)).unwrap();
+        assert_eq!(j["significance"], DEFAULT_SIGNIFICANCE);
+    }
+
+    fn paper(t: &[f64], theta: &[f64], eta: &[f64], cn: &[f64]) -> Vec<&'static str> {
+        CreepCriterion::of_kind(CreepCriterionKind::Paper).drifting(t, theta, eta, cn)
+    }
+
+    /// The rate of a line is its slope per 1000 s, with a standard error at rounding level; on white noise the
+    /// error matches the scatter of the slope over many draws (the AR(1) widening stays near 1 there).
+    #[test]
+    fn rate_fit_reads_slopes_and_honest_errors() {
+        let t = times();
+        let f = RateFit::of(&t, &ramp(5.5, -0.2));
+        let slope = -0.2 / ((N - 1) as f64 * 100.0) * 1e3;
+        assert!((f.rate_per_ks - slope).abs() < 1e-12 && f.se_per_ks < 1e-12, "{f:?}");
+        let mut rng = crate::random::generator(5);
+        let draws: Vec<RateFit> = (0..400)
+            .map(|_| {
+                let y: Vec<f64> = (0..N).map(|_| crate::random::symmetric(&mut rng, 1.0)).collect();
+                RateFit::of(&t, &y)
+            })
+            .collect();
+        let spread = (draws.iter().map(|d| d.rate_per_ks.powi(2)).sum::<f64>() / draws.len() as f64).sqrt();
+        let mean_se = draws.iter().map(|d| d.se_per_ks).sum::<f64>() / draws.len() as f64;
+        assert!((mean_se / spread - 1.0).abs() < 0.15, "se {mean_se} vs spread {spread}");
+        // a random walk (strongly correlated samples) gets a wider error than the white-noise formula gives
+        let mut walk = vec![0.0; N];
+        for k in 1..N {
+            walk[k] = walk[k - 1] + crate::random::symmetric(&mut rng, 1.0);
+        }
+        let f = RateFit::of(&t, &walk);
+        let line = line_fit(&t, &walk);
+        let ss: f64 = line.residuals.iter().map(|r| r * r).sum();
+        let se_ols = (ss / (N as f64 - 2.0) / line.stt).sqrt() * 1e3;
+        assert!(f.se_per_ks > 2.0 * se_ols, "{} vs {se_ols}", f.se_per_ks);
+        assert_eq!(RateFit::of(&t[..3], &walk[..3]).se_per_ks, f64::INFINITY);
+    }
+
+    /// The paper's criterion has no tolerance: the coordination number falling by 0.01 over the hold (a fifth of
+    /// the old tolerance) on a quiet record is creep; the same fall buried in scatter 20 times larger is not
+    /// (yet); rising or flat diagnostics never are.
+    #[test]
+    fn paper_criterion_has_zero_tolerance_and_judges_rates_by_their_error() {
+        let t = times();
+        let quiet = |level: f64, change: f64, scatter: f64| -> Vec<f64> {
+            ramp(level, change)
+                .iter()
+                .zip(noisy(0.0, scatter))
+                .map(|(a, b)| a + b)
+                .collect()
+        };
+        let theta = noisy(30.0, 1e-3);
+        let eta = noisy(0.65, 1e-5);
+        assert_eq!(
+            paper(&t, &theta, &eta, &quiet(5.5, -0.01, 1e-3)),
+            vec!["coordination_number"]
+        );
+        assert!(paper(&t, &theta, &eta, &quiet(5.5, -0.01, 0.2)).is_empty());
+        assert!(paper(&t, &theta, &eta, &quiet(5.5, 0.2, 1e-3)).is_empty());
+        assert!(paper(&t, &theta, &eta, &noisy(5.5, 1e-3)).is_empty());
+        // θ_max relaxing and η_B compacting are the stable signature, rising θ_max or falling η_B creep
+        assert!(
+            paper(
+                &t,
+                &quiet(30.0, -1.0, 1e-3),
+                &quiet(0.65, 1e-3, 1e-5),
+                &noisy(5.5, 1e-3)
+            )
+            .is_empty()
+        );
+        assert_eq!(
+            paper(
+                &t,
+                &quiet(30.0, 0.1, 1e-3),
+                &quiet(0.65, -1e-4, 1e-6),
+                &noisy(5.5, 1e-3)
+            ),
+            vec!["theta_max", "packing_fraction"]
+        );
     }
 }

@@ -29,10 +29,11 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::creep::{CreepCriterion, CreepCriterionKind, HoldDrift};
+use crate::analysis::creep::{CreepCriterion, CreepCriterionKind, HoldDrift, HoldRates};
 use crate::analysis::spinup::fit_density;
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::driver::RunOptions;
+use crate::impact::campaign::Shard;
 use crate::io::scene_file::SI_G;
 
 /// The options of a T_c,3 search (those of `rubblepile spinup critical`).
@@ -52,17 +53,62 @@ pub struct CriticalOptions {
     pub force: bool,
     /// Branch the hold runs off one run of the scene's path (`out/base`) instead of running each from t = 0.
     pub branch: bool,
-    /// The criterion whose T_c,3 and φ are `critical.json`'s top-level values (both are always judged).
+    /// The criterion whose T_c,3 and φ are `critical.json`'s top-level values (all are always judged).
     pub criterion: CreepCriterionKind,
     /// Largest fall of the coordination number (contacts per particle) over the second half of a hold that the
-    /// paper's criterion lets pass; default [`crate::analysis::creep::PAPER_COORDINATION_TOLERANCE`].
+    /// paper-tolerance criterion lets pass; default [`crate::analysis::creep::PAPER_COORDINATION_TOLERANCE`].
     pub coordination_tolerance: Option<f64>,
+    /// Standard errors a weakening rate must exceed for the paper's criterion; default
+    /// [`crate::analysis::creep::DEFAULT_SIGNIFICANCE`].
+    pub significance: Option<f64>,
     /// Length of each hold (s) with `branch`; default: the scene's `t_end − t_final`.
     pub hold: Option<f64>,
-    /// Run every hold of the grid, also after both criteria have a stable hold (whether the verdicts stay stable
+    /// Judge only the first this many seconds of each hold (the hold-length study: one long hold read at several
+    /// lengths); default: the whole hold.
+    pub judge_window: Option<f64>,
+    /// Run every hold of the grid, also after every criterion has a stable hold (whether the verdicts stay stable
     /// at slower spins); default: stop there.
     pub all_holds: bool,
+    /// Holds run at once (each on its own rayon pool); 1: one after another.
+    pub parallel: usize,
+    /// Threads of each hold's pool; default: the calling pool's threads shared among the holds at once.
+    pub threads_per_hold: Option<usize>,
+    /// Run only the holds of this shard of the grid (for a scheduler's job array), then stop without judging;
+    /// a run without `shard` afterwards judges them all (finished holds are reused).
+    pub shard: Option<Shard>,
+    /// Run a hold whose forcing was released to its end; default: stop it at the next release check
+    /// ([`RELEASE_CHECK_S`]), its verdict (not stable) being fixed.
+    pub finish_released: bool,
 }
+
+impl CriticalOptions {
+    /// A search over `from..=to` hours by `step` into `out`, with the defaults of `rubblepile spinup critical`.
+    pub fn new(scene: PathBuf, from: f64, to: f64, step: f64, out: PathBuf) -> Self {
+        CriticalOptions {
+            scene,
+            from,
+            to,
+            step,
+            out,
+            force: false,
+            branch: false,
+            criterion: CreepCriterionKind::Paper,
+            coordination_tolerance: None,
+            significance: None,
+            hold: None,
+            judge_window: None,
+            all_holds: false,
+            parallel: 1,
+            threads_per_hold: None,
+            shard: None,
+            finish_released: false,
+        }
+    }
+}
+
+/// Simulated seconds between the checks of a running hold for a released forcing (each check is a checkpoint):
+/// a released hold stops at most this long after its release unless `finish_released` is asked for.
+pub const RELEASE_CHECK_S: f64 = 2000.0;
 
 /// Why a search or a fit could not be made: bad options or inputs (the caller's), or a run or file that failed.
 #[derive(Debug, thiserror::Error)]
@@ -93,43 +139,58 @@ pub struct CriterionVerdict {
     pub stable: bool,
 }
 
-/// One hold run judged by both creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]).
+/// One hold run judged by the creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HoldVerdict {
     /// T_final (h).
     pub t_final_hours: f64,
     /// Run directory.
     pub dir: PathBuf,
-    /// Whether the forcing was released (global disruption).
+    /// Length of the hold judged (s): the judge window, or the hold's samples when shorter.
+    pub hold_s: f64,
+    /// Whether the forcing was released (global disruption) within the judged hold.
     pub released: bool,
+    /// Time of the release after the hold's start (s).
+    pub release_s: Option<f64>,
     /// The measured second-half changes of θ_max, η_B and the coordination number.
     pub drift: HoldDrift,
+    /// Their rates over the second half, with standard errors (`None`: read from a `critical.csv` written before
+    /// rates were recorded).
+    pub rates: Option<HoldRates>,
     /// Largest θ_max during the hold (degrees).
     pub theta_max_deg: f64,
-    /// The paper's criterion (one-sided, coordination number included).
-    pub paper: CriterionVerdict,
+    /// The paper's criterion (zero tolerance, rates; `None` where no rates were recorded).
+    pub paper: Option<CriterionVerdict>,
+    /// The paper's reading with tolerances (the default before Dec 2026).
+    pub paper_tolerance: CriterionVerdict,
     /// Ours (two-sided on θ_max and η_B).
     pub ours: CriterionVerdict,
-    /// The selected criterion's drifting diagnostics (as `paper` or `ours`).
+    /// The selected criterion's drifting diagnostics.
     pub drifting: Vec<&'static str>,
     /// The selected criterion's verdict.
     pub stable: bool,
 }
 
 impl HoldVerdict {
-    /// The verdict of criterion `kind`.
-    pub fn verdict(&self, kind: CreepCriterionKind) -> &CriterionVerdict {
+    /// The verdict of criterion `kind` (`None`: the paper's on a hold without recorded rates).
+    pub fn verdict(&self, kind: CreepCriterionKind) -> Option<&CriterionVerdict> {
         match kind {
-            CreepCriterionKind::Paper => &self.paper,
-            CreepCriterionKind::Ours => &self.ours,
+            CreepCriterionKind::Paper => self.paper.as_ref(),
+            CreepCriterionKind::PaperTolerance => Some(&self.paper_tolerance),
+            CreepCriterionKind::Ours => Some(&self.ours),
         }
+    }
+
+    /// Whether the hold is stable under `kind` (false where that verdict is missing).
+    pub fn stable_by(&self, kind: CreepCriterionKind) -> bool {
+        self.verdict(kind).is_some_and(|v| v.stable)
     }
 }
 
 /// T_c,3 and φ under one criterion.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct CriterionResult {
-    /// The criterion and its tolerances.
+    /// The criterion and its thresholds.
     pub criterion: CreepCriterion,
     /// T_c,3 (h): the shortest T_final from which every slower hold searched is stable under it.
     pub t_c3_hours: Option<f64>,
@@ -144,15 +205,19 @@ pub struct CriterionResult {
 pub struct CriticalSearch {
     /// The selected criterion (the one behind `t_c3_hours` and `friction_angle_deg`).
     pub criterion: CreepCriterion,
+    /// The judge window (s), when the holds were judged over their first part only.
+    pub judge_window_s: Option<f64>,
     /// The runs, by increasing T_final.
     pub runs: Vec<HoldVerdict>,
     /// T_c,3 (h) under the selected criterion.
     pub t_c3_hours: Option<f64>,
     /// φ (degrees) under the selected criterion.
     pub friction_angle_deg: Option<f64>,
-    /// T_c,3 and φ under the paper's criterion.
+    /// T_c,3 and φ under the paper's criterion (zero tolerance, rates).
     pub paper: CriterionResult,
-    /// T_c,3 and φ under ours.
+    /// Under the paper's reading with tolerances.
+    pub paper_tolerance: CriterionResult,
+    /// Under ours.
     pub ours: CriterionResult,
 }
 
@@ -166,66 +231,225 @@ fn coordination_judged(s: &SpinupSample) -> f64 {
     }
 }
 
-/// Judges the hold (samples at or after `t_final`, s) of one run of T_final = `t_final_hours` in `dir` by both
-/// criteria; `selected` fills [`HoldVerdict::stable`] and [`HoldVerdict::drifting`].
-pub fn judge_hold(
-    samples: &[SpinupSample],
-    t_final: f64,
-    paper: &CreepCriterion,
-    ours: &CreepCriterion,
+/// One hold's record: times since the hold's start (s) and the three diagnostics, and when the forcing was
+/// released (s after the start). What [`judge_series`] judges; read from a run's `spinup.csv` ([`hold_series`]) or
+/// from a compact copy's `holds.csv`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HoldSeries {
+    /// Time since the hold began (s).
+    pub t_s: Vec<f64>,
+    /// θ_max (degrees).
+    pub theta_max_deg: Vec<f64>,
+    /// η_B.
+    pub packing: Vec<f64>,
+    /// Contacts per particle.
+    pub coordination: Vec<f64>,
+    /// Release time after the hold's start (s; negative: before it), if the forcing was released.
+    pub release_s: Option<f64>,
+}
+
+/// The hold of a run (samples at or after `t_final`, s) as a [`HoldSeries`].
+pub fn hold_series(samples: &[SpinupSample], t_final: f64) -> HoldSeries {
+    let hold: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_final).collect();
+    let col = |f: fn(&SpinupSample) -> f64| hold.iter().map(|s| f(s)).collect::<Vec<f64>>();
+    HoldSeries {
+        t_s: hold.iter().map(|s| s.t - t_final).collect(),
+        theta_max_deg: col(|s| s.theta_max_deg),
+        packing: col(|s| s.packing_fraction),
+        coordination: col(coordination_judged),
+        release_s: samples.iter().find(|s| !s.forcing).map(|s| s.t - t_final),
+    }
+}
+
+/// The criteria of one search: the paper's (rates), the paper's with tolerances, ours.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Criteria {
+    /// Zero tolerance, rates.
+    pub paper: CreepCriterion,
+    /// With tolerances.
+    pub paper_tolerance: CreepCriterion,
+    /// Two-sided.
+    pub ours: CreepCriterion,
+}
+
+impl Default for Criteria {
+    /// Every criterion with its default thresholds.
+    fn default() -> Self {
+        Criteria {
+            paper: CreepCriterion::of_kind(CreepCriterionKind::Paper),
+            paper_tolerance: CreepCriterion::of_kind(CreepCriterionKind::PaperTolerance),
+            ours: CreepCriterion::of_kind(CreepCriterionKind::Ours),
+        }
+    }
+}
+
+/// Judges one hold's record over its first `window` seconds (`None`: all of it) by every criterion; `selected`
+/// fills [`HoldVerdict::stable`] and [`HoldVerdict::drifting`].
+pub fn judge_series(
+    series: &HoldSeries,
+    window: Option<f64>,
+    criteria: &Criteria,
     selected: CreepCriterionKind,
     t_final_hours: f64,
     dir: PathBuf,
 ) -> HoldVerdict {
-    let hold: Vec<&SpinupSample> = samples.iter().filter(|s| s.t >= t_final).collect();
-    let released = samples.iter().any(|s| !s.forcing);
-    let col = |f: fn(&SpinupSample) -> f64| hold.iter().map(|s| f(s)).collect::<Vec<f64>>();
-    let theta = col(|s| s.theta_max_deg);
-    let drift = HoldDrift::of(
-        &col(|s| s.t),
-        &theta,
-        &col(|s| s.packing_fraction),
-        &col(coordination_judged),
+    let end = window.unwrap_or(f64::INFINITY) + 1e-6;
+    let n = series.t_s.iter().take_while(|&&t| t <= end).count();
+    let (t, theta, eta, cn) = (
+        &series.t_s[..n],
+        &series.theta_max_deg[..n],
+        &series.packing[..n],
+        &series.coordination[..n],
     );
+    let release_s = series.release_s.filter(|&r| r <= end);
+    let released = release_s.is_some();
+    let drift = HoldDrift::of(t, theta, eta, cn);
+    let rates = HoldRates::of(t, theta, eta, cn);
     let theta_max_deg = theta.iter().cloned().fold(f64::NAN, f64::max);
     let verdict = |c: &CreepCriterion| {
-        let drifting = c.judge(&drift);
+        let drifting = c.judge(&drift, &rates);
         CriterionVerdict {
             stable: !released && drifting.is_empty(),
             drifting,
         }
     };
-    let (paper, ours) = (verdict(paper), verdict(ours));
+    let (paper, paper_tolerance, ours) = (
+        verdict(&criteria.paper),
+        verdict(&criteria.paper_tolerance),
+        verdict(&criteria.ours),
+    );
     let chosen = match selected {
         CreepCriterionKind::Paper => &paper,
+        CreepCriterionKind::PaperTolerance => &paper_tolerance,
         CreepCriterionKind::Ours => &ours,
     }
     .clone();
     HoldVerdict {
         t_final_hours,
         dir,
+        hold_s: t.last().copied().unwrap_or(0.0).min(end),
         released,
+        release_s,
         drift,
+        rates: Some(rates),
         theta_max_deg,
-        paper,
+        paper: Some(paper),
+        paper_tolerance,
         ours,
         drifting: chosen.drifting,
         stable: chosen.stable,
     }
 }
 
+/// Reads the `holds.csv` of a search's compact copy (`analysis/zhang2017/compact.py --search`: `t_final_h`,
+/// `t_hold_s`, `packing_fraction`, `coordination_number`, `coordination_loaded`, `theta_max_deg` and, since Dec
+/// 2026, `forcing` as 1/0, one row per sample of every hold) into one [`HoldSeries`] per hold, by increasing
+/// T_final (h). The coordination number is `coordination_loaded` where every row has it. Without a `forcing`
+/// column the release is unknown (`release_s` is `None`).
+pub fn read_holds_csv(path: &Path) -> Result<Vec<(f64, HoldSeries)>, String> {
+    use crate::io::table::{Cells, read_table};
+    let table = read_table(path, Cells::Lenient).map_err(|e| e.to_string())?;
+    let col = |name: &str| {
+        table
+            .column(name)
+            .ok_or(format!("{}: no column {name}", path.display()))
+    };
+    let (tf, th, eta, cn, theta) = (
+        col("t_final_h")?,
+        col("t_hold_s")?,
+        col("packing_fraction")?,
+        col("coordination_number")?,
+        col("theta_max_deg")?,
+    );
+    let loaded = table
+        .column("coordination_loaded")
+        .filter(|&k| table.rows.iter().all(|r| r.get(k).is_some_and(|v| v.is_finite())));
+    let forcing = table.column("forcing");
+    let get = |r: &[f64], k: usize| r.get(k).copied().unwrap_or(f64::NAN);
+    let mut out: Vec<(f64, HoldSeries)> = Vec::new();
+    for r in &table.rows {
+        let period = get(r, tf);
+        if out.last().is_none_or(|(p, _)| *p != period) {
+            out.push((period, HoldSeries::default()));
+        }
+        let h = &mut out.last_mut().expect("just pushed").1;
+        let t = get(r, th);
+        h.t_s.push(t);
+        h.theta_max_deg.push(get(r, theta));
+        h.packing.push(get(r, eta));
+        h.coordination.push(get(r, loaded.unwrap_or(cn)));
+        if forcing.is_some_and(|k| get(r, k) == 0.0) && h.release_s.is_none() {
+            h.release_s = Some(t);
+        }
+    }
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(out)
+}
+
+/// Judges again, by `criteria` over the first `window` seconds, the holds of `verdicts` (a `critical.csv` read
+/// back) that have a record in `series` ([`read_holds_csv`]): how searches made before the paper's criterion
+/// judged rates get its verdict, and how one set of long holds is read at several hold lengths. A hold released
+/// within its record keeps its release; one the CSV calls released but whose record has no release time (an old
+/// `holds.csv`) stays released. Holds without a record are left as they are.
+pub fn rejudge(
+    verdicts: &[HoldVerdict],
+    series: &[(f64, HoldSeries)],
+    window: Option<f64>,
+    criteria: &Criteria,
+    selected: CreepCriterionKind,
+) -> Vec<HoldVerdict> {
+    verdicts
+        .iter()
+        .map(|v| {
+            let Some((_, s)) = series.iter().find(|(p, _)| (p - v.t_final_hours).abs() < 1e-6) else {
+                return v.clone();
+            };
+            let mut s = s.clone();
+            if v.released && s.release_s.is_none() {
+                // released at an unknown time: inside any window
+                s.release_s = Some(0.0);
+            }
+            judge_series(&s, window, criteria, selected, v.t_final_hours, v.dir.clone())
+        })
+        .collect()
+}
+
+/// Judges the hold (samples at or after `t_final`, s) of one run of T_final = `t_final_hours` in `dir` over its
+/// first `window` seconds ([`judge_series`] of [`hold_series`]).
+pub fn judge_hold(
+    samples: &[SpinupSample],
+    t_final: f64,
+    window: Option<f64>,
+    criteria: &Criteria,
+    selected: CreepCriterionKind,
+    t_final_hours: f64,
+    dir: PathBuf,
+) -> HoldVerdict {
+    judge_series(
+        &hold_series(samples, t_final),
+        window,
+        criteria,
+        selected,
+        t_final_hours,
+        dir,
+    )
+}
+
 /// Index of the first run of the trailing block of holds stable under `kind` (runs by increasing T_final): the
-/// shortest T_final from which every slower hold searched is stable. `None` when the slowest hold creeps.
+/// shortest T_final from which every slower hold searched is stable. `None` when the slowest hold creeps or a
+/// hold lacks that criterion's verdict.
 fn stable_from(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Option<usize> {
-    let start = runs.iter().rposition(|r| !r.verdict(kind).stable).map_or(0, |i| i + 1);
+    if runs.iter().any(|r| r.verdict(kind).is_none()) {
+        return None;
+    }
+    let start = runs.iter().rposition(|r| !r.stable_by(kind)).map_or(0, |i| i + 1);
     (start < runs.len()).then_some(start)
 }
 
 /// Reduces judged runs (by increasing T_final) to T_c,3 and φ under criterion `kind`. T_c,3 is the shortest T_final
 /// from which every slower hold is stable (the verdict made monotone: a stable hold below a creeping one does not
 /// count, see [`set_aside`]); φ the largest θ_max of the hold at T_c,3: Zhang17 §3.3.3 takes φ as the largest
-/// mobilized angle *at the critical state*, the stable hold. (Until 28 Nov 2026 φ was the largest θ_max within
-/// ±0.01 h of T_c,3, which on a 0.01 h grid took the disrupted hold's θ_max, a post-failure value.)
+/// mobilized angle *at the critical state*, the stable hold.
 pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) -> (Option<f64>, Option<f64>) {
     let Some(i) = stable_from(runs, kind) else {
         return (None, None);
@@ -235,13 +459,13 @@ pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) ->
 }
 
 /// The T_final (h) of holds stable under `kind` that lie below a creeping or disrupted one: where the verdict is
-/// not monotone in the spin. [`critical_from_verdicts`] sets them aside; a search with `--step 0.01` between them
-/// and the next creeping hold says whether they were luck.
+/// not monotone in the spin. [`critical_from_verdicts`] sets them aside; a finer search between them and the next
+/// creeping hold says whether they were luck.
 pub fn set_aside(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Vec<f64> {
-    let last_unstable = runs.iter().rposition(|r| !r.verdict(kind).stable);
+    let last_unstable = runs.iter().rposition(|r| !r.stable_by(kind));
     runs.iter()
         .enumerate()
-        .filter(|(i, r)| last_unstable.is_some_and(|u| *i < u) && r.verdict(kind).stable)
+        .filter(|(i, r)| last_unstable.is_some_and(|u| *i < u) && r.stable_by(kind))
         .map(|(_, r)| r.t_final_hours)
         .collect()
 }
@@ -260,85 +484,155 @@ pub fn search_stops(runs: &[HoldVerdict], all_holds: bool) -> bool {
     !all_holds && search_done(runs)
 }
 
-/// One line per hold of the verdicts by both criteria (printed as the search goes).
+/// The number of leading runs (by increasing T_final) a search that judges them one after another keeps: up to and
+/// including the first after which it stops ([`search_stops`]). A parallel search that ran more keeps as many.
+pub fn sequential_stop(runs: &[HoldVerdict], all_holds: bool) -> usize {
+    (1..=runs.len())
+        .find(|&k| search_stops(&runs[..k], all_holds))
+        .unwrap_or(runs.len())
+}
+
+/// One line per hold of the verdicts by every criterion (printed as the search goes).
 pub fn verdict_line(r: &HoldVerdict) -> String {
-    let word = |v: &CriterionVerdict| {
-        if v.stable {
-            "stable".to_string()
-        } else if r.released {
-            "disrupted".to_string()
-        } else {
-            format!("creeps ({})", v.drifting.join(", "))
-        }
+    let word = |v: Option<&CriterionVerdict>| match v {
+        None => "not judged".to_string(),
+        Some(v) if v.stable => "stable".to_string(),
+        Some(_) if r.released => "disrupted".to_string(),
+        Some(v) => format!("creeps ({})", v.drifting.join(", ")),
     };
+    let rates = r.rates.map_or(String::new(), |q| {
+        format!(
+            "; rates per 1000 s: theta_max {:+.3} +- {:.3} deg, eta_B {:+.2e} +- {:.1e}, coordination {:+.4} +- {:.4}",
+            q.theta_max_deg.rate_per_ks,
+            q.theta_max_deg.se_per_ks,
+            q.packing.rate_per_ks,
+            q.packing.se_per_ks,
+            q.coordination.rate_per_ks,
+            q.coordination.se_per_ks
+        )
+    });
     format!(
-        "T_final = {:.2} h: paper {}, ours {}; drift over the second half: theta_max {:+.2} deg, eta_B {:+.5}, \
-         coordination {:+.3}",
+        "T_final = {:.2} h ({:.0} s judged): paper {}, paper-tolerance {}, ours {}; drift over the second half: \
+         theta_max {:+.2} deg, eta_B {:+.5}, coordination {:+.3}{rates}",
         r.t_final_hours,
-        word(&r.paper),
-        word(&r.ours),
+        r.hold_s,
+        word(r.verdict(CreepCriterionKind::Paper)),
+        word(r.verdict(CreepCriterionKind::PaperTolerance)),
+        word(r.verdict(CreepCriterionKind::Ours)),
         r.drift.theta_max_deg,
         r.drift.packing,
         r.drift.coordination
     )
 }
 
-/// The `critical.csv` header: one row per hold with the drifts and both verdicts.
-pub const CRITICAL_CSV_HEADER: &str = "t_final_h,released,theta_max_deg,drift_theta_max_deg,drift_packing,drift_coordination,paper_stable,paper_drifting,ours_stable,ours_drifting\n";
+/// The `critical.csv` header written before Dec 2026 (one-sided tolerance verdicts in `paper_*`, no rates); still
+/// read by [`read_critical_csv`].
+pub const CRITICAL_CSV_HEADER_V1: &str = "t_final_h,released,theta_max_deg,drift_theta_max_deg,drift_packing,drift_coordination,paper_stable,paper_drifting,ours_stable,ours_drifting\n";
 
-/// `critical.csv`: [`CRITICAL_CSV_HEADER`] and one row per hold (drifting diagnostics joined by `;`).
+/// The `critical.csv` header: one row per hold with the judged length, the release, the drifts, the rates and
+/// their standard errors (per 1000 s) and the verdicts of the three criteria.
+pub const CRITICAL_CSV_HEADER: &str = "t_final_h,hold_s,released,release_s,theta_max_deg,drift_theta_max_deg,drift_packing,drift_coordination,rate_theta_max_deg_per_ks,se_theta_max_deg_per_ks,rate_packing_per_ks,se_packing_per_ks,rate_coordination_per_ks,se_coordination_per_ks,paper_stable,paper_drifting,paper_tolerance_stable,paper_tolerance_drifting,ours_stable,ours_drifting\n";
+
+/// `critical.csv`: [`CRITICAL_CSV_HEADER`] and one row per hold (drifting diagnostics joined by `;`; a missing
+/// value is empty).
 pub fn critical_csv(runs: &[HoldVerdict]) -> String {
     let mut out = CRITICAL_CSV_HEADER.to_string();
+    let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or(String::new(), f);
     for r in runs {
+        let q = r.rates;
+        let rate = |f: fn(&HoldRates) -> crate::analysis::creep::RateFit, se: bool| {
+            opt(
+                q.map(|q| {
+                    let x = f(&q);
+                    if se { x.se_per_ks } else { x.rate_per_ks }
+                }),
+                &|v| format!("{v:.6e}"),
+            )
+        };
+        let verdict = |v: Option<&CriterionVerdict>| {
+            v.map_or(",".to_string(), |v| format!("{},{}", v.stable, v.drifting.join(";")))
+        };
         out += &format!(
-            "{:.2},{},{:.3},{:.4},{:.6},{:.4},{},{},{},{}\n",
+            "{:.2},{:.1},{},{},{:.3},{:.4},{:.6},{:.4},{},{},{},{},{},{},{},{},{}\n",
             r.t_final_hours,
+            r.hold_s,
             r.released,
+            opt(r.release_s, &|v| format!("{v:.1}")),
             r.theta_max_deg,
             r.drift.theta_max_deg,
             r.drift.packing,
             r.drift.coordination,
-            r.paper.stable,
-            r.paper.drifting.join(";"),
-            r.ours.stable,
-            r.ours.drifting.join(";"),
+            rate(|q| q.theta_max_deg, false),
+            rate(|q| q.theta_max_deg, true),
+            rate(|q| q.packing, false),
+            rate(|q| q.packing, true),
+            rate(|q| q.coordination, false),
+            rate(|q| q.coordination, true),
+            verdict(r.paper.as_ref()),
+            verdict(Some(&r.paper_tolerance)),
+            verdict(Some(&r.ours)),
         );
     }
     out
 }
 
-/// Reads a `critical.csv` ([`critical_csv`]) back into judged holds (the run directories are not in it: `dir`
-/// is empty; the selected criterion is the paper's), so that T_c,3 and φ can be re-derived by
-/// [`critical_from_verdicts`] from a committed copy without the runs. A malformed row is an error naming its
-/// line and column.
+/// Reads a `critical.csv` ([`critical_csv`], or the older [`CRITICAL_CSV_HEADER_V1`] layout, whose `paper_*`
+/// columns are the paper-tolerance verdicts and which has no rates) back into judged holds (the run directories
+/// are not in it: `dir` is empty; the selected criterion is the paper's where recorded, else the paper's with
+/// tolerances), so that T_c,3 and φ can be re-derived by [`critical_from_verdicts`] from a committed copy without
+/// the runs. A malformed row is an error naming its line and column.
 pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
     const NAMES: [&str; 3] = ["theta_max", "packing_fraction", "coordination_number"];
     let mut lines = text.lines();
-    if lines.next().map(str::trim) != Some(CRITICAL_CSV_HEADER.trim()) {
+    let header = lines.next().map(str::trim);
+    let v1 = header == Some(CRITICAL_CSV_HEADER_V1.trim());
+    if !v1 && header != Some(CRITICAL_CSV_HEADER.trim()) {
         return Err(format!(
             "not a critical.csv: the header must be {}",
             CRITICAL_CSV_HEADER.trim()
         ));
     }
+    let columns: Vec<&str> = if v1 {
+        CRITICAL_CSV_HEADER_V1
+    } else {
+        CRITICAL_CSV_HEADER
+    }
+    .trim()
+    .split(',')
+    .collect();
     let mut out = Vec::new();
     for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let at = |col: &str| format!("line {}: column {col}", k + 2);
         let c: Vec<&str> = line.split(',').collect();
-        if c.len() != 10 {
-            return Err(format!("line {}: {} columns, expected 10", k + 2, c.len()));
+        if c.len() != columns.len() {
+            return Err(format!(
+                "line {}: {} columns, expected {}",
+                k + 2,
+                c.len(),
+                columns.len()
+            ));
         }
-        let num = |i: usize, col: &str| {
-            c[i].trim()
+        let cell = |col: &str| c[columns.iter().position(|n| *n == col).expect("known column")].trim();
+        let num = |col: &str| {
+            cell(col)
                 .parse::<f64>()
                 .map_err(|_| format!("{}: not a number", at(col)))
         };
-        let flag = |i: usize, col: &str| {
-            c[i].trim()
+        let opt_num = |col: &str| -> Result<Option<f64>, String> {
+            if cell(col).is_empty() {
+                Ok(None)
+            } else {
+                num(col).map(Some)
+            }
+        };
+        let flag = |col: &str| {
+            cell(col)
                 .parse::<bool>()
                 .map_err(|_| format!("{}: not true/false", at(col)))
         };
-        let names = |i: usize, col: &str| -> Result<Vec<&'static str>, String> {
-            c[i].split(';')
+        let names = |col: &str| -> Result<Vec<&'static str>, String> {
+            cell(col)
+                .split(';')
                 .filter(|n| !n.is_empty())
                 .map(|n| {
                     NAMES
@@ -348,46 +642,98 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
                 })
                 .collect()
         };
-        let paper = CriterionVerdict {
-            stable: flag(6, "paper_stable")?,
-            drifting: names(7, "paper_drifting")?,
+        let verdict = |prefix: &str| -> Result<CriterionVerdict, String> {
+            Ok(CriterionVerdict {
+                stable: flag(&format!("{prefix}_stable"))?,
+                drifting: names(&format!("{prefix}_drifting"))?,
+            })
         };
+        let (paper, paper_tolerance, rates, hold_s, release_s) = if v1 {
+            (None, verdict("paper")?, None, f64::NAN, None)
+        } else {
+            let fit = |name: &str| -> Result<Option<crate::analysis::creep::RateFit>, String> {
+                Ok(
+                    match (
+                        opt_num(&format!("rate_{name}_per_ks"))?,
+                        opt_num(&format!("se_{name}_per_ks"))?,
+                    ) {
+                        (Some(rate_per_ks), Some(se_per_ks)) => Some(crate::analysis::creep::RateFit {
+                            rate_per_ks,
+                            se_per_ks,
+                            samples: 0,
+                        }),
+                        _ => None,
+                    },
+                )
+            };
+            let rates = match (fit("theta_max_deg")?, fit("packing")?, fit("coordination")?) {
+                (Some(theta_max_deg), Some(packing), Some(coordination)) => Some(HoldRates {
+                    theta_max_deg,
+                    packing,
+                    coordination,
+                }),
+                _ => None,
+            };
+            let paper = if cell("paper_stable").is_empty() {
+                None
+            } else {
+                Some(verdict("paper")?)
+            };
+            (
+                paper,
+                verdict("paper_tolerance")?,
+                rates,
+                num("hold_s")?,
+                opt_num("release_s")?,
+            )
+        };
+        let selected = paper.clone().unwrap_or_else(|| paper_tolerance.clone());
         out.push(HoldVerdict {
-            t_final_hours: num(0, "t_final_h")?,
+            t_final_hours: num("t_final_h")?,
             dir: PathBuf::new(),
-            released: flag(1, "released")?,
+            hold_s,
+            released: flag("released")?,
+            release_s,
             drift: HoldDrift {
-                theta_max_deg: num(3, "drift_theta_max_deg")?,
-                packing: num(4, "drift_packing")?,
-                coordination: num(5, "drift_coordination")?,
+                theta_max_deg: num("drift_theta_max_deg")?,
+                packing: num("drift_packing")?,
+                coordination: num("drift_coordination")?,
             },
-            theta_max_deg: num(2, "theta_max_deg")?,
-            drifting: paper.drifting.clone(),
-            stable: paper.stable,
+            rates,
+            theta_max_deg: num("theta_max_deg")?,
             paper,
-            ours: CriterionVerdict {
-                stable: flag(8, "ours_stable")?,
-                drifting: names(9, "ours_drifting")?,
-            },
+            paper_tolerance,
+            ours: verdict("ours")?,
+            drifting: selected.drifting,
+            stable: selected.stable,
         });
     }
     Ok(out)
 }
 
-/// The paper's criterion with the coordination tolerance `tol` (contacts per particle; `None`: the default), or
-/// a usage error naming `--coordination-tolerance` when it is not a positive number.
-pub fn paper_criterion(tol: Option<f64>) -> Result<CreepCriterion, SearchError> {
-    match tol {
-        None => Ok(CreepCriterion::of_kind(CreepCriterionKind::Paper)),
-        Some(c) if c.is_finite() && c > 0.0 => Ok(CreepCriterion::paper(c)),
-        Some(c) => Err(SearchError::usage(format!(
-            "--coordination-tolerance must be a change of the coordination number > 0 (contacts per particle), \
-             got {c}"
-        ))),
-    }
+/// The criteria of a search: the paper's with `significance` standard errors, the paper's with the coordination
+/// tolerance `tol` (contacts per particle), ours (`None`: defaults); a usage error naming the option when a value
+/// is not a positive number.
+pub fn criteria(significance: Option<f64>, tol: Option<f64>) -> Result<Criteria, SearchError> {
+    let positive = |x: Option<f64>, what: &str| match x {
+        Some(c) if !(c.is_finite() && c > 0.0) => Err(SearchError::usage(format!("{what}, got {c}"))),
+        _ => Ok(x),
+    };
+    let tol = positive(
+        tol,
+        "--coordination-tolerance must be a change of the coordination number > 0 (contacts per particle)",
+    )?;
+    let z = positive(significance, "--significance must be a number of standard errors > 0")?;
+    Ok(Criteria {
+        paper: CreepCriterion::paper(z.unwrap_or(crate::analysis::creep::DEFAULT_SIGNIFICANCE)),
+        paper_tolerance: CreepCriterion::paper_tolerance(
+            tol.unwrap_or(crate::analysis::creep::PAPER_COORDINATION_TOLERANCE),
+        ),
+        ours: CreepCriterion::ours(),
+    })
 }
 
-/// Runs the T_c,3 search (Zhang17 §3.3.3) and writes `critical.json` in `args.out`.
+/// Runs the T_c,3 search (Zhang17 §3.3.3) and writes `critical.json` and `critical.csv` in `args.out`.
 pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     let ok = |x: f64| x.is_finite() && x > 0.0;
     if !ok(args.from) || !ok(args.to) || args.to < args.from {
@@ -402,8 +748,18 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             args.step
         )));
     }
+    if args.parallel == 0 || args.threads_per_hold == Some(0) {
+        return Err(SearchError::usage(
+            "--parallel and --threads-per-hold must be at least 1",
+        ));
+    }
+    if let Some(w) = args.judge_window
+        && !ok(w)
+    {
+        return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
+    }
     let json = args.out.join("critical.json");
-    if json.exists() && !args.force {
+    if json.exists() && !args.force && args.shard.is_none() {
         return Err(SearchError::usage(format!(
             "{} exists (use --force to overwrite it)",
             json.display()
@@ -434,7 +790,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         table["scene"]["particles_file"] = toml::Value::String(abs.display().to_string());
     }
     std::fs::create_dir_all(&args.out).map_err(|e| SearchError::usage(format!("{}: {e}", args.out.display())))?;
-    let (paper, ours) = (paper_criterion(args.coordination_tolerance)?, CreepCriterion::ours());
+    let criteria = criteria(args.significance, args.coordination_tolerance)?;
     let n = ((args.to - args.from) / args.step + 1e-9).floor() as usize;
     let grid: Vec<f64> = (0..=n)
         .map(|k| ((args.from + k as f64 * args.step) * 1e4).round() / 1e4)
@@ -452,41 +808,86 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     } else {
         None
     };
-    let mut runs = Vec::new();
+    // every hold's scene exists before any runs, so that holds are independent jobs
+    let mut jobs = Vec::with_capacity(grid.len());
     for (k, &tf) in grid.iter().enumerate() {
         let dir = args.out.join(format!("T{tf:.2}"));
-        let completed = std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
-        let options = RunOptions {
-            force: true,
-            progress: false,
-            checkpoint_every: Some(crate::driver::DEFAULT_CHECKPOINT_EVERY),
-            checkpoint_every_sim: None,
-            formats: crate::driver::formats::Formats::NONE,
-            stop_after_checkpoints: None,
-            ..RunOptions::default()
-        };
-        let t_final = branches.as_ref().map_or(settings.path.t_final, |b| b[k]);
-        if !completed {
-            eprintln!("spinup critical: running T_final = {tf} h into {}", dir.display());
-            if branches.is_some() {
-                crate::driver::resume_soft(&dir, &options).map_err(|e| SearchError::failed(e.to_string()))?;
-            } else {
+        let scene = match branches {
+            Some(_) => None,
+            None => {
                 table["spinup"]["T_final"] = toml::Value::Float(tf);
                 let scene_text = toml::to_string(&table).map_err(|e| SearchError::usage(e.to_string()))?;
                 let path = args.out.join(format!("T{tf:.2}.toml"));
                 std::fs::write(&path, &scene_text)
                     .map_err(|e| SearchError::failed(format!("{}: {e}", path.display())))?;
-                let scene = crate::granular::soft::scene::load_soft_scene(&path).map_err(SearchError::usage)?;
-                crate::driver::run_soft(&scene, &dir, &options).map_err(|e| SearchError::failed(e.to_string()))?;
+                Some(crate::granular::soft::scene::load_soft_scene(&path).map_err(SearchError::usage)?)
             }
+        };
+        let t_final = branches.as_ref().map_or(settings.path.t_final, |b| b[k]);
+        jobs.push(HoldJob {
+            t_final_hours: tf,
+            t_final,
+            dir,
+            scene,
+        });
+    }
+    let judge = |job: &HoldJob| -> Result<HoldVerdict, SearchError> {
+        let samples = read_spinup_csv(&job.dir.join("spinup.csv")).map_err(SearchError::failed)?;
+        Ok(judge_hold(
+            &samples,
+            job.t_final,
+            args.judge_window,
+            &criteria,
+            args.criterion,
+            job.t_final_hours,
+            job.dir.clone(),
+        ))
+    };
+    if let Some(shard) = args.shard {
+        let mine: Vec<&HoldJob> = jobs
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| shard.contains(*k))
+            .map(|(_, j)| j)
+            .collect();
+        run_holds(&mine, args, &|_| false)?;
+        println!(
+            "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
+            shard.index,
+            shard.count,
+            mine.len(),
+            jobs.len()
+        );
+        return Ok(());
+    }
+    let all: Vec<&HoldJob> = jobs.iter().collect();
+    // the holds run in grid order, `parallel` at once; none is started once the holds already judged (a
+    // contiguous prefix of the grid) are enough for the search to stop, as a search one hold at a time would
+    let judged = std::sync::Mutex::new(Vec::<Option<HoldVerdict>>::new());
+    let enough = |k: usize| -> bool {
+        let mut j = judged.lock().expect("no panic holds the lock");
+        if j.len() < jobs.len() {
+            j.resize(jobs.len(), None);
         }
-        let samples = read_spinup_csv(&dir.join("spinup.csv")).map_err(SearchError::failed)?;
-        let verdict = judge_hold(&samples, t_final, &paper, &ours, args.criterion, tf, dir);
-        println!("{}", verdict_line(&verdict));
-        runs.push(verdict);
-        if search_stops(&runs, args.all_holds) {
+        if j[k].is_none()
+            && let Ok(v) = judge(&jobs[k])
+        {
+            j[k] = Some(v);
+        }
+        let prefix: Vec<HoldVerdict> = j.iter().map_while(|v| v.clone()).collect();
+        search_stops(&prefix, args.all_holds)
+    };
+    run_holds(&all, args, &enough)?;
+    let mut runs = Vec::new();
+    for job in &jobs {
+        if !hold_finished(&job.dir, args.finish_released) {
             break;
         }
+        runs.push(judge(job)?);
+    }
+    runs.truncate(sequential_stop(&runs, args.all_holds));
+    for r in &runs {
+        println!("{}", verdict_line(r));
     }
     let result = |criterion: CreepCriterion| {
         let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs, criterion.kind);
@@ -497,9 +898,14 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             set_aside_hours: set_aside(&runs, criterion.kind),
         }
     };
-    let (paper, ours) = (result(paper), result(ours));
+    let (paper, paper_tolerance, ours) = (
+        result(criteria.paper),
+        result(criteria.paper_tolerance),
+        result(criteria.ours),
+    );
     let selected = match args.criterion {
         CreepCriterionKind::Paper => paper.clone(),
+        CreepCriterionKind::PaperTolerance => paper_tolerance.clone(),
         CreepCriterionKind::Ours => ours.clone(),
     };
     let (t_c3_hours, friction_angle_deg) = (selected.t_c3_hours, selected.friction_angle_deg);
@@ -507,19 +913,21 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     std::fs::write(&csv, critical_csv(&runs)).map_err(|e| SearchError::failed(format!("{}: {e}", csv.display())))?;
     let out = CriticalSearch {
         criterion: selected.criterion,
+        judge_window_s: args.judge_window,
         runs,
         t_c3_hours,
         friction_angle_deg,
         paper,
+        paper_tolerance,
         ours,
     };
     std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
-    for r in [&out.paper, &out.ours] {
+    for r in [&out.paper, &out.paper_tolerance, &out.ours] {
         if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {
             println!(
                 "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
-                 monotone there: refine with --step 0.01 from {first:.2} h to the next creeping hold above {last:.2} h)",
+                 monotone there: refine with a finer --step from {first:.2} h to the next creeping hold above {last:.2} h)",
                 r.criterion.kind.name(),
                 r.set_aside_hours
             );
@@ -543,6 +951,121 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         json.display()
     );
     Ok(())
+}
+
+/// One hold of a search: its period, the time its hold starts, its run directory, and its scene when it runs from
+/// t = 0 (`None`: a branch already written in `dir`).
+struct HoldJob {
+    t_final_hours: f64,
+    t_final: f64,
+    dir: PathBuf,
+    scene: Option<crate::granular::soft::scene::SoftScene>,
+}
+
+/// Whether the forcing of the run in `dir` has been released (its `spinup.csv` says so).
+fn released_in(dir: &Path) -> bool {
+    read_spinup_csv(&dir.join("spinup.csv")).is_ok_and(|s| s.iter().any(|x| !x.forcing))
+}
+
+/// Whether the hold in `dir` needs no more running: completed, or released (unless `finish_released`).
+fn hold_finished(dir: &Path, finish_released: bool) -> bool {
+    let completed = std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
+    completed || (!finish_released && released_in(dir))
+}
+
+/// Runs one hold to its end, in legs of [`RELEASE_CHECK_S`] simulated seconds each ending in a checkpoint, and
+/// stops after the leg in which its forcing was released unless `finish_released`. A hold already finished is
+/// left alone; one stopped midway continues from its checkpoint (bit for bit, [`crate::driver`]).
+fn run_hold(job: &HoldJob, finish_released: bool) -> Result<(), SearchError> {
+    let failed = |e: crate::driver::RunError<crate::granular::soft::run::SoftSummary>| {
+        SearchError::failed(format!("{}: {e}", job.dir.display()))
+    };
+    loop {
+        if hold_finished(&job.dir, finish_released) {
+            return Ok(());
+        }
+        let options = RunOptions {
+            force: true,
+            progress: false,
+            checkpoint_every: Some(crate::driver::DEFAULT_CHECKPOINT_EVERY),
+            checkpoint_every_sim: Some(RELEASE_CHECK_S),
+            formats: crate::driver::formats::Formats::NONE,
+            stop_after_checkpoints: Some(1),
+            ..RunOptions::default()
+        };
+        let result = match (&job.scene, job.dir.join("checkpoint.json").is_file()) {
+            (Some(scene), false) => crate::driver::run_soft(scene, &job.dir, &options),
+            _ => crate::driver::resume_soft(&job.dir, &options),
+        };
+        match result {
+            Ok(_) | Err(crate::driver::RunError::Stopped { .. }) => {}
+            Err(e) => return Err(failed(e)),
+        }
+    }
+}
+
+/// Runs `jobs` (in order), `args.parallel` at once, each on a rayon pool of its own threads ([`threads_per_hold`]);
+/// `enough(k)` is asked after hold k finishes, and once it says so no further hold is started.
+fn run_holds(
+    jobs: &[&HoldJob],
+    args: &CriticalOptions,
+    enough: &(dyn Fn(usize) -> bool + Sync),
+) -> Result<(), SearchError> {
+    use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let first_error = std::sync::Mutex::new(None);
+    let threads = threads_per_hold(args.threads_per_hold, args.parallel);
+    let worker = || {
+        let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+            Ok(p) => p,
+            Err(e) => {
+                *first_error.lock().expect("no panic holds the lock") = Some(SearchError::failed(e.to_string()));
+                stop.store(true, Ordering::SeqCst);
+                return;
+            }
+        };
+        loop {
+            if stop.load(Ordering::SeqCst) {
+                return;
+            }
+            let k = next.fetch_add(1, Ordering::SeqCst);
+            let Some(job) = jobs.get(k) else { return };
+            if !hold_finished(&job.dir, args.finish_released) {
+                eprintln!(
+                    "spinup critical: running T_final = {} h into {} ({threads} thread(s))",
+                    job.t_final_hours,
+                    job.dir.display()
+                );
+            }
+            match pool.install(|| run_hold(job, args.finish_released)) {
+                Ok(()) => {
+                    if enough(k) {
+                        stop.store(true, Ordering::SeqCst);
+                    }
+                }
+                Err(e) => {
+                    first_error.lock().expect("no panic holds the lock").get_or_insert(e);
+                    stop.store(true, Ordering::SeqCst);
+                }
+            }
+        }
+    };
+    std::thread::scope(|s| {
+        for _ in 0..args.parallel.min(jobs.len()).max(1) {
+            s.spawn(worker);
+        }
+    });
+    match first_error.into_inner().expect("no panic holds the lock") {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Threads of each hold's rayon pool: `requested`, or the calling pool's threads shared among the `parallel` holds
+/// at once (at least one each), as campaigns share them among their runs.
+pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
+    requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
 /// The time (s) at which the path `p` (without rests) passes the period `period_h` (hours), between `t_inter` and
@@ -863,8 +1386,7 @@ mod tests {
     }
 
     fn verdict(tf: f64, s: &[SpinupSample], selected: CreepCriterionKind) -> HoldVerdict {
-        let paper = paper_criterion(None).unwrap();
-        judge_hold(s, 1000.0, &paper, &CreepCriterion::ours(), selected, tf, PathBuf::new())
+        judge_hold(s, 1000.0, None, &Criteria::default(), selected, tf, PathBuf::new())
     }
 
     /// The creep criteria on synthetic holds: a steady θ_max is stable, a θ_max rising by 2° over the hold creeps
@@ -892,6 +1414,7 @@ mod tests {
         ];
         assert!(!runs[0].stable && runs[0].drifting == vec!["theta_max"]);
         assert_eq!(runs[0].ours.drifting, vec!["theta_max"]);
+        assert_eq!(runs[0].paper_tolerance.drifting, vec!["theta_max"]);
         assert!(runs[1].stable && runs[2].stable);
         for k in CreepCriterionKind::ALL {
             assert_eq!(critical_from_verdicts(&runs, k), (Some(2.41), Some(39.0)));
@@ -903,9 +1426,9 @@ mod tests {
         let mut s = hold(flat(30.0), flat(0.74), flat(9.0));
         s[50].forcing = false;
         let v = verdict(2.5, &s, CreepCriterionKind::Paper);
-        assert!(!v.stable && !v.paper.stable && !v.ours.stable && v.released);
+        assert!(!v.stable && !v.stable_by(CreepCriterionKind::Paper) && !v.ours.stable && v.released);
         assert!(
-            verdict_line(&v).contains("paper disrupted, ours disrupted"),
+            verdict_line(&v).contains("paper disrupted, paper-tolerance disrupted, ours disrupted"),
             "{}",
             verdict_line(&v)
         );
@@ -945,10 +1468,10 @@ mod tests {
         }
     }
 
-    /// Both T_c,3 values from one search: holds at 2.55–2.58 h lose 0.2 contacts per particle over the hold with
+    /// Every T_c,3 from one search: holds at 2.55–2.58 h lose 0.2 contacts per particle over the hold with
     /// θ_max and η_B flat (our RCP holds), 2.59 h and later keep them. Ours finds T_c,3 = 2.55 h, the paper's
-    /// 2.59 h; the selected criterion fills the top-level verdict, and the search is done only once both have a
-    /// stable hold and one more.
+    /// (either reading) 2.59 h; the selected criterion fills the top-level verdict, and the search is done only
+    /// once all have a stable hold and one more.
     #[test]
     fn both_criteria_give_their_own_t_c3_when_only_the_coordination_number_drifts() {
         let grid = [2.55, 2.56, 2.57, 2.58, 2.59, 2.60];
@@ -964,11 +1487,16 @@ mod tests {
                 )
             })
             .collect();
-        assert!(runs[0].stable && !runs[0].paper.stable);
-        assert_eq!(runs[0].paper.drifting, vec!["coordination_number"]);
+        assert!(runs[0].stable && !runs[0].stable_by(CreepCriterionKind::Paper));
+        assert_eq!(runs[0].paper_tolerance.drifting, vec!["coordination_number"]);
+        assert_eq!(runs[0].paper.as_ref().unwrap().drifting, vec!["coordination_number"]);
         assert!(runs[0].drift.coordination < -0.09 && runs[0].drift.coordination > -0.11);
         let (t_ours, phi_ours) = critical_from_verdicts(&runs, CreepCriterionKind::Ours);
         let (t_paper, phi_paper) = critical_from_verdicts(&runs, CreepCriterionKind::Paper);
+        assert_eq!(
+            critical_from_verdicts(&runs, CreepCriterionKind::PaperTolerance).0,
+            Some(2.59)
+        );
         assert_eq!(t_ours, Some(2.55));
         assert_eq!(t_paper, Some(2.59));
         assert!((phi_ours.unwrap() - 50.0).abs() < 1e-9);
@@ -980,10 +1508,21 @@ mod tests {
             csv.lines()
                 .nth(1)
                 .unwrap()
-                .ends_with(",false,coordination_number,true,"),
+                .ends_with(",false,coordination_number,false,coordination_number,true,"),
             "{csv}"
         );
         assert_eq!(csv.lines().count(), grid.len() + 1);
+        // the table reads back to the same verdicts (rates to the printed digits)
+        let back = read_critical_csv(&csv).unwrap();
+        for (a, b) in runs.iter().zip(&back) {
+            for k in CreepCriterionKind::ALL {
+                assert_eq!(a.verdict(k).map(|v| v.stable), b.verdict(k).map(|v| v.stable));
+            }
+            let (x, y) = (a.rates.unwrap().coordination, b.rates.unwrap().coordination);
+            assert!((x.rate_per_ks - y.rate_per_ks).abs() <= 1e-6 * x.rate_per_ks.abs().max(1e-12));
+        }
+        assert_eq!(sequential_stop(&runs, false), runs.len());
+        assert_eq!(sequential_stop(&runs[..5], true), 5);
     }
 
     /// Regression guard: a bad `--coordination-tolerance` is refused with the option's name and the expected
@@ -1001,15 +1540,62 @@ mod tests {
     }
 
     #[test]
-    fn coordination_tolerance_must_be_positive() {
+    fn coordination_tolerance_and_significance_must_be_positive() {
         for bad in [0.0, -0.1, f64::NAN] {
-            let e = paper_criterion(Some(bad)).unwrap_err().to_string();
+            let e = criteria(None, Some(bad)).unwrap_err().to_string();
             assert!(
                 e.contains("--coordination-tolerance must be") && e.contains("> 0"),
                 "{e}"
             );
+            let e = criteria(Some(bad), None).unwrap_err().to_string();
+            assert!(e.contains("--significance must be") && e.contains("> 0"), "{e}");
         }
-        assert_eq!(paper_criterion(Some(0.1)).unwrap().coordination, Some(0.1));
+        let c = criteria(Some(3.0), Some(0.1)).unwrap();
+        assert_eq!(c.paper_tolerance.coordination, Some(0.1));
+        assert_eq!(c.paper.significance, Some(3.0));
+    }
+
+    /// The judge window reads a long hold as a shorter one: a hold that releases its forcing at 20 000 s is
+    /// stable when judged over its first 16 000 s and released over 32 000 s; the window's second half is the one
+    /// fitted.
+    #[test]
+    fn judge_window_reads_the_first_part_of_a_hold() {
+        let n = 161;
+        let series = HoldSeries {
+            t_s: (0..n).map(|k| 200.0 * k as f64).collect(),
+            theta_max_deg: vec![30.0; n],
+            packing: vec![0.65; n],
+            // contacts lost only after 16 000 s
+            coordination: (0..n)
+                .map(|k| if k <= 80 { 5.5 } else { 5.5 - 0.0005 * (k - 80) as f64 })
+                .collect(),
+            release_s: Some(20_000.0),
+        };
+        let c = Criteria::default();
+        let short = judge_series(
+            &series,
+            Some(16_000.0),
+            &c,
+            CreepCriterionKind::Paper,
+            2.5,
+            PathBuf::new(),
+        );
+        assert!(short.stable && !short.released && short.hold_s == 16_000.0, "{short:?}");
+        let long = judge_series(
+            &series,
+            Some(32_000.0),
+            &c,
+            CreepCriterionKind::Paper,
+            2.5,
+            PathBuf::new(),
+        );
+        assert!(long.released && !long.stable && long.release_s == Some(20_000.0));
+        let mut kept = series.clone();
+        kept.release_s = None;
+        let long = judge_series(&kept, None, &c, CreepCriterionKind::Paper, 2.5, PathBuf::new());
+        assert_eq!(long.drifting, vec!["coordination_number"]);
+        // 0.04 contacts per particle lost over the second half: under the old tolerance of 0.05, creep by rates
+        assert!(long.paper_tolerance.stable, "{long:?}");
     }
 
     #[test]

@@ -25,7 +25,9 @@ pub struct BuildArgs {
     /// Model: hcp, rcp, rcpc, pp1, pp2 or ppc (Zhang17 Table 2).
     #[arg(long)]
     pub model: String,
-    /// Shape: sphere:R, ellipsoid:A,B,C (semi-axes), top[:D_EQ] (Didymos-like, default 780 m), obj:PATH (m).
+    /// Shape: sphere:R, ellipsoid:A,B,C (semi-axes), top[:D_EQ] (axisymmetric Didymos-like top, default 780 m),
+    /// didymos[:LX,LY,LZ,D_EQ] (Naidu et al. 2020: extents 832 × 838 × 786 m, D_eq 780 m, with an equatorial
+    /// bulge), obj:PATH (m).
     #[arg(long)]
     pub shape: String,
     /// Multiply OBJ coordinates by this (1000 for a model in km).
@@ -50,6 +52,11 @@ pub struct BuildArgs {
     /// Seed of every random choice.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// How the lattice of hcp (and of rcpc's core) is turned before carving: perpendicular (close-packed layers ⟂
+    /// the spin axis z), parallel (layers containing it), tilt:DEG (stacking axis DEG degrees from z) or
+    /// random[:SEED] (uniform over rotations; default SEED: --seed). Recorded in NAME.json.
+    #[arg(long, value_name = "ORIENTATION", default_value = "perpendicular")]
+    pub lattice_orientation: String,
     /// Shaking periods of the random-packing recipe (default 10).
     #[arg(long)]
     pub shake_periods: Option<f64>,
@@ -156,6 +163,7 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
         seed: args.seed,
         core_radius: args.core_radius,
         recipe,
+        orientation: args.lattice_orientation.parse().map_err(CliError::usage)?,
     };
     let agg = build_with_progress(&spec, &mut build_progress()).map_err(cli_error)?;
     write_aggregate(&args.out, &agg.particles, &agg.report).map_err(cli_error)?;

@@ -9,7 +9,8 @@ use crate::cli::common::CliError;
 /// `rubblepile spinup …`.
 #[derive(Debug, clap::Subcommand)]
 pub enum SpinupCommand {
-    /// Search T_c,3: hold runs at T_final stepped by 0.01 h until one is free of creep (Zhang17 §3.3.3).
+    /// Search T_c,3: hold runs at T_final stepped by 0.01 h until one is free of creep (Zhang17 §3.3.3), several
+    /// at once with --parallel N or over a job array with --shard I/N.
     Critical(CriticalArgs),
     /// Fit κ of Eq. 22 over bulk densities and give the critical bulk density.
     DensityFit(DensityFitArgs),
@@ -41,13 +42,18 @@ pub struct CriticalArgs {
     /// path without rests.
     #[arg(long)]
     pub branch: bool,
-    /// Which creep criterion gives critical.json's top-level T_c,3 and φ: `paper` (Zhang17 §3.3.3: θ_max rising,
-    /// η_B or the coordination number falling over a hold's second half is creep) or `ours` (θ_max or η_B moving
-    /// either way). Both are judged and recorded per hold; the search runs until both have a stable hold.
-    #[arg(long, value_name = "paper|ours", default_value = "paper")]
+    /// Which creep criterion gives critical.json's top-level T_c,3 and φ: `paper` (Zhang17 §3.3.3 with zero
+    /// tolerance: θ_max rising, η_B or the coordination number falling over a hold's second half at a rate beyond
+    /// --significance standard errors is creep), `paper-tolerance` (the same directions, changes beyond 0.5°, 0.0005
+    /// and --coordination-tolerance; the default before Dec 2026) or `ours` (θ_max or η_B moving either way). All
+    /// are judged and recorded per hold; the search runs until all have a stable hold.
+    #[arg(long, value_name = "paper|paper-tolerance|ours", default_value = "paper")]
     pub creep_criterion: CreepCriterionKind,
+    /// Standard errors by which a weakening rate must exceed zero for the paper's criterion (default 2).
+    #[arg(long, value_name = "Z")]
+    pub significance: Option<f64>,
     /// Largest fall of the coordination number (contacts per particle) over the second half of a hold that the
-    /// paper's criterion lets pass (default 0.05).
+    /// paper-tolerance criterion lets pass (default 0.05).
     #[arg(long, value_name = "CHANGE")]
     pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
@@ -57,6 +63,23 @@ pub struct CriticalArgs {
     /// search stops one hold after that): shows whether the verdicts stay stable at slower spins.
     #[arg(long)]
     pub all_holds: bool,
+    /// Judge only the first SECONDS of each hold (T_c,3 against the hold length from one set of long holds).
+    #[arg(long, value_name = "SECONDS")]
+    pub judge_window: Option<f64>,
+    /// Holds run at once (the base run of --branch is shared and runs first); outputs are those of --parallel 1.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub parallel: usize,
+    /// Threads of each hold (default: the threads of the process shared among the holds at once).
+    #[arg(long, value_name = "K")]
+    pub threads_per_hold: Option<usize>,
+    /// Run only the holds k with k mod N = I (grid order), for a job array (Slurm: --shard $SLURM_ARRAY_TASK_ID/N),
+    /// after writing the branches; judge afterwards with the same command without --shard.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<crate::impact::campaign::Shard>,
+    /// Run a hold whose forcing was released to its end (by default it stops within 2000 simulated seconds of the
+    /// release: its verdict is fixed).
+    #[arg(long)]
+    pub finish_released: bool,
 }
 
 /// `rubblepile spinup density-fit`.
@@ -89,8 +112,14 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         branch: args.branch,
         criterion: args.creep_criterion,
         coordination_tolerance: args.coordination_tolerance,
+        significance: args.significance,
         hold: args.hold,
+        judge_window: args.judge_window,
         all_holds: args.all_holds,
+        parallel: args.parallel,
+        threads_per_hold: args.threads_per_hold,
+        shard: args.shard,
+        finish_released: args.finish_released,
     };
     run_critical(&options).map_err(cli_error)
 }

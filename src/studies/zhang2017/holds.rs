@@ -101,7 +101,7 @@ pub fn chosen_holds(verdicts: &[HoldVerdict]) -> Vec<f64> {
 fn verdict_word(v: &HoldVerdict, kind: CreepCriterionKind) -> &'static str {
     if v.released {
         "released"
-    } else if v.verdict(kind).stable {
+    } else if v.stable_by(kind) {
         "stable"
     } else {
         "creeps"
