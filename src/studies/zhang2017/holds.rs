@@ -194,7 +194,7 @@ pub fn write_holds_section(md: &mut String, searches: &[(String, PathBuf, f64)],
                 v.drift.packing,
                 v.drift.coordination,
                 verdict_word(v, CreepCriterionKind::Ours),
-                verdict_word(v, CreepCriterionKind::Paper),
+                verdict_word(v, CreepCriterionKind::PaperTolerance),
             );
         }
         let stem = format!(
@@ -243,7 +243,7 @@ mod tests {
         assert_eq!(chosen_holds(&v), vec![2.45, 2.50, 2.55, 2.65]);
         assert_eq!(verdict_word(&v[0], CreepCriterionKind::Ours), "released");
         assert_eq!(verdict_word(&v[1], CreepCriterionKind::Ours), "creeps");
-        assert_eq!(verdict_word(&v[3], CreepCriterionKind::Paper), "creeps");
+        assert_eq!(verdict_word(&v[3], CreepCriterionKind::PaperTolerance), "creeps");
         assert_eq!(verdict_word(&v[3], CreepCriterionKind::Ours), "stable");
         // no stable hold: the slowest only
         assert_eq!(chosen_holds(&v[..2]), vec![2.45]);

@@ -151,7 +151,7 @@ pub fn union_search(dir: &Path) -> Option<VariantSearch> {
         search: RungSearch {
             name: dir.file_name()?.to_string_lossy().into_owned(),
             step_hours,
-            paper: critical_from_verdicts(&holds, CreepCriterionKind::Paper),
+            paper: critical_from_verdicts(&holds, CreepCriterionKind::PaperTolerance),
             ours: critical_from_verdicts(&holds, CreepCriterionKind::Ours),
             holds: holds.len(),
         },

@@ -359,15 +359,16 @@ pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSam
     } else {
         format!("critical_{path}")
     };
+    // the sections made before Dec 2026 read the one-sided criterion with tolerances (`paper_tolerance`)
     let critical = read_critical(&model_dir.join(search));
-    let t_c3 = critical.as_ref().and_then(|c| c["t_c3_hours"].as_f64());
-    let phi = critical.as_ref().and_then(|c| c["friction_angle_deg"].as_f64());
+    let t_c3 = critical.as_ref().and_then(|c| c["paper_tolerance"]["t_c3_hours"].as_f64());
+    let phi = critical.as_ref().and_then(|c| c["paper_tolerance"]["friction_angle_deg"].as_f64());
     let t_c3_by_criterion = critical.as_ref().and_then(|c| {
         let get = |k: &str| {
             c.get(k)
                 .map(|r| (r["t_c3_hours"].as_f64(), r["friction_angle_deg"].as_f64()))
         };
-        Some([get("paper")?, get("ours")?])
+        Some([get("paper_tolerance")?, get("ours")?])
     });
     let kappa3 = t_c3.and_then(|t| fit_density(&[(rho_b, t)], SI_G, t)).map(|f| f.kappa);
     let path_error = samples
@@ -499,7 +500,16 @@ pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
     };
     let Some(csv) = std::fs::read_to_string(search_dir.join("critical.csv")).ok() else {
         let text = std::fs::read_to_string(search_dir.join("critical.json")).ok()?;
-        return serde_json::from_str(&text).ok();
+        let mut v: serde_json::Value = serde_json::from_str(&text).ok()?;
+        // a critical.json of before Dec 2026: its `paper` is today's paper-tolerance criterion
+        if v.get("paper_tolerance").is_none() {
+            let old = v.get("paper").cloned().unwrap_or_else(|| {
+                serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] })
+            });
+            v["paper_tolerance"] = old;
+            v["paper"] = serde_json::json!({ "t_c3_hours": null, "friction_angle_deg": null });
+        }
+        return Some(v);
     };
     let mut holds = read_critical_csv(&csv).ok()?;
     if holds.iter().any(|h| h.paper.is_none())
