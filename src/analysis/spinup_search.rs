@@ -79,6 +79,9 @@ pub struct CriticalOptions {
     /// Run a hold whose forcing was released to its end; default: stop it at the next release check
     /// ([`RELEASE_CHECK_S`]), its verdict (not stable) being fixed.
     pub finish_released: bool,
+    /// Write the base run and every hold's branch (or scene) and stop: the first job of a job array whose shards
+    /// then run the holds (shards started together would otherwise all run the base).
+    pub prepare_only: bool,
 }
 
 impl CriticalOptions {
@@ -102,6 +105,7 @@ impl CriticalOptions {
             threads_per_hold: None,
             shard: None,
             finish_released: false,
+            prepare_only: false,
         }
     }
 }
@@ -759,7 +763,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
     }
     let json = args.out.join("critical.json");
-    if json.exists() && !args.force && args.shard.is_none() {
+    if json.exists() && !args.force && args.shard.is_none() && !args.prepare_only {
         return Err(SearchError::usage(format!(
             "{} exists (use --force to overwrite it)",
             json.display()
@@ -843,6 +847,14 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             job.dir.clone(),
         ))
     };
+    if args.prepare_only {
+        println!(
+            "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
+            jobs.len(),
+            args.out.display()
+        );
+        return Ok(());
+    }
     if let Some(shard) = args.shard {
         let mine: Vec<&HoldJob> = jobs
             .iter()

@@ -8,9 +8,11 @@
 //! - the timed systems behind `rubblepile bench …`, each writing CSV and a plot: [`rhs`] (µs per right-hand side,
 //!   1 thread vs all), [`work_precision_sweep`] (error vs time per method), [`nbody`] (point-mass runs, REBOUND
 //!   comparison), [`impact_wall_time`] (the N200 impact's wall time), [`hsdem`] (hard-sphere collisions per
-//!   second), [`scaling`] (every engine's strong scaling). Their option structs derive `clap::Args` so the command
+//!   second), [`scaling`] (every engine's strong scaling), [`critical`] (a T_c,3 search's holds one at a time
+//!   and several at once). Their option structs derive `clap::Args` so the command
 //!   line embeds them; the command line itself only parses and dispatches.
 
+pub mod critical;
 pub mod ellipsoid_problems;
 pub mod hsdem;
 pub mod impact_wall_time;

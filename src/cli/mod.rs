@@ -233,6 +233,9 @@ pub enum BenchCommand {
     Tolerance(crate::bench::tolerance::ToleranceArgs),
     /// Milliseconds per rendered frame at N bodies on 1 and all threads, and VTK export MB/s (CSV + plot).
     Render(crate::bench::render::RenderBenchArgs),
+    /// Wall time of a T_c,3 search's holds one at a time and several at once (`spinup critical --parallel`), on
+    /// one prepared base run, with the load average (CSV + plot).
+    Critical(crate::bench::critical::BenchCriticalArgs),
 }
 
 /// Runs a parsed command line.
@@ -312,6 +315,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             crate::bench::impact_wall_time::impact(&args).map_err(CliError::from)
         }
         Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
+        Command::Bench(BenchCommand::Critical(args)) => Ok(crate::bench::critical::bench(&args)?),
         Command::Bench(BenchCommand::Scaling(args)) => Ok(crate::bench::scaling::scaling(&args)?),
         Command::Bench(BenchCommand::Hsdem(args)) => Ok(crate::bench::hsdem::bench(&args)?),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),

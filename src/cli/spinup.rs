@@ -80,6 +80,10 @@ pub struct CriticalArgs {
     /// release: its verdict is fixed).
     #[arg(long)]
     pub finish_released: bool,
+    /// Write the base run of --branch and every hold's branch, then stop (the first job before an array of
+    /// --shard jobs; see README.md).
+    #[arg(long)]
+    pub prepare_only: bool,
 }
 
 /// `rubblepile spinup density-fit`.
@@ -120,6 +124,7 @@ pub fn critical(args: &CriticalArgs) -> Result<(), CliError> {
         threads_per_hold: args.threads_per_hold,
         shard: args.shard,
         finish_released: args.finish_released,
+        prepare_only: args.prepare_only,
     };
     run_critical(&options).map_err(cli_error)
 }
