@@ -18,6 +18,7 @@ pub use crate::ellipsoid::rigid_rotation;
 pub mod rotational_split;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;
+pub mod spin_limit;
 pub mod spinup;
 pub mod spinup_search;
 pub use crate::granular::soft::spinup_diagnostics;

@@ -51,7 +51,11 @@ pub fn read_search(dir: &Path) -> Option<RungSearch> {
     Some(RungSearch {
         name: dir.file_name()?.to_string_lossy().into_owned(),
         step_hours,
-        paper: if v["paper_tolerance"].is_object() { pair(&v["paper_tolerance"]) } else { top },
+        paper: if v["paper_tolerance"].is_object() {
+            pair(&v["paper_tolerance"])
+        } else {
+            top
+        },
         ours: if v["ours"].is_object() { pair(&v["ours"]) } else { top },
         holds: t.len(),
     })

@@ -361,8 +361,12 @@ pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSam
     };
     // the sections made before Dec 2026 read the one-sided criterion with tolerances (`paper_tolerance`)
     let critical = read_critical(&model_dir.join(search));
-    let t_c3 = critical.as_ref().and_then(|c| c["paper_tolerance"]["t_c3_hours"].as_f64());
-    let phi = critical.as_ref().and_then(|c| c["paper_tolerance"]["friction_angle_deg"].as_f64());
+    let t_c3 = critical
+        .as_ref()
+        .and_then(|c| c["paper_tolerance"]["t_c3_hours"].as_f64());
+    let phi = critical
+        .as_ref()
+        .and_then(|c| c["paper_tolerance"]["friction_angle_deg"].as_f64());
     let t_c3_by_criterion = critical.as_ref().and_then(|c| {
         let get = |k: &str| {
             c.get(k)
@@ -503,9 +507,9 @@ pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
         let mut v: serde_json::Value = serde_json::from_str(&text).ok()?;
         // a critical.json of before Dec 2026: its `paper` is today's paper-tolerance criterion
         if v.get("paper_tolerance").is_none() {
-            let old = v.get("paper").cloned().unwrap_or_else(|| {
-                serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] })
-            });
+            let old = v.get("paper").cloned().unwrap_or_else(
+                || serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] }),
+            );
             v["paper_tolerance"] = old;
             v["paper"] = serde_json::json!({ "t_c3_hours": null, "friction_angle_deg": null });
         }
