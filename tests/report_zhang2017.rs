@@ -3,7 +3,7 @@
 //! scaled runs' Table 3.
 
 use rubblepile::analysis::spinup_diagnostics::{SPINUP_HEADER, SpinupSample};
-use rubblepile::studies::zhang2017::report::write_report;
+use rubblepile::studies::zhang2017::report::{ReportSources, write_report};
 use std::path::Path;
 
 /// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
@@ -99,11 +99,10 @@ fn full_size_section_reads_a_run_still_going() {
     fake_run(&root.join("full/hcp"), 50, 12000.0, 38300.0, 9000.0, false);
     let out = root.join("out");
     let report = write_report(
-        &root.join("runs"),
-        Some(&root.join("full")),
-        None,
-        None,
-        None,
+        &ReportSources {
+            full: Some(&root.join("full")),
+            ..ReportSources::new(&root.join("runs"))
+        },
         &out,
         false,
     )
@@ -125,11 +124,10 @@ fn full_size_section_reads_a_run_still_going() {
     assert!(md.contains("--full "), "{}", &md[..400]);
     assert!(
         write_report(
-            &root.join("runs"),
-            Some(&root.join("full")),
-            None,
-            None,
-            None,
+            &ReportSources {
+                full: Some(&root.join("full")),
+                ..ReportSources::new(&root.join("runs"))
+            },
             &out,
             false
         )
@@ -176,7 +174,7 @@ fn notes_are_appended_verbatim_and_both_creep_verdicts_are_shown() {
     )
     .unwrap();
     let md2 =
-        std::fs::read_to_string(write_report(&root.join("runs"), None, None, None, None, &out, true).unwrap()).unwrap();
+        std::fs::read_to_string(write_report(&ReportSources::new(&root.join("runs")), &out, true).unwrap()).unwrap();
     assert!(md2.ends_with(&format!("\n\n{notes}\n")), "{}", &md2[md2.len() - 300..]);
     let section = &md2[md2.find("## T_c,3 by creep criterion").expect("criterion section")..];
     let row = section.lines().find(|l| l.starts_with("| HCP |")).expect("HCP row");
@@ -267,11 +265,10 @@ fn paths_section_sets_the_three_paths_beside_table_6() {
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(
-            &root.join("runs"),
-            None,
-            Some(&root.join("paths")),
-            None,
-            None,
+            &ReportSources {
+                paths: Some(&root.join("paths")),
+                ..ReportSources::new(&root.join("runs"))
+            },
             &out,
             false,
         )
@@ -386,11 +383,10 @@ fn ladder_section_takes_compact_rungs_and_the_finest_search() {
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(
-            &root.join("runs"),
-            None,
-            None,
-            Some(&root.join("ladder")),
-            None,
+            &ReportSources {
+                ladder: Some(&root.join("ladder")),
+                ..ReportSources::new(&root.join("runs"))
+            },
             &out,
             false,
         )
@@ -540,11 +536,10 @@ fn ordering_and_holds_sections_read_the_variants_and_their_holds() {
     let out = root.join("out");
     let md = std::fs::read_to_string(
         write_report(
-            &root.join("runs"),
-            None,
-            None,
-            None,
-            Some(&root.join("ordering")),
+            &ReportSources {
+                ordering: Some(&root.join("ordering")),
+                ..ReportSources::new(&root.join("runs"))
+            },
             &out,
             false,
         )
@@ -597,7 +592,7 @@ fn fresh_root(tag: &str) -> std::path::PathBuf {
 
 /// The report of `root/runs` alone (no optional sections), written to `root/out`.
 fn report_of_runs(root: &Path) -> String {
-    let path = write_report(&root.join("runs"), None, None, None, None, &root.join("out"), false).unwrap();
+    let path = write_report(&ReportSources::new(&root.join("runs")), &root.join("out"), false).unwrap();
     std::fs::read_to_string(path).unwrap()
 }
 

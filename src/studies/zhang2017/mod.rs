@@ -1,10 +1,12 @@
 //! Zhang et al. (2017, Icarus 294): the report on Table 3's critical spin limits ([`report`]), its spin-up-path
 //! section after Table 6 ([`paths`]), the resolution ladder ([`ladder`]), the packing ordering under changed contact
-//! laws ([`ordering`]), Table 7's materials ([`materials`]) and the Fig. 22 analogue of the searches' holds ([`holds`]),
+//! laws ([`ordering`]), Table 7's materials ([`materials`]), the Fig. 22 analogue of the searches' holds ([`holds`])
+//! and the study that decides the paper's Table 3 at its scale ([`decided`]),
 //! all reading runs into the rows
 //! of [`rows`]. The searches that make its runs are generic and live in
 //! [`crate::analysis::spinup_search`].
 
+pub mod decided;
 pub mod holds;
 pub mod ladder;
 pub mod materials;

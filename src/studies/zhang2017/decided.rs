@@ -1,0 +1,592 @@
+//! Zhang17 decided at the paper's scale: Table 3 by the decided protocol (HCP and RCP at the paper's grain counts,
+//! the other four models scaled), the packing ordering RCP − HCP with `ordering.csv`, T_c,3 against the HCP
+//! lattice's orientation, T_c,3 against the hold length, and the equilibrium bound on HCP's φ.
+//!
+//! The protocol: the Didymos primary of Naidu et al. (2020) ([`crate::aggregate::triaxial_top`]), the bulk density
+//! the paper's grain counts give ([`super::rows::paper_bulk_density`]), the paper's creep criterion with zero
+//! tolerance judged by rates ([`crate::analysis::creep`]), every hold read over the length at which T_c,3 stops
+//! moving ([`decided_hold_length`]).
+//!
+//! Layout read (compact copies, `analysis/zhang2017/compact.py`): `DIR/full/<name>/`, `DIR/scaled/<name>/` and
+//! `DIR/orientation/<name>/` each with `path2/` (the search's base run: T_c1, T_c2, grains) and `critical/`
+//! (`critical.csv`, `holds.csv`, `target.json`, the aggregate's report); `DIR/hold_length/<name>/critical/` for
+//! searches kept only for their long holds. A name's model is its part before the first `_`.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use crate::aggregate::report::AggregateReport;
+use crate::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
+use crate::analysis::creep::CreepCriterionKind;
+use crate::analysis::figures::lines::{LineChart, Mark, Series};
+use crate::analysis::figures::style::write_figure;
+use crate::analysis::spin_limit::least_friction_angle;
+use crate::analysis::spinup_search::{
+    Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
+};
+
+use super::rows::{ModelRow, TABLE3, opt, paper_bulk_density, path_row};
+
+/// The hold lengths (s) at which every search is read: the 16 000 s of the searches before Dec 2026 and two and
+/// about three times that.
+pub const HOLD_LENGTHS: [f64; 3] = [16_000.0, 32_000.0, 50_000.0];
+
+/// The groups of searches under the decided directory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Group {
+    /// HCP and RCP at the paper's grain counts.
+    Full,
+    /// The other four models, scaled.
+    Scaled,
+    /// The scaled HCP at several lattice orientations.
+    Orientation,
+    /// Searches kept only for T_c,3 against the hold length.
+    HoldLength,
+}
+
+impl Group {
+    /// All groups with their directory names.
+    pub const ALL: [(Group, &'static str); 4] = [
+        (Group::Full, "full"),
+        (Group::Scaled, "scaled"),
+        (Group::Orientation, "orientation"),
+        (Group::HoldLength, "hold_length"),
+    ];
+}
+
+/// One search of the decided study.
+#[derive(Debug, Clone)]
+pub struct DecidedSearch {
+    /// Its group.
+    pub group: Group,
+    /// Its directory name (`hcp_full_random1`, `rcp_full`, `pp2`, …).
+    pub name: String,
+    /// Its model (the name up to the first `_`).
+    pub model: String,
+    /// The base run read as a path-2 row (T_c1, T_c2, grains), when `path2/` is there.
+    pub row: Option<ModelRow>,
+    /// The aggregate's report (`critical/target.json`), when there.
+    pub target: Option<AggregateReport>,
+    /// The holds as the search judged them (`critical.csv`).
+    pub verdicts: Vec<HoldVerdict>,
+    /// Every hold's record (`holds.csv`).
+    pub series: Vec<(f64, HoldSeries)>,
+}
+
+impl DecidedSearch {
+    /// The longest length (s) over which every hold that kept its forcing was recorded (the hold lengths it can
+    /// be read at).
+    pub fn recorded_s(&self) -> f64 {
+        self.series
+            .iter()
+            .filter(|(_, s)| s.release_s.is_none())
+            .map(|(_, s)| s.t_s.last().copied().unwrap_or(0.0))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The hold lengths of [`HOLD_LENGTHS`] it can be read at.
+    pub fn lengths(&self) -> Vec<f64> {
+        let recorded = self.recorded_s();
+        HOLD_LENGTHS.iter().copied().filter(|&l| l <= recorded + 1.0).collect()
+    }
+
+    /// The holds judged by every criterion over their first `window` seconds.
+    pub fn judged(&self, window: f64) -> Vec<HoldVerdict> {
+        rejudge(
+            &self.verdicts,
+            &self.series,
+            Some(window),
+            &Criteria::default(),
+            CreepCriterionKind::Paper,
+        )
+    }
+
+    /// T_c,3 (h) and φ (°) by `kind` over holds read at `window` seconds.
+    pub fn t_c3(&self, window: f64, kind: CreepCriterionKind) -> (Option<f64>, Option<f64>) {
+        critical_from_verdicts(&self.judged(window), kind)
+    }
+
+    /// The holds as letters by the paper's criterion at `window`: `R` released, `C` creeping, `S` stable.
+    pub fn letters(&self, window: f64) -> String {
+        self.judged(window)
+            .iter()
+            .map(|h| {
+                let letter = if h.released {
+                    'R'
+                } else if h.stable_by(CreepCriterionKind::Paper) {
+                    'S'
+                } else {
+                    'C'
+                };
+                format!("{letter} {:.2}", h.t_final_hours)
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The lattice orientation of its target (`perpendicular` for a lattice report written before orientations
+    /// were recorded, `–` for a model without a lattice).
+    pub fn orientation(&self) -> String {
+        match &self.target {
+            Some(t) => t.lattice_orientation.clone().unwrap_or_else(|| {
+                if t.model == "hcp" {
+                    "perpendicular".into()
+                } else {
+                    "–".into()
+                }
+            }),
+            None => "–".into(),
+        }
+    }
+
+    /// Grains: the base run's, else the target's.
+    pub fn grains(&self) -> Option<usize> {
+        self.row.as_ref().map(|r| r.n).or(self.target.as_ref().map(|t| t.n))
+    }
+}
+
+/// Reads every search under `dir` (see the module docs), by group and name.
+pub fn read_decided(dir: &Path) -> Vec<DecidedSearch> {
+    let mut out = Vec::new();
+    for (group, sub) in Group::ALL {
+        let Ok(entries) = std::fs::read_dir(dir.join(sub)) else {
+            continue;
+        };
+        let mut names: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+        names.sort();
+        for d in names {
+            let critical = d.join("critical");
+            let Ok(text) = std::fs::read_to_string(critical.join("critical.csv")) else {
+                continue;
+            };
+            let Ok(verdicts) = read_critical_csv(&text) else {
+                continue;
+            };
+            let name = d
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            out.push(DecidedSearch {
+                group,
+                model: name.split('_').next().unwrap_or("").to_string(),
+                row: path_row(&d, "path2").ok().map(|r| r.0),
+                target: std::fs::read_to_string(critical.join("target.json"))
+                    .ok()
+                    .and_then(|t| serde_json::from_str(&t).ok()),
+                series: read_holds_csv(&critical.join("holds.csv")).unwrap_or_default(),
+                verdicts,
+                name,
+            });
+        }
+    }
+    out
+}
+
+/// The hold length (s) at which T_c,3 stops moving: the shortest of [`HOLD_LENGTHS`] from which every search read
+/// at two or more lengths gives the same T_c,3 (paper's criterion) at every longer length it has. 16 000 s when no
+/// search has two lengths.
+pub fn decided_hold_length(searches: &[DecidedSearch]) -> f64 {
+    let settled = |l: f64| {
+        searches.iter().all(|s| {
+            let lengths = s.lengths();
+            let at_l = s.t_c3(l, CreepCriterionKind::Paper).0;
+            lengths
+                .iter()
+                .filter(|&&m| m >= l)
+                .all(|&m| s.t_c3(m, CreepCriterionKind::Paper).0 == at_l)
+        })
+    };
+    HOLD_LENGTHS
+        .iter()
+        .copied()
+        .find(|&l| settled(l))
+        .unwrap_or(HOLD_LENGTHS[HOLD_LENGTHS.len() - 1])
+}
+
+/// The paper's Table 3 T_c,3 (h) and φ (°) of `model`.
+fn paper_t_c3(model: &str) -> Option<(f64, f64)> {
+    TABLE3.iter().find(|p| p.0 == model).map(|p| (p.5, p.2))
+}
+
+fn hours(x: Option<f64>) -> String {
+    opt(x, 2)
+}
+
+/// `ordering.csv`: one row per full-size search (`model, grains, orientation, criterion, hold_s, T_c3_h,
+/// phi_deg`), then `RCP-HCP` whose `T_c3_h` is the RCP search's T_c,3 less the mean of the HCP searches'.
+pub fn ordering_csv(full: &[&DecidedSearch], hold_s: f64) -> String {
+    let mut out = String::from("model,grains,orientation,criterion,hold_s,T_c3_h,phi_deg\n");
+    let cell = |x: Option<f64>, d: usize| x.map_or(String::new(), |v| format!("{v:.d$}"));
+    for s in full {
+        let (t, phi) = s.t_c3(hold_s, CreepCriterionKind::Paper);
+        out += &format!(
+            "{},{},{},paper,{hold_s:.0},{},{}\n",
+            s.model.to_uppercase(),
+            s.grains().map_or(String::new(), |n| n.to_string()),
+            s.orientation(),
+            cell(t, 2),
+            cell(phi, 1)
+        );
+    }
+    out += &format!(
+        "RCP-HCP,,,paper,{hold_s:.0},{},\n",
+        cell(ordering_difference(full, hold_s), 2)
+    );
+    out
+}
+
+/// RCP's T_c,3 less the mean of the HCP searches' (h), by the paper's criterion at `hold_s`; `None` unless every
+/// one has a T_c,3.
+pub fn ordering_difference(full: &[&DecidedSearch], hold_s: f64) -> Option<f64> {
+    let of = |model: &str| -> Option<Vec<f64>> {
+        let v: Vec<Option<f64>> = full
+            .iter()
+            .filter(|s| s.model == model)
+            .map(|s| s.t_c3(hold_s, CreepCriterionKind::Paper).0)
+            .collect();
+        if v.is_empty() { None } else { v.into_iter().collect() }
+    };
+    let (rcp, hcp) = (of("rcp")?, of("hcp")?);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    Some(mean(&rcp) - mean(&hcp))
+}
+
+fn mean_and_sd(v: &[f64]) -> Option<(f64, f64)> {
+    if v.is_empty() {
+        return None;
+    }
+    let n = v.len() as f64;
+    let m = v.iter().sum::<f64>() / n;
+    let sd = if v.len() > 1 {
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    Some((m, sd))
+}
+
+/// The Naidu et al. (2020) body as a homogeneous ellipsoid of its semi-extents' ratios and its volume (m).
+pub fn naidu_ellipsoid() -> [f64; 3] {
+    let semi = NAIDU2020_EXTENTS_M.map(|e| 0.5 * e);
+    let r_eq = 0.5 * NAIDU2020_EQUIVALENT_DIAMETER_M;
+    let scale = (r_eq.powi(3) / (semi[0] * semi[1] * semi[2])).cbrt();
+    semi.map(|a| a * scale)
+}
+
+/// The decided section of the report; writes `ordering.csv` and `decided_hold_length.{svg,png}` into `out`.
+pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<(), String> {
+    let searches = read_decided(dir);
+    let hold = decided_hold_length(&searches);
+    let (rho, volume) = paper_bulk_density();
+    let _ = writeln!(md, "\n## Decided at the paper's scale (issue 55)\n");
+    let _ = writeln!(
+        md,
+        "From the compact copies under `{}` (`src/studies/zhang2017/decided.rs`; commands in \
+         `analysis/zhang2017/decide/README.md`). Protocol: the Didymos primary of Naidu et al. (2020) (`--shape \
+         didymos`: extents 832 × 838 × 786 m, D_eq 780 m, an equatorial bulge); the bulk density the paper's own \
+         grain counts give, ρ_B = M_P / V̄ = {rho:.1} kg/m³ (HCP's 42 062 and RCP's 36 523 grains of 10 m at \
+         Table 3's η_B fill V̄ = {volume:.4e} m³, D_eq {:.0} m); the paper's creep criterion with zero tolerance, \
+         judged by rates (a weakening trend of θ_max, η_B or the coordination number beyond 2 standard errors over \
+         a hold's second half is creep); every hold read over its first **{hold:.0} s**, the length at which T_c,3 \
+         stops moving (table \"Hold length\" below). T_c1/T_c2 are those of each search's base run (path 2).\n",
+        dir.display(),
+        (6.0 * volume / std::f64::consts::PI).cbrt()
+    );
+    let in_group = |g: Group| searches.iter().filter(move |s| s.group == g).collect::<Vec<_>>();
+    // Table 3 by the decided protocol
+    let _ = writeln!(md, "### Table 3 by the decided protocol\n");
+    let _ = writeln!(
+        md,
+        "| model | grains | lattice | T_c1 / T_c2 (h) | T_c3 (h), paper's criterion | φ (°) | T_c3 paper-tolerance / \
+         ours (h) | holds (R released, C creeps, S stable) | paper T_c3, φ | T_c3 − paper (h) |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    let table: Vec<&DecidedSearch> = in_group(Group::Full)
+        .into_iter()
+        .chain(in_group(Group::Scaled))
+        .collect();
+    for s in &table {
+        let (t, phi) = s.t_c3(hold, CreepCriterionKind::Paper);
+        let paper = paper_t_c3(&s.model);
+        let _ = writeln!(
+            md,
+            "| {}{} | {} | {} | {} / {} | {} | {} | {} / {} | {} | {} | {} |",
+            s.model.to_uppercase(),
+            if s.group == Group::Full { " (full)" } else { "" },
+            s.grains().map_or("–".into(), |n| n.to_string()),
+            s.orientation(),
+            hours(s.row.as_ref().and_then(|r| r.limits.t_c1_hours)),
+            hours(s.row.as_ref().and_then(|r| r.limits.t_c2_hours)),
+            hours(t),
+            opt(phi, 1),
+            hours(s.t_c3(hold, CreepCriterionKind::PaperTolerance).0),
+            hours(s.t_c3(hold, CreepCriterionKind::Ours).0),
+            s.letters(hold),
+            paper.map_or("–".into(), |(t, p)| format!("{t:.2} h, {p}°")),
+            match (t, paper) {
+                (Some(t), Some((p, _))) => format!("{:+.2}", t - p),
+                _ => "–".into(),
+            }
+        );
+    }
+    // the ordering
+    let full = in_group(Group::Full);
+    let csv = ordering_csv(&full, hold);
+    std::fs::write(out.join("ordering.csv"), &csv)
+        .map_err(|e| format!("{}: {e}", out.join("ordering.csv").display()))?;
+    let _ = writeln!(
+        md,
+        "\n### The packing ordering at the paper's grain counts (`ordering.csv`)\n"
+    );
+    let diff = ordering_difference(&full, hold);
+    let _ = writeln!(
+        md,
+        "RCP − HCP = **{}** (RCP's T_c3 less the mean over the HCP lattice orientations searched at full size; the \
+         paper's Table 3: +0.43 h).\n",
+        diff.map_or("– (a full-size search without T_c3)".into(), |d| format!("{d:+.2} h"))
+    );
+    let _ = writeln!(md, "```\n{}```\n", csv);
+    // orientation
+    let orient = in_group(Group::Orientation);
+    if !orient.is_empty() {
+        let _ = writeln!(md, "### T_c,3 against the HCP lattice's orientation (scaled)\n");
+        let _ = writeln!(
+            md,
+            "| lattice | stacking axis from the spin axis (°) | grains | T_c1 / T_c2 (h) | T_c3 (h) | φ (°) | holds |"
+        );
+        let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+        let mut random = Vec::new();
+        let mut all = Vec::new();
+        for s in &orient {
+            let (t, phi) = s.t_c3(hold, CreepCriterionKind::Paper);
+            if let Some(t) = t {
+                all.push(t);
+                if s.orientation().starts_with("random") {
+                    random.push(t);
+                }
+            }
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} / {} | {} | {} | {} |",
+                s.orientation(),
+                s.target
+                    .as_ref()
+                    .and_then(|t| t.lattice_tilt_deg)
+                    .map_or("–".into(), |d| format!("{d:.1}")),
+                s.grains().map_or("–".into(), |n| n.to_string()),
+                hours(s.row.as_ref().and_then(|r| r.limits.t_c1_hours)),
+                hours(s.row.as_ref().and_then(|r| r.limits.t_c2_hours)),
+                hours(t),
+                opt(phi, 1),
+                s.letters(hold)
+            );
+        }
+        let stat = |v: &[f64]| {
+            mean_and_sd(v).map_or("–".into(), |(m, sd)| {
+                let (lo, hi) = (
+                    v.iter().cloned().fold(f64::INFINITY, f64::min),
+                    v.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+                );
+                format!("{m:.3} ± {sd:.3} h (n = {}, range {lo:.2}–{hi:.2} h)", v.len())
+            })
+        };
+        let _ = writeln!(
+            md,
+            "\nT_c3 over the random orientations: {}; over all orientations: {}.\n",
+            stat(&random),
+            stat(&all)
+        );
+    }
+    // hold length
+    let _ = writeln!(md, "### Hold length\n");
+    let _ = writeln!(
+        md,
+        "T_c3 (paper's criterion) of every search whose holds are long enough, each hold read over its first L \
+         seconds (`spinup critical --judge-window`): T_c3 stops moving at **{hold:.0} s**.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| search | {} |",
+        HOLD_LENGTHS.map(|l| format!("L = {l:.0} s")).join(" | ")
+    );
+    let _ = writeln!(md, "| --- |{}", " --- |".repeat(HOLD_LENGTHS.len()));
+    let mut series = Vec::new();
+    for (k, s) in searches.iter().filter(|s| s.lengths().len() >= 2).enumerate() {
+        let lengths = s.lengths();
+        let cells: Vec<String> = HOLD_LENGTHS
+            .iter()
+            .map(|&l| {
+                if lengths.contains(&l) {
+                    let (t, phi) = s.t_c3(l, CreepCriterionKind::Paper);
+                    format!("{}, {}° ({})", hours(t), opt(phi, 1), s.letters(l))
+                } else {
+                    "–".into()
+                }
+            })
+            .collect();
+        let _ = writeln!(md, "| {} | {} |", s.name, cells.join(" | "));
+        series.push(Series {
+            label: s.name.clone(),
+            errors: vec![],
+            points: lengths
+                .iter()
+                .filter_map(|&l| s.t_c3(l, CreepCriterionKind::Paper).0.map(|t| (l, t)))
+                .collect(),
+            colour: k,
+            mark: Mark::Points,
+        });
+    }
+    if !series.is_empty() {
+        let chart = LineChart {
+            title: "T_c3 against the hold length (paper's criterion)".into(),
+            x_label: "hold length read (s)".into(),
+            y_label: "T_c3 (h)".into(),
+            series,
+            log_x: false,
+        };
+        write_figure(out, "decided_hold_length", &chart).map_err(|e| e.to_string())?;
+        let _ = writeln!(md, "\n![T_c3 against the hold length](decided_hold_length.png)\n");
+    }
+    // the equilibrium bound on HCP's φ
+    let body = naidu_ellipsoid();
+    let sphere = [0.5 * NAIDU2020_EQUIVALENT_DIAMETER_M; 3];
+    let bound = |axes: [f64; 3], rho: f64, t_h: f64| {
+        least_friction_angle(axes, rho, t_h * 3600.0).map_or("> 90° (tensile)".into(), |p| format!("{p:.1}°"))
+    };
+    let _ = writeln!(
+        md,
+        "\n### The equilibrium bound on φ (Holsapple 2001; `analysis::spin_limit`)\n"
+    );
+    let _ = writeln!(
+        md,
+        "Averaged over the whole body, a cohesionless pile holds its spin only with a friction angle at least the \
+         bound below; the largest angle mobilised in an RVE, φ, cannot be lower. The Naidu ellipsoid has the \
+         radar body's axis ratios and volume ({:.1} × {:.1} × {:.1} m semi-axes).\n",
+        body[0], body[1], body[2]
+    );
+    let _ = writeln!(
+        md,
+        "| case | ρ_B (kg/m³) | T (h) | bound, sphere | bound, Naidu ellipsoid | φ |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- |");
+    for (model, t, phi) in [("hcp", 2.40, 43.0), ("rcp", 2.83, 30.0)] {
+        let _ = writeln!(
+            md,
+            "| paper's {} | 2100 | {t:.2} | {} | {} | {phi}° |",
+            model.to_uppercase(),
+            bound(sphere, 2100.0, t),
+            bound(body, 2100.0, t)
+        );
+    }
+    for s in &full {
+        if let (Some(t), phi) = s.t_c3(hold, CreepCriterionKind::Paper) {
+            let _ = writeln!(
+                md,
+                "| ours: {} | {rho:.1} | {t:.2} | {} | {} | {}° |",
+                s.name,
+                bound(sphere, rho, t),
+                bound(body, rho, t),
+                opt(phi, 1)
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series(release: Option<f64>, loss_after: f64, len: f64) -> HoldSeries {
+        let n = (len / 200.0) as usize + 1;
+        let t: Vec<f64> = (0..n).map(|k| 200.0 * k as f64).collect();
+        HoldSeries {
+            coordination: t
+                .iter()
+                .map(|&x| {
+                    if x <= loss_after {
+                        5.5
+                    } else {
+                        5.5 - 1e-5 * (x - loss_after)
+                    }
+                })
+                .collect(),
+            theta_max_deg: vec![30.0; n],
+            packing: vec![0.65; n],
+            release_s: release,
+            t_s: t,
+        }
+    }
+
+    fn search(name: &str, holds: Vec<(f64, HoldSeries)>) -> DecidedSearch {
+        let verdicts = holds
+            .iter()
+            .map(|(tf, s)| {
+                crate::analysis::spinup_search::judge_series(
+                    s,
+                    None,
+                    &Criteria::default(),
+                    CreepCriterionKind::Paper,
+                    *tf,
+                    PathBuf::new(),
+                )
+            })
+            .collect();
+        DecidedSearch {
+            group: Group::Full,
+            name: name.into(),
+            model: name.split('_').next().unwrap().into(),
+            row: None,
+            target: None,
+            verdicts,
+            series: holds,
+        }
+    }
+
+    /// The hold length is decided where T_c,3 stops moving: a hold at 2.60 h that starts losing contacts after
+    /// 20 000 s is stable read over 16 000 s and creeps over 32 000 and 50 000 s, so RCP's T_c,3 moves from 2.60 to
+    /// 2.65 h between 16 000 and 32 000 s and no further: 32 000 s. `ordering.csv` has one row per search and the
+    /// difference row.
+    #[test]
+    fn hold_length_is_where_t_c3_stops_moving_and_ordering_csv_has_the_difference() {
+        let rcp = search(
+            "rcp_full",
+            vec![
+                (2.55, series(Some(3000.0), f64::INFINITY, 6000.0)),
+                (2.60, series(None, 20_000.0, 50_000.0)),
+                (2.65, series(None, f64::INFINITY, 50_000.0)),
+                (2.70, series(None, f64::INFINITY, 50_000.0)),
+            ],
+        );
+        assert_eq!(rcp.lengths(), HOLD_LENGTHS.to_vec());
+        assert_eq!(rcp.t_c3(16_000.0, CreepCriterionKind::Paper).0, Some(2.60));
+        assert_eq!(rcp.t_c3(32_000.0, CreepCriterionKind::Paper).0, Some(2.65));
+        assert_eq!(rcp.t_c3(50_000.0, CreepCriterionKind::Paper).0, Some(2.65));
+        let hcp = search(
+            "hcp_full_random1",
+            vec![
+                (2.40, series(Some(1000.0), f64::INFINITY, 2000.0)),
+                (2.45, series(None, f64::INFINITY, 32_000.0)),
+                (2.50, series(None, f64::INFINITY, 32_000.0)),
+            ],
+        );
+        assert_eq!(hcp.lengths(), vec![16_000.0, 32_000.0]);
+        let both = [rcp, hcp];
+        assert_eq!(decided_hold_length(&both), 32_000.0);
+        let full: Vec<&DecidedSearch> = both.iter().collect();
+        let csv = ordering_csv(&full, 32_000.0);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "model,grains,orientation,criterion,hold_s,T_c3_h,phi_deg");
+        assert_eq!(lines[1], "RCP,,–,paper,32000,2.65,30.0");
+        assert_eq!(lines[2], "HCP,,–,paper,32000,2.45,30.0");
+        assert_eq!(lines[3], "RCP-HCP,,,paper,32000,0.20,");
+    }
+
+    /// The Naidu ellipsoid keeps the radar extents' ratios and the 780 m body's volume.
+    #[test]
+    fn naidu_ellipsoid_has_the_volume_of_d_eq_780() {
+        let [a, b, c] = naidu_ellipsoid();
+        assert!(((a * b * c).cbrt() - 390.0).abs() < 1e-9);
+        assert!((b / a - 838.0 / 832.0).abs() < 1e-12 && (c / a - 786.0 / 832.0).abs() < 1e-12);
+    }
+}
