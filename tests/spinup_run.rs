@@ -496,6 +496,13 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
     }
     assert!(!dir.join("sh/critical.json").exists(), "a shard judges nothing");
     search("sh", &[]);
+    // `spinup judge` reads the search again from its holds' runs: the same verdicts as the search printed
+    let judged = rubblepile(&dir, &["spinup", "judge", "seq"]);
+    assert!(judged.status.success(), "{}", String::from_utf8_lossy(&judged.stderr));
+    let judged = String::from_utf8_lossy(&judged.stdout).to_string();
+    for line in seq.lines().filter(|l| l.starts_with("T_final")) {
+        assert!(judged.contains(line), "{line}\nnot in\n{judged}");
+    }
     let reference = search_outputs(&dir.join("seq"));
     assert_eq!(reference.len(), 2 + 4 * (1 + snapshots(&dir.join("seq/T6.00")).len()));
     for other in ["par", "sh"] {

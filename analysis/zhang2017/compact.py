@@ -6,7 +6,11 @@ snapshots/0.csv when a run keeps its snapshots). Searches: critical.json and cri
 directory, and holds.csv: every hold's samples from its start (the scene's `spinup.t_final`) to its end, the state
 variables that Zhang17 Fig. 22 follows (θ_max, η_B, the coordination number) with the period and the bound mass.
 
+A search's copy also keeps target.json, the report of the aggregate its scene loads (NAME.json beside the
+particle file), which says the grain count and the lattice's orientation.
+
 Usage: python3 analysis/zhang2017/compact.py RUN_DIR OUT_DIR          # a run
+       python3 analysis/zhang2017/compact.py --base SEARCH_DIR/base OUT_DIR   # a search's base run (no summary.json)
        python3 analysis/zhang2017/compact.py --search SEARCH_DIR OUT_DIR   # a T_c3 search
 Refuses to overwrite OUT_DIR's files unless --force.
 """
@@ -57,11 +61,31 @@ def write_holds(search_dir, dst, force):
         w.writerows(rows)
 
 
+def copy_target(search_dir, dst, force):
+    """target.json: the aggregate report beside the particle file of the search's scenes (if there is one)."""
+    import glob
+    import tomllib
+    scenes = sorted(glob.glob(os.path.join(search_dir, "base", "scene.toml"))) + sorted(
+        glob.glob(os.path.join(search_dir, "T*", "scene.toml")))
+    for scene in scenes:
+        with open(scene, "rb") as f:
+            particles = tomllib.load(f)["scene"].get("particles_file")
+        if not particles:
+            continue
+        if not os.path.isabs(particles):
+            particles = os.path.join(os.path.dirname(scene), particles)
+        report = os.path.splitext(particles)[0] + ".json"
+        if os.path.isfile(report):
+            copy(report, dst, force)
+        return
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("src")
     ap.add_argument("out")
     ap.add_argument("--search", action="store_true", help="SRC is a spinup critical directory")
+    ap.add_argument("--base", action="store_true", help="SRC is a search's base run (it has no summary.json)")
     ap.add_argument("--force", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -69,10 +93,13 @@ def main():
     for name in names:
         src = os.path.join(a.src, name)
         if not os.path.isfile(src):
+            if a.base and name == "summary.json":
+                continue
             sys.exit(f"{src}: missing (a run still going has no summary.json: wait for it)")
         copy(src, os.path.join(a.out, name), a.force)
     if a.search:
         write_holds(a.src, os.path.join(a.out, "holds.csv"), a.force)
+        copy_target(a.src, os.path.join(a.out, "target.json"), a.force)
         return
     with open(os.path.join(a.src, "snapshots", "0.csv")) as f:
         rows = list(csv.DictReader(f))

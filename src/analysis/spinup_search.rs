@@ -1080,6 +1080,53 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
     requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
+/// `rubblepile spinup judge DIR`: judges again the holds of a search directory or of its compact copy
+/// (`critical.csv` and `holds.csv`, or the hold runs' own `spinup.csv` where the copy has none) by every criterion
+/// over their first `window` seconds, prints one line per hold and the T_c,3 and φ of each criterion. Writes
+/// nothing.
+pub fn judge_dir(dir: &Path, window: Option<f64>, significance: Option<f64>) -> Result<(), SearchError> {
+    if let Some(w) = window
+        && !(w.is_finite() && w > 0.0)
+    {
+        return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
+    }
+    let criteria = criteria(significance, None)?;
+    let csv = dir.join("critical.csv");
+    let text = std::fs::read_to_string(&csv).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
+    let verdicts = read_critical_csv(&text).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
+    let series = match read_holds_csv(&dir.join("holds.csv")) {
+        Ok(s) => s,
+        Err(_) => {
+            // a search directory: each hold's own run
+            let mut out = Vec::new();
+            for v in &verdicts {
+                let run = dir.join(format!("T{:.2}", v.t_final_hours));
+                let samples = read_spinup_csv(&run.join("spinup.csv")).map_err(SearchError::failed)?;
+                let scene = crate::granular::soft::scene::load_soft_scene(&run.join("scene.toml"))
+                    .map_err(SearchError::failed)?;
+                let t_final = scene.spinup.map_or(0.0, |s| s.path.t_final);
+                out.push((v.t_final_hours, hold_series(&samples, t_final)));
+            }
+            out
+        }
+    };
+    let judged = rejudge(&verdicts, &series, window, &criteria, CreepCriterionKind::Paper);
+    for v in &judged {
+        println!("{}", verdict_line(v));
+    }
+    for kind in CreepCriterionKind::ALL {
+        match critical_from_verdicts(&judged, kind) {
+            (Some(t), phi) => println!(
+                "{} criterion: T_c3 = {t:.2} h, phi = {} deg",
+                kind.name(),
+                phi.map_or("-".into(), |p| format!("{p:.1}"))
+            ),
+            _ => println!("{} criterion: no T_c3 among these holds", kind.name()),
+        }
+    }
+    Ok(())
+}
+
 /// The time (s) at which the path `p` (without rests) passes the period `period_h` (hours), between `t_inter` and
 /// `t_final`; `None` outside `[T_final, T_inter]`.
 pub fn path_time_at_period(p: &crate::granular::soft::spinup::SpinupPath, period_h: f64) -> Option<f64> {

@@ -328,6 +328,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Aggregate(aggregate::AggregateCommand::Density(args)) => aggregate::density_cmd(&args),
         Command::Spinup(spinup::SpinupCommand::Critical(args)) => spinup::critical(&args),
         Command::Spinup(spinup::SpinupCommand::DensityFit(args)) => spinup::density_fit(&args),
+        Command::Spinup(spinup::SpinupCommand::Judge(args)) => spinup::judge(&args),
         Command::Export(args) => visual::export_cmd(&args),
         Command::Render(args) => visual::render_cmd(&args),
         Command::Convert(args) => visual::convert_cmd(&args),

@@ -14,6 +14,28 @@ pub enum SpinupCommand {
     Critical(CriticalArgs),
     /// Fit κ of Eq. 22 over bulk densities and give the critical bulk density.
     DensityFit(DensityFitArgs),
+    /// Judge the holds of a search again (its directory, or a compact copy with critical.csv and holds.csv) by
+    /// every creep criterion over their first --judge-window seconds; prints, writes nothing.
+    Judge(JudgeArgs),
+}
+
+/// `rubblepile spinup judge`.
+#[derive(Debug, clap::Args)]
+pub struct JudgeArgs {
+    /// A `spinup critical` directory or its compact copy.
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
+    /// Judge only the first SECONDS of each hold.
+    #[arg(long, value_name = "SECONDS")]
+    pub judge_window: Option<f64>,
+    /// Standard errors by which a weakening rate must exceed zero for the paper's criterion (default 2).
+    #[arg(long, value_name = "Z")]
+    pub significance: Option<f64>,
+}
+
+/// `rubblepile spinup judge`.
+pub fn judge(args: &JudgeArgs) -> Result<(), CliError> {
+    crate::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance).map_err(cli_error)
 }
 
 /// `rubblepile spinup critical`.
