@@ -490,6 +490,37 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
     let seq = search("seq", &[]);
     let par = search("par", &["--parallel", "2", "--threads-per-hold", "1"]);
     assert_eq!(seq.replace("seq/", ""), par.replace("par/", ""));
+    // a shard refuses to make the base run; --prepare-only makes it and the branches
+    let early = rubblepile(
+        &dir,
+        &[
+            "spinup",
+            "critical",
+            "--scene",
+            "s.toml",
+            "--from",
+            "5.7",
+            "--to",
+            "6.0",
+            "--step",
+            "0.1",
+            "--branch",
+            "--hold",
+            "600",
+            "--all-holds",
+            "--out",
+            "sh",
+            "--shard",
+            "0/2",
+        ],
+    );
+    assert_eq!(early.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&early.stderr).contains("--prepare-only"),
+        "{early:?}"
+    );
+    let prepared = search("sh", &["--prepare-only"]);
+    assert!(prepared.contains("4 holds prepared"), "{prepared}");
     for shard in ["0/2", "1/2"] {
         let out = search("sh", &["--shard", shard]);
         assert!(out.contains(&format!("shard {shard} ran 2 of 4 holds")), "{out}");

@@ -807,6 +807,19 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             )));
         }
     }
+    if args.shard.is_some() && args.branch {
+        // shards started together must not all run the base: it is the job of --prepare-only
+        if let Some(tf) = grid.iter().find(|tf| {
+            let dir = args.out.join(format!("T{tf:.2}"));
+            !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())
+        }) {
+            return Err(SearchError::usage(format!(
+                "--shard: the branch of T_final = {tf:.2} h is not in {}; run the same command with --prepare-only \
+                 (instead of --shard) first",
+                args.out.display()
+            )));
+        }
+    }
     let branches = if args.branch {
         Some(prepare_branches(args, &table, &base, &settings.path, &grid)?)
     } else {
