@@ -102,6 +102,32 @@ pub fn least_friction_angle(axes: [f64; 3], rho: f64, period_s: f64) -> Option<f
     Some(((max - min) / -(max + min)).asin().to_degrees())
 }
 
+/// The spin at which the least friction angle reaches `phi_deg` (the continuum upper spin limit of Zhang17 Fig. 23)
+/// as κ of Zhang17 Eq. 22, `Ω / √(4πGρ/3)`, for a body of the shape of `axes` (any scale; κ depends on neither the
+/// size nor the density). A sphere gives `κ² = 2 sin φ / (1 + sin φ)`.
+///
+/// ```
+/// use rubblepile::analysis::spin_limit::critical_kappa;
+/// let phi = 30f64.to_radians();
+/// assert!((critical_kappa([1.0; 3], 30.0) - (2.0 * phi.sin() / (1.0 + phi.sin())).sqrt()).abs() < 1e-9);
+/// ```
+pub fn critical_kappa(axes: [f64; 3], phi_deg: f64) -> f64 {
+    // at ρ = 1000 kg/m³; the angle grows with the spin until the stress turns tensile
+    let rho = 1000.0;
+    let unit = (4.0 * std::f64::consts::PI * SI_G * rho / 3.0).sqrt();
+    let angle = |kappa: f64| least_friction_angle(axes, rho, std::f64::consts::TAU / (kappa * unit)).unwrap_or(90.0);
+    let (mut lo, mut hi) = (0.0f64, 2.0f64);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid > 0.0 && angle(mid) < phi_deg {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

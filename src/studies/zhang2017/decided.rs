@@ -20,10 +20,12 @@ use crate::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_
 use crate::analysis::creep::CreepCriterionKind;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
-use crate::analysis::spin_limit::least_friction_angle;
+use crate::analysis::spin_limit::{critical_kappa, least_friction_angle};
+use crate::analysis::spinup::omega_of_hours;
 use crate::analysis::spinup_search::{
     Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
 };
+use crate::io::scene_file::SI_G;
 
 use super::rows::{ModelRow, TABLE3, opt, paper_bulk_density, path_row};
 
@@ -490,6 +492,98 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
             );
         }
     }
+    write_fig23(md, &searches, hold, rho, out)?;
+    Ok(())
+}
+
+/// κ of Eq. 22 of a T_c,3 (h) at bulk density `rho` (kg/m³).
+pub fn kappa_of(t_c3_hours: f64, rho: f64) -> f64 {
+    omega_of_hours(t_c3_hours) / (4.0 * std::f64::consts::PI * SI_G * rho / 3.0).sqrt()
+}
+
+/// Zhang17 Fig. 23's analogue: κ₃ against φ, the paper's six models and ours (decided protocol) beside the continuum
+/// upper spin limit (the volume-averaged bound of [`crate::analysis::spin_limit`]) of a sphere and of the Naidu
+/// ellipsoid; a table says which points lie above the limit. Writes `decided_fig23.{svg,png}`.
+fn write_fig23(md: &mut String, searches: &[DecidedSearch], hold: f64, rho: f64, out: &Path) -> Result<(), String> {
+    let body = naidu_ellipsoid();
+    let _ = writeln!(md, "\n### Fig. 23: κ₃ against φ beside the continuum upper limit\n");
+    let _ = writeln!(
+        md,
+        "κ₃ = Ω_c3 / √(4πGρ_B/3) (Eq. 22; the paper's from its T_c3 at 2100 kg/m³, ours at {rho:.1} kg/m³). The upper \
+         limit is the κ at which the volume-averaged stress needs exactly φ (Holsapple 2001; a point above it holds \
+         a spin no homogeneous continuum of that φ can). The local lower limit of Hirabayashi (2015) is not drawn.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| model | φ (°) | κ₃ | upper limit at φ: sphere / Naidu ellipsoid | above the limit? |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- |");
+    let mut points: Vec<(String, f64, f64)> = TABLE3
+        .iter()
+        .map(|p| (format!("paper {}", p.0.to_uppercase()), p.2, kappa_of(p.5, 2100.0)))
+        .collect();
+    for s in searches
+        .iter()
+        .filter(|s| matches!(s.group, Group::Full | Group::Scaled))
+    {
+        if let (Some(t), Some(phi)) = s.t_c3(hold, CreepCriterionKind::Paper) {
+            points.push((format!("ours {}", s.name), phi, kappa_of(t, rho)));
+        }
+    }
+    for (label, phi, kappa) in &points {
+        let (sphere, ell) = (critical_kappa([1.0; 3], *phi), critical_kappa(body, *phi));
+        let _ = writeln!(
+            md,
+            "| {label} | {phi:.1} | {kappa:.3} | {sphere:.3} / {ell:.3} | {} |",
+            if *kappa > ell.max(sphere) {
+                "above"
+            } else if *kappa < ell.min(sphere) {
+                "below"
+            } else {
+                "between the two shapes' limits"
+            }
+        );
+    }
+    let curve = |axes: [f64; 3]| -> Vec<(f64, f64)> {
+        (10..=80)
+            .step_by(2)
+            .map(|d| (d as f64, critical_kappa(axes, d as f64)))
+            .collect()
+    };
+    let mut series = vec![
+        Series {
+            label: "upper limit, sphere".into(),
+            errors: vec![],
+            points: curve([1.0; 3]),
+            colour: 0,
+            mark: Mark::Dashed,
+        },
+        Series {
+            label: "upper limit, Naidu ellipsoid".into(),
+            errors: vec![],
+            points: curve(body),
+            colour: 1,
+            mark: Mark::Dashed,
+        },
+    ];
+    for (k, (label, phi, kappa)) in points.iter().enumerate() {
+        series.push(Series {
+            label: label.clone(),
+            errors: vec![],
+            points: vec![(*phi, *kappa)],
+            colour: 2 + k,
+            mark: Mark::Points,
+        });
+    }
+    let chart = LineChart {
+        title: "Fig. 23 analogue: kappa_3 against the friction angle".into(),
+        x_label: "phi (deg)".into(),
+        y_label: "kappa_3".into(),
+        series,
+        log_x: false,
+    };
+    write_figure(out, "decided_fig23", &chart).map_err(|e| e.to_string())?;
+    let _ = writeln!(md, "\n![Fig. 23 analogue](decided_fig23.png)\n");
     Ok(())
 }
 
