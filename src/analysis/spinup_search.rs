@@ -235,6 +235,13 @@ fn coordination_judged(s: &SpinupSample) -> f64 {
     }
 }
 
+/// Fewest samples in the second half of a hold's record for its trends to be judged (with fewer, the hold is not
+/// stable under any criterion and its verdict names [`TOO_SHORT`]).
+pub const MIN_SECOND_HALF_SAMPLES: usize = 4;
+
+/// The name a verdict gives a hold whose record is too short to judge.
+pub const TOO_SHORT: &str = "record_too_short";
+
 /// One hold's record: times since the hold's start (s) and the three diagnostics, and when the forcing was
 /// released (s after the start). What [`judge_series`] judges; read from a run's `spinup.csv` ([`hold_series`]) or
 /// from a compact copy's `holds.csv`.
@@ -310,8 +317,14 @@ pub fn judge_series(
     let drift = HoldDrift::of(t, theta, eta, cn);
     let rates = HoldRates::of(t, theta, eta, cn);
     let theta_max_deg = theta.iter().cloned().fold(f64::NAN, f64::max);
+    // a record with too few samples in its second half to fit a trend cannot show that the hold settled
+    let too_short = !released && n / 2 < MIN_SECOND_HALF_SAMPLES;
     let verdict = |c: &CreepCriterion| {
-        let drifting = c.judge(&drift, &rates);
+        let drifting = if too_short {
+            vec![TOO_SHORT]
+        } else {
+            c.judge(&drift, &rates)
+        };
         CriterionVerdict {
             stable: !released && drifting.is_empty(),
             drifting,
@@ -586,7 +599,7 @@ pub fn critical_csv(runs: &[HoldVerdict]) -> String {
 /// tolerances), so that T_c,3 and φ can be re-derived by [`critical_from_verdicts`] from a committed copy without
 /// the runs. A malformed row is an error naming its line and column.
 pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
-    const NAMES: [&str; 3] = ["theta_max", "packing_fraction", "coordination_number"];
+    const NAMES: [&str; 4] = ["theta_max", "packing_fraction", "coordination_number", TOO_SHORT];
     let mut lines = text.lines();
     let header = lines.next().map(str::trim);
     let v1 = header == Some(CRITICAL_CSV_HEADER_V1.trim());
@@ -1093,10 +1106,10 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
     requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
-/// `rubblepile spinup judge DIR`: judges again the holds of a search directory or of its compact copy
-/// (`critical.csv` and `holds.csv`, or the hold runs' own `spinup.csv` where the copy has none) by every criterion
-/// over their first `window` seconds, prints one line per hold and the T_c,3 and φ of each criterion. Writes
-/// nothing.
+/// `rubblepile spinup judge DIR`: judges again the holds of a compact copy (`critical.csv` and `holds.csv`) or of a
+/// search directory, finished or still running (each hold run `T<X>/spinup.csv` as far as it has got), by every
+/// criterion over their first `window` seconds; prints one line per hold and the T_c,3 and φ of each criterion.
+/// Writes nothing.
 pub fn judge_dir(dir: &Path, window: Option<f64>, significance: Option<f64>) -> Result<(), SearchError> {
     if let Some(w) = window
         && !(w.is_finite() && w > 0.0)
@@ -1104,26 +1117,55 @@ pub fn judge_dir(dir: &Path, window: Option<f64>, significance: Option<f64>) -> 
         return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
     }
     let criteria = criteria(significance, None)?;
-    let csv = dir.join("critical.csv");
-    let text = std::fs::read_to_string(&csv).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
-    let verdicts = read_critical_csv(&text).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
-    let series = match read_holds_csv(&dir.join("holds.csv")) {
-        Ok(s) => s,
+    let judged = match read_holds_csv(&dir.join("holds.csv")) {
+        Ok(series) => {
+            let csv = dir.join("critical.csv");
+            let text =
+                std::fs::read_to_string(&csv).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
+            let verdicts =
+                read_critical_csv(&text).map_err(|e| SearchError::usage(format!("{}: {e}", csv.display())))?;
+            rejudge(&verdicts, &series, window, &criteria, CreepCriterionKind::Paper)
+        }
         Err(_) => {
-            // a search directory: each hold's own run
+            // a search directory, finished or still running: every hold run `T<X>` as far as it has got
+            let mut holds: Vec<(f64, PathBuf)> = std::fs::read_dir(dir)
+                .map_err(|e| SearchError::usage(format!("{}: {e}", dir.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.join("spinup.csv").is_file())
+                .filter_map(|p| {
+                    let name = p.file_name()?.to_string_lossy().into_owned();
+                    Some((name.strip_prefix('T')?.parse::<f64>().ok()?, p))
+                })
+                .collect();
+            if holds.is_empty() {
+                return Err(SearchError::usage(format!(
+                    "{}: neither holds.csv nor hold runs T<period>/spinup.csv",
+                    dir.display()
+                )));
+            }
+            holds.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut out = Vec::new();
-            for v in &verdicts {
-                let run = dir.join(format!("T{:.2}", v.t_final_hours));
+            for (tf, run) in holds {
                 let samples = read_spinup_csv(&run.join("spinup.csv")).map_err(SearchError::failed)?;
                 let scene = crate::granular::soft::scene::load_soft_scene(&run.join("scene.toml"))
                     .map_err(SearchError::failed)?;
                 let t_final = scene.spinup.map_or(0.0, |s| s.path.t_final);
-                out.push((v.t_final_hours, hold_series(&samples, t_final)));
+                let series = hold_series(&samples, t_final);
+                if series.t_s.is_empty() {
+                    continue;
+                }
+                out.push(judge_series(
+                    &series,
+                    window,
+                    &criteria,
+                    CreepCriterionKind::Paper,
+                    tf,
+                    run,
+                ));
             }
             out
         }
     };
-    let judged = rejudge(&verdicts, &series, window, &criteria, CreepCriterionKind::Paper);
     for v in &judged {
         println!("{}", verdict_line(v));
     }
