@@ -21,6 +21,7 @@ pub use crate::geometry::shape_metrics;
 pub mod spin_limit;
 pub mod spinup;
 pub mod spinup_search;
+pub mod surface_slopes;
 pub use crate::granular::soft::spinup_diagnostics;
 pub mod tumbler;
 

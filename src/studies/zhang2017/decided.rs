@@ -493,6 +493,86 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
         }
     }
     write_fig23(md, &searches, hold, rho, out)?;
+    write_slopes(md, rho, out)?;
+    Ok(())
+}
+
+/// Zhang17 Fig. 2's analogue: the surface slopes of the decided shape (and of the top of the runs before Dec 2026)
+/// as homogeneous bodies of the decided density spinning at the Didymos period ([`crate::analysis::surface_slopes`]);
+/// writes `decided_slopes.{svg,png}` (slope against latitude, every longitude).
+fn write_slopes(md: &mut String, rho: f64, out: &Path) -> Result<(), String> {
+    use crate::aggregate::shape::Shape;
+    use crate::analysis::surface_slopes::slope_map;
+    let _ = writeln!(md, "\n### Fig. 2: surface slopes at the Didymos period\n");
+    let _ = writeln!(
+        md,
+        "The angle between the inward normal and self-gravity plus the centrifugal pull, at 2.26 h and {rho:.1} \
+         kg/m³, on a grid of 24 latitudes × 48 longitudes (gravity of the homogeneous body from 80³ cells; a degree \
+         or so of error). The paper maps the radar model (its Fig. 2) and finds slopes above 50° in places; ours are \
+         analytic shapes with the radar model's extents, without its small-scale relief.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| shape | largest slope (°) | mean (°) | surface above 30° / 40° / 50° |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- |");
+    let mut series = Vec::new();
+    for (k, (label, spec)) in [
+        ("didymos (Naidu et al. 2020)", "didymos"),
+        ("top (before Dec 2026)", "top"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let shape = Shape::parse(spec, 1.0).map_err(|e| e.to_string())?;
+        let contains = |p: &crate::math::Vec3| shape.contains(p);
+        let map = slope_map(
+            &contains,
+            1.02 * shape.bounding_radius(),
+            shape.volume(),
+            rho,
+            super::rows::DIDYMOS_PERIOD_HOURS * 3600.0,
+            24,
+            40,
+        );
+        // area weights: the grid is uniform in latitude, so a cell's area goes with cos(latitude)
+        let weight = |lat: f64| lat.to_radians().cos();
+        let total: f64 = map.iter().map(|s| weight(s.lat_deg)).sum();
+        let above = |a: f64| {
+            100.0
+                * map
+                    .iter()
+                    .filter(|s| s.slope_deg > a)
+                    .map(|s| weight(s.lat_deg))
+                    .sum::<f64>()
+                / total
+        };
+        let mean = map.iter().map(|s| s.slope_deg * weight(s.lat_deg)).sum::<f64>() / total;
+        let largest = map.iter().map(|s| s.slope_deg).fold(0.0, f64::max);
+        let _ = writeln!(
+            md,
+            "| {label} | {largest:.1} | {mean:.1} | {:.1} % / {:.1} % / {:.1} % |",
+            above(30.0),
+            above(40.0),
+            above(50.0)
+        );
+        series.push(Series {
+            label: label.into(),
+            errors: vec![],
+            points: map.iter().map(|s| (s.lat_deg, s.slope_deg)).collect(),
+            colour: k,
+            mark: Mark::Points,
+        });
+    }
+    let chart = LineChart {
+        title: "Fig. 2 analogue: surface slope against latitude at 2.26 h".into(),
+        x_label: "latitude (deg)".into(),
+        y_label: "slope (deg)".into(),
+        series,
+        log_x: false,
+    };
+    write_figure(out, "decided_slopes", &chart).map_err(|e| e.to_string())?;
+    let _ = writeln!(md, "\n![Fig. 2 analogue](decided_slopes.png)\n");
     Ok(())
 }
 
