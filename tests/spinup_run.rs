@@ -599,3 +599,43 @@ fn a_released_hold_stops_early_unless_asked_to_finish() {
     );
     assert!(b.starts_with(&a), "the stopped hold is a prefix of the finished one");
 }
+
+/// `bench critical` times the holds of one prepared search one at a time and two at once, checks that both judge
+/// alike, and writes its CSV (one row per setting, with the speed-up and the load) and plot; `--reuse-prepared`
+/// keeps the base run.
+#[test]
+fn bench_critical_times_both_settings_on_one_prepared_base() {
+    let dir = temp_dir("bench-critical");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let bench = |extra: &[&str]| {
+        let mut args = vec![
+            "bench", "critical", "--scene", "s.toml", "--from", "5.8", "--to", "6.0", "--step", "0.1", "--hold", "600",
+            "--out", "b", "--force",
+        ];
+        args.extend_from_slice(extra);
+        let c = rubblepile(&dir, &args);
+        assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+        String::from_utf8_lossy(&c.stdout).to_string()
+    };
+    let out = bench(&[]);
+    assert!(out.contains("speed-up of --parallel 2"), "{out}");
+    let csv = read(&dir.join("b/bench_critical.csv"));
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(
+        rows[0],
+        "parallel,threads_per_hold,holds_wall_s,speedup,load_before,load_after"
+    );
+    assert!(
+        rows[1].starts_with("1,") && rows[2].starts_with("2,") && rows.len() == 3,
+        "{csv}"
+    );
+    assert!(dir.join("b/bench_critical.svg").is_file());
+    let base_checkpoint = read(&dir.join("b/searches/prepared/base/checkpoint.json"));
+    let again = bench(&["--reuse-prepared"]);
+    assert!(again.contains("(reused)"), "{again}");
+    assert_eq!(
+        read(&dir.join("b/searches/prepared/base/checkpoint.json")),
+        base_checkpoint
+    );
+}

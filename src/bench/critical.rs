@@ -39,6 +39,10 @@ pub struct BenchCriticalArgs {
     /// Overwrite an earlier benchmark in DIR.
     #[arg(long)]
     pub force: bool,
+    /// Reuse the base run and branches an earlier benchmark of the same scene and grid left in
+    /// `DIR/searches/prepared` (so that the timed part alone needs the quiet machine).
+    #[arg(long)]
+    pub reuse_prepared: bool,
 }
 
 /// The 1-minute load average, from `/proc/loadavg` (NaN where there is none).
@@ -91,8 +95,15 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
         )));
     }
     let searches = args.out.join("searches");
+    let prepared = searches.join("prepared");
+    let reuse = args.reuse_prepared && prepared.join("base").is_dir();
     if searches.exists() {
-        std::fs::remove_dir_all(&searches).map_err(|e| BenchError::failed(format!("{}: {e}", searches.display())))?;
+        for entry in std::fs::read_dir(&searches).map_err(|e| BenchError::failed(e.to_string()))? {
+            let path = entry.map_err(|e| BenchError::failed(e.to_string()))?.path();
+            if !(reuse && path == prepared) {
+                std::fs::remove_dir_all(&path).map_err(|e| BenchError::failed(format!("{}: {e}", path.display())))?;
+            }
+        }
     }
     let options = |out: PathBuf| CriticalOptions {
         branch: true,
@@ -101,14 +112,17 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
         force: true,
         ..CriticalOptions::new(args.scene.clone(), args.from, args.to, args.step, out)
     };
-    let prepared = searches.join("prepared");
     let started = Instant::now();
     critical(&CriticalOptions {
         prepare_only: true,
         ..options(prepared.clone())
     })
     .map_err(|e| BenchError::usage(e.to_string()))?;
-    println!("base run and branches: {:.1} s", started.elapsed().as_secs_f64());
+    println!(
+        "base run and branches{}: {:.1} s",
+        if reuse { " (reused)" } else { "" },
+        started.elapsed().as_secs_f64()
+    );
     let threads = rayon::current_num_threads();
     let mut settings = vec![1];
     settings.extend(args.parallel.iter().copied().filter(|&p| p != 1));
