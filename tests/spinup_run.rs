@@ -463,8 +463,9 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
     let dir = temp_dir("spinup-parallel");
     let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
     std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
-    let search = |out: &str, extra: &[&str]| {
-        let mut args = vec![
+    // the search's own arguments, then what each call adds
+    let args = |out: &'static str, extra: &[&'static str]| -> Vec<&'static str> {
+        let mut a = vec![
             "spinup",
             "critical",
             "--scene",
@@ -482,8 +483,11 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
             "--out",
             out,
         ];
-        args.extend_from_slice(extra);
-        let c = rubblepile(&dir, &args);
+        a.extend_from_slice(extra);
+        a
+    };
+    let search = |out: &'static str, extra: &[&'static str]| {
+        let c = rubblepile(&dir, &args(out, extra));
         assert!(c.status.success(), "{out}: {}", String::from_utf8_lossy(&c.stderr));
         String::from_utf8_lossy(&c.stdout).to_string()
     };
@@ -491,29 +495,7 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
     let par = search("par", &["--parallel", "2", "--threads-per-hold", "1"]);
     assert_eq!(seq.replace("seq/", ""), par.replace("par/", ""));
     // a shard refuses to make the base run; --prepare-only makes it and the branches
-    let early = rubblepile(
-        &dir,
-        &[
-            "spinup",
-            "critical",
-            "--scene",
-            "s.toml",
-            "--from",
-            "5.7",
-            "--to",
-            "6.0",
-            "--step",
-            "0.1",
-            "--branch",
-            "--hold",
-            "600",
-            "--all-holds",
-            "--out",
-            "sh",
-            "--shard",
-            "0/2",
-        ],
-    );
+    let early = rubblepile(&dir, &args("sh", &["--shard", "0/2"]));
     assert_eq!(early.status.code(), Some(2));
     assert!(
         String::from_utf8_lossy(&early.stderr).contains("--prepare-only"),

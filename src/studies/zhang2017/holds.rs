@@ -19,7 +19,6 @@ use crate::analysis::figures::lines::{Mark, Series};
 use crate::analysis::figures::stacked::{Panel, StackedLines};
 use crate::analysis::figures::style::write_figure;
 use crate::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
-use crate::io::table::{Cells, read_table};
 
 use super::rows::DIDYMOS_PERIOD_HOURS;
 
@@ -44,34 +43,20 @@ pub struct HoldSample {
     pub theta_max_deg: f64,
 }
 
-/// Reads `holds.csv`; the coordination number is `coordination_loaded` where every row has it.
+/// Reads `holds.csv` ([`crate::analysis::spinup_search::read_holds_csv`]) as one row per sample; the coordination
+/// number is `coordination_loaded` where every row has it.
 pub fn read_holds(path: &Path) -> Result<Vec<HoldSample>, String> {
-    let table = read_table(path, Cells::Lenient).map_err(|e| e.to_string())?;
-    let col = |name: &str| {
-        table
-            .column(name)
-            .ok_or(format!("{}: no column {name}", path.display()))
-    };
-    let (t, th, eta, cn, theta) = (
-        col("t_final_h")?,
-        col("t_hold_s")?,
-        col("packing_fraction")?,
-        col("coordination_number")?,
-        col("theta_max_deg")?,
-    );
-    let loaded = table
-        .column("coordination_loaded")
-        .filter(|&k| table.rows.iter().all(|r| r.get(k).is_some_and(|v| v.is_finite())));
-    let get = |r: &[f64], k: usize| r.get(k).copied().unwrap_or(f64::NAN);
-    Ok(table
-        .rows
+    let holds = crate::analysis::spinup_search::read_holds_csv(path)?;
+    Ok(holds
         .iter()
-        .map(|r| HoldSample {
-            t_final_hours: get(r, t),
-            t_hold_s: get(r, th),
-            packing: get(r, eta),
-            coordination: get(r, loaded.unwrap_or(cn)),
-            theta_max_deg: get(r, theta),
+        .flat_map(|(period, h)| {
+            (0..h.t_s.len()).map(move |k| HoldSample {
+                t_final_hours: *period,
+                t_hold_s: h.t_s[k],
+                packing: h.packing[k],
+                coordination: h.coordination[k],
+                theta_max_deg: h.theta_max_deg[k],
+            })
         })
         .collect())
 }
