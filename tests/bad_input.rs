@@ -108,6 +108,11 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
         }
         let ckpt = out.join("checkpoint.json");
         let damage = case.damage.as_ref().ok_or("prepare = \"checkpoint\" needs a damage")?;
+        // A damaged file is found by the run's manifest first (issue 53); the damages below stand for run
+        // directories written before it, whose files are checked on their own (`flip-snapshot` keeps it).
+        if damage.op != "flip-snapshot" {
+            std::fs::remove_file(out.join("manifest.txt")).map_err(|e| e.to_string())?;
+        }
         match damage.op.as_str() {
             "truncate" => {
                 let b = std::fs::read(&ckpt).map_err(|e| e.to_string())?;
@@ -131,6 +136,14 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
                 std::fs::write(out.join("timeseries.csv"), "t\n").map_err(|e| e.to_string())?;
             }
             "delete-snapshots" => std::fs::remove_dir_all(out.join("snapshots")).map_err(|e| e.to_string())?,
+            // One bit of snapshot 0 flipped, the manifest kept: the manifest names it.
+            "flip-snapshot" => {
+                let p = out.join("snapshots").join("0.csv");
+                let mut b = std::fs::read(&p).map_err(|e| e.to_string())?;
+                let i = b.len() / 2;
+                b[i] ^= 0x04;
+                std::fs::write(&p, b).map_err(|e| e.to_string())?;
+            }
             // Another writer: this process holds the directory's lock until the case has run.
             "hold-lock" => {
                 let lock = rubblepile::io::run_lock::DirLock::acquire(out).map_err(|e| e.to_string())?;

@@ -162,11 +162,9 @@ fn read_checkpoint(path: &Path) -> Result<BuildCheckpoint, CliError> {
         .map_err(|e| CliError::usage(format!("--resume: {} is not a target checkpoint: {e}", path.display())))
 }
 
-/// Writes a checkpoint atomically (a temporary file renamed over the old one).
+/// Writes a checkpoint atomically, never through a link ([`crate::io::safe_write`]).
 fn write_checkpoint(path: &Path, checkpoint: &BuildCheckpoint) -> std::io::Result<()> {
-    let tmp = path.with_extension("checkpoint.json.tmp");
-    std::fs::write(&tmp, serde_json::to_string(checkpoint)?)?;
-    std::fs::rename(&tmp, path)
+    crate::io::safe_write::write_atomic(path, serde_json::to_string(checkpoint)?)
 }
 
 /// Path of the JSON report beside a target CSV.
@@ -279,7 +277,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
     let (bodies, report) = built.map_err(|e| CliError::failed(format!("target build: {e}")))?;
     write_snapshot(&args.out, 0.0, &bodies).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| CliError::failed(e.to_string()))?;
-    std::fs::write(&json, text + "\n").map_err(|e| CliError::failed(format!("{}: {e}", json.display())))?;
+    crate::io::safe_write::write_atomic(&json, text + "\n")
+        .map_err(|e| CliError::failed(crate::io::safe_write::describe(&json, &e)))?;
     if checkpoint_file.exists() {
         // the build is complete: its checkpoint would only block the next build of this name
         std::fs::remove_file(&checkpoint_file)

@@ -18,7 +18,9 @@ use crate::ellipsoid::summary::RunSummary;
 use crate::engine::{Engine, Outcome, Resumed, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
+use crate::io::manifest::MANIFEST_FILE;
 use crate::io::run_lock::{DirLock, LOCK_FILE, LockError, is_lock_file};
+use crate::io::safe_write;
 
 use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 
@@ -86,8 +88,8 @@ pub enum RunError<S> {
         /// The path.
         dir: PathBuf,
     },
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", .path.display())]
+    /// Reading or writing a file failed (or a symbolic link was found where a file is written).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file.
         path: PathBuf,
@@ -253,9 +255,10 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
         if !force {
             return Err(RunError::OutputExists { dir: dir.to_path_buf() });
         }
-        for name in OUTPUT_FILES {
+        refuse_links(dir)?;
+        for name in OUTPUT_FILES.iter().chain([&MANIFEST_FILE]) {
             let p = dir.join(name);
-            if p.is_file() && name != "impact.json" {
+            if p.is_file() && *name != "impact.json" {
                 std::fs::remove_file(&p).map_err(io_err(&p))?;
             }
         }
@@ -275,8 +278,23 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
         }
     }
     let snaps = dir.join("snapshots");
-    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
     Ok(lock)
+}
+
+/// Refuses, naming the first, a symbolic link among the files a run writes or removes at the top of `dir`, the
+/// `snapshots/` directory and the files in it ([`crate::io::safe_write`]): nothing is written through a link.
+pub fn refuse_links<S>(dir: &Path) -> Result<(), RunError<S>> {
+    let check = |p: &Path| safe_write::refuse_symlink(p).map_err(io_err(p));
+    for name in OUTPUT_FILES.iter().chain([&MANIFEST_FILE, &"snapshots"]) {
+        check(&dir.join(name))?;
+    }
+    if let Ok(entries) = std::fs::read_dir(dir.join("snapshots")) {
+        for entry in entries.flatten() {
+            check(&entry.path())?;
+        }
+    }
+    Ok(())
 }
 
 /// `checkpoint.json`: the driver's envelope around the engine's state `S`.
@@ -368,13 +386,13 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
     let _lock = prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
     let scene_text = standalone_scene(&engine, out_dir);
-    std::fs::write(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
+    safe_write::write_atomic(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
     let identity = Identity {
         scene_base_dir: absolute_base(&engine)?,
         scene_hash: fnv1a_hex(scene_text.as_bytes()),
     };
     let ts_path = out_dir.join("timeseries.csv");
-    let mut timeseries = File::create(&ts_path).map_err(io_err(&ts_path))?;
+    let mut timeseries = safe_write::create_fresh(&ts_path).map_err(io_err(&ts_path))?;
     let header = engine.timeseries_header();
     timeseries.write_all(header.as_bytes()).map_err(io_err(&ts_path))?;
     engine.open_outputs(out_dir).map_err(io_err(out_dir))?;
@@ -493,6 +511,10 @@ pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>>
 pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
     // A directory that does not exist is left to the checks below to name.
     let _lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
+    // Nothing through a link: refused before anything is read or changed.
+    if dir.is_dir() {
+        refuse_links(dir)?;
+    }
     if let Some(t) = completed_run(dir) {
         return Err(RunError::AlreadyCompleted {
             dir: dir.to_path_buf(),
@@ -535,6 +557,19 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             inspect::describe_missing(dir, &missing, &format!("the checkpoint at t = {} s", ckpt.t))
         )));
     }
+    // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
+    // by row), before anything is continued from them.
+    match crate::io::manifest::verify_all(dir) {
+        Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
+        Ok(Some(_)) => {}
+        Ok(None) => {
+            for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
+                let p = dir.join("snapshots").join(format!("{k}.csv"));
+                crate::io::manifest::check_rows(&p, true)
+                    .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
+            }
+        }
+    }
     let ts_path = dir.join("timeseries.csv");
     match std::fs::metadata(&ts_path) {
         Err(e) => return Err(bad(format!("{}: {e}", ts_path.display()))),
@@ -567,7 +602,7 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         }
     }
     let snaps = dir.join("snapshots");
-    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
     let timeseries = reopen_truncated(&ts_path, ckpt.timeseries_bytes)?;
     let identity = Identity {
         scene_base_dir: ckpt.scene_base_dir.clone(),
@@ -585,28 +620,18 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
     on_pool(useful, || drive(&mut engine, dir, options, start, &identity))
 }
 
-/// Writes `checkpoint` into `dir/checkpoint.json` atomically (temporary file, fsync, rename, directory fsync).
+/// Writes `checkpoint` into `dir/checkpoint.json` atomically and durably (temporary file, fsync, rename, directory
+/// fsync: [`safe_write::AtomicFile::finish_durable`]).
 fn write_checkpoint<S: Serialize>(dir: &Path, checkpoint: &Checkpoint<S>) -> std::io::Result<()> {
-    let tmp = dir.join(CHECKPOINT_TMP_FILE);
-    let dst = dir.join(CHECKPOINT_FILE);
-    {
-        let mut w = std::io::BufWriter::new(File::create(&tmp)?);
-        serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-    }
-    std::fs::rename(&tmp, &dst)?;
-    // Make the rename durable; not every platform can open a directory, so failures are ignored.
-    if let Ok(d) = File::open(dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
+    let mut w = safe_write::AtomicFile::create(&dir.join(CHECKPOINT_FILE))?;
+    serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
+    w.write_all(b"\n")?;
+    w.finish_durable()
 }
 
 fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> {
     let text = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
-    std::fs::write(path, text + "\n")
+    safe_write::write_atomic(path, text + "\n")
 }
 
 /// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
@@ -648,6 +673,9 @@ fn drive<E: Engine>(
     } = start;
     let ts_path = out_dir.join("timeseries.csv");
     let mut files = run_files::RunFiles::new(timeseries, &ts_path);
+    // The manifest of the run's finished files (crate::io::manifest), rewritten at each checkpoint and at the end.
+    let manifest = std::cell::RefCell::new(crate::io::manifest::Recorder::new());
+    let mp = out_dir.join(MANIFEST_FILE);
     let file_err = |(path, source): run_files::FileError| RunError::Io { path, source };
     let t_end = engine.t_end();
     let started = Instant::now();
@@ -669,6 +697,14 @@ fn drive<E: Engine>(
         let sp = out_dir.join("summary.json");
         if let Err(e) = write_summary(&sp, &summary) {
             return RunError::Io { path: sp, source: e };
+        }
+        if let Err(e) = files.sync().and_then(|()| {
+            manifest
+                .borrow_mut()
+                .write(out_dir, "failed", true)
+                .map_err(|e| (mp.clone(), e))
+        }) {
+            return RunError::Io { path: e.0, source: e.1 };
         }
         RunError::Failed {
             t: t_good,
@@ -729,6 +765,7 @@ fn drive<E: Engine>(
             // The rows and snapshots the checkpoint counts must be on disk before it is.
             files.sync().map_err(file_err)?;
             let state = engine.save().map_err(io_err(out_dir))?;
+            manifest.borrow_mut().refresh(out_dir).map_err(io_err(&mp))?;
             checkpoints += 1;
             let ckpt = Checkpoint {
                 format: CHECKPOINT_FORMAT.into(),
@@ -748,6 +785,10 @@ fn drive<E: Engine>(
             };
             let cp = out_dir.join(CHECKPOINT_FILE);
             write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+            manifest
+                .borrow_mut()
+                .write(out_dir, &format!("checkpoint at t = {t} s"), false)
+                .map_err(io_err(&mp))?;
             last_checkpoint_wall = Instant::now();
             last_checkpoint_t = t;
             checkpoints_here += 1;
@@ -768,6 +809,10 @@ fn drive<E: Engine>(
     let summary = engine.summary(Outcome::Completed, rows, wall_seconds);
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;
+    manifest
+        .borrow_mut()
+        .write(out_dir, "completed", true)
+        .map_err(io_err(&mp))?;
     Ok(summary)
 }
 

@@ -338,9 +338,10 @@ pub trait Engine: Sized + Send {
 pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, EngineError> {
     let err = |e: std::io::Error| EngineError::File {
         path: path.to_path_buf(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     };
-    let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(err)?;
+    // Never through a link (crate::io::safe_write): the file opened is the regular file at `path`.
+    let mut file = crate::io::safe_write::open_nofollow(path, false).map_err(err)?;
     let len = file.metadata().map_err(err)?.len();
     if len < bytes {
         return Err(EngineError::File {

@@ -417,7 +417,7 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     let bodies_path = out.join("initial_bodies.csv");
     write_snapshot(&bodies_path, 0.0, &bodies).map_err(io(&bodies_path))?;
     let scene_path = out.join("scene.toml");
-    std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
+    crate::io::safe_write::write_atomic(&scene_path, &scene_toml).map_err(io(&scene_path))?;
     let mut scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
     let mut setup = setup;
     if args.radius_m.is_some() || args.period_hours.is_some() || args.settle_to_principal {
@@ -443,18 +443,18 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     }
     let json_path = out.join("flyby.json");
     let json = serde_json::to_string_pretty(&setup).unwrap_or_default() + "\n";
-    std::fs::write(&json_path, json).map_err(io(&json_path))?;
+    crate::io::safe_write::write_atomic(&json_path, json).map_err(io(&json_path))?;
     if !args.no_control {
         let dir = out.join(CONTROL_DIR);
-        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        crate::io::safe_write::ensure_dir(&dir).map_err(io(&dir))?;
         let control_bodies = dir.join("initial_bodies.csv");
-        std::fs::copy(&bodies_path, &control_bodies).map_err(io(&control_bodies))?;
+        crate::io::safe_write::copy_atomic(&bodies_path, &control_bodies).map_err(io(&control_bodies))?;
         let control_toml = scene_text(
             0.0,
             "Control of the flyby in the directory above: the same pile and duration, no planet (mass 0)",
         );
         let control_path = dir.join("scene.toml");
-        std::fs::write(&control_path, &control_toml).map_err(io(&control_path))?;
+        crate::io::safe_write::write_atomic(&control_path, &control_toml).map_err(io(&control_path))?;
     }
     Ok((scene, setup, lock))
 }

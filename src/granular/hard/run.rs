@@ -4,8 +4,7 @@
 //! failure, `last_good_state.csv` with the cause in the summary. Checkpoints ([`HardState`]) continue bit for bit
 //! (`rubblepile resume DIR`).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -137,7 +136,7 @@ fn wall_surfaces(walls: &[crate::geometry::walls::Wall], t: f64, particles: &[Pa
 
 /// Writes the alive particles in the particles-file columns.
 pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
+    let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "{},{STUCK_COLUMN}", PARTICLE_COLUMNS.join(","))?;
     for p in system.particles.iter().filter(|p| p.alive) {
         let v = [
@@ -157,7 +156,7 @@ pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<
         let stuck = p.stuck.map_or(-1, |a| a.wall as i64);
         writeln!(w, "{},{},{},{stuck}", fmt_f64(t), p.id, cols.join(","))?;
     }
-    w.flush()
+    w.finish()
 }
 
 /// Numbers in a checkpoint's bookkeeping ([`HardState`]'s `book`).

@@ -344,7 +344,7 @@ pub fn sample_steps(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
 
 /// Writes spheres in the snapshot columns.
 pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
+    let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz")?;
     for (id, p) in particles.iter().enumerate() {
         let (x, v, s) = (p.position, p.velocity, p.spin);
@@ -354,7 +354,7 @@ pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::
             p.mass, p.radius, x.x, x.y, x.z, v.x, v.y, v.z, s.x, s.y, s.z
         )?;
     }
-    w.flush()
+    w.finish()
 }
 
 /// The particle–particle contacts of `sys` at time `t` (s) with their normal forces, from one force evaluation on a
@@ -653,7 +653,7 @@ impl Engine for SoftEngine {
             sys.keep_records = true;
             sys.set_pair_springs(Vec::new());
             sys.compute_forces(0.0, 0.0);
-            let mut csv = BufWriter::new(File::create(dir.join("spinup.csv"))?);
+            let mut csv = BufWriter::new(crate::io::safe_write::create_fresh(&dir.join("spinup.csv"))?);
             csv.write_all(SPINUP_HEADER.as_bytes())?;
             self.spin = Some(SpinRun {
                 driver,

@@ -255,7 +255,8 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         let line = format!("{}\n", src.display());
         // Rewritten only when it changes: a resumed campaign leaves its directory's files untouched.
         if std::fs::read_to_string(&pointer).ok().as_deref() != Some(line.as_str()) {
-            std::fs::write(&pointer, line).map_err(|source| CampaignError::Io { path: pointer, source })?;
+            crate::io::safe_write::write_atomic(&pointer, line)
+                .map_err(|source| CampaignError::Io { path: pointer, source })?;
         }
     }
     let index_file = options.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());

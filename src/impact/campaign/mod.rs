@@ -149,8 +149,8 @@ pub enum CampaignError {
     /// Another rubblepile process writes the campaign directory (or this shard's index).
     #[error(transparent)]
     Locked(#[from] crate::io::run_lock::LockError),
-    /// Writing the campaign directory or `campaign.csv` failed.
-    #[error("{}: {source}", .path.display())]
+    /// Writing the campaign directory or `campaign.csv` failed (or a symbolic link stands where it writes).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file or directory.
         path: PathBuf,

@@ -349,7 +349,7 @@ impl CampaignAction {
                     source,
                 };
                 std::fs::create_dir_all(&campaign.out).map_err(io)?;
-                std::fs::write(&path, text).map_err(io)?;
+                crate::io::safe_write::write_atomic(&path, text).map_err(io)?;
                 Ok(vec![format!(
                     "wrote {} ({} runs in {tasks} array tasks); submit it with sbatch, then run `campaign merge {}`",
                     path.display(),
