@@ -81,6 +81,7 @@ pub mod index;
 pub mod mpi;
 pub mod plan;
 pub mod shard;
+pub mod slurm;
 
 pub use distributed::*;
 pub use execute::*;
@@ -88,6 +89,7 @@ pub use file::*;
 pub use index::*;
 pub use plan::*;
 pub use shard::*;
+pub use slurm::*;
 
 use std::path::PathBuf;
 
