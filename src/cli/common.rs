@@ -34,11 +34,12 @@ impl CliError {
 /// gets a progress line.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CheckpointArgs {
-    /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never).
+    /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never; else 0.001 to
+    /// 1e7).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
     /// Also checkpoint at the first output sample SECONDS of simulated time after the last
-    /// checkpoint (0 = at every output sample).
+    /// checkpoint (0 = at every output sample; at most 1e18).
     #[arg(long, value_name = "SECONDS")]
     pub checkpoint_every_sim: Option<f64>,
     /// Extra snapshot format(s) beside the CSV snapshots, e.g. `--format xyz` (extended XYZ for OVITO/VMD/ASE);
@@ -46,62 +47,103 @@ pub struct CheckpointArgs {
     #[arg(long, value_name = "NAME")]
     pub format: Vec<String>,
     /// When stderr is not a terminal (a batch log): a progress line (t, %, ETA, the energy error) every SECONDS
-    /// of wall-clock time, 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the bar is shown.
+    /// of wall-clock time (0.1 to 1e7), 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the
+    /// bar is shown.
     #[arg(long, value_name = "SECONDS")]
     pub progress_every: Option<f64>,
+    /// Most steps the run may take, over the scene's `[run] max_steps` [default: the scene's, else 1e9]: a scene
+    /// estimated to need more is refused; a run reaching it stops with a checkpoint (exit code 3).
+    #[arg(long, value_name = "N")]
+    pub max_steps: Option<f64>,
+    /// Most wall-clock seconds this process may run, over the scene's `[run] max_wall_seconds` [default: none]:
+    /// the run stops with a checkpoint at the output sample before it would overrun (exit code 3).
+    #[arg(long, value_name = "SECONDS")]
+    pub max_wall_seconds: Option<f64>,
     /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after_checkpoints: Option<u64>,
 }
 
 impl CheckpointArgs {
-    /// The run options these arguments ask for.
+    /// The run options these arguments ask for: every time option within its floor and ceiling
+    /// ([`crate::io::limits`]), the budget's within [`crate::io::run_budget`]'s, each refused by name otherwise.
     pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
-        let ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !ok(self.checkpoint_every) {
-            return Err(CliError::usage(format!(
-                "--checkpoint-every must be a finite number of seconds >= 0, got {}",
-                self.checkpoint_every
-            )));
-        }
-        if let Some(s) = self.checkpoint_every_sim
-            && !ok(s)
-        {
-            return Err(CliError::usage(format!(
-                "--checkpoint-every-sim must be a finite number of seconds >= 0, got {s}"
-            )));
-        }
+        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
+        use crate::io::limits::{MAX_SIM_INTERVAL, MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY, MIN_WALL_INTERVAL};
+        use crate::io::run_budget::{MAX_MAX_STEPS, MAX_WALL_BUDGET, MIN_WALL_BUDGET};
+        let checkpoint_every = seconds("--checkpoint-every", self.checkpoint_every, Some("never"), MIN_WALL_INTERVAL)?;
+        let checkpoint_every_sim = self
+            .checkpoint_every_sim
+            .map(|s| interval("--checkpoint-every-sim", s, 0.0, MAX_SIM_INTERVAL, "simulated seconds", None))
+            .transpose()?;
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
-        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
         let progress_every = match (self.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
-            (Some(s), _) if ok(s) => s,
-            (Some(s), _) => {
-                return Err(CliError::usage(format!(
-                    "--progress-every must be a finite number of seconds >= 0, got {s}"
-                )));
+            (Some(s), _) => seconds("--progress-every", s, Some("no lines"), MIN_PROGRESS_EVERY)?,
+            (None, Ok(text)) => {
+                let value = text.trim().parse::<f64>().unwrap_or(f64::NAN);
+                seconds(PROGRESS_EVERY_ENV, value, Some("no lines"), MIN_PROGRESS_EVERY).map_err(|_| {
+                    CliError::usage(format!(
+                        "{PROGRESS_EVERY_ENV} must be 0 (no lines) or a number of seconds from {MIN_PROGRESS_EVERY} \
+                         to {MAX_WALL_INTERVAL:e}, got {text:?}"
+                    ))
+                })?
             }
-            (None, Ok(text)) => match text.trim().parse::<f64>() {
-                Ok(s) if ok(s) => s,
-                _ => {
-                    return Err(CliError::usage(format!(
-                        "{PROGRESS_EVERY_ENV} must be a finite number of seconds >= 0, got {text:?}"
-                    )));
-                }
-            },
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
+        let max_steps = self
+            .max_steps
+            .map(|n| {
+                let whole = n.is_finite() && n.fract() == 0.0 && (1.0..=MAX_MAX_STEPS as f64).contains(&n);
+                if whole {
+                    Ok(n as u64)
+                } else {
+                    Err(CliError::usage(format!(
+                        "--max-steps must be a whole number of steps from 1 to {:e}, got {}",
+                        MAX_MAX_STEPS as f64,
+                        crate::io::scene_file::fmt_num(n)
+                    )))
+                }
+            })
+            .transpose()?;
+        let max_wall_seconds = self
+            .max_wall_seconds
+            .map(|s| interval("--max-wall-seconds", s, MIN_WALL_BUDGET, MAX_WALL_BUDGET, "seconds", None))
+            .transpose()?;
+        debug_assert!(MAX_WALL_BUDGET <= MAX_WALL_INTERVAL);
         Ok(RunOptions {
             force: false,
             progress,
-            checkpoint_every: (self.checkpoint_every > 0.0).then_some(self.checkpoint_every),
-            checkpoint_every_sim: self.checkpoint_every_sim,
+            checkpoint_every: (checkpoint_every > 0.0).then_some(checkpoint_every),
+            checkpoint_every_sim,
             formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
             progress_every,
             stop_after_checkpoints: self.stop_after_checkpoints,
+            max_steps,
+            max_wall_seconds,
         })
     }
+}
+
+/// A wall-clock interval option `name` (s): `0` (`off` says what 0 means) or a number in
+/// [`floor`, [`crate::io::limits::MAX_WALL_INTERVAL`]]; otherwise one line naming the option and the range.
+pub(crate) fn seconds(name: &str, value: f64, off: Option<&str>, floor: f64) -> Result<f64, CliError> {
+    interval(name, value, floor, crate::io::limits::MAX_WALL_INTERVAL, "seconds", off)
+}
+
+/// `value` of the option `name` when it is in [`lo`, `hi`] (in `unit`), or `0` when `off` says 0 is allowed (and
+/// what it means); otherwise one line naming the option, the range and the value (never a panic, whatever the
+/// value: NaN, infinite, subnormal or huge).
+pub(crate) fn interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off: Option<&str>) -> Result<f64, CliError> {
+    if (off.is_some() && value == 0.0) || (value >= lo && value <= hi) {
+        return Ok(value);
+    }
+    let zero = off.map_or(String::new(), |what| format!("0 ({what}) or "));
+    Err(CliError::usage(format!(
+        "{name} must be {zero}a number of {unit} from {lo} to {hi:e}, got {}",
+        crate::io::scene_file::fmt_num(value)
+    )))
 }
 
 impl From<crate::bench::BenchError> for CliError {

@@ -140,7 +140,8 @@ pub struct BuildArgs {
     /// Continue an interrupted build from `FILE.checkpoint.json` (same options as the interrupted build).
     #[arg(long, conflicts_with = "force")]
     pub resume: bool,
-    /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s).
+    /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s; 0 = at
+    /// every check, else 0.001 to 1e7).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
 }
@@ -222,12 +223,12 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
-        return Err(CliError::usage(format!(
-            "--checkpoint-every: expected seconds >= 0, got {}",
-            args.checkpoint_every
-        )));
-    }
+    crate::cli::common::seconds(
+        "--checkpoint-every",
+        args.checkpoint_every,
+        Some("at every relaxation check"),
+        crate::io::limits::MIN_WALL_INTERVAL,
+    )?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
         Some(read_checkpoint(&checkpoint_file)?)

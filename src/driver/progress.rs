@@ -42,7 +42,8 @@ impl Progress {
         } else if every.is_finite() && every > 0.0 {
             let now = Instant::now();
             Progress::Lines(Lines {
-                every: Duration::from_secs_f64(every),
+                // Never a panic, whatever a library caller passes (the command line bounds it first).
+                every: Duration::try_from_secs_f64(every).unwrap_or(Duration::MAX),
                 started: now,
                 last: Cell::new(now),
                 t_start: t,

@@ -19,6 +19,7 @@ use crate::engine::{Engine, Outcome, Resumed, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
 use crate::io::manifest::MANIFEST_FILE;
+use crate::io::run_budget::Budget;
 use crate::io::run_lock::{DirLock, LOCK_FILE, LockError, is_lock_file};
 use crate::io::safe_write;
 
@@ -55,6 +56,12 @@ pub struct RunOptions {
     /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many checkpoints
     /// (as if the process had been killed then).
     pub stop_after_checkpoints: Option<u64>,
+    /// Most steps the run may take (`--max-steps`), over the scene's `[run] max_steps`; `None`: the scene's, else
+    /// [`crate::io::run_budget::DEFAULT_MAX_STEPS`] ([`crate::io::run_budget`]).
+    pub max_steps: Option<u64>,
+    /// Most wall-clock seconds this process may run the run (`--max-wall-seconds`), over the scene's
+    /// `[run] max_wall_seconds`; `None`: the scene's, else no limit.
+    pub max_wall_seconds: Option<f64>,
 }
 
 impl Default for RunOptions {
@@ -69,6 +76,8 @@ impl Default for RunOptions {
             formats: formats::Formats::NONE,
             progress_every: progress::DEFAULT_PROGRESS_EVERY,
             stop_after_checkpoints: None,
+            max_steps: None,
+            max_wall_seconds: None,
         }
     }
 }
@@ -132,6 +141,21 @@ pub enum RunError<S> {
     /// Another process (or thread) is writing the directory ([`crate::io::run_lock`]): refused at once.
     #[error(transparent)]
     Locked(#[from] LockError),
+    /// The run stopped with a checkpoint at an output sample because its budget ([`crate::io::run_budget`]: most
+    /// steps, most wall-clock seconds) would not last to the next one.
+    #[error(
+        "stopped at t = {t} s: {reason}; a checkpoint was written: continue with `rubblepile resume {}` and a larger \
+         budget",
+        .dir.display()
+    )]
+    Budget {
+        /// The run directory.
+        dir: PathBuf,
+        /// Time of the checkpoint (s).
+        t: f64,
+        /// Which budget, and how much of it was used.
+        reason: String,
+    },
     /// The run stopped after a checkpoint as asked by [`RunOptions::stop_after_checkpoints`].
     #[error("stopped after checkpoint {checkpoints} at t = {t} s (--stop-after-checkpoints); continue with `rubblepile resume {}`", .dir.display())]
     Stopped {
@@ -160,11 +184,12 @@ impl<S> RunError<S> {
         )
     }
 
-    /// The command line's exit code: 2 for [`RunError::is_usage`], 3 for [`RunError::Stopped`], 1 otherwise.
+    /// The command line's exit code: 2 for [`RunError::is_usage`], 3 for [`RunError::Stopped`] and
+    /// [`RunError::Budget`], 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         if self.is_usage() {
             2
-        } else if matches!(self, RunError::Stopped { .. }) {
+        } else if matches!(self, RunError::Stopped { .. } | RunError::Budget { .. }) {
             3
         } else {
             1
@@ -194,6 +219,7 @@ impl<S> RunError<S> {
             RunError::BadCheckpoint(m) => RunError::BadCheckpoint(m),
             RunError::Locked(e) => RunError::Locked(e),
             RunError::Stopped { dir, t, checkpoints } => RunError::Stopped { dir, t, checkpoints },
+            RunError::Budget { dir, t, reason } => RunError::Budget { dir, t, reason },
         }
     }
 }
@@ -383,6 +409,19 @@ fn same_dir(a: &Path, b: &Path) -> bool {
 /// size underflow, a broken constraint), writes `last_good_state.csv` and `summary.json` (naming the cause) and
 /// returns [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunReport::one_line`].
 pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    // A scene its own work estimate says will not end within the budget is refused before anything is written.
+    let budget = budget_of(&engine, options);
+    if let Some(steps) = engine.estimated_steps()
+        && steps > budget.max_steps as f64
+    {
+        return Err(RunError::Setup(format!(
+            "the scene needs about {steps:.1e} steps to t_end = {} s, more than max_steps = {} ({}); raise it with \
+             [run] max_steps or --max-steps to run the scene anyway, or shorten t_end",
+            engine.t_end(),
+            count(budget.max_steps),
+            budget.steps_from
+        )));
+    }
     let _lock = prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
     let scene_text = standalone_scene(&engine, out_dir);
@@ -405,7 +444,25 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
         timeseries,
     };
     let useful = engine.useful_threads();
-    on_pool(useful, || drive(&mut engine, out_dir, options, start, &identity))
+    on_pool(useful, || drive(&mut engine, out_dir, options, start, &identity, &budget))
+}
+
+/// A step count as people read it: digits below 1e7, `1e9` above.
+fn count(n: u64) -> String {
+    if n < 10_000_000 {
+        n.to_string()
+    } else {
+        format!("{:e}", n as f64)
+    }
+}
+
+/// The budget `engine`'s run is held to: the command line's over the scene's `[run]` table.
+fn budget_of(engine: &impl Engine, options: &RunOptions) -> Budget {
+    Budget::resolve(
+        crate::io::run_budget::from_scene_text(engine.scene_source()),
+        options.max_steps,
+        options.max_wall_seconds,
+    )
 }
 
 /// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
@@ -617,7 +674,8 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         timeseries,
     };
     let useful = engine.useful_threads();
-    on_pool(useful, || drive(&mut engine, dir, options, start, &identity))
+    let budget = budget_of(&engine, options);
+    on_pool(useful, || drive(&mut engine, dir, options, start, &identity, &budget))
 }
 
 /// Writes `checkpoint` into `dir/checkpoint.json` atomically and durably (temporary file, fsync, rename, directory
@@ -662,6 +720,7 @@ fn drive<E: Engine>(
     options: &RunOptions,
     start: Start,
     identity: &Identity,
+    budget: &Budget,
 ) -> Result<E::Summary, RunError<E::Summary>> {
     let Start {
         next_sample,
@@ -721,11 +780,92 @@ fn drive<E: Engine>(
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
+    // Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`), then the
+    // manifest that records it.
+    let checkpoint_at = |state: E::State, t: f64, next_sample: u64, rows: u64, bytes: u64, checkpoints: u64| {
+        manifest.borrow_mut().refresh(out_dir).map_err(io_err(&mp))?;
+        let ckpt = Checkpoint {
+            format: CHECKPOINT_FORMAT.into(),
+            version: CHECKPOINT_VERSION,
+            writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
+            kind: E::KIND.into(),
+            scene_hash: identity.scene_hash.clone(),
+            scene_base_dir: identity.scene_base_dir.clone(),
+            t,
+            t_seconds: t,
+            next_sample,
+            timeseries_rows: rows,
+            timeseries_bytes: bytes,
+            checkpoints,
+            wall_seconds: wall(),
+            engine: state,
+        };
+        let cp = out_dir.join(CHECKPOINT_FILE);
+        write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+        manifest
+            .borrow_mut()
+            .write(out_dir, &format!("checkpoint at t = {t} s"), false)
+            .map_err(io_err(&mp))
+    };
+    // The wall-clock budget holds inside a sample interval too: past the deadline an advance stops, and the run
+    // stops with a checkpoint of the state saved at the sample before (kept only when there is a budget).
+    let deadline = budget
+        .max_wall_seconds
+        .and_then(|s| started.checked_add(std::time::Duration::try_from_secs_f64(s).ok()?));
+    engine.set_deadline(deadline);
+    let budget_stop = |t: f64, reason: String| RunError::Budget {
+        dir: out_dir.to_path_buf(),
+        t,
+        reason,
+    };
+    let steps_spent = |steps: u64| {
+        format!(
+            "max_steps = {} ({}) reached: {steps} steps taken",
+            count(budget.max_steps),
+            budget.steps_from
+        )
+    };
     for (index, sample) in samples.iter().enumerate().skip(next_sample as usize) {
+        // A resumed run whose budget is already spent stops where its checkpoint is, writing nothing.
+        let steps_before = engine.steps_taken();
+        if steps_before >= budget.max_steps {
+            shown.abandon();
+            return Err(budget_stop(engine.time(), steps_spent(steps_before)));
+        }
+        engine.limit_steps(budget.max_steps - steps_before);
+        let interval_started = Instant::now();
+        let t_before = engine.time();
+        let saved = match deadline {
+            Some(_) if index > 0 => Some(engine.save().map_err(io_err(out_dir))?),
+            _ => None,
+        };
         // The error of the last sample: the engine is busy while it advances.
         let error = engine.error_so_far();
         let mut progress = |t: f64| shown.show(t, t_end, error);
-        if let Err(failure) = engine.advance(index, sample, &mut progress) {
+        if let Err(mut failure) = engine.advance(index, sample, &mut progress) {
+            if let (true, Some(state)) = (failure.deadline, saved) {
+                shown.abandon();
+                files.sync().map_err(file_err)?;
+                checkpoints += 1;
+                checkpoint_at(state, t_before, index as u64, rows, bytes, checkpoints)?;
+                let most = budget.max_wall_seconds.unwrap_or_default();
+                return Err(budget_stop(
+                    t_before,
+                    format!(
+                        "the wall-clock budget: max_wall_seconds = {most} s ran out within the sample interval to t = \
+                         {} s",
+                        sample.t
+                    ),
+                ));
+            }
+            if engine.steps_taken() >= budget.max_steps {
+                failure.cause = format!(
+                    "{} within one sample interval (to t = {} s; the integrator said: {})",
+                    steps_spent(engine.steps_taken()),
+                    sample.t,
+                    failure.cause
+                );
+            }
             return Err(fail(engine, &failure, rows, &mut files));
         }
         let row = match engine.sample(sample, wall()) {
@@ -761,37 +901,42 @@ fn drive<E: Engine>(
         let due_sim = options
             .checkpoint_every_sim
             .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
-        if (index as u64) + 1 < total && (due_wall || due_sim) {
+        // The budget: stop here, with a checkpoint, when the next interval (judged by this one) would overrun it.
+        let steps = engine.steps_taken();
+        let interval_steps = steps - steps_before;
+        let spent = started.elapsed().as_secs_f64();
+        let interval_wall = interval_started.elapsed().as_secs_f64();
+        let over_budget = if steps >= budget.max_steps || steps.saturating_add(interval_steps) > budget.max_steps {
+            Some(format!(
+                "the step budget: {} steps taken, {interval_steps} in the last sample interval, max_steps = {} ({})",
+                steps,
+                count(budget.max_steps),
+                budget.steps_from
+            ))
+        } else {
+            budget.max_wall_seconds.and_then(|most| {
+                (spent + interval_wall > most).then(|| {
+                    format!(
+                        "the wall-clock budget: {spent:.1} s run here, {interval_wall:.1} s in the last sample interval, \
+                         max_wall_seconds = {most} s"
+                    )
+                })
+            })
+        };
+        let over_budget = over_budget.filter(|_| (index as u64) + 1 < total);
+        if (index as u64) + 1 < total && (due_wall || due_sim || over_budget.is_some()) {
             // The rows and snapshots the checkpoint counts must be on disk before it is.
             files.sync().map_err(file_err)?;
             let state = engine.save().map_err(io_err(out_dir))?;
-            manifest.borrow_mut().refresh(out_dir).map_err(io_err(&mp))?;
             checkpoints += 1;
-            let ckpt = Checkpoint {
-                format: CHECKPOINT_FORMAT.into(),
-                version: CHECKPOINT_VERSION,
-                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
-                kind: E::KIND.into(),
-                scene_hash: identity.scene_hash.clone(),
-                scene_base_dir: identity.scene_base_dir.clone(),
-                t,
-                t_seconds: t,
-                next_sample: index as u64 + 1,
-                timeseries_rows: rows,
-                timeseries_bytes: bytes,
-                checkpoints,
-                wall_seconds: wall(),
-                engine: state,
-            };
-            let cp = out_dir.join(CHECKPOINT_FILE);
-            write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
-            manifest
-                .borrow_mut()
-                .write(out_dir, &format!("checkpoint at t = {t} s"), false)
-                .map_err(io_err(&mp))?;
+            checkpoint_at(state, t, index as u64 + 1, rows, bytes, checkpoints)?;
             last_checkpoint_wall = Instant::now();
             last_checkpoint_t = t;
             checkpoints_here += 1;
+            if let Some(reason) = over_budget {
+                shown.abandon();
+                return Err(budget_stop(t, reason));
+            }
             if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
                 shown.abandon();
                 return Err(RunError::Stopped {

@@ -11,6 +11,7 @@ pub mod limits;
 pub mod manifest;
 pub mod output_times;
 pub mod particles;
+pub mod run_budget;
 pub mod run_lock;
 pub mod safe_write;
 pub mod scene_fields;

@@ -297,6 +297,8 @@ pub struct HardEngine {
     /// Events when this process started, and its clock (for the summary's events per second).
     events_before: u64,
     clock: Instant,
+    /// Wall-clock instant after which an advance stops ([`Engine::set_deadline`]).
+    deadline: Option<Instant>,
 }
 
 impl HardEngine {
@@ -323,6 +325,7 @@ impl HardEngine {
             last_wall_clock: 0.0,
             events_before: 0,
             clock: Instant::now(),
+            deadline: None,
         }
     }
 
@@ -373,6 +376,18 @@ impl Engine for HardEngine {
         &self.scene.source
     }
 
+    fn estimated_steps(&self) -> Option<f64> {
+        Some((self.scene.t_end / self.scene.dt).ceil())
+    }
+
+    fn steps_taken(&self) -> u64 {
+        self.steps
+    }
+
+    fn set_deadline(&mut self, deadline: Option<Instant>) {
+        self.deadline = deadline;
+    }
+
     fn error_so_far(&self) -> Option<(&'static str, f64)> {
         // Restitution and moving walls change the energy on purpose: the residual after them is the error.
         Some(("energy residual", self.book.energy_residual))
@@ -408,6 +423,9 @@ impl Engine for HardEngine {
         while self.system.t < to.t {
             if self.steps.is_multiple_of(64) {
                 progress(self.system.t);
+                if self.deadline.is_some_and(|d| Instant::now() >= d) {
+                    return Err(Failure::deadline(self.system.t));
+                }
             }
             let left = to.t - self.system.t;
             let h = if left < 1.000001 * dt { left } else { dt };

@@ -533,6 +533,8 @@ pub struct SoftEngine {
     plan: Vec<(u64, Option<usize>)>,
     /// The state before the current step, kept for `last_good_state.csv` (allocated once).
     before: Vec<Particle>,
+    /// Wall-clock instant after which an advance stops ([`Engine::set_deadline`]).
+    deadline: Option<std::time::Instant>,
 }
 
 impl SoftEngine {
@@ -550,6 +552,7 @@ impl SoftEngine {
             spin: None,
             plan,
             before,
+            deadline: None,
         }
     }
 
@@ -613,6 +616,18 @@ impl Engine for SoftEngine {
         &self.scene.source
     }
 
+    fn estimated_steps(&self) -> Option<f64> {
+        Some(self.scene.n_steps as f64)
+    }
+
+    fn steps_taken(&self) -> u64 {
+        self.step
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.deadline = deadline;
+    }
+
     fn error_so_far(&self) -> Option<(&'static str, f64)> {
         Some(("energy error", self.book.max_energy))
     }
@@ -674,6 +689,9 @@ impl Engine for SoftEngine {
             let step = self.step;
             if step.is_multiple_of(256) {
                 progress(step as f64 * dt);
+                if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                    return Err(Failure::deadline(step as f64 * dt));
+                }
             }
             // the spin-up diagnostics at a sample need that step's contact records
             sys.keep_records = self.spin.is_some() && step + 1 == sample_step;

@@ -148,7 +148,8 @@ pub(crate) fn execute(
             false,
             Some(RunNumbers::from(summary.as_ref())),
         ),
-        Ok(Err(ImpactError::Run(RunError::Stopped { .. }))) => (RunStatus::Pending, true, None),
+        // Stopped on request or by its budget: its checkpoint lets the next campaign run resume it.
+        Ok(Err(ImpactError::Run(RunError::Stopped { .. } | RunError::Budget { .. }))) => (RunStatus::Pending, true, None),
         Ok(Err(e)) => (RunStatus::Failed(e.to_string()), false, None),
         Err(panic) => {
             let what = panic
