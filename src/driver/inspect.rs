@@ -222,9 +222,12 @@ fn check_with<E: Engine>(
     report.note(format!("{}: a run of kind {:?} (scene.toml)", dir.display(), E::KIND));
 
     // Status, from summary.json and checkpoint.json.
-    let summary: Option<serde_json::Value> = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
+    let summary_path = dir.join("summary.json");
+    let summary_text = std::fs::read_to_string(&summary_path).ok();
+    let summary: Option<serde_json::Value> = summary_text.as_deref().and_then(|t| serde_json::from_str(t).ok());
+    if summary_text.is_some() && summary.is_none() {
+        report.problem(format!("{}: not JSON (damaged?)", summary_path.display()));
+    }
     let status = summary
         .as_ref()
         .and_then(|v| v.get("status")?.as_str().map(str::to_string));
@@ -240,6 +243,14 @@ fn check_with<E: Engine>(
         (Some(s), _) if s.starts_with("failed") => {
             report.note(format!("status: {s}{}", at(summary_t)));
             Reached::Failed
+        }
+        // A summary that says neither: named as it is, not taken for a missing one.
+        (Some(s), _) => {
+            report.problem(format!(
+                "{}: status {s:?} is none rubblepile writes (\"completed\" or \"failed: …\")",
+                summary_path.display()
+            ));
+            Reached::Unknown
         }
         (_, Some(c)) => {
             report.note(format!(
