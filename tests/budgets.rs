@@ -52,8 +52,14 @@ fn physics(dir: &Path) -> Vec<(String, String)> {
             .collect::<Vec<_>>()
             .join(",")
     };
-    out.push(("timeseries.csv".into(), ts.lines().map(keep).collect::<Vec<_>>().join("\n")));
-    let mut snaps: Vec<_> = std::fs::read_dir(dir.join("snapshots")).unwrap().map(|e| e.unwrap().path()).collect();
+    out.push((
+        "timeseries.csv".into(),
+        ts.lines().map(keep).collect::<Vec<_>>().join("\n"),
+    ));
+    let mut snaps: Vec<_> = std::fs::read_dir(dir.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
     snaps.sort();
     for p in snaps {
         out.push((
@@ -67,7 +73,13 @@ fn physics(dir: &Path) -> Vec<(String, String)> {
 /// Asserts the runs in `a` and `b` hold the same physics ([`physics`]), naming the first line that differs.
 fn same_physics(a: &Path, b: &Path) {
     let (pa, pb) = (physics(a), physics(b));
-    assert_eq!(pa.len(), pb.len(), "{} and {} hold other files", a.display(), b.display());
+    assert_eq!(
+        pa.len(),
+        pb.len(),
+        "{} and {} hold other files",
+        a.display(),
+        b.display()
+    );
     for ((name, x), (_, y)) in pa.iter().zip(&pb) {
         if let Some((i, (l, r))) = x.lines().zip(y.lines()).enumerate().find(|(_, (l, r))| l != r) {
             panic!("{name} line {}: {l}\n  vs {r}", i + 1);
@@ -81,20 +93,42 @@ fn a_scene_estimated_over_its_budget_is_refused_until_the_budget_is_raised() {
     let dir = temp_dir("budget-estimate");
     // 2000 fixed steps (t_end / dt).
     let hard = scene(&dir, "hard", "hard", &[]);
-    let capped = scene(&dir, "hard", "capped", &[("[stepping]", "[run]\nmax_steps = 1000\n\n[stepping]")]);
-    let e = error_line(&rubblepile(&dir, &["run", s(&capped), "--out", "a", "--no-progress"]), 2);
+    let capped = scene(
+        &dir,
+        "hard",
+        "capped",
+        &[("[stepping]", "[run]\nmax_steps = 1000\n\n[stepping]")],
+    );
+    let e = error_line(
+        &rubblepile(&dir, &["run", s(&capped), "--out", "a", "--no-progress"]),
+        2,
+    );
     assert!(
         e.contains("the scene needs about 2.0e3 steps to t_end = 2 s, more than max_steps = 1000 ([run] max_steps)"),
         "{e}"
     );
     assert!(!dir.join("a").exists(), "refused before the output directory is made");
-    let e = error_line(&rubblepile(&dir, &["run", s(&hard), "--out", "a", "--no-progress", "--max-steps", "1999"]), 2);
+    let e = error_line(
+        &rubblepile(
+            &dir,
+            &["run", s(&hard), "--out", "a", "--no-progress", "--max-steps", "1999"],
+        ),
+        2,
+    );
     assert!(e.contains("more than max_steps = 1999 (--max-steps)"), "{e}");
     // The command line raises the scene's budget.
-    let o = rubblepile(&dir, &["run", s(&capped), "--out", "b", "--no-progress", "--max-steps", "2000"]);
+    let o = rubblepile(
+        &dir,
+        &["run", s(&capped), "--out", "b", "--no-progress", "--max-steps", "2000"],
+    );
     assert!(o.status.success(), "{}", describe(&o));
     // `check` of the scene says what `run` will do: a warning over the default ceiling, for the needle.
-    let needle = scene(&dir, "ellipsoids", "needle", &[("axes = [3.0, 2.0, 1.5]", "axes = [3e-9, 2e-9, 1.5e-9]")]);
+    let needle = scene(
+        &dir,
+        "ellipsoids",
+        "needle",
+        &[("axes = [3.0, 2.0, 1.5]", "axes = [3e-9, 2e-9, 1.5e-9]")],
+    );
     let o = rubblepile(&dir, &["run", s(&needle), "--out", "c", "--no-progress"]);
     let e = error_line(&o, 2);
     assert!(e.contains("more than max_steps = 1e9 (the default ceiling)"), "{e}");
@@ -106,10 +140,14 @@ fn a_run_that_reaches_its_step_budget_stops_with_a_checkpoint_and_resumes_exactl
     let sc = scene(&dir, "ellipsoids", "e", &[]);
     let o = rubblepile(&dir, &["run", s(&sc), "--out", "whole", "--no-progress"]);
     assert!(o.status.success(), "{}", describe(&o));
-    let o = rubblepile(&dir, &["run", s(&sc), "--out", "cut", "--no-progress", "--max-steps", "60"]);
+    let o = rubblepile(
+        &dir,
+        &["run", s(&sc), "--out", "cut", "--no-progress", "--max-steps", "60"],
+    );
     let e = error_line(&o, 3);
     assert!(
-        e.contains("stopped at t = ") && e.contains(": the step budget: 60 steps taken")
+        e.contains("stopped at t = ")
+            && e.contains(": the step budget: 60 steps taken")
             && e.contains("max_steps = 60 (--max-steps); a checkpoint was written: continue with `rubblepile resume"),
         "{e}"
     );
@@ -119,8 +157,14 @@ fn a_run_that_reaches_its_step_budget_stops_with_a_checkpoint_and_resumes_exactl
     assert!(o.status.success(), "{}", describe(&o));
     // The same budget again: stopped where it is, nothing written.
     let before = std::fs::read(dir.join("cut/checkpoint.json")).unwrap();
-    let e = error_line(&rubblepile(&dir, &["resume", "cut", "--no-progress", "--max-steps", "60"]), 3);
-    assert!(e.contains("max_steps = 60 (--max-steps) reached: 60 steps taken"), "{e}");
+    let e = error_line(
+        &rubblepile(&dir, &["resume", "cut", "--no-progress", "--max-steps", "60"]),
+        3,
+    );
+    assert!(
+        e.contains("max_steps = 60 (--max-steps) reached: 60 steps taken"),
+        "{e}"
+    );
     assert_eq!(std::fs::read(dir.join("cut/checkpoint.json")).unwrap(), before);
     // A larger budget (here the default): the run ends as the uninterrupted one.
     let o = rubblepile(&dir, &["resume", "cut", "--no-progress"]);
@@ -134,7 +178,10 @@ fn the_wall_clock_budget_stops_between_samples_and_inside_a_long_interval() {
     // 2e7 hard-sphere steps in 200 sample intervals: a second or two, stopped by a budget of one second.
     let hard = scene(&dir, "hard", "slow", &[("dt = 1e-3 ", "dt = 1e-7 ")]);
     let clock = std::time::Instant::now();
-    let whole = rubblepile(&dir, &["run", s(&hard), "--out", "whole", "--no-progress", "--max-steps", "3e7"]);
+    let whole = rubblepile(
+        &dir,
+        &["run", s(&hard), "--out", "whole", "--no-progress", "--max-steps", "3e7"],
+    );
     let whole_seconds = clock.elapsed().as_secs_f64();
     assert!(whole.status.success(), "{}", describe(&whole));
     let args = |verb: &str, target: &str| -> Vec<String> {
@@ -177,12 +224,24 @@ fn the_wall_clock_budget_stops_between_samples_and_inside_a_long_interval() {
     let started = std::time::Instant::now();
     let o = rubblepile(
         &dir,
-        &["run", s(&implicit), "--out", "spin", "--no-progress", "--max-steps", "1e8", "--max-wall-seconds", "1"],
+        &[
+            "run",
+            s(&implicit),
+            "--out",
+            "spin",
+            "--no-progress",
+            "--max-steps",
+            "1e8",
+            "--max-wall-seconds",
+            "1",
+        ],
     );
     let e = error_line(&o, 3);
     assert!(
-        e.contains("stopped at t = 0 s: the wall-clock budget: max_wall_seconds = 1 s ran out within the sample \
-                    interval to t = 1 s"),
+        e.contains(
+            "stopped at t = 0 s: the wall-clock budget: max_wall_seconds = 1 s ran out within the sample \
+                    interval to t = 1 s"
+        ),
         "{e}"
     );
     assert!(started.elapsed().as_secs_f64() < 30.0, "the budget did not hold");

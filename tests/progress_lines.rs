@@ -116,11 +116,20 @@ fn the_environment_sets_the_cadence_and_bad_values_are_refused() {
         );
         assert!(!stderr.contains("panicked"), "{stderr}");
     }
-    assert!(!dir.join("bad-env").exists(), "refused before the output directory is made");
+    assert!(
+        !dir.join("bad-env").exists(),
+        "refused before the output directory is made"
+    );
     for bad in ["-1", "1e308", "1e-320", "1e-9", "NaN"] {
-        let o = rubblepile(&dir, &["run", "s.toml", "--out", "bad-flag", &format!("--progress-every={bad}")]);
+        let o = rubblepile(
+            &dir,
+            &["run", "s.toml", "--out", "bad-flag", &format!("--progress-every={bad}")],
+        );
         assert_eq!(o.status.code(), Some(2), "{bad}");
         let stderr = String::from_utf8_lossy(&o.stderr);
-        assert!(stderr.contains("--progress-every must be 0 (no lines) or a number of seconds from 0.1 to 1e7"), "{stderr}");
+        assert!(
+            stderr.contains("--progress-every must be 0 (no lines) or a number of seconds from 0.1 to 1e7"),
+            "{stderr}"
+        );
     }
 }

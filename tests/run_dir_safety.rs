@@ -34,7 +34,11 @@ fn scene(dir: &Path, engine: &str, replace: &[(&str, &str)]) -> PathBuf {
 /// The one `error: …` line of a failed command (asserting there is exactly one and no panic).
 fn one_error(o: &Output, what: &str) -> String {
     let stderr = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && o.status.code().is_some(), "{what}: {}", describe(o));
+    assert!(
+        !o.status.success() && o.status.code().is_some(),
+        "{what}: {}",
+        describe(o)
+    );
     assert!(!stderr.contains("panicked"), "{what}: {stderr}");
     let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
     assert_eq!(errors.len(), 1, "{what}: not one error line: {stderr}");
@@ -138,40 +142,54 @@ fn stopped(base: &Path, name: &str) -> PathBuf {
 fn a_symlink_where_rubblepile_writes_is_refused_by_name_and_its_target_untouched() {
     let base = temp_dir("links");
     let sc = scene(&base, "ellipsoids", &[("every = 1.0", "every = 1.0\ntrack = [0]")]);
-    let run = finished(&base, "ellipsoids", &[("every = 1.0", "every = 1.0\ntrack = [0]")], "run", &[]);
+    let run = finished(
+        &base,
+        "ellipsoids",
+        &[("every = 1.0", "every = 1.0\ntrack = [0]")],
+        "run",
+        &[],
+    );
     let again = ["run", s(&sc), "--out", s(&run), "--no-progress", "--force"];
-    // `run --force` over a previous run: the lock, every file it writes or removes, its snapshots (the directory and
-    // a file in it).
-    for rel in [
-        ".rubblepile.lock",
-        "scene.toml",
-        "summary.json",
-        "timeseries.csv",
-        "tracks.csv",
-        "checkpoint.json",
-        "manifest.txt",
-        "snapshots/1.csv",
-    ] {
-        refused_through_link(&base, &run, rel, false, &again);
-    }
-    refused_through_link(&base, &run, "snapshots", true, &again);
-    let o = rubblepile(&base, &again);
-    assert!(o.status.success(), "after the links: {}", describe(&o));
-
-    // `resume`: the lock, the files it reopens, rewrites or removes, a snapshot it will write.
     let stop = stopped(&base, "stopped");
     let resume = ["resume", s(&stop), "--no-progress"];
-    for rel in [
-        ".rubblepile.lock",
-        "timeseries.csv",
-        "tracks.csv",
-        "summary.json",
-        "checkpoint.json",
-        "snapshots/3.csv",
-    ] {
-        refused_through_link(&base, &stop, rel, false, &resume);
+    // `run --force` over a previous run: the lock, every file it writes or removes, its snapshots (the directory and
+    // a file in it); `resume`: the lock, the files it reopens, rewrites or removes, a snapshot it will write.
+    let cases: [(&Path, &[&str], &[&str]); 2] = [
+        (
+            &run,
+            &again,
+            &[
+                ".rubblepile.lock",
+                "scene.toml",
+                "summary.json",
+                "timeseries.csv",
+                "tracks.csv",
+                "checkpoint.json",
+                "manifest.txt",
+                "snapshots/1.csv",
+            ],
+        ),
+        (
+            &stop,
+            &resume,
+            &[
+                ".rubblepile.lock",
+                "timeseries.csv",
+                "tracks.csv",
+                "summary.json",
+                "checkpoint.json",
+                "snapshots/3.csv",
+            ],
+        ),
+    ];
+    for (dir, args, files) in cases {
+        for rel in files {
+            refused_through_link(&base, dir, rel, false, args);
+        }
+        refused_through_link(&base, dir, "snapshots", true, args);
     }
-    refused_through_link(&base, &stop, "snapshots", true, &resume);
+    let o = rubblepile(&base, &again);
+    assert!(o.status.success(), "after the links: {}", describe(&o));
 
     // `analyze` (its lock, analysis/ and a file in it), `render` (its lock, frames/ and a frame), `export` (vtk/,
     // a VTK file, an XYZ file).
@@ -191,7 +209,13 @@ fn a_symlink_where_rubblepile_writes_is_refused_by_name_and_its_target_untouched
     refused_through_link(&base, &run, "vtk", true, &vtk);
     std::fs::create_dir_all(run.join("vtk")).unwrap();
     refused_through_link(&base, &run, "vtk/run.pvd", false, &vtk);
-    refused_through_link(&base, &run, "snapshots/0.xyz", false, &["export", "xyz", s(&run), "--force"]);
+    refused_through_link(
+        &base,
+        &run,
+        "snapshots/0.xyz",
+        false,
+        &["export", "xyz", s(&run), "--force"],
+    );
     for args in [&analyze[..], &render[..], &vtk[..]] {
         let o = rubblepile(&base, args);
         assert!(o.status.success(), "{args:?} after the links: {}", describe(&o));
@@ -266,9 +290,19 @@ fn check_finds_a_single_flipped_byte_in_any_file_of_a_finished_run_of_each_engin
     for run in &runs {
         let o = rubblepile(&base, &["check", s(run)]);
         assert!(o.status.success(), "{}", describe(&o));
-        assert!(String::from_utf8_lossy(&o.stdout).contains("manifest: the "), "{}", describe(&o));
+        assert!(
+            String::from_utf8_lossy(&o.stdout).contains("manifest: the "),
+            "{}",
+            describe(&o)
+        );
         let files = run_files(run);
-        for must in ["checkpoint.json", "summary.json", "timeseries.csv", "scene.toml", "manifest.txt"] {
+        for must in [
+            "checkpoint.json",
+            "summary.json",
+            "timeseries.csv",
+            "scene.toml",
+            "manifest.txt",
+        ] {
             assert!(files.iter().any(|f| f == must), "{}: no {must}", run.display());
         }
         for rel in &files {
@@ -319,16 +353,26 @@ fn readers_refuse_a_damaged_or_non_finite_snapshot_with_one_line() {
     let o = rubblepile(&base, &["check", s(&run)]);
     let e = one_error(&o, "check without a manifest");
     assert!(e.contains("cut short mid-row"), "{e}");
-    assert!(String::from_utf8_lossy(&o.stdout).contains("no manifest ("), "{}", describe(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stdout).contains("no manifest ("),
+        "{}",
+        describe(&o)
+    );
     for args in [&analyze[..], &export[..], &render[..]] {
         let e = one_error(&rubblepile(&base, args), &format!("{args:?} without a manifest"));
-        assert!(e.contains("3.csv: damaged: its last line ends without a newline"), "{args:?}: {e}");
+        assert!(
+            e.contains("3.csv: damaged: its last line ends without a newline"),
+            "{args:?}: {e}"
+        );
     }
     // A NaN in the last snapshot: named, never skipped for another one.
     let text = String::from_utf8(good.clone()).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_string).collect();
     let cells: Vec<&str> = lines[1].split(',').collect();
-    lines[1] = std::iter::once("NaN").chain(cells[1..].iter().copied()).collect::<Vec<_>>().join(",");
+    lines[1] = std::iter::once("NaN")
+        .chain(cells[1..].iter().copied())
+        .collect::<Vec<_>>()
+        .join(",");
     std::fs::write(&snap, lines.join("\n") + "\n").unwrap();
     for args in [&analyze[..], &export[..], &render[..]] {
         let e = one_error(&rubblepile(&base, args), &format!("{args:?} NaN"));
@@ -342,5 +386,8 @@ fn readers_refuse_a_damaged_or_non_finite_snapshot_with_one_line() {
     let stop = stopped(&base, "stopped");
     flip(&stop.join("snapshots/1.csv"));
     let e = one_error(&rubblepile(&base, &["resume", s(&stop), "--no-progress"]), "resume");
-    assert!(e.contains("cannot resume") && e.contains("snapshots/1.csv: damaged"), "{e}");
+    assert!(
+        e.contains("cannot resume") && e.contains("snapshots/1.csv: damaged"),
+        "{e}"
+    );
 }

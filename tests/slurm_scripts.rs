@@ -159,13 +159,16 @@ fn run_case(base: &Path, b: &str, f: &str, o: &str) -> Result<(), String> {
     let script_path = out.join("campaign.slurm");
     let script = std::fs::read_to_string(&script_path).map_err(|e| e.to_string())?;
     let sh = |cmd: &mut Command| {
-        cmd.env("PATH", format!("{}:{}", stubs.display(), std::env::var("PATH").unwrap()))
-            .env("RECORD", &record)
-            .env("SLURM_ARRAY_TASK_ID", "2")
-            .env("SLURM_CPUS_PER_TASK", "4")
-            .current_dir(base)
-            .output()
-            .unwrap()
+        cmd.env(
+            "PATH",
+            format!("{}:{}", stubs.display(), std::env::var("PATH").unwrap()),
+        )
+        .env("RECORD", &record)
+        .env("SLURM_ARRAY_TASK_ID", "2")
+        .env("SLURM_CPUS_PER_TASK", "4")
+        .current_dir(base)
+        .output()
+        .unwrap()
     };
     // The array task.
     let o = sh(Command::new("bash").arg(&script_path));
@@ -188,13 +191,29 @@ fn run_case(base: &Path, b: &str, f: &str, o: &str) -> Result<(), String> {
     }
     let s = |p: &Path| p.to_str().unwrap().to_string();
     let want: Vec<Vec<String>> = vec![
-        ["rubblepile", "campaign", &s(&file), "--out", &s(&out), "--shard", "2/3", "--parallel", "1", "--no-progress"]
-            .map(String::from)
-            .to_vec(),
+        [
+            "rubblepile",
+            "campaign",
+            &s(&file),
+            "--out",
+            &s(&out),
+            "--shard",
+            "2/3",
+            "--parallel",
+            "1",
+            "--no-progress",
+        ]
+        .map(String::from)
+        .to_vec(),
         ["sbatch", "--parsable", &s(&script_path)].map(String::from).to_vec(),
-        ["sbatch", "--dependency=afterany:42", "--wrap", &format!("{} campaign merge {}", sh_word(&bin), sh_word(&out))]
-            .map(String::from)
-            .to_vec(),
+        [
+            "sbatch",
+            "--dependency=afterany:42",
+            "--wrap",
+            &format!("{} campaign merge {}", sh_word(&bin), sh_word(&out)),
+        ]
+        .map(String::from)
+        .to_vec(),
         ["rubblepile", "campaign", "merge", &s(&out)].map(String::from).to_vec(),
     ];
     let got = records(&record);
@@ -205,7 +224,9 @@ fn run_case(base: &Path, b: &str, f: &str, o: &str) -> Result<(), String> {
         .lines()
         .find_map(|l| l.strip_prefix("#SBATCH --output="))
         .ok_or("no --output line")?;
-    let read = sbatch_argument(output).replace("%%", "\u{0}").replace("%A_%a", "JOB_TASK");
+    let read = sbatch_argument(output)
+        .replace("%%", "\u{0}")
+        .replace("%A_%a", "JOB_TASK");
     let want_output = format!("{}/slurm-JOB_TASK.out", s(&out).replace("%", "\u{0}"));
     if read != want_output {
         return Err(format!("sbatch reads --output as {read:?}, want {want_output:?}"));
@@ -288,8 +309,10 @@ fn bad_scheduler_values_and_newlines_are_refused_by_name_before_anything_is_writ
     assert!(o.status.success(), "{}", describe(&o));
     let script = std::fs::read_to_string(base.join("out/campaign.slurm")).unwrap();
     assert!(
-        script.contains(&format!("srun {}/bin/rp campaign ", std::fs::canonicalize(&base).unwrap().display()))
-            || script.contains(&format!("srun {}/bin/rp campaign ", base.display())),
+        script.contains(&format!(
+            "srun {}/bin/rp campaign ",
+            std::fs::canonicalize(&base).unwrap().display()
+        )) || script.contains(&format!("srun {}/bin/rp campaign ", base.display())),
         "{script}"
     );
 }

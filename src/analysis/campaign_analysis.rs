@@ -146,16 +146,13 @@ pub fn analyze_campaign(
         path: csv_path.clone(),
         reason: e.to_string(),
     };
-    let file = crate::io::safe_write::AtomicFile::create(&csv_path)
-        .map_err(|e| werr(&crate::io::safe_write::reason(&e)))?;
+    let file =
+        crate::io::safe_write::AtomicFile::create(&csv_path).map_err(|e| werr(&crate::io::safe_write::reason(&e)))?;
     let mut w = csv::Writer::from_writer(file);
     for r in &analysis.runs {
         w.serialize(r).map_err(|e| werr(&e))?;
     }
-    w.into_inner()
-        .map_err(|e| werr(&e))?
-        .finish()
-        .map_err(|e| werr(&e))?;
+    w.into_inner().map_err(|e| werr(&e))?.finish().map_err(|e| werr(&e))?;
     let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
     crate::analysis::run_analysis::write_text(&json_path, &text)?;
     // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them

@@ -152,7 +152,8 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     let mut out = Vec::new();
     for entry in entries.flatten() {
         let path = entry.path();
-        if path.extension().is_none_or(|e| e != "csv") {
+        // A temporary file of a snapshot being written (crate::io::safe_write) is no snapshot yet.
+        if path.extension().is_none_or(|e| e != "csv") || crate::io::safe_write::is_tmp_file(&entry.file_name()) {
             continue;
         }
         // Each is checked whole before its time is believed: a damaged or non-finite one is refused by name,

@@ -69,49 +69,53 @@ impl CheckpointArgs {
     /// ([`crate::io::limits`]), the budget's within [`crate::io::run_budget`]'s, each refused by name otherwise.
     pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
         use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
-        use crate::io::limits::{MAX_SIM_INTERVAL, MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY, MIN_WALL_INTERVAL};
-        use crate::io::run_budget::{MAX_MAX_STEPS, MAX_WALL_BUDGET, MIN_WALL_BUDGET};
-        let checkpoint_every = seconds("--checkpoint-every", self.checkpoint_every, Some("never"), MIN_WALL_INTERVAL)?;
+        use crate::io::limits::{MAX_SIM_INTERVAL, MIN_PROGRESS_EVERY, MIN_WALL_INTERVAL};
+        use crate::io::run_budget::{MAX_WALL_BUDGET, MIN_WALL_BUDGET};
+        let checkpoint_every = seconds(
+            "--checkpoint-every",
+            self.checkpoint_every,
+            Some("never"),
+            MIN_WALL_INTERVAL,
+        )?;
         let checkpoint_every_sim = self
             .checkpoint_every_sim
-            .map(|s| interval("--checkpoint-every-sim", s, 0.0, MAX_SIM_INTERVAL, "simulated seconds", None))
+            .map(|s| {
+                interval(
+                    "--checkpoint-every-sim",
+                    s,
+                    0.0,
+                    MAX_SIM_INTERVAL,
+                    "simulated seconds",
+                    None,
+                )
+            })
             .transpose()?;
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
         let progress_every = match (self.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
             (Some(s), _) => seconds("--progress-every", s, Some("no lines"), MIN_PROGRESS_EVERY)?,
-            (None, Ok(text)) => {
-                let value = text.trim().parse::<f64>().unwrap_or(f64::NAN);
-                seconds(PROGRESS_EVERY_ENV, value, Some("no lines"), MIN_PROGRESS_EVERY).map_err(|_| {
-                    CliError::usage(format!(
-                        "{PROGRESS_EVERY_ENV} must be 0 (no lines) or a number of seconds from {MIN_PROGRESS_EVERY} \
-                         to {MAX_WALL_INTERVAL:e}, got {text:?}"
-                    ))
-                })?
-            }
+            (None, Ok(text)) => crate::driver::progress::every_from_env(&text).map_err(CliError::usage)?,
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
         let max_steps = self
             .max_steps
-            .map(|n| {
-                let whole = n.is_finite() && n.fract() == 0.0 && (1.0..=MAX_MAX_STEPS as f64).contains(&n);
-                if whole {
-                    Ok(n as u64)
-                } else {
-                    Err(CliError::usage(format!(
-                        "--max-steps must be a whole number of steps from 1 to {:e}, got {}",
-                        MAX_MAX_STEPS as f64,
-                        crate::io::scene_file::fmt_num(n)
-                    )))
-                }
-            })
-            .transpose()?;
+            .map(crate::io::run_budget::check_max_steps)
+            .transpose()
+            .map_err(CliError::usage)?;
         let max_wall_seconds = self
             .max_wall_seconds
-            .map(|s| interval("--max-wall-seconds", s, MIN_WALL_BUDGET, MAX_WALL_BUDGET, "seconds", None))
+            .map(|s| {
+                interval(
+                    "--max-wall-seconds",
+                    s,
+                    MIN_WALL_BUDGET,
+                    MAX_WALL_BUDGET,
+                    "seconds",
+                    None,
+                )
+            })
             .transpose()?;
-        debug_assert!(MAX_WALL_BUDGET <= MAX_WALL_INTERVAL);
         Ok(RunOptions {
             force: false,
             progress,
@@ -127,23 +131,14 @@ impl CheckpointArgs {
 }
 
 /// A wall-clock interval option `name` (s): `0` (`off` says what 0 means) or a number in
-/// [`floor`, [`crate::io::limits::MAX_WALL_INTERVAL`]]; otherwise one line naming the option and the range.
+/// [`floor`, [`crate::io::limits::MAX_WALL_INTERVAL`]] ([`crate::io::run_budget::check_interval`]).
 pub(crate) fn seconds(name: &str, value: f64, off: Option<&str>, floor: f64) -> Result<f64, CliError> {
     interval(name, value, floor, crate::io::limits::MAX_WALL_INTERVAL, "seconds", off)
 }
 
-/// `value` of the option `name` when it is in [`lo`, `hi`] (in `unit`), or `0` when `off` says 0 is allowed (and
-/// what it means); otherwise one line naming the option, the range and the value (never a panic, whatever the
-/// value: NaN, infinite, subnormal or huge).
-pub(crate) fn interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off: Option<&str>) -> Result<f64, CliError> {
-    if (off.is_some() && value == 0.0) || (value >= lo && value <= hi) {
-        return Ok(value);
-    }
-    let zero = off.map_or(String::new(), |what| format!("0 ({what}) or "));
-    Err(CliError::usage(format!(
-        "{name} must be {zero}a number of {unit} from {lo} to {hi:e}, got {}",
-        crate::io::scene_file::fmt_num(value)
-    )))
+/// [`crate::io::run_budget::check_interval`] as a usage error.
+fn interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off: Option<&str>) -> Result<f64, CliError> {
+    crate::io::run_budget::check_interval(name, value, lo, hi, unit, off).map_err(CliError::usage)
 }
 
 impl From<crate::bench::BenchError> for CliError {

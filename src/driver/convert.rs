@@ -87,7 +87,10 @@ fn write_particles(path: &Path, t: f64, ps: &[SsParticle]) -> std::io::Result<()
 pub fn convert(input: &Path, output: &Path, spheres: bool, force: bool) -> Result<Converted, ConvertError> {
     // What the output is must be said by its name: a directory or a name without `.csv` or `.ss` is refused before
     // anything is read (a name like `o` once got CSV, and a directory failed only after --force).
-    let by_slash = output.as_os_str().to_string_lossy().ends_with(['/', std::path::MAIN_SEPARATOR]);
+    let by_slash = output
+        .as_os_str()
+        .to_string_lossy()
+        .ends_with(['/', std::path::MAIN_SEPARATOR]);
     if output.is_dir() || by_slash {
         return Err(err(
             output,

@@ -137,6 +137,27 @@ fn read_checkpoint_facts(path: &Path) -> Result<CheckpointFacts, String> {
     })
 }
 
+/// Checks the files `dir`'s manifest records ([`crate::io::manifest::verify_entry`]), as
+/// [`crate::io::manifest::verify_all`] but leaving a missing snapshot or time series to the checks below, which say
+/// what the schedule expected of them.
+fn verify_manifest(dir: &Path) -> Result<Option<usize>, String> {
+    let Some(m) = crate::io::manifest::read(dir)? else {
+        return Ok(None);
+    };
+    let mut verified = 0;
+    for e in &m.entries {
+        // The time series cut short is told below too, against what the checkpoint or summary counts.
+        let short = std::fs::metadata(dir.join(&e.path)).map_or(true, |m| m.len() < e.bytes);
+        let told_below = e.path.starts_with("snapshots/") && !dir.join(&e.path).exists();
+        if told_below || (e.path == "timeseries.csv" && short) {
+            continue;
+        }
+        crate::io::manifest::verify_entry(dir, e)?;
+        verified += 1;
+    }
+    Ok(Some(verified))
+}
+
 /// Checks whether the run directory `dir` is whole (module docs); never writes or locks anything.
 pub fn check_run_dir(dir: &Path) -> RunDirReport {
     let mut report = RunDirReport {
@@ -151,10 +172,10 @@ pub fn check_run_dir(dir: &Path) -> RunDirReport {
         ));
         return report;
     };
-    let manifest = crate::io::manifest::verify_all(dir);
+    let manifest = verify_manifest(dir);
     match &manifest {
         Ok(Some(n)) => report.note(format!(
-            "manifest: the {n} files it records match their sizes and BLAKE3 checksums"
+            "manifest: the {n} files it records that are there match their sizes and BLAKE3 checksums"
         )),
         Ok(None) => report.note(format!(
             "no manifest ({} is missing: a run directory written before rubblepile recorded checksums); its \

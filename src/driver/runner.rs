@@ -297,7 +297,8 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
                 let is_snapshot = name
                     .strip_suffix(".csv")
                     .is_some_and(|stem| !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit()));
-                if is_snapshot {
+                // A killed writer's temporary file goes too (crate::io::safe_write).
+                if is_snapshot || name.starts_with(safe_write::TMP_PREFIX) {
                     std::fs::remove_file(entry.path()).map_err(io_err(&entry.path()))?;
                 }
             }
@@ -444,7 +445,9 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
         timeseries,
     };
     let useful = engine.useful_threads();
-    on_pool(useful, || drive(&mut engine, out_dir, options, start, &identity, &budget))
+    on_pool(useful, || {
+        drive(&mut engine, out_dir, options, start, &identity, &budget)
+    })
 }
 
 /// A step count as people read it: digits below 1e7, `1e9` above.
@@ -614,19 +617,6 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             inspect::describe_missing(dir, &missing, &format!("the checkpoint at t = {} s", ckpt.t))
         )));
     }
-    // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
-    // by row), before anything is continued from them.
-    match crate::io::manifest::verify_all(dir) {
-        Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
-        Ok(Some(_)) => {}
-        Ok(None) => {
-            for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
-                let p = dir.join("snapshots").join(format!("{k}.csv"));
-                crate::io::manifest::check_rows(&p, true)
-                    .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
-            }
-        }
-    }
     let ts_path = dir.join("timeseries.csv");
     match std::fs::metadata(&ts_path) {
         Err(e) => return Err(bad(format!("{}: {e}", ts_path.display()))),
@@ -639,6 +629,19 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
             )));
         }
         Ok(_) => {}
+    }
+    // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
+    // by row), before anything is continued from them.
+    match crate::io::manifest::verify_all(dir) {
+        Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
+        Ok(Some(_)) => {}
+        Ok(None) => {
+            for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
+                let p = dir.join("snapshots").join(format!("{k}.csv"));
+                crate::io::manifest::check_rows(&p, true)
+                    .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
+            }
+        }
     }
     engine
         .restore(

@@ -40,7 +40,8 @@ use std::path::{Path, PathBuf};
 pub const MANIFEST_FILE: &str = "manifest.txt";
 
 /// The first line of a manifest (its format and version).
-const HEADER: &str = "# rubblepile manifest 1: the finished files of this run directory (BLAKE3 of the bytes, bytes, path)";
+const HEADER: &str =
+    "# rubblepile manifest 1: the finished files of this run directory (BLAKE3 of the bytes, bytes, path)";
 
 /// Files at the top of a run directory that grow while the run goes on: recorded at a checkpoint by the bytes they
 /// held then (`+`).
@@ -120,7 +121,9 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
         else {
             return Err(damaged(&format!("malformed line {line:?}")));
         };
-        let bytes = size.parse().map_err(|_| damaged(&format!("malformed size in {line:?}")))?;
+        let bytes = size
+            .parse()
+            .map_err(|_| damaged(&format!("malformed size in {line:?}")))?;
         if hash.len() != 64 || !hash.bytes().all(|b| b.is_ascii_hexdigit()) || !matches!(kind, "=" | "+") {
             return Err(damaged(&format!("malformed line {line:?}")));
         }
@@ -173,7 +176,10 @@ pub fn verify_entry(dir: &Path, entry: &Entry) -> Result<(), String> {
         )
     })?;
     if !meta.is_file() {
-        return Err(format!("{}: not a regular file (the manifest records one)", path.display()));
+        return Err(format!(
+            "{}: not a regular file (the manifest records one)",
+            path.display()
+        ));
     }
     let len = meta.len();
     if len < entry.bytes || (!entry.growing && len != entry.bytes) {
@@ -445,7 +451,11 @@ mod tests {
         r.write(&d, "checkpoint at t = 0 s", false).unwrap();
         assert_eq!(verify_all(&d), Ok(Some(3)), "analysis/ is not recorded");
         std::fs::write(d.join("timeseries.csv"), "t\n0\n1\n").unwrap();
-        assert_eq!(verify_all(&d), Ok(Some(3)), "the time series may grow after a checkpoint");
+        assert_eq!(
+            verify_all(&d),
+            Ok(Some(3)),
+            "the time series may grow after a checkpoint"
+        );
         r.write(&d, "completed", true).unwrap();
         let m = read(&d).unwrap().unwrap();
         assert_eq!(m.state, "completed");
@@ -458,7 +468,10 @@ mod tests {
         assert!(e.contains("snapshots/0.csv: damaged: the BLAKE3 checksum"), "{e}");
         std::fs::write(&snap, "t,x\n0,").unwrap();
         let e = verify_all(&d).unwrap_err();
-        assert!(e.contains("snapshots/0.csv: damaged: 6 bytes, the manifest records 8 (cut short)"), "{e}");
+        assert!(
+            e.contains("snapshots/0.csv: damaged: 6 bytes, the manifest records 8 (cut short)"),
+            "{e}"
+        );
         std::fs::write(&snap, "t,x\n0,1\n").unwrap();
         assert_eq!(verify_all(&d), Ok(Some(3)));
 

@@ -10,6 +10,9 @@
 //!   `--max-wall-seconds`); none by default. The run stops with a checkpoint at the output sample after which the
 //!   next interval would overrun it (judged by the last one), or at the first sample past it.
 //!
+//! [`check_interval`] checks the time options of the command line (cadences, budgets) against their floors and
+//! ceilings ([`crate::io::limits`]).
+//!
 //! A budget stop leaves a checkpoint (unless the run ended first): `rubblepile resume DIR` with a larger budget
 //! continues it, bit for bit as if it had not stopped.
 
@@ -32,6 +35,34 @@ pub const MIN_WALL_BUDGET: f64 = 1.0;
 /// The longest wall-clock budget accepted (s), and the longest wall-clock interval any time option accepts
 /// ([`crate::io::limits::MAX_WALL_INTERVAL`]).
 pub const MAX_WALL_BUDGET: f64 = crate::io::limits::MAX_WALL_INTERVAL;
+
+/// `value` of the time option `name` when it is in [`lo`, `hi`] (in `unit`), or `0` when `off` says 0 is allowed
+/// (and what it means); otherwise one line naming the option, the range and the value, whatever the value (NaN,
+/// infinite, subnormal or huge: nothing converts it before it is checked).
+pub fn check_interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off: Option<&str>) -> Result<f64, String> {
+    if (off.is_some() && value == 0.0) || (value >= lo && value <= hi) {
+        return Ok(value);
+    }
+    let zero = off.map_or(String::new(), |what| format!("0 ({what}) or "));
+    Err(format!(
+        "{name} must be {zero}a number of {unit} from {lo} to {hi:e}, got {}",
+        crate::io::scene_file::fmt_num(value)
+    ))
+}
+
+/// `n` of `--max-steps` as a count of steps: a whole number in [1, [`MAX_MAX_STEPS`]] (given as a number, so that
+/// `1e10` is accepted), or one line saying so.
+pub fn check_max_steps(n: f64) -> Result<u64, String> {
+    if n.is_finite() && n.fract() == 0.0 && (1.0..=MAX_MAX_STEPS as f64).contains(&n) {
+        Ok(n as u64)
+    } else {
+        Err(format!(
+            "--max-steps must be a whole number of steps from 1 to {:e}, got {}",
+            MAX_MAX_STEPS as f64,
+            crate::io::scene_file::fmt_num(n)
+        ))
+    }
+}
 
 /// `[run]` of a scene file. Optional; both keys optional.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
@@ -139,7 +170,10 @@ mod tests {
         let scene = from_scene_text("[scene]\nt_end = 1.0\n[run]\nmax_steps = 5000\nmax_wall_seconds = 60.0\n");
         assert_eq!(scene.max_steps, Some(5000));
         let b = Budget::resolve(scene, None, None);
-        assert_eq!((b.max_steps, b.steps_from, b.max_wall_seconds), (5000, "[run] max_steps", Some(60.0)));
+        assert_eq!(
+            (b.max_steps, b.steps_from, b.max_wall_seconds),
+            (5000, "[run] max_steps", Some(60.0))
+        );
         let b = Budget::resolve(scene, Some(7), Some(2.0));
         assert_eq!((b.max_steps, b.max_wall_seconds), (7, Some(2.0)));
         let b = Budget::resolve(RunSection::default(), None, None);

@@ -226,7 +226,11 @@ impl AtomicFile {
         if durable {
             // Makes the rename durable; not every platform can open a directory, so failures are ignored.
             if let Some(dir) = self.path.parent()
-                && let Ok(d) = File::open(if dir.as_os_str().is_empty() { Path::new(".") } else { dir })
+                && let Ok(d) = File::open(if dir.as_os_str().is_empty() {
+                    Path::new(".")
+                } else {
+                    dir
+                })
             {
                 let _ = d.sync_all();
             }

@@ -108,7 +108,10 @@ pub fn write_figure(
         }
     };
     let mut svg_text = String::new();
-    let drawn = render(&SVGBackend::with_string(&mut svg_text, FIGURE_SIZE).into_drawing_area(), figure);
+    let drawn = render(
+        &SVGBackend::with_string(&mut svg_text, FIGURE_SIZE).into_drawing_area(),
+        figure,
+    );
     if let Err(why) = drawn {
         stale();
         return Err(why);

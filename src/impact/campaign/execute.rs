@@ -149,7 +149,9 @@ pub(crate) fn execute(
             Some(RunNumbers::from(summary.as_ref())),
         ),
         // Stopped on request or by its budget: its checkpoint lets the next campaign run resume it.
-        Ok(Err(ImpactError::Run(RunError::Stopped { .. } | RunError::Budget { .. }))) => (RunStatus::Pending, true, None),
+        Ok(Err(ImpactError::Run(RunError::Stopped { .. } | RunError::Budget { .. }))) => {
+            (RunStatus::Pending, true, None)
+        }
         Ok(Err(e)) => (RunStatus::Failed(e.to_string()), false, None),
         Err(panic) => {
             let what = panic

@@ -150,7 +150,8 @@ pub fn slurm_time_minutes(t: &str) -> Result<u64, String> {
 /// The memory `m` (`sbatch --mem`) in MB, or why it is not a whole number with an optional unit `K`, `M`, `G` or
 /// `T` (a bare number is MB) of at most [`MAX_MEM_MB`] MB. `0` (all of a node's memory, in Slurm) is accepted.
 pub fn slurm_mem_mb(m: &str) -> Result<u64, String> {
-    let form = || "must be a whole number with an optional unit K, M, G or T (e.g. 4G; a bare number is MB)".to_string();
+    let form =
+        || "must be a whole number with an optional unit K, M, G or T (e.g. 4G; a bare number is MB)".to_string();
     let (digits, unit) = match m.as_bytes().last() {
         Some(b'K' | b'M' | b'G' | b'T') => (&m[..m.len() - 1], &m[m.len() - 1..]),
         _ => (m, "M"),
@@ -262,7 +263,13 @@ pub fn slurm_script(runs: usize, paths: &SlurmPaths, job: &SlurmJob) -> String {
         .file_stem()
         .map_or("campaign".into(), |s| s.to_string_lossy().into_owned())
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || "_.-".contains(c) { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "_.-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     let tasks = job.tasks;
     let mut options = String::new();
@@ -331,8 +338,18 @@ mod tests {
             assert_eq!(slurm_time_minutes(t), Ok(minutes), "{t}");
         }
         for t in [
-            "1:99:99", "1-25:00", "1-", "-1", "2 hours", "1:2:3:4", "10:60", "366-0", "", "99999999999999999999",
-            "1-1:1:1:1", "+5",
+            "1:99:99",
+            "1-25:00",
+            "1-",
+            "-1",
+            "2 hours",
+            "1:2:3:4",
+            "10:60",
+            "366-0",
+            "",
+            "99999999999999999999",
+            "1-1:1:1:1",
+            "+5",
         ] {
             assert!(slurm_time_minutes(t).is_err(), "{t} accepted");
         }
