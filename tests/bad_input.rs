@@ -261,10 +261,8 @@ fn every_bad_input_gets_one_clear_error() {
             Some(format!("error does not name {:?}: {}", case.expect, errors[0]))
         } else if looks_finished(&out) {
             Some("left an output directory that looks finished".to_string())
-        } else if let Some(target) = written_through {
-            Some(format!("wrote through a link into {target}"))
         } else {
-            None
+            written_through.map(|target| format!("wrote through a link into {target}"))
         };
         if let Some(p) = problem {
             failures.push(format!("{} ({}): {p}", case.name, case.kind));

@@ -351,7 +351,8 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     let v_inf = args.v_inf_km_s * 1e3;
     // e − 1 = q v∞²/GM: below MIN_HYPERBOLIC_EXCESS the orbit is parabolic to rounding (and the time to perigee
     // unbounded), which is the speed's fault, not the perigee's.
-    if gm > 0.0 && !(args.q_m * v_inf * v_inf / gm >= MIN_HYPERBOLIC_EXCESS) {
+    let excess = args.q_m * v_inf * v_inf / gm;
+    if gm > 0.0 && (excess.is_nan() || excess < MIN_HYPERBOLIC_EXCESS) {
         return Err(invalid(
             "v_inf_km_s",
             format!(
@@ -371,7 +372,7 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     );
     if let Some(p) = args.period_hours {
         let steps = crate::ellipsoid::scene::STEPS_PER_TIME_SCALE * settle_max_time / (p * 3600.0);
-        if !(steps <= crate::io::run_budget::DEFAULT_MAX_STEPS as f64) {
+        if steps.is_nan() || steps > crate::io::run_budget::DEFAULT_MAX_STEPS as f64 {
             return Err(invalid(
                 "period_hours",
                 format!(
