@@ -89,8 +89,9 @@ fn refused_through_link(base: &Path, run: &Path, rel: &str, dir_link: bool, args
     std::fs::remove_file(&link).unwrap();
 }
 
-/// A finished run of `engine`'s base scene in `base/<name>` with a checkpoint, extra snapshot formats `formats`.
-fn finished(base: &Path, engine: &str, replace: &[(&str, &str)], name: &str, formats: &[&str]) -> PathBuf {
+/// Runs `engine`'s base scene (with `replace`) into `base/<name>`, with `extra` arguments and checkpoints every
+/// quarter or so of its simulated time; returns the directory and what the command did.
+fn run_into(base: &Path, engine: &str, replace: &[(&str, &str)], name: &str, extra: &[&str]) -> (PathBuf, Output) {
     let sc = scene(base, engine, replace);
     let out = base.join(name);
     let every = match engine {
@@ -107,32 +108,23 @@ fn finished(base: &Path, engine: &str, replace: &[(&str, &str)], name: &str, for
         "--checkpoint-every-sim",
         every,
     ];
-    for f in formats {
-        args.extend(["--format", f]);
-    }
+    args.extend(extra);
     let o = rubblepile(base, &args);
+    (out, o)
+}
+
+/// A finished run of `engine`'s base scene in `base/<name>` with a checkpoint, extra snapshot formats `formats`.
+fn finished(base: &Path, engine: &str, replace: &[(&str, &str)], name: &str, formats: &[&str]) -> PathBuf {
+    let extra: Vec<&str> = formats.iter().flat_map(|f| ["--format", f]).collect();
+    let (out, o) = run_into(base, engine, replace, name, &extra);
     assert!(o.status.success(), "{engine}: {}", describe(&o));
     out
 }
 
 /// The ellipsoid run stopped right after its first checkpoint (t = 25 s of 60; snapshots 0 and 1 written).
 fn stopped(base: &Path, name: &str) -> PathBuf {
-    let sc = scene(base, "ellipsoids", &[("every = 1.0", "every = 1.0\ntrack = [0]")]);
-    let out = base.join(name);
-    let o = rubblepile(
-        base,
-        &[
-            "run",
-            s(&sc),
-            "--out",
-            s(&out),
-            "--no-progress",
-            "--checkpoint-every-sim",
-            "25",
-            "--stop-after-checkpoints",
-            "1",
-        ],
-    );
+    let track = [("every = 1.0", "every = 1.0\ntrack = [0]")];
+    let (out, o) = run_into(base, "ellipsoids", &track, name, &["--stop-after-checkpoints", "1"]);
     assert_eq!(o.status.code(), Some(3), "{}", describe(&o));
     out
 }
@@ -256,27 +248,6 @@ fn flip(path: &Path) {
     std::fs::write(path, b).unwrap();
 }
 
-/// Every file below `dir` but the lock files (the pid of the last writer, no record of the run), relative.
-fn run_files(dir: &Path) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let e = e.unwrap();
-            if rubblepile::io::run_lock::is_lock_file(&e.file_name()) {
-                continue;
-            }
-            if e.file_type().unwrap().is_dir() {
-                stack.push(e.path());
-            } else {
-                out.push(e.path().strip_prefix(dir).unwrap().display().to_string());
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 #[test]
 fn check_finds_a_single_flipped_byte_in_any_file_of_a_finished_run_of_each_engine() {
     let base = temp_dir("flip");
@@ -295,7 +266,11 @@ fn check_finds_a_single_flipped_byte_in_any_file_of_a_finished_run_of_each_engin
             "{}",
             describe(&o)
         );
-        let files = run_files(run);
+        // Every file but the lock files (the pid of the last writer, no record of the run).
+        let files: Vec<String> = common::files_below(run)
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
         for must in [
             "checkpoint.json",
             "summary.json",
