@@ -69,76 +69,35 @@ impl CheckpointArgs {
     /// ([`crate::io::limits`]), the budget's within [`crate::io::run_budget`]'s, each refused by name otherwise.
     pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
         use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
-        use crate::io::limits::{MAX_SIM_INTERVAL, MIN_PROGRESS_EVERY, MIN_WALL_INTERVAL};
-        use crate::io::run_budget::{MAX_WALL_BUDGET, MIN_WALL_BUDGET};
-        let checkpoint_every = seconds(
-            "--checkpoint-every",
-            self.checkpoint_every,
-            Some("never"),
-            MIN_WALL_INTERVAL,
-        )?;
-        let checkpoint_every_sim = self
-            .checkpoint_every_sim
-            .map(|s| {
-                interval(
-                    "--checkpoint-every-sim",
-                    s,
-                    0.0,
-                    MAX_SIM_INTERVAL,
-                    "simulated seconds",
-                    None,
-                )
-            })
-            .transpose()?;
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
-        let progress_every = match (self.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
-            (Some(s), _) => seconds("--progress-every", s, Some("no lines"), MIN_PROGRESS_EVERY)?,
+        let t = crate::io::run_budget::TimeOptions {
+            checkpoint_every: self.checkpoint_every,
+            checkpoint_every_sim: self.checkpoint_every_sim,
+            progress_every: self.progress_every,
+            max_steps: self.max_steps,
+            max_wall_seconds: self.max_wall_seconds,
+        }
+        .check()
+        .map_err(CliError::usage)?;
+        let progress_every = match (t.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
+            (Some(s), _) => s,
             (None, Ok(text)) => crate::driver::progress::every_from_env(&text).map_err(CliError::usage)?,
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
-        let max_steps = self
-            .max_steps
-            .map(crate::io::run_budget::check_max_steps)
-            .transpose()
-            .map_err(CliError::usage)?;
-        let max_wall_seconds = self
-            .max_wall_seconds
-            .map(|s| {
-                interval(
-                    "--max-wall-seconds",
-                    s,
-                    MIN_WALL_BUDGET,
-                    MAX_WALL_BUDGET,
-                    "seconds",
-                    None,
-                )
-            })
-            .transpose()?;
         Ok(RunOptions {
             force: false,
             progress,
-            checkpoint_every: (checkpoint_every > 0.0).then_some(checkpoint_every),
-            checkpoint_every_sim,
+            checkpoint_every: (t.checkpoint_every > 0.0).then_some(t.checkpoint_every),
+            checkpoint_every_sim: t.checkpoint_every_sim,
             formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
             progress_every,
             stop_after_checkpoints: self.stop_after_checkpoints,
-            max_steps,
-            max_wall_seconds,
+            max_steps: t.max_steps.map(|n| n as u64),
+            max_wall_seconds: t.max_wall_seconds,
         })
     }
-}
-
-/// A wall-clock interval option `name` (s): `0` (`off` says what 0 means) or a number in
-/// [`floor`, [`crate::io::limits::MAX_WALL_INTERVAL`]] ([`crate::io::run_budget::check_interval`]).
-pub(crate) fn seconds(name: &str, value: f64, off: Option<&str>, floor: f64) -> Result<f64, CliError> {
-    interval(name, value, floor, crate::io::limits::MAX_WALL_INTERVAL, "seconds", off)
-}
-
-/// [`crate::io::run_budget::check_interval`] as a usage error.
-fn interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off: Option<&str>) -> Result<f64, CliError> {
-    crate::io::run_budget::check_interval(name, value, lo, hi, unit, off).map_err(CliError::usage)
 }
 
 impl From<crate::bench::BenchError> for CliError {

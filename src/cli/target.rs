@@ -223,12 +223,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    crate::cli::common::seconds(
-        "--checkpoint-every",
-        args.checkpoint_every,
-        Some("at every relaxation check"),
-        crate::io::limits::MIN_WALL_INTERVAL,
-    )?;
+    crate::io::run_budget::check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
+        .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
         Some(read_checkpoint(&checkpoint_file)?)

@@ -50,6 +50,78 @@ pub fn check_interval(name: &str, value: f64, lo: f64, hi: f64, unit: &str, off:
     ))
 }
 
+/// A wall-clock cadence option `name` (s): 0 (`off` says what 0 means) or [`crate::io::limits::MIN_WALL_INTERVAL`]
+/// to [`crate::io::limits::MAX_WALL_INTERVAL`] ([`check_interval`]).
+pub fn check_wall_seconds(name: &str, value: f64, off: &str) -> Result<f64, String> {
+    use crate::io::limits::{MAX_WALL_INTERVAL, MIN_WALL_INTERVAL};
+    check_interval(name, value, MIN_WALL_INTERVAL, MAX_WALL_INTERVAL, "seconds", Some(off))
+}
+
+/// The time options and the budget of a run as the command line gives them (`--checkpoint-every`,
+/// `--checkpoint-every-sim`, `--progress-every`, `--max-steps`, `--max-wall-seconds`), before they are checked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TimeOptions {
+    /// Wall-clock checkpoint cadence (s; 0 = never).
+    pub checkpoint_every: f64,
+    /// Simulated-time checkpoint cadence (s).
+    pub checkpoint_every_sim: Option<f64>,
+    /// Seconds between progress lines (0 = none).
+    pub progress_every: Option<f64>,
+    /// Most steps (a whole number, given as a number).
+    pub max_steps: Option<f64>,
+    /// Most wall-clock seconds.
+    pub max_wall_seconds: Option<f64>,
+}
+
+impl TimeOptions {
+    /// The options checked against their floors and ceilings ([`crate::io::limits`], this module), the first one
+    /// outside them refused in one line naming it; `checkpoint_every` 0 becomes `None` (never).
+    pub fn check(&self) -> Result<TimeOptions, String> {
+        use crate::io::limits::{MAX_SIM_INTERVAL, MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY};
+        let every = check_wall_seconds("--checkpoint-every", self.checkpoint_every, "never")?;
+        let sim = |s| {
+            check_interval(
+                "--checkpoint-every-sim",
+                s,
+                0.0,
+                MAX_SIM_INTERVAL,
+                "simulated seconds",
+                None,
+            )
+        };
+        let progress = |s| {
+            check_interval(
+                "--progress-every",
+                s,
+                MIN_PROGRESS_EVERY,
+                MAX_WALL_INTERVAL,
+                "seconds",
+                Some("no lines"),
+            )
+        };
+        let wall = |s| {
+            check_interval(
+                "--max-wall-seconds",
+                s,
+                MIN_WALL_BUDGET,
+                MAX_WALL_BUDGET,
+                "seconds",
+                None,
+            )
+        };
+        Ok(TimeOptions {
+            checkpoint_every: every,
+            checkpoint_every_sim: self.checkpoint_every_sim.map(sim).transpose()?,
+            progress_every: self.progress_every.map(progress).transpose()?,
+            max_steps: self
+                .max_steps
+                .map(|n| check_max_steps(n).map(|n| n as f64))
+                .transpose()?,
+            max_wall_seconds: self.max_wall_seconds.map(wall).transpose()?,
+        })
+    }
+}
+
 /// `n` of `--max-steps` as a count of steps: a whole number in [1, [`MAX_MAX_STEPS`]] (given as a number, so that
 /// `1e10` is accepted), or one line saying so.
 pub fn check_max_steps(n: f64) -> Result<u64, String> {
