@@ -2,7 +2,9 @@
 //! files, campaign files, aggregate and spin-up options, and damaged checkpoints, each run through the binary. Every
 //! case must end with a non-zero exit code (not a signal), a one-line `error: …` naming what it expects, no panic,
 //! and no output directory that a later run would take for a finished one. `files` may name files in folders (the
-//! folders are created).
+//! folders are created); `env` sets environment variables of the command; `links` plants symbolic links (the link,
+//! `OUT` for the output directory, to a target in the case directory that the harness creates holding `precious`
+//! and checks is untouched after the command: nothing may be written through a link).
 
 mod common;
 use common::temp_dir;
@@ -29,6 +31,10 @@ struct Case {
     damage: Option<Damage>,
     #[serde(default)]
     files: BTreeMap<String, String>,
+    #[serde(default)]
+    env: BTreeMap<String, String>,
+    #[serde(default)]
+    links: BTreeMap<String, String>,
 }
 
 #[derive(Debug, serde::Deserialize)]
@@ -44,11 +50,22 @@ fn root() -> PathBuf {
 }
 
 fn rubblepile(cwd: &Path, args: &[String]) -> std::process::Output {
+    rubblepile_with(cwd, args, &BTreeMap::new())
+}
+
+fn rubblepile_with(cwd: &Path, args: &[String], env: &BTreeMap<String, String>) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_rubblepile"))
         .args(args)
+        .envs(env)
         .current_dir(cwd)
         .output()
         .expect("run the binary")
+}
+
+/// The link of a `links` entry (`OUT` is the output directory) and its target, in the case directory `dir`.
+fn link_paths(dir: &Path, out: &Path, link: &str, target: &str) -> (PathBuf, PathBuf) {
+    let link = link.replace("OUT", &out.display().to_string());
+    (dir.join(link), dir.join(target))
 }
 
 /// Whether `out` holds a run that claims to have completed.
@@ -107,7 +124,21 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
             ));
         }
         let ckpt = out.join("checkpoint.json");
-        let damage = case.damage.as_ref().ok_or("prepare = \"checkpoint\" needs a damage")?;
+        let none = Damage {
+            op: "none".into(),
+            from: None,
+            to: None,
+        };
+        let damage = match (&case.damage, case.links.is_empty()) {
+            (Some(d), _) => d,
+            (None, false) => &none,
+            (None, true) => return Err("prepare = \"checkpoint\" needs a damage (or links)".into()),
+        };
+        // A damaged file is found by the run's manifest first (issue 53); the damages below stand for run
+        // directories written before it, whose files are checked on their own (`flip-snapshot` keeps it).
+        if !matches!(damage.op.as_str(), "flip-snapshot" | "none") {
+            std::fs::remove_file(out.join("manifest.txt")).map_err(|e| e.to_string())?;
+        }
         match damage.op.as_str() {
             "truncate" => {
                 let b = std::fs::read(&ckpt).map_err(|e| e.to_string())?;
@@ -131,6 +162,31 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
                 std::fs::write(out.join("timeseries.csv"), "t\n").map_err(|e| e.to_string())?;
             }
             "delete-snapshots" => std::fs::remove_dir_all(out.join("snapshots")).map_err(|e| e.to_string())?,
+            "none" => {}
+            // Snapshot 0 cut 7 bytes short, mid-number (a run directory without a manifest).
+            "cut-snapshot" => {
+                let p = out.join("snapshots").join("0.csv");
+                let b = std::fs::read(&p).map_err(|e| e.to_string())?;
+                std::fs::write(&p, &b[..b.len() - 7]).map_err(|e| e.to_string())?;
+            }
+            // The first number of snapshot 0's last row made NaN (a run directory without a manifest).
+            "nan-snapshot" => {
+                let p = out.join("snapshots").join("0.csv");
+                let t = std::fs::read_to_string(&p).map_err(|e| e.to_string())?;
+                let mut lines: Vec<String> = t.lines().map(str::to_string).collect();
+                let last = lines.last_mut().ok_or("empty snapshot")?;
+                let rest = last.split_once(',').map_or(String::new(), |(_, r)| r.to_string());
+                *last = format!("NaN,{rest}");
+                std::fs::write(&p, lines.join("\n") + "\n").map_err(|e| e.to_string())?;
+            }
+            // One bit of snapshot 0 flipped, the manifest kept: the manifest names it.
+            "flip-snapshot" => {
+                let p = out.join("snapshots").join("0.csv");
+                let mut b = std::fs::read(&p).map_err(|e| e.to_string())?;
+                let i = b.len() / 2;
+                b[i] ^= 0x04;
+                std::fs::write(&p, b).map_err(|e| e.to_string())?;
+            }
             // Another writer: this process holds the directory's lock until the case has run.
             "hold-lock" => {
                 let lock = rubblepile::io::run_lock::DirLock::acquire(out).map_err(|e| e.to_string())?;
@@ -138,6 +194,22 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
             }
             other => return Err(format!("unknown damage {other:?}")),
         }
+    }
+    for (link, target) in &case.links {
+        let (link, target) = link_paths(dir, out, link, target);
+        if let Some(parent) = target.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| e.to_string())?;
+        }
+        std::fs::write(&target, "precious").map_err(|e| e.to_string())?;
+        if link.is_dir() && !link.is_symlink() {
+            std::fs::remove_dir_all(&link).map_err(|e| e.to_string())?;
+        } else if link.symlink_metadata().is_ok() {
+            std::fs::remove_file(&link).map_err(|e| e.to_string())?;
+        }
+        if let Some(parent) = link.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| e.to_string())?;
+        }
+        std::os::unix::fs::symlink(&target, &link).map_err(|e| e.to_string())?;
     }
     Ok(())
 }
@@ -163,10 +235,18 @@ fn every_bad_input_gets_one_clear_error() {
             .as_ref()
             .unwrap_or(&default_args)
             .iter()
-            .map(|a| a.replace("SCENE", "scene.toml").replace("OUT", &out_s))
+            .map(|a| {
+                a.replace("SCENE", "scene.toml")
+                    .replace("OUT", &out_s)
+                    .replace("ROOT", &root().display().to_string())
+            })
             .collect();
-        let o = rubblepile(&dir, &args);
+        let o = rubblepile_with(&dir, &args, &case.env);
         HELD.lock().unwrap().take();
+        let written_through = case.links.iter().find_map(|(link, target)| {
+            let (_, target) = link_paths(&dir, &out, link, target);
+            (std::fs::read_to_string(&target).ok().as_deref() != Some("precious")).then(|| target.display().to_string())
+        });
         let stderr = String::from_utf8_lossy(&o.stderr);
         let errors: Vec<&str> = stderr.lines().filter(|l| l.starts_with("error: ")).collect();
         let problem = if o.status.code().is_none() {
@@ -182,7 +262,7 @@ fn every_bad_input_gets_one_clear_error() {
         } else if looks_finished(&out) {
             Some("left an output directory that looks finished".to_string())
         } else {
-            None
+            written_through.map(|target| format!("wrote through a link into {target}"))
         };
         if let Some(p) = problem {
             failures.push(format!("{} ({}): {p}", case.name, case.kind));

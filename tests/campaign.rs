@@ -891,7 +891,7 @@ fn slurm_script_carries_the_scheduler_options() {
     assert!(srun[0].starts_with("srun /opt/rp/bin/rubblepile campaign "), "{script}");
     assert!(srun[0].contains("--shard $SLURM_ARRAY_TASK_ID/8"), "{script}");
     assert!(
-        script.contains("--wrap \"/opt/rp/bin/rubblepile campaign merge"),
+        script.contains("--wrap '/opt/rp/bin/rubblepile campaign merge"),
         "{script}"
     );
 

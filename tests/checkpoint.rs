@@ -340,6 +340,8 @@ fn checkpoint_of_the_crates_dop853_is_refused_with_one_line() {
     *integrator = serde_json::to_value(old.save_state()).unwrap();
     assert_eq!(integrator["kind"], "ode-solvers");
     std::fs::write(&path, serde_json::to_string_pretty(&checkpoint).unwrap()).unwrap();
+    // The manifest (issue 53) would name the edited checkpoint as damaged: a run of that time had none.
+    std::fs::remove_file(dir.join("x").join("manifest.txt")).unwrap();
     let out = rubblepile(&dir, &["resume", "x", "--no-progress"]);
     assert_one_line_error(&out, 2, "`ode_solvers` crate's Dop853", "old Dop853 checkpoint");
     assert!(

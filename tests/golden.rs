@@ -118,10 +118,10 @@ fn check_case(name: &str, cwd: &Path, args: &[&str]) {
     let expected_dir = root().join("tests/golden").join(name).join("expected");
     let produced: Vec<PathBuf> = files(&out)
         .into_iter()
-        // The checkpoint and the directory's lock files are no outputs of the physics.
+        // The checkpoint, the manifest of checksums and the directory's lock files are no outputs of the physics.
         .filter(|p| {
             p.file_name()
-                .is_some_and(|f| f != "checkpoint.json" && !is_lock_file(f))
+                .is_some_and(|f| f != "checkpoint.json" && f != "manifest.txt" && !is_lock_file(f))
         })
         .collect();
     if std::env::var_os("RUBBLEPILE_BLESS_GOLDEN").is_some() {

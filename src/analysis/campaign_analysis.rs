@@ -137,25 +137,24 @@ pub fn analyze_campaign(
         q_star_d,
         spin_distributions,
     };
-    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
         path: out_dir.clone(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     })?;
     let csv_path = out_dir.join("campaign_runs.csv");
     let werr = |e: &dyn std::fmt::Display| AnalysisError::Read {
         path: csv_path.clone(),
         reason: e.to_string(),
     };
-    let mut w = csv::Writer::from_path(&csv_path).map_err(|e| werr(&e))?;
+    let file =
+        crate::io::safe_write::AtomicFile::create(&csv_path).map_err(|e| werr(&crate::io::safe_write::reason(&e)))?;
+    let mut w = csv::Writer::from_writer(file);
     for r in &analysis.runs {
         w.serialize(r).map_err(|e| werr(&e))?;
     }
-    w.flush().map_err(|e| werr(&e))?;
+    w.into_inner().map_err(|e| werr(&e))?.finish().map_err(|e| werr(&e))?;
     let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
-        path: json_path.clone(),
-        reason: e.to_string(),
-    })?;
+    crate::analysis::run_analysis::write_text(&json_path, &text)?;
     // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them
     let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
     for why in &not_drawn {

@@ -390,11 +390,14 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
     };
     let out = dir.join("analysis");
     let path = out.join("flyby.json");
-    std::fs::create_dir_all(&out)
-        .and_then(|_| std::fs::write(&path, serde_json::to_string_pretty(&outcome).unwrap_or_default() + "\n"))
+    crate::io::safe_write::ensure_dir(&out)
+        .and_then(|_| {
+            let text = serde_json::to_string_pretty(&outcome).unwrap_or_default() + "\n";
+            crate::io::safe_write::write_atomic(&path, text)
+        })
         .map_err(|e| FlybyAnalysisError::File {
             path: path.clone(),
-            message: e.to_string(),
+            message: crate::io::safe_write::reason(&e),
         })?;
     Ok(outcome)
 }

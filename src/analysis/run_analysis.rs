@@ -31,6 +31,12 @@ pub enum AnalysisError {
         /// What went wrong.
         reason: String,
     },
+    /// A file of the run is damaged (its manifest's checksum, a row cut short, a non-finite number).
+    #[error("{reason}; not analysed")]
+    Damaged {
+        /// What is wrong, naming the file.
+        reason: String,
+    },
     /// No snapshot at the requested time.
     #[error("{dir}: no snapshot at t = {t} s (snapshots at {available:?} s)")]
     NoSnapshot {
@@ -130,6 +136,12 @@ pub(crate) fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError>
     serde_json::from_str(&text).map_err(|e| err(e.to_string()))
 }
 
+/// Refuses a snapshot of the run in `dir` that its manifest says is damaged, or that is cut short or holds a
+/// non-finite number ([`crate::io::manifest::verify_file`]): one line naming it, never an analysis of it.
+fn verified(dir: &Path, snapshot: &Path) -> Result<(), AnalysisError> {
+    crate::io::manifest::verify_file(dir, snapshot, true).map_err(|reason| AnalysisError::Damaged { reason })
+}
+
 /// Snapshot times of a run directory, from the first line of each `snapshots/<k>.csv`.
 fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     let snaps = dir.join("snapshots");
@@ -140,9 +152,13 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     let mut out = Vec::new();
     for entry in entries.flatten() {
         let path = entry.path();
-        if path.extension().is_none_or(|e| e != "csv") {
+        // A temporary file of a snapshot being written (crate::io::safe_write) is no snapshot yet.
+        if path.extension().is_none_or(|e| e != "csv") || crate::io::safe_write::is_tmp_file(&entry.file_name()) {
             continue;
         }
+        // Each is checked whole before its time is believed: a damaged or non-finite one is refused by name,
+        // never passed over for another.
+        verified(dir, &path)?;
         let mut rdr = csv::Reader::from_path(&path).map_err(|e| AnalysisError::Read {
             path: path.clone(),
             reason: e.to_string(),
@@ -247,6 +263,7 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         find(t_at).ok_or_else(|| missing(t_at))?,
     );
     let read = |p: &Path| {
+        verified(dir, p)?;
         read_snapshot_bodies(p).map_err(|e| AnalysisError::Read {
             path: p.to_path_buf(),
             reason: e.to_string(),
@@ -291,9 +308,9 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
         clumps: clump_report.summary(),
         clump_report,
     };
-    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Read {
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
         path: out_dir.clone(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     })?;
     write_fragments_csv(&csv_path, &report)?;
     if let Some(c) = &analysis.composition {
@@ -301,17 +318,15 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
     }
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
     let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    std::fs::write(&json_path, text).map_err(|e| AnalysisError::Read {
-        path: json_path.clone(),
-        reason: e.to_string(),
-    })?;
+    write_text(&json_path, &text)?;
     Ok((analysis, report))
 }
 
-fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
-    std::fs::write(path, text).map_err(|e| AnalysisError::Write {
+/// Writes `text` to `path` atomically, never through a link ([`crate::io::safe_write`]).
+pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
+    crate::io::safe_write::write_atomic(path, text).map_err(|e| AnalysisError::Write {
         path: path.to_path_buf(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     })
 }
 
@@ -337,6 +352,7 @@ fn run_snapshot_bodies(
         reason,
     };
     let text = std::fs::read_to_string(&scene_path).map_err(|e| read_err(&scene_path, e.to_string()))?;
+    verified(dir, snapshot)?;
     match SceneKind::of_text(&text) {
         SceneKind::Ellipsoids => {
             let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
@@ -409,9 +425,9 @@ pub fn analyze_clumps_run(dir: &Path, t_at: Option<f64>, force: bool) -> Result<
         clumps: report.summary(),
         clump_report: report,
     };
-    std::fs::create_dir_all(&out_dir).map_err(|e| AnalysisError::Write {
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
         path: out_dir.clone(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     })?;
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
     write_text(
@@ -433,10 +449,7 @@ fn write_composition_csv(path: &Path, c: &Composition) -> Result<(), AnalysisErr
         let clump = &c.clumps[k];
         text += &format!("{i},{origin},{k},{},{:e}\n", clump.bound, clump.projectile_fraction);
     }
-    std::fs::write(path, text).map_err(|e| AnalysisError::Write {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    })
+    write_text(path, &text)
 }
 
 /// `fragments.csv`: one row per body.
@@ -445,7 +458,8 @@ fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), Analy
         path: path.to_path_buf(),
         reason: e.to_string(),
     };
-    let mut w = csv::Writer::from_path(path).map_err(|e| err(&e))?;
+    let file = crate::io::safe_write::AtomicFile::create(path).map_err(|e| err(&crate::io::safe_write::reason(&e)))?;
+    let mut w = csv::Writer::from_writer(file);
     w.write_record([
         "index",
         "is_projectile",
@@ -498,7 +512,7 @@ fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), Analy
         ])
         .map_err(|e| err(&e))?;
     }
-    w.flush().map_err(|e| err(&e))
+    w.into_inner().map_err(|e| err(&e))?.finish().map_err(|e| err(&e))
 }
 
 /// One analysed run of a campaign (a row of `campaign_runs.csv`). Exponents and fit results are empty when the

@@ -34,11 +34,12 @@ impl CliError {
 /// gets a progress line.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CheckpointArgs {
-    /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never).
+    /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never; else 0.001 to
+    /// 1e7).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
     /// Also checkpoint at the first output sample SECONDS of simulated time after the last
-    /// checkpoint (0 = at every output sample).
+    /// checkpoint (0 = at every output sample; at most 1e18).
     #[arg(long, value_name = "SECONDS")]
     pub checkpoint_every_sim: Option<f64>,
     /// Extra snapshot format(s) beside the CSV snapshots, e.g. `--format xyz` (extended XYZ for OVITO/VMD/ASE);
@@ -46,60 +47,55 @@ pub struct CheckpointArgs {
     #[arg(long, value_name = "NAME")]
     pub format: Vec<String>,
     /// When stderr is not a terminal (a batch log): a progress line (t, %, ETA, the energy error) every SECONDS
-    /// of wall-clock time, 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the bar is shown.
+    /// of wall-clock time (0.1 to 1e7), 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the
+    /// bar is shown.
     #[arg(long, value_name = "SECONDS")]
     pub progress_every: Option<f64>,
+    /// Most steps the run may take, over the scene's `[run] max_steps` [default: the scene's, else 1e9]: a scene
+    /// estimated to need more is refused; a run reaching it stops with a checkpoint (exit code 3).
+    #[arg(long, value_name = "N")]
+    pub max_steps: Option<f64>,
+    /// Most wall-clock seconds this process may run, over the scene's `[run] max_wall_seconds` [default: none]:
+    /// the run stops with a checkpoint at the output sample before it would overrun (exit code 3).
+    #[arg(long, value_name = "SECONDS")]
+    pub max_wall_seconds: Option<f64>,
     /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
     #[arg(long, value_name = "N", hide = true)]
     pub stop_after_checkpoints: Option<u64>,
 }
 
 impl CheckpointArgs {
-    /// The run options these arguments ask for.
+    /// The run options these arguments ask for: every time option within its floor and ceiling
+    /// ([`crate::io::limits`]), the budget's within [`crate::io::run_budget`]'s, each refused by name otherwise.
     pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
-        let ok = |v: f64| v.is_finite() && v >= 0.0;
-        if !ok(self.checkpoint_every) {
-            return Err(CliError::usage(format!(
-                "--checkpoint-every must be a finite number of seconds >= 0, got {}",
-                self.checkpoint_every
-            )));
-        }
-        if let Some(s) = self.checkpoint_every_sim
-            && !ok(s)
-        {
-            return Err(CliError::usage(format!(
-                "--checkpoint-every-sim must be a finite number of seconds >= 0, got {s}"
-            )));
-        }
+        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
-        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
-        let progress_every = match (self.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
-            (Some(s), _) if ok(s) => s,
-            (Some(s), _) => {
-                return Err(CliError::usage(format!(
-                    "--progress-every must be a finite number of seconds >= 0, got {s}"
-                )));
-            }
-            (None, Ok(text)) => match text.trim().parse::<f64>() {
-                Ok(s) if ok(s) => s,
-                _ => {
-                    return Err(CliError::usage(format!(
-                        "{PROGRESS_EVERY_ENV} must be a finite number of seconds >= 0, got {text:?}"
-                    )));
-                }
-            },
+        let t = crate::io::run_budget::TimeOptions {
+            checkpoint_every: self.checkpoint_every,
+            checkpoint_every_sim: self.checkpoint_every_sim,
+            progress_every: self.progress_every,
+            max_steps: self.max_steps,
+            max_wall_seconds: self.max_wall_seconds,
+        }
+        .check()
+        .map_err(CliError::usage)?;
+        let progress_every = match (t.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
+            (Some(s), _) => s,
+            (None, Ok(text)) => crate::driver::progress::every_from_env(&text).map_err(CliError::usage)?,
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
         Ok(RunOptions {
             force: false,
             progress,
-            checkpoint_every: (self.checkpoint_every > 0.0).then_some(self.checkpoint_every),
-            checkpoint_every_sim: self.checkpoint_every_sim,
+            checkpoint_every: (t.checkpoint_every > 0.0).then_some(t.checkpoint_every),
+            checkpoint_every_sim: t.checkpoint_every_sim,
             formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
             progress_every,
             stop_after_checkpoints: self.stop_after_checkpoints,
+            max_steps: t.max_steps.map(|n| n as u64),
+            max_wall_seconds: t.max_wall_seconds,
         })
     }
 }

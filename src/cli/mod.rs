@@ -104,7 +104,7 @@ pub enum Command {
     /// Run a tidal flyby of a target pile past a planet (default Earth); analysis in DIR/analysis/flyby.json.
     Flyby(Box<crate::impact::flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
-    Campaign(campaign::CampaignArgs),
+    Campaign(Box<campaign::CampaignArgs>),
     /// Analyse a run: clumps of any run (largest and second remnant, clumps.csv, sfd.svg); of an impact run also the
     /// per-fragment table and per-run results (Roig03 §4); of a flyby run its state before and after (flyby.json).
     Analyze(analyze::AnalyzeArgs),

@@ -140,7 +140,8 @@ pub struct BuildArgs {
     /// Continue an interrupted build from `FILE.checkpoint.json` (same options as the interrupted build).
     #[arg(long, conflicts_with = "force")]
     pub resume: bool,
-    /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s).
+    /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s; 0 = at
+    /// every check, else 0.001 to 1e7).
     #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
 }
@@ -162,11 +163,9 @@ fn read_checkpoint(path: &Path) -> Result<BuildCheckpoint, CliError> {
         .map_err(|e| CliError::usage(format!("--resume: {} is not a target checkpoint: {e}", path.display())))
 }
 
-/// Writes a checkpoint atomically (a temporary file renamed over the old one).
+/// Writes a checkpoint atomically, never through a link ([`crate::io::safe_write`]).
 fn write_checkpoint(path: &Path, checkpoint: &BuildCheckpoint) -> std::io::Result<()> {
-    let tmp = path.with_extension("checkpoint.json.tmp");
-    std::fs::write(&tmp, serde_json::to_string(checkpoint)?)?;
-    std::fs::rename(&tmp, path)
+    crate::io::safe_write::write_atomic(path, serde_json::to_string(checkpoint)?)
 }
 
 /// Path of the JSON report beside a target CSV.
@@ -224,12 +223,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    if !(args.checkpoint_every.is_finite() && args.checkpoint_every >= 0.0) {
-        return Err(CliError::usage(format!(
-            "--checkpoint-every: expected seconds >= 0, got {}",
-            args.checkpoint_every
-        )));
-    }
+    crate::io::run_budget::check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
+        .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
         Some(read_checkpoint(&checkpoint_file)?)
@@ -279,7 +274,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
     let (bodies, report) = built.map_err(|e| CliError::failed(format!("target build: {e}")))?;
     write_snapshot(&args.out, 0.0, &bodies).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| CliError::failed(e.to_string()))?;
-    std::fs::write(&json, text + "\n").map_err(|e| CliError::failed(format!("{}: {e}", json.display())))?;
+    crate::io::safe_write::write_atomic(&json, text + "\n")
+        .map_err(|e| CliError::failed(crate::io::safe_write::describe(&json, &e)))?;
     if checkpoint_file.exists() {
         // the build is complete: its checkpoint would only block the next build of this name
         std::fs::remove_file(&checkpoint_file)

@@ -79,14 +79,15 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
     }
     ck["scene_hash"] = serde_json::Value::String(fnv1a_hex(scene_text.as_bytes()));
     ck["scene_base_dir"] = serde_json::Value::String(scene_dir.display().to_string());
-    let io = |p: &Path, e: std::io::Error| bad(format!("{}: {e}", p.display()));
+    use crate::io::safe_write::{copy_atomic, ensure_dir, write_atomic};
+    let io = |p: &Path, e: std::io::Error| bad(crate::io::safe_write::describe(p, &e));
     let snapshot = |k: usize| dir.join("snapshots").join(format!("{k}.csv"));
-    std::fs::create_dir_all(dir.join("snapshots")).map_err(|e| io(dir, e))?;
-    std::fs::write(dir.join("scene.toml"), scene_text).map_err(|e| io(&dir.join("scene.toml"), e))?;
+    ensure_dir(&dir.join("snapshots")).map_err(|e| io(&dir.join("snapshots"), e))?;
+    write_atomic(&dir.join("scene.toml"), scene_text).map_err(|e| io(&dir.join("scene.toml"), e))?;
     for f in ["timeseries.csv", "spinup.csv"] {
         let from = parent.join(f);
         if from.is_file() {
-            std::fs::copy(&from, dir.join(f)).map_err(|e| io(&from, e))?;
+            copy_atomic(&from, &dir.join(f)).map_err(|e| io(&dir.join(f), e))?;
         }
     }
     // The parent's snapshots from before the checkpoint are the branch's: the grids agree up to it.
@@ -102,10 +103,11 @@ pub fn branch_soft(parent: &Path, scene_text: &str, scene_dir: &Path, dir: &Path
             at_checkpoint = Some(k);
             continue;
         }
-        std::fs::copy(&from, &to).map_err(|e| io(&from, e))?;
+        copy_atomic(&from, &to).map_err(|e| io(&to, e))?;
     }
     let text = serde_json::to_string_pretty(&ck).expect("checkpoint serialises");
-    std::fs::write(dir.join(CHECKPOINT_FILE), text).map_err(|e| io(&dir.join(CHECKPOINT_FILE), e))?;
+    crate::io::safe_write::write_atomic_durable(&dir.join(CHECKPOINT_FILE), text)
+        .map_err(|e| io(&dir.join(CHECKPOINT_FILE), e))?;
     if let Some(k) = at_checkpoint {
         // The checkpoint's state is that sample's state (a run writes a sample's snapshot, then checkpoints), so the
         // engine restored from it writes the snapshot the branch's own run would have written there.

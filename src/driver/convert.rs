@@ -67,7 +67,7 @@ fn err(path: &Path, reason: impl std::fmt::Display) -> ConvertError {
 
 fn write_particles(path: &Path, t: f64, ps: &[SsParticle]) -> std::io::Result<()> {
     use std::io::Write;
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz")?;
     for (id, p) in ps.iter().enumerate() {
         let v: Vec<String> = [p.mass, p.radius]
@@ -79,16 +79,37 @@ fn write_particles(path: &Path, t: f64, ps: &[SsParticle]) -> std::io::Result<()
             .collect();
         writeln!(w, "{},{id},{}", fmt_f64(t), v.join(","))?;
     }
-    w.flush()
+    w.finish()
 }
 
 /// Converts `input` to `output`, by their extensions (`.ss` ↔ `.csv`); `spheres` picks the particles-file
 /// columns for `.ss` → CSV. Refuses to overwrite `output` unless `force`.
 pub fn convert(input: &Path, output: &Path, spheres: bool, force: bool) -> Result<Converted, ConvertError> {
+    // What the output is must be said by its name: a directory or a name without `.csv` or `.ss` is refused before
+    // anything is read (a name like `o` once got CSV, and a directory failed only after --force).
+    let by_slash = output
+        .as_os_str()
+        .to_string_lossy()
+        .ends_with(['/', std::path::MAIN_SEPARATOR]);
+    if output.is_dir() || by_slash {
+        return Err(err(
+            output,
+            "--to: is a directory; give the output file's name, ending in .csv or .ss",
+        ));
+    }
+    let ext_ok = output
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv") || e.eq_ignore_ascii_case("ss"));
+    if !ext_ok {
+        return Err(err(
+            output,
+            "--to: the output's name must end in .csv or .ss (the format is read from it)",
+        ));
+    }
     if output.exists() && !force {
         return Err(err(output, "exists already (give --force to overwrite it)"));
     }
-    let io = |e: std::io::Error| err(output, e);
+    let io = |e: std::io::Error| err(output, crate::io::safe_write::reason(&e));
     match (is_ss(input), is_ss(output)) {
         (true, false) if spheres => {
             let ss = SsFile::read(input).map_err(|e| err(input, e))?;
@@ -163,7 +184,7 @@ fn csv_to_ss(input: &Path, output: &Path) -> Result<Converted, ConvertError> {
         .check()
         .map_err(|e| err(input, format!("{e}; nothing written")))?;
         let side = ss_sidecar(output);
-        std::fs::copy(input, &side).map_err(|e| err(&side, e))?;
+        crate::io::safe_write::copy_atomic(input, &side).map_err(|e| err(&side, crate::io::safe_write::reason(&e)))?;
         let note = if ellipsoids {
             format!(
                 "ellipsoids written as volume-equivalent spheres with their spin (pkdgrav has no axes or attitudes); \

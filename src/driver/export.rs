@@ -33,8 +33,8 @@ pub enum ExportError {
     /// The output exists already (and `--force` was not given).
     #[error("{}: exists already (give --force to overwrite it)", .0.display())]
     Exists(PathBuf),
-    /// A file could not be read or written.
-    #[error("{}: {source}", .path.display())]
+    /// A file could not be read or written (or a symbolic link stands where one is written).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file.
         path: PathBuf,
@@ -112,6 +112,10 @@ pub fn visit_snapshots(
             pb
         });
         for (k, path) in files {
+            // A damaged file (its manifest's checksum, a row cut short, a non-finite number) is refused by name,
+            // never drawn or converted.
+            let dir = path.parent().and_then(Path::parent).unwrap_or(Path::new("."));
+            crate::io::manifest::verify_file(dir, path, true).map_err(ExportError::Other)?;
             visit(*k, engine.view_of_snapshot(path).map_err(engine_err)?)?;
             if let Some(pb) = &pb {
                 pb.inc(1);

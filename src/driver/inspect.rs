@@ -7,6 +7,10 @@
 //! each readable by the run's engine and holding its time; and a time series as long as the summary or the
 //! checkpoint says. A run still going is read as it stands (nothing is locked: checking never gets in a writer's
 //! way), so it is whole as long as what its checkpoint counts is there.
+//!
+//! Before all that, every file the run's manifest records ([`crate::io::manifest`]) is checked against its size and
+//! checksum, and the first damaged one is the first problem named. A run directory written before the manifest is
+//! said to have none, and its snapshots and time series are checked row by row instead.
 
 use std::path::{Path, PathBuf};
 
@@ -133,6 +137,27 @@ fn read_checkpoint_facts(path: &Path) -> Result<CheckpointFacts, String> {
     })
 }
 
+/// Checks the files `dir`'s manifest records ([`crate::io::manifest::verify_entry`]), as
+/// [`crate::io::manifest::verify_all`] but leaving a missing snapshot or time series to the checks below, which say
+/// what the schedule expected of them.
+fn verify_manifest(dir: &Path) -> Result<Option<usize>, String> {
+    let Some(m) = crate::io::manifest::read(dir)? else {
+        return Ok(None);
+    };
+    let mut verified = 0;
+    for e in &m.entries {
+        // The time series cut short is told below too, against what the checkpoint or summary counts.
+        let short = std::fs::metadata(dir.join(&e.path)).map_or(true, |m| m.len() < e.bytes);
+        let told_below = e.path.starts_with("snapshots/") && !dir.join(&e.path).exists();
+        if told_below || (e.path == "timeseries.csv" && short) {
+            continue;
+        }
+        crate::io::manifest::verify_entry(dir, e)?;
+        verified += 1;
+    }
+    Ok(Some(verified))
+}
+
 /// Checks whether the run directory `dir` is whole (module docs); never writes or locks anything.
 pub fn check_run_dir(dir: &Path) -> RunDirReport {
     let mut report = RunDirReport {
@@ -147,6 +172,18 @@ pub fn check_run_dir(dir: &Path) -> RunDirReport {
         ));
         return report;
     };
+    let manifest = verify_manifest(dir);
+    match &manifest {
+        Ok(Some(n)) => report.note(format!(
+            "manifest: the {n} files it records that are there match their sizes and BLAKE3 checksums"
+        )),
+        Ok(None) => report.note(format!(
+            "no manifest ({} is missing: a run directory written before rubblepile recorded checksums); its \
+             snapshots and time series are checked row by row",
+            dir.join(crate::io::manifest::MANIFEST_FILE).display()
+        )),
+        Err(e) => report.problem(e.clone()),
+    }
     let ckpt_path = dir.join(CHECKPOINT_FILE);
     let ckpt = match ckpt_path.is_file().then(|| read_checkpoint_facts(&ckpt_path)) {
         None => None,
@@ -160,10 +197,12 @@ pub fn check_run_dir(dir: &Path) -> RunDirReport {
     // (where `impact` and `flyby` put theirs) or the current one.
     let mut bases: Vec<PathBuf> = ckpt.iter().filter_map(|c| c.scene_base_dir.clone()).collect();
     bases.extend([dir.to_path_buf(), PathBuf::from(".")]);
+    // Without a manifest, the rows are what there is to check.
+    let rows = matches!(manifest, Ok(None));
     match SceneKind::of_text(&text) {
-        SceneKind::Ellipsoids => check_with::<EllipsoidEngine>(&mut report, &text, &bases, ckpt.as_ref()),
-        SceneKind::SoftSpheres => check_with::<SoftEngine>(&mut report, &text, &bases, ckpt.as_ref()),
-        SceneKind::HardSpheres => check_with::<HardEngine>(&mut report, &text, &bases, ckpt.as_ref()),
+        SceneKind::Ellipsoids => check_with::<EllipsoidEngine>(&mut report, &text, &bases, ckpt.as_ref(), rows),
+        SceneKind::SoftSpheres => check_with::<SoftEngine>(&mut report, &text, &bases, ckpt.as_ref(), rows),
+        SceneKind::HardSpheres => check_with::<HardEngine>(&mut report, &text, &bases, ckpt.as_ref(), rows),
     }
     report
 }
@@ -180,7 +219,13 @@ enum Reached {
     Unknown,
 }
 
-fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf], ckpt: Option<&CheckpointFacts>) {
+fn check_with<E: Engine>(
+    report: &mut RunDirReport,
+    text: &str,
+    bases: &[PathBuf],
+    ckpt: Option<&CheckpointFacts>,
+    rows_too: bool,
+) {
     let dir = report.dir.clone();
     let name = dir.join("scene.toml").display().to_string();
     // The first base's error is the one to name: the others are guesses.
@@ -198,9 +243,12 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
     report.note(format!("{}: a run of kind {:?} (scene.toml)", dir.display(), E::KIND));
 
     // Status, from summary.json and checkpoint.json.
-    let summary: Option<serde_json::Value> = std::fs::read_to_string(dir.join("summary.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok());
+    let summary_path = dir.join("summary.json");
+    let summary_text = std::fs::read_to_string(&summary_path).ok();
+    let summary: Option<serde_json::Value> = summary_text.as_deref().and_then(|t| serde_json::from_str(t).ok());
+    if summary_text.is_some() && summary.is_none() {
+        report.problem(format!("{}: not JSON (damaged?)", summary_path.display()));
+    }
     let status = summary
         .as_ref()
         .and_then(|v| v.get("status")?.as_str().map(str::to_string));
@@ -216,6 +264,14 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
         (Some(s), _) if s.starts_with("failed") => {
             report.note(format!("status: {s}{}", at(summary_t)));
             Reached::Failed
+        }
+        // A summary that says neither: named as it is, not taken for a missing one.
+        (Some(s), _) => {
+            report.problem(format!(
+                "{}: status {s:?} is none rubblepile writes (\"completed\" or \"failed: …\")",
+                summary_path.display()
+            ));
+            Reached::Unknown
         }
         (_, Some(c)) => {
             report.note(format!(
@@ -270,6 +326,9 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
         }
         (Some(rows), ..) => {
             report.note(format!("timeseries.csv: {rows} rows"));
+            if rows_too && let Err(e) = crate::io::manifest::check_rows(&ts_path, false) {
+                report.problem(e);
+            }
             if let (Some(n), Reached::Completed | Reached::Failed) = (summary_rows, &reached)
                 && n != rows
             {
@@ -322,6 +381,11 @@ fn check_with<E: Engine>(report: &mut RunDirReport, text: &str, bases: &[PathBuf
         let Some(k) = s.snapshot else { continue };
         let p = snapshot_path(&dir, k);
         if !p.is_file() {
+            continue;
+        }
+        if rows_too && let Err(e) = crate::io::manifest::check_rows(&p, true) {
+            unreadable += 1;
+            report.problem(e);
             continue;
         }
         match engine.view_of_snapshot(&p) {

@@ -71,7 +71,8 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             if path.is_none() && result.is_ok() {
                 // The built-in scene is an impact: its setup lets `rubblepile analyze` read the run.
                 let json = out.join("impact.json");
-                std::fs::write(&json, crate::ellipsoid::scene::DEFAULT_IMPACT_JSON)
+                crate::io::safe_write::write_atomic(&json, crate::ellipsoid::scene::DEFAULT_IMPACT_JSON)
+                    .and_then(|()| crate::io::manifest::add_files(out, &["impact.json"]))
                     .map_err(|source| RunError::Io { path: json, source })?;
             }
             result

@@ -9,14 +9,21 @@
 //! - `summary.json`: the engine's summary (status, counters, conservation errors beside the wall time);
 //! - `last_good_state.csv` (only when a run fails): the last good state, in snapshot format, the cause named in
 //!   `summary.json` and on stderr;
-//! - `checkpoint.json` (only when due, see [`RunOptions`]): the state [`resume`] continues from.
+//! - `checkpoint.json` (only when due, see [`RunOptions`]): the state [`resume`] continues from;
+//! - `manifest.txt`: every finished file with its size and BLAKE3 checksum ([`crate::io::manifest`]), rewritten at
+//!   each checkpoint and at the end.
+//!
+//! Every file is written without following a symbolic link ([`crate::io::safe_write`]). A run is held to its
+//! budget ([`crate::io::run_budget`]): refused when its work estimate exceeds `max_steps`, stopped with a
+//! checkpoint ([`RunError::Budget`]) when it would overrun its steps or wall-clock seconds.
 //!
 //! # Checkpoints and resume
 //!
 //! A checkpoint is taken at an output sample (never mid-step, never after the last sample) when
 //! [`RunOptions::checkpoint_every`] wall-clock seconds have passed since the last one (or since the process
 //! started), or [`RunOptions::checkpoint_every_sim`] simulated seconds since the last checkpoint's time. It is
-//! written atomically (`checkpoint.json.tmp`, fsync, rename, directory fsync) after the rows it counts are on disk.
+//! written atomically (a temporary file beside it, fsync, rename, directory fsync: [`crate::io::safe_write`]) after
+//! the rows it counts are on disk, and the manifest of the run's finished files ([`crate::io::manifest`]) after it.
 //! Its envelope (format, version, engine kind, scene fingerprint, time, sample index, time-series length, wall
 //! time) is the driver's; the engine's state sits under `engine`. Every `f64` that influences the continuation is
 //! stored as its bit pattern ([`crate::bits::exact_f64`]), so a run resumed from a checkpoint ends with the same

@@ -12,6 +12,28 @@ pub const DEFAULT_PROGRESS_EVERY: f64 = 60.0;
 /// The environment variable that sets the seconds between progress lines when `--progress-every` is not given.
 pub const PROGRESS_EVERY_ENV: &str = "RUBBLEPILE_PROGRESS_EVERY";
 
+/// The cadence [`PROGRESS_EVERY_ENV`] sets (its text `text`): 0 (no lines) or 0.1 to 1e7 s
+/// ([`crate::io::limits::MIN_PROGRESS_EVERY`], [`crate::io::limits::MAX_WALL_INTERVAL`]); otherwise one line naming
+/// the variable and quoting its text.
+pub fn every_from_env(text: &str) -> Result<f64, String> {
+    use crate::io::limits::{MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY};
+    let value = text.trim().parse::<f64>().unwrap_or(f64::NAN);
+    crate::io::run_budget::check_interval(
+        PROGRESS_EVERY_ENV,
+        value,
+        MIN_PROGRESS_EVERY,
+        MAX_WALL_INTERVAL,
+        "",
+        Some(""),
+    )
+    .map_err(|_| {
+        format!(
+            "{PROGRESS_EVERY_ENV} must be 0 (no lines) or a number of seconds from {MIN_PROGRESS_EVERY} to \
+                 {MAX_WALL_INTERVAL:e}, got {text:?}"
+        )
+    })
+}
+
 /// A progress display for a run from `t` to `t_end` (s).
 pub enum Progress {
     /// Nothing shown (`--no-progress`, or lines turned off with a cadence of 0).
@@ -42,7 +64,8 @@ impl Progress {
         } else if every.is_finite() && every > 0.0 {
             let now = Instant::now();
             Progress::Lines(Lines {
-                every: Duration::from_secs_f64(every),
+                // Never a panic, whatever a library caller passes (the command line bounds it first).
+                every: Duration::try_from_secs_f64(every).unwrap_or(Duration::MAX),
                 started: now,
                 last: Cell::new(now),
                 t_start: t,

@@ -18,7 +18,10 @@ use crate::ellipsoid::summary::RunSummary;
 use crate::engine::{Engine, Outcome, Resumed, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
+use crate::io::manifest::MANIFEST_FILE;
+use crate::io::run_budget::Budget;
 use crate::io::run_lock::{DirLock, LOCK_FILE, LockError, is_lock_file};
+use crate::io::safe_write;
 
 use crate::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 
@@ -53,6 +56,12 @@ pub struct RunOptions {
     /// Testing hook: stop with [`RunError::Stopped`] right after this process has written this many checkpoints
     /// (as if the process had been killed then).
     pub stop_after_checkpoints: Option<u64>,
+    /// Most steps the run may take (`--max-steps`), over the scene's `[run] max_steps`; `None`: the scene's, else
+    /// [`crate::io::run_budget::DEFAULT_MAX_STEPS`] ([`crate::io::run_budget`]).
+    pub max_steps: Option<u64>,
+    /// Most wall-clock seconds this process may run the run (`--max-wall-seconds`), over the scene's
+    /// `[run] max_wall_seconds`; `None`: the scene's, else no limit.
+    pub max_wall_seconds: Option<f64>,
 }
 
 impl Default for RunOptions {
@@ -67,6 +76,8 @@ impl Default for RunOptions {
             formats: formats::Formats::NONE,
             progress_every: progress::DEFAULT_PROGRESS_EVERY,
             stop_after_checkpoints: None,
+            max_steps: None,
+            max_wall_seconds: None,
         }
     }
 }
@@ -86,8 +97,8 @@ pub enum RunError<S> {
         /// The path.
         dir: PathBuf,
     },
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", .path.display())]
+    /// Reading or writing a file failed (or a symbolic link was found where a file is written).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file.
         path: PathBuf,
@@ -130,6 +141,21 @@ pub enum RunError<S> {
     /// Another process (or thread) is writing the directory ([`crate::io::run_lock`]): refused at once.
     #[error(transparent)]
     Locked(#[from] LockError),
+    /// The run stopped with a checkpoint at an output sample because its budget ([`crate::io::run_budget`]: most
+    /// steps, most wall-clock seconds) would not last to the next one.
+    #[error(
+        "stopped at t = {t} s: {reason}; a checkpoint was written: continue with `rubblepile resume {}` and a larger \
+         budget",
+        .dir.display()
+    )]
+    Budget {
+        /// The run directory.
+        dir: PathBuf,
+        /// Time of the checkpoint (s).
+        t: f64,
+        /// Which budget, and how much of it was used.
+        reason: String,
+    },
     /// The run stopped after a checkpoint as asked by [`RunOptions::stop_after_checkpoints`].
     #[error("stopped after checkpoint {checkpoints} at t = {t} s (--stop-after-checkpoints); continue with `rubblepile resume {}`", .dir.display())]
     Stopped {
@@ -158,11 +184,12 @@ impl<S> RunError<S> {
         )
     }
 
-    /// The command line's exit code: 2 for [`RunError::is_usage`], 3 for [`RunError::Stopped`], 1 otherwise.
+    /// The command line's exit code: 2 for [`RunError::is_usage`], 3 for [`RunError::Stopped`] and
+    /// [`RunError::Budget`], 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         if self.is_usage() {
             2
-        } else if matches!(self, RunError::Stopped { .. }) {
+        } else if matches!(self, RunError::Stopped { .. } | RunError::Budget { .. }) {
             3
         } else {
             1
@@ -192,6 +219,7 @@ impl<S> RunError<S> {
             RunError::BadCheckpoint(m) => RunError::BadCheckpoint(m),
             RunError::Locked(e) => RunError::Locked(e),
             RunError::Stopped { dir, t, checkpoints } => RunError::Stopped { dir, t, checkpoints },
+            RunError::Budget { dir, t, reason } => RunError::Budget { dir, t, reason },
         }
     }
 }
@@ -253,9 +281,10 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
         if !force {
             return Err(RunError::OutputExists { dir: dir.to_path_buf() });
         }
-        for name in OUTPUT_FILES {
+        refuse_links(dir)?;
+        for name in OUTPUT_FILES.iter().chain([&MANIFEST_FILE]) {
             let p = dir.join(name);
-            if p.is_file() && name != "impact.json" {
+            if p.is_file() && *name != "impact.json" {
                 std::fs::remove_file(&p).map_err(io_err(&p))?;
             }
         }
@@ -268,15 +297,31 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
                 let is_snapshot = name
                     .strip_suffix(".csv")
                     .is_some_and(|stem| !stem.is_empty() && stem.bytes().all(|b| b.is_ascii_digit()));
-                if is_snapshot {
+                // A killed writer's temporary file goes too (crate::io::safe_write).
+                if is_snapshot || name.starts_with(safe_write::TMP_PREFIX) {
                     std::fs::remove_file(entry.path()).map_err(io_err(&entry.path()))?;
                 }
             }
         }
     }
     let snaps = dir.join("snapshots");
-    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
     Ok(lock)
+}
+
+/// Refuses, naming the first, a symbolic link among the files a run writes or removes at the top of `dir`, the
+/// `snapshots/` directory and the files in it ([`crate::io::safe_write`]): nothing is written through a link.
+pub fn refuse_links<S>(dir: &Path) -> Result<(), RunError<S>> {
+    let check = |p: &Path| safe_write::refuse_symlink(p).map_err(io_err(p));
+    for name in OUTPUT_FILES.iter().chain([&MANIFEST_FILE, &"snapshots"]) {
+        check(&dir.join(name))?;
+    }
+    if let Ok(entries) = std::fs::read_dir(dir.join("snapshots")) {
+        for entry in entries.flatten() {
+            check(&entry.path())?;
+        }
+    }
+    Ok(())
 }
 
 /// `checkpoint.json`: the driver's envelope around the engine's state `S`.
@@ -365,16 +410,29 @@ fn same_dir(a: &Path, b: &Path) -> bool {
 /// size underflow, a broken constraint), writes `last_good_state.csv` and `summary.json` (naming the cause) and
 /// returns [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunReport::one_line`].
 pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    // A scene its own work estimate says will not end within the budget is refused before anything is written.
+    let budget = budget_of(&engine, options);
+    if let Some(steps) = engine.estimated_steps()
+        && steps > budget.max_steps as f64
+    {
+        return Err(RunError::Setup(format!(
+            "the scene needs about {steps:.1e} steps to t_end = {} s, more than max_steps = {} ({}); raise it with \
+             [run] max_steps or --max-steps to run the scene anyway, or shorten t_end",
+            engine.t_end(),
+            count(budget.max_steps),
+            budget.steps_from
+        )));
+    }
     let _lock = prepare_output_dir(out_dir, options.force)?;
     let scene_copy = out_dir.join("scene.toml");
     let scene_text = standalone_scene(&engine, out_dir);
-    std::fs::write(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
+    safe_write::write_atomic(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
     let identity = Identity {
         scene_base_dir: absolute_base(&engine)?,
         scene_hash: fnv1a_hex(scene_text.as_bytes()),
     };
     let ts_path = out_dir.join("timeseries.csv");
-    let mut timeseries = File::create(&ts_path).map_err(io_err(&ts_path))?;
+    let mut timeseries = safe_write::create_fresh(&ts_path).map_err(io_err(&ts_path))?;
     let header = engine.timeseries_header();
     timeseries.write_all(header.as_bytes()).map_err(io_err(&ts_path))?;
     engine.open_outputs(out_dir).map_err(io_err(out_dir))?;
@@ -387,7 +445,27 @@ pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Re
         timeseries,
     };
     let useful = engine.useful_threads();
-    on_pool(useful, || drive(&mut engine, out_dir, options, start, &identity))
+    on_pool(useful, || {
+        drive(&mut engine, out_dir, options, start, &identity, &budget)
+    })
+}
+
+/// A step count as people read it: digits below 1e7, `1e9` above.
+fn count(n: u64) -> String {
+    if n < 10_000_000 {
+        n.to_string()
+    } else {
+        format!("{:e}", n as f64)
+    }
+}
+
+/// The budget `engine`'s run is held to: the command line's over the scene's `[run]` table.
+fn budget_of(engine: &impl Engine, options: &RunOptions) -> Budget {
+    Budget::resolve(
+        crate::io::run_budget::from_scene_text(engine.scene_source()),
+        options.max_steps,
+        options.max_wall_seconds,
+    )
 }
 
 /// The final time of a completed run in `dir` (from its `summary.json`), if it completed.
@@ -493,6 +571,10 @@ pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>>
 pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
     // A directory that does not exist is left to the checks below to name.
     let _lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
+    // Nothing through a link: refused before anything is read or changed.
+    if dir.is_dir() {
+        refuse_links(dir)?;
+    }
     if let Some(t) = completed_run(dir) {
         return Err(RunError::AlreadyCompleted {
             dir: dir.to_path_buf(),
@@ -548,6 +630,19 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         }
         Ok(_) => {}
     }
+    // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
+    // by row), before anything is continued from them.
+    match crate::io::manifest::verify_all(dir) {
+        Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
+        Ok(Some(_)) => {}
+        Ok(None) => {
+            for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
+                let p = dir.join("snapshots").join(format!("{k}.csv"));
+                crate::io::manifest::check_rows(&p, true)
+                    .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
+            }
+        }
+    }
     engine
         .restore(
             ckpt.engine,
@@ -567,7 +662,7 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         }
     }
     let snaps = dir.join("snapshots");
-    std::fs::create_dir_all(&snaps).map_err(io_err(&snaps))?;
+    safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
     let timeseries = reopen_truncated(&ts_path, ckpt.timeseries_bytes)?;
     let identity = Identity {
         scene_base_dir: ckpt.scene_base_dir.clone(),
@@ -582,31 +677,22 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         timeseries,
     };
     let useful = engine.useful_threads();
-    on_pool(useful, || drive(&mut engine, dir, options, start, &identity))
+    let budget = budget_of(&engine, options);
+    on_pool(useful, || drive(&mut engine, dir, options, start, &identity, &budget))
 }
 
-/// Writes `checkpoint` into `dir/checkpoint.json` atomically (temporary file, fsync, rename, directory fsync).
+/// Writes `checkpoint` into `dir/checkpoint.json` atomically and durably (temporary file, fsync, rename, directory
+/// fsync: [`safe_write::AtomicFile::finish_durable`]).
 fn write_checkpoint<S: Serialize>(dir: &Path, checkpoint: &Checkpoint<S>) -> std::io::Result<()> {
-    let tmp = dir.join(CHECKPOINT_TMP_FILE);
-    let dst = dir.join(CHECKPOINT_FILE);
-    {
-        let mut w = std::io::BufWriter::new(File::create(&tmp)?);
-        serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
-        w.write_all(b"\n")?;
-        let file = w.into_inner().map_err(|e| e.into_error())?;
-        file.sync_all()?;
-    }
-    std::fs::rename(&tmp, &dst)?;
-    // Make the rename durable; not every platform can open a directory, so failures are ignored.
-    if let Ok(d) = File::open(dir) {
-        let _ = d.sync_all();
-    }
-    Ok(())
+    let mut w = safe_write::AtomicFile::create(&dir.join(CHECKPOINT_FILE))?;
+    serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
+    w.write_all(b"\n")?;
+    w.finish_durable()
 }
 
 fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> {
     let text = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
-    std::fs::write(path, text + "\n")
+    safe_write::write_atomic(path, text + "\n")
 }
 
 /// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
@@ -637,6 +723,7 @@ fn drive<E: Engine>(
     options: &RunOptions,
     start: Start,
     identity: &Identity,
+    budget: &Budget,
 ) -> Result<E::Summary, RunError<E::Summary>> {
     let Start {
         next_sample,
@@ -648,6 +735,9 @@ fn drive<E: Engine>(
     } = start;
     let ts_path = out_dir.join("timeseries.csv");
     let mut files = run_files::RunFiles::new(timeseries, &ts_path);
+    // The manifest of the run's finished files (crate::io::manifest), rewritten at each checkpoint and at the end.
+    let manifest = std::cell::RefCell::new(crate::io::manifest::Recorder::new());
+    let mp = out_dir.join(MANIFEST_FILE);
     let file_err = |(path, source): run_files::FileError| RunError::Io { path, source };
     let t_end = engine.t_end();
     let started = Instant::now();
@@ -670,6 +760,14 @@ fn drive<E: Engine>(
         if let Err(e) = write_summary(&sp, &summary) {
             return RunError::Io { path: sp, source: e };
         }
+        if let Err(e) = files.sync().and_then(|()| {
+            manifest
+                .borrow_mut()
+                .write(out_dir, "failed", true)
+                .map_err(|e| (mp.clone(), e))
+        }) {
+            return RunError::Io { path: e.0, source: e.1 };
+        }
         RunError::Failed {
             t: t_good,
             cause: failure.cause.clone(),
@@ -685,11 +783,92 @@ fn drive<E: Engine>(
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
+    // Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`), then the
+    // manifest that records it.
+    let checkpoint_at = |state: E::State, t: f64, next_sample: u64, rows: u64, bytes: u64, checkpoints: u64| {
+        manifest.borrow_mut().refresh(out_dir).map_err(io_err(&mp))?;
+        let ckpt = Checkpoint {
+            format: CHECKPOINT_FORMAT.into(),
+            version: CHECKPOINT_VERSION,
+            writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
+            kind: E::KIND.into(),
+            scene_hash: identity.scene_hash.clone(),
+            scene_base_dir: identity.scene_base_dir.clone(),
+            t,
+            t_seconds: t,
+            next_sample,
+            timeseries_rows: rows,
+            timeseries_bytes: bytes,
+            checkpoints,
+            wall_seconds: wall(),
+            engine: state,
+        };
+        let cp = out_dir.join(CHECKPOINT_FILE);
+        write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+        manifest
+            .borrow_mut()
+            .write(out_dir, &format!("checkpoint at t = {t} s"), false)
+            .map_err(io_err(&mp))
+    };
+    // The wall-clock budget holds inside a sample interval too: past the deadline an advance stops, and the run
+    // stops with a checkpoint of the state saved at the sample before (kept only when there is a budget).
+    let deadline = budget
+        .max_wall_seconds
+        .and_then(|s| started.checked_add(std::time::Duration::try_from_secs_f64(s).ok()?));
+    engine.set_deadline(deadline);
+    let budget_stop = |t: f64, reason: String| RunError::Budget {
+        dir: out_dir.to_path_buf(),
+        t,
+        reason,
+    };
+    let steps_spent = |steps: u64| {
+        format!(
+            "max_steps = {} ({}) reached: {steps} steps taken",
+            count(budget.max_steps),
+            budget.steps_from
+        )
+    };
     for (index, sample) in samples.iter().enumerate().skip(next_sample as usize) {
+        // A resumed run whose budget is already spent stops where its checkpoint is, writing nothing.
+        let steps_before = engine.steps_taken();
+        if steps_before >= budget.max_steps {
+            shown.abandon();
+            return Err(budget_stop(engine.time(), steps_spent(steps_before)));
+        }
+        engine.limit_steps(budget.max_steps - steps_before);
+        let interval_started = Instant::now();
+        let t_before = engine.time();
+        let saved = match deadline {
+            Some(_) if index > 0 => Some(engine.save().map_err(io_err(out_dir))?),
+            _ => None,
+        };
         // The error of the last sample: the engine is busy while it advances.
         let error = engine.error_so_far();
         let mut progress = |t: f64| shown.show(t, t_end, error);
-        if let Err(failure) = engine.advance(index, sample, &mut progress) {
+        if let Err(mut failure) = engine.advance(index, sample, &mut progress) {
+            if let (true, Some(state)) = (failure.deadline, saved) {
+                shown.abandon();
+                files.sync().map_err(file_err)?;
+                checkpoints += 1;
+                checkpoint_at(state, t_before, index as u64, rows, bytes, checkpoints)?;
+                let most = budget.max_wall_seconds.unwrap_or_default();
+                return Err(budget_stop(
+                    t_before,
+                    format!(
+                        "the wall-clock budget: max_wall_seconds = {most} s ran out within the sample interval to t = \
+                         {} s",
+                        sample.t
+                    ),
+                ));
+            }
+            if engine.steps_taken() >= budget.max_steps {
+                failure.cause = format!(
+                    "{} within one sample interval (to t = {} s; the integrator said: {})",
+                    steps_spent(engine.steps_taken()),
+                    sample.t,
+                    failure.cause
+                );
+            }
             return Err(fail(engine, &failure, rows, &mut files));
         }
         let row = match engine.sample(sample, wall()) {
@@ -725,32 +904,42 @@ fn drive<E: Engine>(
         let due_sim = options
             .checkpoint_every_sim
             .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
-        if (index as u64) + 1 < total && (due_wall || due_sim) {
+        // The budget: stop here, with a checkpoint, when the next interval (judged by this one) would overrun it.
+        let steps = engine.steps_taken();
+        let interval_steps = steps - steps_before;
+        let spent = started.elapsed().as_secs_f64();
+        let interval_wall = interval_started.elapsed().as_secs_f64();
+        let over_budget = if steps >= budget.max_steps || steps.saturating_add(interval_steps) > budget.max_steps {
+            Some(format!(
+                "the step budget: {} steps taken, {interval_steps} in the last sample interval, max_steps = {} ({})",
+                steps,
+                count(budget.max_steps),
+                budget.steps_from
+            ))
+        } else {
+            budget.max_wall_seconds.and_then(|most| {
+                (spent + interval_wall > most).then(|| {
+                    format!(
+                        "the wall-clock budget: {spent:.1} s run here, {interval_wall:.1} s in the last sample interval, \
+                         max_wall_seconds = {most} s"
+                    )
+                })
+            })
+        };
+        let over_budget = over_budget.filter(|_| (index as u64) + 1 < total);
+        if (index as u64) + 1 < total && (due_wall || due_sim || over_budget.is_some()) {
             // The rows and snapshots the checkpoint counts must be on disk before it is.
             files.sync().map_err(file_err)?;
             let state = engine.save().map_err(io_err(out_dir))?;
             checkpoints += 1;
-            let ckpt = Checkpoint {
-                format: CHECKPOINT_FORMAT.into(),
-                version: CHECKPOINT_VERSION,
-                writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
-                kind: E::KIND.into(),
-                scene_hash: identity.scene_hash.clone(),
-                scene_base_dir: identity.scene_base_dir.clone(),
-                t,
-                t_seconds: t,
-                next_sample: index as u64 + 1,
-                timeseries_rows: rows,
-                timeseries_bytes: bytes,
-                checkpoints,
-                wall_seconds: wall(),
-                engine: state,
-            };
-            let cp = out_dir.join(CHECKPOINT_FILE);
-            write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+            checkpoint_at(state, t, index as u64 + 1, rows, bytes, checkpoints)?;
             last_checkpoint_wall = Instant::now();
             last_checkpoint_t = t;
             checkpoints_here += 1;
+            if let Some(reason) = over_budget {
+                shown.abandon();
+                return Err(budget_stop(t, reason));
+            }
             if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
                 shown.abandon();
                 return Err(RunError::Stopped {
@@ -768,6 +957,10 @@ fn drive<E: Engine>(
     let summary = engine.summary(Outcome::Completed, rows, wall_seconds);
     let sp = out_dir.join("summary.json");
     write_summary(&sp, &summary).map_err(io_err(&sp))?;
+    manifest
+        .borrow_mut()
+        .write(out_dir, "completed", true)
+        .map_err(io_err(&mp))?;
     Ok(summary)
 }
 

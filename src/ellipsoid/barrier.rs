@@ -454,11 +454,11 @@ impl BarrierMonitor {
             }
         }
         if m.samples > 0 {
-            let mut f = std::fs::File::create(log)?;
+            let mut f = crate::io::safe_write::create_fresh(log)?;
             writeln!(f, "{}", OVERRUN_COLUMNS.join(","))?;
             f.write_all(kept.as_bytes())?;
             f.sync_all()?;
-            m.file = Some(std::fs::OpenOptions::new().append(true).open(log)?);
+            m.file = Some(f);
         } else {
             std::fs::remove_file(log)?;
         }
@@ -525,7 +525,7 @@ impl BarrierMonitor {
             && let Some(path) = &self.path
         {
             if self.file.is_none() {
-                let mut f = std::fs::File::create(path)?;
+                let mut f = crate::io::safe_write::create_fresh(path)?;
                 writeln!(f, "{}", OVERRUN_COLUMNS.join(","))?;
                 self.file = Some(f);
             }

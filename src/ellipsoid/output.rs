@@ -79,7 +79,8 @@ pub struct TracksWriter {
 impl TracksWriter {
     /// Creates the file and writes the header.
     pub fn create(path: &Path) -> std::io::Result<Self> {
-        let mut w = ::csv::Writer::from_writer(BufWriter::new(File::create(path)?));
+        let file = crate::io::safe_write::create_fresh(path)?;
+        let mut w = ::csv::Writer::from_writer(BufWriter::new(file));
         w.write_record(SNAPSHOT_COLUMNS).map_err(csv_to_io)?;
         w.flush()?;
         Ok(TracksWriter { w })
@@ -99,7 +100,7 @@ impl TracksWriter {
                 )));
             }
         };
-        let mut file = std::fs::OpenOptions::new().write(true).open(path)?;
+        let mut file = crate::io::safe_write::open_nofollow(path, false)?;
         file.set_len(keep)?;
         std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0))?;
         Ok(TracksWriter {
@@ -119,14 +120,13 @@ impl TracksWriter {
 /// Writes a snapshot of `bodies` at time `t` to `path` (header + one row per body), lossless. Not made durable
 /// here: the run driver syncs the snapshots a checkpoint counts before writing it, as for the sphere engines.
 pub fn write_snapshot(path: &Path, t: f64, bodies: &[Body]) -> std::io::Result<()> {
-    let file = File::create(path)?;
-    let mut w = ::csv::Writer::from_writer(BufWriter::new(file));
+    let file = crate::io::safe_write::AtomicFile::create(path)?;
+    let mut w = ::csv::Writer::from_writer(file);
     w.write_record(SNAPSHOT_COLUMNS).map_err(csv_to_io)?;
     for row in snapshot_records(t, bodies) {
         w.write_record(&row).map_err(csv_to_io)?;
     }
-    let inner = w.into_inner().map_err(|e| e.into_error())?;
-    inner.into_inner().map_err(|e| e.into_error()).map(drop)
+    w.into_inner().map_err(|e| e.into_error())?.finish()
 }
 
 /// One body read from a bodies file (values unchecked; the scene validates them).

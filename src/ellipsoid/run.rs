@@ -525,6 +525,26 @@ impl Engine for EllipsoidEngine {
         &self.scene.source
     }
 
+    fn estimated_steps(&self) -> Option<f64> {
+        self.scene.work_steps
+    }
+
+    /// Step attempts (accepted and rejected): what a stiff or spinning scene spends its time on.
+    fn steps_taken(&self) -> u64 {
+        let s = self.integrator.stats();
+        s.steps_accepted + s.steps_rejected
+    }
+
+    /// The integrator's own cap on the attempts of one advance (1e8) lowered to what is left of the budget.
+    fn limit_steps(&mut self, most: u64) {
+        self.integrator
+            .set_max_steps(most.min(crate::integrate::bulirsch_stoer::DEFAULT_MAX_STEPS));
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.integrator.set_deadline(deadline);
+    }
+
     fn error_so_far(&self) -> Option<(&'static str, f64)> {
         Some(("energy error", self.tracker.energy / self.tracker.scales().energy))
     }
@@ -568,6 +588,9 @@ impl Engine for EllipsoidEngine {
         {
             // The integrator stopped at its last accepted step: that is the last good state.
             self.last_good = (self.t, self.y.clone());
+            if matches!(e, crate::integrate::IntegrateError::Deadline { .. }) {
+                return Err(Failure::deadline(self.t));
+            }
             return Err(self.failure(format!("integrator error: {e}")));
         }
         if self.scene.integrator.project_attitudes {

@@ -101,6 +101,9 @@ pub struct SceneFile {
     /// Either these tables or `scene.bodies_file`, not both.
     #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
     pub bodies: Vec<BodySpec>,
+    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
@@ -449,6 +452,10 @@ pub struct LoadedScene {
     /// [`WORK_WARNING_STEPS`] integrator steps; the advice to use `bulirsch-stoer-implicit` when the contact damping
     /// is more than [`STIFF_ADVICE_RATIO`] times faster than the contact ([`contact_stiffness`]).
     pub warnings: Vec<String>,
+    /// The work estimate: about how many integrator steps the run needs to `t_end` ([`STEPS_PER_TIME_SCALE`] per
+    /// fastest time scale); `None` without a time scale (nothing spins, touches or moves relative to the rest).
+    /// The run driver refuses a scene estimated above its step budget ([`crate::io::run_budget`]).
+    pub work_steps: Option<f64>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -569,6 +576,7 @@ impl Validator<'_> {
     /// Validates every section in order and builds the scene (each section's rules in its own function below).
     fn resolve(&self, text: &str, file: SceneFile, base_dir: Option<&Path>) -> Result<LoadedScene, SceneError> {
         let t_end = self.scene_section(&file)?;
+        crate::io::run_budget::validate(self, &file.run)?;
         self.model_section(&file.model)?;
         let physics = self.physics_section(&file.physics)?;
         let g = physics.gravity.map_or(SI_G, |g| g.g);
@@ -580,8 +588,8 @@ impl Validator<'_> {
         let (model, kappa_source) = self.kappa_section(&file.model, &bodies, &physics)?;
         self.separated(&bodies)?;
         self.contact_amplitudes(&bodies, &model, &kappa_source, &physics)?;
-        let warnings = self
-            .work_estimate(&bodies, &model, &physics, t_end)
+        let (work_steps, work_warning) = self.work_estimate(&bodies, &model, &physics, t_end);
+        let warnings = work_warning
             .into_iter()
             .chain(self.stiffness_advice(&bodies, &model, &physics, integrator.method))
             .collect();
@@ -600,6 +608,7 @@ impl Validator<'_> {
             integrator,
             output,
             warnings,
+            work_steps,
         })
     }
 
@@ -992,9 +1001,15 @@ impl Validator<'_> {
     /// scales of each body: its spin period `2π/|ω|`; with contact between several bodies, the contact time
     /// `2π √(R C² / (G m κ))` of two copies of it touching along their smallest semi-axis C (R its equivalent
     /// radius) and the time `C / |v − v_cm|` to cross C; with dissipation, the damping time `4κR / (F0 G m)` at
-    /// contact. A warning (one line, naming the scale and its body) when the estimate exceeds
-    /// [`WORK_WARNING_STEPS`].
-    fn work_estimate(&self, bodies: &[Body], model: &ModelConfig, physics: &Physics, t_end: f64) -> Option<String> {
+    /// contact. Returns the estimate (`None` without a time scale) and a warning (one line, naming the scale and its
+    /// body) when it exceeds [`WORK_WARNING_STEPS`].
+    fn work_estimate(
+        &self,
+        bodies: &[Body],
+        model: &ModelConfig,
+        physics: &Physics,
+        t_end: f64,
+    ) -> (Option<f64>, Option<String>) {
         let several = bodies.len() > 1;
         let total_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
         let v_cm: Vec3 = bodies.iter().map(|b| b.velocity * (b.shape.mass / total_mass)).sum();
@@ -1042,15 +1057,18 @@ impl Validator<'_> {
                 );
             }
         }
-        let (tau, what) = fastest?;
+        let Some((tau, what)) = fastest else {
+            return (None, None);
+        };
         let steps = STEPS_PER_TIME_SCALE * t_end / tau;
-        (steps > WORK_WARNING_STEPS).then(|| {
+        let warning = (steps > WORK_WARNING_STEPS).then(|| {
             format!(
                 "{}: the fastest time scale is {what}: {tau:.2e} s, so about {steps:.1e} integrator steps to t_end = \
                  {t_end} s (more than {WORK_WARNING_STEPS:e}); the run may not end in useful time",
                 self.file
             )
-        })
+        });
+        (Some(steps), warning)
     }
 
     /// Advice to use `bulirsch-stoer-implicit` when the dissipation is stiff: for each body, two copies of it

@@ -220,6 +220,7 @@ pub const TABLES: &[TableDoc] = &[
         array: true,
         meaning: "one ellipsoid each, body[0], body[1], ... in file order (or scene.bodies_file)",
     },
+    crate::io::run_budget::RUN_TABLE,
 ];
 
 /// Every key of the file, in print order.
@@ -417,6 +418,8 @@ pub const FIELDS: &[FieldDoc] = &[
         range: Range::Rule("3 finite numbers"),
         meaning: "spin in the world frame (spin_body = R(q) spin_world)",
     },
+    crate::io::run_budget::MAX_STEPS_FIELD,
+    crate::io::run_budget::MAX_WALL_FIELD,
 ];
 
 /// The rule of `body.position`, with [`MIN_CENTRE_SEPARATION`] in it.

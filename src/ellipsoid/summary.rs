@@ -197,7 +197,7 @@ impl RunSummary {
 pub fn write_summary(path: &Path, summary: &RunSummary) -> std::io::Result<()> {
     let mut text = serde_json::to_string_pretty(summary).map_err(std::io::Error::other)?;
     text.push('\n');
-    std::fs::write(path, text)
+    crate::io::safe_write::write_atomic(path, text)
 }
 
 /// Reads a `summary.json` (non-finite numbers, written as `null`, cannot be read back).

@@ -159,12 +159,26 @@ pub enum EngineError {
 pub struct Failure {
     /// The cause, as reported to the user.
     pub cause: String,
+    /// Whether the advance stopped because the wall-clock deadline of [`Engine::set_deadline`] passed (the run's
+    /// budget, not a broken state): the driver then stops cleanly at the sample before.
+    pub deadline: bool,
 }
 
 impl Failure {
     /// A failure with this cause.
     pub fn new(cause: impl Into<String>) -> Self {
-        Failure { cause: cause.into() }
+        Failure {
+            cause: cause.into(),
+            deadline: false,
+        }
+    }
+
+    /// The advance stopped at the deadline of [`Engine::set_deadline`] (at `t`, s).
+    pub fn deadline(t: f64) -> Self {
+        Failure {
+            cause: format!("the wall-clock deadline passed at t = {t} s"),
+            deadline: true,
+        }
     }
 }
 
@@ -312,6 +326,29 @@ pub trait Engine: Sized + Send {
         usize::MAX
     }
 
+    /// The steps the whole run needs by the scene's own work estimate (integrator steps of the ellipsoids, fixed
+    /// steps of the spheres), for the run's step budget ([`crate::io::run_budget`]): a scene estimated to need more
+    /// than its budget is refused before it starts. Default: no estimate.
+    fn estimated_steps(&self) -> Option<f64> {
+        None
+    }
+
+    /// Steps taken by the run so far, those before its checkpoint included (the measure of
+    /// [`Engine::estimated_steps`]). Default: 0 (no budget is kept).
+    fn steps_taken(&self) -> u64 {
+        0
+    }
+
+    /// Caps the steps the next [`Engine::advance`] may take at `most` (what is left of the run's budget): an engine
+    /// whose steps between two samples are not known in advance (the ellipsoids' adaptive integrator) fails that
+    /// advance beyond it rather than crawl on. Default: nothing (fixed steps: the budget is checked at samples).
+    fn limit_steps(&mut self, _most: u64) {}
+
+    /// Makes the next [`Engine::advance`] calls stop with [`Failure::deadline`] once the wall clock passes
+    /// `deadline` (`None`: never), so that a run's wall-clock budget holds within a long sample interval too; the
+    /// state is then past the last sample and the driver continues from what it saved there. Default: nothing.
+    fn set_deadline(&mut self, _deadline: Option<std::time::Instant>) {}
+
     /// The run's error measure up to its last sample, for the progress lines of a batch log: its name and value
     /// (the relative energy error its summary reports, or the bookkeeping residual where energy is exchanged on
     /// purpose). Default: none.
@@ -338,9 +375,10 @@ pub trait Engine: Sized + Send {
 pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, EngineError> {
     let err = |e: std::io::Error| EngineError::File {
         path: path.to_path_buf(),
-        reason: e.to_string(),
+        reason: crate::io::safe_write::reason(&e),
     };
-    let mut file = std::fs::OpenOptions::new().write(true).open(path).map_err(err)?;
+    // Never through a link (crate::io::safe_write): the file opened is the regular file at `path`.
+    let mut file = crate::io::safe_write::open_nofollow(path, false).map_err(err)?;
     let len = file.metadata().map_err(err)?.len();
     if len < bytes {
         return Err(EngineError::File {

@@ -32,8 +32,8 @@ pub enum ImpactError {
     /// The generated scene was refused (e.g. too many time-series rows).
     #[error(transparent)]
     Scene(#[from] SceneError),
-    /// Writing a file of the run directory failed.
-    #[error("{}: {source}", .path.display())]
+    /// Writing a file of the run directory failed (or a symbolic link stands where it writes).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file.
         path: PathBuf,

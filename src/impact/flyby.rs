@@ -39,6 +39,9 @@ pub const EARTH_RADIUS_M: f64 = 6.371e6;
 /// and the tidal impulse still to come (∝ d⁻² for a straight-line passage) ~1 % of the whole; 20 q would take it
 /// to 0.25 % at about twice the run time (the outer legs dominate the duration).
 pub const DEFAULT_START_Q: f64 = 10.0;
+
+/// Smallest `e − 1 = q v∞² / GM` of a flyby's orbit: below it the hyperbola is a parabola to rounding.
+pub const MIN_HYPERBOLIC_EXCESS: f64 = 1e-9;
 /// Dissipation F0 of a pile of radius [`F0_REFERENCE_RADIUS_M`] (s m⁻², Roig03's "F0 ≈ 1" in km and s, the impact
 /// default); other radii get `F0 (R_ref/R)²`, which keeps the damping of the similar pile the same.
 pub const F0_REFERENCE: f64 = 1e-6;
@@ -346,6 +349,42 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
         .unwrap_or(F0_REFERENCE * (F0_REFERENCE_RADIUS_M / radius).powi(2));
     let gm = G_SI * args.planet_mass;
     let v_inf = args.v_inf_km_s * 1e3;
+    // e − 1 = q v∞²/GM: below MIN_HYPERBOLIC_EXCESS the orbit is parabolic to rounding (and the time to perigee
+    // unbounded), which is the speed's fault, not the perigee's.
+    let excess = args.q_m * v_inf * v_inf / gm;
+    if gm > 0.0 && (excess.is_nan() || excess < MIN_HYPERBOLIC_EXCESS) {
+        return Err(invalid(
+            "v_inf_km_s",
+            format!(
+                "must be at least {:.3e} km/s for q_m = {} m and this planet (slower, the orbit is parabolic to \
+                 rounding: e - 1 < {MIN_HYPERBOLIC_EXCESS:e}), got {}",
+                (MIN_HYPERBOLIC_EXCESS * gm / args.q_m).sqrt() / 1e3,
+                args.q_m,
+                crate::io::scene_file::fmt_num(args.v_inf_km_s)
+            ),
+        ));
+    }
+    // Settling a spun pile is bounded like a run (crate::io::run_budget): its spin alone asks for
+    // STEPS_PER_TIME_SCALE steps a turn, refused before anything is written when that exceeds the ceiling.
+    let settle_max_time = args.settle_max_hours.map_or_else(
+        || SETTLE_MAX_FREE_FALLS * free_fall_time(bodies.iter().map(|b| b.shape.mass).sum(), radius),
+        |h| h * 3600.0,
+    );
+    if let Some(p) = args.period_hours {
+        let steps = crate::ellipsoid::scene::STEPS_PER_TIME_SCALE * settle_max_time / (p * 3600.0);
+        if steps.is_nan() || steps > crate::io::run_budget::DEFAULT_MAX_STEPS as f64 {
+            return Err(invalid(
+                "period_hours",
+                format!(
+                    "a spin period of {} h asks for about {steps:.1e} steps to settle the pile over {settle_max_time:.3e} \
+                     s, more than the step ceiling {:e}; give a longer --period-hours (or a shorter \
+                     --settle-max-hours)",
+                    crate::io::scene_file::fmt_num(p),
+                    crate::io::run_budget::DEFAULT_MAX_STEPS as f64
+                ),
+            ));
+        }
+    }
     let (orbit, t_perigee) = flyby_orbit(gm, args.q_m, v_inf, args.start_q)?;
     let start_distance = args.start_q * args.q_m;
     let t_end = 2.0 * t_perigee;
@@ -417,16 +456,13 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     let bodies_path = out.join("initial_bodies.csv");
     write_snapshot(&bodies_path, 0.0, &bodies).map_err(io(&bodies_path))?;
     let scene_path = out.join("scene.toml");
-    std::fs::write(&scene_path, &scene_toml).map_err(io(&scene_path))?;
+    crate::io::safe_write::write_atomic(&scene_path, &scene_toml).map_err(io(&scene_path))?;
     let mut scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
     let mut setup = setup;
     if args.radius_m.is_some() || args.period_hours.is_some() || args.settle_to_principal {
         let prepared_path = out.join("prepared_bodies.csv");
         write_snapshot(&prepared_path, 0.0, &bodies).map_err(io(&prepared_path))?;
-        let max_time = args.settle_max_hours.map_or_else(
-            || SETTLE_MAX_FREE_FALLS * free_fall_time(setup.mass, radius),
-            |h| h * 3600.0,
-        );
+        let max_time = settle_max_time;
         let (mut settled, mut report) = settle(&scene.bodies, scene.model, scene.physics, args.rtol, max_time)
             .map_err(|e| ImpactError::Run(crate::driver::RunError::Setup(format!("settling the pile: {e}"))))?;
         if args.settle_to_principal {
@@ -443,18 +479,18 @@ pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLo
     }
     let json_path = out.join("flyby.json");
     let json = serde_json::to_string_pretty(&setup).unwrap_or_default() + "\n";
-    std::fs::write(&json_path, json).map_err(io(&json_path))?;
+    crate::io::safe_write::write_atomic(&json_path, json).map_err(io(&json_path))?;
     if !args.no_control {
         let dir = out.join(CONTROL_DIR);
-        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        crate::io::safe_write::ensure_dir(&dir).map_err(io(&dir))?;
         let control_bodies = dir.join("initial_bodies.csv");
-        std::fs::copy(&bodies_path, &control_bodies).map_err(io(&control_bodies))?;
+        crate::io::safe_write::copy_atomic(&bodies_path, &control_bodies).map_err(io(&control_bodies))?;
         let control_toml = scene_text(
             0.0,
             "Control of the flyby in the directory above: the same pile and duration, no planet (mass 0)",
         );
         let control_path = dir.join("scene.toml");
-        std::fs::write(&control_path, &control_toml).map_err(io(&control_path))?;
+        crate::io::safe_write::write_atomic(&control_path, &control_toml).map_err(io(&control_path))?;
     }
     Ok((scene, setup, lock))
 }

@@ -388,13 +388,13 @@ pub fn prepare_impact(cfg: &ImpactConfig, out: &Path, force: bool) -> Result<Pre
         source: std::io::Error::other(e),
     })?;
     json["target"] = serde_json::Value::String(cfg.target.display().to_string());
-    std::fs::write(
+    crate::io::safe_write::write_atomic(
         &json_path,
         serde_json::to_string_pretty(&json).unwrap_or_default() + "\n",
     )
     .map_err(io(&json_path))?;
     let scene_path = out.join("scene.toml");
-    std::fs::write(&scene_path, &plan.scene_toml).map_err(io(&scene_path))?;
+    crate::io::safe_write::write_atomic(&scene_path, &plan.scene_toml).map_err(io(&scene_path))?;
     let scene = parse_scene(&plan.scene_toml, &scene_path.display().to_string(), Some(out))?;
     Ok(PreparedImpact { scene, plan, lock })
 }

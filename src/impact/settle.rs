@@ -78,7 +78,24 @@ pub fn settle(
     let check_every = t_ff / CHECKS_PER_FREE_FALL;
     loop {
         let target = (t + check_every).min(max_time);
-        integrator.advance(&system, &mut t, &mut y, target)?;
+        // Bounded like a run (crate::io::run_budget): at most the step ceiling in all.
+        let stats = integrator.stats();
+        let taken = stats.steps_accepted + stats.steps_rejected;
+        let left = crate::io::run_budget::DEFAULT_MAX_STEPS.saturating_sub(taken);
+        integrator.set_max_steps(left.min(crate::integrate::bulirsch_stoer::DEFAULT_MAX_STEPS));
+        integrator
+            .advance(&system, &mut t, &mut y, target)
+            .map_err(|e| match e {
+                IntegrateError::TooManySteps { t, .. }
+                    if left <= crate::integrate::bulirsch_stoer::DEFAULT_MAX_STEPS =>
+                {
+                    IntegrateError::TooManySteps {
+                        t,
+                        max_steps: crate::io::run_budget::DEFAULT_MAX_STEPS,
+                    }
+                }
+                e => e,
+            })?;
         let d = system.diagnostics(&y);
         energy_error = energy_error.max((d.energy() - d0.energy() - d.dissipated).abs() / d0.energy_scale);
         let now = system.bodies_at(t, &y);

@@ -233,6 +233,12 @@ pub enum IntegrateError {
         /// The limit.
         max_steps: u64,
     },
+    /// The wall-clock deadline set by [`Integrator::set_deadline`] passed (a run's wall-clock budget).
+    #[error("the wall-clock deadline passed at t = {t} s (last good state kept)")]
+    Deadline {
+        /// Last good time (s).
+        t: f64,
+    },
     /// A configuration error (e.g. rk4 without a step, tolerances of the wrong length).
     #[error("integrator configuration: {0}")]
     Config(String),
@@ -256,6 +262,13 @@ pub trait Integrator {
     /// the tolerance instead of one tolerance per step. A span that is not positive and finite switches it
     /// off. The default does nothing (the Dormand–Prince methods control the error per step).
     fn set_span(&mut self, _span: f64) {}
+    /// Caps the step attempts of each later [`Integrator::advance`] call at `max_steps` (beyond it the call fails
+    /// with [`IntegrateError::TooManySteps`], the last accepted point kept): a run's step budget
+    /// ([`crate::io::run_budget`]). The default does nothing.
+    fn set_max_steps(&mut self, _max_steps: u64) {}
+    /// Makes each later [`Integrator::advance`] stop with [`IntegrateError::Deadline`] (the last accepted point kept)
+    /// once the wall clock passes `deadline` (`None`: never): a run's wall-clock budget. The default does nothing.
+    fn set_deadline(&mut self, _deadline: Option<std::time::Instant>) {}
     /// Which method this is.
     fn method(&self) -> Method;
     /// Everything that influences later calls to [`Integrator::advance`] (see [`IntegratorState`]).

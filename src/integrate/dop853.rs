@@ -456,6 +456,8 @@ pub struct Dop853 {
     tol: Tolerances,
     initial_step: Option<f64>,
     max_steps: u64,
+    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
+    deadline: Option<std::time::Instant>,
     h_min: f64,
     h_max: f64,
     max_nonfinite_retries: u32,
@@ -508,6 +510,7 @@ impl Dop853 {
             tol: tolerances,
             initial_step: step.map(f64::abs),
             max_steps: DEFAULT_MAX_STEPS,
+            deadline: None,
             h_min: 0.0,
             h_max: f64::INFINITY,
             max_nonfinite_retries: DEFAULT_MAX_NONFINITE_RETRIES,
@@ -769,6 +772,9 @@ impl Dop853 {
                     });
                 }
             }
+            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                return Err(IntegrateError::Deadline { t: *t });
+            }
             if attempts >= self.max_steps {
                 return Err(IntegrateError::TooManySteps {
                     t: *t,
@@ -848,6 +854,14 @@ enum Arg {
 }
 
 impl Integrator for Dop853 {
+    fn set_max_steps(&mut self, max_steps: u64) {
+        self.max_steps = max_steps.max(1);
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.deadline = deadline;
+    }
+
     fn advance(
         &mut self,
         system: &dyn OdeSystem,

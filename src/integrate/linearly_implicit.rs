@@ -121,6 +121,8 @@ pub struct LinearlyImplicit {
     tol: Tolerances,
     km: usize,
     max_steps: u64,
+    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
+    deadline: Option<std::time::Instant>,
     span: Option<f64>,
     /// Proposed |H| for the next step; 0 = unknown.
     h: f64,
@@ -201,6 +203,7 @@ impl LinearlyImplicit {
             tol: tolerances,
             km,
             max_steps: DEFAULT_MAX_STEPS,
+            deadline: None,
             span: None,
             h: 0.0,
             k,
@@ -525,6 +528,9 @@ impl LinearlyImplicit {
                     IntegrateError::StepUnderflow { t: *t, h: dir * self.h }
                 });
             }
+            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                return Err(IntegrateError::Deadline { t: *t });
+            }
             if attempts >= self.max_steps {
                 return Err(IntegrateError::TooManySteps {
                     t: *t,
@@ -594,6 +600,14 @@ impl LinearlyImplicit {
 }
 
 impl Integrator for LinearlyImplicit {
+    fn set_max_steps(&mut self, max_steps: u64) {
+        self.max_steps = max_steps.max(1);
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.deadline = deadline;
+    }
+
     fn advance(
         &mut self,
         system: &dyn OdeSystem,

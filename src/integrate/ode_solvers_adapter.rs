@@ -128,6 +128,8 @@ pub struct OdeSolversAdapter {
     /// Step to start the next call with (adaptive methods); 0 = automatic.
     h_next: f64,
     max_steps: u64,
+    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
+    deadline: Option<std::time::Instant>,
     chunk_steps: Option<usize>,
     stats: Stats,
 }
@@ -190,6 +192,7 @@ impl OdeSolversAdapter {
                 step.map_or(0.0, f64::abs)
             },
             max_steps: super::bulirsch_stoer::DEFAULT_MAX_STEPS,
+            deadline: None,
             chunk_steps: None,
             stats: Stats {
                 smallest_step: f64::INFINITY,
@@ -275,6 +278,9 @@ impl OdeSolversAdapter {
         let dir = if t_target > x { 1.0 } else { -1.0 };
 
         let result = loop {
+            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                break Err(IntegrateError::Deadline { t: x });
+            }
             if steps >= self.max_steps {
                 break Err(IntegrateError::TooManySteps {
                     t: x,
@@ -514,6 +520,14 @@ fn last_finite(ys: &[DVector<f64>]) -> (usize, DVector<f64>) {
 }
 
 impl Integrator for OdeSolversAdapter {
+    fn set_max_steps(&mut self, max_steps: u64) {
+        self.max_steps = max_steps.max(1);
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.deadline = deadline;
+    }
+
     fn advance(
         &mut self,
         system: &dyn OdeSystem,

@@ -24,7 +24,7 @@
 //!   each other (the shards of one campaign directory, each writing its own runs and index).
 //! - On a file system without advisory locks the directory is written unlocked, after a warning on stderr.
 
-use std::fs::{File, OpenOptions, TryLockError};
+use std::fs::{File, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -64,7 +64,11 @@ pub enum LockError {
         advice: Option<&'static str>,
     },
     /// The lock file could not be opened or locked.
-    #[error("{}: cannot lock: {source}", .path.display())]
+    #[error("{}", if crate::io::safe_write::is_symlink_refusal(.source) {
+        .source.to_string()
+    } else {
+        format!("{}: cannot lock: {}", .path.display(), .source)
+    })]
     Io {
         /// The lock file.
         path: PathBuf,
@@ -184,13 +188,8 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
         h.depth += 1;
         return Ok(DirLock { path });
     }
-    let mut file = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .map_err(io(&named))?;
+    // Never through a link: a lock file that is one would have the pid written into whatever it points at.
+    let mut file = crate::io::safe_write::open_nofollow(&path, true).map_err(io(&named))?;
     let attempt = if shared {
         file.try_lock_shared()
     } else {

@@ -291,7 +291,8 @@ impl SsFile {
     /// pkdgrav or [`SsFile::read`] would choke on is written.
     pub fn write(&self, path: &Path) -> Result<(), SsError> {
         self.check()?;
-        std::fs::write(path, self.to_bytes(&Units::pkdgrav())).map_err(|e| SsError::Io(e.to_string()))
+        crate::io::safe_write::write_atomic(path, self.to_bytes(&Units::pkdgrav()))
+            .map_err(|e| SsError::Io(crate::io::safe_write::describe(path, &e)))
     }
 }
 

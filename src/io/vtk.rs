@@ -9,7 +9,6 @@
 //! and ids is 4.9 MB. (Raw appended data would save the base64 third, but it makes the file invalid XML, which
 //! XML-based readers such as `vtkio` refuse.) Integers are `Int32` where every value fits, else `Int64`.
 
-use std::io::Write;
 use std::path::Path;
 
 use quick_xml::Writer;
@@ -315,12 +314,7 @@ pub fn write_collection(path: &Path, entries: &[CollectionEntry]) -> std::io::Re
 }
 
 fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let tmp = path.with_extension("tmp");
-    {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-    }
-    std::fs::rename(&tmp, path)
+    crate::io::safe_write::write_atomic(path, bytes)
 }
 
 #[cfg(test)]

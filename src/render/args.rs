@@ -5,6 +5,9 @@ use std::path::PathBuf;
 use super::run::{ColourBy, RenderRunOptions};
 use super::{Projection, View};
 
+/// Largest `--extent` accepted (m): 1e300, beyond it the camera's scale underflows.
+pub const MAX_EXTENT_M: f64 = 1e300;
+
 /// `rubblepile render`.
 #[derive(Debug, clap::Args)]
 pub struct RenderArgs {
@@ -40,7 +43,23 @@ pub struct RenderArgs {
 impl RenderArgs {
     /// The options these arguments ask for (errors name the flag).
     pub fn options(&self) -> Result<RenderRunOptions, String> {
+        // Said exactly: `"iso "` is a typo the reader should see, not a view taken on trust.
+        if self.view.trim() != self.view || self.view.is_empty() {
+            return Err(format!(
+                "--view: expected x, y, z or iso (without spaces), got {:?}",
+                self.view
+            ));
+        }
         let view: View = self.view.parse().map_err(|e: super::RenderError| e.to_string())?;
+        if let Some(e) = self.extent
+            && !(crate::io::limits::MIN_MEANINGFUL..=MAX_EXTENT_M).contains(&e)
+        {
+            return Err(format!(
+                "--extent: expected a half-width in metres from {:e} to {MAX_EXTENT_M:e}, got {}",
+                crate::io::limits::MIN_MEANINGFUL,
+                crate::io::scene_file::fmt_num(e)
+            ));
+        }
         let colour: ColourBy = self.color.parse()?;
         let bad_size = || format!("--size: expected WIDTHxHEIGHT in pixels, got {:?}", self.size);
         let (w, h) = self.size.split_once('x').ok_or_else(bad_size)?;

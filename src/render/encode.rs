@@ -4,9 +4,9 @@
 //! GIF frames are quantised to 256 colours each with the `gif` crate's NeuQuant; its speed setting trades colour
 //! fidelity for time, and frames may be halved in size ([`GifOptions::halve`]) to keep large animations light.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
+
+use crate::io::safe_write::AtomicFile;
 
 use super::error::RenderError;
 use super::image::RgbImage;
@@ -20,13 +20,14 @@ fn io_error(path: &Path, source: std::io::Error) -> RenderError {
 
 /// Writes `image` as an 8-bit RGB PNG at `path`.
 pub fn write_png(path: &Path, image: &RgbImage) -> Result<(), RenderError> {
-    let file = File::create(path).map_err(|e| io_error(path, e))?;
-    let mut encoder = png::Encoder::new(BufWriter::new(file), image.width, image.height);
+    let mut file = AtomicFile::create(path).map_err(|e| io_error(path, e))?;
+    let mut encoder = png::Encoder::new(&mut file, image.width, image.height);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     let mut writer = encoder.write_header().map_err(|e| png_error(path, e))?;
     writer.write_image_data(&image.pixels).map_err(|e| png_error(path, e))?;
-    writer.finish().map_err(|e| png_error(path, e))
+    writer.finish().map_err(|e| png_error(path, e))?;
+    file.finish().map_err(|e| io_error(path, e))
 }
 
 /// The PNG encoder reports I/O failures inside its own error type; they are file errors for the caller.
@@ -58,7 +59,7 @@ impl Default for GifOptions {
 
 /// An animated GIF being written, one frame at a time; loops forever.
 pub struct GifWriter {
-    encoder: gif::Encoder<BufWriter<File>>,
+    encoder: gif::Encoder<AtomicFile>,
     path: PathBuf,
     width: u32,
     height: u32,
@@ -100,8 +101,8 @@ impl GifWriter {
         };
         let w16 = u16::try_from(out_w).map_err(|_| too_big())?;
         let h16 = u16::try_from(out_h).map_err(|_| too_big())?;
-        let file = File::create(path).map_err(|e| io_error(path, e))?;
-        let mut encoder = gif::Encoder::new(BufWriter::new(file), w16, h16, &[]).map_err(|e| gif_error(path, e))?;
+        let file = AtomicFile::create(path).map_err(|e| io_error(path, e))?;
+        let mut encoder = gif::Encoder::new(file, w16, h16, &[]).map_err(|e| gif_error(path, e))?;
         encoder
             .set_repeat(gif::Repeat::Infinite)
             .map_err(|e| gif_error(path, e))?;
@@ -146,8 +147,8 @@ impl GifWriter {
     /// Writes the GIF trailer and flushes the file.
     pub fn finish(self) -> Result<(), RenderError> {
         let path = self.path;
-        let mut writer = self.encoder.into_inner().map_err(|e| io_error(&path, e))?;
-        writer.flush().map_err(|e| io_error(&path, e))
+        let writer = self.encoder.into_inner().map_err(|e| io_error(&path, e))?;
+        writer.finish().map_err(|e| io_error(&path, e))
     }
 }
 

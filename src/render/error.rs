@@ -7,7 +7,11 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
     /// A file could not be created or written.
-    #[error("cannot write {}: {source}", path.display())]
+    #[error("{}", if crate::io::safe_write::is_symlink_refusal(.source) {
+        .source.to_string()
+    } else {
+        format!("cannot write {}: {}", .path.display(), .source)
+    })]
     Io {
         /// The file.
         path: PathBuf,

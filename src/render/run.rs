@@ -258,7 +258,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     };
     let has_snapshots = dir.join("snapshots").is_dir();
     if has_snapshots && !parent.is_dir() {
-        std::fs::create_dir_all(&parent).map_err(|source| RenderError::Io {
+        crate::io::safe_write::ensure_dir(&parent).map_err(|source| RenderError::Io {
             path: parent.clone(),
             source,
         })?;
@@ -282,7 +282,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     let scale = colour_scale(opts.colour, &mut all_values);
 
     // Pass 2: draw and write.
-    std::fs::create_dir_all(&frames_dir).map_err(|source| RenderError::Io {
+    crate::io::safe_write::ensure_dir(&frames_dir).map_err(|source| RenderError::Io {
         path: frames_dir.clone(),
         source,
     })?;

@@ -92,17 +92,40 @@ pub fn write_figure(
     figure: &impl Figure,
 ) -> Result<[String; 2], crate::analysis::AnalysisError> {
     ensure_font()?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    use crate::io::safe_write;
+    let io = |p: &Path, e: std::io::Error| format!("{}: {}", p.display(), safe_write::reason(&e));
+    safe_write::ensure_dir(dir).map_err(|e| io(dir, e))?;
     let (svg, png) = (format!("{stem}.svg"), format!("{stem}.png"));
     let (svg_path, png_path) = (dir.join(&svg), dir.join(&png));
-    let drawn = render(&SVGBackend::new(&svg_path, FIGURE_SIZE).into_drawing_area(), figure)
-        .and_then(|()| render(&BitMapBackend::new(&png_path, FIGURE_SIZE).into_drawing_area(), figure));
-    // both backends are dropped (and have written whatever they hold) by now
+    // Both drawn into temporaries first (the SVG in memory, the PNG into a fresh file beside it: plotters' bitmap
+    // backend writes only to a path), then renamed into place: never through a link, never half a figure.
+    // On a drawing error the figure's old files go too: a stale figure must not pass for this one.
+    let stale = || {
+        for p in [&svg_path, &png_path] {
+            if safe_write::refuse_symlink(p).is_ok() {
+                let _ = std::fs::remove_file(p);
+            }
+        }
+    };
+    let mut svg_text = String::new();
+    let drawn = render(
+        &SVGBackend::with_string(&mut svg_text, FIGURE_SIZE).into_drawing_area(),
+        figure,
+    );
     if let Err(why) = drawn {
-        let _ = std::fs::remove_file(&svg_path);
-        let _ = std::fs::remove_file(&png_path);
+        stale();
         return Err(why);
     }
+    let (png_tmp, _) = safe_write::temp_beside(&png_path).map_err(|e| io(&png_path, e))?;
+    let drawn = render(&BitMapBackend::new(&png_tmp, FIGURE_SIZE).into_drawing_area(), figure);
+    // the backend is dropped (and has written whatever it holds) by now
+    if let Err(why) = drawn {
+        let _ = std::fs::remove_file(&png_tmp);
+        stale();
+        return Err(why);
+    }
+    safe_write::write_atomic(&svg_path, &svg_text).map_err(|e| io(&svg_path, e))?;
+    safe_write::rename_into(&png_tmp, &png_path).map_err(|e| io(&png_path, e))?;
     Ok([svg, png])
 }
 

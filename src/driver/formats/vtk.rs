@@ -39,7 +39,7 @@ impl SnapshotFormat for Vtk {
 
     fn write(&self, dir: &Path, k: usize, view: &SnapshotView, written: &[(usize, f64)]) -> std::io::Result<()> {
         let vtk_dir = dir.join("vtk");
-        std::fs::create_dir_all(&vtk_dir)?;
+        crate::io::safe_write::ensure_dir(&vtk_dir)?;
         let parts = pieces(view);
         for (name, piece) in &parts {
             piece.write(&vtk_dir.join(format!("{name}_{k}.vtp")))?;

@@ -21,7 +21,7 @@ impl SnapshotFormat for ExtendedXyz {
     fn write(&self, dir: &Path, k: usize, view: &SnapshotView, _written: &[(usize, f64)]) -> std::io::Result<()> {
         let (t, particles) = (view.t, &view.particles);
         let path = dir.join("snapshots").join(format!("{k}.xyz"));
-        let mut w = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let mut w = crate::io::safe_write::AtomicFile::create(&path)?;
         writeln!(w, "{}", particles.len())?;
         writeln!(
             w,
@@ -43,7 +43,7 @@ impl SnapshotFormat for ExtendedXyz {
                 .collect();
             writeln!(w, "{species} {}", numbers.join(" "))?;
         }
-        w.flush()
+        w.finish()
     }
 
     fn files(&self, dir: &Path) -> Vec<std::path::PathBuf> {

@@ -4,8 +4,7 @@
 //! failure, `last_good_state.csv` with the cause in the summary. Checkpoints ([`HardState`]) continue bit for bit
 //! (`rubblepile resume DIR`).
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
@@ -137,7 +136,7 @@ fn wall_surfaces(walls: &[crate::geometry::walls::Wall], t: f64, particles: &[Pa
 
 /// Writes the alive particles in the particles-file columns.
 pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
+    let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "{},{STUCK_COLUMN}", PARTICLE_COLUMNS.join(","))?;
     for p in system.particles.iter().filter(|p| p.alive) {
         let v = [
@@ -157,7 +156,7 @@ pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<
         let stuck = p.stuck.map_or(-1, |a| a.wall as i64);
         writeln!(w, "{},{},{},{stuck}", fmt_f64(t), p.id, cols.join(","))?;
     }
-    w.flush()
+    w.finish()
 }
 
 /// Numbers in a checkpoint's bookkeeping ([`HardState`]'s `book`).
@@ -298,6 +297,8 @@ pub struct HardEngine {
     /// Events when this process started, and its clock (for the summary's events per second).
     events_before: u64,
     clock: Instant,
+    /// Wall-clock instant after which an advance stops ([`Engine::set_deadline`]).
+    deadline: Option<Instant>,
 }
 
 impl HardEngine {
@@ -324,6 +325,7 @@ impl HardEngine {
             last_wall_clock: 0.0,
             events_before: 0,
             clock: Instant::now(),
+            deadline: None,
         }
     }
 
@@ -374,6 +376,18 @@ impl Engine for HardEngine {
         &self.scene.source
     }
 
+    fn estimated_steps(&self) -> Option<f64> {
+        Some((self.scene.t_end / self.scene.dt).ceil())
+    }
+
+    fn steps_taken(&self) -> u64 {
+        self.steps
+    }
+
+    fn set_deadline(&mut self, deadline: Option<Instant>) {
+        self.deadline = deadline;
+    }
+
     fn error_so_far(&self) -> Option<(&'static str, f64)> {
         // Restitution and moving walls change the energy on purpose: the residual after them is the error.
         Some(("energy residual", self.book.energy_residual))
@@ -409,6 +423,9 @@ impl Engine for HardEngine {
         while self.system.t < to.t {
             if self.steps.is_multiple_of(64) {
                 progress(self.system.t);
+                if self.deadline.is_some_and(|d| Instant::now() >= d) {
+                    return Err(Failure::deadline(self.system.t));
+                }
             }
             let left = to.t - self.system.t;
             let h = if left < 1.000001 * dt { left } else { dt };

@@ -96,6 +96,9 @@ pub struct HardSceneFile {
     /// `[[wall]]` tables. Optional.
     #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
     pub walls: Vec<WallSpec>,
+    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
@@ -356,6 +359,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         ));
     }
     let t_end = v.field(&fields::T_END, file.scene.t_end)?;
+    crate::io::run_budget::validate(&v, &file.run)?;
     let dt = v.step("stepping.dt", file.stepping.dt, t_end)?;
     let collapse_speed = v.field(&fields::COLLAPSE_SPEED, file.stepping.collapse_speed)?;
     let skin_steps = v.field(&fields::SKIN_STEPS, file.stepping.skin_steps)?;

@@ -163,6 +163,7 @@ pub const TABLES: &[TableDoc] = &[
         array: false,
         meaning: "A sin(omega t + phi) along a direction added to the wall's position (optional)",
     },
+    crate::io::run_budget::RUN_TABLE,
 ];
 
 /// Every key of the file, in print order.
@@ -361,6 +362,8 @@ pub const FIELDS: &[FieldDoc] = &[
         range: Range::Rule("true | false"),
         meaning: "particles that touch it are removed and counted",
     },
+    crate::io::run_budget::MAX_STEPS_FIELD,
+    crate::io::run_budget::MAX_WALL_FIELD,
 ];
 
 /// The reference of the hard-sphere scene file.

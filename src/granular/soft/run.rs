@@ -344,7 +344,7 @@ pub fn sample_steps(scene: &SoftScene) -> Vec<(u64, Option<usize>)> {
 
 /// Writes spheres in the snapshot columns.
 pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::io::Result<()> {
-    let mut w = BufWriter::new(File::create(path)?);
+    let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz")?;
     for (id, p) in particles.iter().enumerate() {
         let (x, v, s) = (p.position, p.velocity, p.spin);
@@ -354,7 +354,7 @@ pub fn write_particles_csv(path: &Path, t: f64, particles: &[Particle]) -> std::
             p.mass, p.radius, x.x, x.y, x.z, v.x, v.y, v.z, s.x, s.y, s.z
         )?;
     }
-    w.flush()
+    w.finish()
 }
 
 /// The particle–particle contacts of `sys` at time `t` (s) with their normal forces, from one force evaluation on a
@@ -533,6 +533,8 @@ pub struct SoftEngine {
     plan: Vec<(u64, Option<usize>)>,
     /// The state before the current step, kept for `last_good_state.csv` (allocated once).
     before: Vec<Particle>,
+    /// Wall-clock instant after which an advance stops ([`Engine::set_deadline`]).
+    deadline: Option<std::time::Instant>,
 }
 
 impl SoftEngine {
@@ -550,6 +552,7 @@ impl SoftEngine {
             spin: None,
             plan,
             before,
+            deadline: None,
         }
     }
 
@@ -613,6 +616,18 @@ impl Engine for SoftEngine {
         &self.scene.source
     }
 
+    fn estimated_steps(&self) -> Option<f64> {
+        Some(self.scene.n_steps as f64)
+    }
+
+    fn steps_taken(&self) -> u64 {
+        self.step
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.deadline = deadline;
+    }
+
     fn error_so_far(&self) -> Option<(&'static str, f64)> {
         Some(("energy error", self.book.max_energy))
     }
@@ -653,7 +668,7 @@ impl Engine for SoftEngine {
             sys.keep_records = true;
             sys.set_pair_springs(Vec::new());
             sys.compute_forces(0.0, 0.0);
-            let mut csv = BufWriter::new(File::create(dir.join("spinup.csv"))?);
+            let mut csv = BufWriter::new(crate::io::safe_write::create_fresh(&dir.join("spinup.csv"))?);
             csv.write_all(SPINUP_HEADER.as_bytes())?;
             self.spin = Some(SpinRun {
                 driver,
@@ -674,6 +689,9 @@ impl Engine for SoftEngine {
             let step = self.step;
             if step.is_multiple_of(256) {
                 progress(step as f64 * dt);
+                if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
+                    return Err(Failure::deadline(step as f64 * dt));
+                }
             }
             // the spin-up diagnostics at a sample need that step's contact records
             sys.keep_records = self.spin.is_some() && step + 1 == sample_step;

@@ -114,6 +114,9 @@ pub struct SoftSceneFile {
     /// `[spinup]`, optional: spin-up forcing and diagnostics ([`crate::granular::soft::spinup`]).
     #[serde(default)]
     pub spinup: Option<crate::granular::soft::spinup::SpinupSection>,
+    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
@@ -577,6 +580,7 @@ impl V<'_> {
             return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
         }
         let t_end = self.field(&fields::T_END, file.scene.t_end)?;
+        crate::io::run_budget::validate(self, &file.run)?;
         let dt = self.step("integrator.dt", file.integrator.dt, t_end)?;
         let steps = (t_end / dt).round();
         if !(1.0..=1e12).contains(&steps) {

@@ -299,6 +299,7 @@ pub const TABLES: &[TableDoc] = &[
         array: false,
         meaning: "spin-up forcing along a period path T(t) and its diagnostics (optional; Zhang17 §2.3.4)",
     },
+    crate::io::run_budget::RUN_TABLE,
 ];
 
 /// Every key of the file, in print order.
@@ -498,6 +499,8 @@ pub const FIELDS: &[FieldDoc] = &[
     },
     SPINUP_INTERIOR_DEPTH,
     SPINUP_INTERIOR_RAMP,
+    crate::io::run_budget::MAX_STEPS_FIELD,
+    crate::io::run_budget::MAX_WALL_FIELD,
 ];
 
 /// The reference of the soft-sphere scene file.

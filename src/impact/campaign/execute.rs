@@ -148,7 +148,10 @@ pub(crate) fn execute(
             false,
             Some(RunNumbers::from(summary.as_ref())),
         ),
-        Ok(Err(ImpactError::Run(RunError::Stopped { .. }))) => (RunStatus::Pending, true, None),
+        // Stopped on request or by its budget: its checkpoint lets the next campaign run resume it.
+        Ok(Err(ImpactError::Run(RunError::Stopped { .. } | RunError::Budget { .. }))) => {
+            (RunStatus::Pending, true, None)
+        }
         Ok(Err(e)) => (RunStatus::Failed(e.to_string()), false, None),
         Err(panic) => {
             let what = panic
@@ -255,7 +258,8 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         let line = format!("{}\n", src.display());
         // Rewritten only when it changes: a resumed campaign leaves its directory's files untouched.
         if std::fs::read_to_string(&pointer).ok().as_deref() != Some(line.as_str()) {
-            std::fs::write(&pointer, line).map_err(|source| CampaignError::Io { path: pointer, source })?;
+            crate::io::safe_write::write_atomic(&pointer, line)
+                .map_err(|source| CampaignError::Io { path: pointer, source })?;
         }
     }
     let index_file = options.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());

@@ -1,6 +1,6 @@
 //! `campaign.csv`: one row per grid point with its status and outcome, rewritten atomically.
 
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
 
 use crate::driver::RunSummary;
@@ -197,7 +197,7 @@ pub(crate) fn fmt_num(x: f64) -> String {
     }
 }
 
-/// Writes `campaign.csv` (via `campaign.csv.tmp` and a rename).
+/// Writes `campaign.csv` atomically and durably, never through a link ([`crate::io::safe_write`]).
 pub(crate) fn write_campaign_csv(
     out: &Path,
     file: &str,
@@ -205,11 +205,6 @@ pub(crate) fn write_campaign_csv(
     runs: &[RunRecord],
 ) -> Result<(), CampaignError> {
     let path = out.join(file);
-    let tmp = out.join(format!("{file}.tmp"));
-    let io = |p: &Path| {
-        let path = p.to_path_buf();
-        move |source| CampaignError::Io { path, source }
-    };
     let mut w = csv::Writer::from_writer(Vec::new());
     let to_io = |e: csv::Error| CampaignError::Io {
         path: path.clone(),
@@ -242,11 +237,7 @@ pub(crate) fn write_campaign_csv(
         path: path.clone(),
         source: std::io::Error::other(e.to_string()),
     })?;
-    let mut file = std::fs::File::create(&tmp).map_err(io(&tmp))?;
-    file.write_all(&bytes).map_err(io(&tmp))?;
-    file.sync_all().map_err(io(&tmp))?;
-    drop(file);
-    std::fs::rename(&tmp, &path).map_err(io(&path))
+    crate::io::safe_write::write_atomic_durable(&path, bytes).map_err(|source| CampaignError::Io { path, source })
 }
 
 /// The last `t` in a (growing) `timeseries.csv`, for the progress display.

@@ -81,6 +81,7 @@ pub mod index;
 pub mod mpi;
 pub mod plan;
 pub mod shard;
+pub mod slurm;
 
 pub use distributed::*;
 pub use execute::*;
@@ -88,6 +89,7 @@ pub use file::*;
 pub use index::*;
 pub use plan::*;
 pub use shard::*;
+pub use slurm::*;
 
 use std::path::PathBuf;
 
@@ -149,8 +151,8 @@ pub enum CampaignError {
     /// Another rubblepile process writes the campaign directory (or this shard's index).
     #[error(transparent)]
     Locked(#[from] crate::io::run_lock::LockError),
-    /// Writing the campaign directory or `campaign.csv` failed.
-    #[error("{}: {source}", .path.display())]
+    /// Writing the campaign directory or `campaign.csv` failed (or a symbolic link stands where it writes).
+    #[error("{}", crate::io::safe_write::describe(.path, .source))]
     Io {
         /// The file or directory.
         path: PathBuf,

@@ -118,137 +118,6 @@ pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
     })
 }
 
-/// What the Slurm script of `campaign slurm` asks of the scheduler and which binary it runs (options named as
-/// `sbatch`'s).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct SlurmJob {
-    /// Array tasks (shards), at least 1.
-    pub tasks: usize,
-    /// Cores per task, at least 1.
-    pub threads: usize,
-    /// `--time` (wall-clock limit per task: `MINUTES`, `HH:MM:SS`, `D-HH:MM`, …); `None`: the partition's default.
-    pub time: Option<String>,
-    /// `--partition`; `None`: the cluster's default.
-    pub partition: Option<String>,
-    /// `--account` charged; `None`: the user's default.
-    pub account: Option<String>,
-    /// `--mem` per node (e.g. `4G`, `500M`; a bare number is MB); `None`: the partition's default.
-    pub mem: Option<String>,
-    /// Most array tasks running at once (`--array=0-(N-1)%K`); `None`: no limit.
-    pub throttle: Option<usize>,
-    /// The rubblepile executable the tasks run.
-    pub binary: PathBuf,
-}
-
-impl SlurmJob {
-    /// Checks the options as `sbatch` would read them, naming the option at fault: counts at least 1, a time of
-    /// digits with `-` and `:` in one of Slurm's forms, memory as digits with an optional K/M/G/T unit, and
-    /// partition and account names of letters, digits and `_ . - ,` (nothing the shell would read).
-    pub fn check(&self) -> Result<(), (String, String)> {
-        let bad = |opt: &str, why: &str, got: &str| Err((format!("--{opt}"), format!("{why}, got {got:?}")));
-        if self.tasks == 0 {
-            return bad("tasks", "must be at least 1", "0");
-        }
-        if self.threads == 0 {
-            return bad("threads-per-task", "must be at least 1", "0");
-        }
-        if self.throttle == Some(0) {
-            return bad("throttle", "must be at least 1 (array tasks at once)", "0");
-        }
-        if let Some(t) = &self.time
-            && !slurm_time(t)
-        {
-            return bad(
-                "time",
-                "must be a Slurm time limit: MINUTES, MINUTES:SECONDS, HOURS:MINUTES:SECONDS, DAYS-HOURS, \
-                 DAYS-HOURS:MINUTES or DAYS-HOURS:MINUTES:SECONDS",
-                t,
-            );
-        }
-        if let Some(m) = &self.mem {
-            let digits = m.trim_end_matches(['K', 'M', 'G', 'T']);
-            if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) || m.len() > digits.len() + 1 {
-                return bad(
-                    "mem",
-                    "must be a whole number with an optional unit K, M, G or T (e.g. 4G)",
-                    m,
-                );
-            }
-        }
-        for (opt, value) in [("partition", &self.partition), ("account", &self.account)] {
-            if let Some(v) = value
-                && (v.is_empty() || !v.bytes().all(|b| b.is_ascii_alphanumeric() || b"_.-,".contains(&b)))
-            {
-                return bad(opt, "must be a name of letters, digits, '_', '.', '-' or ','", v);
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Whether `t` is one of Slurm's time-limit forms (`sbatch --time`).
-fn slurm_time(t: &str) -> bool {
-    let numbers = |s: &str, most: usize| {
-        let parts: Vec<&str> = s.split(':').collect();
-        parts.len() <= most
-            && parts
-                .iter()
-                .all(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit()))
-    };
-    match t.split_once('-') {
-        Some((days, rest)) => numbers(days, 1) && numbers(rest, 3),
-        None => numbers(t, 3),
-    }
-}
-
-/// A Slurm job-array script running `campaign` as `job.tasks` shards, one array task each, with `job.threads`
-/// cores per task and the scheduler options of `job`; its tasks call `job.binary`.
-pub fn slurm_script(campaign: &Campaign, campaign_file: &Path, job: &SlurmJob) -> String {
-    let out = campaign.out.display();
-    let name = campaign_file
-        .file_stem()
-        .map_or("campaign".into(), |s| s.to_string_lossy().into_owned());
-    let runs = campaign.points.len();
-    let tasks = job.tasks;
-    let mut options = String::new();
-    for (opt, value) in [
-        ("time", &job.time),
-        ("partition", &job.partition),
-        ("account", &job.account),
-        ("mem", &job.mem),
-    ] {
-        if let Some(v) = value {
-            options.push_str(&format!("#SBATCH --{opt}={v}\n"));
-        }
-    }
-    format!(
-        "#!/bin/bash\n\
-         # {runs} impact runs of {file} in {tasks} shards (written by `rubblepile campaign slurm`).\n\
-         # Submit:  jobid=$(sbatch --parsable {out}/campaign.slurm)\n\
-         # Then:    sbatch --dependency=afterany:$jobid --wrap \"{bin} campaign merge {out}\"\n\
-         # A task that dies leaves its finished runs and checkpoints; resubmitting the array resumes them.\n\
-         #SBATCH --job-name=rubblepile-{name}\n\
-         #SBATCH --array=0-{last}{throttle}\n\
-         #SBATCH --ntasks=1\n\
-         #SBATCH --cpus-per-task={threads}\n\
-         {options}\
-         #SBATCH --output={out}/slurm-%A_%a.out\n\
-         set -euo pipefail\n\
-         export RAYON_NUM_THREADS=$SLURM_CPUS_PER_TASK\n\
-         srun {bin} campaign {file} --out {out} --shard $SLURM_ARRAY_TASK_ID/{tasks} --parallel 1 --no-progress\n",
-        file = campaign_file.display(),
-        bin = job.binary.display(),
-        last = tasks - 1,
-        threads = job.threads,
-        throttle = job.throttle.map_or(String::new(), |k| format!("%{k}")),
-    )
-}
-
-/// Where `campaign slurm` writes its script.
-pub fn slurm_script_path(campaign: &Campaign) -> PathBuf {
-    campaign.out.join("campaign.slurm")
-}
-
 /// `rubblepile campaign merge|slurm …`.
 #[derive(Debug, clap::Subcommand)]
 pub enum CampaignAction {
@@ -332,24 +201,27 @@ impl CampaignAction {
                         .or_else(|| std::env::current_exe().ok())
                         .unwrap_or_else(|| PathBuf::from("rubblepile")),
                 };
-                job.check().map_err(|(field, message)| CampaignError::Invalid {
+                let invalid = |(field, message)| CampaignError::Invalid {
                     file: file.display().to_string(),
                     field,
                     message,
-                })?;
+                };
+                job.check().map_err(invalid)?;
                 let mut campaign = load_campaign(file)?;
                 if let Some(o) = out {
-                    campaign.out = std::path::absolute(o).unwrap_or_else(|_| o.clone());
+                    campaign.out = o.clone();
                 }
                 let abs_file = campaign.source.clone().unwrap_or_else(|| file.clone());
-                let text = slurm_script(&campaign, &abs_file, &job);
+                let paths = SlurmPaths::resolve(&job.binary, &abs_file, &campaign.out).map_err(invalid)?;
+                campaign.out = paths.out.clone();
+                let text = slurm_script(campaign.points.len(), &paths, &job);
                 let path = slurm_script_path(&campaign);
                 let io = |source| CampaignError::Io {
                     path: path.clone(),
                     source,
                 };
                 std::fs::create_dir_all(&campaign.out).map_err(io)?;
-                std::fs::write(&path, text).map_err(io)?;
+                crate::io::safe_write::write_atomic(&path, text).map_err(io)?;
                 Ok(vec![format!(
                     "wrote {} ({} runs in {tasks} array tasks); submit it with sbatch, then run `campaign merge {}`",
                     path.display(),
