@@ -848,7 +848,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
                 table["spinup"]["T_final"] = toml::Value::Float(tf);
                 let scene_text = toml::to_string(&table).map_err(|e| SearchError::usage(e.to_string()))?;
                 let path = args.out.join(format!("T{tf:.2}.toml"));
-                std::fs::write(&path, &scene_text)
+                crate::io::safe_write::write_atomic(&path, &scene_text)
                     .map_err(|e| SearchError::failed(format!("{}: {e}", path.display())))?;
                 Some(crate::granular::soft::scene::load_soft_scene(&path).map_err(SearchError::usage)?)
             }
@@ -948,7 +948,8 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     };
     let (t_c3_hours, friction_angle_deg) = (selected.t_c3_hours, selected.friction_angle_deg);
     let csv = args.out.join("critical.csv");
-    std::fs::write(&csv, critical_csv(&runs)).map_err(|e| SearchError::failed(format!("{}: {e}", csv.display())))?;
+    crate::io::safe_write::write_atomic(&csv, critical_csv(&runs))
+        .map_err(|e| SearchError::failed(format!("{}: {e}", csv.display())))?;
     let out = CriticalSearch {
         criterion: selected.criterion,
         judge_window_s: args.judge_window,
@@ -959,7 +960,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         paper_tolerance,
         ours,
     };
-    std::fs::write(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
+    crate::io::safe_write::write_atomic(&json, serde_json::to_string_pretty(&out).expect("serialises") + "\n")
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.paper_tolerance, &out.ours] {
         if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {

@@ -181,7 +181,8 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
             println!("speed-up of --parallel {}: {:.3}x", r.parallel, base / r.wall_s);
         }
     }
-    std::fs::write(&csv_path, text).map_err(|e| BenchError::failed(format!("{}: {e}", csv_path.display())))?;
+    crate::io::safe_write::write_atomic(&csv_path, text)
+        .map_err(|e| BenchError::failed(format!("{}: {e}", csv_path.display())))?;
     plot(&args.out.join("bench_critical.svg"), &rows).map_err(BenchError::failed)?;
     println!("wrote {}", csv_path.display());
     Ok(())
