@@ -334,7 +334,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     // the ordering
     let full = in_group(Group::Full);
     let csv = ordering_csv(&full, hold);
-    crate::io::safe_write::write_atomic(out.join("ordering.csv"), &csv)
+    crate::io::safe_write::write_atomic(&out.join("ordering.csv"), &csv)
         .map_err(|e| format!("{}: {e}", out.join("ordering.csv").display()))?;
     let _ = writeln!(
         md,
