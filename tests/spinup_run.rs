@@ -516,6 +516,18 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
     for line in seq.lines().filter(|l| l.starts_with("T_final")) {
         assert!(judged.contains(line), "{line}\nnot in\n{judged}");
     }
+    // … and writes them as the search's own critical.csv (a running search's compact copy), never over a file
+    let csv = dir.join("judged_critical.csv");
+    let csv_arg = csv.to_string_lossy().to_string();
+    let written = rubblepile(&dir, &["spinup", "judge", "seq", "--csv", &csv_arg]);
+    assert!(written.status.success(), "{}", String::from_utf8_lossy(&written.stderr));
+    assert_eq!(
+        std::fs::read_to_string(&csv).unwrap(),
+        std::fs::read_to_string(dir.join("seq/critical.csv")).unwrap()
+    );
+    let again = rubblepile(&dir, &["spinup", "judge", "seq", "--csv", &csv_arg]);
+    assert_eq!(again.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&again.stderr).contains("--csv"), "{again:?}");
     let reference = search_outputs(&dir.join("seq"));
     assert_eq!(reference.len(), 2 + 4 * (1 + snapshots(&dir.join("seq/T6.00")).len()));
     for other in ["par", "sh"] {

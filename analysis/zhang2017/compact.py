@@ -12,6 +12,8 @@ particle file), which says the grain count and the lattice's orientation.
 Usage: python3 analysis/zhang2017/compact.py RUN_DIR OUT_DIR          # a run
        python3 analysis/zhang2017/compact.py --base SEARCH_DIR/base OUT_DIR   # a search's base run (no summary.json)
        python3 analysis/zhang2017/compact.py --search SEARCH_DIR OUT_DIR   # a T_c3 search
+       python3 analysis/zhang2017/compact.py --search --running SEARCH_DIR OUT_DIR   # one still running: holds.csv
+           as far as each hold has got; then `rubblepile spinup judge SEARCH_DIR --csv OUT_DIR/critical.csv`
 Refuses to overwrite OUT_DIR's files unless --force.
 """
 import argparse
@@ -32,15 +34,27 @@ HOLD_COLUMNS = ["period_h", "body_mass_fraction", "packing_fraction", "coordinat
                 "theta_max_deg"]
 
 
-def write_holds(search_dir, dst, force):
+def running_holds(search_dir):
+    """The holds of a search still running (no critical.json yet): every T<period>/ with a spinup.csv, as far as
+    each has got, in the shape of critical.json's `runs`."""
+    runs = []
+    for name in sorted(os.listdir(search_dir)):
+        if name.startswith("T") and os.path.isfile(os.path.join(search_dir, name, "spinup.csv")):
+            runs.append({"dir": name, "t_final_hours": float(name[1:])})
+    return runs
+
+
+def write_holds(search_dir, dst, force, running=False):
     """One row per sample of every hold in critical.json's `runs`, from the hold's start on: t_final_h (the hold's
     period), t_hold_s (seconds since the hold began), HOLD_COLUMNS (empty where a run lacks the column) and
     forcing (1 while the spin-up forcing acts, 0 once it was released)."""
     import tomllib
     if os.path.exists(dst) and not force:
         sys.exit(f"{dst} exists (use --force to overwrite it)")
-    with open(os.path.join(search_dir, "critical.json")) as f:
-        runs = json.load(f)["runs"]
+    runs = running_holds(search_dir) if running else None
+    if runs is None:
+        with open(os.path.join(search_dir, "critical.json")) as f:
+            runs = json.load(f)["runs"]
     rows = []
     for run in runs:
         hold = os.path.join(search_dir, os.path.basename(run["dir"]))
@@ -86,10 +100,13 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--search", action="store_true", help="SRC is a spinup critical directory")
     ap.add_argument("--base", action="store_true", help="SRC is a search's base run (it has no summary.json)")
+    ap.add_argument("--running", action="store_true",
+                    help="with --search: a search still running (holds.csv only; write its critical.csv with "
+                         "`rubblepile spinup judge SRC --csv OUT/critical.csv`)")
     ap.add_argument("--force", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
-    names = ["critical.json", "critical.csv"] if a.search else ["spinup.csv", "timeseries.csv", "summary.json", "scene.toml"]
+    names = ([] if a.running else ["critical.json", "critical.csv"]) if a.search else ["spinup.csv", "timeseries.csv", "summary.json", "scene.toml"]
     for name in names:
         src = os.path.join(a.src, name)
         if not os.path.isfile(src):
@@ -98,7 +115,7 @@ def main():
             sys.exit(f"{src}: missing (a run still going has no summary.json: wait for it)")
         copy(src, os.path.join(a.out, name), a.force)
     if a.search:
-        write_holds(a.src, os.path.join(a.out, "holds.csv"), a.force)
+        write_holds(a.src, os.path.join(a.out, "holds.csv"), a.force, a.running)
         copy_target(a.src, os.path.join(a.out, "target.json"), a.force)
         return
     with open(os.path.join(a.src, "snapshots", "0.csv")) as f:

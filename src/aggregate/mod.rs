@@ -21,6 +21,7 @@ pub mod random_packing;
 pub mod report;
 pub mod shape;
 pub mod size_distribution;
+pub mod top;
 pub mod triaxial_top;
 
 use crate::aggregate::lattice_orientation::LatticeOrientation;

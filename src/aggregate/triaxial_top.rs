@@ -9,7 +9,7 @@
 //! diameter is the one asked for: 7.8 % for Naidu et al.'s figures. So the body spans exactly the given extents and
 //! has exactly the given volume; what lies between is our analytic reading of "a top with an equatorial bulge".
 
-use crate::aggregate::shape::Top;
+use crate::aggregate::top::Top;
 use crate::math::Vec3;
 
 /// A top with three semi-extents and a ridge sized for a given volume (see the module docs).

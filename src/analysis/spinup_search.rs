@@ -1110,8 +1110,23 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
 /// `rubblepile spinup judge DIR`: judges again the holds of a compact copy (`critical.csv` and `holds.csv`) or of a
 /// search directory, finished or still running (each hold run `T<X>/spinup.csv` as far as it has got), by every
 /// criterion over their first `window` seconds; prints one line per hold and the T_c,3 and φ of each criterion.
-/// Writes nothing.
-pub fn judge_dir(dir: &Path, window: Option<f64>, significance: Option<f64>) -> Result<(), SearchError> {
+/// Writes nothing but `csv_out` when given: the verdicts as a `critical.csv` (the compact copy of a search still
+/// running, beside the `holds.csv` of `analysis/zhang2017/compact.py --search --running`); an existing file is
+/// refused.
+pub fn judge_dir(
+    dir: &Path,
+    window: Option<f64>,
+    significance: Option<f64>,
+    csv_out: Option<&Path>,
+) -> Result<(), SearchError> {
+    if let Some(out) = csv_out
+        && out.exists()
+    {
+        return Err(SearchError::usage(format!(
+            "--csv: {} exists; rubblepile does not overwrite it",
+            out.display()
+        )));
+    }
     if let Some(w) = window
         && !(w.is_finite() && w > 0.0)
     {
@@ -1169,6 +1184,10 @@ pub fn judge_dir(dir: &Path, window: Option<f64>, significance: Option<f64>) -> 
     };
     for v in &judged {
         println!("{}", verdict_line(v));
+    }
+    if let Some(out) = csv_out {
+        crate::io::safe_write::write_atomic(out, critical_csv(&judged))
+            .map_err(|e| SearchError::failed(crate::io::safe_write::describe(out, &e)))?;
     }
     for kind in CreepCriterionKind::ALL {
         match critical_from_verdicts(&judged, kind) {

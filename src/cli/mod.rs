@@ -342,22 +342,9 @@ fn check_run_dir(dir: &std::path::Path) -> Result<(), CliError> {
     for f in &report.findings {
         println!("{}{}", if f.problem { "problem: " } else { "" }, f.line);
     }
-    let problems: Vec<&str> = report.problems().map(|f| f.line.as_str()).collect();
-    match problems.as_slice() {
-        [] => {
-            println!("{} is whole", dir.display());
-            Ok(())
-        }
-        [first, rest @ ..] => Err(CliError::usage(format!(
-            "{} is not whole: {first}{}",
-            dir.display(),
-            match rest.len() {
-                0 => String::new(),
-                1 => " (and 1 more problem)".into(),
-                n => format!(" (and {n} more problems)"),
-            }
-        ))),
-    }
+    let line = report.verdict(dir).map_err(CliError::usage)?;
+    println!("{line}");
+    Ok(())
 }
 
 /// clap's multi-line argument error as one line, e.g. `the following required arguments were not

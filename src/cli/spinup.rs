@@ -15,7 +15,7 @@ pub enum SpinupCommand {
     /// Fit κ of Eq. 22 over bulk densities and give the critical bulk density.
     DensityFit(DensityFitArgs),
     /// Judge the holds of a search again (its directory, or a compact copy with critical.csv and holds.csv) by
-    /// every creep criterion over their first --judge-window seconds; prints, writes nothing.
+    /// every creep criterion over their first --judge-window seconds; prints (and writes --csv).
     Judge(JudgeArgs),
 }
 
@@ -31,11 +31,15 @@ pub struct JudgeArgs {
     /// Standard errors by which a weakening rate must exceed zero for the paper's criterion (default 2).
     #[arg(long, value_name = "Z")]
     pub significance: Option<f64>,
+    /// Also write the verdicts as a critical.csv (a running search's compact copy; never overwrites).
+    #[arg(long, value_name = "FILE")]
+    pub csv: Option<PathBuf>,
 }
 
 /// `rubblepile spinup judge`.
 pub fn judge(args: &JudgeArgs) -> Result<(), CliError> {
-    crate::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance).map_err(cli_error)
+    crate::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
+        .map_err(cli_error)
 }
 
 /// `rubblepile spinup critical`.

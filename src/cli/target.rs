@@ -7,7 +7,7 @@ use crate::cli::common::CliError;
 use crate::driver::DEFAULT_CHECKPOINT_EVERY;
 use crate::ellipsoid::output::write_snapshot;
 use crate::impact::target::{TargetSpec, build_target_resumable};
-use crate::impact::target_checkpoint::BuildCheckpoint;
+use crate::impact::target_checkpoint::{BuildCheckpoint, checkpoint_path, read_checkpoint, write_checkpoint};
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]
@@ -146,28 +146,6 @@ pub struct BuildArgs {
     pub checkpoint_every: f64,
 }
 
-/// Path of the checkpoint of an interrupted build beside a target CSV.
-pub fn checkpoint_path(csv: &Path) -> PathBuf {
-    csv.with_extension("checkpoint.json")
-}
-
-/// Reads the checkpoint `--resume` continues from.
-fn read_checkpoint(path: &Path) -> Result<BuildCheckpoint, CliError> {
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        CliError::usage(format!(
-            "--resume: cannot read {} ({e}); nothing to resume",
-            path.display()
-        ))
-    })?;
-    serde_json::from_str(&text)
-        .map_err(|e| CliError::usage(format!("--resume: {} is not a target checkpoint: {e}", path.display())))
-}
-
-/// Writes a checkpoint atomically, never through a link ([`crate::io::safe_write`]).
-fn write_checkpoint(path: &Path, checkpoint: &BuildCheckpoint) -> std::io::Result<()> {
-    crate::io::safe_write::write_atomic(path, serde_json::to_string(checkpoint)?)
-}
-
 /// Path of the JSON report beside a target CSV.
 pub fn report_path(csv: &Path) -> PathBuf {
     csv.with_extension("json")
@@ -175,26 +153,14 @@ pub fn report_path(csv: &Path) -> PathBuf {
 
 /// Runs `target build`.
 pub fn build(args: &BuildArgs) -> Result<(), CliError> {
-    let mut spec = match (
-        TargetSpec::table1(args.fragments, args.period_hours, args.seed),
+    let mut spec = TargetSpec::table1_or_sizes(
+        args.fragments,
+        args.period_hours,
+        args.seed,
         args.r_largest_km,
         args.r_smallest_km,
-    ) {
-        (_, Some(large), Some(small)) => {
-            let mut s = TargetSpec::table1(30, args.period_hours, args.seed).expect("Table 1 has N = 30");
-            s.fragments = args.fragments;
-            s.r_largest = large * 1e3;
-            s.r_smallest = small * 1e3;
-            s
-        }
-        (Some(s), None, None) => s,
-        _ => {
-            return Err(CliError::usage(format!(
-                "--fragments {}: Table 1 has only 30, 100 and 200; give both --r-largest-km and --r-smallest-km",
-                args.fragments
-            )));
-        }
-    };
+    )
+    .map_err(CliError::usage)?;
     if let Some(m) = args.total_mass {
         spec.total_mass = m;
     }
@@ -227,7 +193,7 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
         .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
-        Some(read_checkpoint(&checkpoint_file)?)
+        Some(read_checkpoint(&checkpoint_file).map_err(CliError::usage)?)
     } else if checkpoint_file.exists() && !args.force {
         return Err(CliError::usage(format!(
             "--out: {} holds an interrupted build; continue it with --resume or start afresh with --force",

@@ -51,6 +51,24 @@ impl RunDirReport {
         self.findings.iter().filter(|f| f.problem)
     }
 
+    /// The verdict on `dir` in one line: `Ok("DIR is whole")`, or `Err` naming the first problem and how many
+    /// more there are.
+    pub fn verdict(&self, dir: &Path) -> Result<String, String> {
+        let problems: Vec<&str> = self.problems().map(|f| f.line.as_str()).collect();
+        match problems.as_slice() {
+            [] => Ok(format!("{} is whole", dir.display())),
+            [first, rest @ ..] => Err(format!(
+                "{} is not whole: {first}{}",
+                dir.display(),
+                match rest.len() {
+                    0 => String::new(),
+                    1 => " (and 1 more problem)".into(),
+                    n => format!(" (and {n} more problems)"),
+                }
+            )),
+        }
+    }
+
     fn note(&mut self, line: String) {
         self.findings.push(Finding { problem: false, line });
     }

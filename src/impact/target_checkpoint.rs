@@ -6,11 +6,30 @@
 //! step-size and order control, and the running totals. Every float is stored as its bit pattern
 //! ([`crate::bits`]), so a resumed build ends with the same bits as one that was never stopped.
 
+use std::path::{Path, PathBuf};
+
 use crate::bits::{exact_f64, exact_f64_vec};
 use crate::ellipsoid::body::Body;
 use crate::impact::target_spec::{TargetError, TargetSpec};
 use crate::integrate::IntegratorState;
 use crate::math::{Vec3, Vec4};
+
+/// Path of the checkpoint of an interrupted build beside a target CSV (`NAME.checkpoint.json`).
+pub fn checkpoint_path(csv: &Path) -> PathBuf {
+    csv.with_extension("checkpoint.json")
+}
+
+/// Reads the checkpoint a resumed build continues from; the error is one line naming the file.
+pub fn read_checkpoint(path: &Path) -> Result<BuildCheckpoint, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("--resume: cannot read {} ({e}); nothing to resume", path.display()))?;
+    serde_json::from_str(&text).map_err(|e| format!("--resume: {} is not a target checkpoint: {e}", path.display()))
+}
+
+/// Writes a checkpoint atomically, never through a link ([`crate::io::safe_write`]).
+pub fn write_checkpoint(path: &Path, checkpoint: &BuildCheckpoint) -> std::io::Result<()> {
+    crate::io::safe_write::write_atomic(path, serde_json::to_string(checkpoint)?)
+}
 
 /// The `format` tag of a target-build checkpoint.
 pub const TARGET_CHECKPOINT_FORMAT: &str = "rubblepile-target-checkpoint";

@@ -55,6 +55,34 @@ fn is_printed(reading: &KappaReading) -> bool {
 }
 
 impl TargetSpec {
+    /// The Table 1 target with `fragments`, or any count with both size limits given (km; `r_largest_km`,
+    /// `r_smallest_km`: the other Table 1 defaults of the 30-fragment target kept); an error names the option.
+    pub fn table1_or_sizes(
+        fragments: usize,
+        period_hours: f64,
+        seed: u64,
+        r_largest_km: Option<f64>,
+        r_smallest_km: Option<f64>,
+    ) -> Result<Self, String> {
+        match (
+            TargetSpec::table1(fragments, period_hours, seed),
+            r_largest_km,
+            r_smallest_km,
+        ) {
+            (_, Some(large), Some(small)) => {
+                let mut s = TargetSpec::table1(30, period_hours, seed).expect("Table 1 has N = 30");
+                s.fragments = fragments;
+                s.r_largest = large * 1e3;
+                s.r_smallest = small * 1e3;
+                Ok(s)
+            }
+            (Some(s), None, None) => Ok(s),
+            _ => Err(format!(
+                "--fragments {fragments}: Table 1 has only 30, 100 and 200; give both --r-largest-km and --r-smallest-km"
+            )),
+        }
+    }
+
     /// The Roig03 Table 1 target with `fragments` ∈ {30, 100, 200} (64→16, 60→10, 59→7 km), or `None`.
     pub fn table1(fragments: usize, period_hours: f64, seed: u64) -> Option<Self> {
         let (r_largest, r_smallest) = match fragments {

@@ -126,8 +126,8 @@ impl DecidedSearch {
             .join(", ")
     }
 
-    /// The lattice orientation of its target (`perpendicular` for a lattice report written before orientations
-    /// were recorded, `–` for a model without a lattice).
+    /// The lattice orientation of its target (`perpendicular` for an HCP whose target report predates orientations
+    /// or was not copied, `–` for a model without a lattice).
     pub fn orientation(&self) -> String {
         match &self.target {
             Some(t) => t.lattice_orientation.clone().unwrap_or_else(|| {
@@ -137,6 +137,8 @@ impl DecidedSearch {
                     "–".into()
                 }
             }),
+            // a copy made before targets were recorded: every HCP lattice was then stacked along the spin axis
+            None if self.model == "hcp" => "perpendicular".into(),
             None => "–".into(),
         }
     }
