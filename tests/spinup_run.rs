@@ -596,7 +596,7 @@ fn a_released_hold_stops_early_unless_asked_to_finish() {
 
 /// `bench critical` times the holds of one prepared search one at a time and two at once, checks that both judge
 /// alike, and writes its CSV (one row per setting, with the speed-up and the load) and plot; `--reuse-prepared`
-/// keeps the base run.
+/// keeps the base run; `--single-thread` adds the one-thread baseline.
 #[test]
 fn bench_critical_times_both_settings_on_one_prepared_base() {
     let dir = temp_dir("bench-critical");
@@ -632,4 +632,38 @@ fn bench_critical_times_both_settings_on_one_prepared_base() {
         read(&dir.join("b/searches/prepared/base/checkpoint.json")),
         base_checkpoint
     );
+    // --single-thread adds the one-thread, one-at-a-time row between the reference and --parallel 2
+    let c = std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+        .args([
+            "bench",
+            "critical",
+            "--scene",
+            "s.toml",
+            "--from",
+            "5.8",
+            "--to",
+            "6.0",
+            "--step",
+            "0.1",
+            "--hold",
+            "600",
+            "--out",
+            "b",
+            "--force",
+            "--reuse-prepared",
+            "--single-thread",
+        ])
+        .env("RAYON_NUM_THREADS", "2")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let csv = read(&dir.join("b/bench_critical.csv"));
+    let settings: Vec<String> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').take(2).collect::<Vec<_>>().join(","))
+        .collect();
+    assert_eq!(settings, ["1,2", "1,1", "2,1"], "{csv}");
+    assert!(dir.join("b/searches/parallel1_threads1/critical.csv").is_file());
 }

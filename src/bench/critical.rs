@@ -43,6 +43,10 @@ pub struct BenchCriticalArgs {
     /// `DIR/searches/prepared` (so that the timed part alone needs the quiet machine).
     #[arg(long)]
     pub reuse_prepared: bool,
+    /// Also time the holds one at a time on a single thread each (`--parallel 1 --threads-per-hold 1`): the
+    /// baseline that shows how much of `--parallel`'s gain the threads of one hold already take.
+    #[arg(long)]
+    pub single_thread: bool,
 }
 
 /// The 1-minute load average, from `/proc/loadavg` (NaN where there is none).
@@ -124,14 +128,26 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
         started.elapsed().as_secs_f64()
     );
     let threads = rayon::current_num_threads();
-    let mut settings = vec![1];
-    settings.extend(args.parallel.iter().copied().filter(|&p| p != 1));
+    // (holds at once, threads per hold): one at a time on every thread first (the speed-up's reference)
+    let mut settings = vec![(1, threads)];
+    if args.single_thread && threads > 1 {
+        settings.push((1, 1));
+    }
+    settings.extend(
+        args.parallel
+            .iter()
+            .filter(|&&p| p != 1)
+            .map(|&p| (p, (threads / p).max(1))),
+    );
     let mut rows = Vec::new();
     let mut reference: Option<String> = None;
-    for p in settings {
-        let dir = searches.join(format!("parallel{p}"));
+    for (p, threads_per_hold) in settings {
+        let dir = if p == 1 && threads_per_hold != threads {
+            searches.join(format!("parallel1_threads{threads_per_hold}"))
+        } else {
+            searches.join(format!("parallel{p}"))
+        };
         copy_dir(&prepared, &dir)?;
-        let threads_per_hold = (threads / p).max(1);
         let load_before = load_average();
         let t0 = Instant::now();
         critical(&CriticalOptions {
@@ -147,7 +163,8 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
             None => reference = Some(csv),
             Some(r) if *r != csv => {
                 return Err(BenchError::failed(format!(
-                    "--parallel {p} judged the holds differently from --parallel 1 ({})",
+                    "--parallel {p} with {threads_per_hold} thread(s) per hold judged the holds differently from \
+                     --parallel 1 ({})",
                     dir.display()
                 )));
             }
@@ -177,8 +194,13 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
             r.load_before,
             r.load_after
         );
-        if r.parallel != 1 {
-            println!("speed-up of --parallel {}: {:.3}x", r.parallel, base / r.wall_s);
+        if r.parallel != 1 || r.threads_per_hold != threads {
+            println!(
+                "speed-up of --parallel {} x {} thread(s): {:.3}x",
+                r.parallel,
+                r.threads_per_hold,
+                base / r.wall_s
+            );
         }
     }
     crate::io::safe_write::write_atomic(&csv_path, text)
@@ -193,24 +215,32 @@ fn plot(path: &Path, rows: &[Timing]) -> Result<(), String> {
     crate::analysis::figures::style::ensure_font()?;
     let root = SVGBackend::new(path, (640, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let max_p = rows.iter().map(|r| r.parallel).max().unwrap_or(1) as f64 + 0.5;
+    let max_x = rows.len() as f64 + 0.5;
     let max_w = rows.iter().map(|r| r.wall_s).fold(0.0, f64::max) * 1.2;
     let mut chart = ChartBuilder::on(&root)
         .caption("T_c3 search: wall time of the holds", ("sans-serif", 18))
         .margin(10)
         .x_label_area_size(35)
         .y_label_area_size(70)
-        .build_cartesian_2d(0.5..max_p, 0.0..max_w.max(1.0))
+        .build_cartesian_2d(0.5..max_x, 0.0..max_w.max(1.0))
         .map_err(|e| e.to_string())?;
     chart
         .configure_mesh()
-        .x_desc("holds at once (--parallel)")
+        .x_desc("holds at once x threads per hold")
+        .x_labels(rows.len() + 1)
+        .x_label_formatter(&|x| {
+            let i = x.round() as usize;
+            match rows.get(i.wrapping_sub(1)) {
+                Some(r) if (x - i as f64).abs() < 1e-9 => format!("{} x {}", r.parallel, r.threads_per_hold),
+                _ => String::new(),
+            }
+        })
         .y_desc("wall time of the holds (s)")
         .draw()
         .map_err(|e| e.to_string())?;
     chart
-        .draw_series(rows.iter().map(|r| {
-            let x = r.parallel as f64;
+        .draw_series(rows.iter().enumerate().map(|(i, r)| {
+            let x = (i + 1) as f64;
             Rectangle::new([(x - 0.3, 0.0), (x + 0.3, r.wall_s)], BLUE.filled())
         }))
         .map_err(|e| e.to_string())?;

@@ -440,7 +440,14 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
             mark: Mark::Points,
         });
     }
-    if !series.is_empty() {
+    // a search with no T_c3 at any length has no point to draw
+    series.retain(|s| !s.points.is_empty());
+    if series.is_empty() {
+        let _ = writeln!(
+            md,
+            "\nNo search has a T_c3 by the paper's criterion at any hold length yet: no figure.\n"
+        );
+    } else {
         let chart = LineChart {
             title: "T_c3 against the hold length (paper's criterion)".into(),
             x_label: "hold length read (s)".into(),
@@ -739,7 +746,7 @@ mod tests {
         assert_eq!(rcp.t_c3(32_000.0, CreepCriterionKind::Paper).0, Some(2.65));
         assert_eq!(rcp.t_c3(50_000.0, CreepCriterionKind::Paper).0, Some(2.65));
         let hcp = search(
-            "hcp_full_random1",
+            "hcp_full",
             vec![
                 (2.40, series(Some(1000.0), f64::INFINITY, 2000.0)),
                 (2.45, series(None, f64::INFINITY, 32_000.0)),
@@ -754,8 +761,52 @@ mod tests {
         let lines: Vec<&str> = csv.lines().collect();
         assert_eq!(lines[0], "model,grains,orientation,criterion,hold_s,T_c3_h,phi_deg");
         assert_eq!(lines[1], "RCP,,–,paper,32000,2.65,30.0");
-        assert_eq!(lines[2], "HCP,,–,paper,32000,2.45,30.0");
+        // no target report copied: an HCP from before orientations were recorded, stacked along the spin axis
+        assert_eq!(lines[2], "HCP,,perpendicular,paper,32000,2.45,30.0");
         assert_eq!(lines[3], "RCP-HCP,,,paper,32000,0.20,");
+    }
+
+    /// A decided directory whose long searches have no T_c3 by the paper's criterion at any hold length (every hold
+    /// creeps) still gives its section: the hold-length table without a figure, not the error "nothing to plot".
+    #[test]
+    fn hold_length_section_without_any_t_c3_is_written_without_a_figure() {
+        let dir = std::env::temp_dir().join(format!("rubblepile-decided-no-tc3-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let critical = dir.join("orientation/hcp_3k_random1/critical");
+        std::fs::create_dir_all(&critical).unwrap();
+        let creeping = search(
+            "hcp_3k_random1",
+            vec![
+                (2.50, series(None, 1000.0, 32_000.0)),
+                (2.55, series(None, 1000.0, 32_000.0)),
+            ],
+        );
+        assert_eq!(creeping.t_c3(16_000.0, CreepCriterionKind::Paper).0, None);
+        let mut holds = String::from("t_final_h,t_hold_s,packing_fraction,coordination_number,theta_max_deg\n");
+        for (tf, h) in &creeping.series {
+            for k in 0..h.t_s.len() {
+                holds += &format!(
+                    "{tf},{},{},{},{}\n",
+                    h.t_s[k], h.packing[k], h.coordination[k], h.theta_max_deg[k]
+                );
+            }
+        }
+        std::fs::write(critical.join("holds.csv"), holds).unwrap();
+        std::fs::write(
+            critical.join("critical.csv"),
+            crate::analysis::spinup_search::critical_csv(&creeping.verdicts),
+        )
+        .unwrap();
+        let out = dir.join("out");
+        std::fs::create_dir_all(&out).unwrap();
+        let mut md = String::new();
+        write_decided_section(&mut md, &dir, &out).unwrap();
+        assert!(
+            md.contains("No search has a T_c3 by the paper's criterion at any hold length yet"),
+            "{md}"
+        );
+        assert!(!out.join("decided_hold_length.png").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// The Naidu ellipsoid keeps the radar extents' ratios and the 780 m body's volume.
