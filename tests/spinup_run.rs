@@ -602,13 +602,18 @@ fn bench_critical_times_both_settings_on_one_prepared_base() {
     let dir = temp_dir("bench-critical");
     let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
     std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    // two threads whatever the machine, so that the settings are (1 x 2, [1 x 1,] 2 x 1)
     let bench = |extra: &[&str]| {
-        let mut args = vec![
-            "bench", "critical", "--scene", "s.toml", "--from", "5.8", "--to", "6.0", "--step", "0.1", "--hold", "600",
-            "--out", "b", "--force",
-        ];
-        args.extend_from_slice(extra);
-        let c = rubblepile(&dir, &args);
+        let c = std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
+            .args([
+                "bench", "critical", "--scene", "s.toml", "--from", "5.8", "--to", "6.0", "--step", "0.1", "--hold",
+                "600", "--out", "b", "--force",
+            ])
+            .args(extra)
+            .env("RAYON_NUM_THREADS", "2")
+            .current_dir(&dir)
+            .output()
+            .unwrap();
         assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
         String::from_utf8_lossy(&c.stdout).to_string()
     };
@@ -633,31 +638,7 @@ fn bench_critical_times_both_settings_on_one_prepared_base() {
         base_checkpoint
     );
     // --single-thread adds the one-thread, one-at-a-time row between the reference and --parallel 2
-    let c = std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
-        .args([
-            "bench",
-            "critical",
-            "--scene",
-            "s.toml",
-            "--from",
-            "5.8",
-            "--to",
-            "6.0",
-            "--step",
-            "0.1",
-            "--hold",
-            "600",
-            "--out",
-            "b",
-            "--force",
-            "--reuse-prepared",
-            "--single-thread",
-        ])
-        .env("RAYON_NUM_THREADS", "2")
-        .current_dir(&dir)
-        .output()
-        .unwrap();
-    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    bench(&["--reuse-prepared", "--single-thread"]);
     let csv = read(&dir.join("b/bench_critical.csv"));
     let settings: Vec<String> = csv
         .lines()
