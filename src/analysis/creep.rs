@@ -375,7 +375,7 @@ mod tests {
         assert!(p.is_empty() && o.is_empty(), "paper {p:?}, ours {o:?}");
     }
 
-    /// Regression guard (issue 21: the coordination number had dropped out of the creep test). The coordination
+    /// Regression guard (the coordination number had once dropped out of the creep test). The coordination
     /// number falls by 0.2 over the hold (0.1 over its second half), θ_max and η_B settled: creep for the paper,
     /// stable for ours — the case of our RCP holds of 23 Nov 2026.
     #[test]

@@ -276,7 +276,7 @@ const PARALLEL_BODIES: usize = 64;
 
 /// Bodies per thread at least ([`EllipsoidSystem::useful_threads`]): with fewer, joining a parallel pass costs more
 /// than the thread's share of it. The N200 impact (201 bodies, ~8 per thread's pass on 16 threads) ran in 5.76 s on 8
-/// threads of a 16-core node and 7.19 s on all 16 (issue 39's measurement); 25 bodies per thread gives 8.
+/// threads of a 16-core node and 7.19 s on all 16; 25 bodies per thread gives 8.
 pub const BODIES_PER_THREAD: usize = 25;
 
 // Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).

@@ -801,7 +801,7 @@ impl FrozenOctree {
     /// nodes' moments recomputed there; `g` is the gravitational constant. The frozen tree is only read (the
     /// particles and moments at `positions` go into a copy of the tree's arrays, O(N), beside the lists' O(N log N)
     /// sums), so that several evaluations may share it without a lock held across their parallel work (a rayon
-    /// worker blocked on such a lock can wait for a job of its own; issue 39).
+    /// worker blocked on such a lock can wait for a job of its own).
     pub fn accelerations(&self, positions: &[Vec3], masses: &[f64], g: f64) -> (Vec<Vec3>, Vec<f64>) {
         let mut tree = self.tree.clone();
         tree.particles

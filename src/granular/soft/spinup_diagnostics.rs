@@ -41,7 +41,7 @@
 //! grazing overlap opens and closes from step to step as the pile breathes and moves the raw count by a few
 //! hundredths of a contact per particle at a sample; the floor leaves out those that carry under 1 % of the mean
 //! (in a self-gravitating pile the outermost layer's contacts carry a few tenths of the mean, so they stay counted).
-//! The creep test judges `coordination_loaded` where a run has it (issue 40, item 3).
+//! The creep test judges `coordination_loaded` where a run has it.
 //!
 //! **Reductions.** `s_max` is the largest deviatoric stress `(σ₁ − σ₃)/2`, `p_max` the largest compressive
 //! pressure `−(σ₁ + σ₂ + σ₃)/3` (reported positive, Pa), `θ_max` the largest mobilized friction angle (degrees)
