@@ -1,4 +1,4 @@
-//! The quick stability suite (`rubblepile bench stability --quick`, cases in `src/stability/cases.rs`) and the
+//! The quick stability suite (`rubblepile bench stability --quick`, cases in `src/bench/stability/cases/`) and the
 //! contact-barrier detector end to end (Roig03 Eqs. 13–14): the 3× head-on impact must be reported naming
 //! bodies 1 and 2, the calibrated one must not; θ = 0 keeps `||q| − 1|` below 1e-9; F0 = 100 keeps
 //! `H − H0 − 2∫F` below 1e-6; κ = 1.6 and κ = 50 complete; no quick case fails.

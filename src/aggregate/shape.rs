@@ -4,7 +4,7 @@
 //!
 //! One enum, [`Shape`], with `contains(p)` and an exact volume: a sphere, a triaxial ellipsoid, the Didymos primary
 //! with Naidu et al. (2020)'s extents ([`TriaxialTop`], the nominal shape of the Zhang17 scenes), the axisymmetric
-//! Didymos-like "top" ([`Top`], the shape of our Zhang17 runs before Dec 2026), and any closed triangulated OBJ
+//! Didymos-like "top" ([`Top`], the shape of our earlier Zhang17 runs), and any closed triangulated OBJ
 //! model ([`crate::geometry::polyhedron::Polyhedron`]).
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! The axisymmetric Didymos-like top ([`Top`]): the shape our Zhang17 runs were carved from before Dec 2026, kept as
+//! The axisymmetric Didymos-like top ([`Top`]): the shape our earlier Zhang17 runs were carved from, kept as
 //! the named variant `--shape top`, and the unit figure that the `triaxial_top` module stretches to
 //! Naidu et al. (2020)'s extents.
 

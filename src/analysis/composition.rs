@@ -1,4 +1,4 @@
-//! Composition of the outcome of a collision between two rubble piles (issue 20; the escape test is Roig03
+//! Composition of the outcome of a collision between two rubble piles (the escape test is Roig03
 //! Eq. 43 applied to clumps): which bodies stick together, whether each clump stays bound, and how much of each
 //! clump came from the projectile.
 //!

@@ -17,12 +17,11 @@
 //!   here depends on the hold's length except through the error of the rate, so a longer hold can only sharpen a
 //!   verdict, not move a threshold.
 //! - [`CreepCriterionKind::PaperTolerance`]: the same one-sided reading with tolerances on the *change* over the
-//!   second half (θ_max +0.5°, η_B −0.0005, contacts −0.05 per particle; ours, the paper gives none): the default
-//!   of the searches made before Dec 2026, kept to read them and as the documented alternative.
+//!   second half (θ_max +0.5°, η_B −0.0005, contacts −0.05 per particle; ours, the paper gives none), kept to read
+//!   the searches made with it and as the documented alternative.
 //! - [`CreepCriterionKind::Ours`]: two-sided on θ_max (0.5°) and η_B (0.0005) over the second half, the
-//!   coordination number not judged: the criterion of the runs behind the 23 Nov 2026 report. We dropped the
-//!   coordination number then because our scaled RCP holds lost about 0.1 contacts per particle per half-hold at
-//!   every period from 2.74 to 3.00 h with θ_max near 25°; by the paper's rule all of those creep.
+//!   coordination number not judged (our scaled RCP holds lose contacts at every period while θ_max stays put,
+//!   which the paper's rule reads as creep).
 //!
 //! Either way a hold whose forcing was released (global disruption) is not stable; that is the search's business
 //! (`analysis::spinup_search`, which uses these criteria).
@@ -37,7 +36,7 @@ use crate::analysis::spinup::PACKING_THRESHOLD;
 pub enum CreepCriterionKind {
     /// The paper's, zero tolerance: a significantly rising θ_max, falling η_B or falling coordination number.
     Paper,
-    /// The paper's one-sided reading with tolerances on the second-half change (before Dec 2026).
+    /// The paper's one-sided reading with tolerances on the second-half change (the default of earlier searches).
     PaperTolerance,
     /// Ours: θ_max or η_B moving either way beyond a tolerance; the coordination number not judged.
     Ours,
@@ -375,9 +374,9 @@ mod tests {
         assert!(p.is_empty() && o.is_empty(), "paper {p:?}, ours {o:?}");
     }
 
-    /// Regression guard (issue 21: the coordination number had dropped out of the creep test). The coordination
+    /// Regression guard (the coordination number had once dropped out of the creep test). The coordination
     /// number falls by 0.2 over the hold (0.1 over its second half), θ_max and η_B settled: creep for the paper,
-    /// stable for ours — the case of our RCP holds of 23 Nov 2026.
+    /// stable for ours — the case of our scaled RCP holds.
     #[test]
     fn paper_criterion_judges_the_coordination_number_that_ours_dropped() {
         let t = times();

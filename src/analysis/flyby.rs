@@ -1,4 +1,4 @@
-//! Outcome of a tidal flyby run (issue 20): mass lost, the largest remnant's spin period and shape before and
+//! Outcome of a tidal flyby run: mass lost, the largest remnant's spin period and shape before and
 //! after, and a class after Richardson, Bottke & Love 1998 (Icarus 134, 47–76; "RBL98").
 //!
 //! - **Largest remnant**: the bodies bound to one another, found by peeling: start from all bodies; drop every
@@ -11,7 +11,7 @@
 //!   `a² = 5 (I₂ + I₃ − I₁)/(2M)` etc.; reported as `b/a`, `c/a`.
 //! - **Spin state** ([`crate::ellipsoid::spin_state`]): principal-axis or tumbling (L–ω angle, `L²/2E` against the
 //!   principal moments, the precession and rotation periods of the free tumble), before and after.
-//! - **The tide's effect** (issue 41): a run of `rubblepile flyby` has a control run (`DIR/control/`, the same pile
+//! - **The tide's effect**: a run of `rubblepile flyby` has a control run (`DIR/control/`, the same pile
 //!   over the same time without the planet); every change below is the run's minus the control's, so that what the
 //!   pile does by itself (settling, the cycle of a tumbler) cancels. Without a control the run's own changes are
 //!   used, and the outcome says so (`tide.from_control = false`).

@@ -165,7 +165,7 @@ pub struct HoldVerdict {
     pub theta_max_deg: f64,
     /// The paper's criterion (zero tolerance, rates; `None` where no rates were recorded).
     pub paper: Option<CriterionVerdict>,
-    /// The paper's reading with tolerances (the default before Dec 2026).
+    /// The paper's reading with tolerances (the default of earlier searches).
     pub paper_tolerance: CriterionVerdict,
     /// Ours (two-sided on θ_max and η_B).
     pub ours: CriterionVerdict,

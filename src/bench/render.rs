@@ -1,7 +1,8 @@
 //! `rubblepile bench render`: what looking at a run costs. Milliseconds per 800×800 frame ([`render_frame`]: ray
-//! casting, colour bar, caption) for random clouds of N ellipsoids, on 1 and on all threads, side by side in one
-//! run; and the VTK writer's throughput (MB/s of `.vtp` bytes produced) for the same snapshots, plus the size of
-//! a 42 000-sphere snapshot (the issue's 5 MB budget). Writes `bench_render.csv` and `bench_render.svg`/`.png`.
+//! casting, colour bar, caption) for random clouds of N ellipsoids, on 1 and on all threads, side by side in one run;
+//! and the VTK writer's throughput (MB/s of `.vtp` bytes produced) for the same snapshots, plus the size of a
+//! 42 000-sphere snapshot (a pile of Zhang17's size, budgeted at 5 MB). Writes `bench_render.csv` and
+//! `bench_render.svg`/`.png`.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -185,7 +186,7 @@ pub fn render(args: &RenderBenchArgs) -> Result<(), BenchError> {
         }
         println!("{line} VTK {:.2} MB at {mbs:.0} MB/s", bytes as f64 / 1e6);
     }
-    // The size budget of the issue: a 42 000-sphere snapshot.
+    // The size budget: a 42 000-sphere snapshot, a pile of Zhang17's size.
     let big = cloud_view(42_000, true);
     let (bytes, mbs) = time_vtk(&big, 3)?;
     rows.push(format!("spheres,42000,1,0,,{bytes},{mbs:e}"));

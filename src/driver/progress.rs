@@ -1,6 +1,6 @@
 //! How a run shows its progress on stderr: the indicatif bar on a terminal, and on anything else (a batch job's log,
 //! a pipe) one plain line every few seconds of wall clock — simulated time, per cent done, ETA and the engine's
-//! error so far — so a log is not silent until `done:` (issue 41).
+//! error so far — so a log is not silent until `done:`.
 
 use std::cell::Cell;
 use std::io::IsTerminal;

@@ -697,8 +697,8 @@ fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> 
 
 /// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
 /// worker). An engine's parallel passes are then forked from inside the pool; forked from outside it, every pass
-/// is injected into the pool and the caller sleeps until it ends, which cost 45 µs per right-hand side of the
-/// N200 impact on two threads (212 against 167 µs). The pool's other workers stay awake for the run
+/// is injected into the pool and the caller sleeps until it ends, a cost of tens of µs per right-hand side
+/// (`analysis/speed/NOTES.md`). The pool's other workers stay awake for the run
 /// ([`warm_pool::with_warm_workers`]).
 ///
 /// With `useful` threads fewer than the pool has (see [`Engine::useful_threads`]), `op` runs on a pool of its own

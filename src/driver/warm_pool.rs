@@ -3,9 +3,8 @@
 //! An engine's right-hand side forks a few short parallel passes (tens of µs each, three per evaluation of the
 //! ellipsoid engine) and the integrator runs serially between evaluations. rayon lets a worker that finds no work
 //! spin with `sched_yield` for a few tens of µs and then sleep on a futex; the next fork has to wake it, and until
-//! it runs, the forking thread does the work alone. On the N200 impact at F0 = 1e-4 on two threads this cost
-//! 4.4 million `sched_yield` and 82 000 `futex` calls over 68 853 evaluations (64 and 1.2 per evaluation), about
-//! 10 % of the samples in the kernel (see `analysis/speed/REPORT.md`, "warm workers").
+//! it runs, the forking thread does the work alone, and the system calls of spinning and waking take a sizeable
+//! share of a run (`analysis/speed/REPORT.md`, "warm workers").
 //!
 //! [`with_warm_workers`] runs an operation on the current pool while one helper task per other worker polls the
 //! pool with [`rayon::yield_now`], which runs any job it can steal (so the helpers do the forked work) and makes no

@@ -264,8 +264,7 @@ struct RhsScratch {
 const PARALLEL_CANDIDATES: usize = 512;
 
 /// From this many bodies the pair cache's check (one distance per body, ~1 ns each) runs in parallel: below it a
-/// fork–join (tens of µs on a 16-core node with sleeping workers) costs more than the whole check, and the N200
-/// impact makes one check per evaluation.
+/// fork–join (tens of µs with sleeping workers) costs more than the whole check, which runs once per evaluation.
 const PARALLEL_COVERS: usize = 8192;
 
 /// Candidates per parallel task at least (a culled candidate costs a few ns, a kept one ~100 ns).
@@ -275,8 +274,7 @@ const CANDIDATES_PER_TASK: usize = 64;
 const PARALLEL_BODIES: usize = 64;
 
 /// Bodies per thread at least ([`EllipsoidSystem::useful_threads`]): with fewer, joining a parallel pass costs more
-/// than the thread's share of it. The N200 impact (201 bodies, ~8 per thread's pass on 16 threads) ran in 5.76 s on 8
-/// threads of a 16-core node and 7.19 s on all 16 (issue 39's measurement); 25 bodies per thread gives 8.
+/// than the thread's share of it (the N200 impact runs faster on 8 threads than on 16; `analysis/scaling/NOTES.md`).
 pub const BODIES_PER_THREAD: usize = 25;
 
 // Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).

@@ -18,8 +18,8 @@ const MIN_BLOCKS: usize = 8;
 /// Most blocks: each costs a force buffer of N entries, and the per-body sum adds them all.
 const MAX_BLOCKS: usize = 64;
 
-/// Bodies per block: 2000 bodies make 31 blocks, about two per thread on 16 threads (8 blocks left 8 of 16
-/// threads idle in the gravity pass: 2.4 ms per N2000 RHS on 8 threads, 2.1 ms on 16; issue 39).
+/// Bodies per block: 2000 bodies make 31 blocks, about two per thread on 16 threads, so that no thread idles in the
+/// gravity pass (`analysis/scaling/NOTES.md`).
 const BODIES_PER_BLOCK: usize = 64;
 
 /// The number of blocks of the half loop over `n` bodies: `n / 64`, between 8 and 64.

@@ -22,12 +22,9 @@ use crate::math::Vec3;
 pub const DEFAULT_THETA: f64 = 0.5;
 
 /// Bodies from which [`GravityMethod::Auto`] uses the tree. Below it the exact blocked pair sum costs at most
-/// about what the tree saves (2000 bodies: 49 ms against 43 ms per RHS; 10 000: 725 against 254 ms, see
-/// `analysis/n2000/REPORT.md`), and it is exactly pairwise. The tree's forces jump where interaction lists
-/// change; under Bulirsch–Stoer the lists are fixed per step ([`crate::gravity::octree::FrozenOctree`]), so a
-/// tree run keeps its error-per-unit-step control, but at 2000 bodies the frozen tree, summed in double
-/// precision, was slower than the exact sum (18.6 s against 13.3 s of wall for the first 90 s of the N2000
-/// impact) and left an energy error of 1e-7 where the exact sum left 4e-12.
+/// about what the tree saves, and it is exactly pairwise; under Bulirsch–Stoer the tree's lists are fixed per step
+/// ([`crate::gravity::octree::FrozenOctree`]), but at 2000 bodies that was both slower than the exact sum and less
+/// accurate in energy (`analysis/n2000/REPORT.md`, `analysis/n2000/NOTES.md`).
 pub const TREE_FROM: usize = 5000;
 
 /// Largest opening angle accepted (dimensionless): above `2/√3` a node could be used whole for a point inside

@@ -1,4 +1,4 @@
-//! Tide of a planet on a prescribed (Kepler) orbit: the `[physics.flyby]` term (issue 20; the setting of
+//! Tide of a planet on a prescribed (Kepler) orbit: the `[physics.flyby]` term (the setting of
 //! Richardson, Bottke & Love 1998, Icarus 134, 47–76, "Tidal distortion and disruption of Earth-crossing asteroids").
 //!
 //! The frame's origin falls freely on a Kepler orbit `s(t)` about the planet ([`crate::gravity::kepler`]); the

@@ -1,57 +1,30 @@
-//! Barnes–Hut octree with quadrupole moments and a group walk (Zhang17 §2.1 uses pkdgrav's tree; our notes
-//! ask for at least quadrupole order and a real O(N log N) method; the group walk is Barnes 1990, J. Comput.
-//! Phys. 87, 161; the opening criterion Barnes 1994, in Computational Astrophysics, Springer).
+//! Barnes–Hut octree with quadrupole moments and a group walk (Zhang17 §2.1 uses pkdgrav's tree; the group walk is
+//! Barnes 1990, J. Comput. Phys. 87, 161; the opening criterion Barnes 1994, in Computational Astrophysics, Springer;
+//! the single-precision lists those of pkdgrav3, Potter, Stadel & Teyssier 2017, Comput. Astrophys. Cosmol. 4, 2).
 //!
-//! Build: each particle gets a 63-bit Morton key (21 bits per axis over the bounding cube); the particles are
-//! sorted by key, so every node's particles are one contiguous run of the sorted array, and the nodes are
-//! laid out in depth-first order in flat arrays with a "next" index (the first node after the subtree), which
-//! makes the walk a loop without a stack. A node is split while it holds more than [`LEAF_SIZE`] particles
-//! (to depth 21, where coincident particles stay together).
+//! Build: the particles are sorted by a 63-bit Morton key (21 bits per axis over the bounding cube), so every node's
+//! particles are one contiguous run; the nodes are laid out depth-first in flat arrays with a "next" index (the first
+//! node after the subtree), so the walk is a loop without a stack. A node is split while it holds more than
+//! [`LEAF_SIZE`] particles (to depth 21, where coincident particles stay together).
 //!
-//! Each node stores its mass `M`, centre of mass `c`, traceless quadrupole `Q = Σ m (3 d dᵀ − |d|² I)`
-//! (`d = x − c`), its cube's side `l` and the offset `δ` of `c` from the cube's centre. A node is used whole
-//! for a point at `r = p − c` when `|r| > l/θ + δ` (Barnes 1994's criterion; never for a point inside its cube
-//! when θ < 2/√3), with
+//! Each node stores its mass `M`, centre of mass `c`, traceless quadrupole `Q = Σ m (3 d dᵀ − |d|² I)` (`d = x − c`),
+//! its cube's side `l` and the offset `δ` of `c` from the cube's centre. A node is used whole for a point at
+//! `r = p − c` when `|r| > l/θ + δ` (never for a point inside its cube when θ < 2/√3), with
 //! `φ = −G M/|r| − G rᵀQr / (2|r|⁵)` and `a = −∇φ = −G M r/|r|³ + G (Q r/|r|⁵ − 5/2 (rᵀQr) r/|r|⁷)`.
-//! Leaves are used whole in the same way ("far leaves") when they hold at least [`FAR_LEAF_MIN`] particles
-//! and the tree at least [`FAR_LEAVES_FROM`]; other leaves are summed directly. Small leaves are excluded
-//! because on a lattice they are all alike (an FCC ball's octree has leaves of the four sites of one cubic
-//! cell), so the octupole their quadrupole misses adds up coherently instead of averaging out: on a
-//! 10 000-site FCC ball at θ = 0.5 the largest force error, relative to the largest force, was 3.0e-3 with
-//! leaves of four used whole and 7e-4 with five or more (as with no leaf used whole), with leaves of up to
-//! eight. Leaves now hold up to 32: on the FCC ball the near field is summed directly over a few hundred
-//! more particles, but a node is used whole only farther out, the RMS error at θ = 0.5 fell from 4.4e-4 to
-//! 1.9e-4 (uniform ball 5.6e-4 → 3.4e-4), and the step got faster (10 000 spheres: tree every step
-//! 1.4e5 → 1.85e5 particle-steps/s; leaves of 16 and buckets of 32 were as fast). Small trees are
-//! excluded because there direct sums cost little and keep a small aggregate's forces pairwise (its
-//! angular momentum to rounding, `ssdem_conservation`).
+//! Leaves are used whole in the same way when they hold at least [`FAR_LEAF_MIN`] particles and the tree at least
+//! [`FAR_LEAVES_FROM`]; other leaves are summed directly (on a lattice small leaves are all alike, so the octupole
+//! their quadrupole misses adds up coherently; a small tree's direct sums keep its forces pairwise).
 //!
-//! Group walk (Barnes 1990): the particles of one bucket (the largest node of at most [`BUCKET_SIZE`]
-//! particles on each branch, a leaf or a small subtree) share one interaction list, built by one walk in
-//! which a node is used whole when the criterion holds at the point of the bucket's bounding box nearest to
-//! the node's centre of mass, hence for every particle of the bucket: the forces are those of the
-//! per-particle walk with some nodes opened further, so the error is never larger. The walk gathers the
-//! particles of the leaves summed directly into one contiguous list. The lists are then applied to the
-//! bucket's particles eight at a time in single precision, four in double (a last few as a half block),
-//! each entry (a node's moments or a
-//! particle) read once per block, so the sums stay in registers and the compiler vectorises over the block.
-//! A source at distance zero (the particle itself) is skipped by a select, not a branch. Buckets are
-//! independent (rayon-parallel, buffers reused per worker); each particle sums its list in a fixed order,
-//! so results do not depend on the number of threads.
+//! Group walk: the particles of one bucket (at most [`BUCKET_SIZE`]) share one interaction list, a node being used
+//! whole only when the criterion holds at the bucket's point nearest to it, so the error is never larger than the
+//! per-particle walk's. Buckets are independent (rayon-parallel) and each particle sums its list in a fixed order:
+//! the results do not depend on the number of threads. [`FrozenOctree`] keeps the lists of one configuration and
+//! sums them with the moments recomputed, a field smooth in the positions (an extrapolation integrator fixes them
+//! per step).
 //!
-//! Frozen lists ([`FrozenOctree`]): the lists of one configuration, kept while the particles move a little and
-//! summed with the nodes' moments recomputed, give a field that is smooth in the positions (a fresh walk's field
-//! jumps where a list changes). An extrapolation integrator fixes them per step.
-//!
-//! Precision: a tree large enough to use leaves whole (at least [`FAR_LEAVES_FROM`] particles, where the
-//! multipole error is 1e-5 to 1e-3 anyway) sums its lists in single precision, as pkdgrav3 does (Potter,
-//! Stadel & Teyssier 2017, Comput. Astrophys. Cosmol. 4, 2): every list entry is stored relative to its
-//! bucket's centre, lengths in units of a power of two near the bucket's side and masses in units of a power
-//! of two near the total mass (exact rescalings that keep the f32 sums far from overflow), so only the
-//! rounding of the offsets and the sums (~1e-7 relative; the unit test `single_precision_changes_the_field_
-//! by_rounding_only` bounds it) is added. Twice as many lanes fit a vector register: the tree step at 10 000
-//! spheres went from 1.0e5 to 1.4e5 particle-steps/s. Smaller trees, summed directly and exactly pairwise,
-//! stay in double precision.
+//! Precision: a tree of at least [`FAR_LEAVES_FROM`] particles sums its lists in single precision, every entry
+//! relative to its bucket's centre in power-of-two units of length and mass (exact rescalings, far from f32 overflow),
+//! so only rounding (~1e-7 relative) is added; smaller trees stay in double precision.
 
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};
@@ -801,7 +774,7 @@ impl FrozenOctree {
     /// nodes' moments recomputed there; `g` is the gravitational constant. The frozen tree is only read (the
     /// particles and moments at `positions` go into a copy of the tree's arrays, O(N), beside the lists' O(N log N)
     /// sums), so that several evaluations may share it without a lock held across their parallel work (a rayon
-    /// worker blocked on such a lock can wait for a job of its own; issue 39).
+    /// worker blocked on such a lock can wait for a job of its own).
     pub fn accelerations(&self, positions: &[Vec3], masses: &[f64], g: f64) -> (Vec<Vec3>, Vec<f64>) {
         let mut tree = self.tree.clone();
         tree.particles

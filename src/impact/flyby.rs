@@ -1,4 +1,4 @@
-//! A tidal flyby of a rubble pile past a planet (issue 20; the experiment of Richardson, Bottke & Love 1998, Icarus
+//! A tidal flyby of a rubble pile past a planet (the experiment of Richardson, Bottke & Love 1998, Icarus
 //! 134, 47–76) as a library call: the `[physics.flyby]` term ([`crate::ellipsoid::tide`]) on a target pile.
 //!
 //! [`prepare_flyby`] reads a target bodies file (e.g. from `rubblepile target build`), optionally rescales it to a
@@ -8,7 +8,7 @@
 //! dissipation, the flyby; Bulirsch–Stoer). The run starts with the planet at `start_q · q` on the way in and ends
 //! at the same distance on the way out. The same run again: `rubblepile run DIR/scene.toml --out OTHER`.
 //!
-//! **A fair flyby** (issue 41): a pile that was rescaled or re-spun is first settled without tide
+//! **A fair flyby**: a pile that was rescaled or re-spun is first settled without tide
 //! ([`crate::impact::settle`]; the pile as prepared is kept as `prepared_bodies.csv`, the settled one is
 //! `initial_bodies.csv`, the run's "before"), optionally put into principal-axis rotation about its largest moment
 //! (`--settle-to-principal`), and a control run of the same pile over the same time without the planet (mass 0)

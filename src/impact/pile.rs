@@ -1,4 +1,4 @@
-//! Rubble-pile projectiles (issue 20): a whole pile of ellipsoids (a target file of `rubblepile target build`)
+//! Rubble-pile projectiles: a whole pile of ellipsoids (a target file of `rubblepile target build`)
 //! thrown at the target instead of Roig03 §3's single ellipsoid.
 //!
 //! The projectile pile keeps its own internal state (relative positions, velocities, spins: a relaxed pile

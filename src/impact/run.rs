@@ -34,7 +34,7 @@ pub const DEFAULT_T_END: f64 = 10_000.0;
 pub const DEFAULT_RTOL: f64 = 1e-6;
 
 /// Default tolerance of the Dormand–Prince methods, which apply it to each step: at 1e-8, Dop853 runs the N2000 + P2
-/// impact to 10 000 s in 7 min 37 s on 2 cores with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
+/// impact to 10 000 s with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
 pub const DEFAULT_RTOL_PER_STEP: f64 = 1e-8;
 
 /// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for the Bulirsch–Stoer methods (of the whole run),

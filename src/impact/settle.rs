@@ -1,4 +1,4 @@
-//! Settling a rescaled or re-spun pile before a flyby (issue 41): the pile evolves under its own gravity, contact
+//! Settling a rescaled or re-spun pile before a flyby: the pile evolves under its own gravity, contact
 //! and dissipation (no tide) until it moves as one rigid body, so that what a flyby measures afterwards is the
 //! tide's doing and not the pile's own settling.
 //!

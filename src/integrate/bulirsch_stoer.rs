@@ -36,8 +36,8 @@
 //! # Error per unit step (deviation from ODEX)
 //!
 //! ODEX bounds the error of every step by the tolerance, so the final error of a run grows with its number of
-//! steps: on the outer Solar System at `rtol = 1e-10` it ended at 1e4 × rtol, and the higher the order (the
-//! longer the steps), the closer the true local error comes to its estimate. When the run's span `T` is known
+//! steps (to 1e4 × rtol on the outer Solar System, `analysis/work_precision/REPORT.md`), and the higher the order
+//! (the longer the steps), the closer the true local error comes to its estimate. When the run's span `T` is known
 //! ([`Integrator::set_span`], which the run driver and the benchmarks call), a step of length `H` is
 //! accepted when `err ≤ s H / T` instead of `err ≤ 1` (with `s =` [`RUN_BUDGET`], and `s H / T` floored at
 //! `10 ε / rtol`, below which round-off decides): the local errors of the whole run then add up to about
@@ -52,9 +52,8 @@
 //! compensation, which carries what that addition rounded away into the next step (and into the next
 //! [`Integrator::advance`] when the caller hands the returned state back unchanged; it is saved with
 //! [`Integrator::save_state`], so a resumed run is bit-identical). Written on the states, every substep and
-//! every tableau entry rounds at `ε |y|`, and the run's error stops following `rtol` near `1e-11`: on the outer
-//! Solar System at `rtol = 1e-12` the final error was 2.6e-11 with states, 1.2e-11 with increments and 9.3e-12
-//! with increments and compensation (`bench tolerance`).
+//! every tableau entry rounds at `ε |y|`, and the run's error stops following `rtol` near `1e-11`
+//! (`bench tolerance`; `analysis/work_precision/REPORT.md`).
 //!
 //! # Safeguards
 //!

@@ -1,6 +1,6 @@
 //! The physical constants and limits every engine's scene uses (the SI `G`, the smallest tolerance, size, step,
-//! the largest counts and input sizes), one rule per engine-neutral concept (issue 38, "every input bounded, finite
-//! and named"). They sit in a file of their own, below `io::scene_file` (which re-exports them and checks scenes
+//! the largest counts and input sizes), one rule per engine-neutral concept, so that every input is bounded, finite
+//! and named. They sit in a file of their own, below `io::scene_file` (which re-exports them and checks scenes
 //! against them) and `io::output_times` (which checks a snapshot cadence), so that both read them one way.
 
 /// The SI gravitational constant used when a scene gives none (m³ kg⁻¹ s⁻²).

@@ -1,6 +1,6 @@
 //! The manifest of a run directory (`DIR/manifest.txt`): every finished file of the run with its size and its
 //! BLAKE3 checksum, so that `check DIR`, `resume`, `analyze`, `export` and `render` find a damaged file (a byte
-//! flipped, a file cut short) and name it instead of reading it (issue 53, "run directories that can be verified").
+//! flipped, a file cut short) and name it instead of reading it.
 //!
 //! # What it records, and when
 //!

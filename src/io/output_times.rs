@@ -1,8 +1,8 @@
 //! Snapshot times computed from a cadence or a count, shared by the three engines' `[output] snapshot_every` and
 //! the commands that write scenes (`impact --snapshot-every`, the flyby's evenly spaced snapshots). Each time is
 //! `k × step` computed from its index (not by adding steps, which drifts), and the last is `t_end` itself: a product
-//! that rounds one ulp above `t_end` would be refused by the scene check (issue 41: `flyby --snapshots N` failed
-//! for 147 of N = 2…1201).
+//! that rounds one ulp above `t_end` would be refused by the scene check (computed as
+//! `t_end·k/(N−1)`, the last of `flyby --snapshots N` did so for 147 of N = 2…1201).
 
 /// Relative distance (of the cadence) below which a cadence time next to `t_end` is taken as `t_end` itself, so a
 /// cadence that divides `t_end` up to rounding does not add a snapshot a hair before the last.
@@ -99,7 +99,7 @@ mod tests {
 
     #[test]
     fn evenly_spaced_times_end_exactly_on_t_end_for_every_count() {
-        // The flyby case of issue 41: t_end·k/(N−1) rounded one ulp above t_end for some N.
+        // The flyby's case: t_end·k/(N−1) rounded one ulp above t_end for some N.
         let t_end = 2.0 * 6.0 * 6.371e6 / 12e3 + 0.1;
         for n in 2..=1201 {
             let t = evenly_spaced(t_end, n);

@@ -1,5 +1,5 @@
-//! A run's budget (issue 53, "budgets, not crawls"): the `[run]` table every engine's scene file accepts, and the
-//! limits the run driver holds a run to.
+//! A run's budget, so that a run ends within stated limits rather than crawling on: the `[run]` table every
+//! engine's scene file accepts, and the limits the run driver holds a run to.
 //!
 //! - `max_steps`: the most steps a run may take (integrator step attempts of the ellipsoids, fixed steps of the
 //!   spheres), [`DEFAULT_MAX_STEPS`] unless the scene (`[run] max_steps`) or the command line (`--max-steps`) says

@@ -1,6 +1,6 @@
 //! The one way rubblepile writes a file into a directory it owns (a run directory, its `analysis/`, `frames/`,
-//! `vtk/`, a campaign directory): never through a symbolic link, and whole or not at all (issue 53, "nothing
-//! written outside the run directory").
+//! `vtk/`, a campaign directory): never through a symbolic link (so nothing is written outside that directory),
+//! and whole or not at all.
 //!
 //! - [`write_atomic`] and [`AtomicFile`]: the bytes go to a fresh temporary file in the same directory (created
 //!   with `O_CREAT | O_EXCL`, which never follows a link), and a rename puts it in place. A rename replaces a link

@@ -1,9 +1,8 @@
 //! The field reference of the scene files: one [`FieldDoc`] row per key a scene parser accepts (its unit, default,
 //! allowed range and meaning), the text `rubblepile check --explain` prints from them ([`explain_text`]), and the
 //! [`Validator`] check that reads a row's bounds ([`Validator::within`]), so that where a field's range is a plain
-//! interval the validator enforces exactly what the reference prints (issue 41, "the field reference exists only
-//! in rustdoc"). Each engine keeps its rows beside its scene parser; [`crate::io::schema_keys`] lists the keys a
-//! schema accepts, against which the rows are tested.
+//! interval the validator enforces exactly what the reference prints. Each engine keeps its rows beside its scene
+//! parser; [`crate::io::schema_keys`] lists the keys a schema accepts, against which the rows are tested.
 
 use crate::io::scene_file::{MIN_MEANINGFUL, SceneError, Validator, fmt_num};
 

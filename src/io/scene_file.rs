@@ -3,8 +3,8 @@
 //! field checks of [`Validator`], and the physical constants and limits every engine's scene uses
 //! (defined in `io::limits`, re-exported here).
 //!
-//! The limits are one rule per engine-neutral concept, so the three engines agree (issue 38, "every input bounded,
-//! finite and named"): a positive size is at least [`MIN_MEANINGFUL`]; a time step or cadence at least
+//! The limits are one rule per engine-neutral concept, so the three engines agree and every input is bounded,
+//! finite and named: a positive size is at least [`MIN_MEANINGFUL`]; a time step or cadence at least
 //! `t_end ×` [`MIN_STEP_FRACTION`]; counts stay below [`MAX_TIMESERIES_ROWS`], [`MAX_SNAPSHOTS`], [`MAX_BODIES`],
 //! [`MAX_EVENTS_PER_STEP`] and [`MAX_THREADS`]; input files are read through [`BoundedReader`] ([`MAX_INPUT_BYTES`],
 //! [`MAX_LINE_BYTES`]); fixed-length arrays are read by [`exact`]; and a scene whose estimated work exceeds

@@ -1,8 +1,7 @@
-//! The scene copy a run keeps in its directory (`DIR/scene.toml`), made to stand alone: every input file the
-//! scene names by a relative path is written there by its absolute path, so `render`, `export`, `analyze`,
-//! `check` and `resume` read the same files whatever directory they are started from (issue 41, "runs that stand
-//! alone"). Absolute paths rather than copies: a particles or bodies file can hold millions of rows, and the
-//! copy would double the run's inputs on disk.
+//! The scene copy a run keeps in its directory (`DIR/scene.toml`), made to stand alone: every input file the scene
+//! names by a relative path is written there by its absolute path, so `render`, `export`, `analyze`, `check` and
+//! `resume` read the same files whatever directory they are started from. Absolute paths rather than copies: a
+//! particles or bodies file can hold millions of rows, and the copy would double the run's inputs on disk.
 //!
 //! Only the file fields are rewritten, on their own lines; comments and layout stay as written. A value the
 //! line-wise rewrite cannot reach (an escaped string, an inline `scene = { … }` table) is caught by re-reading the

@@ -5,41 +5,21 @@
 //! neighbours and the walls are predicted and queued ([`super::events`]); the globally earliest is processed, only the
 //! particles involved are re-predicted, and so on until the step ends.
 //!
-//! Neighbours (a Verlet list with skins, kept across steps): every particle k has an anchor a_k (its position when
-//! it was last listed) and a travel allowance L_k; the candidate pairs are those with
-//! `|a_i − a_j| < R_i + R_j + L_i + L_j` (found for all particles at once on a cell grid,
-//! [`crate::geometry::neighbours::sphere_pairs`]). A pair outside that list cannot meet while each particle stays
-//! within its allowance of its anchor. That is checked at the start of every drift (distance from the anchor plus
-//! `|v| h`) and, after every collision, for the particles involved (distance plus `|v|` times the time left); a bound
-//! on the travel under gravity gives each particle a time before which the drift-start check cannot fail, so only
-//! the particles past it are checked (`set_expiry`; the same decisions, fewer square roots). A
-//! particle that could leave its allowance is re-anchored alone at that instant: fresh anchor and allowance, its
-//! pairs found again against every other particle's (unchanged) anchor and allowance, which keeps the criterion
-//! exact for every pair (the other anchors are filed in a cell grid, [`super::anchors`], so this costs the cells
-//! around the particle, not a pass over all particles). When more than half of the particles fail at a drift start,
-//! the whole list is built afresh instead (with skins spread over [0.5, 1.5) × `skin_steps` so that they do not all
-//! expire together). So no collision is ever missed, whatever the kicks and collisions do to the speeds.
-//! `L_k = max(min(skin_steps · |v_k| · h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))` (at least 1e-3 of the
-//! smallest radius), so a particle is re-listed about every `skin_steps` steps, slow particles in dense regions keep
-//! small allowances and no allowance exceeds a radius more than the drift needs (large skins only grow the lists).
-//! `skin_steps = 0` is the old scheme (one allowance `2 v_max h` for all and a fresh list at every step and whenever a
-//! particle fails), kept as the reference of the regression test `tests/hsdem_neighbours.rs`. The same allowance
-//! also lists each particle's near walls: a fixed wall farther than `R_k + L_k` from the anchor cannot be touched
-//! before the particle is re-listed, so only moving walls and near ones are predicted.
+//! Neighbours (a Verlet list with per-particle skins): particle k has an anchor a_k (its position when last listed)
+//! and a travel allowance L_k; the candidate pairs are those with `|a_i − a_j| < R_i + R_j + L_i + L_j`
+//! ([`crate::geometry::neighbours::sphere_pairs`]), and a near wall is one within `R_k + L_k` of the anchor. A particle
+//! that could leave its allowance (checked at each drift start and after each of its collisions) is re-listed alone
+//! against the other anchors ([`super::anchors`]); when more than half fail at once the whole list is rebuilt. So no
+//! collision is ever missed. `L_k = max(min(skin_steps · |v_k| · h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))`
+//! (at least 1e-3 of the smallest radius); `skin_steps = 0` gives one allowance `2 v_max h` for all and a fresh list
+//! at every step, the reference of `tests/hsdem_neighbours.rs`.
 //!
-//! What a drift start predicts. Every kick changes every velocity, so every wall contact is predicted afresh at each
-//! drift start (from the near walls). Pairs are not: a uniform kick changes no relative velocity, so a pair of free
-//! particles keeps a certificate across steps (the earliest time it can come within reach, [`super::certificates`])
-//! and is predicted afresh only when that comes due, at the first drift start after either particle collided or was
-//! re-listed (certified there unless a particle collided in the last drift: in a dense pile, where particles collide
-//! at every step, their pairs are simply predicted at every drift start, as before), or at every step when one is
-//! stuck (stuck particles are not kicked). Every event is still computed from the positions and
-//! velocities at the drift start or the collision, exactly as when every listed pair was predicted at every drift
-//! start (`prune_predictions = false`), so the certificates change no bit (`tests/hsdem_certificates.rs`).
+//! Every wall contact is predicted afresh at each drift start; a pair of free particles keeps a certificate across
+//! steps ([`super::certificates`]), since a uniform kick changes no relative velocity. Events are always computed from
+//! the state at the drift start or the collision, so the certificates change no bit (`tests/hsdem_certificates.rs`).
 //!
-//! Overlap handling: a pair or a wall contact that touches or overlaps and approaches collides at once; no overlap is
-//! ever integrated, so overlaps stay at round-off level. Particles stuck to a sticky wall move rigidly with it (on the
-//! secant over the step, landing exactly on the wall's law at the step end) and act as infinite masses.
+//! A pair or wall contact that touches or overlaps and approaches collides at once: no overlap is ever integrated.
+//! Particles stuck to a sticky wall move rigidly with it and act as infinite masses.
 
 use super::anchors::{AnchorGrid, Entry};
 use super::certificates::{self, Calendar, Due};
@@ -70,10 +50,8 @@ static PHASE_REPREDICT: Phase = Phase::new("hard.repredict", Kind::Serial);
 /// Moving every particle to the end of the drift.
 static PHASE_ADVANCE: Phase = Phase::new("hard.advance", Kind::Serial);
 
-/// Default [`StepperSettings::skin_steps`]. On the equilibrated model atmosphere (dilute) 8, 16, 32 and 64 cost 3.7,
-/// 2.4, 2.0 and 1.9 s of CPU for 5000 steps against 8.8 s with a fresh list every step
-/// (`analysis/richardson2011/NOTES.md`, 22 Nov 2026, before the certificates and the anchor grid); 16 keeps the lists
-/// shorter in dense piles.
+/// Default [`StepperSettings::skin_steps`]: on the dilute model atmosphere any of 8 to 64 costs under half of a
+/// fresh list every step (`analysis/richardson2011/MODULE_NOTES.md`), and 16 keeps the lists shorter in dense piles.
 pub const DEFAULT_SKIN_STEPS: f64 = 16.0;
 
 /// Settings of the stepper.

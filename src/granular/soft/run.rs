@@ -49,9 +49,8 @@ use rayon::prelude::*;
 pub const BROKEN_OVERLAP: f64 = 0.5;
 
 /// Spheres per thread at least ([`SoftEngine`]'s `useful_threads`): the smallest grain measured still to gain from
-/// more threads. The 2000-sphere ball of `bench scaling` (`ssdem-2k`, 125 spheres per thread on 16 threads) went
-/// from 2.71× at 8 threads to 3.38× at 16 on a 16-core node (issue 39, `analysis/scaling/REPORT.md`); below that
-/// grain nothing was measured, so a smaller run forks over no more threads than this gives.
+/// more threads (`bench scaling`'s `ssdem-2k`; `analysis/scaling/NOTES.md`), so a smaller run forks over no more
+/// threads than this gives.
 pub const SPHERES_PER_THREAD: usize = 125;
 
 static PHASE_CHECK_STATE: Phase = Phase::new("soft.check_state", Kind::Parallel);

@@ -4,29 +4,19 @@
 //! (RVEs, §3.3.1, Eqs. 15–16) reduced to s_max, p_max and θ_max (Eqs. 20–21).
 //!
 //! **Packing fraction.** The Voronoi cells come from [`crate::geometry::voronoi`], each started as a cube of
-//! half-side twice the largest diameter. The paper bounds the tessellation by the shape model and then keeps only
-//! interior particles, because cells cut by the boundary measure the boundary, not the packing. Our equivalent: a
-//! cell still touching its starting cube is open to the outside (it belongs to the outermost layer, or to a shed
-//! particle) and is excluded; so is every particle within 10 % of the sum of the radii from the surface of such a
-//! particle (a proximity test rather than the contact list, so that a contact opening for a step does not let a
-//! second-layer cell flicker into the average: on a carved HCP ball that flicker moved η_B by up to 0.0008), because where the surface
-//! layer has gaps (a lattice or packing carved by a shape) the second layer's cells are closed only by distant
-//! bisectors and measure the gaps, not the packing (on a carved HCP ball keeping the second layer lowers η_B by
-//! about 0.03 and makes it noisy at the 0.001 level of T_c,2); and so is every particle outside the central body.
-//! η_B is the ratio of the summed sphere volumes to the summed cell volumes over the rest (the volume-weighted
-//! form of Eq. 14, which does not let a few small cells dominate). That is the default rule,
-//! [`InteriorRule::Layers`]. For unequal spheres it flickers: in our PP1 (radii 10.7–85 m) one large sphere
-//! entering or leaving the set moves η_B by about 0.01 between samples. The depth rule
-//! ([`InteriorRule::Depth`], `[spinup] interior_depth`) weights every closed cell by its depth below the surface
-//! layer instead (distance to the nearest centre with an open cell; the weight ramps linearly from 0 to 1), so
-//! that η_B is a continuous function of the positions as long as the set of open cells holds.
-//!
-//! **Open cells** are those that reach the sphere inscribed in the starting cube ([`VoronoiCell::reaches`]), in
-//! both rules. Until 23 Nov 2026 the test was whether a face of the (axis-aligned) cube survived, which turns
-//! with the body: a few surface cells closed and opened every quarter of a spin period, and η_B wiggled with
-//! period T/4 (±5e-4 in the scaled RCP, dips of 0.005 in PP1; the wiggle's minima fell at the same times in the
-//! RCP runs at 1800, 2100 and 2400 kg/m³, whose dynamical times differ, and their spacing follows T/4 along
-//! the path). The `analysis/zhang2017` runs were made again with the new test on 23 Nov 2026.
+//! half-side twice the largest diameter. Like the paper, we keep only interior particles, because cells cut by the
+//! boundary measure the boundary, not the packing. A cell that reaches the sphere inscribed in its starting cube
+//! ([`VoronoiCell::reaches`]; a sphere, so that the test does not turn with the body) is open to the outside (the
+//! outermost layer, or a shed particle) and is excluded; so is every particle within 10 % of the sum of the radii
+//! from the surface of such a particle (a proximity test rather than the contact list, so that a contact opening for
+//! a step does not let a second-layer cell flicker in), because where the surface layer has gaps the second layer's
+//! cells are closed only by distant bisectors and measure the gaps; and so is every particle outside the central
+//! body. η_B is the ratio of the summed sphere volumes to the summed cell volumes over the rest (the volume-weighted
+//! form of Eq. 14, which does not let a few small cells dominate): the default rule, [`InteriorRule::Layers`]. For
+//! unequal spheres it flickers as one large sphere enters or leaves the set; the depth rule ([`InteriorRule::Depth`],
+//! `[spinup] interior_depth`) weights every closed cell by its depth below the surface layer instead (distance to the
+//! nearest centre with an open cell; the weight ramps linearly from 0 to 1), so that η_B is a continuous function of
+//! the positions as long as the set of open cells holds.
 //!
 //! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
 //! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
@@ -41,7 +31,7 @@
 //! grazing overlap opens and closes from step to step as the pile breathes and moves the raw count by a few
 //! hundredths of a contact per particle at a sample; the floor leaves out those that carry under 1 % of the mean
 //! (in a self-gravitating pile the outermost layer's contacts carry a few tenths of the mean, so they stay counted).
-//! The creep test judges `coordination_loaded` where a run has it (issue 40, item 3).
+//! The creep test judges `coordination_loaded` where a run has it.
 //!
 //! **Reductions.** `s_max` is the largest deviatoric stress `(σ₁ − σ₃)/2`, `p_max` the largest compressive
 //! pressure `−(σ₁ + σ₂ + σ₃)/3` (reported positive, Pa), `θ_max` the largest mobilized friction angle (degrees)

@@ -1,5 +1,5 @@
 //! `rubblepile campaign slurm`: a Slurm job-array script running a campaign as shards ([`super::shard`]), written
-//! so that it runs only what it says (issue 53, "job scripts that run only what they say").
+//! so that it runs only what it says.
 //!
 //! - Every value put into the script is quoted for the reader that reads it: shell words in single quotes
 //!   ([`sh_quote`]; a path holding `;`, `$(…)`, a backtick or a quote stays one word and is never run), `#SBATCH`

@@ -1,4 +1,4 @@
-//! Roig et al. (2003, Icarus 165) after the referee (issue 42): the rotational share of §4.1 against F0, the
+//! Roig et al. (2003, Icarus 165) after the referee: the rotational share of §4.1 against F0, the
 //! inertia model, the targets' own spin and a target relaxed at the impact's κ; Fig. 4's exponents fitted
 //! above a Δv floor and on the escaping fragments only; the seed scatter with the target realisation in it;
 //! §4.2's "small fragments from the impact point".

@@ -29,8 +29,8 @@ use crate::io::scene_file::SI_G;
 
 use super::rows::{ModelRow, TABLE3, opt, paper_bulk_density, path_row};
 
-/// The hold lengths (s) at which every search is read: the 16 000 s of the searches before Dec 2026 and two and
-/// about three times that.
+/// The hold lengths (s) at which every search is read: the 16 000 s of the earlier searches and two and about
+/// three times that.
 pub const HOLD_LENGTHS: [f64; 3] = [16_000.0, 32_000.0, 50_000.0];
 
 /// The groups of searches under the decided directory.
@@ -506,7 +506,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     Ok(())
 }
 
-/// Zhang17 Fig. 2's analogue: the surface slopes of the decided shape (and of the top of the runs before Dec 2026)
+/// Zhang17 Fig. 2's analogue: the surface slopes of the decided shape (and of the top of the earlier runs)
 /// as homogeneous bodies of the decided density spinning at the Didymos period ([`crate::analysis::surface_slopes`]);
 /// writes `decided_slopes.{svg,png}` (slope against latitude, every longitude).
 fn write_slopes(md: &mut String, rho: f64, out: &Path) -> Result<(), String> {

@@ -1,5 +1,5 @@
 //! Zhang17 Fig. 22, its closest analogue: θ_max, η_B and the coordination number through the holds of a T_c,3
-//! search, for holds on both sides of T_c,3 (issue 40, item 3).
+//! search, for holds on both sides of T_c,3.
 //!
 //! The paper holds PP2 at the end of path 2 (2.26 h) with three bulk densities (2409, 2610 and 2811 kg/m³) and
 //! shows creep in the first two and the stable signature in the third: η_B and the coordination number rise a

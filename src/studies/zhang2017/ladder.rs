@@ -1,4 +1,4 @@
-//! The resolution ladder (issue 40): one model's path-2 run and T_c,3 search at several grain counts, the same
+//! The resolution ladder: one model's path-2 run and T_c,3 search at several grain counts, the same
 //! body and material with lengths scaled by the grain radius (`analysis/zhang2017/ladder/README.md`), against
 //! the paper's value at its own count (Zhang17 Tables 2 and 3: RCP, 36 523 grains of ≈ 10 m; HCP, 42 062). Does
 //! the packing dependence of T_c,3 appear as N grows? Rungs of several models (`rcp_8k`, `hcp_full`) share one

@@ -1,6 +1,6 @@
 //! Zhang17 §4.4, Table 7: the HCP and PP2 models with a weaker (β = 0.3, μ_s = 0.5) and a stronger (β = 0.6,
 //! μ_s = 1.3) material than the nominal one (β = 0.5, μ_s = 1.0), each pile settled with its own material before
-//! the spin-up (issue 40: a lattice settled with μ_s = 1.0 and then spun with μ_s = 0.5 compacts during its holds).
+//! the spin-up (a lattice settled with μ_s = 1.0 and then spun with μ_s = 0.5 compacts during its holds).
 //!
 //! Layout read: `RUNS/<model>_beta<β>_mus<μ_s>/path2` and `…/critical` ([`variant_dir`]), the nominal material's
 //! run being the Table 3 one, `RUNS/<model>`. Such directories are neither Table 3 rows nor bulk-density points

@@ -1,6 +1,6 @@
 //! Does the paper's packing ordering of T_c,3 (Zhang17 Table 3: HCP strongest at 2.40 h, RCP weakest at 2.83 h)
 //! depend on the contact law? The HCP and RCP models' T_c,3 searches with the twisting and rolling resistance of
-//! Zhang17 Eqs. 11–12 changed (issue 40: the measured reason the ordering is or is not reproduced).
+//! Zhang17 Eqs. 11–12 changed: the measured reason the ordering is or is not reproduced.
 //!
 //! Layout read: `ORDERING/<model>_<variant>/critical*/critical.csv` (compact copies of `rubblepile spinup critical`
 //! directories: a coarse search and, where it bracketed T_c,3, a finer one), `<variant>` one of [`VARIANTS`]; the

@@ -176,7 +176,7 @@ pub fn successive_scatter(values: &[f64]) -> f64 {
 /// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
 /// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
 /// [`crate::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
-/// the scaled runs with the rotation-free open test resolve (sample scatter 2.6e-5 to 1.0e-4, 23 Nov 2026).
+/// the scaled runs with the rotation-free open test resolve (`analysis/zhang2017/MODULE_NOTES.md`).
 pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
     let samples = (window / spacing).max(1.0);
     noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
