@@ -790,7 +790,12 @@ fn a_rank_killed_mid_campaign_loses_nothing() {
     assert!(done_on_disk >= done_before, "{rows:?}");
     // Again: the rest is completed, nothing is run twice.
     let o = mpirun(3, &args).output().unwrap();
-    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        stderr(&o),
+        std::fs::read_to_string(&index).unwrap_or_default()
+    );
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains(&format!("{} runs to do of 6", 6 - done_on_disk)), "{out}");
     let reference = load_campaign(&file).unwrap();

@@ -681,13 +681,11 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
     on_pool(useful, || drive(&mut engine, dir, options, start, &identity, &budget))
 }
 
-/// Writes `checkpoint` into `dir/checkpoint.json` atomically and durably (temporary file, fsync, rename, directory
-/// fsync: [`safe_write::AtomicFile::finish_durable`]).
-fn write_checkpoint<S: Serialize>(dir: &Path, checkpoint: &Checkpoint<S>) -> std::io::Result<()> {
-    let mut w = safe_write::AtomicFile::create(&dir.join(CHECKPOINT_FILE))?;
-    serde_json::to_writer_pretty(&mut w, checkpoint).map_err(std::io::Error::other)?;
-    w.write_all(b"\n")?;
-    w.finish_durable()
+/// The bytes of `dir/checkpoint.json` for `checkpoint`.
+fn checkpoint_bytes<S: Serialize>(checkpoint: &Checkpoint<S>) -> std::io::Result<Vec<u8>> {
+    let mut bytes = serde_json::to_vec_pretty(checkpoint).map_err(std::io::Error::other)?;
+    bytes.push(b'\n');
+    Ok(bytes)
 }
 
 fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> {
@@ -783,10 +781,10 @@ fn drive<E: Engine>(
     let mut last_checkpoint_wall = Instant::now();
     let mut last_checkpoint_t = engine.time();
     let mut checkpoints_here: u64 = 0;
-    // Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`), then the
-    // manifest that records it.
+    // Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`) between two
+    // manifests: the first records it as pending, the second as the checkpoint, so that a run killed at any instant
+    // leaves a directory whose manifest verifies the checkpoint there (the old one or the new).
     let checkpoint_at = |state: E::State, t: f64, next_sample: u64, rows: u64, bytes: u64, checkpoints: u64| {
-        manifest.borrow_mut().refresh(out_dir).map_err(io_err(&mp))?;
         let ckpt = Checkpoint {
             format: CHECKPOINT_FORMAT.into(),
             version: CHECKPOINT_VERSION,
@@ -804,7 +802,17 @@ fn drive<E: Engine>(
             engine: state,
         };
         let cp = out_dir.join(CHECKPOINT_FILE);
-        write_checkpoint(out_dir, &ckpt).map_err(io_err(&cp))?;
+        let ckpt_bytes = checkpoint_bytes(&ckpt).map_err(io_err(&cp))?;
+        manifest
+            .borrow_mut()
+            .write_with_pending(
+                out_dir,
+                &format!("checkpoint at t = {t} s being written"),
+                false,
+                Some((CHECKPOINT_FILE, &ckpt_bytes)),
+            )
+            .map_err(io_err(&mp))?;
+        safe_write::write_atomic_durable(&cp, &ckpt_bytes).map_err(io_err(&cp))?;
         manifest
             .borrow_mut()
             .write(out_dir, &format!("checkpoint at t = {t} s"), false)

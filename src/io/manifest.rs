@@ -26,6 +26,10 @@
 //! first bytes must be these), and the path relative to the run directory with `/` between folders. The last line
 //! is the checksum of every byte above it, so a damaged manifest is itself found.
 //!
+//! The checkpoint is the one file a run replaces. Before it is replaced, the manifest is written once more with a
+//! `~` line for it (the checkpoint about to be put in place: the file may be exactly this instead), so that a run
+//! killed between the checkpoint's rename and the next manifest leaves a directory that verifies and resumes.
+//!
 //! # Run directories without one
 //!
 //! A run directory written before the manifest is checked row by row instead ([`check_rows`]): every row as many
@@ -61,6 +65,9 @@ pub struct Entry {
     pub hash: String,
     /// Whether the file may have grown since (`+`): only its first `bytes` bytes are checked.
     pub growing: bool,
+    /// The file being put in place when the manifest was written (`~`: size and BLAKE3), which the file may be
+    /// instead of the recorded one.
+    pub pending: Option<(u64, String)>,
 }
 
 /// A run directory's manifest, as read.
@@ -115,6 +122,7 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
         .ok_or_else(|| damaged("no `# state:` line"))?
         .to_string();
     let mut entries = Vec::new();
+    let mut pending = Vec::new();
     for line in lines {
         let mut parts = line.splitn(4, ' ');
         let (Some(hash), Some(size), Some(kind), Some(rel)) = (parts.next(), parts.next(), parts.next(), parts.next())
@@ -124,17 +132,29 @@ pub fn read(dir: &Path) -> Result<Option<Manifest>, String> {
         let bytes = size
             .parse()
             .map_err(|_| damaged(&format!("malformed size in {line:?}")))?;
-        if hash.len() != 64 || !hash.bytes().all(|b| b.is_ascii_hexdigit()) || !matches!(kind, "=" | "+") {
+        if hash.len() != 64 || !hash.bytes().all(|b| b.is_ascii_hexdigit()) || !matches!(kind, "=" | "+" | "~") {
             return Err(damaged(&format!("malformed line {line:?}")));
+        }
+        if kind == "~" {
+            pending.push((rel.to_string(), bytes, hash.to_string()));
+            continue;
         }
         entries.push(Entry {
             path: rel.to_string(),
             bytes,
             hash: hash.to_string(),
             growing: kind == "+",
+            pending: None,
         });
     }
     entries.sort_by(|a, b| a.path.cmp(&b.path));
+    // A pending file without a recorded one (the first checkpoint) is, like any file written after the manifest,
+    // not recorded.
+    for (rel, bytes, hash) in pending {
+        if let Ok(i) = entries.binary_search_by(|e| e.path.as_str().cmp(&rel)) {
+            entries[i].pending = Some((bytes, hash));
+        }
+    }
     Ok(Some(Manifest { state, entries }))
 }
 
@@ -160,8 +180,27 @@ fn feed(h: &mut blake3::Hasher, mut r: impl Read) -> std::io::Result<()> {
     }
 }
 
-/// Checks the file of `entry` in `dir` against it; the error (one line) names the file and what differs.
+/// Checks the file of `entry` in `dir` against it, or against the file that was being put in place
+/// ([`Entry::pending`]); the error (one line) names the file and what differs from the recorded one.
 pub fn verify_entry(dir: &Path, entry: &Entry) -> Result<(), String> {
+    let recorded = verify_recorded(dir, entry);
+    match (&recorded, &entry.pending) {
+        (Err(_), Some((bytes, hash))) => {
+            let pending = Entry {
+                path: entry.path.clone(),
+                bytes: *bytes,
+                hash: hash.clone(),
+                growing: false,
+                pending: None,
+            };
+            verify_recorded(dir, &pending).or(recorded)
+        }
+        _ => recorded,
+    }
+}
+
+/// Checks the file of `entry` in `dir` against its recorded size and checksum.
+fn verify_recorded(dir: &Path, entry: &Entry) -> Result<(), String> {
     let path = dir.join(&entry.path);
     let meta = std::fs::symlink_metadata(&path).map_err(|e| {
         format!(
@@ -368,21 +407,23 @@ impl Recorder {
         Ok((hex, len))
     }
 
-    /// Hashes the files below `dir` now without writing anything, so that the next [`Recorder::write`] reads only
-    /// what changed in between: the driver calls it just before a checkpoint, which keeps the instant between the
-    /// checkpoint's rename and the manifest's (when a killed run leaves a manifest that does not know its newest
-    /// checkpoint) short.
-    pub fn refresh(&mut self, dir: &Path) -> std::io::Result<()> {
-        for (rel, path) in recordable_files(dir)? {
-            self.hash(&rel, &path)?;
-        }
-        Ok(())
-    }
-
     /// Writes `dir/manifest.txt` for the files below `dir` now, the run being `state` (`completed`, `failed`,
     /// `checkpoint at t = … s`): atomically and durably. `finished`: the run wrote its last byte, so every file is
     /// recorded exactly (`=`); otherwise the files of [`GROWING`] are recorded as prefixes (`+`).
     pub fn write(&mut self, dir: &Path, state: &str, finished: bool) -> std::io::Result<()> {
+        self.write_with_pending(dir, state, finished, None)
+    }
+
+    /// [`Recorder::write`], with a `~` line for the file `pending.0` (a relative path) that is about to be replaced
+    /// by the bytes `pending.1`: written before the replacement, so that the directory verifies whichever of the
+    /// two the file is when the run is killed.
+    pub fn write_with_pending(
+        &mut self,
+        dir: &Path,
+        state: &str,
+        finished: bool,
+        pending: Option<(&str, &[u8])>,
+    ) -> std::io::Result<()> {
         let mut text = format!("{HEADER}\n# state: {state}\n");
         for (rel, path) in recordable_files(dir)? {
             let (hash, bytes) = self.hash(&rel, &path)?;
@@ -392,6 +433,9 @@ impl Recorder {
                 '='
             };
             text.push_str(&format!("{hash} {bytes} {kind} {rel}\n"));
+        }
+        if let Some((rel, bytes)) = pending {
+            text.push_str(&format!("{} {} ~ {rel}\n", blake3::hash(bytes).to_hex(), bytes.len()));
         }
         let sum = blake3::hash(text.as_bytes()).to_hex();
         text.push_str(&format!("# end {sum}\n"));
@@ -416,6 +460,7 @@ pub fn add_files(dir: &Path, names: &[&str]) -> std::io::Result<()> {
             bytes,
             hash: hash_prefix(&path, bytes)?,
             growing: false,
+            pending: None,
         });
     }
     entries.sort_by(|a, b| a.path.cmp(&b.path));
@@ -481,6 +526,51 @@ mod tests {
         bytes[70] ^= 1;
         std::fs::write(&mp, &bytes).unwrap();
         assert!(verify_all(&d).unwrap_err().contains("damaged manifest"));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A run killed between the checkpoint's rename and the manifest after it: the manifest written before the
+    /// rename records the new checkpoint as pending, so both the old and the new checkpoint verify, and a flipped
+    /// byte in either is still found.
+    #[test]
+    fn a_checkpoint_replaced_after_the_manifest_verifies_as_pending() {
+        let d = temp("pending");
+        let cp = d.join("checkpoint.json");
+        std::fs::write(&cp, "{\"t\": 1}\n").unwrap();
+        let mut r = Recorder::new();
+        r.write(&d, "checkpoint at t = 1 s", false).unwrap();
+        let new = b"{\"t\": 2}\n";
+        r.write_with_pending(
+            &d,
+            "checkpoint at t = 2 s being written",
+            false,
+            Some(("checkpoint.json", new)),
+        )
+        .unwrap();
+        assert_eq!(verify_all(&d), Ok(Some(1)), "the old checkpoint, before the rename");
+        std::fs::write(&cp, new).unwrap();
+        assert_eq!(
+            verify_all(&d),
+            Ok(Some(1)),
+            "the new checkpoint, killed before the next manifest"
+        );
+        std::fs::write(&cp, "{\"t\": 3}\n").unwrap();
+        let e = verify_all(&d).unwrap_err();
+        assert!(e.contains("checkpoint.json: damaged: the BLAKE3 checksum"), "{e}");
+        // the manifest after the rename knows only the new one
+        std::fs::write(&cp, new).unwrap();
+        r.write(&d, "checkpoint at t = 2 s", false).unwrap();
+        assert_eq!(
+            read(&d).unwrap().unwrap().entry("checkpoint.json").unwrap().pending,
+            None
+        );
+        std::fs::write(&cp, "{\"t\": 1}\n").unwrap();
+        assert!(verify_all(&d).is_err(), "the old checkpoint is no longer accepted");
+        // a first checkpoint (nothing recorded yet) is not recorded while pending
+        std::fs::remove_file(&cp).unwrap();
+        r.write_with_pending(&d, "first", false, Some(("checkpoint.json", new)))
+            .unwrap();
+        assert_eq!(verify_all(&d), Ok(Some(0)));
         std::fs::remove_dir_all(&d).unwrap();
     }
 
