@@ -77,7 +77,10 @@ fn bench_scaling_writes_every_case_at_every_thread_count() {
         // the Karp–Flatt column is the formula of the speed-up column
         let s: f64 = two[col("speedup")].parse().unwrap();
         let e: f64 = two[col("karp_flatt")].parse().unwrap();
-        assert!((e - (1.0 / s - 0.5) / 0.5).abs() < 2e-3, "{e} against S = {s}");
+        // (S is printed to 4 decimals: its rounding moves 1/S by up to 0.5e-4/S², which a loaded machine's small S
+        // makes larger than the formula's own rounding)
+        let tolerance = 2e-3 + 2.0 * 0.5e-4 / (s * s);
+        assert!((e - (1.0 / s - 0.5) / 0.5).abs() < tolerance, "{e} against S = {s}");
         let seconds: f64 = two[col("seconds")].parse().unwrap();
         let rate: f64 = two[col("rate_per_s")].parse().unwrap();
         let work: f64 = two[col("work")].parse().unwrap();
