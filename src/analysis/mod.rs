@@ -7,6 +7,7 @@ pub mod campaign_analysis;
 pub mod clumps;
 pub mod composition;
 pub mod creep;
+pub mod creep_extrapolation;
 pub mod csv_rows;
 pub mod ejection_fits;
 pub mod figures;
