@@ -8,8 +8,8 @@
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use rubblepile::bench::ellipsoid_problems::WorkPrecisionProblem;
-use rubblepile::bench::problems::{Arenstorf, Kepler, TestProblem};
+use rubblepile::impact::problems::WorkPrecisionProblem;
+use rubblepile::integrate::problems::{Arenstorf, Kepler, TestProblem};
 use rubblepile::integrate::dop853::{self, Dop853};
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
 use rubblepile::integrate::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Tolerances};

@@ -3,7 +3,7 @@
 //! exact solution, the dissipation's analytic Jacobian against finite differences, momentum conservation over a
 //! stiff pile's settling, and bit-identical resume.
 
-use rubblepile::bench::problems::{StiffDampedOscillator, TestProblem};
+use rubblepile::integrate::problems::{StiffDampedOscillator, TestProblem};
 use rubblepile::integrate::linearly_implicit::LinearlyImplicit;
 use rubblepile::integrate::{Integrator, Method, Tolerances, make_integrator};
 
@@ -230,7 +230,7 @@ fn stiff_pile_settles_conserving_momenta() {
 /// `bench stability --method`: every case's scene runs with the method asked for, its tolerances unchanged.
 #[test]
 fn stability_cases_take_another_method() {
-    use rubblepile::bench::stability::cases::all_cases;
+    use rubblepile::driver::stability::cases::all_cases;
     for case in all_cases(true) {
         let before = case.scene_toml.clone();
         let id = case.id.clone();
@@ -314,7 +314,7 @@ fn check_advises_the_implicit_method_for_stiff_damping() {
 /// the explicit method needs about 11 000.
 #[test]
 fn stiff_pair_error_follows_the_tolerance_against_the_explicit_reference() {
-    use rubblepile::bench::ellipsoid_problems::WorkPrecisionProblem;
+    use rubblepile::impact::problems::WorkPrecisionProblem;
     use rubblepile::bench::work_precision::{References, Setting, run_once};
     let problem = WorkPrecisionProblem::StiffPair.setup();
     let reference = References::compute(&problem, 1e-11).unwrap();

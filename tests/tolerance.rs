@@ -1,7 +1,7 @@
 //! Tolerance proportionality and the scale-free error norm (issue 19): the final error of a run follows `rtol`
 //! whatever the masses, on the canonical problems of `bench tolerance`.
 
-use rubblepile::bench::ellipsoid_problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
+use rubblepile::impact::problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
 use rubblepile::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use rubblepile::ellipsoid::equations::{EllipsoidSystem, GravityTerm, ModelConfig, Physics};
 use rubblepile::integrate::{Method, OdeSystem, Tolerances, make_integrator};

@@ -6,7 +6,7 @@
 mod common;
 
 use common::{rubblepile, temp_dir};
-use rubblepile::bench::ellipsoid_problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
+use rubblepile::impact::problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
 use rubblepile::bench::work_precision::{CSV_HEADER, Setting, run_once, time_at_error};
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::{Integrator, Method, OdeSystem, Tolerances};

@@ -24,7 +24,7 @@
 
 use std::time::Instant;
 
-use super::ellipsoid_problems::{ProblemSetup, ReferenceKind};
+use crate::impact::problems::{ProblemSetup, ReferenceKind};
 use crate::integrate::{IntegrateError, Method, Stats, Tolerances, make_integrator};
 
 /// Runs longer than this (s) are repeated at most [`LONG_RUN_REPEATS`] times and timed by their minimum.

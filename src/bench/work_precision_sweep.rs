@@ -1,6 +1,6 @@
 //! `rubblepile bench work-precision`: work–precision diagrams (final-state error and energy residual against
 //! integration wall time) of Bulirsch–Stoer, Dop853, Dopri5 and Rk4 on the canonical problems of
-//! [`crate::bench::ellipsoid_problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
+//! [`crate::impact::problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
 //! The measurement itself is [`crate::bench::work_precision`]; this file holds the command line, the CSV
 //! and the plot.
 
@@ -11,7 +11,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::BenchError as CliError;
-use crate::bench::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
+use crate::impact::problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use crate::bench::work_precision::{
     CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };

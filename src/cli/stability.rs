@@ -3,8 +3,9 @@
 
 use std::path::PathBuf;
 
-use crate::bench::stability::cases::all_cases;
-use crate::bench::stability::{StabilityRow, Verdict, prepare_out, result_paths, run_case, write_csv, write_markdown};
+use crate::driver::stability::cases::all_cases;
+use crate::bench::stability::{prepare_out, result_paths, write_csv, write_markdown};
+use crate::driver::stability::{StabilityRow, Verdict, run_case};
 use crate::cli::common::CliError;
 
 /// `rubblepile bench stability`.

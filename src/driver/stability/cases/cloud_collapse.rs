@@ -60,7 +60,7 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
             " (1.5 x escape)"
         }
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
             Err(e) => return failed_to_read(e.into()),

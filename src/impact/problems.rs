@@ -27,7 +27,7 @@
 
 use clap::ValueEnum;
 
-use crate::bench::problems::torque_free_spin;
+use crate::integrate::problems::torque_free_spin;
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,

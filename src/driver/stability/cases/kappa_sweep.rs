@@ -49,7 +49,7 @@ pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
         "kappa = {kappa}: head-on tip-to-tip impact at {SWEEP_SPEED} m/s, kappa calibrated with beta = 10, v = {v_cal:.3e} m/s, contact{}, {t_end} s",
         if gravity { " + gravity" } else { " only (no gravity)" }
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(2.0) {
             Ok(x) => x,
             Err(e) => return failed_to_read(e.into()),

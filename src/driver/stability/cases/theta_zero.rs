@@ -41,7 +41,7 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
         )
     };
     let exact = tilt == 0.0 && wobble == 0.0;
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
             Err(e) => return failed_to_read(e.into()),
