@@ -639,7 +639,7 @@ fn material_section_sets_each_material_beside_table_7() {
     let section = &md[md.find("## Material").expect("a Table 7 section")..];
     let row = |start: &str| line_starting(section, start);
     // Eq. 22 by hand for the weak material's T_c3 (ours) of 2.56 h at this fake body's bulk density
-    let rho = 2100.0 * 30.0 * 1e7 / rubblepile::studies::zhang2017::rows::DIDYMOS_MASS;
+    let rho = 2100.0 * 30.0 * 1e7 / rubblepile::analysis::spinup::DIDYMOS_MASS;
     let omega = 2.0 * std::f64::consts::PI / (2.56 * 3600.0);
     let kappa = omega / (4.0 * std::f64::consts::PI * 6.674e-11 * rho / 3.0).sqrt();
     let rho_c = rho * (2.56f64 / 2.26).powi(2);

@@ -11,10 +11,8 @@ use std::time::Instant;
 use super::BenchError;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::driver::formats::vtk::pieces;
-use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::engine::{ParticleView, SnapshotView};
-use crate::math::Vec3;
+use crate::ellipsoid::cloud::cloud_view;
+use crate::engine::SnapshotView;
 use crate::render::{Camera, ColourScale, FrameBody, Framing, Projection, View, render_frame};
 
 /// `rubblepile bench render`.
@@ -39,36 +37,6 @@ pub struct RenderBenchArgs {
     /// Overwrite an earlier benchmark in DIR.
     #[arg(long)]
     pub force: bool,
-}
-
-/// One random snapshot of `n` ellipsoids (or spheres of the same volumes when `spheres`).
-pub fn cloud_view(n: usize, spheres: bool) -> SnapshotView {
-    let bodies = random_cloud(n, 1, &CloudParams::default());
-    let particles = bodies
-        .iter()
-        .enumerate()
-        .map(|(id, b)| {
-            let r = b.shape.axes.product().cbrt();
-            ParticleView {
-                id,
-                mass: b.shape.mass,
-                position: b.position,
-                velocity: b.velocity,
-                spin_world: b.spin_body,
-                axes: if spheres { Vec3::repeat(r) } else { b.shape.axes },
-                rotation: if spheres {
-                    crate::math::Mat3::identity()
-                } else {
-                    rotation_matrix(&b.quaternion).transpose()
-                },
-            }
-        })
-        .collect();
-    SnapshotView {
-        spheres,
-        particles,
-        ..Default::default()
-    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

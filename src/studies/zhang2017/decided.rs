@@ -3,7 +3,7 @@
 //! lattice's orientation, T_c,3 against the hold length, and the equilibrium bound on HCP's φ.
 //!
 //! The protocol: the Didymos primary of Naidu et al. (2020) ([`crate::aggregate::triaxial_top`]), the bulk density
-//! the paper's grain counts give ([`super::rows::paper_bulk_density`]), the paper's creep criterion with zero
+//! the paper's grain counts give ([`crate::analysis::spinup::paper_bulk_density`]), the paper's creep criterion with zero
 //! tolerance judged by rates ([`crate::analysis::creep`]), every hold read over the length at which T_c,3 stops
 //! moving ([`decided_hold_length`]).
 //!
@@ -21,13 +21,13 @@ use crate::analysis::creep::CreepCriterionKind;
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
 use crate::analysis::spin_limit::{critical_kappa, least_friction_angle};
-use crate::analysis::spinup::omega_of_hours;
+use crate::analysis::spinup::{omega_of_hours, paper_bulk_density};
 use crate::analysis::spinup_search::{
     Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
 };
 use crate::io::scene_file::SI_G;
 
-use super::rows::{ModelRow, TABLE3, opt, paper_bulk_density, path_row};
+use super::rows::{ModelRow, TABLE3, opt, path_row};
 
 /// The hold lengths (s) at which every search is read: the 16 000 s of the earlier searches and two and about
 /// three times that.

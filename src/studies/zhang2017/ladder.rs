@@ -14,10 +14,9 @@ use std::path::Path;
 
 use crate::analysis::figures::lines::{LineChart, Mark, Series};
 use crate::analysis::figures::style::write_figure;
+use crate::analysis::spinup_search::read_critical;
 
-use super::rows::{
-    ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical, search_subdirs,
-};
+use super::rows::{ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, search_subdirs};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.

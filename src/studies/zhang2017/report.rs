@@ -577,7 +577,7 @@ pub fn report_command(args: &ReportZhang2017Args) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::spinup::CriticalLimits;
+    use crate::analysis::spinup::{CriticalLimits, DIDYMOS_MASS};
 
     fn row(model: &str, rho: f64, t: [Option<f64>; 3]) -> ModelRow {
         ModelRow {

@@ -7,39 +7,12 @@ use crate::io::table::{Cells, read_header, read_table};
 use std::path::Path;
 
 use crate::analysis::spinup::{
-    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, dynamical_time, first_departure,
-    fit_density, smoothed_critical_limits,
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, critical_limits, dynamical_time,
+    first_departure, fit_density, smoothed_critical_limits,
 };
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use crate::analysis::spinup_search::read_critical;
 use crate::io::scene_file::SI_G;
-
-/// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
-pub const DIDYMOS_MASS: f64 = 5.23e11;
-
-/// Zhang17 Table 2's grain counts of its two monodisperse models with Table 3's initial packing η_B of each:
-/// (model, grains, η_B). Their grains have the radius [`PAPER_GRAIN_RADIUS`].
-pub const PAPER_COUNTS_AND_PACKINGS: [(&str, usize, f64); 2] = [("hcp", 42_062, 0.739), ("rcp", 36_523, 0.641)];
-/// Zhang17 Table 2: the grain radius of HCP and RCP (m).
-pub const PAPER_GRAIN_RADIUS: f64 = 10.0;
-
-/// The bulk density (kg/m³) the paper's piles had, derived from its own numbers: each monodisperse model's grains
-/// (N spheres of 10 m) fill the carved volume `V = N (4/3)π r³ / η_B` at the packing Table 3 gives; HCP's and
-/// RCP's volumes agree to 0.1 % (2.384e8 and 2.387e8 m³, D_eq 769 m), and M_P of Table 1 in their mean is
-/// `ρ_B = M_P / V̄` ≈ 2193 kg/m³, not the nominal 2100. Returns (ρ_B, V̄ in m³).
-///
-/// ```
-/// let (rho, v) = rubblepile::studies::zhang2017::rows::paper_bulk_density();
-/// assert!((rho - 2192.5).abs() < 0.5 && (v / 2.3854e8 - 1.0).abs() < 1e-3);
-/// ```
-pub fn paper_bulk_density() -> (f64, f64) {
-    let grain = 4.0 / 3.0 * std::f64::consts::PI * PAPER_GRAIN_RADIUS.powi(3);
-    let volumes: Vec<f64> = PAPER_COUNTS_AND_PACKINGS
-        .iter()
-        .map(|&(_, n, eta)| n as f64 * grain / eta)
-        .collect();
-    let mean = volumes.iter().sum::<f64>() / volumes.len() as f64;
-    (DIDYMOS_MASS / mean, mean)
-}
 
 /// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
 pub type LimitAndAngle = (Option<f64>, Option<f64>);
@@ -488,50 +461,4 @@ pub fn search_subdirs(dir: &Path) -> Vec<std::path::PathBuf> {
         .collect();
     subs.sort();
     subs
-}
-
-/// The result of a T_c,3 search directory, re-derived from its judged holds (`critical.csv`) by
-/// [`crate::analysis::spinup_search::critical_from_verdicts`], so that every search is read by today's rule
-/// whenever it ran: `t_c3_hours` and `friction_angle_deg` (the paper's criterion, the search's default), `paper`,
-/// `paper_tolerance`, `ours`, and `runs` (their `t_final_hours`). A search made before the paper's criterion
-/// judged rates is judged again from its `holds.csv` where the compact copy has one
-/// ([`crate::analysis::spinup_search::rejudge`]); without it, its `paper` values are null. A directory with only
-/// `critical.json` is read as written. `None` when neither file is there or readable.
-pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
-    use crate::analysis::creep::CreepCriterionKind;
-    use crate::analysis::spinup_search::{
-        Criteria, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
-    };
-    let Some(csv) = std::fs::read_to_string(search_dir.join("critical.csv")).ok() else {
-        let text = std::fs::read_to_string(search_dir.join("critical.json")).ok()?;
-        let mut v: serde_json::Value = serde_json::from_str(&text).ok()?;
-        // a critical.json of before Dec 2026: its `paper` is today's paper-tolerance criterion
-        if v.get("paper_tolerance").is_none() {
-            let old = v.get("paper").cloned().unwrap_or_else(
-                || serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] }),
-            );
-            v["paper_tolerance"] = old;
-            v["paper"] = serde_json::json!({ "t_c3_hours": null, "friction_angle_deg": null });
-        }
-        return Some(v);
-    };
-    let mut holds = read_critical_csv(&csv).ok()?;
-    if holds.iter().any(|h| h.paper.is_none())
-        && let Ok(series) = read_holds_csv(&search_dir.join("holds.csv"))
-    {
-        holds = rejudge(&holds, &series, None, &Criteria::default(), CreepCriterionKind::Paper);
-    }
-    let of = |kind| {
-        let (t, phi) = critical_from_verdicts(&holds, kind);
-        serde_json::json!({ "t_c3_hours": t, "friction_angle_deg": phi })
-    };
-    let paper = of(CreepCriterionKind::Paper);
-    Some(serde_json::json!({
-        "t_c3_hours": paper["t_c3_hours"],
-        "friction_angle_deg": paper["friction_angle_deg"],
-        "paper": paper,
-        "paper_tolerance": of(CreepCriterionKind::PaperTolerance),
-        "ours": of(CreepCriterionKind::Ours),
-        "runs": holds.iter().map(|h| serde_json::json!({ "t_final_hours": h.t_final_hours })).collect::<Vec<_>>(),
-    }))
 }
