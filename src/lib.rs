@@ -33,9 +33,7 @@
 
 pub mod aggregate;
 pub mod analysis;
-pub mod bench;
 pub mod bits;
-pub mod cli;
 pub mod driver;
 pub mod ellipsoid;
 pub mod engine;
@@ -49,4 +47,3 @@ pub mod math;
 pub mod phase;
 pub mod random;
 pub mod render;
-pub mod studies;

@@ -9,9 +9,9 @@ use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use rubblepile::impact::problems::WorkPrecisionProblem;
-use rubblepile::integrate::problems::{Arenstorf, Kepler, TestProblem};
 use rubblepile::integrate::dop853::{self, Dop853};
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
+use rubblepile::integrate::problems::{Arenstorf, Kepler, TestProblem};
 use rubblepile::integrate::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Tolerances};
 
 fn tol(rtol: f64, n: usize) -> Tolerances {

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use crate::driver::stability::cases::all_cases;
 use crate::bench::stability::{prepare_out, result_paths, write_csv, write_markdown};
-use crate::driver::stability::{StabilityRow, Verdict, run_case};
 use crate::cli::common::CliError;
+use rubblepile::driver::stability::cases::all_cases;
+use rubblepile::driver::stability::{StabilityRow, Verdict, run_case};
 
 /// `rubblepile bench stability`.
 #[derive(Debug, clap::Args)]
@@ -26,8 +26,8 @@ pub struct StabilityArgs {
     pub only: Vec<String>,
     /// The integrator every case runs with (its tolerances unchanged), e.g. `bulirsch-stoer-implicit` to compare
     /// the stiff rows.
-    #[arg(long, value_enum, default_value_t = crate::integrate::Method::BulirschStoer)]
-    pub method: crate::integrate::Method,
+    #[arg(long, value_enum, default_value_t = rubblepile::integrate::Method::BulirschStoer)]
+    pub method: rubblepile::integrate::Method,
 }
 
 /// Runs `bench stability`; exits with code 1 when a case fails.

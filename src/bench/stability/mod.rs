@@ -1,10 +1,10 @@
 //! `rubblepile bench stability`'s result files: `stability.csv` and `stability.md`, one row per case of the
-//! stability suite ([`crate::driver::stability`], which holds the cases, runs them and judges them).
+//! stability suite ([`rubblepile::driver::stability`], which holds the cases, runs them and judges them).
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::driver::stability::{StabilityError, StabilityRow};
+use rubblepile::driver::stability::{StabilityError, StabilityRow};
 
 /// Columns of `stability.csv`.
 pub const CSV_COLUMNS: [&str; 11] = [

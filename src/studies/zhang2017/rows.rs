@@ -3,16 +3,16 @@
 //! (`report.rs`) and its spin-up-path section (`paths.rs`), which both read rows from here and not each other.
 //! Zhang et al. (2017, Icarus 294), Tables 1, 3 and 4, §4.2.
 
-use crate::io::table::{Cells, read_header, read_table};
+use rubblepile::io::table::{Cells, read_header, read_table};
 use std::path::Path;
 
-use crate::analysis::spinup::{
+use rubblepile::analysis::spinup::{
     AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, critical_limits, dynamical_time,
     first_departure, fit_density, smoothed_critical_limits,
 };
-use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
-use crate::analysis::spinup_search::read_critical;
-use crate::io::scene_file::SI_G;
+use rubblepile::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use rubblepile::analysis::spinup_search::read_critical;
+use rubblepile::io::scene_file::SI_G;
 
 /// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
 pub type LimitAndAngle = (Option<f64>, Option<f64>);
@@ -50,13 +50,6 @@ pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
 
 /// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`,
 /// material variants `<model>_beta<β>_mus<μ_s>`, Table 7).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::rows::base_model;
-/// assert_eq!(base_model("rcp_rho1800"), "rcp");
-/// assert_eq!(base_model("hcp_beta0.3_mus0.5"), "hcp");
-/// assert_eq!(base_model("hcp"), "hcp");
-/// ```
 pub fn base_model(name: &str) -> &str {
     let name = name.split("_rho").next().unwrap_or(name);
     if is_material_variant(name) {
@@ -67,12 +60,6 @@ pub fn base_model(name: &str) -> &str {
 }
 
 /// Whether a run directory's name is a material variant (`<model>_beta<β>_mus<μ_s>`, Zhang17 Table 7).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::rows::is_material_variant;
-/// assert!(is_material_variant("pp2_beta0.6_mus1.3"));
-/// assert!(!is_material_variant("rcp_rho1800"));
-/// ```
 pub fn is_material_variant(name: &str) -> bool {
     name.split_once("_beta").is_some_and(|(_, rest)| rest.contains("_mus"))
 }
@@ -148,11 +135,11 @@ pub fn successive_scatter(values: &[f64]) -> f64 {
 
 /// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
 /// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
-/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
+/// [`rubblepile::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
 /// the scaled runs with the rotation-free open test resolve (`analysis/zhang2017/MODULE_NOTES.md`).
 pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
     let samples = (window / spacing).max(1.0);
-    noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
+    noise / samples.sqrt() < 0.5 * rubblepile::analysis::spinup::PACKING_THRESHOLD
 }
 
 /// One model's row.
@@ -184,7 +171,7 @@ pub struct ModelRow {
     /// See `t_c3`.
     pub phi: Option<f64>,
     /// T_c,3 (h) and φ (°) by the paper's creep criterion and by ours, from a `critical.json` that records both
-    /// (searches made after the paper's criterion came in; [`crate::analysis::creep`]); `None` for older ones.
+    /// (searches made after the paper's criterion came in; [`rubblepile::analysis::creep`]); `None` for older ones.
     pub t_c3_by_criterion: Option<[LimitAndAngle; 2]>,
     /// κ₃ of Eq. 22.
     pub kappa3: Option<f64>,
@@ -288,13 +275,16 @@ fn books_forcing(run: &Path) -> bool {
 }
 
 /// Reads one model's runs under `RUNS/<model>`: its path-2 run and its T_c,3 search.
-pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), rubblepile::analysis::AnalysisError> {
     path_row(model_dir, "path2")
 }
 
 /// Reads the run `RUNS/<model>/<path>` (e.g. `path1`, `path3`) and the T_c,3 search on that path
 /// (`critical/` for path 2, `critical_<path>/` for the others).
-pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+pub fn path_row(
+    model_dir: &Path,
+    path: &str,
+) -> Result<(ModelRow, Vec<SpinupSample>), rubblepile::analysis::AnalysisError> {
     let model = model_dir
         .file_name()
         .map(|s| s.to_string_lossy().to_string())
@@ -461,4 +451,24 @@ pub fn search_subdirs(dir: &Path) -> Vec<std::path::PathBuf> {
         .collect();
     subs.sort();
     subs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bulk-density and material variants belong to their base model.
+    #[test]
+    fn a_variant_belongs_to_its_base_model() {
+        assert_eq!(base_model("rcp_rho1800"), "rcp");
+        assert_eq!(base_model("hcp_beta0.3_mus0.5"), "hcp");
+        assert_eq!(base_model("hcp"), "hcp");
+    }
+
+    /// A material variant names both β and μ_s; a bulk-density variant is none.
+    #[test]
+    fn material_variants_name_beta_and_mu_s() {
+        assert!(is_material_variant("pp2_beta0.6_mus1.3"));
+        assert!(!is_material_variant("rcp_rho1800"));
+    }
 }
