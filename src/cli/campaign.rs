@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError};
-use rubblepile::impact::campaign::{CampaignOptions, load_campaign, run_campaign_anywhere};
+use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignOptions, load_campaign, run_campaign_anywhere};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
@@ -76,11 +76,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
         return Ok(()); // an MPI worker rank: rank 0 reports
     };
     println!("{}", report.one_line());
-    let index = args
-        .shard
-        .map_or(rubblepile::impact::campaign::CAMPAIGN_CSV.to_string(), |s| {
-            s.index_file()
-        });
+    let index = args.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());
     match report.problem(&campaign.out.join(index)) {
         Some((message, code)) => Err(CliError { message, code }),
         None => Ok(()),

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use crate::cli::common::{CheckpointArgs, CliError, report};
 use rubblepile::driver::{RunOptions, run_scene};
 use rubblepile::impact::projectile::ProjectileSpec;
-use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact};
+use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact, snapshot_times};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]
@@ -124,12 +124,8 @@ impl ImpactArgs {
             f0: self.f0,
             beta: self.beta,
             kappa_reading: self.kappa_reading,
-            snapshots: rubblepile::impact::run::snapshot_times(
-                self.t_end,
-                self.snapshots.as_deref(),
-                self.snapshot_every,
-            )
-            .map_err(CliError::usage)?,
+            snapshots: snapshot_times(self.t_end, self.snapshots.as_deref(), self.snapshot_every)
+                .map_err(CliError::usage)?,
             every: self.every,
             inertia: if self.inertia == "uniform" {
                 rubblepile::ellipsoid::body::InertiaModel::Uniform

@@ -8,6 +8,7 @@ use rubblepile::driver::DEFAULT_CHECKPOINT_EVERY;
 use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::impact::target::{TargetSpec, build_target_resumable};
 use rubblepile::impact::target_checkpoint::{BuildCheckpoint, checkpoint_path, read_checkpoint, write_checkpoint};
+use rubblepile::io::run_budget::check_wall_seconds;
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]
@@ -189,12 +190,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    rubblepile::io::run_budget::check_wall_seconds(
-        "--checkpoint-every",
-        args.checkpoint_every,
-        "at every relaxation check",
-    )
-    .map_err(CliError::usage)?;
+    check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
+        .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
         Some(read_checkpoint(&checkpoint_file).map_err(CliError::usage)?)

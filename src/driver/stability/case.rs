@@ -14,7 +14,7 @@ use crate::ellipsoid::scene::LoadedScene;
 use crate::integrate::{Tolerances, make_integrator};
 use crate::math::{Vec3, Vec4};
 
-/// A case's verdict (see the module docs of [`crate::driver::stability`]).
+/// A case's verdict (see the module docs of `driver::stability`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Verdict {
     /// Everything as expected.
