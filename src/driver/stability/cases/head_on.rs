@@ -61,7 +61,7 @@ pub fn head_on(id: &str, factor: f64) -> Case {
     let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(every / 10.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let pairs = run
             .summary

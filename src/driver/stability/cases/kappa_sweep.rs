@@ -52,7 +52,7 @@ pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
     let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(2.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let report = run.summary.barrier.clone();
         let got = run.overrun_pairs() > 0;

@@ -43,7 +43,7 @@ pub fn tiny_orbit(id: &str) -> Case {
     let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let (mut dr, mut dphi) = (0.0_f64, 0.0_f64);
         for (t, b) in &snaps {
@@ -107,7 +107,7 @@ pub fn tiny_resting(id: &str) -> Case {
     let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let Some((_, last)) = snaps.last() else {

@@ -46,7 +46,7 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
     let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let n = snaps.len();
