@@ -1,5 +1,5 @@
-//! `rubblepile bench stability`: runs the stability suite of [`crate::bench::stability`] (Roig03 model in its
-//! regimes of trouble) and writes `stability.csv`, `stability.md` and one run directory per case.
+//! `rubblepile bench stability`: runs the stability suite of [`rubblepile::driver::stability`] (Roig03 model in its
+//! regimes of trouble) and writes `stability.csv`, `stability.md` ([`crate::bench::stability`]) and a run per case.
 
 use std::path::PathBuf;
 
