@@ -44,7 +44,8 @@ pub struct StabilityRow {
     pub rhs_evaluations: u64,
     /// Wall-clock time of the case (s): the run, including output.
     pub wall_seconds: f64,
-    /// The run's relative energy residual `max |H − H0 − 2∫F| / energy scale` ([`RunSummary::energy_error`]).
+    /// The run's relative energy residual `max |H − H0 − 2∫F| / energy scale`
+    /// ([`crate::driver::RunSummary::energy_error`]).
     pub energy_error: f64,
     /// max over samples and bodies of `||q| − 1|`.
     pub max_quat_norm_error: f64,
