@@ -10,32 +10,40 @@
 //! # Layers
 //!
 //! Imports only go down: a module may use the modules of lower layers, never those of its own layer or above, so
-//! there is no import cycle and no engine sees the driver, the analysis or the command line. `tests/layers.rs` reads
-//! every `crate::` path in `src/` and checks this table (the table below is what it reads).
+//! there is no import cycle and no engine sees the driver or the analysis. `tests/layers.rs` reads every `crate::`
+//! path in `src/` and checks this table (the table below is what it reads).
 //!
 //! - **L0**: `math`, `bits`, `phase` — fixed-size linear algebra, bit-exact floats, wall time per phase of the hot
 //!   loops (serial or parallel);
 //! - **L1**: `random` — seeded random numbers (`rand_pcg`; seeds live in scene files);
 //! - **L2**: `geometry`, `gravity`, `integrate`, `io` — shapes, walls and neighbour search; self-gravity; the ODE
-//!   solvers; the scene-file floor and lossless formatting;
+//!   solvers and their canonical test problems; the scene-file floor and lossless formatting;
 //! - **L3**: `engine` — the contract between an engine and the driver ([`engine::Engine`]);
 //! - **L4**: `ellipsoid`, `granular` — the engines (interacting ellipsoids; soft and hard spheres), each with its scene
 //!   schema, equations, outputs and [`engine::Engine`] implementation;
-//! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures) and the choice of engine;
-//! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver;
+//! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures), the choice of engine,
+//!   and the stability suite's cases run through it;
+//! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver,
+//!   with the canonical problems of the ellipsoid model;
 //! - **L7**: `analysis` — science on finished runs that any run needs (fragment statistics, fits, clumps, spin-up
 //!   diagnostics and searches, figures);
-//! - **L8**: `render`, `studies` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF;
-//!   the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of `analysis`;
-//! - **L9**: `bench` — benchmarks and timed systems (they plot with `analysis`' figures), with the canonical test
-//!   problems shared by tests;
-//! - **L10**: `cli` — argument parsing and dispatch.
+//! - **L8**: `render` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF.
+//!
+//! # Programs
+//!
+//! The programs are not the library's: they are the module tree of the `rubblepile` binary (`src/main.rs`), which
+//! uses the library as `rubblepile::…` and its own modules as `crate::…`, again only downwards (`tests/layers.rs`
+//! reads this list too, and checks that no library file names a program):
+//!
+//! - **P0**: `studies` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
+//!   `analysis`;
+//! - **P1**: `bench` — benchmarks and timed systems on the canonical test problems (they plot with `analysis`'
+//!   figures);
+//! - **P2**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;
-pub mod bench;
 pub mod bits;
-pub mod cli;
 pub mod driver;
 pub mod ellipsoid;
 pub mod engine;
@@ -49,4 +57,3 @@ pub mod math;
 pub mod phase;
 pub mod random;
 pub mod render;
-pub mod studies;

@@ -1,5 +1,10 @@
-//! `rubblepile`: see [`rubblepile::cli`].
+//! `rubblepile`: the command line ([`cli`]) and the programs it runs on top of the library: the benchmarks and
+//! timed systems ([`bench`]) and the three papers' reports ([`studies`]).
+
+mod bench;
+mod cli;
+mod studies;
 
 fn main() -> std::process::ExitCode {
-    rubblepile::cli::main()
+    cli::main()
 }

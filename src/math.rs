@@ -35,3 +35,23 @@ pub fn median(values: &[f64]) -> f64 {
         0.5 * (v[n / 2 - 1] + v[n / 2])
     }
 }
+
+/// Interpolates, in log–log, the wall time at which a method's (time, error) curve reaches `error`
+/// (`points` in any order; the curve is taken as the sequence sorted by time). `None` when `error` is
+/// outside the curve's range.
+pub fn time_at_error(points: &[(f64, f64)], error: f64) -> Option<f64> {
+    let mut p: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0 && e.is_finite())
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for w in p.windows(2) {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        if (e0 - error) * (e1 - error) <= 0.0 && e0 != e1 {
+            let s = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
+            return Some((t0.ln() + s * (t1.ln() - t0.ln())).exp());
+        }
+    }
+    None
+}

@@ -1,7 +1,7 @@
 //! Exact answers for the issue 42 post-processing of Roig03: the Fig. 4 fits above a Δv floor and on the
 //! escaping fragments (`analysis::ejection_fits`), the split of K_R into the targets' own spin and the impact's
-//! (`analysis::rotational_split`), a pile's drift from its rigid rotation (`analysis::pile_equilibrium`) and the
-//! run-name parser of `studies::roig2003::referee`.
+//! (`analysis::rotational_split`), a pile's drift from its rigid rotation (`analysis::pile_equilibrium`). The
+//! run-name parser and the merge of `studies::roig2003::referee` are the binary's, tested beside them.
 
 use rubblepile::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor, fit_selected};
 use rubblepile::analysis::fits::FitError;
@@ -10,7 +10,6 @@ use rubblepile::analysis::pile_equilibrium::pile_drift;
 use rubblepile::analysis::rotational_split::rotational_split;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::math::{Vec3, Vec4};
-use rubblepile::studies::roig2003::referee::{RefereeRun, merge_with_committed, parse_run_name, read_csv, write_csvs};
 
 /// A target fragment (or the projectile) with only the fields the fits and the site measure read.
 fn fragment(index: usize, size: f64, speed: f64, escaping: bool, cosine: f64, is_projectile: bool) -> FragmentAnalysis {
@@ -242,71 +241,4 @@ fn one_moved_body_of_four_drifts_by_three_quarters_and_the_others_by_a_quarter()
     assert!((drift.rms_displacement - d * 3f64.sqrt() / 4.0).abs() < 1e-9);
     assert!((drift.max_displacement - 0.75 * d).abs() < 1e-9);
     assert!(pile_drift(&initial, &later[..3], 400.0, KAPPA).is_none());
-}
-
-#[test]
-fn run_names_give_target_projectile_and_seed() {
-    let parse = parse_run_name;
-    assert_eq!(parse("N200_T4_P2_z45_s3"), Some(("N200_T4".into(), "P2".into(), 3)));
-    assert_eq!(
-        parse("N200_T4_s2_P1_z45_s1"),
-        Some(("N200_T4_s2".into(), "P1".into(), 1))
-    );
-    assert_eq!(
-        parse("N200_T4_P2_z45_s2_f3e-7"),
-        Some(("N200_T4".into(), "P2".into(), 2))
-    );
-    assert_eq!(
-        parse("N200_T4_reduced_P3_z45_s1"),
-        Some(("N200_T4_reduced".into(), "P3".into(), 1))
-    );
-    assert_eq!(parse("P2_z45_s1"), None);
-    assert_eq!(parse("N200_T4_printed"), None);
-}
-
-/// Guards `report roig2003-referee collect` against dropping committed rows: collecting one new group (here a
-/// `per_n` row) keeps every other group's committed rows in their order, and a collected group replaces its
-/// own committed rows.
-#[test]
-fn collecting_one_group_keeps_the_committed_rows_of_the_others() {
-    let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/roig2003");
-    let rows: Vec<RefereeRun> = read_csv(&committed.join("referee_runs.csv")).unwrap();
-    let equilibrium: Vec<rubblepile::studies::roig2003::referee::EquilibriumRow> =
-        read_csv(&committed.join("referee_equilibrium.csv")).unwrap();
-    let committed_only: Vec<RefereeRun> = rows.iter().filter(|r| r.group != "per_n").cloned().collect();
-    let dir = std::env::temp_dir().join(format!("rubblepile-referee-merge-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    write_csvs(&dir, &committed_only, &equilibrium).unwrap();
-
-    let (same, eq) = merge_with_committed(&dir, Vec::new(), Vec::new()).unwrap();
-    // Debug text, not `==`: the rows hold NaN where a fit had too few points.
-    let text = |rows: &[RefereeRun]| format!("{rows:?}");
-    assert!(
-        text(&same) == text(&committed_only),
-        "nothing collected: the committed rows, unchanged and in order"
-    );
-    assert_eq!(eq.len(), equilibrium.len());
-
-    let mut new = committed_only[0].clone();
-    new.group = "per_n".into();
-    new.run = "N30_T4_P1_z45_s1".into();
-    new.target = "N30_T4".into();
-    let (merged, _) = merge_with_committed(&dir, vec![new.clone()], Vec::new()).unwrap();
-    assert_eq!(merged.len(), committed_only.len() + 1);
-    assert!(
-        text(&merged[merged.len() - 1..]) == text(&[new]),
-        "per_n sorts after the committed groups"
-    );
-
-    let mut replaced = committed_only[0].clone();
-    replaced.f_ke = 0.5;
-    let group = replaced.group.clone();
-    let (merged, _) = merge_with_committed(&dir, vec![replaced.clone()], Vec::new()).unwrap();
-    let in_group: Vec<&RefereeRun> = merged.iter().filter(|r| r.group == group).collect();
-    assert_eq!(
-        in_group,
-        vec![&replaced],
-        "a collected group replaces its committed rows"
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -4,23 +4,10 @@
 
 mod common;
 use common::{rubblepile, temp_dir};
-use rubblepile::bench::scaling::{CSV_HEADER, default_threads, karp_flatt};
 
-#[test]
-fn karp_flatt_inverts_amdahls_law() {
-    // Amdahl with serial fraction f on p threads: S = 1 / (f + (1 − f)/p); Karp–Flatt gives f back.
-    for (f, p) in [(0.1, 2), (0.02, 16), (0.5, 4)] {
-        let s = 1.0 / (f + (1.0 - f) / p as f64);
-        let (speedup, efficiency, e) = karp_flatt(1.0, 1.0 / s, p);
-        assert!((speedup - s).abs() < 1e-12);
-        assert!((efficiency - s / p as f64).abs() < 1e-12);
-        assert!((e.unwrap() - f).abs() < 1e-12, "{e:?} against {f}");
-    }
-    assert_eq!(karp_flatt(2.0, 2.0, 1).2, None, "undefined on one thread");
-    assert_eq!(default_threads(16), vec![1, 2, 4, 8, 16]);
-    assert_eq!(default_threads(12), vec![1, 2, 4, 8, 12]);
-    assert_eq!(default_threads(1), vec![1]);
-}
+/// `scaling.csv`'s header, as `rubblepile bench scaling` writes it.
+const CSV_HEADER: &str = "case,threads,seconds,work,unit,rate_per_s,speedup,efficiency,karp_flatt,\
+serial_seconds,parallel_seconds,measured_serial_fraction,fingerprint";
 
 #[test]
 fn bench_scaling_writes_every_case_at_every_thread_count() {

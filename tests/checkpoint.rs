@@ -8,9 +8,9 @@ use common::{rubblepile, snapshots, temp_dir};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use rubblepile::bench::problems::{Arenstorf, TestProblem};
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
+use rubblepile::integrate::problems::{Arenstorf, TestProblem};
 use rubblepile::integrate::{Integrator, IntegratorState, Method, Tolerances, make_integrator};
 use rubblepile::io::checkpoint::{CHECKPOINT_FILE, CHECKPOINT_TMP_FILE};
 

@@ -5,9 +5,8 @@
 
 use rubblepile::analysis::creep::CreepCriterionKind;
 use rubblepile::analysis::spinup_search::{
-    CRITICAL_CSV_HEADER, CRITICAL_CSV_HEADER_V1, critical_csv, read_critical_csv,
+    CRITICAL_CSV_HEADER, CRITICAL_CSV_HEADER_V1, critical_csv, read_critical, read_critical_csv,
 };
-use rubblepile::studies::zhang2017::rows::read_critical;
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {

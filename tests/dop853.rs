@@ -8,10 +8,10 @@
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use rubblepile::bench::ellipsoid_problems::WorkPrecisionProblem;
-use rubblepile::bench::problems::{Arenstorf, Kepler, TestProblem};
+use rubblepile::impact::problems::WorkPrecisionProblem;
 use rubblepile::integrate::dop853::{self, Dop853};
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
+use rubblepile::integrate::problems::{Arenstorf, Kepler, TestProblem};
 use rubblepile::integrate::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Tolerances};
 
 fn tol(rtol: f64, n: usize) -> Tolerances {

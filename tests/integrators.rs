@@ -3,9 +3,11 @@
 //!
 //! Run with `--nocapture` to see the measured errors and statistics.
 
-use rubblepile::bench::problems::{Arenstorf, ExponentialDecay, HarmonicOscillator, Kepler, RigidBody, TestProblem};
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::ode_solvers_adapter::OdeSolversAdapter;
+use rubblepile::integrate::problems::{
+    Arenstorf, ExponentialDecay, HarmonicOscillator, Kepler, RigidBody, TestProblem,
+};
 use rubblepile::integrate::{IntegrateError, Integrator, Method, OdeSystem, Stats, Tolerances, make_integrator};
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -1,6 +1,8 @@
-//! The crate's layering (the table in `src/lib.rs`'s doc comment): every `crate::` path in `src/` outside comments
+//! The crate's layering (the tables in `src/lib.rs`'s doc comment): every `crate::` path in `src/` outside comments
 //! goes from a top-level module to one of a strictly lower layer, so that there is no import cycle among the
-//! top-level modules and no arrow up (an engine never sees the driver, the analysis or the command line).
+//! top-level modules and no arrow up (an engine never sees the driver or the analysis). The library's modules
+//! (`src/lib.rs`, layers `Ln`) and the programs (the binary's modules in `src/main.rs`, layers `Pn`) are two trees:
+//! a library file names no program, and the programs' `crate::` paths go down among the programs.
 //!
 //! Inside the rooms, the same between files: the graph of file → file dependencies of `src/` (paths in code and
 //! intra-doc links, `use` groups split, `super::`/`self::` resolved, re-exports counted as the `mod.rs` that makes
@@ -13,12 +15,23 @@ fn src() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("src")
 }
 
-/// The layer of each top-level module, read from the `- **Ln**: `a`, `b` — …` lines of `src/lib.rs`.
+/// The layer of each top-level module of the library, read from the `- **Ln**: `a`, `b` — …` lines of `src/lib.rs`.
 fn layers() -> BTreeMap<String, usize> {
+    table('L')
+}
+
+/// The layer of each program (a top-level module of the binary), read from the `- **Pn**: `a` — …` lines of
+/// `src/lib.rs`.
+fn programs() -> BTreeMap<String, usize> {
+    table('P')
+}
+
+/// The `- **<kind>n**: `a`, `b` — …` lines of `src/lib.rs`, as module → n.
+fn table(kind: char) -> BTreeMap<String, usize> {
     let lib = std::fs::read_to_string(src().join("lib.rs")).unwrap();
     let mut out = BTreeMap::new();
     for line in lib.lines() {
-        let Some(rest) = line.strip_prefix("//! - **L") else {
+        let Some(rest) = line.strip_prefix(&format!("//! - **{kind}")) else {
             continue;
         };
         let (n, rest) = rest.split_once("**:").expect("`- **Ln**: ...`");
@@ -81,40 +94,56 @@ fn imports() -> Vec<(String, String, String)> {
     out
 }
 
+/// The modules `file` (in `src/`) declares with `prefix` (`pub mod ` or `mod `).
+fn declared(file: &str, prefix: &str) -> Vec<String> {
+    std::fs::read_to_string(src().join(file))
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix(prefix).and_then(|r| r.strip_suffix(';')))
+        .map(String::from)
+        .collect()
+}
+
 #[test]
 fn every_top_level_module_has_a_layer() {
-    let layers = layers();
-    let lib = std::fs::read_to_string(src().join("lib.rs")).unwrap();
-    let modules: Vec<&str> = lib
-        .lines()
-        .filter_map(|l| l.strip_prefix("pub mod ").and_then(|r| r.strip_suffix(';')))
-        .collect();
-    assert!(modules.len() >= 10, "{modules:?}");
-    for m in &modules {
-        assert!(
-            layers.contains_key(*m),
-            "module `{m}` is in no layer of src/lib.rs's table"
-        );
-    }
-    for m in layers.keys() {
-        assert!(
-            modules.contains(&m.as_str()),
-            "the layer table names `{m}`, which is no module"
-        );
+    for (file, prefix, layers, kind, at_least) in [
+        ("lib.rs", "pub mod ", layers(), "layer", 10),
+        ("main.rs", "mod ", programs(), "program", 3),
+    ] {
+        let modules = declared(file, prefix);
+        assert!(modules.len() >= at_least, "{file}: {modules:?}");
+        for m in &modules {
+            assert!(
+                layers.contains_key(m),
+                "module `{m}` of src/{file} is in no {kind} of src/lib.rs's table"
+            );
+        }
+        for m in layers.keys() {
+            assert!(
+                modules.contains(m),
+                "the {kind} table names `{m}`, which is no module of src/{file}"
+            );
+        }
     }
 }
 
 #[test]
 fn imports_only_go_down_the_layers() {
-    let layers = layers();
+    let (layers, programs) = (layers(), programs());
     let mut upward = Vec::new();
     for (from, to, at) in imports() {
-        let (Some(&lf), Some(&lt)) = (layers.get(&from), layers.get(&to)) else {
+        // A library module's paths stay in the library, a program's among the programs.
+        let (table, kind) = if programs.contains_key(&from) {
+            (&programs, "P")
+        } else {
+            (&layers, "L")
+        };
+        let (Some(&lf), Some(&lt)) = (table.get(&from), table.get(&to)) else {
             upward.push(format!("{at}: crate::{to} from `{from}` (a module outside the table)"));
             continue;
         };
         if lt >= lf {
-            upward.push(format!("{at}: `{from}` (L{lf}) uses crate::{to} (L{lt})"));
+            upward.push(format!("{at}: `{from}` ({kind}{lf}) uses crate::{to} ({kind}{lt})"));
         }
     }
     assert!(
@@ -122,6 +151,57 @@ fn imports_only_go_down_the_layers() {
         "{} imports do not go down:\n{}",
         upward.len(),
         upward.join("\n")
+    );
+}
+
+/// The programs are the binary's, not the library's: `src/lib.rs` declares none of them, and no file of the library
+/// (`src/` but `src/main.rs` and the programs' folders) names one with a `crate::` path, in code or in its docs.
+#[test]
+fn the_library_declares_no_program() {
+    let programs = programs();
+    assert!(programs.len() >= 3, "{programs:?}");
+    let lib = std::fs::read_to_string(src().join("lib.rs")).unwrap();
+    let in_main = declared("main.rs", "mod ");
+    for p in programs.keys() {
+        // `mod p;`, `pub mod p;`, `pub(crate) mod p {`, …
+        let declares = lib.lines().map(str::trim).any(|l| {
+            !l.starts_with("//")
+                && l.split_whitespace()
+                    .collect::<Vec<_>>()
+                    .windows(2)
+                    .any(|w| w[0] == "mod" && w[1].trim_end_matches([';', '{']) == p)
+        });
+        assert!(!declares, "src/lib.rs declares the program `{p}`");
+        assert!(in_main.contains(p), "src/main.rs does not declare the program `{p}`");
+    }
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    let mut named = Vec::new();
+    for f in files {
+        let rel = f.strip_prefix(src()).unwrap();
+        let top = rel
+            .iter()
+            .next()
+            .unwrap()
+            .to_string_lossy()
+            .trim_end_matches(".rs")
+            .to_string();
+        if top == "main" || programs.contains_key(&top) {
+            continue;
+        }
+        for (k, line) in std::fs::read_to_string(&f).unwrap().lines().enumerate() {
+            for p in programs.keys() {
+                if line.contains(&format!("crate::{p}")) {
+                    named.push(format!("src/{}:{}: {}", rel.display(), k + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(
+        named.is_empty(),
+        "{} library lines name a program:\n{}",
+        named.len(),
+        named.join("\n")
     );
 }
 

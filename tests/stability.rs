@@ -1,4 +1,4 @@
-//! The quick stability suite (`rubblepile bench stability --quick`, cases in `src/bench/stability/cases/`) and the
+//! The quick stability suite (`rubblepile bench stability --quick`, cases in `src/driver/stability/cases/`) and the
 //! contact-barrier detector end to end (Roig03 Eqs. 13–14): the 3× head-on impact must be reported naming
 //! bodies 1 and 2, the calibrated one must not; θ = 0 keeps `||q| − 1|` below 1e-9; F0 = 100 keeps
 //! `H − H0 − 2∫F` below 1e-6; κ = 1.6 and κ = 50 complete; no quick case fails.
@@ -10,8 +10,8 @@ mod common;
 use std::path::Path;
 
 use common::{rubblepile, temp_dir};
-use rubblepile::bench::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
-use rubblepile::bench::stability::{CaseResult, Verdict, run_case};
+use rubblepile::driver::stability::cases::{QUATERNION_HARD, RTOL, all_cases};
+use rubblepile::driver::stability::{CaseResult, Verdict, run_case};
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::ellipsoid::scene::parse_scene;

@@ -1,9 +1,9 @@
 //! Tolerance proportionality and the scale-free error norm (issue 19): the final error of a run follows `rtol`
 //! whatever the masses, on the canonical problems of `bench tolerance`.
 
-use rubblepile::bench::ellipsoid_problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
 use rubblepile::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use rubblepile::ellipsoid::equations::{EllipsoidSystem, GravityTerm, ModelConfig, Physics};
+use rubblepile::impact::problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
 use rubblepile::integrate::{Method, OdeSystem, Tolerances, make_integrator};
 use rubblepile::math::{Vec3, Vec4};
 

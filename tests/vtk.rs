@@ -406,7 +406,7 @@ fn export_of_a_finished_run_writes_the_files_the_run_wrote() {
 
 #[test]
 fn a_42000_sphere_snapshot_stays_under_5_mb() {
-    let view = rubblepile::bench::render::cloud_view(42_000, true);
+    let view = rubblepile::ellipsoid::cloud::cloud_view(42_000, true);
     let bytes: usize = rubblepile::driver::formats::vtk::pieces(&view)
         .iter()
         .map(|(_, p)| p.to_bytes().unwrap().len())

@@ -309,7 +309,7 @@ fn decided_scenes_load_and_their_headers_build_what_their_names_say() {
         .collect();
     names.sort();
     assert!(names.len() >= 13, "{names:?}");
-    let (rho, _) = rubblepile::studies::zhang2017::rows::paper_bulk_density();
+    let (rho, _) = rubblepile::analysis::spinup::paper_bulk_density();
     for name in &names {
         let text = std::fs::read_to_string(d.join(name)).unwrap();
         let table: toml::Table = toml::from_str(&text).unwrap_or_else(|e| panic!("{name}: {e}"));

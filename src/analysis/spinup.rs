@@ -177,6 +177,34 @@ pub fn omega_of_hours(period_hours: f64) -> f64 {
     2.0 * std::f64::consts::PI / (period_hours * 3600.0)
 }
 
+/// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
+pub const DIDYMOS_MASS: f64 = 5.23e11;
+
+/// Zhang17 Table 2's grain counts of its two monodisperse models with Table 3's initial packing η_B of each:
+/// (model, grains, η_B). Their grains have the radius [`PAPER_GRAIN_RADIUS`].
+pub const PAPER_COUNTS_AND_PACKINGS: [(&str, usize, f64); 2] = [("hcp", 42_062, 0.739), ("rcp", 36_523, 0.641)];
+/// Zhang17 Table 2: the grain radius of HCP and RCP (m).
+pub const PAPER_GRAIN_RADIUS: f64 = 10.0;
+
+/// The bulk density (kg/m³) the paper's piles had, derived from its own numbers: each monodisperse model's grains
+/// (N spheres of 10 m) fill the carved volume `V = N (4/3)π r³ / η_B` at the packing Table 3 gives; HCP's and
+/// RCP's volumes agree to 0.1 % (2.384e8 and 2.387e8 m³, D_eq 769 m), and M_P of Table 1 in their mean is
+/// `ρ_B = M_P / V̄` ≈ 2193 kg/m³, not the nominal 2100. Returns (ρ_B, V̄ in m³).
+///
+/// ```
+/// let (rho, v) = rubblepile::analysis::spinup::paper_bulk_density();
+/// assert!((rho - 2192.5).abs() < 0.5 && (v / 2.3854e8 - 1.0).abs() < 1e-3);
+/// ```
+pub fn paper_bulk_density() -> (f64, f64) {
+    let grain = 4.0 / 3.0 * std::f64::consts::PI * PAPER_GRAIN_RADIUS.powi(3);
+    let volumes: Vec<f64> = PAPER_COUNTS_AND_PACKINGS
+        .iter()
+        .map(|&(_, n, eta)| n as f64 * grain / eta)
+        .collect();
+    let mean = volumes.iter().sum::<f64>() / volumes.len() as f64;
+    (DIDYMOS_MASS / mean, mean)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

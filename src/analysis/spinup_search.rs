@@ -1480,6 +1480,47 @@ pub fn model_dir(runs: &Path, model: &str) -> PathBuf {
     runs.join(model)
 }
 
+/// The result of a T_c,3 search directory, re-derived from its judged holds (`critical.csv`) by
+/// [`critical_from_verdicts`], so that every search is read by today's rule whenever it ran: `t_c3_hours` and
+/// `friction_angle_deg` (the paper's criterion, the search's default), `paper`, `paper_tolerance`, `ours`, and
+/// `runs` (their `t_final_hours`). A search made before the paper's criterion judged rates is judged again from its
+/// `holds.csv` where the compact copy has one ([`rejudge`]); without it, its `paper` values are null. A directory
+/// with only `critical.json` is read as written. `None` when neither file is there or readable.
+pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
+    let Some(csv) = std::fs::read_to_string(search_dir.join("critical.csv")).ok() else {
+        let text = std::fs::read_to_string(search_dir.join("critical.json")).ok()?;
+        let mut v: serde_json::Value = serde_json::from_str(&text).ok()?;
+        // a critical.json of before Dec 2026: its `paper` is today's paper-tolerance criterion
+        if v.get("paper_tolerance").is_none() {
+            let old = v.get("paper").cloned().unwrap_or_else(
+                || serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] }),
+            );
+            v["paper_tolerance"] = old;
+            v["paper"] = serde_json::json!({ "t_c3_hours": null, "friction_angle_deg": null });
+        }
+        return Some(v);
+    };
+    let mut holds = read_critical_csv(&csv).ok()?;
+    if holds.iter().any(|h| h.paper.is_none())
+        && let Ok(series) = read_holds_csv(&search_dir.join("holds.csv"))
+    {
+        holds = rejudge(&holds, &series, None, &Criteria::default(), CreepCriterionKind::Paper);
+    }
+    let of = |kind| {
+        let (t, phi) = critical_from_verdicts(&holds, kind);
+        serde_json::json!({ "t_c3_hours": t, "friction_angle_deg": phi })
+    };
+    let paper = of(CreepCriterionKind::Paper);
+    Some(serde_json::json!({
+        "t_c3_hours": paper["t_c3_hours"],
+        "friction_angle_deg": paper["friction_angle_deg"],
+        "paper": paper,
+        "paper_tolerance": of(CreepCriterionKind::PaperTolerance),
+        "ours": of(CreepCriterionKind::Ours),
+        "runs": holds.iter().map(|h| serde_json::json!({ "t_final_hours": h.t_final_hours })).collect::<Vec<_>>(),
+    }))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

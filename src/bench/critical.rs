@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::BenchError;
-use crate::analysis::spinup_search::{CriticalOptions, critical};
+use rubblepile::analysis::spinup_search::{CriticalOptions, critical};
 
 /// `rubblepile bench critical`.
 #[derive(Debug, clap::Args)]
@@ -203,7 +203,7 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
             );
         }
     }
-    crate::io::safe_write::write_atomic(&csv_path, text)
+    rubblepile::io::safe_write::write_atomic(&csv_path, text)
         .map_err(|e| BenchError::failed(format!("{}: {e}", csv_path.display())))?;
     plot(&args.out.join("bench_critical.svg"), &rows).map_err(BenchError::failed)?;
     println!("wrote {}", csv_path.display());
@@ -212,7 +212,7 @@ pub fn bench(args: &BenchCriticalArgs) -> Result<(), BenchError> {
 
 fn plot(path: &Path, rows: &[Timing]) -> Result<(), String> {
     use plotters::prelude::*;
-    crate::analysis::figures::style::ensure_font()?;
+    rubblepile::analysis::figures::style::ensure_font()?;
     let root = SVGBackend::new(path, (640, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let max_x = rows.len() as f64 + 0.5;

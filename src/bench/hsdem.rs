@@ -1,6 +1,6 @@
 //! `rubblepile bench hsdem`: the speed of the hard-sphere engine (Richardson11 §2.1: kick–drift–kick steps with
 //! predicted collisions) on a scene, in collisions and steps per second of one core, with the split of the time over
-//! the stepper's phases ([`crate::phase`], `hard.*`).
+//! the stepper's phases ([`rubblepile::phase`], `hard.*`).
 //!
 //! The canonical case is Richardson11 §3.1's model atmosphere (`analysis/richardson2011/atmosphere.toml`: 991
 //! elastic spheres in a cylinder on a plane under uniform gravity). Its first seconds (a blob falling and
@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::BenchError;
-use crate::granular::hard::scene::load_hard_scene;
-use crate::granular::hard::stepper::System;
-use crate::phase;
+use rubblepile::granular::hard::scene::load_hard_scene;
+use rubblepile::granular::hard::stepper::System;
+use rubblepile::phase;
 
 /// `rubblepile bench hsdem`.
 #[derive(Debug, clap::Args)]
@@ -153,7 +153,7 @@ pub fn time_scene(
             .filter(|(_, s)| phases && *s > 0.0)
             .collect();
         let c = system.counters;
-        let collisions = |c: &crate::granular::hard::stepper::Counters| c.pair_collisions + c.wall_collisions;
+        let collisions = |c: &rubblepile::granular::hard::stepper::Counters| c.pair_collisions + c.wall_collisions;
         Ok(HsdemTiming {
             t_from,
             t_to: t_end,
@@ -167,14 +167,6 @@ pub fn time_scene(
             phases,
         })
     })
-}
-
-/// The model atmosphere's speed as the scaling benchmark wants it: `(collisions, steps, wall seconds)` of the whole
-/// run of the scene at `scene` to `t_end` (default the scene's) on `threads` threads, phase timers as they are (off
-/// unless the caller turned them on with [`phase::enable`]).
-pub fn time_atmosphere(scene: &Path, t_end: Option<f64>, threads: usize) -> Result<(u64, u64, f64), BenchError> {
-    let t = time_scene(scene, 0.0, t_end, threads, phase::enabled())?;
-    Ok((t.collisions, t.steps, t.wall_seconds))
 }
 
 /// `rubblepile bench hsdem`: times the scene, prints the rates and the phase split, writes the CSV.

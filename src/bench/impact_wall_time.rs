@@ -9,10 +9,10 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::BenchError as CliError;
-use crate::driver::RunOptions;
-use crate::impact::projectile::ProjectileSpec;
-use crate::impact::run::{ImpactConfig, run_impact};
-use crate::integrate::Method;
+use rubblepile::driver::RunOptions;
+use rubblepile::impact::projectile::ProjectileSpec;
+use rubblepile::impact::run::{ImpactConfig, run_impact};
+use rubblepile::integrate::Method;
 
 /// `rubblepile bench impact`.
 #[derive(Debug, clap::Args)]
@@ -155,7 +155,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         .iter()
         .flat_map(|m| match m.rtol {
             Some(r) => vec![(m.method, r)],
-            None if args.rtol.is_empty() => vec![(m.method, crate::impact::run::default_rtol(m.method))],
+            None if args.rtol.is_empty() => vec![(m.method, rubblepile::impact::run::default_rtol(m.method))],
             None => args.rtol.iter().map(|r| (m.method, *r)).collect(),
         })
         .collect();
@@ -216,7 +216,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
             rtol,
             f0,
             threads: threads as usize,
-            median_s: crate::math::median(&walls),
+            median_s: rubblepile::math::median(&walls),
             min_s: min,
             steps: s.steps_accepted,
             rhs_evaluations: s.rhs_evaluations,
@@ -276,11 +276,11 @@ struct WallTimeBars<'a> {
     goal: f64,
 }
 
-impl crate::analysis::figures::style::Figure for WallTimeBars<'_> {
+impl rubblepile::analysis::figures::style::Figure for WallTimeBars<'_> {
     fn draw<DB: plotters::prelude::DrawingBackend>(
         &self,
         root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-    ) -> crate::analysis::figures::style::PlotResult {
+    ) -> rubblepile::analysis::figures::style::PlotResult {
         use plotters::prelude::*;
         let err = |e: &dyn std::fmt::Display| e.to_string();
         let results = self.results;
@@ -434,7 +434,7 @@ fn plot(results: &[ImpactTiming], title: String, args: &ImpactBenchArgs) -> Resu
         title,
         goal: args.goal,
     };
-    crate::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure)
+    rubblepile::analysis::figures::style::write_figure(&args.out, "bench_impact", &figure)
         .map(|_| ())
         .map_err(String::from)
 }

@@ -1,10 +1,9 @@
-//! Benchmarks, canonical test problems and timed systems (the russell_ode layout: one module of problems shared by
-//! the tests and the benchmarks):
-//! - [`problems`]: canonical ODE problems with known solutions (Arenstorf orbit, Kepler, …);
-//! - [`ellipsoid_problems`]: canonical problems of the ellipsoid model (free top, bouncing pair, N30 impact, N-body
-//!   tests);
+//! Benchmarks and timed systems, on the canonical test problems that the library keeps beside what they exercise
+//! (the russell_ode layout: [`rubblepile::integrate::problems`], ODE problems with known solutions;
+//! [`rubblepile::impact::problems`], the problems of the ellipsoid model; [`rubblepile::driver::stability`], the stability
+//! suite's cases):
 //! - [`work_precision`]: work–precision measurements (timed runs, final-state and energy errors);
-//! - [`stability`]: the stability suite of stiff and extreme cases (`rubblepile bench stability`);
+//! - [`stability`]: the result files of the stability suite of stiff and extreme cases (`rubblepile bench stability`);
 //! - the timed systems behind `rubblepile bench …`, each writing CSV and a plot: [`rhs`] (µs per right-hand side,
 //!   1 thread vs all), [`work_precision_sweep`] (error vs time per method), [`nbody`] (point-mass runs, REBOUND
 //!   comparison), [`impact_wall_time`] (the N200 impact's wall time), [`hsdem`] (hard-sphere collisions per
@@ -13,11 +12,9 @@
 //!   line embeds them; the command line itself only parses and dispatches.
 
 pub mod critical;
-pub mod ellipsoid_problems;
 pub mod hsdem;
 pub mod impact_wall_time;
 pub mod nbody;
-pub mod problems;
 pub mod render;
 pub mod rhs;
 pub mod scaling;

@@ -1,6 +1,6 @@
 //! `rubblepile bench nbody`: timed point-mass runs of the ellipsoid model (tiny spheres, gravity only, G = 1)
 //! with their final states, the rubblepile side of the comparison with REBOUND in `analysis/rebound_compare/`
-//! (problems from [`crate::bench::ellipsoid_problems::NBodyProblem`]; Rein & Liu 2012, Rein & Spiegel 2015
+//! (problems from [`rubblepile::impact::problems::NBodyProblem`]; Rein & Liu 2012, Rein & Spiegel 2015
 //! for the REBOUND side).
 //!
 //! Besides the wall time of the integration (measured inside the binary, so process start-up and file I/O do
@@ -14,10 +14,10 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use super::BenchError as CliError;
-use crate::bench::ellipsoid_problems::{NBodyProblem, PointMassGravity, ProblemSetup};
 use crate::bench::work_precision::{Setting, median, run_once, thread_cpu_seconds};
 use crate::bench::work_precision_sweep::prepare_outputs;
-use crate::integrate::{IntegrateError, Method, OdeSystem, Stats, Tolerances, make_integrator};
+use rubblepile::impact::problems::{NBodyProblem, PointMassGravity, ProblemSetup};
+use rubblepile::integrate::{IntegrateError, Method, OdeSystem, Stats, Tolerances, make_integrator};
 
 /// `rubblepile bench nbody`.
 ///

@@ -9,13 +9,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use super::BenchError;
-use crate::analysis::figures::lines::{LineChart, Mark, Series};
-use crate::driver::formats::vtk::pieces;
-use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::engine::{ParticleView, SnapshotView};
-use crate::math::Vec3;
-use crate::render::{Camera, ColourScale, FrameBody, Framing, Projection, View, render_frame};
+use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
+use rubblepile::driver::formats::vtk::pieces;
+use rubblepile::ellipsoid::cloud::cloud_view;
+use rubblepile::engine::SnapshotView;
+use rubblepile::render::{Camera, ColourScale, FrameBody, Framing, Projection, View, render_frame};
 
 /// `rubblepile bench render`.
 #[derive(Debug, clap::Args)]
@@ -25,7 +23,7 @@ pub struct RenderBenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "30,200,2000")]
     pub bodies: Vec<usize>,
     /// Thread counts, comma-separated [default: 1 and all available].
-    #[arg(long, value_delimiter = ',', value_parser = crate::io::scene_file::thread_count)]
+    #[arg(long, value_delimiter = ',', value_parser = rubblepile::io::scene_file::thread_count)]
     pub threads: Option<Vec<usize>>,
     /// Frame size (pixels, square).
     #[arg(long, default_value_t = 800)]
@@ -41,39 +39,9 @@ pub struct RenderBenchArgs {
     pub force: bool,
 }
 
-/// One random snapshot of `n` ellipsoids (or spheres of the same volumes when `spheres`).
-pub fn cloud_view(n: usize, spheres: bool) -> SnapshotView {
-    let bodies = random_cloud(n, 1, &CloudParams::default());
-    let particles = bodies
-        .iter()
-        .enumerate()
-        .map(|(id, b)| {
-            let r = b.shape.axes.product().cbrt();
-            ParticleView {
-                id,
-                mass: b.shape.mass,
-                position: b.position,
-                velocity: b.velocity,
-                spin_world: b.spin_body,
-                axes: if spheres { Vec3::repeat(r) } else { b.shape.axes },
-                rotation: if spheres {
-                    crate::math::Mat3::identity()
-                } else {
-                    rotation_matrix(&b.quaternion).transpose()
-                },
-            }
-        })
-        .collect();
-    SnapshotView {
-        spheres,
-        particles,
-        ..Default::default()
-    }
-}
-
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
-    crate::math::median(&v)
+    rubblepile::math::median(&v)
 }
 
 /// Median ms to draw one frame of `view` on `threads` threads (after one untimed frame).
@@ -204,7 +172,8 @@ pub fn render(args: &RenderBenchArgs) -> Result<(), BenchError> {
         series,
         log_x: true,
     };
-    crate::analysis::figures::style::write_figure(&args.out, "bench_render", &chart).map_err(BenchError::failed)?;
+    rubblepile::analysis::figures::style::write_figure(&args.out, "bench_render", &chart)
+        .map_err(BenchError::failed)?;
     println!("  wrote {} and bench_render.svg/.png", csv.display());
     Ok(())
 }

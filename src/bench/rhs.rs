@@ -1,21 +1,21 @@
 //! `rubblepile bench rhs`: the cost of one right-hand-side evaluation, serial and parallel, with gravity among
-//! centres (Roig03 Eq. 6) summed exactly, by the octree ([`crate::ellipsoid::gravity_tree`]) or left out (the
-//! pair work alone), with the pair counts ([`crate::ellipsoid::equations::PairCensus`]) that set the pair work.
+//! centres (Roig03 Eq. 6) summed exactly, by the octree ([`rubblepile::ellipsoid::gravity_tree`]) or left out (the
+//! pair work alone), with the pair counts ([`rubblepile::ellipsoid::equations::PairCensus`]) that set the pair work.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::time::Instant;
 
 use super::BenchError as CliError;
-use crate::driver::warm_pool::with_warm_workers;
-use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::ellipsoid::equations::{
+use rubblepile::driver::warm_pool::with_warm_workers;
+use rubblepile::ellipsoid::cloud::{CloudParams, random_cloud};
+use rubblepile::ellipsoid::equations::{
     ContactTerm, DissipationTerm, EllipsoidSystem, GravityTerm, ModelConfig, PairCensus, Physics,
 };
-use crate::ellipsoid::gravity_tree::{GravityMethod, MAX_THETA};
-use crate::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
-use crate::integrate::OdeSystem;
-use crate::io::scene_file::SI_G;
+use rubblepile::ellipsoid::gravity_tree::{GravityMethod, MAX_THETA};
+use rubblepile::ellipsoid::scene::DEFAULT_CONTACT_CUTOFF;
+use rubblepile::integrate::OdeSystem;
+use rubblepile::io::scene_file::SI_G;
 
 /// `rubblepile bench rhs`.
 #[derive(Debug, clap::Args)]
@@ -50,7 +50,7 @@ pub struct RhsArgs {
     #[arg(long, value_delimiter = ',', default_value = "auto", value_parser = ["auto", "direct", "tree", "tree-step", "none"])]
     pub gravity: Vec<String>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]).
-    #[arg(long, default_value_t = crate::ellipsoid::gravity_tree::DEFAULT_THETA)]
+    #[arg(long, default_value_t = rubblepile::ellipsoid::gravity_tree::DEFAULT_THETA)]
     pub theta: f64,
     /// Write `bench_rhs.csv` (bodies, threads, median_us, min_us, repeats, gravity, packing: `lattice` or the
     /// target file's stem, and the pair counts of the timed state: candidate_pairs, interacting_pairs,
@@ -122,16 +122,6 @@ pub fn time_rhs(
     })
 }
 
-/// The system benchmarked by `bench rhs`: gravity (default method) + contact + dissipation (F0 = 1 s/m²).
-pub fn bench_system(n: usize, seed: u64, kappa: f64) -> EllipsoidSystem {
-    bench_system_with(n, seed, kappa, GravityMethod::default())
-}
-
-/// [`bench_system`] with gravity summed by `method`.
-pub fn bench_system_with(n: usize, seed: u64, kappa: f64, method: GravityMethod) -> EllipsoidSystem {
-    lattice_system(n, seed, kappa, Some(method))
-}
-
 fn lattice_system(n: usize, seed: u64, kappa: f64, method: Option<GravityMethod>) -> EllipsoidSystem {
     let bodies = random_cloud(n, seed, &CloudParams::default());
     EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), bench_physics(method))
@@ -151,15 +141,15 @@ pub fn bench_physics(method: Option<GravityMethod>) -> Physics {
 
 /// What one benchmark row times: a lattice of N bodies, or a relaxed pile read from a target file.
 enum Packing {
-    /// `bench_system_with`'s jittered lattice.
+    /// [`lattice_system`]'s jittered lattice.
     Lattice(usize),
     /// A target's bodies at its κ, labelled by the file's stem.
-    Pile(String, Vec<crate::ellipsoid::body::Body>, f64),
+    Pile(String, Vec<rubblepile::ellipsoid::body::Body>, f64),
 }
 
 /// Reads a target file and the κ of its `FILE.json` report.
 fn read_pile(path: &std::path::Path) -> Result<Packing, CliError> {
-    let bodies = crate::impact::run::read_target(path).map_err(|e| CliError::usage(format!("--targets: {e}")))?;
+    let bodies = rubblepile::impact::run::read_target(path).map_err(|e| CliError::usage(format!("--targets: {e}")))?;
     let json = path.with_extension("json");
     let text = std::fs::read_to_string(&json)
         .map_err(|e| CliError::usage(format!("--targets: {} ({e}); κ is read from it", json.display())))?;
@@ -343,8 +333,8 @@ fn plot_rhs<DB: plotters::prelude::DrawingBackend>(
     results: &[(usize, RhsTiming, String)],
     lines: &[(usize, String)],
 ) -> Result<(), String> {
-    use crate::analysis::figures::style;
     use plotters::prelude::*;
+    use rubblepile::analysis::figures::style;
     let err = |e: &dyn std::fmt::Display| e.to_string();
     // plotters measures (and, in PNGs, draws) text with the font the figures embed; it must be registered first
     style::ensure_font()?;

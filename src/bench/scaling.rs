@@ -3,7 +3,7 @@
 //! parallel efficiency `S(p)/p`, and the Karp–Flatt serial fraction `e(p) = (1/S − 1/p)/(1 − 1/p)` (Karp & Flatt
 //! 1990: the serial fraction that Amdahl's law would need to explain the measured speed-up). Beside the inferred
 //! fraction, the measured one: the share of the wall time spent in the serial phases of the engines' hot loops
-//! ([`crate::phase`]) and outside any timed phase (the integrator's and the driver's own work, which is serial).
+//! ([`rubblepile::phase`]) and outside any timed phase (the integrator's and the driver's own work, which is serial).
 //!
 //! Cases (`--cases`, default all):
 //! - `rhs-n200` / `rhs-n2000` / `rhs-n10000` / `rhs-n10000-tree`: one right-hand side of the relaxed piles
@@ -27,14 +27,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::BenchError;
-use crate::driver::RunOptions;
-use crate::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
-use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
-use crate::impact::campaign::{CampaignOptions, parse_campaign, run_campaign};
-use crate::impact::projectile::ProjectileSpec;
-use crate::impact::run::{ImpactConfig, read_target, run_impact};
-use crate::integrate::{Method, OdeSystem};
-use crate::phase::{self, Kind};
+use rubblepile::driver::RunOptions;
+use rubblepile::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
+use rubblepile::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
+use rubblepile::impact::campaign::{CampaignOptions, parse_campaign, run_campaign};
+use rubblepile::impact::projectile::ProjectileSpec;
+use rubblepile::impact::run::{ImpactConfig, read_target, run_impact};
+use rubblepile::integrate::{Method, OdeSystem};
+use rubblepile::phase::{self, Kind};
 
 /// Every case, in the order they run.
 pub const CASES: [&str; 11] = [
@@ -188,7 +188,7 @@ fn split(phases: &[phase::Total], seconds: f64) -> (f64, f64) {
 
 fn fingerprint_f64(values: &[f64]) -> String {
     let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_bits().to_le_bytes()).collect();
-    crate::bits::fnv1a_hex(&bytes)
+    rubblepile::bits::fnv1a_hex(&bytes)
 }
 
 /// A relaxed pile with its κ (from `FILE.json`), under gravity by `method`, contact and dissipation.
@@ -277,14 +277,14 @@ fn impact_case(case: &str, cfg: &ImpactConfig, dir: &Path, threads: usize) -> Re
         serial_seconds,
         parallel_seconds,
         phases,
-        fingerprint: crate::bits::fnv1a_hex(&snapshot),
+        fingerprint: rubblepile::bits::fnv1a_hex(&snapshot),
     })
 }
 
 /// Soft-sphere steps of `sys` on `threads` threads.
 fn ssdem_case(
     case: &str,
-    sys: &crate::granular::soft::forces::SoftSystem,
+    sys: &rubblepile::granular::soft::forces::SoftSystem,
     threads: usize,
     steps: u64,
 ) -> Result<Measurement, BenchError> {
@@ -294,7 +294,7 @@ fn ssdem_case(
         let mut s = sys.clone();
         let dt = std::f64::consts::PI * (0.5 * s.particles[0].mass / s.material.k_n).sqrt() / 50.0;
         for k in 0..3 {
-            crate::granular::soft::leapfrog::step(&mut s, k as f64 * dt, dt);
+            rubblepile::granular::soft::leapfrog::step(&mut s, k as f64 * dt, dt);
         }
         s.particles
             .iter()
@@ -383,7 +383,7 @@ fn campaign_case(root: &Path, dir: &Path, runs: usize, t_end: f64, threads: usiz
         serial_seconds: f64::NAN,
         parallel_seconds: f64::NAN,
         phases,
-        fingerprint: crate::bits::fnv1a_hex(&finals),
+        fingerprint: rubblepile::bits::fnv1a_hex(&finals),
     })
 }
 
@@ -513,7 +513,7 @@ fn measure(args: &ScalingArgs, case: &str, threads: usize, cache: &mut Systems) 
 #[derive(Default)]
 struct Systems {
     piles: Vec<(String, bool, EllipsoidSystem)>,
-    soft: Vec<(String, crate::granular::soft::forces::SoftSystem)>,
+    soft: Vec<(String, rubblepile::granular::soft::forces::SoftSystem)>,
 }
 
 impl Systems {
@@ -531,12 +531,12 @@ impl Systems {
         Ok(&self.piles.last().expect("just pushed").2)
     }
 
-    fn ssdem(&mut self, case: &str) -> &crate::granular::soft::forces::SoftSystem {
+    fn ssdem(&mut self, case: &str) -> &rubblepile::granular::soft::forces::SoftSystem {
         if let Some(k) = self.soft.iter().position(|(c, _)| c == case) {
             return &self.soft[k].1;
         }
         let (n, gravity, interval) = match case {
-            "ssdem-40k-tree10" => (40_000, Some(crate::gravity::SelfGravity::Tree { theta: 0.5 }), 10),
+            "ssdem-40k-tree10" => (40_000, Some(rubblepile::gravity::SelfGravity::Tree { theta: 0.5 }), 10),
             "ssdem-2k" => (2_000, None, 1),
             _ => (40_000, None, 1),
         };
@@ -716,7 +716,7 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
         write_phases_csv(&files[1], &rows).map_err(|e| BenchError::failed(format!("{}: {e}", files[1].display())))?;
     }
     let _ = std::fs::remove_dir_all(args.out.join("scratch"));
-    crate::analysis::figures::style::write_figure(&args.out, "scaling", &SpeedupPlot { rows: &rows })
+    rubblepile::analysis::figures::style::write_figure(&args.out, "scaling", &SpeedupPlot { rows: &rows })
         .map_err(|e| BenchError::failed(format!("{}: {e}", files[2].display())))?;
     println!(
         "  wrote {}, {}, {} and {}",
@@ -771,14 +771,14 @@ struct SpeedupPlot<'a> {
     rows: &'a [Measurement],
 }
 
-impl crate::analysis::figures::style::Figure for SpeedupPlot<'_> {
+impl rubblepile::analysis::figures::style::Figure for SpeedupPlot<'_> {
     fn draw<DB: plotters::prelude::DrawingBackend>(
         &self,
         root: &plotters::prelude::DrawingArea<DB, plotters::coord::Shift>,
-    ) -> crate::analysis::figures::style::PlotResult {
-        use crate::analysis::figures::style;
+    ) -> rubblepile::analysis::figures::style::PlotResult {
         use plotters::prelude::*;
-        let err = |e: &dyn std::fmt::Display| crate::analysis::AnalysisError::Output(e.to_string());
+        use rubblepile::analysis::figures::style;
+        let err = |e: &dyn std::fmt::Display| rubblepile::analysis::AnalysisError::Output(e.to_string());
         let speedups = derived(self.rows);
         let p_max = self.rows.iter().map(|r| r.threads).max().unwrap_or(1) as f64;
         let s_max = speedups.iter().map(|d| d.0).fold(p_max, f64::max);
@@ -835,5 +835,26 @@ impl crate::analysis::figures::style::Figure for SpeedupPlot<'_> {
                 .map_err(|e| err(&e))?;
         }
         style::draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn karp_flatt_inverts_amdahls_law() {
+        // Amdahl with serial fraction f on p threads: S = 1 / (f + (1 − f)/p); Karp–Flatt gives f back.
+        for (f, p) in [(0.1, 2), (0.02, 16), (0.5, 4)] {
+            let s = 1.0 / (f + (1.0 - f) / p as f64);
+            let (speedup, efficiency, e) = karp_flatt(1.0, 1.0 / s, p);
+            assert!((speedup - s).abs() < 1e-12);
+            assert!((efficiency - s / p as f64).abs() < 1e-12);
+            assert!((e.unwrap() - f).abs() < 1e-12, "{e:?} against {f}");
+        }
+        assert_eq!(karp_flatt(2.0, 2.0, 1).2, None, "undefined on one thread");
+        assert_eq!(default_threads(16), vec![1, 2, 4, 8, 16]);
+        assert_eq!(default_threads(12), vec![1, 2, 4, 8, 12]);
+        assert_eq!(default_threads(1), vec![1]);
     }
 }

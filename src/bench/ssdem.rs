@@ -6,13 +6,13 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::BenchError;
-use crate::granular::soft::contact::Material;
-use crate::granular::soft::forces::{Gravity, SoftSystem};
-use crate::granular::soft::packing::fcc_ball;
-use crate::granular::soft::run::checked_step;
-use crate::gravity::SelfGravity;
-use crate::io::scene_file::SI_G;
-use crate::math::Vec3;
+use rubblepile::granular::soft::contact::Material;
+use rubblepile::granular::soft::forces::{Gravity, SoftSystem};
+use rubblepile::granular::soft::packing::fcc_ball;
+use rubblepile::granular::soft::run::checked_step;
+use rubblepile::gravity::SelfGravity;
+use rubblepile::io::scene_file::SI_G;
+use rubblepile::math::Vec3;
 
 /// `rubblepile bench ssdem`.
 #[derive(Debug, clap::Args)]
@@ -31,7 +31,7 @@ pub struct BenchSsdemArgs {
     #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
     pub steps: u64,
     /// Thread counts to time (comma-separated).
-    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = crate::io::scene_file::thread_count)]
+    #[arg(long, default_value = "1,2", value_delimiter = ',', value_parser = rubblepile::io::scene_file::thread_count)]
     pub threads: Vec<usize>,
     /// Write `bench_ssdem.csv` and `bench_ssdem.svg` here.
     #[arg(long, value_name = "DIR")]
@@ -44,7 +44,7 @@ pub struct BenchSsdemArgs {
     /// (`analysis/ssdem_perf/`).
     #[arg(long, value_name = "FILE")]
     pub dump_particles: Option<PathBuf>,
-    /// Also time every phase of the step ([`crate::phase`]) and print, per thread count, each phase's share of
+    /// Also time every phase of the step ([`rubblepile::phase`]) and print, per thread count, each phase's share of
     /// the timed steps and the serial fraction (the phase timers cost two clock reads per phase and step).
     #[arg(long)]
     pub phases: bool,
@@ -77,7 +77,7 @@ pub fn bench_system(n: usize, gravity: Option<SelfGravity>, gravity_interval: u6
 /// Particle-steps per second of `steps` leapfrog steps on `threads` threads (a pool of its own), as a run takes
 /// its steps between output samples ([`checked_step`]: the state before each step kept for `last_good_state.csv`,
 /// the new state checked, the dissipation summed at every step, the springs' stored energy not, as runs sum it
-/// only at samples). One untimed step comes first; when phase timing is on ([`crate::phase`]) its totals are reset
+/// only at samples). One untimed step comes first; when phase timing is on ([`rubblepile::phase`]) its totals are reset
 /// after it, so that they hold the timed steps only.
 pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, BenchError> {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -90,8 +90,8 @@ pub fn time_steps(sys: &SoftSystem, threads: usize, steps: u64) -> Result<f64, B
     let mut before = Vec::new();
     let elapsed = pool.install(|| -> Result<f64, String> {
         checked_step(&mut s, &mut before, 0, dt, |_, _| ())?;
-        if crate::phase::enabled() {
-            crate::phase::reset();
+        if rubblepile::phase::enabled() {
+            rubblepile::phase::reset();
         }
         let start = Instant::now();
         for k in 1..=steps {
@@ -122,7 +122,7 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
     }
     let sys = bench_system(args.particles as usize, gravity, args.gravity_interval);
     if let Some(path) = &args.dump_particles {
-        crate::granular::soft::run::write_particles_csv(path, 0.0, &sys.particles)
+        rubblepile::granular::soft::run::write_particles_csv(path, 0.0, &sys.particles)
             .map_err(|e| BenchError::failed(format!("--dump-particles {}: {e}", path.display())))?;
     }
     let mut rows = Vec::new();
@@ -130,9 +130,9 @@ pub fn bench(args: &BenchSsdemArgs) -> Result<(), BenchError> {
         if t == 0 {
             return Err(BenchError::usage("--threads: each count must be >= 1, got 0"));
         }
-        crate::phase::enable(args.phases);
+        rubblepile::phase::enable(args.phases);
         let rate = time_steps(&sys, t, args.steps)?;
-        crate::phase::enable(false);
+        rubblepile::phase::enable(false);
         println!(
             "N = {}, gravity {} (interval {}), {t} thread(s): {rate:.4e} particle-steps/s ({} contacts)",
             args.particles, args.gravity, args.gravity_interval, sys.stats.pair_contacts
@@ -167,7 +167,7 @@ pub fn phase_table(wall: f64, steps: u64) -> String {
     let mut text = String::new();
     let (mut serial, mut parallel) = (0.0, 0.0);
     for prefix in ["soft.", "gravity."] {
-        let (mine, s, p) = crate::phase::split(prefix);
+        let (mine, s, p) = rubblepile::phase::split(prefix);
         serial += s;
         parallel += p;
         for t in mine.iter().filter(|t| t.calls > 0) {
@@ -194,7 +194,7 @@ pub fn phase_table(wall: f64, steps: u64) -> String {
 fn plot(path: &Path, rows: &[(usize, f64)], gravity: &str, n: u64) -> Result<(), String> {
     use plotters::prelude::*;
     // plotters measures text with the embedded font (its ab_glyph feature): register it first
-    crate::analysis::figures::style::ensure_font()?;
+    rubblepile::analysis::figures::style::ensure_font()?;
     let root = SVGBackend::new(path, (640, 420)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
     let max_t = rows.iter().map(|r| r.0).max().unwrap_or(1) as f64 + 0.5;

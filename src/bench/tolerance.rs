@@ -13,9 +13,9 @@ use std::io::Write;
 use std::path::PathBuf;
 
 use super::BenchError;
-use crate::bench::ellipsoid_problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
 use crate::bench::work_precision::{DEFAULT_REFERENCE_TOLERANCE, SweepConfig, sweep};
-use crate::integrate::Method;
+use rubblepile::impact::problems::{NBodyProblem, ProblemSetup, WorkPrecisionProblem};
+use rubblepile::integrate::Method;
 
 /// `rubblepile bench tolerance`.
 #[derive(Debug, clap::Args)]

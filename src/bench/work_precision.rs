@@ -5,7 +5,7 @@
 //! the end point against computing time, one curve per code, tolerances one per decade) and the
 //! work–precision diagrams of DifferentialEquations.jl's SciMLBenchmarks.
 //!
-//! * **Time** is the wall-clock time of the [`crate::integrate::Integrator::advance`] calls only: building the system, the
+//! * **Time** is the wall-clock time of the [`rubblepile::integrate::Integrator::advance`] calls only: building the system, the
 //!   initial state, the diagnostics at the energy checks and all I/O are outside the clock. Each setting is
 //!   run `repeats` times and the **median** is reported; a setting whose first run takes less than
 //!   [`SHORT_RUN_SECONDS`] is run more often (up to [`SHORT_RUN_MAX_REPEATS`] times, about
@@ -24,8 +24,8 @@
 
 use std::time::Instant;
 
-use super::ellipsoid_problems::{ProblemSetup, ReferenceKind};
-use crate::integrate::{IntegrateError, Method, Stats, Tolerances, make_integrator};
+use rubblepile::impact::problems::{ProblemSetup, ReferenceKind};
+use rubblepile::integrate::{IntegrateError, Method, Stats, Tolerances, make_integrator};
 
 /// Runs longer than this (s) are repeated at most [`LONG_RUN_REPEATS`] times and timed by their minimum.
 pub const LONG_RUN_SECONDS: f64 = 2.0;
@@ -170,7 +170,7 @@ pub struct SweepRow {
     pub cpu_seconds: f64,
 }
 
-pub use crate::math::median;
+pub use rubblepile::math::median;
 
 /// Runs `setting` `repeats` times (more for short runs, fewer for long ones, see the module docs); the error is computed with
 /// `error_of(final state)`.
@@ -498,22 +498,61 @@ pub fn csv_line(row: &SweepRow) -> String {
     )
 }
 
-/// Interpolates, in log–log, the wall time at which a method's (time, error) curve reaches `error`
-/// (`points` in any order; the curve is taken as the sequence sorted by time). `None` when `error` is
-/// outside the curve's range.
-pub fn time_at_error(points: &[(f64, f64)], error: f64) -> Option<f64> {
-    let mut p: Vec<(f64, f64)> = points
-        .iter()
-        .copied()
-        .filter(|(t, e)| *t > 0.0 && *e > 0.0 && e.is_finite())
-        .collect();
-    p.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for w in p.windows(2) {
-        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
-        if (e0 - error) * (e1 - error) <= 0.0 && e0 != e1 {
-            let s = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
-            return Some((t0.ln() + s * (t1.ln() - t0.ln())).exp());
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rubblepile::impact::problems::WorkPrecisionProblem;
+
+    #[test]
+    fn top_analytic_reference_agrees_with_tight_bulirsch_stoer() {
+        let top = WorkPrecisionProblem::Top.setup();
+        let run = run_once(&top, &Setting::adaptive(Method::BulirschStoer, 1e-12)).unwrap();
+        let err = top.spin_error(top.t_end, &run.y).unwrap();
+        eprintln!(
+            "top: BS 1e-12 spin error {err:.3e}, energy {:.3e}, {:?}",
+            run.energy_error, run.stats
+        );
+        assert!(err <= 1e-9, "spin error {err:e}");
+        assert!(run.energy_error <= 1e-10, "energy {:e}", run.energy_error);
+        // |L| is conserved by the analytic solution and by the run.
+        let moments = top.system.principal_moments()[0];
+        let w_exact = top.exact_spin(top.t_end).unwrap();
+        let w0 = top.bodies[0].spin_body;
+        let l = |w: &rubblepile::math::Vec3| moments.component_mul(w).norm();
+        assert!((l(&w_exact) / l(&w0) - 1.0).abs() < 1e-13);
+        // And a loose run is visibly worse: the error measures something.
+        let loose = run_once(&top, &Setting::adaptive(Method::BulirschStoer, 1e-5)).unwrap();
+        assert!(top.spin_error(top.t_end, &loose.y).unwrap() > 1e3 * err);
+    }
+
+    /// The stiff damped pair of the benchmarks (`bench work-precision --problem stiff-pair`, damping ~1000× faster than
+    /// the contact): the implicit method's final-state error against the tight explicit reference (which finishes
+    /// here, so the reference is explicit) stays within 10 × rtol and falls with rtol, in a few hundred steps where
+    /// the explicit method needs about 11 000.
+    #[test]
+    fn stiff_pair_error_follows_the_tolerance_against_the_explicit_reference() {
+        let problem = WorkPrecisionProblem::StiffPair.setup();
+        let reference = References::compute(&problem, 1e-11).unwrap();
+        assert_eq!(reference.runs.len(), 1);
+        assert_eq!(
+            reference.runs[0].method,
+            Method::BulirschStoer,
+            "the explicit reference finishes"
+        );
+        assert!(reference.explicit_given_up.is_none());
+        let mut previous = f64::INFINITY;
+        for tol in [1e-4, 1e-6] {
+            let run = run_once(&problem, &Setting::adaptive(Method::BulirschStoerImplicit, tol)).unwrap();
+            let err = problem.state_error(&run.y, &reference.runs[0].state);
+            eprintln!(
+                "rtol {tol:e}: error {err:e} ({:.2} x rtol), {} steps",
+                err / tol,
+                run.stats.steps_accepted
+            );
+            assert!(err <= 10.0 * tol, "error {err:e} at rtol {tol:e}");
+            assert!(err < previous, "error {err:e} not below {previous:e}");
+            assert!(run.stats.steps_accepted < 2000, "{} steps", run.stats.steps_accepted);
+            previous = err;
         }
     }
-    None
 }

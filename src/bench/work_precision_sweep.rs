@@ -1,6 +1,6 @@
 //! `rubblepile bench work-precision`: work–precision diagrams (final-state error and energy residual against
 //! integration wall time) of Bulirsch–Stoer, Dop853, Dopri5 and Rk4 on the canonical problems of
-//! [`crate::bench::ellipsoid_problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
+//! [`rubblepile::impact::problems`], after Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.10.
 //! The measurement itself is [`crate::bench::work_precision`]; this file holds the command line, the CSV
 //! and the plot.
 
@@ -11,11 +11,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::BenchError as CliError;
-use crate::bench::ellipsoid_problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use crate::bench::work_precision::{
     CSV_HEADER, DEFAULT_TOLERANCES, LONG_RUN_REPEATS, LONG_RUN_SECONDS, Sweep, SweepConfig, SweepRow, csv_line, sweep,
 };
-use crate::integrate::Method;
+use rubblepile::impact::problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
+use rubblepile::integrate::Method;
 
 /// `rubblepile bench work-precision`.
 ///
@@ -379,7 +379,7 @@ pub fn draw_work_precision<DB: DrawingBackend>(
     rows: &[SweepRow],
 ) -> Result<(), String> {
     // plotters measures (and in bitmaps draws) text with the font the figures embed: register it first
-    crate::analysis::figures::style::ensure_font()?;
+    rubblepile::analysis::figures::style::ensure_font()?;
     let e = |err: &dyn std::fmt::Display| err.to_string();
     area.fill(&WHITE).map_err(|x| e(&x))?;
     let area = area.titled(title, ("sans-serif", 20)).map_err(|x| e(&x))?;
@@ -454,4 +454,47 @@ pub fn draw_work_precision<DB: DrawingBackend>(
             .map_err(|x| e(&x))?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bench::work_precision::Setting;
+
+    /// `--replot` reads back what a sweep wrote: each row's method, `rtol` (empty for Rk4), `h` (empty for the
+    /// adaptive methods) and measured columns.
+    #[test]
+    fn read_csv_reads_back_what_write_csv_writes() {
+        let row = |setting, error| SweepRow {
+            setting,
+            error,
+            energy_error: 2e-9,
+            wall_seconds: 0.5,
+            rhs_evaluations: 1200,
+            steps: 100,
+            rejected_steps: 3,
+            timed_runs: 5,
+            statistic: "median",
+            cpu_seconds: 0.25,
+        };
+        let rows = [
+            row(Setting::adaptive(Method::BulirschStoer, 1e-4), 3e-5),
+            row(Setting::rk4(0.2), 1e-3),
+        ];
+        let path = std::env::temp_dir().join(format!("rubblepile-unit-wp-csv-{}.csv", std::process::id()));
+        write_csv(&path, &rows).unwrap();
+        let back = read_csv(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(back.len(), rows.len());
+        for (a, b) in back.iter().zip(&rows) {
+            assert_eq!(a.setting, b.setting);
+            assert_eq!(
+                (a.error, a.energy_error, a.wall_seconds),
+                (b.error, b.energy_error, b.wall_seconds)
+            );
+            assert_eq!((a.rhs_evaluations, a.steps), (b.rhs_evaluations, b.steps));
+        }
+        assert_eq!(back[0].setting.tolerance, Some(1e-4));
+        assert_eq!(back[1].setting.step, Some(0.2));
+    }
 }

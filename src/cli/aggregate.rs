@@ -1,14 +1,14 @@
 //! `rubblepile aggregate build|density`: rubble-pile aggregates for spin-up studies (Zhang17 §2.3.2, Table 2;
-//! see [`crate::aggregate`]) written as a particle file (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, the
+//! see [`rubblepile::aggregate`]) written as a particle file (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`, the
 //! soft-sphere scene's `particles_file`) with a JSON report beside it (`NAME.json`).
 
 use std::path::PathBuf;
 
-use crate::aggregate::files::{check_outputs, density_variant, write_aggregate};
-use crate::aggregate::random_packing::{BuildProgress, Recipe};
-use crate::aggregate::shape::Shape;
-use crate::aggregate::{BuildSpec, Grains, Model, build_with_progress};
 use crate::cli::common::CliError;
+use rubblepile::aggregate::files::{check_outputs, density_variant, write_aggregate};
+use rubblepile::aggregate::random_packing::{BuildProgress, Recipe};
+use rubblepile::aggregate::shape::Shape;
+use rubblepile::aggregate::{BuildSpec, Grains, Model, build_with_progress};
 
 /// `rubblepile aggregate …`.
 #[derive(Debug, clap::Subcommand)]
@@ -95,10 +95,10 @@ pub struct DensityArgs {
 }
 
 /// Bad input to the aggregate layer is a usage error; a failed build is a failure.
-fn cli_error(e: crate::aggregate::AggregateError) -> CliError {
+fn cli_error(e: rubblepile::aggregate::AggregateError) -> CliError {
     match e {
-        crate::aggregate::AggregateError::Input { .. } => CliError::usage(e),
-        crate::aggregate::AggregateError::Failed(_) => CliError::failed(e),
+        rubblepile::aggregate::AggregateError::Input { .. } => CliError::usage(e),
+        rubblepile::aggregate::AggregateError::Failed(_) => CliError::failed(e),
     }
 }
 

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use crate::analysis::run_analysis::{AnalysisError, Fit, analyze_run};
 use crate::cli::common::CliError;
+use rubblepile::analysis::run_analysis::{AnalysisError, Fit, analyze_run};
 
 /// `rubblepile analyze`.
 #[derive(Debug, clap::Args)]
@@ -24,8 +24,8 @@ pub struct AnalyzeArgs {
 /// Runs `analyze`, holding the lock of `DIR/analysis/` from the first check to the last figure (so a second
 /// `analyze` of the run is refused at once, while the run itself may still be writing `DIR`).
 pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
-    let _lock = crate::analysis::run_analysis::lock_analysis(&args.dir, "scene.toml").map_err(CliError::usage)?;
-    if crate::analysis::flyby::is_flyby_run(&args.dir) {
+    let _lock = rubblepile::analysis::run_analysis::lock_analysis(&args.dir, "scene.toml").map_err(CliError::usage)?;
+    if rubblepile::analysis::flyby::is_flyby_run(&args.dir) {
         return analyze_flyby_run(args);
     }
     if let Some(at) = args.at
@@ -33,7 +33,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     {
         return Err(CliError::usage(format!("--at: must be a time >= 0 s, got {at}")));
     }
-    if !crate::analysis::run_analysis::is_impact_run(&args.dir) {
+    if !rubblepile::analysis::run_analysis::is_impact_run(&args.dir) {
         return analyze_clumps_of_run(args);
     }
     if args.at == Some(0.0) {
@@ -45,12 +45,12 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
-    let (figures, not_drawn) = crate::analysis::figures::write_run_figures(&args.dir, &a, &report);
+    let (figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&args.dir, &a, &report);
     for why in &not_drawn {
         eprintln!("warning: figure not drawn: {why}");
     }
     let s = &a.summary;
-    let alpha = |f: &Fit<crate::analysis::fits::PowerLawFit>| match f {
+    let alpha = |f: &Fit<rubblepile::analysis::fits::PowerLawFit>| match f {
         Fit::Ok(p) => format!("{:.2} ± {:.2}", p.alpha, p.sigma_alpha),
         Fit::Failed(why) => format!("n/a ({why})"),
     };
@@ -86,8 +86,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
 /// `analyze` of a run that is not an impact (no `impact.json`): the clumps of one snapshot
 /// (`analysis/clumps.csv`, `analysis.json`, the size–frequency figure `analysis/sfd.svg`).
 fn analyze_clumps_of_run(args: &AnalyzeArgs) -> Result<(), CliError> {
-    let a =
-        crate::analysis::run_analysis::analyze_clumps_run(&args.dir, args.at, args.force).map_err(CliError::usage)?;
+    let a = rubblepile::analysis::run_analysis::analyze_clumps_run(&args.dir, args.at, args.force)
+        .map_err(CliError::usage)?;
     println!("{}", a.write_figure_and_describe(&args.dir));
     Ok(())
 }
@@ -116,16 +116,15 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
     }
-    let selection = crate::analysis::run_analysis::SpinSelection {
+    let selection = rubblepile::analysis::run_analysis::SpinSelection {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
     };
-    let a = crate::analysis::campaign_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection).map_err(
-        |e| match e {
+    let a = rubblepile::analysis::campaign_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection)
+        .map_err(|e| match e {
             AnalysisError::Fragments(_) => CliError::failed(e),
             _ => CliError::usage(e),
-        },
-    )?;
+        })?;
     let q_star = match &a.q_star_d {
         Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
         Fit::Failed(why) => format!("n/a ({why})"),
@@ -207,8 +206,8 @@ fn analyze_flyby_run(args: &AnalyzeArgs) -> Result<(), CliError> {
             out.display()
         )));
     }
-    let o = crate::analysis::flyby::analyze_flyby(&args.dir).map_err(|e| match e {
-        crate::analysis::flyby::FlybyAnalysisError::Locked(_) => CliError::usage(e),
+    let o = rubblepile::analysis::flyby::analyze_flyby(&args.dir).map_err(|e| match e {
+        rubblepile::analysis::flyby::FlybyAnalysisError::Locked(_) => CliError::usage(e),
         _ => CliError::failed(e),
     })?;
     println!("{} (wrote {})", o.one_line(), out.display());

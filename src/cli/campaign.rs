@@ -1,10 +1,10 @@
-//! `rubblepile campaign FILE.toml`: a grid of impact runs (see [`crate::impact::campaign`] for the file
+//! `rubblepile campaign FILE.toml`: a grid of impact runs (see [`rubblepile::impact::campaign`] for the file
 //! format, the campaign directory and how interrupted campaigns resume).
 
 use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError};
-use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign_anywhere};
+use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignOptions, load_campaign, run_campaign_anywhere};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
@@ -12,7 +12,7 @@ use crate::impact::campaign::{CampaignOptions, load_campaign, run_campaign_anywh
 pub struct CampaignArgs {
     /// `merge DIR` or `slurm FILE --tasks N` instead of running a campaign.
     #[command(subcommand)]
-    pub action: Option<crate::impact::campaign::CampaignAction>,
+    pub action: Option<rubblepile::impact::campaign::CampaignAction>,
     /// Campaign file (TOML): `[campaign]` out, targets, projectiles, angles, seeds, parallel; optional
     /// `[impact]` overrides and `[[projectile]]` custom projectiles.
     #[arg(required = true)]
@@ -23,11 +23,11 @@ pub struct CampaignArgs {
     /// Run only shard I of N (0 <= I < N): the grid points k with k mod N = I (a job array's task); its index
     /// goes to DIR/campaign.shard-I-of-N.csv, and `campaign merge DIR` rebuilds campaign.csv.
     #[arg(long, value_name = "I/N")]
-    pub shard: Option<crate::impact::campaign::Shard>,
+    pub shard: Option<rubblepile::impact::campaign::Shard>,
     /// Threads of this process, 1 to 4096 [default: the node's cores over its MPI ranks; all cores without MPI].
     /// The runs at once share them: each run has its own pool of threads-per-rank / parallel threads, at least
     /// one, so `--parallel 16 --threads-per-rank 1` runs 16 runs at once on one thread each.
-    #[arg(long, value_name = "N", value_parser = crate::io::scene_file::thread_count)]
+    #[arg(long, value_name = "N", value_parser = rubblepile::io::scene_file::thread_count)]
     pub threads_per_rank: Option<usize>,
     /// Runs at once (overrides `campaign.parallel`).
     #[arg(long, value_name = "N")]
@@ -44,7 +44,7 @@ pub struct CampaignArgs {
 /// campaign file, 1 when a run failed (the others still ran), 3 when runs stopped after a checkpoint on
 /// request (`--stop-after-checkpoints`).
 pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
-    let to_cli = |e: crate::impact::campaign::CampaignError| CliError {
+    let to_cli = |e: rubblepile::impact::campaign::CampaignError| CliError {
         message: e.to_string(),
         code: e.exit_code(),
     };
@@ -70,15 +70,13 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
     if let Some(out) = &args.out {
         campaign.out = out.clone();
     }
-    let threads = crate::impact::campaign::threads_per_rank(args.threads_per_rank);
+    let threads = rubblepile::impact::campaign::threads_per_rank(args.threads_per_rank);
     rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().ok();
     let Some(report) = run_campaign_anywhere(&campaign, &options).map_err(to_cli)? else {
         return Ok(()); // an MPI worker rank: rank 0 reports
     };
     println!("{}", report.one_line());
-    let index = args
-        .shard
-        .map_or(crate::impact::campaign::CAMPAIGN_CSV.to_string(), |s| s.index_file());
+    let index = args.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());
     match report.problem(&campaign.out.join(index)) {
         Some((message, code)) => Err(CliError { message, code }),
         None => Ok(()),

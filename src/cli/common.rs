@@ -2,7 +2,7 @@
 //! progress flags of `run`, `resume` and the batch commands ([`CheckpointArgs`]), and the report of a run's end
 //! ([`report`]). Below `cli/mod.rs`, which re-exports them, so that each subcommand's file uses them one way.
 
-use crate::driver::{DEFAULT_CHECKPOINT_EVERY, RunOptions};
+use rubblepile::driver::{DEFAULT_CHECKPOINT_EVERY, RunOptions};
 
 /// A CLI failure: the message (one line) and the exit code.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -66,13 +66,13 @@ pub struct CheckpointArgs {
 
 impl CheckpointArgs {
     /// The run options these arguments ask for: every time option within its floor and ceiling
-    /// ([`crate::io::limits`]), the budget's within [`crate::io::run_budget`]'s, each refused by name otherwise.
+    /// ([`rubblepile::io::limits`]), the budget's within [`rubblepile::io::run_budget`]'s, each refused by name otherwise.
     pub(crate) fn options(&self, progress: bool) -> Result<RunOptions, CliError> {
-        use crate::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
+        use rubblepile::driver::progress::{DEFAULT_PROGRESS_EVERY, PROGRESS_EVERY_ENV};
         if self.stop_after_checkpoints == Some(0) {
             return Err(CliError::usage("--stop-after-checkpoints must be at least 1"));
         }
-        let t = crate::io::run_budget::TimeOptions {
+        let t = rubblepile::io::run_budget::TimeOptions {
             checkpoint_every: self.checkpoint_every,
             checkpoint_every_sim: self.checkpoint_every_sim,
             progress_every: self.progress_every,
@@ -83,7 +83,7 @@ impl CheckpointArgs {
         .map_err(CliError::usage)?;
         let progress_every = match (t.progress_every, std::env::var(PROGRESS_EVERY_ENV)) {
             (Some(s), _) => s,
-            (None, Ok(text)) => crate::driver::progress::every_from_env(&text).map_err(CliError::usage)?,
+            (None, Ok(text)) => rubblepile::driver::progress::every_from_env(&text).map_err(CliError::usage)?,
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
         Ok(RunOptions {
@@ -91,7 +91,7 @@ impl CheckpointArgs {
             progress,
             checkpoint_every: (t.checkpoint_every > 0.0).then_some(t.checkpoint_every),
             checkpoint_every_sim: t.checkpoint_every_sim,
-            formats: crate::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
+            formats: rubblepile::driver::formats::Formats::parse(&self.format).map_err(CliError::usage)?,
             progress_every,
             stop_after_checkpoints: self.stop_after_checkpoints,
             max_steps: t.max_steps.map(|n| n as u64),
@@ -111,8 +111,8 @@ impl From<crate::bench::BenchError> for CliError {
 
 /// Prints the one-line summary of a finished (or failed) run and its warnings (`warning: …` lines on stderr, e.g.
 /// contact-barrier overruns); maps errors to exit codes.
-pub(crate) fn report<S: crate::engine::RunReport>(
-    result: Result<S, crate::driver::RunError<S>>,
+pub(crate) fn report<S: rubblepile::engine::RunReport>(
+    result: Result<S, rubblepile::driver::RunError<S>>,
 ) -> Result<(), CliError> {
     let print = |summary: &S| {
         println!("{}", summary.one_line());
@@ -126,7 +126,7 @@ pub(crate) fn report<S: crate::engine::RunReport>(
             Ok(())
         }
         Err(e) => {
-            if let crate::driver::RunError::Failed { summary, .. } = &e {
+            if let rubblepile::driver::RunError::Failed { summary, .. } = &e {
                 print(summary);
             }
             Err(CliError {

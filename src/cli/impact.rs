@@ -1,5 +1,5 @@
 //! `rubblepile impact`: a projectile (Roig03 Table 2) on a rubble-pile target, run to `t_end` — a thin wrapper
-//! around [`crate::impact::run`].
+//! around [`rubblepile::impact::run`].
 //!
 //! The run directory holds, besides the core's outputs, `initial_bodies.csv` (target + projectile in the
 //! centre-of-mass frame), `impact.json` (Q, impact time, projectile) and `scene.toml`, an ordinary scene whose
@@ -8,9 +8,9 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError, report};
-use crate::driver::{RunOptions, run_scene};
-use crate::impact::projectile::ProjectileSpec;
-use crate::impact::run::{ImpactConfig, ImpactError, prepare_impact};
+use rubblepile::driver::{RunOptions, run_scene};
+use rubblepile::impact::projectile::ProjectileSpec;
+use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact, snapshot_times};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]
@@ -46,10 +46,10 @@ pub struct ImpactArgs {
     /// Integrator: bulirsch-stoer (Roig03's), dop853 or dopri5 (these project the attitudes onto |q| = 1 at
     /// every output sample).
     #[arg(long, default_value = "bulirsch-stoer")]
-    pub method: crate::integrate::Method,
+    pub method: rubblepile::integrate::Method,
     /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is Roig03's "F0 ≈ 1" in km and s, and the value
     /// closest to its outcomes in analysis/roig2003/F0_SCAN.md.
-    #[arg(long, default_value_t = crate::impact::run::DEFAULT_F0)]
+    #[arg(long, default_value_t = rubblepile::impact::run::DEFAULT_F0)]
     pub f0: f64,
     /// Inertia model of the ellipsoids: gaussian (Roig03 Eq. 4 with the model's κ) or uniform
     /// (homogeneous ellipsoids, free of the §4.3 spin bias).
@@ -61,8 +61,8 @@ pub struct ImpactArgs {
     /// Which kinetic energy K the contact barrier is β times (Roig03 Eq. 13): printed (½ m_l v², Eq. 14 as
     /// printed), impactor (½ m_k v²) or reduced (½ μ v², the pair's collision energy; gives Roig03's
     /// κ ≈ 10). See analysis/roig2003/DISCUSSION.md.
-    #[arg(long, default_value_t = crate::ellipsoid::calibration::KappaReading::Printed)]
-    pub kappa_reading: crate::ellipsoid::calibration::KappaReading,
+    #[arg(long, default_value_t = rubblepile::ellipsoid::calibration::KappaReading::Printed)]
+    pub kappa_reading: rubblepile::ellipsoid::calibration::KappaReading,
     /// Snapshot times (s), comma-separated [default: 0,100,400,1000,10000, cut at --t-end, plus --t-end].
     #[arg(long, value_delimiter = ',')]
     pub snapshots: Option<Vec<f64>>,
@@ -83,7 +83,7 @@ pub struct ImpactArgs {
     pub no_progress: bool,
     /// Rubble-pile projectile.
     #[command(flatten)]
-    pub pile: crate::impact::pile::PileArgs,
+    pub pile: rubblepile::impact::pile::PileArgs,
     /// Checkpoint options.
     #[command(flatten)]
     pub checkpoints: CheckpointArgs,
@@ -120,17 +120,17 @@ impl ImpactArgs {
             contact_time: self.contact_time,
             t_end: self.t_end,
             method: self.method,
-            rtol: self.rtol.unwrap_or(crate::impact::run::default_rtol(self.method)),
+            rtol: self.rtol.unwrap_or(rubblepile::impact::run::default_rtol(self.method)),
             f0: self.f0,
             beta: self.beta,
             kappa_reading: self.kappa_reading,
-            snapshots: crate::impact::run::snapshot_times(self.t_end, self.snapshots.as_deref(), self.snapshot_every)
+            snapshots: snapshot_times(self.t_end, self.snapshots.as_deref(), self.snapshot_every)
                 .map_err(CliError::usage)?,
             every: self.every,
             inertia: if self.inertia == "uniform" {
-                crate::ellipsoid::body::InertiaModel::Uniform
+                rubblepile::ellipsoid::body::InertiaModel::Uniform
             } else {
-                crate::ellipsoid::body::InertiaModel::Gaussian
+                rubblepile::ellipsoid::body::InertiaModel::Gaussian
             },
             pile,
         };
@@ -166,7 +166,7 @@ fn cli_error(e: ImpactError) -> CliError {
     CliError { message, code }
 }
 
-/// Runs `impact`: prints the impact's one-line description, then runs it (see [`crate::impact::run`]).
+/// Runs `impact`: prints the impact's one-line description, then runs it (see [`rubblepile::impact::run`]).
 pub fn impact(args: &ImpactArgs) -> Result<(), CliError> {
     let cfg = args.config()?;
     let options = RunOptions {

@@ -4,16 +4,16 @@
 //!   [--checkpoint-every-sim S]`: runs a scene (the built-in default scene without SCENE) and writes
 //!   its outputs into DIR, with checkpoints as asked;
 //! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
-//!   continues an interrupted run from `DIR/checkpoint.json` (see [`crate::driver`]);
+//!   continues an interrupted run from `DIR/checkpoint.json` (see [`rubblepile::driver`]);
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to; `rubblepile check DIR` (a
-//!   directory): whether a run directory is whole ([`crate::driver::inspect`]), one line per finding, exit code 2
+//!   directory): whether a run directory is whole ([`rubblepile::driver::inspect`]), one line per finding, exit code 2
 //!   when it is not; `rubblepile check --explain [KIND]`: every key of a scene file with its unit, default and
-//!   allowed range ([`crate::driver::explain`]);
+//!   allowed range ([`rubblepile::driver::explain`]);
 //! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
 //! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
 //! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
-//!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`crate::impact::campaign`]);
+//!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`rubblepile::impact::campaign`]);
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
 //! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
 //! - `rubblepile report richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
@@ -26,7 +26,7 @@
 //!   timed point-mass runs with their final states, for the comparison with REBOUND
 //!   (`analysis/rebound_compare`);
 //! - `rubblepile ssdem advise --radius R --density RHO [--body-radius B] [--spin-period-h T | --speed V]
-//!   [--max-overlap 0.01]` or `--scene FILE`: k_N and dt for soft spheres (see [`crate::granular::soft::advise`]);
+//!   [--max-overlap 0.01]` or `--scene FILE`: k_N and dt for soft spheres (see [`rubblepile::granular::soft::advise`]);
 //! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second;
 //! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius R
 //!   --bulk-density RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
@@ -34,8 +34,8 @@
 //!   ([`spinup`]); `rubblepile report zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
 //!
 //! - `rubblepile export vtk|xyz DIR [--force]`: a finished run's snapshots for ParaView or OVITO
-//!   ([`crate::driver::export`]); `rubblepile render DIR [--view iso] [--color speed] [--size 800x800]`: PNG frames
-//!   and an animated GIF ([`crate::render::run`]); `rubblepile bench render`: their cost.
+//!   ([`rubblepile::driver::export`]); `rubblepile render DIR [--view iso] [--color speed] [--size 800x800]`: PNG frames
+//!   and an animated GIF ([`rubblepile::render::run`]); `rubblepile bench render`: their cost.
 //!
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
@@ -48,7 +48,7 @@
 //!
 //! # One writer per directory
 //!
-//! Every command that writes a directory locks it first ([`crate::io::run_lock`]) and keeps the lock until it has
+//! Every command that writes a directory locks it first ([`rubblepile::io::run_lock`]) and keeps the lock until it has
 //! written its last byte there: `run` (with `--force` too), `resume`, `impact` and `flyby` their run directory;
 //! `campaign` its campaign directory (a shard only its own index, beside the other shards) and each run directory;
 //! `campaign merge` the campaign directory; `export` the run directory (the run itself may write the same VTK and
@@ -73,9 +73,9 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use crate::driver::RunOptions;
 use common::report;
 pub use common::{CheckpointArgs, CliError};
+use rubblepile::driver::RunOptions;
 
 /// Dynamics of rubble-pile asteroids: interacting ellipsoids (Roig et al. 2003).
 #[derive(Debug, Parser)]
@@ -102,7 +102,7 @@ pub enum Command {
     /// Run an impact of a projectile (P1, P2, P3 or custom) on a target.
     Impact(Box<impact::ImpactArgs>),
     /// Run a tidal flyby of a target pile past a planet (default Earth); analysis in DIR/analysis/flyby.json.
-    Flyby(Box<crate::impact::flyby::FlybyArgs>),
+    Flyby(Box<rubblepile::impact::flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(Box<campaign::CampaignArgs>),
     /// Analyse a run: clumps of any run (largest and second remnant, clumps.csv, sfd.svg); of an impact run also the
@@ -135,11 +135,11 @@ pub enum Command {
     #[command(hide = true)]
     ReportZhang2017(crate::studies::zhang2017::report::ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
-    Export(crate::driver::export::ExportArgs),
+    Export(rubblepile::driver::export::ExportArgs),
     /// Convert pkdgrav `.ss` files to and from bodies/particles CSV (units converted at the edge).
-    Convert(crate::driver::convert::ConvertArgs),
+    Convert(rubblepile::driver::convert::ConvertArgs),
     /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
-    Render(crate::render::args::RenderArgs),
+    Render(rubblepile::render::args::RenderArgs),
 }
 
 /// `rubblepile report …`: one verb for the papers' reproduction reports.
@@ -204,7 +204,7 @@ pub struct CheckArgs {
     pub print_default: bool,
     /// Print every key of a KIND scene file (all kinds without one): its unit, default, allowed range and meaning.
     #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"])]
-    pub explain: Option<Option<crate::driver::SceneKind>>,
+    pub explain: Option<Option<rubblepile::driver::SceneKind>>,
 }
 
 /// `rubblepile bench …`.
@@ -246,12 +246,12 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 force: args.force,
                 ..args.checkpoints.options(!args.no_progress)?
             };
-            let result = crate::driver::run_file(args.scene.as_deref(), &args.out, &options);
+            let result = rubblepile::driver::run_file(args.scene.as_deref(), &args.out, &options);
             if result.is_err() || !(args.render || args.scene.is_none()) {
                 return report(result);
             }
-            let (before, after) =
-                crate::render::run::after_run(&args.out, args.scene.is_none(), args.force).map_err(CliError::failed)?;
+            let (before, after) = rubblepile::render::run::after_run(&args.out, args.scene.is_none(), args.force)
+                .map_err(CliError::failed)?;
             println!("{before}");
             report(result)?;
             after.iter().for_each(|l| println!("{l}"));
@@ -259,21 +259,21 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         }
         Command::Resume(args) => {
             let options = args.checkpoints.options(!args.no_progress)?;
-            report(crate::driver::resume_dir(&args.dir, &options))
+            report(rubblepile::driver::resume_dir(&args.dir, &options))
         }
         Command::Check(args) => {
             if let Some(kind) = args.explain {
-                print!("{}", crate::driver::explain(kind));
+                print!("{}", rubblepile::driver::explain(kind));
                 return Ok(());
             }
             if args.print_default {
-                print!("{}", crate::ellipsoid::scene::DEFAULT_SCENE_TOML);
+                print!("{}", rubblepile::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
             }
             if let Some(dir) = args.scene.as_deref().filter(|p| p.is_dir()) {
                 return check_run_dir(dir);
             }
-            let (warnings, lines) = crate::driver::check_file(args.scene.as_deref()).map_err(CliError::usage)?;
+            let (warnings, lines) = rubblepile::driver::check_file(args.scene.as_deref()).map_err(CliError::usage)?;
             for w in warnings {
                 eprintln!("warning: {w}");
             }
@@ -285,7 +285,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
-        Command::Flyby(args) => crate::analysis::flyby::flyby_command(&args)
+        Command::Flyby(args) => rubblepile::analysis::flyby::flyby_command(&args)
             .map(|lines| lines.iter().for_each(|l| println!("{l}")))
             .map_err(|(message, code)| CliError { message, code }),
         Command::Campaign(args) => campaign::campaign(&args),
@@ -338,7 +338,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
 /// `rubblepile check DIR`: one line per finding on stdout (problems as `problem: …`); not whole is an error (exit
 /// code 2) naming the first problem.
 fn check_run_dir(dir: &std::path::Path) -> Result<(), CliError> {
-    let report = crate::driver::inspect::check_run_dir(dir);
+    let report = rubblepile::driver::inspect::check_run_dir(dir);
     for f in &report.findings {
         println!("{}{}", if f.problem { "problem: " } else { "" }, f.line);
     }

@@ -1,10 +1,10 @@
-//! `rubblepile spinup …`: the options, and the calls into [`crate::analysis::spinup_search`].
+//! `rubblepile spinup …`: the options, and the calls into [`rubblepile::analysis::spinup_search`].
 
 use std::path::PathBuf;
 
-use crate::analysis::creep::CreepCriterionKind;
-use crate::analysis::spinup_search::{CriticalOptions, SearchError, critical as run_critical, density_fit as fit};
 use crate::cli::common::CliError;
+use rubblepile::analysis::creep::CreepCriterionKind;
+use rubblepile::analysis::spinup_search::{CriticalOptions, SearchError, critical as run_critical, density_fit as fit};
 
 /// `rubblepile spinup …`.
 #[derive(Debug, clap::Subcommand)]
@@ -38,7 +38,7 @@ pub struct JudgeArgs {
 
 /// `rubblepile spinup judge`.
 pub fn judge(args: &JudgeArgs) -> Result<(), CliError> {
-    crate::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
+    rubblepile::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
         .map_err(cli_error)
 }
 
@@ -101,7 +101,7 @@ pub struct CriticalArgs {
     /// Run only the holds k with k mod N = I (grid order), for a job array (Slurm: --shard $SLURM_ARRAY_TASK_ID/N),
     /// after writing the branches; judge afterwards with the same command without --shard.
     #[arg(long, value_name = "I/N")]
-    pub shard: Option<crate::impact::campaign::Shard>,
+    pub shard: Option<rubblepile::impact::campaign::Shard>,
     /// Run a hold whose forcing was released to its end (by default it stops within 2000 simulated seconds of the
     /// release: its verdict is fixed).
     #[arg(long)]

@@ -4,8 +4,8 @@
 use std::path::PathBuf;
 
 use crate::cli::common::CliError;
-use crate::granular::soft::advise::{Advice, DEFAULT_MAX_OVERLAP, advise_for_grains};
-use crate::granular::soft::scene::load_soft_scene;
+use rubblepile::granular::soft::advise::{Advice, DEFAULT_MAX_OVERLAP, advise_for_grains};
+use rubblepile::granular::soft::scene::load_soft_scene;
 
 /// `rubblepile ssdem …`.
 #[derive(Debug, clap::Subcommand)]
@@ -66,7 +66,7 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
             a.dt /= f;
             a.stability_limit /= f;
             a.gravity_interval = a.dynamical_time.map_or(1, |t| {
-                crate::granular::soft::advise::gravity_interval(t, a.dt, a.contact_time)
+                rubblepile::granular::soft::advise::gravity_interval(t, a.dt, a.contact_time)
             });
         }
         a

@@ -1,11 +1,12 @@
-//! `rubblepile bench stability`: runs the stability suite of [`crate::bench::stability`] (Roig03 model in its
-//! regimes of trouble) and writes `stability.csv`, `stability.md` and one run directory per case.
+//! `rubblepile bench stability`: runs the stability suite of [`rubblepile::driver::stability`] (Roig03 model in its
+//! regimes of trouble) and writes `stability.csv`, `stability.md` ([`crate::bench::stability`]) and a run per case.
 
 use std::path::PathBuf;
 
-use crate::bench::stability::cases::all_cases;
-use crate::bench::stability::{StabilityRow, Verdict, prepare_out, result_paths, run_case, write_csv, write_markdown};
+use crate::bench::stability::{prepare_out, result_paths, write_csv, write_markdown};
 use crate::cli::common::CliError;
+use rubblepile::driver::stability::cases::all_cases;
+use rubblepile::driver::stability::{StabilityRow, Verdict, run_case};
 
 /// `rubblepile bench stability`.
 #[derive(Debug, clap::Args)]
@@ -25,8 +26,8 @@ pub struct StabilityArgs {
     pub only: Vec<String>,
     /// The integrator every case runs with (its tolerances unchanged), e.g. `bulirsch-stoer-implicit` to compare
     /// the stiff rows.
-    #[arg(long, value_enum, default_value_t = crate::integrate::Method::BulirschStoer)]
-    pub method: crate::integrate::Method,
+    #[arg(long, value_enum, default_value_t = rubblepile::integrate::Method::BulirschStoer)]
+    pub method: rubblepile::integrate::Method,
 }
 
 /// Runs `bench stability`; exits with code 1 when a case fails.

@@ -4,10 +4,11 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 use crate::cli::common::CliError;
-use crate::driver::DEFAULT_CHECKPOINT_EVERY;
-use crate::ellipsoid::output::write_snapshot;
-use crate::impact::target::{TargetSpec, build_target_resumable};
-use crate::impact::target_checkpoint::{BuildCheckpoint, checkpoint_path, read_checkpoint, write_checkpoint};
+use rubblepile::driver::DEFAULT_CHECKPOINT_EVERY;
+use rubblepile::ellipsoid::output::write_snapshot;
+use rubblepile::impact::target::{TargetSpec, build_target_resumable};
+use rubblepile::impact::target_checkpoint::{BuildCheckpoint, checkpoint_path, read_checkpoint, write_checkpoint};
+use rubblepile::io::run_budget::check_wall_seconds;
 
 /// `rubblepile target …`.
 #[derive(Debug, clap::Subcommand)]
@@ -56,7 +57,7 @@ pub fn table(args: &TableArgs) -> Result<(), CliError> {
     let mut columns: Vec<Vec<String>> = Vec::new();
     for path in &args.reports {
         let text = std::fs::read_to_string(path).map_err(|e| CliError::usage(format!("{}: {e}", path.display())))?;
-        let r: crate::impact::target::TargetReport =
+        let r: rubblepile::impact::target::TargetReport =
             serde_json::from_str(&text).map_err(|e| CliError::usage(format!("{}: {e}", path.display())))?;
         let ours = [
             r.total_mass_kg / 1e18,
@@ -133,7 +134,7 @@ pub struct BuildArgs {
     pub drop_detached: bool,
     /// Which K of Roig03 Eq. 13 sets κ: printed, impactor or reduced (the impacts' κ; see `rubblepile impact`)
     #[arg(long, default_value = "printed")]
-    pub kappa_reading: crate::ellipsoid::calibration::KappaReading,
+    pub kappa_reading: rubblepile::ellipsoid::calibration::KappaReading,
     /// Overwrite FILE.csv / FILE.json (and a checkpoint) of an earlier build.
     #[arg(long)]
     pub force: bool,
@@ -189,7 +190,7 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    crate::io::run_budget::check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
+    check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
         .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
@@ -240,8 +241,8 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
     let (bodies, report) = built.map_err(|e| CliError::failed(format!("target build: {e}")))?;
     write_snapshot(&args.out, 0.0, &bodies).map_err(|e| CliError::failed(format!("{}: {e}", args.out.display())))?;
     let text = serde_json::to_string_pretty(&report).map_err(|e| CliError::failed(e.to_string()))?;
-    crate::io::safe_write::write_atomic(&json, text + "\n")
-        .map_err(|e| CliError::failed(crate::io::safe_write::describe(&json, &e)))?;
+    rubblepile::io::safe_write::write_atomic(&json, text + "\n")
+        .map_err(|e| CliError::failed(rubblepile::io::safe_write::describe(&json, &e)))?;
     if checkpoint_file.exists() {
         // the build is complete: its checkpoint would only block the next build of this name
         std::fs::remove_file(&checkpoint_file)

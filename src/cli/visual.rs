@@ -1,19 +1,19 @@
 //! `rubblepile export FORMAT RUN_DIR` (visualisation files of a finished run), `rubblepile render RUN_DIR`
 //! (PNG frames and an animated GIF) and `rubblepile convert FILE --to FILE` (pkdgrav `.ss` files).
 
-use crate::analysis::run_analysis::FragmentFields;
 use crate::cli::common::CliError;
-use crate::driver::export::{ExportError, export};
-use crate::driver::formats::Formats;
-use crate::render::args::RenderArgs;
-use crate::render::run::{RenderReport, RenderRunError, RenderRunOptions, render_run};
+use rubblepile::analysis::run_analysis::FragmentFields;
+use rubblepile::driver::export::{ExportError, export};
+use rubblepile::driver::formats::Formats;
+use rubblepile::render::args::RenderArgs;
+use rubblepile::render::run::{RenderReport, RenderRunError, RenderRunOptions, render_run};
 
 /// Runs `export`.
-pub fn export_cmd(args: &crate::driver::export::ExportArgs) -> Result<(), CliError> {
+pub fn export_cmd(args: &rubblepile::driver::export::ExportArgs) -> Result<(), CliError> {
     let formats = Formats::parse(std::slice::from_ref(&args.format))
         .map_err(|e| CliError::usage(e.to_string().replacen("--format", "FORMAT", 1)))?;
     let fields = FragmentFields::read(&args.dir).map_err(CliError::usage)?;
-    let extra = |view: &crate::engine::SnapshotView| {
+    let extra = |view: &rubblepile::engine::SnapshotView| {
         Ok(fields
             .as_ref()
             .map(|f| f.columns(view.particles.iter().map(|p| p.id)))
@@ -41,7 +41,7 @@ pub fn export_cmd(args: &crate::driver::export::ExportArgs) -> Result<(), CliErr
             "open {} in ParaView",
             args.dir
                 .join("vtk")
-                .join(crate::driver::formats::vtk::COLLECTION_FILE)
+                .join(rubblepile::driver::formats::vtk::COLLECTION_FILE)
                 .display()
         );
     }
@@ -71,9 +71,9 @@ pub fn render_cmd(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// Runs `convert`.
-pub fn convert_cmd(args: &crate::driver::convert::ConvertArgs) -> Result<(), CliError> {
-    let c =
-        crate::driver::convert::convert(&args.input, &args.to, args.spheres, args.force).map_err(CliError::usage)?;
+pub fn convert_cmd(args: &rubblepile::driver::convert::ConvertArgs) -> Result<(), CliError> {
+    let c = rubblepile::driver::convert::convert(&args.input, &args.to, args.spheres, args.force)
+        .map_err(CliError::usage)?;
     println!("wrote {} ({} bodies): {}", args.to.display(), c.count, c.note);
     Ok(())
 }

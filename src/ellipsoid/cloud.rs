@@ -1,7 +1,9 @@
 //! Random clouds of ellipsoids (for benchmarks and stress tests), seeded and reproducible.
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::math::Vec3;
+use crate::ellipsoid::quaternion::rotation_matrix;
+use crate::engine::{ParticleView, SnapshotView};
+use crate::math::{Mat3, Vec3};
 use crate::random::{generator, random_quaternion, symmetric, uniform};
 
 /// Parameters of [`random_cloud`].
@@ -83,6 +85,37 @@ pub fn random_cloud(n: usize, seed: u64, p: &CloudParams) -> Vec<Body> {
         });
     }
     bodies
+}
+
+/// One random snapshot of `n` ellipsoids of [`random_cloud`] (seed 1, default [`CloudParams`]), or spheres of the
+/// same volumes when `spheres`: a scene-sized input for the renderer and the snapshot writers.
+pub fn cloud_view(n: usize, spheres: bool) -> SnapshotView {
+    let bodies = random_cloud(n, 1, &CloudParams::default());
+    let particles = bodies
+        .iter()
+        .enumerate()
+        .map(|(id, b)| {
+            let r = b.shape.axes.product().cbrt();
+            ParticleView {
+                id,
+                mass: b.shape.mass,
+                position: b.position,
+                velocity: b.velocity,
+                spin_world: b.spin_body,
+                axes: if spheres { Vec3::repeat(r) } else { b.shape.axes },
+                rotation: if spheres {
+                    Mat3::identity()
+                } else {
+                    rotation_matrix(&b.quaternion).transpose()
+                },
+            }
+        })
+        .collect();
+    SnapshotView {
+        spheres,
+        particles,
+        ..Default::default()
+    }
 }
 
 #[cfg(test)]

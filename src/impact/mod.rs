@@ -6,12 +6,15 @@
 //! - [`run`]: one impact run (target + projectile → run directory → [`crate::driver::run_scene`]);
 //! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
 //!   in parallel, resumable, summarised in `campaign.csv`;
-//! - [`flyby`]: a tidal flyby of a pile past a planet (`rubblepile flyby`).
+//! - [`flyby`]: a tidal flyby of a pile past a planet (`rubblepile flyby`);
+//! - [`problems`]: the canonical problems of the ellipsoid model (free top, bouncing pair, N30 impact, N-body
+//!   tests), shared by the tests and the benchmarks.
 
 pub mod campaign;
 pub mod error;
 pub mod flyby;
 pub mod pile;
+pub mod problems;
 pub mod projectile;
 pub mod run;
 pub mod settle;

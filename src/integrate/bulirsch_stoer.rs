@@ -125,7 +125,7 @@ pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = 10;
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, bulirsch_stoer::BulirschStoer};
-/// use rubblepile::bench::problems::{HarmonicOscillator, TestProblem};
+/// use rubblepile::integrate::problems::{HarmonicOscillator, TestProblem};
 ///
 /// let osc = HarmonicOscillator::new(1.0);
 /// let mut bs = BulirschStoer::new(Tolerances::uniform(1e-12, 1e-12, 2), None).unwrap();

@@ -440,7 +440,7 @@ fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, dop853::Dop853};
-/// use rubblepile::bench::problems::{HarmonicOscillator, TestProblem};
+/// use rubblepile::integrate::problems::{HarmonicOscillator, TestProblem};
 ///
 /// let osc = HarmonicOscillator::new(1.0);
 /// let mut dop = Dop853::new(Tolerances::uniform(1e-10, 1e-10, 2), None).unwrap();

@@ -106,7 +106,7 @@ const MAX_NONFINITE_RETRIES: u32 = 10;
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, linearly_implicit::LinearlyImplicit};
-/// use rubblepile::bench::problems::{StiffDampedOscillator, TestProblem};
+/// use rubblepile::integrate::problems::{StiffDampedOscillator, TestProblem};
 ///
 /// let osc = StiffDampedOscillator::default(); // damping 1000 times faster than the slow mode
 /// let mut li = LinearlyImplicit::new(Tolerances::uniform(1e-8, 1e-8, 2)).unwrap();

@@ -9,12 +9,14 @@
 //!   cross-checks);
 //! - [`linearly_implicit`]: linearly implicit Euler extrapolation (SEULEX of Hairer & Wanner, *Solving ODEs II*,
 //!   §IV.9) for stiff systems, using the stiff part a system supplies ([`OdeSystem::stiff_part`]);
-//! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution).
+//! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution);
+//! - [`problems`]: canonical ODE problems with known solutions (Arenstorf orbit, Kepler, …), shared by the
+//!   tests and the benchmarks.
 //!
 //! What they share (the system and integrator traits, methods, tolerances, statistics, errors and the states a
 //! checkpoint keeps) is in `common.rs`, re-exported here: each method imports it from there, and only this file
-//! names the methods ([`make_integrator`]), so the files form no circle. The canonical test problems and the
-//! work–precision measurements that exercise these solvers live in `bench`.
+//! names the methods ([`make_integrator`]), so the files form no circle. The work–precision measurements that
+//! exercise these solvers are the `rubblepile bench` program's.
 
 pub mod bulirsch_stoer;
 pub mod compensated;
@@ -22,6 +24,7 @@ pub mod dop853;
 pub mod elliptic;
 pub mod linearly_implicit;
 pub mod ode_solvers_adapter;
+pub mod problems;
 
 mod common;
 pub use common::*;

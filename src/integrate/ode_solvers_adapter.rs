@@ -107,7 +107,7 @@ impl System<f64, DVector<f64>> for Wrapped<'_> {
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Method, Tolerances, ode_solvers_adapter::OdeSolversAdapter};
-/// use rubblepile::bench::problems::{HarmonicOscillator, TestProblem};
+/// use rubblepile::integrate::problems::{HarmonicOscillator, TestProblem};
 ///
 /// let osc = HarmonicOscillator::new(1.0);
 /// let mut dop = OdeSolversAdapter::new(Method::Dop853, Tolerances::uniform(1e-10, 1e-10, 2), None).unwrap();

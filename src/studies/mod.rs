@@ -1,5 +1,5 @@
 //! The three papers this crate reproduces, one room each: the code that writes a paper's report (its tables beside
-//! the paper's numbers, its referee sections, its figures), built on the post-processing of [`crate::analysis`] that
+//! the paper's numbers, its referee sections, its figures), built on the post-processing of [`rubblepile::analysis`] that
 //! any run needs.
 //!
 //! - [`roig2003`]: Roig et al. (2003, Icarus 165), §4 — `rubblepile report roig2003`;

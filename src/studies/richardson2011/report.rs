@@ -1,15 +1,15 @@
 //! `rubblepile report richardson2011`: regenerates `analysis/richardson2011/REPORT.md` and its figures from the
-//! model-atmosphere runs (Richardson11 §3.1, [`crate::analysis::atmosphere`]) and the tumbler runs (§3.2,
-//! [`crate::analysis::tumbler`]), with the paper's numbers beside ours. Hand-written, measured notes (speed, run
+//! model-atmosphere runs (Richardson11 §3.1, [`rubblepile::analysis::atmosphere`]) and the tumbler runs (§3.2,
+//! [`rubblepile::analysis::tumbler`]), with the paper's numbers beside ours. Hand-written, measured notes (speed, run
 //! commands) come from `NOTES.md` in the output directory and are appended verbatim.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::analysis::atmosphere::{AtmosphereRun, KS_FRACTIONS, analyse_atmosphere_run, mean_std};
-use crate::analysis::figures::lines::{LineChart, Mark, Series};
-use crate::analysis::figures::style::write_figure;
-use crate::analysis::tumbler::{CO_ROTATION_TOLERANCE, TumblerRun, analyse_tumbler_run};
+use rubblepile::analysis::atmosphere::{AtmosphereRun, KS_FRACTIONS, analyse_atmosphere_run, mean_std};
+use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
+use rubblepile::analysis::figures::style::write_figure;
+use rubblepile::analysis::tumbler::{CO_ROTATION_TOLERANCE, TumblerRun, analyse_tumbler_run};
 
 /// Richardson11 §3.1: expected scale heights for masses 1, 3, 10.
 const PAPER_SCALE_HEIGHTS: [f64; 3] = [1.88, 0.626, 0.188];
@@ -87,7 +87,7 @@ fn atmosphere_figures(run: &AtmosphereRun, tag: &str, fig_dir: &Path) -> Result<
     for (s, &m) in run.masses.iter().enumerate() {
         let mut z = run.final_heights[s].clone();
         z.sort_by(f64::total_cmp);
-        let h = crate::analysis::atmosphere::mean(&z);
+        let h = rubblepile::analysis::atmosphere::mean(&z);
         let n = z.len() as f64;
         series.push(Series {
             label: format!("{}: heights", species_name(m)),

@@ -11,27 +11,27 @@
 //! 2. [`write_report`] reads those two files and writes `REFEREE.md` (tables) and `figures/referee_f0.svg`
 //!    (and `.png`): the rotational share and f_KE against F0 with the paper's ranges.
 //!
-//! The fragment quantities are those of [`crate::analysis::fragments`] (the same call `rubblepile analyze`
-//! makes); the new ones come from [`crate::analysis::ejection_fits`], [`crate::analysis::rotational_split`]
-//! and [`crate::analysis::pile_equilibrium`].
+//! The fragment quantities are those of [`rubblepile::analysis::fragments`] (the same call `rubblepile analyze`
+//! makes); the new ones come from [`rubblepile::analysis::ejection_fits`], [`rubblepile::analysis::rotational_split`]
+//! and [`rubblepile::analysis::pile_equilibrium`].
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::AnalysisError;
-use crate::analysis::atmosphere::mean_std;
-use crate::analysis::csv_rows::{read_rows, write_rows};
-use crate::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor};
-use crate::analysis::figures::lines::{LineChart, Mark, Series};
-use crate::analysis::figures::style::write_figure;
-use crate::analysis::fits::{PowerLawFit, fit_power_law};
-use crate::analysis::fragments::{FragmentParams, analyse_fragments, pearson, read_snapshot_bodies};
-use crate::analysis::pile_equilibrium::pile_drift;
-use crate::analysis::rotational_split::rotational_split;
-use crate::analysis::run_analysis::snapshot_path;
-use crate::ellipsoid::body::Body;
-use crate::ellipsoid::equations::G_SI;
+use rubblepile::analysis::AnalysisError;
+use rubblepile::analysis::atmosphere::mean_std;
+use rubblepile::analysis::csv_rows::{read_rows, write_rows};
+use rubblepile::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor};
+use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
+use rubblepile::analysis::figures::style::write_figure;
+use rubblepile::analysis::fits::{PowerLawFit, fit_power_law};
+use rubblepile::analysis::fragments::{FragmentParams, analyse_fragments, pearson, read_snapshot_bodies};
+use rubblepile::analysis::pile_equilibrium::pile_drift;
+use rubblepile::analysis::rotational_split::rotational_split;
+use rubblepile::analysis::run_analysis::snapshot_path;
+use rubblepile::ellipsoid::body::Body;
+use rubblepile::ellipsoid::equations::G_SI;
 
 /// The Δv floor of the Fig. 4 fits (m/s): above the largest ejection speed a fragment of a 4 h pile gets from
 /// the pile's turning alone over 400 s, `2 sin(Ω t/2) Ω R ≈ 8.5 m/s` at the apparent radius 110 km.
@@ -128,7 +128,7 @@ pub struct RefereeRun {
     pub energy_error: f64,
 }
 
-/// One snapshot of a target run alone ([`crate::analysis::pile_equilibrium`]).
+/// One snapshot of a target run alone ([`rubblepile::analysis::pile_equilibrium`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EquilibriumRow {
     /// Target name.
@@ -183,7 +183,7 @@ pub fn parse_run_name(name: &str) -> Option<(String, String, u64)> {
     (k > 0).then(|| (tokens[..k].join("_"), tokens[k].to_string(), seed))
 }
 
-fn alpha(fit: &Result<PowerLawFit, crate::analysis::fits::FitError>) -> (f64, f64, usize) {
+fn alpha(fit: &Result<PowerLawFit, rubblepile::analysis::fits::FitError>) -> (f64, f64, usize) {
     fit.as_ref()
         .map_or((f64::NAN, f64::NAN, 0), |f| (f.alpha, f.sigma_alpha, f.points))
 }
@@ -202,7 +202,7 @@ pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError>
     let impact_path = dir.join("impact.json");
     let projectile_index = number(&read_json(&impact_path)?, "projectile_index", &impact_path)? as usize;
     let scene_path = dir.join("scene.toml");
-    let scene = crate::ellipsoid::scene::parse_toml(&read_text(&scene_path)?, &scene_path.display().to_string())
+    let scene = rubblepile::ellipsoid::scene::parse_toml(&read_text(&scene_path)?, &scene_path.display().to_string())
         .map_err(|e| AnalysisError::Input(e.to_string()))?;
     let g = scene.physics.gravity.and_then(|g| g.g).unwrap_or(G_SI);
     let (initial, at) = (snapshot(dir, 0.0)?, snapshot(dir, T_AT)?);
@@ -228,7 +228,7 @@ pub fn collect_run(dir: &Path, group: &str) -> Result<RefereeRun, AnalysisError>
     let sites = ejected_sites(&report.fragments, 0.5 * s.escape_velocity);
     let centre = {
         let bodies = initial.iter().enumerate().filter(|(i, _)| *i != projectile_index);
-        let (r, m) = bodies.fold((crate::math::Vec3::zeros(), 0.0), |(r, m), (_, b)| {
+        let (r, m) = bodies.fold((rubblepile::math::Vec3::zeros(), 0.0), |(r, m), (_, b)| {
             (r + b.position * b.shape.mass, m + b.shape.mass)
         });
         r / m
@@ -885,4 +885,75 @@ pub fn referee_command(args: &RefereeArgs) -> Result<(), AnalysisError> {
         RefereeArgs::Report { out } => println!("wrote {}", write_report(out)?.display()),
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn run_names_give_target_projectile_and_seed() {
+        let parse = parse_run_name;
+        assert_eq!(parse("N200_T4_P2_z45_s3"), Some(("N200_T4".into(), "P2".into(), 3)));
+        assert_eq!(
+            parse("N200_T4_s2_P1_z45_s1"),
+            Some(("N200_T4_s2".into(), "P1".into(), 1))
+        );
+        assert_eq!(
+            parse("N200_T4_P2_z45_s2_f3e-7"),
+            Some(("N200_T4".into(), "P2".into(), 2))
+        );
+        assert_eq!(
+            parse("N200_T4_reduced_P3_z45_s1"),
+            Some(("N200_T4_reduced".into(), "P3".into(), 1))
+        );
+        assert_eq!(parse("P2_z45_s1"), None);
+        assert_eq!(parse("N200_T4_printed"), None);
+    }
+
+    /// Guards `report roig2003-referee collect` against dropping committed rows: collecting one new group (here a
+    /// `per_n` row) keeps every other group's committed rows in their order, and a collected group replaces its
+    /// own committed rows.
+    #[test]
+    fn collecting_one_group_keeps_the_committed_rows_of_the_others() {
+        let committed = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("analysis/roig2003");
+        let rows: Vec<RefereeRun> = read_csv(&committed.join("referee_runs.csv")).unwrap();
+        let equilibrium: Vec<EquilibriumRow> = read_csv(&committed.join("referee_equilibrium.csv")).unwrap();
+        let committed_only: Vec<RefereeRun> = rows.iter().filter(|r| r.group != "per_n").cloned().collect();
+        let dir = std::env::temp_dir().join(format!("rubblepile-referee-merge-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        write_csvs(&dir, &committed_only, &equilibrium).unwrap();
+
+        let (same, eq) = merge_with_committed(&dir, Vec::new(), Vec::new()).unwrap();
+        // Debug text, not `==`: the rows hold NaN where a fit had too few points.
+        let text = |rows: &[RefereeRun]| format!("{rows:?}");
+        assert!(
+            text(&same) == text(&committed_only),
+            "nothing collected: the committed rows, unchanged and in order"
+        );
+        assert_eq!(eq.len(), equilibrium.len());
+
+        let mut new = committed_only[0].clone();
+        new.group = "per_n".into();
+        new.run = "N30_T4_P1_z45_s1".into();
+        new.target = "N30_T4".into();
+        let (merged, _) = merge_with_committed(&dir, vec![new.clone()], Vec::new()).unwrap();
+        assert_eq!(merged.len(), committed_only.len() + 1);
+        assert!(
+            text(&merged[merged.len() - 1..]) == text(&[new]),
+            "per_n sorts after the committed groups"
+        );
+
+        let mut replaced = committed_only[0].clone();
+        replaced.f_ke = 0.5;
+        let group = replaced.group.clone();
+        let (merged, _) = merge_with_committed(&dir, vec![replaced.clone()], Vec::new()).unwrap();
+        let in_group: Vec<&RefereeRun> = merged.iter().filter(|r| r.group == group).collect();
+        assert_eq!(
+            in_group,
+            vec![&replaced],
+            "a collected group replaces its committed rows"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -10,8 +10,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::kappa::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
-use crate::analysis::campaign_analysis::analyze_campaign;
-use crate::analysis::run_analysis::{AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection};
+use rubblepile::analysis::campaign_analysis::analyze_campaign;
+use rubblepile::analysis::run_analysis::{AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection};
 
 /// A published outcome of Roig03 as a closed interval (with the paper's words).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,9 +45,6 @@ pub const MAXWELLIAN_RATIO: Published = Published { low: 2.0, high: 3.0 };
 pub const EJECTION_RELATIVE: Published = Published { low: 1e-4, high: 5e-4 };
 /// Roig03 §4.2 (Fig. 5): Q*_D ≈ 2.6e9 erg/g.
 pub const Q_STAR_D: f64 = 2.6e9;
-/// Roig03 Fig. 5: bound fraction ≈ 1.04 − 0.2e-9 Q (Q in erg/g).
-pub const BOUND_LINE: (f64, f64) = (1.04, -0.2e-9);
-
 /// What the report needs besides the campaign analysis.
 #[derive(Debug, Clone)]
 pub struct ReportInputs<'a> {
@@ -126,7 +123,7 @@ fn values(runs: &[CampaignRun], f: impl Fn(&CampaignRun) -> Option<f64>) -> Vec<
 
 /// Median of the values of `v` (NaN when empty).
 fn median(v: &[(f64, &str)]) -> f64 {
-    crate::math::median(&v.iter().map(|p| p.0).collect::<Vec<_>>())
+    rubblepile::math::median(&v.iter().map(|p| p.0).collect::<Vec<_>>())
 }
 
 /// "min (run) … max (run), median m; k of n inside [low, high]".
@@ -445,7 +442,7 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         c,
         inputs.campaign_dir,
         inputs.other_kappa,
-        crate::ellipsoid::equations::G_SI,
+        rubblepile::ellipsoid::equations::G_SI,
     );
 
     // ---------------------------------------------------------------- spin bias
@@ -827,7 +824,7 @@ fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
     let typical: Vec<String> = outcomes
         .iter()
         .zip(&sds)
-        .map(|((name, _, fmt), s)| format!("{name} {}", fmt(crate::math::median(s))))
+        .map(|((name, _, fmt), s)| format!("{name} {}", fmt(rubblepile::math::median(s))))
         .collect();
     let _ = writeln!(
         w,

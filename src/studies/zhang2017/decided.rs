@@ -2,9 +2,9 @@
 //! the other four models scaled), the packing ordering RCP − HCP with `ordering.csv`, T_c,3 against the HCP
 //! lattice's orientation, T_c,3 against the hold length, and the equilibrium bound on HCP's φ.
 //!
-//! The protocol: the Didymos primary of Naidu et al. (2020) ([`crate::aggregate::triaxial_top`]), the bulk density
-//! the paper's grain counts give ([`super::rows::paper_bulk_density`]), the paper's creep criterion with zero
-//! tolerance judged by rates ([`crate::analysis::creep`]), every hold read over the length at which T_c,3 stops
+//! The protocol: the Didymos primary of Naidu et al. (2020) ([`rubblepile::aggregate::triaxial_top`]), the bulk density
+//! the paper's grain counts give ([`rubblepile::analysis::spinup::paper_bulk_density`]), the paper's creep criterion with zero
+//! tolerance judged by rates ([`rubblepile::analysis::creep`]), every hold read over the length at which T_c,3 stops
 //! moving ([`decided_hold_length`]).
 //!
 //! Layout read (compact copies, `analysis/zhang2017/compact.py`): `DIR/full/<name>/`, `DIR/scaled/<name>/` and
@@ -15,19 +15,19 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use crate::aggregate::report::AggregateReport;
-use crate::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
-use crate::analysis::creep::CreepCriterionKind;
-use crate::analysis::figures::lines::{LineChart, Mark, Series};
-use crate::analysis::figures::style::write_figure;
-use crate::analysis::spin_limit::{critical_kappa, least_friction_angle};
-use crate::analysis::spinup::omega_of_hours;
-use crate::analysis::spinup_search::{
+use rubblepile::aggregate::report::AggregateReport;
+use rubblepile::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
+use rubblepile::analysis::creep::CreepCriterionKind;
+use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
+use rubblepile::analysis::figures::style::write_figure;
+use rubblepile::analysis::spin_limit::{critical_kappa, least_friction_angle};
+use rubblepile::analysis::spinup::{omega_of_hours, paper_bulk_density};
+use rubblepile::analysis::spinup_search::{
     Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
 };
-use crate::io::scene_file::SI_G;
+use rubblepile::io::scene_file::SI_G;
 
-use super::rows::{ModelRow, TABLE3, opt, paper_bulk_density, path_row};
+use super::rows::{ModelRow, TABLE3, opt, path_row};
 
 /// The hold lengths (s) at which every search is read: the 16 000 s of the earlier searches and two and about
 /// three times that.
@@ -336,7 +336,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     // the ordering
     let full = in_group(Group::Full);
     let csv = ordering_csv(&full, hold);
-    crate::io::safe_write::write_atomic(&out.join("ordering.csv"), &csv)
+    rubblepile::io::safe_write::write_atomic(&out.join("ordering.csv"), &csv)
         .map_err(|e| format!("{}: {e}", out.join("ordering.csv").display()))?;
     let _ = writeln!(
         md,
@@ -507,11 +507,11 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
 }
 
 /// Zhang17 Fig. 2's analogue: the surface slopes of the decided shape (and of the top of the earlier runs)
-/// as homogeneous bodies of the decided density spinning at the Didymos period ([`crate::analysis::surface_slopes`]);
+/// as homogeneous bodies of the decided density spinning at the Didymos period ([`rubblepile::analysis::surface_slopes`]);
 /// writes `decided_slopes.{svg,png}` (slope against latitude, every longitude).
 fn write_slopes(md: &mut String, rho: f64, out: &Path) -> Result<(), String> {
-    use crate::aggregate::shape::Shape;
-    use crate::analysis::surface_slopes::slope_map;
+    use rubblepile::aggregate::shape::Shape;
+    use rubblepile::analysis::surface_slopes::slope_map;
     let _ = writeln!(md, "\n### Fig. 2: surface slopes at the Didymos period\n");
     let _ = writeln!(
         md,
@@ -534,7 +534,7 @@ fn write_slopes(md: &mut String, rho: f64, out: &Path) -> Result<(), String> {
     .enumerate()
     {
         let shape = Shape::parse(spec, 1.0).map_err(|e| e.to_string())?;
-        let contains = |p: &crate::math::Vec3| shape.contains(p);
+        let contains = |p: &rubblepile::math::Vec3| shape.contains(p);
         let map = slope_map(
             &contains,
             1.02 * shape.bounding_radius(),
@@ -591,7 +591,7 @@ pub fn kappa_of(t_c3_hours: f64, rho: f64) -> f64 {
 }
 
 /// Zhang17 Fig. 23's analogue: κ₃ against φ, the paper's six models and ours (decided protocol) beside the continuum
-/// upper spin limit (the volume-averaged bound of [`crate::analysis::spin_limit`]) of a sphere and of the Naidu
+/// upper spin limit (the volume-averaged bound of [`rubblepile::analysis::spin_limit`]) of a sphere and of the Naidu
 /// ellipsoid; a table says which points lie above the limit. Writes `decided_fig23.{svg,png}`.
 fn write_fig23(md: &mut String, searches: &[DecidedSearch], hold: f64, rho: f64, out: &Path) -> Result<(), String> {
     let body = naidu_ellipsoid();
@@ -705,7 +705,7 @@ mod tests {
         let verdicts = holds
             .iter()
             .map(|(tf, s)| {
-                crate::analysis::spinup_search::judge_series(
+                rubblepile::analysis::spinup_search::judge_series(
                     s,
                     None,
                     &Criteria::default(),
@@ -794,7 +794,7 @@ mod tests {
         std::fs::write(critical.join("holds.csv"), holds).unwrap();
         std::fs::write(
             critical.join("critical.csv"),
-            crate::analysis::spinup_search::critical_csv(&creeping.verdicts),
+            rubblepile::analysis::spinup_search::critical_csv(&creeping.verdicts),
         )
         .unwrap();
         let out = dir.join("out");

@@ -12,12 +12,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::figures::lines::{LineChart, Mark, Series};
-use crate::analysis::figures::style::write_figure;
+use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
+use rubblepile::analysis::figures::style::write_figure;
+use rubblepile::analysis::spinup_search::read_critical;
 
-use super::rows::{
-    ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, read_critical, search_subdirs,
-};
+use super::rows::{ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, search_subdirs};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.
@@ -76,12 +75,6 @@ pub fn chosen_search(searches: &[RungSearch]) -> Option<&RungSearch> {
 pub const PAPER_GRAINS: [(&str, usize); 2] = [("hcp", 42_062), ("rcp", 36_523)];
 
 /// The model a rung belongs to: its directory name up to the first `_` (`rcp_8k` → `rcp`, `hcp_full` → `hcp`).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::ladder::rung_model;
-/// assert_eq!(rung_model("rcp_8k"), "rcp");
-/// assert_eq!(rung_model("hcp_full"), "hcp");
-/// ```
 pub fn rung_model(rung: &str) -> String {
     base_model(rung).split('_').next().unwrap_or("").to_lowercase()
 }
@@ -303,4 +296,16 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
     let _ = writeln!(md, "![ladder: φ](ladder_phi.png)\n");
     let _ = writeln!(md, "![ladder: T_c1 and T_c2](ladder_limits.png)");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rung's model is its directory name up to the first `_`.
+    #[test]
+    fn a_rung_belongs_to_the_model_its_name_starts_with() {
+        assert_eq!(rung_model("rcp_8k"), "rcp");
+        assert_eq!(rung_model("hcp_full"), "hcp");
+    }
 }

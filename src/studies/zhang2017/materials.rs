@@ -11,8 +11,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::spinup::fit_density;
-use crate::io::scene_file::SI_G;
+use rubblepile::analysis::spinup::fit_density;
+use rubblepile::io::scene_file::SI_G;
 
 use super::ordering::union_search;
 use super::rows::{DIDYMOS_PERIOD_HOURS, ModelRow, bulk_density, is_material_variant, opt};
@@ -33,12 +33,6 @@ pub const NOMINAL_MATERIAL: (f64, f64) = (0.5, 1.0);
 
 /// The run directory of `model` with material (β, μ_s): the model itself for the nominal material, else
 /// `<model>_beta<β>_mus<μ_s>`.
-///
-/// ```
-/// use rubblepile::studies::zhang2017::materials::variant_dir;
-/// assert_eq!(variant_dir("hcp", 0.3, 0.5), "hcp_beta0.3_mus0.5");
-/// assert_eq!(variant_dir("hcp", 0.5, 1.0), "hcp");
-/// ```
 pub fn variant_dir(model: &str, beta: f64, mu_s: f64) -> String {
     if (beta, mu_s) == NOMINAL_MATERIAL {
         model.to_string()
@@ -119,5 +113,17 @@ pub fn write_materials_section(md: &mut String, runs: &Path, rows: &[ModelRow]) 
             opt(at_stop.and_then(|s| s.after_release_theta_deg), 1),
             fit.map_or("–".into(), |f| format!("{:.3}, {:.0}", f.kappa, f.critical_density)),
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The nominal material runs in the model's own directory, the others in `<model>_beta<β>_mus<μ_s>`.
+    #[test]
+    fn the_nominal_material_runs_in_the_model_directory() {
+        assert_eq!(variant_dir("hcp", 0.3, 0.5), "hcp_beta0.3_mus0.5");
+        assert_eq!(variant_dir("hcp", 0.5, 1.0), "hcp");
     }
 }

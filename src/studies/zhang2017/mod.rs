@@ -4,7 +4,7 @@
 //! and the study that decides the paper's Table 3 at its scale ([`decided`]),
 //! all reading runs into the rows
 //! of [`rows`]. The searches that make its runs are generic and live in
-//! [`crate::analysis::spinup_search`].
+//! [`rubblepile::analysis::spinup_search`].
 
 pub mod decided;
 pub mod holds;
@@ -13,4 +13,6 @@ pub mod materials;
 pub mod ordering;
 pub mod paths;
 pub mod report;
+#[cfg(test)]
+mod report_tests;
 pub mod rows;

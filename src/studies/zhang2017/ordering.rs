@@ -11,8 +11,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::creep::CreepCriterionKind;
-use crate::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
+use rubblepile::analysis::creep::CreepCriterionKind;
+use rubblepile::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
 
 use super::ladder::RungSearch;
 use super::rows::{TABLE3, opt, search_subdirs};
@@ -53,8 +53,6 @@ pub struct VariantSearch {
 /// One variant's searches: per model of [`MODELS`], the search if it was run.
 #[derive(Debug, Clone)]
 pub struct VariantRow {
-    /// Directory suffix of [`VARIANTS`].
-    pub variant: &'static str,
     /// What the variant changes.
     pub what: &'static str,
     /// The HCP and RCP searches, in [`MODELS`] order.
@@ -100,7 +98,6 @@ pub fn read_variants(runs: &Path, ordering: &Path) -> Vec<VariantRow> {
                 }
             };
             VariantRow {
-                variant,
                 what,
                 searches: MODELS.map(|m| union_search(&dir(m))),
             }
@@ -249,7 +246,6 @@ mod tests {
     #[test]
     fn the_ordering_is_rcp_minus_hcp_and_needs_both() {
         let row = |h, r| VariantRow {
-            variant: "nominal",
             what: "",
             searches: [search(h), search(r)],
         };

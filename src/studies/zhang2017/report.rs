@@ -8,7 +8,7 @@
 //! printed beside ours for HCP, RCP, RCPC, PP1, PP2 and PPC.
 //!
 //! Per model: N and the particle radii (the radius scaling against the paper's sizes), T_c,1 and T_c,2 from the
-//! forced part after `t_start` ([`crate::analysis::spinup::critical_limits`]), the failure mode, T_c,3 and φ, κ₃
+//! forced part after `t_start` ([`rubblepile::analysis::spinup::critical_limits`]), the failure mode, T_c,3 and φ, κ₃
 //! of Eq. 22 with `ρ_B = 2100 M/M_P` (Zhang17 §4.2, M_P = 5.23e11 kg), the largest overlap, the largest departure
 //! of the spin period from the path while forced, and the run's wall time.
 //!
@@ -17,20 +17,20 @@
 //! the nominal run, into an Eq. 22 section: κ₁, κ₂, κ₃ fitted over the densities ([`density_series`]) and the
 //! critical bulk density at the Didymos period, beside the paper's Table 4.
 //!
-//! When a `critical.json` records T_c,3 by both creep criteria ([`crate::analysis::creep`]), a section gives both
+//! When a `critical.json` records T_c,3 by both creep criteria ([`rubblepile::analysis::creep`]), a section gives both
 //! beside Table 3. The hand-written `NOTES.md` in the output directory (the paper-vs-ours table over every table
 //! and figure of Zhang17, what is missing and what would decide it) is appended verbatim at the end
 //! ([`crate::studies::report_notes`]).
 
-use crate::io::table::{Cells, read_table};
+use rubblepile::io::table::{Cells, read_table};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::analysis::figures::spinup_figures::SpinupTimeSeries;
-use crate::analysis::figures::style::write_figure;
-use crate::analysis::spinup::{DensityFit, fit_density};
-use crate::analysis::spinup_diagnostics::SpinupSample;
-use crate::io::scene_file::SI_G;
+use rubblepile::analysis::figures::spinup_figures::SpinupTimeSeries;
+use rubblepile::analysis::figures::style::write_figure;
+use rubblepile::analysis::spinup::{DensityFit, fit_density};
+use rubblepile::analysis::spinup_diagnostics::SpinupSample;
+use rubblepile::io::scene_file::SI_G;
 
 use super::rows::*;
 
@@ -142,6 +142,7 @@ pub struct ReportSources<'a> {
 
 impl<'a> ReportSources<'a> {
     /// The runs alone, no optional section.
+    #[cfg(test)]
     pub fn new(runs: &'a Path) -> Self {
         ReportSources {
             runs,
@@ -159,7 +160,7 @@ pub fn write_report(
     sources: &ReportSources<'_>,
     out: &Path,
     force: bool,
-) -> Result<std::path::PathBuf, crate::analysis::AnalysisError> {
+) -> Result<std::path::PathBuf, rubblepile::analysis::AnalysisError> {
     let ReportSources {
         runs,
         full,
@@ -416,7 +417,7 @@ fn hold_searches(
     out
 }
 
-/// T_c,3 and φ by both creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]) for the models whose
+/// T_c,3 and φ by both creep criteria (Zhang17 §3.3.3; [`rubblepile::analysis::creep`]) for the models whose
 /// `critical.json` records both; nothing when none does (searches made before the paper's criterion came in).
 fn write_criterion_section(md: &mut String, rows: &[&ModelRow]) {
     let with: Vec<(&ModelRow, [LimitAndAngle; 2])> = rows
@@ -577,7 +578,7 @@ pub fn report_command(args: &ReportZhang2017Args) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::spinup::CriticalLimits;
+    use rubblepile::analysis::spinup::{CriticalLimits, DIDYMOS_MASS};
 
     fn row(model: &str, rho: f64, t: [Option<f64>; 3]) -> ModelRow {
         ModelRow {

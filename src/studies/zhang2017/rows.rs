@@ -3,43 +3,16 @@
 //! (`report.rs`) and its spin-up-path section (`paths.rs`), which both read rows from here and not each other.
 //! Zhang et al. (2017, Icarus 294), Tables 1, 3 and 4, §4.2.
 
-use crate::io::table::{Cells, read_header, read_table};
+use rubblepile::io::table::{Cells, read_header, read_table};
 use std::path::Path;
 
-use crate::analysis::spinup::{
-    AXIS_RATIO_THRESHOLD, CriticalLimits, DensityFit, FailureMode, critical_limits, dynamical_time, first_departure,
-    fit_density, smoothed_critical_limits,
+use rubblepile::analysis::spinup::{
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, critical_limits, dynamical_time,
+    first_departure, fit_density, smoothed_critical_limits,
 };
-use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
-use crate::io::scene_file::SI_G;
-
-/// Zhang17 Table 1: the nominal mass of the Didymos primary (kg), the reference of `ρ_B = 2100 M/M_P`.
-pub const DIDYMOS_MASS: f64 = 5.23e11;
-
-/// Zhang17 Table 2's grain counts of its two monodisperse models with Table 3's initial packing η_B of each:
-/// (model, grains, η_B). Their grains have the radius [`PAPER_GRAIN_RADIUS`].
-pub const PAPER_COUNTS_AND_PACKINGS: [(&str, usize, f64); 2] = [("hcp", 42_062, 0.739), ("rcp", 36_523, 0.641)];
-/// Zhang17 Table 2: the grain radius of HCP and RCP (m).
-pub const PAPER_GRAIN_RADIUS: f64 = 10.0;
-
-/// The bulk density (kg/m³) the paper's piles had, derived from its own numbers: each monodisperse model's grains
-/// (N spheres of 10 m) fill the carved volume `V = N (4/3)π r³ / η_B` at the packing Table 3 gives; HCP's and
-/// RCP's volumes agree to 0.1 % (2.384e8 and 2.387e8 m³, D_eq 769 m), and M_P of Table 1 in their mean is
-/// `ρ_B = M_P / V̄` ≈ 2193 kg/m³, not the nominal 2100. Returns (ρ_B, V̄ in m³).
-///
-/// ```
-/// let (rho, v) = rubblepile::studies::zhang2017::rows::paper_bulk_density();
-/// assert!((rho - 2192.5).abs() < 0.5 && (v / 2.3854e8 - 1.0).abs() < 1e-3);
-/// ```
-pub fn paper_bulk_density() -> (f64, f64) {
-    let grain = 4.0 / 3.0 * std::f64::consts::PI * PAPER_GRAIN_RADIUS.powi(3);
-    let volumes: Vec<f64> = PAPER_COUNTS_AND_PACKINGS
-        .iter()
-        .map(|&(_, n, eta)| n as f64 * grain / eta)
-        .collect();
-    let mean = volumes.iter().sum::<f64>() / volumes.len() as f64;
-    (DIDYMOS_MASS / mean, mean)
-}
+use rubblepile::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
+use rubblepile::analysis::spinup_search::read_critical;
+use rubblepile::io::scene_file::SI_G;
 
 /// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
 pub type LimitAndAngle = (Option<f64>, Option<f64>);
@@ -77,13 +50,6 @@ pub const DIDYMOS_PERIOD_HOURS: f64 = 2.26;
 
 /// The model a run directory belongs to: `rcp_rho1800` → `rcp` (bulk-density variants are `<model>_rho<ρ_B>`,
 /// material variants `<model>_beta<β>_mus<μ_s>`, Table 7).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::rows::base_model;
-/// assert_eq!(base_model("rcp_rho1800"), "rcp");
-/// assert_eq!(base_model("hcp_beta0.3_mus0.5"), "hcp");
-/// assert_eq!(base_model("hcp"), "hcp");
-/// ```
 pub fn base_model(name: &str) -> &str {
     let name = name.split("_rho").next().unwrap_or(name);
     if is_material_variant(name) {
@@ -94,12 +60,6 @@ pub fn base_model(name: &str) -> &str {
 }
 
 /// Whether a run directory's name is a material variant (`<model>_beta<β>_mus<μ_s>`, Zhang17 Table 7).
-///
-/// ```
-/// use rubblepile::studies::zhang2017::rows::is_material_variant;
-/// assert!(is_material_variant("pp2_beta0.6_mus1.3"));
-/// assert!(!is_material_variant("rcp_rho1800"));
-/// ```
 pub fn is_material_variant(name: &str) -> bool {
     name.split_once("_beta").is_some_and(|(_, rest)| rest.contains("_mus"))
 }
@@ -175,11 +135,11 @@ pub fn successive_scatter(values: &[f64]) -> f64 {
 
 /// Whether η_B with sample scatter `noise`, averaged over a window of `window` s of samples `spacing` s apart,
 /// resolves the T_c,2 threshold: the scatter of the mean, `noise/√(window/spacing)`, must be below half of
-/// [`crate::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
+/// [`rubblepile::analysis::spinup::PACKING_THRESHOLD`]. The report reads single samples (`window == spacing`), which
 /// the scaled runs with the rotation-free open test resolve (`analysis/zhang2017/MODULE_NOTES.md`).
 pub fn t_c2_resolved(noise: f64, window: f64, spacing: f64) -> bool {
     let samples = (window / spacing).max(1.0);
-    noise / samples.sqrt() < 0.5 * crate::analysis::spinup::PACKING_THRESHOLD
+    noise / samples.sqrt() < 0.5 * rubblepile::analysis::spinup::PACKING_THRESHOLD
 }
 
 /// One model's row.
@@ -211,7 +171,7 @@ pub struct ModelRow {
     /// See `t_c3`.
     pub phi: Option<f64>,
     /// T_c,3 (h) and φ (°) by the paper's creep criterion and by ours, from a `critical.json` that records both
-    /// (searches made after the paper's criterion came in; [`crate::analysis::creep`]); `None` for older ones.
+    /// (searches made after the paper's criterion came in; [`rubblepile::analysis::creep`]); `None` for older ones.
     pub t_c3_by_criterion: Option<[LimitAndAngle; 2]>,
     /// κ₃ of Eq. 22.
     pub kappa3: Option<f64>,
@@ -315,13 +275,16 @@ fn books_forcing(run: &Path) -> bool {
 }
 
 /// Reads one model's runs under `RUNS/<model>`: its path-2 run and its T_c,3 search.
-pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+pub fn model_row(model_dir: &Path) -> Result<(ModelRow, Vec<SpinupSample>), rubblepile::analysis::AnalysisError> {
     path_row(model_dir, "path2")
 }
 
 /// Reads the run `RUNS/<model>/<path>` (e.g. `path1`, `path3`) and the T_c,3 search on that path
 /// (`critical/` for path 2, `critical_<path>/` for the others).
-pub fn path_row(model_dir: &Path, path: &str) -> Result<(ModelRow, Vec<SpinupSample>), crate::analysis::AnalysisError> {
+pub fn path_row(
+    model_dir: &Path,
+    path: &str,
+) -> Result<(ModelRow, Vec<SpinupSample>), rubblepile::analysis::AnalysisError> {
     let model = model_dir
         .file_name()
         .map(|s| s.to_string_lossy().to_string())
@@ -490,48 +453,22 @@ pub fn search_subdirs(dir: &Path) -> Vec<std::path::PathBuf> {
     subs
 }
 
-/// The result of a T_c,3 search directory, re-derived from its judged holds (`critical.csv`) by
-/// [`crate::analysis::spinup_search::critical_from_verdicts`], so that every search is read by today's rule
-/// whenever it ran: `t_c3_hours` and `friction_angle_deg` (the paper's criterion, the search's default), `paper`,
-/// `paper_tolerance`, `ours`, and `runs` (their `t_final_hours`). A search made before the paper's criterion
-/// judged rates is judged again from its `holds.csv` where the compact copy has one
-/// ([`crate::analysis::spinup_search::rejudge`]); without it, its `paper` values are null. A directory with only
-/// `critical.json` is read as written. `None` when neither file is there or readable.
-pub fn read_critical(search_dir: &Path) -> Option<serde_json::Value> {
-    use crate::analysis::creep::CreepCriterionKind;
-    use crate::analysis::spinup_search::{
-        Criteria, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
-    };
-    let Some(csv) = std::fs::read_to_string(search_dir.join("critical.csv")).ok() else {
-        let text = std::fs::read_to_string(search_dir.join("critical.json")).ok()?;
-        let mut v: serde_json::Value = serde_json::from_str(&text).ok()?;
-        // a critical.json of before Dec 2026: its `paper` is today's paper-tolerance criterion
-        if v.get("paper_tolerance").is_none() {
-            let old = v.get("paper").cloned().unwrap_or_else(
-                || serde_json::json!({ "t_c3_hours": v["t_c3_hours"], "friction_angle_deg": v["friction_angle_deg"] }),
-            );
-            v["paper_tolerance"] = old;
-            v["paper"] = serde_json::json!({ "t_c3_hours": null, "friction_angle_deg": null });
-        }
-        return Some(v);
-    };
-    let mut holds = read_critical_csv(&csv).ok()?;
-    if holds.iter().any(|h| h.paper.is_none())
-        && let Ok(series) = read_holds_csv(&search_dir.join("holds.csv"))
-    {
-        holds = rejudge(&holds, &series, None, &Criteria::default(), CreepCriterionKind::Paper);
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Bulk-density and material variants belong to their base model.
+    #[test]
+    fn a_variant_belongs_to_its_base_model() {
+        assert_eq!(base_model("rcp_rho1800"), "rcp");
+        assert_eq!(base_model("hcp_beta0.3_mus0.5"), "hcp");
+        assert_eq!(base_model("hcp"), "hcp");
     }
-    let of = |kind| {
-        let (t, phi) = critical_from_verdicts(&holds, kind);
-        serde_json::json!({ "t_c3_hours": t, "friction_angle_deg": phi })
-    };
-    let paper = of(CreepCriterionKind::Paper);
-    Some(serde_json::json!({
-        "t_c3_hours": paper["t_c3_hours"],
-        "friction_angle_deg": paper["friction_angle_deg"],
-        "paper": paper,
-        "paper_tolerance": of(CreepCriterionKind::PaperTolerance),
-        "ours": of(CreepCriterionKind::Ours),
-        "runs": holds.iter().map(|h| serde_json::json!({ "t_final_hours": h.t_final_hours })).collect::<Vec<_>>(),
-    }))
+
+    /// A material variant names both β and μ_s; a bulk-density variant is none.
+    #[test]
+    fn material_variants_name_beta_and_mu_s() {
+        assert!(is_material_variant("pp2_beta0.6_mus1.3"));
+        assert!(!is_material_variant("rcp_rho1800"));
+    }
 }

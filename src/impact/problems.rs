@@ -27,7 +27,6 @@
 
 use clap::ValueEnum;
 
-use crate::bench::problems::torque_free_spin;
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
@@ -35,6 +34,7 @@ use crate::ellipsoid::equations::{
 use crate::impact::projectile::{ProjectileSpec, set_up_impact};
 use crate::impact::target::to_centre_of_mass_frame;
 use crate::integrate::OdeSystem;
+use crate::integrate::problems::torque_free_spin;
 use crate::math::{Vec3, Vec4};
 
 /// The N30_T4 target of Roig03 §3 (`targets/N30_T4.csv`), embedded so the problem does not depend on the

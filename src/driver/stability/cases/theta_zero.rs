@@ -41,10 +41,10 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
         )
     };
     let exact = tilt == 0.0 && wobble == 0.0;
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let (mut spin_err, mut q_err, mut off_axis) = (0.0_f64, 0.0_f64, 0.0_f64);
         let w0 = (wobble * wobble + w3 * w3).sqrt();

@@ -2,8 +2,8 @@
 //! time against the scene's t_end, wall time so far from `timeseries.csv`, residuals so far), next to the
 //! scaled runs' Table 3.
 
+use crate::studies::zhang2017::report::{ReportSources, write_report};
 use rubblepile::analysis::spinup_diagnostics::{SPINUP_HEADER, SpinupSample};
-use rubblepile::studies::zhang2017::report::{ReportSources, write_report};
 use std::path::Path;
 
 /// Writes a path-2 run directory: `samples` every 200 s up to `t_last`, one snapshot of `n` spheres, a scene
@@ -191,13 +191,13 @@ fn committed_report_ends_with_the_committed_notes() {
     let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     let notes = std::fs::read_to_string(dir.join("NOTES.md")).unwrap();
     let mut expected = String::new();
-    rubblepile::studies::report_notes::append_notes(&mut expected, &dir);
+    crate::studies::report_notes::append_notes(&mut expected, &dir);
     assert_eq!(
         expected,
-        format!("\n{}\n", rubblepile::studies::report_notes::with_tally(&notes))
+        format!("\n{}\n", crate::studies::report_notes::with_tally(&notes))
     );
     assert!(
-        notes.contains(rubblepile::studies::report_notes::TALLY_MARKER),
+        notes.contains(crate::studies::report_notes::TALLY_MARKER),
         "NOTES.md's tally is computed, not typed"
     );
     assert!(
@@ -639,7 +639,7 @@ fn material_section_sets_each_material_beside_table_7() {
     let section = &md[md.find("## Material").expect("a Table 7 section")..];
     let row = |start: &str| line_starting(section, start);
     // Eq. 22 by hand for the weak material's T_c3 (ours) of 2.56 h at this fake body's bulk density
-    let rho = 2100.0 * 30.0 * 1e7 / rubblepile::studies::zhang2017::rows::DIDYMOS_MASS;
+    let rho = 2100.0 * 30.0 * 1e7 / rubblepile::analysis::spinup::DIDYMOS_MASS;
     let omega = 2.0 * std::f64::consts::PI / (2.56 * 3600.0);
     let kappa = omega / (4.0 * std::f64::consts::PI * 6.674e-11 * rho / 3.0).sqrt();
     let rho_c = rho * (2.56f64 / 2.26).powi(2);

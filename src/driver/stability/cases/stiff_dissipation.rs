@@ -45,7 +45,7 @@ pub fn sticking(id: &str) -> Case {
         atol: RTOL,
     };
     let description = "F0 = 100 s/m^2: two spinning ellipsoids meet off-centre at 1 m/s (gravity, contact, calibrate beta = 10, v = 2 m/s) and stick, 3000 s".to_string();
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let bodies = match final_bodies(run) {
             Ok(b) => b,
             Err(e) => return failed_to_read(e),
@@ -110,7 +110,7 @@ pub fn sticking_in_contact(id: &str) -> Case {
         atol: RTOL,
     };
     let description = "F0 = 100 s/m^2 in contact: 800x600x400 m ellipsoid touching a 1000x700x500 m one, closing at 0.1 m/s (gravity, contact), 2000 s".to_string();
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let bodies = match final_bodies(run) {
             Ok(b) => b,
             Err(e) => return failed_to_read(e),

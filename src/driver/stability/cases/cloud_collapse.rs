@@ -60,10 +60,10 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
             " (1.5 x escape)"
         }
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let settings = crate::ellipsoid::barrier::BarrierSettings::for_kappa_source(&run.scene.kappa_source);
         let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, &settings, b).len();

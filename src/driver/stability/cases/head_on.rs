@@ -58,10 +58,10 @@ pub fn head_on(id: &str, factor: f64) -> Case {
     let description = format!(
         "head-on tip-to-tip impact of bodies 1 and 2 at {factor} x the calibrated {HEAD_ON_V_CAL} m/s (beta = 10), gravity + contact, no dissipation"
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(every / 10.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let pairs = run
             .summary

@@ -43,10 +43,10 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
             "resting contact, free: the same pair released at rest 5 m above touching, no dissipation, oscillating for {t_end:e} s, atol = {atol:e}"
         )
     };
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let n = snaps.len();

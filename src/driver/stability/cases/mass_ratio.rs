@@ -40,10 +40,10 @@ pub fn tiny_orbit(id: &str) -> Case {
         "mass ratio {:.1e}: 10 m sphere on a circular orbit (r = 3 km, period {period:.0} s) around a 1 km sphere, 3 orbits",
         mt / m
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let (mut dr, mut dphi) = (0.0_f64, 0.0_f64);
         for (t, b) in &snaps {
@@ -104,10 +104,10 @@ pub fn tiny_resting(id: &str) -> Case {
     let description = format!(
         "mass ratio {ratio:.1e}: 10 m sphere dropped from 10 m onto a 1 km sphere (gravity, contact, F0 = 0.1 s/m^2), settling for {t_end} s"
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let snaps = match run.snapshots() {
             Ok(s) => s,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let Some((_, last)) = snaps.last() else {

@@ -49,10 +49,10 @@ pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
         "kappa = {kappa}: head-on tip-to-tip impact at {SWEEP_SPEED} m/s, kappa calibrated with beta = 10, v = {v_cal:.3e} m/s, contact{}, {t_end} s",
         if gravity { " + gravity" } else { " only (no gravity)" }
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let (ratio, sep) = match run.contact_extremes(2.0) {
             Ok(x) => x,
-            Err(e) => return failed_to_read(e.into()),
+            Err(e) => return failed_to_read(e),
         };
         let report = run.summary.barrier.clone();
         let got = run.overrun_pairs() > 0;

@@ -41,7 +41,7 @@ pub fn flat_pair(id: &str, plates: bool) -> Case {
     let description = format!(
         "two {shape}, C/A = 0.05, dropped onto each other at 0.3 m/s (gravity, contact, F0 = 0.1 s/m^2, calibrate beta = 10, v = {v_cal} m/s), settling for {t_end} s"
     );
-    let check: crate::bench::stability::case::Check = Box::new(move |run: &CaseRun| {
+    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
         let bodies = match final_bodies(run) {
             Ok(b) => b,
             Err(e) => return failed_to_read(e),

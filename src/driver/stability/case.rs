@@ -14,7 +14,7 @@ use crate::ellipsoid::scene::LoadedScene;
 use crate::integrate::{Tolerances, make_integrator};
 use crate::math::{Vec3, Vec4};
 
-/// A case's verdict (see the module docs of `bench::stability`).
+/// A case's verdict (see the module docs of `driver::stability`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Verdict {
     /// Everything as expected.
@@ -78,7 +78,7 @@ pub struct CaseRun {
 
 impl CaseRun {
     /// The snapshots the run wrote, as `(t, bodies)`, in time order.
-    pub fn snapshots(&self) -> Result<Vec<(f64, Vec<Body>)>, crate::bench::BenchError> {
+    pub fn snapshots(&self) -> Result<Vec<(f64, Vec<Body>)>, String> {
         let mut out = Vec::new();
         for (k, &t) in self.scene.output.times.iter().enumerate() {
             let path = self.dir.join("snapshots").join(format!("{k}.csv"));
@@ -95,7 +95,7 @@ impl CaseRun {
     /// sampled every `dt` s: the case's scene is integrated again (same physics, method and tolerances), so that
     /// the run itself can keep a coarse output grid and its step counts say what the dynamics costs. An
     /// integrator failure ends the sampling quietly (the run's own row reports it).
-    pub fn contact_extremes(&self, dt: f64) -> Result<(f64, f64), crate::bench::BenchError> {
+    pub fn contact_extremes(&self, dt: f64) -> Result<(f64, f64), String> {
         let scene = &self.scene;
         let system = EllipsoidSystem::new(&scene.bodies, scene.model, scene.physics);
         let settings = scene.integrator;
@@ -134,7 +134,7 @@ impl CaseRun {
 }
 
 /// Reads a snapshot file into bodies.
-pub fn read_bodies(path: &Path) -> Result<Vec<Body>, crate::bench::BenchError> {
+pub fn read_bodies(path: &Path) -> Result<Vec<Body>, String> {
     let records = read_bodies_csv(path).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(records
         .iter()

@@ -14,7 +14,7 @@
 //! | [`RigidBody`] | 3 | Euler's equations of a free rigid body: exact solution ([`torque_free_spin`], Jacobi elliptic functions), energy and angular momentum |
 //!
 //! The problems of the ellipsoid model itself (a free top, a bouncing pair, the N30 target, N-body tests)
-//! are in `bench::ellipsoid_problems`, built on these.
+//! are in `impact::problems`, built on these.
 
 use crate::integrate::OdeSystem;
 use crate::integrate::elliptic::{incomplete_f, jacobi_sn_cn_dn};
@@ -445,7 +445,7 @@ impl TestProblem for RigidBody {
 /// Returns `None` when two moments agree to 1e-12 (a symmetric top) or an input is not finite.
 ///
 /// ```
-/// use rubblepile::bench::problems::torque_free_spin;
+/// use rubblepile::integrate::problems::torque_free_spin;
 /// let (i, w0) = ([1.0, 2.0, 3.0], [0.3, -0.2, 0.9]);
 /// let w = torque_free_spin(i, w0, 10.0).unwrap();
 /// let e = |w: &[f64; 3]| (0..3).map(|k| i[k] * w[k] * w[k]).sum::<f64>();

@@ -10,7 +10,7 @@
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 
-use crate::bench::stability::case::{Case, CaseRun, Judgement, judge};
+use crate::driver::stability::case::{Case, CaseRun, Judgement, judge};
 use crate::ellipsoid::barrier::SPEED_MARGIN;
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::calibration::lambda;
