@@ -98,7 +98,13 @@ mod tests {
     /// error as an independent least-squares fit (numpy.linalg.lstsq and the same error propagation) gives them.
     #[test]
     fn the_zero_and_its_error_match_an_independent_fit() {
-        let rates = [(2.50, 0.0494), (2.55, 0.0438), (2.60, 0.0388), (2.65, 0.0331), (2.70, 0.0248)];
+        let rates = [
+            (2.50, 0.0494),
+            (2.55, 0.0438),
+            (2.60, 0.0388),
+            (2.65, 0.0331),
+            (2.70, 0.0248),
+        ];
         let z = zero_rate_period(&rates).unwrap();
         assert!((z.period_h - 2.917_028_380_634).abs() < 1e-9, "{z:?}");
         assert!((z.se_h - 0.019_010_333_867).abs() < 1e-9, "{z:?}");

@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 use rubblepile::aggregate::report::AggregateReport;
 use rubblepile::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
 use rubblepile::analysis::creep::CreepCriterionKind;
+use rubblepile::analysis::creep_extrapolation::{ZeroRate, weakening_zeros};
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
 use rubblepile::analysis::spin_limit::{critical_kappa, least_friction_angle};
@@ -277,6 +278,45 @@ pub fn naidu_ellipsoid() -> [f64; 3] {
     semi.map(|a| a * scale)
 }
 
+/// The table "Where creep stops": for each search, read at the longest hold length it has, the period at which
+/// the weakening rates of its held (not released) holds reach zero ([`rubblepile::analysis::creep_extrapolation::zero_rate_period`]).
+fn write_zero_rates(md: &mut String, searches: &[DecidedSearch]) {
+    let _ = writeln!(md, "\n### Where creep stops: the weakening rates' zero\n");
+    let _ = writeln!(
+        md,
+        "With zero tolerance a hold creeps whenever a rate is significant, however small. Here the weakening rates \
+         (coordination number and η_B falling, θ_max rising, over each hold's second half) of the holds that kept \
+         their forcing are fitted by a line against T_final, read at the longest length every such hold has; its \
+         zero is the period from which no hold would weaken (`analysis::creep_extrapolation`; the error from the \
+         rates' scatter about the line). \"largest\" is the slowest of the three: the period from which the paper's \
+         test would call every hold stable.\n"
+    );
+    let _ = writeln!(
+        md,
+        "| search | hold read (s) | holds fitted | coordination (h) | η_B (h) | θ_max (h) | largest (h) |"
+    );
+    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+    for s in searches {
+        let Some(&window) = s.lengths().last() else {
+            continue;
+        };
+        let judged = s.judged(window);
+        let zeros = weakening_zeros(&judged);
+        let cell = |z: &Option<ZeroRate>| z.map_or("–".into(), |z| format!("{:.2} ± {:.2}", z.period_h, z.se_h));
+        let held = judged.iter().filter(|v| !v.released).count();
+        let largest = zeros.iter().flatten().max_by(|a, b| a.period_h.total_cmp(&b.period_h));
+        let _ = writeln!(
+            md,
+            "| {} | {window:.0} | {held} | {} | {} | {} | {} |",
+            s.name,
+            cell(&zeros[0]),
+            cell(&zeros[1]),
+            cell(&zeros[2]),
+            cell(&largest.copied())
+        );
+    }
+}
+
 /// The decided section of the report; writes `ordering.csv` and `decided_hold_length.{svg,png}` into `out`.
 pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<(), String> {
     let searches = read_decided(dir);
@@ -458,6 +498,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
         write_figure(out, "decided_hold_length", &chart).map_err(|e| e.to_string())?;
         let _ = writeln!(md, "\n![T_c3 against the hold length](decided_hold_length.png)\n");
     }
+    write_zero_rates(md, &searches);
     // the equilibrium bound on HCP's φ
     let body = naidu_ellipsoid();
     let sphere = [0.5 * NAIDU2020_EQUIVALENT_DIAMETER_M; 3];
@@ -806,6 +847,8 @@ mod tests {
             "{md}"
         );
         assert!(!out.join("decided_hold_length.png").exists());
+        // two held holds are too few for the rates' zero
+        assert!(md.contains("| hcp_3k_random1 | 32000 | 2 | – | – | – | – |"), "{md}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
