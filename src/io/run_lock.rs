@@ -8,8 +8,10 @@
 //! holder writes its process id into the file right after locking it, so that a refused writer can name it (in the
 //! instant between the two, a refused writer reads the previous holder's pid).
 //!
-//! - A second writer is refused at once, never made to wait: [`LockError::Held`] names the directory and the
-//!   holder's pid (the command line prints it as one line, exit code 2).
+//! - A second writer is refused within a quarter of a second (the lock is retried that long, since a child process
+//!   between fork and exec can hold a released lock for a moment), never made to wait for the holder:
+//!   [`LockError::Held`] names the directory and the holder's pid (the command line prints it as one line, exit
+//!   code 2).
 //! - The lock lives as long as the [`DirLock`] guard; the OS releases it when the process ends however it ends
 //!   (killed, crashed), so a dead holder never blocks anyone.
 //! - Lock files are never deleted: deleting one while another process opens it would let two processes lock two
@@ -119,7 +121,7 @@ pub struct DirLock {
 impl DirLock {
     /// Locks the existing directory `dir` exclusively (`dir/.rubblepile.lock`).
     ///
-    /// Errors: [`LockError::Held`] at once when another process, or another thread of this one, holds the lock;
+    /// Errors: [`LockError::Held`] within a quarter of a second when another process, or another thread of this one, holds the lock;
     /// [`LockError::Io`] when the lock file cannot be created or locked (e.g. `dir` does not exist).
     pub fn acquire(dir: &Path) -> Result<DirLock, LockError> {
         lock(dir, LOCK_FILE, dir.to_path_buf(), false)
@@ -158,6 +160,9 @@ impl Drop for DirLock {
     }
 }
 
+/// How long a lock held by another process is retried before it is refused: longer than a fork-to-exec window.
+const LOCK_RETRY: std::time::Duration = std::time::Duration::from_millis(250);
+
 /// The pid written in the lock file `path` (its first line), if any.
 fn holder_pid(path: &Path) -> Option<u32> {
     let mut text = String::new();
@@ -190,10 +195,22 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
     }
     // Never through a link: a lock file that is one would have the pid written into whatever it points at.
     let mut file = crate::io::safe_write::open_nofollow(&path, true).map_err(io(&named))?;
-    let attempt = if shared {
-        file.try_lock_shared()
-    } else {
-        file.try_lock()
+    // A lock just released can still be held for a moment by a child process of this one (or of the last holder)
+    // started by another thread between its fork and its exec: the child's copy of the descriptor shares the lock
+    // until exec closes it. So a refusal is retried for up to LOCK_RETRY before it is believed.
+    let started = std::time::Instant::now();
+    let attempt = loop {
+        let attempt = if shared {
+            file.try_lock_shared()
+        } else {
+            file.try_lock()
+        };
+        match attempt {
+            Err(TryLockError::WouldBlock) if started.elapsed() < LOCK_RETRY => {
+                std::thread::sleep(std::time::Duration::from_millis(10))
+            }
+            _ => break attempt,
+        }
     };
     let file = match attempt {
         Ok(()) => {
@@ -265,6 +282,30 @@ mod tests {
             .spawn(|| DirLock::acquire(&d).is_ok())
             .join()
             .unwrap()));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    /// A lock held for a moment by a descriptor outside the registry (as a child between fork and exec holds it) is
+    /// granted once released within [`LOCK_RETRY`]; one held longer is refused.
+    #[test]
+    fn a_lock_released_within_the_retry_is_granted_one_held_longer_is_refused() {
+        let d = temp("retry");
+        let hold_for = |ms: u64| {
+            let f = File::create(d.join(LOCK_FILE)).unwrap();
+            f.try_lock().unwrap();
+            std::thread::spawn(move || {
+                std::thread::sleep(std::time::Duration::from_millis(ms));
+                drop(f);
+            })
+        };
+        let brief = hold_for(50);
+        assert!(DirLock::acquire(&d).is_ok(), "released after 50 ms");
+        brief.join().unwrap();
+        let long = hold_for(2000);
+        let t0 = std::time::Instant::now();
+        assert!(DirLock::acquire(&d).is_err(), "held for 2 s");
+        assert!(t0.elapsed() < std::time::Duration::from_millis(1500));
+        long.join().unwrap();
         let _ = std::fs::remove_dir_all(&d);
     }
 

@@ -175,7 +175,7 @@ impl CampaignError {
 /// Locks the campaign directory `out` for this process ([`crate::io::run_lock`]) until the guards are dropped: whole,
 /// or, for a shard, shared with the other shards (each writes its own runs) and with its own index exclusively. So two
 /// campaigns, a campaign and a shard, or one shard twice never write one campaign directory at once; each run
-/// directory is locked by its run besides. Errors: [`CampaignError::Locked`], at once.
+/// directory is locked by its run besides. Errors: [`CampaignError::Locked`], without waiting for the holder.
 pub fn lock_campaign_dir(out: &std::path::Path, shard: Option<Shard>) -> Result<Vec<DirLock>, CampaignError> {
     let advice = "use another --out";
     Ok(match shard {
