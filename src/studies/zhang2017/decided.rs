@@ -109,6 +109,16 @@ impl DecidedSearch {
         critical_from_verdicts(&self.judged(window), kind)
     }
 
+    /// The shortest T_final (h) from which no hold searched is released within `window` seconds: the pile's
+    /// failure (global disruption, Zhang17 §3.3.3) stops there, whether or not it still creeps. `None` when the
+    /// slowest hold is released.
+    pub fn no_release_from(&self, window: f64) -> Option<f64> {
+        let judged = self.judged(window);
+        let last_released = judged.iter().rposition(|h| h.released);
+        let first = last_released.map_or(0, |i| i + 1);
+        judged.get(first).map(|h| h.t_final_hours)
+    }
+
     /// The holds as letters by the paper's criterion at `window`: `R` released, `C` creeping, `S` stable.
     pub fn letters(&self, window: f64) -> String {
         self.judged(window)
@@ -342,9 +352,12 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     let _ = writeln!(
         md,
         "| model | grains | lattice | T_c1 / T_c2 (h) | T_c3 (h), paper's criterion | φ (°) | T_c3 paper-tolerance / \
-         ours (h) | holds (R released, C creeps, S stable) | paper T_c3, φ | T_c3 − paper (h) |"
+         ours (h) | no release from (h) | holds (R released, C creeps, S stable) | paper T_c3, φ | T_c3 − paper (h) |"
     );
-    let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
+    let _ = writeln!(
+        md,
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
     let table: Vec<&DecidedSearch> = in_group(Group::Full)
         .into_iter()
         .chain(in_group(Group::Scaled))
@@ -354,7 +367,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
         let paper = paper_t_c3(&s.model);
         let _ = writeln!(
             md,
-            "| {}{} | {} | {} | {} / {} | {} | {} | {} / {} | {} | {} | {} |",
+            "| {}{} | {} | {} | {} / {} | {} | {} | {} / {} | {} | {} | {} | {} |",
             s.model.to_uppercase(),
             if s.group == Group::Full { " (full)" } else { "" },
             s.grains().map_or("–".into(), |n| n.to_string()),
@@ -365,6 +378,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
             opt(phi, 1),
             hours(s.t_c3(hold, CreepCriterionKind::PaperTolerance).0),
             hours(s.t_c3(hold, CreepCriterionKind::Ours).0),
+            hours(s.no_release_from(hold)),
             s.letters(hold),
             paper.map_or("–".into(), |(t, p)| format!("{t:.2} h, {p}°")),
             match (t, paper) {
@@ -396,9 +410,10 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
         let _ = writeln!(md, "### T_c,3 against the HCP lattice's orientation (scaled)\n");
         let _ = writeln!(
             md,
-            "| lattice | stacking axis from the spin axis (°) | grains | T_c1 / T_c2 (h) | T_c3 (h) | φ (°) | holds |"
+            "| lattice | stacking axis from the spin axis (°) | grains | T_c1 / T_c2 (h) | T_c3 (h) | φ (°) | no release \
+             from (h), at the longest length | holds |"
         );
-        let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- |");
+        let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- |");
         let mut random = Vec::new();
         let mut all = Vec::new();
         for s in &orient {
@@ -411,7 +426,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
             }
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} / {} | {} | {} | {} |",
+                "| {} | {} | {} | {} / {} | {} | {} | {} | {} |",
                 s.orientation(),
                 s.target
                     .as_ref()
@@ -422,6 +437,9 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
                 hours(s.row.as_ref().and_then(|r| r.limits.t_c2_hours)),
                 hours(t),
                 opt(phi, 1),
+                s.lengths()
+                    .last()
+                    .map_or("–".into(), |&l| format!("{} ({l:.0} s)", hours(s.no_release_from(l)))),
                 s.letters(hold)
             );
         }
@@ -850,6 +868,30 @@ mod tests {
         // two held holds are too few for the rates' zero
         assert!(md.contains("| hcp_3k_random1 | 32000 | 2 | – | – | – | – |"), "{md}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// The failure stops at the slowest released hold's successor, whatever the creep verdicts: a hold released
+    /// after 20 000 s counts at 32 000 s and not at 16 000 s; a search whose slowest hold is released has none.
+    #[test]
+    fn no_release_from_is_the_hold_after_the_slowest_released_one() {
+        let s = search(
+            "hcp_3k_perpendicular",
+            vec![
+                (2.45, series(Some(3000.0), f64::INFINITY, 6000.0)),
+                (2.50, series(Some(20_000.0), f64::INFINITY, 22_000.0)),
+                (2.55, series(None, 1000.0, 32_000.0)),
+                (2.60, series(None, 1000.0, 32_000.0)),
+            ],
+        );
+        assert_eq!(s.no_release_from(16_000.0), Some(2.50));
+        assert_eq!(s.no_release_from(32_000.0), Some(2.55));
+        assert_eq!(
+            s.t_c3(32_000.0, CreepCriterionKind::Paper).0,
+            None,
+            "every held hold creeps"
+        );
+        let all_released = search("hcp_x", vec![(2.45, series(Some(3000.0), f64::INFINITY, 6000.0))]);
+        assert_eq!(all_released.no_release_from(16_000.0), None);
     }
 
     /// The Naidu ellipsoid keeps the radar extents' ratios and the 780 m body's volume.
