@@ -205,6 +205,61 @@ fn the_library_declares_no_program() {
     );
 }
 
+/// No file of the library (`src/` but `src/main.rs` and the programs' folders) prints: the lines it has for a person
+/// go through `rubblepile::io::messages::emit`, whose sink a library user can replace. That file is the sink itself
+/// and is skipped, and so is everything from a file's first `#[cfg(test)]` line on (tests may print what they
+/// like). Comments and string contents are masked, so a comment naming a macro is no print.
+#[test]
+fn the_library_does_not_print() {
+    let programs = programs();
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    let mut printing = Vec::new();
+    for f in files {
+        let rel = f.strip_prefix(src()).unwrap();
+        let top = rel
+            .iter()
+            .next()
+            .unwrap()
+            .to_string_lossy()
+            .trim_end_matches(".rs")
+            .to_string();
+        if top == "main" || programs.contains_key(&top) || rel == Path::new("io/messages.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).unwrap();
+        let tests_from = text
+            .lines()
+            .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+            .map_or(usize::MAX, |k| k + 1);
+        let masked = mask(&text);
+        let mut lines: BTreeMap<usize, String> = BTreeMap::new();
+        for ((&c, &code), &line) in masked.text.iter().zip(&masked.code).zip(&masked.line) {
+            if code && line < tests_from {
+                lines.entry(line).or_default().push(c);
+            }
+        }
+        for (line, code) in lines {
+            let is_print = |m: &str| {
+                code.match_indices(m)
+                    .any(|(i, _)| !code[..i].ends_with(|c: char| is_ident(c)))
+            };
+            if ["println!", "eprintln!", "print!(", "eprint!(", "dbg!("]
+                .iter()
+                .any(|m| is_print(m))
+            {
+                printing.push(format!("src/{}:{line}: {}", rel.display(), code.trim()));
+            }
+        }
+    }
+    assert!(
+        printing.is_empty(),
+        "{} library lines print (use rubblepile::io::messages::emit):\n{}",
+        printing.len(),
+        printing.join("\n")
+    );
+}
+
 /// The command line parses and dispatches; science and timed systems live in `analysis` and `bench`. Its size is a
 /// cheap guard against logic creeping back in.
 #[test]
