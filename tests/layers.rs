@@ -55,6 +55,31 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// The top-level module of a file of `src/` (`analysis/figures/mod.rs` → `analysis`, `lib.rs` → `lib`).
+fn top_of(rel: &Path) -> String {
+    rel.iter()
+        .next()
+        .unwrap()
+        .to_string_lossy()
+        .trim_end_matches(".rs")
+        .to_string()
+}
+
+/// The library's files (`src/` but `src/main.rs` and the programs' folders), each as (path, path inside `src/`).
+fn library_files() -> Vec<(PathBuf, PathBuf)> {
+    let programs = programs();
+    let mut files = Vec::new();
+    rust_files(&src(), &mut files);
+    files
+        .into_iter()
+        .filter_map(|f| {
+            let rel = f.strip_prefix(src()).unwrap().to_path_buf();
+            let top = top_of(&rel);
+            (top != "main" && !programs.contains_key(&top)).then_some((f, rel))
+        })
+        .collect()
+}
+
 /// `(from module, to module, file:line)` of every `crate::x` path outside comments.
 fn imports() -> Vec<(String, String, String)> {
     let mut files = Vec::new();
@@ -62,14 +87,7 @@ fn imports() -> Vec<(String, String, String)> {
     let mut out = Vec::new();
     for f in files {
         let rel = f.strip_prefix(src()).unwrap().to_path_buf();
-        let first = rel
-            .components()
-            .next()
-            .unwrap()
-            .as_os_str()
-            .to_string_lossy()
-            .to_string();
-        let from = first.trim_end_matches(".rs").to_string();
+        let from = top_of(&rel);
         if from == "lib" || from == "main" {
             continue;
         }
@@ -174,21 +192,8 @@ fn the_library_declares_no_program() {
         assert!(!declares, "src/lib.rs declares the program `{p}`");
         assert!(in_main.contains(p), "src/main.rs does not declare the program `{p}`");
     }
-    let mut files = Vec::new();
-    rust_files(&src(), &mut files);
     let mut named = Vec::new();
-    for f in files {
-        let rel = f.strip_prefix(src()).unwrap();
-        let top = rel
-            .iter()
-            .next()
-            .unwrap()
-            .to_string_lossy()
-            .trim_end_matches(".rs")
-            .to_string();
-        if top == "main" || programs.contains_key(&top) {
-            continue;
-        }
+    for (f, rel) in library_files() {
         for (k, line) in std::fs::read_to_string(&f).unwrap().lines().enumerate() {
             for p in programs.keys() {
                 if line.contains(&format!("crate::{p}")) {
@@ -202,6 +207,50 @@ fn the_library_declares_no_program() {
         "{} library lines name a program:\n{}",
         named.len(),
         named.join("\n")
+    );
+}
+
+/// No file of the library (`src/` but `src/main.rs` and the programs' folders) prints: the lines it has for a person
+/// go through `rubblepile::io::messages::emit`, whose sink a library user can replace. That file is the sink itself
+/// and is skipped, and so is everything from a file's first `#[cfg(test)]` line on (tests may print what they
+/// like). Comments and string contents are masked, so a comment naming a macro is no print.
+#[test]
+fn the_library_does_not_print() {
+    let mut printing = Vec::new();
+    for (f, rel) in library_files() {
+        if rel == Path::new("io/messages.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&f).unwrap();
+        let tests_from = text
+            .lines()
+            .position(|l| l.trim_start().starts_with("#[cfg(test)]"))
+            .map_or(usize::MAX, |k| k + 1);
+        let masked = mask(&text);
+        let mut lines: BTreeMap<usize, String> = BTreeMap::new();
+        for ((&c, &code), &line) in masked.text.iter().zip(&masked.code).zip(&masked.line) {
+            if code && line < tests_from {
+                lines.entry(line).or_default().push(c);
+            }
+        }
+        for (line, code) in lines {
+            let is_print = |m: &str| {
+                code.match_indices(m)
+                    .any(|(i, _)| !code[..i].ends_with(|c: char| is_ident(c)))
+            };
+            if ["println!", "eprintln!", "print!(", "eprint!(", "dbg!("]
+                .iter()
+                .any(|m| is_print(m))
+            {
+                printing.push(format!("src/{}:{line}: {}", rel.display(), code.trim()));
+            }
+        }
+    }
+    assert!(
+        printing.is_empty(),
+        "{} library lines print (use rubblepile::io::messages::emit):\n{}",
+        printing.len(),
+        printing.join("\n")
     );
 }
 

@@ -10,6 +10,7 @@ use crate::analysis::run_analysis::{
     AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_run, lock_analysis, read_json,
     spin_distributions,
 };
+use crate::io::messages::{Channel, emit};
 
 /// Analyses every completed run listed in `CAMPAIGN_DIR/campaign.csv` at `t_at` (each run's own
 /// `analysis/` is written or, with `force`, rewritten, figures included) and writes
@@ -68,7 +69,7 @@ pub fn analyze_campaign(
         };
         let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, &a, &report);
         for why in &not_drawn {
-            eprintln!("warning: {run}: figure not drawn: {why}");
+            emit(Channel::Warning, &format!("warning: {run}: figure not drawn: {why}"));
         }
         spins.push(
             report
@@ -158,7 +159,7 @@ pub fn analyze_campaign(
     // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them
     let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
     for why in &not_drawn {
-        eprintln!("warning: figure not drawn: {why}");
+        emit(Channel::Warning, &format!("warning: figure not drawn: {why}"));
     }
     Ok(analysis)
 }

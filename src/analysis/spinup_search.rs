@@ -34,6 +34,7 @@ use crate::analysis::spinup::fit_density;
 use crate::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use crate::driver::RunOptions;
 use crate::impact::campaign::Shard;
+use crate::io::messages::{Channel, emit};
 use crate::io::scene_file::SI_G;
 
 /// The options of a T_c,3 search (those of `rubblepile spinup critical`).
@@ -874,10 +875,13 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         ))
     };
     if args.prepare_only {
-        println!(
-            "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
-            jobs.len(),
-            args.out.display()
+        emit(
+            Channel::Out,
+            &format!(
+                "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
+                jobs.len(),
+                args.out.display()
+            ),
         );
         return Ok(());
     }
@@ -889,12 +893,15 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             .map(|(_, j)| j)
             .collect();
         run_holds(&mine, args, &|_| false)?;
-        println!(
-            "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
-            shard.index,
-            shard.count,
-            mine.len(),
-            jobs.len()
+        emit(
+            Channel::Out,
+            &format!(
+                "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
+                shard.index,
+                shard.count,
+                mine.len(),
+                jobs.len()
+            ),
         );
         return Ok(());
     }
@@ -925,7 +932,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     }
     runs.truncate(sequential_stop(&runs, args.all_holds));
     for r in &runs {
-        println!("{}", verdict_line(r));
+        emit(Channel::Out, &verdict_line(r));
     }
     let result = |criterion: CreepCriterion| {
         let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs, criterion.kind);
@@ -964,30 +971,42 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.paper_tolerance, &out.ours] {
         if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {
-            println!(
-                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
+            emit(
+                Channel::Out,
+                &format!(
+                    "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
                  monotone there: refine with a finer --step from {first:.2} h to the next creeping hold above {last:.2} h)",
-                r.criterion.kind.name(),
-                r.set_aside_hours
+                    r.criterion.kind.name(),
+                    r.set_aside_hours
+                ),
             );
         }
         match (r.t_c3_hours, r.friction_angle_deg) {
-            (Some(t), Some(p)) => println!(
-                "{} criterion: T_c3 = {t:.2} h, phi = {p:.1} deg",
-                r.criterion.kind.name()
+            (Some(t), Some(p)) => emit(
+                Channel::Out,
+                &format!(
+                    "{} criterion: T_c3 = {t:.2} h, phi = {p:.1} deg",
+                    r.criterion.kind.name()
+                ),
             ),
-            _ => println!(
-                "{} criterion: no stable T_final up to {} h",
-                r.criterion.kind.name(),
-                args.to
+            _ => emit(
+                Channel::Out,
+                &format!(
+                    "{} criterion: no stable T_final up to {} h",
+                    r.criterion.kind.name(),
+                    args.to
+                ),
             ),
         }
     }
-    println!(
-        "selected ({}): {} ({})",
-        args.criterion.name(),
-        t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
-        json.display()
+    emit(
+        Channel::Out,
+        &format!(
+            "selected ({}): {} ({})",
+            args.criterion.name(),
+            t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
+            json.display()
+        ),
     );
     Ok(())
 }
@@ -1071,10 +1090,13 @@ fn run_holds(
             let k = next.fetch_add(1, Ordering::SeqCst);
             let Some(job) = jobs.get(k) else { return };
             if !hold_finished(&job.dir, args.finish_released) {
-                eprintln!(
-                    "spinup critical: running T_final = {} h into {} ({threads} thread(s))",
-                    job.t_final_hours,
-                    job.dir.display()
+                emit(
+                    Channel::Progress,
+                    &format!(
+                        "spinup critical: running T_final = {} h into {} ({threads} thread(s))",
+                        job.t_final_hours,
+                        job.dir.display()
+                    ),
                 );
             }
             match pool.install(|| run_hold(job, args.finish_released)) {
@@ -1183,7 +1205,7 @@ pub fn judge_dir(
         }
     };
     for v in &judged {
-        println!("{}", verdict_line(v));
+        emit(Channel::Out, &verdict_line(v));
     }
     if let Some(out) = csv_out {
         crate::io::safe_write::write_atomic(out, critical_csv(&judged))
@@ -1191,12 +1213,18 @@ pub fn judge_dir(
     }
     for kind in CreepCriterionKind::ALL {
         match critical_from_verdicts(&judged, kind) {
-            (Some(t), phi) => println!(
-                "{} criterion: T_c3 = {t:.2} h, phi = {} deg",
-                kind.name(),
-                phi.map_or("-".into(), |p| format!("{p:.1}"))
+            (Some(t), phi) => emit(
+                Channel::Out,
+                &format!(
+                    "{} criterion: T_c3 = {t:.2} h, phi = {} deg",
+                    kind.name(),
+                    phi.map_or("-".into(), |p| format!("{p:.1}"))
+                ),
             ),
-            _ => println!("{} criterion: no T_c3 among these holds", kind.name()),
+            _ => emit(
+                Channel::Out,
+                &format!("{} criterion: no T_c3 among these holds", kind.name()),
+            ),
         }
     }
     Ok(())
@@ -1381,9 +1409,12 @@ fn prepare_branches(
                 stop_after_checkpoints: Some(1),
                 ..RunOptions::default()
             };
-            eprintln!(
-                "spinup critical: base run to t = {t_leg} s of {t_ck} s (T_final = {tf} h starts at {} s)",
-                starts[k]
+            emit(
+                Channel::Progress,
+                &format!(
+                    "spinup critical: base run to t = {t_leg} s of {t_ck} s (T_final = {tf} h starts at {} s)",
+                    starts[k]
+                ),
             );
             let result = match here {
                 Some(_) => resume_soft(&base_dir, &options),
@@ -1464,13 +1495,16 @@ pub fn density_fit(points: &[String], period: f64) -> Result<(), SearchError> {
         )));
     }
     let fit = fit_density(&pts, SI_G, period).ok_or_else(|| SearchError::usage("--points: nothing to fit"))?;
-    println!(
-        "kappa = {:.4} +- {:.4} from {} points; critical bulk density at T = {} h: {:.0} kg/m^3",
-        fit.kappa,
-        fit.sigma_kappa,
-        pts.len(),
-        period,
-        fit.critical_density
+    emit(
+        Channel::Out,
+        &format!(
+            "kappa = {:.4} +- {:.4} from {} points; critical bulk density at T = {} h: {:.0} kg/m^3",
+            fit.kappa,
+            fit.sigma_kappa,
+            pts.len(),
+            period,
+            fit.critical_density
+        ),
     );
     Ok(())
 }

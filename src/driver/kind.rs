@@ -9,6 +9,7 @@ use crate::ellipsoid::run::EllipsoidEngine;
 use crate::engine::RunReport;
 use crate::granular::hard::run::HardEngine;
 use crate::granular::soft::run::SoftEngine;
+use crate::io::messages::{Channel, emit};
 
 /// The text of `rubblepile check --explain [KIND]`: the field reference of one kind's scene file, or of all three
 /// (`None`), one after the other.
@@ -65,7 +66,7 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
                 .then(|| super::runner::lock_output_dir(out, options.force))
                 .transpose()?;
             for w in engine.scene_warnings() {
-                eprintln!("warning: {w}");
+                emit(Channel::Warning, &format!("warning: {w}"));
             }
             let result = erase(super::runner::run(engine, out, options));
             if path.is_none() && result.is_ok() {
@@ -81,7 +82,7 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             let engine = SoftEngine::load(path.expect("a soft-sphere scene comes from a file"))
                 .map_err(|e| RunError::Setup(e.to_string()))?;
             for w in engine.scene_warnings() {
-                eprintln!("warning: {w}");
+                emit(Channel::Warning, &format!("warning: {w}"));
             }
             erase(super::runner::run(engine, out, options))
         }
@@ -89,7 +90,7 @@ pub fn run_file(path: Option<&Path>, out: &Path, options: &RunOptions) -> AnyRes
             let engine = HardEngine::load(path.expect("a hard-sphere scene comes from a file"))
                 .map_err(|e| RunError::Setup(e.to_string()))?;
             for w in engine.scene_warnings() {
-                eprintln!("warning: {w}");
+                emit(Channel::Warning, &format!("warning: {w}"));
             }
             erase(super::runner::run(engine, out, options))
         }

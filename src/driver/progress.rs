@@ -6,6 +6,8 @@ use std::cell::Cell;
 use std::io::IsTerminal;
 use std::time::{Duration, Instant};
 
+use crate::io::messages::{Channel, emit};
+
 /// Default wall-clock seconds between progress lines on a non-terminal (the runner's `RunOptions::progress_every`).
 pub const DEFAULT_PROGRESS_EVERY: f64 = 60.0;
 
@@ -84,9 +86,9 @@ impl Progress {
             Progress::Lines(lines) => {
                 if lines.last.get().elapsed() >= lines.every {
                     lines.last.set(Instant::now());
-                    eprintln!(
-                        "{}",
-                        progress_line(t, t_end, lines.t_start, lines.started.elapsed(), error)
+                    emit(
+                        Channel::Progress,
+                        &progress_line(t, t_end, lines.t_start, lines.started.elapsed(), error),
                     );
                 }
             }

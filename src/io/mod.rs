@@ -1,6 +1,6 @@
 //! The engine-independent floor of file input and output: lossless float formatting ([`fmt_f64`]), the checkpoint
 //! file names ([`checkpoint`]), the scene-file reading, parsing and field checks every engine's scene uses
-//! ([`scene_file`]), the run's stand-alone scene copy ([`standalone`]), and the one-writer lock of the directories rubblepile writes ([`run_lock`]), the one way it writes a file there: atomically and never through a link ([`safe_write`]), and the manifest of checksums that lets a run directory be verified ([`manifest`]). Each engine's own
+//! ([`scene_file`]), the run's stand-alone scene copy ([`standalone`]), and the one-writer lock of the directories rubblepile writes ([`run_lock`]), the one way it writes a file there: atomically and never through a link ([`safe_write`]), the manifest of checksums that lets a run directory be verified ([`manifest`]), and the outlet of every line the library means for a person ([`messages`]). Each engine's own
 //! output formats live with the engine (e.g. `ellipsoid::output`).
 //!
 //! Floats are written with `{:e}` (Rust's shortest representation that round-trips, in scientific notation), so a
@@ -9,6 +9,7 @@
 pub mod checkpoint;
 pub mod limits;
 pub mod manifest;
+pub mod messages;
 pub mod output_times;
 pub mod particles;
 pub mod run_budget;

@@ -231,11 +231,14 @@ fn lock(dir: &Path, name: &str, what: PathBuf, shared: bool) -> Result<DirLock, 
         // An exclusive holder has written its pid; shared holders have left the file empty.
         Err(TryLockError::WouldBlock) => return Err(refused(holder_pid(&path))),
         Err(TryLockError::Error(e)) if e.kind() == std::io::ErrorKind::Unsupported => {
-            eprintln!(
-                "warning: {}: this file system has no advisory file locks; nothing keeps a second rubblepile \
-                 process from writing {} at the same time",
-                named.display(),
-                what.display()
+            super::messages::emit(
+                super::messages::Channel::Warning,
+                &format!(
+                    "warning: {}: this file system has no advisory file locks; nothing keeps a second rubblepile \
+                     process from writing {} at the same time",
+                    named.display(),
+                    what.display()
+                ),
             );
             None
         }

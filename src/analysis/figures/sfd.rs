@@ -111,7 +111,10 @@ impl crate::analysis::run_analysis::ClumpRunAnalysis {
         let figure = SizeFrequency::of(&self.clump_report, self.t_at);
         let drawn = crate::analysis::figures::style::write_figure(&dir.join("analysis"), "sfd", &figure);
         if let Err(why) = &drawn {
-            eprintln!("warning: figure not drawn: sfd: {why}");
+            crate::io::messages::emit(
+                crate::io::messages::Channel::Warning,
+                &format!("warning: figure not drawn: sfd: {why}"),
+            );
         }
         format!(
             "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",

@@ -11,6 +11,7 @@ use crate::driver::{RunError, RunOptions, resume_run};
 use crate::ellipsoid::output::read_bodies_csv;
 use crate::impact::run::{ImpactError, ImpactPlan, run_impact};
 use crate::io::checkpoint::CHECKPOINT_FILE;
+use crate::io::messages::{Channel, emit};
 
 use super::*;
 
@@ -224,8 +225,9 @@ impl Display {
         }
     }
 
+    /// Emits `line` with the bars cleared and redrawn after it, so the line is not drawn over by them.
     fn println(&self, line: &str) {
-        self.multi.suspend(|| println!("{line}"));
+        self.multi.suspend(|| emit(Channel::Out, line));
     }
 }
 
@@ -293,7 +295,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
         if options.verbose {
             match &display {
                 Some(d) => d.println(&line),
-                None => println!("{line}"),
+                None => emit(Channel::Out, &line),
             }
         }
     };

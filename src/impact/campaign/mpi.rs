@@ -19,6 +19,8 @@
 
 use std::time::{Duration, Instant};
 
+use crate::io::messages::{Channel, emit};
+
 use ::mpi::traits::*;
 
 use super::*;
@@ -136,10 +138,13 @@ fn coordinate(
         .collect();
     let workers = world.size() - 1;
     if options.verbose {
-        println!(
-            "campaign over MPI: {} runs to do of {}, {workers} worker ranks (rank 0 coordinates)",
-            todo.len(),
-            runs.len()
+        emit(
+            Channel::Out,
+            &format!(
+                "campaign over MPI: {} runs to do of {}, {workers} worker ranks (rank 0 coordinates)",
+                todo.len(),
+                runs.len()
+            ),
         );
     }
     let (mut next, mut done, mut active) = (0, 0, workers);
@@ -163,7 +168,10 @@ fn coordinate(
                 r.numbers = summary.as_deref().map(RunNumbers::from_summary_text);
                 done += 1;
                 if options.verbose {
-                    println!("[{done}/{}] {} (rank {from}): {}", todo.len(), r.name, r.status);
+                    emit(
+                        Channel::Out,
+                        &format!("[{done}/{}] {} (rank {from}): {}", todo.len(), r.name, r.status),
+                    );
                 }
             }
         }
