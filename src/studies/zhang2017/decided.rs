@@ -119,6 +119,16 @@ impl DecidedSearch {
         judged.get(first).map(|h| h.t_final_hours)
     }
 
+    /// [`DecidedSearch::no_release_from`] as a table cell: `≤ T` when not even the fastest hold searched is released
+    /// (the failure stops at or before it), `–` when the slowest is.
+    pub fn no_release_cell(&self, window: f64) -> String {
+        let none_released = self.judged(window).iter().all(|h| !h.released);
+        match self.no_release_from(window) {
+            Some(t) if none_released => format!("≤ {t:.2}"),
+            t => hours(t),
+        }
+    }
+
     /// The holds as letters by the paper's criterion at `window`: `R` released, `C` creeping, `S` stable.
     pub fn letters(&self, window: f64) -> String {
         self.judged(window)
@@ -378,7 +388,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
             opt(phi, 1),
             hours(s.t_c3(hold, CreepCriterionKind::PaperTolerance).0),
             hours(s.t_c3(hold, CreepCriterionKind::Ours).0),
-            hours(s.no_release_from(hold)),
+            s.no_release_cell(hold),
             s.letters(hold),
             paper.map_or("–".into(), |(t, p)| format!("{t:.2} h, {p}°")),
             match (t, paper) {
@@ -439,7 +449,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
                 opt(phi, 1),
                 s.lengths()
                     .last()
-                    .map_or("–".into(), |&l| format!("{} ({l:.0} s)", hours(s.no_release_from(l)))),
+                    .map_or("–".into(), |&l| format!("{} ({l:.0} s)", s.no_release_cell(l))),
                 s.letters(hold)
             );
         }
@@ -890,8 +900,16 @@ mod tests {
             None,
             "every held hold creeps"
         );
+        assert_eq!(s.no_release_cell(32_000.0), "2.55");
         let all_released = search("hcp_x", vec![(2.45, series(Some(3000.0), f64::INFINITY, 6000.0))]);
         assert_eq!(all_released.no_release_from(16_000.0), None);
+        assert_eq!(all_released.no_release_cell(16_000.0), "–");
+        let none_released = search("hcp_y", vec![(2.45, series(None, 1000.0, 32_000.0))]);
+        assert_eq!(
+            none_released.no_release_cell(16_000.0),
+            "≤ 2.45",
+            "failure stops at or before the fastest"
+        );
     }
 
     /// The Naidu ellipsoid keeps the radar extents' ratios and the 780 m body's volume.
