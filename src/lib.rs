@@ -13,8 +13,8 @@
 //! there is no import cycle and no engine sees the driver or the analysis. `tests/layers.rs` reads every `crate::`
 //! path in `src/` and checks this table (the table below is what it reads).
 //!
-//! - **L0**: `math`, `bits`, `phase` — fixed-size linear algebra, bit-exact floats, wall time per phase of the hot
-//!   loops (serial or parallel);
+//! - **L0**: `math`, `bits`, `phase`, `named` — fixed-size linear algebra, bit-exact floats, wall time per phase of
+//!   the hot loops (serial or parallel), the names users type for closed sets of values;
 //! - **L1**: `random` — seeded random numbers (`rand_pcg`; seeds live in scene files);
 //! - **L2**: `geometry`, `gravity`, `integrate`, `io` — shapes, walls and neighbour search; self-gravity; the ODE
 //!   solvers and their canonical test problems; the scene-file floor and lossless formatting;
@@ -35,7 +35,7 @@
 //! uses the library as `rubblepile::…` and its own modules as `crate::…`, again only downwards (`tests/layers.rs`
 //! reads this list too, and checks that no library file names a program):
 //!
-//! - **P0**: `studies` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
+//! - **P0**: `studies`, `choice` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
 //!   `analysis`;
 //! - **P1**: `bench` — benchmarks and timed systems on the canonical test problems (they plot with `analysis`'
 //!   figures);
@@ -54,6 +54,7 @@ pub mod impact;
 pub mod integrate;
 pub mod io;
 pub mod math;
+pub mod named;
 pub mod phase;
 pub mod random;
 pub mod render;

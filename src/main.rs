@@ -2,6 +2,7 @@
 //! timed systems ([`bench`]) and the three papers' reports ([`studies`]).
 
 mod bench;
+mod choice;
 mod cli;
 mod studies;
 

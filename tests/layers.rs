@@ -254,8 +254,42 @@ fn the_library_does_not_print() {
     );
 }
 
+/// No file of the library names clap: how a program reads its arguments is the program's business. The library
+/// offers plain values and [`rubblepile::named::Named`] sets, and the binary turns them into flags. Comments and
+/// string contents are masked, so a doc comment that mentions clap is no use of it.
+#[test]
+fn the_library_does_not_use_clap() {
+    let mut users = Vec::new();
+    for (f, rel) in library_files() {
+        let text = std::fs::read_to_string(&f).unwrap();
+        let masked = mask(&text);
+        let mut lines: BTreeMap<usize, String> = BTreeMap::new();
+        for ((&c, &code), &line) in masked.text.iter().zip(&masked.code).zip(&masked.line) {
+            if code {
+                lines.entry(line).or_default().push(c);
+            }
+        }
+        for (line, code) in lines {
+            let names_clap = code
+                .match_indices("clap")
+                .any(|(i, _)| !code[..i].ends_with(is_ident) && !code[i + 4..].starts_with(is_ident));
+            if names_clap {
+                users.push(format!("src/{}:{line}: {}", rel.display(), code.trim()));
+            }
+        }
+    }
+    assert!(
+        users.is_empty(),
+        "{} library lines use clap:\n{}",
+        users.len(),
+        users.join("\n")
+    );
+}
+
 /// The command line parses and dispatches; science and timed systems live in `analysis` and `bench`. Its size is a
-/// cheap guard against logic creeping back in.
+/// cheap guard against logic creeping back in. The bound was 2000 lines until the flag structs of `flyby`, `render`,
+/// `export`, `convert`, `campaign merge|slurm` and `--projectile-pile` (about 350 lines of flags and their help) moved
+/// here from the library, which no longer knows clap.
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -265,8 +299,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2000,
-        "src/cli/ has {lines} lines (at most 2000: move logic to analysis/ or bench/)"
+        lines <= 2400,
+        "src/cli/ has {lines} lines (at most 2400: move logic to analysis/ or bench/)"
     );
 }
 

@@ -11,6 +11,7 @@ use std::process::Command;
 use rubblepile::driver::SceneKind;
 use rubblepile::io::scene_fields::{Range, SceneReference};
 use rubblepile::io::schema_keys::{SchemaKeys, schema_keys};
+use rubblepile::named::Named;
 
 /// The reference's keys and tables against the schema's, with every difference named.
 fn assert_reference_matches(reference: &SceneReference, schema: &SchemaKeys) {

@@ -32,7 +32,7 @@ use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
 use crate::ellipsoid::spin_state::{SpinState, spin_state_of_fit};
-use crate::impact::flyby::{CONTROL_DIR, FlybyArgs, run_flyby};
+use crate::impact::flyby::{CONTROL_DIR, FlybyConfig, run_flyby};
 use crate::impact::run::read_target;
 use crate::impact::settle::SettleReport;
 use crate::math::{Mat3, Vec3};
@@ -404,7 +404,7 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
 
 /// `rubblepile flyby`: prepares and runs the flyby of `args` ([`run_flyby`]), then analyses it ([`analyze_flyby`]);
 /// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request).
-pub fn flyby_command(args: &FlybyArgs) -> Result<Vec<String>, (String, u8)> {
+pub fn flyby_command(args: &FlybyConfig) -> Result<Vec<String>, (String, u8)> {
     let runs = run_flyby(args, &crate::driver::RunOptions::default()).map_err(|e| (e.to_string(), e.exit_code()))?;
     let Some(runs) = runs else {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);

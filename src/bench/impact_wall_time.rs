@@ -87,8 +87,7 @@ fn parse_method_spec(text: &str) -> Result<MethodSpec, String> {
         }
         None => (text, None),
     };
-    let method = <Method as clap::ValueEnum>::from_str(name, true)
-        .ok()
+    let method = <Method as rubblepile::named::Named>::from_name(name)
         .filter(|m| *m != Method::Rk4)
         .ok_or_else(|| {
             format!(

@@ -35,14 +35,14 @@ use rubblepile::integrate::{IntegrateError, Method, OdeSystem, Stats, Tolerances
 #[derive(Debug, clap::Args)]
 pub struct NBodyArgs {
     /// The problem: pythagorean (masses 3, 4, 5 at rest, t = 0..10) or outer-solar (Sun + 4 giants, t = 0..1000).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::choice::choice::<NBodyProblem>())]
     pub problem: NBodyProblem,
     /// Tolerances rtol = atol, comma-separated.
     #[arg(long, value_delimiter = ',', value_name = "TOL",
           default_values_t = [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12])]
     pub rtol: Vec<f64>,
     /// Methods, comma-separated, from bulirsch-stoer, dop853, dopri5.
-    #[arg(long, value_enum, value_delimiter = ',', value_name = "METHOD",
+    #[arg(long, value_parser = crate::choice::choice::<Method>(), value_delimiter = ',', value_name = "METHOD",
           default_values_t = [Method::BulirschStoer])]
     pub methods: Vec<Method>,
     /// Timed runs per setting (median and minimum reported).

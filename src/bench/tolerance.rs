@@ -27,7 +27,7 @@ pub struct ToleranceArgs {
     #[arg(long)]
     pub force: bool,
     /// Methods, comma-separated (default bulirsch-stoer,dop853; bulirsch-stoer-implicit for the stiff problems).
-    #[arg(long, value_enum, value_delimiter = ',', value_name = "METHOD")]
+    #[arg(long, value_parser = crate::choice::choice::<Method>(), value_delimiter = ',', value_name = "METHOD")]
     pub methods: Option<Vec<Method>>,
     /// Problems, comma-separated, from top, pair, pair-dissipative, n30, n200, pythagorean, outer-solar, stiff-pair,
     /// pile (default all).

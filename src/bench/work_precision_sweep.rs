@@ -16,6 +16,7 @@ use crate::bench::work_precision::{
 };
 use rubblepile::impact::problems::{ProblemSetup, ReferenceKind, WorkPrecisionProblem};
 use rubblepile::integrate::Method;
+use rubblepile::named::Named;
 
 /// `rubblepile bench work-precision`.
 ///
@@ -37,7 +38,7 @@ pub struct WorkPrecisionArgs {
     /// and contact, G = 1), pair-dissipative (the same with F0 = 0.1), n30 (the N30_T4 target hit by P1, SI),
     /// n200 (N200_T4 hit by P2 to 400 s), stiff-pair (two overlapping ellipsoids, F0 = 1e4, damping 1000× faster
     /// than the contact), pile (N30_T4 squeezed to 0.9, F0 = 1e-2 s m⁻²; both with --f0).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = crate::choice::choice::<WorkPrecisionProblem>())]
     pub problem: WorkPrecisionProblem,
     /// Output directory (created if missing).
     #[arg(long, value_name = "DIR")]
@@ -53,7 +54,7 @@ pub struct WorkPrecisionArgs {
     pub rtol: Option<Vec<f64>>,
     /// Methods, comma-separated, from bulirsch-stoer, dop853, dopri5, rk4, bulirsch-stoer-implicit (default the first
     /// four).
-    #[arg(long, value_enum, value_delimiter = ',', value_name = "METHOD")]
+    #[arg(long, value_parser = crate::choice::choice::<Method>(), value_delimiter = ',', value_name = "METHOD")]
     pub methods: Option<Vec<Method>>,
     /// Fixed steps of rk4 (time unit of the problem), comma-separated (default: six per problem).
     #[arg(long, value_delimiter = ',', value_name = "H")]
@@ -172,8 +173,8 @@ pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, crate::bench::BenchError> 
                 num(k).map(Some)
             }
         };
-        let method =
-            <Method as clap::ValueEnum>::from_str(&rec[c[0]], true).map_err(|e| err(&format!("{}: {e}", at(0))))?;
+        let method = <Method as rubblepile::named::Named>::from_name(&rec[c[0]])
+            .ok_or_else(|| err(&format!("{}: no integrator is named {:?}", at(0), &rec[c[0]])))?;
         rows.push(SweepRow {
             setting: crate::bench::work_precision::Setting {
                 method,

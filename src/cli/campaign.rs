@@ -4,7 +4,10 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError};
-use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignOptions, load_campaign, run_campaign_anywhere};
+use rubblepile::impact::campaign::{
+    CAMPAIGN_CSV, CampaignError, CampaignOptions, SlurmJob, load_campaign, merge_campaign, run_campaign_anywhere,
+    write_slurm,
+};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
@@ -12,7 +15,7 @@ use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignOptions, load_campaign,
 pub struct CampaignArgs {
     /// `merge DIR` or `slurm FILE --tasks N` instead of running a campaign.
     #[command(subcommand)]
-    pub action: Option<rubblepile::impact::campaign::CampaignAction>,
+    pub action: Option<CampaignAction>,
     /// Campaign file (TOML): `[campaign]` out, targets, projectiles, angles, seeds, parallel; optional
     /// `[impact]` overrides and `[[projectile]]` custom projectiles.
     #[arg(required = true)]
@@ -80,5 +83,99 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
     match report.problem(&campaign.out.join(index)) {
         Some((message, code)) => Err(CliError { message, code }),
         None => Ok(()),
+    }
+}
+
+/// `rubblepile campaign merge|slurm …`.
+#[derive(Debug, clap::Subcommand)]
+pub enum CampaignAction {
+    /// Rebuild DIR/campaign.csv from the run directories (after shards ran separately).
+    Merge {
+        /// The campaign directory.
+        dir: PathBuf,
+    },
+    /// Write DIR/campaign.slurm, a Slurm job array running the campaign as N shards (not submitted).
+    Slurm {
+        /// The campaign file.
+        file: PathBuf,
+        /// The campaign directory (overrides `campaign.out`).
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+        /// Array tasks (shards).
+        #[arg(long, value_name = "N")]
+        tasks: usize,
+        /// Cores per task (each task runs one impact at a time on them).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        threads_per_task: usize,
+        /// Wall-clock limit per array task (`sbatch --time`: MINUTES, HH:MM:SS, D-HH:MM, …) [default: the
+        /// partition's].
+        #[arg(long, value_name = "LIMIT")]
+        time: Option<String>,
+        /// Slurm partition (`sbatch --partition`) [default: the cluster's].
+        #[arg(long, value_name = "NAME")]
+        partition: Option<String>,
+        /// Account charged (`sbatch --account`) [default: the user's].
+        #[arg(long, value_name = "NAME")]
+        account: Option<String>,
+        /// Memory per task's node (`sbatch --mem`, e.g. 4G; a bare number is MB) [default: the partition's].
+        #[arg(long, value_name = "SIZE")]
+        mem: Option<String>,
+        /// Most array tasks running at once (the array's `%K`) [default: no limit].
+        #[arg(long, value_name = "K")]
+        throttle: Option<usize>,
+        /// The rubblepile executable the tasks run [default: this one, by its absolute path].
+        #[arg(long, value_name = "PATH")]
+        binary: Option<PathBuf>,
+    },
+}
+
+impl CampaignAction {
+    /// Does it; the lines to print.
+    pub fn run(&self) -> Result<Vec<String>, CampaignError> {
+        match self {
+            CampaignAction::Merge { dir } => {
+                let r = merge_campaign(dir)?;
+                Ok(vec![format!(
+                    "merged {} runs into {}: {} completed, {} failed, {} pending",
+                    r.runs.len(),
+                    dir.join(CAMPAIGN_CSV).display(),
+                    r.completed(),
+                    r.failed(),
+                    r.pending()
+                )])
+            }
+            CampaignAction::Slurm {
+                file,
+                out,
+                tasks,
+                threads_per_task,
+                time,
+                partition,
+                account,
+                mem,
+                throttle,
+                binary,
+            } => {
+                let job = SlurmJob {
+                    tasks: *tasks,
+                    threads: *threads_per_task,
+                    time: time.clone(),
+                    partition: partition.clone(),
+                    account: account.clone(),
+                    mem: mem.clone(),
+                    throttle: *throttle,
+                    binary: binary
+                        .clone()
+                        .or_else(|| std::env::current_exe().ok())
+                        .unwrap_or_else(|| PathBuf::from("rubblepile")),
+                };
+                let (path, runs, out) = write_slurm(file, out.as_deref(), &job)?;
+                Ok(vec![format!(
+                    "wrote {} ({runs} runs in {tasks} array tasks); submit it with sbatch, then run `campaign merge {}`",
+                    path.display(),
+                    out.display()
+                )])
+            }
+        }
     }
 }

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError, report};
 use rubblepile::driver::{RunOptions, run_scene};
+use rubblepile::impact::pile::{ProjectilePile, as_field};
 use rubblepile::impact::projectile::ProjectileSpec;
 use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact, snapshot_times};
 
@@ -45,7 +46,7 @@ pub struct ImpactArgs {
     pub rtol: Option<f64>,
     /// Integrator: bulirsch-stoer (Roig03's), dop853 or dopri5 (these project the attitudes onto |q| = 1 at
     /// every output sample).
-    #[arg(long, default_value = "bulirsch-stoer")]
+    #[arg(long, default_value = "bulirsch-stoer", value_parser = crate::choice::choice::<rubblepile::integrate::Method>())]
     pub method: rubblepile::integrate::Method,
     /// Dissipation coefficient F0 (s m⁻²). The default 1e-6 is Roig03's "F0 ≈ 1" in km and s, and the value
     /// closest to its outcomes in analysis/roig2003/F0_SCAN.md.
@@ -83,7 +84,7 @@ pub struct ImpactArgs {
     pub no_progress: bool,
     /// Rubble-pile projectile.
     #[command(flatten)]
-    pub pile: rubblepile::impact::pile::PileArgs,
+    pub pile: PileArgs,
     /// Checkpoint options.
     #[command(flatten)]
     pub checkpoints: CheckpointArgs,
@@ -176,4 +177,27 @@ pub fn impact(args: &ImpactArgs) -> Result<(), CliError> {
     let prepared = prepare_impact(&cfg, &args.out, args.force).map_err(cli_error)?;
     println!("{}", prepared.plan.title);
     report(run_scene(&prepared.scene, &args.out, &options))
+}
+
+/// `--projectile-pile FILE [--pile-fixed-attitude]` of `rubblepile impact`.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct PileArgs {
+    /// A rubble-pile projectile: a bodies file such as targets/N30_T4.csv (any N and spin), thrown whole at
+    /// --projectile-speed-km-s; replaces --projectile and --projectile-radius-km.
+    #[arg(long)]
+    pub projectile_pile: Option<PathBuf>,
+    /// Keep the projectile pile's orientation of the file instead of a random attitude drawn from --seed.
+    #[arg(long, requires = "projectile_pile")]
+    pub pile_fixed_attitude: bool,
+}
+
+impl PileArgs {
+    /// The projectile pile these arguments ask for, if any; a file that cannot be read is
+    /// [`ImpactError::Invalid`] with field `projectile_pile`.
+    pub fn read(&self) -> Result<Option<ProjectilePile>, ImpactError> {
+        self.projectile_pile
+            .as_ref()
+            .map(|file| ProjectilePile::read(file, !self.pile_fixed_attitude).map_err(as_field("projectile_pile")))
+            .transpose()
+    }
 }

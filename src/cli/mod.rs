@@ -60,7 +60,9 @@ pub mod aggregate;
 pub mod analyze;
 pub mod campaign;
 pub mod common;
+pub mod flyby;
 pub mod impact;
+pub mod render_args;
 pub mod report_richardson2011;
 pub mod spinup;
 pub mod ssdem;
@@ -102,7 +104,7 @@ pub enum Command {
     /// Run an impact of a projectile (P1, P2, P3 or custom) on a target.
     Impact(Box<impact::ImpactArgs>),
     /// Run a tidal flyby of a target pile past a planet (default Earth); analysis in DIR/analysis/flyby.json.
-    Flyby(Box<rubblepile::impact::flyby::FlybyArgs>),
+    Flyby(Box<flyby::FlybyArgs>),
     /// Run a campaign of impacts (targets × projectiles × angles × seeds) from a campaign file; resumable.
     Campaign(Box<campaign::CampaignArgs>),
     /// Analyse a run: clumps of any run (largest and second remnant, clumps.csv, sfd.svg); of an impact run also the
@@ -135,11 +137,11 @@ pub enum Command {
     #[command(hide = true)]
     ReportZhang2017(crate::studies::zhang2017::report::ReportZhang2017Args),
     /// Write a finished run's snapshots in another format: `export vtk DIR` (ParaView) or `export xyz DIR`.
-    Export(rubblepile::driver::export::ExportArgs),
+    Export(visual::ExportArgs),
     /// Convert pkdgrav `.ss` files to and from bodies/particles CSV (units converted at the edge).
-    Convert(rubblepile::driver::convert::ConvertArgs),
+    Convert(visual::ConvertArgs),
     /// Draw a run: one PNG per snapshot and an animated GIF in DIR/frames.
-    Render(rubblepile::render::args::RenderArgs),
+    Render(render_args::RenderArgs),
 }
 
 /// `rubblepile report …`: one verb for the papers' reproduction reports.
@@ -203,7 +205,8 @@ pub struct CheckArgs {
     #[arg(long, conflicts_with = "scene")]
     pub print_default: bool,
     /// Print every key of a KIND scene file (all kinds without one): its unit, default, allowed range and meaning.
-    #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"])]
+    #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"],
+          value_parser = crate::choice::choice::<rubblepile::driver::SceneKind>())]
     pub explain: Option<Option<rubblepile::driver::SceneKind>>,
 }
 
@@ -285,7 +288,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
-        Command::Flyby(args) => rubblepile::analysis::flyby::flyby_command(&args)
+        Command::Flyby(args) => rubblepile::analysis::flyby::flyby_command(&(*args).into())
             .map(|lines| lines.iter().for_each(|l| println!("{l}")))
             .map_err(|(message, code)| CliError { message, code }),
         Command::Campaign(args) => campaign::campaign(&args),

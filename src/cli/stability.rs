@@ -26,7 +26,7 @@ pub struct StabilityArgs {
     pub only: Vec<String>,
     /// The integrator every case runs with (its tolerances unchanged), e.g. `bulirsch-stoer-implicit` to compare
     /// the stiff rows.
-    #[arg(long, value_enum, default_value_t = rubblepile::integrate::Method::BulirschStoer)]
+    #[arg(long, value_parser = crate::choice::choice::<rubblepile::integrate::Method>(), default_value_t = rubblepile::integrate::Method::BulirschStoer)]
     pub method: rubblepile::integrate::Method,
 }
 

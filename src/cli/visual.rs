@@ -2,14 +2,43 @@
 //! (PNG frames and an animated GIF) and `rubblepile convert FILE --to FILE` (pkdgrav `.ss` files).
 
 use crate::cli::common::CliError;
+use crate::cli::render_args::RenderArgs;
 use rubblepile::analysis::run_analysis::FragmentFields;
 use rubblepile::driver::export::{ExportError, export};
 use rubblepile::driver::formats::Formats;
-use rubblepile::render::args::RenderArgs;
 use rubblepile::render::run::{RenderReport, RenderRunError, RenderRunOptions, render_run};
+use std::path::PathBuf;
+
+/// `rubblepile export`.
+#[derive(Debug, clap::Args)]
+pub struct ExportArgs {
+    /// Format: `vtk` (ParaView: DIR/vtk/*.vtp and DIR/vtk/run.pvd) or `xyz` (DIR/snapshots/<k>.xyz).
+    pub format: String,
+    /// The run directory (any engine).
+    pub dir: PathBuf,
+    /// Overwrite files an earlier export (or the run itself) wrote in this format.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// `rubblepile convert`.
+#[derive(Debug, clap::Args)]
+pub struct ConvertArgs {
+    /// Input: a pkdgrav `.ss` file, or a bodies/particles/snapshot CSV.
+    pub input: PathBuf,
+    /// Output: a `.csv` (from `.ss`) or a `.ss` file (from CSV).
+    #[arg(long, value_name = "FILE")]
+    pub to: PathBuf,
+    /// `.ss` → CSV: write the sphere engines' particles columns (t,id,mass,radius,…) instead of a bodies file.
+    #[arg(long)]
+    pub spheres: bool,
+    /// Overwrite the output.
+    #[arg(long)]
+    pub force: bool,
+}
 
 /// Runs `export`.
-pub fn export_cmd(args: &rubblepile::driver::export::ExportArgs) -> Result<(), CliError> {
+pub fn export_cmd(args: &ExportArgs) -> Result<(), CliError> {
     let formats = Formats::parse(std::slice::from_ref(&args.format))
         .map_err(|e| CliError::usage(e.to_string().replacen("--format", "FORMAT", 1)))?;
     let fields = FragmentFields::read(&args.dir).map_err(CliError::usage)?;
@@ -71,7 +100,7 @@ pub fn render_cmd(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// Runs `convert`.
-pub fn convert_cmd(args: &rubblepile::driver::convert::ConvertArgs) -> Result<(), CliError> {
+pub fn convert_cmd(args: &ConvertArgs) -> Result<(), CliError> {
     let c = rubblepile::driver::convert::convert(&args.input, &args.to, args.spheres, args.force)
         .map_err(CliError::usage)?;
     println!("wrote {} ({} bodies): {}", args.to.display(), c.count, c.note);

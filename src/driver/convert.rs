@@ -20,22 +20,6 @@ use crate::io::fmt_f64;
 use crate::io::ss::{SsFile, SsParticle, is_ss};
 use crate::math::{Vec3, Vec4};
 
-/// `rubblepile convert`.
-#[derive(Debug, clap::Args)]
-pub struct ConvertArgs {
-    /// Input: a pkdgrav `.ss` file, or a bodies/particles/snapshot CSV.
-    pub input: PathBuf,
-    /// Output: a `.csv` (from `.ss`) or a `.ss` file (from CSV).
-    #[arg(long, value_name = "FILE")]
-    pub to: PathBuf,
-    /// `.ss` → CSV: write the sphere engines' particles columns (t,id,mass,radius,…) instead of a bodies file.
-    #[arg(long)]
-    pub spheres: bool,
-    /// Overwrite the output.
-    #[arg(long)]
-    pub force: bool,
-}
-
 /// pkdgrav colour written for every particle (green in its default colour table).
 pub const SS_COLOUR: i32 = 3;
 

@@ -49,18 +49,6 @@ pub enum ExportError {
     Other(String),
 }
 
-/// `rubblepile export`.
-#[derive(Debug, clap::Args)]
-pub struct ExportArgs {
-    /// Format: `vtk` (ParaView: DIR/vtk/*.vtp and DIR/vtk/run.pvd) or `xyz` (DIR/snapshots/<k>.xyz).
-    pub format: String,
-    /// The run directory (any engine).
-    pub dir: PathBuf,
-    /// Overwrite files an earlier export (or the run itself) wrote in this format.
-    #[arg(long)]
-    pub force: bool,
-}
-
 /// The snapshot files of the run in `dir`, `(k, path)` sorted by `k`.
 pub fn snapshot_files(dir: &Path) -> Result<Vec<(usize, PathBuf)>, ExportError> {
     let snap_dir = dir.join("snapshots");

@@ -1,6 +1,7 @@
 //! The one place where an engine is chosen: from one read of a scene's `scene.kind` (or of a run directory's
 //! `scene.toml` copy). `run`, `resume` and `check` of the command line go through here.
 
+use crate::named::Named;
 use std::path::Path;
 
 use super::runner::{RunError, RunOptions};

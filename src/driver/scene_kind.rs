@@ -9,7 +9,7 @@ use crate::granular::hard::run::HardEngine;
 use crate::granular::soft::run::SoftEngine;
 
 /// The engines a scene file can name in `scene.kind` (on the command line by the same names).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum SceneKind {
     /// `kind = "ellipsoids"` (also a scene without `kind`): interacting ellipsoids (Roig03).
     Ellipsoids,
@@ -17,6 +17,33 @@ pub enum SceneKind {
     SoftSpheres,
     /// `kind = "hard-spheres"`: hard spheres with predicted collisions (Richardson11).
     HardSpheres,
+}
+
+impl crate::named::Named for SceneKind {
+    /// Every kind, in the order `rubblepile check --explain` prints them.
+    const ALL: &'static [SceneKind] = &[SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
+
+    fn name(self) -> &'static str {
+        match self {
+            SceneKind::Ellipsoids => "ellipsoids",
+            SceneKind::SoftSpheres => SoftEngine::KIND,
+            SceneKind::HardSpheres => HardEngine::KIND,
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            SceneKind::Ellipsoids => "interacting ellipsoids (Roig03)",
+            SceneKind::SoftSpheres => "soft-sphere DEM (Zhang17)",
+            SceneKind::HardSpheres => "hard spheres with predicted collisions (Richardson11)",
+        }
+    }
+}
+
+impl std::fmt::Display for SceneKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(crate::named::Named::name(*self))
+    }
 }
 
 impl SceneKind {
@@ -47,9 +74,6 @@ impl SceneKind {
 }
 
 impl SceneKind {
-    /// Every kind, in the order `rubblepile check --explain` prints them.
-    pub const ALL: [SceneKind; 3] = [SceneKind::Ellipsoids, SceneKind::SoftSpheres, SceneKind::HardSpheres];
-
     /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
     pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
         match self {

@@ -48,76 +48,56 @@ pub const F0_REFERENCE: f64 = 1e-6;
 /// Radius (m) at which [`F0_REFERENCE`] applies (Roig03's 100 km piles).
 pub const F0_REFERENCE_RADIUS_M: f64 = 1e5;
 
-/// `rubblepile flyby`: a rubble pile (a target file) past a planet on a hyperbolic orbit.
-#[derive(Debug, Clone, clap::Args)]
-pub struct FlybyArgs {
+/// A flyby experiment (`rubblepile flyby`): a rubble pile (a target file) past a planet on a hyperbolic orbit.
+/// Field names are those of the command line's flags (`q_m` is `--q-m`), so errors name what the user typed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlybyConfig {
     /// Target bodies file (snapshot columns, e.g. from `rubblepile target build`).
-    #[arg(long)]
     pub target: PathBuf,
     /// Rescale the pile to this apparent radius (m; max over fragments of |r − r_cm| + A); a rescaled pile is
     /// settled before the run [default: as built].
-    #[arg(long)]
     pub radius_m: Option<f64>,
     /// Set the pile into rigid rotation about its z axis with this period (hours); a re-spun pile is settled before
     /// the run [default: the target's spins].
-    #[arg(long)]
     pub period_hours: Option<f64>,
     /// Planet mass (kg; 0 for a control run without tide, the frame then moves straight at v∞) [default: Earth].
-    #[arg(long, default_value_t = EARTH_MASS_KG)]
     pub planet_mass: f64,
     /// Planet radius (m) [default: Earth's mean radius].
-    #[arg(long, default_value_t = EARTH_RADIUS_M)]
     pub planet_radius_m: f64,
     /// The planet's J2 (dimensionless; Earth 1.0826e-3), with `--planet-radius-m` as its reference radius
     /// [default: none, a point mass].
-    #[arg(long)]
     pub planet_j2: Option<f64>,
     /// The planet's spin axis X,Y,Z in the run's frame (the flyby orbit lies in the x–y plane), used with
     /// `--planet-j2` [default: 0,0,1].
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub planet_pole: Option<Vec<f64>>,
     /// Perigee distance from the planet's centre (m).
-    #[arg(long)]
     pub q_m: f64,
     /// Speed at infinity (km/s).
-    #[arg(long, default_value_t = 5.8)]
     pub v_inf_km_s: f64,
     /// Orbit orientation Ω,i,ω (degrees; see `physics.flyby.orientation_deg`) [default: 0,0,0, prograde in x–y].
-    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub orientation_deg: Option<Vec<f64>>,
     /// Start and end with the planet this many q away.
-    #[arg(long, default_value_t = DEFAULT_START_Q)]
     pub start_q: f64,
     /// κ of the pile [default: "kappa" of the target's NAME.json, as built].
-    #[arg(long)]
     pub kappa: Option<f64>,
     /// Dissipation F0 (s m⁻²) [default: 1e-6 (100 km/R)², R the pile's apparent radius].
-    #[arg(long)]
     pub f0: Option<f64>,
     /// Relative (and absolute) tolerance of Bulirsch–Stoer over the run (and over the settling).
-    #[arg(long, default_value_t = 1e-6)]
     pub rtol: f64,
     /// Number of snapshots, evenly spaced from start to end (2 to 100000).
-    #[arg(long, default_value_t = 9)]
     pub snapshots: usize,
     /// Output directory.
-    #[arg(long)]
     pub out: PathBuf,
     /// Overwrite an earlier run in DIR.
-    #[arg(long)]
     pub force: bool,
     /// Write the run directory (scene, bodies) but do not run it (the pile is still settled when it would be).
-    #[arg(long)]
     pub no_run: bool,
     /// Skip the control run without the planet (by default it runs into DIR/control over the same time).
-    #[arg(long)]
     pub no_control: bool,
     /// After settling, put the pile into rigid rotation about its axis of largest moment with the same |L|
     /// (settles an as-built pile too).
-    #[arg(long)]
     pub settle_to_principal: bool,
     /// Cap on the settling time (hours) [default: 100 free-fall times √(3π/(32 G ρ)) of the pile].
-    #[arg(long)]
     pub settle_max_hours: Option<f64>,
 }
 
@@ -241,7 +221,7 @@ fn target_kappa(target: &Path) -> Option<f64> {
 
 /// Validates `args`, writes the run directory (refused when not empty unless `force`, or when another process writes
 /// it) and returns the scene, with the directory's lock ([`crate::io::run_lock`]: keep it until the run has ended).
-pub fn prepare_flyby(args: &FlybyArgs) -> Result<(LoadedScene, FlybySetup, DirLock), ImpactError> {
+pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, DirLock), ImpactError> {
     let positive = |x: f64| x.is_finite() && x > 0.0;
     for (field, x) in [
         ("planet_radius_m", args.planet_radius_m),
@@ -514,7 +494,7 @@ pub struct FlybyRuns {
 }
 
 /// Prepares and (unless `no_run`) runs the flyby of `args`, then its control (unless `no_control`).
-pub fn run_flyby(args: &FlybyArgs, options: &RunOptions) -> Result<Option<FlybyRuns>, ImpactError> {
+pub fn run_flyby(args: &FlybyConfig, options: &RunOptions) -> Result<Option<FlybyRuns>, ImpactError> {
     let (scene, setup, _lock) = prepare_flyby(args)?;
     if args.no_run {
         return Ok(None);

@@ -33,29 +33,6 @@ pub struct ProjectilePile {
     pub random_attitude: bool,
 }
 
-/// `--projectile-pile FILE [--pile-fixed-attitude]` of `rubblepile impact`.
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct PileArgs {
-    /// A rubble-pile projectile: a bodies file such as targets/N30_T4.csv (any N and spin), thrown whole at
-    /// --projectile-speed-km-s; replaces --projectile and --projectile-radius-km.
-    #[arg(long)]
-    pub projectile_pile: Option<PathBuf>,
-    /// Keep the projectile pile's orientation of the file instead of a random attitude drawn from --seed.
-    #[arg(long, requires = "projectile_pile")]
-    pub pile_fixed_attitude: bool,
-}
-
-impl PileArgs {
-    /// The projectile pile these arguments ask for, if any; a file that cannot be read is
-    /// [`ImpactError::Invalid`] with field `projectile_pile`.
-    pub fn read(&self) -> Result<Option<ProjectilePile>, ImpactError> {
-        self.projectile_pile
-            .as_ref()
-            .map(|file| ProjectilePile::read(file, !self.pile_fixed_attitude).map_err(as_field("projectile_pile")))
-            .transpose()
-    }
-}
-
 /// Turns an error reading a pile file into [`ImpactError::Invalid`] naming `field` (the file and the reason in
 /// the message).
 pub fn as_field(field: &str) -> impl Fn(ImpactError) -> ImpactError + '_ {

@@ -25,8 +25,6 @@
 //! * [`ProblemSetup::energy_residual`] — `|H(t) − H(0) − 2∫₀ᵗF dt| / E_scale(0)`, with `E_scale = K + |U_C| +
 //!   |U_G|` of [`Diagnostics`] at `t = 0` (`F = 0` without dissipation).
 
-use clap::ValueEnum;
-
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
@@ -44,7 +42,7 @@ pub const N30_T4_CSV: &str = include_str!("../../targets/N30_T4.csv");
 pub const N200_T4_CSV: &str = include_str!("../../targets/N200_T4.csv");
 
 /// The problems of `rubblepile bench work-precision --problem`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum WorkPrecisionProblem {
     /// A free asymmetric top: one ellipsoid, no forces, with the analytic body-frame spin as reference.
     Top,
@@ -65,9 +63,9 @@ pub enum WorkPrecisionProblem {
     Pile,
 }
 
-impl WorkPrecisionProblem {
+impl crate::named::Named for WorkPrecisionProblem {
     /// All problems, in `--problem` order.
-    pub const ALL: [WorkPrecisionProblem; 7] = [
+    const ALL: &'static [WorkPrecisionProblem] = &[
         WorkPrecisionProblem::Top,
         WorkPrecisionProblem::Pair,
         WorkPrecisionProblem::PairDissipative,
@@ -78,7 +76,7 @@ impl WorkPrecisionProblem {
     ];
 
     /// The `--problem` value, e.g. `"pair-dissipative"`.
-    pub fn name(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
             WorkPrecisionProblem::Top => "top",
             WorkPrecisionProblem::Pair => "pair",
@@ -90,6 +88,26 @@ impl WorkPrecisionProblem {
         }
     }
 
+    fn help(self) -> &'static str {
+        match self {
+            WorkPrecisionProblem::Top => "a free asymmetric top with its analytic spin",
+            WorkPrecisionProblem::Pair => "two ellipsoids in gravity and contact, bouncing (G = 1)",
+            WorkPrecisionProblem::PairDissipative => "the pair with Rayleigh dissipation (F0 = 0.1)",
+            WorkPrecisionProblem::N30 => "N30_T4 hit by P1 (5 km/s, 45°), SI",
+            WorkPrecisionProblem::N200 => "N200_T4 hit by P2 as in the Roig03 campaign, to 400 s",
+            WorkPrecisionProblem::StiffPair => "a stiff damped pair (damping ~1000× faster than contact)",
+            WorkPrecisionProblem::Pile => "an overdamped pile: N30_T4 squeezed to 0.9, relaxing",
+        }
+    }
+}
+
+impl std::fmt::Display for WorkPrecisionProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(crate::named::Named::name(*self))
+    }
+}
+
+impl WorkPrecisionProblem {
     /// Whether the problem has dissipation whose F0 `--f0` may set.
     pub fn takes_f0(self) -> bool {
         matches!(self, WorkPrecisionProblem::StiffPair | WorkPrecisionProblem::Pile)
@@ -121,7 +139,7 @@ impl WorkPrecisionProblem {
 
 /// The problems of `rubblepile bench nbody --problem` (point masses: spheres of radius 1e-6, gravity only,
 /// G = 1, no contact term, no dissipation, so only `r` and `u` are integrated).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum NBodyProblem {
     /// Burrau's Pythagorean three-body problem: masses 3, 4, 5 at rest at (1, 3), (−2, −1), (1, −1), to t = 10.
     Pythagorean,
@@ -130,15 +148,32 @@ pub enum NBodyProblem {
     OuterSolar,
 }
 
-impl NBodyProblem {
+impl crate::named::Named for NBodyProblem {
+    const ALL: &'static [NBodyProblem] = &[NBodyProblem::Pythagorean, NBodyProblem::OuterSolar];
+
     /// The `--problem` value.
-    pub fn name(self) -> &'static str {
+    fn name(self) -> &'static str {
         match self {
             NBodyProblem::Pythagorean => "pythagorean",
             NBodyProblem::OuterSolar => "outer-solar",
         }
     }
 
+    fn help(self) -> &'static str {
+        match self {
+            NBodyProblem::Pythagorean => "Burrau's Pythagorean three-body problem, to t = 10",
+            NBodyProblem::OuterSolar => "the Sun and the four giant planets, to t = 1000",
+        }
+    }
+}
+
+impl std::fmt::Display for NBodyProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(crate::named::Named::name(*self))
+    }
+}
+
+impl NBodyProblem {
     /// Builds the problem (one energy check, at the end: the integrator runs straight to `t_end`).
     pub fn setup(self) -> ProblemSetup {
         match self {

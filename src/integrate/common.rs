@@ -44,7 +44,7 @@ pub trait OdeSystem: Sync {
 }
 
 /// Which integrator runs a system (the scene's `[integrator] method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
     /// Adaptive Bulirsch–Stoer (ours), `"bulirsch-stoer"`.
@@ -60,16 +60,39 @@ pub enum Method {
     BulirschStoerImplicit,
 }
 
-impl fmt::Display for Method {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = match self {
+impl crate::named::Named for Method {
+    const ALL: &'static [Method] = &[
+        Method::BulirschStoer,
+        Method::Dop853,
+        Method::Dopri5,
+        Method::Rk4,
+        Method::BulirschStoerImplicit,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
             Method::BulirschStoer => "bulirsch-stoer",
             Method::Dop853 => "dop853",
             Method::Dopri5 => "dopri5",
             Method::Rk4 => "rk4",
             Method::BulirschStoerImplicit => "bulirsch-stoer-implicit",
-        };
-        f.write_str(s)
+        }
+    }
+
+    fn help(self) -> &'static str {
+        match self {
+            Method::BulirschStoer => "adaptive Bulirsch–Stoer (ours)",
+            Method::Dop853 => "Dormand–Prince 8(5,3) (ours)",
+            Method::Dopri5 => "Dormand–Prince 5(4) from ode_solvers",
+            Method::Rk4 => "classical fixed-step Runge–Kutta 4 from ode_solvers (needs a step)",
+            Method::BulirschStoerImplicit => "linearly implicit Euler extrapolation for stiff systems (ours)",
+        }
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(crate::named::Named::name(*self))
     }
 }
 

@@ -84,7 +84,7 @@ pub(crate) fn one_line(s: &str) -> String {
 
 /// Formats a number for a message: plainly in `[1e-4, 1e16)` (and 0), in scientific notation otherwise, so that
 /// `1e308` is not printed as 309 digits.
-pub(crate) fn fmt_num(x: f64) -> String {
+pub fn fmt_num(x: f64) -> String {
     if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&x.abs()) {
         format!("{x}")
     } else {

@@ -20,7 +20,6 @@
 //! All parallel work goes through rayon's global API, so a caller can bound the threads by running inside
 //! `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(|| …)`.
 
-pub mod args;
 pub mod camera;
 pub mod colour;
 pub mod encode;

@@ -118,117 +118,33 @@ pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
     })
 }
 
-/// `rubblepile campaign merge|slurm …`.
-#[derive(Debug, clap::Subcommand)]
-pub enum CampaignAction {
-    /// Rebuild DIR/campaign.csv from the run directories (after shards ran separately).
-    Merge {
-        /// The campaign directory.
-        dir: PathBuf,
-    },
-    /// Write DIR/campaign.slurm, a Slurm job array running the campaign as N shards (not submitted).
-    Slurm {
-        /// The campaign file.
-        file: PathBuf,
-        /// The campaign directory (overrides `campaign.out`).
-        #[arg(long, value_name = "DIR")]
-        out: Option<PathBuf>,
-        /// Array tasks (shards).
-        #[arg(long, value_name = "N")]
-        tasks: usize,
-        /// Cores per task (each task runs one impact at a time on them).
-        #[arg(long, value_name = "N", default_value_t = 2)]
-        threads_per_task: usize,
-        /// Wall-clock limit per array task (`sbatch --time`: MINUTES, HH:MM:SS, D-HH:MM, …) [default: the
-        /// partition's].
-        #[arg(long, value_name = "LIMIT")]
-        time: Option<String>,
-        /// Slurm partition (`sbatch --partition`) [default: the cluster's].
-        #[arg(long, value_name = "NAME")]
-        partition: Option<String>,
-        /// Account charged (`sbatch --account`) [default: the user's].
-        #[arg(long, value_name = "NAME")]
-        account: Option<String>,
-        /// Memory per task's node (`sbatch --mem`, e.g. 4G; a bare number is MB) [default: the partition's].
-        #[arg(long, value_name = "SIZE")]
-        mem: Option<String>,
-        /// Most array tasks running at once (the array's `%K`) [default: no limit].
-        #[arg(long, value_name = "K")]
-        throttle: Option<usize>,
-        /// The rubblepile executable the tasks run [default: this one, by its absolute path].
-        #[arg(long, value_name = "PATH")]
-        binary: Option<PathBuf>,
-    },
-}
-
-impl CampaignAction {
-    /// Does it; the lines to print.
-    pub fn run(&self) -> Result<Vec<String>, CampaignError> {
-        match self {
-            CampaignAction::Merge { dir } => {
-                let r = merge_campaign(dir)?;
-                Ok(vec![format!(
-                    "merged {} runs into {}: {} completed, {} failed, {} pending",
-                    r.runs.len(),
-                    dir.join(CAMPAIGN_CSV).display(),
-                    r.completed(),
-                    r.failed(),
-                    r.pending()
-                )])
-            }
-            CampaignAction::Slurm {
-                file,
-                out,
-                tasks,
-                threads_per_task,
-                time,
-                partition,
-                account,
-                mem,
-                throttle,
-                binary,
-            } => {
-                let job = SlurmJob {
-                    tasks: *tasks,
-                    threads: *threads_per_task,
-                    time: time.clone(),
-                    partition: partition.clone(),
-                    account: account.clone(),
-                    mem: mem.clone(),
-                    throttle: *throttle,
-                    binary: binary
-                        .clone()
-                        .or_else(|| std::env::current_exe().ok())
-                        .unwrap_or_else(|| PathBuf::from("rubblepile")),
-                };
-                let invalid = |(field, message)| CampaignError::Invalid {
-                    file: file.display().to_string(),
-                    field,
-                    message,
-                };
-                job.check().map_err(invalid)?;
-                let mut campaign = load_campaign(file)?;
-                if let Some(o) = out {
-                    campaign.out = o.clone();
-                }
-                let abs_file = campaign.source.clone().unwrap_or_else(|| file.clone());
-                let paths = SlurmPaths::resolve(&job.binary, &abs_file, &campaign.out).map_err(invalid)?;
-                campaign.out = paths.out.clone();
-                let text = slurm_script(campaign.points.len(), &paths, &job);
-                let path = slurm_script_path(&campaign);
-                let io = |source| CampaignError::Io {
-                    path: path.clone(),
-                    source,
-                };
-                std::fs::create_dir_all(&campaign.out).map_err(io)?;
-                crate::io::safe_write::write_atomic(&path, text).map_err(io)?;
-                Ok(vec![format!(
-                    "wrote {} ({} runs in {tasks} array tasks); submit it with sbatch, then run `campaign merge {}`",
-                    path.display(),
-                    campaign.points.len(),
-                    campaign.out.display()
-                )])
-            }
-        }
+/// Writes the Slurm job array of the campaign file `file` (its directory `out` when given, else `campaign.out`) as
+/// `DIR/campaign.slurm` (not submitted): returns the script's path, the number of runs and the campaign directory.
+pub fn write_slurm(
+    file: &Path,
+    out: Option<&Path>,
+    job: &SlurmJob,
+) -> Result<(PathBuf, usize, PathBuf), CampaignError> {
+    let invalid = |(field, message)| CampaignError::Invalid {
+        file: file.display().to_string(),
+        field,
+        message,
+    };
+    job.check().map_err(invalid)?;
+    let mut campaign = load_campaign(file)?;
+    if let Some(o) = out {
+        campaign.out = o.to_path_buf();
     }
+    let abs_file = campaign.source.clone().unwrap_or_else(|| file.to_path_buf());
+    let paths = SlurmPaths::resolve(&job.binary, &abs_file, &campaign.out).map_err(invalid)?;
+    campaign.out = paths.out.clone();
+    let text = slurm_script(campaign.points.len(), &paths, job);
+    let path = slurm_script_path(&campaign);
+    let io = |source| CampaignError::Io {
+        path: path.clone(),
+        source,
+    };
+    std::fs::create_dir_all(&campaign.out).map_err(io)?;
+    crate::io::safe_write::write_atomic(&path, text).map_err(io)?;
+    Ok((path, campaign.points.len(), campaign.out))
 }

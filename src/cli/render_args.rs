@@ -2,8 +2,8 @@
 
 use std::path::PathBuf;
 
-use super::run::{ColourBy, RenderRunOptions};
-use super::{Projection, View};
+use rubblepile::render::run::{ColourBy, RenderRunOptions};
+use rubblepile::render::{Projection, RenderError, View};
 
 /// Largest `--extent` accepted (m): 1e300, beyond it the camera's scale underflows.
 pub const MAX_EXTENT_M: f64 = 1e300;
@@ -50,14 +50,14 @@ impl RenderArgs {
                 self.view
             ));
         }
-        let view: View = self.view.parse().map_err(|e: super::RenderError| e.to_string())?;
+        let view: View = self.view.parse().map_err(|e: RenderError| e.to_string())?;
         if let Some(e) = self.extent
-            && !(crate::io::limits::MIN_MEANINGFUL..=MAX_EXTENT_M).contains(&e)
+            && !(rubblepile::io::limits::MIN_MEANINGFUL..=MAX_EXTENT_M).contains(&e)
         {
             return Err(format!(
                 "--extent: expected a half-width in metres from {:e} to {MAX_EXTENT_M:e}, got {}",
-                crate::io::limits::MIN_MEANINGFUL,
-                crate::io::scene_file::fmt_num(e)
+                rubblepile::io::limits::MIN_MEANINGFUL,
+                rubblepile::io::scene_file::fmt_num(e)
             ));
         }
         let colour: ColourBy = self.color.parse()?;
