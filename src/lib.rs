@@ -26,8 +26,9 @@
 //! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver,
 //!   with the canonical problems of the ellipsoid model;
 //! - **L7**: `analysis` — science on finished runs that any run needs (fragment statistics, fits, clumps, spin-up
-//!   diagnostics and searches, figures);
-//! - **L8**: `render` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated GIF.
+//!   diagnostics and the verdicts of searches, figures);
+//! - **L8**: `render`, `experiment` — pictures of runs: ray-cast frames of ellipsoids and spheres, PNG and animated
+//!   GIF; experiments that run many simulations and judge them with the analysis (the T_c,3 search).
 //!
 //! # Programs
 //!
@@ -47,6 +48,7 @@ pub mod bits;
 pub mod driver;
 pub mod ellipsoid;
 pub mod engine;
+pub mod experiment;
 pub mod geometry;
 pub mod granular;
 pub mod gravity;

@@ -1,10 +1,10 @@
-//! A T_c,3 search's `critical.csv` read back (`spinup_search::read_critical_csv`), so that the Zhang17 tables
+//! A T_c,3 search's `critical.csv` read back (`critical::read_critical_csv`), so that the Zhang17 tables
 //! regenerate from committed compact copies: every committed CSV of today's layout round-trips byte for byte, one
 //! of the layout before Dec 2026 keeps its verdicts through a rewrite, the T_c,3 and φ re-derived from it equal
 //! those its search wrote into `critical.json`, and a malformed row names its column.
 
 use rubblepile::analysis::creep::CreepCriterionKind;
-use rubblepile::analysis::spinup_search::{
+use rubblepile::analysis::critical::{
     CRITICAL_CSV_HEADER, CRITICAL_CSV_HEADER_V1, critical_csv, read_critical, read_critical_csv,
 };
 use std::path::{Path, PathBuf};

@@ -24,7 +24,7 @@
 //!   which the paper's rule reads as creep).
 //!
 //! Either way a hold whose forcing was released (global disruption) is not stable; that is the search's business
-//! (`analysis::spinup_search`, which uses these criteria).
+//! (`analysis::critical`, which uses these criteria).
 
 use serde::Serialize;
 

@@ -8,7 +8,7 @@
 //! Its standard error comes from the scatter of the rates about the line (first-order error propagation of
 //! −a/b); the scatter, not the rates' own errors, measures how well a line describes them.
 
-use crate::analysis::spinup_search::HoldVerdict;
+use crate::analysis::critical::HoldVerdict;
 
 /// The period at which a fitted weakening rate reaches zero.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,6 +1,6 @@
 //! Post-processing of states and runs: what any run needs (fragments, fits, clumps, composition, flyby outcome,
-//! spin-up diagnostics and searches, creep, the model atmosphere and tumbler measurements, figures). The three
-//! papers' reports are one layer up, in `src/studies/` (nothing here names them).
+//! spin-up diagnostics, the verdicts of T_c,3 searches, creep, the model atmosphere and tumbler measurements,
+//! figures). The three papers' reports are in the binary, in `src/studies/` (nothing here names them).
 
 pub mod atmosphere;
 pub mod campaign_analysis;
@@ -8,6 +8,7 @@ pub mod clumps;
 pub mod composition;
 pub mod creep;
 pub mod creep_extrapolation;
+pub mod critical;
 pub mod csv_rows;
 pub mod ejection_fits;
 pub mod figures;
@@ -21,7 +22,6 @@ pub mod run_analysis;
 pub use crate::geometry::shape_metrics;
 pub mod spin_limit;
 pub mod spinup;
-pub mod spinup_search;
 pub mod surface_slopes;
 pub use crate::granular::soft::spinup_diagnostics;
 pub mod tumbler;

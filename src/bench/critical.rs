@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::BenchError;
-use rubblepile::analysis::spinup_search::{CriticalOptions, critical};
+use rubblepile::experiment::critical_search::{CriticalOptions, critical};
 
 /// `rubblepile bench critical`.
 #[derive(Debug, clap::Args)]

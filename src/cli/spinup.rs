@@ -1,10 +1,11 @@
-//! `rubblepile spinup …`: the options, and the calls into [`rubblepile::analysis::spinup_search`].
+//! `rubblepile spinup …`: the options, and the calls into [`rubblepile::analysis::critical`] and [`rubblepile::experiment::critical_search`].
 
 use std::path::PathBuf;
 
 use crate::cli::common::CliError;
 use rubblepile::analysis::creep::CreepCriterionKind;
-use rubblepile::analysis::spinup_search::{CriticalOptions, SearchError, critical as run_critical, density_fit as fit};
+use rubblepile::analysis::critical::{SearchError, density_fit as fit};
+use rubblepile::experiment::critical_search::{CriticalOptions, critical as run_critical};
 
 /// `rubblepile spinup …`.
 #[derive(Debug, clap::Subcommand)]
@@ -38,7 +39,7 @@ pub struct JudgeArgs {
 
 /// `rubblepile spinup judge`.
 pub fn judge(args: &JudgeArgs) -> Result<(), CliError> {
-    rubblepile::analysis::spinup_search::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
+    rubblepile::analysis::critical::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
         .map_err(cli_error)
 }
 

@@ -19,13 +19,13 @@ use rubblepile::aggregate::report::AggregateReport;
 use rubblepile::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
 use rubblepile::analysis::creep::CreepCriterionKind;
 use rubblepile::analysis::creep_extrapolation::{ZeroRate, weakening_zeros};
+use rubblepile::analysis::critical::{
+    Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
+};
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
 use rubblepile::analysis::spin_limit::{critical_kappa, least_friction_angle};
 use rubblepile::analysis::spinup::{omega_of_hours, paper_bulk_density};
-use rubblepile::analysis::spinup_search::{
-    Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
-};
 use rubblepile::io::scene_file::SI_G;
 
 use super::rows::{ModelRow, TABLE3, opt, path_row};
@@ -774,7 +774,7 @@ mod tests {
         let verdicts = holds
             .iter()
             .map(|(tf, s)| {
-                rubblepile::analysis::spinup_search::judge_series(
+                rubblepile::analysis::critical::judge_series(
                     s,
                     None,
                     &Criteria::default(),
@@ -863,7 +863,7 @@ mod tests {
         std::fs::write(critical.join("holds.csv"), holds).unwrap();
         std::fs::write(
             critical.join("critical.csv"),
-            rubblepile::analysis::spinup_search::critical_csv(&creeping.verdicts),
+            rubblepile::analysis::critical::critical_csv(&creeping.verdicts),
         )
         .unwrap();
         let out = dir.join("out");

@@ -15,10 +15,10 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use rubblepile::analysis::creep::CreepCriterionKind;
+use rubblepile::analysis::critical::{HoldVerdict, critical_from_verdicts, read_critical_csv};
 use rubblepile::analysis::figures::lines::{Mark, Series};
 use rubblepile::analysis::figures::stacked::{Panel, StackedLines};
 use rubblepile::analysis::figures::style::write_figure;
-use rubblepile::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
 
 use super::rows::DIDYMOS_PERIOD_HOURS;
 
@@ -43,10 +43,10 @@ pub struct HoldSample {
     pub theta_max_deg: f64,
 }
 
-/// Reads `holds.csv` ([`rubblepile::analysis::spinup_search::read_holds_csv`]) as one row per sample; the coordination
+/// Reads `holds.csv` ([`rubblepile::analysis::critical::read_holds_csv`]) as one row per sample; the coordination
 /// number is `coordination_loaded` where every row has it.
 pub fn read_holds(path: &Path) -> Result<Vec<HoldSample>, String> {
-    let holds = rubblepile::analysis::spinup_search::read_holds_csv(path)?;
+    let holds = rubblepile::analysis::critical::read_holds_csv(path)?;
     Ok(holds
         .iter()
         .flat_map(|(period, h)| {

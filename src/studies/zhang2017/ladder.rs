@@ -12,9 +12,9 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+use rubblepile::analysis::critical::read_critical;
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
-use rubblepile::analysis::spinup_search::read_critical;
 
 use super::rows::{ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, search_subdirs};
 

@@ -4,7 +4,7 @@
 //! and the study that decides the paper's Table 3 at its scale ([`decided`]),
 //! all reading runs into the rows
 //! of [`rows`]. The searches that make its runs are generic and live in
-//! [`rubblepile::analysis::spinup_search`].
+//! [`rubblepile::analysis::critical`].
 
 pub mod decided;
 pub mod holds;

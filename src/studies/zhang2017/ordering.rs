@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use rubblepile::analysis::creep::CreepCriterionKind;
-use rubblepile::analysis::spinup_search::{HoldVerdict, critical_from_verdicts, read_critical_csv};
+use rubblepile::analysis::critical::{HoldVerdict, critical_from_verdicts, read_critical_csv};
 
 use super::ladder::RungSearch;
 use super::rows::{TABLE3, opt, search_subdirs};

@@ -6,12 +6,12 @@
 use rubblepile::io::table::{Cells, read_header, read_table};
 use std::path::Path;
 
+use rubblepile::analysis::critical::read_critical;
 use rubblepile::analysis::spinup::{
     AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, critical_limits, dynamical_time,
     first_departure, fit_density, smoothed_critical_limits,
 };
 use rubblepile::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
-use rubblepile::analysis::spinup_search::read_critical;
 use rubblepile::io::scene_file::SI_G;
 
 /// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
