@@ -93,8 +93,9 @@ impl DecidedSearch {
         HOLD_LENGTHS.iter().copied().filter(|&l| l <= recorded + 1.0).collect()
     }
 
-    /// The holds judged by every criterion over their first `window` seconds.
-    pub fn judged(&self, window: f64) -> Vec<HoldVerdict> {
+    /// The holds judged by every criterion over their first `window` seconds, including those still running
+    /// whose record is shorter than `window` (see [`DecidedSearch::is_pending`]).
+    fn judged_all(&self, window: f64) -> Vec<HoldVerdict> {
         rejudge(
             &self.verdicts,
             &self.series,
@@ -102,6 +103,27 @@ impl DecidedSearch {
             &Criteria::default(),
             CreepCriterionKind::Paper,
         )
+    }
+
+    /// Whether the hold `h`, read at `window` seconds, is still running: not released, and its record (`holds.csv`)
+    /// shorter than `window` (within a second, as [`DecidedSearch::lengths`]).
+    fn is_pending(&self, h: &HoldVerdict, window: f64) -> bool {
+        let recorded = self
+            .series
+            .iter()
+            .find(|(t, _)| (t - h.t_final_hours).abs() < 1e-9)
+            .and_then(|(_, s)| s.t_s.last().copied())
+            .unwrap_or(0.0);
+        !h.released && recorded + 1.0 < window
+    }
+
+    /// The holds judged by every criterion over their first `window` seconds: those released, and those recorded
+    /// for the whole window. A hold still running (copied before it reached `window`) has no verdict at that length
+    /// yet: read over its shorter record it would pass for stable.
+    pub fn judged(&self, window: f64) -> Vec<HoldVerdict> {
+        let mut judged = self.judged_all(window);
+        judged.retain(|h| !self.is_pending(h, window));
+        judged
     }
 
     /// T_c,3 (h) and φ (°) by `kind` over holds read at `window` seconds.
@@ -129,13 +151,16 @@ impl DecidedSearch {
         }
     }
 
-    /// The holds as letters by the paper's criterion at `window`: `R` released, `C` creeping, `S` stable.
+    /// The holds as letters by the paper's criterion at `window`: `R` released, `C` creeping, `S` stable, `…` still
+    /// running and not yet recorded for `window` seconds.
     pub fn letters(&self, window: f64) -> String {
-        self.judged(window)
+        self.judged_all(window)
             .iter()
             .map(|h| {
                 let letter = if h.released {
                     'R'
+                } else if self.is_pending(h, window) {
+                    '…'
                 } else if h.stable_by(CreepCriterionKind::Paper) {
                     'S'
                 } else {
@@ -878,6 +903,26 @@ mod tests {
         // two held holds are too few for the rates' zero
         assert!(md.contains("| hcp_3k_random1 | 32000 | 2 | – | – | – | – |"), "{md}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Regression guard: a hold copied while still running, recorded for less than the hold length read, has no
+    /// verdict there (read over its short record it would pass for stable and give a T_c,3), and the holds list
+    /// shows it as `…`.
+    #[test]
+    fn a_hold_still_running_is_not_judged_at_a_longer_length() {
+        let s = search(
+            "hcp_3k_random3",
+            vec![
+                (2.35, series(Some(3000.0), f64::INFINITY, 6000.0)),
+                (2.45, series(None, 1000.0, 50_000.0)),
+                (2.50, series(None, f64::INFINITY, 10_208.0)),
+            ],
+        );
+        assert_eq!(s.t_c3(16_000.0, CreepCriterionKind::Paper).0, None);
+        assert_eq!(s.judged(16_000.0).len(), 2);
+        assert_eq!(s.letters(16_000.0), "R 2.35, C 2.45, … 2.50");
+        // read at a length it has reached, it is judged (stable: it never creeps)
+        assert_eq!(s.t_c3(8000.0, CreepCriterionKind::Paper).0, Some(2.50));
     }
 
     /// The failure stops at the slowest released hold's successor, whatever the creep verdicts: a hold released
