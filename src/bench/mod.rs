@@ -11,6 +11,7 @@
 //!   and several at once). Their option structs derive `clap::Args` so the command
 //!   line embeds them; the command line itself only parses and dispatches.
 
+pub mod ab;
 pub mod critical;
 pub mod hsdem;
 pub mod impact_wall_time;

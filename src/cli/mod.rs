@@ -239,6 +239,8 @@ pub enum BenchCommand {
     /// Wall time of a T_c,3 search's holds one at a time and several at once (`spinup critical --parallel`), on
     /// one prepared base run, with the load average (CSV + plot).
     Critical(crate::bench::critical::BenchCriticalArgs),
+    /// Two builds timed on the same command, alternately, in one invocation (before/after a change; CSV + plot).
+    Ab(crate::bench::ab::BenchAbArgs),
 }
 
 /// Runs a parsed command line.
@@ -319,6 +321,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         }
         Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
         Command::Bench(BenchCommand::Critical(args)) => Ok(crate::bench::critical::bench(&args)?),
+        Command::Bench(BenchCommand::Ab(args)) => Ok(crate::bench::ab::bench(&args)?),
         Command::Bench(BenchCommand::Scaling(args)) => Ok(crate::bench::scaling::scaling(&args)?),
         Command::Bench(BenchCommand::Hsdem(args)) => Ok(crate::bench::hsdem::bench(&args)?),
         Command::Ssdem(ssdem::SsdemCommand::Advise(args)) => ssdem::advise(&args),
