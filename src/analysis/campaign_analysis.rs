@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-use crate::analysis::fits::PowerLawFit;
 use crate::analysis::run_analysis::{
     AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_run, lock_analysis, read_json,
     spin_distributions,
@@ -82,7 +81,7 @@ pub fn analyze_campaign(
         let num = |c: usize| rec[c].parse::<f64>().map_err(|e| err(&format!("{run}: {e}")));
         let run_summary = read_json(&run_dir.join("summary.json")).ok();
         let from_summary = |key: &str| run_summary.as_ref().and_then(|v| v[key].as_f64());
-        let (ej, sp) = (fit_ok(&a.ejection_speed_vs_size), fit_ok(&a.spin_vs_size));
+        let (ej, sp) = (a.ejection_speed_vs_size.ok(), a.spin_vs_size.ok());
         let (best_n, maxwell) = match &a.spin_fits {
             Fit::Ok(c) => {
                 let rss = |n: f64| c.fixed.iter().find(|f| f.n == n).map(|f| f.rss);
@@ -162,11 +161,4 @@ pub fn analyze_campaign(
         emit(Channel::Warning, &format!("warning: figure not drawn: {why}"));
     }
     Ok(analysis)
-}
-
-fn fit_ok(f: &Fit<PowerLawFit>) -> Option<&PowerLawFit> {
-    match f {
-        Fit::Ok(p) => Some(p),
-        Fit::Failed(_) => None,
-    }
 }

@@ -269,7 +269,8 @@ pub fn read_energy_series(
 pub(crate) mod tests {
     use super::*;
 
-    fn inputs() -> EnergyInputs {
+    /// The inputs of the run [`write_synthetic_run`] writes.
+    pub(crate) fn inputs() -> EnergyInputs {
         EnergyInputs {
             projectile: 1,
             projectile_mass: 2.0,
