@@ -33,22 +33,9 @@ pub fn analyze_campaign(
         path: index.clone(),
         reason: e.to_string(),
     };
-    let mut rdr = csv::Reader::from_path(&index).map_err(|e| err(&e))?;
-    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
-    let col = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| err(&format!("no `{name}` column")))
-    };
-    let (c_run, c_target, c_proj, c_angle, c_q, c_status) = (
-        col("run")?,
-        col("target")?,
-        col("projectile")?,
-        col("angle_deg")?,
-        col("q_erg_per_g")?,
-        col("status")?,
-    );
+    let names = ["run", "target", "projectile", "angle_deg", "q_erg_per_g", "status"];
+    let (mut rdr, [c_run, c_target, c_proj, c_angle, c_q, c_status]) =
+        crate::io::table::open_columns(&index, names).map_err(|e| err(&e))?;
     let mut runs = Vec::new();
     let mut spins: Vec<Vec<f64>> = Vec::new();
     let mut skipped = Vec::new();
