@@ -15,37 +15,36 @@ use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::bits::exact_f64_vec;
 use crate::engine::{
-    Engine, EngineError, Failure, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError,
-    Schedule, SnapshotView, read_sphere_snapshot,
+    Engine, EngineError, Failure, MOMENTUM_COLUMNS, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample,
+    SampleError, Schedule, SnapshotView, column_names, momentum_values, read_sphere_snapshot,
 };
 use crate::io::fmt_f64;
 use crate::math::Vec3;
 
 /// Columns of `timeseries.csv`.
-pub const TIMESERIES_COLUMNS: [&str; 22] = [
-    "t",
-    "kinetic",
-    "rotational",
-    "potential",
-    "energy",
-    "energy_change",
-    "energy_residual",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-    "collisions",
-    "pair_collisions",
-    "wall_collisions",
-    "events_per_second",
-    "max_overlap",
-    "free",
-    "stuck",
-    "absorbed",
-    "wall_seconds",
-];
+pub const TIMESERIES_COLUMNS: [&str; 22] = column_names(&[
+    &[
+        "t",
+        "kinetic",
+        "rotational",
+        "potential",
+        "energy",
+        "energy_change",
+        "energy_residual",
+    ],
+    &MOMENTUM_COLUMNS,
+    &[
+        "collisions",
+        "pair_collisions",
+        "wall_collisions",
+        "events_per_second",
+        "max_overlap",
+        "free",
+        "stuck",
+        "absorbed",
+        "wall_seconds",
+    ],
+]);
 
 /// `summary.json` of a hard-sphere run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -491,7 +490,7 @@ impl Engine for HardEngine {
         } else {
             0.0
         };
-        let row = [
+        let energies = [
             to.t,
             d.kinetic,
             d.rotational,
@@ -499,12 +498,8 @@ impl Engine for HardEngine {
             e,
             (e - book.e0) / book.scale,
             (e - book.e0 - c.energy_exchanged) / book.scale,
-            d.momentum.x,
-            d.momentum.y,
-            d.momentum.z,
-            d.angular_momentum.x,
-            d.angular_momentum.y,
-            d.angular_momentum.z,
+        ];
+        let events = [
             (coll - last_coll) as f64,
             (c.pair_collisions - last_pair) as f64,
             (c.wall_collisions - last_wall) as f64,
@@ -515,7 +510,13 @@ impl Engine for HardEngine {
             c.absorbed as f64,
             wall,
         ];
-        let cols: Vec<String> = row.iter().map(|&x| fmt_f64(x)).collect();
+        let momenta = momentum_values(&d.momentum, &d.angular_momentum);
+        let cols: Vec<String> = energies
+            .iter()
+            .chain(&momenta)
+            .chain(&events)
+            .map(|&x| fmt_f64(x))
+            .collect();
         self.last_counts = [coll, c.pair_collisions, c.wall_collisions, c.events];
         self.last_wall_clock = wall;
         Ok(cols.join(",") + "\n")
