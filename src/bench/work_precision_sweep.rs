@@ -141,16 +141,9 @@ fn draw_both(svg: &Path, title: &str, rows: &[SweepRow]) -> Result<PathBuf, CliE
 /// Reads the rows of a `work_precision_<problem>.csv` back (the columns [`write_csv`] writes).
 pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, crate::bench::BenchError> {
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let names = [
-        "method",
-        "rtol",
-        "error",
-        "energy_error",
-        "wall_seconds",
-        "rhs_evaluations",
-        "steps",
-        "h",
-    ];
+    // the first eight columns of those written (`method` to `h`)
+    let mut header = CSV_HEADER.split(',');
+    let names: [&str; 8] = std::array::from_fn(|_| header.next().unwrap_or_default());
     let (mut rdr, c) = rubblepile::io::table::open_columns(path, names).map_err(|e| err(&e))?;
     let mut rows = Vec::new();
     for (line, rec) in rdr.records().enumerate() {
