@@ -5,7 +5,6 @@
 
 use std::path::Path;
 
-use crate::analysis::fits::PowerLawFit;
 use crate::analysis::run_analysis::{
     AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_run, lock_analysis, read_json,
     spin_distributions,
@@ -34,22 +33,9 @@ pub fn analyze_campaign(
         path: index.clone(),
         reason: e.to_string(),
     };
-    let mut rdr = csv::Reader::from_path(&index).map_err(|e| err(&e))?;
-    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
-    let col = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| err(&format!("no `{name}` column")))
-    };
-    let (c_run, c_target, c_proj, c_angle, c_q, c_status) = (
-        col("run")?,
-        col("target")?,
-        col("projectile")?,
-        col("angle_deg")?,
-        col("q_erg_per_g")?,
-        col("status")?,
-    );
+    let names = ["run", "target", "projectile", "angle_deg", "q_erg_per_g", "status"];
+    let (mut rdr, [c_run, c_target, c_proj, c_angle, c_q, c_status]) =
+        crate::io::table::open_columns(&index, names).map_err(|e| err(&e))?;
     let mut runs = Vec::new();
     let mut spins: Vec<Vec<f64>> = Vec::new();
     let mut skipped = Vec::new();
@@ -82,7 +68,7 @@ pub fn analyze_campaign(
         let num = |c: usize| rec[c].parse::<f64>().map_err(|e| err(&format!("{run}: {e}")));
         let run_summary = read_json(&run_dir.join("summary.json")).ok();
         let from_summary = |key: &str| run_summary.as_ref().and_then(|v| v[key].as_f64());
-        let (ej, sp) = (fit_ok(&a.ejection_speed_vs_size), fit_ok(&a.spin_vs_size));
+        let (ej, sp) = (a.ejection_speed_vs_size.ok(), a.spin_vs_size.ok());
         let (best_n, maxwell) = match &a.spin_fits {
             Fit::Ok(c) => {
                 let rss = |n: f64| c.fixed.iter().find(|f| f.n == n).map(|f| f.rss);
@@ -162,11 +148,4 @@ pub fn analyze_campaign(
         emit(Channel::Warning, &format!("warning: figure not drawn: {why}"));
     }
     Ok(analysis)
-}
-
-fn fit_ok(f: &Fit<PowerLawFit>) -> Option<&PowerLawFit> {
-    match f {
-        Fit::Ok(p) => Some(p),
-        Fit::Failed(_) => None,
-    }
 }

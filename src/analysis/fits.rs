@@ -273,6 +273,21 @@ fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 
+/// The data checks of the line fits: as many `x` as `y`, all finite.
+fn paired_finite(x: &[f64], y: &[f64]) -> Result<(), FitError> {
+    if x.len() != y.len() {
+        return Err(FitError::InvalidInput(format!(
+            "x has {} values, y has {}",
+            x.len(),
+            y.len()
+        )));
+    }
+    if !all_finite(x) || !all_finite(y) {
+        return Err(FitError::NonFinite("data"));
+    }
+    Ok(())
+}
+
 /// A fit of Roig03 Eq. (44), `f(x) = a xⁿ exp(−x²/b²)`, to a histogram.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SpinFit {
@@ -491,16 +506,7 @@ pub struct LineFit {
 /// Standard errors use `s² = rss/(N − 2)`: `σ_slope² = s²/Sxx`, `σ_intercept² = s² (1/N + x̄²/Sxx)`,
 /// `cov = −x̄ s²/Sxx`.
 pub fn fit_line(x: &[f64], y: &[f64]) -> Result<LineFit, FitError> {
-    if x.len() != y.len() {
-        return Err(FitError::InvalidInput(format!(
-            "x has {} values, y has {}",
-            x.len(),
-            y.len()
-        )));
-    }
-    if !all_finite(x) || !all_finite(y) {
-        return Err(FitError::NonFinite("data"));
-    }
+    paired_finite(x, y)?;
     let n = x.len();
     if n < 2 {
         return Err(FitError::TooFewPoints { points: n, needed: 2 });
@@ -586,16 +592,7 @@ pub struct PowerLawFit {
 /// Fits `y = c x^α` by least squares on `ln y = ln c + α ln x`. Pairs with `x ≤ 0` or `y ≤ 0` are skipped
 /// (counted in `skipped`); NaN/∞ anywhere is an error, as are fewer than 3 usable points.
 pub fn fit_power_law(x: &[f64], y: &[f64]) -> Result<PowerLawFit, FitError> {
-    if x.len() != y.len() {
-        return Err(FitError::InvalidInput(format!(
-            "x has {} values, y has {}",
-            x.len(),
-            y.len()
-        )));
-    }
-    if !all_finite(x) || !all_finite(y) {
-        return Err(FitError::NonFinite("data"));
-    }
+    paired_finite(x, y)?;
     let (lx, ly): (Vec<f64>, Vec<f64>) = x
         .iter()
         .zip(y)

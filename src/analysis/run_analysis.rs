@@ -81,6 +81,14 @@ impl<T> Fit<T> {
             Err(e) => Fit::Failed(e.to_string()),
         }
     }
+
+    /// The fit, `None` when it failed.
+    pub fn ok(&self) -> Option<&T> {
+        match self {
+            Fit::Ok(v) => Some(v),
+            Fit::Failed(_) => None,
+        }
+    }
 }
 
 /// Per-run results (`analysis.json`).
@@ -595,10 +603,8 @@ pub struct SpinDistribution {
 impl SpinDistribution {
     /// The best fixed-n fit (the curve of Fig. 7), if the fits succeeded.
     pub fn best(&self) -> Option<&SpinFit> {
-        match &self.fits {
-            Fit::Ok(c) => c.fixed.iter().find(|f| f.n == c.best_n),
-            Fit::Failed(_) => None,
-        }
+        let c = self.fits.ok()?;
+        c.fixed.iter().find(|f| f.n == c.best_n)
     }
 }
 

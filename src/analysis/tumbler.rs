@@ -172,23 +172,14 @@ fn drum_particles(rows: &[ParticleRow]) -> Vec<DrumParticle> {
         .collect()
 }
 
-/// The analysis of one tumbler run.
+/// The analysis of one tumbler run: its [`TumblerFacts`] (read through it: `run.froude`, `run.fill`, …) and the
+/// measures of its snapshots.
 #[derive(Debug, Clone)]
 pub struct TumblerRun {
     /// Run directory.
     pub dir: PathBuf,
-    /// Froude number `ω² R / g`.
-    pub froude: f64,
-    /// Drum spin (rad/s).
-    pub omega: f64,
-    /// Drum radius (m).
-    pub radius: f64,
-    /// Particle radius (m) of the free particles.
-    pub particle_radius: f64,
-    /// Free and stuck particles.
-    pub free: usize,
-    /// Stuck (lining) particles.
-    pub stuck: usize,
+    /// The run-level facts.
+    pub facts: TumblerFacts,
     /// `(t, angle in degrees)` per late snapshot (t ≥ half the run) with a fit.
     pub angles: Vec<(f64, f64)>,
     /// Mean and standard deviation of the angles (degrees).
@@ -198,11 +189,7 @@ pub struct TumblerRun {
     /// `(t, angle, fit error)` in degrees for every snapshot with a fit, the first half of the run included (how
     /// the surface got there: a bed still tilting with the drum, or settled).
     pub angle_history: Vec<(f64, f64, f64)>,
-    /// Normal and tangential coefficients of restitution from the scene's `[material]` (NaN when absent).
-    pub restitution: (f64, f64),
-    /// Fill of the bed at the start ([`initial_fill`]).
-    pub fill: f64,
-    /// [`centrifuging_threshold`] for that fill.
+    /// [`centrifuging_threshold`] for the fill.
     pub threshold: f64,
     /// `(t, measures)` per snapshot.
     pub centrifuging: Vec<(f64, Centrifuging)>,
@@ -210,28 +197,13 @@ pub struct TumblerRun {
     pub late: Centrifuging,
     /// The same over its two halves, 50–75 % and 75–100 % of the run: equal when the measures have settled.
     pub late_halves: [Centrifuging; 2],
-    /// From `summary.json`: status, time reached, events per second, wall seconds, collisions.
-    pub status: String,
-    /// Time reached (s).
-    pub t_reached: f64,
-    /// Events per wall-clock second.
-    pub events_per_second: f64,
-    /// Wall-clock seconds.
-    pub wall_seconds: f64,
-    /// Collisions applied.
-    pub collisions: u64,
-    /// The scene's step `stepping.dt` (s; NaN when absent).
-    pub dt: f64,
-    /// The run's energy residual (`energy_error` of the summary, or the largest |energy_residual| of a stopped
-    /// run's time series; NaN when neither is there): the integration error once restitution and the walls' work
-    /// are booked.
-    pub energy_error: f64,
 }
 
-impl TumblerRun {
-    /// The lining's inner radius over the particle radius, `(R − 2r) / r` (R the wall radius).
-    pub fn radius_ratio(&self) -> f64 {
-        (self.radius - 2.0 * self.particle_radius) / self.particle_radius
+impl std::ops::Deref for TumblerRun {
+    type Target = TumblerFacts;
+
+    fn deref(&self) -> &TumblerFacts {
+        &self.facts
     }
 }
 
@@ -284,10 +256,24 @@ pub struct TumblerFacts {
     pub wall_seconds: f64,
     /// Collisions applied.
     pub collisions: u64,
-    /// [`TumblerRun::dt`].
+    /// The scene's step `stepping.dt` (s; NaN when absent).
     pub dt: f64,
-    /// [`TumblerRun::energy_error`].
+    /// The run's energy residual (`energy_error` of the summary, or the largest |energy_residual| of a stopped
+    /// run's time series; NaN when neither is there): the integration error once restitution and the walls' work
+    /// are booked.
     pub energy_error: f64,
+}
+
+impl TumblerFacts {
+    /// The lining's inner radius over the particle radius, `(R − 2r) / r` (R the wall radius).
+    pub fn radius_ratio(&self) -> f64 {
+        (self.radius - 2.0 * self.particle_radius) / self.particle_radius
+    }
+
+    /// Normal and tangential coefficients of restitution from the scene's `[material]` (NaN when absent).
+    pub fn restitution(&self) -> (f64, f64) {
+        (self.eps_n, self.eps_t)
+    }
 }
 
 /// File of a compact copy holding [`TumblerFacts`] (one row).
@@ -435,29 +421,15 @@ pub fn analyse_tumbler_run(dir: &Path) -> Result<TumblerRun, AnalysisError> {
     };
     Ok(TumblerRun {
         dir: dir.to_path_buf(),
-        froude: facts.froude,
-        omega: facts.omega,
-        radius: facts.radius,
-        particle_radius: facts.particle_radius,
-        free: facts.free,
-        stuck: facts.stuck,
         angle: mean_std(&a),
         angles,
         angle_fit_errors: fit_errors,
         angle_history: history,
-        restitution: (facts.eps_n, facts.eps_t),
-        fill: facts.fill,
         threshold: centrifuging_threshold(facts.fill, facts.radius, facts.particle_radius),
         late: between(0.5, 1.0),
         late_halves: [between(0.5, 0.75), between(0.75, 1.0)],
         centrifuging: measures,
-        status: facts.status,
-        t_reached,
-        events_per_second: facts.events_per_second,
-        wall_seconds: facts.wall_seconds,
-        collisions: facts.collisions,
-        dt: facts.dt,
-        energy_error: facts.energy_error,
+        facts,
     })
 }
 

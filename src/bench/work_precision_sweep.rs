@@ -142,28 +142,14 @@ fn draw_both(svg: &Path, title: &str, rows: &[SweepRow]) -> Result<PathBuf, CliE
 /// Reads the rows of a `work_precision_<problem>.csv` back (the columns [`write_csv`] writes).
 pub fn read_csv(path: &Path) -> Result<Vec<SweepRow>, crate::bench::BenchError> {
     let err = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
-    let mut rdr = csv::Reader::from_path(path).map_err(|e| err(&e))?;
-    let headers = rdr.headers().map_err(|e| err(&e))?.clone();
-    let col = |name: &str| {
-        headers
-            .iter()
-            .position(|h| h == name)
-            .ok_or_else(|| err(&format!("no `{name}` column")))
-    };
-    let c = [
-        col("method")?,
-        col("rtol")?,
-        col("error")?,
-        col("energy_error")?,
-        col("wall_seconds")?,
-        col("rhs_evaluations")?,
-        col("steps")?,
-        col("h")?,
-    ];
+    // the first eight columns of those written (`method` to `h`)
+    let mut header = CSV_HEADER.split(',');
+    let names: [&str; 8] = std::array::from_fn(|_| header.next().unwrap_or_default());
+    let (mut rdr, c) = rubblepile::io::table::open_columns(path, names).map_err(|e| err(&e))?;
     let mut rows = Vec::new();
     for (line, rec) in rdr.records().enumerate() {
         let rec = rec.map_err(|e| err(&e))?;
-        let at = |k: usize| format!("row {}", line + 2) + &format!(", column {}", headers.get(c[k]).unwrap_or(""));
+        let at = |k: usize| format!("row {}", line + 2) + &format!(", column {}", names[k]);
         let num =
             |k: usize| -> Result<f64, String> { rec[c[k]].parse::<f64>().map_err(|e| err(&format!("{}: {e}", at(k)))) };
         let opt = |k: usize| -> Result<Option<f64>, String> {

@@ -5,6 +5,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use crate::ellipsoid::body::Body;
+use crate::engine::{MOMENTUM_COLUMNS, column_names};
 use crate::io::fmt_f64;
 
 /// Columns of a snapshot (and of a bodies file): time (s), body index, mass (kg), semi-axes A, B, C
@@ -17,22 +18,19 @@ pub const SNAPSHOT_COLUMNS: [&str; 19] = [
 /// gravitational potential, dissipated `2∫F dt` (≤ 0); the relative energy residual
 /// `(H − H0 − dissipated)/energy_scale(0)`; total linear momentum (kg m/s); total angular momentum about the origin
 /// (kg m²/s); wall-clock seconds since the run started.
-pub const TIMESERIES_COLUMNS: [&str; 14] = [
-    "t",
-    "kinetic_translational",
-    "kinetic_rotational",
-    "potential_contact",
-    "potential_gravity",
-    "dissipated",
-    "energy_residual",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-    "wall_seconds",
-];
+pub const TIMESERIES_COLUMNS: [&str; 14] = column_names(&[
+    &[
+        "t",
+        "kinetic_translational",
+        "kinetic_rotational",
+        "potential_contact",
+        "potential_gravity",
+        "dissipated",
+        "energy_residual",
+    ],
+    &MOMENTUM_COLUMNS,
+    &["wall_seconds"],
+]);
 
 fn csv_to_io(e: ::csv::Error) -> std::io::Error {
     match e.into_kind() {

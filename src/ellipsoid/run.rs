@@ -631,16 +631,10 @@ impl Engine for EllipsoidEngine {
             d.potential_gravity,
             d.dissipated,
             self.tracker.energy_residual(&d) / self.tracker.energy_scale_for_rows(),
-            d.momentum.x,
-            d.momentum.y,
-            d.momentum.z,
-            d.angular_momentum.x,
-            d.angular_momentum.y,
-            d.angular_momentum.z,
-            wall_seconds,
         ];
-        let mut row = String::with_capacity(fields.len() * 24);
-        for (k, &x) in fields.iter().enumerate() {
+        let momenta = crate::engine::momentum_values(&d.momentum, &d.angular_momentum);
+        let mut row = String::with_capacity(TIMESERIES_COLUMNS.len() * 24);
+        for (k, &x) in fields.iter().chain(&momenta).chain(&[wall_seconds]).enumerate() {
             if k > 0 {
                 row.push(',');
             }

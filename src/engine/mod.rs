@@ -19,6 +19,41 @@ use serde::de::DeserializeOwned;
 
 pub use schedule::{Sample, Schedule};
 
+use crate::math::Vec3;
+
+/// The `timeseries.csv` columns of the total linear momentum (kg m/s) and angular momentum (kg m²/s), named alike
+/// by every engine that writes them.
+pub const MOMENTUM_COLUMNS: [&str; 6] = ["px", "py", "pz", "lx", "ly", "lz"];
+
+/// The values of [`MOMENTUM_COLUMNS`]: the linear momentum `p`, then the angular momentum `l`.
+pub fn momentum_values(p: &Vec3, l: &Vec3) -> [f64; 6] {
+    [p.x, p.y, p.z, l.x, l.y, l.z]
+}
+
+/// The `N` column names of `parts` in order, for lists that share a group such as [`MOMENTUM_COLUMNS`]; in a
+/// `const`, parts that do not add up to `N` names stop the build.
+///
+/// ```
+/// use rubblepile::engine::column_names;
+/// const NAMES: [&str; 3] = column_names(&[&["t"], &["x", "y"]]);
+/// assert_eq!(NAMES, ["t", "x", "y"]);
+/// ```
+pub const fn column_names<const N: usize>(parts: &[&[&'static str]]) -> [&'static str; N] {
+    let mut names = [""; N];
+    let (mut n, mut p) = (0, 0);
+    while p < parts.len() {
+        let mut k = 0;
+        while k < parts[p].len() {
+            names[n] = parts[p][k];
+            n += 1;
+            k += 1;
+        }
+        p += 1;
+    }
+    assert!(n == N, "the parts do not add up to N column names");
+    names
+}
+
 /// One particle of a snapshot, the same for every engine, for output formats that know no engine
 /// (`driver::formats`).
 #[derive(Debug, Clone, Copy, PartialEq)]

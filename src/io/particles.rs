@@ -5,6 +5,15 @@
 
 use std::path::Path;
 
+use crate::math::Vec3;
+
+/// A sphere's state in the particles-file column order `mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (kg, m, m/s, rad/s).
+pub fn sphere_state(mass: f64, radius: f64, position: &Vec3, velocity: &Vec3, spin: &Vec3) -> [f64; 11] {
+    [
+        mass, radius, position.x, position.y, position.z, velocity.x, velocity.y, velocity.z, spin.x, spin.y, spin.z,
+    ]
+}
+
 /// Why a particles file could not be read (one line, without the file name, which the caller adds).
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ParticlesFileError {
@@ -130,21 +139,8 @@ fn read_ss_particles(
         .iter()
         .enumerate()
         .map(|(k, p)| {
-            let row: [f64; 13] = [
-                ss.time,
-                k as f64,
-                p.mass,
-                p.radius,
-                p.position.x,
-                p.position.y,
-                p.position.z,
-                p.velocity.x,
-                p.velocity.y,
-                p.velocity.z,
-                p.spin.x,
-                p.spin.y,
-                p.spin.z,
-            ];
+            let mut row = vec![ss.time, k as f64];
+            row.extend(sphere_state(p.mass, p.radius, &p.position, &p.velocity, &p.spin));
             ParticleRecord {
                 line: k + 1,
                 values: idx.iter().map(|&i| row[i]).collect(),

@@ -2,6 +2,7 @@
 //! series, snapshots and logs that the analysis and the benchmarks read back. Errors name the file, the line and the
 //! column.
 
+use std::fs::File;
 use std::path::{Path, PathBuf};
 
 /// Why a table could not be read.
@@ -118,6 +119,22 @@ pub fn read_header(path: &Path) -> Result<Vec<String>, TableError> {
     let file = crate::io::scene_file::open_bounded(path).map_err(|e| read_err(e.into()))?;
     let mut reader = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(file);
     Ok(reader.headers().map_err(read_err)?.iter().map(str::to_string).collect())
+}
+
+/// A CSV reader on `path` (`csv::Reader::from_path`, cells as written) and the position in its header of each of
+/// `names`. The error is one line without the path (the caller names the file): the CSV error, or
+/// ``no `name` column``.
+pub fn open_columns<const N: usize>(path: &Path, names: [&str; N]) -> Result<(csv::Reader<File>, [usize; N]), String> {
+    let mut reader = csv::Reader::from_path(path).map_err(|e| e.to_string())?;
+    let headers = reader.headers().map_err(|e| e.to_string())?;
+    let mut at = [0; N];
+    for (k, name) in at.iter_mut().zip(names) {
+        *k = headers
+            .iter()
+            .position(|h| h == name)
+            .ok_or_else(|| format!("no `{name}` column"))?;
+    }
+    Ok((reader, at))
 }
 
 #[cfg(test)]

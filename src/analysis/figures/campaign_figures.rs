@@ -17,8 +17,8 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::analysis::figures::style::{
-    DATA_COLOUR, FIT_COLOUR, Figure, GUIDE_COLOUR, PlotResult, REFERENCE_COLOUR, SERIES_COLOURS, draw_err, draw_legend,
-    finite_extent, inside_runs, label_style, linear_samples, small_style, title_style, write_figure,
+    DATA_COLOUR, FIT_COLOUR, Figure, FigureLog, GUIDE_COLOUR, PlotResult, REFERENCE_COLOUR, SERIES_COLOURS, draw_err,
+    draw_legend, figure_chart, finite_extent, inside_runs, label_style, linear_samples, small_style, write_figure,
 };
 use crate::analysis::fits::{LineCrossing, LineFit, spin_integral};
 use crate::analysis::run_analysis::{CampaignAnalysis, Fit};
@@ -96,12 +96,7 @@ impl Figure for BoundFractionVsQ {
         // Q from 0, so the intercepts of the fitted and published lines are visible.
         let x1 = 1.15 * q_max.max(q_star.unwrap_or(0.0)).max(3.0e9);
         let (xr, yr) = ((0.0, x1), (0.0, 1.15));
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(64)
+        let mut chart = figure_chart(root, &self.title, 64)
             .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
             .map_err(draw_err)?;
         chart
@@ -267,12 +262,7 @@ impl Figure for SpinDistributions {
             .filter(|y| y.is_finite())
             .fold(0.0, f64::max);
         let yr = (0.0, 1.2 * peak);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(78)
+        let mut chart = figure_chart(root, &self.title, 78)
             .build_cartesian_2d(0.0..x1, yr.0..yr.1)
             .map_err(draw_err)?;
         chart
@@ -355,8 +345,7 @@ pub fn spin_distribution_curves(analysis: &CampaignAnalysis) -> (Vec<(String, f6
 /// could not be drawn (or projectile left out of Fig. 7), why.
 pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) -> (Vec<String>, Vec<String>) {
     let dir = campaign_dir.join("analysis");
-    let mut written = Vec::new();
-    let mut failed = Vec::new();
+    let mut log = FigureLog::default();
     let fig5 = BoundFractionVsQ {
         title: format!(
             "Bound mass fraction vs specific impact energy at t = {} s",
@@ -372,33 +361,24 @@ pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) 
             .iter()
             .filter_map(|r| Some((r.q_erg_per_g, r.largest_remnant_fraction?)))
             .collect(),
-        fit: match &analysis.bound_fraction_vs_q {
-            Fit::Ok(l) => Some(*l),
-            Fit::Failed(_) => None,
-        },
-        q_star_d: match &analysis.q_star_d {
-            Fit::Ok(c) => Some(*c),
-            Fit::Failed(_) => None,
-        },
+        fit: analysis.bound_fraction_vs_q.ok().copied(),
+        q_star_d: analysis.q_star_d.ok().copied(),
     };
-    match write_figure(&dir, "bound_fraction_vs_q", &fig5) {
-        Ok(files) => written.extend(files),
-        Err(why) => failed.push(format!("bound_fraction_vs_q: {why}")),
-    }
+    log.write(&dir, "bound_fraction_vs_q", &fig5);
     let (curves, missing) = spin_distribution_curves(analysis);
-    failed.extend(missing.into_iter().map(|m| format!("spin_distributions: {m}")));
-    let fits: Vec<(&str, f64, f64)> = curves.iter().map(|(l, n, b)| (l.as_str(), *n, *b)).collect();
-    match write_spin_distributions(&dir, &fits, "rad/s") {
-        Ok(files) => written.extend(files),
-        Err(why) => failed.push(format!("spin_distributions: {why}")),
+    for m in missing {
+        log.record("spin_distributions", Err(m));
     }
-    (written, failed)
+    let fits: Vec<(&str, f64, f64)> = curves.iter().map(|(l, n, b)| (l.as_str(), *n, *b)).collect();
+    let drawn = write_spin_distributions(&dir, &fits, "rad/s");
+    log.record("spin_distributions", drawn.map_err(String::from));
+    (log.written, log.failed)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::figures::testing::{assert_figure_files, temp_dir};
+    use crate::analysis::figures::testing::{assert_figure_files, assert_writes, temp_dir};
 
     /// ∫₀^∞ of the plotted curve is 1 (Eq. 45), by the trapezoidal rule on x = b u², which removes the
     /// xⁿ cusp at 0 for small n; the integrand is negligible beyond 12 b.
@@ -439,7 +419,6 @@ mod tests {
 
     #[test]
     fn bound_fraction_groups_and_writes_both_files() {
-        let dir = temp_dir("bound-fraction");
         let fig = BoundFractionVsQ {
             title: "Bound mass fraction vs Q".into(),
             runs: vec![
@@ -458,10 +437,9 @@ mod tests {
         assert_eq!(g[0].label, "P1");
         assert!((g[0].q - 0.445e9).abs() < 1.0 && (g[0].mean - 0.95).abs() < 1e-12);
         assert_eq!((g[2].min, g[2].max), (0.31, 0.35));
-        write_figure(&dir, "bound_fraction_vs_q", &fig).unwrap();
-        let svg = assert_figure_files(
-            &dir,
+        let svg = assert_writes(
             "bound_fraction_vs_q",
+            &fig,
             &[
                 "specific impact energy Q (erg/g)",
                 "bound fraction of the target mass; largest remnant (dimensionless)",
@@ -469,6 +447,5 @@ mod tests {
         );
         assert!(svg.contains("Q*_D = 2.60e9") && svg.contains("1.04 − 0.2×10⁻⁹ Q"));
         assert!(svg.contains("largest remnant / total mass (2 runs)"));
-        let _ = std::fs::remove_dir_all(&dir);
     }
 }

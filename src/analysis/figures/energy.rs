@@ -27,6 +27,7 @@
 use std::path::Path;
 
 use crate::ellipsoid::body::Body;
+use crate::engine::{MOMENTUM_COLUMNS, column_names};
 
 /// What Fig. 2 needs beyond the two CSV files (from the run's analysis).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,17 +121,8 @@ fn read_columns(path: &Path, names: &[&str]) -> Result<Vec<Vec<f64>>, String> {
     Ok(rows)
 }
 
-const TIMESERIES: [&str; 9] = [
-    "t",
-    "kinetic_translational",
-    "kinetic_rotational",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-];
+/// The columns of the ellipsoid engine's time series read here: t, the two kinetic energies, P and L.
+const TIMESERIES: [&str; 9] = column_names(&[&["t", "kinetic_translational", "kinetic_rotational"], &MOMENTUM_COLUMNS]);
 const TRACKS: [&str; 9] = ["t", "id", "mass", "vx", "vy", "vz", "wx", "wy", "wz"];
 
 /// One projectile row of `tracks.csv`: time, velocity, kinetic translational and rotational energy.
@@ -269,7 +261,8 @@ pub fn read_energy_series(
 pub(crate) mod tests {
     use super::*;
 
-    fn inputs() -> EnergyInputs {
+    /// The inputs of the run [`write_synthetic_run`] writes.
+    pub(crate) fn inputs() -> EnergyInputs {
         EnergyInputs {
             projectile: 1,
             projectile_mass: 2.0,

@@ -5,8 +5,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::style::{
-    Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, finite_extent, label_style, padded, small_style,
-    title_style,
+    Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, figure_chart, finite_extent, label_style, padded,
+    small_style,
 };
 
 /// How one series is drawn.
@@ -71,13 +71,7 @@ impl Figure for LineChart {
             return Err("nothing to plot".into());
         };
         let yr = padded(y0, y1, 0.06);
-        let mut builder = ChartBuilder::on(root);
-        let chart = builder
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(70);
+        let mut chart = figure_chart(root, &self.title, 70);
         if self.log_x {
             let (a, b) = (x0 / 1.5, x1 * 1.5);
             let mut c = chart

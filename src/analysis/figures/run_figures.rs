@@ -23,14 +23,15 @@
 use std::path::Path;
 
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::analysis::figures::energy::{EnergyInputs, EnergySeries, momentum_scales, read_energy_series};
 use crate::analysis::figures::style::{
-    DATA_COLOUR, FIT_COLOUR, Figure, GUIDE_COLOUR, HIGHLIGHT_COLOUR, PlotResult, REFERENCE_COLOUR, SERIES_COLOURS,
-    draw_err, draw_legend, finite_extent, inside_runs, label_style, linear_samples, log_samples, log_tick, padded,
-    padded_log, small_style, square_margins, title_style, write_figure,
+    DATA_COLOUR, FIT_COLOUR, Figure, FigureLog, GUIDE_COLOUR, HIGHLIGHT_COLOUR, PlotResult, REFERENCE_COLOUR,
+    SERIES_COLOURS, draw_err, draw_legend, figure_chart, finite_extent, inside_runs, label_style, linear_samples,
+    log_log_chart, log_samples, log_tick, padded, padded_log, small_style, square_margins, title_style, write_figure,
 };
 use crate::analysis::fits::{PowerLawFit, SpinFit};
 use crate::analysis::fragments::FragmentReport;
@@ -89,24 +90,7 @@ impl Figure for SizeScatter {
             (y0, y1) = (y0.min(*h), y1.max(*h));
         }
         let (xr, yr) = (padded_log(x0, x1, 1.25), padded_log(y0, y1, 2.0));
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(78)
-            .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
-            .map_err(draw_err)?;
-        chart
-            .configure_mesh()
-            .x_desc(SIZE_LABEL)
-            .y_desc(&self.y_label)
-            .axis_desc_style(label_style())
-            .label_style(small_style())
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .draw()
-            .map_err(draw_err)?;
+        let mut chart = log_log_chart(root, &self.title, 78, (xr, yr), SIZE_LABEL, &self.y_label)?;
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, DATA_COLOUR.mix(0.65).filled())))
             .map_err(draw_err)?
@@ -176,12 +160,7 @@ impl Figure for SpinHistogram {
         let width = self.centres[1] - self.centres[0];
         let x1 = self.centres[self.centres.len() - 1] + width;
         let y1 = self.counts.iter().cloned().fold(1.0, f64::max) * 1.35;
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(64)
+        let mut chart = figure_chart(root, &self.title, 64)
             .build_cartesian_2d(0.0..x1, 0.0..y1)
             .map_err(draw_err)?;
         chart
@@ -256,12 +235,7 @@ impl Figure for RotationModeVsSize {
             return Err("no spinning fragment to plot".into());
         };
         let xr = padded_log(x0, x1, 1.25);
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, title_style())
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(64)
+        let mut chart = figure_chart(root, &self.title, 64)
             .build_cartesian_2d((xr.0..xr.1).log_scale(), -1.15..1.15)
             .map_err(draw_err)?;
         chart
@@ -473,22 +447,8 @@ impl EnergyPartition {
             return Err("no positive energy to plot".into());
         };
         let yr = padded_log(lo.max(hi * 1e-7), hi, 2.0);
-        let mut chart = ChartBuilder::on(area)
-            .caption("(a) energy partition", label_style())
-            .margin(8)
-            .x_label_area_size(40)
-            .y_label_area_size(78)
-            .build_cartesian_2d(tr.0..tr.1, (yr.0..yr.1).log_scale())
-            .map_err(draw_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time t (s)")
-            .y_desc("E / K_projectile(0) (dimensionless)")
-            .axis_desc_style(label_style())
-            .label_style(small_style())
-            .y_label_formatter(&log_tick)
-            .draw()
-            .map_err(draw_err)?;
+        let y_desc = "E / K_projectile(0) (dimensionless)";
+        let mut chart = time_log_panel(area, "(a) energy partition", (tr, yr), y_desc, &log_tick)?;
         for (name, values, dash, colour) in curves {
             let pts: Vec<(f64, f64)> = s.t.iter().copied().zip(values.iter().copied()).collect();
             let style = colour.stroke_width(2);
@@ -520,22 +480,9 @@ impl EnergyPartition {
             Some((lo, hi)) => padded_log(lo, hi, 3.0),
             None => (1e-18, 1e-14),
         };
-        let mut chart = ChartBuilder::on(area)
-            .caption("(b) conservation of total momenta", label_style())
-            .margin(8)
-            .x_label_area_size(40)
-            .y_label_area_size(78)
-            .build_cartesian_2d(tr.0..tr.1, (yr.0..yr.1).log_scale())
-            .map_err(draw_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time t (s)")
-            .y_desc("relative drift (dimensionless)")
-            .axis_desc_style(label_style())
-            .label_style(small_style())
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(draw_err)?;
+        let caption = "(b) conservation of total momenta";
+        let drift_tick = |v: &f64| format!("{v:.0e}");
+        let mut chart = time_log_panel(area, caption, (tr, yr), "relative drift (dimensionless)", &drift_tick)?;
         let curves = [
             (
                 format!("angular momentum |L(t) − L(0)| / {}", self.scale_names.1),
@@ -570,6 +517,37 @@ impl EnergyPartition {
         // upper left: before the impact the drift sits at round-off, far below the top
         draw_legend(&mut chart, SeriesLabelPosition::UpperLeft)
     }
+}
+
+/// A chart with a linear time axis and a logarithmic y axis.
+type TimeLogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, LogCoord<f64>>>;
+
+/// A panel of Fig. 2 on `area`: `caption`, time `tr` (s) along x, the positive range `yr` on a log y axis described
+/// by `y_desc` with ticks labelled by `y_tick`.
+fn time_log_panel<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    (tr, yr): ((f64, f64), (f64, f64)),
+    y_desc: &str,
+    y_tick: &dyn Fn(&f64) -> String,
+) -> Result<TimeLogChart<'a, DB>, crate::analysis::AnalysisError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, label_style())
+        .margin(8)
+        .x_label_area_size(40)
+        .y_label_area_size(78)
+        .build_cartesian_2d(tr.0..tr.1, (yr.0..yr.1).log_scale())
+        .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time t (s)")
+        .y_desc(y_desc)
+        .axis_desc_style(label_style())
+        .label_style(small_style())
+        .y_label_formatter(y_tick)
+        .draw()
+        .map_err(draw_err)?;
+    Ok(chart)
 }
 
 impl Figure for EnergyPartition {
@@ -637,16 +615,7 @@ pub fn write_run_figures(
     let dir = run_dir.join("analysis");
     let target: Vec<_> = report.fragments.iter().filter(|f| !f.is_projectile).collect();
     let t_at = analysis.t_at;
-    let fit_of = |f: &Fit<PowerLawFit>| match f {
-        Fit::Ok(p) => Some(*p),
-        Fit::Failed(_) => None,
-    };
-    let mut written = Vec::new();
-    let mut failed = Vec::new();
-    let mut record = |stem: &str, r: Result<[String; 2], String>| match r {
-        Ok(files) => written.extend(files),
-        Err(why) => failed.push(format!("{stem}: {why}")),
-    };
+    let mut log = FigureLog::default();
 
     let fig2 = energy_inputs(run_dir, report)
         .ok_or_else(|| "no projectile in the fragment report".to_string())
@@ -659,36 +628,30 @@ pub fn write_run_figures(
             };
             Ok(write_figure(&dir, "energy_partition", &fig)?)
         });
-    record("energy_partition", fig2);
+    log.record("energy_partition", fig2);
 
     let sfd = super::sfd::SizeFrequency::of(&analysis.clump_report, t_at);
-    record("sfd", write_figure(&dir, "sfd", &sfd).map_err(String::from));
+    log.write(&dir, "sfd", &sfd);
 
     let fig3 = VelocityField {
         title: format!("Fragment ejection velocities relative to the target barycentre, t = {t_at} s"),
         fragments: target.iter().map(|f| (f.ejection_velocity, f.escaping)).collect(),
         escape_velocity: analysis.summary.escape_velocity,
     };
-    record(
-        "velocity_field",
-        write_figure(&dir, "velocity_field", &fig3).map_err(String::from),
-    );
+    log.write(&dir, "velocity_field", &fig3);
 
     let fig4 = SizeScatter {
         title: format!("Ejection speed vs size at t = {t_at} s"),
         y_label: "ejection speed |Δv| (m/s)".into(),
         points: target.iter().map(|f| (f.size, f.ejection_speed)).collect(),
-        fit: fit_of(&analysis.ejection_speed_vs_size),
+        fit: analysis.ejection_speed_vs_size.ok().copied(),
         reference: Some((-1.5, "−3/2 power law (equipartition)".into())),
         horizontal: Some((
             analysis.summary.escape_velocity,
             format!("escape speed v_esc = {:.1} m/s", analysis.summary.escape_velocity),
         )),
     };
-    record(
-        "ejection_vs_size",
-        write_figure(&dir, "ejection_vs_size", &fig4).map_err(String::from),
-    );
+    log.write(&dir, "ejection_vs_size", &fig4);
 
     let fig6 = SpinHistogram {
         title: format!("Spin rates of the target fragments at t = {t_at} s"),
@@ -702,23 +665,17 @@ pub fn write_run_figures(
             Fit::Failed(_) => Vec::new(),
         },
     };
-    record(
-        "spin_histogram",
-        write_figure(&dir, "spin_histogram", &fig6).map_err(String::from),
-    );
+    log.write(&dir, "spin_histogram", &fig6);
 
     let fig8 = SizeScatter {
         title: format!("Spin rate vs size at t = {t_at} s"),
         y_label: "spin rate ω, corrected (rad/s)".into(),
         points: target.iter().map(|f| (f.size, f.spin_rate_corrected)).collect(),
-        fit: fit_of(&analysis.spin_vs_size),
+        fit: analysis.spin_vs_size.ok().copied(),
         reference: Some((-2.5, "−5/2 power law (equipartition)".into())),
         horizontal: None,
     };
-    record(
-        "spin_vs_size",
-        write_figure(&dir, "spin_vs_size", &fig8).map_err(String::from),
-    );
+    log.write(&dir, "spin_vs_size", &fig8);
 
     let fig9 = RotationModeVsSize {
         title: format!("Axis rotation mode vs size at t = {t_at} s"),
@@ -727,17 +684,14 @@ pub fn write_run_figures(
             .filter_map(|f| f.rotation_mode_measure.map(|m| (f.size, m)))
             .collect(),
     };
-    record(
-        "rotation_mode_vs_size",
-        write_figure(&dir, "rotation_mode_vs_size", &fig9).map_err(String::from),
-    );
-    (written, failed)
+    log.write(&dir, "rotation_mode_vs_size", &fig9);
+    (log.written, log.failed)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::analysis::figures::testing::{assert_figure_files, temp_dir};
+    use crate::analysis::figures::testing::{assert_figure_files, assert_writes, temp_dir};
 
     fn fit(alpha: f64) -> PowerLawFit {
         PowerLawFit {
@@ -781,38 +735,31 @@ mod tests {
 
     #[test]
     fn spin_histogram_writes_both_files() {
-        let dir = temp_dir("spin-histogram");
         let fig = SpinHistogram {
             title: "Spin rates".into(),
             centres: vec![0.5e-3, 1.5e-3, 2.5e-3, 3.5e-3],
             counts: vec![3.0, 6.0, 4.0, 1.0],
             fits: Vec::new(),
         };
-        write_figure(&dir, "spin_histogram", &fig).unwrap();
-        assert_figure_files(
-            &dir,
+        assert_writes(
             "spin_histogram",
+            &fig,
             &["spin rate ω, corrected (rad/s)", "fragments per bin"],
         );
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn rotation_mode_writes_both_files_with_sam_and_lam() {
-        let dir = temp_dir("rotation-mode");
         let fig = RotationModeVsSize {
             title: "Axis rotation mode vs size".into(),
             points: vec![(0.1, 0.5), (0.3, -0.7), (0.6, 0.9), (0.2, -1.0)],
         };
-        write_figure(&dir, "rotation_mode_vs_size", &fig).unwrap();
-        let svg = assert_figure_files(&dir, "rotation_mode_vs_size", &[SIZE_LABEL, "(dimensionless)"]);
+        let svg = assert_writes("rotation_mode_vs_size", &fig, &[SIZE_LABEL, "(dimensionless)"]);
         assert!(svg.contains("SAM") && svg.contains("LAM") && svg.contains("2 SAM, 2 LAM"));
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn velocity_field_writes_both_files_with_its_legend() {
-        let dir = temp_dir("velocity-field");
         let fig = VelocityField {
             title: "Fragment ejection velocities".into(),
             fragments: vec![
@@ -822,10 +769,9 @@ mod tests {
             ],
             escape_velocity: 20.0,
         };
-        write_figure(&dir, "velocity_field", &fig).unwrap();
-        let svg = assert_figure_files(
-            &dir,
+        let svg = assert_writes(
             "velocity_field",
+            &fig,
             &[
                 "ejection velocity Δv_x (m/s)",
                 "ejection velocity Δv_z (m/s)",
@@ -833,22 +779,13 @@ mod tests {
             ],
         );
         assert!(svg.contains("escaping fragments (Eq. 43): 1") && svg.contains("bound fragments: 2"));
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]
     fn energy_partition_reads_synthetic_run_and_writes_both_files() {
         let dir = temp_dir("energy-partition");
         crate::analysis::figures::energy::tests::write_synthetic_run(&dir, true);
-        let inputs = EnergyInputs {
-            projectile: 1,
-            projectile_mass: 2.0,
-            projectile_moments: [1.0, 1.0, 4.0],
-            target_mass: 6.0,
-            summary_projectile_energy: 9.0,
-            momentum_scale: 10.0,
-            angular_momentum_scale: 100.0,
-        };
+        let inputs = crate::analysis::figures::energy::tests::inputs();
         let series = read_energy_series(&dir, &inputs).unwrap();
         assert!((series.projectile_kinetic.as_ref().unwrap()[1] - 0.5 / 11.0).abs() < 1e-12);
         let fig = EnergyPartition {

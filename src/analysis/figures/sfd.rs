@@ -6,10 +6,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use super::style::{
-    Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, label_style, log_tick, padded_log, small_style,
-    title_style,
-};
+use super::style::{Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, log_log_chart, padded_log};
 use crate::analysis::clumps::{ClumpReport, Fate};
 
 /// `(m, N(≥ m))` for the masses `masses` (kg): one point per mass, heaviest first (N = 1, 2, …).
@@ -62,27 +59,15 @@ impl Figure for SizeFrequency {
         };
         let n1 = points().map(|p| p.1).fold(1.0, f64::max);
         let (xr, yr) = (padded_log(m0, m1, 1.5), padded_log(0.8, n1, 1.3));
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                format!("Cumulative mass distribution of clumps at t = {} s", self.t),
-                title_style(),
-            )
-            .margin(12)
-            .margin_right(30)
-            .x_label_area_size(46)
-            .y_label_area_size(70)
-            .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
-            .map_err(draw_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("clump mass m (kg)")
-            .y_desc("N(≥ m), number of clumps")
-            .axis_desc_style(label_style())
-            .label_style(small_style())
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
-            .draw()
-            .map_err(draw_err)?;
+        let title = format!("Cumulative mass distribution of clumps at t = {} s", self.t);
+        let mut chart = log_log_chart(
+            root,
+            &title,
+            70,
+            (xr, yr),
+            "clump mass m (kg)",
+            "N(≥ m), number of clumps",
+        )?;
         for (k, (label, pts)) in self.series.iter().enumerate() {
             let colour = SERIES_COLOURS[k % SERIES_COLOURS.len()];
             // a cumulative count is a staircase: N steps up by one at each mass, going down in mass

@@ -129,6 +129,31 @@ pub fn write_figure(
     Ok([svg, png])
 }
 
+/// What writing a set of figures gave: the files written and, for each figure that could not be drawn, why
+/// (`stem: reason`, one line each; the other figures are still written).
+#[derive(Debug, Default)]
+pub struct FigureLog {
+    /// File names written.
+    pub written: Vec<String>,
+    /// `stem: reason` of each figure not drawn.
+    pub failed: Vec<String>,
+}
+
+impl FigureLog {
+    /// Books the outcome of the figure `stem`.
+    pub fn record(&mut self, stem: &str, outcome: Result<[String; 2], String>) {
+        match outcome {
+            Ok(files) => self.written.extend(files),
+            Err(why) => self.failed.push(format!("{stem}: {why}")),
+        }
+    }
+
+    /// Writes `figure` as `dir/<stem>.svg` and `.png` ([`write_figure`]) and books the outcome.
+    pub fn write(&mut self, dir: &Path, stem: &str, figure: &impl Figure) {
+        self.record(stem, write_figure(dir, stem, figure).map_err(String::from));
+    }
+}
+
 /// Text style of titles.
 pub fn title_style() -> TextStyle<'static> {
     (FONT_FAMILY, TITLE_FONT).into_font().into()
@@ -142,6 +167,52 @@ pub fn label_style() -> TextStyle<'static> {
 /// Text style of legends, ticks and annotations.
 pub fn small_style() -> TextStyle<'static> {
     (FONT_FAMILY, SMALL_FONT).into_font().into()
+}
+
+/// The chart builder of a one-panel figure on `root`: `title` as its caption, the common margins, and a y label
+/// area `y_label_width` px wide (room for the tick labels).
+pub fn figure_chart<'a, 'b, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    y_label_width: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(root);
+    builder
+        .caption(title, title_style())
+        .margin(12)
+        .margin_right(30)
+        .x_label_area_size(46)
+        .y_label_area_size(y_label_width);
+    builder
+}
+
+/// A chart with logarithmic x and y axes.
+pub type LogLogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+/// A log–log [`figure_chart`] over the positive ranges `xr` and `yr`, its mesh drawn with the axis descriptions
+/// `x_desc`, `y_desc` and [`log_tick`] labels.
+pub fn log_log_chart<'a, DB: DrawingBackend>(
+    root: &'a DrawingArea<DB, Shift>,
+    title: &str,
+    y_label_width: u32,
+    (xr, yr): ((f64, f64), (f64, f64)),
+    x_desc: &str,
+    y_desc: &str,
+) -> Result<LogLogChart<'a, DB>, crate::analysis::AnalysisError> {
+    let mut chart = figure_chart(root, title, y_label_width)
+        .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+        .map_err(draw_err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style(label_style())
+        .label_style(small_style())
+        .x_label_formatter(&log_tick)
+        .y_label_formatter(&log_tick)
+        .draw()
+        .map_err(draw_err)?;
+    Ok(chart)
 }
 
 /// Draws the legend of `chart` (the series given a `.label`) at `position`, boxed on a light background.

@@ -4,7 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::figures::style::FIGURE_SIZE;
+use crate::analysis::figures::style::{FIGURE_SIZE, Figure, write_figure};
 
 /// A fresh, empty temporary directory for one test.
 pub fn temp_dir(name: &str) -> PathBuf {
@@ -43,6 +43,16 @@ pub fn assert_figure_files(dir: &Path, stem: &str, labels: &[&str]) -> String {
     for label in labels {
         assert!(svg.contains(label), "{stem}.svg lacks {label:?}");
     }
+    svg
+}
+
+/// Writes `figure` as `stem` into a fresh temporary directory, checks its files ([`assert_figure_files`] with
+/// `labels`), removes the directory and returns the SVG text.
+pub fn assert_writes(stem: &str, figure: &impl Figure, labels: &[&str]) -> String {
+    let dir = temp_dir(stem);
+    write_figure(&dir, stem, figure).unwrap();
+    let svg = assert_figure_files(&dir, stem, labels);
+    let _ = std::fs::remove_dir_all(&dir);
     svg
 }
 

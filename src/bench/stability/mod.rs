@@ -45,6 +45,21 @@ fn csv_field(s: &str) -> String {
     }
 }
 
+/// The measured columns of a row, `steps` to `min_step`, as text: the wall time with `wall_digits` decimals, the
+/// energy and quaternion errors and the smallest step in scientific notation with `exp_digits`.
+fn measured(r: &StabilityRow, wall_digits: usize, exp_digits: usize) -> [String; 7] {
+    let exp = |x: f64| format!("{x:.exp_digits$e}");
+    [
+        r.steps.to_string(),
+        r.rejections.to_string(),
+        r.rhs_evaluations.to_string(),
+        format!("{:.wall_digits$}", r.wall_seconds),
+        exp(r.energy_error),
+        exp(r.max_quat_norm_error),
+        exp(r.min_step),
+    ]
+}
+
 /// Writes `stability.csv` (columns [`CSV_COLUMNS`]).
 pub fn write_csv(path: &Path, rows: &[StabilityRow]) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
@@ -52,16 +67,10 @@ pub fn write_csv(path: &Path, rows: &[StabilityRow]) -> std::io::Result<()> {
     for r in rows {
         writeln!(
             f,
-            "{},{},{},{},{},{:.3},{:.3e},{:.3e},{:.3e},{},{}",
+            "{},{},{},{},{}",
             csv_field(&r.case),
             csv_field(&r.description),
-            r.steps,
-            r.rejections,
-            r.rhs_evaluations,
-            r.wall_seconds,
-            r.energy_error,
-            r.max_quat_norm_error,
-            r.min_step,
+            measured(r, 3, 3).join(","),
             r.verdict.as_str(),
             csv_field(&r.note)
         )?;
@@ -81,15 +90,9 @@ pub fn write_markdown(path: &Path, rows: &[StabilityRow], title: &str) -> std::i
     for r in rows {
         writeln!(
             f,
-            "| {} | {} | {} | {} | {:.2} | {:.1e} | {:.1e} | {:.1e} | {} |",
+            "| {} | {} | {} |",
             r.case,
-            r.steps,
-            r.rejections,
-            r.rhs_evaluations,
-            r.wall_seconds,
-            r.energy_error,
-            r.max_quat_norm_error,
-            r.min_step,
+            measured(r, 2, 1).join(" | "),
             r.verdict.as_str()
         )?;
     }
@@ -109,6 +112,39 @@ pub fn write_markdown(path: &Path, rows: &[StabilityRow], title: &str) -> std::i
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn csv_and_markdown_rows_write_the_measurements_at_their_precisions() {
+        let row = StabilityRow {
+            case: "a1".into(),
+            description: "d".into(),
+            steps: 12,
+            rejections: 3,
+            rhs_evaluations: 456,
+            wall_seconds: 1.23456,
+            energy_error: 2.5e-12,
+            max_quat_norm_error: 7.25e-15,
+            min_step: f64::NAN,
+            verdict: rubblepile::driver::stability::Verdict::Warn,
+            note: "n".into(),
+        };
+        let dir = std::env::temp_dir().join(format!("rubblepile-bench-stability-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let [csv, md] = result_paths(&dir);
+        write_csv(&csv, std::slice::from_ref(&row)).unwrap();
+        write_markdown(&md, std::slice::from_ref(&row), "t").unwrap();
+        let csv = std::fs::read_to_string(csv).unwrap();
+        let md = std::fs::read_to_string(md).unwrap();
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(
+            csv.lines().nth(1),
+            Some("a1,d,12,3,456,1.235,2.500e-12,7.250e-15,NaN,warn,n")
+        );
+        assert!(
+            md.contains("\n| a1 | 12 | 3 | 456 | 1.23 | 2.5e-12 | 7.3e-15 | NaN | warn |\n"),
+            "{md}"
+        );
+    }
 
     #[test]
     fn csv_fields_are_quoted() {

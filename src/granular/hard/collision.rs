@@ -54,6 +54,24 @@ pub struct Outcome {
     pub guarded: bool,
 }
 
+impl Outcome {
+    /// Nothing changed: the bodies were not approaching.
+    const NONE: Outcome = Outcome {
+        applied: false,
+        approach_speed: 0.0,
+        guarded: false,
+    };
+
+    /// Applied at the normal relative speed `un` (m/s, negative: approaching).
+    fn applied(un: f64, guarded: bool) -> Outcome {
+        Outcome {
+            applied: true,
+            approach_speed: -un,
+            guarded,
+        }
+    }
+}
+
 /// The relative contact velocity `u` of body 2 with respect to body 1 and the unit normal from 1 to 2.
 pub fn contact_velocity(b1: &Body, b2: &Body) -> (Vec3, Vec3) {
     let n = (b2.position - b1.position).normalize();
@@ -97,11 +115,7 @@ pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed
     let (u, n) = contact_velocity(b1, b2);
     let un = u.dot(&n);
     let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
-        return Outcome {
-            applied: false,
-            approach_speed: 0.0,
-            guarded: false,
-        };
+        return Outcome::NONE;
     };
     let u_n = n * un;
     let u_t = u - u_n;
@@ -114,11 +128,7 @@ pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed
     b2.velocity -= p * (b1.mass / m);
     b1.spin += q * (b1.radius / b1.inertia);
     b2.spin += q * (b2.radius / b2.inertia);
-    Outcome {
-        applied: true,
-        approach_speed: -un,
-        guarded,
-    }
+    Outcome::applied(un, guarded)
 }
 
 /// Resolves a collision of a sphere with an infinitely massive surface (a wall, or a particle stuck to one):
@@ -131,20 +141,12 @@ pub fn resolve_wall(b: &mut Body, n: &Vec3, surface_velocity: &Vec3, r: Restitut
     let u = b.velocity + b.spin.cross(&arm) - surface_velocity;
     let un = u.dot(n);
     let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
-        return Outcome {
-            applied: false,
-            approach_speed: 0.0,
-            guarded: false,
-        };
+        return Outcome::NONE;
     };
     let u_n = n * un;
     let u_t = u - u_n;
     let beta = 1.0 / (1.0 + b.mass * b.radius * b.radius / b.inertia);
     b.velocity -= u_n * (1.0 + r.eps_n) + u_t * (beta * (1.0 - r.eps_t));
     b.spin -= arm.cross(&u) * (b.mass * beta * (1.0 - r.eps_t) / b.inertia);
-    Outcome {
-        applied: true,
-        approach_speed: -un,
-        guarded,
-    }
+    Outcome::applied(un, guarded)
 }

@@ -15,37 +15,36 @@ use super::scene::{HardScene, PARTICLE_COLUMNS, STUCK_COLUMN};
 use super::stepper::{Counters, Diagnostics, NeighbourState, System};
 use crate::bits::exact_f64_vec;
 use crate::engine::{
-    Engine, EngineError, Failure, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample, SampleError,
-    Schedule, SnapshotView, read_sphere_snapshot,
+    Engine, EngineError, Failure, MOMENTUM_COLUMNS, NamedSurface, Outcome, ParticleView, Resumed, RunReport, Sample,
+    SampleError, Schedule, SnapshotView, column_names, momentum_values, read_sphere_snapshot,
 };
 use crate::io::fmt_f64;
 use crate::math::Vec3;
 
 /// Columns of `timeseries.csv`.
-pub const TIMESERIES_COLUMNS: [&str; 22] = [
-    "t",
-    "kinetic",
-    "rotational",
-    "potential",
-    "energy",
-    "energy_change",
-    "energy_residual",
-    "px",
-    "py",
-    "pz",
-    "lx",
-    "ly",
-    "lz",
-    "collisions",
-    "pair_collisions",
-    "wall_collisions",
-    "events_per_second",
-    "max_overlap",
-    "free",
-    "stuck",
-    "absorbed",
-    "wall_seconds",
-];
+pub const TIMESERIES_COLUMNS: [&str; 22] = column_names(&[
+    &[
+        "t",
+        "kinetic",
+        "rotational",
+        "potential",
+        "energy",
+        "energy_change",
+        "energy_residual",
+    ],
+    &MOMENTUM_COLUMNS,
+    &[
+        "collisions",
+        "pair_collisions",
+        "wall_collisions",
+        "events_per_second",
+        "max_overlap",
+        "free",
+        "stuck",
+        "absorbed",
+        "wall_seconds",
+    ],
+]);
 
 /// `summary.json` of a hard-sphere run.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -139,19 +138,7 @@ pub fn write_particles(path: &Path, t: f64, system: &System) -> std::io::Result<
     let mut w = crate::io::safe_write::AtomicFile::create(path)?;
     writeln!(w, "{},{STUCK_COLUMN}", PARTICLE_COLUMNS.join(","))?;
     for p in system.particles.iter().filter(|p| p.alive) {
-        let v = [
-            p.mass,
-            p.radius,
-            p.position.x,
-            p.position.y,
-            p.position.z,
-            p.velocity.x,
-            p.velocity.y,
-            p.velocity.z,
-            p.spin.x,
-            p.spin.y,
-            p.spin.z,
-        ];
+        let v = crate::io::particles::sphere_state(p.mass, p.radius, &p.position, &p.velocity, &p.spin);
         let cols: Vec<String> = v.iter().map(|&x| fmt_f64(x)).collect();
         let stuck = p.stuck.map_or(-1, |a| a.wall as i64);
         writeln!(w, "{},{},{},{stuck}", fmt_f64(t), p.id, cols.join(","))?;
@@ -166,7 +153,7 @@ const BOOK_LEN: usize = 20;
 const PARTICLE_STATE: usize = 16;
 
 /// Bookkeeping of a run (energy and momentum references and the largest errors so far).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Book {
     e0: f64,
     scale: f64,
@@ -175,6 +162,50 @@ struct Book {
     momentum_error: f64,
     momentum_change: f64,
     p0: Vec3,
+}
+
+/// The counters of a checkpoint ([`HardState::counts`]), in their order there: the one table of save and restore.
+fn count_slots(c: &mut Counters) -> [&mut u64; 7] {
+    [
+        &mut c.pair_collisions,
+        &mut c.wall_collisions,
+        &mut c.events,
+        &mut c.guarded,
+        &mut c.rebuilds,
+        &mut c.reanchors,
+        &mut c.absorbed,
+    ]
+}
+
+/// The bookkeeping numbers of a checkpoint ([`HardState::book`]) in the counters and the book, in their order
+/// there: the one table of save and restore.
+fn book_slots<'a>(c: &'a mut Counters, b: &'a mut Book) -> [&'a mut f64; BOOK_LEN] {
+    use nalgebra::base::coordinates::XYZ;
+    let XYZ { x: px, y: py, z: pz } = &mut *b.p0;
+    let XYZ { x: wx, y: wy, z: wz } = &mut *c.wall_impulse;
+    let XYZ { x: fx, y: fy, z: fz } = &mut *c.field_impulse;
+    [
+        &mut c.max_overlap,
+        &mut c.energy_exchanged,
+        &mut b.e0,
+        &mut b.scale,
+        &mut b.energy_change,
+        &mut b.energy_residual,
+        &mut b.momentum_error,
+        px,
+        py,
+        pz,
+        &mut c.energy_restitution,
+        &mut c.energy_walls,
+        &mut c.energy_removed,
+        wx,
+        wy,
+        wz,
+        fx,
+        fy,
+        fz,
+        &mut b.momentum_change,
+    ]
 }
 
 fn pack_particles(system: &System) -> Vec<f64> {
@@ -459,7 +490,7 @@ impl Engine for HardEngine {
         } else {
             0.0
         };
-        let row = [
+        let energies = [
             to.t,
             d.kinetic,
             d.rotational,
@@ -467,12 +498,8 @@ impl Engine for HardEngine {
             e,
             (e - book.e0) / book.scale,
             (e - book.e0 - c.energy_exchanged) / book.scale,
-            d.momentum.x,
-            d.momentum.y,
-            d.momentum.z,
-            d.angular_momentum.x,
-            d.angular_momentum.y,
-            d.angular_momentum.z,
+        ];
+        let events = [
             (coll - last_coll) as f64,
             (c.pair_collisions - last_pair) as f64,
             (c.wall_collisions - last_wall) as f64,
@@ -483,7 +510,13 @@ impl Engine for HardEngine {
             c.absorbed as f64,
             wall,
         ];
-        let cols: Vec<String> = row.iter().map(|&x| fmt_f64(x)).collect();
+        let momenta = momentum_values(&d.momentum, &d.angular_momentum);
+        let cols: Vec<String> = energies
+            .iter()
+            .chain(&momenta)
+            .chain(&events)
+            .map(|&x| fmt_f64(x))
+            .collect();
         self.last_counts = [coll, c.pair_collisions, c.wall_collisions, c.events];
         self.last_wall_clock = wall;
         Ok(cols.join(",") + "\n")
@@ -579,9 +612,8 @@ impl Engine for HardEngine {
 
     fn save(&mut self) -> std::io::Result<HardState> {
         let system = &self.system;
-        let c = system.counters;
+        let (mut c, mut book) = (system.counters, self.book);
         let nb = system.neighbour_state();
-        let book = &self.book;
         Ok(HardState {
             steps: self.steps,
             state: pack_particles(system),
@@ -590,37 +622,8 @@ impl Engine for HardEngine {
                 .map(|s| s.anchors.iter().flat_map(|a| a.iter().copied()).collect())
                 .unwrap_or_default(),
             allowances: nb.as_ref().map(|s| s.allowances.clone()).unwrap_or_default(),
-            counts: [
-                c.pair_collisions,
-                c.wall_collisions,
-                c.events,
-                c.guarded,
-                c.rebuilds,
-                c.reanchors,
-                c.absorbed,
-            ],
-            book: vec![
-                c.max_overlap,
-                c.energy_exchanged,
-                book.e0,
-                book.scale,
-                book.energy_change,
-                book.energy_residual,
-                book.momentum_error,
-                book.p0.x,
-                book.p0.y,
-                book.p0.z,
-                c.energy_restitution,
-                c.energy_walls,
-                c.energy_removed,
-                c.wall_impulse.x,
-                c.wall_impulse.y,
-                c.wall_impulse.z,
-                c.field_impulse.x,
-                c.field_impulse.y,
-                c.field_impulse.z,
-                book.momentum_change,
-            ],
+            counts: count_slots(&mut c).map(|x| *x),
+            book: book_slots(&mut c, &mut book).map(|x| *x).to_vec(),
             last_counts: self.last_counts,
             last_wall_clock: self.last_wall_clock,
         })
@@ -653,37 +656,19 @@ impl HardEngine {
                 ck.book.len()
             ));
         }
-        let v3 = |k: usize| Vec3::new(ck.book[k], ck.book[k + 1], ck.book[k + 2]);
-        let [pair, wall, events, guarded, rebuilds, reanchors, absorbed] = ck.counts;
-        system.counters = Counters {
-            pair_collisions: pair,
-            wall_collisions: wall,
-            events,
-            guarded,
-            rebuilds,
-            reanchors,
-            absorbed,
-            max_overlap: ck.book[0],
-            energy_exchanged: ck.book[1],
-            energy_restitution: ck.book[10],
-            energy_walls: ck.book[11],
-            energy_removed: ck.book[12],
-            wall_impulse: v3(13),
-            field_impulse: v3(16),
-        };
-        self.book = Book {
-            e0: ck.book[2],
-            scale: ck.book[3],
-            energy_change: ck.book[4],
-            energy_residual: ck.book[5],
-            momentum_error: ck.book[6],
-            momentum_change: ck.book[19],
-            p0: v3(7),
-        };
+        let (mut counters, mut book) = (Counters::default(), Book::default());
+        for (slot, &n) in count_slots(&mut counters).into_iter().zip(&ck.counts) {
+            *slot = n;
+        }
+        for (slot, &x) in book_slots(&mut counters, &mut book).into_iter().zip(&ck.book) {
+            *slot = x;
+        }
+        system.counters = counters;
+        self.book = book;
         self.steps = ck.steps;
         self.last_counts = ck.last_counts;
         self.last_wall_clock = ck.last_wall_clock;
-        self.events_before = events;
+        self.events_before = counters.events;
         self.good = self.system.clone();
         self.clock = Instant::now();
         Ok(())

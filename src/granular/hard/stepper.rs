@@ -1100,7 +1100,8 @@ impl System {
             return;
         }
         self.counters.wall_collisions += 1;
-        if wall.absorbing {
+        if wall.absorbing || wall.sticky {
+            // The particle leaves the dynamics: its kinetic and potential energy and its momentum go with it.
             let g_pot = self
                 .settings
                 .gravity
@@ -1109,6 +1110,8 @@ impl System {
             self.counters.energy_exchanged -= e_before + g_pot;
             self.counters.energy_removed -= e_before + g_pot;
             self.counters.wall_impulse -= p.velocity * p.mass;
+        }
+        if wall.absorbing {
             self.counters.absorbed += 1;
             self.floor = None;
             self.neighbours.grid.remove(i);
@@ -1116,14 +1119,6 @@ impl System {
             return;
         }
         if wall.sticky {
-            let g_pot = self
-                .settings
-                .gravity
-                .map(|g| -p.mass * g.dot(&p.position))
-                .unwrap_or(0.0);
-            self.counters.energy_exchanged -= e_before + g_pot;
-            self.counters.energy_removed -= e_before + g_pot;
-            self.counters.wall_impulse -= p.velocity * p.mass;
             let att = Attachment {
                 wall: w,
                 offset: wall.to_local(&(p.position - origin_now)),

@@ -684,6 +684,20 @@ mod tests {
         }
     }
 
+    /// The settings of the driver tests: `target` on [`path`] with no rests, about z.
+    fn settings(target: SpinupTarget) -> SpinupSettings {
+        SpinupSettings {
+            path: path(0, 0.0),
+            axis: Vec3::z(),
+            target,
+            release_axis_ratio: 0.1,
+            release_packing: 0.01,
+            release_samples: 2,
+            rve_particles: 300,
+            interior: InteriorRule::Layers,
+        }
+    }
+
     #[test]
     fn path_nodes_linear_stages_and_rests() {
         let p = path(0, 0.0);
@@ -773,16 +787,7 @@ mod tests {
     #[test]
     fn forcing_is_the_same_on_any_number_of_threads() {
         for target in [SpinupTarget::Period, SpinupTarget::AngularMomentum] {
-            let settings = SpinupSettings {
-                path: path(0, 0.0),
-                axis: Vec3::new(0.0, 0.0, 1.0),
-                target,
-                release_axis_ratio: 0.1,
-                release_packing: 0.01,
-                release_samples: 2,
-                rve_particles: 300,
-                interior: InteriorRule::Layers,
-            };
+            let settings = settings(target);
             let ps: Vec<Particle> = (0..3000)
                 .map(|k| {
                     let x = k as f64;
@@ -814,16 +819,7 @@ mod tests {
 
     #[test]
     fn increment_sets_the_target_angular_momentum_keeps_momentum_and_reports_its_work() {
-        let settings = SpinupSettings {
-            path: path(0, 0.0),
-            axis: Vec3::new(0.0, 0.0, 1.0),
-            target: SpinupTarget::AngularMomentum,
-            release_axis_ratio: 0.1,
-            release_packing: 0.01,
-            release_samples: 2,
-            rve_particles: 300,
-            interior: InteriorRule::Layers,
-        };
+        let settings = settings(SpinupTarget::AngularMomentum);
         let mut ps: Vec<Particle> = (0..6)
             .map(|k| Particle {
                 mass: 1.0 + k as f64,
@@ -883,16 +879,7 @@ mod tests {
             p.position = centre + (p.position - centre) * 1.1;
         }
         let period_after = |target: SpinupTarget| {
-            let settings = SpinupSettings {
-                path: path(0, 0.0),
-                axis: Vec3::z(),
-                target,
-                release_axis_ratio: 0.1,
-                release_packing: 0.01,
-                release_samples: 2,
-                rve_particles: 300,
-                interior: InteriorRule::Layers,
-            };
+            let settings = settings(target);
             let d = SpinupDriver::new(settings, &ps0);
             let mut ps = expanded.clone();
             d.apply(&mut ps, &member, 20.0);
@@ -908,16 +895,7 @@ mod tests {
 
     #[test]
     fn release_needs_consecutive_confirmations_and_state_round_trips() {
-        let settings = SpinupSettings {
-            path: path(0, 0.0),
-            axis: Vec3::z(),
-            target: SpinupTarget::Period,
-            release_axis_ratio: 0.1,
-            release_packing: 0.01,
-            release_samples: 2,
-            rve_particles: 300,
-            interior: InteriorRule::Layers,
-        };
+        let settings = settings(SpinupTarget::Period);
         let mut d = SpinupDriver::new(settings, &[]);
         d.observe(5.0, 0.5, 0.5, 0.5); // before t_start: ignored
         assert_eq!(d.reference, None);

@@ -58,7 +58,7 @@ pub fn lining_froude(run: &TumblerRun) -> f64 {
 /// The run's restitution, and "smooth drum" when no particle is stuck to the wall (Richardson11 §3.2's aside:
 /// the drum then drives the bed by its surface friction alone), so that such runs get series of their own.
 fn restitution_label(run: &TumblerRun) -> String {
-    drum_label(run.restitution, run.stuck)
+    drum_label(run.restitution(), run.stuck)
 }
 
 /// [`restitution_label`] of restitution `(ε_n, ε_t)` with `stuck` particles on the wall.
@@ -192,8 +192,8 @@ pub fn tumbler_paper_markdown(runs: &[TumblerRun], command: &str) -> String {
             md,
             "| {:.3} | {} | {} | {:.3} | {} | {:.3} | {:.2} | {angle} | {} | {:.1} | {halves} | {last} | {:.2} | {:.2} | {:.3e} | {:.1e} | {} | {:.2e} | {:.0} |",
             lining_froude(run),
-            run.restitution.0,
-            run.restitution.1,
+            run.eps_n,
+            run.eps_t,
             run.omega,
             run.status,
             run.t_reached,
@@ -250,8 +250,8 @@ pub fn write_tumbler_paper_report(args: &TumblerPaperArgs) -> Result<PathBuf, An
     runs.sort_by(|a, b| {
         a.froude
             .total_cmp(&b.froude)
-            .then(a.restitution.0.total_cmp(&b.restitution.0))
-            .then(a.restitution.1.total_cmp(&b.restitution.1))
+            .then(a.eps_n.total_cmp(&b.eps_n))
+            .then(a.eps_t.total_cmp(&b.eps_t))
     });
     let command = format!(
         "rubblepile report richardson2011-tumbler {} --out {}",
@@ -358,7 +358,7 @@ mod tests {
         assert_eq!(run.t_reached, 0.4);
         assert_eq!(run.collisions, 400);
         assert!((run.wall_seconds - 12.0).abs() < 1e-12 && (run.events_per_second - 400.0 / 12.0).abs() < 1e-9);
-        assert_eq!(run.restitution, (0.5, 0.3));
+        assert_eq!(run.restitution(), (0.5, 0.3));
         // Three snapshots in the second half, each at 35° to within the column discretisation, with a fit error well
         // under a degree (the packed surface is a staircase about the line).
         assert_eq!(run.angles.len(), 3);

@@ -375,6 +375,18 @@ fn column(rows: &[&RefereeRun], f: impl Fn(&RefereeRun) -> f64, scale: f64, digi
     mean_sd(&rows.iter().map(|r| f(r) * scale).collect::<Vec<_>>(), digits)
 }
 
+/// One statistics column of a table: a run's value, its scale (100 for percentages) and its decimals.
+type Stat = (fn(&RefereeRun) -> f64, f64, usize);
+
+/// A table row `| lead | runs | mean ± sd | … |` of `rows`, one cell per stat ([`column`]).
+fn stats_row(md: &mut String, lead: &str, rows: &[&RefereeRun], stats: &[Stat]) {
+    let cells: Vec<String> = stats
+        .iter()
+        .map(|&(f, scale, digits)| column(rows, f, scale, digits))
+        .collect();
+    let _ = writeln!(md, "| {lead} | {} | {} |", rows.len(), cells.join(" | "));
+}
+
 /// Roig03's Fig. 4 and Fig. 8 exponents (P1, P2, P3).
 const PAPER_EJECTION: [(&str, f64); 3] = [("P1", -0.42), ("P2", -0.28), ("P3", -0.32)];
 const PAPER_SPIN: [(&str, f64); 3] = [("P1", -1.09), ("P2", -1.11), ("P3", -1.13)];
@@ -403,19 +415,17 @@ fn f0_table(runs: &[RefereeRun], md: &mut String) {
     );
     for f0 in f0s {
         let rows = select(runs, |r| fig2(r) && r.f0 == f0);
-        let _ = writeln!(
-            md,
-            "| {f0:.0e} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-            rows.len(),
-            column(&rows, |r| r.f_ke, 100.0, 2),
-            column(&rows, |r| r.rot_share, 100.0, 1),
-            column(&rows, |r| r.rot_share_target_frame, 100.0, 1),
-            column(&rows, |r| r.added_share, 100.0, 1),
-            column(&rows, |r| r.bound_fraction, 1.0, 3),
-            column(&rows, |r| r.n_escaping as f64, 1.0, 0),
-            column(&rows, |r| r.alpha_all, 1.0, 2),
-            column(&rows, |r| r.spin_alpha, 1.0, 2),
-        );
+        let stats: [Stat; 8] = [
+            (|r| r.f_ke, 100.0, 2),
+            (|r| r.rot_share, 100.0, 1),
+            (|r| r.rot_share_target_frame, 100.0, 1),
+            (|r| r.added_share, 100.0, 1),
+            (|r| r.bound_fraction, 1.0, 3),
+            (|r| r.n_escaping as f64, 1.0, 0),
+            (|r| r.alpha_all, 1.0, 2),
+            (|r| r.spin_alpha, 1.0, 2),
+        ];
+        stats_row(md, &format!("{f0:.0e}"), &rows, &stats);
     }
 }
 
@@ -437,17 +447,14 @@ fn split_table(runs: &[RefereeRun], md: &mut String) {
             if rows.is_empty() {
                 continue;
             }
-            let _ = writeln!(
-                md,
-                "| {} | {p} | {} | {} | {} | {} | {} | {} |",
-                label(group),
-                rows.len(),
-                column(&rows, |r| r.rot_share, 100.0, 1),
-                column(&rows, |r| r.kr_initial_ratio, 100.0, 2),
-                column(&rows, |r| r.pre_existing, 100.0, 2),
-                column(&rows, |r| r.pre_existing_per_fragment, 100.0, 2),
-                column(&rows, |r| r.added_share, 100.0, 1),
-            );
+            let stats: [Stat; 5] = [
+                (|r| r.rot_share, 100.0, 1),
+                (|r| r.kr_initial_ratio, 100.0, 2),
+                (|r| r.pre_existing, 100.0, 2),
+                (|r| r.pre_existing_per_fragment, 100.0, 2),
+                (|r| r.added_share, 100.0, 1),
+            ];
+            stats_row(md, &format!("{} | {p}", label(group)), &rows, &stats);
         }
     }
 }
@@ -466,18 +473,16 @@ fn variant_table(runs: &[RefereeRun], variants: [Variant<'_>; 2], md: &mut Strin
             if rows.is_empty() {
                 continue;
             }
-            let _ = writeln!(
-                md,
-                "| {p}, {label} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                rows.len(),
-                column(&rows, |r| r.f_ke, 100.0, 2),
-                column(&rows, |r| r.rot_share, 100.0, 1),
-                column(&rows, |r| r.bound_fraction, 1.0, 3),
-                column(&rows, |r| r.alpha_all, 1.0, 2),
-                column(&rows, |r| r.alpha_escaping, 1.0, 2),
-                column(&rows, |r| r.spin_alpha, 1.0, 2),
-                column(&rows, |r| r.kappa, 1.0, 2),
-            );
+            let stats: [Stat; 7] = [
+                (|r| r.f_ke, 100.0, 2),
+                (|r| r.rot_share, 100.0, 1),
+                (|r| r.bound_fraction, 1.0, 3),
+                (|r| r.alpha_all, 1.0, 2),
+                (|r| r.alpha_escaping, 1.0, 2),
+                (|r| r.spin_alpha, 1.0, 2),
+                (|r| r.kappa, 1.0, 2),
+            ];
+            stats_row(md, &format!("{p}, {label}"), &rows, &stats);
         }
     }
 }

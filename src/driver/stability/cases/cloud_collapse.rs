@@ -42,16 +42,7 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
     } else {
         (1.5 * v_esc * 100.0).ceil() / 100.0
     };
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: v_cal },
-        gravity: true,
-        contact: true,
-        f0: Some(1e-3),
-        every: t_end / 10.0,
-        snapshots: Some(vec![0.0, t_end]),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(t_end, v_cal, Some(1e-3), 10, 1);
     let description = format!(
         "cloud collapse: N = {n} ellipsoids (R_eq 1-1.5 km, spacing 2.6 R, near rest; escape speed {v_esc:.2} m/s) under gravity + contact + F0 = 1e-3 s/m^2, calibrate beta = 10, v = {v_cal} m/s{}, {t_end} s",
         if naive {
@@ -60,11 +51,8 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
             " (1.5 x escape)"
         }
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let snaps = match run.snapshots() {
-            Ok(s) => s,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &bodies, move |run| {
+        let snaps = run.snapshots()?;
         let settings = crate::ellipsoid::barrier::BarrierSettings::for_kappa_source(&run.scene.kappa_source);
         let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, &settings, b).len();
         let (c0, c1) = (
@@ -73,8 +61,7 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
         );
         let broke = run.summary.barrier.as_ref().map_or(0, |b| b.broke_through_pairs);
         let overruns = run.overrun_pairs();
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
+        let mut checks = run_checks(run, true);
         checks.push(quaternion_check(run));
         checks.push((true, broke == 0, format!("no break-through ({broke} pairs)")));
         let contacts_text = format!("touching pairs {c0} at t = 0, {c1} at t_end");
@@ -91,12 +78,6 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
                 format!("overruns {overruns} (expected 0); {contacts_text}"),
             ));
         }
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &bodies),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

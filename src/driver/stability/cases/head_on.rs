@@ -17,52 +17,19 @@ pub fn head_on(id: &str, factor: f64) -> Case {
         Vec4::w(),
         [0.0; 3],
     );
-    let large = rock(
-        [1000.0, 700.0, 500.0],
-        [-1000.0, 0.0, 0.0],
-        [0.0; 3],
-        Vec4::w(),
-        [0.0; 3],
-    );
-    let small = rock([600.0, 450.0, 300.0], [1400.0, 0.0, 0.0], [0.0; 3], Vec4::w(), [0.0; 3]);
-    let (v1, v2) = head_on_velocities(v, large.shape.mass, small.shape.mass);
+    let [large, small] = tip_to_tip(v);
     // Eq. 14's barrier is β ½ m_l v_cal², the collision's energy ½ μ v²: through above v² > β (m_k + m_l)/m_k v_cal².
     let through_factor2 = 10.0 * (small.shape.mass + large.shape.mass) / small.shape.mass;
-    let bodies = [
-        spectator,
-        Body {
-            velocity: Vec3::new(v1, 0.0, 0.0),
-            ..large
-        },
-        Body {
-            velocity: Vec3::new(v2, 0.0, 0.0),
-            ..small
-        },
-    ];
+    let bodies = [spectator, large, small];
     // surfaces 800 m apart: contact after 800/v s; contact + rebound within 1600/v s more.
     let t_end = (2400.0 / v).ceil() + 200.0;
-    let every = t_end / 40.0;
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated {
-            beta: 10.0,
-            v: HEAD_ON_V_CAL,
-        },
-        gravity: true,
-        contact: true,
-        f0: None,
-        every,
-        snapshots: Some(grid(t_end, 4)),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(t_end, HEAD_ON_V_CAL, None, 40, 4);
+    let every = spec.every;
     let description = format!(
         "head-on tip-to-tip impact of bodies 1 and 2 at {factor} x the calibrated {HEAD_ON_V_CAL} m/s (beta = 10), gravity + contact, no dissipation"
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let (ratio, sep) = match run.contact_extremes(every / 10.0) {
-            Ok(x) => x,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &bodies, move |run| {
+        let (ratio, sep) = run.contact_extremes(every / 10.0)?;
         let pairs = run
             .summary
             .barrier
@@ -72,8 +39,7 @@ pub fn head_on(id: &str, factor: f64) -> Case {
         let named = pairs.len() == 1 && pairs[0].i == 1 && pairs[0].j == 2;
         let measured = format!("max speed/calibrated {ratio:.3}, centres down to {sep:.3} of touching");
         if factor < SPEED_MARGIN {
-            let mut checks = vec![completed_check(run)];
-            checks.extend(energy_check(run, ENERGY_STRICT, "energy"));
+            let mut checks = run_checks(run, false);
             checks.push((
                 true,
                 run.overrun_pairs() == 0,
@@ -84,7 +50,7 @@ pub fn head_on(id: &str, factor: f64) -> Case {
                 d.dot(&dv) > 0.0
             });
             checks.push((true, rebound == Ok(true), "rebounded (separating at t_end)".into()));
-            judge(&checks)
+            Ok(judge(&checks))
         } else {
             let through = pairs.first().is_some_and(|p| p.broke_through);
             let expect_through = factor * factor > through_factor2;
@@ -109,20 +75,14 @@ pub fn head_on(id: &str, factor: f64) -> Case {
                 format!("broke through: {through} (expected {expect_through})"),
             ));
             match &run.failure {
-                None => checks.extend(energy_check(run, ENERGY_STRICT, "energy")),
+                None => checks.extend(energy_check(run, false)),
                 Some(cause) => checks.push((
                     true,
                     expect_through && cause.contains("broke through") && cause.contains("bodies 1 and 2"),
                     "a stop names the break-through of bodies 1 and 2".into(),
                 )),
             }
-            judge(&checks)
+            Ok(judge(&checks))
         }
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &bodies),
-        check,
-    }
+    })
 }

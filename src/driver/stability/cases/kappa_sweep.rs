@@ -13,47 +13,20 @@ pub const SWEEP_SPEED: f64 = 0.8;
 /// diverges as the centres meet, and the bodies fall through each other, which must be reported as a
 /// break-through (and the run then stops at the singularity with a message naming the pair).
 pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
-    let large = rock(
-        [1000.0, 700.0, 500.0],
-        [-1000.0, 0.0, 0.0],
-        [0.0; 3],
-        Vec4::w(),
-        [0.0; 3],
-    );
-    let small = rock([600.0, 450.0, 300.0], [1400.0, 0.0, 0.0], [0.0; 3], Vec4::w(), [0.0; 3]);
-    let v_cal = speed_for_kappa(kappa, 10.0, &small, &large);
-    let (v1, v2) = head_on_velocities(SWEEP_SPEED, large.shape.mass, small.shape.mass);
-    let bodies = [
-        Body {
-            velocity: Vec3::new(v1, 0.0, 0.0),
-            ..large
-        },
-        Body {
-            velocity: Vec3::new(v2, 0.0, 0.0),
-            ..small
-        },
-    ];
+    let bodies = tip_to_tip(SWEEP_SPEED);
+    let v_cal = speed_for_kappa(kappa, 10.0, &bodies[1], &bodies[0]);
     let t_end = 4000.0;
     let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: v_cal },
         gravity,
-        contact: true,
-        f0: None,
-        every: 200.0,
-        snapshots: Some(grid(t_end, 4)),
-        atol: RTOL,
+        ..SceneSpec::calibrated(t_end, v_cal, None, 20, 4)
     };
     let expect_overrun = SWEEP_SPEED > SPEED_MARGIN * v_cal;
     let description = format!(
         "kappa = {kappa}: head-on tip-to-tip impact at {SWEEP_SPEED} m/s, kappa calibrated with beta = 10, v = {v_cal:.3e} m/s, contact{}, {t_end} s",
         if gravity { " + gravity" } else { " only (no gravity)" }
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let (ratio, sep) = match run.contact_extremes(2.0) {
-            Ok(x) => x,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &bodies, move |run| {
+        let (ratio, sep) = run.contact_extremes(2.0)?;
         let report = run.summary.barrier.clone();
         let got = run.overrun_pairs() > 0;
         let named = report
@@ -84,16 +57,9 @@ pub fn kappa_sweep(id: &str, kappa: f64, gravity: bool) -> Case {
                 ));
             }
         } else {
-            checks.push(completed_check(run));
-            checks.extend(energy_check(run, ENERGY_STRICT, "energy"));
+            checks.extend(run_checks(run, false));
             checks.push((true, !through, format!("no break-through ({through})")));
         }
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &bodies),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

@@ -25,26 +25,13 @@ pub fn tiny_orbit(id: &str) -> Case {
             ..tiny
         },
     ];
-    let t_end = 3.0 * period;
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: 1.0 },
-        gravity: true,
-        contact: true,
-        f0: None,
-        every: t_end / 30.0,
-        snapshots: Some(grid(t_end, 30)),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(3.0 * period, 1.0, None, 30, 30);
     let description = format!(
         "mass ratio {:.1e}: 10 m sphere on a circular orbit (r = 3 km, period {period:.0} s) around a 1 km sphere, 3 orbits",
         mt / m
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let snaps = match run.snapshots() {
-            Ok(s) => s,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &bodies, move |run| {
+        let snaps = run.snapshots()?;
         let (mut dr, mut dphi) = (0.0_f64, 0.0_f64);
         for (t, b) in &snaps {
             let rel = b[1].position - b[0].position;
@@ -55,8 +42,7 @@ pub fn tiny_orbit(id: &str) -> Case {
             d = d.min(TAU - d);
             dphi = dphi.max(d);
         }
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_STRICT, "energy"));
+        let mut checks = run_checks(run, false);
         checks.push((false, dr <= 1e-7, format!("radius drift {dr:.1e} <= 1e-7")));
         checks.push((
             false,
@@ -68,14 +54,8 @@ pub fn tiny_orbit(id: &str) -> Case {
             dr <= 1e-3 && dphi <= 1e-3,
             "radius and phase within 1e-3 (fail bound)".into(),
         ));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &bodies),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }
 
 /// Case (c2): the 10 m sphere dropped from 10 m above the 1 km sphere's surface (mass ratio 1e-6), with
@@ -91,35 +71,20 @@ pub fn tiny_resting(id: &str) -> Case {
     );
     let ratio = tiny.shape.mass / big.shape.mass;
     let t_end = 20_000.0;
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: 1.0 },
-        gravity: true,
-        contact: true,
-        f0: Some(0.1),
-        every: t_end / 40.0,
-        snapshots: Some(grid(t_end, 20)),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(t_end, 1.0, Some(0.1), 40, 20);
     let description = format!(
         "mass ratio {ratio:.1e}: 10 m sphere dropped from 10 m onto a 1 km sphere (gravity, contact, F0 = 0.1 s/m^2), settling for {t_end} s"
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let snaps = match run.snapshots() {
-            Ok(s) => s,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &[big, tiny], |run| {
+        let snaps = run.snapshots()?;
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
-        let Some((_, last)) = snaps.last() else {
-            return failed_to_read("no snapshot".into());
-        };
+        let (_, last) = snaps.last().ok_or("no snapshot")?;
         let half = &snaps[snaps.len() / 2].1;
         let d_end = dist(last);
         let rel = (last[1].velocity - last[0].velocity).norm();
         let off = d_end / (BIG_R + TINY_R) - 1.0;
         let drift = (d_end - dist(half)).abs();
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
+        let mut checks = run_checks(run, true);
         checks.push((
             false,
             off.abs() < 1e-3,
@@ -132,12 +97,6 @@ pub fn tiny_resting(id: &str) -> Case {
             format!("distance drift over the second half {drift:.1e} m < 1 mm"),
         ));
         checks.push((true, off.abs() < 0.05, "within 5% of R + r (fail bound)".into()));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &[big, tiny]),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

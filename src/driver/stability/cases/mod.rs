@@ -116,6 +116,24 @@ pub struct SceneSpec {
     pub atol: f64,
 }
 
+impl SceneSpec {
+    /// The spec of most cases: gravity and contact, dissipation `f0` (s m⁻²) if any, κ calibrated with β = 10 and
+    /// `v_cal` (m/s, Eq. 14), the tolerance [`RTOL`]; `rows` time-series rows and `snapshots` + 1 snapshots
+    /// evenly over `t_end` (s).
+    pub fn calibrated(t_end: f64, v_cal: f64, f0: Option<f64>, rows: u32, snapshots: usize) -> SceneSpec {
+        SceneSpec {
+            t_end,
+            kappa: Kappa::Calibrated { beta: 10.0, v: v_cal },
+            gravity: true,
+            contact: true,
+            f0,
+            every: t_end / f64::from(rows),
+            snapshots: Some(grid(t_end, snapshots)),
+            atol: RTOL,
+        }
+    }
+}
+
 /// Snapshot times `0, t_end/n, …, t_end`.
 pub fn grid(t_end: f64, n: usize) -> Vec<f64> {
     (0..=n).map(|k| t_end * k as f64 / n as f64).collect()
@@ -182,9 +200,54 @@ pub fn speed_for_kappa(kappa: f64, beta: f64, small: &Body, large: &Body) -> f64
     (G_SI * small.shape.mass / (beta * (rk + rl))).sqrt() * (0.5 * (x - x.ln())).exp()
 }
 
-/// Velocities `(v_i, v_j)` along x that give relative speed `v` with zero total momentum.
-fn head_on_velocities(v: f64, m_i: f64, m_j: f64) -> (f64, f64) {
-    (v * m_j / (m_i + m_j), -v * m_i / (m_i + m_j))
+/// `a` and `b` moving along x, towards each other when `a` lies at smaller x, at relative speed `v` (m/s) with
+/// zero total momentum.
+fn approaching(a: Body, b: Body, v: f64) -> [Body; 2] {
+    let m = a.shape.mass + b.shape.mass;
+    let (va, vb) = (v * b.shape.mass / m, -v * a.shape.mass / m);
+    [
+        Body {
+            velocity: Vec3::new(va, 0.0, 0.0),
+            ..a
+        },
+        Body {
+            velocity: Vec3::new(vb, 0.0, 0.0),
+            ..b
+        },
+    ]
+}
+
+/// The head-on pair of cases (a) and (f): the largest body (1000 × 700 × 500 m, at x = −1000 m) and the smallest
+/// (600 × 450 × 300 m, at x = 1400 m), tip to tip along x with their surfaces 800 m apart, meeting at `v` (m/s).
+fn tip_to_tip(v: f64) -> [Body; 2] {
+    let large = rock(
+        [1000.0, 700.0, 500.0],
+        [-1000.0, 0.0, 0.0],
+        [0.0; 3],
+        Vec4::w(),
+        [0.0; 3],
+    );
+    let small = rock([600.0, 450.0, 300.0], [1400.0, 0.0, 0.0], [0.0; 3], Vec4::w(), [0.0; 3]);
+    approaching(large, small, v)
+}
+
+/// A case of the scene `spec` with `bodies`, judged by `check`; a check that cannot read the run's outputs
+/// (`Err`) fails the case, saying why.
+fn case(
+    id: &str,
+    description: String,
+    spec: &SceneSpec,
+    bodies: &[Body],
+    check: impl Fn(&CaseRun) -> Result<Judgement, String> + Send + Sync + 'static,
+) -> Case {
+    Case {
+        id: id.into(),
+        description,
+        scene_toml: scene_toml(id, spec, bodies),
+        check: Box::new(move |run| {
+            check(run).unwrap_or_else(|e| judge(&[(true, false, format!("outputs readable: {e}"))]))
+        }),
+    }
 }
 
 // -------------------------------------------------------------------------------------------------
@@ -199,7 +262,14 @@ fn completed_check(run: &CaseRun) -> (bool, bool, String) {
     }
 }
 
-fn energy_check(run: &CaseRun, strict: f64, label: &str) -> [(bool, bool, String); 2] {
+/// The energy residual against the loose bound (hard) and, soft, against [`ENERGY_DISSIPATIVE`] for the
+/// bookkeeping `H − H0 − 2∫F` of a `dissipative` run, else against [`ENERGY_STRICT`].
+fn energy_check(run: &CaseRun, dissipative: bool) -> [(bool, bool, String); 2] {
+    let (strict, label) = if dissipative {
+        (ENERGY_DISSIPATIVE, "H - H0 - 2intF")
+    } else {
+        (ENERGY_STRICT, "energy")
+    };
     let e = run.summary.energy_error;
     [
         (
@@ -209,6 +279,23 @@ fn energy_check(run: &CaseRun, strict: f64, label: &str) -> [(bool, bool, String
         ),
         (true, e <= ENERGY_LOOSE, format!("<= {ENERGY_LOOSE:e} (fail bound)")),
     ]
+}
+
+/// The checks every case starts with: [`completed_check`] and [`energy_check`].
+fn run_checks(run: &CaseRun, dissipative: bool) -> Vec<(bool, bool, String)> {
+    let mut checks = vec![completed_check(run)];
+    checks.extend(energy_check(run, dissipative));
+    checks
+}
+
+/// No stall: at most 1e6 step attempts (hard).
+fn no_stall_check(run: &CaseRun) -> (bool, bool, String) {
+    let attempts = run.summary.steps_accepted + run.summary.steps_rejected;
+    (
+        true,
+        attempts <= 1_000_000,
+        format!("no stall: {attempts} step attempts <= 1e6"),
+    )
 }
 
 fn quaternion_check(run: &CaseRun) -> (bool, bool, String) {
@@ -272,10 +359,6 @@ fn settled_check(run: &CaseRun) -> (bool, bool, String) {
         frac.abs() < 1e-3,
         format!("settled into rigid motion: last 10% of the run dissipated {frac:.1e} of the total (< 1e-3)"),
     )
-}
-
-fn failed_to_read(e: String) -> Judgement {
-    judge(&[(true, false, format!("outputs readable: {e}"))])
 }
 
 /// Relative speed (m/s) and the sphere-equivalent separation `√(x/κλ)` of bodies `i`, `j`.

@@ -23,16 +23,7 @@ pub fn flat_pair(id: &str, plates: bool) -> Case {
     );
     let t_end = 10_000.0;
     let v_cal = if plates { 2.0 } else { 1.0 };
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: v_cal },
-        gravity: true,
-        contact: true,
-        f0: Some(0.1),
-        every: t_end / 40.0,
-        snapshots: Some(grid(t_end, 20)),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(t_end, v_cal, Some(0.1), 40, 20);
     let shape = if plates {
         "plates A = B = 2000 m"
     } else {
@@ -41,14 +32,9 @@ pub fn flat_pair(id: &str, plates: bool) -> Case {
     let description = format!(
         "two {shape}, C/A = 0.05, dropped onto each other at 0.3 m/s (gravity, contact, F0 = 0.1 s/m^2, calibrate beta = 10, v = {v_cal} m/s), settling for {t_end} s"
     );
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let bodies = match final_bodies(run) {
-            Ok(b) => b,
-            Err(e) => return failed_to_read(e),
-        };
-        let (_, sep) = pair_state(&bodies, 0, 1);
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
+    case(id, description, &spec, &[a, b], |run| {
+        let (_, sep) = pair_state(&final_bodies(run)?, 0, 1);
+        let mut checks = run_checks(run, true);
         checks.push(quaternion_check(run));
         checks.push(settled_check(run));
         checks.push((
@@ -59,12 +45,6 @@ pub fn flat_pair(id: &str, plates: bool) -> Case {
             ),
         ));
         checks.push(no_overrun_check(run));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &[a, b]),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

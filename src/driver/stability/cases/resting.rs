@@ -24,14 +24,8 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
         [0.0; 3],
     );
     let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: 2.0 },
-        gravity: true,
-        contact: true,
-        f0: damped.then_some(1e-2),
-        every: t_end / 100.0,
-        snapshots: Some(grid(t_end, 100)),
         atol,
+        ..SceneSpec::calibrated(t_end, 2.0, damped.then_some(1e-2), 100, 100)
     };
     let crawl_demo = atol < RESTING_ATOL;
     let description = if damped {
@@ -43,20 +37,16 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
             "resting contact, free: the same pair released at rest 5 m above touching, no dissipation, oscillating for {t_end:e} s, atol = {atol:e}"
         )
     };
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let snaps = match run.snapshots() {
-            Ok(s) => s,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &[low, high], move |run| {
+        let snaps = run.snapshots()?;
         let dist = |b: &[Body]| (b[1].position - b[0].position).norm();
         let n = snaps.len();
         if n < 3 {
-            return failed_to_read("fewer than 3 snapshots".into());
+            return Err("fewer than 3 snapshots".into());
         }
         let d0 = dist(&snaps[0].1);
-        let mut checks = vec![completed_check(run)];
+        let mut checks = run_checks(run, damped);
         if damped {
-            checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
             let (d_half, d_end) = (dist(&snaps[n / 2].1), dist(&snaps[n - 1].1));
             let drift = (d_end - d_half).abs();
             let (dv, sep) = pair_state(&snaps[n - 1].1, 0, 1);
@@ -71,7 +61,6 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
                 format!("at rest in contact: relative speed {dv:.1e} m/s < 1e-6, separation ratio {sep:.4} < 1"),
             ));
         } else {
-            checks.extend(energy_check(run, ENERGY_STRICT, "energy"));
             let d_max = snaps.iter().map(|(_, b)| dist(b)).fold(0.0, f64::max);
             let d_min = snaps.iter().map(|(_, b)| dist(b)).fold(f64::INFINITY, f64::min);
             let over = d_max - d0;
@@ -103,12 +92,6 @@ pub fn resting(id: &str, damped: bool, atol: f64, t_end: f64) -> Case {
         }
         checks.push(quaternion_check(run));
         checks.push(no_overrun_check(run));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &[low, high]),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

@@ -22,45 +22,16 @@ pub fn sticking(id: &str) -> Case {
         axis_angle([1.0, 1.0, 0.0], 0.5),
         [0.0, -2e-4, 1e-4],
     );
-    let (va, vb) = head_on_velocities(1.0, a.shape.mass, b.shape.mass);
-    let bodies = [
-        Body {
-            velocity: Vec3::new(va, 0.0, 0.0),
-            ..a
-        },
-        Body {
-            velocity: Vec3::new(vb, 0.0, 0.0),
-            ..b
-        },
-    ];
-    let t_end = 3000.0;
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: 2.0 },
-        gravity: true,
-        contact: true,
-        f0: Some(100.0),
-        every: t_end / 30.0,
-        snapshots: Some(grid(t_end, 30)),
-        atol: RTOL,
-    };
+    let bodies = approaching(a, b, 1.0);
+    let spec = SceneSpec::calibrated(3000.0, 2.0, Some(100.0), 30, 30);
     let description = "F0 = 100 s/m^2: two spinning ellipsoids meet off-centre at 1 m/s (gravity, contact, calibrate beta = 10, v = 2 m/s) and stick, 3000 s".to_string();
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let bodies = match final_bodies(run) {
-            Ok(b) => b,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &bodies, |run| {
+        let bodies = final_bodies(run)?;
         let d = bodies[0].position - bodies[1].position;
         let radial = (bodies[0].velocity - bodies[1].velocity).dot(&d) / d.norm();
         let (_, sep) = pair_state(&bodies, 0, 1);
-        let s = &run.summary;
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
-        checks.push((
-            true,
-            s.steps_accepted + s.steps_rejected <= 1_000_000,
-            format!("no stall: {} step attempts <= 1e6", s.steps_accepted + s.steps_rejected),
-        ));
+        let mut checks = run_checks(run, true);
+        checks.push(no_stall_check(run));
         checks.push((
             true,
             radial.abs() < 1e-2,
@@ -75,14 +46,8 @@ pub fn sticking(id: &str) -> Case {
             format!("captured in contact: separation ratio {sep:.3} < 1"),
         ));
         checks.push(quaternion_check(run));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &bodies),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }
 
 /// Case (e2): F0 = 100 s m⁻² on a pair already touching: the ellipsoids of case (h) stacked at the touching
@@ -98,32 +63,12 @@ pub fn sticking_in_contact(id: &str) -> Case {
         Vec4::w(),
         [0.0, -1e-5, 0.0],
     );
-    let t_end = 2000.0;
-    let spec = SceneSpec {
-        t_end,
-        kappa: Kappa::Calibrated { beta: 10.0, v: 2.0 },
-        gravity: true,
-        contact: true,
-        f0: Some(100.0),
-        every: t_end / 20.0,
-        snapshots: Some(grid(t_end, 20)),
-        atol: RTOL,
-    };
+    let spec = SceneSpec::calibrated(2000.0, 2.0, Some(100.0), 20, 20);
     let description = "F0 = 100 s/m^2 in contact: 800x600x400 m ellipsoid touching a 1000x700x500 m one, closing at 0.1 m/s (gravity, contact), 2000 s".to_string();
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let bodies = match final_bodies(run) {
-            Ok(b) => b,
-            Err(e) => return failed_to_read(e),
-        };
-        let (_, sep) = pair_state(&bodies, 0, 1);
-        let s = &run.summary;
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_DISSIPATIVE, "H - H0 - 2intF"));
-        checks.push((
-            true,
-            s.steps_accepted + s.steps_rejected <= 1_000_000,
-            format!("no stall: {} step attempts <= 1e6", s.steps_accepted + s.steps_rejected),
-        ));
+    case(id, description, &spec, &[low, high], |run| {
+        let (_, sep) = pair_state(&final_bodies(run)?, 0, 1);
+        let mut checks = run_checks(run, true);
+        checks.push(no_stall_check(run));
         checks.push(settled_check(run));
         checks.push((
             false,
@@ -131,12 +76,6 @@ pub fn sticking_in_contact(id: &str) -> Case {
             format!("stuck in contact: separation ratio {sep:.4} < 1"),
         ));
         checks.push(quaternion_check(run));
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &[low, high]),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }

@@ -41,11 +41,8 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
         )
     };
     let exact = tilt == 0.0 && wobble == 0.0;
-    let check: crate::driver::stability::case::Check = Box::new(move |run: &CaseRun| {
-        let snaps = match run.snapshots() {
-            Ok(s) => s,
-            Err(e) => return failed_to_read(e),
-        };
+    case(id, description, &spec, &[body], move |run| {
+        let snaps = run.snapshots()?;
         let (mut spin_err, mut q_err, mut off_axis) = (0.0_f64, 0.0_f64, 0.0_f64);
         let w0 = (wobble * wobble + w3 * w3).sqrt();
         for (t, b) in &snaps {
@@ -61,8 +58,7 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
         }
         let q_norm = run.summary.quaternion_norm_error;
         let budget = quaternion_budget(run.summary.steps_accepted);
-        let mut checks = vec![completed_check(run)];
-        checks.extend(energy_check(run, ENERGY_STRICT, "energy"));
+        let mut checks = run_checks(run, false);
         checks.push(quaternion_check(run));
         checks.push((
             false,
@@ -99,12 +95,6 @@ pub fn theta_zero(id: &str, tilt: f64, wobble: f64) -> Case {
                 format!("alpha, beta stay 0: max |alpha|, |beta| = {off_axis:e} <= 1e-15"),
             ));
         }
-        judge(&checks)
-    });
-    Case {
-        id: id.into(),
-        description,
-        scene_toml: scene_toml(id, &spec, &[body]),
-        check,
-    }
+        Ok(judge(&checks))
+    })
 }
