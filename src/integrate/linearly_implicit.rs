@@ -255,7 +255,8 @@ impl BaseRule for LinearlyImplicitEuler {
         })
     }
 
-    /// The state keeps the step budget of the loop's settings (the others are the defaults the method runs with).
+    /// Of the loop's settings the state keeps the step budget: `h_min`, `h_max` and the non-finite retries stay the
+    /// integrator's own (its layout predates them).
     fn unpack<'a>(state: &'a IntegratorState, carried: &mut Carried) -> Unpacked<'a> {
         let IntegratorState::LinearlyImplicit(s) = state else {
             return Err(wrong_state(state, Self::METHOD));
