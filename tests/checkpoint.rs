@@ -565,3 +565,52 @@ fn dop853_and_dopri5_states_restore_exactly() {
     let looser = OdeSolversAdapter::new(Method::Dopri5, Tolerances::uniform(1e-8, 1e-9, 4), None).unwrap();
     assert!(dopri.restore_state(&looser.save_state()).is_err(), "other tolerances");
 }
+
+/// A state that fails a check of `restore_state` leaves the integrator as it was (every check comes before any
+/// field is set): for each method, a state saved earlier in the run with one field spoiled (a non-finite
+/// compensation, a bad span, a column count out of range, a negative step) is refused, and the integrator keeps
+/// its later state.
+#[test]
+fn refused_states_leave_the_integrator_as_it_was() {
+    let tol = || Tolerances::uniform(1e-10, 1e-10, 4);
+    let methods = [Method::BulirschStoer, Method::BulirschStoerImplicit, Method::Dop853];
+    for method in methods {
+        let mut integ = make_integrator(method, tol(), None).unwrap();
+        integ.set_span(Arenstorf.t_end());
+        let (mut t, mut y) = (Arenstorf.t0(), Arenstorf.initial_state());
+        advance_all(integ.as_mut(), &mut t, &mut y, &[0.5]);
+        let earlier = integ.save_state();
+        advance_all(integ.as_mut(), &mut t, &mut y, &[1.0]);
+        let before = integ.save_state();
+        assert_ne!(earlier, before, "{method}");
+        let mut spoiled: Vec<IntegratorState> = Vec::new();
+        match &earlier {
+            IntegratorState::BulirschStoer(s) => {
+                let mut bad = s.clone();
+                bad.compensation = vec![f64::NAN; 4];
+                spoiled.push(IntegratorState::BulirschStoer(bad));
+                let mut bad = s.clone();
+                bad.columns.span = Some(-1.0);
+                spoiled.push(IntegratorState::BulirschStoer(bad));
+            }
+            IntegratorState::LinearlyImplicit(s) => {
+                let mut bad = s.clone();
+                bad.compensation = vec![1.0; 3];
+                spoiled.push(IntegratorState::LinearlyImplicit(bad));
+                let mut bad = s.clone();
+                bad.columns.k = bad.km;
+                spoiled.push(IntegratorState::LinearlyImplicit(bad));
+            }
+            IntegratorState::Dop853(s) => {
+                let mut bad = s.clone();
+                bad.h = -1.0;
+                spoiled.push(IntegratorState::Dop853(bad));
+            }
+            other => panic!("{method}: unexpected state {other:?}"),
+        }
+        for bad in &spoiled {
+            assert!(integ.restore_state(bad).is_err(), "{method}: {bad:?} accepted");
+            assert_eq!(integ.save_state(), before, "{method}: changed by a refused state");
+        }
+    }
+}

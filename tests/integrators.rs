@@ -644,3 +644,32 @@ fn bs_compensated_summation_keeps_increments_below_half_an_ulp() {
         y2[0] - 1.0
     );
 }
+
+/// Advancing to the current time is a no-op for every method, whatever the state holds (even NaN): the time and
+/// state stay as they are, no step is taken and no evaluation made.
+#[test]
+fn advancing_to_the_current_time_is_a_no_op_for_every_method() {
+    let methods = [
+        Method::BulirschStoer,
+        Method::Dop853,
+        Method::BulirschStoerImplicit,
+        Method::Dopri5,
+        Method::Rk4,
+    ];
+    for method in methods {
+        let step = (method == Method::Rk4).then_some(0.1);
+        let mut integ = make_integrator(method, tol(1e-9, 1e-9, 2), step).unwrap();
+        let osc = HarmonicOscillator::new(1.0);
+        for y0 in [vec![1.0, 0.0], vec![f64::NAN, 0.0]] {
+            let (mut t, mut y) = (2.0, y0.clone());
+            integ.advance(&osc, &mut t, &mut y, 2.0).unwrap();
+            assert_eq!(t, 2.0, "{method}");
+            assert_eq!(
+                y.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                y0.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                "{method}"
+            );
+            assert_eq!(integ.stats().rhs_evaluations, 0, "{method}");
+        }
+    }
+}

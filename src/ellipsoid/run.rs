@@ -702,8 +702,8 @@ impl Engine for EllipsoidEngine {
             steps_accepted: stats.steps_accepted,
             steps_rejected: stats.steps_rejected,
             rejections: match self.integrator.save_state() {
-                IntegratorState::BulirschStoer(s) => Some(s.rejections),
-                IntegratorState::LinearlyImplicit(s) => Some(s.rejections),
+                IntegratorState::BulirschStoer(s) => Some(s.columns.rejections),
+                IntegratorState::LinearlyImplicit(s) => Some(s.columns.rejections),
                 _ => None,
             },
             rhs_evaluations: stats.rhs_evaluations,

@@ -55,6 +55,14 @@
 //! every tableau entry rounds at `ε |y|`, and the run's error stops following `rtol` near `1e-11`
 //! (`bench tolerance`; `analysis/work_precision/REPORT.md`).
 //!
+//! # The step loop and the other extrapolation method
+//!
+//! The loop around the steps (landing on output times, the step budget and deadline, halving after non-finite
+//! values, compensated summation, statistics, the loop's part of a checkpoint) is [`Adaptive`]'s
+//! (`adaptive_loop.rs`); this file supplies the step ([`Extrapolation`] with [`Midpoint`], Gragg's rule). The
+//! column and order control of [`Extrapolation`] also drives the linearly implicit Euler rule of
+//! `linearly_implicit.rs` (SEULEX), with that code's constants ([`Strategy`]).
+//!
 //! # Safeguards
 //!
 //! * **Stability check** (ODEX): in the first midpoint substep of columns 1 and 2 the change of
@@ -67,29 +75,32 @@
 //!   The same halving happens when the error estimate diverges with the column index (`j > 2` and
 //!   `err_j ≥ max(4 err_{j−1}, 1)`, ODEX's `ERROLD`) or is astronomically large (`err · ε ≥ 1`).
 //! * **Non-finite values**: a NaN/∞ error estimate also halves `H`; after
-//!   [`BulirschStoer::set_max_nonfinite_retries`] (default 10) consecutive such rejections, or when
+//!   [`Adaptive::set_max_nonfinite_retries`] (default 10) consecutive such rejections, or when
 //!   the step underflows right after one, [`IntegrateError::NonFinite`] is returned. A non-finite
 //!   derivative at an *accepted* point fails at once (no step size can cure it).
 //! * The caller's `t, y` are only ever overwritten by accepted states.
 
-pub use super::common::{BulirschStoerState, Rejections};
-use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances, begin_advance};
+use super::adaptive_loop::{
+    Adaptive, Carried, Cause, FirstStep, Outcome, StepMethod, Trial, all_finite, bad_state, hinit_h0, hinit_h1,
+    validate_tolerances, wrong_state,
+};
+pub use super::adaptive_loop::{DEFAULT_MAX_NONFINITE_RETRIES, DEFAULT_MAX_STEPS};
+#[cfg(doc)]
+use super::common::Integrator;
+pub use super::common::{BulirschStoerState, ColumnControlState, Rejections};
+use super::common::{IntegrateError, IntegratorState, Method, OdeSystem, Tolerances};
 use super::compensated::Compensation;
 
-/// Step-size factor bound parameter (ODEX `fac1`).
-const FAC1: f64 = 0.02;
-/// Step-size factor bound parameter (ODEX `fac2`).
-const FAC2: f64 = 4.0;
-/// Order decrease threshold on the work ratio (ODEX `fac3`).
-const FAC3: f64 = 0.8;
-/// Order increase threshold on the work ratio (ODEX `fac4`).
-const FAC4: f64 = 0.9;
-/// Safety factor on the error (ODEX `safe1`).
-const SAFE1: f64 = 0.65;
-/// Safety factor on the step (ODEX `safe2`).
-const SAFE2: f64 = 0.94;
-/// Step reduction after a failed stability check, a growing or non-finite error (ODEX `safe3`).
-const SAFE3: f64 = 0.5;
+/// ODEX's step and order control (its `fac1 … fac4`, `safe1`, `safe2`).
+const ODEX: Strategy = Strategy {
+    gragg: true,
+    fac1: 0.02,
+    fac2: 4.0,
+    fac3: 0.8,
+    fac4: 0.9,
+    safe1: 0.65,
+    safe2: 0.94,
+};
 /// Columns in which the stability check runs (ODEX `jstab`).
 const STABILITY_COLUMNS: usize = 2;
 /// Limit on `‖Δf‖² / ‖f‖²` in the stability check.
@@ -103,22 +114,18 @@ const STABILITY_RATIO: f64 = 4.0;
 pub const RUN_BUDGET: f64 = 0.25;
 /// Default maximum number of columns (ODEX `km`).
 pub const DEFAULT_MAX_COLUMNS: usize = 9;
-/// Default maximum number of step attempts per call to [`Integrator::advance`].
-pub const DEFAULT_MAX_STEPS: u64 = 100_000_000;
-/// Default number of consecutive non-finite rejections before giving up.
-pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = 10;
 
 /// Adaptive Gragg–Bulirsch–Stoer extrapolation integrator (ODEX strategy), see the
-/// [module documentation](self).
+/// [module documentation](self): the step loop [`Adaptive`] around [`Extrapolation`] of Gragg's rule.
 ///
 /// The step size and column count are carried from one [`Integrator::advance`] call to the next,
 /// so a sequence of output times does not restart the step control; when a step is shortened to
 /// land exactly on an output time, the un-shortened proposal is kept for the next call. Call
-/// [`BulirschStoer::reset`] after a discontinuity of the state or of the equations.
+/// [`Adaptive::reset`] after a discontinuity of the state or of the equations.
 ///
 /// Statistics ([`Integrator::stats`]) count every RHS call (including the initial-step guess and
 /// the derivative at the start of each `advance`); `smallest_step` leaves out steps shortened
-/// only to land on an output time. [`BulirschStoer::rejections`] splits the rejected steps by cause.
+/// only to land on an output time. [`Adaptive::rejections`] splits the rejected steps by cause.
 ///
 /// All work arrays are allocated once (at the first call and whenever the dimension changes);
 /// a step allocates nothing.
@@ -137,85 +144,11 @@ pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = 10;
 /// assert!((y[0] - 1.0).abs() < 1e-10 && y[1].abs() < 1e-10);
 /// assert!(bs.stats().steps_accepted > 0);
 /// ```
-#[derive(Debug, Clone)]
-pub struct BulirschStoer {
-    tol: Tolerances,
-    initial_step: Option<f64>,
-    km: usize,
-    max_steps: u64,
-    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
-    deadline: Option<std::time::Instant>,
-    h_min: f64,
-    h_max: f64,
-    max_nonfinite_retries: u32,
-    /// Span of the whole run (s) for error-per-unit-step control ([`Integrator::set_span`]); `None` = error per
-    /// step (ODEX).
-    span: Option<f64>,
-
-    // Step control carried between steps and calls.
-    /// Proposed |H| for the next step; 0 = unknown (initial guess needed).
-    h: f64,
-    /// Target column count `k` (ODEX `K`), `2 ..= km − 1`.
-    k: usize,
-    /// The previous attempt was rejected.
-    reject: bool,
-    /// At least one step has been attempted (ODEX `nstep > 0`).
-    started: bool,
-
-    // Step-number sequence and per-column data, 1-based (index 0 unused).
-    nj: Vec<f64>,
-    a: Vec<f64>,
-    hh: Vec<f64>,
-    w: Vec<f64>,
-
-    // Work arrays, length `n` (tab: km rows of n).
-    n: usize,
-    dz: Vec<f64>,
-    yh1: Vec<f64>,
-    yh2: Vec<f64>,
-    /// The trial state `y + yh2` handed to the right-hand side.
-    ytrial: Vec<f64>,
-    /// Compensated summation of the accepted increments ([`Compensation`]): carried into the next call only if
-    /// the caller passes back the state the last `advance` returned.
-    comp: Compensation,
-    dy: Vec<f64>,
-    scal: Vec<f64>,
-    tab: Vec<f64>,
-
-    stats: Stats,
-    rejections: Rejections,
-}
-
-/// Why a step has to be retried with a halved step.
-#[derive(Clone, Copy)]
-enum Shrink {
-    Stability,
-    Divergence,
-    NonFinite,
-}
-
-/// Result of one column of the extrapolation tableau.
-enum Column {
-    /// Column computed; the error estimate (0 for the first column).
-    Done(f64),
-    /// Step must be retried with a halved step.
-    Shrink(Shrink),
-}
-
-/// Result of one step attempt.
-enum Attempt {
-    Accepted,
-    Rejected,
-    Shrink(Shrink),
-}
-
-fn all_finite(v: &[f64]) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
+pub type BulirschStoer = Adaptive<Extrapolation<Midpoint>>;
 
 impl BulirschStoer {
     /// A new integrator with per-component `tolerances` and an optional initial step `step`
-    /// (|step| is used for the very first step only, and again after [`BulirschStoer::reset`];
+    /// (|step| is used for the very first step only, and again after [`Adaptive::reset`];
     /// `None` = automatic guess from `f(t0, y0)` and one more evaluation, Hairer's `hinit`).
     ///
     /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or
@@ -224,132 +157,189 @@ impl BulirschStoer {
     /// systems later passed to [`Integrator::advance`].
     pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
         validate_tolerances(&tolerances)?;
-        if let Some(h) = step
-            && !(h.is_finite() && h != 0.0)
-        {
+        Adaptive::with_method(
+            Extrapolation::new(tolerances, DEFAULT_MAX_COLUMNS, Midpoint::default()),
+            step,
+        )
+    }
+}
+
+impl<R: BaseRule> Adaptive<Extrapolation<R>> {
+    /// Sets the maximum number of extrapolation columns `km` (`3 ≤ km ≤ 20`; ODEX's default 9, SEULEX's 12).
+    /// The highest order reached is `2 km` with Gragg's rule, `km` with the Euler rule.
+    pub fn set_max_columns(&mut self, km: usize) -> Result<(), IntegrateError> {
+        if !(3..=20).contains(&km) {
             return Err(IntegrateError::Config(format!(
-                "bulirsch-stoer initial step must be non-zero and finite, got {h}"
+                "{} max columns must be in 3..=20, got {km}",
+                R::METHOD
             )));
         }
-        let mut bs = BulirschStoer {
-            tol: tolerances,
-            initial_step: step.map(f64::abs),
-            km: DEFAULT_MAX_COLUMNS,
-            max_steps: DEFAULT_MAX_STEPS,
-            deadline: None,
-            h_min: 0.0,
-            h_max: f64::INFINITY,
-            max_nonfinite_retries: DEFAULT_MAX_NONFINITE_RETRIES,
-            span: None,
-            h: 0.0,
+        self.method.set_max_columns(km);
+        Ok(())
+    }
+
+    /// The current target number of extrapolation columns `k` (order `2k` with Gragg's rule, `k` with the Euler
+    /// rule).
+    pub fn columns(&self) -> usize {
+        self.method.k
+    }
+}
+
+/// The constants and choices of an extrapolation code's step and order control: ODEX's for Gragg's rule (this
+/// file), SEULEX's for the linearly implicit Euler rule (`linearly_implicit.rs`).
+#[derive(Debug, Clone, Copy)]
+pub struct Strategy {
+    /// Gragg's rule (ODEX): `n_j = 2j` substeps, an error expansion in `h²`, the work `A_1 = n_1 + 1` (counting
+    /// `f(t, y)`), ODEX's order choice after a step accepted in column `k + 1`, and an infinite error of a non-finite
+    /// tableau counted as non-finite values; otherwise the Euler rule (SEULEX): `n_j = j`, an expansion in `h`,
+    /// `A_1 = n_1`, the order chosen as after column `k`, an infinite error always a divergence.
+    pub gragg: bool,
+    /// Lower bound on the step-size factor (`fac1`).
+    pub fac1: f64,
+    /// Upper bound on the step-size factor (`fac2`).
+    pub fac2: f64,
+    /// Order decrease threshold on the work ratio (`fac3`).
+    pub fac3: f64,
+    /// Order increase threshold on the work ratio (`fac4`).
+    pub fac4: f64,
+    /// Safety factor on the error (`safe1`).
+    pub safe1: f64,
+    /// Safety factor on the step (`safe2`).
+    pub safe2: f64,
+}
+
+/// The base rule an [`Extrapolation`] extrapolates — Gragg's modified midpoint rule ([`Midpoint`]) or the linearly
+/// implicit Euler method (`linearly_implicit.rs`) — with the checkpoint layout of its method.
+pub trait BaseRule {
+    /// What the rule takes from the system at the start of each step ([`StepMethod::Frozen`]).
+    type Frozen<'s>;
+    /// The method's name.
+    const METHOD: Method;
+    /// The step and order control of the code the rule comes from.
+    const STRATEGY: Strategy;
+    /// Sizes the rule's work arrays for dimension `n`.
+    fn resize(&mut self, n: usize);
+    /// Right-hand side evaluations so far.
+    fn evaluations(&self) -> u64;
+    /// [`StepMethod::start`]: the derivative at `(t, y)` and what the rule keeps for the step.
+    fn start<'s>(&mut self, system: &'s dyn OdeSystem, t: f64, y: &[f64]) -> Option<Self::Frozen<'s>>;
+    /// [`StepMethod::initial_step`], with `scal` the error scale at `y` and `k` the target column count.
+    fn initial_step(&mut self, system: &dyn OdeSystem, y: &[f64], scal: &[f64], k: usize, first: &FirstStep) -> f64;
+    /// Writes `T_{j,1}` of `column`, the rule's result with `n_j` substeps, as an increment from its `y` into `row`.
+    fn column(
+        &mut self,
+        system: &dyn OdeSystem,
+        frozen: &mut Self::Frozen<'_>,
+        column: &Column<'_>,
+        row: &mut [f64],
+    ) -> Result<(), Cause>;
+    /// Sets the evaluation count (a restored state's).
+    fn set_evaluations(&mut self, n: u64);
+    /// The method's checkpoint state from the column control's part.
+    fn save(&self, km: usize, columns: ColumnControlState, carried: Carried) -> IntegratorState;
+    /// The dimension, the number of columns, the column control's part and the compensation of `state`, with the
+    /// loop's other settings it holds set into `carried`; [`IntegrateError::Config`] for another method's state.
+    fn unpack<'a>(state: &'a IntegratorState, carried: &mut Carried) -> Unpacked<'a>;
+    /// Restores the rule's own part of `state` (after every check passed).
+    fn restore_own(&mut self, _state: &IntegratorState) {}
+}
+
+/// Column `j` of the step `trial` from `y`, as [`BaseRule::column`] is asked for it.
+pub struct Column<'a> {
+    /// The state at the step's start.
+    pub y: &'a [f64],
+    /// The step.
+    pub trial: &'a Trial,
+    /// The column (1-based).
+    pub j: usize,
+    /// The error scale `atol_i + rtol_i |y_i|` (for the stability checks).
+    pub scal: &'a [f64],
+}
+
+/// What [`BaseRule::unpack`] reads of a state: its dimension, number of columns, column control and compensation.
+pub type Unpacked<'a> = Result<(usize, usize, &'a ColumnControlState, &'a [f64]), IntegrateError>;
+
+/// An extrapolation step: the base rule `R` in columns `j = 1, 2, …` extrapolated by Aitken–Neville, with the
+/// column (order) and step control of ODEX or SEULEX ([`BaseRule::STRATEGY`]).
+#[derive(Debug, Clone)]
+pub struct Extrapolation<R> {
+    tol: Tolerances,
+    /// Maximum number of columns `km`.
+    km: usize,
+    /// Target column count `k` (ODEX `K`), `2 ..= km − 1`.
+    k: usize,
+    /// The previous attempt was rejected.
+    reject: bool,
+    /// At least one step has been attempted (ODEX `nstep > 0`).
+    started: bool,
+    /// Span of the whole run (s) for error-per-unit-step control; `None` = error per step.
+    span: Option<f64>,
+    // Step-number sequence and per-column data, 1-based (index 0 unused).
+    nj: Vec<f64>,
+    a: Vec<f64>,
+    hh: Vec<f64>,
+    w: Vec<f64>,
+    n: usize,
+    /// `atol_i + rtol_i |y_i|` at the step's start.
+    scal: Vec<f64>,
+    /// The tableau, `km` rows of `n` (increments from the step's start).
+    tab: Vec<f64>,
+    rule: R,
+}
+
+/// The scaled RMS norm of `v` against `scal`.
+pub(super) fn rms(v: &[f64], scal: &[f64]) -> f64 {
+    let sum: f64 = v.iter().zip(scal).map(|(x, s)| (x / s).powi(2)).sum();
+    (sum / v.len() as f64).sqrt()
+}
+
+impl<R: BaseRule> Extrapolation<R> {
+    /// The step of `rule` with `km` columns (`3 ≤ km ≤ 20`) for per-component `tol` (validated).
+    pub(super) fn new(tol: Tolerances, km: usize, rule: R) -> Self {
+        let mut e = Extrapolation {
+            tol,
+            km,
             k: 2,
             reject: false,
             started: false,
+            span: None,
             nj: Vec::new(),
             a: Vec::new(),
             hh: Vec::new(),
             w: Vec::new(),
             n: 0,
-            dz: Vec::new(),
-            yh1: Vec::new(),
-            yh2: Vec::new(),
-            ytrial: Vec::new(),
-            comp: Compensation::default(),
-            dy: Vec::new(),
             scal: Vec::new(),
             tab: Vec::new(),
-            stats: Stats {
-                smallest_step: f64::INFINITY,
-                ..Stats::default()
-            },
-            rejections: Rejections::default(),
+            rule,
         };
-        bs.setup_sequence();
-        bs.k = bs.initial_columns();
-        Ok(bs)
+        e.setup_sequence();
+        e.k = e.initial_columns();
+        e
     }
 
-    /// Sets the maximum number of extrapolation columns `km` (ODEX default 9; `3 ≤ km ≤ 20`).
-    /// The highest order reached is `2 km`.
-    pub fn set_max_columns(&mut self, km: usize) -> Result<(), IntegrateError> {
-        if !(3..=20).contains(&km) {
-            return Err(IntegrateError::Config(format!(
-                "bulirsch-stoer max columns must be in 3..=20, got {km}"
-            )));
-        }
+    /// The rule itself.
+    pub(super) fn rule(&self) -> &R {
+        &self.rule
+    }
+
+    fn set_max_columns(&mut self, km: usize) {
         self.km = km;
         self.setup_sequence();
         self.k = self.k.clamp(2, km - 1);
         if self.n > 0 {
             self.tab = vec![0.0; km * self.n];
         }
-        Ok(())
     }
 
-    /// Sets the maximum number of step attempts (accepted + rejected) in one call to
-    /// [`Integrator::advance`] (default 10⁸); more gives [`IntegrateError::TooManySteps`].
-    pub fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps;
-    }
-
-    /// Sets the smallest allowed step size (default 0): a proposed `|h| < max(h_min, 10 ε |t|)`
-    /// gives [`IntegrateError::StepUnderflow`].
-    pub fn set_h_min(&mut self, h_min: f64) {
-        self.h_min = h_min.abs();
-    }
-
-    /// Sets the largest allowed step size (default ∞).
-    pub fn set_h_max(&mut self, h_max: f64) {
-        self.h_max = h_max.abs();
-        if self.h > self.h_max {
-            self.h = self.h_max;
-        }
-    }
-
-    /// Sets how many consecutive rejections caused by NaN/∞ trial values are retried (each with a
-    /// halved step) before [`IntegrateError::NonFinite`] is returned (default 10).
-    pub fn set_max_nonfinite_retries(&mut self, retries: u32) {
-        self.max_nonfinite_retries = retries;
-    }
-
-    /// Forgets the step-size and order history: the next step starts like the first one (initial
-    /// step guess, initial column count). Use after a discontinuity in the state or equations.
-    pub fn reset(&mut self) {
-        self.comp = Compensation::default();
-        self.h = 0.0;
-        self.k = self.initial_columns();
-        self.reject = false;
-        self.started = false;
-    }
-
-    /// The step size the next step will try (`None` before the first step or after [`reset`]).
-    ///
-    /// [`reset`]: BulirschStoer::reset
-    pub fn proposed_step(&self) -> Option<f64> {
-        (self.h > 0.0).then_some(self.h)
-    }
-
-    /// The current target number of extrapolation columns `k` (order `2k`).
-    pub fn columns(&self) -> usize {
-        self.k
-    }
-
-    /// Rejected steps by cause (cumulative).
-    pub fn rejections(&self) -> Rejections {
-        self.rejections
-    }
-
-    /// The tolerances in use.
-    pub fn tolerances(&self) -> &Tolerances {
-        &self.tol
-    }
-
-    /// Step-number sequence `n_j = 2j` and cumulative work `A_j = 1 + n_1 + … + n_j`.
+    /// Step-number sequence `n_j` and cumulative work `A_j = A_1 + n_2 + … + n_j`.
     fn setup_sequence(&mut self) {
         let km = self.km;
-        self.nj = (0..=km).map(|j| 2.0 * j as f64).collect();
+        let gragg = R::STRATEGY.gragg;
+        self.nj = (0..=km)
+            .map(|j| if gragg { 2.0 * j as f64 } else { j as f64 })
+            .collect();
         self.a = vec![0.0; km + 1];
-        self.a[1] = self.nj[1] + 1.0;
+        self.a[1] = self.nj[1] + if gragg { 1.0 } else { 0.0 };
         for j in 2..=km {
             self.a[j] = self.a[j - 1] + self.nj[j];
         }
@@ -357,26 +347,12 @@ impl BulirschStoer {
         self.w = vec![0.0; km + 1];
     }
 
-    /// ODEX's initial column count from the tightest relative tolerance.
+    /// The initial column count from the tightest relative tolerance (ODEX, SEULEX).
     fn initial_columns(&self) -> usize {
         let rtol = self.tol.rtol.iter().copied().fold(f64::INFINITY, f64::min);
         let guess = (-(rtol + f64::EPSILON).log10() * 0.6 + 1.5).floor();
         let guess = if guess.is_finite() { guess.max(0.0) as usize } else { 2 };
         guess.min(self.km - 1).max(2)
-    }
-
-    fn ensure_workspace(&mut self, n: usize) {
-        if self.n == n && self.dz.len() == n {
-            return;
-        }
-        self.n = n;
-        self.dz = vec![0.0; n];
-        self.yh1 = vec![0.0; n];
-        self.yh2 = vec![0.0; n];
-        self.ytrial = vec![0.0; n];
-        self.dy = vec![0.0; n];
-        self.scal = vec![0.0; n];
-        self.tab = vec![0.0; self.km * n];
     }
 
     /// `scal_i = atol_i + rtol_i |y_i|` (floored at the smallest positive normal number).
@@ -386,69 +362,431 @@ impl BulirschStoer {
         }
     }
 
-    /// `dy = f(t, ytrial)`, the derivative at the trial state `y + d_m` of the midpoint rule.
-    fn eval_trial(&mut self, system: &dyn OdeSystem, t: f64) {
-        let z = std::mem::take(&mut self.ytrial);
-        self.eval(system, t, &z, Out::Dy);
-        self.ytrial = z;
+    /// `((n_{k+1} n_k / 4)²` (Gragg) or `4 n_{k+1} n_k` (Euler): above it column `k − 1`'s error leaves no hope of
+    /// convergence in column `k + 1` (the convergence monitor).
+    fn monitor_limit(&self, k: usize) -> f64 {
+        if R::STRATEGY.gragg {
+            let lim = self.nj[k + 1] * self.nj[k] / 4.0;
+            lim * lim
+        } else {
+            self.nj[k + 1] * self.nj[k] * 4.0
+        }
     }
 
-    fn eval(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], out: Out) {
-        self.stats.rhs_evaluations += 1;
-        let dst = match out {
-            Out::Dz => &mut self.dz,
-            Out::Dy => &mut self.dy,
+    /// `(n_{k+1} / 2)²` (Gragg) or `2 n_{k+1}` (Euler): above it column `k`'s error leaves no hope of convergence in
+    /// column `k + 1`.
+    fn hope_limit(&self, k: usize) -> f64 {
+        if R::STRATEGY.gragg {
+            let lim = self.nj[k + 1] / 2.0;
+            lim * lim
+        } else {
+            self.nj[k + 1] * 2.0
+        }
+    }
+
+    /// Computes column `j` (1-based) of the tableau for the step `trial` from `y`, extrapolates, and for `j ≥ 2`
+    /// estimates the error and the optimal step `hh[j]` and work `w[j]`. `err_prev` holds the (floored) error of
+    /// the previous column.
+    fn column(
+        &mut self,
+        system: &dyn OdeSystem,
+        frozen: &mut R::Frozen<'_>,
+        y: &[f64],
+        trial: &Trial,
+        j: usize,
+        err_prev: &mut f64,
+    ) -> Result<f64, Cause> {
+        let n = self.n;
+        let column = Column {
+            y,
+            trial,
+            j,
+            scal: &self.scal,
         };
-        system.rhs(t, y, dst);
+        self.rule
+            .column(system, frozen, &column, &mut self.tab[(j - 1) * n..j * n])?;
+        if j == 1 {
+            return Ok(0.0);
+        }
+        let gragg = R::STRATEGY.gragg;
+        // Aitken–Neville: row r (0-based) becomes T_{j, j−r}.
+        for l in (2..=j).rev() {
+            let ratio = self.nj[j] / self.nj[l - 1];
+            let inv = if gragg {
+                1.0 / (ratio * ratio - 1.0)
+            } else {
+                1.0 / (ratio - 1.0)
+            };
+            let (lo, hi) = self.tab.split_at_mut((l - 1) * n);
+            for (d, &s) in lo[(l - 2) * n..].iter_mut().zip(&hi[..n]) {
+                *d = s + (s - *d) * inv;
+            }
+        }
+        // Error estimate ‖T_{j,j} − T_{j,j−1}‖.
+        let mut sum = 0.0;
+        {
+            let (r0, r1) = self.tab.split_at(n);
+            for i in 0..n {
+                let sc =
+                    (self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max((y[i] + r0[i]).abs())).max(f64::MIN_POSITIVE);
+                sum += ((r0[i] - r1[i]) / sc).powi(2);
+            }
+        }
+        let h = trial.h;
+        let mut err = (sum / n as f64).sqrt();
+        if let Some(span) = self.span {
+            // Error per unit step: this step may spend the share RUN_BUDGET·|h|/span of the tolerance. Below
+            // 10 ε / rtol the share would ask for less than round-off can deliver.
+            let rtol = self.tol.rtol.iter().copied().fold(f64::INFINITY, f64::min);
+            let floor = (10.0 * f64::EPSILON / rtol).min(1.0);
+            err /= (RUN_BUDGET * h.abs() / span).clamp(floor, 1.0);
+        }
+        if err.is_nan() || (gragg && err.is_infinite() && !all_finite(&self.tab[..n])) {
+            return Err(Cause::NonFinite);
+        }
+        if err * f64::EPSILON >= 1.0 || (j > 2 && err >= *err_prev) {
+            return Err(Cause::Divergence);
+        }
+        // ODEX: ERROLD = MAX(4*ERR, 1). A column only counts as diverging when its error is both above 1
+        // (not converged) and more than four times the previous one; a smaller floor would reject steps
+        // whose columns have converged to round-off noise (err ≪ 1 but not monotone), halving H forever.
+        *err_prev = (4.0 * err).max(1.0);
+        // The error of T_{j,j−1} is O(H^{p+1}), p = 2j − 2 (Gragg) or j − 1 (Euler); per unit step it is O(H^p).
+        let order = if gragg { 2 * j - 1 } else { j };
+        let expo = if self.span.is_some() {
+            1.0 / (order - 1) as f64
+        } else {
+            1.0 / order as f64
+        };
+        let s = R::STRATEGY;
+        let facmin = s.fac1.powf(expo);
+        let fac = (s.fac2 / facmin).min(facmin.max((err / s.safe1).powf(expo) / s.safe2));
+        self.hh[j] = (h.abs() / fac).min(trial.h_max);
+        self.w[j] = self.a[j] / self.hh[j];
+        Ok(err)
     }
 
-    /// Initial step guess in the style of Hairer's `hinit` (uses `f(t, y)` already in `dz` and one
-    /// more evaluation). Returns |h|.
-    fn initial_step_guess(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], dir: f64, span: f64) -> f64 {
-        let n = self.n as f64;
+    /// The columns of one attempt (ODEX's and SEULEX's strategy with the convergence monitor); `special` = first
+    /// or last step, where the column count grows until convergence. On acceptance the increment `T_{k,k}` is in
+    /// `tab[0..n]`.
+    fn columns(
+        &mut self,
+        system: &dyn OdeSystem,
+        frozen: &mut R::Frozen<'_>,
+        y: &[f64],
+        trial: &Trial,
+        special: bool,
+    ) -> Outcome {
+        let (k, h_abs) = (self.k, trial.h.abs());
+        let mut err_prev = f64::INFINITY;
+        let mut err = 0.0;
+        macro_rules! column {
+            ($j:expr) => {
+                match self.column(system, frozen, y, trial, $j, &mut err_prev) {
+                    Ok(e) => err = e,
+                    Err(why) => return Outcome::Halve(why),
+                }
+            };
+        }
+        if special {
+            for j in 1..=k {
+                column!(j);
+                if j > 1 && err <= 1.0 {
+                    return self.accept(j, h_abs, trial.h_max);
+                }
+            }
+        } else {
+            for j in 1..k {
+                column!(j);
+            }
+            // Convergence monitor.
+            if !(k == 2 || self.reject) {
+                if err <= 1.0 {
+                    return self.accept(k - 1, h_abs, trial.h_max);
+                }
+                if err > self.monitor_limit(k) {
+                    return self.reject_step(k - 1);
+                }
+            }
+            column!(k);
+            if err <= 1.0 {
+                return self.accept(k, h_abs, trial.h_max);
+            }
+        }
+        // Hope for convergence in column k + 1.
+        if err > self.hope_limit(k) {
+            return self.reject_step(k);
+        }
+        column!(k + 1);
+        if err > 1.0 {
+            self.reject_step(k + 1)
+        } else {
+            self.accept(k + 1, h_abs, trial.h_max)
+        }
+    }
+
+    /// Step accepted after `kc` columns: choose the next column count and step (ODEX, SEULEX).
+    fn accept(&mut self, kc: usize, h_abs: f64, h_max: f64) -> Outcome {
+        let s = R::STRATEGY;
+        let (km, k, w) = (self.km, self.k, &self.w);
+        let kopt = if kc == 2 {
+            if self.reject { 2 } else { 3.min(km - 1) }
+        } else if kc <= k || !s.gragg {
+            let mut kopt = kc;
+            if w[kc - 1] < w[kc] * s.fac3 {
+                kopt = kc - 1;
+            }
+            if w[kc] < w[kc - 1] * s.fac4 {
+                kopt = (kc + 1).min(km - 1);
+            }
+            kopt
+        } else {
+            let mut kopt = kc - 1;
+            if kc > 3 && w[kc - 2] < w[kc - 1] * s.fac3 {
+                kopt = kc - 2;
+            }
+            if w[kc] < w[kopt] * s.fac4 {
+                kopt = kc.min(km - 1);
+            }
+            kopt
+        };
+        // Accepted in column km (one past the target k = km − 1): the target stays below km.
+        let kopt = kopt.min(km - 1);
+        let h_next = if self.reject {
+            self.k = kopt.min(kc);
+            self.reject = false;
+            h_abs.min(self.hh[self.k])
+        } else {
+            let h_new = if kopt <= kc {
+                self.hh[kopt]
+            } else if s.gragg && kc < k && w[kc] < w[kc - 1] * s.fac4 {
+                self.hh[kc] * self.a[kopt + 1] / self.a[kc]
+            } else {
+                self.hh[kc] * self.a[kopt] / self.a[kc]
+            };
+            self.k = kopt;
+            h_new.min(h_max)
+        };
+        Outcome::Accepted { h_next }
+    }
+
+    /// Step rejected by the error test after `kc` columns: reduce `k` and the step (ODEX, SEULEX).
+    fn reject_step(&mut self, kc: usize) -> Outcome {
+        let mut k = self.k.min(kc).min(self.km - 1);
+        if k > 2 && self.w[k - 1] < self.w[k] * R::STRATEGY.fac3 {
+            k -= 1;
+        }
+        self.k = k;
+        self.reject = true;
+        Outcome::Rejected { h_next: self.hh[k] }
+    }
+}
+
+impl<R: BaseRule> StepMethod for Extrapolation<R> {
+    type Frozen<'s> = R::Frozen<'s>;
+    const METHOD: Method = R::METHOD;
+
+    fn tolerances(&self) -> &Tolerances {
+        &self.tol
+    }
+
+    fn prepare(&mut self, n: usize) {
+        if self.n == n && self.scal.len() == n {
+            return;
+        }
+        self.n = n;
+        self.scal = vec![0.0; n];
+        self.tab = vec![0.0; self.km * n];
+        self.rule.resize(n);
+    }
+
+    fn start<'s>(&mut self, system: &'s dyn OdeSystem, t: f64, y: &[f64]) -> Option<Self::Frozen<'s>> {
+        self.rule.start(system, t, y)
+    }
+
+    fn initial_step(&mut self, system: &dyn OdeSystem, y: &[f64], first: &FirstStep) -> f64 {
         self.fill_scal(y);
-        let (mut d0, mut d1) = (0.0, 0.0);
-        for ((&yi, &fi), &sc) in y.iter().zip(&self.dz).zip(&self.scal) {
-            d0 += (yi / sc).powi(2);
-            d1 += (fi / sc).powi(2);
+        self.rule.initial_step(system, y, &self.scal, self.k, first)
+    }
+
+    fn attempt(&mut self, system: &dyn OdeSystem, frozen: &mut Self::Frozen<'_>, y: &[f64], trial: &Trial) -> Outcome {
+        let special = !self.started || trial.last;
+        self.started = true;
+        self.fill_scal(y);
+        let outcome = match self.columns(system, frozen, y, trial, special) {
+            // Never hand a non-finite state to the caller (a non-finite value makes the error NaN, so this takes
+            // an error scale without a relative part at least).
+            Outcome::Accepted { .. } if !all_finite(&self.tab[..self.n]) => Outcome::Halve(Cause::NonFinite),
+            outcome => outcome,
+        };
+        if let Outcome::Halve(_) = outcome {
+            self.reject = true;
         }
-        let (d0, d1) = ((d0 / n).sqrt(), (d1 / n).sqrt());
-        let mut h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
-        h0 = h0.min(span).min(self.h_max);
+        outcome
+    }
+
+    fn commit(&mut self, y: &mut [f64], comp: &mut Compensation) {
+        comp.add(y, &self.tab[..self.n]);
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.rule.evaluations()
+    }
+
+    fn order(&self) -> usize {
+        self.k
+    }
+
+    fn set_order(&mut self, order: usize) {
+        self.k = order;
+    }
+
+    fn set_evaluations(&mut self, n: u64) {
+        self.rule.set_evaluations(n);
+    }
+
+    fn set_span(&mut self, span: Option<f64>) {
+        self.span = span;
+    }
+
+    fn reset(&mut self) {
+        self.k = self.initial_columns();
+        self.reject = false;
+        self.started = false;
+    }
+
+    fn save(&self, carried: Carried) -> IntegratorState {
+        let columns = ColumnControlState {
+            span: self.span,
+            h: carried.h,
+            k: self.k,
+            reject: self.reject,
+            started: self.started,
+            hh: self.hh.clone(),
+            w: self.w.clone(),
+            stats: carried.stats,
+            rejections: carried.rejections,
+        };
+        self.rule.save(self.km, columns, carried)
+    }
+
+    fn restore(&mut self, state: &IntegratorState, carried: &mut Carried) -> Result<(), IntegrateError> {
+        let (dim, km, s, compensation) = R::unpack(state, carried)?;
+        carried.dim = dim;
+        carried.compensation.clear();
+        carried.compensation.extend_from_slice(compensation);
+        (carried.h, carried.stats, carried.rejections) = (s.h, s.stats, s.rejections);
+        carried.check(R::METHOD, self.tol.rtol.len())?;
+        let bad = |what: String| Err(bad_state(R::METHOD, what));
+        if !(3..=20).contains(&km) {
+            return bad(format!("max columns {km} not in 3..=20"));
+        }
+        if !(2..km).contains(&s.k) {
+            return bad(format!("column count {} not in 2..{km}", s.k));
+        }
+        if s.hh.len() != km + 1 || s.w.len() != km + 1 {
+            return bad(format!("per-column arrays must have {} entries", km + 1));
+        }
+        if s.span.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
+            return bad("bad span".into());
+        }
+        if km != self.km {
+            self.set_max_columns(km);
+        }
+        self.span = s.span;
+        self.k = s.k;
+        self.reject = s.reject;
+        self.started = s.started;
+        self.hh.copy_from_slice(&s.hh);
+        self.w.copy_from_slice(&s.w);
+        self.rule.restore_own(state);
+        Ok(())
+    }
+}
+
+/// Gragg's modified midpoint rule with smoothing (the base rule of ODEX), and its work arrays.
+#[derive(Debug, Clone, Default)]
+pub struct Midpoint {
+    /// `f(t, y)` at the step's start.
+    dz: Vec<f64>,
+    /// The increments `d_{m−1}`, `d_m` from the step's start.
+    yh1: Vec<f64>,
+    yh2: Vec<f64>,
+    /// The trial state `y + d_m` handed to the right-hand side.
+    ytrial: Vec<f64>,
+    /// The derivative at the trial state.
+    dy: Vec<f64>,
+    evals: u64,
+}
+
+impl Midpoint {
+    /// `dy = f(t, ytrial)`, the derivative at the trial state `y + d_m`.
+    fn eval_trial(&mut self, system: &dyn OdeSystem, t: f64) {
+        self.evals += 1;
+        system.rhs(t, &self.ytrial, &mut self.dy);
+    }
+}
+
+impl BaseRule for Midpoint {
+    type Frozen<'s> = ();
+    const METHOD: Method = Method::BulirschStoer;
+    const STRATEGY: Strategy = ODEX;
+
+    fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.dz,
+            &mut self.yh1,
+            &mut self.yh2,
+            &mut self.ytrial,
+            &mut self.dy,
+        ] {
+            *v = vec![0.0; n];
+        }
+    }
+
+    fn start(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64]) -> Option<()> {
+        system.begin_step(t, y);
+        self.evals += 1;
+        system.rhs(t, y, &mut self.dz);
+        all_finite(&self.dz).then_some(())
+    }
+
+    /// Hairer's `hinit` with the order `2k`: `f(t, y)` is in `dz`, one more evaluation.
+    fn initial_step(&mut self, system: &dyn OdeSystem, y: &[f64], scal: &[f64], k: usize, first: &FirstStep) -> f64 {
+        let &FirstStep { t, dir, span, h_max } = first;
+        let (d0, d1) = (rms(y, scal), rms(&self.dz, scal));
+        let h0 = hinit_h0(d0, d1).min(span).min(h_max);
         if h0.is_nan() || h0 <= 0.0 {
-            return 1e-6f64.min(self.h_max);
+            return 1e-6f64.min(h_max);
         }
-        // Explicit Euler trial step into yh1, derivative into dy.
-        for ((z, &yi), &fi) in self.yh1.iter_mut().zip(y).zip(&self.dz) {
+        // Explicit Euler trial step into ytrial, derivative into dy.
+        for ((z, &yi), &fi) in self.ytrial.iter_mut().zip(y).zip(&self.dz) {
             *z = yi + dir * h0 * fi;
         }
-        let yh1 = std::mem::take(&mut self.yh1);
-        self.eval(system, t + dir * h0, &yh1, Out::Dy);
-        self.yh1 = yh1;
+        self.eval_trial(system, t + dir * h0);
         let mut d2 = 0.0;
-        for ((&f1, &f0), &sc) in self.dy.iter().zip(&self.dz).zip(&self.scal) {
+        for ((&f1, &f0), &sc) in self.dy.iter().zip(&self.dz).zip(scal) {
             d2 += ((f1 - f0) / sc).powi(2);
         }
-        let d2 = (d2 / n).sqrt() / h0;
-        if !d2.is_finite() {
-            return h0;
-        }
-        let order = 2.0 * self.k as f64;
-        let h1 = if d1.max(d2) <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / d1.max(d2)).powf(1.0 / (order + 1.0))
-        };
-        (100.0 * h0).min(h1).min(span).min(self.h_max)
+        let d2 = (d2 / y.len() as f64).sqrt() / h0;
+        let order = 2.0 * k as f64;
+        hinit_h1(h0, d1, d2, 1.0 / (order + 1.0), span, h_max)
     }
 
-    /// Computes column `j` (1-based) of the tableau for the step `(t, y) → t + h`, extrapolates,
-    /// and for `j ≥ 2` estimates the error and the optimal step `hh[j]` and work `w[j]`.
-    /// `err_prev` holds the (floored) error of the previous column.
-    fn column(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], h: f64, j: usize, err_prev: &mut f64) -> Column {
-        let n = self.n;
-        let nsub = self.nj[j] as usize;
-        let hj = h / self.nj[j];
+    /// Gragg's rule with `n_j = 2j` substeps of `h_j = H/n_j`, on the increments `d_m = z_m − y`, with ODEX's
+    /// stability check in the first substep of columns 1 and 2, and the smoothing step.
+    fn column(
+        &mut self,
+        system: &dyn OdeSystem,
+        _frozen: &mut (),
+        column: &Column<'_>,
+        row: &mut [f64],
+    ) -> Result<(), Cause> {
+        let &Column { y, trial, j, scal } = column;
+        let (t, h) = (trial.t, trial.h);
+        let nj = 2.0 * j as f64;
+        let nsub = 2 * j;
+        let hj = h / nj;
         let two_hj = 2.0 * hj;
         // Increments from the step's start: d_0 = 0 (yh1), d_1 = hj f(t, y) (yh2); the trial state z_1 = y + d_1.
         for (((a, b), z), (&yi, &fi)) in self
@@ -466,15 +804,14 @@ impl BulirschStoer {
             self.eval_trial(system, t + hj * m as f64);
             if m == 1 && j <= STABILITY_COLUMNS {
                 let (mut del1, mut del2) = (0.0, 0.0);
-                for i in 0..n {
-                    let sc = self.scal[i];
-                    del1 += (self.dz[i] / sc).powi(2);
-                    del2 += ((self.dy[i] - self.dz[i]) / sc).powi(2);
+                for ((&f0, &f1), &sc) in self.dz.iter().zip(&self.dy).zip(scal) {
+                    del1 += (f0 / sc).powi(2);
+                    del2 += ((f1 - f0) / sc).powi(2);
                 }
                 // ODEX floors ‖f‖² at ε; we skip the check when f(t, y) vanishes exactly
                 // (nothing to compare with), otherwise it would halve H down to ~1e-20.
                 if del1 > 0.0 && del2 > STABILITY_RATIO * del1.max(f64::EPSILON) {
-                    return Column::Shrink(Shrink::Stability);
+                    return Err(Cause::Stability);
                 }
             }
             // d_{m+1} = d_{m-1} + 2 hj f(z_m), stored over d_{m-1} (then swap roles), and z_{m+1} = y + d_{m+1}.
@@ -491,463 +828,36 @@ impl BulirschStoer {
         }
         // Smoothing step.
         self.eval_trial(system, t + h);
-        {
-            let row = &mut self.tab[(j - 1) * n..j * n];
-            for (((r, &a), &b), &d) in row
-                .iter_mut()
-                .zip(self.yh1.iter())
-                .zip(self.yh2.iter())
-                .zip(self.dy.iter())
-            {
-                *r = 0.5 * (a + b + hj * d);
-            }
+        for (((r, &a), &b), &d) in row.iter_mut().zip(&self.yh1).zip(&self.yh2).zip(&self.dy) {
+            *r = 0.5 * (a + b + hj * d);
         }
-        if j == 1 {
-            return Column::Done(0.0);
-        }
-        // Aitken–Neville: row r (0-based) becomes T_{j, j−r}.
-        for l in (2..=j).rev() {
-            let ratio = self.nj[j] / self.nj[l - 1];
-            let inv = 1.0 / (ratio * ratio - 1.0);
-            let (lo, hi) = self.tab.split_at_mut((l - 1) * n);
-            let dst = &mut lo[(l - 2) * n..];
-            let src = &hi[..n];
-            for (d, &s) in dst.iter_mut().zip(src.iter()) {
-                *d = s + (s - *d) * inv;
-            }
-        }
-        // Error estimate ‖T_{j,j} − T_{j,j−1}‖.
-        let mut sum = 0.0;
-        {
-            let (r0, r1) = self.tab.split_at(n);
-            for i in 0..n {
-                let sc =
-                    (self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max((y[i] + r0[i]).abs())).max(f64::MIN_POSITIVE);
-                sum += ((r0[i] - r1[i]) / sc).powi(2);
-            }
-        }
-        let mut err = (sum / n as f64).sqrt();
-        if let Some(span) = self.span {
-            // Error per unit step: this step may spend the share RUN_BUDGET·|h|/span of the tolerance. Below
-            // 10 ε / rtol the share would ask for less than round-off can deliver.
-            let rtol = self.tol.rtol.iter().copied().fold(f64::INFINITY, f64::min);
-            let floor = (10.0 * f64::EPSILON / rtol).min(1.0);
-            err /= (RUN_BUDGET * h.abs() / span).clamp(floor, 1.0);
-        }
-        if err.is_nan() || (err.is_infinite() && !all_finite(&self.tab[..n])) {
-            return Column::Shrink(Shrink::NonFinite);
-        }
-        if err * f64::EPSILON >= 1.0 || (j > 2 && err >= *err_prev) {
-            return Column::Shrink(Shrink::Divergence);
-        }
-        // ODEX: ERROLD = MAX(4*ERR, 1). A column only counts as diverging when its error is both above 1
-        // (not converged) and more than four times the previous one; a smaller floor would reject steps
-        // whose columns have converged to round-off noise (err ≪ 1 but not monotone), halving H forever.
-        *err_prev = (4.0 * err).max(1.0);
-        // The error of T_{j,j−1} is O(H^{2j−1}); per unit step it is O(H^{2j−2}).
-        let expo = if self.span.is_some() {
-            1.0 / (2 * j - 2) as f64
-        } else {
-            1.0 / (2 * j - 1) as f64
-        };
-        let facmin = FAC1.powf(expo);
-        let fac = (FAC2 / facmin).min(facmin.max((err / SAFE1).powf(expo) / SAFE2));
-        self.hh[j] = (h.abs() / fac).min(self.h_max);
-        self.w[j] = self.a[j] / self.hh[j];
-        Column::Done(err)
+        Ok(())
     }
 
-    /// One step attempt from `(t, y)` with signed step `h`; `special` selects ODEX's handling of
-    /// the first and the last step. On acceptance the increment `T_{k,k}` is in `tab[0..n]` and `self.h`,
-    /// `self.k` hold the proposal for the next step.
-    fn attempt(&mut self, system: &dyn OdeSystem, t: f64, y: &[f64], h: f64, special: bool) -> Attempt {
-        self.fill_scal(y);
-        let k = self.k;
-        let mut err_prev = f64::INFINITY;
-        let mut err = 0.0;
-        macro_rules! column {
-            ($j:expr) => {
-                match self.column(system, t, y, h, $j, &mut err_prev) {
-                    Column::Done(e) => err = e,
-                    Column::Shrink(why) => return Attempt::Shrink(why),
-                }
-            };
-        }
-        if special {
-            // First or last step: increase the column count until convergence.
-            for j in 1..=k {
-                column!(j);
-                if j > 1 && err <= 1.0 {
-                    return self.accept(j, h.abs());
-                }
-            }
-        } else {
-            for j in 1..k {
-                column!(j);
-            }
-            // Convergence monitor.
-            if !(k == 2 || self.reject) {
-                if err <= 1.0 {
-                    return self.accept(k - 1, h.abs());
-                }
-                let lim = self.nj[k + 1] * self.nj[k] / 4.0;
-                if err > lim * lim {
-                    return self.reject_step(k - 1);
-                }
-            }
-            column!(k);
-            if err <= 1.0 {
-                return self.accept(k, h.abs());
-            }
-        }
-        // Hope for convergence in column k + 1.
-        let lim = self.nj[k + 1] / 2.0;
-        if err > lim * lim {
-            return self.reject_step(k);
-        }
-        column!(k + 1);
-        if err > 1.0 {
-            self.reject_step(k + 1)
-        } else {
-            self.accept(k + 1, h.abs())
-        }
+    fn evaluations(&self) -> u64 {
+        self.evals
     }
 
-    /// Step accepted after `kc` columns: choose the next column count and step (ODEX).
-    fn accept(&mut self, kc: usize, h_abs: f64) -> Attempt {
-        let km = self.km;
-        let k = self.k;
-        let w = &self.w;
-        let kopt = if kc == 2 {
-            if self.reject { 2 } else { 3.min(km - 1) }
-        } else if kc <= k {
-            let mut kopt = kc;
-            if w[kc - 1] < w[kc] * FAC3 {
-                kopt = kc - 1;
-            }
-            if w[kc] < w[kc - 1] * FAC4 {
-                kopt = (kc + 1).min(km - 1);
-            }
-            kopt
-        } else {
-            let mut kopt = kc - 1;
-            if kc > 3 && w[kc - 2] < w[kc - 1] * FAC3 {
-                kopt = kc - 2;
-            }
-            if w[kc] < w[kopt] * FAC4 {
-                kopt = kc.min(km - 1);
-            }
-            kopt
-        };
-        if self.reject {
-            self.k = kopt.min(kc);
-            self.h = h_abs.min(self.hh[self.k]);
-            self.reject = false;
-        } else {
-            let h_new = if kopt <= kc {
-                self.hh[kopt]
-            } else if kc < k && w[kc] < w[kc - 1] * FAC4 {
-                self.hh[kc] * self.a[kopt + 1] / self.a[kc]
-            } else {
-                self.hh[kc] * self.a[kopt] / self.a[kc]
-            };
-            self.k = kopt;
-            self.h = h_new.min(self.h_max);
-        }
-        Attempt::Accepted
+    fn set_evaluations(&mut self, n: u64) {
+        self.evals = n;
     }
 
-    /// Step rejected by the error test after `kc` columns: reduce `k` and the step (ODEX).
-    fn reject_step(&mut self, kc: usize) -> Attempt {
-        let mut k = self.k.min(kc).min(self.km - 1);
-        if k > 2 && self.w[k - 1] < self.w[k] * FAC3 {
-            k -= 1;
-        }
-        self.k = k;
-        self.h = self.hh[k];
-        self.reject = true;
-        Attempt::Rejected
-    }
-}
-
-#[derive(Clone, Copy)]
-enum Out {
-    Dz,
-    Dy,
-}
-
-pub(super) fn validate_tolerances(tol: &Tolerances) -> Result<(), IntegrateError> {
-    if tol.rtol.len() != tol.atol.len() {
-        return Err(IntegrateError::Config(format!(
-            "rtol has {} components but atol has {}",
-            tol.rtol.len(),
-            tol.atol.len()
-        )));
-    }
-    for (i, (&r, &a)) in tol.rtol.iter().zip(tol.atol.iter()).enumerate() {
-        if !(r.is_finite() && a.is_finite() && r >= 0.0 && a >= 0.0 && (r > 0.0 || a > 0.0)) {
-            return Err(IntegrateError::Config(format!(
-                "tolerances of component {i} must be finite, non-negative and not both zero \
-                 (rtol = {r}, atol = {a})"
-            )));
-        }
-    }
-    Ok(())
-}
-
-impl BulirschStoer {
-    /// The stepping loop of [`Integrator::advance`], after its checks: `y`'s dimension is the workspace's and
-    /// the compensation is set up.
-    fn advance_steps(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        let n = self.n;
-        let dir = if t_target > *t { 1.0 } else { -1.0 };
-        system.begin_step(*t, y);
-        self.eval(system, *t, y, Out::Dz);
-        if !all_finite(&self.dz) {
-            return Err(IntegrateError::NonFinite { t: *t });
-        }
-        if self.h == 0.0 {
-            let span = (t_target - *t).abs();
-            self.h = match self.initial_step {
-                Some(h) => h.min(self.h_max),
-                None => self.initial_step_guess(system, *t, y, dir, span),
-            };
-        }
-
-        let mut attempts: u64 = 0;
-        let mut nonfinite_run: u32 = 0;
-        let mut clean = true; // no rejection since the last accepted step
-        loop {
-            let remaining = (t_target - *t).abs();
-            let last = self.h * 1.01 >= remaining;
-            if !last {
-                let floor = self.h_min.max(10.0 * f64::EPSILON * t.abs());
-                if self.h.is_nan() || self.h < floor || self.h == 0.0 {
-                    return Err(if nonfinite_run > 0 {
-                        IntegrateError::NonFinite { t: *t }
-                    } else {
-                        IntegrateError::StepUnderflow { t: *t, h: dir * self.h }
-                    });
-                }
-            }
-            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-                return Err(IntegrateError::Deadline { t: *t });
-            }
-            if attempts >= self.max_steps {
-                return Err(IntegrateError::TooManySteps {
-                    t: *t,
-                    max_steps: self.max_steps,
-                });
-            }
-            attempts += 1;
-            let h_abs = if last { remaining } else { self.h };
-            let (saved_h, saved_k) = (self.h, self.k);
-            let special = !self.started || last;
-            self.started = true;
-            match self.attempt(system, *t, y, dir * h_abs, special) {
-                Attempt::Accepted => {
-                    if !all_finite(&self.tab[..n]) {
-                        // Cannot happen with rtol > 0 (a non-finite value makes err NaN), but
-                        // never hand a non-finite state to the caller.
-                        self.stats.steps_rejected += 1;
-                        self.rejections.nonfinite += 1;
-                        self.h = h_abs * SAFE3;
-                        self.reject = true;
-                        nonfinite_run += 1;
-                        clean = false;
-                        if nonfinite_run > self.max_nonfinite_retries {
-                            return Err(IntegrateError::NonFinite { t: *t });
-                        }
-                        continue;
-                    }
-                    self.comp.add(y, &self.tab[..self.n]);
-                    self.stats.steps_accepted += 1;
-                    if !(last && h_abs < saved_h) {
-                        // Steps shortened only to land on an output time say nothing about stiffness.
-                        self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
-                    }
-                    nonfinite_run = 0;
-                    if last {
-                        *t = t_target;
-                        if clean && h_abs < saved_h {
-                            // Shortened to land on t_target: keep the un-shortened proposal.
-                            self.h = self.h.max(saved_h);
-                            self.k = saved_k;
-                        }
-                        return Ok(());
-                    }
-                    *t += dir * h_abs;
-                    clean = true;
-                    system.begin_step(*t, y);
-                    self.eval(system, *t, y, Out::Dz);
-                    if !all_finite(&self.dz) {
-                        return Err(IntegrateError::NonFinite { t: *t });
-                    }
-                }
-                Attempt::Rejected => {
-                    self.stats.steps_rejected += 1;
-                    self.rejections.error += 1;
-                    nonfinite_run = 0;
-                    clean = false;
-                }
-                Attempt::Shrink(why) => {
-                    self.stats.steps_rejected += 1;
-                    self.h = h_abs * SAFE3;
-                    self.reject = true;
-                    clean = false;
-                    match why {
-                        Shrink::Stability => self.rejections.stability += 1,
-                        Shrink::Divergence => self.rejections.divergence += 1,
-                        Shrink::NonFinite => self.rejections.nonfinite += 1,
-                    }
-                    if let Shrink::NonFinite = why {
-                        nonfinite_run += 1;
-                        if nonfinite_run > self.max_nonfinite_retries {
-                            return Err(IntegrateError::NonFinite { t: *t });
-                        }
-                    } else {
-                        nonfinite_run = 0;
-                    }
-                }
-            }
-        }
-    }
-}
-
-impl Integrator for BulirschStoer {
-    fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps.max(1);
-    }
-
-    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
-        self.deadline = deadline;
-    }
-
-    fn advance(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        let n = system.dim();
-        if !begin_advance(n, self.tol.rtol.len(), t, y, t_target)? {
-            return Ok(());
-        }
-        self.ensure_workspace(n);
-        self.comp.begin(y);
-        let result = self.advance_steps(system, t, y, t_target);
-        system.end_steps();
-        self.comp.end(y);
-        result
-    }
-
-    fn stats(&self) -> Stats {
-        self.stats
-    }
-
-    fn set_span(&mut self, span: f64) {
-        self.span = (span.is_finite() && span > 0.0).then_some(span);
-    }
-
-    fn method(&self) -> Method {
-        Method::BulirschStoer
-    }
-
-    fn save_state(&self) -> IntegratorState {
+    fn save(&self, km: usize, columns: ColumnControlState, carried: Carried) -> IntegratorState {
         IntegratorState::BulirschStoer(BulirschStoerState {
-            dim: self.tol.rtol.len(),
-            km: self.km,
-            max_steps: self.max_steps,
-            h_min: self.h_min,
-            h_max: self.h_max,
-            max_nonfinite_retries: self.max_nonfinite_retries,
-            initial_step: self.initial_step,
-            span: self.span,
-            h: self.h,
-            k: self.k,
-            reject: self.reject,
-            started: self.started,
-            hh: self.hh.clone(),
-            w: self.w.clone(),
-            stats: self.stats.into(),
-            rejections: self.rejections,
-            compensation: self.comp.carry.clone(),
+            dim: carried.dim,
+            km,
+            limits: carried.limits,
+            initial_step: carried.initial_step,
+            columns,
+            compensation: carried.compensation,
         })
     }
 
-    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
-        let s = match state {
-            IntegratorState::BulirschStoer(s) => s,
-            other => {
-                return Err(IntegrateError::Config(format!(
-                    "cannot restore a {} state into bulirsch-stoer",
-                    other.method()
-                )));
-            }
+    fn unpack<'a>(state: &'a IntegratorState, carried: &mut Carried) -> Unpacked<'a> {
+        let IntegratorState::BulirschStoer(s) = state else {
+            return Err(wrong_state(state, Self::METHOD));
         };
-        let bad = |what: String| Err(IntegrateError::Config(format!("bulirsch-stoer state: {what}")));
-        if s.dim != self.tol.rtol.len() {
-            return bad(format!(
-                "saved for dimension {}, tolerances have {}",
-                s.dim,
-                self.tol.rtol.len()
-            ));
-        }
-        if !(3..=20).contains(&s.km) {
-            return bad(format!("max columns {} not in 3..=20", s.km));
-        }
-        if !(2..s.km).contains(&s.k) {
-            return bad(format!("column count {} not in 2..{}", s.k, s.km));
-        }
-        if s.hh.len() != s.km + 1 || s.w.len() != s.km + 1 {
-            return bad(format!("per-column arrays must have {} entries", s.km + 1));
-        }
-        if !(s.h.is_finite() && s.h >= 0.0) || s.h_min.is_nan() || s.h_max.is_nan() {
-            return bad(format!(
-                "bad step sizes (h = {}, h_min = {}, h_max = {})",
-                s.h, s.h_min, s.h_max
-            ));
-        }
-        if s.initial_step.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
-            return bad("bad initial step".into());
-        }
-        if s.km != self.km {
-            self.set_max_columns(s.km)?;
-        }
-        self.max_steps = s.max_steps;
-        self.h_min = s.h_min;
-        self.h_max = s.h_max;
-        self.max_nonfinite_retries = s.max_nonfinite_retries;
-        self.initial_step = s.initial_step;
-        if s.span.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
-            return bad("bad span".into());
-        }
-        self.span = s.span;
-        self.h = s.h;
-        self.k = s.k;
-        self.reject = s.reject;
-        self.started = s.started;
-        self.hh.copy_from_slice(&s.hh);
-        self.w.copy_from_slice(&s.w);
-        if !(s.compensation.is_empty() || s.compensation.len() == s.dim) || !all_finite(&s.compensation) {
-            return bad(format!(
-                "compensation must be empty or have {} finite entries, got {}",
-                s.dim,
-                s.compensation.len()
-            ));
-        }
-        self.stats = s.stats.into();
-        self.rejections = s.rejections;
-        self.comp.carry.clone_from(&s.compensation);
-        // The saved state is the caller's: the compensation belongs to whatever state it passes next.
-        self.comp.forget_output();
-        Ok(())
+        (carried.limits, carried.initial_step) = (s.limits, s.initial_step);
+        Ok((s.dim, s.km, &s.columns, &s.compensation))
     }
 }

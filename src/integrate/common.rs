@@ -164,6 +164,16 @@ pub struct Stats {
     pub smallest_step: f64,
 }
 
+impl Stats {
+    /// The statistics before the first step: all zero, `smallest_step` infinite.
+    pub fn initial() -> Self {
+        Stats {
+            smallest_step: f64::INFINITY,
+            ..Stats::default()
+        }
+    }
+}
+
 /// [`Stats`] as stored in a checkpoint (`smallest_step` as exact bits, so `∞` survives).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SavedStats {
@@ -267,17 +277,14 @@ pub enum IntegrateError {
     Config(String),
 }
 
+/// What [`Integrator::advance`] returns: `Ok` once landed on the target time, else why it stopped.
+pub type Advanced = Result<(), IntegrateError>;
+
 /// An integrator that advances a state to requested times, landing on each exactly.
 pub trait Integrator {
     /// Advances `y` from `*t` to `t_target` (> `*t`), landing exactly on `t_target`.
     /// On success `*t == t_target`. On error `*t, y` hold the last accepted point.
-    fn advance(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError>;
+    fn advance(&mut self, system: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_target: f64) -> Advanced;
     /// Cumulative statistics.
     fn stats(&self) -> Stats;
     /// Tells the integrator the span of the whole run (s), so that a method that can control the error per unit
@@ -305,17 +312,9 @@ pub trait Integrator {
     fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError>;
 }
 
-/// Everything a `BulirschStoer` carries between [`Integrator::advance`] calls
-/// ([`Integrator::save_state`]): the step-size and column control, the per-column proposals and
-/// work of the last attempt, the counters and the settings. The work arrays are not saved: every
-/// call recomputes them before reading them. The tolerances are not saved either: the integrator
-/// the state is restored into must be built with the same ones (only their length is checked).
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BulirschStoerState {
-    /// Length of the tolerance vectors (the system's dimension).
-    pub dim: usize,
-    /// Maximum number of columns `km`.
-    pub km: usize,
+/// The step limits a `BulirschStoer` and a `Dop853` save (flattened into their states).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepLimits {
     /// Maximum step attempts per `advance`.
     pub max_steps: u64,
     /// Smallest allowed step (s).
@@ -326,9 +325,12 @@ pub struct BulirschStoerState {
     pub h_max: f64,
     /// Consecutive non-finite rejections retried.
     pub max_nonfinite_retries: u32,
-    /// The configured initial step (s), if any.
-    #[serde(with = "exact_f64_opt")]
-    pub initial_step: Option<f64>,
+}
+
+/// The step and column control both extrapolation methods save (flattened into their states): the proposed step,
+/// the target column count, the per-column proposals and work of the last attempt, the counters.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ColumnControlState {
     /// The run's span for error-per-unit-step control (s), if set.
     #[serde(with = "exact_f64_opt")]
     pub span: Option<f64>,
@@ -342,7 +344,7 @@ pub struct BulirschStoerState {
     pub reject: bool,
     /// At least one step has been attempted.
     pub started: bool,
-    /// Optimal step per column of the last attempt (index 0 unused, length `km + 1`).
+    /// Optimal step per column of the last attempt (s; index 0 unused, length `km + 1`).
     #[serde(with = "exact_f64_vec")]
     pub hh: Vec<f64>,
     /// Work per unit step per column of the last attempt (index 0 unused, length `km + 1`).
@@ -352,13 +354,35 @@ pub struct BulirschStoerState {
     pub stats: SavedStats,
     /// Cumulative rejections by cause.
     pub rejections: Rejections,
+}
+
+/// Everything a `BulirschStoer` carries between [`Integrator::advance`] calls
+/// ([`Integrator::save_state`]): the step-size and column control, the per-column proposals and
+/// work of the last attempt, the counters and the settings. The work arrays are not saved: every
+/// call recomputes them before reading them. The tolerances are not saved either: the integrator
+/// the state is restored into must be built with the same ones (only their length is checked).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BulirschStoerState {
+    /// Length of the tolerance vectors (the system's dimension).
+    pub dim: usize,
+    /// Maximum number of columns `km`.
+    pub km: usize,
+    /// Step budget and step-size limits.
+    #[serde(flatten)]
+    pub limits: StepLimits,
+    /// The configured initial step (s), if any.
+    #[serde(with = "exact_f64_opt")]
+    pub initial_step: Option<f64>,
+    /// Step and column control, counters.
+    #[serde(flatten)]
+    pub columns: ColumnControlState,
     /// What compensated summation carries into the next step (length `dim`, or empty = zero; states saved before
     /// the compensation existed have none).
     #[serde(default, with = "exact_f64_vec")]
     pub compensation: Vec<f64>,
 }
 
-/// Rejected steps of a `BulirschStoer` by cause (cumulative); their sum is
+/// Rejected steps of an adaptive integrator by cause (cumulative); their sum is
 /// [`Stats::steps_rejected`].
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Rejections {
@@ -385,16 +409,9 @@ pub struct Dop853State {
     /// The configured initial step (s), if any.
     #[serde(with = "exact_f64_opt")]
     pub initial_step: Option<f64>,
-    /// Maximum step attempts per `advance`.
-    pub max_steps: u64,
-    /// Smallest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_min: f64,
-    /// Largest allowed step (s).
-    #[serde(with = "exact_f64")]
-    pub h_max: f64,
-    /// Consecutive non-finite rejections retried.
-    pub max_nonfinite_retries: u32,
+    /// Step budget and step-size limits.
+    #[serde(flatten)]
+    pub limits: StepLimits,
     /// Proposed `|h|` for the next step (s); 0 = not yet known. After landing on an output time this is the
     /// proposal from before the shortened last step.
     #[serde(with = "exact_f64")]
@@ -421,28 +438,9 @@ pub struct LinearlyImplicitState {
     pub km: usize,
     /// Maximum step attempts per advance.
     pub max_steps: u64,
-    /// The run's span for error-per-unit-step control (s), if set.
-    #[serde(with = "exact_f64_opt")]
-    pub span: Option<f64>,
-    /// Proposed `|H|` for the next step (s); 0 = not yet known.
-    #[serde(with = "exact_f64")]
-    pub h: f64,
-    /// Target column count.
-    pub k: usize,
-    /// The previous attempt was rejected.
-    pub reject: bool,
-    /// At least one step has been attempted.
-    pub started: bool,
-    /// Optimal step per column of the last attempt (s; index 0 unused, `km + 1` entries).
-    #[serde(with = "exact_f64_vec")]
-    pub hh: Vec<f64>,
-    /// Work per unit step per column of the last attempt (index 0 unused, `km + 1` entries).
-    #[serde(with = "exact_f64_vec")]
-    pub w: Vec<f64>,
-    /// Cumulative statistics.
-    pub stats: SavedStats,
-    /// Cumulative rejections by cause.
-    pub rejections: Rejections,
+    /// Step and column control, counters.
+    #[serde(flatten)]
+    pub columns: ColumnControlState,
     /// Linear solves so far.
     pub solves: u64,
     /// What the compensated summation carries into the next step (`dim` entries, or empty = zero).

@@ -32,6 +32,7 @@
 //!
 //! # Landing, continuation, checkpoints
 //!
+//! The loop around the steps is [`Adaptive`]'s (`adaptive_loop.rs`); this file supplies the step ([`Dop853Step`]).
 //! Each [`Integrator::advance`] lands exactly on its target: the last step is shortened (when `1.01 h` reaches
 //! past the target, as in DOP853) and its end time is the target itself. The next call starts with the step the
 //! control proposed before that shortening (the "last full step"), so a sequence of output times does not restart
@@ -61,7 +62,7 @@
 //! # Failures
 //!
 //! As [`super::bulirsch_stoer`]: a non-finite stage (a NaN error estimate, or a non-finite new state) halves the
-//! step (an infinite estimate of finite values is an ordinary rejection, the step shrinking 3-fold), and after [`Dop853::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
+//! step (an infinite estimate of finite values is an ordinary rejection, the step shrinking 3-fold), and after [`Adaptive::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
 //! right after one, [`IntegrateError::NonFinite`] is returned; a non-finite derivative at an accepted state fails
 //! at once. A step below `max(h_min, 10 ε |t|)` gives [`IntegrateError::StepUnderflow`]. The caller's `t, y` are
 //! only ever set to accepted states: on error they hold the last one.
@@ -73,8 +74,16 @@
 //! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
 //! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
 
+use super::adaptive_loop::{
+    Adaptive, Carried, Cause, FirstStep, Outcome, StepMethod, Trial, hinit_h0, hinit_h1, validate_tolerances,
+    wrong_state,
+};
+pub use super::adaptive_loop::{DEFAULT_MAX_NONFINITE_RETRIES, DEFAULT_MAX_STEPS};
 pub use super::common::Dop853State;
-use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances, begin_advance};
+#[cfg(doc)]
+use super::common::Integrator;
+use super::common::{IntegrateError, IntegratorState, Method, OdeSystem, Tolerances};
+use super::compensated::Compensation;
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
 
@@ -83,10 +92,6 @@ use rayon::prelude::*;
 pub const CHUNK: usize = 2048;
 /// Default dimension from which the vector loops run on rayon's pool ([`Dop853::set_parallel_from`]).
 pub const DEFAULT_PARALLEL_FROM: usize = 16_384;
-/// Default maximum number of step attempts per call to [`Integrator::advance`].
-pub const DEFAULT_MAX_STEPS: u64 = super::bulirsch_stoer::DEFAULT_MAX_STEPS;
-/// Default number of consecutive non-finite rejections before giving up.
-pub const DEFAULT_MAX_NONFINITE_RETRIES: u32 = super::bulirsch_stoer::DEFAULT_MAX_NONFINITE_RETRIES;
 
 /// Safety factor of the step-size control.
 const SAFE: f64 = 0.9;
@@ -96,8 +101,6 @@ const FAC1: f64 = 0.333;
 const FAC2: f64 = 6.0;
 /// Exponent of the step-size control: 1/8 (β = 0).
 const EXPO: f64 = 1.0 / 8.0;
-/// Step reduction after a non-finite stage.
-const NONFINITE_SHRINK: f64 = 0.5;
 
 /// The vector work on the parallel path.
 static VECTOR: Phase = Phase::new("integrate.dop853.vector", Kind::Parallel);
@@ -436,7 +439,7 @@ fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize
     }
 }
 
-/// The DOP853 integrator (see the [module documentation](self)).
+/// The DOP853 integrator (see the [module documentation](self)): the step loop [`Adaptive`] around [`Dop853Step`].
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, dop853::Dop853};
@@ -451,20 +454,44 @@ fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize
 /// }
 /// assert!((y[0] - 1.0).abs() < 1e-8 && y[1].abs() < 1e-8);
 /// ```
+pub type Dop853 = Adaptive<Dop853Step>;
+
+impl Dop853 {
+    /// A new integrator with per-component `tolerances` and an optional initial step `step` (|step| is used for
+    /// the very first step only; `None` = Hairer's automatic guess from `f(t0, y0)` and one more evaluation).
+    ///
+    /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or contain negative
+    /// or non-finite values, if some component has `rtol = atol = 0`, or if `step` is not non-zero and finite.
+    /// The vectors' length must equal the dimension of the systems later passed to [`Integrator::advance`].
+    pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
+        validate_tolerances(&tolerances)?;
+        let method = Dop853Step {
+            tol: tolerances,
+            parallel_from: DEFAULT_PARALLEL_FROM,
+            evals: 0,
+            n: 0,
+            k: Vec::new(),
+            y: Vec::new(),
+            y_new: Vec::new(),
+            y_stage: Vec::new(),
+            partials: Vec::new(),
+        };
+        Adaptive::with_method(method, step)
+    }
+
+    /// Sets the dimension from which the vector loops run on rayon's current pool (default
+    /// [`DEFAULT_PARALLEL_FROM`]); below it they run on the calling thread. No bit of the results depends on it.
+    pub fn set_parallel_from(&mut self, n: usize) {
+        self.method.parallel_from = n;
+    }
+}
+
+/// One DOP853 step and its work arrays.
 #[derive(Debug, Clone)]
-pub struct Dop853 {
+pub struct Dop853Step {
     tol: Tolerances,
-    initial_step: Option<f64>,
-    max_steps: u64,
-    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
-    deadline: Option<std::time::Instant>,
-    h_min: f64,
-    h_max: f64,
-    max_nonfinite_retries: u32,
     parallel_from: usize,
-    /// Proposed `|h|` for the next step; 0 = unknown (initial guess needed).
-    h: f64,
-    stats: Stats,
+    evals: u64,
 
     // Work arrays (allocated once per dimension).
     n: usize,
@@ -480,116 +507,7 @@ pub struct Dop853 {
     partials: Vec<[f64; 3]>,
 }
 
-/// The outcome of one step attempt.
-enum Attempt {
-    /// Accepted; the new state is in `y_new`.
-    Accepted,
-    /// Rejected by the error test.
-    Rejected,
-    /// A stage or the new state was not finite.
-    NonFinite,
-}
-
-impl Dop853 {
-    /// A new integrator with per-component `tolerances` and an optional initial step `step` (|step| is used for
-    /// the very first step only; `None` = Hairer's automatic guess from `f(t0, y0)` and one more evaluation).
-    ///
-    /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or contain negative
-    /// or non-finite values, if some component has `rtol = atol = 0`, or if `step` is not non-zero and finite.
-    /// The vectors' length must equal the dimension of the systems later passed to [`Integrator::advance`].
-    pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
-        super::bulirsch_stoer::validate_tolerances(&tolerances)?;
-        if let Some(h) = step
-            && !(h.is_finite() && h != 0.0)
-        {
-            return Err(IntegrateError::Config(format!(
-                "dop853 initial step must be non-zero and finite, got {h}"
-            )));
-        }
-        Ok(Dop853 {
-            tol: tolerances,
-            initial_step: step.map(f64::abs),
-            max_steps: DEFAULT_MAX_STEPS,
-            deadline: None,
-            h_min: 0.0,
-            h_max: f64::INFINITY,
-            max_nonfinite_retries: DEFAULT_MAX_NONFINITE_RETRIES,
-            parallel_from: DEFAULT_PARALLEL_FROM,
-            h: 0.0,
-            stats: Stats {
-                smallest_step: f64::INFINITY,
-                ..Stats::default()
-            },
-            n: 0,
-            k: Vec::new(),
-            y: Vec::new(),
-            y_new: Vec::new(),
-            y_stage: Vec::new(),
-            partials: Vec::new(),
-        })
-    }
-
-    /// Sets the maximum number of step attempts (accepted + rejected) in one call to [`Integrator::advance`]
-    /// (default 10⁸); more gives [`IntegrateError::TooManySteps`].
-    pub fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps;
-    }
-
-    /// Sets the smallest allowed step size (default 0): a proposed `|h| < max(h_min, 10 ε |t|)` gives
-    /// [`IntegrateError::StepUnderflow`].
-    pub fn set_h_min(&mut self, h_min: f64) {
-        self.h_min = h_min.abs();
-    }
-
-    /// Sets the largest allowed step size (default ∞). With a loose tolerance it makes the method run at a
-    /// fixed step (the convergence tests use it so).
-    pub fn set_h_max(&mut self, h_max: f64) {
-        self.h_max = h_max.abs();
-        if self.h > self.h_max {
-            self.h = self.h_max;
-        }
-    }
-
-    /// Sets how many consecutive rejections caused by NaN/∞ stages are retried (each with a halved step) before
-    /// [`IntegrateError::NonFinite`] is returned (default 10).
-    pub fn set_max_nonfinite_retries(&mut self, retries: u32) {
-        self.max_nonfinite_retries = retries;
-    }
-
-    /// Sets the dimension from which the vector loops run on rayon's current pool (default
-    /// [`DEFAULT_PARALLEL_FROM`]); below it they run on the calling thread. No bit of the results depends on it.
-    pub fn set_parallel_from(&mut self, n: usize) {
-        self.parallel_from = n;
-    }
-
-    /// Forgets the step-size history: the next step starts like the first one. Use after a discontinuity in the
-    /// state or the equations.
-    pub fn reset(&mut self) {
-        self.h = 0.0;
-    }
-
-    /// The step size the next step will try (`None` before the first step or after [`Dop853::reset`]).
-    pub fn proposed_step(&self) -> Option<f64> {
-        (self.h > 0.0).then_some(self.h)
-    }
-
-    /// The tolerances in use.
-    pub fn tolerances(&self) -> &Tolerances {
-        &self.tol
-    }
-
-    fn ensure_workspace(&mut self, n: usize) {
-        if self.n == n && self.y.len() == n {
-            return;
-        }
-        self.n = n;
-        self.k = vec![vec![0.0; n]; 12];
-        self.y = vec![0.0; n];
-        self.y_new = vec![0.0; n];
-        self.y_stage = vec![0.0; n];
-        self.partials = vec![[0.0; 3]; n.div_ceil(CHUNK)];
-    }
-
+impl Dop853Step {
     fn parallel(&self) -> bool {
         self.n >= self.parallel_from
     }
@@ -605,7 +523,7 @@ impl Dop853 {
 
     /// `k[stage] = f(t, arg)`, counting the evaluation.
     fn eval(&mut self, system: &dyn OdeSystem, t: f64, stage: usize, arg: Arg) {
-        self.stats.rhs_evaluations += 1;
+        self.evals += 1;
         let src = match arg {
             Arg::State => &self.y,
             Arg::Stage => &self.y_stage,
@@ -625,67 +543,16 @@ impl Dop853 {
         bad == 0.0
     }
 
-    /// Hairer's initial step guess `hinit` (§II.4) with the error's scaled RMS norms, from `f(t, y)` in `k[0]` and
-    /// one more evaluation (into `k[1]`). Returns `|h|`.
-    fn initial_step_guess(&mut self, system: &dyn OdeSystem, t: f64, dir: f64, span: f64) -> f64 {
-        let n = self.n as f64;
-        let parallel = self.parallel();
-        let (y, k, tol) = (&self.y, &self.k, &self.tol);
-        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
-        let [dy, df, _] = Self::timed(parallel, || {
-            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
-                let (mut dy, mut df) = (0.0, 0.0);
-                for i in lo..hi {
-                    let sc = scale(i);
-                    dy += (y[i] / sc).powi(2);
-                    df += (k[0][i] / sc).powi(2);
-                }
-                [dy, df, 0.0]
-            })
-        });
-        let (d0, d1) = ((dy / n).sqrt(), (df / n).sqrt());
-        let mut h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
-        h0 = h0.min(span).min(self.h_max);
-        if h0.is_nan() || h0 <= 0.0 {
-            return 1e-6f64.min(span).min(self.h_max);
-        }
-        // Explicit Euler step into y_stage, its derivative into k[1].
-        let (y, k) = (&self.y, &self.k);
+    /// Copies `from` into `to` chunk by chunk (parallel on the parallel path).
+    fn copy(parallel: bool, from: &[f64], to: &mut [f64]) {
         Self::timed(parallel, || {
-            each_chunk(parallel, &mut self.y_stage, |lo, o| {
-                for ((z, &yi), &fi) in o.iter_mut().zip(&y[lo..]).zip(&k[0][lo..]) {
-                    *z = yi + dir * h0 * fi;
-                }
-            })
+            each_chunk(parallel, to, |lo, o| o.copy_from_slice(&from[lo..lo + o.len()]))
         });
-        self.eval(system, t + dir * h0, 1, Arg::Stage);
-        let (y, k, tol) = (&self.y, &self.k, &self.tol);
-        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
-        let [d2, _, _] = Self::timed(parallel, || {
-            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
-                let mut d2 = 0.0;
-                for (i, (&f1, &f0)) in (lo..hi).zip(k[1][lo..hi].iter().zip(&k[0][lo..hi])) {
-                    d2 += ((f1 - f0) / scale(i)).powi(2);
-                }
-                [d2, 0.0, 0.0]
-            })
-        });
-        let d2 = (d2 / n).sqrt() / h0;
-        if !d2.is_finite() {
-            return h0;
-        }
-        let der = d1.max(d2);
-        let h1 = if der <= 1e-15 {
-            (h0 * 1e-3).max(1e-6)
-        } else {
-            (0.01 / der).powf(EXPO)
-        };
-        (100.0 * h0).min(h1).min(span).min(self.h_max)
     }
 
-    /// One step attempt from `(t, self.y)` with `k[0] = f(t, y)` and signed step `h` ending at `t_end`. Returns
-    /// the outcome and the error estimate.
-    fn attempt(&mut self, system: &dyn OdeSystem, t: f64, h: f64, t_end: f64) -> (Attempt, f64) {
+    /// The stages and the new state of the step `h` from `(t, self.y)` with `k[0] = f(t, y)`, ending at `t_end`.
+    /// Returns the outcome of the error test and the error estimate.
+    fn stages(&mut self, system: &dyn OdeSystem, t: f64, h: f64, t_end: f64) -> (Attempt, f64) {
         let parallel = self.parallel();
         for (s, row) in STAGES.iter().enumerate() {
             let (y, k) = (&self.y, &self.k);
@@ -739,109 +606,16 @@ impl Dop853 {
             (Attempt::Rejected, err)
         }
     }
+}
 
-    /// The stepping loop of [`Integrator::advance`], after its checks, on the state in `self.y`.
-    fn advance_steps(&mut self, system: &dyn OdeSystem, t: &mut f64, t_target: f64) -> Result<(), IntegrateError> {
-        let dir = if t_target > *t { 1.0 } else { -1.0 };
-        system.begin_step(*t, &self.y);
-        self.eval(system, *t, 0, Arg::State);
-        if !self.finite(0) {
-            return Err(IntegrateError::NonFinite { t: *t });
-        }
-        if self.h == 0.0 {
-            let span = (t_target - *t).abs();
-            self.h = match self.initial_step {
-                Some(h) => h.min(self.h_max),
-                None => self.initial_step_guess(system, *t, dir, span),
-            };
-        }
-        let mut attempts: u64 = 0;
-        let mut nonfinite_run: u32 = 0;
-        let mut reject = false; // the previous attempt was rejected (DOP853's REJECT)
-        let mut clean = true; // no rejection since the last accepted step
-        loop {
-            let remaining = (t_target - *t).abs();
-            let last = self.h * 1.01 >= remaining;
-            if !last {
-                let floor = self.h_min.max(10.0 * f64::EPSILON * t.abs());
-                if self.h.is_nan() || self.h < floor || self.h == 0.0 {
-                    return Err(if nonfinite_run > 0 {
-                        IntegrateError::NonFinite { t: *t }
-                    } else {
-                        IntegrateError::StepUnderflow { t: *t, h: dir * self.h }
-                    });
-                }
-            }
-            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-                return Err(IntegrateError::Deadline { t: *t });
-            }
-            if attempts >= self.max_steps {
-                return Err(IntegrateError::TooManySteps {
-                    t: *t,
-                    max_steps: self.max_steps,
-                });
-            }
-            attempts += 1;
-            let h_abs = if last { remaining } else { self.h };
-            let proposed = self.h;
-            let t_end = if last { t_target } else { *t + dir * h_abs };
-            let (outcome, err) = self.attempt(system, *t, dir * h_abs, t_end);
-            match outcome {
-                Attempt::Accepted => {
-                    let fac = (err.powf(EXPO) / SAFE).clamp(1.0 / FAC2, 1.0 / FAC1);
-                    let mut h_new = (h_abs / fac).min(self.h_max);
-                    if reject {
-                        h_new = h_new.min(h_abs);
-                    }
-                    std::mem::swap(&mut self.y, &mut self.y_new);
-                    self.stats.steps_accepted += 1;
-                    if !(last && h_abs < proposed) {
-                        // Steps shortened only to land on an output time say nothing about the problem.
-                        self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
-                    }
-                    *t = t_end;
-                    if last {
-                        // Shortened to land on t_target: keep the proposal from before the shortening.
-                        self.h = if clean && h_abs < proposed {
-                            h_new.max(proposed)
-                        } else {
-                            h_new
-                        };
-                        return Ok(());
-                    }
-                    self.h = h_new;
-                    reject = false;
-                    clean = true;
-                    nonfinite_run = 0;
-                    system.begin_step(*t, &self.y);
-                    // FSAL: the derivative at the new state is the next step's first stage.
-                    self.eval(system, *t, 0, Arg::State);
-                    if !self.finite(0) {
-                        return Err(IntegrateError::NonFinite { t: *t });
-                    }
-                }
-                Attempt::Rejected => {
-                    self.stats.steps_rejected += 1;
-                    // err > 1: the step shrinks, by at most 1/FAC1.
-                    let fac = (err.powf(EXPO) / SAFE).min(1.0 / FAC1);
-                    self.h = h_abs / fac;
-                    reject = true;
-                    clean = false;
-                    nonfinite_run = 0;
-                }
-                Attempt::NonFinite => {
-                    self.stats.steps_rejected += 1;
-                    self.h = h_abs * NONFINITE_SHRINK;
-                    reject = true;
-                    clean = false;
-                    nonfinite_run += 1;
-                    if nonfinite_run > self.max_nonfinite_retries {
-                        return Err(IntegrateError::NonFinite { t: *t });
-                    }
-                }
-            }
-        }
-    }
+/// The outcome of the error test of one step.
+enum Attempt {
+    /// Accepted; the new state is in `y_new`.
+    Accepted,
+    /// Rejected by the error test.
+    Rejected,
+    /// A stage or the new state was not finite.
+    NonFinite,
 }
 
 /// Which vector a stage is evaluated at.
@@ -853,64 +627,140 @@ enum Arg {
     Stage,
 }
 
-impl Integrator for Dop853 {
-    fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps.max(1);
-    }
+impl StepMethod for Dop853Step {
+    type Frozen<'s> = ();
+    const METHOD: Method = Method::Dop853;
 
-    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
-        self.deadline = deadline;
-    }
-
-    fn advance(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        let n = system.dim();
-        if !begin_advance(n, self.tol.rtol.len(), t, y, t_target)? {
-            return Ok(());
+    fn prepare(&mut self, n: usize) {
+        if self.n == n && self.y.len() == n {
+            return;
         }
-        self.ensure_workspace(n);
+        self.n = n;
+        self.k = vec![vec![0.0; n]; 12];
+        self.y = vec![0.0; n];
+        self.y_new = vec![0.0; n];
+        self.y_stage = vec![0.0; n];
+        self.partials = vec![[0.0; 3]; n.div_ceil(CHUNK)];
+    }
+
+    /// The step works on its own copy of the state (`y`, swapped with `y_new` on acceptance).
+    fn enter(&mut self, y: &[f64], _comp: &mut Compensation) {
+        Self::copy(self.parallel(), y, &mut self.y);
+    }
+
+    /// The system sees the step's own copy of the state; `f(t, y)` into `k[0]`.
+    fn start(&mut self, system: &dyn OdeSystem, t: f64, _y: &[f64]) -> Option<()> {
+        system.begin_step(t, &self.y);
+        // FSAL after an accepted step: the derivative at the new state is the next step's first stage.
+        self.eval(system, t, 0, Arg::State);
+        self.finite(0).then_some(())
+    }
+
+    /// Hairer's initial step guess `hinit` (§II.4) with the error's scaled RMS norms and the exponent 1/8, from
+    /// `f(t, y)` in `k[0]` and one more evaluation (into `k[1]`).
+    fn initial_step(&mut self, system: &dyn OdeSystem, _y: &[f64], first: &FirstStep) -> f64 {
+        let &FirstStep { t, dir, span, h_max } = first;
+        let n = self.n as f64;
         let parallel = self.parallel();
-        let own = &mut self.y;
-        Self::timed(parallel, || {
-            each_chunk(parallel, own, |lo, o| o.copy_from_slice(&y[lo..lo + o.len()]))
+        let (y, k, tol) = (&self.y, &self.k, &self.tol);
+        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
+        let [dy, df, _] = Self::timed(parallel, || {
+            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
+                let (mut dy, mut df) = (0.0, 0.0);
+                for i in lo..hi {
+                    let sc = scale(i);
+                    dy += (y[i] / sc).powi(2);
+                    df += (k[0][i] / sc).powi(2);
+                }
+                [dy, df, 0.0]
+            })
         });
-        let result = self.advance_steps(system, t, t_target);
-        system.end_steps();
-        // `self.y` is the last accepted state, whatever the result.
-        let own = &self.y;
+        let (d0, d1) = ((dy / n).sqrt(), (df / n).sqrt());
+        let h0 = hinit_h0(d0, d1).min(span).min(h_max);
+        if h0.is_nan() || h0 <= 0.0 {
+            return 1e-6f64.min(span).min(h_max);
+        }
+        // Explicit Euler step into y_stage, its derivative into k[1].
+        let (y, k) = (&self.y, &self.k);
         Self::timed(parallel, || {
-            each_chunk(parallel, y, |lo, o| o.copy_from_slice(&own[lo..lo + o.len()]))
+            each_chunk(parallel, &mut self.y_stage, |lo, o| {
+                for ((z, &yi), &fi) in o.iter_mut().zip(&y[lo..]).zip(&k[0][lo..]) {
+                    *z = yi + dir * h0 * fi;
+                }
+            })
         });
-        result
+        self.eval(system, t + dir * h0, 1, Arg::Stage);
+        let (y, k, tol) = (&self.y, &self.k, &self.tol);
+        let scale = |i: usize| (tol.atol[i] + tol.rtol[i] * y[i].abs()).max(f64::MIN_POSITIVE);
+        let [d2, _, _] = Self::timed(parallel, || {
+            chunk_sums(parallel, self.n, &mut self.partials, |lo, hi| {
+                let mut d2 = 0.0;
+                for (i, (&f1, &f0)) in (lo..hi).zip(k[1][lo..hi].iter().zip(&k[0][lo..hi])) {
+                    d2 += ((f1 - f0) / scale(i)).powi(2);
+                }
+                [d2, 0.0, 0.0]
+            })
+        });
+        hinit_h1(h0, d1, (d2 / n).sqrt() / h0, EXPO, span, h_max)
     }
 
-    fn stats(&self) -> Stats {
-        self.stats
+    /// DOP853's step-size control: `h_new = h / clamp(err^{1/8} / 0.9, 1/6, 1/0.333)`, not growing right after a
+    /// rejection.
+    fn attempt(&mut self, system: &dyn OdeSystem, _frozen: &mut (), _y: &[f64], trial: &Trial) -> Outcome {
+        let (outcome, err) = self.stages(system, trial.t, trial.h, trial.t_end);
+        let h_abs = trial.h.abs();
+        match outcome {
+            Attempt::Accepted => {
+                let fac = (err.powf(EXPO) / SAFE).clamp(1.0 / FAC2, 1.0 / FAC1);
+                let h_next = (h_abs / fac).min(trial.h_max);
+                Outcome::Accepted {
+                    h_next: if trial.after_rejection {
+                        h_next.min(h_abs)
+                    } else {
+                        h_next
+                    },
+                }
+            }
+            // err > 1: the step shrinks, by at most 1/FAC1.
+            Attempt::Rejected => Outcome::Rejected {
+                h_next: h_abs / (err.powf(EXPO) / SAFE).min(1.0 / FAC1),
+            },
+            Attempt::NonFinite => Outcome::Halve(Cause::NonFinite),
+        }
     }
 
-    fn method(&self) -> Method {
-        Method::Dop853
+    fn commit(&mut self, _y: &mut [f64], _comp: &mut Compensation) {
+        std::mem::swap(&mut self.y, &mut self.y_new);
     }
 
-    fn save_state(&self) -> IntegratorState {
+    /// `self.y` is the last accepted state, whatever the result.
+    fn leave(&mut self, y: &mut [f64], _comp: &mut Compensation) {
+        Self::copy(self.parallel(), &self.y, y);
+    }
+
+    fn evaluations(&self) -> u64 {
+        self.evals
+    }
+
+    fn set_evaluations(&mut self, n: u64) {
+        self.evals = n;
+    }
+
+    fn tolerances(&self) -> &Tolerances {
+        &self.tol
+    }
+
+    fn save(&self, carried: Carried) -> IntegratorState {
         IntegratorState::Dop853(Dop853State {
-            dim: self.tol.rtol.len(),
-            initial_step: self.initial_step,
-            max_steps: self.max_steps,
-            h_min: self.h_min,
-            h_max: self.h_max,
-            max_nonfinite_retries: self.max_nonfinite_retries,
-            h: self.h,
-            stats: self.stats.into(),
+            dim: carried.dim,
+            initial_step: carried.initial_step,
+            limits: carried.limits,
+            h: carried.h,
+            stats: carried.stats,
         })
     }
 
-    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
+    fn restore(&mut self, state: &IntegratorState, carried: &mut Carried) -> Result<(), IntegrateError> {
         let s = match state {
             IntegratorState::Dop853(s) => s,
             IntegratorState::OdeSolvers(s) if s.method == Method::Dop853 => {
@@ -920,37 +770,13 @@ impl Integrator for Dop853 {
                         .into(),
                 ));
             }
-            other => {
-                return Err(IntegrateError::Config(format!(
-                    "cannot restore a {} state into dop853",
-                    other.method()
-                )));
-            }
+            other => return Err(wrong_state(other, Method::Dop853)),
         };
-        let bad = |what: String| Err(IntegrateError::Config(format!("dop853 state: {what}")));
-        if s.dim != self.tol.rtol.len() {
-            return bad(format!(
-                "saved for dimension {}, tolerances have {}",
-                s.dim,
-                self.tol.rtol.len()
-            ));
-        }
-        if !(s.h.is_finite() && s.h >= 0.0) || s.h_min.is_nan() || s.h_max.is_nan() {
-            return bad(format!(
-                "bad step sizes (h = {}, h_min = {}, h_max = {})",
-                s.h, s.h_min, s.h_max
-            ));
-        }
-        if s.initial_step.is_some_and(|h| !(h.is_finite() && h > 0.0)) {
-            return bad("bad initial step".into());
-        }
-        self.initial_step = s.initial_step;
-        self.max_steps = s.max_steps;
-        self.h_min = s.h_min;
-        self.h_max = s.h_max;
-        self.max_nonfinite_retries = s.max_nonfinite_retries;
-        self.h = s.h;
-        self.stats = s.stats.into();
-        Ok(())
+        carried.dim = s.dim;
+        carried.limits = s.limits;
+        carried.initial_step = s.initial_step;
+        carried.h = s.h;
+        carried.stats = s.stats;
+        carried.check(Method::Dop853, self.tol.rtol.len())
     }
 }

@@ -4,7 +4,9 @@
 //! Differential-Algebraic Problems* (2nd ed., Springer 1996), §IV.9 "Extrapolation methods" (the linearly implicit
 //! Euler method, its h-expansion for an arbitrary matrix `J`, and the strategy of their code SEULEX: harmonic
 //! step-number sequence, order and step-size selection by work per unit step, stability check). This is an
-//! independent implementation written from that description, in the structure of our [`super::bulirsch_stoer`].
+//! independent implementation written from that description, in the structure of our [`super::bulirsch_stoer`]: this
+//! file supplies the base rule ([`LinearlyImplicitEuler`]) and SEULEX's constants, and the extrapolation, the
+//! column and step control ([`Extrapolation`]) and the step loop ([`Adaptive`]) are those of our ODEX.
 //!
 //! # The method
 //!
@@ -37,12 +39,15 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::bulirsch_stoer::{RUN_BUDGET, validate_tolerances};
-use super::common::{
-    IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Rejections, Stats, Tolerances, begin_advance,
+pub use super::adaptive_loop::DEFAULT_MAX_STEPS;
+use super::adaptive_loop::{
+    Adaptive, Carried, Cause, FirstStep, all_finite, hinit_h0, validate_tolerances, wrong_state,
 };
+use super::bulirsch_stoer::{BaseRule, Column, ColumnControlState, Extrapolation, Strategy, Unpacked, rms};
+#[cfg(doc)]
+use super::common::Integrator;
+use super::common::{IntegrateError, IntegratorState, Method, OdeSystem, Tolerances};
 pub use super::common::{LinearlyImplicitState, StiffSolve};
-use super::compensated::Compensation;
 
 /// A dense `J` (row-major `n × n`) solved by LU, refactorised when `h` changes: for small systems and tests.
 #[derive(Debug, Clone)]
@@ -79,30 +84,23 @@ impl StiffSolve for DenseStiff {
     }
 }
 
-/// Lower bound on the step-size factor (SEULEX `fac1`).
-const FAC1: f64 = 0.1;
-/// Upper bound on the step-size factor (SEULEX `fac2`).
-const FAC2: f64 = 4.0;
-/// Order decrease threshold on the work ratio (SEULEX `fac3`).
-const FAC3: f64 = 0.7;
-/// Order increase threshold on the work ratio (SEULEX `fac4`).
-const FAC4: f64 = 0.9;
-/// Safety factor on the error (SEULEX `safe1`).
-const SAFE1: f64 = 0.6;
-/// Safety factor on the step (SEULEX `safe2`).
-const SAFE2: f64 = 0.93;
-/// Step reduction after a failed stability check or a growing or non-finite error.
-const SAFE3: f64 = 0.5;
+/// SEULEX's step and order control (its `fac1 … fac4`, `safe1`, `safe2`).
+const SEULEX: Strategy = Strategy {
+    gragg: false,
+    fac1: 0.1,
+    fac2: 4.0,
+    fac3: 0.7,
+    fac4: 0.9,
+    safe1: 0.6,
+    safe2: 0.93,
+};
 /// Limit on `‖Δ_1‖ / ‖Δ_0‖` in the stability check of column 2.
 const STABILITY_RATIO: f64 = 2.0;
 /// Default maximum number of columns (SEULEX `km`): the highest order is `km`.
 pub const DEFAULT_MAX_COLUMNS: usize = 12;
-/// Default maximum number of step attempts per call to [`Integrator::advance`].
-pub const DEFAULT_MAX_STEPS: u64 = 100_000_000;
-/// Consecutive non-finite rejections before giving up.
-const MAX_NONFINITE_RETRIES: u32 = 10;
 
-/// Linearly implicit Euler extrapolation (SEULEX strategy), see the [module documentation](self).
+/// Linearly implicit Euler extrapolation (SEULEX strategy), see the [module documentation](self): the step loop
+/// [`Adaptive`] around [`Extrapolation`] of [`LinearlyImplicitEuler`].
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, linearly_implicit::LinearlyImplicit};
@@ -116,61 +114,39 @@ const MAX_NONFINITE_RETRIES: u32 = 10;
 /// assert!((y[0] - exact[0]).abs() < 1e-6);
 /// assert!(li.stats().steps_accepted < 200); // an explicit method needs ~1e6 steps here
 /// ```
-#[derive(Debug, Clone)]
-pub struct LinearlyImplicit {
-    tol: Tolerances,
-    km: usize,
-    max_steps: u64,
-    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
-    deadline: Option<std::time::Instant>,
-    span: Option<f64>,
-    /// Proposed |H| for the next step; 0 = unknown.
-    h: f64,
-    /// Target column count `k`, `2 ..= km − 1`.
-    k: usize,
-    reject: bool,
-    started: bool,
-    /// Step numbers `n_j = j` and cumulative work `A_j`, 1-based.
-    nj: Vec<f64>,
-    a: Vec<f64>,
-    /// Optimal step and work per unit step per column of the last attempt, 1-based.
-    hh: Vec<f64>,
-    w: Vec<f64>,
-    n: usize,
+pub type LinearlyImplicit = Adaptive<Extrapolation<LinearlyImplicitEuler>>;
+
+impl LinearlyImplicit {
+    /// A new integrator with per-component `tolerances` (see [`Tolerances`]). Errors with
+    /// [`IntegrateError::Config`] on tolerances of different lengths, negative, non-finite, or both zero.
+    pub fn new(tolerances: Tolerances) -> Result<Self, IntegrateError> {
+        validate_tolerances(&tolerances)?;
+        let rule = LinearlyImplicitEuler::default();
+        Adaptive::with_method(Extrapolation::new(tolerances, DEFAULT_MAX_COLUMNS, rule), None)
+    }
+
+    /// Linear solves `(I − h J) x = b` so far (one per substep).
+    pub fn solves(&self) -> u64 {
+        self.method.rule().solves
+    }
+}
+
+/// The linearly implicit Euler method (the base rule of SEULEX) with the stiff part the system supplies, and its
+/// work arrays.
+#[derive(Debug, Clone, Default)]
+pub struct LinearlyImplicitEuler {
     /// `f(t, y)` at the step's start.
     f0: Vec<f64>,
     /// The derivative at a trial state.
     f: Vec<f64>,
     /// The increment of a column's substeps from the step's start.
     d: Vec<f64>,
+    /// One substep's increment `Δ_m`.
     delta: Vec<f64>,
+    /// The trial state `y + d`.
     trial: Vec<f64>,
-    scal: Vec<f64>,
-    /// The tableau, `km` rows of `n` (increments from the step's start).
-    tab: Vec<f64>,
-    /// Compensated summation of the accepted increments ([`Compensation`]).
-    comp: Compensation,
-    stats: Stats,
-    rejections: Rejections,
+    evals: u64,
     solves: u64,
-}
-
-enum Column {
-    Done(f64),
-    Shrink(Shrink),
-}
-
-#[derive(Clone, Copy)]
-enum Shrink {
-    Stability,
-    Divergence,
-    NonFinite,
-}
-
-enum Attempt {
-    Accepted,
-    Rejected,
-    Shrink(Shrink),
 }
 
 /// The identity solve of a system without a stiff part (`J = 0`).
@@ -180,135 +156,68 @@ impl StiffSolve for NoStiffPart {
     fn solve(&mut self, _h: f64, _b: &mut [f64]) {}
 }
 
-impl LinearlyImplicit {
-    /// A new integrator with per-component `tolerances` (see [`Tolerances`]). Errors with
-    /// [`IntegrateError::Config`] on tolerances of different lengths, negative, non-finite, or both zero.
-    pub fn new(tolerances: Tolerances) -> Result<Self, IntegrateError> {
-        validate_tolerances(&tolerances)?;
-        let km = DEFAULT_MAX_COLUMNS;
-        let nj: Vec<f64> = (0..=km).map(|j| j as f64).collect();
-        let mut a = vec![0.0; km + 1];
-        for j in 1..=km {
-            a[j] = a[j - 1] + nj[j];
-        }
-        let rtol = tolerances.rtol.iter().copied().fold(f64::INFINITY, f64::min);
-        // SEULEX's initial column count from the tolerance: about one order per decade of it.
-        let k0 = (-(rtol + f64::EPSILON).log10() * 0.6 + 1.5).floor();
-        let k = if k0.is_finite() {
-            (k0.max(0.0) as usize).clamp(2, km - 1)
-        } else {
-            2
-        };
-        Ok(LinearlyImplicit {
-            tol: tolerances,
-            km,
-            max_steps: DEFAULT_MAX_STEPS,
-            deadline: None,
-            span: None,
-            h: 0.0,
-            k,
-            reject: false,
-            started: false,
-            nj,
-            a,
-            hh: vec![0.0; km + 1],
-            w: vec![0.0; km + 1],
-            n: 0,
-            f0: Vec::new(),
-            f: Vec::new(),
-            d: Vec::new(),
-            delta: Vec::new(),
-            trial: Vec::new(),
-            scal: Vec::new(),
-            tab: Vec::new(),
-            comp: Compensation::default(),
-            stats: Stats {
-                smallest_step: f64::INFINITY,
-                ..Stats::default()
-            },
-            rejections: Rejections::default(),
-            solves: 0,
-        })
-    }
+impl BaseRule for LinearlyImplicitEuler {
+    type Frozen<'s> = Box<dyn StiffSolve + 's>;
+    const METHOD: Method = Method::BulirschStoerImplicit;
+    const STRATEGY: Strategy = SEULEX;
 
-    /// Rejected steps by cause (cumulative).
-    pub fn rejections(&self) -> Rejections {
-        self.rejections
-    }
-
-    /// Linear solves `(I − h J) x = b` so far (one per substep).
-    pub fn solves(&self) -> u64 {
-        self.solves
-    }
-
-    /// The current target column count `k` (order `k`).
-    pub fn columns(&self) -> usize {
-        self.k
-    }
-
-    fn ensure_workspace(&mut self, n: usize) {
-        if self.n == n && self.f0.len() == n {
-            return;
-        }
-        self.n = n;
-        for v in [
-            &mut self.f0,
-            &mut self.f,
-            &mut self.d,
-            &mut self.delta,
-            &mut self.trial,
-            &mut self.scal,
-        ] {
+    fn resize(&mut self, n: usize) {
+        for v in [&mut self.f0, &mut self.f, &mut self.d, &mut self.delta, &mut self.trial] {
             *v = vec![0.0; n];
         }
-        self.tab = vec![0.0; self.km * n];
     }
 
-    /// The scaled RMS norm of `v` against `scal`.
-    fn norm(&self, v: &[f64]) -> f64 {
-        let sum: f64 = v.iter().zip(&self.scal).map(|(x, s)| (x / s).powi(2)).sum();
-        (sum / self.n as f64).sqrt()
+    fn evaluations(&self) -> u64 {
+        self.evals
     }
 
-    /// Initial step from `‖y‖/‖f‖` (the first half of Hairer's `hinit`): the step control grows it by up to
-    /// `FAC2` per step.
-    fn initial_step(&self, y: &[f64], span: f64) -> f64 {
-        let d0 = self.norm(y);
-        let d1 = self.norm(&self.f0);
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 { 1e-6 } else { 0.01 * d0 / d1 };
+    fn set_evaluations(&mut self, n: u64) {
+        self.evals = n;
+    }
+
+    /// The derivative at the step's start, and the stiff part linearised there.
+    fn start<'s>(&mut self, system: &'s dyn OdeSystem, t: f64, y: &[f64]) -> Option<Box<dyn StiffSolve + 's>> {
+        system.begin_step(t, y);
+        self.evals += 1;
+        system.rhs(t, y, &mut self.f0);
+        if !all_finite(&self.f0) {
+            return None;
+        }
+        Some(system.stiff_part(t, y).unwrap_or_else(|| Box::new(NoStiffPart)))
+    }
+
+    /// The first half of Hairer's `hinit`, `0.01 ‖y‖ / ‖f‖`: the step control grows it by up to `fac2` per step.
+    fn initial_step(&mut self, _system: &dyn OdeSystem, y: &[f64], scal: &[f64], _k: usize, first: &FirstStep) -> f64 {
+        let h0 = hinit_h0(rms(y, scal), rms(&self.f0, scal));
         if h0.is_finite() && h0 > 0.0 {
-            h0.min(span)
+            h0.min(first.span)
         } else {
-            1e-6f64.min(span)
+            1e-6f64.min(first.span)
         }
     }
 
-    /// Column `j` of the tableau for the step `(t, y) → t + h` with the stiff part `stiff`.
-    #[allow(clippy::too_many_arguments)]
+    /// `n_j = j` substeps `(I − h_j J) Δ_m = h_j f(t + m h_j, y + d_m)` of `h_j = H/n_j`, with SEULEX's stability
+    /// check in column 2 (the second increment at most twice the first).
     fn column(
         &mut self,
         system: &dyn OdeSystem,
-        stiff: &mut dyn StiffSolve,
-        t: f64,
-        y: &[f64],
-        h: f64,
-        j: usize,
-        err_prev: &mut f64,
-    ) -> Column {
-        let n = self.n;
-        let nsub = j;
-        let hj = h / self.nj[j];
+        stiff: &mut Box<dyn StiffSolve + '_>,
+        column: &Column<'_>,
+        row: &mut [f64],
+    ) -> Result<(), Cause> {
+        let &Column { y, trial, j, scal } = column;
+        let hj = trial.h / j as f64;
         self.d.fill(0.0);
         let mut first_norm = 0.0;
-        for m in 0..nsub {
+        for m in 0..j {
             if m == 0 {
                 self.delta.copy_from_slice(&self.f0);
             } else {
                 for ((z, &yi), &di) in self.trial.iter_mut().zip(y).zip(&self.d) {
                     *z = yi + di;
                 }
-                self.stats.rhs_evaluations += 1;
-                system.rhs(t + hj * m as f64, &self.trial, &mut self.f);
+                self.evals += 1;
+                system.rhs(trial.t + hj * m as f64, &self.trial, &mut self.f);
                 self.delta.copy_from_slice(&self.f);
             }
             for x in self.delta.iter_mut() {
@@ -316,393 +225,49 @@ impl LinearlyImplicit {
             }
             stiff.solve(hj, &mut self.delta);
             self.solves += 1;
-            if !self.delta.iter().all(|x| x.is_finite()) {
-                return Column::Shrink(Shrink::NonFinite);
+            if !all_finite(&self.delta) {
+                return Err(Cause::NonFinite);
             }
             if j == 2 {
-                let size = self.norm(&self.delta);
+                let size = rms(&self.delta, scal);
                 if m == 0 {
                     first_norm = size;
                 } else if first_norm > 0.0 && size > STABILITY_RATIO * first_norm {
-                    return Column::Shrink(Shrink::Stability);
+                    return Err(Cause::Stability);
                 }
             }
             for (di, &x) in self.d.iter_mut().zip(&self.delta) {
                 *di += x;
             }
         }
-        self.tab[(j - 1) * n..j * n].copy_from_slice(&self.d);
-        if j == 1 {
-            return Column::Done(0.0);
-        }
-        // Aitken–Neville in h: row r (0-based) becomes T_{j, j−r}.
-        for l in (2..=j).rev() {
-            let inv = 1.0 / (self.nj[j] / self.nj[l - 1] - 1.0);
-            let (lo, hi) = self.tab.split_at_mut((l - 1) * n);
-            for (dst, &src) in lo[(l - 2) * n..].iter_mut().zip(&hi[..n]) {
-                *dst = src + (src - *dst) * inv;
-            }
-        }
-        let mut sum = 0.0;
-        {
-            let (r0, r1) = self.tab.split_at(n);
-            for i in 0..n {
-                let sc =
-                    (self.tol.atol[i] + self.tol.rtol[i] * y[i].abs().max((y[i] + r0[i]).abs())).max(f64::MIN_POSITIVE);
-                sum += ((r0[i] - r1[i]) / sc).powi(2);
-            }
-        }
-        let mut err = (sum / n as f64).sqrt();
-        if let Some(span) = self.span {
-            let rtol = self.tol.rtol.iter().copied().fold(f64::INFINITY, f64::min);
-            let floor = (10.0 * f64::EPSILON / rtol).min(1.0);
-            err /= (RUN_BUDGET * h.abs() / span).clamp(floor, 1.0);
-        }
-        if err.is_nan() {
-            return Column::Shrink(Shrink::NonFinite);
-        }
-        if err * f64::EPSILON >= 1.0 || (j > 2 && err >= *err_prev) {
-            return Column::Shrink(Shrink::Divergence);
-        }
-        *err_prev = (4.0 * err).max(1.0);
-        // T_{j,j−1} has order j − 1: its local error is O(H^j), per unit step O(H^{j−1}).
-        let expo = if self.span.is_some() {
-            1.0 / (j - 1) as f64
-        } else {
-            1.0 / j as f64
-        };
-        let facmin = FAC1.powf(expo);
-        let fac = (FAC2 / facmin).min(facmin.max((err / SAFE1).powf(expo) / SAFE2));
-        self.hh[j] = h.abs() / fac;
-        self.w[j] = self.a[j] / self.hh[j];
-        Column::Done(err)
+        row.copy_from_slice(&self.d);
+        Ok(())
     }
 
-    /// One step attempt (SEULEX's column strategy with its convergence monitor); `special` = first or last step,
-    /// where the column count grows until convergence.
-    fn attempt(
-        &mut self,
-        system: &dyn OdeSystem,
-        stiff: &mut dyn StiffSolve,
-        t: f64,
-        y: &[f64],
-        h: f64,
-        special: bool,
-    ) -> Attempt {
-        for ((sc, &yi), (&a, &r)) in self
-            .scal
-            .iter_mut()
-            .zip(y)
-            .zip(self.tol.atol.iter().zip(&self.tol.rtol))
-        {
-            *sc = (a + r * yi.abs()).max(f64::MIN_POSITIVE);
-        }
-        let k = self.k;
-        let mut err_prev = f64::INFINITY;
-        let mut err = 0.0;
-        macro_rules! column {
-            ($j:expr) => {
-                match self.column(system, stiff, t, y, h, $j, &mut err_prev) {
-                    Column::Done(e) => err = e,
-                    Column::Shrink(why) => return Attempt::Shrink(why),
-                }
-            };
-        }
-        if special {
-            for j in 1..=k {
-                column!(j);
-                if j > 1 && err <= 1.0 {
-                    return self.accept(j, h.abs());
-                }
-            }
-        } else {
-            for j in 1..k {
-                column!(j);
-            }
-            if !(k == 2 || self.reject) {
-                if err <= 1.0 {
-                    return self.accept(k - 1, h.abs());
-                }
-                if err > self.nj[k + 1] * self.nj[k] * 4.0 {
-                    return self.reject_step(k - 1);
-                }
-            }
-            column!(k);
-            if err <= 1.0 {
-                return self.accept(k, h.abs());
-            }
-        }
-        if err > self.nj[k + 1] * 2.0 {
-            return self.reject_step(k);
-        }
-        column!(k + 1);
-        if err > 1.0 {
-            self.reject_step(k + 1)
-        } else {
-            self.accept(k + 1, h.abs())
-        }
-    }
-
-    /// Step accepted after `kc` columns: the next column count minimises the work per unit step.
-    fn accept(&mut self, kc: usize, h_abs: f64) -> Attempt {
-        let km = self.km;
-        let w = &self.w;
-        let kopt = if kc == 2 {
-            if self.reject { 2 } else { 3.min(km - 1) }
-        } else {
-            let mut kopt = kc;
-            if w[kc - 1] < w[kc] * FAC3 {
-                kopt = kc - 1;
-            }
-            if w[kc] < w[kc - 1] * FAC4 {
-                kopt = (kc + 1).min(km - 1);
-            }
-            kopt
-        };
-        // Accepted in column km (one past the target k = km − 1): the target stays below km.
-        let kopt = kopt.min(km - 1);
-        // The tableau's answer is column kc: put T_{kc,kc} in row 0 (it is there already).
-        if self.reject {
-            self.k = kopt.min(kc);
-            self.h = h_abs.min(self.hh[self.k]);
-            self.reject = false;
-        } else {
-            self.h = if kopt <= kc {
-                self.hh[kopt]
-            } else {
-                self.hh[kc] * self.a[kopt] / self.a[kc]
-            };
-            self.k = kopt;
-        }
-        Attempt::Accepted
-    }
-
-    /// Step rejected by the error test after `kc` columns: reduce the column count and the step.
-    fn reject_step(&mut self, kc: usize) -> Attempt {
-        let mut k = self.k.min(kc).min(self.km - 1);
-        if k > 2 && self.w[k - 1] < self.w[k] * FAC3 {
-            k -= 1;
-        }
-        self.k = k;
-        self.h = self.hh[k];
-        self.reject = true;
-        Attempt::Rejected
-    }
-
-    fn advance_steps(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        let n = self.n;
-        let dir = if t_target > *t { 1.0 } else { -1.0 };
-        system.begin_step(*t, y);
-        self.stats.rhs_evaluations += 1;
-        system.rhs(*t, y, &mut self.f0);
-        if !self.f0.iter().all(|x| x.is_finite()) {
-            return Err(IntegrateError::NonFinite { t: *t });
-        }
-        let mut stiff = system.stiff_part(*t, y).unwrap_or_else(|| Box::new(NoStiffPart));
-        if self.h == 0.0 {
-            for (sc, (&yi, (&a, &r))) in self
-                .scal
-                .iter_mut()
-                .zip(y.iter().zip(self.tol.atol.iter().zip(&self.tol.rtol)))
-            {
-                *sc = (a + r * yi.abs()).max(f64::MIN_POSITIVE);
-            }
-            self.h = self.initial_step(y, (t_target - *t).abs());
-        }
-        let mut attempts: u64 = 0;
-        let mut nonfinite_run: u32 = 0;
-        let mut clean = true;
-        loop {
-            let remaining = (t_target - *t).abs();
-            let last = self.h * 1.01 >= remaining;
-            if !last && (self.h.is_nan() || self.h < 10.0 * f64::EPSILON * t.abs() || self.h == 0.0) {
-                return Err(if nonfinite_run > 0 {
-                    IntegrateError::NonFinite { t: *t }
-                } else {
-                    IntegrateError::StepUnderflow { t: *t, h: dir * self.h }
-                });
-            }
-            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-                return Err(IntegrateError::Deadline { t: *t });
-            }
-            if attempts >= self.max_steps {
-                return Err(IntegrateError::TooManySteps {
-                    t: *t,
-                    max_steps: self.max_steps,
-                });
-            }
-            attempts += 1;
-            let h_abs = if last { remaining } else { self.h };
-            let (saved_h, saved_k) = (self.h, self.k);
-            let special = !self.started || last;
-            self.started = true;
-            match self.attempt(system, stiff.as_mut(), *t, y, dir * h_abs, special) {
-                Attempt::Accepted => {
-                    self.comp.add(y, &self.tab[..n]);
-                    self.stats.steps_accepted += 1;
-                    if !(last && h_abs < saved_h) {
-                        self.stats.smallest_step = self.stats.smallest_step.min(h_abs);
-                    }
-                    nonfinite_run = 0;
-                    if last {
-                        *t = t_target;
-                        if clean && h_abs < saved_h {
-                            self.h = self.h.max(saved_h);
-                            self.k = saved_k;
-                        }
-                        return Ok(());
-                    }
-                    *t += dir * h_abs;
-                    clean = true;
-                    system.begin_step(*t, y);
-                    self.stats.rhs_evaluations += 1;
-                    system.rhs(*t, y, &mut self.f0);
-                    if !self.f0.iter().all(|x| x.is_finite()) {
-                        return Err(IntegrateError::NonFinite { t: *t });
-                    }
-                    // The stiff part of the next step, linearised at its start.
-                    stiff = system.stiff_part(*t, y).unwrap_or_else(|| Box::new(NoStiffPart));
-                }
-                Attempt::Rejected => {
-                    self.stats.steps_rejected += 1;
-                    self.rejections.error += 1;
-                    nonfinite_run = 0;
-                    clean = false;
-                }
-                Attempt::Shrink(why) => {
-                    self.stats.steps_rejected += 1;
-                    self.h = h_abs * SAFE3;
-                    self.reject = true;
-                    clean = false;
-                    match why {
-                        Shrink::Stability => self.rejections.stability += 1,
-                        Shrink::Divergence => self.rejections.divergence += 1,
-                        Shrink::NonFinite => self.rejections.nonfinite += 1,
-                    }
-                    if let Shrink::NonFinite = why {
-                        nonfinite_run += 1;
-                        if nonfinite_run > MAX_NONFINITE_RETRIES {
-                            return Err(IntegrateError::NonFinite { t: *t });
-                        }
-                    } else {
-                        nonfinite_run = 0;
-                    }
-                }
-            }
-        }
-    }
-}
-
-impl Integrator for LinearlyImplicit {
-    fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps.max(1);
-    }
-
-    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
-        self.deadline = deadline;
-    }
-
-    fn advance(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        let n = system.dim();
-        if !begin_advance(n, self.tol.rtol.len(), t, y, t_target)? {
-            return Ok(());
-        }
-        self.ensure_workspace(n);
-        self.comp.begin(y);
-        let result = self.advance_steps(system, t, y, t_target);
-        system.end_steps();
-        self.comp.end(y);
-        result
-    }
-
-    fn stats(&self) -> Stats {
-        self.stats
-    }
-
-    fn set_span(&mut self, span: f64) {
-        self.span = (span.is_finite() && span > 0.0).then_some(span);
-    }
-
-    fn method(&self) -> Method {
-        Method::BulirschStoerImplicit
-    }
-
-    fn save_state(&self) -> IntegratorState {
+    fn save(&self, km: usize, columns: ColumnControlState, carried: Carried) -> IntegratorState {
         IntegratorState::LinearlyImplicit(LinearlyImplicitState {
-            dim: self.tol.rtol.len(),
-            km: self.km,
-            max_steps: self.max_steps,
-            span: self.span,
-            h: self.h,
-            k: self.k,
-            reject: self.reject,
-            started: self.started,
-            hh: self.hh.clone(),
-            w: self.w.clone(),
-            stats: self.stats.into(),
-            rejections: self.rejections,
+            dim: carried.dim,
+            km,
+            max_steps: carried.limits.max_steps,
+            columns,
             solves: self.solves,
-            compensation: self.comp.carry.clone(),
+            compensation: carried.compensation,
         })
     }
 
-    fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
-        let s = match state {
-            IntegratorState::LinearlyImplicit(s) => s,
-            other => {
-                return Err(IntegrateError::Config(format!(
-                    "cannot restore a {} state into bulirsch-stoer-implicit",
-                    other.method()
-                )));
-            }
+    /// Of the loop's settings the state keeps the step budget: `h_min`, `h_max` and the non-finite retries stay the
+    /// integrator's own (its layout predates them).
+    fn unpack<'a>(state: &'a IntegratorState, carried: &mut Carried) -> Unpacked<'a> {
+        let IntegratorState::LinearlyImplicit(s) = state else {
+            return Err(wrong_state(state, Self::METHOD));
         };
-        let bad = |what: String| Err(IntegrateError::Config(format!("bulirsch-stoer-implicit state: {what}")));
-        if s.dim != self.tol.rtol.len() {
-            return bad(format!(
-                "saved for dimension {}, tolerances have {}",
-                s.dim,
-                self.tol.rtol.len()
-            ));
+        carried.limits.max_steps = s.max_steps;
+        Ok((s.dim, s.km, &s.columns, &s.compensation))
+    }
+
+    fn restore_own(&mut self, state: &IntegratorState) {
+        if let IntegratorState::LinearlyImplicit(s) = state {
+            self.solves = s.solves;
         }
-        if s.km != self.km || !(2..s.km).contains(&s.k) {
-            return bad(format!("columns {} of {} (expected at most {})", s.k, s.km, self.km));
-        }
-        if s.hh.len() != s.km + 1 || s.w.len() != s.km + 1 {
-            return bad(format!("per-column arrays must have {} entries", s.km + 1));
-        }
-        if !(s.h.is_finite() && s.h >= 0.0) || s.span.is_some_and(|t| !(t.is_finite() && t > 0.0)) {
-            return bad(format!("bad step size {} or span {:?}", s.h, s.span));
-        }
-        if !(s.compensation.is_empty() || s.compensation.len() == s.dim)
-            || !s.compensation.iter().all(|c| c.is_finite())
-        {
-            return bad(format!("compensation must be empty or {} finite entries", s.dim));
-        }
-        self.max_steps = s.max_steps;
-        self.span = s.span;
-        self.h = s.h;
-        self.k = s.k;
-        self.reject = s.reject;
-        self.started = s.started;
-        self.hh.copy_from_slice(&s.hh);
-        self.w.copy_from_slice(&s.w);
-        self.stats = s.stats.into();
-        self.rejections = s.rejections;
-        self.solves = s.solves;
-        self.comp.carry.clone_from(&s.compensation);
-        self.comp.forget_output();
-        Ok(())
     }
 }

@@ -1,6 +1,9 @@
 //! Integrators for first-order systems `y' = f(t, y)`.
 //!
-//! One integrator per file behind the small [`Integrator`] trait (the REBOUND layout):
+//! One integrator per file behind the small [`Integrator`] trait (the REBOUND layout), the three of our own as one
+//! step loop around a method's step:
+//! - [`adaptive_loop`]: the loop (landing on output times, non-finite retries, compensated summation, budgets,
+//!   statistics, the common part of a checkpoint state) and the trait a method implements to run in it;
 //! - [`bulirsch_stoer`]: our own adaptive Gragg–Bulirsch–Stoer extrapolation integrator in the style of
 //!   Hairer's ODEX (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9), the method Roig03 §3 used;
 //! - [`dop853`]: our own DOP853 of Dormand & Prince (order 8 with Hairer's 5th- and 3rd-order error estimators
@@ -18,6 +21,7 @@
 //! names the methods ([`make_integrator`]), so the files form no circle. The work–precision measurements that
 //! exercise these solvers are the `rubblepile bench` program's.
 
+pub mod adaptive_loop;
 pub mod bulirsch_stoer;
 pub mod compensated;
 pub mod dop853;

@@ -38,11 +38,16 @@
 //! * **Checkpoints.** Since every `advance` starts a new `ode_solvers` run, the state carried between
 //!   calls is only the next initial step, the counters and the settings ([`OdeSolversState`]);
 //!   restoring it continues bit for bit.
+//! * **Budgets**: the step budget and wall-clock deadline are [`Budget`]'s, as in the step loop of our own methods
+//!   (`adaptive_loop.rs`), checked before every `ode_solvers` run; a call's checks are theirs too.
 //! * **Failure**: on error `t, y` are left at the last accepted state (the start of the call if no
 //!   step was accepted), never at a trial state.
 
+use super::adaptive_loop::{Budget, wrong_state};
 pub use super::common::OdeSolversState;
-use super::common::{IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances};
+use super::common::{
+    Advanced, IntegrateError, Integrator, IntegratorState, Method, OdeSystem, Stats, Tolerances, begin_advance,
+};
 use ode_solvers::dop_shared::IntegrationError;
 use ode_solvers::{DVector, Dop853, Dopri5, OutputType, Rk4, System};
 use std::cell::{Cell, RefCell};
@@ -127,9 +132,7 @@ pub struct OdeSolversAdapter {
     step: Option<f64>,
     /// Step to start the next call with (adaptive methods); 0 = automatic.
     h_next: f64,
-    max_steps: u64,
-    /// Wall-clock instant after which an advance stops ([`IntegrateError::Deadline`]); not part of the saved state.
-    deadline: Option<std::time::Instant>,
+    budget: Budget,
     chunk_steps: Option<usize>,
     stats: Stats,
 }
@@ -191,19 +194,15 @@ impl OdeSolversAdapter {
             } else {
                 step.map_or(0.0, f64::abs)
             },
-            max_steps: super::bulirsch_stoer::DEFAULT_MAX_STEPS,
-            deadline: None,
+            budget: Budget::DEFAULT,
             chunk_steps: None,
-            stats: Stats {
-                smallest_step: f64::INFINITY,
-                ..Stats::default()
-            },
+            stats: Stats::initial(),
         })
     }
 
     /// Sets the maximum number of steps in one call to [`Integrator::advance`] (default 10⁸).
     pub fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps;
+        self.budget.max_steps = max_steps;
     }
 
     /// Sets the number of steps per `ode_solvers` run (see the module docs); `None` = automatic
@@ -217,34 +216,8 @@ impl OdeSolversAdapter {
             .unwrap_or_else(|| (CHUNK_BYTES / (8 * (n + 1))).clamp(16, 1 << 20))
     }
 
-    fn check(&self, system: &dyn OdeSystem, t: f64, y: &[f64], t_target: f64) -> Result<(), IntegrateError> {
-        let n = system.dim();
-        if y.len() != n || self.n_tol != n {
-            return Err(IntegrateError::Config(format!(
-                "dimension mismatch: system {n}, state {}, tolerances {}",
-                y.len(),
-                self.n_tol
-            )));
-        }
-        if !t.is_finite() || !t_target.is_finite() {
-            return Err(IntegrateError::Config(format!(
-                "times must be finite (t = {t}, t_target = {t_target})"
-            )));
-        }
-        if !y.iter().all(|v| v.is_finite()) {
-            return Err(IntegrateError::NonFinite { t });
-        }
-        Ok(())
-    }
-
     /// Dop853 / Dopri5.
-    fn advance_adaptive(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
+    fn advance_adaptive(&mut self, system: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_target: f64) -> Advanced {
         let n = y.len();
         let chunk = self.chunk(n);
         let evals = Cell::new(0u64);
@@ -278,16 +251,10 @@ impl OdeSolversAdapter {
         let dir = if t_target > x { 1.0 } else { -1.0 };
 
         let result = loop {
-            if self.deadline.is_some_and(|d| std::time::Instant::now() >= d) {
-                break Err(IntegrateError::Deadline { t: x });
+            if let Err(e) = self.budget.check(x, steps) {
+                break Err(e);
             }
-            if steps >= self.max_steps {
-                break Err(IntegrateError::TooManySteps {
-                    t: x,
-                    max_steps: self.max_steps,
-                });
-            }
-            let n_max = (chunk as u64).min(self.max_steps - steps).min(u32::MAX as u64) as u32;
+            let n_max = (chunk as u64).min(self.budget.max_steps - steps).min(u32::MAX as u64) as u32;
             let f = Wrapped {
                 system,
                 t0: 0.0,
@@ -300,55 +267,37 @@ impl OdeSolversAdapter {
             let h0 = dir * self.h_next;
             let evals_before = evals.get();
             let h_max = (t_target - x).abs();
+            // One run of the crate's `$solver` with its controller's safety factor, β, and smallest and largest step
+            // ratios; its accepted steps' times, the last finite state and its index.
+            macro_rules! run {
+                ($solver:ident, $safety:expr, $beta:expr, $fac_min:expr, $fac_max:expr) => {{
+                    let mut s = $solver::from_param(
+                        f,
+                        x,
+                        t_target,
+                        t_target - x,
+                        state.clone(),
+                        rtol,
+                        atol,
+                        $safety,
+                        $beta,
+                        $fac_min,
+                        $fac_max,
+                        h_max,
+                        h0,
+                        n_max,
+                        u32::MAX,
+                        OutputType::Sparse,
+                    );
+                    let res = s.integrate();
+                    let (xs, ys) = s.results().get();
+                    let (last, last_state) = last_finite(ys);
+                    (res, xs.clone(), last, last_state)
+                }};
+            }
             let (res, xs, last, last_state) = match self.method {
-                Method::Dop853 => {
-                    let mut s = Dop853::from_param(
-                        f,
-                        x,
-                        t_target,
-                        t_target - x,
-                        state.clone(),
-                        rtol,
-                        atol,
-                        0.9,
-                        0.0,
-                        0.333,
-                        6.0,
-                        h_max,
-                        h0,
-                        n_max,
-                        u32::MAX,
-                        OutputType::Sparse,
-                    );
-                    let res = s.integrate();
-                    let (xs, ys) = s.results().get();
-                    let (last, last_state) = last_finite(ys);
-                    (res, xs.clone(), last, last_state)
-                }
-                _ => {
-                    let mut s = Dopri5::from_param(
-                        f,
-                        x,
-                        t_target,
-                        t_target - x,
-                        state.clone(),
-                        rtol,
-                        atol,
-                        0.9,
-                        0.04,
-                        0.2,
-                        10.0,
-                        h_max,
-                        h0,
-                        n_max,
-                        u32::MAX,
-                        OutputType::Sparse,
-                    );
-                    let res = s.integrate();
-                    let (xs, ys) = s.results().get();
-                    let (last, last_state) = last_finite(ys);
-                    (res, xs.clone(), last, last_state)
-                }
+                Method::Dop853 => run!(Dop853, 0.9, 0.0, 0.333, 6.0),
+                _ => run!(Dopri5, 0.9, 0.04, 0.2, 10.0),
             };
             // xs[0] is the chunk's start; xs[1..=last] are accepted steps with finite states.
             let finite_end = last == xs.len() - 1;
@@ -420,22 +369,16 @@ impl OdeSolversAdapter {
     }
 
     /// Fixed-step Rk4 landing exactly on `t_target`.
-    fn advance_rk4(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
+    fn advance_rk4(&mut self, system: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_target: f64) -> Advanced {
         let h = self.step.expect("rk4 step checked in new");
         let t_start = *t;
         let span = t_target - t_start;
         let dir = span.signum();
         let n_total = ((span.abs() / h) * (1.0 - 1e-12)).ceil().max(1.0);
-        if n_total > self.max_steps as f64 {
+        if n_total > self.budget.max_steps as f64 {
             return Err(IntegrateError::TooManySteps {
                 t: t_start,
-                max_steps: self.max_steps,
+                max_steps: self.budget.max_steps,
             });
         }
         let n_total = n_total as u64;
@@ -520,33 +463,22 @@ fn last_finite(ys: &[DVector<f64>]) -> (usize, DVector<f64>) {
 }
 
 impl Integrator for OdeSolversAdapter {
-    fn set_max_steps(&mut self, max_steps: u64) {
-        self.max_steps = max_steps.max(1);
-    }
-
-    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
-        self.deadline = deadline;
-    }
-
-    fn advance(
-        &mut self,
-        system: &dyn OdeSystem,
-        t: &mut f64,
-        y: &mut [f64],
-        t_target: f64,
-    ) -> Result<(), IntegrateError> {
-        self.check(system, *t, y, t_target)?;
-        if t_target == *t {
-            return Ok(());
-        }
-        if y.is_empty() {
-            *t = t_target;
+    fn advance(&mut self, system: &dyn OdeSystem, t: &mut f64, y: &mut [f64], t_target: f64) -> Advanced {
+        if !begin_advance(system.dim(), self.n_tol, t, y, t_target)? {
             return Ok(());
         }
         match self.method {
             Method::Rk4 => self.advance_rk4(system, t, y, t_target),
             _ => self.advance_adaptive(system, t, y, t_target),
         }
+    }
+
+    fn set_deadline(&mut self, deadline: Option<std::time::Instant>) {
+        self.budget.deadline = deadline;
+    }
+
+    fn set_max_steps(&mut self, max_steps: u64) {
+        self.budget.max_steps = max_steps.max(1);
     }
 
     fn stats(&self) -> Stats {
@@ -565,7 +497,7 @@ impl Integrator for OdeSolversAdapter {
             atol: self.atol,
             step: self.step,
             h_next: self.h_next,
-            max_steps: self.max_steps,
+            max_steps: self.budget.max_steps,
             chunk_steps: self.chunk_steps,
             stats: self.stats.into(),
         })
@@ -574,13 +506,7 @@ impl Integrator for OdeSolversAdapter {
     fn restore_state(&mut self, state: &IntegratorState) -> Result<(), IntegrateError> {
         let s = match state {
             IntegratorState::OdeSolvers(s) if s.method == self.method => s,
-            other => {
-                return Err(IntegrateError::Config(format!(
-                    "cannot restore a {} state into {}",
-                    other.method(),
-                    self.method
-                )));
-            }
+            other => return Err(wrong_state(other, self.method)),
         };
         let same = |a: f64, b: f64| a.to_bits() == b.to_bits();
         if s.dim != self.n_tol || !same(s.rtol, self.rtol) || !same(s.atol, self.atol) {
@@ -600,7 +526,7 @@ impl Integrator for OdeSolversAdapter {
         }
         self.step = s.step;
         self.h_next = s.h_next;
-        self.max_steps = s.max_steps;
+        self.budget.max_steps = s.max_steps;
         self.chunk_steps = s.chunk_steps.map(|c| c.max(1));
         self.stats = s.stats.into();
         Ok(())
