@@ -16,9 +16,10 @@ use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::{from_unit_quaternion, rotation_matrix, to_unit_quaternion};
 use crate::impact::error::{ImpactError, read_target};
 pub use crate::impact::projectile::PileRecord;
-use crate::impact::projectile::{ERG_PER_G_PER_J_PER_KG, ImpactSetup, ProjectileSpec, first_contact_distance};
+use crate::impact::projectile::{
+    ERG_PER_G_PER_J_PER_KG, ImpactSetup, ProjectileSpec, first_contact_distance, target_and_direction,
+};
 use crate::impact::target::to_centre_of_mass_frame;
-use crate::math::Vec3;
 use crate::random::{generator, random_quaternion};
 
 /// A rubble-pile projectile: the bodies of a pile file (any frame, any N and spin).
@@ -107,12 +108,8 @@ pub fn set_up_pile_impact(
     contact_time: f64,
     seed: u64,
 ) -> (Vec<Body>, ImpactSetup) {
-    let mut bodies = target.to_vec();
-    to_centre_of_mass_frame(&mut bodies);
+    let (mut bodies, target_mass, n) = target_and_direction(target, angle_deg);
     let n_t = bodies.len();
-    let target_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let zeta = angle_deg.to_radians();
-    let n = Vec3::new(0.0, zeta.sin(), zeta.cos());
     let incoming = pile.oriented_bodies(seed);
     let touch = first_contact_distance(&bodies, &incoming, &n);
     let start = touch + projectile.speed * contact_time;

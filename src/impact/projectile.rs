@@ -92,6 +92,16 @@ pub struct ImpactSetup {
     pub projectile_pile: Option<PileRecord>,
 }
 
+/// The target's bodies in their centre-of-mass frame, their total mass (kg) and the unit vector `n` from the
+/// target's centre towards the incoming projectile, at `angle_deg` (ζ, degrees) from the z axis in the y–z plane.
+pub fn target_and_direction(target: &[Body], angle_deg: f64) -> (Vec<Body>, f64, Vec3) {
+    let mut bodies = target.to_vec();
+    to_centre_of_mass_frame(&mut bodies);
+    let target_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let zeta = angle_deg.to_radians();
+    (bodies, target_mass, Vec3::new(0.0, zeta.sin(), zeta.cos()))
+}
+
 /// Adds the projectile to `target` (bodies of the target, any frame) and returns the whole system in its
 /// centre-of-mass frame, with the setup. `contact_time` (s) is when the surfaces first touch.
 pub fn set_up_impact(
@@ -101,11 +111,7 @@ pub fn set_up_impact(
     contact_time: f64,
     seed: u64,
 ) -> (Vec<Body>, ImpactSetup) {
-    let mut bodies = target.to_vec();
-    to_centre_of_mass_frame(&mut bodies);
-    let target_mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let zeta = angle_deg.to_radians();
-    let n = Vec3::new(0.0, zeta.sin(), zeta.cos());
+    let (mut bodies, target_mass, n) = target_and_direction(target, angle_deg);
     let shape = projectile.shape();
     let quaternion = random_quaternion(&mut generator(seed));
     let incoming = [Body {
