@@ -41,14 +41,15 @@ pub fn run_campaign_anywhere(
     }
     #[cfg(not(feature = "mpi"))]
     if ranks > 1 {
-        return Err(CampaignError::Invalid {
+        return Err(crate::io::scene_file::SceneError::Invalid {
             file: campaign.name.clone(),
             field: "mpirun".into(),
             message: format!(
                 "started as one of {ranks} MPI ranks, but this rubblepile was built without MPI: build it with \
                  `cargo build --release --features mpi` (needs Open MPI and libclang), or run without mpirun"
             ),
-        });
+        }
+        .into());
     }
     run_campaign(campaign, options).map(Some)
 }

@@ -107,10 +107,10 @@ pub struct CustomProjectile {
 /// messages naming the line and the field (`unknown field `x` in [campaign]`, `campaign.out: missing …`).
 pub(crate) fn parse_toml(text: &str, name: &str) -> Result<CampaignFile, CampaignError> {
     crate::io::scene_file::parse_toml_as(text, name).map_err(|e| match e {
-        crate::io::scene_file::SceneError::Syntax { file, message } => CampaignError::Syntax { file, message },
-        other => CampaignError::Syntax {
+        crate::io::scene_file::SceneError::Syntax { .. } => CampaignError::File(e),
+        other => CampaignError::File(crate::io::scene_file::SceneError::Syntax {
             file: name.to_string(),
             message: other.to_string(),
-        },
+        }),
     })
 }

@@ -122,32 +122,11 @@ pub const CAMPAIGN_COLUMNS: [&str; 14] = [
 /// A bad campaign file, or a campaign directory that cannot be written. Messages are one line.
 #[derive(Debug, thiserror::Error)]
 pub enum CampaignError {
-    /// The campaign file could not be read.
-    #[error("{file}: cannot read: {reason}")]
-    Read {
-        /// The file as named.
-        file: String,
-        /// The OS error.
-        reason: String,
-    },
-    /// Malformed TOML, an unknown or missing key, a value of the wrong type.
-    #[error("{file}: {message}")]
-    Syntax {
-        /// The file.
-        file: String,
-        /// One line, with the field and the line.
-        message: String,
-    },
-    /// A value out of range (or a target file that cannot be used).
-    #[error("{file}: {field}: {message}")]
-    Invalid {
-        /// The file.
-        file: String,
-        /// Dotted path of the field, e.g. `campaign.angles[2]`.
-        field: String,
-        /// What was expected and what was given.
-        message: String,
-    },
+    /// The campaign file could not be read, is malformed (TOML, an unknown or missing key, a value of the wrong
+    /// type) or has a value out of range (or a target file that cannot be used): the scene files' errors, whose
+    /// `Invalid` field is the dotted path, e.g. `campaign.angles[2]`.
+    #[error(transparent)]
+    File(#[from] crate::io::scene_file::SceneError),
     /// Another rubblepile process writes the campaign directory (or this shard's index).
     #[error(transparent)]
     Locked(#[from] crate::io::run_lock::LockError),

@@ -50,7 +50,7 @@ pub fn run_campaign_mpi(
     campaign: &Campaign,
     options: &CampaignOptions,
 ) -> Result<Option<CampaignReport>, CampaignError> {
-    let universe = ::mpi::initialize().ok_or_else(|| CampaignError::Invalid {
+    let universe = ::mpi::initialize().ok_or_else(|| crate::io::scene_file::SceneError::Invalid {
         file: campaign.name.clone(),
         field: "mpirun".into(),
         message: "MPI could not be initialised".into(),

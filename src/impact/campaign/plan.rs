@@ -53,7 +53,7 @@ pub struct Campaign {
 /// Reads and validates a campaign file; relative paths in it are resolved against its directory.
 pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
     let name = path.display().to_string();
-    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| CampaignError::Read {
+    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| crate::io::scene_file::SceneError::Read {
         file: name.clone(),
         reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
     })?;
@@ -94,10 +94,12 @@ fn join_clean(base: &Path, rel: &Path) -> PathBuf {
 }
 
 fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
-    let invalid = |field: String, message: String| CampaignError::Invalid {
-        file: name.to_string(),
-        field,
-        message,
+    let invalid = |field: String, message: String| {
+        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
+            file: name.to_string(),
+            field,
+            message,
+        })
     };
     let c = &file.campaign;
     let imp = &file.impact;

@@ -79,7 +79,7 @@ fn status_of(dir: &Path, point: &GridPoint) -> (RunStatus, Option<RunNumbers>) {
 /// The campaign whose directory is `dir` (from the campaign file recorded there, [`CAMPAIGN_SOURCE`]).
 pub fn campaign_of_dir(dir: &Path) -> Result<Campaign, CampaignError> {
     let pointer = dir.join(CAMPAIGN_SOURCE);
-    let text = std::fs::read_to_string(&pointer).map_err(|e| CampaignError::Read {
+    let text = std::fs::read_to_string(&pointer).map_err(|e| crate::io::scene_file::SceneError::Read {
         file: pointer.display().to_string(),
         reason: format!("{e} (is {} a campaign directory?)", dir.display()),
     })?;
@@ -125,7 +125,7 @@ pub fn write_slurm(
     out: Option<&Path>,
     job: &SlurmJob,
 ) -> Result<(PathBuf, usize, PathBuf), CampaignError> {
-    let invalid = |(field, message)| CampaignError::Invalid {
+    let invalid = |(field, message)| crate::io::scene_file::SceneError::Invalid {
         file: file.display().to_string(),
         field,
         message,
