@@ -7,10 +7,13 @@
 //! step"): the relative motion of a particle and a wall is then a straight line, every time of impact is exact, and
 //! the wall is exactly where its law puts it at the step ends. The spin Ω (rad/s, right-handed about the wall axis)
 //! moves no surface of these axisymmetric primitives; it only adds `Ω â × ρ` to the surface velocity.
+//!
+//! The [`Oscillation`] law is the one of both granular engines: the soft-sphere walls (`walls::soft`) take its
+//! displacement and its exact velocity at the current time.
 
 use crate::math::Vec3;
 
-/// Sinusoidal oscillation `A sin(ω t + φ) d̂`.
+/// Sinusoidal oscillation `A (sin(ω t + φ) − sin φ) d̂`: zero at t = 0 whatever the phase.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Oscillation {
     /// Amplitude A (m), ≥ 0.
@@ -21,6 +24,18 @@ pub struct Oscillation {
     pub phase: f64,
     /// Unit direction d̂.
     pub direction: Vec3,
+}
+
+impl Oscillation {
+    /// Displacement `A (sin(ω t + φ) − sin φ) d̂` (m) at time `t` (s).
+    pub fn displacement(&self, t: f64) -> Vec3 {
+        self.direction * (self.amplitude * ((self.omega * t + self.phase).sin() - self.phase.sin()))
+    }
+
+    /// Velocity `A ω cos(ω t + φ) d̂` (m/s) at time `t` (s): the time derivative of [`Oscillation::displacement`].
+    pub fn velocity(&self, t: f64) -> Vec3 {
+        self.direction * (self.amplitude * (self.omega * (self.omega * t + self.phase).cos()))
+    }
 }
 
 /// How a wall moves.
@@ -39,7 +54,7 @@ impl WallMotion {
     pub fn displacement(&self, t: f64) -> Vec3 {
         let mut d = self.velocity * t;
         if let Some(o) = &self.oscillation {
-            d += o.direction * (o.amplitude * ((o.omega * t + o.phase).sin() - o.phase.sin()));
+            d += o.displacement(t);
         }
         d
     }

@@ -2,34 +2,15 @@
 //! spring–dashpot–slider law as a particle pair, with the wall as an infinitely massive partner).
 //!
 //! A wall reports, for a sphere of centre `c` and radius `r` at time `t`, the contact geometry
-//! ([`WallTouch`]): the unit normal from the sphere's centre towards the wall, the overlap and the wall's
-//! velocity at the contact point. Walls may oscillate sinusoidally ([`Oscillation`], for shaking).
+//! ([`WallTouch`]): the unit normal from the sphere's centre towards the wall, the overlap, and the velocity and
+//! spin of the wall's surface at the contact point. Walls may oscillate sinusoidally (the [`Oscillation`] law of
+//! both granular engines, for shaking); a cylinder ([`cylinder`]) may also spin about its axis (a drum).
 
+pub mod cylinder;
+
+pub use super::motion::Oscillation;
 use crate::math::Vec3;
-use serde::{Deserialize, Serialize};
-
-/// Sinusoidal rigid translation of a wall: offset `A sin(2π f t)` (m), velocity `2π f A cos(2π f t)` (m/s).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Oscillation {
-    /// Amplitude vector `A` (m): direction and size of the displacement.
-    pub amplitude: [f64; 3],
-    /// Frequency `f` (Hz, > 0).
-    pub frequency: f64,
-}
-
-impl Oscillation {
-    /// Displacement of the wall at time `t` (s), in m.
-    pub fn offset(&self, t: f64) -> Vec3 {
-        Vec3::from(self.amplitude) * (std::f64::consts::TAU * self.frequency * t).sin()
-    }
-
-    /// Velocity of the wall at time `t` (s), in m/s.
-    pub fn velocity(&self, t: f64) -> Vec3 {
-        let w = std::f64::consts::TAU * self.frequency;
-        Vec3::from(self.amplitude) * (w * (w * t).cos())
-    }
-}
+pub use cylinder::Cylinder;
 
 /// Where a sphere touches a wall.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -40,6 +21,9 @@ pub struct WallTouch {
     pub overlap: f64,
     /// Velocity of the wall's surface at the contact point (m/s).
     pub wall_velocity: Vec3,
+    /// Angular velocity of the wall (rad/s): the partner's spin in the twisting and rolling laws (Zhang17 Eqs. 3–10);
+    /// zero but for a spinning cylinder.
+    pub wall_spin: Vec3,
 }
 
 /// An infinite plane through `point` whose unit `normal` points into the half-space the particles occupy.
@@ -64,18 +48,21 @@ pub struct SphereContainer {
     pub oscillation: Option<Oscillation>,
 }
 
-/// A wall of either kind.
+/// A wall of any kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Wall {
     /// An infinite plane.
     Plane(Plane),
     /// A spherical container (contact on its inner surface).
     Sphere(SphereContainer),
+    /// A cylinder, infinite or finite, touched from inside or outside ([`cylinder`]).
+    Cylinder(Cylinder),
 }
 
+/// The displacement (m) and velocity (m/s) of an optionally oscillating wall at time `t` (s).
 fn motion(osc: &Option<Oscillation>, t: f64) -> (Vec3, Vec3) {
     match osc {
-        Some(o) => (o.offset(t), o.velocity(t)),
+        Some(o) => (o.displacement(t), o.velocity(t)),
         None => (Vec3::zeros(), Vec3::zeros()),
     }
 }
@@ -98,6 +85,7 @@ impl Plane {
             normal: -self.normal,
             overlap,
             wall_velocity: velocity,
+            wall_spin: Vec3::zeros(),
         })
     }
 }
@@ -113,6 +101,7 @@ impl SphereContainer {
             normal: d / distance,
             overlap,
             wall_velocity: velocity,
+            wall_spin: Vec3::zeros(),
         })
     }
 }
@@ -123,6 +112,16 @@ impl Wall {
         match self {
             Wall::Plane(p) => p.touch(centre, radius, t),
             Wall::Sphere(s) => s.touch(centre, radius, t),
+            Wall::Cylinder(c) => c.touch(centre, radius, t),
+        }
+    }
+
+    /// The wall's reference point at rest (m): a plane's point, a sphere's or cylinder's centre.
+    pub fn anchor(&self) -> Vec3 {
+        match self {
+            Wall::Plane(p) => p.point,
+            Wall::Sphere(s) => s.centre,
+            Wall::Cylinder(c) => c.centre,
         }
     }
 }
