@@ -40,10 +40,10 @@ fn scene_dt(gravity: bool, dt: f64) -> String {
             v[2]
         );
     }
-    s += "[[wall]]\ntype = \"cylinder\"\nradius = 0.3\nlength = 2.0\n";
-    s += "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n\
-          oscillation = { amplitude = 0.01, omega = 60.0 }\n";
-    s += "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.5]\naxis = [0.0, 0.0, -1.0]\n";
+    s += "[[wall]]\nkind = \"cylinder\"\nradius = 0.3\nlength = 2.0\n";
+    s += "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+          oscillation = { amplitude = 0.01, angular_frequency = 60.0 }\n";
+    s += "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.5]\nnormal = [0.0, 0.0, -1.0]\n";
     s
 }
 
@@ -114,7 +114,7 @@ fn bouncing_balls(dt: f64) -> String {
             "[[particle]]\nmass = 1.0\nradius = 0.01\nposition = [{x:?}, 0.0, {z:?}]\nvelocity = [0.0, 0.0, {vz:?}]\n"
         );
     }
-    s + "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n"
+    s + "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
 }
 
 /// Guards the explanation of the tumbler's energy residual (Richardson11 NOTES): under gravity the residual is the

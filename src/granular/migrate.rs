@@ -334,10 +334,36 @@ impl Edits<'_> {
         });
     }
 
-    /// The text with every edit made (last first, so the spans stay valid), and the renames.
+    /// The text with every edit made (last first, so the spans stay valid), and the renames. A line whose edits
+    /// change its length keeps its trailing comment in its column where the spaces before it allow.
     fn finish(mut self) -> Migration {
+        let text = self.text;
+        // Per edited line (its start): the change of length and where its last edit ends.
+        let mut lines: std::collections::BTreeMap<usize, (isize, usize)> = std::collections::BTreeMap::new();
+        for (range, replacement) in self.edits.iter().filter(|(_, r)| !r.contains('\n')) {
+            let start = text[..range.start].rfind('\n').map_or(0, |p| p + 1);
+            let line = lines.entry(start).or_insert((0, range.end));
+            line.0 += replacement.len() as isize - range.len() as isize;
+            line.1 = line.1.max(range.end);
+        }
+        for (_, (delta, last)) in lines {
+            let end = text[last..].find('\n').map_or(text.len(), |p| last + p);
+            let rest = &text[last..end];
+            let Some(hash) = rest.find('#') else { continue };
+            if delta == 0 || rest[..hash].contains(['"', '\'']) {
+                continue;
+            }
+            let spaces = rest[..hash].len() - rest[..hash].trim_end_matches(' ').len();
+            let at = last + hash;
+            if delta > 0 {
+                let cut = (delta as usize).min(spaces.saturating_sub(1));
+                self.edits.push((at - cut..at, String::new()));
+            } else if spaces > 0 {
+                self.edits.push((at..at, " ".repeat(delta.unsigned_abs())));
+            }
+        }
         self.edits.sort_by_key(|(r, _)| (r.start, r.end));
-        let mut text = self.text.to_string();
+        let mut text = text.to_string();
         for (range, replacement) in self.edits.iter().rev() {
             text.replace_range(range.clone(), replacement);
         }
@@ -410,20 +436,20 @@ radius = 0.4
         let t = &m.text;
         assert!(t.starts_with("# a comment that stays\n"), "{t}");
         assert!(
-            t.contains("[stepping]   # the step\ndt = 1e-3\n") && t.contains("[material]\nk_n = 1e6\n"),
+            t.contains("[stepping]     # the step\ndt = 1e-3\n") && t.contains("[material]\nk_n = 1e6\n"),
             "{t}"
         );
         let omega: f64 = std::f64::consts::TAU * 5.0;
         assert!(
             t.contains(&format!(
-                "oscillation = {{ amplitude = 0.01, direction = [0.0, 0.0, -1.0], angular_frequency = {omega:?} }}   # m, Hz"
+                "oscillation = {{ amplitude = 0.01, direction = [0.0, 0.0, -1.0], angular_frequency = {omega:?} }} # m, Hz"
             )),
             "{t}"
         );
-        assert!(
-            t.contains("amplitude = 0.5   # m\ndirection = [0.6, 0.8, 0.0]\n"),
-            "{t}"
-        );
+        // The comment keeps its column.
+        let line = t.lines().find(|l| l.starts_with("amplitude = 0.5 ")).unwrap();
+        assert_eq!(line.find('#'), "amplitude = [0.3, 0.4, 0.0]   # m".find('#'), "{t}");
+        assert!(t.contains("# m\ndirection = [0.6, 0.8, 0.0]\n"), "{t}");
         let table: toml::Table = t.parse().unwrap();
         let w = &table["wall"][1]["oscillation"];
         assert_eq!(w["angular_frequency"].as_float(), Some(std::f64::consts::TAU * 2.0));
@@ -444,7 +470,7 @@ radius = 0.4
     fn hard_old_names_are_rewritten_in_place() {
         let m = migrate(OLD_HARD);
         let t = &m.text;
-        assert!(t.contains("uniform = [0.0, 0.0, -9.81]   # m/s²"), "{t}");
+        assert!(t.contains("uniform = [0.0, 0.0, -9.81] # m/s²"), "{t}");
         assert!(
             t.contains("kind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"),
             "{t}"
