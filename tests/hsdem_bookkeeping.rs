@@ -18,7 +18,7 @@ fn scene_dt(gravity: bool, dt: f64) -> String {
         "[scene]\nkind = \"hard-spheres\"\nt_end = 1.0\nseed = 3\n[stepping]\ndt = {dt:?}\ncollapse_speed = 1e-6\n",
     );
     if gravity {
-        s += "[gravity]\ng = [0.0, 0.0, -9.81]\n";
+        s += "[gravity]\nuniform = [0.0, 0.0, -9.81]\n";
     }
     s += "[material]\neps_n = 0.6\neps_t = 0.5\n[output]\ntimes = [0.0, 1.0]\nevery = 0.1\n";
     for k in 0..12 {

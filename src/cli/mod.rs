@@ -5,8 +5,7 @@
 //!   its outputs into DIR, with checkpoints as asked;
 //! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
 //!   continues an interrupted run from `DIR/checkpoint.json` (see [`rubblepile::driver`]);
-//! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to (`--migrate` rewrites a
-//!   granular scene to the current key names); `rubblepile check DIR` (a
+//! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to; `rubblepile check DIR` (a
 //!   directory): whether a run directory is whole ([`rubblepile::driver::inspect`]), one line per finding, exit code 2
 //!   when it is not; `rubblepile check --explain [KIND]`: every key of a scene file with its unit, default and
 //!   allowed range ([`rubblepile::driver::explain`]);
@@ -209,14 +208,13 @@ pub struct CheckArgs {
     #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"],
           value_parser = crate::choice::choice::<rubblepile::driver::SceneKind>())]
     pub explain: Option<Option<rubblepile::driver::SceneKind>>,
-    /// Rewrite the granular scene file SCENE to the current key names (old names are read with a warning): to
-    /// stdout, to --out, or over SCENE itself with --force.
+    /// Rewrite the granular scene SCENE to the current key names: to stdout, to --out FILE, or in place with --force.
     #[arg(long, requires = "scene", conflicts_with_all = ["print_default", "explain"])]
     pub migrate: bool,
-    /// With --migrate: write the migrated scene to this file (an existing one only with --force).
+    /// With --migrate: the file to write (an existing one only with --force).
     #[arg(long, value_name = "FILE", requires = "migrate")]
     pub out: Option<PathBuf>,
-    /// With --migrate: overwrite (SCENE itself without --out, or an existing --out file).
+    /// With --migrate: overwrite SCENE itself (or an existing --out FILE).
     #[arg(long, requires = "migrate")]
     pub force: bool,
 }
@@ -286,8 +284,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
                 print!("{}", rubblepile::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
             }
-            if let (true, Some(scene)) = (args.migrate, args.scene.as_deref()) {
-                return migrate(scene, args.out, args.force);
+            if let (true, Some(scene)) = (args.migrate, &args.scene) {
+                return rubblepile::granular::migrate::command(scene, args.out, args.force).map_err(CliError::usage);
             }
             if let Some(dir) = args.scene.as_deref().filter(|p| p.is_dir()) {
                 return check_run_dir(dir);
@@ -353,30 +351,6 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Render(args) => visual::render_cmd(&args),
         Command::Convert(args) => visual::convert_cmd(&args),
     }
-}
-
-/// `rubblepile check --migrate SCENE [--out FILE] [--force]`: the migrated text on stdout (without a file to
-/// write), each old name on stderr.
-fn migrate(scene: &std::path::Path, out: Option<PathBuf>, force: bool) -> Result<(), CliError> {
-    use rubblepile::granular::migrate::{Destination, migrate_file};
-    let destination = match (out, force) {
-        (Some(file), _) => Destination::File(file),
-        (None, true) => Destination::InPlace,
-        (None, false) => Destination::Text,
-    };
-    let report = migrate_file(scene, &destination, force).map_err(CliError::usage)?;
-    for r in &report.migration.renames {
-        eprintln!("migrated: {} -> {}", r.old, r.new);
-    }
-    match report.written {
-        Some(path) => println!(
-            "wrote {} ({} old names)",
-            path.display(),
-            report.migration.renames.len()
-        ),
-        None => print!("{}", report.migration.text),
-    }
-    Ok(())
 }
 
 /// `rubblepile check DIR`: one line per finding on stdout (problems as `problem: …`); not whole is an error (exit

@@ -72,8 +72,8 @@ pub fn migrate(text: &str) -> Migration {
         return unchanged();
     };
     let soft = match values.get("scene").and_then(|s| s.get("kind")).and_then(|k| k.as_str()) {
-        Some(crate::granular::soft::scene::KIND) => true,
-        Some(crate::granular::hard::scene::KIND) => false,
+        Some(crate::granular::vocabulary::SOFT_KIND) => true,
+        Some(crate::granular::vocabulary::HARD_KIND) => false,
         _ => return unchanged(),
     };
     let mut edits = Edits {
@@ -179,6 +179,34 @@ pub fn migrate_file(path: &Path, destination: &Destination, force: bool) -> Resu
         migration,
         written: target,
     })
+}
+
+/// `rubblepile check --migrate SCENE [--out FILE] [--force]`: [`migrate_file`] to FILE, to SCENE itself with
+/// `force` and no FILE, else to the output channel (`io::messages`); each old name found as a `migrated: old -> new`
+/// warning line.
+pub fn command(scene: &Path, out: Option<PathBuf>, force: bool) -> Result<(), String> {
+    use crate::io::messages::{Channel, emit};
+    let destination = match (out, force) {
+        (Some(file), _) => Destination::File(file),
+        (None, true) => Destination::InPlace,
+        (None, false) => Destination::Text,
+    };
+    let report = migrate_file(scene, &destination, force)?;
+    for r in &report.migration.renames {
+        emit(Channel::Warning, &format!("migrated: {} -> {}", r.old, r.new));
+    }
+    match report.written {
+        Some(path) => emit(
+            Channel::Out,
+            &format!(
+                "wrote {} ({} old names)",
+                path.display(),
+                report.migration.renames.len()
+            ),
+        ),
+        None => report.migration.text.lines().for_each(|l| emit(Channel::Out, l)),
+    }
+    Ok(())
 }
 
 /// The entry `name` of table `t`: its key and value with their spans.

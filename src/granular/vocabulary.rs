@@ -27,6 +27,12 @@ use crate::io::scene_fields::{FieldDoc, Range, TableDoc};
 use crate::io::scene_file::{SceneError, Validator, exact};
 use crate::math::Vec3;
 
+/// The `scene.kind` of a soft-sphere scene (`granular::soft::scene`).
+pub const SOFT_KIND: &str = "soft-spheres";
+
+/// The `scene.kind` of a hard-sphere scene (`granular::hard::scene`).
+pub const HARD_KIND: &str = "hard-spheres";
+
 /// `wall.oscillation`: `A (sin(ω t + φ) − sin φ) d̂` added to the wall's position.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -70,7 +70,7 @@ use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WA
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
-pub const KIND: &str = "hard-spheres";
+pub const KIND: &str = crate::granular::vocabulary::HARD_KIND;
 
 /// Required columns of a particles file (the snapshots add [`STUCK_COLUMN`]).
 pub const PARTICLE_COLUMNS: [&str; 13] = [

@@ -89,7 +89,7 @@ use crate::io::scene_file::{
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
-pub const KIND: &str = "soft-spheres";
+pub const KIND: &str = crate::granular::vocabulary::SOFT_KIND;
 
 /// A whole soft-sphere scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

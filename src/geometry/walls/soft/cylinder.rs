@@ -8,7 +8,8 @@
 //! The nearest surface point is the hard-sphere primitive's (`walls::cylinder::nearest`) taken in the plane through
 //! the axis and the sphere's centre, where the surface is axisymmetric.
 
-use super::{Oscillation, WallTouch, motion};
+use super::super::motion::Oscillation;
+use super::touch::{WallTouch, motion};
 use crate::math::Vec3;
 
 /// A cylinder wall (sizes in m).

@@ -7,24 +7,13 @@
 //! both granular engines, for shaking); a cylinder ([`cylinder`]) may also spin about its axis (a drum).
 
 pub mod cylinder;
+pub mod touch;
 
 pub use super::motion::Oscillation;
 use crate::math::Vec3;
 pub use cylinder::Cylinder;
-
-/// Where a sphere touches a wall.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WallTouch {
-    /// Unit normal from the sphere's centre towards the wall (the pair law's `n̂`, Zhang17 Eq. 1).
-    pub normal: Vec3,
-    /// Overlap `x` (m, > 0).
-    pub overlap: f64,
-    /// Velocity of the wall's surface at the contact point (m/s).
-    pub wall_velocity: Vec3,
-    /// Angular velocity of the wall (rad/s): the partner's spin in the twisting and rolling laws (Zhang17 Eqs. 3–10);
-    /// zero but for a spinning cylinder.
-    pub wall_spin: Vec3,
-}
+pub use touch::WallTouch;
+use touch::motion;
 
 /// An infinite plane through `point` whose unit `normal` points into the half-space the particles occupy.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -57,14 +46,6 @@ pub enum Wall {
     Sphere(SphereContainer),
     /// A cylinder, infinite or finite, touched from inside or outside ([`cylinder`]).
     Cylinder(Cylinder),
-}
-
-/// The displacement (m) and velocity (m/s) of an optionally oscillating wall at time `t` (s).
-fn motion(osc: &Option<Oscillation>, t: f64) -> (Vec3, Vec3) {
-    match osc {
-        Some(o) => (o.displacement(t), o.velocity(t)),
-        None => (Vec3::zeros(), Vec3::zeros()),
-    }
 }
 
 impl Plane {
