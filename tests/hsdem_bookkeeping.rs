@@ -106,7 +106,7 @@ fn the_gravity_fields_impulse_is_apart_from_the_momentum_residual() {
 fn bouncing_balls(dt: f64) -> String {
     let mut s = format!(
         "[scene]\nkind = \"hard-spheres\"\nt_end = 2.0\nseed = 3\n[stepping]\ndt = {dt:?}\ncollapse_speed = 0.0\n\
-         [gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 1.0\neps_t = 1.0\n[output]\ntimes = [0.0, 2.0]\nevery = 0.05\n"
+         [gravity]\nuniform = [0.0, 0.0, -9.81]\n[material]\neps_n = 1.0\neps_t = 1.0\n[output]\ntimes = [0.0, 2.0]\nevery = 0.05\n"
     );
     for k in 0..5 {
         let (x, z, vz) = (0.1 * k as f64, 0.05 + 0.037 * k as f64, 0.1 * k as f64);
