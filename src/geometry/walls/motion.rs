@@ -73,3 +73,45 @@ impl WallMotion {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The soft-sphere walls' former law, `A sin(2π f t)` with velocity `2π f A cos(2π f t)` for an amplitude vector
+    /// `A` along an axis, is this law to the bit with `ω = 2π f` (the product as the old law formed it),
+    /// `amplitude = |A|`, `direction` the signed axis and `φ = 0`: scenes migrated to the one oscillation run as
+    /// before.
+    #[test]
+    fn old_soft_oscillation_is_the_same_law_to_the_bit() {
+        for (a, axis) in [([0.0, 0.0, 0.01], 2), ([-0.3, 0.0, 0.0], 0), ([0.0, 7e-4, 0.0], 1)] {
+            for f in [5.0, 0.3, 17.125, 1e-3] {
+                let w = std::f64::consts::TAU * f;
+                let mut direction = Vec3::zeros();
+                direction[axis] = f64::signum(a[axis]);
+                let new = Oscillation {
+                    amplitude: f64::abs(a[axis]),
+                    omega: w,
+                    phase: 0.0,
+                    direction,
+                };
+                for t in [0.0, 1e-4, 0.37, 12.5, 1234.567] {
+                    let old_offset = Vec3::from(a) * (std::f64::consts::TAU * f * t).sin();
+                    let old_velocity = Vec3::from(a) * (w * (w * t).cos());
+                    for k in 0..3 {
+                        assert_eq!(
+                            new.displacement(t)[k].to_bits(),
+                            old_offset[k].to_bits(),
+                            "A {a:?} f {f} t {t}"
+                        );
+                        assert_eq!(
+                            new.velocity(t)[k].to_bits(),
+                            old_velocity[k].to_bits(),
+                            "A {a:?} f {f} t {t}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
