@@ -517,20 +517,37 @@ impl V<'_> {
     fn wall(&self, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         let label = format!("wall[{k}]");
         let field = |name: &str| format!("{label}.{name}");
-        let need = |name: &str, present: bool| {
-            if present {
-                Ok(())
-            } else {
-                Err(self.invalid(field(name), format!("missing (required for a {} wall)", w.kind)))
+        // The keys each kind requires and those it may take besides; any other placement key is refused.
+        let (required, optional): (&[&str], &[&str]) = match w.kind.as_str() {
+            "plane" => (&["point", "normal"], &[]),
+            "sphere" => (&["centre", "radius"], &[]),
+            "cylinder" => (&["centre", "axis", "radius"], &["length", "spin"]),
+            other => {
+                return Err(self.invalid(
+                    field("kind"),
+                    format!("must be \"plane\", \"sphere\" or \"cylinder\", got {other:?}"),
+                ));
             }
         };
-        let unused = |name: &str, present: bool| {
-            if present {
-                Err(self.invalid(field(name), format!("not used by a {} wall", w.kind)))
-            } else {
-                Ok(())
+        let given = [
+            ("point", w.point.is_some()),
+            ("normal", w.normal.is_some()),
+            ("centre", w.centre.is_some()),
+            ("axis", w.axis.is_some()),
+            ("radius", w.radius.is_some()),
+            ("length", w.length.is_some()),
+            ("spin", w.spin.is_some()),
+        ];
+        for name in required {
+            if !given.iter().any(|(n, present)| n == name && *present) {
+                return Err(self.invalid(field(name), format!("missing (required for a {} wall)", w.kind)));
             }
-        };
+        }
+        for (name, present) in given {
+            if present && !required.contains(&name) && !optional.contains(&name) {
+                return Err(self.invalid(field(name), format!("not used by a {} wall", w.kind)));
+            }
+        }
         let shaking = |direction: Option<Vec3>| {
             w.oscillation
                 .as_ref()
@@ -539,17 +556,6 @@ impl V<'_> {
         };
         match w.kind.as_str() {
             "plane" => {
-                need("point", w.point.is_some())?;
-                need("normal", w.normal.is_some())?;
-                for (name, given) in [
-                    ("centre", w.centre.is_some()),
-                    ("axis", w.axis.is_some()),
-                    ("radius", w.radius.is_some()),
-                    ("length", w.length.is_some()),
-                    ("spin", w.spin.is_some()),
-                ] {
-                    unused(name, given)?;
-                }
                 let point = self.vector(&field("point"), w.point.unwrap_or_default())?;
                 let normal = unit(self, &field("normal"), w.normal.unwrap_or_default())?;
                 Ok(Wall::Plane(Plane {
@@ -558,30 +564,12 @@ impl V<'_> {
                     oscillation: shaking(Some(normal))?,
                 }))
             }
-            "sphere" => {
-                need("centre", w.centre.is_some())?;
-                need("radius", w.radius.is_some())?;
-                for (name, given) in [
-                    ("point", w.point.is_some()),
-                    ("normal", w.normal.is_some()),
-                    ("axis", w.axis.is_some()),
-                    ("length", w.length.is_some()),
-                    ("spin", w.spin.is_some()),
-                ] {
-                    unused(name, given)?;
-                }
-                Ok(Wall::Sphere(SphereContainer {
-                    centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
-                    radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
-                    oscillation: shaking(None)?,
-                }))
-            }
-            "cylinder" => {
-                need("centre", w.centre.is_some())?;
-                need("axis", w.axis.is_some())?;
-                need("radius", w.radius.is_some())?;
-                unused("point", w.point.is_some())?;
-                unused("normal", w.normal.is_some())?;
+            "sphere" => Ok(Wall::Sphere(SphereContainer {
+                centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
+                radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
+                oscillation: shaking(None)?,
+            })),
+            _ => {
                 let axis = unit(self, &field("axis"), w.axis.unwrap_or_default())?;
                 let spin = w.spin.unwrap_or(0.0);
                 if !spin.is_finite() {
@@ -599,10 +587,6 @@ impl V<'_> {
                     spin,
                 }))
             }
-            other => Err(self.invalid(
-                field("kind"),
-                format!("must be \"plane\", \"sphere\" or \"cylinder\", got {other:?}"),
-            )),
         }
     }
 
