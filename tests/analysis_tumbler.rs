@@ -188,7 +188,7 @@ fn a_run_is_averaged_over_its_second_half_and_each_quarter_of_it() {
     std::fs::write(
         dir.join("scene.toml"),
         format!(
-            "[gravity]\ng = [0.0, 0.0, -9.81]\n[[wall]]\ntype = \"cylinder\"\nradius = {R_DRUM:?}\nspin = {OMEGA:?}\n"
+            "[gravity]\nuniform = [0.0, 0.0, -9.81]\n[[wall]]\nkind = \"cylinder\"\nradius = {R_DRUM:?}\nspin = {OMEGA:?}\n"
         ),
     )
     .unwrap();

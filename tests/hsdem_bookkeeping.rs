@@ -18,7 +18,7 @@ fn scene_dt(gravity: bool, dt: f64) -> String {
         "[scene]\nkind = \"hard-spheres\"\nt_end = 1.0\nseed = 3\n[stepping]\ndt = {dt:?}\ncollapse_speed = 1e-6\n",
     );
     if gravity {
-        s += "[gravity]\ng = [0.0, 0.0, -9.81]\n";
+        s += "[gravity]\nuniform = [0.0, 0.0, -9.81]\n";
     }
     s += "[material]\neps_n = 0.6\neps_t = 0.5\n[output]\ntimes = [0.0, 1.0]\nevery = 0.1\n";
     for k in 0..12 {
@@ -40,10 +40,10 @@ fn scene_dt(gravity: bool, dt: f64) -> String {
             v[2]
         );
     }
-    s += "[[wall]]\ntype = \"cylinder\"\nradius = 0.3\nlength = 2.0\n";
-    s += "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n\
-          oscillation = { amplitude = 0.01, omega = 60.0 }\n";
-    s += "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.5]\naxis = [0.0, 0.0, -1.0]\n";
+    s += "[[wall]]\nkind = \"cylinder\"\nradius = 0.3\nlength = 2.0\n";
+    s += "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\
+          oscillation = { amplitude = 0.01, angular_frequency = 60.0 }\n";
+    s += "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.5]\nnormal = [0.0, 0.0, -1.0]\n";
     s
 }
 
@@ -106,7 +106,7 @@ fn the_gravity_fields_impulse_is_apart_from_the_momentum_residual() {
 fn bouncing_balls(dt: f64) -> String {
     let mut s = format!(
         "[scene]\nkind = \"hard-spheres\"\nt_end = 2.0\nseed = 3\n[stepping]\ndt = {dt:?}\ncollapse_speed = 0.0\n\
-         [gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 1.0\neps_t = 1.0\n[output]\ntimes = [0.0, 2.0]\nevery = 0.05\n"
+         [gravity]\nuniform = [0.0, 0.0, -9.81]\n[material]\neps_n = 1.0\neps_t = 1.0\n[output]\ntimes = [0.0, 2.0]\nevery = 0.05\n"
     );
     for k in 0..5 {
         let (x, z, vz) = (0.1 * k as f64, 0.05 + 0.037 * k as f64, 0.1 * k as f64);
@@ -114,7 +114,7 @@ fn bouncing_balls(dt: f64) -> String {
             "[[particle]]\nmass = 1.0\nradius = 0.01\nposition = [{x:?}, 0.0, {z:?}]\nvelocity = [0.0, 0.0, {vz:?}]\n"
         );
     }
-    s + "[[wall]]\ntype = \"plane\"\norigin = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n"
+    s + "[[wall]]\nkind = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
 }
 
 /// Guards the explanation of the tumbler's energy residual (Richardson11 NOTES): under gravity the residual is the

@@ -18,7 +18,7 @@ dt = 2e-4
 collapse_speed = 4e-3
 
 [gravity]
-g = [0.0, 0.0, -9.81]
+uniform = [0.0, 0.0, -9.81]
 
 [material]
 eps_n = 0.8
@@ -29,21 +29,21 @@ every = 0.02
 times = [0.0, 0.1, 0.2, 0.3]
 
 [[wall]]
-type = "cylinder"
+kind = "cylinder"
 axis = [0.0, 1.0, 0.0]
 radius = 0.03
 spin = 12.0
 
 [[wall]]
-type = "plane"
-origin = [0.0, -0.0025, 0.0]
-axis = [0.0, 1.0, 0.0]
+kind = "plane"
+point = [0.0, -0.0025, 0.0]
+normal = [0.0, 1.0, 0.0]
 eps_t = 1.0
 
 [[wall]]
-type = "plane"
-origin = [0.0, 0.0025, 0.0]
-axis = [0.0, -1.0, 0.0]
+kind = "plane"
+point = [0.0, 0.0025, 0.0]
+normal = [0.0, -1.0, 0.0]
 eps_t = 1.0
 "#;
 

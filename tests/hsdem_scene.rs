@@ -15,7 +15,7 @@ dt = 1e-3
 collapse_speed = 1e-4
 
 [gravity]
-g = [0.0, 0.0, -9.81]
+uniform = [0.0, 0.0, -9.81]
 
 [material]
 eps_n = 0.9
@@ -39,15 +39,15 @@ spin = [0.0, 3.0, 0.0]
 eps_n = 1.0
 
 [[wall]]
-type = "cylinder"
+kind = "cylinder"
 radius = 0.3
 length = 2.0
 
 [[wall]]
-type = "plane"
-origin = [0.0, 0.0, 0.0]
-axis = [0.0, 0.0, 1.0]
-oscillation = { amplitude = 0.001, omega = 30.0 }
+kind = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
+oscillation = { amplitude = 0.001, angular_frequency = 30.0 }
 "#;
 
 #[test]
@@ -115,7 +115,7 @@ fn bad_input_is_one_line_naming_the_field() {
             "material.eps_n: must be in [0, 1], got 1.5",
         ),
         ("dt = 1e-3", "dt = -1.0", "stepping.dt: must be > 0 and finite, got -1"),
-        ("type = \"cylinder\"", "type = \"cone\"", "wall[0].type: must be one of"),
+        ("kind = \"cylinder\"", "kind = \"cone\"", "wall[0].kind: must be one of"),
         ("radius = 0.3", "", "wall[0].radius: required for a cylinder"),
         ("mass = 2.0", "mass = 0.0", "particle[1].mass: must be > 0"),
         (
@@ -129,8 +129,8 @@ fn bad_input_is_one_line_naming_the_field() {
             "particle[0].position: overlaps particle[1]",
         ),
         (
-            "omega = 30.0 }",
-            "omega = 30.0, direction = [0.0, 0.0, 0.0] }",
+            "angular_frequency = 30.0 }",
+            "angular_frequency = 30.0, direction = [0.0, 0.0, 0.0] }",
             "wall[1].oscillation.direction",
         ),
     ];

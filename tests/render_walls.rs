@@ -464,10 +464,10 @@ fn a_moving_wall_is_drawn_where_it_was_at_each_snapshot() {
 kind = "soft-spheres"
 t_end = 1.0
 
-[integrator]
+[stepping]
 dt = 1e-3
 
-[contact]
+[material]
 k_n = 1e3
 
 [output]
@@ -478,7 +478,7 @@ times = [0.25, 0.75]
 kind = "sphere"
 centre = [0.0, 0.0, 0.0]
 radius = 1.0
-oscillation = { amplitude = [0.5, 0.0, 0.0], frequency = 1.0 }
+oscillation = { amplitude = 0.5, direction = [1.0, 0.0, 0.0], angular_frequency = 6.283185307179586 }
 
 [[particle]]
 radius = 0.1

@@ -60,7 +60,8 @@ fn ellipsoid_reference_is_the_schema() {
 fn soft_sphere_reference_is_the_schema() {
     let schema = schema_keys::<rubblepile::granular::soft::scene::SoftSceneFile>();
     assert_reference_matches(SceneKind::SoftSpheres.reference(), &schema);
-    assert!(schema.leaves.contains("wall.oscillation.frequency"));
+    assert!(schema.leaves.contains("wall.oscillation.angular_frequency"));
+    assert!(schema.leaves.contains("wall.axis") && schema.leaves.contains("wall.spin"));
     assert!(schema.leaves.contains("spinup.T_final"));
 }
 
@@ -69,6 +70,7 @@ fn hard_sphere_reference_is_the_schema() {
     let schema = schema_keys::<rubblepile::granular::hard::scene::HardSceneFile>();
     assert_reference_matches(SceneKind::HardSpheres.reference(), &schema);
     assert!(schema.leaves.contains("wall.oscillation.direction"));
+    assert!(schema.leaves.contains("wall.normal") && schema.leaves.contains("gravity.uniform"));
 }
 
 /// A hand-built schema whose keys are known: nested, optional, renamed, array-of-tables and strictly read
@@ -174,9 +176,9 @@ const SOFT: &str = r#"
 [scene]
 kind = "soft-spheres"
 t_end = 0.01
-[integrator]
+[stepping]
 dt = 7e-5
-[contact]
+[material]
 k_n = 4.2e8
 eps_n = 0.55
 eps_t = 0.55
@@ -386,14 +388,14 @@ fn soft_sphere_bounds_are_the_validators() {
     let tested = bounds_enforced(SceneKind::SoftSpheres, SOFT);
     let expected = [
         "scene.t_end",
-        "contact.k_n",
-        "contact.eps_n",
-        "contact.eps_t",
-        "contact.mu_s",
-        "contact.mu_t",
-        "contact.mu_r",
-        "contact.beta",
-        "contact.max_start_overlap",
+        "material.k_n",
+        "material.eps_n",
+        "material.eps_t",
+        "material.mu_s",
+        "material.mu_t",
+        "material.mu_r",
+        "material.beta",
+        "material.max_start_overlap",
         "gravity.theta",
         "gravity.G",
         "spinup.T_start",
@@ -477,13 +479,13 @@ fn printed_defaults_are_the_parsers() {
     assert_eq!(
         soft,
         [
-            "contact.eps_n",
-            "contact.eps_t",
-            "contact.mu_s",
-            "contact.mu_t",
-            "contact.mu_r",
-            "contact.beta",
-            "contact.max_start_overlap",
+            "material.eps_n",
+            "material.eps_t",
+            "material.mu_s",
+            "material.mu_t",
+            "material.mu_r",
+            "material.beta",
+            "material.max_start_overlap",
             "spinup.rest_length",
             "spinup.release_axis_ratio",
             "spinup.release_packing",
@@ -537,18 +539,18 @@ fn check_explain_prints_the_reference() {
     let text = String::from_utf8(out.stdout).unwrap();
     let k_n = text
         .lines()
-        .find(|l| l.starts_with("contact.k_n "))
-        .unwrap_or_else(|| panic!("no contact.k_n line in:\n{text}"));
+        .find(|l| l.starts_with("material.k_n "))
+        .unwrap_or_else(|| panic!("no material.k_n line in:\n{text}"));
     let columns: Vec<&str> = k_n.split("  ").map(str::trim).filter(|c| !c.is_empty()).collect();
     assert_eq!(
         &columns[..4],
-        ["contact.k_n", "N/m", "required", ">= 1e-300, finite"],
+        ["material.k_n", "N/m", "required", ">= 1e-300, finite"],
         "{k_n}"
     );
-    assert!(text.contains("\n[contact]: "), "{text}");
+    assert!(text.contains("\n[material]: "), "{text}");
     assert!(text.contains("\n[[particle]]: "), "{text}");
     assert!(text.contains("\n[spinup]: "), "{text}");
-    let eps = text.lines().find(|l| l.starts_with("contact.eps_n ")).unwrap();
+    let eps = text.lines().find(|l| l.starts_with("material.eps_n ")).unwrap();
     assert!(eps.contains("0.55") && eps.contains("(0, 1]"), "{eps}");
     // One line per key: the printed table is the whole reference.
     let reference = SceneKind::SoftSpheres.reference();

@@ -24,10 +24,10 @@ t_end = 2400.0
 seed = 7
 particles_file = "ball.csv"
 
-[integrator]
+[stepping]
 dt = 1.2
 
-[contact]
+[material]
 k_n = 15.0
 
 [gravity]

@@ -157,7 +157,7 @@ fn read(p: &Path) -> String {
 /// Ten spheres at rest in a loose self-gravitating clump (G = 1e-3) inside a spherical container.
 fn scene(gravity_extra: &str) -> String {
     let mut s = format!(
-        "[scene]\nkind = \"soft-spheres\"\nt_end = 0.5\nseed = 1\n\n[integrator]\ndt = 2e-4\n\n[contact]\nk_n = 2e5\n\n\
+        "[scene]\nkind = \"soft-spheres\"\nt_end = 0.5\nseed = 1\n\n[stepping]\ndt = 2e-4\n\n[material]\nk_n = 2e5\n\n\
          [gravity]\nself = \"direct\"\nG = 1e-3\n{gravity_extra}\n\n[output]\nevery = 0.05\n\n\
          [[wall]]\nkind = \"sphere\"\ncentre = [0.0, 0.0, 0.0]\nradius = 0.6\n"
     );

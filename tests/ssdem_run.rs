@@ -13,10 +13,10 @@ kind = "soft-spheres"
 t_end = 0.5
 seed = 3
 
-[integrator]
+[stepping]
 dt = {dt}
 
-[contact]
+[material]
 k_n = 2e5
 
 [gravity]
@@ -32,7 +32,7 @@ times = [0.0, 0.25, 0.5]
 kind = "plane"
 point = [0.0, 0.0, 0.0]
 normal = [0.0, 0.0, 1.0]
-oscillation = {{ amplitude = [0.0, 0.0, 0.002], frequency = 10.0 }}
+oscillation = {{ amplitude = 0.002, angular_frequency = 62.83185307179586 }}
 
 [[wall]]
 kind = "sphere"
@@ -186,7 +186,7 @@ fn bad_input_gives_one_line_errors_naming_the_field() {
         "2e-4",
         "particle[0].position: overlaps particle[12]",
     );
-    bad("", "0.05", "integrator.dt: must be <= the leapfrog stability limit");
+    bad("", "0.05", "stepping.dt: must be <= the leapfrog stability limit");
     let dir = temp_dir("ssdem-bad");
     let s = scene("", "2e-4").replace("self = \"direct\"", "self = \"fast\"");
     std::fs::write(dir.join("s.toml"), s).unwrap();
@@ -204,7 +204,7 @@ fn bad_input_gives_one_line_errors_naming_the_field() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("warning:")
-            && String::from_utf8_lossy(&out.stderr).contains("integrator.dt")
+            && String::from_utf8_lossy(&out.stderr).contains("stepping.dt")
     );
 }
 

@@ -202,7 +202,7 @@ fn a_small_soft_sphere_run_uses_one_thread_per_125_spheres() {
     assert_eq!(SPHERES_PER_THREAD, 125);
     let scene = |n: usize| {
         let mut text = String::from(
-            "[scene]\nkind = \"soft-spheres\"\nt_end = 1e-4\n[integrator]\ndt = 1e-5\n[contact]\nk_n = 1e5\n[output]\nevery = 1e-4\n",
+            "[scene]\nkind = \"soft-spheres\"\nt_end = 1e-4\n[stepping]\ndt = 1e-5\n[material]\nk_n = 1e5\n[output]\nevery = 1e-4\n",
         );
         for k in 0..n {
             // A row of unit spheres 3 m apart: no contacts, nothing to refuse.

@@ -31,9 +31,9 @@ kind = "soft-spheres"
 t_end = 0.01
 seed = 1
 particles_file = "p.csv"   # relative to this file
-[integrator]
+[stepping]
 dt = 1e-4
-[contact]
+[material]
 k_n = 4.2e8
 [output]
 every = 0.005

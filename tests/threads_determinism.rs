@@ -131,7 +131,7 @@ fn soft_sphere_ball_is_bit_identical_on_one_to_four_threads() {
     let dir = temp_dir("threads-soft");
     let scene = format!(
         "[scene]\nkind = \"soft-spheres\"\nt_end = 2e-4\nseed = 1\nparticles_file = {:?}\n\
-         [integrator]\ndt = 4e-6\n[contact]\nk_n = 1.5e11\neps_n = 0.1\neps_t = 0.1\n\
+         [stepping]\ndt = 4e-6\n[material]\nk_n = 1.5e11\neps_n = 0.1\neps_t = 0.1\n\
          [gravity]\nself = \"tree\"\ntheta = 0.5\nG = 1.0\n[output]\nevery = 4e-5\ntimes = [0.0, 2e-4]\n",
         root().join("tests/data/settled_hcp_ball.csv").display().to_string()
     );

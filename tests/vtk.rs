@@ -200,9 +200,9 @@ const SOFT_PACKING: &str = r#"
 [scene]
 kind = "soft-spheres"
 t_end = 1e-4
-[integrator]
+[stepping]
 dt = 1e-5
-[contact]
+[material]
 k_n = 1e5
 max_start_overlap = 0.05
 [output]
@@ -286,40 +286,40 @@ radius = 0.05
 position = [0.3, 0.2, 0.5]
 velocity = [0.1, 0.0, 0.0]
 [[wall]]
-type = "plane"
-origin = [0.0, 0.0, -1.0]
-axis = [0.1, 0.2, 1.0]
-oscillation = { amplitude = 0.01, omega = 60.0, phase = 0.3, direction = [0.0, 0.0, 1.0] }
+kind = "plane"
+point = [0.0, 0.0, -1.0]
+normal = [0.1, 0.2, 1.0]
+oscillation = { amplitude = 0.01, angular_frequency = 60.0, phase = 0.3, direction = [0.0, 0.0, 1.0] }
 [[wall]]
-type = "disk"
-origin = [0.0, 0.0, 2.0]
+kind = "disk"
+centre = [0.0, 0.0, 2.0]
 axis = [1.0, 1.0, 0.0]
 radius = 0.7
 velocity = [0.0, 0.5, 0.0]
 [[wall]]
-type = "cylinder"
-origin = [0.0, 0.0, 0.0]
+kind = "cylinder"
+centre = [0.0, 0.0, 0.0]
 axis = [0.0, 0.3, 1.0]
 radius = 3.0
 length = 4.0
 spin = 2.0
 [[wall]]
-type = "cylinder"
-origin = [5.0, 0.0, 0.0]
+kind = "cylinder"
+centre = [5.0, 0.0, 0.0]
 radius = 0.5
 [[wall]]
-type = "ring"
-origin = [0.0, -2.0, 0.0]
+kind = "ring"
+centre = [0.0, -2.0, 0.0]
 axis = [0.0, 1.0, 0.0]
 radius = 1.25
 [[wall]]
-type = "line"
-origin = [-4.0, 0.0, 0.0]
+kind = "line"
+centre = [-4.0, 0.0, 0.0]
 axis = [1.0, 0.0, 0.0]
 length = 1.0
 [[wall]]
-type = "point"
-origin = [-6.0, 1.0, 1.0]
+kind = "point"
+centre = [-6.0, 1.0, 1.0]
 "#;
 
 #[test]
@@ -420,9 +420,9 @@ fn soft_sphere_walls_lie_on_their_plane_and_sphere_where_they_oscillated_to() {
 [scene]
 kind = "soft-spheres"
 t_end = 0.02
-[integrator]
+[stepping]
 dt = 1e-3
-[contact]
+[material]
 k_n = 1e5
 [output]
 every = 0.01
@@ -432,12 +432,12 @@ vtk = true
 kind = "plane"
 point = [0.0, 0.0, -0.5]
 normal = [0.0, 0.6, 0.8]
-oscillation = { amplitude = [0.0, 0.0, 0.05], frequency = 5.0 }
+oscillation = { amplitude = 0.05, direction = [0.0, 0.0, 1.0], angular_frequency = 31.41592653589793 }
 [[wall]]
 kind = "sphere"
 centre = [0.1, 0.0, 0.2]
 radius = 4.0
-oscillation = { amplitude = [0.02, 0.0, 0.0], frequency = 3.0 }
+oscillation = { amplitude = 0.02, direction = [1.0, 0.0, 0.0], angular_frequency = 18.84955592153876 }
 [[particle]]
 radius = 0.5
 mass = 1.0

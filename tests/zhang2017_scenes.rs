@@ -163,7 +163,7 @@ fn contact_law_variants_differ_from_their_nominal_scene_only_in_beta_and_the_cap
         for t in [&mut variant, &mut nominal] {
             t["scene"].as_table_mut().unwrap().remove("particles_file");
         }
-        let contact = |t: &mut toml::Table| t["contact"].as_table_mut().unwrap().clone();
+        let contact = |t: &mut toml::Table| t["material"].as_table_mut().unwrap().clone();
         let (vc, nc) = (contact(&mut variant), contact(&mut nominal));
         for key in ["beta", "mu_t", "mu_r"] {
             if vc.get(key) != nc.get(key) {
@@ -172,7 +172,7 @@ fn contact_law_variants_differ_from_their_nominal_scene_only_in_beta_and_the_cap
         }
         assert!(!changed.is_empty(), "{name} changes nothing");
         for t in [&mut variant, &mut nominal] {
-            let c = t["contact"].as_table_mut().unwrap();
+            let c = t["material"].as_table_mut().unwrap();
             for key in ["beta", "mu_t", "mu_r"] {
                 c.remove(key);
             }
@@ -200,7 +200,7 @@ fn density_and_material_variants_differ_from_their_nominal_scene_only_in_what_th
             t["scene"].as_table_mut().unwrap().remove(*k);
         }
         for k in contact_keys {
-            t["contact"].as_table_mut().unwrap().remove(*k);
+            t["material"].as_table_mut().unwrap().remove(*k);
         }
         t
     };
@@ -237,7 +237,7 @@ fn density_and_material_variants_differ_from_their_nominal_scene_only_in_what_th
             .strip_prefix("beta")
             .and_then(|m| m.split_once("_mus"))
             .unwrap_or_else(|| panic!("{name}: not <model>_beta<β>_mus<μ_s>_path2.toml"));
-        let contact = &variant["contact"];
+        let contact = &variant["material"];
         assert_eq!(contact["beta"].as_float(), beta.parse().ok(), "{name}");
         assert_eq!(contact["mu_s"].as_float(), mu_s.parse().ok(), "{name}");
         assert!(
@@ -252,8 +252,8 @@ fn density_and_material_variants_differ_from_their_nominal_scene_only_in_what_th
         );
         let settle = format!("{model}_settle_{material}.toml");
         let (s, s0) = (table(&settle), table(&format!("{model}_settle.toml")));
-        assert_eq!(s["contact"]["beta"].as_float(), beta.parse().ok(), "{settle}");
-        assert_eq!(s["contact"]["mu_s"].as_float(), mu_s.parse().ok(), "{settle}");
+        assert_eq!(s["material"]["beta"].as_float(), beta.parse().ok(), "{settle}");
+        assert_eq!(s["material"]["mu_s"].as_float(), mu_s.parse().ok(), "{settle}");
         assert_eq!(without(s, &[], &keys), without(s0, &[], &keys), "{settle}");
     }
 }

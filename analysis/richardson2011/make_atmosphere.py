@@ -51,7 +51,7 @@ collapse_speed = 0.0         # elastic anyway
 skin_steps = 32              # neighbour-list skin: the fastest setting measured on this dilute gas (NOTES.md)
 
 [gravity]
-g = [0.0, 0.0, -1.0]
+uniform = [0.0, 0.0, -1.0]
 
 [material]
 eps_n = 1.0
@@ -62,13 +62,13 @@ every = {args.every}
 times = [{times}]
 
 [[wall]]
-type = "plane"
-origin = [0.0, 0.0, 0.0]
-axis = [0.0, 0.0, 1.0]
+kind = "plane"
+point = [0.0, 0.0, 0.0]
+normal = [0.0, 0.0, 1.0]
 
 [[wall]]
-type = "cylinder"
-origin = [0.0, 0.0, 0.0]
+kind = "cylinder"
+centre = [0.0, 0.0, 0.0]
 axis = [0.0, 0.0, 1.0]
 radius = {radius}
 """)

@@ -153,7 +153,7 @@ dt = {args.dt}                  # s
 collapse_speed = {2 * G * args.dt:.6g}      # m/s: twice g dt, so resting contacts bounce elastically (inelastic-collapse guard)
 
 [gravity]
-g = [0.0, 0.0, -{G}]         # m/s^2
+uniform = [0.0, 0.0, -{G}]   # m/s^2
 
 [material]
 eps_n = {args.eps_n}                  # glass-like normal restitution (our choice; the paper's value was lost in extraction)
@@ -164,21 +164,21 @@ every = 0.01                 # s
 times = [{", ".join(format(t, fmt) for t in times)}]
 
 [[wall]]                     # 0: the drum, spinning about +y at omega = sqrt(Fr g / R){", R = " + str(R_FR) + " m" if paper else ""}
-type = "cylinder"
-origin = [0.0, 0.0, 0.0]
+kind = "cylinder"
+centre = [0.0, 0.0, 0.0]
 axis = [0.0, 1.0, 0.0]
 radius = {R_CYL}
 spin = {omega!r}           # rad/s
 
 [[wall]]                     # end planes, frictionless
-type = "plane"
-origin = [0.0, {-LENGTH / 2}, 0.0]
-axis = [0.0, 1.0, 0.0]
+kind = "plane"
+point = [0.0, {-LENGTH / 2}, 0.0]
+normal = [0.0, 1.0, 0.0]
 eps_t = 1.0
 
 [[wall]]
-type = "plane"
-origin = [0.0, {LENGTH / 2}, 0.0]
-axis = [0.0, -1.0, 0.0]
+kind = "plane"
+point = [0.0, {LENGTH / 2}, 0.0]
+normal = [0.0, -1.0, 0.0]
 eps_t = 1.0
 """)

@@ -407,9 +407,12 @@ pub fn random_heap(
             oscillation: osc,
         })
     };
+    // ω = 2π (1/period), the factors in the order the shaking has always been computed in (its bits unchanged).
     let osc = Oscillation {
-        amplitude: [0.0, 0.0, amplitude],
-        frequency: 1.0 / period,
+        amplitude,
+        omega: std::f64::consts::TAU * (1.0 / period),
+        phase: 0.0,
+        direction: Vec3::z(),
     };
     let material = frictionless(k_shake, recipe.restitution);
     let notes = format!(

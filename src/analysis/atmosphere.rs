@@ -234,16 +234,18 @@ pub fn interrupted_summary(dir: &Path) -> Option<serde_json::Value> {
 pub fn read_run_files(dir: &Path) -> Result<RunFiles, AnalysisError> {
     let sp = dir.join("scene.toml");
     let text = std::fs::read_to_string(&sp).map_err(|e| format!("{}: {e}", sp.display()))?;
+    // A scene copy of an older run may use the old names: read it as its migrated text.
+    let text = crate::granular::migrate::migrate(&text).text;
     let scene: toml::Value = toml::from_str(&text).map_err(|e| format!("{}: {e}", sp.display()))?;
     let g = scene
         .get("gravity")
-        .and_then(|x| x.get("g"))
+        .and_then(|x| x.get("uniform"))
         .and_then(|x| x.as_array())
         .and_then(|a| a.get(2))
         .and_then(|x| x.as_float())
         .map(|gz| -gz)
         .filter(|g| *g > 0.0)
-        .ok_or_else(|| format!("{}: gravity.g must point down (gz < 0)", sp.display()))?;
+        .ok_or_else(|| format!("{}: gravity.uniform must point down (gz < 0)", sp.display()))?;
     let jp = dir.join("summary.json");
     let summary = match std::fs::read_to_string(&jp) {
         Ok(text) => serde_json::from_str(&text).map_err(|e| format!("{}: {e}", jp.display()))?,
@@ -283,7 +285,7 @@ pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, AnalysisError
         .and_then(|w| w.as_array())
         .and_then(|ws| {
             ws.iter()
-                .find(|w| w.get("type").and_then(|t| t.as_str()) == Some("cylinder"))
+                .find(|w| w.get("kind").and_then(|t| t.as_str()) == Some("cylinder"))
         })
         .and_then(|w| w.get("radius"))
         .and_then(|r| r.as_float())

@@ -208,6 +208,15 @@ pub struct CheckArgs {
     #[arg(long, value_name = "KIND", conflicts_with_all = ["scene", "print_default"],
           value_parser = crate::choice::choice::<rubblepile::driver::SceneKind>())]
     pub explain: Option<Option<rubblepile::driver::SceneKind>>,
+    /// Rewrite the granular scene SCENE to the current key names: to stdout, to --out FILE, or in place with --force.
+    #[arg(long, requires = "scene", conflicts_with_all = ["print_default", "explain"])]
+    pub migrate: bool,
+    /// With --migrate: the file to write (an existing one only with --force).
+    #[arg(long, value_name = "FILE", requires = "migrate")]
+    pub out: Option<PathBuf>,
+    /// With --migrate: overwrite SCENE itself (or an existing --out FILE).
+    #[arg(long, requires = "migrate")]
+    pub force: bool,
 }
 
 /// `rubblepile bench …`.
@@ -274,6 +283,9 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             if args.print_default {
                 print!("{}", rubblepile::ellipsoid::scene::DEFAULT_SCENE_TOML);
                 return Ok(());
+            }
+            if let (true, Some(scene)) = (args.migrate, &args.scene) {
+                return rubblepile::granular::migrate::command(scene, args.out, args.force).map_err(CliError::usage);
             }
             if let Some(dir) = args.scene.as_deref().filter(|p| p.is_dir()) {
                 return check_run_dir(dir);

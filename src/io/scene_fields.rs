@@ -116,7 +116,7 @@ impl std::fmt::Display for Range {
 /// `[[particle]]` table's `radius`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FieldDoc {
-    /// Dotted path, e.g. `contact.k_n`.
+    /// Dotted path, e.g. `material.k_n`.
     pub key: &'static str,
     /// SI unit (`-` for a dimensionless number, `text`, `bool`, `count` for the others).
     pub unit: &'static str,

@@ -159,10 +159,10 @@ t_end = {t_end!r}
 seed = 1
 particles_file = "{os.path.abspath(os.path.join(work, 'grains.csv'))}"
 
-[integrator]
+[stepping]
 dt = {dt!r}
 
-[contact]
+[material]
 k_n = {K_N!r}
 eps_n = {EPS!r}
 eps_t = {EPS!r}

@@ -86,13 +86,22 @@ pub const SPHERE_BANDS: usize = 32;
 impl super::soft::Wall {
     /// The soft-sphere wall's surface at time `t` (s), where its oscillation has carried it: a plane as a square
     /// patch of half-size `extent` (m) about its point, a spherical container as a latitude–longitude mesh whose
-    /// vertices lie on the sphere.
+    /// vertices lie on the sphere, a cylinder as the hard-sphere primitive's mesh (an infinite one cut to `extent`).
     pub fn surface_at(&self, t: f64, extent: f64) -> SurfaceMesh {
-        let offset = |o: &Option<super::soft::Oscillation>| o.as_ref().map_or(Vec3::zeros(), |o| o.offset(t));
+        let offset = |o: &Option<super::motion::Oscillation>| o.as_ref().map_or(Vec3::zeros(), |o| o.displacement(t));
         match self {
             super::soft::Wall::Plane(p) => {
                 Wall::new(Shape::Plane, p.point + offset(&p.oscillation), p.normal).surface_at(0.0, extent)
             }
+            super::soft::Wall::Cylinder(c) => Wall::new(
+                Shape::Cylinder {
+                    radius: c.radius,
+                    length: c.length,
+                },
+                c.centre + offset(&c.oscillation),
+                c.axis,
+            )
+            .surface_at(0.0, extent),
             super::soft::Wall::Sphere(s) => {
                 let centre = s.centre + offset(&s.oscillation);
                 let mut m = SurfaceMesh::default();

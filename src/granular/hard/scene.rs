@@ -15,7 +15,7 @@
 //! skin_steps = 16.0                # neighbour-list skin in steps (0 = a fresh list every step)
 //!
 //! [gravity]                        # optional: uniform field
-//! g = [0.0, 0.0, -9.81]            # m/s²
+//! uniform = [0.0, 0.0, -9.81]      # m/s², uniform acceleration
 //!
 //! [material]                       # defaults for every particle
 //! eps_n = 1.0
@@ -34,11 +34,26 @@
 //! # stuck_to = 0                   # attached to wall 0 from t = 0 (moves rigidly with it: a rough lining)
 //!
 //! [[wall]]
-//! type = "plane"                   # plane | disk | cylinder | ring | point | line
-//! origin = [0.0, 0.0, 0.0]         # m, reference point at t = 0
-//! axis = [0.0, 0.0, 1.0]           # normal of plane/disk/ring, axis of cylinder/line
-//! oscillation = { amplitude = 0.01, omega = 60.0, phase = 0.0, direction = [0.0, 0.0, 1.0] }
+//! kind = "plane"                   # plane | disk | cylinder | ring | point | line
+//! point = [0.0, 0.0, 0.0]          # m, a point of the plane at t = 0 (the others: centre)
+//! normal = [0.0, 0.0, 1.0]         # plane normal (the others: axis)
+//! oscillation = { amplitude = 0.01, angular_frequency = 60.0, phase = 0.0, direction = [0.0, 0.0, 1.0] }   # m, rad/s, rad
+//!
+//! [[wall]]
+//! kind = "cylinder"                # a drum (both faces are walls)
+//! centre = [0.0, 0.0, 0.5]         # m, the middle of the axis segment at t = 0
+//! axis = [0.0, 1.0, 0.0]
+//! radius = 0.4                     # m
+//! length = 0.2                     # m; absent = infinite
+//! spin = 1.0                       # rad/s about the axis (right-handed)
 //! ```
+//!
+//! The names are those of the soft-sphere scene wherever the concept is the same (`granular::vocabulary`):
+//! `[stepping] dt` (s), `[material]`, `[gravity] uniform` (m/s²), and for walls `kind`, `point` and `normal` of a
+//! plane, `centre` and `axis` of the others, `radius`, `length` (m), `velocity` (m/s), `oscillation = { amplitude
+//! (m), angular_frequency (rad/s), phase (rad), direction }` and `spin` (rad/s). The old names (`gravity.g`, a
+//! wall's `type`, `origin`, a plane's `axis`, an oscillation's `omega`) are still read, each with a warning
+//! (`granular::migrate`; `rubblepile check --migrate` rewrites a file).
 //!
 //! Bad input never panics: every error is one line naming the field and what was expected.
 
@@ -49,12 +64,13 @@ use serde::{Deserialize, Serialize};
 use super::particle::{Attachment, Particle};
 use super::scene_fields as fields;
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
-use crate::geometry::walls::{Oscillation, Shape, Wall, WallMotion};
+use crate::geometry::walls::{Shape, Wall, WallMotion};
+use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
 use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WARNING_STEPS, exact, parse_toml_as};
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
-pub const KIND: &str = "hard-spheres";
+pub const KIND: &str = crate::granular::vocabulary::HARD_KIND;
 
 /// Required columns of a particles file (the snapshots add [`STUCK_COLUMN`]).
 pub const PARTICLE_COLUMNS: [&str; 13] = [
@@ -155,7 +171,7 @@ fn default_skin_steps() -> f64 {
 pub struct GravitySection {
     /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Required in the table.
     #[serde(deserialize_with = "exact::array")]
-    pub g: [f64; 3],
+    pub uniform: [f64; 3],
 }
 
 /// `[material]`: restitution of every particle unless its own table overrides it.
@@ -229,48 +245,38 @@ pub struct ParticleSpec {
     pub stuck_to: Option<usize>,
 }
 
-/// `wall.oscillation`: `A sin(ω t + φ) d̂` added to the wall's position (minus its value at t = 0).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct OscillationSpec {
-    /// Amplitude A (m): 0 or in [1e-300, finite).
-    pub amplitude: f64,
-    /// Angular frequency ω (rad/s), finite, with a finite wall speed `A ω`.
-    pub omega: f64,
-    /// Phase φ (rad). Default 0.
-    #[serde(default)]
-    pub phase: f64,
-    /// Direction d̂ (normalised; must not vanish). Default the wall axis.
-    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
-    pub direction: Option<[f64; 3]>,
-}
-
 /// `[[wall]]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
     /// `"plane"`, `"disk"`, `"cylinder"`, `"ring"`, `"point"` or `"line"`. Required.
-    #[serde(rename = "type")]
     pub kind: String,
-    /// Reference point at t = 0 (m): a point of the plane, the centre of disk/ring, the centre of the cylinder's
-    /// or line's axis segment. Default the origin.
-    #[serde(default, deserialize_with = "exact::array")]
-    pub origin: [f64; 3],
-    /// Orientation: plane/disk/ring normal, cylinder/line axis (normalised; must not vanish). Default `[0, 0, 1]`.
+    /// Plane: a point of it at t = 0 (m). Default the origin.
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    pub point: Option<[f64; 3]>,
+    /// Plane: its normal (normalised; must not vanish). Default `[0, 0, 1]`.
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    pub normal: Option<[f64; 3]>,
+    /// The others: the centre at t = 0 (m) of the disk, ring or point, the middle of the cylinder's or line's axis
+    /// segment. Default the origin.
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    pub centre: Option<[f64; 3]>,
+    /// The others: the axis, normal to a disk or ring (normalised; must not vanish). Default `[0, 0, 1]`.
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub axis: Option<[f64; 3]>,
     /// Radius (m) of a disk (≥ 1e-300), ring (0 or ≥ 1e-300; 0 is a point) or cylinder (0 or ≥ 1e-300; 0 is a
     /// line).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
-    /// Length (m, 0 or ≥ 1e-300) of a cylinder or line, centred on `origin`; absent = infinite. A cylinder of length
+    /// Length (m, 0 or ≥ 1e-300) of a cylinder or line, centred on `centre`; absent = infinite. A cylinder of length
     /// 0 is a ring.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub length: Option<f64>,
     /// Constant translation velocity (m/s). Default 0.
     #[serde(default, deserialize_with = "exact::array")]
     pub velocity: [f64; 3],
-    /// Sinusoidal oscillation. Optional.
+    /// Sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase (rad),
+    /// direction (default the normal or axis). Optional.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub oscillation: Option<OscillationSpec>,
     /// Spin about the axis (rad/s, right-handed); moves the surface tangentially. Default 0.
@@ -332,14 +338,6 @@ impl V<'_> {
             Err(self.invalid(field, format!("must be finite, got {v:?}")))
         }
     }
-    fn unit(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
-        let x = self.vec(field, v)?;
-        if x.norm() > 0.0 {
-            Ok(x.normalize())
-        } else {
-            Err(self.invalid(field, format!("must be a non-zero vector, got {v:?}")))
-        }
-    }
 }
 
 /// Reads and validates a hard-sphere scene file.
@@ -350,7 +348,9 @@ pub fn load_hard_scene(path: &Path) -> Result<HardScene, SceneError> {
 
 /// Parses and validates hard-sphere scene text; `base_dir` resolves a relative `particles_file`.
 pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardScene, SceneError> {
-    let file: HardSceneFile = parse_toml_as(text, name)?;
+    // Old names are read as the new ones, each with a warning.
+    let migration = crate::granular::migrate::migrate(text);
+    let file: HardSceneFile = parse_toml_as(&migration.text, name)?;
     let v = V { file: name };
     if file.scene.kind != KIND {
         return Err(v.invalid(
@@ -372,7 +372,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         ));
     }
     let gravity = match &file.gravity {
-        Some(g) => Some(v.vec("gravity.g", g.g)?),
+        Some(g) => Some(v.vec("gravity.uniform", g.uniform)?),
         None => None,
     };
     let eps_n = v.field(&fields::MATERIAL_EPS_N, file.material.eps_n)?;
@@ -477,7 +477,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
                 let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", gn), ("x", x)]) {
                     "m" => format!("particle[{k}].mass"),
                     "x" => format!("particle[{k}].position"),
-                    _ => "gravity.g".to_string(),
+                    _ => "gravity.uniform".to_string(),
                 };
                 return Err(v.invalid(
                     field,
@@ -490,7 +490,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         }
     }
     let steps = t_end / dt;
-    let mut warnings = Vec::new();
+    let mut warnings = migration.warnings(name);
     if steps > WORK_WARNING_STEPS {
         warnings.push(format!(
             "{name}: stepping.dt = {dt:e} s means {steps:.1e} steps to t_end = {t_end} s (more than \
@@ -660,44 +660,30 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         }
         other => {
             return Err(v.invalid(
-                f("type"),
+                f("kind"),
                 format!(
                     "must be one of \"plane\", \"disk\", \"cylinder\", \"ring\", \"point\", \"line\", got {other:?}"
                 ),
             ));
         }
     };
-    let axis = v.unit(&f("axis"), w.axis.unwrap_or([0.0, 0.0, 1.0]))?;
-    let mut wall = Wall::new(shape, v.vec(&f("origin"), w.origin)?, axis);
-    let oscillation = match &w.oscillation {
-        Some(o) => Some(Oscillation {
-            amplitude: v.size_or_zero(&f("oscillation.amplitude"), o.amplitude)?,
-            omega: {
-                // The wall's speed A ω must be finite too: collisions take it as the surface velocity.
-                if !(o.omega.is_finite() && (o.amplitude * o.omega).is_finite()) {
-                    return Err(v.invalid(
-                        f("oscillation.omega"),
-                        format!(
-                            "must be finite with a finite wall speed amplitude x omega, got {:e} (amplitude {:e} m)",
-                            o.omega, o.amplitude
-                        ),
-                    ));
-                }
-                o.omega
-            },
-            phase: {
-                if !o.phase.is_finite() {
-                    return Err(v.invalid(f("oscillation.phase"), format!("must be finite, got {}", o.phase)));
-                }
-                o.phase
-            },
-            direction: match o.direction {
-                Some(d) => v.unit(&f("oscillation.direction"), d)?,
-                None => axis,
-            },
-        }),
-        None => None,
+    // A plane is placed by a point and its normal, the others by their centre and axis.
+    let (at, facing) = if w.kind == "plane" {
+        no("centre", w.centre.is_some())?;
+        no("axis", w.axis.is_some())?;
+        (("point", w.point), ("normal", w.normal))
+    } else {
+        no("point", w.point.is_some())?;
+        no("normal", w.normal.is_some())?;
+        (("centre", w.centre), ("axis", w.axis))
     };
+    let axis = unit(v, &f(facing.0), facing.1.unwrap_or([0.0, 0.0, 1.0]))?;
+    let mut wall = Wall::new(shape, v.vec(&f(at.0), at.1.unwrap_or_default())?, axis);
+    let oscillation = w
+        .oscillation
+        .as_ref()
+        .map(|o| oscillation(v, &format!("wall[{k}]"), o, Some(axis)))
+        .transpose()?;
     if !w.spin.is_finite() {
         return Err(v.invalid(f("spin"), format!("must be finite, got {}", w.spin)));
     }

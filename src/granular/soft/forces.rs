@@ -102,8 +102,9 @@ pub struct SoftSystem {
 
 /// From this many spheres per task on, the wall contacts are evaluated in parallel.
 const PAR_MIN: usize = 64;
-/// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), law output.
-type WallHit = (usize, Springs, f64, Vec3, Output);
+/// One sphere–wall contact of a step: wall index, springs, overlap (m), wall velocity (m/s), wall spin (rad/s), law
+/// output.
+type WallHit = (usize, Springs, f64, Vec3, Vec3, Output);
 
 fn lookup(list: &[((usize, usize), Springs)], key: (usize, usize)) -> Option<Springs> {
     list.binary_search_by(|e| e.0.cmp(&key)).ok().map(|k| list[k].1)
@@ -238,13 +239,13 @@ impl SoftSystem {
                                 lever_j: f64::INFINITY,
                                 relative_velocity: touch.wall_velocity - p.velocity - p.spin.cross(&nrm) * li,
                                 spin_i: p.spin,
-                                spin_j: Vec3::zeros(),
+                                spin_j: touch.wall_spin,
                                 r_eff: p.radius,
                                 mass_eff: p.mass,
                             };
                             let mut springs = lookup(old, (i, w)).unwrap_or_else(|| Springs::new(nrm));
                             let out = evaluate_law(&law, &kin, &mut springs, dt);
-                            hits.push((w, springs, touch.overlap, touch.wall_velocity, out));
+                            hits.push((w, springs, touch.overlap, touch.wall_velocity, touch.wall_spin, out));
                         }
                         hits
                     })
@@ -252,12 +253,17 @@ impl SoftSystem {
             });
             PHASE_WALL_SUM.time(|| {
                 for (i, hits) in per_particle.into_iter().enumerate() {
-                    for (w, springs, overlap, wall_velocity, out) in hits {
+                    for (w, springs, overlap, wall_velocity, wall_spin, out) in hits {
                         forces[i] += out.force_i;
                         torques[i] += out.torque_i;
                         stats.spring_energy += out.stored_energy;
                         dissipated += out.dissipated;
                         wall_work += out.force_i.dot(&wall_velocity) * dt;
+                        if wall_spin != Vec3::zeros() {
+                            // A spinning wall also works through the twisting and rolling couples it takes
+                            // (`torque_j`, the opposite of those on the sphere).
+                            wall_work -= out.torque_j.dot(&wall_spin) * dt;
+                        }
                         stats.max_overlap_fraction = stats.max_overlap_fraction.max(overlap / self.particles[i].radius);
                         stats.wall_contacts += 1;
                         if self.keep_records {

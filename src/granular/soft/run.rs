@@ -381,15 +381,11 @@ fn wall_surfaces(
     t: f64,
     particles: &[ParticleView],
 ) -> Vec<NamedSurface> {
-    use crate::geometry::walls::soft::Wall;
     walls
         .iter()
         .enumerate()
         .map(|(k, w)| {
-            let anchor = match w {
-                Wall::Plane(p) => p.point,
-                Wall::Sphere(s) => s.centre,
-            };
+            let anchor = w.anchor();
             NamedSurface {
                 name: format!("wall{k}"),
                 mesh: w.surface_at(t, crate::engine::reach(particles, &anchor)),

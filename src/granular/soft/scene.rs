@@ -7,10 +7,10 @@
 //! seed = 1                     # recorded; the engine draws no random numbers
 //! # particles_file = "p.csv"   # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
 //!
-//! [integrator]
+//! [stepping]
 //! dt = 1e-4                    # s, fixed leapfrog step (see `rubblepile ssdem advise`)
 //!
-//! [contact]                    # Zhang17 Eqs. 1–12; defaults: the paper's nominal material
+//! [material]                   # Zhang17 Eqs. 1–12; defaults: the paper's nominal material
 //! k_n = 1e6                    # N/m, required; k_S = 2/7 k_N
 //! eps_n = 0.55                 # normal restitution, (0, 1]
 //! eps_t = 0.55                 # tangential restitution, (0, 1]
@@ -21,7 +21,7 @@
 //! max_start_overlap = 0.05     # largest initial overlap / smaller radius accepted
 //!
 //! [gravity]                    # optional; absent = no gravity
-//! uniform = [0.0, 0.0, -9.81]  # m/s²
+//! uniform = [0.0, 0.0, -9.81]  # m/s², uniform acceleration
 //! self = "tree"                # or "direct"; absent = no self-gravity
 //! theta = 0.5                  # tree opening angle
 //! interval_steps = 1           # steps (integer >= 1): self-gravity every k steps (r-RESPA); see `ssdem advise`
@@ -32,15 +32,23 @@
 //! times = [0.0, 10.0]          # s, snapshots (each at the nearest step); default [0, t_end]
 //!
 //! [[wall]]
-//! kind = "plane"               # point + normal (towards the particles)
+//! kind = "plane"               # a half-space: point + normal (towards the particles)
 //! point = [0.0, 0.0, 0.0]      # m
 //! normal = [0.0, 0.0, 1.0]
-//! oscillation = { amplitude = [0.0, 0.0, 0.01], frequency = 5.0 }   # m, Hz; optional
+//! oscillation = { amplitude = 0.01, angular_frequency = 31.4, phase = 0.0, direction = [0.0, 0.0, 1.0] }   # m, rad/s, rad
 //!
 //! [[wall]]
 //! kind = "sphere"              # the inside of a sphere: centre + radius
 //! centre = [0.0, 0.0, 0.0]     # m
 //! radius = 5.0                 # m
+//!
+//! [[wall]]
+//! kind = "cylinder"            # a drum (both faces): centre + axis + radius, length (absent = infinite)
+//! centre = [0.0, 0.0, 0.0]     # m, the middle of the axis segment
+//! axis = [0.0, 1.0, 0.0]
+//! radius = 5.0                 # m
+//! length = 20.0                # m
+//! spin = 0.0                   # rad/s about the axis (right-handed)
 //!
 //! [[particle]]
 //! radius = 0.5                 # m
@@ -50,8 +58,15 @@
 //! spin = [0.0, 0.0, 0.0]       # rad/s, default 0
 //! ```
 //!
+//! The names are those of the hard-sphere scene wherever the concept is the same (`granular::vocabulary`):
+//! `[stepping] dt` (s), `[material]`, `[gravity] uniform` (m/s²), and for walls `kind`, `point` and `normal` of a
+//! plane, `centre`, `axis`, `radius`, `length` (m), `oscillation = { amplitude (m), angular_frequency (rad/s),
+//! phase (rad), direction }` and `spin` (rad/s). The old names (`[integrator]`, `[contact]`, an oscillation's
+//! vector `amplitude` and `frequency` in Hz) are still read, each with a warning (`granular::migrate`; `rubblepile
+//! check --migrate` rewrites a file).
+//!
 //! Errors are one line naming the file, the dotted field and what was expected (the crate's [`SceneError`]).
-//! Warnings (returned with the scene, printed by the command line) flag a step more than ten times the
+//! Warnings (returned with the scene, printed by the command line) flag an old name, a step more than ten times the
 //! advised one and a `k_N` far below the advised one.
 
 use std::path::{Path, PathBuf};
@@ -59,36 +74,22 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::neighbours::sphere_pairs;
-use crate::geometry::walls::soft::{Oscillation, Plane, SphereContainer, Wall};
+use crate::geometry::walls::soft::{Cylinder, Plane, SphereContainer, Wall};
 use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, advise};
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
 use crate::granular::soft::scene_fields as fields;
+use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::{
     MAX_BODIES, MIN_MEANINGFUL, MIN_STEP_FRACTION, SI_G, SceneError, WORK_WARNING_STEPS, exact,
 };
 
-/// `wall.oscillation` read strictly (three amplitude components, no unknown keys) into the wall's [`Oscillation`].
-fn exact_oscillation<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<Oscillation>, D::Error> {
-    #[derive(Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct Spec {
-        #[serde(deserialize_with = "exact::array")]
-        amplitude: [f64; 3],
-        frequency: f64,
-    }
-    let s = Spec::deserialize(d)?;
-    Ok(Some(Oscillation {
-        amplitude: s.amplitude,
-        frequency: s.frequency,
-    }))
-}
 use crate::math::Vec3;
 
 /// The scene kind this module reads.
-pub const KIND: &str = "soft-spheres";
+pub const KIND: &str = crate::granular::vocabulary::SOFT_KIND;
 
 /// A whole soft-sphere scene file.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -96,10 +97,10 @@ pub const KIND: &str = "soft-spheres";
 pub struct SoftSceneFile {
     /// `[scene]`.
     pub scene: SoftSceneSection,
-    /// `[integrator]`.
-    pub integrator: SoftIntegratorSection,
-    /// `[contact]`.
-    pub contact: ContactSection,
+    /// `[stepping]`.
+    pub stepping: SoftSteppingSection,
+    /// `[material]`.
+    pub material: MaterialSection,
     /// `[gravity]`, optional.
     #[serde(default)]
     pub gravity: GravitySection,
@@ -136,10 +137,10 @@ pub struct SoftSceneSection {
     pub particles_file: Option<String>,
 }
 
-/// `[integrator]`.
+/// `[stepping]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct SoftIntegratorSection {
+pub struct SoftSteppingSection {
     /// Fixed leapfrog step (s, at most the stability limit `2 √(μ_min/k_N)` and `t_end`, at least `t_end × 1e-12`).
     /// More than 1e9 steps are run with a warning.
     pub dt: f64,
@@ -164,10 +165,10 @@ fn d005() -> f64 {
     0.05
 }
 
-/// `[contact]`: the material (defaults: Zhang17's nominal set, §2.3.3).
+/// `[material]`: the contact law's material (defaults: Zhang17's nominal set, §2.3.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ContactSection {
+pub struct MaterialSection {
     /// Normal spring constant (N/m, > 0). Required.
     pub k_n: f64,
     /// Normal restitution ε_n, in (0, 1]. Default 0.55.
@@ -197,7 +198,7 @@ pub struct ContactSection {
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform external field (m/s², finite). Default none.
+    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Default none.
     #[serde(default, deserialize_with = "exact::option")]
     pub uniform: Option<[f64; 3]>,
     /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
@@ -241,24 +242,33 @@ pub struct SoftOutputSection {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
-    /// `"plane"` or `"sphere"`.
+    /// `"plane"`, `"sphere"` or `"cylinder"`.
     pub kind: String,
     /// Plane: a point on it (m).
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub point: Option<[f64; 3]>,
     /// Plane: normal towards the particles (any length > 0; normalised).
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub normal: Option<[f64; 3]>,
-    /// Sphere: centre (m).
-    #[serde(default, deserialize_with = "exact::option")]
+    /// Sphere: centre; cylinder: the middle of its axis segment (m).
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     pub centre: Option<[f64; 3]>,
-    /// Sphere: inner radius (m, ≥ 1e-300).
-    #[serde(default)]
+    /// Cylinder: axis (any length > 0; normalised).
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[f64; 3]>,
+    /// Sphere: inner radius; cylinder: radius (m, ≥ 1e-300).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub radius: Option<f64>,
-    /// Optional sinusoidal translation: `amplitude` (m, three finite numbers) and `frequency` (Hz, ≥ 1e-300), with a
-    /// finite wall speed `2π f |A|`.
-    #[serde(default, deserialize_with = "exact_oscillation")]
-    pub oscillation: Option<Oscillation>,
+    /// Cylinder: length along the axis, centred on `centre` (m, ≥ 1e-300). Default infinite.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length: Option<f64>,
+    /// Optional sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase
+    /// (rad), direction (default the plane's normal or the cylinder's axis; required for a sphere).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub oscillation: Option<OscillationSpec>,
+    /// Cylinder: spin about the axis (rad/s, right-handed, finite). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spin: Option<f64>,
 }
 
 /// `[[particle]]`.
@@ -352,14 +362,18 @@ pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Resu
         file: name.to_string(),
         message: one_line(&message),
     };
-    let de = toml::Deserializer::parse(text).map_err(|e| syntax(e.message().to_string()))?;
+    // Old names are read as the new ones, each with a warning.
+    let migration = crate::granular::migrate::migrate(text);
+    let de = toml::Deserializer::parse(&migration.text).map_err(|e| syntax(e.message().to_string()))?;
     let file: SoftSceneFile = serde_path_to_error::deserialize(de).map_err(|e| {
         let path = e.path().to_string();
         let inner = e.into_inner();
         syntax(format!("{path}: {}", inner.message()))
     })?;
     let v = V { file: name };
-    v.resolve_soft(text, file, base_dir)
+    let mut scene = v.resolve_soft(text, file, base_dir)?;
+    scene.warnings.splice(0..0, migration.warnings(name));
+    Ok(scene)
 }
 
 use crate::io::scene_file::Validator as V;
@@ -502,76 +516,77 @@ impl V<'_> {
 
     fn wall(&self, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         let label = format!("wall[{k}]");
-        if let Some(o) = &w.oscillation {
-            let a = self.vector(&format!("{label}.oscillation.amplitude"), o.amplitude)?;
-            let f = self.within(
-                &fields::OSCILLATION_FREQUENCY,
-                &format!("{label}.oscillation.frequency"),
-                o.frequency,
-            )?;
-            if !(std::f64::consts::TAU * f * a.norm()).is_finite() {
+        let field = |name: &str| format!("{label}.{name}");
+        // The keys each kind requires and those it may take besides; any other placement key is refused.
+        let (required, optional): (&[&str], &[&str]) = match w.kind.as_str() {
+            "plane" => (&["point", "normal"], &[]),
+            "sphere" => (&["centre", "radius"], &[]),
+            "cylinder" => (&["centre", "axis", "radius"], &["length", "spin"]),
+            other => {
                 return Err(self.invalid(
-                    format!("{label}.oscillation.frequency"),
-                    format!(
-                        "gives a non-finite wall speed 2 pi f |A| (|A| = {:e} m), got {f:e}",
-                        a.norm()
-                    ),
+                    field("kind"),
+                    format!("must be \"plane\", \"sphere\" or \"cylinder\", got {other:?}"),
                 ));
             }
-        }
-        let need = |name: &str, present: bool| {
-            if present {
-                Ok(())
-            } else {
-                Err(self.invalid(
-                    format!("{label}.{name}"),
-                    format!("missing (required for a {} wall)", w.kind),
-                ))
-            }
         };
-        let unused = |name: &str, present: bool| {
-            if present {
-                Err(self.invalid(format!("{label}.{name}"), format!("not used by a {} wall", w.kind)))
-            } else {
-                Ok(())
+        let given = [
+            ("point", w.point.is_some()),
+            ("normal", w.normal.is_some()),
+            ("centre", w.centre.is_some()),
+            ("axis", w.axis.is_some()),
+            ("radius", w.radius.is_some()),
+            ("length", w.length.is_some()),
+            ("spin", w.spin.is_some()),
+        ];
+        for name in required {
+            if !given.iter().any(|(n, present)| n == name && *present) {
+                return Err(self.invalid(field(name), format!("missing (required for a {} wall)", w.kind)));
             }
+        }
+        for (name, present) in given {
+            if present && !required.contains(&name) && !optional.contains(&name) {
+                return Err(self.invalid(field(name), format!("not used by a {} wall", w.kind)));
+            }
+        }
+        let shaking = |direction: Option<Vec3>| {
+            w.oscillation
+                .as_ref()
+                .map(|o| oscillation(self, &label, o, direction))
+                .transpose()
         };
         match w.kind.as_str() {
             "plane" => {
-                need("point", w.point.is_some())?;
-                need("normal", w.normal.is_some())?;
-                unused("centre", w.centre.is_some())?;
-                unused("radius", w.radius.is_some())?;
-                let point = self.vector(&format!("{label}.point"), w.point.unwrap_or_default())?;
-                let normal = self.vector(&format!("{label}.normal"), w.normal.unwrap_or_default())?;
-                if normal.norm() == 0.0 {
-                    return Err(self.invalid(format!("{label}.normal"), "must be a non-zero vector, got [0, 0, 0]"));
-                }
+                let point = self.vector(&field("point"), w.point.unwrap_or_default())?;
+                let normal = unit(self, &field("normal"), w.normal.unwrap_or_default())?;
                 Ok(Wall::Plane(Plane {
                     point,
-                    normal: normal.normalize(),
-                    oscillation: w.oscillation,
+                    normal,
+                    oscillation: shaking(Some(normal))?,
                 }))
             }
-            "sphere" => {
-                need("centre", w.centre.is_some())?;
-                need("radius", w.radius.is_some())?;
-                unused("point", w.point.is_some())?;
-                unused("normal", w.normal.is_some())?;
-                Ok(Wall::Sphere(SphereContainer {
-                    centre: self.vector(&format!("{label}.centre"), w.centre.unwrap_or_default())?,
-                    radius: self.within(
-                        &fields::WALL_RADIUS,
-                        &format!("{label}.radius"),
-                        w.radius.unwrap_or_default(),
-                    )?,
-                    oscillation: w.oscillation,
+            "sphere" => Ok(Wall::Sphere(SphereContainer {
+                centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
+                radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
+                oscillation: shaking(None)?,
+            })),
+            _ => {
+                let axis = unit(self, &field("axis"), w.axis.unwrap_or_default())?;
+                let spin = w.spin.unwrap_or(0.0);
+                if !spin.is_finite() {
+                    return Err(self.invalid(field("spin"), format!("must be finite (rad/s), got {spin}")));
+                }
+                Ok(Wall::Cylinder(Cylinder {
+                    centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
+                    axis,
+                    radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
+                    length: w
+                        .length
+                        .map(|l| self.within(&fields::WALL_LENGTH, &field("length"), l))
+                        .transpose()?,
+                    oscillation: shaking(Some(axis))?,
+                    spin,
                 }))
             }
-            other => Err(self.invalid(
-                format!("{label}.kind"),
-                format!("must be \"plane\" or \"sphere\", got {other:?}"),
-            )),
         }
     }
 
@@ -581,17 +596,17 @@ impl V<'_> {
         }
         let t_end = self.field(&fields::T_END, file.scene.t_end)?;
         crate::io::run_budget::validate(self, &file.run)?;
-        let dt = self.step("integrator.dt", file.integrator.dt, t_end)?;
+        let dt = self.step("stepping.dt", file.stepping.dt, t_end)?;
         let steps = (t_end / dt).round();
         if !(1.0..=1e12).contains(&steps) {
             return Err(self.invalid(
-                "integrator.dt",
+                "stepping.dt",
                 format!("t_end/dt must be in [1, 1e12], got {}", t_end / dt),
             ));
         }
         let n_steps = steps as u64;
 
-        let c = &file.contact;
+        let c = &file.material;
         let material = Material {
             k_n: self.field(&fields::K_N, c.k_n)?,
             eps_n: self.field(&fields::EPS_N, c.eps_n)?,
@@ -717,7 +732,7 @@ impl V<'_> {
                 return Err(self.invalid(
                     format!("particle[{i}].position"),
                     format!(
-                        "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start, more than contact.max_start_overlap = {max_start}"
+                        "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start, more than material.max_start_overlap = {max_start}"
                     ),
                 ));
             }
@@ -730,7 +745,7 @@ impl V<'_> {
                     return Err(self.invalid(
                         format!("particle[{i}].position"),
                         format!(
-                            "overlaps wall[{k}] by {} m = {:.4} of its radius at the start, more than contact.max_start_overlap = {max_start}",
+                            "overlaps wall[{k}] by {} m = {:.4} of its radius at the start, more than material.max_start_overlap = {max_start}",
                             touch.overlap,
                             touch.overlap / p.radius
                         ),
@@ -749,7 +764,7 @@ impl V<'_> {
             let lightest = particles.iter().position(|p| p.mass == m_min).unwrap_or(0);
             // No step can be both stable and at least t_end × 1e-12: the stiffness (or a tiny mass) is the cause.
             return Err(self.invalid(
-                "contact.k_n",
+                "material.k_n",
                 format!(
                     "gives a leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:.3e} s (m_min = {m_min:.3e} kg, \
                      particle[{lightest}]), below t_end x {MIN_STEP_FRACTION:e}: more than 1e12 steps, got {:e} N/m",
@@ -759,9 +774,9 @@ impl V<'_> {
         }
         if dt > limit {
             return Err(self.invalid(
-                "integrator.dt",
+                "stepping.dt",
                 format!(
-                    "must be <= the leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:e} s for contact.k_n = {:e} N/m, got {dt:e} (advised: {:e} s)",
+                    "must be <= the leapfrog stability limit 2 sqrt(m_min/2 / k_n) = {limit:e} s for material.k_n = {:e} N/m, got {dt:e} (advised: {:e} s)",
                     material.k_n,
                     limit / (2.0 / std::f64::consts::PI * crate::granular::soft::advise::STEPS_PER_CONTACT)
                 ),
@@ -771,18 +786,20 @@ impl V<'_> {
             / crate::granular::soft::advise::STEPS_PER_CONTACT;
         if dt > 10.0 * advised_dt {
             warnings.push(format!(
-                "{}: integrator.dt = {dt:e} s is more than 10 x the advised {advised_dt:e} s for contact.k_n (contacts resolved by fewer than 5 steps)",
+                "{}: stepping.dt = {dt:e} s is more than 10 x the advised {advised_dt:e} s for material.k_n (contacts resolved by fewer than 5 steps)",
                 self.file
             ));
         }
         if n_steps as f64 > WORK_WARNING_STEPS {
             warnings.push(format!(
-                "{}: integrator.dt = {dt:e} s means {n_steps} steps to t_end = {t_end} s (more than \
+                "{}: stepping.dt = {dt:e} s means {n_steps} steps to t_end = {t_end} s (more than \
                  {WORK_WARNING_STEPS:e}); the run may not end in useful time",
                 self.file
             ));
         }
         if material.k_n < 0.1 * advice.k_n {
+            // Run summaries record this line, and the recorded ones are compared byte for byte: it keeps the
+            // words it was first written with ("contact" the contact law of `[material]`).
             warnings.push(format!(
                 "{}: contact.k_n = {:e} N/m is below a tenth of the advised {:e} N/m: overlaps may exceed 1 % of the smallest radius",
                 self.file, material.k_n, advice.k_n
@@ -799,7 +816,7 @@ impl V<'_> {
             let k = crate::granular::soft::advise::gravity_interval(t_dyn, dt, contact_time);
             if gravity_interval > 2 * k {
                 warnings.push(format!(
-                    "{}: gravity.interval_steps = {gravity_interval} is more than twice the {k} advised for this dt and contact.k_n (rubblepile ssdem advise)",
+                    "{}: gravity.interval_steps = {gravity_interval} is more than twice the {k} advised for this dt and material.k_n (rubblepile ssdem advise)",
                     self.file
                 ));
             }

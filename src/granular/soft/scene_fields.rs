@@ -18,72 +18,72 @@ pub const T_END: FieldDoc = FieldDoc {
     meaning: "end time; the run takes round(t_end/dt) steps",
 };
 
-/// `contact.k_n`.
+/// `material.k_n`.
 pub const K_N: FieldDoc = FieldDoc {
-    key: "contact.k_n",
+    key: "material.k_n",
     unit: "N/m",
     default: "required",
     range: Range::Positive,
     meaning: "normal spring constant (k_S = 2/7 k_N); see `rubblepile ssdem advise`",
 };
 
-/// `contact.eps_n`.
+/// `material.eps_n`.
 pub const EPS_N: FieldDoc = FieldDoc {
-    key: "contact.eps_n",
+    key: "material.eps_n",
     unit: "-",
     default: "0.55",
     range: RESTITUTION,
     meaning: "normal coefficient of restitution",
 };
 
-/// `contact.eps_t`.
+/// `material.eps_t`.
 pub const EPS_T: FieldDoc = FieldDoc {
-    key: "contact.eps_t",
+    key: "material.eps_t",
     unit: "-",
     default: "0.55",
     range: RESTITUTION,
     meaning: "tangential coefficient of restitution",
 };
 
-/// `contact.mu_s`.
+/// `material.mu_s`.
 pub const MU_S: FieldDoc = FieldDoc {
-    key: "contact.mu_s",
+    key: "material.mu_s",
     unit: "-",
     default: "1.0",
     range: Range::NonNegative,
     meaning: "sliding friction coefficient",
 };
 
-/// `contact.mu_t`.
+/// `material.mu_t`.
 pub const MU_T: FieldDoc = FieldDoc {
-    key: "contact.mu_t",
+    key: "material.mu_t",
     unit: "-",
     default: "1.3",
     range: Range::NonNegative,
     meaning: "twisting friction coefficient",
 };
 
-/// `contact.mu_r`.
+/// `material.mu_r`.
 pub const MU_R: FieldDoc = FieldDoc {
-    key: "contact.mu_r",
+    key: "material.mu_r",
     unit: "-",
     default: "1.05",
     range: Range::NonNegative,
     meaning: "rolling friction coefficient",
 };
 
-/// `contact.beta`.
+/// `material.beta`.
 pub const BETA: FieldDoc = FieldDoc {
-    key: "contact.beta",
+    key: "material.beta",
     unit: "-",
     default: "0.5",
     range: Range::NonNegative,
     meaning: "shape parameter (0 = no twisting or rolling resistance)",
 };
 
-/// `contact.max_start_overlap`.
+/// `material.max_start_overlap`.
 pub const MAX_START_OVERLAP: FieldDoc = FieldDoc {
-    key: "contact.max_start_overlap",
+    key: "material.max_start_overlap",
     unit: "-",
     default: "0.05",
     range: Range::NonNegative,
@@ -112,18 +112,18 @@ pub const GRAVITY_THETA: FieldDoc = FieldDoc {
 pub const WALL_RADIUS: FieldDoc = FieldDoc {
     key: "wall.radius",
     unit: "m",
-    default: "required by \"sphere\"",
+    default: "required by \"sphere\", \"cylinder\"",
     range: Range::Positive,
-    meaning: "inner radius of a sphere wall",
+    meaning: "inner radius of a sphere wall, radius of a cylinder",
 };
 
-/// `wall.oscillation.frequency`.
-pub const OSCILLATION_FREQUENCY: FieldDoc = FieldDoc {
-    key: "wall.oscillation.frequency",
-    unit: "Hz",
-    default: "required",
+/// `wall.length`.
+pub const WALL_LENGTH: FieldDoc = FieldDoc {
+    key: "wall.length",
+    unit: "m",
+    default: "infinite",
     range: Range::Positive,
-    meaning: "frequency f of the sinusoidal translation (wall speed 2 pi f |A| finite)",
+    meaning: "length of a cylinder along its axis, centred on its centre",
 };
 
 /// `particle.radius`.
@@ -260,14 +260,14 @@ pub const TABLES: &[TableDoc] = &[
         meaning: "what is simulated and for how long (required)",
     },
     TableDoc {
-        key: "integrator",
+        key: "stepping",
         array: false,
         meaning: "the fixed leapfrog step (required)",
     },
     TableDoc {
-        key: "contact",
+        key: "material",
         array: false,
-        meaning: "the material, Zhang17 Eqs. 1-12 (required for k_n; the rest default to Zhang17's nominal set)",
+        meaning: "the contact law's material, Zhang17 Eqs. 1-12 (required for k_n; the rest default to Zhang17's nominal set)",
     },
     TableDoc {
         key: "gravity",
@@ -282,13 +282,9 @@ pub const TABLES: &[TableDoc] = &[
     TableDoc {
         key: "wall",
         array: true,
-        meaning: "one wall each: a plane (point, normal) or the inside of a sphere (centre, radius)",
+        meaning: "one wall each: a plane (point, normal), the inside of a sphere (centre, radius) or a cylinder (centre, axis, radius, length)",
     },
-    TableDoc {
-        key: "wall.oscillation",
-        array: false,
-        meaning: "sinusoidal translation A sin(2 pi f t) of the wall (optional)",
-    },
+    crate::granular::vocabulary::OSCILLATION_TABLE,
     TableDoc {
         key: "particle",
         array: true,
@@ -327,7 +323,7 @@ pub const FIELDS: &[FieldDoc] = &[
         meaning: "initial particles (t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz) instead of [[particle]]",
     },
     FieldDoc {
-        key: "integrator.dt",
+        key: "stepping.dt",
         unit: "s",
         default: "required",
         range: Range::Rule("<= 2 sqrt(m_min/2 / k_n) and t_end, >= t_end x 1e-12"),
@@ -346,7 +342,7 @@ pub const FIELDS: &[FieldDoc] = &[
         unit: "m/s^2",
         default: "none",
         range: Range::Rule("3 finite numbers"),
-        meaning: "uniform external field",
+        meaning: "uniform acceleration",
     },
     FieldDoc {
         key: "gravity.self",
@@ -396,8 +392,8 @@ pub const FIELDS: &[FieldDoc] = &[
         key: "wall.kind",
         unit: "text",
         default: "required",
-        range: Range::Rule("\"plane\" | \"sphere\""),
-        meaning: "a plane, or the inside of a sphere",
+        range: Range::Rule("\"plane\" | \"sphere\" | \"cylinder\""),
+        meaning: "a half-space, the inside of a sphere, or a cylinder (touched from inside or outside)",
     },
     FieldDoc {
         key: "wall.point",
@@ -416,19 +412,33 @@ pub const FIELDS: &[FieldDoc] = &[
     FieldDoc {
         key: "wall.centre",
         unit: "m",
-        default: "required by \"sphere\"",
+        default: "required by \"sphere\", \"cylinder\"",
         range: Range::Rule("3 finite numbers"),
-        meaning: "centre of a sphere wall",
+        meaning: "centre of a sphere wall, middle of a cylinder's axis",
+    },
+    FieldDoc {
+        key: "wall.axis",
+        unit: "-",
+        default: "required by \"cylinder\"",
+        range: Range::Rule("3 finite numbers, non-zero"),
+        meaning: "cylinder axis (normalised)",
     },
     WALL_RADIUS,
+    WALL_LENGTH,
+    crate::granular::vocabulary::OSCILLATION_AMPLITUDE,
+    crate::granular::vocabulary::OSCILLATION_ANGULAR_FREQUENCY,
+    crate::granular::vocabulary::OSCILLATION_PHASE,
     FieldDoc {
-        key: "wall.oscillation.amplitude",
-        unit: "m",
-        default: "required",
-        range: Range::Rule("3 finite numbers"),
-        meaning: "amplitude vector A of the translation",
+        key: "wall.oscillation.direction",
+        unit: "-",
+        default: "normal or axis",
+        range: Range::Rule("3 finite numbers, non-zero; required by \"sphere\""),
+        meaning: "direction of the oscillation (normalised)",
     },
-    OSCILLATION_FREQUENCY,
+    FieldDoc {
+        range: Range::Rule("finite; \"cylinder\" only"),
+        ..crate::granular::vocabulary::WALL_SPIN
+    },
     PARTICLE_RADIUS,
     PARTICLE_MASS,
     PARTICLE_DENSITY,

@@ -323,7 +323,7 @@ mod tests {
         std::fs::write(
             dir.join("scene.toml"),
             format!(
-                "[stepping]\ndt = 5e-4\n[gravity]\ng = [0.0, 0.0, -9.81]\n[material]\neps_n = 0.5\neps_t = 0.3\n[[wall]]\ntype = \"cylinder\"\n\
+                "[stepping]\ndt = 5e-4\n[gravity]\nuniform = [0.0, 0.0, -9.81]\n[material]\neps_n = 0.5\neps_t = 0.3\n[[wall]]\nkind = \"cylinder\"\n\
                  radius = {R_WALL:?}\nspin = {omega:?}\n"
             ),
         )

@@ -2,45 +2,18 @@
 //! spring–dashpot–slider law as a particle pair, with the wall as an infinitely massive partner).
 //!
 //! A wall reports, for a sphere of centre `c` and radius `r` at time `t`, the contact geometry
-//! ([`WallTouch`]): the unit normal from the sphere's centre towards the wall, the overlap and the wall's
-//! velocity at the contact point. Walls may oscillate sinusoidally ([`Oscillation`], for shaking).
+//! ([`WallTouch`]): the unit normal from the sphere's centre towards the wall, the overlap, and the velocity and
+//! spin of the wall's surface at the contact point. Walls may oscillate sinusoidally (the [`Oscillation`] law of
+//! both granular engines, for shaking); a cylinder ([`cylinder`]) may also spin about its axis (a drum).
 
+pub mod cylinder;
+pub mod touch;
+
+pub use super::motion::Oscillation;
 use crate::math::Vec3;
-use serde::{Deserialize, Serialize};
-
-/// Sinusoidal rigid translation of a wall: offset `A sin(2π f t)` (m), velocity `2π f A cos(2π f t)` (m/s).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Oscillation {
-    /// Amplitude vector `A` (m): direction and size of the displacement.
-    pub amplitude: [f64; 3],
-    /// Frequency `f` (Hz, > 0).
-    pub frequency: f64,
-}
-
-impl Oscillation {
-    /// Displacement of the wall at time `t` (s), in m.
-    pub fn offset(&self, t: f64) -> Vec3 {
-        Vec3::from(self.amplitude) * (std::f64::consts::TAU * self.frequency * t).sin()
-    }
-
-    /// Velocity of the wall at time `t` (s), in m/s.
-    pub fn velocity(&self, t: f64) -> Vec3 {
-        let w = std::f64::consts::TAU * self.frequency;
-        Vec3::from(self.amplitude) * (w * (w * t).cos())
-    }
-}
-
-/// Where a sphere touches a wall.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct WallTouch {
-    /// Unit normal from the sphere's centre towards the wall (the pair law's `n̂`, Zhang17 Eq. 1).
-    pub normal: Vec3,
-    /// Overlap `x` (m, > 0).
-    pub overlap: f64,
-    /// Velocity of the wall's surface at the contact point (m/s).
-    pub wall_velocity: Vec3,
-}
+pub use cylinder::Cylinder;
+pub use touch::WallTouch;
+use touch::motion;
 
 /// An infinite plane through `point` whose unit `normal` points into the half-space the particles occupy.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,20 +37,15 @@ pub struct SphereContainer {
     pub oscillation: Option<Oscillation>,
 }
 
-/// A wall of either kind.
+/// A wall of any kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Wall {
     /// An infinite plane.
     Plane(Plane),
     /// A spherical container (contact on its inner surface).
     Sphere(SphereContainer),
-}
-
-fn motion(osc: &Option<Oscillation>, t: f64) -> (Vec3, Vec3) {
-    match osc {
-        Some(o) => (o.offset(t), o.velocity(t)),
-        None => (Vec3::zeros(), Vec3::zeros()),
-    }
+    /// A cylinder, infinite or finite, touched from inside or outside ([`cylinder`]).
+    Cylinder(Cylinder),
 }
 
 impl Plane {
@@ -98,6 +66,7 @@ impl Plane {
             normal: -self.normal,
             overlap,
             wall_velocity: velocity,
+            wall_spin: Vec3::zeros(),
         })
     }
 }
@@ -113,6 +82,7 @@ impl SphereContainer {
             normal: d / distance,
             overlap,
             wall_velocity: velocity,
+            wall_spin: Vec3::zeros(),
         })
     }
 }
@@ -123,6 +93,16 @@ impl Wall {
         match self {
             Wall::Plane(p) => p.touch(centre, radius, t),
             Wall::Sphere(s) => s.touch(centre, radius, t),
+            Wall::Cylinder(c) => c.touch(centre, radius, t),
+        }
+    }
+
+    /// The wall's reference point at rest (m): a plane's point, a sphere's or cylinder's centre.
+    pub fn anchor(&self) -> Vec3 {
+        match self {
+            Wall::Plane(p) => p.point,
+            Wall::Sphere(s) => s.centre,
+            Wall::Cylinder(c) => c.centre,
         }
     }
 }

@@ -1,0 +1,147 @@
+//! The one vocabulary of the two granular scene files (`kind = "soft-spheres"`, Zhang17; `kind = "hard-spheres"`,
+//! Richardson11): what both call by the same name, in SI units, and the pieces both parsers share — the wall
+//! oscillation's schema ([`OscillationSpec`]), its check ([`oscillation`]) and its rows of the field reference.
+//!
+//! | concept                          | key                                                   | unit        |
+//! |----------------------------------|-------------------------------------------------------|-------------|
+//! | time step                        | `[stepping] dt`                                       | s           |
+//! | contact material                 | `[material]` (`eps_n`, `eps_t`, soft: `k_n`, `mu_*`…) | SI per key  |
+//! | uniform gravity                  | `[gravity] uniform = [gx, gy, gz]`                    | m/s²        |
+//! | wall                             | `[[wall]]`, its shape `kind`                          | text        |
+//! | a point of a plane               | `wall.point`                                          | m           |
+//! | plane normal                     | `wall.normal`                                         | − (unit)    |
+//! | centre (sphere, cylinder, disk…) | `wall.centre`                                         | m           |
+//! | axis (cylinder, disk, ring, line)| `wall.axis`                                           | − (unit)    |
+//! | radius, length                   | `wall.radius`, `wall.length` (absent = infinite)      | m           |
+//! | translation                      | `wall.velocity` (hard)                                | m/s         |
+//! | oscillation                      | `wall.oscillation = { amplitude, angular_frequency, phase, direction }` | m, rad/s, rad, − |
+//! | spin about the axis              | `wall.spin`                                           | rad/s       |
+//!
+//! The oscillation displaces the wall by `A (sin(ω t + φ) − sin φ) d̂` (`geometry::walls::motion`), so it is
+//! where its keys put it at t = 0 whatever the phase. Old names are still read (`granular::migrate`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::geometry::walls::motion::Oscillation;
+use crate::io::scene_fields::{FieldDoc, Range, TableDoc};
+use crate::io::scene_file::{SceneError, Validator, exact};
+use crate::math::Vec3;
+
+/// The `scene.kind` of a soft-sphere scene (`granular::soft::scene`).
+pub const SOFT_KIND: &str = "soft-spheres";
+
+/// The `scene.kind` of a hard-sphere scene (`granular::hard::scene`).
+pub const HARD_KIND: &str = "hard-spheres";
+
+/// `wall.oscillation`: `A (sin(ω t + φ) − sin φ) d̂` added to the wall's position.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OscillationSpec {
+    /// Amplitude A (m): 0 or in [1e-300, finite).
+    pub amplitude: f64,
+    /// Angular frequency ω (rad/s; ω = 2π f), finite, with a finite wall speed `A ω`.
+    pub angular_frequency: f64,
+    /// Phase φ (rad). Default 0.
+    #[serde(default)]
+    pub phase: f64,
+    /// Direction d̂ (normalised; must not vanish). Default the wall's normal or axis.
+    #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+}
+
+/// The oscillation of `wall` (`wall[k]`, for messages) checked: the amplitude a size or zero, `ω` and `φ` finite, the
+/// wall speed `A ω` finite, the direction a non-zero vector (normalised) or, absent, `default_direction` (a wall
+/// without an axis has none: the direction is then required).
+pub(crate) fn oscillation(
+    v: &Validator,
+    wall: &str,
+    spec: &OscillationSpec,
+    default_direction: Option<Vec3>,
+) -> Result<Oscillation, SceneError> {
+    let f = |key: &str| format!("{wall}.oscillation.{key}");
+    let amplitude = v.size_or_zero(&f("amplitude"), spec.amplitude)?;
+    let omega = spec.angular_frequency;
+    // The wall's speed A ω must be finite too: the contacts take it as the surface velocity.
+    if !(omega.is_finite() && (amplitude * omega).is_finite()) {
+        return Err(v.invalid(
+            f("angular_frequency"),
+            format!("must be finite (rad/s) with a finite wall speed amplitude x angular_frequency, got {omega:e} (amplitude {amplitude:e} m)"),
+        ));
+    }
+    if !spec.phase.is_finite() {
+        return Err(v.invalid(f("phase"), format!("must be finite (rad), got {}", spec.phase)));
+    }
+    let direction = match (spec.direction, default_direction) {
+        (Some(d), _) => unit(v, &f("direction"), d)?,
+        (None, Some(d)) => d,
+        (None, None) => {
+            return Err(v.invalid(
+                f("direction"),
+                "missing (required: this wall has no normal or axis to default to)",
+            ));
+        }
+    };
+    Ok(Oscillation {
+        amplitude,
+        omega,
+        phase: spec.phase,
+        direction,
+    })
+}
+
+/// The field `field`'s vector `x` normalised: three finite numbers, not all zero (a wall's normal, axis or
+/// direction).
+pub(crate) fn unit(v: &Validator, field: &str, x: [f64; 3]) -> Result<Vec3, SceneError> {
+    if !x.iter().all(|c| c.is_finite()) {
+        return Err(v.invalid(field, format!("must be finite, got {x:?}")));
+    }
+    let y = Vec3::from(x);
+    if y.norm() > 0.0 {
+        Ok(y.normalize())
+    } else {
+        Err(v.invalid(field, format!("must be a non-zero vector, got {x:?}")))
+    }
+}
+
+/// The `[[wall]] oscillation` table of both references.
+pub const OSCILLATION_TABLE: TableDoc = TableDoc {
+    key: "wall.oscillation",
+    array: false,
+    meaning: "sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)",
+};
+
+/// `wall.oscillation.amplitude`.
+pub const OSCILLATION_AMPLITUDE: FieldDoc = FieldDoc {
+    key: "wall.oscillation.amplitude",
+    unit: "m",
+    default: "required",
+    range: Range::Rule("0 or >= 1e-300, finite"),
+    meaning: "amplitude A",
+};
+
+/// `wall.oscillation.angular_frequency`.
+pub const OSCILLATION_ANGULAR_FREQUENCY: FieldDoc = FieldDoc {
+    key: "wall.oscillation.angular_frequency",
+    unit: "rad/s",
+    default: "required",
+    range: Range::Rule("finite, A omega finite"),
+    meaning: "angular frequency omega = 2 pi f",
+};
+
+/// `wall.oscillation.phase`.
+pub const OSCILLATION_PHASE: FieldDoc = FieldDoc {
+    key: "wall.oscillation.phase",
+    unit: "rad",
+    default: "0",
+    range: Range::Rule("finite"),
+    meaning: "phase phi",
+};
+
+/// `wall.spin` of a wall with an axis.
+pub const WALL_SPIN: FieldDoc = FieldDoc {
+    key: "wall.spin",
+    unit: "rad/s",
+    default: "0",
+    range: Range::Rule("finite"),
+    meaning: "spin about the axis (right-handed): moves the surface tangentially",
+};
