@@ -21,8 +21,7 @@
 //! - **L3**: `engine` — the contract between an engine and the driver ([`engine::Engine`]);
 //! - **L4**: `ellipsoid`, `granular` — the engines (interacting ellipsoids; soft and hard spheres), each with its scene
 //!   schema, equations, outputs and [`engine::Engine`] implementation;
-//! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures), the choice of engine,
-//!   and the stability suite's cases run through it;
+//! - **L5**: `driver` — the one run driver (schedule, outputs, checkpoints, resume, failures), the choice of engine;
 //! - **L6**: `aggregate`, `impact` — builders of rubble piles and impact experiments on top of the engines and driver,
 //!   with the canonical problems of the ellipsoid model;
 //! - **L7**: `analysis` — science on finished runs that any run needs (fragment statistics, fits, clumps, spin-up

@@ -227,30 +227,6 @@ fn stiff_pile_settles_conserving_momenta() {
     );
 }
 
-/// `bench stability --method`: every case's scene runs with the method asked for, its tolerances unchanged.
-#[test]
-fn stability_cases_take_another_method() {
-    use rubblepile::driver::stability::cases::all_cases;
-    for case in all_cases(true) {
-        let before = case.scene_toml.clone();
-        let id = case.id.clone();
-        let after = case.with_method(Method::BulirschStoerImplicit).scene_toml;
-        assert!(before.contains("method = \"bulirsch-stoer\"\n"), "{id}: no method line");
-        assert!(
-            after.contains("method = \"bulirsch-stoer-implicit\"\n"),
-            "{id}: method not replaced"
-        );
-        assert_eq!(
-            after.replace(
-                "method = \"bulirsch-stoer-implicit\"\n",
-                "method = \"bulirsch-stoer\"\n"
-            ),
-            before,
-            "{id}: more than the method line changed"
-        );
-    }
-}
-
 /// Two touching spheres of radius 1 km and 2000 kg m⁻³ (κ = 10, SI gravity, contact) at `f0`, integrated by
 /// `method`: a scene's text.
 fn touching_spheres(f0: f64, method: &str) -> String {

@@ -1,6 +1,6 @@
 //! Benchmarks and timed systems, on the canonical test problems that the library keeps beside what they exercise
 //! (the russell_ode layout: [`rubblepile::integrate::problems`], ODE problems with known solutions;
-//! [`rubblepile::impact::problems`], the problems of the ellipsoid model; [`rubblepile::driver::stability`], the stability
+//! [`rubblepile::impact::problems`], the problems of the ellipsoid model; [`crate::bench::stability`], the stability
 //! suite's cases):
 //! - [`work_precision`]: work–precision measurements (timed runs, final-state and energy errors);
 //! - [`stability`]: the result files of the stability suite of stiff and extreme cases (`rubblepile bench stability`);

@@ -1,12 +1,12 @@
-//! `rubblepile bench stability`: runs the stability suite of [`rubblepile::driver::stability`] (Roig03 model in its
+//! `rubblepile bench stability`: runs the stability suite of [`crate::bench::stability`] (Roig03 model in its
 //! regimes of trouble) and writes `stability.csv`, `stability.md` ([`crate::bench::stability`]) and a run per case.
 
 use std::path::PathBuf;
 
+use crate::bench::stability::cases::all_cases;
+use crate::bench::stability::suite::{StabilityRow, Verdict, run_case};
 use crate::bench::stability::{prepare_out, result_paths, write_csv, write_markdown};
 use crate::cli::common::CliError;
-use rubblepile::driver::stability::cases::all_cases;
-use rubblepile::driver::stability::{StabilityRow, Verdict, run_case};
 
 /// `rubblepile bench stability`.
 #[derive(Debug, clap::Args)]

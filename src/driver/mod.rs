@@ -43,7 +43,6 @@ pub mod progress;
 pub mod run_files;
 pub mod runner;
 pub mod scene_kind;
-pub mod stability;
 pub mod warm_pool;
 
 pub use crate::ellipsoid::summary::RunSummary;

@@ -1,10 +1,16 @@
 //! `rubblepile bench stability`'s result files: `stability.csv` and `stability.md`, one row per case of the
-//! stability suite ([`rubblepile::driver::stability`], which holds the cases, runs them and judges them).
+//! stability suite: its cases ([`cases`]), how a case is judged ([`case`]) and how one is run ([`suite`]).
+
+pub mod case;
+pub mod cases;
+pub mod suite;
+#[cfg(test)]
+mod suite_tests;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use rubblepile::driver::stability::{StabilityError, StabilityRow};
+use suite::{StabilityError, StabilityRow};
 
 /// Columns of `stability.csv`.
 pub const CSV_COLUMNS: [&str; 11] = [
@@ -125,7 +131,7 @@ mod tests {
             energy_error: 2.5e-12,
             max_quat_norm_error: 7.25e-15,
             min_step: f64::NAN,
-            verdict: rubblepile::driver::stability::Verdict::Warn,
+            verdict: suite::Verdict::Warn,
             note: "n".into(),
         };
         let dir = std::env::temp_dir().join(format!("rubblepile-bench-stability-{}", std::process::id()));

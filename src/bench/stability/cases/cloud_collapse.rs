@@ -53,8 +53,8 @@ pub fn cloud_collapse(id: &str, n: usize, t_end: f64, naive: bool) -> Case {
     );
     case(id, description, &spec, &bodies, move |run| {
         let snaps = run.snapshots()?;
-        let settings = crate::ellipsoid::barrier::BarrierSettings::for_kappa_source(&run.scene.kappa_source);
-        let count = |b: &[Body]| crate::ellipsoid::barrier::contacts(&run.scene.model, &settings, b).len();
+        let settings = rubblepile::ellipsoid::barrier::BarrierSettings::for_kappa_source(&run.scene.kappa_source);
+        let count = |b: &[Body]| rubblepile::ellipsoid::barrier::contacts(&run.scene.model, &settings, b).len();
         let (c0, c1) = (
             snaps.first().map_or(0, |(_, b)| count(b)),
             snaps.last().map_or(0, |(_, b)| count(b)),

@@ -5,16 +5,16 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::driver::RunSummary;
-use crate::ellipsoid::barrier::{BarrierSettings, contacts};
-use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::ellipsoid::equations::EllipsoidSystem;
-use crate::ellipsoid::output::read_bodies_csv;
-use crate::ellipsoid::scene::LoadedScene;
-use crate::integrate::{Tolerances, make_integrator};
-use crate::math::{Vec3, Vec4};
+use rubblepile::driver::RunSummary;
+use rubblepile::ellipsoid::barrier::{BarrierSettings, contacts};
+use rubblepile::ellipsoid::body::{Body, Ellipsoid};
+use rubblepile::ellipsoid::equations::EllipsoidSystem;
+use rubblepile::ellipsoid::output::read_bodies_csv;
+use rubblepile::ellipsoid::scene::LoadedScene;
+use rubblepile::integrate::{Tolerances, make_integrator};
+use rubblepile::math::{Vec3, Vec4};
 
-/// A case's verdict (see the module docs of `driver::stability`).
+/// A case's verdict (see the module docs of `suite`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Verdict {
     /// Everything as expected.
@@ -90,7 +90,7 @@ impl CaseRun {
         Ok(out)
     }
 
-    /// The largest `relative speed / calibrated speed` of any touching pair ([`crate::ellipsoid::barrier::contacts`])
+    /// The largest `relative speed / calibrated speed` of any touching pair ([`rubblepile::ellipsoid::barrier::contacts`])
     /// and the smallest centre distance in units of the touching distance, `(0, 1)` when no pair touched,
     /// sampled every `dt` s: the case's scene is integrated again (same physics, method and tolerances), so that
     /// the run itself can keep a coarse output grid and its step counts say what the dynamics costs. An
@@ -123,6 +123,7 @@ impl CaseRun {
     }
 
     /// Whether the run completed.
+    #[cfg_attr(not(test), allow(dead_code, reason = "read by the suite's tests"))]
     pub fn completed(&self) -> bool {
         self.failure.is_none()
     }
@@ -169,7 +170,7 @@ pub struct Case {
 impl Case {
     /// The same case run by `method` instead of the suite's Bulirsch–Stoer (same tolerances): its scene's
     /// `[integrator] method` line replaced.
-    pub fn with_method(self, method: crate::integrate::Method) -> Case {
+    pub fn with_method(self, method: rubblepile::integrate::Method) -> Case {
         Case {
             scene_toml: self
                 .scene_toml

@@ -10,14 +10,14 @@
 use std::f64::consts::{PI, TAU};
 use std::fmt::Write as _;
 
-use crate::driver::stability::case::{Case, CaseRun, Judgement, judge};
-use crate::ellipsoid::barrier::SPEED_MARGIN;
-use crate::ellipsoid::body::{Body, Ellipsoid};
-use crate::ellipsoid::calibration::lambda;
-use crate::ellipsoid::cloud::{CloudParams, random_cloud};
-use crate::ellipsoid::equations::G_SI;
-use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::math::{Vec3, Vec4};
+use super::case::{Case, CaseRun, Judgement, judge};
+use rubblepile::ellipsoid::barrier::SPEED_MARGIN;
+use rubblepile::ellipsoid::body::{Body, Ellipsoid};
+use rubblepile::ellipsoid::calibration::lambda;
+use rubblepile::ellipsoid::cloud::{CloudParams, random_cloud};
+use rubblepile::ellipsoid::equations::G_SI;
+use rubblepile::ellipsoid::quaternion::rotation_matrix;
+use rubblepile::math::{Vec3, Vec4};
 
 mod cloud_collapse;
 mod head_on;
@@ -328,10 +328,10 @@ fn final_bodies(run: &CaseRun) -> Result<Vec<Body>, String> {
         .ok_or_else(|| "no snapshot".to_string())
 }
 
-/// The rows of a run's `timeseries.csv` as numbers (columns of [`crate::ellipsoid::output::TIMESERIES_COLUMNS`]).
+/// The rows of a run's `timeseries.csv` as numbers (columns of [`rubblepile::ellipsoid::output::TIMESERIES_COLUMNS`]).
 fn timeseries(run: &CaseRun) -> Result<Vec<Vec<f64>>, String> {
     let path = run.dir.join("timeseries.csv");
-    crate::io::table::read_table(&path, crate::io::table::Cells::Strict)
+    rubblepile::io::table::read_table(&path, rubblepile::io::table::Cells::Strict)
         .map(|t| t.rows)
         .map_err(|e| e.to_string())
 }
@@ -366,7 +366,7 @@ fn pair_state(bodies: &[Body], i: usize, j: usize) -> (f64, f64) {
     let (bi, bj) = (&bodies[i], &bodies[j]);
     let sigma = |b: &Body| {
         let r = rotation_matrix(&b.quaternion);
-        r.transpose() * crate::math::Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
+        r.transpose() * rubblepile::math::Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
     };
     let g = sigma(bi) + sigma(bj);
     let d = bi.position - bj.position;

@@ -1,8 +1,8 @@
 //! The stability suite: the interacting-ellipsoids model (Roig03 §2, Eqs. 10–14, 28–41) pushed to its
-//! regimes of trouble, each as an ordinary scene run through [`crate::driver::run_scene`].
+//! regimes of trouble, each as an ordinary scene run through [`rubblepile::driver::run_scene`].
 //!
 //! The cases ([`cases::all_cases`]) are (a) head-on impacts at the calibrated speed of Roig03 Eq. 14 and
-//! above it (the contact-barrier detector of [`crate::ellipsoid::barrier`] must name the pair), (b) needles
+//! above it (the contact-barrier detector of [`rubblepile::ellipsoid::barrier`] must name the pair), (b) needles
 //! and plates with C/A = 0.05, (c) a mass ratio of 1e-6, (d) attitudes at the Euler-angle singularity θ = 0,
 //! (e) stiff dissipation F0 = 100 s m⁻², (f) κ from 1.6 to 50, (g) a cloud of N = 2000 collapsing,
 //! (h) a resting contact held for 1e6 s. `rubblepile bench stability` runs them and writes `stability.csv`
@@ -18,16 +18,13 @@
 //! - **fail**: a hard criterion broke: a crash or a stop the case does not expect, NaN, an energy residual
 //!   above the loose bound, a missing or wrong warning.
 
-pub mod case;
-pub mod cases;
-
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::driver::{RunError, RunOptions, run_scene};
-use crate::ellipsoid::scene::parse_scene;
+use rubblepile::driver::{RunError, RunOptions, run_scene};
+use rubblepile::ellipsoid::scene::parse_scene;
 
-pub use case::{Case, CaseRun, Check, Judgement, Verdict, judge, read_bodies};
+pub use super::case::{Case, CaseRun, Verdict};
 
 /// One row of `stability.csv`.
 #[derive(Debug, Clone, PartialEq)]
@@ -45,7 +42,7 @@ pub struct StabilityRow {
     /// Wall-clock time of the case (s): the run, including output.
     pub wall_seconds: f64,
     /// The run's relative energy residual `max |H − H0 − 2∫F| / energy scale`
-    /// ([`crate::driver::RunSummary::energy_error`]).
+    /// ([`rubblepile::driver::RunSummary::energy_error`]).
     pub energy_error: f64,
     /// max over samples and bodies of `||q| − 1|`.
     pub max_quat_norm_error: f64,
@@ -63,6 +60,7 @@ pub struct CaseResult {
     /// The row.
     pub row: StabilityRow,
     /// The run.
+    #[cfg_attr(not(test), allow(dead_code, reason = "read by the suite's tests"))]
     pub run: CaseRun,
 }
 
@@ -111,7 +109,7 @@ pub fn run_case(case: &Case, runs_dir: &Path, force: bool) -> Result<CaseResult,
         progress: false,
         checkpoint_every: None,
         checkpoint_every_sim: None,
-        formats: crate::driver::formats::Formats::NONE,
+        formats: rubblepile::driver::formats::Formats::NONE,
         stop_after_checkpoints: None,
         ..RunOptions::default()
     };
@@ -153,6 +151,7 @@ pub fn run_case(case: &Case, runs_dir: &Path, force: bool) -> Result<CaseResult,
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::stability::case::judge;
 
     #[test]
     fn judge_orders_verdicts() {
