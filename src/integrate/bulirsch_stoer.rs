@@ -42,11 +42,9 @@ const STABILITY_COLUMNS: usize = 2;
 /// Limit on `‖Δf‖² / ‖f‖²` in the stability check.
 const STABILITY_RATIO: f64 = 4.0;
 /// Share of the tolerance the local errors of a whole run may add up to under error-per-unit-step control
-/// ([`Integrator::set_span`]). Measured on the outer Solar System: at the largest steps the order chooses,
-/// `‖T_{j,j} − T_{j,j−1}‖` underestimates the true local error of `T_{j,j}` by 2–3× (a one-step tableau against
-/// a Dop853 1e-15 reference), and Kepler shear turns an along-track error into a growing one. With a budget of
-/// 1 the final error reached 240 × rtol, with 1/3 106 ×, with 1/4 at most 77 × over rtol 1e-6…1e-11
-/// (`bench tolerance`).
+/// ([`Integrator::set_span`]). Below 1 because at the largest steps `‖T_{j,j} − T_{j,j−1}‖` underestimates the true
+/// local error of `T_{j,j}`, and Kepler shear turns an along-track error into a growing one (the values tried:
+/// `analysis/work_precision/NOTES.md`).
 pub const RUN_BUDGET: f64 = 0.25;
 /// Default maximum number of columns (ODEX `km`).
 pub const DEFAULT_MAX_COLUMNS: usize = 9;
