@@ -5,7 +5,7 @@
 //! layers meet the spin axis decides how many contacts survive the settling under self-gravity and rotation, and
 //! with them the pile's strength, so the orientation is a build input recorded in the aggregate's report:
 //!
-//! - `perpendicular`: layers ⟂ the spin axis (the stacking axis c along z; what every build did before);
+//! - `perpendicular`: layers ⟂ the spin axis (the stacking axis c along z; the default);
 //! - `parallel`: layers containing the spin axis (c along y: the lattice turned 90° about x);
 //! - `tilt:DEG`: c tilted by DEG degrees from z towards −y (a turn about x; `tilt:54.7356` puts the spin axis on a
 //!   body diagonal of the lattice's cubic cell);
@@ -36,7 +36,7 @@ pub enum LatticeOrientation {
 }
 
 impl Default for LatticeOrientation {
-    /// [`LatticeOrientation::Perpendicular`], what builds did before the orientation was an input.
+    /// [`LatticeOrientation::Perpendicular`]: the lattice of a build that names no orientation.
     fn default() -> Self {
         LatticeOrientation::Perpendicular
     }

@@ -1,34 +1,16 @@
-//! Random packings by Zhang17's recipe (§2.3.2): spheres placed at random in a spherical cloud collapse under
-//! their own gravity with very inelastic collisions; the heap is shaken vertically and sinusoidally inside a
-//! rigid spherical container in a uniform 1 g field; it then settles under self-gravity with no external field.
-//! All stages are frictionless (μ_S = μ_T = μ_R = β = 0), so that voids close and no Brazil-nut segregation
-//! occurs. Everything runs on the SSDEM engine ([`crate::granular::soft`]); the caller carves the result.
+//! Random packings by Zhang17's recipe (§2.3.2) on the SSDEM engine ([`crate::granular::soft`]): a random cloud
+//! collapses under self-gravity with very inelastic collisions, is shaken vertically and sinusoidally in a rigid
+//! spherical container in 1 g, then settles under self-gravity alone; all stages frictionless (μ_S = μ_T = μ_R =
+//! β = 0) so voids close without Brazil-nut segregation. The caller carves the result.
 //!
-//! Scaled parameters (all in [`Recipe`], reported with every aggregate). The engine step is set by the
-//! stiffest, lightest contact, so each stage picks its own `k_N` for the overlap it can tolerate and a step of
-//! `contact time / steps_per_contact`:
-//! - dynamic load: a pair of smaller radius `r_s` meeting at speed `v` overlaps by `v √(μ/k_N)` with `μ ≤ m_s`, so
-//!   `k_N ≥ (4/3)π ρ r_s v²/f²` for an overlap `f r_s`; we take `r_s = r_max` (conservative);
-//! - static load: pressure `p` on a grain's cross-section `4r²` overlaps by `4 p r²/k_N`, so `k_N ≥ 4 p r_max/f`.
-//!
-//! Stages and their defaults ([`Recipe::default`]):
-//! 1. cloud: random sequential placement (largest grains first) in a ball filled to `cloud_packing` = 0.2;
-//! 2. collapse: self-gravity, ε = `restitution` = 0.1, for `collapse_freefall_times` = 2 free-fall times of the
-//!    cloud, `t_ff = √(3π/(32 G ρ_cloud))`, with `k_N` for escape-speed impacts at `collapse_overlap` = 10 %;
-//! 3. shaking: the heap (re-centred) in a container of radius `((V_grains/container_fill)·3/(4π))^{1/3}`,
-//!    container_fill = 0.56, grains beyond it pulled radially inside; uniform field g = 9.81 m/s² along −z;
-//!    container oscillating along z with amplitude `A = shake_amplitude` × mean radius and frequency from
-//!    `Γ = A ω²/g = shake_gamma` = 1.5, for `shake_periods` = 10 periods; then `calm_periods` = 3 periods at
-//!    rest in the field; then 1 period with the field off (the load relaxes); `k_N` from the static load of the
-//!    container's full height `2 R_c` and the wall speed `2Aω`, at `shake_overlap` = 3 %;
-//! 4. settle: no container, self-gravity only, `k_N` from the central pressure of the uniform-sphere estimate at
-//!    `settle_overlap` = 1 % (ten times stiffer, so that overlaps do not inflate the packing fraction), run in chunks of half a free-fall time of the pile until the
-//!    kinetic energy is below `settle_kinetic_fraction` = 1e-6 of the gravitational energy's magnitude, at most
-//!    `settle_max_chunks` = 8 chunks.
-//!
-//! Self-gravity is direct below `direct_below` = 1500 grains and an octree with θ = `tree_theta` = 0.8 above
-//! (accuracy matters little here: it only has to pull the heap together), evaluated every `gravity_interval` steps
-//! (default 1). Every step count is deterministic.
+//! Parameters and their defaults: [`Recipe`] / [`Recipe::default`] (reported with every aggregate). Each stage
+//! picks `k_N` for the overlap fraction `f` it tolerates and a step of contact time / `steps_per_contact`: dynamic
+//! load `k_N ≥ (4/3)π ρ r_max v²/f²`, static load `k_N ≥ 4 p r_max/f`. Stages: (1) sequential placement, largest
+//! first, to `cloud_packing`; (2) collapse for `collapse_freefall_times` × `t_ff = √(3π/(32 G ρ_cloud))`, `k_N` for
+//! escape-speed impacts; (3) shaking in a container filled to `container_fill`, `Γ = A ω²/g = shake_gamma`, then
+//! calm periods, then one with the field off; (4) settle in half-free-fall chunks until the kinetic energy is below
+//! `settle_kinetic_fraction` of |U| (at most `settle_max_chunks`). Self-gravity is direct below `direct_below`,
+//! else an octree (`tree_theta`), every `gravity_interval` steps. Deterministic.
 
 use crate::geometry::walls::soft::{Oscillation, SphereContainer, Wall};
 use crate::granular::soft::contact::Material;

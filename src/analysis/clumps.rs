@@ -1,35 +1,16 @@
-//! Clumps of any snapshot (ellipsoids, soft or hard spheres): the re-accumulated bodies an impact or a disruption
-//! leaves, with the largest remnant — the headline number of impact studies (pkdgrav's companion and
-//! friends-of-friends finders give the same; Michel et al. 2001, Science 294; Leinhardt & Richardson 2002, Icarus
-//! 159).
+//! Clumps of any snapshot (ellipsoids, soft or hard spheres) and the largest remnant, as pkdgrav's companion and
+//! friends-of-friends finders define them (Michel et al. 2001, Science 294; Leinhardt & Richardson 2002, Icarus 159).
 //!
-//! Definitions (choices of ours, documented here and in the README):
-//!
-//! 1. **Linking** (friends of friends on surface gaps, [`crate::ellipsoid::clumps`]): two bodies are friends
-//!    when the gap between their surfaces is at most `ℓ = f · min(cᵢ, cⱼ)`, `c` the smallest semi-axis (a sphere's
-//!    radius), `f` = [`DEFAULT_GAP_FRACTION`] = 0.1 by default; exact for spheres, for ellipsoids every pair within
-//!    `ℓ` is linked and none beyond `ℓ (aᵢ/cᵢ + aⱼ/cⱼ)/2`.
-//! 2. **Boundness** (with self-gravity, `G > 0`): a member `i` of a linked set `S` (mass `M`, centre-of-mass
-//!    velocity `V`) stays when its two-body energy against the rest of the set is negative,
-//!    `Eᵢ = ½ mᵢ |vᵢ − V|² M/(M − mᵢ) − G mᵢ Σ_{j∈S, j≠i} mⱼ/|rᵢ − rⱼ| < 0`: the kinetic energy relative to the
-//!    set's centre of mass (times `M/(M − mᵢ)`, the recoil of the rest, so that for two bodies it is the exact
-//!    two-body energy) against the set's potential on it, summed pair by pair (no monopole: members touch).
-//!    Each pass drops the most unbound quarter (at least one) of the members with `Eᵢ > 0`, as the unbinding of
-//!    SUBFIND does (Springel et al. 2001, MNRAS 328), so that a fast member's momentum, which shifts `V`, does not
-//!    unbind slow members with it; the kept and the dropped members are each re-linked among themselves (friends
-//!    of friends within the subset) and refined again, to a fixed point: every clump is then linked and every
-//!    member bound to the rest of its clump. A set of two or more members drops fewer than all of them, so each
-//!    pass makes strict subsets and the refinement ends. Without self-gravity (no gravity in the
-//!    scene, a uniform field only, hard spheres) nothing is refined: clumps are the linked sets.
-//! 3. **Per clump**: mass, centre-of-mass position and velocity, the inertia tensor about the centre of mass
-//!    `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))` (members' principal moments `Iᵢ` of the run's inertia model,
-//!    uniform solids for spheres) and the angular momentum `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ωᵢ)` about it (`dᵢ`, `uᵢ`
-//!    relative position and velocity); spin `ω = I⁻¹ L`, period `2π/|ω|`; principal moments `I₁ ≤ I₂ ≤ I₃` of
-//!    `I`; the equivalent uniform ellipsoid of that tensor, `a² = 5 (I₂ + I₃ − I₁)/(2M)`, `b² = 5 (I₁ + I₃ −
-//!    I₂)/(2M)`, `c² = 5 (I₁ + I₂ − I₃)/(2M)`, given as `b/a`, `c/a`.
-//! 4. **Fate**: the most massive clump is the largest remnant (`largest`); every other clump is `bound` to it when
-//!    their two-body energy `½ μ |Vₖ − V₀|² − G Mₖ M₀/|Rₖ − R₀|` (`μ` the reduced mass, centres of mass as points)
-//!    is negative, `escaping` otherwise (always without self-gravity).
+//! 1. Linking ([`crate::ellipsoid::clumps`]): friends when the surface gap is ≤ `f · min(cᵢ, cⱼ)` (`c` the smallest
+//!    semi-axis, `f` = [`DEFAULT_GAP_FRACTION`]); exact for spheres, for ellipsoids none beyond `ℓ (aᵢ/cᵢ + aⱼ/cⱼ)/2`.
+//! 2. Boundness (self-gravity only): member `i` of set `S` stays when `Eᵢ = ½ mᵢ |vᵢ − V|² M/(M − mᵢ) −
+//!    G mᵢ Σ_{j≠i} mⱼ/|rᵢ − rⱼ| < 0` (exact two-body energy for two bodies; pairwise, no monopole). Each pass drops the
+//!    most unbound quarter (≥ 1) as SUBFIND does (Springel et al. 2001, MNRAS 328), re-links kept and dropped
+//!    members and refines again to a fixed point (strict subsets each pass, so it ends).
+//! 3. Per clump: mass, centre of mass, `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))`, `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ωᵢ)`,
+//!    `ω = I⁻¹ L`, and the equivalent uniform ellipsoid `a² = 5 (I₂ + I₃ − I₁)/(2M)` (cyclic), as `b/a`, `c/a`.
+//! 4. Fate: the heaviest is `largest`; another is `bound` when `½ μ |Vₖ − V₀|² − G Mₖ M₀/|Rₖ − R₀| < 0`, else
+//!    `escaping` (always without self-gravity).
 
 use rayon::prelude::*;
 

@@ -1,21 +1,11 @@
-//! Composition of the outcome of a collision between two rubble piles (the escape test is Roig03
-//! Eq. 43 applied to clumps): which bodies stick together, whether each clump stays bound, and how much of each
-//! clump came from the projectile.
-//!
-//! Definitions (choices of ours; the paper has a single-ellipsoid projectile and no clumps):
-//! * **Origin**: every body is tagged `target` or `projectile` by its index (the ranges in `impact.json`).
-//! * **Clump**: a connected set of bodies in contact, two bodies being in contact when their ellipsoids,
-//!   each semi-axis enlarged by [`CLUMP_MARGIN`], overlap (the overlap test of the contact model,
-//!   [`crate::geometry::ellipsoid_overlap::are_apart`], applied by [`crate::ellipsoid::clumps`]). Resting bodies
-//!   sit in shallow overlap under the contact barrier; the margin also joins those a hair apart.
-//! * **Bound clump** (Eq. 43 with the clump as one body): `K_c = ½ M_c |V_c − V_sys|²` (barycentric frame of
-//!   the whole system) below `|U_c| = Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`.
-//! * **Largest remnant**: the most massive clump. Its spin is `ω = I⁻¹ L` about its barycentre, with
-//!   `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))` and `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ω_bᵢ)` (`dᵢ`, `uᵢ` position and
-//!   velocity relative to the clump's barycentre, `Iᵢ` the principal moments of the run's inertia model);
-//!   period `2π/|ω|`, no §4.3 correction (the aggregate's inertia is mostly the parallel-axis terms).
-//! * **Mixing** of the other bound clumps: their mass-weighted projectile fraction
-//!   `Σ_c m_c^proj / Σ_c M_c`, and how many hold bodies of both origins.
+//! Composition of the outcome of a collision between two rubble piles (the paper has a single-ellipsoid projectile;
+//! these are our definitions): bodies are `target` or `projectile` by index (`impact.json`); clumps link bodies whose
+//! ellipsoids, each semi-axis enlarged by [`CLUMP_MARGIN`], overlap ([`crate::geometry::ellipsoid_overlap::are_apart`]
+//! via [`crate::ellipsoid::clumps`]). A clump is bound by Roig03 Eq. 43 with the clump as one body:
+//! `½ M_c |V_c − V_sys|² < Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`. The largest remnant is the heaviest clump, its spin
+//! `ω = I⁻¹ L` with `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))`, `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ω_bᵢ)` (barycentric),
+//! period `2π/|ω|` (no §4.3 correction: parallel-axis terms dominate). Mixing of the other bound clumps: their
+//! mass-weighted projectile fraction and how many hold bodies of both origins.
 
 use crate::analysis::clumps::clump_spin;
 use crate::ellipsoid::body::Body;

@@ -1,30 +1,15 @@
-//! The creep test of a run held at T_final, behind the search for T_c,3 (Zhang17 §3.3.3, §4.3 and Fig. 22).
+//! The creep test of a run held at T_final, behind the search for T_c,3 (Zhang17 §3.3.3, §4.3, Fig. 22). The paper
+//! calls a hold creeping when, after t_final, θ_max gradually rises or η_B and the coordination number gradually
+//! fall (a small rise then levelling off, as in Fig. 22, is re-compaction, not creep); T_c,3 is the shortest T_final
+//! that does not creep. It gives no tolerance.
 //!
-//! **What the paper asks.** Zhang17 §3.3.3 holds the body at T_final after the spin-up and calls the hold creeping
-//! when, after t_final, the shear load keeps growing or the interior keeps loosening: in its own diagnostics, a
-//! gradual *rise* of the largest mobilized friction angle θ_max, or a gradual *fall* of the interior packing
-//! fraction η_B and of the coordination number (mean contacts per particle). Its stable example (Fig. 22, PP2 at
-//! 2811 kg/m³) shows η_B and the coordination number *rising* a little once the acceleration stops (the pile
-//! re-compacts) and then levelling off; that is not creep. T_c,3 is the shortest T_final whose hold does not creep.
-//! The paper gives no tolerance: any persistent weakening trend is creep.
-//!
-//! **The criteria here** ([`CreepCriterionKind`]) look at the second half of the hold (the first half is left to the
-//! transient that follows the end of the acceleration, so that "gradual" means a trend that persists):
-//! - [`CreepCriterionKind::Paper`] (the default): the paper's one-sided rule with zero tolerance, judged by *rates*.
-//!   Each diagnostic's least-squares slope over the second half is given per 1000 s with its standard error
-//!   ([`RateFit`]; the error widened for the serial correlation of the samples); a diagnostic creeps when its
-//!   weakening rate (θ_max up, η_B down, contacts down) exceeds [`DEFAULT_SIGNIFICANCE`] standard errors. Nothing
-//!   here depends on the hold's length except through the error of the rate, so a longer hold can only sharpen a
-//!   verdict, not move a threshold.
-//! - [`CreepCriterionKind::PaperTolerance`]: the same one-sided reading with tolerances on the *change* over the
-//!   second half (θ_max +0.5°, η_B −0.0005, contacts −0.05 per particle; ours, the paper gives none), kept to read
-//!   the searches made with it and as the documented alternative.
-//! - [`CreepCriterionKind::Ours`]: two-sided on θ_max (0.5°) and η_B (0.0005) over the second half, the
-//!   coordination number not judged (our scaled RCP holds lose contacts at every period while θ_max stays put,
-//!   which the paper's rule reads as creep).
-//!
-//! Either way a hold whose forcing was released (global disruption) is not stable; that is the search's business
-//! (`analysis::critical`, which uses these criteria).
+//! The criteria ([`CreepCriterionKind`]) judge the second half of the hold (the first is the transient):
+//! [`CreepCriterionKind::Paper`] (default), the one-sided rule with zero tolerance on rates: a diagnostic creeps when
+//! its weakening least-squares slope exceeds [`DEFAULT_SIGNIFICANCE`] standard errors ([`RateFit`], per 1000 s, the
+//! error widened for serial correlation), so a longer hold only sharpens a verdict;
+//! [`CreepCriterionKind::PaperTolerance`], one-sided with (our) tolerances on the change (θ_max +0.5°, η_B −0.0005,
+//! contacts −0.05); [`CreepCriterionKind::Ours`], two-sided on θ_max and η_B only (scaled RCP holds lose contacts
+//! while θ_max stays put). A released hold is not stable either: that is `analysis::critical`'s business.
 
 use serde::Serialize;
 

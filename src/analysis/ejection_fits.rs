@@ -1,19 +1,11 @@
-//! Roig et al. (2003, Icarus 165) §4.2 and Fig. 4: the ejection speed–size power law `Δv ∝ size^α` fitted to
-//! subsets of the target fragments, each with its standard error, and where the ejected fragments started.
-//!
-//! The paper fits "the data" of its Fig. 4 without saying which fragments enter the fit. In a rotating pile a
-//! fragment the impact never reached still has an ejection speed (Roig03's `Δv` is the change of its velocity
-//! relative to the target's barycentre between `t = 0` and `t_at`, and the pile turns meanwhile), so every run
-//! has a floor of slow, unperturbed fragments. Three fits answer the question of which fragments count:
-//! * **all** target fragments (what `rubblepile analyze` reports);
-//! * fragments with `Δv` **above a floor** (m/s): the ones the impact actually threw;
-//! * the **escaping** fragments only (Eq. 43), those above Fig. 4's dotted escape line.
-//!
-//! Each fit is [`fit_power_law`] on `(size, Δv)`: least squares in `(ln size, ln Δv)`, `σ_α` from the residual
-//! variance. §4.2's spatial claim ("only small fragments are ejected at the impact point, while the largest ones
-//! tend to be ejected at the antipodal point") is measured on the fragments above the floor by
-//! [`ejected_sites`]: the correlation of `ln size` with the impact-site cosine, and the median sizes of the
-//! ejected fragments from each hemisphere.
+//! Roig03 §4.2 and Fig. 4: the ejection speed–size power law `Δv ∝ size^α` fitted to subsets of the target
+//! fragments with standard errors, and where the ejected fragments started. The paper does not say which fragments
+//! enter its fit, and a rotating pile always has a floor of slow, unperturbed fragments (`Δv` is relative to the
+//! target barycentre between `t = 0` and `t_at`), so three fits: all target fragments (as `analyze`), those above a
+//! `Δv` floor (m/s), and the escaping ones (Eq. 43). Each is [`fit_power_law`] (least squares in logs, `σ_α` from
+//! the residual variance). §4.2's spatial claim (small fragments ejected at the impact point, the largest at the
+//! antipode) is measured by [`ejected_sites`]: the correlation of `ln size` with the impact-site cosine and the
+//! median sizes from each hemisphere.
 
 use crate::analysis::fits::{FitError, PowerLawFit, fit_power_law};
 use crate::analysis::fragments::{EjectionSites, FragmentAnalysis, pearson};

@@ -1,27 +1,14 @@
-//! Outcome of a tidal flyby run: mass lost, the largest remnant's spin period and shape before and
-//! after, and a class after Richardson, Bottke & Love 1998 (Icarus 134, 47–76; "RBL98").
+//! Outcome of a tidal flyby run: mass lost, the largest remnant's spin and shape before and after, and a class after
+//! Richardson, Bottke & Love 1998 (Icarus 134, 47–76; "RBL98").
 //!
-//! - **Largest remnant**: the bodies bound to one another, found by peeling: start from all bodies; drop every
-//!   body whose energy relative to the rest of the set, `½ |v − v_S|² − G (M_S − m)/|r − r_S|` (S the set's centre
-//!   of mass, the body's own mass removed from it), is ≥ 0; repeat until none is dropped. Mass lost = 1 − M_LR/M.
-//! - **Spin**: `ω = I⁻¹ L` about the remnant's centre of mass (orbital terms of the fragments plus their own spins,
-//!   with the run's inertia model), period `2π/|ω|` (h).
-//! - **Shape**: the semi-axes `a ≥ b ≥ c` of the uniform ellipsoid with the remnant's inertia tensor (fragments as
-//!   uniform solids of their own axes, κ = 5/2): with principal moments `I₁ ≤ I₂ ≤ I₃`,
-//!   `a² = 5 (I₂ + I₃ − I₁)/(2M)` etc.; reported as `b/a`, `c/a`.
-//! - **Spin state** ([`crate::ellipsoid::spin_state`]): principal-axis or tumbling (L–ω angle, `L²/2E` against the
-//!   principal moments, the precession and rotation periods of the free tumble), before and after.
-//! - **The tide's effect**: a run of `rubblepile flyby` has a control run (`DIR/control/`, the same pile
-//!   over the same time without the planet); every change below is the run's minus the control's, so that what the
-//!   pile does by itself (settling, the cycle of a tumbler) cancels. Without a control the run's own changes are
-//!   used, and the outcome says so (`tide.from_control = false`).
-//! - **Class** (our thresholds, after RBL98's S / B / M / N classes, which are by the fraction of mass shed), from
-//!   the tide's effect: `disrupted` (RBL98 "S", Shoemaker–Levy-9-like): the tide took ≥ 50 % of the mass from the
-//!   remnant; `mass loss` (RBL98 "B" for 10–50 % lost, "M" below 10 %): the tide took any fragment; `reshaped`
-//!   (RBL98 "N" with a shape change): no mass lost but `b/a` or `c/a` changed by ≥ [`RESHAPE_THRESHOLD`];
-//!   `spin changed`: shape kept but the invariant period `π|L|/E` changed by ≥ [`SPIN_CHANGE_THRESHOLD`] of its
-//!   value before; `unaffected` otherwise. `π|L|/E` is `2π/|ω|` for principal-axis rotation and a constant of free
-//!   tumbling, so the phase of a tumbler's cycle (over which `2π/|ω|` of a snapshot varies) does not enter.
+//! Largest remnant by peeling: drop every body with `½ |v − v_S|² − G (M_S − m)/|r − r_S| ≥ 0` (S the set without
+//! the body) until none drops; mass lost = 1 − M_LR/M. Spin `ω = I⁻¹ L` about its centre of mass, period `2π/|ω|` (h);
+//! shape the uniform ellipsoid of its inertia, `a² = 5 (I₂ + I₃ − I₁)/(2M)` (cyclic), as `b/a`, `c/a`; spin state per
+//! [`crate::ellipsoid::spin_state`]. The tide's effect is the run's change minus its control run's (`DIR/control/`,
+//! no planet), else the run's own (`tide.from_control = false`). Class (our thresholds after RBL98's S/B/M/N):
+//! `disrupted` (≥ 50 % of the mass taken), `mass loss` (any fragment), `reshaped` (`b/a` or `c/a` moved by
+//! ≥ [`RESHAPE_THRESHOLD`]), `spin changed` (`π|L|/E` moved by ≥ [`SPIN_CHANGE_THRESHOLD`]; a constant of free
+//! tumbling, so a tumbler's phase does not enter), else `unaffected`.
 
 use std::path::{Path, PathBuf};
 

@@ -1,44 +1,16 @@
-//! Post-impact fragment analysis of Roig03 §4: energy partition (§4.1), ejection velocities and escape
-//! (§4.2, Eq. 43, footnote 6), spins with the `√(5/(2κ))` correction (§4.3) and tumbling (§4.4, Eq. 46).
+//! Post-impact fragment analysis of Roig03 §4: energy partition (§4.1), ejection velocities and escape (§4.2,
+//! Eq. 43, footnote 6), spins with the `√(5/(2κ))` correction (§4.3) and tumbling (§4.4, Eq. 46), from the
+//! snapshots at `t = 0` and `t_at` (the paper: 400 s). The projectile (or a contiguous range of bodies) is
+//! excluded from every target quantity but counts in Eq. 43's binding energy and the system barycentre.
 //!
-//! Everything is computed from two snapshots of the same bodies (same order and count): the state at
-//! `t = 0` and the state at the analysis time `t_at` (the paper uses `t = 400 s`, ≈ 300 s after the impact).
-//! One body is the projectile (or, for a rubble-pile projectile, a contiguous range of bodies, whose barycentre
-//! then stands for "the projectile" below): it is analysed and flagged, but excluded from every "target" quantity
-//! (parent-body size, target barycentre, bound mass fraction, fragment kinetic energy, ejection-speed
-//! statistics). It still counts in the binding energy of Eq. 43 (the sum runs over all other bodies) and
-//! in the barycentre of the whole system.
-//!
-//! Conventions (the choices where the paper is not explicit):
-//! * **Parent-body size** (Figs. 4, 8, 9: "normalized to the size of the parent body"): the radius
-//!   `R_eff = (3 V_T / 4π)^{1/3}` of the sphere whose volume `V_T` is the total volume of the target
-//!   fragments, the same "effective radius of the target" that enters `v_esc` (footnote 6). Each fragment's
-//!   size is its equivalent radius `(A B C)^{1/3}` divided by `R_eff`; the voids of the rubble pile are not
-//!   counted.
-//! * **Ejection velocity** (§4.2, Fig. 3 caption "referred to the barycenter of the target"):
-//!   `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]`, with `V_T` the mass-weighted mean velocity of the
-//!   target fragments (projectile excluded) at each time. A rigid translation of everything gives zero.
-//! * **Escape** (Eq. 43): `K_i = ½ m_i |v_i − V_sys|²` (translational only, barycentric frame of the whole
-//!   system at `t_at`), `U_i^bind = −Σ_{j≠i} G m_i m_j / |r_i − r_j|` over all other bodies; the fragment
-//!   escapes iff `K_i ≥ |U_i^bind|`. Reported `binding_energy` is the magnitude `|U_i^bind| ≥ 0`.
-//! * **Bound mass fraction** (Fig. 5: "fraction of target mass that remains bounded"): the mass of the
-//!   non-escaping target fragments over the target mass, projectile excluded from both. It is *not* the
-//!   largest remnant (reported separately as `largest_fragment_fraction`).
-//! * **f_KE** (§4.1, Fig. 2a): the total (translational + rotational) kinetic energy of the target fragments
-//!   at `t_at`, barycentric frame of the whole system, divided by the projectile's kinetic energy at `t = 0`
-//!   relative to the target, `½ m_p |v_p(0) − V_T(0)|²`. The paper's curve is the final fragment energy
-//!   itself, not its increase; the initial value (the target's own spin) is reported alongside.
-//! * **Spin correction** (§4.3): spins "should be roughly multiplied by `√(5/(2κ))`" to account for the
-//!   Gaussian (non-uniform) density of Eq. 4; for κ ≈ 10 this halves spin rates and doubles periods. So
-//!   `ω_corr = ω √(5/(2κ_I))` and `P_corr = P / √(5/(2κ_I))`, with `κ_I` the κ of the inertia model
-//!   ([`InertiaModel::inertia_kappa`]): for [`InertiaModel::Uniform`] `κ_I = 5/2` and the factor is 1.
-//! * **Tumbling** (§4.4, Eq. 46): `I_eff = |L_s|² / (2 K_R)` with `L_s = I ω`, `K_R = ½ ωᵀ I ω` (body frame,
-//!   principal moments of Eq. 4). With the sorted moments `I₁ ≤ I₂ ≤ I₃` the axis-rotation-mode measure is
-//!   the piecewise-linear map
-//!   `s = (I_eff − I₂)/(I₃ − I₂)` for `I_eff ≥ I₂` and `s = (I_eff − I₂)/(I₂ − I₁)` for `I_eff < I₂`,
-//!   clamped to `[−1, 1]`: `+1` pure short-axis rotation (about the axis of `I₃`), `−1` pure long-axis
-//!   rotation (axis of `I₁`), `0` rotation about the intermediate axis. SAM iff `I_eff > I₂`
-//!   (`I₂ < I_eff ≤ I₃`), LAM iff `I_eff < I₂` (`I₁ ≤ I_eff < I₂`), as in §4.4.
+//! Our readings where the paper is not explicit: parent size `R_eff = (3 V_T / 4π)^{1/3}` over the target
+//! fragments' volume (voids not counted; footnote 6); `Δv_i = [v_i − V_T](t_at) − [v_i − V_T](0)` with `V_T` the
+//! target's mean velocity; escape iff `½ m_i |v_i − V_sys|² ≥ Σ_{j≠i} G m_i m_j / r_ij` (Eq. 43, translational,
+//! `binding_energy` ≥ 0); bound mass fraction over the target (not the largest remnant); `f_KE` = the target's total
+//! kinetic energy at `t_at` / `½ m_p |v_p(0) − V_T(0)|²` (the final energy, not its increase). Spins
+//! `ω_corr = ω √(5/(2κ_I))` with `κ_I` = [`InertiaModel::inertia_kappa`] (factor 1 for [`InertiaModel::Uniform`]).
+//! Tumbling: `I_eff = |Iω|² / (ωᵀ I ω)`, `s = (I_eff − I₂)/(I₃ − I₂)` above `I₂`, `(I_eff − I₂)/(I₂ − I₁)` below,
+//! clamped to `[−1, 1]` (+1 short-axis, −1 long-axis); SAM iff `I_eff > I₂`, LAM iff `I_eff < I₂`.
 
 use std::path::Path;
 

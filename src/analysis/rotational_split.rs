@@ -1,22 +1,11 @@
-//! How much of the fragments' rotational kinetic energy an impact gave them, and how much they already had
-//! (Roig et al. 2003, Icarus 165, §4.1 and Fig. 2a: "only a small fraction — between 10–20 % — remains in the
-//! rotational energy of the fragments").
-//!
-//! Roig03 defines `K_R = Σ ωᵢᵀ Iᵢ ωᵢ / 2` (Eq. 5, with the moments of Eq. 4) over all fragments, whatever gave
-//! them their spin, and Fig. 2a plots it beside the total fragment kinetic energy, both after the impact. Its
-//! targets spin (4 h or 12 h) before the impact, so part of `K_R` is the targets' own rotation. Two ways to
-//! take that part out, both zero for a target that keeps turning rigidly:
-//! * **frame of the initial spin**: `K_R,add = Σ ½ (wᵢ − Ω₀)ᵀ Tᵢ (wᵢ − Ω₀)`, with `wᵢ` the world-frame spin at
-//!   the analysis time, `Tᵢ` the world-frame inertia tensor then, and `Ω₀` the target's best-fit rigid
-//!   rotation at `t = 0` ([`fit_rigid_rotation`]): the spin energy seen from a frame turning with the target's
-//!   initial rotation;
-//! * **per fragment**: the same with each fragment's own world-frame spin at `t = 0` in place of `Ω₀`.
-//!
-//! The rest, `K_R − K_R,add`, is the pre-existing part (the target's spin and its cross term with the
-//! impact's). The translational energy that `K_R` is compared with is taken in the barycentric frame of the whole
-//! system (as `rubblepile analyze`: [`crate::analysis::fragments`]) and, as a variant, in the frame of the
-//! target fragments' own barycentre (Fig. 3's "velocities referred to the barycenter of the target"), which
-//! removes the target's recoil from `K_T`.
+//! How much of the fragments' rotational energy an impact gave them, and how much they already had (Roig03 §4.1,
+//! Fig. 2a: "between 10–20 %" remains in rotation). Eq. 5's `K_R = Σ ωᵢᵀ Iᵢ ωᵢ / 2` counts the targets' own
+//! pre-impact spin (4 h or 12 h); two ways to take it out, both zero for a target that keeps turning rigidly:
+//! in the frame of the initial spin, `K_R,add = Σ ½ (wᵢ − Ω₀)ᵀ Tᵢ (wᵢ − Ω₀)` (world-frame spin and inertia at the
+//! analysis time, `Ω₀` the best-fit rigid rotation at t = 0, [`fit_rigid_rotation`]); per fragment, with each
+//! fragment's own spin at t = 0 in place of `Ω₀`. `K_R − K_R,add` is the pre-existing part. The translational energy
+//! compared with it is taken in the system's barycentric frame (as [`crate::analysis::fragments`]) and, as a
+//! variant, in the target fragments' barycentre (Fig. 3's frame), which removes the target's recoil.
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::rotation_matrix;

@@ -107,7 +107,7 @@ pub fn running_mean(times: &[f64], values: &[f64], window: f64) -> Vec<f64> {
 /// [`critical_limits`] on centred running means over `window` seconds ([`running_mean`]) of b/a, c/a and η_B
 /// sampled at `times` (s). With the window set to the body's [`dynamical_time`], the breathing oscillation of
 /// a pile of a few thousand particles no longer trips the 0.001 threshold of η_B; the price is that a departure
-/// is seen up to half a window early (the mean looks ahead), about 0.04 h on path 2 for a 2700 s window. The
+/// is seen up to half a window early (the mean looks ahead). The
 /// reference values are those of the first sample whose window is whole (a window cut at the start would
 /// average part of an oscillation: up to 0.64 of its amplitude); later windows may be cut at the end.
 pub fn smoothed_critical_limits(

@@ -1,51 +1,17 @@
-//! Contact-barrier overrun detector (Roig03 §2, Eqs. 10–14).
+//! Contact-barrier overrun detector (Roig03 §2, Eqs. 10–14). Roig03 calibrate κ (Eq. 13) so that the smallest
+//! barrier is β times `K = ½ m_l v²` (Eq. 14, `β ~ 10`), to "avoid penetration between the bodies"; nothing in
+//! the equations enforces it, so this module watches every touching pair and says when a collision went deeper.
 //!
-//! Roig03 calibrate κ (Eq. 13) so that the contact barrier of the pair with the smallest barrier is
-//! β times a prescribed kinetic energy, `K = ½ m_l v²` (Eq. 14 for spheres with equivalent radii,
-//! `β ~ 10`): a collision at relative speed `v` then stops well before the centres meet, and
-//! "we avoid penetration between the bodies". Nothing in the equations enforces it: a faster
-//! collision simply goes deeper, and one with more energy than the barrier passes through. This
-//! module watches every touching pair and says when that happened.
+//! Per pair in contact (`x = κ Δᵀ G⁻¹ Δ < κλ_ij`, Eqs. 10, 12; `a = P_ij det(G)^{−1/2}` in J; `μ` the reduced
+//! mass): overlap energy `E_c = a (e^{−x} − e^{−κλ})`, collision energy `E = ½ μ v_n² + E_c` (nearly constant in a
+//! head-on contact), relative speed `v_eq = √(2E/μ)`, calibrated speed `v_c² = G M_ref e^{κλ}/(β κλ (R_i + R_j))`
+//! (Eq. 14 on the pair, `M_ref` per [`KappaReading`]), barrier `B = a (1 − e^{−κλ})`. Verdicts (warnings):
+//! **overrun** when `v_eq > `[`SPEED_MARGIN`]` · v_c` (1.25: room for mutual gravity and ellipsoidal shapes),
+//! **broke through** when `E ≥ B`. β is `model.calibrate.beta`, or [`DEFAULT_BETA`] for a given κ.
 //!
-//! # What is measured, per pair `(i, j)` in contact
-//!
-//! With `x = κ Δᵀ G⁻¹ Δ` (the exponent of Eq. 10 in the form of `potential.rs`), the pair's amplitude
-//! `a = P_ij det(G)^{−1/2}` (J, its contact energy at full overlap), `κλ_ij` (Eq. 12) the exponent at which
-//! two spheres of the equivalent radii touch, and `μ = m_i m_j/(m_i + m_j)`:
-//!
-//! - the pair is *in contact* when `x < κλ_ij`;
-//! - energy stored in the overlap beyond touching: `E_c = a (e^{−x} − e^{−κλ})` (J, ≥ 0);
-//! - collision energy `E = ½ μ v_n² + E_c`, where `v_n` is the normal (centre-to-centre) relative speed:
-//!   during a head-on contact this is nearly constant (kinetic energy turns into overlap and back);
-//! - the pair's *relative speed* `v_eq = √(2E/μ)` (m/s): the head-on impact speed this state corresponds to;
-//! - the pair's *calibrated speed* `v_c`: Eq. 14 applied to the pair itself,
-//!   `v_c² = G M_ref e^{κλ}/(β κλ (R_i + R_j))` with the calibration's reading of `K`
-//!   (`M_ref = min(m_i, m_j)` as printed, `max(m_i, m_j)` or `m_i + m_j`; see
-//!   [`KappaReading`]); for the smallest–largest pair of a calibrated scene this is exactly
-//!   `model.calibrate.v`;
-//! - the barrier height `B = a (1 − e^{−κλ})` (J): the energy needed to push the centres together.
-//!
-//! # Verdicts
-//!
-//! - **overrun** (a warning): `v_eq > margin · v_c`, with [`SPEED_MARGIN`] = 1.25. The pair went deeper
-//!   than a collision at the calibrated speed would; the margin leaves room for the mutual gravity of
-//!   km-size bodies (it adds a few per cent to the impact speed) and for ellipsoidal shapes;
-//! - **broke through** (a warning, reported as such): `E ≥ B`: the collision carries more energy than
-//!   the whole barrier and the bodies pass through each other.
-//!
-//! β is `model.calibrate.beta` when κ was calibrated; for a given κ it is [`DEFAULT_BETA`] (Roig03's
-//! `β ~ 10`), so that `v_c` is "the speed a β = 10 calibration would have protected".
-//!
-//! # Why a warning and not a stop
-//!
-//! The run driver (`driver`) checks every sampled state (every time-series row) and goes on:
-//! an overrun makes the colliding pair's outcome unphysical (deep interpenetration, too little
-//! rebound), but every other pair stays valid, nothing becomes NaN, and an impact campaign loses no
-//! run. Each overrun sample is appended (and flushed) to `barrier_overruns.csv` as it is found, so a
-//! long run can be watched; `summary.json` lists the pairs (`barrier`), and the command line prints
-//! one `warning: bodies 3 and 7 overran the contact barrier at t = … s (relative speed … m/s >
-//! calibrated … m/s …)` line per pair on stderr. Contacts that begin and end between two samples
-//! are not seen: sample (`output.every`) faster than a contact lasts.
+//! A warning, not a stop: only the colliding pair's outcome is unphysical. The driver checks every sampled state,
+//! appends each overrun to `barrier_overruns.csv` (flushed), lists the pairs in `summary.json` (`barrier`) and
+//! prints one stderr line per pair; contacts shorter than `output.every` are not seen.
 
 use std::collections::BTreeMap;
 use std::io::Write;

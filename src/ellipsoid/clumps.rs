@@ -1,24 +1,15 @@
-//! Clumps: connected sets of bodies that touch, the one home of the contact graph behind every clump of the crate:
-//! the clump analysis of any run (`analysis::clumps`, which refines these sets by mutual gravitational boundness),
-//! the composition of a pile-on-pile collision (`analysis::composition`) and the target build (fragments that left
-//! the pile during its collapse, `impact::target`).
+//! Clumps: connected sets of touching bodies, the contact graph behind every clump of the crate (`analysis::clumps`,
+//! which refines them by boundness; `analysis::composition`; fragments shed during the target build,
+//! `impact::target`). Two bodies are linked when their ellipsoids, each enlarged about its centre, overlap
+//! ([`are_apart`]); clumps are the connected components (friends of friends, union–find). [`Linking`]:
 //!
-//! Two bodies are linked when their ellipsoids, each enlarged about its centre, overlap (the overlap test of the
-//! contact model, [`are_apart`]); the clumps are the connected components of that graph (friends of friends,
-//! union–find). Two rules choose the enlargement ([`Linking`]):
+//! - [`Linking::SurfaceGap`]`(f)`, after pkdgrav's companion finder: linked when the surface gap is at most
+//!   `ℓ = f · min(cᵢ, cⱼ)` (`c` the smallest semi-axis). Each body is scaled by `1 + ℓ/(2c)`; since the support
+//!   function obeys `h(u) + s c ≤ (1 + s) h(u) ≤ h(u) + s a`, every gap ≤ ℓ is linked and none above
+//!   `ℓ (aᵢ/cᵢ + aⱼ/cⱼ)/2`: exact for spheres.
+//! - [`Linking::ScaledAxes`]`(m)`: every semi-axis times `1 + m` (target build, composition).
 //!
-//! - [`Linking::SurfaceGap`]`(f)`, a friends-of-friends on *surface gaps* after the companion finder of pkdgrav
-//!   (bodies touching within a tolerance): a pair is linked when the gap between the surfaces is at most the
-//!   linking length `ℓ = f · min(cᵢ, cⱼ)`, `c` a body's smallest semi-axis (its radius for a sphere). Each body is
-//!   scaled by `1 + ℓ/(2c)`. A scaled ellipsoid's support function is `(1 + s) h(u) ≥ h(u) + s c`, so it contains
-//!   every point within `s c = ℓ/2` of the body: every pair with a gap ≤ ℓ is linked. Since `h(u) ≤ a` it holds
-//!   no point farther than `ℓ a/(2c)`: a linked pair's gap is at most `ℓ (aᵢ/cᵢ + aⱼ/cⱼ)/2`. For spheres both
-//!   bounds are `ℓ`: the test is exact.
-//! - [`Linking::ScaledAxes`]`(m)`: every semi-axis times `1 + m` (the rule of the target build and of the
-//!   composition analysis).
-//!
-//! Resting bodies sit in shallow overlap under the contact barrier (Roig03 Eqs. 12–13) and are linked by either
-//! rule; the tolerance also joins those a hair apart.
+//! Resting bodies sit in shallow overlap under the contact barrier (Roig03 Eqs. 12–13) and are linked by either rule.
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::rotation_matrix;

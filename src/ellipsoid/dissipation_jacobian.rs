@@ -1,53 +1,17 @@
 //! The analytic Jacobian of the point dissipation (Roig03 Eq. 41) with respect to the momenta, and the solve of
-//! `(I − h J) x = b` that the linearly implicit integrator needs ([`crate::integrate::linearly_implicit`]).
+//! `(I − h J) x = b` for the linearly implicit integrator ([`crate::integrate::linearly_implicit`]).
 //!
-//! # The stiff part
+//! With `V = (ṙ_i, ω_i)` (world-frame spins), `G_ij = [1, −[d_i]×, −1, [d_j]×]`, `H_ij = [0, 1, 0, −1]` and
+//! `Q = Tr(P) 1 − P`, [`crate::ellipsoid::dissipation`]'s `F_ij = −½ Vᵀ D_ij V` with the PSD
+//! `D_ij = 2 F0 U_C [H_ijᵀ Q H_ij / (2κ) + G_ijᵀ G_ij]`. With `V = B P` from the momenta and `Ṗ = C (F, τ)` (the
+//! Lagrange projection `Π` included), `J = −C D B` at fixed positions and attitudes; the stiff part handed over is
+//! `[[0, T], [0, J]]` with the exact kinematic rows `T = diag(1/m, M(q)⁻¹)`, so its stiff eigenvectors are the damped
+//! contact's. Left out (a W-method's order does not depend on the matrix): `∂U_C, d_i, P/∂x` and the contact `∂²U`.
 //!
-//! `F = Σ_pairs F_ij` is a quadratic form in the bodies' velocities `V = (ṙ_1, ω_1, …, ṙ_N, ω_N)` (world-frame spins):
-//! with the pair's `G_ij = [1, −[d_i]×, −1, [d_j]×]` (so `v0 = G_ij V`), `H_ij = [0, 1, 0, −1]` (so `w = H_ij V`) and
-//! `Q = Tr(P) 1 − P`, [`crate::ellipsoid::dissipation`]'s
-//! `F_ij = −F0 U_C [wᵀ Q w/(2κ) + |v0|²] = −½ Vᵀ D_ij V`, with the symmetric positive semi-definite
-//!
-//! ```text
-//! D_ij = 2 F0 U_C [ H_ijᵀ Q H_ij / (2κ) + G_ijᵀ G_ij ]      (12 × 12, over the pair's two bodies)
-//! ```
-//!
-//! and the generalised force conjugate to `V` is `∂F/∂V = −D V`, `D = Σ D_ij` (6 × 6 blocks over the pairs in
-//! contact). The momenta `P = (u_i, p_i)` give `V = B P` (`ṙ = u/m`, `ω = Rᵀ 2 W₃(q) M(q)⁻¹ p`), and a force
-//! `(F, τ)` conjugate to `V` gives the momentum rates `Ṗ = C (F, τ)` (`u̇ = F`, `ṗ = Π 2 W₃ᵀ R τ` with the projection
-//! `Π g = g − q (qᵀM⁻¹g)/(qᵀM⁻¹q)` of the Lagrange multiplier). So the dissipation's Jacobian is
-//!
-//! ```text
-//! J = ∂Ṗ/∂P = −C D B      (other rows and columns zero)
-//! ```
-//!
-//! at fixed positions and attitudes. The stiff part handed to the integrator adds the kinematic rows
-//! `ṙ = u/m`, `q̇ = M(q)⁻¹ p` (`T = diag(1/m, M⁻¹)`, exact and free to solve): `[[0, T], [0, J]]` over
-//! `((r, q), (u, p))`. With them the stiff eigenvectors of the approximation are those of the damped contact (a
-//! relative velocity decaying at rate `λ` carries the displacement `v/λ` with it), and the stiff pair's
-//! work–precision run at rtol 1e-6 took 5.7× fewer RHS evaluations than with `J` alone
-//! (`analysis/work_precision/REPORT.md`). It leaves out the dissipation's dependence on positions and attitudes
-//! (through `U_C`, `d_i`, `P`) and the contact potential's `∂²U/∂x²`: the integrator is a W-method, whose order does
-//! not depend on the matrix and whose stability does — it holds exactly the stiff part at large F0, the damping,
-//! and the contact oscillation stays explicit as in Bulirsch–Stoer.
-//!
-//! # The solve, mass-weighted
-//!
-//! `B C = diag(1/m_i, K_i)` with `K_i = Rᵀ I_b⁻¹ R` (the world-frame inverse inertia; `W₃ M⁻¹ q = 0` removes `Π`,
-//! and `Wᵀ W = |q|² 1` the rest): call it `M_V⁻¹`. By the push-through identity
-//! `(I + h C D B)⁻¹ = I − h C D (I + h B C D)⁻¹ B`, the solution of `(I − h J) x = b` is
-//!
-//! ```text
-//! (M_V + h D) v = M_V B b,      x = b − h C D v,
-//! ```
-//!
-//! (then the kinematic rows by back-substitution, `x_r = b_r + h x_u/m`, `x_q = b_q + h M⁻¹ x_p`), with
-//! a system of dimension 6N whose matrix is symmetric positive definite (`M_V` is, `D` is semi-definite). It is
-//! solved by conjugate gradients preconditioned by its 6 × 6 diagonal blocks (each by Cholesky), serially in a fixed
-//! order, so the result is the same bits on any number of threads. Whatever `v` the iteration ends with,
-//! `x − b = −h C D v` is a sum of pair force patterns, each of which has zero total force and zero total torque
-//! about the origin (`F` vanishes for every common rigid motion, so `D` annihilates them and its forces do no work
-//! on them): the solve changes neither total momentum.
+//! Solve: with `M_V⁻¹ = B C = diag(1/m_i, Rᵀ I_b⁻¹ R)` and the push-through identity, `(M_V + h D) v = M_V B b`,
+//! `x = b − h C D v` (kinematic rows by back-substitution): SPD of dimension 6N, by conjugate gradients with 6 × 6
+//! block-Cholesky preconditioning, serial in a fixed order (same bits on any thread count). `x − b` is a sum of pair
+//! force patterns with zero total force and torque, so the solve conserves both momenta whatever the iteration ends.
 
 use std::ops::{AddAssign, SubAssign};
 

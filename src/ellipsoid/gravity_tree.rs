@@ -15,10 +15,8 @@
 use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::math::Vec3;
 
-/// Default opening angle θ (dimensionless): on a 2000-ellipsoid jittered lattice (`bench rhs`'s packing) the
-/// RMS relative force error against the exact sum is 2.6e-4 at θ = 0.5 (2.5e-5 at θ = 0.3), on ten copies of
-/// the N200_T4 pile 1.2e-4; the potential's relative error is 2e-6 to 8e-6 (`tests/ellipsoid_gravity_tree.rs`
-/// bounds them by 1e-3 and 1e-4).
+/// Default opening angle θ (dimensionless): `tests/ellipsoid_gravity_tree.rs` bounds the RMS relative force error
+/// against the exact sum by 1e-3 and the potential's by 1e-4 (the errors found: `analysis/n2000/NOTES.md`).
 pub const DEFAULT_THETA: f64 = 0.5;
 
 /// Bodies from which [`GravityMethod::Auto`] uses the tree. Below it the exact blocked pair sum costs at most

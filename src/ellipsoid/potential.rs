@@ -1,23 +1,14 @@
-//! The Gaussian-overlap contact potential (Roig03 Eqs. 7–12) in the equivalent, cheaper form of
-//! [`crate::ellipsoid`] ("Conventions and corrected forms"):
+//! The Gaussian-overlap contact potential (Roig03 Eqs. 7–12) in the equivalent, cheaper form of [`crate::ellipsoid`]
+//! ("Conventions and corrected forms"): `Σ_i = R_iᵀ diag(A², B², C²) R_i`, `G = Σ_i + Σ_j`, `Δ = r_i − r_j`,
+//! `U_C = P_ij det(G)^{−1/2} exp(−κ Δᵀ G⁻¹ Δ)`, `P_ij = U0_ij m_i m_j (κ/π)^{3/2}`. Gradients:
+//! `∂U_C/∂r_i = −2κ U_C G⁻¹Δ`, `∂U_C/∂q_i,k = 2 U_C ⟨D_i R_i S, ∂R_i/∂q_k⟩_F`, `S = −½ G⁻¹ + κ (G⁻¹Δ)(G⁻¹Δ)ᵀ`.
 //!
-//! `Σ_i = R_iᵀ diag(A², B², C²) R_i`, `G = Σ_i + Σ_j`, `Δ = r_i − r_j`,
-//! `U_C = P_ij · det(G)^{−1/2} · exp(−κ Δᵀ G⁻¹ Δ)` with `P_ij = U0_ij m_i m_j (κ/π)^{3/2}`.
-//!
-//! Gradients: `∂U_C/∂r_i = −2κ U_C G⁻¹Δ`; `∂U_C/∂q_i,k = 2 U_C ⟨D_i R_i S, ∂R_i/∂q_k⟩_F` with
-//! `S = −½ G⁻¹ + κ (G⁻¹Δ)(G⁻¹Δ)ᵀ` (chain rule of `ln U_C` through `G` and `R(q)`).
-//!
-//! Far pairs: with `x = κ Δᵀ G⁻¹ Δ`, the potential is multiplied by a C² taper `T(x)` that is 1 for
-//! `x ≤ x₀ = κλ_ij − ln(cutoff)` and falls to exactly 0 at `x₁ = x₀ + 4` (quintic smoothstep). At contact
-//! `x = κλ_ij` (two spheres at `R_i + R_j`), so everything the taper changes is below `cutoff` of the pair's
-//! potential at contact, i.e. below `cutoff · e^{−κλ}` of its amplitude (the potential at full overlap).
-//! Measuring the cut from the amplitude alone, as first specified, is wrong for stiff pairs: when
-//! `κλ > −ln(cutoff)` (κ = 25 for two unequal spheres with λ = 1.5) the contact itself lies below
-//! `1e-16 × amplitude` and would be cut away (`tests/ellipsoid_gradients.rs` guards this).
-//! The right-hand side stays twice continuously differentiable when a pair enters or leaves the neighbour
-//! list — a hard cut makes the force and torque jump, which an extrapolation integrator cannot step across
-//! (it drove Bulirsch–Stoer to step-size underflow when a non-spinning projectile came within range).
-//! With the taper: `∂U/∂Δ = −2κ U (T − T′) G⁻¹Δ` and `S = −½ T G⁻¹ + κ (T − T′) y yᵀ`, `U = U_raw T`.
+//! Far pairs (ours): with `x = κ Δᵀ G⁻¹ Δ`, `U = U_raw T(x)`, a C² quintic taper that is 1 up to
+//! `x₀ = κλ_ij − ln(cutoff)` and 0 from `x₀ + 4`, so it changes only what is below `cutoff` of the pair's potential
+//! at contact (`x = κλ_ij`; cut relative to the amplitude it would remove a stiff pair's contact itself, guarded in
+//! `tests/ellipsoid_gradients.rs`) and the right-hand side stays C² as pairs enter or leave the neighbour list (a hard
+//! cut makes forces jump, which extrapolation cannot step across). Then `∂U/∂Δ = −2κ U (T − T′) G⁻¹Δ`,
+//! `S = −½ T G⁻¹ + κ (T − T′) y yᵀ`.
 
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::{Mat3, Vec3, Vec4};

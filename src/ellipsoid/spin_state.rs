@@ -1,24 +1,15 @@
-//! The rotation state of a rigid body (or of a pile read as one): principal-axis rotation or tumbling, and for a
-//! tumbler its two periods of free, torque-free rotation.
+//! The rotation state of a rigid body (or a pile read as one): principal-axis rotation or tumbling, and a tumbler's
+//! two periods of free rotation. Sources: Landau & Lifshitz, *Mechanics* (3rd ed., 1976) §37, Eqs. 37.10–37.11;
+//! Kaasalainen 2001 (A&A 376, 302); Pravec et al. 2005 (Icarus 173, 108) for the modes and `P_ψ`, `P_φ` (Apophis:
+//! Pravec et al. 2014, Icarus 233, 48).
 //!
-//! Sources: L. D. Landau & E. M. Lifshitz, *Mechanics* (3rd ed., 1976), §37 (the Jacobi elliptic solution of
-//! Euler's equations, Eqs. 37.10–37.11, and the precession rate of the Euler angle φ); M. Kaasalainen, "Interpretation
-//! of lightcurves of precessing asteroids", *A&A* 376 (2001) 302–309, and P. Pravec et al., "Tumbling asteroids",
-//! *Icarus* 173 (2005) 108–131 (short- and long-axis modes, the periods `P_ψ` and `P_φ`; Apophis' state in Pravec
-//! et al. 2014, *Icarus* 233, 48–60). Written from those descriptions.
-//!
-//! With principal moments `I₁ ≤ I₂ ≤ I₃`, angular momentum `L` and rotational energy `E = ½ L·I⁻¹L` (the rigid
-//! rotation `ω = I⁻¹L` of [`crate::ellipsoid::rigid_rotation`]), the body tumbles unless `L ∥ ω`; the quantity
-//! `D = L²/2E` lies in `[I₁, I₃]`. `D > I₂`: short-axis mode (SAM, the axis of largest moment circulates about
-//! `L`); `D < I₂`: long-axis mode (LAM, the axis of smallest moment does). In either mode, with `(a, b, c)` the
-//! moments `(I₁, I₂, I₃)` for SAM and `(I₃, I₂, I₁)` for LAM (Landau & Lifshitz: "interchange the indices 1 and 3"),
-//! `λ² = (c − b)(L² − 2E a)/(a b c)` and `k² = (b − a)(2E c − L²)/((c − b)(L² − 2E a))`, the body-frame spin is
+//! With `I₁ ≤ I₂ ≤ I₃`, `L`, `E = ½ L·I⁻¹L` ([`crate::ellipsoid::rigid_rotation`]), `D = L²/2E ∈ [I₁, I₃]`: SAM when
+//! `D > I₂`, LAM when `D < I₂`. With `(a, b, c) = (I₁, I₂, I₃)` (SAM) or `(I₃, I₂, I₁)` (LAM),
+//! `λ² = (c − b)(L² − 2E a)/(a b c)`, `k² = (b − a)(2E c − L²)/((c − b)(L² − 2E a))`,
 //! `ω_a² = (2Ec − L²)/(a(c − a)) cn²(λt)`, `ω_b² = (2Ec − L²)/(b(c − b)) sn²(λt)`,
-//! `ω_c² = (L² − 2Ea)/(c(c − a)) dn²(λt)`, periodic with `P_ψ = 4K(k²)/λ` (the rotation, or libration, period
-//! about the mode's axis `c`), and the mode's axis turns about `L` at the rate
-//! `φ̇ = L (a ω_a² + b ω_b²)/(a² ω_a² + b² ω_b²)`; its mean over `P_ψ` gives the precession period `P_φ = 2π/⟨φ̇⟩`
-//! (the mean is taken by the trapezoidal rule over one period, which converges geometrically for a smooth periodic
-//! integrand). For a symmetric top (`I₁ = I₂`) `φ̇ = L/I₁` exactly.
+//! `ω_c² = (L² − 2Ea)/(c(c − a)) dn²(λt)`; `P_ψ = 4K(k²)/λ`; the axis precesses at
+//! `φ̇ = L (a ω_a² + b ω_b²)/(a² ω_a² + b² ω_b²)`, `P_φ = 2π/⟨φ̇⟩` (trapezoidal mean over `P_ψ`, geometrically
+//! convergent); a symmetric top (`I₁ = I₂`) has `φ̇ = L/I₁` exactly.
 
 use serde::Serialize;
 

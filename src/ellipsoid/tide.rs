@@ -1,28 +1,15 @@
-//! Tide of a planet on a prescribed (Kepler) orbit: the `[physics.flyby]` term (the setting of
-//! Richardson, Bottke & Love 1998, Icarus 134, 47–76, "Tidal distortion and disruption of Earth-crossing asteroids").
-//!
-//! The frame's origin falls freely on a Kepler orbit `s(t)` about the planet ([`crate::gravity::kepler`]); the
-//! planet sits at `R(t) = −s(t)` in the frame. Each body (a point mass at its centre: the planet's torque on a single
-//! ellipsoid's own quadrupole is left out, as the ellipsoids' mutual gravity is a monopole, Roig03 Eq. 6) gets the
-//! planet's full attraction minus the origin's, exactly (not linearised):
+//! Tide of a planet on a prescribed Kepler orbit, the `[physics.flyby]` term (the setting of Richardson, Bottke &
+//! Love 1998, Icarus 134, 47–76). The frame's origin falls freely on `s(t)` ([`crate::gravity::kepler`]), the planet
+//! at `R = −s`; each body, a point mass (as the mutual gravity, Roig03 Eq. 6), gets the exact (not linearised)
 //! `a_i = −GM (r_i − R)/|r_i − R|³ − GM R/|R|³`.
 //!
-//! **Energy.** The tide does work, so `H = K + U_C + U_G` is not conserved. The motion in this frame is exactly the
-//! restricted problem of a fixed planet seen from the freely falling origin, whose inertial energy
-//! `Σ ½ m_i |v_i + V₀|² + U_C + U_G − Σ GM m_i/|r_i − R|` (`V₀ = ṡ` the origin's velocity relative to the planet) is
-//! conserved. Subtracting the constant Kepler energy of the origin, `M (½|V₀|² − GM/|R|)` (`M` the total mass),
-//! leaves `H + E_tide` conserved (up to the dissipated `2∫F dt`), with the tidal energy
-//! `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (`P` the total momentum in the frame). [`TideTerm::energy`]
-//! computes it; the run's energy residual adds it to `H`, so no state component is added and the integrator's state
-//! (and checkpoints) keep their shape. Both differences of nearly equal terms are evaluated in forms free of
-//! cancellation (`|R| − |d| = (2 r·R − r·r)/(|R| + |d|)`).
-//!
-//! **J2** (optional, `j2` with `radius`): the planet's field gains the zonal term of [`crate::gravity::zonal`] about
-//! a fixed spin axis `pole`, at each body's position relative to the planet, `a_i += g_J2(r_i − R)`. The frame still
-//! falls on the Kepler orbit, so the origin's acceleration is not changed: the equations stay those of a frame with a
-//! prescribed acceleration, exact for any prescribed orbit, and the pile's centre of mass drifts off the origin by
-//! the J2 pull (of order `J2 (R/q)²` of the tidal acceleration). The conserved energy gains `Σ m_i Φ_J2(r_i − R)` in
-//! `E_tide` (the field is static in the planet's frame).
+//! Energy: `H + E_tide` is conserved (up to `2∫F dt`), `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (`V₀ = ṡ`,
+//! `P` the frame momentum): the restricted problem's inertial energy minus the origin's constant Kepler energy.
+//! [`TideTerm::energy`] computes it for the residual, so the state and checkpoints keep their shape; both near-equal
+//! differences are cancellation-free (`|R| − |d| = (2 r·R − r·r)/(|R| + |d|)`). Optional J2 (`j2`, `radius`, `pole`):
+//! `a_i += g_J2(r_i − R)` ([`crate::gravity::zonal`]) with the origin still on the Kepler orbit (exact for a
+//! prescribed frame acceleration; the centre of mass drifts by `~J2 (R/q)²` of the tide), and `E_tide` gains
+//! `Σ m_i Φ_J2(r_i − R)`.
 
 use serde::{Deserialize, Serialize};
 

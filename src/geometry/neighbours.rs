@@ -402,7 +402,7 @@ mod tests {
     }
 
     /// A sphere of radius 1e12 cells (an integrator's wild trial state: an attitude quaternion of huge norm) among
-    /// a pile: the search finishes at once (it used to walk 1e24 cell rows) and finds the brute-force pairs.
+    /// a pile: the search finishes at once (a cell scan would walk 1e24 cell rows) and finds the brute-force pairs.
     #[test]
     fn huge_sphere_scans_the_bodies_instead_of_the_cells() {
         let mut next = uniform(7);

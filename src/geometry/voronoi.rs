@@ -1,28 +1,14 @@
-//! Voronoi cells of a particle packing and the interior packing fraction η_B (Zhang17 §3, "packing efficiency"
-//! from a Voronoi tessellation; the paper used Voro++).
+//! Voronoi cells of a particle packing and the interior packing fraction η_B (Zhang17 §3, "packing efficiency" from
+//! a Voronoi tessellation; the paper used Voro++). Our own construction: each cell starts as a cube around its
+//! particle and is clipped by its neighbours' planes in order of distance, until the next neighbour lies beyond twice
+//! the cell's farthest vertex. Cells are convex polyhedra kept as face polygons; volume = Σ area × plane distance / 3.
 //!
-//! Our own cell-based construction, written for this one use: each particle's cell starts as a cube around it and
-//! is clipped by the bisector planes of its neighbours in order of distance, until the next neighbour lies beyond
-//! twice the cell's farthest vertex (no farther neighbour can cut it).
-//!
-//! **Unequal spheres.** [`radical_cells`] uses the radical (power, Laguerre) planes instead of bisectors: the
-//! plane between spheres `i` and `j` at distance `d` lies `(d² + r_i² − r_j²)/(2d)` from `i`, where the power
-//! distances `|x − c|² − r²` are equal, so it passes through the contact circle of touching spheres and every
-//! cell holds its whole sphere (Voro++'s radical option, used for polydisperse packings). Plain bisectors cut
-//! into the larger sphere of a pair and hand that volume to the smaller one's cell; over a set of interior cells
-//! chosen near a rough surface (where large spheres are more often excluded) that bias is large (a PP1 pile of
-//! radii 10.7–85.4 m gave η_B 0.47 with bisectors against a filling fraction of 0.73). With equal radii the
-//! two are the same cells, bit for bit. Cells are convex polyhedra kept as face
-//! polygons; the volume is Σ_faces area × (distance of the face plane from the particle) / 3.
-//!
-//! Why not a crate: the Voro++ bindings need a C++ build, and the pure-Rust tessellators we looked at build
-//! whole diagrams in a box or add arbitrary-precision back-ends; we need only cell volumes and a boundary flag,
-//! which this file gives in a few hundred lines, tested on lattices with exact answers.
-//!
-//! **Boundary cells.** A cell that still has a face of its starting cube after clipping is open to the outside
-//! of the packing: its volume measures the cube, not the packing. Those cells are flagged and excluded from
-//! [`packing_fraction`]; so are, optionally, particles within a given depth of the surface (the paper's
-//! "interior"), via the `interior` mask the caller passes.
+//! [`radical_cells`] use the radical (power, Laguerre) planes, `(d² + r_i² − r_j²)/(2d)` from `i`, through the contact
+//! circle, so every cell holds its whole sphere (Voro++'s radical option; plain bisectors hand part of the larger
+//! sphere to the smaller one's cell, a large bias near a rough surface); equal radii give the same cells bit for bit.
+//! A cell keeping a face of its starting cube is open (it measures the cube) and is excluded from
+//! [`packing_fraction`], as are particles outside the caller's `interior` mask. Not a crate: Voro++ needs a C++ build,
+//! and we need only cell volumes and a boundary flag (tested on lattices with exact answers).
 
 use crate::geometry::neighbours::sphere_pairs;
 use crate::math::Vec3;

@@ -1,25 +1,14 @@
-//! The old names of the granular scene files, read and rewritten to the one vocabulary
-//! (`granular::vocabulary`): both parsers read a scene through [`migrate`] (so an old scene still runs, each old
-//! name with a one-line warning), and `rubblepile check --migrate` writes the migrated text ([`migrate_file`]).
+//! The old names of the granular scene files, rewritten to the one vocabulary (`granular::vocabulary`): both parsers
+//! read a scene through [`migrate`] (one warning per old name), `rubblepile check --migrate` writes the migrated text
+//! ([`migrate_file`]). Old → new: soft `[integrator]` → `[stepping]`, `[contact]` → `[material]`,
+//! `wall.oscillation.frequency = f` (Hz) → `angular_frequency = 2π f` (rad/s), `amplitude = [ax, ay, az]` (m) →
+//! `amplitude = |A|`, `direction = A/|A|`; hard `gravity.g` → `gravity.uniform` (m/s²), `wall.type` → `wall.kind`,
+//! `wall.origin` → `wall.point` (plane) or `wall.centre`, a plane's `wall.axis` → `wall.normal`,
+//! `wall.oscillation.omega` → `angular_frequency` (rad/s).
 //!
-//! | engine | old                                              | new                                                |
-//! |--------|--------------------------------------------------|----------------------------------------------------|
-//! | soft   | `[integrator]`                                   | `[stepping]`                                       |
-//! | soft   | `[contact]`                                      | `[material]`                                       |
-//! | soft   | `wall.oscillation.frequency = f` (Hz)            | `wall.oscillation.angular_frequency = 2π f` (rad/s) |
-//! | soft   | `wall.oscillation.amplitude = [ax, ay, az]` (m)  | `amplitude = \|A\|` (m), `direction = A/\|A\|`     |
-//! | hard   | `gravity.g` (m/s²)                               | `gravity.uniform` (m/s²)                           |
-//! | hard   | `wall.type`                                      | `wall.kind`                                        |
-//! | hard   | `wall.origin` (m)                                | `wall.point` of a plane, `wall.centre` of the rest |
-//! | hard   | `wall.axis` of a plane                           | `wall.normal`                                      |
-//! | hard   | `wall.oscillation.omega` (rad/s)                 | `wall.oscillation.angular_frequency` (rad/s)       |
-//!
-//! The rewrite edits the text where the old keys and values are (spans of the TOML parse), so comments, order and
-//! layout stay; a key is only renamed where its new name is not there already (a scene that gives both is left to
-//! the parser, which names the unknown old key). Converted numbers are written in the shortest form that reads back
-//! as the same `f64`, and the oscillation law turns `2π f` into the same bits the old law computed, so a migrated
-//! scene runs bit for bit as before. An amplitude vector along an axis splits exactly; along no axis, its length and
-//! direction are rounded once each.
+//! The rewrite edits the TOML parse's spans, so comments, order and layout stay; a key is renamed only where its new
+//! name is absent. Numbers are written shortest-round-trip, and `2π f` gives the bits the old law computed, so a
+//! migrated scene runs bit for bit as before (an off-axis amplitude vector rounds its length and direction once).
 
 use std::ops::Range;
 use std::path::{Path, PathBuf};

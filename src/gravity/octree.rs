@@ -1,30 +1,17 @@
-//! Barnes–Hut octree with quadrupole moments and a group walk (Zhang17 §2.1 uses pkdgrav's tree; the group walk is
-//! Barnes 1990, J. Comput. Phys. 87, 161; the opening criterion Barnes 1994, in Computational Astrophysics, Springer;
-//! the single-precision lists those of pkdgrav3, Potter, Stadel & Teyssier 2017, Comput. Astrophys. Cosmol. 4, 2).
+//! Barnes–Hut octree with quadrupole moments and a group walk (Zhang17 §2.1 uses pkdgrav's tree; group walk Barnes
+//! 1990, J. Comput. Phys. 87, 161; opening criterion Barnes 1994; single-precision lists after pkdgrav3, Potter,
+//! Stadel & Teyssier 2017, Comput. Astrophys. Cosmol. 4, 2).
 //!
-//! Build: the particles are sorted by a 63-bit Morton key (21 bits per axis over the bounding cube), so every node's
-//! particles are one contiguous run; the nodes are laid out depth-first in flat arrays with a "next" index (the first
-//! node after the subtree), so the walk is a loop without a stack. A node is split while it holds more than
-//! [`LEAF_SIZE`] particles (to depth 21, where coincident particles stay together).
-//!
-//! Each node stores its mass `M`, centre of mass `c`, traceless quadrupole `Q = Σ m (3 d dᵀ − |d|² I)` (`d = x − c`),
-//! its cube's side `l` and the offset `δ` of `c` from the cube's centre. A node is used whole for a point at
-//! `r = p − c` when `|r| > l/θ + δ` (never for a point inside its cube when θ < 2/√3), with
-//! `φ = −G M/|r| − G rᵀQr / (2|r|⁵)` and `a = −∇φ = −G M r/|r|³ + G (Q r/|r|⁵ − 5/2 (rᵀQr) r/|r|⁷)`.
-//! Leaves are used whole in the same way when they hold at least [`FAR_LEAF_MIN`] particles and the tree at least
-//! [`FAR_LEAVES_FROM`]; other leaves are summed directly (on a lattice small leaves are all alike, so the octupole
-//! their quadrupole misses adds up coherently; a small tree's direct sums keep its forces pairwise).
-//!
-//! Group walk: the particles of one bucket (at most [`BUCKET_SIZE`]) share one interaction list, a node being used
-//! whole only when the criterion holds at the bucket's point nearest to it, so the error is never larger than the
-//! per-particle walk's. Buckets are independent (rayon-parallel) and each particle sums its list in a fixed order:
-//! the results do not depend on the number of threads. [`FrozenOctree`] keeps the lists of one configuration and
-//! sums them with the moments recomputed, a field smooth in the positions (an extrapolation integrator fixes them
-//! per step).
-//!
-//! Precision: a tree of at least [`FAR_LEAVES_FROM`] particles sums its lists in single precision, every entry
-//! relative to its bucket's centre in power-of-two units of length and mass (exact rescalings, far from f32 overflow),
-//! so only rounding (~1e-7 relative) is added; smaller trees stay in double precision.
+//! Particles sorted by 63-bit Morton key, nodes depth-first in flat arrays with a "next" index (a stackless walk),
+//! split above [`LEAF_SIZE`] to depth 21. Per node: mass `M`, centre `c`, `Q = Σ m (3 d dᵀ − |d|² I)`, side `l`,
+//! offset `δ` of `c` from the cube's centre; used whole at `r = p − c` when `|r| > l/θ + δ`, with
+//! `φ = −G M/|r| − G rᵀQr / (2|r|⁵)`, `a = −G M r/|r|³ + G (Q r/|r|⁵ − 5/2 (rᵀQr) r/|r|⁷)`. Leaves are used whole
+//! only from [`FAR_LEAF_MIN`] particles in trees from [`FAR_LEAVES_FROM`] (on a lattice the octupole small leaves
+//! miss adds up coherently); others are summed directly. A bucket (≤ [`BUCKET_SIZE`]) shares one list, a node
+//! accepted at the bucket's nearest point, so the error never exceeds the per-particle walk's; fixed-order sums make
+//! results independent of the thread count. [`FrozenOctree`] keeps one configuration's lists with the moments
+//! recomputed (smooth in the positions). Trees from [`FAR_LEAVES_FROM`] sum in f32 relative to the bucket's centre
+//! in power-of-two units (adds ~1e-7 relative rounding only).
 
 use crate::math::Vec3;
 use crate::phase::{Kind, Phase};

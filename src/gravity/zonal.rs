@@ -1,14 +1,8 @@
-//! The second zonal harmonic (J2) of an oblate planet: the leading correction to its point-mass field
-//! (Murray & Dermott 1999, *Solar System Dynamics*, §4.9; Kaula 1966). With `d` the position relative to the
-//! planet's centre, `r = |d|`, `z = d·k̂` along the planet's spin axis `k̂` and `R` the planet's reference radius,
-//!
-//! `Φ_J2(d) = (G M J2 R² / 2) (3 z² − r²) / r⁵`   (J/kg),
-//!
+//! The second zonal harmonic (J2) of an oblate planet, the leading correction to its point-mass field (Murray &
+//! Dermott 1999, *Solar System Dynamics*, §4.9; Kaula 1966). With `d` relative to the planet's centre, `r = |d|`,
+//! `z = d·k̂` along the spin axis `k̂`, `R` the reference radius: `Φ_J2(d) = (G M J2 R² / 2) (3 z² − r²) / r⁵` (J/kg),
 //! the part of `Φ = −(GM/r) [1 − J2 (R/r)² P₂(z/r)]` beyond the monopole, and
-//!
-//! `g_J2 = −∇Φ_J2 = (G M J2 R² / 2) r⁻⁵ [(15 z²/r² − 3) d − 6 z k̂]`   (m/s²).
-//!
-//! Earth: J2 = 1.0826e-3 with R = 6378.137 km (its equatorial radius; the flyby's radius field sets `R`).
+//! `g_J2 = −∇Φ_J2 = (G M J2 R² / 2) r⁻⁵ [(15 z²/r² − 3) d − 6 z k̂]` (m/s²). Earth: J2 = 1.0826e-3, R = 6378.137 km.
 //!
 //! ```
 //! use rubblepile::gravity::zonal::J2Field;

@@ -1,29 +1,14 @@
-//! Canonical problems of the interacting-ellipsoids model, shared by the tests and the benchmarks
-//! (`rubblepile bench work-precision`, `rubblepile bench nbody`), in the style of russell_ode's `Samples`:
-//! each problem is built by one function and comes with its end time, its error measure and, where there
-//! is one, its analytic reference.
+//! Canonical problems of the interacting-ellipsoids model for the tests and the benchmarks (`bench work-precision`,
+//! `bench nbody`), in the style of russell_ode's `Samples`: one function each, with its end time, error measure and
+//! reference. [`WorkPrecisionProblem`]: `Top` (torque-free ellipsoid, analytic ω, [`torque_free_spin`]), `Pair`
+//! and `PairDissipative` (two ellipsoids, G = 1, F0 = 0.1), `N30` (`targets/N30_T4.csv` + projectile P1), `StiffPair`
+//! (F0 = 1e4), `Pile` (N30 squeezed to 0.9, F0 = 1e-6…1e-2), referenced to another method at 1e-14 or a tight
+//! explicit (else implicit) BS; [`NBodyProblem`]: `Pythagorean`, `OuterSolar` (REBOUND, `analysis/rebound_compare`).
 //!
-//! | problem | bodies | physics | reference |
-//! |---|---|---|---|
-//! | [`WorkPrecisionProblem::Top`] | 1 ellipsoid | none (torque-free) | analytic body-frame ω ([`torque_free_spin`]) |
-//! | [`WorkPrecisionProblem::Pair`] | 2 ellipsoids, G = 1, one bounce | gravity + contact | another method at 1e-14 |
-//! | [`WorkPrecisionProblem::PairDissipative`] | the same | + dissipation, F0 = 0.1 | another method at 1e-14 |
-//! | [`WorkPrecisionProblem::N30`] | `targets/N30_T4.csv` + projectile P1 | SI gravity + contact + dissipation | another method at 1e-14 |
-//! | [`WorkPrecisionProblem::StiffPair`] | 2 overlapping ellipsoids, G = 1 | gravity + contact + dissipation, F0 = 1e4 (damping 1000× faster than the contact period) | tight explicit BS, else tight implicit |
-//! | [`WorkPrecisionProblem::Pile`] | `targets/N30_T4.csv` squeezed to 0.9 of its size | SI gravity + contact + dissipation, F0 = 1e-6, 1e-4 or 1e-2 | tight explicit BS, else tight implicit |
-//! | [`NBodyProblem::Pythagorean`] | 3 point masses (tiny spheres), G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
-//! | [`NBodyProblem::OuterSolar`] | Sun + 4 giants, G = 1 | gravity only | REBOUND (`analysis/rebound_compare`) |
-//!
-//! Error measures (dimensionless):
-//! * [`ProblemSetup::state_error`] — the *block norm*: the state of every body is split into blocks
-//!   (`r`, `q`, `u = m v`, `p = M(q) q̇` for rotating bodies; `r`, `u` for point masses); for each block kind
-//!   `max_b |y_b − y_ref,b|₂ / max_b |y_ref,b|₂` (maximum over bodies `b` of the Euclidean error of the block,
-//!   over the largest Euclidean norm of that block in the reference), and the error is the maximum over the
-//!   block kinds. The `∫F dt` component of dissipative problems is left out (the energy residual covers it).
-//! * [`ProblemSetup::spin_error`] (the top) — `|ω(t_end) − ω_exact(t_end)|₂ / |ω_exact(t_end)|₂` with `ω`
-//!   the body-frame angular velocity (rad/s).
-//! * [`ProblemSetup::energy_residual`] — `|H(t) − H(0) − 2∫₀ᵗF dt| / E_scale(0)`, with `E_scale = K + |U_C| +
-//!   |U_G|` of [`Diagnostics`] at `t = 0` (`F = 0` without dissipation).
+//! Errors (dimensionless): [`ProblemSetup::state_error`], per block kind (`r`, `q`, `u`, `p`) the largest body
+//! error over the largest reference block norm, maxed over kinds (`∫F dt` left out); [`ProblemSetup::spin_error`],
+//! `|ω − ω_exact|₂ / |ω_exact|₂` (body frame); [`ProblemSetup::energy_residual`],
+//! `|H(t) − H(0) − 2∫F dt| / E_scale(0)`, `E_scale = K + |U_C| + |U_G|` ([`Diagnostics`]).
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::equations::{

@@ -1,20 +1,12 @@
-//! Rubble-pile targets as in Roig03 §3 and Table 1.
-//!
-//! 1. Sizes: equivalent radii from the cumulative distribution `N(>R) ∝ R^−2.5` truncated to
-//!    `[R_smallest, R_largest]`; the largest and the smallest fragment are fixed at the extremes and the other
-//!    `N − 2` are drawn (seeded); a draw is kept when the total mass is within `mass_tolerance` of the requested
-//!    total (Table 1 totals are 1.0e19 kg ± 0.5 %), otherwise the next draw of the same stream is tried.
-//! 2. Shapes `B/A = 0.7`, `C/A = 0.5`, density 3000 kg m⁻³, so `A = R / (0.35)^{1/3}`.
-//! 3. Placement: the largest fragment at the centre, the others (largest first) at uniformly random points
-//!    and random attitudes inside a sphere just large enough, with no two ellipsoids touching (the
-//!    Perram–Wertheim test); if a fragment finds no room the sphere grows by 3 % and placement restarts.
-//! 4. Every fragment in rigid rotation `Ω ẑ` (period `T`), then the pile is evolved with gravity, contact and
-//!    dissipation until it moves as a nearly rigid body: the kinetic energy of the motion relative to the
-//!    best-fit rigid rotation falls below `rigidity` (1e-4) of the total, at two successive checks after at
-//!    least three free-fall times. The contraction spins the pile up, so the relaxed pile is set back into exact
-//!    rigid rotation at `Ω` and relaxed again, until its period is within 2 % of `T` (at most 4 rounds).
-//! 5. κ from Roig03 Eq. 14 with β = 10, v = 5 km/s over the fragments (the projectiles of Table 2 are smaller
-//!    than the largest and larger than the smallest fragment, so the same κ serves the impacts).
+//! Rubble-pile targets as in Roig03 §3 and Table 1. (1) Sizes: equivalent radii from `N(>R) ∝ R^−2.5` on
+//! `[R_smallest, R_largest]`, both extremes fixed, `N − 2` drawn (seeded) until the total mass is within
+//! `mass_tolerance` (Table 1: 1.0e19 kg ± 0.5 %). (2) `B/A = 0.7`, `C/A = 0.5`, 3000 kg m⁻³, `A = R / 0.35^{1/3}`.
+//! (3) Largest at the centre, the others (largest first) at random points and attitudes in a sphere, none touching
+//! (Perram–Wertheim); no room grows the sphere 3 % and restarts. (4) Rigid rotation `Ω ẑ` (period `T`), then
+//! relaxed with gravity, contact and dissipation until the kinetic energy relative to the best-fit rigid rotation is
+//! below `rigidity` (1e-4) at two successive checks after three free-fall times; the contraction spins it up, so it
+//! is reset to `Ω` and relaxed again until within 2 % of `T` (≤ 4 rounds). (5) κ from Eq. 14 with β = 10,
+//! v = 5 km/s over the fragments (Table 2's projectiles lie within their sizes, so the same κ serves the impacts).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::calibration::calibrate_kappa_read;

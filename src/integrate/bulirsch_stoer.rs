@@ -1,84 +1,20 @@
-//! Adaptive Gragg–Bulirsch–Stoer extrapolation integrator.
+//! Adaptive Gragg–Bulirsch–Stoer extrapolation after ODEX: Hairer, Nørsett & Wanner, *Solving Ordinary
+//! Differential Equations I* (2nd ed., Springer 1993), §II.9; an independent implementation of that description.
 //!
-//! Source of the method: E. Hairer, S. P. Nørsett & G. Wanner, *Solving Ordinary Differential
-//! Equations I: Nonstiff Problems* (2nd ed., Springer 1993), §II.9 "Extrapolation methods", and
-//! the strategy of their Fortran code ODEX described there (harmonic step-number sequence,
-//! order and step-size selection by work per unit step, convergence monitor, stability check).
-//! This is an independent implementation written from that description.
+//! A step `H` runs Gragg's midpoint rule ([`Midpoint`]) with `n_j = 2j` substeps and a smoothed end value, and
+//! extrapolates to `h → 0` with the Aitken–Neville tableau `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) /
+//! ((n_j / n_{j−k})² − 1)` (`T_{j,j}` of order `2j`); the error is `‖T_{j,j} − T_{j,j−1}‖` in the scaled RMS norm
+//! of [`Tolerances`]. Step and order control, convergence monitor and stability check (halve `H` when
+//! `‖f(z_1) − f(z_0)‖² > 4 ‖f(z_0)‖²`, `safe3 = 0.5`) are ODEX's; the same control ([`Extrapolation`],
+//! [`Strategy`]) drives SEULEX in `linearly_implicit.rs`, and the loop around the steps is [`Adaptive`]'s.
 //!
-//! # The method
-//!
-//! One step of size `H` from `(t, y)` computes, for columns `j = 1, 2, …`, Gragg's modified
-//! midpoint rule with `n_j = 2j` substeps of size `h_j = H/n_j`
-//!
-//! ```text
-//! z_0 = y,  z_1 = z_0 + h_j f(t, z_0),  z_{m+1} = z_{m−1} + 2 h_j f(t + m h_j, z_m)   (m = 1 … n_j − 1)
-//! T_{j,1} = ½ (z_{n_j − 1} + z_{n_j} + h_j f(t + H, z_{n_j}))                           (smoothing)
-//! ```
-//!
-//! whose error has an expansion in even powers of `h_j`, and extrapolates it to `h → 0` with the
-//! Aitken–Neville tableau
-//! `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) / ((n_j / n_{j−k})² − 1)`.
-//! `T_{j,j}` has order `2j`; the error estimate of column `j` is `‖T_{j,j} − T_{j,j−1}‖` in the
-//! scaled RMS norm of [`Tolerances`] with `sc_i = atol_i + rtol_i · max(|y_i|, |y_i + T_{j,j,i}|)` (the
-//! tableau holds increments, see below).
-//!
-//! # Step and order control (as in ODEX)
-//!
-//! For every column `j ≥ 2` an optimal step `H_j = H / fac_j` is proposed, with
-//! `fac_j = min(fac2/facmin, max(facmin, (err_j/safe1)^{1/(2j−1)} / safe2))`,
-//! `facmin = fac1^{1/(2j−1)}` (`fac1 = 0.02, fac2 = 4, safe1 = 0.65, safe2 = 0.94`), and its work
-//! per unit step `W_j = A_j / H_j` (`A_j` = RHS evaluations for `j` columns). The next target
-//! column count `k` minimises the work (decrease when `W_{k−1} < 0.8 W_k`, increase when
-//! `W_k < 0.9 W_{k−1}`). The convergence monitor rejects a step early when the error of column
-//! `k − 1` is too large to hope for convergence in column `k + 1`.
-//!
-//! # Error per unit step (deviation from ODEX)
-//!
-//! ODEX bounds the error of every step by the tolerance, so the final error of a run grows with its number of
-//! steps (to 1e4 × rtol on the outer Solar System, `analysis/work_precision/REPORT.md`), and the higher the order
-//! (the longer the steps), the closer the true local error comes to its estimate. When the run's span `T` is known
-//! ([`Integrator::set_span`], which the run driver and the benchmarks call), a step of length `H` is
-//! accepted when `err ≤ s H / T` instead of `err ≤ 1` (with `s =` [`RUN_BUDGET`], and `s H / T` floored at
-//! `10 ε / rtol`, below which round-off decides): the local errors of the whole run then add up to about
-//! `s · rtol`, and the final error follows `rtol` (`bench tolerance`). The optimal step uses the exponent
-//! `1/(2j − 2)` of the error per unit step. At high order this costs few steps (`(T/H)^{1/(2j−2)}`, about
-//! 1.3× for 100 steps of order 16).
-//!
-//! # Increments and compensated summation (deviation from ODEX)
-//!
-//! The midpoint rule and the tableau run on the increments `d_m = z_m − y` from the step's start, not on the
-//! states: the right-hand side is called at `y + d_m`, and the step ends with `y += T_{k,k}` summed with Kahan's
-//! compensation, which carries what that addition rounded away into the next step (and into the next
-//! [`Integrator::advance`] when the caller hands the returned state back unchanged; it is saved with
-//! [`Integrator::save_state`], so a resumed run is bit-identical). Written on the states, every substep and
-//! every tableau entry rounds at `ε |y|`, and the run's error stops following `rtol` near `1e-11`
-//! (`bench tolerance`; `analysis/work_precision/REPORT.md`).
-//!
-//! # The step loop and the other extrapolation method
-//!
-//! The loop around the steps (landing on output times, the step budget and deadline, halving after non-finite
-//! values, compensated summation, statistics, the loop's part of a checkpoint) is [`Adaptive`]'s
-//! (`adaptive_loop.rs`); this file supplies the step ([`Extrapolation`] with [`Midpoint`], Gragg's rule). The
-//! column and order control of [`Extrapolation`] also drives the linearly implicit Euler rule of
-//! `linearly_implicit.rs` (SEULEX), with that code's constants ([`Strategy`]).
-//!
-//! # Safeguards
-//!
-//! * **Stability check** (ODEX): in the first midpoint substep of columns 1 and 2 the change of
-//!   the derivative is compared with the derivative itself; if
-//!   `‖f(z_1) − f(z_0)‖² > 4 ‖f(z_0)‖²` (scaled norms) the step is rejected and **`H` halved**
-//!   (ODEX's default `safe3 = 0.5`). Deviation from ODEX: the check is skipped when `f(t, y)` is
-//!   exactly zero (e.g. `y' = t` at `t = 0`), where ODEX would halve `H` some 60 times. Note that the
-//!   check compares scaled norms, so it also fires when `f` is nearly zero in the tolerance scale
-//!   (a state starting at rest with tiny velocity tolerances may see a few halvings at the start).
-//!   The same halving happens when the error estimate diverges with the column index (`j > 2` and
-//!   `err_j ≥ max(4 err_{j−1}, 1)`, ODEX's `ERROLD`) or is astronomically large (`err · ε ≥ 1`).
-//! * **Non-finite values**: a NaN/∞ error estimate also halves `H`; after
-//!   [`Adaptive::set_max_nonfinite_retries`] (default 10) consecutive such rejections, or when
-//!   the step underflows right after one, [`IntegrateError::NonFinite`] is returned. A non-finite
-//!   derivative at an *accepted* point fails at once (no step size can cure it).
-//! * The caller's `t, y` are only ever overwritten by accepted states.
+//! Deviations from ODEX: (1) with the span `T` known ([`Integrator::set_span`]) a step is accepted when
+//! `err ≤ s H / T` (`s =` [`RUN_BUDGET`], floored at `10 ε / rtol`) and the optimal step uses the exponent
+//! `1/(2j − 2)`, so a run's final error follows `rtol` instead of growing with its step count; (2) rule and tableau
+//! run on increments `d_m = z_m − y`, and `y += T_{k,k}` is Kahan-compensated (the compensation crosses
+//! [`Integrator::advance`] and is saved by [`Integrator::save_state`]: a resume is bit-identical); (3) the stability
+//! check is skipped when `f(t, y)` is exactly zero. A NaN/∞ estimate halves `H`; after
+//! [`Adaptive::set_max_nonfinite_retries`] such rejections in a row, [`IntegrateError::NonFinite`].
 
 use super::adaptive_loop::{
     Adaptive, Carried, Cause, FirstStep, Outcome, StepMethod, Trial, all_finite, bad_state, hinit_h0, hinit_h1,
@@ -106,11 +42,9 @@ const STABILITY_COLUMNS: usize = 2;
 /// Limit on `‖Δf‖² / ‖f‖²` in the stability check.
 const STABILITY_RATIO: f64 = 4.0;
 /// Share of the tolerance the local errors of a whole run may add up to under error-per-unit-step control
-/// ([`Integrator::set_span`]). Measured on the outer Solar System: at the largest steps the order chooses,
-/// `‖T_{j,j} − T_{j,j−1}‖` underestimates the true local error of `T_{j,j}` by 2–3× (a one-step tableau against
-/// a Dop853 1e-15 reference), and Kepler shear turns an along-track error into a growing one. With a budget of
-/// 1 the final error reached 240 × rtol, with 1/3 106 ×, with 1/4 at most 77 × over rtol 1e-6…1e-11
-/// (`bench tolerance`).
+/// ([`Integrator::set_span`]). Below 1 because at the largest steps `‖T_{j,j} − T_{j,j−1}‖` underestimates the true
+/// local error of `T_{j,j}`, and Kepler shear turns an along-track error into a growing one (the values tried:
+/// `analysis/work_precision/NOTES.md`).
 pub const RUN_BUDGET: f64 = 0.25;
 /// Default maximum number of columns (ODEX `km`).
 pub const DEFAULT_MAX_COLUMNS: usize = 9;

@@ -1,78 +1,19 @@
-//! The explicit Runge–Kutta method DOP853 of Dormand & Prince: order 8, with the 5th- and 3rd-order error
-//! estimators and the step-size control of Hairer's code DOP853.
+//! The explicit Runge–Kutta method DOP853 of Dormand & Prince (order 8, error estimator 8(5,3), step control of
+//! Hairer's code DOP853): Hairer, Nørsett & Wanner, *Solving Ordinary Differential Equations I* (2nd ed., 1993),
+//! §II.10, and §II.4 for the initial step `hinit`; the published coefficients, an independent implementation (the
+//! `ode_solvers` crate's Dop853 stays reachable through [`super::ode_solvers_adapter`] for cross-checks).
 //!
-//! Source of the method: E. Hairer, S. P. Nørsett & G. Wanner, *Solving Ordinary Differential Equations I:
-//! Nonstiff Problems* (2nd ed., Springer 1993), §II.10 (the code DOP853: the order-8 method of Dormand & Prince,
-//! its error estimator "of order 8(5,3)" and its step-size control) and §II.4 (the initial step guess). The
-//! coefficients below are the published ones of that code. This is an independent implementation written from that
-//! description; it replaces the `ode_solvers` crate's Dop853 for `method = "dop853"` (the crate's still runs through
-//! [`super::ode_solvers_adapter`], for cross-checks).
+//! Twelve stages `k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)`, `y_new = y + h Σ b_i k_i` (FSAL). With
+//! `E5 = Σ (e5_i/sc_i)²`, `E3 = Σ (e3_i/sc_i)²` in the scaled norm of [`Tolerances`],
+//! `err = |h| E5 / sqrt(n (E5 + 0.01 E3))`; `h_new = h / clamp(err^{1/8} / 0.9, 1/6, 1/0.333)`, accepted when
+//! `err ≤ 1`, no growth right after a rejection, β = 0. The loop (landing on output times, restart with the last
+//! full step, failures, statistics) is [`Adaptive`]'s; this file supplies the step ([`Dop853Step`]).
 //!
-//! # The method
-//!
-//! A step of size `h` from `(t, y)` evaluates twelve stages `k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)` and
-//! takes the 8th-order solution `y_new = y + h Σ b_i k_i` (FSAL: `f(t + h, y_new)` is the next step's `k_1`).
-//! The error of a step is measured with both of Hairer's estimators, in the scaled norm of [`Tolerances`]
-//! (`sc_i = atol_i + rtol_i · max(|y_i|, |y_new,i|)`, straight from the per-component tolerances):
-//!
-//! ```text
-//! E5 = Σ_i (e5_i / sc_i)²,  e5 = Σ_j (b_j − b̂_j) k_j          (the 5th-order estimator)
-//! E3 = Σ_i (e3_i / sc_i)²,  e3 = Σ_j b_j k_j − (b̃_1 k_1 + b̃_9 k_9 + b̃_12 k_12)   (the 3rd-order one)
-//! err = |h| · E5 / sqrt(n · (E5 + 0.01 E3))
-//! ```
-//!
-//! which behaves as the 5th-order estimate for small `h` and as the 3rd-order one where that is larger.
-//!
-//! # Step-size control (DOP853's)
-//!
-//! `h_new = h / fac`, `fac = clamp((err^{1/8}) / 0.9, 1/6, 1/0.333)` (safety 0.9, the step grows at most 6-fold
-//! and shrinks at most 3-fold); a step is accepted when `err ≤ 1`, and after a rejection the next accepted step
-//! does not grow. There is no β (Lund) stabilisation: DOP853's default is β = 0. The first step is Hairer's
-//! `hinit` (§II.4), with the norms of the error's scaled RMS norm and the exponent 1/8 of DOP853.
-//!
-//! # Landing, continuation, checkpoints
-//!
-//! The loop around the steps is [`Adaptive`]'s (`adaptive_loop.rs`); this file supplies the step ([`Dop853Step`]).
-//! Each [`Integrator::advance`] lands exactly on its target: the last step is shortened (when `1.01 h` reaches
-//! past the target, as in DOP853) and its end time is the target itself. The next call starts with the step the
-//! control proposed before that shortening (the "last full step"), so a sequence of output times does not restart
-//! the control. The derivative at the start of a call is always evaluated afresh (the caller may change the state
-//! between calls, e.g. project the attitudes), so nothing but the proposed step, the settings and the counters
-//! passes from one call to the next ([`Dop853State`]), and a restored integrator continues bit for bit.
-//!
-//! # Parallel, deterministic vector work
-//!
-//! Every loop over the state (the stage sums, the new state, the error norms, the initial-step guess) runs over
-//! fixed chunks of [`CHUNK`] components; from [`DEFAULT_PARALLEL_FROM`] components on the chunks run on rayon's
-//! current pool. The element-wise work does the same arithmetic whichever thread does it, and the norms' sums of
-//! squares are summed within each chunk in order and then over the chunks in chunk order (never with a reduction
-//! whose association depends on how rayon splits), so the results are bit-identical on any number of threads,
-//! and on the serial path. The twelve stages and the work vectors are allocated once per dimension; a step
-//! allocates nothing. The vector work is timed as the phases `integrate.dop853.vector` (parallel) and
-//! `integrate.dop853.vector_serial` ([`crate::phase`]).
-//!
-//! # The system's step hooks
-//!
-//! [`OdeSystem::begin_step`] is called with every state from which steps are attempted (the start of each call
-//! and each accepted state, before the derivative there), so a system that fixes a discrete choice per step (tree
-//! gravity's interaction lists) sees one choice per step; a rejected attempt retries from the same state and keeps
-//! it (the choice is a function of that state, so calling again would only repeat the work).
-//! [`OdeSystem::end_steps`] is called when the call returns, whether it succeeded or failed.
-//!
-//! # Failures
-//!
-//! As [`super::bulirsch_stoer`]: a non-finite stage (a NaN error estimate, or a non-finite new state) halves the
-//! step (an infinite estimate of finite values is an ordinary rejection, the step shrinking 3-fold), and after [`Adaptive::set_max_nonfinite_retries`] consecutive such rejections, or when the step underflows
-//! right after one, [`IntegrateError::NonFinite`] is returned; a non-finite derivative at an accepted state fails
-//! at once. A step below `max(h_min, 10 ε |t|)` gives [`IntegrateError::StepUnderflow`]. The caller's `t, y` are
-//! only ever set to accepted states: on error they hold the last one.
-//!
-//! # Statistics
-//!
-//! [`Integrator::stats`] counts every RHS call (the derivative at the start of each call, `hinit`'s extra one, 11
-//! per attempt and 1 per accepted step that does not end a call), every rejected attempt (error test and non-finite
-//! stages alike, before the first accepted step too), and takes `smallest_step` over the accepted steps that were
-//! not shortened only to land on an output time (as [`super::bulirsch_stoer`]).
+//! Invariants: [`OdeSystem::begin_step`] sees each state steps are attempted from (a rejected retry keeps its
+//! choice), [`OdeSystem::end_steps`] each return. The vector work runs over fixed chunks of [`CHUNK`] components,
+//! on rayon from [`DEFAULT_PARALLEL_FROM`], with the norms summed within and then over chunks in order: results
+//! are bit-identical on any number of threads; a step allocates nothing. Only the proposed step, settings and
+//! counters pass between calls ([`Dop853State`]), so a restored integrator continues bit for bit.
 
 use super::adaptive_loop::{
     Adaptive, Carried, Cause, FirstStep, Outcome, StepMethod, Trial, hinit_h0, hinit_h1, validate_tolerances,

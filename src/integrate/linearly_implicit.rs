@@ -1,41 +1,15 @@
-//! Linearly implicit Euler extrapolation (SEULEX) for stiff systems: `method = "bulirsch-stoer-implicit"`.
+//! Linearly implicit Euler extrapolation (SEULEX) for stiff systems, `method = "bulirsch-stoer-implicit"`: Hairer &
+//! Wanner, *Solving Ordinary Differential Equations II* (2nd ed., Springer 1996), §IV.9; an independent
+//! implementation. This file supplies the base rule ([`LinearlyImplicitEuler`]) and SEULEX's constants; the
+//! extrapolation and column/step control ([`Extrapolation`]) and the loop ([`Adaptive`]) are our ODEX's
+//! ([`super::bulirsch_stoer`]), with its error per unit step ([`Integrator::set_span`]) and Kahan-compensated sum.
 //!
-//! Source of the method: E. Hairer & G. Wanner, *Solving Ordinary Differential Equations II: Stiff and
-//! Differential-Algebraic Problems* (2nd ed., Springer 1996), §IV.9 "Extrapolation methods" (the linearly implicit
-//! Euler method, its h-expansion for an arbitrary matrix `J`, and the strategy of their code SEULEX: harmonic
-//! step-number sequence, order and step-size selection by work per unit step, stability check). This is an
-//! independent implementation written from that description, in the structure of our [`super::bulirsch_stoer`]: this
-//! file supplies the base rule ([`LinearlyImplicitEuler`]) and SEULEX's constants, and the extrapolation, the
-//! column and step control ([`Extrapolation`]) and the step loop ([`Adaptive`]) are those of our ODEX.
-//!
-//! # The method
-//!
-//! At the start `(t, y)` of a step of size `H` the system supplies its stiff part, a matrix `J ≈ ∂f/∂y`
-//! ([`OdeSystem::stiff_part`]), which is kept for every substep of the step. Column `j` takes `n_j = j` substeps of
-//! `h = H/n_j` of the linearly implicit Euler method
-//!
-//! ```text
-//! (I − h J) Δ_m = h f(t + m h, y_m),   y_{m+1} = y_m + Δ_m,   T_{j,1} = y_{n_j}
-//! ```
-//!
-//! whose error has an expansion in powers of `h` for any fixed `J` (a W-method: `J` need not be the exact
-//! Jacobian, only the stability depends on how well it represents the stiff part), and extrapolates it with the
-//! Aitken–Neville tableau `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) / (n_j/n_{j−k} − 1)`; `T_{j,j}` has order `j`.
-//! The error estimate of column `j` is `‖T_{j,j} − T_{j,j−1}‖` in the scaled RMS norm of [`Tolerances`]. A system
-//! without a stiff part (`J = 0`) is integrated by extrapolated explicit Euler — correct, but slower than
-//! [`super::bulirsch_stoer`].
-//!
-//! # Tolerances, step and order control
-//!
-//! As in [`super::bulirsch_stoer`]: with the run's span known ([`Integrator::set_span`]) a step of length `H` is
-//! accepted when `err ≤ s H / T` (`s =` [`super::bulirsch_stoer::RUN_BUDGET`]), so `rtol` and `atol` (scale-free,
-//! in m, m/s, rad/s) bound the error of the whole run; without it, of each step. The next step and column count
-//! minimise the work per unit step `A_j / H_j` (`A_j = n_1 + … + n_j` substeps, each one evaluation and one linear
-//! solve) over the columns `k − 1, k, k + 1`, with SEULEX's safety factors; a step whose error estimate grows with
-//! the column, or whose second substep increment in column 2 exceeds twice the first (the stiff part left
-//! unresolved by `J`), is retried with half the step. Output times are landed on exactly by shortening the last
-//! step, and the un-shortened proposal is kept for the next call. The increments are summed into the state with
-//! Kahan's compensation, saved with the checkpoint state, so a resumed run is bit-identical.
+//! A step `H` takes the system's stiff part `J ≈ ∂f/∂y` ([`OdeSystem::stiff_part`]) once; column `j` runs `n_j = j`
+//! substeps `(I − h J) Δ_m = h f(t + m h, y_m)`, `y_{m+1} = y_m + Δ_m`, `T_{j,1} = y_{n_j}`, extrapolated by
+//! `T_{j,k+1} = T_{j,k} + (T_{j,k} − T_{j−1,k}) / (n_j/n_{j−k} − 1)` (`T_{j,j}` of order `j`; a W-method: any `J`
+//! keeps the order, only stability depends on it). Error `‖T_{j,j} − T_{j,j−1}‖` in the norm of [`Tolerances`]. A
+//! step is halved when the error grows with the column or column 2's second increment exceeds twice its first (the
+//! stiff part unresolved by `J`). With `J = 0` this is extrapolated explicit Euler: correct, slower than ODEX.
 
 use nalgebra::{DMatrix, DVector};
 

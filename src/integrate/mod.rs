@@ -1,25 +1,13 @@
-//! Integrators for first-order systems `y' = f(t, y)`.
+//! Integrators for first-order systems `y' = f(t, y)`, one per file behind the small [`Integrator`] trait (the
+//! REBOUND layout); our own three are one step loop ([`adaptive_loop`]) around a method's step:
+//! [`bulirsch_stoer`] (ODEX-style Gragg–Bulirsch–Stoer, Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9; the method
+//! of Roig03 §3), [`dop853`] (Dormand & Prince, §II.10), [`linearly_implicit`] (SEULEX, Hairer & Wanner, *Solving
+//! ODEs II*, §IV.9, with the system's [`OdeSystem::stiff_part`]); [`ode_solvers_adapter`] runs the `ode_solvers`
+//! crate's methods for cross-checks. [`elliptic`]: Jacobi elliptic functions and integrals (the torque-free top);
+//! [`problems`]: canonical ODE problems with known solutions for tests and benchmarks.
 //!
-//! One integrator per file behind the small [`Integrator`] trait (the REBOUND layout), the three of our own as one
-//! step loop around a method's step:
-//! - [`adaptive_loop`]: the loop (landing on output times, non-finite retries, compensated summation, budgets,
-//!   statistics, the common part of a checkpoint state) and the trait a method implements to run in it;
-//! - [`bulirsch_stoer`]: our own adaptive Gragg–Bulirsch–Stoer extrapolation integrator in the style of
-//!   Hairer's ODEX (Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.9), the method Roig03 §3 used;
-//! - [`dop853`]: our own DOP853 of Dormand & Prince (order 8 with Hairer's 5th- and 3rd-order error estimators
-//!   and step-size control, §II.10 of the same book), its vector work parallel and deterministic;
-//! - [`ode_solvers_adapter`]: the same systems under `ode_solvers`' Dopri5 and Rk4 (and its Dop853, for
-//!   cross-checks);
-//! - [`linearly_implicit`]: linearly implicit Euler extrapolation (SEULEX of Hairer & Wanner, *Solving ODEs II*,
-//!   §IV.9) for stiff systems, using the stiff part a system supplies ([`OdeSystem::stiff_part`]);
-//! - [`elliptic`]: Jacobi elliptic functions and elliptic integrals (the torque-free top's exact solution);
-//! - [`problems`]: canonical ODE problems with known solutions (Arenstorf orbit, Kepler, …), shared by the
-//!   tests and the benchmarks.
-//!
-//! What they share (the system and integrator traits, methods, tolerances, statistics, errors and the states a
-//! checkpoint keeps) is in `common.rs`, re-exported here: each method imports it from there, and only this file
-//! names the methods ([`make_integrator`]), so the files form no circle. The work–precision measurements that
-//! exercise these solvers are the `rubblepile bench` program's.
+//! The shared traits, tolerances, statistics, errors and checkpoint states are in `common.rs`, re-exported here;
+//! only this file names the methods ([`make_integrator`]), so the files form no circle.
 
 pub mod adaptive_loop;
 pub mod bulirsch_stoer;

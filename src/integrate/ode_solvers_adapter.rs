@@ -1,47 +1,16 @@
-//! The `ode_solvers` crate's Dop853, Dopri5 and Rk4 behind our [`Integrator`] trait, for
-//! cross-checks against [`super::bulirsch_stoer`]. `make_integrator` runs Dopri5 and Rk4 here; `"dop853"`
-//! runs our own `dop853::Dop853`, and the crate's Dop853 stays reachable through
-//! [`OdeSolversAdapter::new`] to compare the two (and it reads the checkpoint states its runs wrote, which our
-//! Dop853 refuses).
+//! The `ode_solvers` crate's (0.6.2) Dop853, Dopri5 and Rk4 behind our [`Integrator`] trait, for cross-checks
+//! against [`super::bulirsch_stoer`]; `"dop853"` runs our own `dop853::Dop853`, the crate's stays reachable
+//! through [`OdeSolversAdapter::new`] (and reads the checkpoints its runs wrote).
 //!
-//! Notes on how the crate is driven (read from `ode_solvers` 0.6.2):
-//! * **Scalar tolerances.** `ode_solvers` accepts one `rtol` and one `atol` for all components. When `rtol`
-//!   is the same for every component and only `atol` varies (the scale-free tolerances of
-//!   [`Tolerances::scale_free`]), the adaptive methods integrate the rescaled state `z_i = y_i / c_i`,
-//!   `c_i = atol_i / min_j atol_j`, with the scalar pair `(rtol, min atol)`: its error norm is then exactly the
-//!   per-component norm of `y` (numerator and denominator both scale by `c_i`). Otherwise the adapter uses the
-//!   *minimum* over the components of each vector (the most demanding), so every component is integrated at
-//!   least as accurately as requested.
-//! * **Output.** The solvers are run with `OutputType::Sparse`, which records the state after every
-//!   accepted step (the dense-output mode is unreliable for our purpose: it interpolates at
-//!   multiples of `dx` and, near the end point, extrapolates; its `dx` is ignored in sparse mode).
-//!   To bound the memory this takes, one call to `advance` is split into chunks of at most
-//!   [`OdeSolversAdapter::set_chunk_steps`] steps (default: about 64 MiB of stored states),
-//!   each restarted from the last accepted state with the last step size.
-//! * **Landing.** Dop853/Dopri5 shorten their last step to reach the end point; the adapter then sets
-//!   `t = t_target` exactly. Rk4 runs `⌈(t_target − t)/step⌉ − 1` full steps followed by one
-//!   shortened step (in a rescaled time variable so the step count is exact).
-//! * **Dop853 time bug workaround.** `ode_solvers` 0.6.2 has `c₁₂ = 0` instead of `1` in its DOP853
-//!   tableau (`butcher_tableau.rs`), so the 12th stage is evaluated at `t` instead of `t + h`:
-//!   wrong for non-autonomous systems (it is harmless for autonomous ones). The adapter therefore
-//!   runs Dop853 on the autonomous extended system `(y, τ)` with `τ' = 1` and passes `τ` as the time;
-//!   the tolerances are scaled by `√(n/(n+1))` so the RMS error norm equals that of the
-//!   `n`-dimensional system (τ is integrated exactly, so it adds nothing to the error).
-//! * **Stiffness detection** of the crate is disabled (it would abort the cross-check integrations).
-//! * **Statistics**: RHS evaluations are counted by the adapter itself (exact); accepted steps
-//!   are the states `ode_solvers` outputs; rejected steps are derived from the evaluation count
-//!   (`ode_solvers` reports statistics only on success and skips rejections before the first
-//!   accepted step), falling back to its own count if the derivation is inconsistent.
-//!   `smallest_step` includes steps shortened to land on an output time.
-//! * **Continuation.** Each `advance` starts a new `ode_solvers` run; Dop853/Dopri5 start it with the
-//!   last full step of the previous call (or the automatic guess / the given `step` at first).
-//! * **Checkpoints.** Since every `advance` starts a new `ode_solvers` run, the state carried between
-//!   calls is only the next initial step, the counters and the settings ([`OdeSolversState`]);
-//!   restoring it continues bit for bit.
-//! * **Budgets**: the step budget and wall-clock deadline are [`Budget`]'s, as in the step loop of our own methods
-//!   (`adaptive_loop.rs`), checked before every `ode_solvers` run; a call's checks are theirs too.
-//! * **Failure**: on error `t, y` are left at the last accepted state (the start of the call if no
-//!   step was accepted), never at a trial state.
+//! How the crate is driven: one `rtol` and `atol` only, so with per-component `atol` alone ([`Tolerances::scale_free`])
+//! the state is rescaled `z_i = y_i / c_i`, `c_i = atol_i / min_j atol_j` (same norm exactly), else the minimum of
+//! each vector is used. `OutputType::Sparse` (dense output extrapolates near the end), in chunks of
+//! [`OdeSolversAdapter::set_chunk_steps`] steps to bound memory; the end lands at `t = t_target` exactly (Rk4 with a
+//! shortened last step). The crate's DOP853 tableau has `c₁₂ = 0` instead of `1`, wrong for non-autonomous systems,
+//! so Dop853 runs on `(y, τ)` with `τ' = 1`, tolerances scaled by `√(n/(n+1))`. Stiffness detection is off. RHS
+//! calls are counted here, rejections derived from them. Each `advance` is a new crate run started from the last
+//! full step; only that step, counters and settings are carried ([`OdeSolversState`]: restores bit for bit).
+//! [`Budget`] checks before each run; on error `t, y` hold the last accepted state.
 
 use super::adaptive_loop::{Budget, wrong_state};
 pub use super::common::OdeSolversState;

@@ -1,20 +1,9 @@
-//! Canonical test problems with known solutions or invariants.
-//!
-//! Shared by the integrator tests and benchmarks. Every problem is a small struct implementing
-//! [`OdeSystem`] and [`TestProblem`] (initial state, a natural end time, the exact solution where
-//! one is known), plus problem-specific invariants (energy, angular momentum, …).
-//!
-//! | problem | dim | what it checks |
-//! |---|---|---|
-//! | [`HarmonicOscillator`] | 2 | exact solution, order of convergence |
-//! | [`Kepler`] | 4 | exact solution via Kepler's equation, energy and angular momentum |
-//! | [`Arenstorf`] | 4 | periodic orbit of the restricted three-body problem (hard step control) |
-//! | [`ExponentialDecay`] | 1 | mildly stiff linear decay, stability of explicit methods |
-//! | [`StiffDampedOscillator`] | 2 | overdamped oscillator, stiffness ratio ~4ζ²: exact solution, stiff integrators (with its exact Jacobian) |
-//! | [`RigidBody`] | 3 | Euler's equations of a free rigid body: exact solution ([`torque_free_spin`], Jacobi elliptic functions), energy and angular momentum |
-//!
-//! The problems of the ellipsoid model itself (a free top, a bouncing pair, the N30 target, N-body tests)
-//! are in `impact::problems`, built on these.
+//! Canonical test problems with known solutions or invariants, shared by the integrator tests and benchmarks; each
+//! a small struct implementing [`OdeSystem`] and [`TestProblem`] (initial state, natural end time, exact solution
+//! where known): [`HarmonicOscillator`] (order of convergence), [`Kepler`] (Kepler's equation, energy, angular
+//! momentum), [`Arenstorf`] (restricted three-body periodic orbit, hard step control), [`ExponentialDecay`] (mildly
+//! stiff), [`StiffDampedOscillator`] (stiffness ratio ~4ζ², exact Jacobian), [`RigidBody`] (Euler's equations,
+//! exact via [`torque_free_spin`]). The ellipsoid model's problems are in `impact::problems`.
 
 use crate::integrate::OdeSystem;
 use crate::integrate::elliptic::{incomplete_f, jacobi_sn_cn_dn};

@@ -1,40 +1,13 @@
-//! The manifest of a run directory (`DIR/manifest.txt`): every finished file of the run with its size and its
-//! BLAKE3 checksum, so that `check DIR`, `resume`, `analyze`, `export` and `render` find a damaged file (a byte
-//! flipped, a file cut short) and name it instead of reading it.
+//! The manifest of a run directory (`DIR/manifest.txt`): every finished file with its size and BLAKE3 checksum, so
+//! that `check`, `resume`, `analyze`, `export` and `render` name a damaged file instead of reading it.
 //!
-//! # What it records, and when
-//!
-//! The run driver rewrites the manifest (atomically, [`crate::io::safe_write`]) after each checkpoint, when the run
-//! completes and when it fails ([`Recorder::write`]). It lists every regular file below the run directory at that
-//! moment (scene copy, snapshots, checkpoint, summary, time series, the engines' own files, the impact and flyby
-//! setups, extra snapshot formats) except the lock files, temporary files, the manifest itself and the trees other
-//! commands write later on their own (`analysis/`, `frames/`). A file that grows while the run goes on
-//! ([`GROWING`]: the time series and the engines' per-sample logs) is recorded, at a checkpoint, by the bytes it
-//! held then: it may be longer later (the run went on), and those bytes must be unchanged.
-//!
-//! # The file
-//!
-//! ```text
-//! # rubblepile manifest 1: the finished files of this run directory (BLAKE3 of the bytes, bytes, path)
-//! # state: checkpoint at t = 8 s
-//! 3f0c…  12345 = snapshots/0.csv
-//! 9a1b…  20480 + timeseries.csv
-//! # end 51e2…
-//! ```
-//!
-//! One line a file: the checksum (64 hex digits), the size in bytes, `=` (the file must be exactly this) or `+` (its
-//! first bytes must be these), and the path relative to the run directory with `/` between folders. The last line
-//! is the checksum of every byte above it, so a damaged manifest is itself found.
-//!
-//! The checkpoint is the one file a run replaces. Before it is replaced, the manifest is written once more with a
-//! `~` line for it (the checkpoint about to be put in place: the file may be exactly this instead), so that a run
-//! killed between the checkpoint's rename and the next manifest leaves a directory that verifies and resumes.
-//!
-//! # Run directories without one
-//!
-//! A run directory written before the manifest is checked row by row instead ([`check_rows`]): every row as many
-//! cells as the header, every number finite (snapshots), and the file ending with a newline (a file cut short ends
-//! mid-row).
+//! The driver rewrites it atomically ([`crate::io::safe_write`]) after each checkpoint, at completion and on failure
+//! ([`Recorder::write`]), listing every regular file except locks, temporaries, itself and the trees other commands
+//! write later (`analysis/`, `frames/`). Line format: `<64 hex> <bytes> <=|+|~> <path>` — `=` exactly these bytes,
+//! `+` a prefix ([`GROWING`] files, recorded at a checkpoint), `~` the checkpoint about to replace the current one
+//! (written before the rename, so a run killed between rename and manifest still verifies and resumes); header lines
+//! `# rubblepile manifest 1: …`, `# state: …`, and a last line `# end <checksum of every byte above>`. Run
+//! directories without a manifest are checked row by row ([`check_rows`]: cell counts, finite numbers, final newline).
 
 use std::collections::HashMap;
 use std::io::Read;

@@ -1,30 +1,15 @@
-//! One writer per directory: an exclusive advisory lock that every rubblepile process writing a directory (a run
-//! directory, a campaign directory, a run's `frames/` or `analysis/`) holds for as long as it writes there.
+//! One writer per directory: an exclusive advisory lock ([`std::fs::File::try_lock`]: `flock`, `LockFileEx`) that
+//! every process writing a directory holds while it writes, on `DIR/.rubblepile.lock`, or `DIR/.rubblepile-<part>.lock`
+//! for a part written separately (`frames`, `analysis`, a campaign shard's index). The holder writes its pid into it.
 //!
-//! The lock is the OS's advisory file lock ([`std::fs::File::try_lock`]: `flock` on Unix, `LockFileEx` on Windows)
-//! on a lock file at the top of the directory: `DIR/.rubblepile.lock` for the directory itself, and
-//! `DIR/.rubblepile-<part>.lock` for one part of it written separately (`frames`, `analysis`, a campaign shard's
-//! index), so that, for instance, `analyze` can write `DIR/analysis/` while the run is still writing `DIR`. The
-//! holder writes its process id into the file right after locking it, so that a refused writer can name it (in the
-//! instant between the two, a refused writer reads the previous holder's pid).
-//!
-//! - A second writer is refused within a quarter of a second (the lock is retried that long, since a child process
-//!   between fork and exec can hold a released lock for a moment), never made to wait for the holder:
-//!   [`LockError::Held`] names the directory and the holder's pid (the command line prints it as one line, exit
-//!   code 2).
-//! - The lock lives as long as the [`DirLock`] guard; the OS releases it when the process ends however it ends
-//!   (killed, crashed), so a dead holder never blocks anyone.
-//! - Lock files are never deleted: deleting one while another process opens it would let two processes lock two
-//!   different files of the same name. They are not outputs: emptiness checks and `--force` ignore them
-//!   ([`is_lock_file`]).
-//! - Readers (`check`, `render` and `export` reading snapshots, `analyze` reading a run) take no lock on what they
-//!   read and are never blocked.
-//! - Within one process the lock is re-entrant on the thread that holds it: a command may lock its output
-//!   directory before preparing it and the run driver lock it again to write the run. Another thread of the same
-//!   process is refused like another process.
-//! - [`DirLock::acquire_shared`] takes the lock shared: holders of the shared lock exclude an exclusive one but not
-//!   each other (the shards of one campaign directory, each writing its own runs and index).
-//! - On a file system without advisory locks the directory is written unlocked, after a warning on stderr.
+//! - A second writer is refused within a quarter of a second (a child between fork and exec may briefly hold a
+//!   released lock): [`LockError::Held`] names the directory and pid (one line, exit code 2).
+//! - The lock lives with the [`DirLock`] guard; the OS releases it however the process ends.
+//! - Lock files are never deleted (two processes could lock two files of one name); emptiness checks and `--force`
+//!   ignore them ([`is_lock_file`]). Readers take no lock and are never blocked.
+//! - Re-entrant on the holding thread (a command locks, the driver locks again); other threads are refused.
+//!   [`DirLock::acquire_shared`]: shared holders exclude an exclusive one, not each other (campaign shards).
+//! - Without advisory locks on the file system, the directory is written unlocked after a warning.
 
 use std::fs::{File, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};

@@ -1,20 +1,11 @@
-//! The one way rubblepile writes a file into a directory it owns (a run directory, its `analysis/`, `frames/`,
-//! `vtk/`, a campaign directory): never through a symbolic link (so nothing is written outside that directory),
-//! and whole or not at all.
-//!
-//! - [`write_atomic`] and [`AtomicFile`]: the bytes go to a fresh temporary file in the same directory (created
-//!   with `O_CREAT | O_EXCL`, which never follows a link), and a rename puts it in place. A rename replaces a link
-//!   itself, never its target, and a reader sees the old file or the new one, never half of one.
-//! - [`create_fresh`]: a file that grows while a run goes (`timeseries.csv`, `tracks.csv`, `spinup.csv`) is created
-//!   anew with `O_EXCL`; [`open_nofollow`] reopens one (on resume) or a lock file, and checks that what it opened is
-//!   the regular file at that path, not a file a link leads to.
-//! - [`ensure_dir`]: a subdirectory (`snapshots/`, `frames/`, `analysis/`, `vtk/`) that is a link is refused too,
-//!   since everything written below it would land where the link leads.
-//!
-//! A link where rubblepile expects a regular file or directory is refused with an error ([`SymlinkRefused`]) whose
-//! one line names the path. The checks use `symlink_metadata` (portable: `O_NOFOLLOW` needs the `libc` crate), and
-//! where a check and the open could race, the open itself cannot follow a link (`O_EXCL`) or is checked after the
-//! fact (device and inode on Unix).
+//! The one way rubblepile writes a file into a directory it owns (run directory, `analysis/`, `frames/`, `vtk/`,
+//! campaign directory): never through a symbolic link, and whole or not at all. [`write_atomic`] and [`AtomicFile`]
+//! write a fresh temporary (`O_CREAT | O_EXCL`) in the same directory and rename it into place (readers see the old
+//! or new file, never half). [`create_fresh`] creates growing files (`timeseries.csv`, `tracks.csv`, `spinup.csv`)
+//! with `O_EXCL`; [`open_nofollow`] reopens one (or a lock file) and checks it is the regular file at that path.
+//! [`ensure_dir`] refuses a linked subdirectory. A link is refused with [`SymlinkRefused`] naming the path; checks use
+//! `symlink_metadata` (`O_NOFOLLOW` would need `libc`), and where check and open could race the open cannot follow a
+//! link or is re-checked (device and inode on Unix).
 
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};

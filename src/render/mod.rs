@@ -1,24 +1,12 @@
-//! Pictures of runs: bodies drawn as shaded ellipsoids and spheres by exact ray casting, walls as translucent
-//! surfaces, written as PNG frames and an animated GIF.
+//! Pictures of runs: ellipsoids and spheres shaded by exact ray casting, walls as translucent surfaces, as PNG frames
+//! and an animated GIF. One file per step: [`camera`] ([`View`], [`Projection`], [`Framing`], the primary rays of
+//! [`Camera`]); [`raycast`] (exact ray–ellipsoid intersection, depth-buffered row-parallel [`render_bodies`]);
+//! [`colour`] ([`ColourMap`], [`ColourScale`]); [`walls`] ([`WallPolygon`]); [`overlay`] ([`ScaleBar`], [`Triad`]);
+//! [`frame`] ([`render_frame`], [`render_frame_with_walls`], an [`RgbImage`]); [`encode`] ([`write_png`],
+//! [`GifWriter`]).
 //!
-//! The pipeline, one file per step:
-//!
-//! - [`camera`]: where the picture is taken from ([`View`], [`Projection`]), what it shows ([`Framing`]) and the
-//!   primary ray of every pixel ([`Camera`]);
-//! - [`raycast`]: exact ray–ellipsoid intersection and the depth-buffered, row-parallel renderer
-//!   ([`render_bodies`]);
-//! - [`colour`]: the perceptual colour map ([`ColourMap`]) and the mapping of one scalar per body to a colour
-//!   ([`ColourScale`], continuous or categorical);
-//! - [`walls`]: the run's walls as translucent polygons ([`WallPolygon`]) blended over the bodies;
-//! - [`overlay`]: the scale bar ([`ScaleBar`]) and the axis triad ([`Triad`]) on every frame;
-//! - [`frame`]: one finished frame ([`render_frame`], [`render_frame_with_walls`]): bodies coloured by a scale, walls,
-//!   a colour bar, a caption, a scale bar and an axis triad, as an [`RgbImage`];
-//! - [`encode`]: PNG files ([`write_png`]) and animated GIFs ([`GifWriter`]).
-//!
-//! Units: positions and semi-axes in metres, rotations body → world, image sizes in pixels.
-//!
-//! All parallel work goes through rayon's global API, so a caller can bound the threads by running inside
-//! `rayon::ThreadPoolBuilder::new().num_threads(n).build()?.install(|| …)`.
+//! Units: positions and semi-axes in metres, rotations body → world, image sizes in pixels. Parallel work uses
+//! rayon's global API, so a caller bounds the threads with `ThreadPoolBuilder::new().num_threads(n).build()?.install`.
 
 pub mod camera;
 pub mod colour;

@@ -1,28 +1,13 @@
-//! The data of Roig03 Fig. 2: energy partition (a) and conservation of linear and angular momentum (b) over a
-//! run, from the run's `timeseries.csv` (totals over all bodies) and `tracks.csv` (the projectile's own state
-//! at the same times).
+//! The data of Roig03 Fig. 2: energy partition (a) and momentum conservation (b) over a run, from `timeseries.csv`
+//! (totals) and `tracks.csv` (the projectile's state at the same times).
 //!
-//! Frame. Kinetic energies are taken relative to the barycentre of the *target* (all bodies but the
-//! projectile), as the ejection velocities of Fig. 3 are: with `P` the total momentum, `m_p`, `v_p` the
-//! projectile's mass and velocity and `M_T` the target mass, the target barycentre moves at
-//! `V_T = (P − m_p v_p)/M_T`, and
-//! * projectile: `K_p = ½ m_p |v_p − V_T|² + ½ ωᵀ I ω` (ω in body axes, `I` its principal moments);
-//! * fragments: `K_f = (K_trans − ½ m_p |v_p|²) − ½ M_T |V_T|² + (K_rot − ½ ωᵀ I ω)`, i.e. the totals of
-//!   `timeseries.csv` minus the projectile, moved to the target's frame.
-//!
-//! So the fragments' curve starts at the target's own spin energy (not at the energy of the whole system's
-//! drift), and the projectile's starts at `½ m_p |v_p − V_T|²`, the impact energy of the analysis summary.
-//! Energies are normalised by the projectile's `K_p` at the first time-series time (by the summary's
-//! projectile kinetic energy without tracks).
-//!
-//! Without `tracks.csv` (or without rows for the projectile) the projectile cannot be separated: panel (a)
-//! then shows the totals of all bodies in the system's barycentric frame, `K_trans − ½ |P|²/(M_T + m_p)` and
-//! `K_rot`, and says so.
-//!
-//! Momentum drift: `|P(t) − P(0)| / S_P` and `|L(t) − L(0)| / S_L` (L about the origin, as in
-//! `timeseries.csv`), with the scales of [`momentum_scales`]: `S_P = Σ m_i |v_i|` and
-//! `S_L = Σ (m_i |r_i × v_i| + |I_i ω_i|)` over all bodies at t = 0, the sizes of the sums whose round-off
-//! the drift measures.
+//! Kinetic energies are relative to the *target* barycentre (as Fig. 3's ejection velocities), moving at
+//! `V_T = (P − m_p v_p)/M_T`: projectile `K_p = ½ m_p |v_p − V_T|² + ½ ωᵀ I ω`; fragments
+//! `K_f = (K_trans − ½ m_p |v_p|²) − ½ M_T |V_T|² + (K_rot − ½ ωᵀ I ω)`, normalised by the first `K_p` (the summary's
+//! projectile energy without tracks). Without the projectile's tracks panel (a) shows the system totals,
+//! `K_trans − ½ |P|²/(M_T + m_p)` and `K_rot`, and says so. Momentum drift `|P(t) − P(0)| / S_P`,
+//! `|L(t) − L(0)| / S_L` (L about the origin) with [`momentum_scales`]: `S_P = Σ m_i |v_i|`,
+//! `S_L = Σ (m_i |r_i × v_i| + |I_i ω_i|)` at t = 0, the sizes of the sums whose round-off the drift measures.
 
 use std::path::Path;
 

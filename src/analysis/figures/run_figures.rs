@@ -1,24 +1,13 @@
-//! Figures of one impact run (Roig03 Figs. 2, 3, 4, 6, 8 and 9), written by `rubblepile analyze RUN_DIR` into
-//! `RUN_DIR/analysis/` as SVG and PNG:
+//! Figures of one impact run (Roig03 Figs. 2, 3, 4, 6, 8, 9), written by `rubblepile analyze RUN_DIR` into
+//! `RUN_DIR/analysis/` as SVG and PNG: `energy_partition` (Fig. 2), `velocity_field` (Fig. 3, with the escape
+//! circle), `ejection_vs_size` (Fig. 4, power-law fit, −3/2 reference), `spin_histogram` (Fig. 6, the n = 0.5 and
+//! n = 2 fits of Eq. 44), `spin_vs_size` (Fig. 8, −5/2 reference), `rotation_mode_vs_size` (Fig. 9, SAM/LAM) and
+//! `sfd` (clump mass distribution, [`super::sfd`]).
 //!
-//! | file stem | Roig03 | content |
-//! |---|---|---|
-//! | `energy_partition` | Fig. 2 | (a) projectile / fragment kinetic energies vs time; (b) momentum drift |
-//! | `velocity_field` | Fig. 3 | ejection velocities in the (v_x, v_y) and (v_y, v_z) planes, escape circle |
-//! | `ejection_vs_size` | Fig. 4 | ejection speed vs size, power-law fit, −3/2 reference, escape speed |
-//! | `spin_histogram` | Fig. 6 | histogram of corrected spin rates with the n = 0.5 and n = 2 fits of Eq. 44 |
-//! | `spin_vs_size` | Fig. 8 | corrected spin rate vs size, power-law fit, −5/2 reference |
-//! | `rotation_mode_vs_size` | Fig. 9 | SAM/LAM measure vs size |
-//! | `sfd` | — | cumulative mass distribution of the clumps, all and escaping ([`super::sfd`]) |
-//!
-//! Only target fragments are plotted (the projectile is excluded, as in every target quantity of
-//! [`crate::analysis::fragments`]). Sizes are the fragments' equivalent radii over the parent body's effective
-//! radius; spins are the §4.3-corrected ones.
-//!
-//! The dashed equipartition references of Figs. 4 and 8 (exponents −3/2 and −5/2) have no normalisation in the
-//! paper, which only says they bound the data from above. Here they pass through the fitted power law at the
-//! largest plotted fragment (through that fragment's own value when there is no fit), so the two lines meet at
-//! the large end and the gap at small sizes shows how much steeper equipartition is.
+//! Only target fragments are plotted ([`crate::analysis::fragments`]); sizes over the parent's effective radius,
+//! spins §4.3-corrected. The paper gives the equipartition references of Figs. 4 and 8 no normalisation (they
+//! bound the data from above); here they pass through the fit at the largest plotted fragment (through its value
+//! without a fit).
 
 use std::path::Path;
 

@@ -1,51 +1,17 @@
-//! Walls: the hard-sphere wall primitives and their times of impact, and ([`soft`]) the soft-sphere walls.
+//! Walls of infinite mass and prescribed motion ([`motion`]): the hard-sphere primitives with their times of impact
+//! (Richardson11 §2.2), and ([`soft`]) the soft-sphere walls, which need an overlap and normal ([`soft::Wall`]).
 //!
-//! The two engines meet walls differently, so the module holds two families: a hard sphere needs the *time* at which
-//! it first touches a wall (the primitives below, each with `nearest` and `toi`), a soft sphere needs the *overlap*
-//! and normal of a penalty contact at the current time ([`soft::Wall`]). Both give the wall infinite mass and a
-//! prescribed motion.
-//!
-//! Hard-sphere wall primitives and their times of impact (Richardson11 §2.2; the derivations are
-//! below, under "Derivations").
-//!
-//! Every primitive is axisymmetric about its wall axis and is described in a wall frame whose z axis is that axis
-//! and whose origin is the wall's reference point: [`plane`], [`disk`], [`cylinder`] (infinite or finite, open),
-//! [`ring`], [`point`], [`line`]. Each primitive module provides `nearest` (the distance from a sphere centre to the
-//! surface and the unit contact normal, pointing from the nearest surface point to the centre) and `toi` (the first
-//! time in `(0, t_max]` at which a sphere moving on a straight line relative to the wall first touches the surface
-//! from outside). [`Wall::time_of_impact`] wraps them: a sphere that already touches or overlaps the surface and
-//! approaches it collides at once (t = 0), so round-off never loses a collision and overlaps never grow.
-//!
-//! Walls have infinite mass and move as prescribed ([`motion`]).
-//!
-//! # Derivations
-//!
-//! The paper's displayed equations did not survive text extraction, so the forms used here were re-derived from the
-//! standard hard-sphere literature (Richardson 1994; Richardson et al. 2009, App. B) and checked against brute-force
-//! stepping of the distance function in `tests/hsdem_toi.rs`; "≈Eq. n" marks our best guess of the paper's numbering.
-//!
-//! **Particle–wall contact.** The unit normal `n̂` runs from the contact point to the sphere's centre, so the contact
-//! point sits at `R = −s n̂` from the centre of a sphere of radius `s`. The relative velocity there is
-//! `u = v + ω × R − v_wall`, where `v_wall` is the wall's own velocity at that point (translation, oscillation, spin).
-//!
-//! **Infinite plane (≈Eq. 9).** With the signed distance `ρ⊥ = (r − o)·n̂` and normal speed `v⊥ = (v − v_w)·n̂`, the
-//! upper face is reached at `t = (s − ρ⊥)/v⊥` when `v⊥ < 0` and the lower face at `t = (−s − ρ⊥)/v⊥` when `v⊥ > 0`;
-//! the wall's velocity is frozen within a step. **Finite disk**: a plane hit counts only inside the disk's radius,
-//! otherwise the rim is tried as a ring.
-//!
-//! **Cylinder (≈Eqs. 10–12).** Drop the axial components of position and velocity; a sphere reaches the surface when
-//! `v⊥² t² + 2(ρ⊥·v⊥) t + ρ⊥² − (R_c ∓ s)² = 0`. From inside (`|ρ⊥| < R_c`) the inner face `R_c − s` is always met
-//! unless `v⊥ = 0` (the positive root); from outside the outer face `R_c + s` only when `ρ⊥·v⊥ < 0` (the smaller
-//! positive root). A finite cylinder of length `L` accepts a side hit only if the axial coordinate at impact is within
-//! `L/2`; its ends are rings. Degenerate cylinders: `L = 0` is a ring, `R_c = 0` a line (no inner face), both a point.
-//!
-//! **Ring (≈Eqs. 13–21, 25).** A sphere of radius `s` touches a thin ring of radius `R` when its centre reaches the
-//! torus of tube radius `s` around the ring: in the ring's frame (z the axis; `P`, `D` the relative position and
-//! velocity) `(|p|² + R² − s²)² = 4R²(p_x² + p_y²)` along `p = P + D t` gives a quartic with `α = D·D`,
-//! `β = 2 P·D`, `γ = |P|² − s² − R²`: `a₄ = α²`, `a₃ = 2αβ`, `a₂ = β² + 2αγ + 4R²D_z²`, `a₁ = 2βγ + 8R²P_zD_z`,
-//! `a₀ = γ² + 4R²(P_z² − s²)`, whose smallest positive real root is the time of impact ([`roots`]). A ring of zero
-//! radius is a point (the sphere quadratic) and a sphere moving along the axis is handled apart. The contact normal
-//! runs from the nearest point of the ring to the centre.
+//! Each primitive ([`plane`], [`disk`], [`cylinder`], [`ring`], [`point`], [`line`]) is axisymmetric about its wall
+//! frame's z axis and has `nearest` (distance and unit normal from the surface to the centre) and `toi` (first touch
+//! from outside in `(0, t_max]` along a straight relative path); [`Wall::time_of_impact`] collides a touching,
+//! approaching sphere at t = 0, so round-off never loses a collision. The paper's equations did not survive text
+//! extraction: the forms are re-derived (Richardson 1994; Richardson et al. 2009, App. B; "≈Eq. n" guesses the
+//! paper's numbering) and checked by brute force in `tests/hsdem_toi.rs`. Contact: `n̂` from contact point to centre,
+//! `u = v + ω × (−s n̂) − v_wall`. Derivations: plane (≈Eq. 9) `t = (±s − ρ⊥)/v⊥`; disk, a plane hit inside `R`
+//! else the rim ring; cylinder (≈Eqs. 10–12) `v⊥² t² + 2(ρ⊥·v⊥) t + ρ⊥² − (R_c ∓ s)² = 0` in the axial-free
+//! components; ring (≈Eqs. 13–21, 25) the centre meets the torus `(|p|² + R² − s²)² = 4R²(p_x² + p_y²)`, along
+//! `p = P + D t` the quartic `a₄ = α²`, `a₃ = 2αβ`, `a₂ = β² + 2αγ + 4R²D_z²`, `a₁ = 2βγ + 8R²P_zD_z`,
+//! `a₀ = γ² + 4R²(P_z² − s²)` (`α = D·D`, `β = 2 P·D`, `γ = |P|² − s² − R²`), smallest positive root ([`roots`]).
 
 pub mod cylinder;
 pub mod disk;

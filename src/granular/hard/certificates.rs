@@ -1,21 +1,13 @@
-//! Pair certificates kept across steps: for each listed pair of free particles, a time before which the pair cannot
-//! touch, so that a drift start re-predicts only the pairs whose certificate has come due (Richardson11 §2.1 re-predicts
-//! every pair at every drift start because the kicks change every velocity).
+//! Pair certificates kept across steps: for each listed pair of free particles a time before which it cannot touch,
+//! so a drift start re-predicts only pairs whose certificate came due (Richardson11 §2.1 re-predicts every pair). A
+//! uniform kick adds the same `g h/2` to every free particle, so the relative trajectory stays one straight line
+//! until a collision, re-listing or sticking of either (the event calendar of event-driven MD: Lubachevsky 1991,
+//! J. Comput. Phys. 94, 255; Rapaport, *The Art of Molecular Dynamics Simulation*, ch. 14).
 //!
-//! Why a certificate survives the kicks: uniform gravity adds the same `g h/2` to the velocity of every free
-//! particle, so the relative velocity `v_i − v_j` of two free particles, and with it their relative trajectory, is
-//! not changed by a kick; only a collision of either particle (or its re-listing, or sticking to a wall) changes it.
-//! The relative trajectory is then one straight line across any number of kick–drift–kick steps, and a time computed
-//! from it at one moment stays valid at later drift starts (the event-calendar idea of event-driven molecular dynamics:
-//! Lubachevsky 1991, J. Comput. Phys. 94, 255; Rapaport, *The Art of Molecular Dynamics Simulation*, ch. 14).
-//!
-//! The stepper still computes every event it queues exactly as before, from the positions and velocities at the drift
-//! start: a certificate only decides which pairs need that prediction. So that it never skips a pair that the
-//! prediction would have queued, the certificate is the time at which the pair first comes within `s + m` (contact
-//! distance `s` plus a margin `m` that covers, many times over, the rounding by which the positions and velocities
-//! the stepper will use at a later drift start differ from the straight relative line), and it expires after
-//! [`HORIZON_STEPS`] steps however far apart the pair stays, which bounds that rounding. The runs' bits are therefore
-//! those of re-predicting every pair at every drift start (`tests/hsdem_certificates.rs`).
+//! A certificate only decides which pairs are predicted; events are still computed from the drift-start state. It is
+//! the time the pair first comes within `s + m` (contact distance plus a margin covering, many times over, the
+//! rounding between that straight line and later drift-start states) and expires after [`HORIZON_STEPS`] steps, so
+//! no pair is skipped and the bits equal re-predicting every pair every step (`tests/hsdem_certificates.rs`).
 
 use crate::math::Vec3;
 

@@ -1,19 +1,15 @@
-//! Collision resolution of rough spheres with normal and tangential restitution (Richardson11 §2.1, ≈Eqs. 4–8;
-//! [`crate::granular::hard`], "Collisions", "Particle–particle" and "Particle–wall").
+//! Collision resolution of rough spheres with normal and tangential restitution (Richardson11 §2.1, ≈Eqs. 4–8).
 //!
-//! Contact-point velocities decide: with n̂ from sphere 1 to sphere 2, `u = (v₂ + R₂ n̂×ω₂) − (v₁ + R₁ ω₁×n̂)`, and a
-//! collision acts only if `u·n̂ < 0`. The normal part of `u` is reversed and scaled by ε_n, the tangential part
-//! scaled by ε_t (1: smooth, 0: transverse motion killed, −1: reversed). With `μ = m₁m₂/M` and
-//! `β = 1/(1 + μ(R₁²/I₁ + R₂²/I₂))` the impulses are `p = (1+ε_n) u_n + β(1−ε_t) u_t` and
-//! `q = μβ(1−ε_t)(n̂ × u)`; momentum and angular momentum are conserved exactly (the impulses are equal and opposite
-//! and act at the contact point on the line of centres), and the energy change is the closed form of
-//! [`pair_energy_change`].
+//! With n̂ from sphere 1 to 2, the contact-point velocity `u = (v₂ + R₂ n̂×ω₂) − (v₁ + R₁ ω₁×n̂)` acts only if
+//! `u·n̂ < 0`. With `μ = m₁m₂/M` and `β = 1/(1 + μ(R₁²/I₁ + R₂²/I₂))` (2/7 for uniform spheres) the impulses are
+//! `p = (1+ε_n) u_n + β(1−ε_t) u_t`, `q = μβ(1−ε_t)(n̂ × u)`: `v₁ += (m₂/M) p`, `v₂ −= (m₁/M) p`, `ω₁ += (R₁/I₁) q`,
+//! `ω₂ += (R₂/I₂) q`; ε_n ∈ [0, 1], ε_t ∈ [−1, 1] (1 smooth, −1 reversed). Both momenta are conserved exactly; the
+//! energy change is [`pair_energy_change`]. Against a wall (infinite mass): `v −= (1 + ε_n) u_n + (2/7)(1 − ε_t) u_t`,
+//! `ω −= (5/7)(1 − ε_t)(R × u)/s²`; a wall's ε override the particle's, sticky walls hold, absorbing ones remove.
 //!
-//! The inelastic-collapse guard: a collision whose normal approach speed |u·n̂| is below `collapse_speed` is made
-//! elastic (ε_n = 1, ε_t = 1). Without it a pile at rest under gravity with ε_n < 1 makes ever faster sequences of
-//! ever smaller bounces (inelastic collapse, an infinite number of collisions in finite time) and the event loop
-//! never reaches the end of the step; with it the slowest contacts bounce elastically at speeds of order g·dt and the
-//! number of events per step stays bounded.
+//! Inelastic-collapse guard: a collision approaching slower than `collapse_speed` is made elastic, so a pile at rest
+//! under gravity bounces at speeds of order g·dt instead of making infinitely many ever smaller bounces in finite
+//! time, and the events per step stay bounded.
 
 use crate::math::Vec3;
 

@@ -1,25 +1,16 @@
-//! The hard-sphere stepper (Richardson11 §2.1; [`crate::granular::hard`], "Collisions", "Stepping").
+//! The hard-sphere stepper (Richardson11 §2.1): kick–drift–kick with uniform gravity in the half kicks; within the
+//! drift of length h every particle's earliest events against neighbours and walls are queued ([`super::events`]),
+//! the globally earliest processed and only its particles re-predicted, until the step ends.
 //!
-//! One step of length h is kick–drift–kick: half a kick of uniform gravity, a drift of length h in which particles
-//! move on straight lines and collide, half a kick. Within the drift every particle's earliest events against its
-//! neighbours and the walls are predicted and queued ([`super::events`]); the globally earliest is processed, only the
-//! particles involved are re-predicted, and so on until the step ends.
-//!
-//! Neighbours (a Verlet list with per-particle skins): particle k has an anchor a_k (its position when last listed)
-//! and a travel allowance L_k; the candidate pairs are those with `|a_i − a_j| < R_i + R_j + L_i + L_j`
-//! ([`crate::geometry::neighbours::sphere_pairs`]), and a near wall is one within `R_k + L_k` of the anchor. A particle
-//! that could leave its allowance (checked at each drift start and after each of its collisions) is re-listed alone
-//! against the other anchors ([`super::anchors`]); when more than half fail at once the whole list is rebuilt. So no
-//! collision is ever missed. `L_k = max(min(skin_steps · |v_k| · h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))`
-//! (at least 1e-3 of the smallest radius); `skin_steps = 0` gives one allowance `2 v_max h` for all and a fresh list
-//! at every step, the reference of `tests/hsdem_neighbours.rs`.
-//!
-//! Every wall contact is predicted afresh at each drift start; a pair of free particles keeps a certificate across
-//! steps ([`super::certificates`]), since a uniform kick changes no relative velocity. Events are always computed from
-//! the state at the drift start or the collision, so the certificates change no bit (`tests/hsdem_certificates.rs`).
-//!
-//! A pair or wall contact that touches or overlaps and approaches collides at once: no overlap is ever integrated.
-//! Particles stuck to a sticky wall move rigidly with it and act as infinite masses.
+//! Neighbours: a Verlet list with per-particle skins. Particle k has an anchor `a_k` and allowance `L_k`; candidates
+//! have `|a_i − a_j| < R_i + R_j + L_i + L_j` ([`crate::geometry::neighbours::sphere_pairs`]), near walls lie within
+//! `R_k + L_k`. A particle that could leave its allowance (checked at each drift start and after each of its
+//! collisions) is re-listed alone ([`super::anchors`]; more than half at once: a full rebuild), so no collision is
+//! missed. `L_k = max(min(skin_steps · |v_k| h + ½ |g| (skin_steps · h)², R_k), |v_k| (t1 − t))`, ≥ 1e-3 of the
+//! smallest radius; `skin_steps = 0` is the per-step reference of `tests/hsdem_neighbours.rs`. Wall contacts are
+//! re-predicted each drift start, free pairs keep certificates ([`super::certificates`]) and change no bit
+//! (`tests/hsdem_certificates.rs`). Touching, approaching contacts collide at once: no overlap is integrated.
+//! Particles stuck to a sticky wall move rigidly with it as infinite masses.
 
 use super::anchors::{AnchorGrid, Entry};
 use super::certificates::{self, Calendar, Due};

@@ -1,20 +1,11 @@
-//! Choosing `k_N` and the step (Zhang17 §2.3.3: "k_N and the time step are chosen so that no overlap exceeds
-//! 1 % of the smallest radius"; the recipe is that of Schwartz et al. 2012, §2.6).
-//!
-//! - A collision at speed `v` of a sphere of mass `m` on a wall (the worst case, reduced mass `m`) overlaps by
-//!   `x = v √(m/k_N)`, so `k_N ≥ m v² / x_max²` with `x_max = f r_min` (f = 1 % by default), `m` the largest
-//!   particle mass and `v` the largest expected speed: the given speed, or the body's escape speed
-//!   `R √(8πGρ/3)` and its equatorial spin speed `2πR/T`, whichever is larger.
-//! - A static load `F` overlaps by `F/k_N`: for a self-gravitating body the central pressure of a uniform
-//!   sphere `p_c = 2π/3 G ρ² R²` acting on a particle's cross-section `4 r²` asks `k_N ≥ 4 r² p_c / x_max`.
-//! - The step resolves the shortest contact, `T_c = π √(μ_min/k_N)` with `μ_min = m_min/2`, in 50 steps:
-//!   `dt = T_c/50`. Leapfrog is unstable for a spring of that frequency above `dt = 2 √(μ_min/k_N)`, the
-//!   stability limit reported (and enforced by the scene check).
-//! - Self-gravity every `k` steps (r-RESPA, `soft::respa`): the body's dynamical time
-//!   `t_dyn = 1/√(Gρ)` (ρ the bulk density) must hold at least 100 gravity blocks, `k dt ≤ t_dyn/100`, and a
-//!   block must stay well below half a contact oscillation, where the impulse method resonates:
-//!   `k dt ≤ T_c/5`. So `k = max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`: 10 at the advised step
-//!   (`dt = T_c/50`) for any body of asteroid density, where `t_dyn` is hours and the contact rule binds.
+//! Choosing `k_N` and the step (Zhang17 §2.3.3: no overlap above 1 % of the smallest radius; the recipe of Schwartz
+//! et al. 2012, §2.6). Dynamic: a sphere hitting a wall at `v` overlaps `v √(m/k_N)`, so `k_N ≥ m v² / x_max²`,
+//! `x_max = f r_min`, `m` the largest mass, `v` the given speed or the larger of `R √(8πGρ/3)` and `2πR/T`. Static:
+//! `k_N ≥ 4 r² p_c / x_max` with the uniform sphere's central pressure `p_c = 2π/3 G ρ² R²`. Step: `dt = T_c/50`,
+//! `T_c = π √(μ_min/k_N)`, `μ_min = m_min/2`; leapfrog's limit `2 √(μ_min/k_N)` is reported (and enforced by the scene
+//! check). Gravity interval (r-RESPA, `soft::respa`): `k = max(1, min(⌊t_dyn/(100 dt)⌋, ⌊T_c/(5 dt)⌋))`,
+//! `t_dyn = 1/√(Gρ)` (≥ 100 blocks per dynamical time, blocks well below half a contact oscillation, where the
+//! impulse method resonates); 10 at the advised step for asteroid densities.
 
 use crate::io::scene_file::SI_G;
 use serde::Serialize;

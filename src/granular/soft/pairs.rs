@@ -1,29 +1,14 @@
-//! The pair contacts of a force evaluation (Zhang17 Eq. 1: the forces and torques of every touching pair by the
-//! contact law of Eqs. 1–12): a Verlet list in compressed rows, the pair spring histories beside it, and the
-//! evaluation, on one thread or many, with the same bits.
+//! The pair contacts of a force evaluation (Zhang17 Eq. 1, the contact law of Eqs. 1–12): a Verlet list in compressed
+//! rows with the pair spring histories beside it, evaluated on one thread or many with the same bits.
 //!
-//! **List.** The candidate pairs `(i, j)`, `i < j`, closer than the sum of their radii plus a skin, come from the
-//! cell grid of [`crate::geometry::neighbours`]; the list is rebuilt (in parallel) when a sphere has moved more
-//! than half the skin since the last build. Row `i` holds the partners `j > i`, ascending, and every entry a spring
-//! slot (empty: the pair did not touch at the last evaluation). On a rebuild the springs of touching pairs are
-//! carried over row by row: every touching pair is in the new list.
-//!
-//! **Order of the sums.** The rows are cut into blocks of [`ROWS_PER_BLOCK`] spheres. Sphere `p`'s contact force
-//! and torque are summed in one fixed order: first the pairs `(k, p)` with `k` in `p`'s own block, ascending `k`,
-//! then its own row (partners `j > p`, ascending `j`), then the pairs `(k, p)` of earlier blocks, block by block
-//! from the nearest to the first, each block's ascending `k`. On one thread the blocks are evaluated from the last
-//! to the first, each block's rows in ascending order, and each pair is added to both spheres as it is evaluated,
-//! which gives that order. On several threads the blocks are evaluated in parallel, each the same way except that
-//! a pair whose partner lies beyond the block stores the partner's share (force and torque on `j`); a pass over
-//! the spheres then adds the stored shares in the order above. The forces therefore depend neither on the number
-//! of threads nor on when the list was rebuilt (pairs that do not touch add nothing: a stored zero share leaves a
-//! sum unchanged, as a running sum that starts at +0 is never −0). No per-thread force arrays are reduced and
-//! nothing is summed serially over the pairs; only pairs that cross a block store anything (48 bytes), and on
-//! one thread nothing is stored at all. Rows are walked forward in memory within a block, so that the hardware
-//! prefetch follows.
-//!
-//! The scalar sums of an evaluation (spring energy, dissipation) are summed per block of rows, in row order, and
-//! the blocks' totals in block order: the same on any number of threads.
+//! List: candidate pairs `i < j` within the radii sum plus a skin from [`crate::geometry::neighbours`], rebuilt (in
+//! parallel) when a sphere moved more than half the skin; row `i` holds partners `j > i` ascending, each with a spring
+//! slot, and touching pairs' springs carry over a rebuild. Order: rows are cut into blocks of [`ROWS_PER_BLOCK`];
+//! sphere `p` sums its own block's pairs `(k, p)`, then its row, then earlier blocks from the nearest back, each by
+//! ascending index. Serially (blocks last to first) each pair is added to both spheres as evaluated; in parallel,
+//! pairs crossing a block store the partner's share (48 bytes) and a pass adds the shares in that order. So the
+//! forces depend neither on the thread count nor on when the list was rebuilt (a non-touching pair adds +0). Scalar
+//! sums (spring energy, dissipation) go per block in row order, then over blocks in order.
 
 use crate::geometry::neighbours::sphere_pair_rows;
 use crate::granular::soft::contact::{Kinematics, Law, Output, Springs, evaluate_inner};

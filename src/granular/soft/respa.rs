@@ -1,21 +1,14 @@
-//! Multiple time stepping for self-gravity: the impulse method / r-RESPA (Tuckerman, Berne & Martyna 1992,
-//! J. Chem. Phys. 97, 1990; Zhang17 §2.1 integrates all forces with one leapfrog step, this splits them).
-//!
-//! Self-gravity changes on the body's dynamical time `1/√(Gρ)`, the contacts on the contact time; so the
-//! slow force (self-gravity) is evaluated once per block of `k` steps and applied as two kicks of `k dt/2`,
-//! one at each end of the block, around `k` ordinary kick–drift–kick steps with the fast forces (contacts and
-//! the uniform field):
-//!
+//! Multiple time stepping for self-gravity: the impulse method / r-RESPA (Tuckerman, Berne & Martyna 1992, J. Chem.
+//! Phys. 97, 1990; Zhang17 §2.1 uses one leapfrog step for all forces, this splits them). Self-gravity changes on
+//! `1/√(Gρ)`, contacts on the contact time, so gravity is evaluated once per block of `k` steps:
 //! `v += a_slow k dt/2`, then `k` × (`v += F/m dt/2; x += v dt; F(x); v += F/m dt/2`), then `a_slow(x)`,
 //! `v += a_slow k dt/2`.
 //!
-//! Each block is a composition of symplectic, time-reversible maps in a symmetric order, so it stays
-//! symplectic and time-reversible; every kick and drift conserves total linear and angular momentum up to
-//! rounding when the slow forces are pairwise equal and opposite (direct summation). With `k = 1` the
-//! forces are summed together as before. The resonance of the impulse method (`k dt` near a multiple of half
-//! a fast period) is kept away by [`crate::granular::soft::advise::gravity_interval`]. Mid-block, the
-//! velocities already carry the opening kick and the gravitational energy is that of the block's start, so
-//! energies are exact only at block ends (`SoftSystem::gravity_phase == 0`).
+//! A symmetric composition of symplectic, time-reversible maps, so a block is both; momenta are conserved to rounding
+//! when the slow forces are pairwise (direct summation); `k = 1` is plain leapfrog. The impulse method's resonance
+//! (`k dt` near a multiple of half a fast period) is avoided by [`crate::granular::soft::advise::gravity_interval`].
+//! Mid-block the velocities carry the opening kick and the gravitational energy is the block start's, so energies
+//! are exact only at block ends (`SoftSystem::gravity_phase == 0`).
 
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::ordered_sum::ordered_sum;

@@ -1,27 +1,15 @@
-//! The soft-sphere engine as the run driver (`driver`) sees it (`rubblepile run` on a `kind = "soft-spheres"`
-//! scene): the output contract of the crate adapted to spheres.
+//! The soft-sphere engine as the run driver sees it (`rubblepile run`, `kind = "soft-spheres"`). Outputs: `scene.toml`;
+//! `timeseries.csv` (flushed per row; columns `t,step,kinetic_energy,gravitational_energy,spring_energy,
+//! dissipated_energy,wall_work,energy_residual,momentum_error,angular_momentum_error,max_overlap_fraction,contacts,
+//! coordination_number,forcing_work,wall_seconds`); `snapshots/<k>.csv` (`t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz`,
+//! usable as a `particles_file`); `summary.json` ([`SoftSummary`]); `last_good_state.csv`, `checkpoint.json`; and
+//! with `[spinup]`, `spinup.csv` (the forcing acts after every step).
 //!
-//! Files in the output directory:
-//! - `scene.toml`: the scene text;
-//! - `timeseries.csv` (flushed per row), every `output.every` (whole steps) and at each snapshot:
-//!   `t,step,kinetic_energy,gravitational_energy,spring_energy,dissipated_energy,wall_work,energy_residual,
-//!   momentum_error,angular_momentum_error,max_overlap_fraction,contacts,coordination_number,forcing_work,
-//!   wall_seconds`;
-//!   `energy_residual = (E + W_dissipated − W_walls − W_forcing − E₀)/S` with `E` kinetic + gravitational + spring
-//!   energy and `S = KE₀ + |U₀| + spring₀` (1 J if zero); momenta errors are `|P − P₀|/Σ m|v|₀` and
-//!   `|L − ΔL_forcing − L₀|/Σ(|x × m v| + I|ω|)₀` (scale 1 if zero); `W_forcing` and `ΔL_forcing` are the work
-//!   and angular momentum given by the spin-up forcing (0 without `[spinup]`), so that the residuals measure the
-//!   integration error in spin-up runs too; `max_overlap_fraction` is the largest contact overlap over the smaller
-//!   radius of the contact at that step;
-//! - `snapshots/<k>.csv`: `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (usable as a `particles_file`);
-//! - `summary.json` ([`SoftSummary`]), `last_good_state.csv` on failure, `checkpoint.json` when due;
-//! - with a `[spinup]` table: `spinup.csv`, one row of `analysis::spinup_diagnostics` per time-series
-//!   row; the forcing (`granular::soft::spinup`) acts after every step.
-//!
-//! Checkpoints hold every particle's state, the last forces and torques (leapfrog needs them), the spring
-//! histories and the bookkeeping, all as exact f64 bit patterns, so `rubblepile resume` continues bit for bit.
-//! A non-finite state or an overlap above half the smaller radius stops the run with the last good state
-//! saved and the cause named.
+//! `energy_residual = (E + W_dissipated − W_walls − W_forcing − E₀)/S`, `E` kinetic + gravitational + spring,
+//! `S = KE₀ + |U₀| + spring₀` (1 J if zero); `|P − P₀|/Σ m|v|₀`, `|L − ΔL_forcing − L₀|/Σ(|x × m v| + I|ω|)₀`, so the
+//! residuals measure integration error in spin-up runs too. Checkpoints hold exact f64 bits of the particles, the
+//! last forces and torques, the springs and the bookkeeping: `resume` continues bit for bit. A non-finite state or an
+//! overlap above half the smaller radius stops the run, saving the last good state and naming the cause.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};

@@ -1,53 +1,16 @@
-//! Quasi-static spin-up of a soft-sphere rubble pile (Zhang17 §2.3.4, Fig. 3 and Table 5): the scene table
-//! `[spinup]`, the spin-period path `T(t)`, the angular-momentum forcing of the central body, and its release
-//! once global disruption is confirmed.
+//! Quasi-static spin-up of a soft-sphere rubble pile (Zhang17 §2.3.4, Fig. 3, Table 5): the scene table
+//! `[spinup]` ([`SpinupSection`]: periods in hours, times in seconds), the period path `T(t)`, the forcing of the
+//! central body and its release once global disruption is confirmed.
 //!
-//! ```toml
-//! [spinup]                     # Zhang17 Table 5, path 2; periods in hours, times in seconds
-//! T_start = 5.0                # h, period held while the body settles, 0 ≤ t ≤ t_start
-//! T_inter = 3.0                # h, reached linearly at t_inter
-//! T_final = 2.26               # h, reached at t_final, then held until the end of the run (creep tests)
-//! t_start = 700.0              # s
-//! t_inter = 7000.0             # s
-//! t_final = 32000.0            # s
-//! rests = 0                    # rest stages inserted in the slow phase (path 1: 5)
-//! rest_length = 0.0            # s, length of each rest (path 1: 7000)
-//! axis = [0.0, 0.0, 1.0]       # spin axis, fixed in space (normalised); default z
-//! target = "period"            # what the forcing holds on the path: "period" (default) or "angular_momentum"
-//! release_axis_ratio = 0.1     # disruption: |Δ(b/a)| or |Δ(c/a)| above this ...
-//! release_packing = 0.01       # ... or |Δη_B| above this (both from the values at t_start) ...
-//! release_samples = 2          # ... at this many consecutive output samples: forcing released
-//! rve_particles = 300          # target particles per representative volume element (stress diagnostics)
-//! interior_depth = 170.0       # m, optional: η_B over particles this deep below the surface layer ...
-//! interior_ramp = 170.0        # m, ... with weights rising from 0 to 1 over this further depth (default: depth)
-//! ```
-//!
-//! **The path.** `T = T_start` until `t_start` (the body settles at a slow spin); then linear in `T` (as the paper
-//! says, "linearly spun up") to `T_inter` at `t_inter`; then from `T_inter` to `T_final` at `t_final` in
-//! `rests + 1` equal spin-up stages, each linear in `T` and separated by `rests` rests of `rest_length` during which
-//! `T` is held (Fig. 3); after `t_final`, `T = T_final` (the hold of the creep tests, as long as the run lasts).
-//!
-//! **The central body** is the largest (by mass) set of particles connected through contacts at the current step.
-//! Shed or orbiting particles have no contact with it and are not forced; a particle in flight for a few steps
-//! after a bounce is also left alone for those steps, which carries no bias since it keeps its momentum.
-//!
-//! **The forcing** acts by angular-momentum increments (the authors' "angular-momentum spin-up"): after each step
-//! the body's angular momentum `L` about its centre of mass along `axis` is set to a target `L*` by adding the
-//! difference `ΔL = L* − L` as a rigid-rotation increment `Δω = ΔL/I` about the body's current centre of mass (`I`
-//! its current moment of inertia about the axis through it): `v_i += Δω a × (x_i − R)`, `ω_i += Δω a` for every
-//! member. This conserves the body's linear momentum and changes its angular momentum along `a` by exactly `ΔL`;
-//! the work and angular momentum it adds are booked in the run's residuals. The target (`target` in the table):
-//! - `"period"` (default): `L* = I Ω(t)`, `Ω = 2π/T(t)`, so that the body's rotation period `2π I/L` is the path's
-//!   after every step — Zhang17 §2.3.4: the period "is strictly constrained to the spin-up path" until global
-//!   disruption; a body that expands is given the angular momentum that keeps it on the path;
-//! - `"angular_momentum"`: `L* = I_ref Ω(t)` with `I_ref` the moment of inertia of the current members *as they were
-//!   placed at t = 0* (about the initial centre of mass): a body that expands spins slower than the path instead of
-//!   being given more angular momentum, and losing members lowers the target in proportion.
-//!
-//! **Release** ("global disruption confirmed", Zhang17 §2.3.4 footnote 6: the packing efficiency and the axis
-//! ratios drop rapidly): at output samples the driver compares b/a, c/a and η_B with their values at the first
-//! sample at or after `t_start`; when a change exceeds ten times the T_c,1 / T_c,2 thresholds (defaults) at
-//! `release_samples` consecutive samples, the forcing stops for good and the body evolves freely.
+//! Path ([`SpinupPath`]): `T = T_start` until `t_start`, linear in `T` to `T_inter` at `t_inter`, then to `T_final`
+//! at `t_final` in `rests + 1` linear stages separated by rests of `rest_length` (Fig. 3), then held. The central
+//! body is the heaviest contact-connected set of particles ([`central_body`]). After each step its angular momentum
+//! `L` along `axis` is set to `L*` by a rigid-rotation increment about its centre of mass, `Δω = (L* − L)/I`:
+//! `v_i += Δω a × (x_i − R)`, `ω_i += Δω a` (linear momentum kept; the work is booked in the residuals). `L* = I Ω(t)`
+//! for `target = "period"` (the period "is strictly constrained to the spin-up path", §2.3.4), `L* = I_ref Ω(t)`
+//! with `I_ref` of the members as placed at t = 0 for `"angular_momentum"` (an expanding body spins down).
+//! Release (§2.3.4 footnote 6): when b/a, c/a or η_B moves from its value at `t_start` by more than
+//! `release_axis_ratio` / `release_packing` at `release_samples` consecutive outputs, the forcing stops for good.
 
 use serde::{Deserialize, Serialize};
 

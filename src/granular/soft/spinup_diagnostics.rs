@@ -1,41 +1,16 @@
-//! Run-time diagnostics of a spin-up run (Zhang17 §3, Fig. 5), one row of `spinup.csv` per output sample:
-//! spin period, b/a and c/a (§3.1), the interior packing fraction η_B (§3.2, Eqs. 13–14), coordination number
-//! and the fractions of particles with 0 and 1 contacts, and the stresses of representative volume elements
-//! (RVEs, §3.3.1, Eqs. 15–16) reduced to s_max, p_max and θ_max (Eqs. 20–21).
+//! Run-time diagnostics of a spin-up run (Zhang17 §3, Fig. 5), one row of `spinup.csv` per output sample: spin
+//! period, b/a, c/a (§3.1), interior packing fraction η_B (§3.2, Eqs. 13–14), coordination numbers, the fractions
+//! with 0 and 1 contacts, and RVE stresses (§3.3.1, Eqs. 15–16) reduced to s_max, p_max, θ_max (Eqs. 20–21).
 //!
-//! **Packing fraction.** The Voronoi cells come from [`crate::geometry::voronoi`], each started as a cube of
-//! half-side twice the largest diameter. Like the paper, we keep only interior particles, because cells cut by the
-//! boundary measure the boundary, not the packing. A cell that reaches the sphere inscribed in its starting cube
-//! ([`VoronoiCell::reaches`]; a sphere, so that the test does not turn with the body) is open to the outside (the
-//! outermost layer, or a shed particle) and is excluded; so is every particle within 10 % of the sum of the radii
-//! from the surface of such a particle (a proximity test rather than the contact list, so that a contact opening for
-//! a step does not let a second-layer cell flicker in), because where the surface layer has gaps the second layer's
-//! cells are closed only by distant bisectors and measure the gaps; and so is every particle outside the central
-//! body. η_B is the ratio of the summed sphere volumes to the summed cell volumes over the rest (the volume-weighted
-//! form of Eq. 14, which does not let a few small cells dominate): the default rule, [`InteriorRule::Layers`]. For
-//! unequal spheres it flickers as one large sphere enters or leaves the set; the depth rule ([`InteriorRule::Depth`],
-//! `[spinup] interior_depth`) weights every closed cell by its depth below the surface layer instead (distance to the
-//! nearest centre with an open cell; the weight ramps linearly from 0 to 1), so that η_B is a continuous function of
-//! the positions as long as the set of open cells holds.
-//!
-//! **RVEs.** The central body's particles are split by a binary tree: a set larger than 4/3 × `rve_particles`
-//! is cut at the median of its longest extent, so every RVE holds between 2/3 and 4/3 of the target and RVEs are
-//! of similar size (an octree's surface octants would be partly empty). Eq. 16's RVE volume is the sum of its
-//! particles' volumes `V_i`: the Voronoi cell for a closed cell, `(4/3)π r³/η_B` (the mean interior cell of that
-//! sphere size) for an open one, whose cell measures only the starting cube. Contacts with walls carry no branch
-//! vector here and are left out of the stresses (spin-up scenes have no walls).
-//!
-//! **Coordination number.** `coordination_number` counts every touching pair of the force evaluation, however
-//! little it carries; `coordination_loaded` counts only contacts whose normal force is at least
-//! [`CONTACT_FORCE_FLOOR`] times the mean normal force of all sphere contacts of that evaluation. A contact at a
-//! grazing overlap opens and closes from step to step as the pile breathes and moves the raw count by a few
-//! hundredths of a contact per particle at a sample; the floor leaves out those that carry under 1 % of the mean
-//! (in a self-gravitating pile the outermost layer's contacts carry a few tenths of the mean, so they stay counted).
-//! The creep test judges `coordination_loaded` where a run has it.
-//!
-//! **Reductions.** `s_max` is the largest deviatoric stress `(σ₁ − σ₃)/2`, `p_max` the largest compressive
-//! pressure `−(σ₁ + σ₂ + σ₃)/3` (reported positive, Pa), `θ_max` the largest mobilized friction angle (degrees)
-//! over the RVEs.
+//! η_B (interior particles only, as in the paper): Voronoi cells ([`crate::geometry::voronoi`]) start as cubes of
+//! half-side twice the largest diameter; a cell reaching the inscribed sphere ([`VoronoiCell::reaches`]) is open and
+//! excluded, as is every particle within 10 % of the radii sum of an open one (the gapped second layer) and every
+//! particle outside the central body. [`InteriorRule::Layers`]: `Σ V_sphere / Σ V_cell` (volume-weighted Eq. 14);
+//! [`InteriorRule::Depth`] weights cells by depth below the surface layer, so η_B is continuous in the positions.
+//! RVEs: median cuts of the longest extent until each holds 2/3–4/3 of `rve_particles`; Eq. 16's volume sums cell
+//! volumes, `(4/3)π r³/η_B` for open cells; wall contacts are left out. `coordination_loaded` counts contacts above
+//! [`CONTACT_FORCE_FLOOR`] × the mean normal force (grazing contacts flicker; the creep test judges this one).
+//! `s_max = max (σ₁ − σ₃)/2`, `p_max = max −(σ₁ + σ₂ + σ₃)/3` (Pa, positive), `θ_max` in degrees.
 
 use std::path::Path;
 

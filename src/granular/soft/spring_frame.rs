@@ -1,20 +1,13 @@
-//! Carrying spring histories along with the contact frame (Zhang17 §2.2.1–2.2.2: "we account for this motion
-//! at every step by transforming δ_T according to the change in n̂"; our notes, "Springs follow the contact
-//! frame").
+//! Carrying spring histories along with the contact frame (Zhang17 §2.2.1–2.2.2: "transforming δ_T according to the
+//! change in n̂"). Each step the tangential and rolling springs turn by the shortest-arc swing from the old normal to
+//! the new, then about the new normal by the pair's mean spin about the mean normal times the step (twist); lengths
+//! are kept and a rounding residue along the normal is projected out. A rigidly co-rotating pair's springs stay fixed
+//! in its frame to second order (`tests/ssdem_spring_frame.rs`).
 //!
-//! Each step, the tangential and rolling springs are rotated in two parts: first by the rotation that takes
-//! the old normal to the new one along the shortest arc (the swing), then about the new normal by the mean
-//! spin of the pair about the mean normal times the step (the twist). Both are rotations, so spring lengths
-//! are unchanged; what is left of a normal component from rounding is then projected out. For a pair that
-//! co-rotates rigidly the composition equals the pair's rotation to second order in the step, so the springs
-//! stay fixed in the pair's frame (tested in `tests/ssdem_spring_frame.rs`).
-//!
-//! This runs once per contact and step, so it avoids trigonometry: the swing is Rodrigues' formula written
-//! with `a = n_old × n_new` and `c = n_old · n_new` only, `R v = c v + a × v + a (a·v)/(1 + c)` (exact, since
-//! `|a|² = (1 − c)(1 + c)`), and the twist angle, a few milliradians at most in a sensible run, takes its sine
-//! and cosine from their Taylor series (to the ninth and eighth power: below 2⁻⁵ rad the first omitted term
-//! is under 10⁻¹⁸ of the angle). Nearly antiparallel normals, which never occur in one step of a real
-//! contact, fall back to an explicit axis–angle rotation.
+//! No trigonometry (once per contact and step): the swing is Rodrigues' `R v = c v + a × v + a (a·v)/(1 + c)` with
+//! `a = n_old × n_new`, `c = n_old · n_new` (exact, `|a|² = (1 − c)(1 + c)`); the twist's sine and cosine are Taylor
+//! series to the 9th and 8th power (below 2⁻⁵ rad the first omitted term is under 10⁻¹⁸ of the angle). Nearly
+//! antiparallel normals fall back to an explicit axis–angle rotation.
 
 use crate::math::Vec3;
 use nalgebra::{Rotation3, Unit};

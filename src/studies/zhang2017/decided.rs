@@ -367,7 +367,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     let searches = read_decided(dir);
     let hold = decided_hold_length(&searches);
     let (rho, volume) = paper_bulk_density();
-    let _ = writeln!(md, "\n## Decided at the paper's scale (issue 55)\n");
+    let _ = writeln!(md, "\n## Decided at the paper's scale\n");
     let _ = writeln!(
         md,
         "From the compact copies under `{}` (`src/studies/zhang2017/decided.rs`; commands in \
