@@ -415,6 +415,11 @@ impl EllipsoidEngine {
         &self.scene.warnings
     }
 
+    /// The bodies now: shapes, positions (m), velocities (m/s), attitude quaternions and body-frame spins (rad/s).
+    pub fn bodies(&self) -> Vec<crate::ellipsoid::body::Body> {
+        self.system.bodies_at(self.t, &self.y)
+    }
+
     /// What the scene resolves to, for `rubblepile check` (κ, physics terms, integrator, outputs, bodies).
     pub fn describe(&self) -> Vec<String> {
         let s = &self.scene;
