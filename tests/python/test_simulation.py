@@ -183,3 +183,50 @@ def test_ctrl_c_leaves_a_checkpoint_that_resumes(tmp_path):
     for name in a:
         if name != "summary.json":
             assert a[name] == b[name], name
+
+
+def test_state_set_saved_and_read_back(tmp_path):
+    sim = rubblepile.Simulation.from_scene(SCENES["ellipsoids"])
+    sim.integrate(20.0)
+    st = sim.state()
+    pos = st["positions"] + np.array([[0.0, 0.0, 0.0], [1.0, 0.25, -0.5]])
+    vel = st["velocities"] * 0.5
+    q = np.array([[0.0, 0.0, 0.0, 1.0], [0.0, 0.6, 0.0, 0.8]])
+    w = np.array([[0.0, 0.0, 0.01], [0.02, 0.0, 0.0]])
+    sim.set_state(positions=pos, velocities=vel, quaternions=q, angular_velocities=w)
+    now = sim.state()
+    np.testing.assert_array_equal(now["positions"], pos)
+    np.testing.assert_allclose(now["velocities"], vel, rtol=1e-15, atol=0)
+    np.testing.assert_allclose(now["quaternions"], q, rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(now["angular_velocities"], w, rtol=1e-12, atol=1e-15)
+    sim.positions = pos  # the property setters
+    np.testing.assert_array_equal(sim.positions, pos)
+    now = sim.state()
+    sim.save(tmp_path / "saved")
+    sim.close()
+    back = rubblepile.Simulation.from_run(tmp_path / "saved")
+    assert back.t == 20.0
+    again = back.state()
+    for name in ["positions", "velocities", "quaternions", "angular_velocities", "masses", "semi_axes"]:
+        np.testing.assert_array_equal(again[name], now[name], err_msg=name)
+    back.integrate()  # continues from the changed state
+    assert back.done
+    back.close()
+    # The CLI reads the directory the saved run finished.
+    r = run_cli("check", str(tmp_path / "saved"))
+    assert r.returncode == 0, r.stdout + r.stderr
+
+
+def test_state_writes_are_checked():
+    sim = rubblepile.Simulation.from_scene(SCENES["ellipsoids"])
+    sim.step()
+    with pytest.raises(rubblepile.SceneError, match=r"positions: expected shape \(2, 3\)"):
+        sim.set_state(positions=np.zeros((3, 3)))
+    with pytest.raises(rubblepile.SceneError, match="non-finite"):
+        sim.set_state(velocities=np.full((2, 3), np.nan))
+    with pytest.raises(rubblepile.SceneError, match="masses: not a writable"):
+        sim.set_state(masses=np.ones((2, 1)))
+    spheres = rubblepile.Simulation.from_scene(SCENES["soft-spheres"])
+    spheres.step()
+    with pytest.raises(rubblepile.SceneError, match="soft-spheres"):
+        spheres.set_state(positions=np.zeros((1, 3)))

@@ -691,6 +691,81 @@ impl Simulation {
         Ok(d)
     }
 
+    /// Sets the state of an ellipsoid run between samples (see `rubblepile.Simulation.set_state`): `state` maps
+    /// `positions`, `velocities`, `angular_velocities` (world frame) or `spins_body`, `quaternions` to float64
+    /// arrays of one row per body.
+    fn _set_state(&self, py: Python<'_>, state: &Bound<'_, PyDict>) -> PyResult<()> {
+        let mut arrays: Vec<(String, Array2<f64>)> = Vec::new();
+        for (k, v) in state.iter() {
+            let name: String = k.extract()?;
+            let a: numpy::PyReadonlyArray2<'_, f64> = v
+                .extract()
+                .map_err(|_| PyValueError::new_err(format!("{name}: expected a 2-D float64 array")))?;
+            arrays.push((name, a.as_array().to_owned()));
+        }
+        self.read(py, |any| {
+            let Any::Ellipsoids(s) = any else {
+                return Err(Failure::scene(format!(
+                    "the state of a {} run cannot be set (only that of an ellipsoid run)",
+                    any.kind()
+                )));
+            };
+            let mut bodies = s.engine().bodies();
+            let n = bodies.len();
+            let mut world_spin: Option<Array2<f64>> = None;
+            const WRITABLE: [&str; 5] = [
+                "positions",
+                "velocities",
+                "quaternions",
+                "angular_velocities",
+                "spins_body",
+            ];
+            if let Some((other, _)) = arrays.iter().find(|(k, _)| !WRITABLE.contains(&k.as_str())) {
+                return Err(Failure::scene(format!(
+                    "{other}: not a writable state array ({})",
+                    WRITABLE.join(", ")
+                )));
+            }
+            for (name, a) in &arrays {
+                let width = if name == "quaternions" { 4 } else { 3 };
+                if a.dim() != (n, width) {
+                    return Err(Failure::scene(format!(
+                        "{name}: expected shape ({n}, {width}), got {:?}",
+                        a.dim()
+                    )));
+                }
+                for (i, b) in bodies.iter_mut().enumerate() {
+                    let r = a.row(i);
+                    let v3 = rubblepile::math::Vec3::new(r[0], r[1], r[2]);
+                    match name.as_str() {
+                        "positions" => b.position = v3,
+                        "velocities" => b.velocity = v3,
+                        "spins_body" => b.spin_body = v3,
+                        "quaternions" => b.quaternion = rubblepile::math::Vec4::new(r[0], r[1], r[2], r[3]),
+                        _ => {}
+                    }
+                }
+                if name == "angular_velocities" {
+                    world_spin = Some(a.clone());
+                }
+            }
+            if let Some(w) = world_spin {
+                if arrays.iter().any(|(k, _)| k == "spins_body") {
+                    return Err(Failure::scene(
+                        "angular_velocities, spins_body: give one of the two spins, not both".into(),
+                    ));
+                }
+                for (i, b) in bodies.iter_mut().enumerate() {
+                    let r = w.row(i);
+                    let q = b.quaternion.normalize();
+                    b.spin_body = rubblepile::ellipsoid::quaternion::rotation_matrix(&q)
+                        * rubblepile::math::Vec3::new(r[0], r[1], r[2]);
+                }
+            }
+            s.engine_mut().set_bodies(&bodies).map_err(Failure::from)
+        })
+    }
+
     fn __enter__(slf: Py<Self>) -> Py<Self> {
         slf
     }

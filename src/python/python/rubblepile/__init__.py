@@ -240,6 +240,20 @@ class Simulation:
         """
         return dict(self._inner._state())
 
+    def set_state(self, **arrays: Any) -> None:
+        """Sets the state of an ellipsoid run between two samples; the run continues from it. Keywords, each an
+        array of one row per body in scene order: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s),
+        ``quaternions`` (n, 4; scalar last, normalised here), and one of ``angular_velocities`` (n, 3; rad/s,
+        world frame) or ``spins_body`` (n, 3; rad/s, principal axes). Masses and semi-axes are the scene's.
+
+        The conserved quantities are still measured against t = 0, so a change of energy counts in
+        :attr:`energy_error`. :meth:`save` (or a checkpoint) then holds the new state. Raises :class:`SceneError`
+        for a sphere run (not writable yet), a wrong shape, a non-finite value, or attitudes of a run that does not
+        integrate them.
+        """
+        state = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
+        self._inner._set_state(state)
+
     @property
     def ids(self) -> np.ndarray:
         """Index of each particle in the scene."""
@@ -255,20 +269,36 @@ class Simulation:
         """Centres (m), shape (n, 3)."""
         return self.state()["positions"]
 
+    @positions.setter
+    def positions(self, value: np.ndarray) -> None:
+        self.set_state(positions=value)
+
     @property
     def velocities(self) -> np.ndarray:
         """Velocities of the centres (m/s), shape (n, 3)."""
         return self.state()["velocities"]
+
+    @velocities.setter
+    def velocities(self, value: np.ndarray) -> None:
+        self.set_state(velocities=value)
 
     @property
     def angular_velocities(self) -> np.ndarray:
         """Spins in the world frame (rad/s), shape (n, 3)."""
         return self.state()["angular_velocities"]
 
+    @angular_velocities.setter
+    def angular_velocities(self, value: np.ndarray) -> None:
+        self.set_state(angular_velocities=value)
+
     @property
     def quaternions(self) -> np.ndarray:
         """Attitudes (alpha, beta, gamma, delta; scalar last), shape (n, 4); ellipsoids only."""
         return self._only("quaternions")
+
+    @quaternions.setter
+    def quaternions(self, value: np.ndarray) -> None:
+        self.set_state(quaternions=value)
 
     @property
     def semi_axes(self) -> np.ndarray:
@@ -351,7 +381,7 @@ def analyze(dir: PathLike, at: Optional[float] = None, *, force: bool = False) -
 
     An impact run (one with ``impact.json``) is analysed at ``at`` (s; default 400): fragments, energy partition,
     ejection and spin fits (Roig03 Sec. 4), clumps. Any other run: the clumps of the snapshot at ``at`` (default the
-    last). Returns ``analysis.json`` as a dict (e.g. ``largest_remnant`` with its ``mass`` in kg), plus ``lines``
+    last). Returns ``analysis.json`` as a dict (e.g. ``largest_remnant`` with its ``mass_kg``, ``mass_fraction``, ``n_members``, ``period_h``), plus ``lines``
     (the command line's summary lines) and, for an impact run, ``fragments`` (``analysis/fragments.csv``, column
     name -> array). Raises :class:`SceneError` (no such snapshot, an analysis already there without ``force``, ...).
     """
