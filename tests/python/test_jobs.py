@@ -68,3 +68,15 @@ def test_impact_errors_name_the_argument(tmp_path):
         rubblepile.impact(TARGET, tmp_path / "b", projectile="P9", run=False)
     with pytest.raises(rubblepile.SceneError, match="nope.csv"):
         rubblepile.impact(tmp_path / "nope.csv", tmp_path / "c", run=False)
+
+
+def test_build_target_is_the_command_lines(tmp_path):
+    r = run_cli("target", "build", "--fragments", "30", "--period-hours", "4", "--out", str(tmp_path / "cli.csv"))
+    assert r.returncode == 0, r.stderr
+    report = rubblepile.build_target(30, 4.0, tmp_path / "py.csv")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    assert report == json.loads((tmp_path / "cli.json").read_text())
+    with pytest.raises(rubblepile.SceneError, match="exists"):
+        rubblepile.build_target(30, 4.0, tmp_path / "py.csv")
+    with pytest.raises(rubblepile.SceneError, match="rigidity"):
+        rubblepile.build_target(30, 4.0, tmp_path / "x.csv", rigidity=2.0)

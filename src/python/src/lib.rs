@@ -947,6 +947,78 @@ fn analyze(py: Python<'_>, dir: PathBuf, at: Option<f64>, force: bool) -> PyResu
     result.map_err(|e| e.into_py(py))
 }
 
+/// `rubblepile.build_target`: `rubblepile target build` (see the Python docstring); returns the report JSON text.
+#[pyfunction]
+#[pyo3(signature = (fragments, period_hours, out, *, seed=1, r_largest_km=None, r_smallest_km=None, total_mass=None, f0=None, rigidity=1e-4, drop_detached=false, kappa_reading="printed", force=false))]
+#[allow(clippy::too_many_arguments)]
+fn build_target(
+    py: Python<'_>,
+    fragments: usize,
+    period_hours: f64,
+    out: PathBuf,
+    seed: u64,
+    r_largest_km: Option<f64>,
+    r_smallest_km: Option<f64>,
+    total_mass: Option<f64>,
+    f0: Option<f64>,
+    rigidity: f64,
+    drop_detached: bool,
+    kappa_reading: &str,
+    force: bool,
+) -> PyResult<String> {
+    use rubblepile::impact::target::{TargetSpec, build_target};
+    let usage = |m: String| Failure::scene(m);
+    let result = py.detach(|| {
+        let mut spec =
+            TargetSpec::table1_or_sizes(fragments, period_hours, seed, r_largest_km, r_smallest_km).map_err(usage)?;
+        if let Some(m) = total_mass {
+            spec.total_mass = m;
+        }
+        if let Some(f0) = f0 {
+            spec.f0 = f0;
+        }
+        if !(rigidity > 0.0 && rigidity < 1.0) {
+            return Err(usage(format!(
+                "rigidity: expected a fraction in (0, 1), got {rigidity}"
+            )));
+        }
+        spec.rigidity = rigidity;
+        spec.drop_detached = drop_detached;
+        spec.kappa_reading = kappa_reading
+            .parse()
+            .map_err(|e: String| usage(format!("kappa_reading: {e}")))?;
+        if out.extension().is_none_or(|e| e != "csv") {
+            return Err(usage(format!(
+                "out: expected a path ending in .csv, got {}",
+                out.display()
+            )));
+        }
+        let json = out.with_extension("json");
+        if !force && (out.exists() || json.exists()) {
+            return Err(usage(format!(
+                "out: {} (or its .json) exists; use force=True to overwrite it",
+                out.display()
+            )));
+        }
+        let failed = |m: String| Failure {
+            class: Class::Other,
+            ..Failure::scene(m)
+        };
+        if let Some(dir) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| failed(format!("{}: {e}", dir.display())))?;
+        }
+        let (bodies, report) =
+            build_target(&spec, &mut |_, _, _, _| {}).map_err(|e| failed(format!("target build: {e}")))?;
+        rubblepile::ellipsoid::output::write_snapshot(&out, 0.0, &bodies)
+            .map_err(|e| failed(format!("{}: {e}", out.display())))?;
+        let text = serde_json::to_string_pretty(&report).map_err(|e| failed(e.to_string()))?;
+        rubblepile::io::safe_write::write_atomic(&json, text.clone() + "\n")
+            .map_err(|e| failed(rubblepile::io::safe_write::describe(&json, &e)))?;
+        Ok(text)
+    });
+    result.map_err(|e| e.into_py(py))
+}
+
 /// The extension module.
 #[pymodule]
 fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -959,5 +1031,6 @@ fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Simulation>()?;
     m.add_function(wrap_pyfunction!(impact, m)?)?;
     m.add_function(wrap_pyfunction!(analyze, m)?)?;
+    m.add_function(wrap_pyfunction!(build_target, m)?)?;
     Ok(())
 }

@@ -35,6 +35,7 @@ __all__ = [
     "RunFailed",
     "RunStopped",
     "analyze",
+    "build_target",
     "impact",
     "read_run",
     "read_snapshot",
@@ -394,3 +395,33 @@ def analyze(dir: PathLike, at: Optional[float] = None, *, force: bool = False) -
 
         out["fragments"] = _read_csv(frag)
     return out
+
+
+def build_target(
+    fragments: int,
+    period_hours: float,
+    out: PathLike,
+    *,
+    seed: int = 1,
+    r_largest_km: Optional[float] = None,
+    r_smallest_km: Optional[float] = None,
+    total_mass: Optional[float] = None,
+    f0: Optional[float] = None,
+    rigidity: float = 1e-4,
+    drop_detached: bool = False,
+    kappa_reading: str = "printed",
+    force: bool = False,
+) -> Dict[str, Any]:
+    """Builds a rubble-pile target as ``rubblepile target build`` does: ``fragments`` ellipsoids (30, 100 and 200
+    take Roig03 Table 1's radii; any other number needs ``r_largest_km`` and ``r_smallest_km``, km) relaxed under
+    self-gravity into a pile spinning with period ``period_hours`` (h). Writes the bodies file ``out`` (``.csv``,
+    for :func:`impact`'s ``target``) and its report beside it (``.json``), which it returns as a dict.
+    ``total_mass`` (kg), ``f0`` (s m^-2, dissipation while relaxing), ``rigidity`` (dimensionless, in (0, 1)).
+
+    Raises :class:`SceneError` naming the argument for a bad value, or when ``out`` exists (unless ``force``).
+    """
+    text = _rubblepile.build_target(
+        fragments, period_hours, os.fspath(out), seed=seed, r_largest_km=r_largest_km, r_smallest_km=r_smallest_km,
+        total_mass=total_mass, f0=f0, rigidity=rigidity, drop_detached=drop_detached, kappa_reading=kappa_reading,
+        force=force)
+    return json.loads(text)

@@ -105,3 +105,18 @@ def impact(
     checkpoint_every_sim: Optional[float] = None,
 ) -> Simulation: ...
 def analyze(dir: str, at: Optional[float] = None, *, force: bool = False) -> Tuple[str, List[str]]: ...
+def build_target(
+    fragments: int,
+    period_hours: float,
+    out: str,
+    *,
+    seed: int = 1,
+    r_largest_km: Optional[float] = None,
+    r_smallest_km: Optional[float] = None,
+    total_mass: Optional[float] = None,
+    f0: Optional[float] = None,
+    rigidity: float = 1e-4,
+    drop_detached: bool = False,
+    kappa_reading: str = "printed",
+    force: bool = False,
+) -> str: ...

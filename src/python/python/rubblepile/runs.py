@@ -13,7 +13,8 @@ PathLike = Union[str, "os.PathLike[str]"]
 
 
 def _read_csv(path: str) -> Dict[str, np.ndarray]:
-    """A CSV file with a header as a dict column name -> array (floats where every cell parses, else strings)."""
+    """A CSV file with a header as a dict column name -> array (booleans for true/false columns, floats where every
+    cell parses, else strings)."""
     with open(path, newline="") as f:
         rows = list(csv.reader(f))
     if not rows:
@@ -22,6 +23,9 @@ def _read_csv(path: str) -> Dict[str, np.ndarray]:
     out: Dict[str, np.ndarray] = {}
     for k, name in enumerate(header):
         cells = [r[k] if k < len(r) else "" for r in body]
+        if cells and all(c in ("true", "false") for c in cells):
+            out[name] = np.array([c == "true" for c in cells], dtype=bool)
+            continue
         try:
             out[name] = np.array([float(c) for c in cells], dtype=float)
         except ValueError:
