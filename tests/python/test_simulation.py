@@ -230,3 +230,18 @@ def test_state_writes_are_checked():
     spheres.step()
     with pytest.raises(rubblepile.SceneError, match="soft-spheres"):
         spheres.set_state(positions=np.zeros((1, 3)))
+
+
+def test_a_spent_budget_stops_with_a_checkpoint(tmp_path):
+    scene = SCENES["soft-spheres"].read_text().replace("t_end = 10.0 ", "t_end = 300.0 ")
+    sim = rubblepile.Simulation.from_scene(scene, tmp_path / "run", max_wall_seconds=0.3)
+    with pytest.raises(rubblepile.RunStopped, match="max_wall_seconds") as e:
+        sim.integrate()
+    assert 0.0 < e.value.t < 300.0
+    with pytest.raises(rubblepile.SceneError, match="has ended"):
+        sim.step()
+    sim.close()
+    assert (tmp_path / "run" / "checkpoint.json").is_file()
+    sim = rubblepile.Simulation.from_run(tmp_path / "run")
+    assert sim.t == e.value.t
+    sim.close()
