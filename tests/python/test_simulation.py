@@ -38,7 +38,9 @@ def test_same_files_as_the_command_line(kind, tmp_path):
     # (the fixed-step engines end on their last whole step, within one step of t_end)
     assert sim.done and t == sim.t and abs(t - sim.t_end) < 1e-3
     errors = (sim.energy_error, sim.momentum_error, sim.angular_momentum_error)
+    assert sim.summary() == summary(py_dir) and sim.wall_seconds == summary(py_dir)["wall_seconds"]
     sim.close()
+    assert sim.energy_error == errors[0]  # still readable after close
     cli, py = run_files(cli_dir), run_files(py_dir)
     assert sorted(cli) == sorted(py)
     for name in cli:

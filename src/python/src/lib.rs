@@ -590,7 +590,7 @@ impl Simulation {
         self.read(py, |any| Ok(any.t_end()))
     }
 
-    /// Whether the run reached its last sample (its `summary.json` is written).
+    /// Whether the run has ended (completed, failed or stopped by its budget): nothing more to advance.
     #[getter]
     fn done(&self, py: Python<'_>) -> PyResult<bool> {
         self.read(py, |any| Ok(any.is_done()))

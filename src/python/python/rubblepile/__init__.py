@@ -67,6 +67,8 @@ class Simulation:
 
     def __init__(self, inner: "_rubblepile.Simulation") -> None:
         self._inner = inner
+        # The summary at close(), so that the numbers stay readable after a `with` block.
+        self._closed_summary: Optional[Dict[str, Any]] = None
 
     # --- construction -------------------------------------------------------------------------------------------
     @classmethod
@@ -151,7 +153,13 @@ class Simulation:
         self._inner.save(os.fspath(dir), force=force)
 
     def close(self) -> None:
-        """Ends the session: releases the run directory's lock (the files stay). Further calls raise."""
+        """Ends the session: releases the run directory's lock (the files stay). The summary and its errors stay
+        readable; further calls that need the run raise :class:`SceneError`."""
+        if self._closed_summary is None:
+            try:
+                self._closed_summary = self.summary()
+            except RubblepileError:
+                pass
         self._inner.close()
 
     def __enter__(self) -> "Simulation":
@@ -173,7 +181,8 @@ class Simulation:
 
     @property
     def done(self) -> bool:
-        """Whether the run completed (its last sample reached, ``summary.json`` written)."""
+        """Whether the run has ended: completed (its last sample reached, ``summary.json`` written), failed or
+        stopped by its budget; nothing more to advance."""
         return self._inner.done
 
     @property
@@ -198,11 +207,19 @@ class Simulation:
 
     # --- the summary's numbers -------------------------------------------------------------------------------------
     def summary(self) -> Dict[str, Any]:
-        """The run's summary as ``summary.json`` holds it (the engine's fields), computed now; ``status`` is
-        ``"running"`` until the run completes."""
+        """The run's summary as ``summary.json`` holds it (the engine's fields): the file itself once the run
+        ended with one (completed or failed), else computed now, its ``status`` ``"running"`` (or ``"stopped"``
+        after its budget ran out)."""
+        if self._closed_summary is not None:
+            return dict(self._closed_summary)
+        written = os.path.join(self.out_dir, "summary.json")
+        if self.done and os.path.isfile(written):
+            # As written when the run ended (its wall time stopped then).
+            with open(written) as f:
+                return json.load(f)
         s = json.loads(self._inner._summary_json())
-        if not self.done and "status" in s:
-            s["status"] = "running"
+        if "status" in s:
+            s["status"] = "stopped" if self.done else "running"
         return s
 
     @property
@@ -225,7 +242,11 @@ class Simulation:
 
     @property
     def wall_seconds(self) -> float:
-        """Wall-clock seconds of the run so far (s)."""
+        """Wall-clock seconds of the run so far (s), pauses between calls included (the run's ``wall_seconds``)."""
+        if self._closed_summary is not None or self.done:
+            s = self.summary()
+            if "wall_seconds" in s and s.get("status") != "stopped":
+                return float(s["wall_seconds"])
         return self._inner.wall_seconds
 
     # --- the state ----------------------------------------------------------------------------------------------
