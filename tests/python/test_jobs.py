@@ -80,3 +80,21 @@ def test_build_target_is_the_command_lines(tmp_path):
         rubblepile.build_target(30, 4.0, tmp_path / "py.csv")
     with pytest.raises(rubblepile.SceneError, match="rigidity"):
         rubblepile.build_target(30, 4.0, tmp_path / "x.csv", rigidity=2.0)
+
+
+def test_flyby_is_the_command_lines(tmp_path):
+    # The control flyby of tests/flyby.rs (planet mass 0, a rescaled and re-spun N30 pile, no control run).
+    args = ["--target", str(TARGET), "--radius-m", "170", "--period-hours", "30.5", "--q-m", "3.8e7",
+            "--planet-mass", "0", "--no-control"]
+    r = run_cli("flyby", *args, "--out", str(tmp_path / "cli"))
+    assert r.returncode == 0, r.stderr
+    out = rubblepile.flyby(TARGET, tmp_path / "py", radius_m=170.0, period_hours=30.5, q_m=3.8e7,
+                           planet_mass=0.0, control=False)
+    assert out["analysis"] is not None
+    a, b = run_files(tmp_path / "cli"), run_files(tmp_path / "py")
+    assert sorted(a) == sorted(b)
+    for name in a:
+        assert a[name] == b[name], name
+    # the lines but the run's wall time
+    cli_lines = [l for l in r.stdout.splitlines() if not l.startswith("run: ")]
+    assert [l for l in out["lines"] if not l.startswith("run: ")] == cli_lines

@@ -1019,6 +1019,86 @@ fn build_target(
     result.map_err(|e| e.into_py(py))
 }
 
+/// `rubblepile.flyby`: `rubblepile flyby` (see the Python docstring): prepares, runs (and its control) and
+/// analyses a flyby; returns the command line's lines.
+#[pyfunction]
+#[pyo3(signature = (target, out, *, q_m, v_inf_km_s=5.8, radius_m=None, period_hours=None, planet_mass=rubblepile::impact::flyby::EARTH_MASS_KG, planet_radius_m=rubblepile::impact::flyby::EARTH_RADIUS_M, planet_j2=None, planet_pole=None, orientation_deg=None, start_q=rubblepile::impact::flyby::DEFAULT_START_Q, kappa=None, f0=None, rtol=1e-6, snapshots=9, force=false, run=true, control=true, settle_to_principal=false, settle_max_hours=None))]
+#[allow(clippy::too_many_arguments)]
+fn flyby(
+    py: Python<'_>,
+    target: PathBuf,
+    out: PathBuf,
+    q_m: f64,
+    v_inf_km_s: f64,
+    radius_m: Option<f64>,
+    period_hours: Option<f64>,
+    planet_mass: f64,
+    planet_radius_m: f64,
+    planet_j2: Option<f64>,
+    planet_pole: Option<Vec<f64>>,
+    orientation_deg: Option<Vec<f64>>,
+    start_q: f64,
+    kappa: Option<f64>,
+    f0: Option<f64>,
+    rtol: f64,
+    snapshots: usize,
+    force: bool,
+    run: bool,
+    control: bool,
+    settle_to_principal: bool,
+    settle_max_hours: Option<f64>,
+) -> PyResult<Vec<String>> {
+    use rubblepile::analysis::flyby::{analyze_flyby, settling_line};
+    use rubblepile::impact::flyby::{FlybyConfig, run_flyby};
+    let cfg = FlybyConfig {
+        target,
+        radius_m,
+        period_hours,
+        planet_mass,
+        planet_radius_m,
+        planet_j2,
+        planet_pole,
+        q_m,
+        v_inf_km_s,
+        orientation_deg,
+        start_q,
+        kappa,
+        f0,
+        rtol,
+        snapshots,
+        out,
+        force,
+        no_run: !run,
+        no_control: !control,
+        settle_to_principal,
+        settle_max_hours,
+    };
+    let options = options(false, None, None, None, None);
+    let result = py.detach(|| {
+        let runs = run_flyby(&cfg, &options).map_err(impact_failure)?;
+        let Some(runs) = runs else {
+            return Ok(vec![format!("wrote {}", cfg.out.join("scene.toml").display())]);
+        };
+        let o = analyze_flyby(&cfg.out).map_err(|e| Failure {
+            class: Class::Other,
+            ..Failure::scene(e.to_string())
+        })?;
+        let mut lines = Vec::new();
+        lines.extend(runs.setup.settling.as_ref().map(settling_line));
+        lines.push(format!("run: {}", rubblepile::engine::RunReport::one_line(&runs.run)));
+        if let Some(c) = &runs.control {
+            lines.push(format!(
+                "control ({}): {}",
+                rubblepile::impact::flyby::CONTROL_DIR,
+                rubblepile::engine::RunReport::one_line(c)
+            ));
+        }
+        lines.extend(o.lines());
+        Ok::<_, Failure>(lines)
+    });
+    result.map_err(|e| e.into_py(py))
+}
+
 /// The extension module.
 #[pymodule]
 fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1032,5 +1112,6 @@ fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(impact, m)?)?;
     m.add_function(wrap_pyfunction!(analyze, m)?)?;
     m.add_function(wrap_pyfunction!(build_target, m)?)?;
+    m.add_function(wrap_pyfunction!(flyby, m)?)?;
     Ok(())
 }

@@ -36,6 +36,7 @@ __all__ = [
     "RunStopped",
     "analyze",
     "build_target",
+    "flyby",
     "impact",
     "read_run",
     "read_snapshot",
@@ -446,3 +447,51 @@ def build_target(
         total_mass=total_mass, f0=f0, rigidity=rigidity, drop_detached=drop_detached, kappa_reading=kappa_reading,
         force=force)
     return json.loads(text)
+
+
+def flyby(
+    target: PathLike,
+    out: PathLike,
+    *,
+    q_m: float,
+    v_inf_km_s: float = 5.8,
+    radius_m: Optional[float] = None,
+    period_hours: Optional[float] = None,
+    planet_mass: float = 5.9722e24,
+    planet_radius_m: float = 6.371e6,
+    planet_j2: Optional[float] = None,
+    planet_pole: Optional[list] = None,
+    orientation_deg: Optional[list] = None,
+    start_q: float = 10.0,
+    kappa: Optional[float] = None,
+    f0: Optional[float] = None,
+    rtol: float = 1e-6,
+    snapshots: int = 9,
+    force: bool = False,
+    run: bool = True,
+    control: bool = True,
+    settle_to_principal: bool = False,
+    settle_max_hours: Optional[float] = None,
+) -> Dict[str, Any]:
+    """A tidal flyby of a rubble pile past a planet, as ``rubblepile flyby`` runs it: the pile of ``target`` (a
+    bodies file; rescaled to ``radius_m`` (m) and re-spun to ``period_hours`` (h) when given, then settled) on a
+    hyperbolic orbit of perigee ``q_m`` (m from the planet's centre) and speed at infinity ``v_inf_km_s`` (km/s, as
+    the command line's flag) past a planet of ``planet_mass`` (kg; 0: a control without tide) and
+    ``planet_radius_m`` (m), from and to ``start_q`` perigee distances; then, unless ``control=False``, the same
+    run without the planet in ``out/control``; then the analysis (``out/analysis/flyby.json``).
+
+    Returns ``{"lines": [the command line's lines], "analysis": flyby.json as a dict or None}``. With
+    ``run=False`` only the run directory is written. Raises :class:`SceneError` naming the argument.
+    """
+    lines = _rubblepile.flyby(
+        os.fspath(target), os.fspath(out), q_m=q_m, v_inf_km_s=v_inf_km_s, radius_m=radius_m,
+        period_hours=period_hours, planet_mass=planet_mass, planet_radius_m=planet_radius_m, planet_j2=planet_j2,
+        planet_pole=planet_pole, orientation_deg=orientation_deg, start_q=start_q, kappa=kappa, f0=f0, rtol=rtol,
+        snapshots=snapshots, force=force, run=run, control=control, settle_to_principal=settle_to_principal,
+        settle_max_hours=settle_max_hours)
+    path = os.path.join(os.fspath(out), "analysis", "flyby.json")
+    analysis = None
+    if os.path.isfile(path):
+        with open(path) as f:
+            analysis = json.load(f)
+    return {"lines": list(lines), "analysis": analysis}
