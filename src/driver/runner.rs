@@ -15,7 +15,7 @@ use crate::bits::{exact_f64, fnv1a_hex};
 use crate::ellipsoid::run::EllipsoidEngine;
 use crate::ellipsoid::scene::LoadedScene;
 use crate::ellipsoid::summary::RunSummary;
-use crate::engine::{Engine, Outcome, Resumed, SampleError};
+use crate::engine::{Engine, Outcome, Resumed, Sample, SampleError};
 use crate::granular::soft::run::{SoftEngine, SoftSummary};
 use crate::granular::soft::scene::SoftScene;
 use crate::io::manifest::MANIFEST_FILE;
@@ -359,7 +359,7 @@ struct Header {
     kind: Option<String>,
 }
 
-/// Where [`drive`] starts: t = 0, or a checkpoint.
+/// Where a [`Session`] starts: t = 0, or a checkpoint.
 struct Start {
     next_sample: u64,
     rows: u64,
@@ -409,45 +409,8 @@ fn same_dir(a: &Path, b: &Path) -> bool {
 /// `out_dir` unless `options.force`. When the engine fails (non-finite state, step
 /// size underflow, a broken constraint), writes `last_good_state.csv` and `summary.json` (naming the cause) and
 /// returns [`RunError::Failed`]. Prints nothing but the progress bar; see [`RunReport::one_line`].
-pub fn run<E: Engine>(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
-    // A scene its own work estimate says will not end within the budget is refused before anything is written.
-    let budget = budget_of(&engine, options);
-    if let Some(steps) = engine.estimated_steps()
-        && steps > budget.max_steps as f64
-    {
-        return Err(RunError::Setup(format!(
-            "the scene needs about {steps:.1e} steps to t_end = {} s, more than max_steps = {} ({}); raise it with \
-             [run] max_steps or --max-steps to run the scene anyway, or shorten t_end",
-            engine.t_end(),
-            count(budget.max_steps),
-            budget.steps_from
-        )));
-    }
-    let _lock = prepare_output_dir(out_dir, options.force)?;
-    let scene_copy = out_dir.join("scene.toml");
-    let scene_text = standalone_scene(&engine, out_dir);
-    safe_write::write_atomic(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
-    let identity = Identity {
-        scene_base_dir: absolute_base(&engine)?,
-        scene_hash: fnv1a_hex(scene_text.as_bytes()),
-    };
-    let ts_path = out_dir.join("timeseries.csv");
-    let mut timeseries = safe_write::create_fresh(&ts_path).map_err(io_err(&ts_path))?;
-    let header = engine.timeseries_header();
-    timeseries.write_all(header.as_bytes()).map_err(io_err(&ts_path))?;
-    engine.open_outputs(out_dir).map_err(io_err(out_dir))?;
-    let start = Start {
-        next_sample: 0,
-        rows: 0,
-        bytes: header.len() as u64,
-        wall_before: 0.0,
-        checkpoints: 0,
-        timeseries,
-    };
-    let useful = engine.useful_threads();
-    on_pool(useful, || {
-        drive(&mut engine, out_dir, options, start, &identity, &budget)
-    })
+pub fn run<E: Engine>(engine: E, out_dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    Session::start(engine, out_dir, options)?.run_to_end()
 }
 
 /// A step count as people read it: digits below 1e7, `1e9` above.
@@ -569,8 +532,13 @@ pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>>
 /// files, a snapshot written before the checkpoint missing, a time series shorter than at the checkpoint); otherwise
 /// as [`run`].
 pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary, RunError<E::Summary>> {
+    Session::<E>::resume(dir, options)?.run_to_end()
+}
+
+/// The setup of [`resume`], up to the first sample to advance.
+fn resume_session<E: Engine>(dir: &Path, options: &RunOptions) -> Result<Session<E>, RunError<E::Summary>> {
     // A directory that does not exist is left to the checks below to name.
-    let _lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
+    let lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
     // Nothing through a link: refused before anything is read or changed.
     if dir.is_dir() {
         refuse_links(dir)?;
@@ -676,9 +644,8 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
         checkpoints: ckpt.checkpoints,
         timeseries,
     };
-    let useful = engine.useful_threads();
     let budget = budget_of(&engine, options);
-    on_pool(useful, || drive(&mut engine, dir, options, start, &identity, &budget))
+    Ok(Session::new(engine, dir, options, start, identity, budget, lock))
 }
 
 /// The bytes of `dir/checkpoint.json` for `checkpoint`.
@@ -714,54 +681,229 @@ fn on_pool<R: Send>(useful: usize, op: impl FnOnce() -> R + Send) -> R {
     }
 }
 
-/// The sampling loop shared by [`run`] and [`resume`].
-fn drive<E: Engine>(
-    engine: &mut E,
-    out_dir: &Path,
-    options: &RunOptions,
-    start: Start,
-    identity: &Identity,
-    budget: &Budget,
-) -> Result<E::Summary, RunError<E::Summary>> {
-    let Start {
-        next_sample,
-        mut rows,
-        mut bytes,
-        wall_before,
-        mut checkpoints,
-        timeseries,
-    } = start;
-    let ts_path = out_dir.join("timeseries.csv");
-    let mut files = run_files::RunFiles::new(timeseries, &ts_path);
-    // The manifest of the run's finished files (crate::io::manifest), rewritten at each checkpoint and at the end.
-    let manifest = std::cell::RefCell::new(crate::io::manifest::Recorder::new());
-    let mp = out_dir.join(MANIFEST_FILE);
-    let file_err = |(path, source): run_files::FileError| RunError::Io { path, source };
-    let t_end = engine.t_end();
-    let started = Instant::now();
-    let wall = || wall_before + started.elapsed().as_secs_f64();
-    let shown = progress::Progress::new(options.progress, options.progress_every, t_end, engine.time());
+/// How one call of [`Session::step`] ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step<S> {
+    /// One output sample was reached and written; more remain.
+    Sampled,
+    /// The last output sample was reached: the run completed, its summary written.
+    Completed(S),
+}
 
-    // On failure: the rows so far, the last good state and the summary, then the error.
-    let fail = |engine: &E, failure: &crate::engine::Failure, rows: u64, files: &mut run_files::RunFiles| {
-        shown.abandon();
-        if let Err((path, source)) = files.flush() {
+/// A run in progress, held in memory and advanced one output sample at a time: what [`run`] and [`resume`] drive
+/// to the end, for callers that want the state between samples (the Python front, `src/python/`). It writes the
+/// same files as [`run`], as it goes, and holds the output directory's lock until dropped.
+///
+/// The wall-clock time it reports counts from [`Session::start`] (or [`Session::resume`]), pauses between
+/// [`Session::step`] calls included.
+pub struct Session<E: Engine> {
+    engine: E,
+    out_dir: PathBuf,
+    options: RunOptions,
+    identity: Identity,
+    budget: Budget,
+    files: run_files::RunFiles,
+    manifest: crate::io::manifest::Recorder,
+    samples: Vec<Sample>,
+    next_sample: usize,
+    rows: u64,
+    bytes: u64,
+    wall_before: f64,
+    checkpoints: u64,
+    checkpoints_here: u64,
+    started: Instant,
+    last_checkpoint_wall: Instant,
+    last_checkpoint_t: f64,
+    shown: progress::Progress,
+    deadline: Option<Instant>,
+    done: bool,
+    _lock: Option<DirLock>,
+}
+
+impl<E: Engine> Session<E> {
+    /// Starts a run of `engine` from its initial state in `out_dir`, as [`run`] does before its first sample
+    /// (refusing a scene whose work estimate exceeds its budget, locking and preparing the directory, writing
+    /// `scene.toml` and the time series' header). Errors: as [`run`].
+    pub fn start(mut engine: E, out_dir: &Path, options: &RunOptions) -> Result<Self, RunError<E::Summary>> {
+        // A scene its own work estimate says will not end within the budget is refused before anything is written.
+        let budget = budget_of(&engine, options);
+        if let Some(steps) = engine.estimated_steps()
+            && steps > budget.max_steps as f64
+        {
+            return Err(RunError::Setup(format!(
+                "the scene needs about {steps:.1e} steps to t_end = {} s, more than max_steps = {} ({}); raise it with \
+                 [run] max_steps or --max-steps to run the scene anyway, or shorten t_end",
+                engine.t_end(),
+                count(budget.max_steps),
+                budget.steps_from
+            )));
+        }
+        let lock = prepare_output_dir(out_dir, options.force)?;
+        let scene_copy = out_dir.join("scene.toml");
+        let scene_text = standalone_scene(&engine, out_dir);
+        safe_write::write_atomic(&scene_copy, &scene_text).map_err(io_err(&scene_copy))?;
+        let identity = Identity {
+            scene_base_dir: absolute_base(&engine)?,
+            scene_hash: fnv1a_hex(scene_text.as_bytes()),
+        };
+        let ts_path = out_dir.join("timeseries.csv");
+        let mut timeseries = safe_write::create_fresh(&ts_path).map_err(io_err(&ts_path))?;
+        let header = engine.timeseries_header();
+        timeseries.write_all(header.as_bytes()).map_err(io_err(&ts_path))?;
+        engine.open_outputs(out_dir).map_err(io_err(out_dir))?;
+        let start = Start {
+            next_sample: 0,
+            rows: 0,
+            bytes: header.len() as u64,
+            wall_before: 0.0,
+            checkpoints: 0,
+            timeseries,
+        };
+        Ok(Session::new(
+            engine,
+            out_dir,
+            options,
+            start,
+            identity,
+            budget,
+            Some(lock),
+        ))
+    }
+
+    /// Continues the run in `dir` from its checkpoint, as [`resume`] does before its first sample. Errors: as
+    /// [`resume`].
+    pub fn resume(dir: &Path, options: &RunOptions) -> Result<Self, RunError<E::Summary>> {
+        resume_session(dir, options)
+    }
+
+    fn new(
+        mut engine: E,
+        out_dir: &Path,
+        options: &RunOptions,
+        start: Start,
+        identity: Identity,
+        budget: Budget,
+        lock: Option<DirLock>,
+    ) -> Self {
+        let ts_path = out_dir.join("timeseries.csv");
+        let started = Instant::now();
+        let shown = progress::Progress::new(options.progress, options.progress_every, engine.t_end(), engine.time());
+        // The wall-clock budget holds inside a sample interval too: past the deadline an advance stops, and the run
+        // stops with a checkpoint of the state saved at the sample before (kept only when there is a budget).
+        let deadline = budget
+            .max_wall_seconds
+            .and_then(|s| started.checked_add(std::time::Duration::try_from_secs_f64(s).ok()?));
+        engine.set_deadline(deadline);
+        Session {
+            samples: engine.samples(),
+            last_checkpoint_t: engine.time(),
+            engine,
+            out_dir: out_dir.to_path_buf(),
+            options: *options,
+            identity,
+            budget,
+            files: run_files::RunFiles::new(start.timeseries, &ts_path),
+            // The manifest of the run's finished files (crate::io::manifest), rewritten at each checkpoint and at
+            // the end.
+            manifest: crate::io::manifest::Recorder::new(),
+            next_sample: start.next_sample as usize,
+            rows: start.rows,
+            bytes: start.bytes,
+            wall_before: start.wall_before,
+            checkpoints: start.checkpoints,
+            checkpoints_here: 0,
+            started,
+            last_checkpoint_wall: Instant::now(),
+            shown,
+            deadline,
+            done: false,
+            _lock: lock,
+        }
+    }
+
+    /// The engine, with its state at the last sample reached.
+    pub fn engine(&self) -> &E {
+        &self.engine
+    }
+
+    /// The engine, to change its state between samples (the run is then no longer the scene's alone; a checkpoint
+    /// written after the change holds the changed state).
+    pub fn engine_mut(&mut self) -> &mut E {
+        &mut self.engine
+    }
+
+    /// The run's output directory.
+    pub fn out_dir(&self) -> &Path {
+        &self.out_dir
+    }
+
+    /// Every output sample of the run, in time order.
+    pub fn samples(&self) -> &[Sample] {
+        &self.samples
+    }
+
+    /// The index of the next sample to reach (the number reached so far).
+    pub fn next_sample(&self) -> usize {
+        self.next_sample
+    }
+
+    /// Whether every sample was reached (the run completed).
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    /// The run's wall-clock seconds so far (those before its checkpoint included).
+    pub fn wall_seconds(&self) -> f64 {
+        self.wall_before + self.started.elapsed().as_secs_f64()
+    }
+
+    /// The engine's summary of the run so far, as [`Engine::summary`] of a completed run would give it now.
+    pub fn summary(&self) -> E::Summary {
+        self.engine.summary(Outcome::Completed, self.rows, self.wall_seconds())
+    }
+
+    /// Runs the remaining samples to the end (on rayon's pool, as [`run`] does) and returns the summary.
+    pub fn run_to_end(mut self) -> Result<E::Summary, RunError<E::Summary>> {
+        let useful = self.engine.useful_threads();
+        on_pool(useful, || {
+            loop {
+                if let Step::Completed(summary) = self.step()? {
+                    return Ok(summary);
+                }
+            }
+        })
+    }
+
+    /// Runs `op` with the session on rayon's pool as [`run`] does (the engine's parallel passes forked from a
+    /// worker; a pool of [`Engine::useful_threads`] threads when that is fewer).
+    pub fn on_pool<R: Send>(&mut self, op: impl FnOnce(&mut Self) -> R + Send) -> R {
+        let useful = self.engine.useful_threads();
+        on_pool(useful, || op(self))
+    }
+
+    /// On failure: the rows so far, the last good state and the summary, then the error.
+    fn fail(&mut self, failure: &crate::engine::Failure) -> RunError<E::Summary> {
+        self.done = true;
+        self.shown.abandon();
+        if let Err((path, source)) = self.files.flush() {
             return RunError::Io { path, source };
         }
-        let lgs = out_dir.join("last_good_state.csv");
-        let t_good = match engine.write_last_good_state(&lgs) {
+        let lgs = self.out_dir.join("last_good_state.csv");
+        let t_good = match self.engine.write_last_good_state(&lgs) {
             Ok(t) => t,
             Err(e) => return RunError::Io { path: lgs, source: e },
         };
-        let summary = engine.summary(Outcome::Failed(failure), rows, wall());
-        let sp = out_dir.join("summary.json");
+        let summary = self
+            .engine
+            .summary(Outcome::Failed(failure), self.rows, self.wall_seconds());
+        let sp = self.out_dir.join("summary.json");
         if let Err(e) = write_summary(&sp, &summary) {
             return RunError::Io { path: sp, source: e };
         }
-        if let Err(e) = files.sync().and_then(|()| {
-            manifest
-                .borrow_mut()
-                .write(out_dir, "failed", true)
+        let mp = self.out_dir.join(MANIFEST_FILE);
+        if let Err(e) = self.files.sync().and_then(|()| {
+            self.manifest
+                .write(&self.out_dir, "failed", true)
                 .map_err(|e| (mp.clone(), e))
         }) {
             return RunError::Io { path: e.0, source: e.1 };
@@ -772,39 +914,34 @@ fn drive<E: Engine>(
             last_good_state: lgs,
             summary: Box::new(summary),
         }
-    };
+    }
 
-    let samples = engine.samples();
-    let total = samples.len() as u64;
-    let scene_formats: &[&str] = if engine.scene_vtk() { &["vtk"] } else { &[] };
-    let extra_formats = options.formats.with(scene_formats).selected();
-    let mut last_checkpoint_wall = Instant::now();
-    let mut last_checkpoint_t = engine.time();
-    let mut checkpoints_here: u64 = 0;
-    // Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`) between two
-    // manifests: the first records it as pending, the second as the checkpoint, so that a run killed at any instant
-    // leaves a directory whose manifest verifies the checkpoint there (the old one or the new).
-    let checkpoint_at = |state: E::State, t: f64, next_sample: u64, rows: u64, bytes: u64, checkpoints: u64| {
+    /// Writes the checkpoint of `state` (the state at the sample before `next_sample`, at time `t`) between two
+    /// manifests: the first records it as pending, the second as the checkpoint, so that a run killed at any
+    /// instant leaves a directory whose manifest verifies the checkpoint there (the old one or the new).
+    fn checkpoint_at(&mut self, state: E::State, t: f64, next_sample: u64) -> Result<(), RunError<E::Summary>> {
+        self.checkpoints += 1;
         let ckpt = Checkpoint {
             format: CHECKPOINT_FORMAT.into(),
             version: CHECKPOINT_VERSION,
             writer: format!("rubblepile {}", env!("CARGO_PKG_VERSION")),
             kind: E::KIND.into(),
-            scene_hash: identity.scene_hash.clone(),
-            scene_base_dir: identity.scene_base_dir.clone(),
+            scene_hash: self.identity.scene_hash.clone(),
+            scene_base_dir: self.identity.scene_base_dir.clone(),
             t,
             t_seconds: t,
             next_sample,
-            timeseries_rows: rows,
-            timeseries_bytes: bytes,
-            checkpoints,
-            wall_seconds: wall(),
+            timeseries_rows: self.rows,
+            timeseries_bytes: self.bytes,
+            checkpoints: self.checkpoints,
+            wall_seconds: self.wall_seconds(),
             engine: state,
         };
+        let out_dir = &self.out_dir;
+        let mp = out_dir.join(MANIFEST_FILE);
         let cp = out_dir.join(CHECKPOINT_FILE);
         let ckpt_bytes = checkpoint_bytes(&ckpt).map_err(io_err(&cp))?;
-        manifest
-            .borrow_mut()
+        self.manifest
             .write_with_pending(
                 out_dir,
                 &format!("checkpoint at t = {t} s being written"),
@@ -813,54 +950,106 @@ fn drive<E: Engine>(
             )
             .map_err(io_err(&mp))?;
         safe_write::write_atomic_durable(&cp, &ckpt_bytes).map_err(io_err(&cp))?;
-        manifest
-            .borrow_mut()
+        self.manifest
             .write(out_dir, &format!("checkpoint at t = {t} s"), false)
             .map_err(io_err(&mp))
-    };
-    // The wall-clock budget holds inside a sample interval too: past the deadline an advance stops, and the run
-    // stops with a checkpoint of the state saved at the sample before (kept only when there is a budget).
-    let deadline = budget
-        .max_wall_seconds
-        .and_then(|s| started.checked_add(std::time::Duration::try_from_secs_f64(s).ok()?));
-    engine.set_deadline(deadline);
-    let budget_stop = |t: f64, reason: String| RunError::Budget {
-        dir: out_dir.to_path_buf(),
-        t,
-        reason,
-    };
-    let steps_spent = |steps: u64| {
+    }
+
+    /// Writes a checkpoint of the state now (at the last sample reached), from which [`resume`] continues the run.
+    ///
+    /// Errors: [`RunError::Setup`] before the first sample and after the last (no checkpoint is taken there);
+    /// [`RunError::Io`].
+    pub fn checkpoint(&mut self) -> Result<(), RunError<E::Summary>> {
+        if self.next_sample == 0 || self.done {
+            return Err(RunError::Setup(format!(
+                "no checkpoint of the run in {} {}: a checkpoint sits between two output samples",
+                self.out_dir.display(),
+                if self.done {
+                    "after it completed"
+                } else {
+                    "before its first output sample"
+                }
+            )));
+        }
+        self.files.sync().map_err(file_error)?;
+        let state = self.engine.save().map_err(io_err(&self.out_dir))?;
+        let t = self.engine.time();
+        self.checkpoint_at(state, t, self.next_sample as u64)?;
+        self.last_checkpoint_wall = Instant::now();
+        self.last_checkpoint_t = t;
+        Ok(())
+    }
+
+    fn steps_spent(&self, steps: u64) -> String {
         format!(
             "max_steps = {} ({}) reached: {steps} steps taken",
-            count(budget.max_steps),
-            budget.steps_from
+            count(self.budget.max_steps),
+            self.budget.steps_from
         )
-    };
-    for (index, sample) in samples.iter().enumerate().skip(next_sample as usize) {
-        // A resumed run whose budget is already spent stops where its checkpoint is, writing nothing.
-        let steps_before = engine.steps_taken();
-        if steps_before >= budget.max_steps {
-            shown.abandon();
-            return Err(budget_stop(engine.time(), steps_spent(steps_before)));
+    }
+
+    fn budget_stop(&mut self, t: f64, reason: String) -> RunError<E::Summary> {
+        self.done = true;
+        RunError::Budget {
+            dir: self.out_dir.to_path_buf(),
+            t,
+            reason,
         }
-        engine.limit_steps(budget.max_steps - steps_before);
+    }
+
+    /// Advances the run to its next output sample and writes what is due there (the time-series row, a snapshot,
+    /// a checkpoint); after the last sample, the summary and the final manifest.
+    ///
+    /// Errors: as [`run`]; after any error, and after the run completed, the session is finished and a further
+    /// call is refused with [`RunError::Setup`].
+    pub fn step(&mut self) -> Result<Step<E::Summary>, RunError<E::Summary>> {
+        let result = self.step_inner();
+        if result.is_err() {
+            self.done = true;
+        }
+        result
+    }
+
+    fn step_inner(&mut self) -> Result<Step<E::Summary>, RunError<E::Summary>> {
+        if self.done {
+            return Err(RunError::Setup(format!(
+                "the run in {} has ended (t = {} s); nothing to advance",
+                self.out_dir.display(),
+                self.engine.time()
+            )));
+        }
+        let index = self.next_sample;
+        let total = self.samples.len() as u64;
+        let Some(&sample) = self.samples.get(index) else {
+            return self.complete().map(Step::Completed);
+        };
+        let budget_max_steps = self.budget.max_steps;
+        let t_end = self.engine.t_end();
+        // A resumed run whose budget is already spent stops where its checkpoint is, writing nothing.
+        let steps_before = self.engine.steps_taken();
+        if steps_before >= budget_max_steps {
+            self.shown.abandon();
+            let reason = self.steps_spent(steps_before);
+            return Err(self.budget_stop(self.engine.time(), reason));
+        }
+        self.engine.limit_steps(budget_max_steps - steps_before);
         let interval_started = Instant::now();
-        let t_before = engine.time();
-        let saved = match deadline {
-            Some(_) if index > 0 => Some(engine.save().map_err(io_err(out_dir))?),
+        let t_before = self.engine.time();
+        let saved = match self.deadline {
+            Some(_) if index > 0 => Some(self.engine.save().map_err(io_err(&self.out_dir))?),
             _ => None,
         };
         // The error of the last sample: the engine is busy while it advances.
-        let error = engine.error_so_far();
+        let error = self.engine.error_so_far();
+        let shown = &self.shown;
         let mut progress = |t: f64| shown.show(t, t_end, error);
-        if let Err(mut failure) = engine.advance(index, sample, &mut progress) {
+        if let Err(mut failure) = self.engine.advance(index, &sample, &mut progress) {
             if let (true, Some(state)) = (failure.deadline, saved) {
-                shown.abandon();
-                files.sync().map_err(file_err)?;
-                checkpoints += 1;
-                checkpoint_at(state, t_before, index as u64, rows, bytes, checkpoints)?;
-                let most = budget.max_wall_seconds.unwrap_or_default();
-                return Err(budget_stop(
+                self.shown.abandon();
+                self.files.sync().map_err(file_error)?;
+                self.checkpoint_at(state, t_before, index as u64)?;
+                let most = self.budget.max_wall_seconds.unwrap_or_default();
+                return Err(self.budget_stop(
                     t_before,
                     format!(
                         "the wall-clock budget: max_wall_seconds = {most} s ran out within the sample interval to t = \
@@ -869,53 +1058,62 @@ fn drive<E: Engine>(
                     ),
                 ));
             }
-            if engine.steps_taken() >= budget.max_steps {
+            if self.engine.steps_taken() >= budget_max_steps {
                 failure.cause = format!(
                     "{} within one sample interval (to t = {} s; the integrator said: {})",
-                    steps_spent(engine.steps_taken()),
+                    self.steps_spent(self.engine.steps_taken()),
                     sample.t,
                     failure.cause
                 );
             }
-            return Err(fail(engine, &failure, rows, &mut files));
+            return Err(self.fail(&failure));
         }
-        let row = match engine.sample(sample, wall()) {
+        let row = match self.engine.sample(&sample, self.wall_seconds()) {
             Ok(row) => row,
-            Err(SampleError::Failed(failure)) => return Err(fail(engine, &failure, rows, &mut files)),
-            Err(SampleError::Io { path, source }) => return Err(RunError::Io { path, source }),
+            Err(SampleError::Failed(failure)) => return Err(self.fail(&failure)),
+            Err(SampleError::Io { path, source }) => {
+                self.done = true;
+                return Err(RunError::Io { path, source });
+            }
         };
-        files.write_row(&row).map_err(file_err)?;
-        rows += 1;
-        bytes += row.len() as u64;
+        self.files.write_row(&row).map_err(file_error)?;
+        self.rows += 1;
+        self.bytes += row.len() as u64;
+        self.next_sample = index + 1;
         if let Some(k) = sample.snapshot {
-            let p = out_dir.join("snapshots").join(format!("{k}.csv"));
-            engine.write_snapshot(&p).map_err(io_err(&p))?;
-            files.snapshot_written(p);
+            let p = self.out_dir.join("snapshots").join(format!("{k}.csv"));
+            self.engine.write_snapshot(&p).map_err(io_err(&p))?;
+            self.files.snapshot_written(p);
+            let scene_formats: &[&str] = if self.engine.scene_vtk() { &["vtk"] } else { &[] };
+            let extra_formats = self.options.formats.with(scene_formats).selected();
             if !extra_formats.is_empty() {
-                let view = engine.view();
+                let view = self.engine.view();
                 // Every snapshot up to this one (a resumed run's earlier ones included), for formats' run indexes.
-                let written: Vec<(usize, f64)> = samples[..=index]
+                let written: Vec<(usize, f64)> = self.samples[..=index]
                     .iter()
                     .filter_map(|s| s.snapshot.map(|k| (k, s.t)))
                     .collect();
                 for f in &extra_formats {
-                    f.write(out_dir, k, &view, &written).map_err(io_err(out_dir))?;
+                    f.write(&self.out_dir, k, &view, &written)
+                        .map_err(io_err(&self.out_dir))?;
                 }
             }
         }
-        let t = engine.time();
-        shown.show(t, t_end, engine.error_so_far());
+        let t = self.engine.time();
+        self.shown.show(t, t_end, self.engine.error_so_far());
 
+        let options = &self.options;
         let due_wall = options
             .checkpoint_every
-            .is_some_and(|s| s > 0.0 && last_checkpoint_wall.elapsed().as_secs_f64() >= s);
+            .is_some_and(|s| s > 0.0 && self.last_checkpoint_wall.elapsed().as_secs_f64() >= s);
         let due_sim = options
             .checkpoint_every_sim
-            .is_some_and(|s| t - last_checkpoint_t >= s.max(0.0));
+            .is_some_and(|s| t - self.last_checkpoint_t >= s.max(0.0));
         // The budget: stop here, with a checkpoint, when the next interval (judged by this one) would overrun it.
-        let steps = engine.steps_taken();
+        let budget = &self.budget;
+        let steps = self.engine.steps_taken();
         let interval_steps = steps - steps_before;
-        let spent = started.elapsed().as_secs_f64();
+        let spent = self.started.elapsed().as_secs_f64();
         let interval_wall = interval_started.elapsed().as_secs_f64();
         let over_budget = if steps >= budget.max_steps || steps.saturating_add(interval_steps) > budget.max_steps {
             Some(format!(
@@ -936,40 +1134,52 @@ fn drive<E: Engine>(
         };
         let over_budget = over_budget.filter(|_| (index as u64) + 1 < total);
         if (index as u64) + 1 < total && (due_wall || due_sim || over_budget.is_some()) {
-            // The rows and snapshots the checkpoint counts must be on disk before it is.
-            files.sync().map_err(file_err)?;
-            let state = engine.save().map_err(io_err(out_dir))?;
-            checkpoints += 1;
-            checkpoint_at(state, t, index as u64 + 1, rows, bytes, checkpoints)?;
-            last_checkpoint_wall = Instant::now();
-            last_checkpoint_t = t;
-            checkpoints_here += 1;
+            self.checkpoint()?;
+            self.checkpoints_here += 1;
             if let Some(reason) = over_budget {
-                shown.abandon();
-                return Err(budget_stop(t, reason));
+                self.shown.abandon();
+                return Err(self.budget_stop(t, reason));
             }
-            if options.stop_after_checkpoints.is_some_and(|n| checkpoints_here >= n) {
-                shown.abandon();
+            if self
+                .options
+                .stop_after_checkpoints
+                .is_some_and(|n| self.checkpoints_here >= n)
+            {
+                self.shown.abandon();
+                self.done = true;
                 return Err(RunError::Stopped {
-                    dir: out_dir.to_path_buf(),
+                    dir: self.out_dir.to_path_buf(),
                     t,
-                    checkpoints,
+                    checkpoints: self.checkpoints,
                 });
             }
         }
+        if self.next_sample == self.samples.len() {
+            return self.complete().map(Step::Completed);
+        }
+        Ok(Step::Sampled)
     }
-    // The wall time is the run's; the final flush to disk comes after it, before the summary says "completed".
-    let wall_seconds = wall();
-    files.sync().map_err(file_err)?;
-    shown.finish();
-    let summary = engine.summary(Outcome::Completed, rows, wall_seconds);
-    let sp = out_dir.join("summary.json");
-    write_summary(&sp, &summary).map_err(io_err(&sp))?;
-    manifest
-        .borrow_mut()
-        .write(out_dir, "completed", true)
-        .map_err(io_err(&mp))?;
-    Ok(summary)
+
+    /// After the last sample: the summary and the final manifest.
+    fn complete(&mut self) -> Result<E::Summary, RunError<E::Summary>> {
+        self.done = true;
+        // The wall time is the run's; the final flush to disk comes after it, before the summary says "completed".
+        let wall_seconds = self.wall_seconds();
+        self.files.sync().map_err(file_error)?;
+        self.shown.finish();
+        let summary = self.engine.summary(Outcome::Completed, self.rows, wall_seconds);
+        let sp = self.out_dir.join("summary.json");
+        write_summary(&sp, &summary).map_err(io_err(&sp))?;
+        let mp = self.out_dir.join(MANIFEST_FILE);
+        self.manifest
+            .write(&self.out_dir, "completed", true)
+            .map_err(io_err(&mp))?;
+        Ok(summary)
+    }
+}
+
+fn file_error<S>((path, source): run_files::FileError) -> RunError<S> {
+    RunError::Io { path, source }
 }
 
 /// Runs an ellipsoid scene ([`run`] with [`EllipsoidEngine`]).

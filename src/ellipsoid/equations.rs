@@ -509,7 +509,22 @@ impl EllipsoidSystem {
     /// The packed initial state (quaternions normalised, `q̇ ⊥ q`).
     pub fn initial_state(&self) -> Vec<f64> {
         let mut y = vec![0.0; self.dim()];
-        for (i, b) in self.initial.iter().enumerate() {
+        self.pack_bodies(&self.initial, &mut y);
+        y
+    }
+
+    /// Whether attitudes are integrated (false for a system of spheres without dissipation, whose spins are
+    /// constant and whose attitudes follow from them).
+    pub fn integrates_attitudes(&self) -> bool {
+        self.rotation
+    }
+
+    /// Writes the positions, velocities and (when integrated, [`EllipsoidSystem::integrates_attitudes`]) attitudes
+    /// and body-frame spins of `bodies` (one per body of the system, in order; their shapes are not read) into the
+    /// packed state `y`, as [`EllipsoidSystem::initial_state`] packs the initial bodies (quaternions normalised,
+    /// `q̇ ⊥ q`). Components past the bodies' are left as they are.
+    pub fn pack_bodies(&self, bodies: &[Body], y: &mut [f64]) {
+        for (i, b) in bodies.iter().enumerate() {
             let s = &mut y[i * self.stride..(i + 1) * self.stride];
             let u = b.velocity * b.shape.mass;
             s[0..3].copy_from_slice(b.position.as_slice());
@@ -524,7 +539,6 @@ impl EllipsoidSystem {
                 s[3..6].copy_from_slice(u.as_slice());
             }
         }
-        y
     }
 
     /// Pulls every attitude of the packed state `y` back onto the constraint `|q| = 1, q·q̇ = 0` and returns the

@@ -415,6 +415,71 @@ impl EllipsoidEngine {
         &self.scene.warnings
     }
 
+    /// The bodies now: shapes, positions (m), velocities (m/s), attitude quaternions and body-frame spins (rad/s).
+    pub fn bodies(&self) -> Vec<crate::ellipsoid::body::Body> {
+        self.system.bodies_at(self.t, &self.y)
+    }
+
+    /// Replaces the state now by `bodies` (one per body, in order, shapes and masses the scene's): positions (m),
+    /// velocities (m/s), attitude quaternions (normalised here) and body-frame spins (rad/s). For a run between
+    /// two samples (e.g. from Python); the run continues from the new state, its conserved quantities measured
+    /// against those at t = 0 as before (so a change of energy counts in the energy error). Attitudes and spins
+    /// cannot change where they are not integrated ([`EllipsoidSystem::integrates_attitudes`]).
+    ///
+    /// Errors ([`EngineError::State`], one line, nothing changed): another number of bodies, another shape or
+    /// mass, a non-finite value, a changed attitude or spin that is not integrated.
+    pub fn set_bodies(&mut self, bodies: &[crate::ellipsoid::body::Body]) -> Result<(), EngineError> {
+        let now = self.bodies();
+        if bodies.len() != now.len() {
+            return Err(EngineError::State(format!(
+                "{} bodies given, the run has {}",
+                bodies.len(),
+                now.len()
+            )));
+        }
+        for (i, (b, old)) in bodies.iter().zip(&now).enumerate() {
+            if b.shape != old.shape {
+                return Err(EngineError::State(format!(
+                    "body[{i}]: its shape and mass are the scene's and cannot change"
+                )));
+            }
+            let finite = [b.position, b.velocity, b.spin_body]
+                .iter()
+                .all(|v| v.iter().all(|x| x.is_finite()))
+                && b.quaternion.iter().all(|x| x.is_finite())
+                && b.quaternion.norm() > 0.0;
+            if !finite {
+                return Err(EngineError::State(format!(
+                    "body[{i}]: a non-finite value (or a zero quaternion)"
+                )));
+            }
+            if !self.system.integrates_attitudes() && (b.quaternion != old.quaternion || b.spin_body != old.spin_body) {
+                return Err(EngineError::State(format!(
+                    "body[{i}]: attitudes and spins are not integrated in this run (spheres without dissipation); \
+                     only positions and velocities can change"
+                )));
+            }
+        }
+        let mut y = self.y.clone();
+        self.system.pack_bodies(bodies, &mut y);
+        // The integrator's compensated sums belong to the old state.
+        let mut state = self.integrator.save_state();
+        let compensation = match &mut state {
+            crate::integrate::IntegratorState::BulirschStoer(s) => Some(&mut s.compensation),
+            crate::integrate::IntegratorState::LinearlyImplicit(s) => Some(&mut s.compensation),
+            _ => None,
+        };
+        if let Some(c) = compensation {
+            c.iter_mut().for_each(|c| *c = 0.0);
+            self.integrator
+                .restore_state(&state)
+                .map_err(|e| EngineError::State(format!("integrator: {e}")))?;
+        }
+        self.y = y;
+        self.last_good = (self.t, self.y.clone());
+        Ok(())
+    }
+
     /// What the scene resolves to, for `rubblepile check` (κ, physics terms, integrator, outputs, bodies).
     pub fn describe(&self) -> Vec<String> {
         let s = &self.scene;
