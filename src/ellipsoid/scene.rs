@@ -83,39 +83,33 @@ pub const DEFAULT_SCENE_NAME: &str = "<built-in default scene>";
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// `[scene]`: what is simulated and for how long. Required.
-    #[field(table, meaning = "what is simulated and for how long (required)")]
+    /// what is simulated and for how long (required)
+    #[field(table)]
     pub scene: SceneSection,
-    /// `[model]`: model constants (κ, moments of inertia). Required.
-    #[field(table, meaning = "model constants: exactly one of kappa or calibrate (required)")]
+    /// model constants: exactly one of kappa or calibrate (required)
+    #[field(table)]
     pub model: ModelSection,
-    /// `[physics]`: which force terms are on. Optional; an absent table turns every term off
-    /// (the bodies then move freely).
+    /// the force terms; an absent term is not computed (absent table: bodies move freely)
     #[serde(default)]
-    #[field(
-        table,
-        meaning = "the force terms; an absent term is not computed (absent table: bodies move freely)"
-    )]
+    #[field(table)]
     pub physics: PhysicsSection,
-    /// `[integrator]`: method and tolerances. Optional; defaults as documented on
-    /// [`IntegratorSection`].
+    /// method and tolerances (optional)
     #[serde(default)]
-    #[field(table, meaning = "method and tolerances (optional)")]
+    #[field(table)]
     pub integrator: IntegratorSection,
-    /// `[output]`: snapshot times and time-series cadence. Required.
-    #[field(table, meaning = "snapshot times and time-series cadence (required)")]
+    /// snapshot times and time-series cadence (required)
+    #[field(table)]
     pub output: OutputSection,
-    /// `[[body]]`: the bodies, one table each, numbered `body[0]`, `body[1]`, … in file order.
-    /// Either these tables or `scene.bodies_file`, not both.
+    /// `[[body]]`: one ellipsoid each, `body[0]`, `body[1]`, … in file order (or `scene.bodies_file`).
     #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
     #[field(
         table,
         meaning = "one ellipsoid each, body[0], body[1], ... in file order (or scene.bodies_file)"
     )]
     pub bodies: Vec<BodySpec>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
-    #[field(table, meaning = "the run's budget: most steps and wall-clock seconds (optional)")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
@@ -129,8 +123,8 @@ pub struct SceneSection {
     #[field(unit = "text", default = "required", range = Rule("\"ellipsoids\""))]
     #[field(meaning = "which engine reads the scene")]
     pub kind: String,
-    /// End time of the run (s), > 0. Required. The run starts at t = 0.
-    #[field(unit = "s", default = "required", range = Positive, meaning = "end time of the run; it starts at t = 0")]
+    /// end time of the run; it starts at t = 0
+    #[field(unit = "s", default = "required", range = Positive)]
     pub t_end: f64,
     /// Random seed (non-negative integer). Default 0. Recorded in `summary.json`; the ellipsoids
     /// model itself is deterministic and draws no random numbers.
@@ -164,12 +158,9 @@ pub struct ModelSection {
                    calibrate"
     )]
     pub kappa: Option<f64>,
-    /// Compute κ from Roig03 Eq. 14 instead of giving it: `calibrate = { beta = 10.0, v = 20.0 }`.
+    /// kappa from Roig03 Eq. 14 for the lightest and heaviest body, instead of model.kappa
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(
-        table,
-        meaning = "kappa from Roig03 Eq. 14 for the lightest and heaviest body, instead of model.kappa"
-    )]
+    #[field(table)]
     pub calibrate: Option<CalibrateSpec>,
     /// Moments of inertia: `"gaussian"` (Roig03 Eq. 4 with the model's κ, the paper's choice) or
     /// `"uniform"` (uniform-density ellipsoid, i.e. Eq. 4 with κ = 5/2). Default `"gaussian"`.
@@ -190,9 +181,8 @@ pub struct CalibrateSpec {
     #[field(unit = "-", default = "required", range = Positive)]
     #[field(meaning = "contact barrier over the kinetic energy at speed v (Roig03 Eq. 14)")]
     pub beta: f64,
-    /// Relative speed `v` of Eq. 14 (m/s, > 0) the contact must withstand. Required.
+    /// relative speed the contact must withstand (Roig03 Eq. 14)
     #[field(unit = "m/s", default = "required", range = Positive)]
-    #[field(meaning = "relative speed the contact must withstand (Roig03 Eq. 14)")]
     pub v: f64,
     /// Which kinetic energy the barrier is β times (Roig03 Eq. 13's `K`): `"printed"` (`½ m_l v²`, Eq. 14
     /// as printed; the default), `"impactor"` (`½ m_k v²`) or `"reduced"` (`½ μ v²`, the pair's relative
@@ -208,27 +198,21 @@ pub struct CalibrateSpec {
 #[scene(table = "physics")]
 #[serde(deny_unknown_fields)]
 pub struct PhysicsSection {
-    /// Monopole gravity between centres of mass (Roig03 Eq. 6): `gravity = {}` or `gravity = { G = … }`.
+    /// monopole gravity between centres of mass (Roig03 Eq. 6); `gravity = {}` turns it on
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(
-        table,
-        meaning = "monopole gravity between centres of mass (Roig03 Eq. 6); `gravity = {}` turns it on"
-    )]
+    #[field(table)]
     pub gravity: Option<GravitySpec>,
-    /// Gaussian-overlap contact potential (Roig03 Eqs. 7–12): `contact = {}` or `contact = { cutoff = … }`.
+    /// Gaussian-overlap contact potential (Roig03 Eqs. 7-12); `contact = {}` turns it on
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(
-        table,
-        meaning = "Gaussian-overlap contact potential (Roig03 Eqs. 7-12); `contact = {}` turns it on"
-    )]
+    #[field(table)]
     pub contact: Option<ContactSpec>,
-    /// Point dissipation (Roig03 Eqs. 40–41): `dissipation = { F0 = … }`.
+    /// point dissipation (Roig03 Eqs. 40-41)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(table, meaning = "point dissipation (Roig03 Eqs. 40-41)")]
+    #[field(table)]
     pub dissipation: Option<DissipationSpec>,
-    /// Tide of a planet on a prescribed orbit, `[physics.flyby]` (see [`FlybySpec`]). Default: none.
+    /// tide of a planet on a prescribed Kepler orbit (none if absent)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(table, meaning = "tide of a planet on a prescribed Kepler orbit (none if absent)")]
+    #[field(table)]
     pub flyby: Option<FlybySpec>,
 }
 
@@ -425,15 +409,13 @@ pub struct OutputSection {
 #[scene(table = "body")]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
-    /// Semi-axes `[A, B, C]` (m) along the body x, y, z axes, with `A ≥ B ≥ C ≥ 1e-300` (exactly three). Required.
+    /// semi-axes along the body x, y, z axes
     #[serde(deserialize_with = "exact::array")]
     #[field(unit = "m", default = "required", range = Rule("[A, B, C], A >= B >= C >= 1e-300"))]
-    #[field(meaning = "semi-axes along the body x, y, z axes")]
     pub axes: [f64; 3],
-    /// Mass (kg, finite, ≥ 1e-300). Give exactly one of `mass` and `density`.
+    /// mass; exactly one of mass, density
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "kg", default = "(mass or density)", range = Positive)]
-    #[field(meaning = "mass; exactly one of mass, density")]
     pub mass: Option<f64>,
     /// Bulk density (kg/m³, finite, ≥ 1e-300); then `mass = density · 4/3 π A B C` (which must be finite and
     /// ≥ 1e-300 too). Give exactly one of `mass` and `density`.

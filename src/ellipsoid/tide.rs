@@ -54,14 +54,12 @@ pub struct FlybySpec {
     #[field(unit = "kg", default = "required", range = NonNegative)]
     #[field(meaning = "planet mass (0: no pull, the frame moves in a straight line at v_inf)")]
     pub mass: f64,
-    /// Planet radius (m, > 0). Optional (no default): when given, the perigee must lie outside it.
+    /// planet radius: the perigee must lie outside it; the reference radius of j2
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "none", range = Positive)]
-    #[field(meaning = "planet radius: the perigee must lie outside it; the reference radius of j2")]
     pub radius: Option<f64>,
-    /// Perigee distance `q` (m, > 0) between the planet's centre and the frame origin. Required.
+    /// perigee distance between the planet's centre and the frame origin
     #[field(unit = "m", default = "required", range = Positive)]
-    #[field(meaning = "perigee distance between the planet's centre and the frame origin")]
     pub q: f64,
     /// Speed at infinity `v∞` (m/s, > 0) of a hyperbolic flyby, `e = 1 + q v∞²/GM`. Give exactly one of `v_inf`
     /// and `eccentricity`.
@@ -75,8 +73,8 @@ pub struct FlybySpec {
     #[field(unit = "-", default = "(v_inf or eccentricity)", range = Rule(">= 0, != 1; needs mass > 0"))]
     #[field(meaning = "orbit eccentricity (< 1 elliptic, > 1 hyperbolic); exactly one of v_inf, eccentricity")]
     pub eccentricity: Option<f64>,
-    /// Time of perigee passage (s, finite). Required.
-    #[field(unit = "s", default = "required", range = Rule("finite"), meaning = "time of perigee passage")]
+    /// time of perigee passage
+    #[field(unit = "s", default = "required", range = Rule("finite"))]
     pub t_perigee: f64,
     /// Orientation `[Ω, i, ω]` (degrees) of the frame origin's orbit about the planet: longitude of the node,
     /// inclination and argument of perigee, perifocal → frame `R_z(Ω) R_x(i) R_z(ω)`. Default `[0, 0, 0]`: the orbit

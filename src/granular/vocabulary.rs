@@ -38,21 +38,19 @@ pub const HARD_KIND: &str = "hard-spheres";
 #[scene(table = "wall.oscillation")]
 #[serde(deny_unknown_fields)]
 pub struct OscillationSpec {
-    /// Amplitude A (m): 0 or in [1e-300, finite).
-    #[field(unit = "m", default = "required", range = Rule("0 or >= 1e-300, finite"), meaning = "amplitude A")]
+    /// amplitude A
+    #[field(unit = "m", default = "required", range = Rule("0 or >= 1e-300, finite"))]
     pub amplitude: f64,
-    /// Angular frequency ω (rad/s; ω = 2π f), finite, with a finite wall speed `A ω`.
+    /// angular frequency omega = 2 pi f
     #[field(unit = "rad/s", default = "required", range = Rule("finite, A omega finite"))]
-    #[field(meaning = "angular frequency omega = 2 pi f")]
     pub angular_frequency: f64,
-    /// Phase φ (rad). Default 0.
+    /// phase phi
     #[serde(default)]
-    #[field(unit = "rad", default = "0", range = Rule("finite"), meaning = "phase phi")]
+    #[field(unit = "rad", default = "0", range = Rule("finite"))]
     pub phase: f64,
-    /// Direction d̂ (normalised; must not vanish). Default the wall's normal or axis.
+    /// direction of the oscillation (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "normal or axis, else required", range = Rule("3 finite numbers, non-zero"))]
-    #[field(meaning = "direction of the oscillation (normalised)")]
     pub direction: Option<[f64; 3]>,
 }
 

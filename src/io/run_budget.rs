@@ -141,13 +141,10 @@ pub fn check_max_steps(n: f64) -> Result<u64, String> {
 #[scene(table = "run")]
 #[serde(deny_unknown_fields)]
 pub struct RunSection {
-    /// Most steps the run may take ([`DEFAULT_MAX_STEPS`] when absent), in [1, [`MAX_MAX_STEPS`]].
+    /// most steps the run may take; a scene estimated to need more is refused, a run reaching it stops with a
+    /// checkpoint (also --max-steps)
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "count", default = "1e9", range = closed(1.0, MAX_MAX_STEPS as f64))]
-    #[field(
-        meaning = "most steps the run may take; a scene estimated to need more is refused, a run reaching it stops \
-                   with a checkpoint (also --max-steps)"
-    )]
     pub max_steps: Option<u64>,
     /// Most wall-clock seconds a process may run the run (none when absent), in [[`MIN_WALL_BUDGET`],
     /// [`MAX_WALL_BUDGET`]].

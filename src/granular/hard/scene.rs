@@ -97,40 +97,34 @@ pub struct ParticleRow {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct HardSceneFile {
-    /// `[scene]`. Required.
-    #[field(table, meaning = "what is simulated and for how long (required)")]
+    /// what is simulated and for how long (required)
+    #[field(table)]
     pub scene: HardSceneSection,
-    /// `[stepping]`. Required (for `dt`).
-    #[field(table, meaning = "the kick-drift-kick step and the event guards (required)")]
+    /// the kick-drift-kick step and the event guards (required)
+    #[field(table)]
     pub stepping: SteppingSection,
-    /// `[gravity]`: optional uniform field.
+    /// uniform field (optional; absent = none)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(table, meaning = "uniform field (optional; absent = none)")]
+    #[field(table)]
     pub gravity: Option<GravitySection>,
-    /// `[material]`: particle defaults. Optional.
+    /// restitution of every particle unless its own table overrides it (optional)
     #[serde(default)]
-    #[field(
-        table,
-        meaning = "restitution of every particle unless its own table overrides it (optional)"
-    )]
+    #[field(table)]
     pub material: MaterialSection,
-    /// `[output]`. Required.
-    #[field(table, meaning = "snapshot times and time-series cadence (required)")]
+    /// snapshot times and time-series cadence (required)
+    #[field(table)]
     pub output: HardOutputSection,
-    /// `[[particle]]` tables (or `scene.particles_file`).
+    /// one sphere each (or scene.particles_file)
     #[serde(default, rename = "particle", skip_serializing_if = "Vec::is_empty")]
-    #[field(table, meaning = "one sphere each (or scene.particles_file)")]
+    #[field(table)]
     pub particles: Vec<ParticleSpec>,
-    /// `[[wall]]` tables. Optional.
+    /// one wall each: plane, disk, cylinder, ring, point or line, possibly moving
     #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
-    #[field(
-        table,
-        meaning = "one wall each: plane, disk, cylinder, ring, point or line, possibly moving"
-    )]
+    #[field(table)]
     pub walls: Vec<WallSpec>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
-    #[field(table, meaning = "the run's budget: most steps and wall-clock seconds (optional)")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
@@ -139,17 +133,15 @@ pub struct HardSceneFile {
 #[scene(table = "scene")]
 #[serde(deny_unknown_fields)]
 pub struct HardSceneSection {
-    /// Must be `"hard-spheres"`.
+    /// which engine reads the scene
     #[field(unit = "text", default = "required", range = Rule("\"hard-spheres\""))]
-    #[field(meaning = "which engine reads the scene")]
     pub kind: String,
-    /// End time (s), > 0. Required.
-    #[field(unit = "s", default = "required", range = Positive, meaning = "end time of the run; it starts at t = 0")]
+    /// end time of the run; it starts at t = 0
+    #[field(unit = "s", default = "required", range = Positive)]
     pub t_end: f64,
-    /// Seed (recorded in `summary.json`; the hard-sphere engine is deterministic and draws no random numbers).
+    /// recorded in summary.json; the engine draws no random numbers
     #[serde(default)]
     #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
-    #[field(meaning = "recorded in summary.json; the engine draws no random numbers")]
     pub seed: u64,
     /// CSV with the initial particles instead of `[[particle]]` tables, relative to the scene file's directory;
     /// columns `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (kg, m, m/s, rad/s; `t` and `id` ignored), so a snapshot
@@ -204,9 +196,9 @@ fn default_skin_steps() -> f64 {
 #[scene(table = "gravity")]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Required in the table.
+    /// uniform acceleration
     #[serde(deserialize_with = "exact::array")]
-    #[field(unit = "m/s^2", default = "required", range = Rule("3 finite numbers"), meaning = "uniform acceleration")]
+    #[field(unit = "m/s^2", default = "required", range = Rule("3 finite numbers"))]
     pub uniform: [f64; 3],
 }
 
@@ -215,15 +207,13 @@ pub struct GravitySection {
 #[scene(table = "material")]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
-    /// Normal coefficient of restitution ε_n ∈ [0, 1] (dimensionless). Default 1 (elastic).
+    /// normal coefficient of restitution of every particle
     #[serde(default = "one")]
     #[field(unit = "-", default = "1 (elastic)", range = closed(0.0, 1.0))]
-    #[field(meaning = "normal coefficient of restitution of every particle")]
     pub eps_n: f64,
-    /// Tangential coefficient of restitution ε_t ∈ [−1, 1] (dimensionless; 1 smooth). Default 1.
+    /// tangential coefficient of restitution of every particle
     #[serde(default = "one")]
     #[field(unit = "-", default = "1 (smooth)", range = closed(-1.0, 1.0))]
-    #[field(meaning = "tangential coefficient of restitution of every particle")]
     pub eps_t: f64,
 }
 
@@ -242,7 +232,7 @@ impl Default for MaterialSection {
 #[scene(table = "output")]
 #[serde(deny_unknown_fields)]
 pub struct HardOutputSection {
-    /// Snapshot times (s), strictly increasing in `[0, t_end]`, at most 1e5 ([`crate::io::scene_file::MAX_SNAPSHOTS`]). Default `[0, t_end]`.
+    /// Snapshot times (`snapshots/<k>.csv`); not with `snapshot_every`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], <= 1e5"))]
     #[field(meaning = "snapshot times (snapshots/<k>.csv); not with snapshot_every")]
@@ -253,9 +243,8 @@ pub struct HardOutputSection {
     #[field(unit = "s", default = "none", range = Rule(">= 1e-300, <= 1e5 snapshots"))]
     #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
     pub snapshot_every: Option<f64>,
-    /// Time-series cadence (s), at least `t_end × 1e-12` and `t_end / 1e8` (at most 1e8 rows). Required.
+    /// time-series cadence (timeseries.csv rows)
     #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
-    #[field(meaning = "time-series cadence (timeseries.csv rows)")]
     pub every: f64,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
@@ -270,11 +259,11 @@ pub struct HardOutputSection {
 #[scene(table = "particle")]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Mass (kg), finite, ≥ 1e-300.
-    #[field(unit = "kg", default = "required", range = Positive, meaning = "mass")]
+    /// mass
+    #[field(unit = "kg", default = "required", range = Positive)]
     pub mass: f64,
-    /// Radius (m), finite, ≥ 1e-300.
-    #[field(unit = "m", default = "required", range = Positive, meaning = "radius")]
+    /// radius
+    #[field(unit = "m", default = "required", range = Positive)]
     pub radius: f64,
     /// Centre `[x, y, z]` (m, finite). At t = 0 it may overlap another sphere or a wall by at most
     /// [`MAX_START_OVERLAP`] of its radius.
@@ -282,22 +271,21 @@ pub struct ParticleSpec {
     #[field(unit = "m", default = "required", range = Rule("3 finite numbers; overlaps <= 1e-3 of the radius"))]
     #[field(meaning = "centre")]
     pub position: [f64; 3],
-    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    /// velocity
     #[serde(default, deserialize_with = "exact::array")]
-    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"), meaning = "velocity")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub velocity: [f64; 3],
-    /// Spin, world frame (rad/s, finite, with a finite rotational energy). Default 0.
+    /// spin, world frame
     #[serde(default, deserialize_with = "exact::array")]
-    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"), meaning = "spin, world frame")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub spin: [f64; 3],
-    /// ε_n ∈ [0, 1]; default `material.eps_n`. A pair uses the mean of its two particles' values.
+    /// this particle's eps_n; a pair uses the mean of its two values
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "material.eps_n", range = closed(0.0, 1.0))]
-    #[field(meaning = "this particle's eps_n; a pair uses the mean of its two values")]
     pub eps_n: Option<f64>,
-    /// ε_t ∈ [−1, 1]; default `material.eps_t`.
+    /// this particle's eps_t
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(unit = "-", default = "material.eps_t", range = closed(-1.0, 1.0), meaning = "this particle's eps_t")]
+    #[field(unit = "-", default = "material.eps_t", range = closed(-1.0, 1.0))]
     pub eps_t: Option<f64>,
     /// Index of the wall this particle is attached to from t = 0 (it then moves rigidly with the wall, as an
     /// infinite mass: a rough lining). Default: free.
@@ -312,19 +300,16 @@ pub struct ParticleSpec {
 #[scene(table = "wall")]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
-    /// `"plane"`, `"disk"`, `"cylinder"`, `"ring"`, `"point"` or `"line"`. Required.
+    /// the wall's shape
     #[field(unit = "text", default = "required", range = Rule("plane | disk | cylinder | ring | point | line"))]
-    #[field(meaning = "the wall's shape")]
     pub kind: String,
-    /// Plane: a point of it at t = 0 (m). Default the origin.
+    /// a point of the plane at t = 0
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "[0, 0, 0]", range = Rule("3 finite numbers; plane only"))]
-    #[field(meaning = "a point of the plane at t = 0")]
     pub point: Option<[f64; 3]>,
-    /// Plane: its normal (normalised; must not vanish). Default `[0, 0, 1]`.
+    /// plane normal (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; plane only"))]
-    #[field(meaning = "plane normal (normalised)")]
     pub normal: Option<[f64; 3]>,
     /// The others: the centre at t = 0 (m) of the disk, ring or point, the middle of the cylinder's or line's axis
     /// segment. Default the origin.
@@ -332,10 +317,9 @@ pub struct WallSpec {
     #[field(unit = "m", default = "[0, 0, 0]", range = Rule("3 finite numbers; not a plane"))]
     #[field(meaning = "centre at t = 0 of a disk, ring or point; middle of a cylinder's or line's axis")]
     pub centre: Option<[f64; 3]>,
-    /// The others: the axis, normal to a disk or ring (normalised; must not vanish). Default `[0, 0, 1]`.
+    /// disk/ring normal, cylinder/line axis (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; not a plane"))]
-    #[field(meaning = "disk/ring normal, cylinder/line axis (normalised)")]
     pub axis: Option<[f64; 3]>,
     /// Radius (m) of a disk (≥ 1e-300), ring (0 or ≥ 1e-300; 0 is a point) or cylinder (0 or ≥ 1e-300; 0 is a
     /// line).
@@ -350,43 +334,33 @@ pub struct WallSpec {
     #[field(unit = "m", default = "infinite", range = Rule("0 or >= 1e-300; cylinder, line"))]
     #[field(meaning = "length centred on centre; a cylinder of length 0 is a ring")]
     pub length: Option<f64>,
-    /// Constant translation velocity (m/s). Default 0.
+    /// constant translation velocity
     #[serde(default, deserialize_with = "exact::array")]
     #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
-    #[field(meaning = "constant translation velocity")]
     pub velocity: [f64; 3],
-    /// Sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase (rad),
-    /// direction (default the normal or axis). Optional.
+    /// sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(
-        table,
-        meaning = "sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)"
-    )]
+    #[field(table)]
     pub oscillation: Option<OscillationSpec>,
-    /// Spin about the axis (rad/s, right-handed); moves the surface tangentially. Default 0.
+    /// spin about the axis (right-handed): moves the surface tangentially
     #[serde(default)]
     #[field(unit = "rad/s", default = "0", range = Rule("finite"))]
-    #[field(meaning = "spin about the axis (right-handed): moves the surface tangentially")]
     pub spin: f64,
-    /// ε_n override ∈ [0, 1] for collisions with this wall.
+    /// eps_n of collisions with this wall
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "the particle's", range = closed(0.0, 1.0))]
-    #[field(meaning = "eps_n of collisions with this wall")]
     pub eps_n: Option<f64>,
-    /// ε_t override ∈ [−1, 1].
+    /// eps_t of collisions with this wall
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "the particle's", range = closed(-1.0, 1.0))]
-    #[field(meaning = "eps_t of collisions with this wall")]
     pub eps_t: Option<f64>,
-    /// Particles that touch it stay rigidly attached and move with it. Default false.
+    /// particles that touch it stay attached and move with it
     #[serde(default)]
     #[field(unit = "bool", default = "false", range = Rule("true | false; not with absorbing"))]
-    #[field(meaning = "particles that touch it stay attached and move with it")]
     pub sticky: bool,
-    /// Particles that touch it are removed and counted. Default false.
+    /// particles that touch it are removed and counted
     #[serde(default)]
     #[field(unit = "bool", default = "false", range = Rule("true | false"))]
-    #[field(meaning = "particles that touch it are removed and counted")]
     pub absorbing: bool,
 }
 

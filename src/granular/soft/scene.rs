@@ -95,48 +95,38 @@ pub const KIND: &str = crate::granular::vocabulary::SOFT_KIND;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct SoftSceneFile {
-    /// `[scene]`.
-    #[field(table, meaning = "what is simulated and for how long (required)")]
-    pub scene: SoftSceneSection,
-    /// `[stepping]`.
-    #[field(table, meaning = "the fixed leapfrog step (required)")]
-    pub stepping: SoftSteppingSection,
-    /// `[material]`.
+    /// what is simulated and for how long (required)
     #[field(table)]
-    #[field(
-        meaning = "the contact law's material, Zhang17 Eqs. 1-12 (required for k_n; the rest default to Zhang17's \
-                   nominal set)"
-    )]
+    pub scene: SoftSceneSection,
+    /// the fixed leapfrog step (required)
+    #[field(table)]
+    pub stepping: SoftSteppingSection,
+    /// the contact law's material, Zhang17 Eqs. 1-12 (required for k_n; the rest default to Zhang17's nominal set)
+    #[field(table)]
     pub material: MaterialSection,
-    /// `[gravity]`, optional.
+    /// uniform field and self-gravity (optional; absent = no gravity)
     #[serde(default)]
-    #[field(table, meaning = "uniform field and self-gravity (optional; absent = no gravity)")]
+    #[field(table)]
     pub gravity: GravitySection,
-    /// `[output]`.
-    #[field(table, meaning = "time-series cadence and snapshot times (required)")]
+    /// time-series cadence and snapshot times (required)
+    #[field(table)]
     pub output: SoftOutputSection,
-    /// `[[wall]]` tables.
+    /// one wall each: a plane (point, normal), the inside of a sphere (centre, radius) or a cylinder (centre, axis,
+    /// radius, length)
     #[serde(default, rename = "wall")]
     #[field(table)]
-    #[field(
-        meaning = "one wall each: a plane (point, normal), the inside of a sphere (centre, radius) or a cylinder \
-                   (centre, axis, radius, length)"
-    )]
     pub walls: Vec<WallSpec>,
-    /// `[[particle]]` tables (or `scene.particles_file`).
+    /// one sphere each (or scene.particles_file)
     #[serde(default, rename = "particle")]
-    #[field(table, meaning = "one sphere each (or scene.particles_file)")]
+    #[field(table)]
     pub particles: Vec<ParticleSpec>,
-    /// `[spinup]`, optional: spin-up forcing and diagnostics ([`crate::granular::soft::spinup`]).
+    /// spin-up forcing along a period path T(t) and its diagnostics (optional; Zhang17 §2.3.4)
     #[serde(default)]
-    #[field(
-        table,
-        meaning = "spin-up forcing along a period path T(t) and its diagnostics (optional; Zhang17 §2.3.4)"
-    )]
+    #[field(table)]
     pub spinup: Option<crate::granular::soft::spinup::SpinupSection>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
-    #[field(table, meaning = "the run's budget: most steps and wall-clock seconds (optional)")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
@@ -145,18 +135,15 @@ pub struct SoftSceneFile {
 #[scene(table = "scene")]
 #[serde(deny_unknown_fields)]
 pub struct SoftSceneSection {
-    /// Must be `"soft-spheres"`.
+    /// which engine reads the scene
     #[field(unit = "text", default = "required", range = Rule("\"soft-spheres\""))]
-    #[field(meaning = "which engine reads the scene")]
     pub kind: String,
-    /// End time (s, > 0).
+    /// end time; the run takes round(t_end/dt) steps
     #[field(unit = "s", default = "required", range = Positive)]
-    #[field(meaning = "end time; the run takes round(t_end/dt) steps")]
     pub t_end: f64,
-    /// Seed, recorded in the summary (default 0).
+    /// recorded in the summary; the engine draws no random numbers
     #[serde(default)]
     #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
-    #[field(meaning = "recorded in the summary; the engine draws no random numbers")]
     pub seed: u64,
     /// CSV of the initial particles (relative to the scene's directory), columns
     /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (`t`, `id` optional and ignored): a snapshot works.
@@ -202,40 +189,36 @@ fn d005() -> f64 {
 #[scene(table = "material")]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
-    /// Normal spring constant (N/m, > 0). Required.
+    /// normal spring constant (k_S = 2/7 k_N); see `rubblepile ssdem advise`
     #[field(unit = "N/m", default = "required", range = Positive)]
-    #[field(meaning = "normal spring constant (k_S = 2/7 k_N); see `rubblepile ssdem advise`")]
     pub k_n: f64,
-    /// Normal restitution ε_n, in (0, 1]. Default 0.55.
-    #[serde(default = "d055")]
-    #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0), meaning = "normal coefficient of restitution")]
-    pub eps_n: f64,
-    /// Tangential restitution ε_t, in (0, 1]. Default 0.55.
+    /// normal coefficient of restitution
     #[serde(default = "d055")]
     #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
-    #[field(meaning = "tangential coefficient of restitution")]
+    pub eps_n: f64,
+    /// tangential coefficient of restitution
+    #[serde(default = "d055")]
+    #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
     pub eps_t: f64,
-    /// Sliding friction μ_S (≥ 0). Default 1.0.
+    /// sliding friction coefficient
     #[serde(default = "d1")]
-    #[field(unit = "-", default = "1.0", range = NonNegative, meaning = "sliding friction coefficient")]
+    #[field(unit = "-", default = "1.0", range = NonNegative)]
     pub mu_s: f64,
-    /// Twisting friction μ_T (≥ 0). Default 1.3.
+    /// twisting friction coefficient
     #[serde(default = "d13")]
-    #[field(unit = "-", default = "1.3", range = NonNegative, meaning = "twisting friction coefficient")]
+    #[field(unit = "-", default = "1.3", range = NonNegative)]
     pub mu_t: f64,
-    /// Rolling friction μ_R (≥ 0). Default 1.05.
+    /// rolling friction coefficient
     #[serde(default = "d105")]
-    #[field(unit = "-", default = "1.05", range = NonNegative, meaning = "rolling friction coefficient")]
+    #[field(unit = "-", default = "1.05", range = NonNegative)]
     pub mu_r: f64,
-    /// Shape parameter β (≥ 0). Default 0.5.
+    /// shape parameter (0 = no twisting or rolling resistance)
     #[serde(default = "d05")]
     #[field(unit = "-", default = "0.5", range = NonNegative)]
-    #[field(meaning = "shape parameter (0 = no twisting or rolling resistance)")]
     pub beta: f64,
-    /// Largest initial overlap accepted, as a fraction of the smaller radius (≥ 0). Default 0.05.
+    /// largest initial overlap accepted, as a fraction of the smaller radius
     #[serde(default = "d005")]
     #[field(unit = "-", default = "0.05", range = NonNegative)]
-    #[field(meaning = "largest initial overlap accepted, as a fraction of the smaller radius")]
     pub max_start_overlap: f64,
 }
 
@@ -244,19 +227,17 @@ pub struct MaterialSection {
 #[scene(table = "gravity")]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Default none.
+    /// uniform acceleration
     #[serde(default, deserialize_with = "exact::option")]
-    #[field(unit = "m/s^2", default = "none", range = Rule("3 finite numbers"), meaning = "uniform acceleration")]
+    #[field(unit = "m/s^2", default = "none", range = Rule("3 finite numbers"))]
     pub uniform: Option<[f64; 3]>,
-    /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
+    /// self-gravity by octree (quadrupole) or exact pair sum; absent = none
     #[serde(default, rename = "self")]
     #[field(unit = "text", default = "none", range = Rule("\"tree\" | \"direct\""))]
-    #[field(meaning = "self-gravity by octree (quadrupole) or exact pair sum; absent = none")]
     pub self_gravity: Option<String>,
-    /// Tree opening angle θ (in (0, 1]). Default 0.5.
+    /// tree opening angle; only with self = "tree"
     #[serde(default)]
     #[field(unit = "-", default = "0.5", range = open_closed(0.0, 1.0))]
-    #[field(meaning = "tree opening angle; only with self = \"tree\"")]
     pub theta: Option<f64>,
     /// Steps (an integer ≥ 1) between self-gravity evaluations: self-gravity is applied as kicks of `k dt/2` at
     /// both ends of each block of `k` steps (r-RESPA, [`crate::granular::soft::respa`]). Default 1 (every step).
@@ -264,10 +245,9 @@ pub struct GravitySection {
     #[field(unit = "steps", default = "1", range = Rule("integer >= 1; > 1 needs self"))]
     #[field(meaning = "steps between self-gravity evaluations (r-RESPA kicks)")]
     pub interval_steps: Option<i64>,
-    /// Gravitational constant (m³ kg⁻¹ s⁻², > 0). Default 6.674e-11.
+    /// gravitational constant of the self-gravity
     #[serde(default, rename = "G")]
     #[field(unit = "m^3 kg^-1 s^-2", default = "6.674e-11", range = Positive)]
-    #[field(meaning = "gravitational constant of the self-gravity")]
     pub g: Option<f64>,
 }
 
@@ -307,52 +287,40 @@ pub struct SoftOutputSection {
 #[scene(table = "wall")]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
-    /// `"plane"`, `"sphere"` or `"cylinder"`.
+    /// a half-space, the inside of a sphere, or a cylinder (touched from inside or outside)
     #[field(unit = "text", default = "required", range = Rule("\"plane\" | \"sphere\" | \"cylinder\""))]
-    #[field(meaning = "a half-space, the inside of a sphere, or a cylinder (touched from inside or outside)")]
     pub kind: String,
-    /// Plane: a point on it (m).
+    /// a point of the plane
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "required by \"plane\"", range = Rule("3 finite numbers"))]
-    #[field(meaning = "a point of the plane")]
     pub point: Option<[f64; 3]>,
-    /// Plane: normal towards the particles (any length > 0; normalised).
+    /// plane normal towards the particles (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "required by \"plane\"", range = Rule("3 finite numbers, non-zero"))]
-    #[field(meaning = "plane normal towards the particles (normalised)")]
     pub normal: Option<[f64; 3]>,
-    /// Sphere: centre; cylinder: the middle of its axis segment (m).
+    /// centre of a sphere wall, middle of a cylinder's axis
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "required by \"sphere\", \"cylinder\"", range = Rule("3 finite numbers"))]
-    #[field(meaning = "centre of a sphere wall, middle of a cylinder's axis")]
     pub centre: Option<[f64; 3]>,
-    /// Cylinder: axis (any length > 0; normalised).
+    /// cylinder axis (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "required by \"cylinder\"", range = Rule("3 finite numbers, non-zero"))]
-    #[field(meaning = "cylinder axis (normalised)")]
     pub axis: Option<[f64; 3]>,
-    /// Sphere: inner radius; cylinder: radius (m, ≥ 1e-300).
+    /// inner radius of a sphere wall, radius of a cylinder
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "required by \"sphere\", \"cylinder\"", range = Positive)]
-    #[field(meaning = "inner radius of a sphere wall, radius of a cylinder")]
     pub radius: Option<f64>,
-    /// Cylinder: length along the axis, centred on `centre` (m, ≥ 1e-300). Default infinite.
+    /// length of a cylinder along its axis, centred on its centre
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "infinite", range = Positive)]
-    #[field(meaning = "length of a cylinder along its axis, centred on its centre")]
     pub length: Option<f64>,
-    /// Optional sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase
-    /// (rad), direction (default the plane's normal or the cylinder's axis; required for a sphere).
+    /// sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    #[field(
-        table,
-        meaning = "sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)"
-    )]
+    #[field(table)]
     pub oscillation: Option<OscillationSpec>,
-    /// Cylinder: spin about the axis (rad/s, right-handed, finite). Default 0.
+    /// spin about the axis (right-handed): moves the surface tangentially
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "rad/s", default = "0", range = Rule("finite; \"cylinder\" only"))]
-    #[field(meaning = "spin about the axis (right-handed): moves the surface tangentially")]
     pub spin: Option<f64>,
 }
 
@@ -361,31 +329,28 @@ pub struct WallSpec {
 #[scene(table = "particle")]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Radius (m, finite, ≥ 1e-300).
-    #[field(unit = "m", default = "required", range = Positive, meaning = "sphere radius")]
+    /// sphere radius
+    #[field(unit = "m", default = "required", range = Positive)]
     pub radius: f64,
-    /// Mass (kg, finite, ≥ 1e-300); exactly one of `mass` and `density`.
+    /// mass; exactly one of mass, density
     #[serde(default)]
     #[field(unit = "kg", default = "(mass or density)", range = Positive)]
-    #[field(meaning = "mass; exactly one of mass, density")]
     pub mass: Option<f64>,
-    /// Grain density (kg/m³, finite, ≥ 1e-300); then `mass = 4/3 π r³ density` (finite, ≥ 1e-300).
+    /// grain density: mass = 4/3 pi r^3 density
     #[serde(default)]
     #[field(unit = "kg/m^3", default = "(mass or density)", range = Positive)]
-    #[field(meaning = "grain density: mass = 4/3 pi r^3 density")]
     pub density: Option<f64>,
-    /// Centre position (m, finite).
+    /// centre
     #[serde(deserialize_with = "exact::array")]
     #[field(unit = "m", default = "required", range = Rule("3 finite numbers; overlaps <= contact.max_start_overlap"))]
-    #[field(meaning = "centre")]
     pub position: [f64; 3],
-    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    /// velocity
     #[serde(default, deserialize_with = "exact::array")]
-    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"), meaning = "velocity")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub velocity: [f64; 3],
-    /// Spin (rad/s, finite, with a finite rotational energy). Default 0.
+    /// spin
     #[serde(default, deserialize_with = "exact::array")]
-    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"), meaning = "spin")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub spin: [f64; 3],
 }
 

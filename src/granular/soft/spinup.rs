@@ -77,42 +77,38 @@ fn d_rve() -> usize {
 #[scene(table = "spinup")]
 #[serde(deny_unknown_fields)]
 pub struct SpinupSection {
-    /// Period held while the body settles (h, > 0).
+    /// spin period held while the body settles
     #[serde(rename = "T_start")]
-    #[field(unit = "h", default = "required", range = Positive, meaning = "spin period held while the body settles")]
+    #[field(unit = "h", default = "required", range = Positive)]
     pub period_start_h: f64,
-    /// Period at `t_inter` (h, > 0, ≤ `T_start`).
+    /// spin period at t_inter (<= T_start)
     #[serde(rename = "T_inter")]
-    #[field(unit = "h", default = "required", range = Positive, meaning = "spin period at t_inter (<= T_start)")]
+    #[field(unit = "h", default = "required", range = Positive)]
     pub period_inter_h: f64,
-    /// Final period, held after `t_final` (h, > 0, ≤ `T_inter`).
+    /// final spin period, held after t_final (<= T_inter)
     #[serde(rename = "T_final")]
     #[field(unit = "h", default = "required", range = Positive)]
-    #[field(meaning = "final spin period, held after t_final (<= T_inter)")]
     pub period_final_h: f64,
-    /// End of the settling phase (s, ≥ 0).
-    #[field(unit = "s", default = "required", range = NonNegative, meaning = "end of the settling phase")]
-    pub t_start: f64,
-    /// End of the fast linear spin-up (s, ≥ `t_start`).
+    /// end of the settling phase
     #[field(unit = "s", default = "required", range = NonNegative)]
-    #[field(meaning = "end of the fast linear spin-up (>= t_start)")]
+    pub t_start: f64,
+    /// end of the fast linear spin-up (>= t_start)
+    #[field(unit = "s", default = "required", range = NonNegative)]
     pub t_inter: f64,
-    /// End of the slow spin-up (s, ≥ `t_inter`).
-    #[field(unit = "s", default = "required", range = NonNegative, meaning = "end of the slow spin-up (>= t_inter)")]
+    /// end of the slow spin-up (>= t_inter)
+    #[field(unit = "s", default = "required", range = NonNegative)]
     pub t_final: f64,
-    /// Rest stages in the slow phase (default 0).
+    /// rest stages in the slow phase
     #[serde(default)]
-    #[field(unit = "count", default = "0", range = Rule("integer >= 0"), meaning = "rest stages in the slow phase")]
+    #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub rests: u32,
-    /// Length of each rest (s, ≥ 0; default 0); all rests together shorter than `t_final − t_inter`.
+    /// length of each rest; all rests together shorter than t_final - t_inter
     #[serde(default)]
     #[field(unit = "s", default = "0", range = NonNegative)]
-    #[field(meaning = "length of each rest; all rests together shorter than t_final - t_inter")]
     pub rest_length: f64,
-    /// Spin axis, fixed in space (three finite numbers, non-zero; default `[0, 0, 1]`).
+    /// spin axis, fixed in space
     #[serde(default, deserialize_with = "crate::io::scene_file::exact::option")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero"))]
-    #[field(meaning = "spin axis, fixed in space")]
     pub axis: Option<[f64; 3]>,
     /// What the forcing holds on the path: `"period"` (default; the body's rotation period `2π I/L` equals `T(t)`
     /// after every step, Zhang17 §2.3.4: "strictly constrained to the spin-up path") or `"angular_momentum"`
@@ -121,25 +117,21 @@ pub struct SpinupSection {
     #[field(unit = "text", default = "\"period\"", range = Rule("\"period\" | \"angular_momentum\""))]
     #[field(meaning = "what the forcing holds on the path: the rotation period, or L = I_ref 2 pi/T(t)")]
     pub target: Option<String>,
-    /// Release threshold on b/a and c/a (> 0; default 0.1).
+    /// disruption when |d(b/a)| or |d(c/a)| exceeds this
     #[serde(default = "d_release_axis")]
     #[field(unit = "-", default = "0.1", range = Positive)]
-    #[field(meaning = "disruption when |d(b/a)| or |d(c/a)| exceeds this")]
     pub release_axis_ratio: f64,
-    /// Release threshold on η_B (> 0; default 0.01).
+    /// disruption when the interior packing fraction changes by more than this
     #[serde(default = "d_release_packing")]
     #[field(unit = "-", default = "0.01", range = Positive)]
-    #[field(meaning = "disruption when the interior packing fraction changes by more than this")]
     pub release_packing: f64,
-    /// Consecutive samples beyond a release threshold that confirm disruption (≥ 1; default 2).
+    /// consecutive samples beyond a release threshold that confirm disruption
     #[serde(default = "d_release_samples")]
     #[field(unit = "count", default = "2", range = Rule("integer >= 1"))]
-    #[field(meaning = "consecutive samples beyond a release threshold that confirm disruption")]
     pub release_samples: u32,
-    /// Target particles per RVE (≥ 8; default 300).
+    /// target particles per representative volume element (stress diagnostics)
     #[serde(default = "d_rve")]
     #[field(unit = "count", default = "300", range = Rule("integer >= 8"))]
-    #[field(meaning = "target particles per representative volume element (stress diagnostics)")]
     pub rve_particles: usize,
     /// Which particles η_B is taken over ([`InteriorRule`]): unset, the layer rule (default); set, the depth (m,
     /// ≥ 0) below the surface layer from which a particle counts, with weight rising linearly to 1 over
@@ -150,10 +142,9 @@ pub struct SpinupSection {
         meaning = "depth below the surface layer from which a particle counts in eta_B (piles of unequal spheres)"
     )]
     pub interior_depth: Option<f64>,
-    /// See `interior_depth` (m, > 0).
+    /// depth span over which a particle's eta_B weight rises from 0 to 1; needs interior_depth
     #[serde(default)]
     #[field(unit = "m", default = "interior_depth", range = Positive)]
-    #[field(meaning = "depth span over which a particle's eta_B weight rises from 0 to 1; needs interior_depth")]
     pub interior_ramp: Option<f64>,
 }
 

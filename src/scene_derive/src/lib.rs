@@ -5,11 +5,137 @@
 //! On the struct, `#[scene(table = "physics.gravity")]` gives its dotted path (absent: the file's top level). On
 //! every field, either `#[field(unit = …, default = …, range = …)]` (a value: `range` is a `Range` variant or
 //! constructor named without its type, `Positive`, `open_closed(1.5, MAX_KAPPA)`, `Rule("…")`) or `#[field(table)]`
-//! (a table, an `Option` of one or a `Vec` of them, an array of tables); `meaning = …` is the row's text, by default
-//! the first paragraph of the field's rustdoc. A field without `#[field]` is a compile error. The key is the serde
-//! name (`#[serde(rename = …)]` respected). A value row is also an associated const named as the field in capitals
-//! (`GravitySpec::THETA`), which the validators read their bounds from. syn's derive guide:
-//! <https://docs.rs/syn/2/syn/struct.DeriveInput.html>.
+//! (a table, an `Option` of one or a `Vec` of them, an array of tables). `meaning = …` is the row's text; by
+//! default it is the first paragraph of the field's rustdoc, verbatim, which is then written as the printed line
+//! (lower case, no full stop). A field without `#[field]` is a compile error, and so is a sub-table whose struct
+//! declares another path. The key is the serde name (`#[serde(rename = …)]` respected). A value row is also an
+//! associated const named as the field in capitals (`GravitySpec::THETA`), which the validators read their bounds
+//! from. syn's derive guide: <https://docs.rs/syn/2/syn/struct.DeriveInput.html>.
+//!
+//! ```
+//! # mod io {
+//! #     pub mod scene_fields {
+//! #         pub enum Range { Positive, Rule(&'static str) }
+//! #         pub struct FieldDoc {
+//! #             pub key: &'static str,
+//! #             pub unit: &'static str,
+//! #             pub default: &'static str,
+//! #             pub range: Range,
+//! #             pub meaning: &'static str,
+//! #         }
+//! #         pub struct TableDoc { pub key: &'static str, pub array: bool, pub meaning: &'static str }
+//! #         pub trait SceneFields {
+//! #             const TABLE: &'static str;
+//! #             fn collect(fields: &mut Vec<FieldDoc>, tables: &mut Vec<TableDoc>);
+//! #         }
+//! #         pub const fn same_key(a: &str, b: &str) -> bool {
+//! #             let (a, b) = (a.as_bytes(), b.as_bytes());
+//! #             let mut i = 0;
+//! #             while i < a.len() && i < b.len() && a[i] == b[i] { i += 1; }
+//! #             i == a.len() && i == b.len()
+//! #         }
+//! #     }
+//! # }
+//! use scene_derive::SceneFields;
+//!
+//! #[derive(serde::Deserialize, SceneFields)]
+//! struct File {
+//!     /// What is simulated (required).
+//!     #[field(table)]
+//!     scene: Scene,
+//! }
+//!
+//! #[derive(serde::Deserialize, SceneFields)]
+//! #[scene(table = "scene")]
+//! struct Scene {
+//!     /// end time of the run
+//!     #[field(unit = "s", default = "required", range = Positive)]
+//!     t_end: f64,
+//!     #[field(unit = "text", default = "none", range = Rule("a name"), meaning = "what it is called")]
+//!     #[serde(rename = "Name")]
+//!     name: String,
+//! }
+//!
+//! # fn main() {
+//! use io::scene_fields::SceneFields as _;
+//! let (mut fields, mut tables) = (Vec::new(), Vec::new());
+//! File::collect(&mut fields, &mut tables);
+//! let keys: Vec<_> = fields.iter().map(|f| (f.key, f.meaning)).collect();
+//! assert_eq!(keys, [("scene.t_end", "end time of the run"), ("scene.Name", "what it is called")]);
+//! assert_eq!(Scene::T_END.unit, "s");
+//! assert_eq!((tables[0].key, tables[0].meaning), ("scene", "What is simulated (required)."));
+//! # }
+//! ```
+//!
+//! A field without a row does not compile:
+//!
+//! ```compile_fail
+//! # mod io {
+//! #     pub mod scene_fields {
+//! #         pub enum Range { Positive, Rule(&'static str) }
+//! #         pub struct FieldDoc {
+//! #             pub key: &'static str,
+//! #             pub unit: &'static str,
+//! #             pub default: &'static str,
+//! #             pub range: Range,
+//! #             pub meaning: &'static str,
+//! #         }
+//! #         pub struct TableDoc { pub key: &'static str, pub array: bool, pub meaning: &'static str }
+//! #         pub trait SceneFields {
+//! #             const TABLE: &'static str;
+//! #             fn collect(fields: &mut Vec<FieldDoc>, tables: &mut Vec<TableDoc>);
+//! #         }
+//! #         pub const fn same_key(a: &str, b: &str) -> bool {
+//! #             let (a, b) = (a.as_bytes(), b.as_bytes());
+//! #             let mut i = 0;
+//! #             while i < a.len() && i < b.len() && a[i] == b[i] { i += 1; }
+//! #             i == a.len() && i == b.len()
+//! #         }
+//! #     }
+//! # }
+//! #[derive(scene_derive::SceneFields)]
+//! struct Scene {
+//!     t_end: f64,
+//! }
+//! # fn main() {}
+//! ```
+//!
+//! Nor does a sub-table whose struct declares another path than the one its parent reads it under:
+//!
+//! ```compile_fail
+//! # mod io {
+//! #     pub mod scene_fields {
+//! #         pub enum Range { Positive, Rule(&'static str) }
+//! #         pub struct FieldDoc {
+//! #             pub key: &'static str,
+//! #             pub unit: &'static str,
+//! #             pub default: &'static str,
+//! #             pub range: Range,
+//! #             pub meaning: &'static str,
+//! #         }
+//! #         pub struct TableDoc { pub key: &'static str, pub array: bool, pub meaning: &'static str }
+//! #         pub trait SceneFields {
+//! #             const TABLE: &'static str;
+//! #             fn collect(fields: &mut Vec<FieldDoc>, tables: &mut Vec<TableDoc>);
+//! #         }
+//! #         pub const fn same_key(a: &str, b: &str) -> bool {
+//! #             let (a, b) = (a.as_bytes(), b.as_bytes());
+//! #             let mut i = 0;
+//! #             while i < a.len() && i < b.len() && a[i] == b[i] { i += 1; }
+//! #             i == a.len() && i == b.len()
+//! #         }
+//! #     }
+//! # }
+//! #[derive(scene_derive::SceneFields)]
+//! struct File {
+//!     #[field(table, meaning = "what is simulated")]
+//!     scene: Scene,
+//! }
+//! #[derive(scene_derive::SceneFields)]
+//! #[scene(table = "stepping")]
+//! struct Scene {}
+//! # fn main() {}
+//! ```
 
 use proc_macro::TokenStream;
 use proc_macro2::TokenStream as Tokens;
