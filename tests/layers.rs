@@ -44,14 +44,16 @@ fn table(kind: char) -> BTreeMap<String, usize> {
     out
 }
 
+/// The `.rs` files under `dir`, less those of a crate of its own (`src/scene_derive/`, whose `crate::` is not this
+/// one's).
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let p = entry.unwrap().path();
-        // `src/python/` is a crate of its own (the Python front), above the library, not a module of it.
-        if p == src().join("python") {
+        // A folder with its own Cargo.toml is a crate of its own (the scene-field derive, the Python front), not a
+        // module of the library.
+        if p.is_dir() && p.join("Cargo.toml").exists() {
             continue;
-        }
-        if p.is_dir() {
+        } else if p.is_dir() {
             rust_files(&p, out);
         } else if p.extension().is_some_and(|e| e == "rs") {
             out.push(p);

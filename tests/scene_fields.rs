@@ -1,128 +1,64 @@
-//! The scene-file field reference (`rubblepile check --explain`, `rubblepile::io::scene_fields`) against what the
-//! scene parsers really do (issue 41 item 4): every key a parser's schema accepts has a row and every row is a key
-//! the schema accepts (read from the schema's own `Deserialize` impl by `rubblepile::io::schema_keys`), and every
-//! bound a row prints is the one the validator enforces (a value just past it is refused naming the field and the
-//! row's range; a closed end is accepted).
+//! The scene-file field reference (`rubblepile check --explain`, `rubblepile::io::scene_fields`), whose rows are
+//! written on the scene structs' fields and collected by `#[derive(SceneFields)]` (which refuses a field without a
+//! row at compile time): the printed reference of each engine is the committed one (`tests/data/explain/`), and
+//! every bound a row prints is the one the validator enforces (a value just past it is refused naming the field and
+//! the row's range; a closed end is accepted), and every printed numeric default is the parser's.
+//!
+//! To re-record the expected references after an intended change: `RUBBLEPILE_BLESS_EXPLAIN=1 cargo test --release
+//! --test scene_fields`.
 
 use std::collections::BTreeSet;
 use std::path::Path;
 use std::process::Command;
 
 use rubblepile::driver::SceneKind;
-use rubblepile::io::scene_fields::{Range, SceneReference};
-use rubblepile::io::schema_keys::{SchemaKeys, schema_keys};
+use rubblepile::io::scene_fields::Range;
 use rubblepile::named::Named;
 
-/// The reference's keys and tables against the schema's, with every difference named.
-fn assert_reference_matches(reference: &SceneReference, schema: &SchemaKeys) {
-    let rows: Vec<&str> = reference.fields.iter().map(|f| f.key).collect();
-    let row_set: BTreeSet<String> = rows.iter().map(|k| k.to_string()).collect();
-    assert_eq!(
-        row_set.len(),
-        rows.len(),
-        "{}: a key has two rows: {rows:?}",
-        reference.kind
-    );
-    let tables: BTreeSet<String> = reference.tables.iter().map(|t| t.key.to_string()).collect();
-    assert_eq!(
-        tables.len(),
-        reference.tables.len(),
-        "{}: a table is listed twice",
-        reference.kind
-    );
-    let unexplained: Vec<&String> = schema.leaves.difference(&row_set).collect();
-    let unknown: Vec<&String> = row_set.difference(&schema.leaves).collect();
-    assert!(
-        unexplained.is_empty() && unknown.is_empty(),
-        "{}: keys the parser accepts without a row: {unexplained:?}; rows the parser does not know: {unknown:?}",
-        reference.kind
-    );
-    let unexplained: Vec<&String> = schema.tables.difference(&tables).collect();
-    let unknown: Vec<&String> = tables.difference(&schema.tables).collect();
-    assert!(
-        unexplained.is_empty() && unknown.is_empty(),
-        "{}: tables the parser accepts without a row: {unexplained:?}; table rows the parser does not know: \
-         {unknown:?}",
-        reference.kind
-    );
-}
-
+/// `check --explain KIND` against `tests/data/explain/KIND.txt`, line by line; each key and table once.
 #[test]
-fn ellipsoid_reference_is_the_schema() {
-    let schema = schema_keys::<rubblepile::ellipsoid::scene::SceneFile>();
-    assert_reference_matches(SceneKind::Ellipsoids.reference(), &schema);
-    // The walk reached the nested and optional tables, so the comparison above covered them.
-    assert!(schema.leaves.contains("physics.flyby.orientation_deg"));
-    assert!(schema.leaves.contains("body.spin_world"));
-}
-
-#[test]
-fn soft_sphere_reference_is_the_schema() {
-    let schema = schema_keys::<rubblepile::granular::soft::scene::SoftSceneFile>();
-    assert_reference_matches(SceneKind::SoftSpheres.reference(), &schema);
-    assert!(schema.leaves.contains("wall.oscillation.angular_frequency"));
-    assert!(schema.leaves.contains("wall.axis") && schema.leaves.contains("wall.spin"));
-    assert!(schema.leaves.contains("spinup.T_final"));
-}
-
-#[test]
-fn hard_sphere_reference_is_the_schema() {
-    let schema = schema_keys::<rubblepile::granular::hard::scene::HardSceneFile>();
-    assert_reference_matches(SceneKind::HardSpheres.reference(), &schema);
-    assert!(schema.leaves.contains("wall.oscillation.direction"));
-    assert!(schema.leaves.contains("wall.normal") && schema.leaves.contains("gravity.uniform"));
-}
-
-/// A hand-built schema whose keys are known: nested, optional, renamed, array-of-tables and strictly read
-/// fixed-length fields (which refuse the walk's made-up value and must still be listed).
-#[test]
-fn schema_keys_of_a_hand_built_schema() {
-    #[allow(dead_code)]
-    #[derive(serde::Deserialize)]
-    #[serde(deny_unknown_fields)]
-    struct Top {
-        a: f64,
-        #[serde(rename = "B")]
-        b: Option<u64>,
-        inner: Inner,
-        maybe: Option<Inner>,
-        #[serde(rename = "item")]
-        items: Vec<Item>,
+fn explain_is_the_committed_reference() {
+    for kind in SceneKind::ALL {
+        let name = kind.name();
+        let out = rubblepile(&["check", "--explain", name]);
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8(out.stdout).unwrap();
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/data/explain/{name}.txt"));
+        if std::env::var_os("RUBBLEPILE_BLESS_EXPLAIN").is_some() {
+            std::fs::write(&path, &text).unwrap();
+        }
+        let expected = std::fs::read_to_string(&path).unwrap();
+        for (n, (got, want)) in text.lines().zip(expected.lines()).enumerate() {
+            assert_eq!(got, want, "{name}: line {} differs from {}", n + 1, path.display());
+        }
+        assert_eq!(text.lines().count(), expected.lines().count(), "{name}: line count");
+        let reference = kind.reference();
+        let keys: BTreeSet<&str> = reference.fields.iter().map(|f| f.key).collect();
+        assert_eq!(keys.len(), reference.fields.len(), "{name}: a key has two rows");
+        let tables: BTreeSet<&str> = reference.tables.iter().map(|t| t.key).collect();
+        assert_eq!(tables.len(), reference.tables.len(), "{name}: a table has two rows");
+        // Every row lives in a table that has a row (or at the top level).
+        for f in &reference.fields {
+            let table = f.key.rsplit_once('.').map_or("", |(t, _)| t);
+            assert!(
+                table.is_empty() || tables.contains(table),
+                "{name}: {} has no table row",
+                f.key
+            );
+        }
     }
-    #[allow(dead_code)]
-    #[derive(serde::Deserialize)]
-    struct Inner {
-        x: String,
-        deep: Item,
-    }
-    #[allow(dead_code)]
-    #[derive(serde::Deserialize)]
-    struct Item {
-        #[serde(deserialize_with = "rubblepile::io::scene_file::exact::array")]
-        v: [f64; 3],
-        flag: bool,
-    }
-    let keys = schema_keys::<Top>();
-    let set = |v: &[&str]| v.iter().map(|s| s.to_string()).collect::<BTreeSet<String>>();
-    assert_eq!(
-        keys.tables,
-        set(&["inner", "inner.deep", "maybe", "maybe.deep", "item"])
-    );
-    assert_eq!(
-        keys.leaves,
-        set(&[
-            "a",
-            "B",
-            "inner.x",
-            "inner.deep.v",
-            "inner.deep.flag",
-            "maybe.x",
-            "maybe.deep.v",
-            "maybe.deep.flag",
-            "item.v",
-            "item.flag",
-        ])
-    );
+}
+
+/// The rows a validator reads are the struct's own consts, under the dotted key serde reads (renames applied).
+#[test]
+fn rows_are_the_struct_fields() {
+    use rubblepile::ellipsoid::scene::{DissipationSpec, GravitySpec};
+    use rubblepile::granular::soft::spinup::SpinupSection;
+    assert_eq!(GravitySpec::G.key, "physics.gravity.G");
+    assert_eq!(DissipationSpec::F0.key, "physics.dissipation.F0");
+    assert_eq!(SpinupSection::PERIOD_START_H.key, "spinup.T_start");
+    let reference = SceneKind::Ellipsoids.reference();
+    assert_eq!(reference.field("physics.gravity.theta"), Some(&GravitySpec::THETA));
 }
 
 const ELLIPSOIDS: &str = r#"
@@ -278,7 +214,7 @@ fn bounds_enforced(kind: SceneKind, base: &str) -> Vec<&'static str> {
     let reference = kind.reference();
     let arrays: Vec<&str> = reference.tables.iter().filter(|t| t.array).map(|t| t.key).collect();
     let mut tested = Vec::new();
-    for row in reference.fields {
+    for row in &reference.fields {
         if arrays.iter().any(|a| row.key.starts_with(&format!("{a}."))) {
             continue;
         }
@@ -436,7 +372,7 @@ fn serde_defaults_are_the_references<T: serde::de::DeserializeOwned + serde::Ser
 ) -> Vec<&'static str> {
     let reference = kind.reference();
     let mut compared = Vec::new();
-    for row in reference.fields {
+    for row in &reference.fields {
         let Some(Ok(default)) = row.default.split_whitespace().next().map(str::parse::<f64>) else {
             continue;
         };
@@ -554,7 +490,7 @@ fn check_explain_prints_the_reference() {
     assert!(eps.contains("0.55") && eps.contains("(0, 1]"), "{eps}");
     // One line per key: the printed table is the whole reference.
     let reference = SceneKind::SoftSpheres.reference();
-    for f in reference.fields {
+    for f in &reference.fields {
         assert_eq!(
             text.lines().filter(|l| l.starts_with(&format!("{} ", f.key))).count(),
             1,

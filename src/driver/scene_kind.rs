@@ -74,12 +74,23 @@ impl SceneKind {
 }
 
 impl SceneKind {
-    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning).
+    /// The field reference of this kind's scene file (every key, its unit, default, range and meaning), collected
+    /// once from the rows on its scene structs.
     pub fn reference(self) -> &'static crate::io::scene_fields::SceneReference {
+        use crate::io::scene_fields::SceneReference;
+        use std::sync::OnceLock;
+        static REFERENCES: [OnceLock<SceneReference>; 3] = [OnceLock::new(), OnceLock::new(), OnceLock::new()];
+        let kind = crate::named::Named::name(self);
         match self {
-            SceneKind::Ellipsoids => &crate::ellipsoid::scene_fields::REFERENCE,
-            SceneKind::SoftSpheres => &crate::granular::soft::scene_fields::REFERENCE,
-            SceneKind::HardSpheres => &crate::granular::hard::scene_fields::REFERENCE,
+            SceneKind::Ellipsoids => {
+                REFERENCES[0].get_or_init(|| SceneReference::of::<crate::ellipsoid::scene::SceneFile>(kind))
+            }
+            SceneKind::SoftSpheres => {
+                REFERENCES[1].get_or_init(|| SceneReference::of::<crate::granular::soft::scene::SoftSceneFile>(kind))
+            }
+            SceneKind::HardSpheres => {
+                REFERENCES[2].get_or_init(|| SceneReference::of::<crate::granular::hard::scene::HardSceneFile>(kind))
+            }
         }
     }
 }

@@ -31,7 +31,6 @@ pub mod quaternion;
 pub mod rigid_rotation;
 pub mod run;
 pub mod scene;
-pub mod scene_fields;
 pub mod spin_state;
 pub mod summary;
 pub mod tide;

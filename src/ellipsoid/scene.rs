@@ -43,12 +43,12 @@
 use std::path::{Path, PathBuf};
 
 use nalgebra::{Quaternion, UnitQuaternion};
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
-use crate::ellipsoid::scene_fields as fields;
 pub use crate::ellipsoid::tide::FlybySpec;
 use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
 use crate::integrate::Method;
@@ -80,44 +80,57 @@ pub const DEFAULT_SCENE_NAME: &str = "<built-in default scene>";
 
 /// A whole scene file. Tables: `[scene]`, `[model]`, `[physics]`, `[integrator]`, `[output]` and
 /// one `[[body]]` table per body (or `scene.bodies_file` instead of the `[[body]]` tables).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
-    /// `[scene]`: what is simulated and for how long. Required.
+    /// what is simulated and for how long (required)
+    #[field(table)]
     pub scene: SceneSection,
-    /// `[model]`: model constants (κ, moments of inertia). Required.
+    /// model constants: exactly one of kappa or calibrate (required)
+    #[field(table)]
     pub model: ModelSection,
-    /// `[physics]`: which force terms are on. Optional; an absent table turns every term off
-    /// (the bodies then move freely).
+    /// the force terms; an absent term is not computed (absent table: bodies move freely)
     #[serde(default)]
+    #[field(table)]
     pub physics: PhysicsSection,
-    /// `[integrator]`: method and tolerances. Optional; defaults as documented on
-    /// [`IntegratorSection`].
+    /// method and tolerances (optional)
     #[serde(default)]
+    #[field(table)]
     pub integrator: IntegratorSection,
-    /// `[output]`: snapshot times and time-series cadence. Required.
+    /// snapshot times and time-series cadence (required)
+    #[field(table)]
     pub output: OutputSection,
-    /// `[[body]]`: the bodies, one table each, numbered `body[0]`, `body[1]`, … in file order.
-    /// Either these tables or `scene.bodies_file`, not both.
+    /// `[[body]]`: one ellipsoid each, `body[0]`, `body[1]`, … in file order (or `scene.bodies_file`).
     #[serde(default, rename = "body", skip_serializing_if = "Vec::is_empty")]
+    #[field(
+        table,
+        meaning = "one ellipsoid each, body[0], body[1], ... in file order (or scene.bodies_file)"
+    )]
     pub bodies: Vec<BodySpec>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "scene")]
 #[serde(deny_unknown_fields)]
 pub struct SceneSection {
     /// What is simulated. Required; `"ellipsoids"` (the Roig03 interacting-ellipsoids model) here;
     /// `"soft-spheres"` scenes are read by `granular::soft::scene` instead.
+    #[field(unit = "text", default = "required", range = Rule("\"ellipsoids\""))]
+    #[field(meaning = "which engine reads the scene")]
     pub kind: String,
-    /// End time of the run (s), > 0. Required. The run starts at t = 0.
+    /// end time of the run; it starts at t = 0
+    #[field(unit = "s", default = "required", range = Positive)]
     pub t_end: f64,
     /// Random seed (non-negative integer). Default 0. Recorded in `summary.json`; the ellipsoids
     /// model itself is deterministic and draws no random numbers.
     #[serde(default)]
+    #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
+    #[field(meaning = "recorded in summary.json; the model draws no random numbers")]
     pub seed: u64,
     /// Optional CSV file with the initial bodies, replacing the `[[body]]` tables. The path is
     /// relative to the scene file's directory. Columns as in the snapshots
@@ -126,78 +139,107 @@ pub struct SceneSection {
     /// from a bodies file are used as written (checked to have unit norm within 1e-6, not
     /// renormalised) so that a run restarted from a snapshot continues bit-for-bit.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "path", default = "none", range = Rule("readable CSV, <= 1e7 rows"))]
+    #[field(meaning = "initial bodies (snapshot columns) instead of [[body]], relative to the scene file")]
     pub bodies_file: Option<String>,
 }
 
 /// `[model]`: give exactly one of `kappa` or `calibrate`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "model")]
 #[serde(deny_unknown_fields)]
 pub struct ModelSection {
     /// Width parameter κ of the Gaussian mass distribution (Roig03 Eq. 2), dimensionless, > 3/2.
     /// Larger κ = stiffer, more sharply bounded bodies.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "(kappa or calibrate)", range = open_closed(1.5, MAX_KAPPA))]
+    #[field(
+        meaning = "width of the Gaussian mass distribution (Roig03 Eq. 2); larger = stiffer; exactly one of kappa, \
+                   calibrate"
+    )]
     pub kappa: Option<f64>,
-    /// Compute κ from Roig03 Eq. 14 instead of giving it: `calibrate = { beta = 10.0, v = 20.0 }`.
+    /// kappa from Roig03 Eq. 14 for the lightest and heaviest body, instead of model.kappa
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub calibrate: Option<CalibrateSpec>,
     /// Moments of inertia: `"gaussian"` (Roig03 Eq. 4 with the model's κ, the paper's choice) or
     /// `"uniform"` (uniform-density ellipsoid, i.e. Eq. 4 with κ = 5/2). Default `"gaussian"`.
     #[serde(default)]
+    #[field(unit = "text", default = "\"gaussian\"", range = Rule("\"gaussian\" | \"uniform\""))]
+    #[field(meaning = "moments of inertia: Roig03 Eq. 4 with the model's kappa, or a uniform ellipsoid")]
     pub inertia: InertiaModel,
 }
 
 /// `model.calibrate`: κ from Roig03 Eq. 14 for the smallest (by mass) and the largest body of the
 /// scene, with their equivalent radii `(A B C)^{1/3}` and the gravity term's G (SI G if gravity is off).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "model.calibrate")]
 #[serde(deny_unknown_fields)]
 pub struct CalibrateSpec {
     /// β of Eq. 14 (dimensionless, > 0): the contact barrier between the two bodies is β times
     /// their kinetic energy at relative speed `v`. Required.
+    #[field(unit = "-", default = "required", range = Positive)]
+    #[field(meaning = "contact barrier over the kinetic energy at speed v (Roig03 Eq. 14)")]
     pub beta: f64,
-    /// Relative speed `v` of Eq. 14 (m/s, > 0) the contact must withstand. Required.
+    /// relative speed the contact must withstand (Roig03 Eq. 14)
+    #[field(unit = "m/s", default = "required", range = Positive)]
     pub v: f64,
     /// Which kinetic energy the barrier is β times (Roig03 Eq. 13's `K`): `"printed"` (`½ m_l v²`, Eq. 14
     /// as printed; the default), `"impactor"` (`½ m_k v²`) or `"reduced"` (`½ μ v²`, the pair's relative
     /// kinetic energy). See [`KappaReading`].
     #[serde(default)]
+    #[field(unit = "text", default = "\"printed\"", range = Rule("\"printed\" | \"impactor\" | \"reduced\""))]
+    #[field(meaning = "which kinetic energy the barrier is beta times (Roig03 Eq. 13's K)")]
     pub reading: KappaReading,
 }
 
 /// `[physics]`: every term is optional; an absent term is not computed at all.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, SceneFields)]
+#[scene(table = "physics")]
 #[serde(deny_unknown_fields)]
 pub struct PhysicsSection {
-    /// Monopole gravity between centres of mass (Roig03 Eq. 6): `gravity = {}` or `gravity = { G = … }`.
+    /// monopole gravity between centres of mass (Roig03 Eq. 6); `gravity = {}` turns it on
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub gravity: Option<GravitySpec>,
-    /// Gaussian-overlap contact potential (Roig03 Eqs. 7–12): `contact = {}` or `contact = { cutoff = … }`.
+    /// Gaussian-overlap contact potential (Roig03 Eqs. 7-12); `contact = {}` turns it on
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub contact: Option<ContactSpec>,
-    /// Point dissipation (Roig03 Eqs. 40–41): `dissipation = { F0 = … }`.
+    /// point dissipation (Roig03 Eqs. 40-41)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub dissipation: Option<DissipationSpec>,
-    /// Tide of a planet on a prescribed orbit, `[physics.flyby]` (see [`FlybySpec`]). Default: none.
+    /// tide of a planet on a prescribed Kepler orbit (none if absent)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub flyby: Option<FlybySpec>,
 }
 
 /// `physics.gravity`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, SceneFields)]
+#[scene(table = "physics.gravity")]
 #[serde(deny_unknown_fields)]
 pub struct GravitySpec {
     /// Gravitational constant `G` (m³ kg⁻¹ s⁻²), > 0. Default 6.674e-11 (SI). Also used in the
     /// contact amplitude U0 (Roig03 Eq. 11) and in `model.calibrate`.
     #[serde(default, rename = "G", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m^3 kg^-1 s^-2", default = "6.674e-11", range = Positive)]
+    #[field(meaning = "gravitational constant; also sets the contact amplitude U0 (Roig03 Eq. 11)")]
     pub g: Option<f64>,
     /// How the pair sum is done: `"direct"` (exact, O(N²)), `"tree"` (Barnes–Hut octree, O(N log N)) or
     /// `"auto"` (exact below 5000 bodies, tree from there on). Default `"auto"`. See
     /// [`crate::ellipsoid::gravity_tree`].
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "text", default = "\"auto\"", range = Rule("\"auto\" | \"direct\" | \"tree\""))]
+    #[field(meaning = "exact O(N^2) sum, Barnes-Hut tree, or exact below 5000 bodies and tree from there")]
     pub method: Option<GravityMethodSpec>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]): a node is used whole beyond `side/θ` from a
     /// body. Default 0.5 (RMS relative force error 2.6e-4 against the exact sum on 2000 ellipsoids). Ignored by
     /// `"direct"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "0.5", range = open_closed(0.0, crate::ellipsoid::gravity_tree::MAX_THETA))]
+    #[field(meaning = "tree opening angle: a node is used whole beyond side/theta; ignored by \"direct\"")]
     pub theta: Option<f64>,
 }
 
@@ -215,27 +257,34 @@ pub enum GravityMethodSpec {
 }
 
 /// `physics.contact`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, SceneFields)]
+#[scene(table = "physics.contact")]
 #[serde(deny_unknown_fields)]
 pub struct ContactSpec {
     /// Relative amplitude below which far pairs are skipped (dimensionless, in (0, 1)): a pair whose
     /// contact potential is provably below `cutoff × U0` is not evaluated. Default 1e-16.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "1e-16", range = open(0.0, 1.0))]
+    #[field(meaning = "pairs whose contact potential is provably below cutoff x U0 are skipped (also >= 1e-300)")]
     pub cutoff: Option<f64>,
 }
 
 /// `physics.dissipation`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "physics.dissipation")]
 #[serde(deny_unknown_fields)]
 pub struct DissipationSpec {
     /// Dissipation coefficient `F0` (s m⁻², ≥ 0) of Roig03 Eq. 41. Required. The dissipation is
     /// weighted by the contact overlap, so it acts only on touching pairs.
     #[serde(rename = "F0")]
+    #[field(unit = "s m^-2", default = "required", range = NonNegative)]
+    #[field(meaning = "dissipation coefficient (Roig03 Eq. 41), acting on touching pairs only")]
     pub f0: f64,
 }
 
 /// `[integrator]`. The whole table is optional.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "integrator")]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
     /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
@@ -252,6 +301,13 @@ pub struct IntegratorSection {
     /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
     /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
     #[serde(default = "default_method")]
+    #[field(unit = "text", default = "\"bulirsch-stoer\"")]
+    #[field(range = Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""))]
+    #[field(
+        meaning = "adaptive Gragg-Bulirsch-Stoer, Dormand-Prince 8(5,3) or 5(4), fixed-step RK4, or linearly implicit \
+                   extrapolation for stiff dissipation (contact damping time well below the contact period; `check` \
+                   advises it)"
+    )]
     pub method: Method,
     /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
     /// is judged in the units a user thinks in (position in m, velocity in m/s, spin in rad/s, attitude as a
@@ -261,15 +317,21 @@ pub struct IntegratorSection {
     /// step. In `[1e-15, 1)` ([`MIN_RTOL`]); only for the adaptive methods (refused with `"rk4"`, which has no
     /// error control).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "1e-10", range = closed_open(MIN_RTOL, 1.0))]
+    #[field(meaning = "relative tolerance of the adaptive methods (refused with \"rk4\")")]
     pub rtol: Option<f64>,
     /// Absolute tolerance (≥ 0, finite). Default 1e-10. In the user units above: m for positions, m/s for
     /// velocities, rad/s for spins (the integrator scales it by each body's mass and moment of inertia). Only for the
     /// adaptive methods (refused with `"rk4"`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m, m/s, rad/s", default = "1e-10", range = NonNegative)]
+    #[field(meaning = "absolute tolerance in each state's own unit (refused with \"rk4\")")]
     pub atol: Option<f64>,
     /// The fixed step of `"rk4"` (s, required there, ≥ `t_end × 1e-12` and ≥ 1e-300). Refused with the adaptive
     /// methods, which choose their own steps.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "required by \"rk4\"", range = Rule(">= t_end x 1e-12; \"rk4\" only"))]
+    #[field(meaning = "the fixed step of \"rk4\"")]
     pub step: Option<f64>,
     /// Whether to pull the attitudes back onto `|q| = 1` at every output sample (`true`/`false`; see
     /// [`crate::ellipsoid::equations::EllipsoidSystem::project_attitudes`]). Default: `true` for `"dop853"`,
@@ -279,6 +341,8 @@ pub struct IntegratorSection {
     /// `"bulirsch-stoer-implicit"`, which controls the error in the same run-wide norm. The run's
     /// `quaternion_norm_error` is the largest `||q| − 1|` before projection, and above 1e-3 it still stops the run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "bool", default = "true (false for bulirsch-stoer)", range = Rule("true | false"))]
+    #[field(meaning = "pull the attitudes back onto |q| = 1 at every output sample")]
     pub project_attitudes: Option<bool>,
 }
 
@@ -303,66 +367,92 @@ impl Default for IntegratorSection {
 }
 
 /// `[output]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "output")]
 #[serde(deny_unknown_fields)]
 pub struct OutputSection {
     /// Snapshot times (s): strictly increasing, each in `[0, t_end]`. The integrator lands on each
     /// exactly and writes `snapshots/<k>.csv` for the k-th time. Default `[0, t_end]`; `[]` = no snapshots.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], <= 1e5"))]
+    #[field(meaning = "snapshot times (snapshots/<k>.csv); [] = none; not with snapshot_every")]
     pub times: Option<Vec<f64>>,
     /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
     /// `t_end` (each `k × snapshot_every`, the last exactly `t_end`), at most 1e5. Give `times` or this, not both.
     /// Default: none (`times` decides).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "none", range = Rule(">= 1e-300, <= 1e5 snapshots"))]
+    #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
     pub snapshot_every: Option<f64>,
     /// Time-series cadence (s, > 0): a row of `timeseries.csv` every `every` seconds from 0 to
     /// `t_end` inclusive (plus one at each snapshot time). Required. At most 1e8 rows.
+    #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
+    #[field(meaning = "time-series cadence: a row of timeseries.csv every `every` seconds")]
     pub every: f64,
     /// Bodies (indices into the scene's body list, 0-based) whose full state is written to `tracks.csv` at every
     /// time-series row, in the snapshot columns (e.g. the projectile of an impact). Each index at most once.
     /// Default `[]`: no `tracks.csv`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "count", default = "[]", range = Rule("body indices < number of bodies, each once"))]
+    #[field(meaning = "bodies whose full state is written to tracks.csv at every time-series row")]
     pub track: Option<Vec<usize>>,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    #[field(unit = "bool", default = "false", range = Rule("true | false"))]
+    #[field(meaning = "also write every snapshot as VTK (vtk/*.vtp, vtk/run.pvd)")]
     pub vtk: bool,
 }
 
 /// `[[body]]`: one ellipsoid and its initial state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "body")]
 #[serde(deny_unknown_fields)]
 pub struct BodySpec {
-    /// Semi-axes `[A, B, C]` (m) along the body x, y, z axes, with `A ≥ B ≥ C ≥ 1e-300` (exactly three). Required.
+    /// semi-axes along the body x, y, z axes
     #[serde(deserialize_with = "exact::array")]
+    #[field(unit = "m", default = "required", range = Rule("[A, B, C], A >= B >= C >= 1e-300"))]
     pub axes: [f64; 3],
-    /// Mass (kg, finite, ≥ 1e-300). Give exactly one of `mass` and `density`.
+    /// mass; exactly one of mass, density
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "kg", default = "(mass or density)", range = Positive)]
     pub mass: Option<f64>,
     /// Bulk density (kg/m³, finite, ≥ 1e-300); then `mass = density · 4/3 π A B C` (which must be finite and
     /// ≥ 1e-300 too). Give exactly one of `mass` and `density`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "kg/m^3", default = "(mass or density)", range = Positive)]
+    #[field(meaning = "bulk density: mass = density 4/3 pi A B C")]
     pub density: Option<f64>,
     /// Centre-of-mass position `[x, y, z]` (m, finite), world frame. Required. No two bodies' centres may lie
     /// closer than [`MIN_CENTRE_SEPARATION`] times the smaller of their smallest semi-axes.
     #[serde(deserialize_with = "exact::array")]
+    #[field(unit = "m", default = "required", range = Rule("finite; centres >= 0.5 x the smaller C apart"))]
+    #[field(meaning = "centre of mass, world frame")]
     pub position: [f64; 3],
     /// Centre-of-mass velocity `[vx, vy, vz]` (m/s, finite, with a finite kinetic energy and momentum), world frame.
     /// Default `[0, 0, 0]`.
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
+    #[field(meaning = "centre-of-mass velocity, world frame")]
     pub velocity: [f64; 3],
     /// Attitude quaternion `[α, β, γ, δ]` (vector part first, scalar last; Roig03 Eq. 19), whose
     /// rotation matrix R(q) (Eq. 21) maps world to body coordinates. Must have unit norm within 1e-6;
     /// it is then normalised. Default `[0, 0, 0, 1]` (body axes = world axes).
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "[0, 0, 0, 1]", range = Rule("|q| = 1 within 1e-6"))]
+    #[field(meaning = "attitude [alpha, beta, gamma, delta], scalar last; R(q) maps world to body (Roig03 Eq. 21)")]
     pub quaternion: Option<[f64; 4]>,
     /// Spin `[ω1, ω2, ω3]` (rad/s, finite, with a finite rotational energy) about the body's principal axes
     /// (A, B, C). At most one of `spin_body` and `spin_world`; default no spin.
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
+    #[field(meaning = "spin about the body's principal axes (A, B, C); at most one of spin_body, spin_world")]
     pub spin_body: Option<[f64; 3]>,
     /// Spin `[ωx, ωy, ωz]` (rad/s) in the world frame; converted with `spin_body = R(q) · spin_world`.
     /// At most one of `spin_body` and `spin_world`; default no spin.
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
+    #[field(meaning = "spin in the world frame (spin_body = R(q) spin_world)")]
     pub spin_world: Option<[f64; 3]>,
 }
 
@@ -505,7 +595,21 @@ struct RawBody {
     spin_world: Option<[f64; 3]>,
 }
 
-pub use crate::ellipsoid::scene_fields::{MAX_KAPPA, MIN_CENTRE_SEPARATION};
+/// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
+/// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
+/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
+pub const MAX_KAPPA: f64 = 175.0;
+
+/// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
+/// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
+/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
+/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
+pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
+
+// The numbers written into the rows' words, held to the constants they restate.
+const _: () = assert!(MIN_CENTRE_SEPARATION == 0.5);
+const _: () = assert!(crate::ellipsoid::gravity_tree::TREE_FROM == 5000);
+const _: () = assert!(crate::ellipsoid::gravity_tree::DEFAULT_THETA == 0.5);
 
 /// Integrator steps assumed per fastest time scale of a scene, for its work estimate (see [`LoadedScene::warnings`]):
 /// an adaptive step resolves a spin turn or a contact in a few to a few tens of steps.
@@ -623,7 +727,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let t_end = self.field(&fields::T_END, file.scene.t_end)?;
+        let t_end = self.field(&SceneSection::T_END, file.scene.t_end)?;
 
         Ok(t_end)
     }
@@ -640,8 +744,8 @@ impl Validator<'_> {
             }
             (Some(k), None) => self.kappa_value("model.kappa", k)?,
             (None, Some(c)) => {
-                self.field(&fields::CALIBRATE_BETA, c.beta)?;
-                self.field(&fields::CALIBRATE_V, c.v)?;
+                self.field(&CalibrateSpec::BETA, c.beta)?;
+                self.field(&CalibrateSpec::V, c.v)?;
             }
         }
 
@@ -650,7 +754,7 @@ impl Validator<'_> {
 
     /// κ in (1.5, [`MAX_KAPPA`]].
     fn kappa_value(&self, field: &str, k: f64) -> Result<(), SceneError> {
-        if fields::KAPPA.range.contains(k) {
+        if ModelSection::KAPPA.range.contains(k) {
             Ok(())
         } else if k.is_finite() && k > MAX_KAPPA {
             Err(self.invalid(
@@ -658,7 +762,7 @@ impl Validator<'_> {
                 format!(
                     "must be at most {MAX_KAPPA}, in {} (MAX_KAPPA: the contact amplitude holds e^(2 kappa), which \
                      overflows beyond it), got {}",
-                    fields::KAPPA.range,
+                    ModelSection::KAPPA.range,
                     fmt_num(k)
                 ),
             ))
@@ -667,7 +771,7 @@ impl Validator<'_> {
                 field,
                 format!(
                     "must be > 1.5 and finite, in {}, got {}",
-                    fields::KAPPA.range,
+                    ModelSection::KAPPA.range,
                     fmt_num(k)
                 ),
             ))
@@ -679,9 +783,9 @@ impl Validator<'_> {
         let gravity = match p.gravity {
             Some(g) => {
                 use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
-                let theta = self.field(&fields::GRAVITY_THETA, g.theta.unwrap_or(DEFAULT_THETA))?;
+                let theta = self.field(&GravitySpec::THETA, g.theta.unwrap_or(DEFAULT_THETA))?;
                 Some(GravityTerm {
-                    g: self.field(&fields::GRAVITY_G, g.g.unwrap_or(SI_G))?,
+                    g: self.field(&GravitySpec::G, g.g.unwrap_or(SI_G))?,
                     method: match g.method.unwrap_or_default() {
                         GravityMethodSpec::Direct => GravityMethod::Direct,
                         GravityMethodSpec::Tree => GravityMethod::Tree { theta },
@@ -694,7 +798,7 @@ impl Validator<'_> {
         let contact = match p.contact {
             Some(c) => {
                 let cutoff = c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF);
-                let cutoff = self.field(&fields::CONTACT_CUTOFF, cutoff)?;
+                let cutoff = self.field(&ContactSpec::CUTOFF, cutoff)?;
                 if cutoff < MIN_MEANINGFUL {
                     return Err(self.invalid(
                         "physics.contact.cutoff",
@@ -707,7 +811,7 @@ impl Validator<'_> {
         };
         let dissipation = match p.dissipation {
             Some(d) => Some(DissipationTerm {
-                f0: self.field(&fields::DISSIPATION_F0, d.f0)?,
+                f0: self.field(&DissipationSpec::F0, d.f0)?,
             }),
             None => None,
         };
@@ -722,17 +826,17 @@ impl Validator<'_> {
     /// only), the fixed step of `"rk4"` (≥ `t_end ×` [`crate::io::scene_file::MIN_STEP_FRACTION`]; `"rk4"` only).
     fn integrator_section(&self, i: &IntegratorSection, t_end: f64) -> Result<IntegratorSettings, SceneError> {
         let rtol = i.rtol.unwrap_or_else(default_tolerance);
-        if !fields::RTOL.range.contains(rtol) {
+        if !IntegratorSection::RTOL.range.contains(rtol) {
             return Err(self.invalid(
-                fields::RTOL.key,
+                IntegratorSection::RTOL.key,
                 format!(
                     "must be in {}, got {rtol:e}: a relative tolerance of 1 or more controls nothing, \
                      and below {MIN_RTOL:e} the integrators' error estimates are round-off (f64 epsilon is 2.2e-16)",
-                    fields::RTOL.range
+                    IntegratorSection::RTOL.range
                 ),
             ));
         }
-        let atol = self.field(&fields::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
+        let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
         let step = match i.step {
             Some(h) => Some(self.step("integrator.step", h, t_end)?),
             None => None,
@@ -1155,9 +1259,9 @@ impl Validator<'_> {
             ));
         }
         let mass = match (b.mass, b.density) {
-            (Some(m), None) => self.within(&fields::BODY_MASS, &f("mass"), m)?,
+            (Some(m), None) => self.within(&BodySpec::MASS, &f("mass"), m)?,
             (None, Some(rho)) => {
-                let rho = self.within(&fields::BODY_DENSITY, &f("density"), rho)?;
+                let rho = self.within(&BodySpec::DENSITY, &f("density"), rho)?;
                 let volume = 4.0 / 3.0 * std::f64::consts::PI * a * bb * c;
                 if !(volume.is_finite() && volume >= MIN_MEANINGFUL) {
                     return Err(self.invalid(

@@ -11,6 +11,7 @@
 //! prescribed frame acceleration; the centre of mass drifts by `~J2 (R/q)²` of the tide), and `E_tide` gains
 //! `Σ m_i Φ_J2(r_i − R)`.
 
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
@@ -31,36 +32,50 @@ use crate::math::Vec3;
 /// j2 = 1.0826e-3              # optional (needs radius); Earth's
 /// pole = [0.0, 0.0, 1.0]      # optional: the planet's spin axis in the frame
 /// ```
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "physics.flyby")]
 #[serde(deny_unknown_fields)]
 pub struct FlybySpec {
     /// Planet mass (kg, ≥ 0). Required. `GM` uses the scene's `physics.gravity.G` (SI G without gravity). A mass of
     /// 0 is allowed: the planet then pulls on nothing and the frame moves in a straight line at `v_inf`.
+    #[field(unit = "kg", default = "required", range = NonNegative)]
+    #[field(meaning = "planet mass (0: no pull, the frame moves in a straight line at v_inf)")]
     pub mass: f64,
-    /// Planet radius (m, > 0). Optional (no default): when given, the perigee must lie outside it.
+    /// planet radius: the perigee must lie outside it; the reference radius of j2
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "none", range = Positive)]
     pub radius: Option<f64>,
-    /// Perigee distance `q` (m, > 0) between the planet's centre and the frame origin. Required.
+    /// perigee distance between the planet's centre and the frame origin
+    #[field(unit = "m", default = "required", range = Positive)]
     pub q: f64,
     /// Speed at infinity `v∞` (m/s, > 0) of a hyperbolic flyby, `e = 1 + q v∞²/GM`. Give exactly one of `v_inf`
     /// and `eccentricity`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m/s", default = "(v_inf or eccentricity)", range = Positive)]
+    #[field(meaning = "speed at infinity of a hyperbolic flyby; exactly one of v_inf, eccentricity")]
     pub v_inf: Option<f64>,
     /// Eccentricity `e` (≥ 0, ≠ 1; < 1 elliptic, > 1 hyperbolic), the explicit form. Give exactly one of `v_inf`
     /// and `eccentricity`; needs `mass > 0`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "(v_inf or eccentricity)", range = Rule(">= 0, != 1; needs mass > 0"))]
+    #[field(meaning = "orbit eccentricity (< 1 elliptic, > 1 hyperbolic); exactly one of v_inf, eccentricity")]
     pub eccentricity: Option<f64>,
-    /// Time of perigee passage (s, finite). Required.
+    /// time of perigee passage
+    #[field(unit = "s", default = "required", range = Rule("finite"))]
     pub t_perigee: f64,
     /// Orientation `[Ω, i, ω]` (degrees) of the frame origin's orbit about the planet: longitude of the node,
     /// inclination and argument of perigee, perifocal → frame `R_z(Ω) R_x(i) R_z(ω)`. Default `[0, 0, 0]`: the orbit
     /// in the x–y plane, anticlockwise about +z, the origin at `+q x̂` from the planet at perigee (the planet at
     /// `−q x̂` in the frame).
     #[serde(default, deserialize_with = "crate::io::scene_file::exact::array")]
+    #[field(unit = "deg", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
+    #[field(meaning = "[node, inclination, argument of perigee] of the orbit about the planet")]
     pub orientation_deg: [f64; 3],
     /// The planet's second zonal harmonic J2 (dimensionless, finite; Earth 1.0826e-3 with its equatorial radius
     /// 6378.137 km). Optional, default none (a point mass); needs `radius`, the reference radius of J2.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "none", range = Rule("finite; needs radius"))]
+    #[field(meaning = "the planet's second zonal harmonic (Earth 1.0826e-3)")]
     pub j2: Option<f64>,
     /// The planet's spin axis (frame coordinates, any non-zero length; normalised), used with `j2`. Default
     /// `[0, 0, 1]`.
@@ -69,6 +84,8 @@ pub struct FlybySpec {
         deserialize_with = "crate::io::scene_file::exact::option",
         skip_serializing_if = "Option::is_none"
     )]
+    #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero"))]
+    #[field(meaning = "the planet's spin axis in the frame (normalised), used with j2")]
     pub pole: Option<[f64; 3]>,
 }
 
@@ -159,12 +176,11 @@ impl TideTerm {
 
 /// Validates `physics.flyby` (errors name the field) and resolves it with the scene's `G` (m³ kg⁻¹ s⁻²).
 pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<TideTerm, SceneError> {
-    use crate::ellipsoid::scene_fields as fields;
-    let mass = v.field(&fields::FLYBY_MASS, spec.mass)?;
+    let mass = v.field(&FlybySpec::MASS, spec.mass)?;
     let gm = g * mass;
-    let q = v.field(&fields::FLYBY_Q, spec.q)?;
+    let q = v.field(&FlybySpec::Q, spec.q)?;
     let radius = match spec.radius {
-        Some(r) => Some(v.field(&fields::FLYBY_RADIUS, r)?),
+        Some(r) => Some(v.field(&FlybySpec::RADIUS, r)?),
         None => None,
     };
     if let Some(r) = radius
@@ -198,7 +214,7 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
             ));
         }
         (Some(vi), None) => {
-            let vi = v.field(&fields::FLYBY_V_INF, vi)?;
+            let vi = v.field(&FlybySpec::V_INF, vi)?;
             KeplerOrbit::hyperbolic(gm, q, vi, spec.t_perigee, rotation)
                 .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
         }

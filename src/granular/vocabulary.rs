@@ -23,9 +23,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::walls::motion::Oscillation;
-use crate::io::scene_fields::{FieldDoc, Range, TableDoc};
 use crate::io::scene_file::{SceneError, Validator, exact};
 use crate::math::Vec3;
+use scene_derive::SceneFields;
 
 /// The `scene.kind` of a soft-sphere scene (`granular::soft::scene`).
 pub const SOFT_KIND: &str = "soft-spheres";
@@ -34,18 +34,23 @@ pub const SOFT_KIND: &str = "soft-spheres";
 pub const HARD_KIND: &str = "hard-spheres";
 
 /// `wall.oscillation`: `A (sin(ω t + φ) − sin φ) d̂` added to the wall's position.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "wall.oscillation")]
 #[serde(deny_unknown_fields)]
 pub struct OscillationSpec {
-    /// Amplitude A (m): 0 or in [1e-300, finite).
+    /// amplitude A
+    #[field(unit = "m", default = "required", range = Rule("0 or >= 1e-300, finite"))]
     pub amplitude: f64,
-    /// Angular frequency ω (rad/s; ω = 2π f), finite, with a finite wall speed `A ω`.
+    /// angular frequency omega = 2 pi f
+    #[field(unit = "rad/s", default = "required", range = Rule("finite, A omega finite"))]
     pub angular_frequency: f64,
-    /// Phase φ (rad). Default 0.
+    /// phase phi
     #[serde(default)]
+    #[field(unit = "rad", default = "0", range = Rule("finite"))]
     pub phase: f64,
-    /// Direction d̂ (normalised; must not vanish). Default the wall's normal or axis.
+    /// direction of the oscillation (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "normal or axis, else required", range = Rule("3 finite numbers, non-zero"))]
     pub direction: Option<[f64; 3]>,
 }
 
@@ -102,46 +107,3 @@ pub(crate) fn unit(v: &Validator, field: &str, x: [f64; 3]) -> Result<Vec3, Scen
         Err(v.invalid(field, format!("must be a non-zero vector, got {x:?}")))
     }
 }
-
-/// The `[[wall]] oscillation` table of both references.
-pub const OSCILLATION_TABLE: TableDoc = TableDoc {
-    key: "wall.oscillation",
-    array: false,
-    meaning: "sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)",
-};
-
-/// `wall.oscillation.amplitude`.
-pub const OSCILLATION_AMPLITUDE: FieldDoc = FieldDoc {
-    key: "wall.oscillation.amplitude",
-    unit: "m",
-    default: "required",
-    range: Range::Rule("0 or >= 1e-300, finite"),
-    meaning: "amplitude A",
-};
-
-/// `wall.oscillation.angular_frequency`.
-pub const OSCILLATION_ANGULAR_FREQUENCY: FieldDoc = FieldDoc {
-    key: "wall.oscillation.angular_frequency",
-    unit: "rad/s",
-    default: "required",
-    range: Range::Rule("finite, A omega finite"),
-    meaning: "angular frequency omega = 2 pi f",
-};
-
-/// `wall.oscillation.phase`.
-pub const OSCILLATION_PHASE: FieldDoc = FieldDoc {
-    key: "wall.oscillation.phase",
-    unit: "rad",
-    default: "0",
-    range: Range::Rule("finite"),
-    meaning: "phase phi",
-};
-
-/// `wall.spin` of a wall with an axis.
-pub const WALL_SPIN: FieldDoc = FieldDoc {
-    key: "wall.spin",
-    unit: "rad/s",
-    default: "0",
-    range: Range::Rule("finite"),
-    meaning: "spin about the axis (right-handed): moves the surface tangentially",
-};

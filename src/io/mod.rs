@@ -17,7 +17,6 @@ pub mod run_lock;
 pub mod safe_write;
 pub mod scene_fields;
 pub mod scene_file;
-pub mod schema_keys;
 pub mod ss;
 pub mod standalone;
 pub mod table;

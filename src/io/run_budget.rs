@@ -16,9 +16,9 @@
 //! A budget stop leaves a checkpoint (unless the run ended first): `rubblepile resume DIR` with a larger budget
 //! continues it, bit for bit as if it had not stopped.
 
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
-use crate::io::scene_fields::{FieldDoc, Range, TableDoc};
 use crate::io::scene_file::{SceneError, Validator};
 
 /// The step budget of a run when neither the scene nor the command line sets one: 1e9 steps, the work above which
@@ -137,15 +137,23 @@ pub fn check_max_steps(n: f64) -> Result<u64, String> {
 }
 
 /// `[run]` of a scene file. Optional; both keys optional.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "run")]
 #[serde(deny_unknown_fields)]
 pub struct RunSection {
-    /// Most steps the run may take ([`DEFAULT_MAX_STEPS`] when absent), in [1, [`MAX_MAX_STEPS`]].
+    /// most steps the run may take; a scene estimated to need more is refused, a run reaching it stops with a
+    /// checkpoint (also --max-steps)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "count", default = "1e9", range = closed(1.0, MAX_MAX_STEPS as f64))]
     pub max_steps: Option<u64>,
     /// Most wall-clock seconds a process may run the run (none when absent), in [[`MIN_WALL_BUDGET`],
     /// [`MAX_WALL_BUDGET`]].
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "none", range = closed(MIN_WALL_BUDGET, MAX_WALL_BUDGET))]
+    #[field(
+        meaning = "most wall-clock seconds a process may run it; it stops with a checkpoint before overrunning (also \
+                   --max-wall-seconds)"
+    )]
     pub max_wall_seconds: Option<f64>,
 }
 
@@ -156,40 +164,13 @@ impl RunSection {
     }
 }
 
-/// The `[run]` table's row of the field reference.
-pub const RUN_TABLE: TableDoc = TableDoc {
-    key: "run",
-    array: false,
-    meaning: "the run's budget: most steps and wall-clock seconds (optional)",
-};
-
-/// `run.max_steps`.
-pub const MAX_STEPS_FIELD: FieldDoc = FieldDoc {
-    key: "run.max_steps",
-    unit: "count",
-    default: "1e9",
-    range: Range::closed(1.0, MAX_MAX_STEPS as f64),
-    meaning: "most steps the run may take; a scene estimated to need more is refused, a run reaching it stops \
-              with a checkpoint (also --max-steps)",
-};
-
-/// `run.max_wall_seconds`.
-pub const MAX_WALL_FIELD: FieldDoc = FieldDoc {
-    key: "run.max_wall_seconds",
-    unit: "s",
-    default: "none",
-    range: Range::closed(MIN_WALL_BUDGET, MAX_WALL_BUDGET),
-    meaning: "most wall-clock seconds a process may run it; it stops with a checkpoint before overrunning (also \
-              --max-wall-seconds)",
-};
-
 /// Checks the `[run]` table of a scene, naming the field.
 pub(crate) fn validate(v: &Validator<'_>, run: &RunSection) -> Result<(), SceneError> {
     if let Some(n) = run.max_steps {
-        v.field(&MAX_STEPS_FIELD, n as f64)?;
+        v.field(&RunSection::MAX_STEPS, n as f64)?;
     }
     if let Some(s) = run.max_wall_seconds {
-        v.field(&MAX_WALL_FIELD, s)?;
+        v.field(&RunSection::MAX_WALL_SECONDS, s)?;
     }
     Ok(())
 }

@@ -1,8 +1,8 @@
 //! The field reference of the scene files: one [`FieldDoc`] row per key a scene parser accepts (its unit, default,
 //! allowed range and meaning), the text `rubblepile check --explain` prints from them ([`explain_text`]), and the
 //! [`Validator`] check that reads a row's bounds ([`Validator::within`]), so that where a field's range is a plain
-//! interval the validator enforces exactly what the reference prints. Each engine keeps its rows beside its scene
-//! parser; [`crate::io::schema_keys`] lists the keys a schema accepts, against which the rows are tested.
+//! interval the validator enforces exactly what the reference prints. The rows are written on the serde structs'
+//! fields and collected by `#[derive(SceneFields)]` (the `scene_derive` crate), which refuses a field without one.
 
 use crate::io::scene_file::{MIN_MEANINGFUL, SceneError, Validator, fmt_num};
 
@@ -139,20 +139,52 @@ pub struct TableDoc {
     pub meaning: &'static str,
 }
 
+/// The rows of a scene struct, written on its fields and collected by `#[derive(scene_derive::SceneFields)]`.
+pub trait SceneFields {
+    /// Dotted path of the table the struct is read from (`` for the file's top level).
+    const TABLE: &'static str;
+    /// Appends the struct's value rows, then each sub-table's row and its own rows, in declaration order.
+    fn collect(fields: &mut Vec<FieldDoc>, tables: &mut Vec<TableDoc>);
+}
+
+/// Whether two keys are equal: the derive's compile-time check that a sub-table's struct declares the path its
+/// parent reads it under (`==` on `str` is not `const`).
+pub const fn same_key(a: &str, b: &str) -> bool {
+    let (a, b) = (a.as_bytes(), b.as_bytes());
+    if a.len() != b.len() {
+        return false;
+    }
+    let mut i = 0;
+    while i < a.len() {
+        if a[i] != b[i] {
+            return false;
+        }
+        i += 1;
+    }
+    true
+}
+
 /// The whole reference of one engine's scene file.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct SceneReference {
     /// The `scene.kind` string.
     pub kind: &'static str,
     /// Its tables.
-    pub tables: &'static [TableDoc],
+    pub tables: Vec<TableDoc>,
     /// Its keys, in the order they are printed.
-    pub fields: &'static [FieldDoc],
+    pub fields: Vec<FieldDoc>,
 }
 
 impl SceneReference {
+    /// The reference of the file whose top-level struct is `T`.
+    pub fn of<T: SceneFields>(kind: &'static str) -> SceneReference {
+        let (mut fields, mut tables) = (Vec::new(), Vec::new());
+        T::collect(&mut fields, &mut tables);
+        SceneReference { kind, tables, fields }
+    }
+
     /// The row of `key`, if there is one.
-    pub fn field(&self, key: &str) -> Option<&'static FieldDoc> {
+    pub fn field(&self, key: &str) -> Option<&FieldDoc> {
         self.fields.iter().find(|f| f.key == key)
     }
 }
@@ -184,7 +216,7 @@ pub fn explain_text(reference: &SceneReference) -> String {
     out.push_str(&line("field", "unit", "default", "range", "meaning"));
     let mut current: Option<&str> = None;
     let mut headed: Vec<&str> = Vec::new();
-    for f in reference.fields {
+    for f in &reference.fields {
         let table = table_of(f.key);
         if current != Some(table) {
             current = Some(table);

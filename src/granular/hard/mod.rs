@@ -20,5 +20,4 @@ pub mod events;
 pub mod particle;
 pub mod run;
 pub mod scene;
-pub mod scene_fields;
 pub mod stepper;

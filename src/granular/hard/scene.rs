@@ -59,15 +59,18 @@
 
 use std::path::{Path, PathBuf};
 
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use super::particle::{Attachment, Particle};
-use super::scene_fields as fields;
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Shape, Wall, WallMotion};
 use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
 use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WARNING_STEPS, exact, parse_toml_as};
 use crate::math::Vec3;
+
+// The default written into `stepping.skin_steps`'s row, held to the constant it restates.
+const _: () = assert!(DEFAULT_SKIN_STEPS == 16.0);
 
 /// The scene kind this module reads.
 pub const KIND: &str = crate::granular::vocabulary::HARD_KIND;
@@ -91,69 +94,92 @@ pub struct ParticleRow {
 }
 
 /// The whole file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct HardSceneFile {
-    /// `[scene]`. Required.
+    /// what is simulated and for how long (required)
+    #[field(table)]
     pub scene: HardSceneSection,
-    /// `[stepping]`. Required (for `dt`).
+    /// the kick-drift-kick step and the event guards (required)
+    #[field(table)]
     pub stepping: SteppingSection,
-    /// `[gravity]`: optional uniform field.
+    /// uniform field (optional; absent = none)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub gravity: Option<GravitySection>,
-    /// `[material]`: particle defaults. Optional.
+    /// restitution of every particle unless its own table overrides it (optional)
     #[serde(default)]
+    #[field(table)]
     pub material: MaterialSection,
-    /// `[output]`. Required.
+    /// snapshot times and time-series cadence (required)
+    #[field(table)]
     pub output: HardOutputSection,
-    /// `[[particle]]` tables (or `scene.particles_file`).
+    /// one sphere each (or scene.particles_file)
     #[serde(default, rename = "particle", skip_serializing_if = "Vec::is_empty")]
+    #[field(table)]
     pub particles: Vec<ParticleSpec>,
-    /// `[[wall]]` tables. Optional.
+    /// one wall each: plane, disk, cylinder, ring, point or line, possibly moving
     #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
+    #[field(table)]
     pub walls: Vec<WallSpec>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "scene")]
 #[serde(deny_unknown_fields)]
 pub struct HardSceneSection {
-    /// Must be `"hard-spheres"`.
+    /// which engine reads the scene
+    #[field(unit = "text", default = "required", range = Rule("\"hard-spheres\""))]
     pub kind: String,
-    /// End time (s), > 0. Required.
+    /// end time of the run; it starts at t = 0
+    #[field(unit = "s", default = "required", range = Positive)]
     pub t_end: f64,
-    /// Seed (recorded in `summary.json`; the hard-sphere engine is deterministic and draws no random numbers).
+    /// recorded in summary.json; the engine draws no random numbers
     #[serde(default)]
+    #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub seed: u64,
     /// CSV with the initial particles instead of `[[particle]]` tables, relative to the scene file's directory;
     /// columns `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (kg, m, m/s, rad/s; `t` and `id` ignored), so a snapshot
     /// can be used directly. Restitution comes from `[material]`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "path", default = "none", range = Rule("readable CSV, <= 1e7 rows"))]
+    #[field(meaning = "initial particles (t,id,mass,radius,x,...,wz[,stuck_to]) instead of [[particle]]")]
     pub particles_file: Option<String>,
 }
 
 /// `[stepping]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "stepping")]
 #[serde(deny_unknown_fields)]
 pub struct SteppingSection {
     /// Kick–drift–kick step (s), at least `t_end × 1e-12` (at most 1e12 steps) and 1e-300. Required. Steps are
     /// shortened to land on output times. More than 1e9 steps (`t_end/dt`) are run with a warning.
+    #[field(unit = "s", default = "required", range = Rule(">= t_end x 1e-12"))]
+    #[field(meaning = "kick-drift-kick step, shortened to land on output times")]
     pub dt: f64,
     /// Inelastic-collapse guard (m/s, ≥ 0): a collision whose normal approach speed is below this is elastic.
     /// Default 0 (off).
     #[serde(default)]
+    #[field(unit = "m/s", default = "0 (off)", range = NonNegative)]
+    #[field(meaning = "inelastic-collapse guard: slower normal approaches bounce elastically")]
     pub collapse_speed: f64,
     /// Most events one step may process (in [1, 1e9], [`MAX_EVENTS_PER_STEP`]); beyond it the run stops as stalled.
     /// Default 1e7.
     #[serde(default = "default_max_events")]
+    #[field(unit = "count", default = "1e7", range = closed(1.0, MAX_EVENTS_PER_STEP as f64))]
+    #[field(meaning = "most events one step may process; beyond it the run stops as stalled")]
     pub max_events_per_step: u64,
     /// Neighbour-list skin in steps (dimensionless, ≥ 0): a particle's travel allowance is about
     /// `skin_steps · |v| · dt` and the list is kept across steps, re-listing a particle when it could leave its
     /// allowance; 0 = a fresh list for all at every step. Default 16.
     #[serde(default = "default_skin_steps")]
+    #[field(unit = "steps", default = "16", range = NonNegative)]
+    #[field(meaning = "neighbour-list skin, about skin_steps |v| dt per particle; 0 = a fresh list every step")]
     pub skin_steps: f64,
 }
 
@@ -166,23 +192,28 @@ fn default_skin_steps() -> f64 {
 }
 
 /// `[gravity]`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "gravity")]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Required in the table.
+    /// uniform acceleration
     #[serde(deserialize_with = "exact::array")]
+    #[field(unit = "m/s^2", default = "required", range = Rule("3 finite numbers"))]
     pub uniform: [f64; 3],
 }
 
 /// `[material]`: restitution of every particle unless its own table overrides it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "material")]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
-    /// Normal coefficient of restitution ε_n ∈ [0, 1] (dimensionless). Default 1 (elastic).
+    /// normal coefficient of restitution of every particle
     #[serde(default = "one")]
+    #[field(unit = "-", default = "1 (elastic)", range = closed(0.0, 1.0))]
     pub eps_n: f64,
-    /// Tangential coefficient of restitution ε_t ∈ [−1, 1] (dimensionless; 1 smooth). Default 1.
+    /// tangential coefficient of restitution of every particle
     #[serde(default = "one")]
+    #[field(unit = "-", default = "1 (smooth)", range = closed(-1.0, 1.0))]
     pub eps_t: f64,
 }
 
@@ -197,102 +228,139 @@ impl Default for MaterialSection {
 }
 
 /// `[output]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "output")]
 #[serde(deny_unknown_fields)]
 pub struct HardOutputSection {
-    /// Snapshot times (s), strictly increasing in `[0, t_end]`, at most 1e5 ([`crate::io::scene_file::MAX_SNAPSHOTS`]). Default `[0, t_end]`.
+    /// Snapshot times (`snapshots/<k>.csv`); not with `snapshot_every`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], <= 1e5"))]
+    #[field(meaning = "snapshot times (snapshots/<k>.csv); not with snapshot_every")]
     pub times: Option<Vec<f64>>,
     /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
     /// `t_end` (the last exactly `t_end`), at most 1e5. Give `times` or this, not both. Default: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "none", range = Rule(">= 1e-300, <= 1e5 snapshots"))]
+    #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
     pub snapshot_every: Option<f64>,
-    /// Time-series cadence (s), at least `t_end × 1e-12` and `t_end / 1e8` (at most 1e8 rows). Required.
+    /// time-series cadence (timeseries.csv rows)
+    #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
     pub every: f64,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    #[field(unit = "bool", default = "false", range = Rule("true | false"))]
+    #[field(meaning = "also write every snapshot as VTK (vtk/*.vtp, vtk/run.pvd)")]
     pub vtk: bool,
 }
 
 /// `[[particle]]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "particle")]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Mass (kg), finite, ≥ 1e-300.
+    /// mass
+    #[field(unit = "kg", default = "required", range = Positive)]
     pub mass: f64,
-    /// Radius (m), finite, ≥ 1e-300.
+    /// radius
+    #[field(unit = "m", default = "required", range = Positive)]
     pub radius: f64,
     /// Centre `[x, y, z]` (m, finite). At t = 0 it may overlap another sphere or a wall by at most
     /// [`MAX_START_OVERLAP`] of its radius.
     #[serde(deserialize_with = "exact::array")]
+    #[field(unit = "m", default = "required", range = Rule("3 finite numbers; overlaps <= 1e-3 of the radius"))]
+    #[field(meaning = "centre")]
     pub position: [f64; 3],
-    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    /// velocity
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub velocity: [f64; 3],
-    /// Spin, world frame (rad/s, finite, with a finite rotational energy). Default 0.
+    /// spin, world frame
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub spin: [f64; 3],
-    /// ε_n ∈ [0, 1]; default `material.eps_n`. A pair uses the mean of its two particles' values.
+    /// this particle's eps_n; a pair uses the mean of its two values
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "material.eps_n", range = closed(0.0, 1.0))]
     pub eps_n: Option<f64>,
-    /// ε_t ∈ [−1, 1]; default `material.eps_t`.
+    /// this particle's eps_t
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "material.eps_t", range = closed(-1.0, 1.0))]
     pub eps_t: Option<f64>,
     /// Index of the wall this particle is attached to from t = 0 (it then moves rigidly with the wall, as an
     /// infinite mass: a rough lining). Default: free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "count", default = "free", range = Rule("a wall index"))]
+    #[field(meaning = "wall this particle is attached to from t = 0 (moves rigidly with it)")]
     pub stuck_to: Option<usize>,
 }
 
 /// `[[wall]]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "wall")]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
-    /// `"plane"`, `"disk"`, `"cylinder"`, `"ring"`, `"point"` or `"line"`. Required.
+    /// the wall's shape
+    #[field(unit = "text", default = "required", range = Rule("plane | disk | cylinder | ring | point | line"))]
     pub kind: String,
-    /// Plane: a point of it at t = 0 (m). Default the origin.
+    /// a point of the plane at t = 0
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "[0, 0, 0]", range = Rule("3 finite numbers; plane only"))]
     pub point: Option<[f64; 3]>,
-    /// Plane: its normal (normalised; must not vanish). Default `[0, 0, 1]`.
+    /// plane normal (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; plane only"))]
     pub normal: Option<[f64; 3]>,
     /// The others: the centre at t = 0 (m) of the disk, ring or point, the middle of the cylinder's or line's axis
     /// segment. Default the origin.
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "[0, 0, 0]", range = Rule("3 finite numbers; not a plane"))]
+    #[field(meaning = "centre at t = 0 of a disk, ring or point; middle of a cylinder's or line's axis")]
     pub centre: Option<[f64; 3]>,
-    /// The others: the axis, normal to a disk or ring (normalised; must not vanish). Default `[0, 0, 1]`.
+    /// disk/ring normal, cylinder/line axis (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; not a plane"))]
     pub axis: Option<[f64; 3]>,
     /// Radius (m) of a disk (≥ 1e-300), ring (0 or ≥ 1e-300; 0 is a point) or cylinder (0 or ≥ 1e-300; 0 is a
     /// line).
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "required by disk, ring, cylinder")]
+    #[field(range = Rule(">= 1e-300 (disk); 0 or >= 1e-300 (ring, cylinder)"))]
+    #[field(meaning = "radius; a ring of 0 is a point, a cylinder of 0 a line")]
     pub radius: Option<f64>,
     /// Length (m, 0 or ≥ 1e-300) of a cylinder or line, centred on `centre`; absent = infinite. A cylinder of length
     /// 0 is a ring.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "infinite", range = Rule("0 or >= 1e-300; cylinder, line"))]
+    #[field(meaning = "length centred on centre; a cylinder of length 0 is a ring")]
     pub length: Option<f64>,
-    /// Constant translation velocity (m/s). Default 0.
+    /// constant translation velocity
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub velocity: [f64; 3],
-    /// Sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase (rad),
-    /// direction (default the normal or axis). Optional.
+    /// sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub oscillation: Option<OscillationSpec>,
-    /// Spin about the axis (rad/s, right-handed); moves the surface tangentially. Default 0.
+    /// spin about the axis (right-handed): moves the surface tangentially
     #[serde(default)]
+    #[field(unit = "rad/s", default = "0", range = Rule("finite"))]
     pub spin: f64,
-    /// ε_n override ∈ [0, 1] for collisions with this wall.
+    /// eps_n of collisions with this wall
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "the particle's", range = closed(0.0, 1.0))]
     pub eps_n: Option<f64>,
-    /// ε_t override ∈ [−1, 1].
+    /// eps_t of collisions with this wall
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "the particle's", range = closed(-1.0, 1.0))]
     pub eps_t: Option<f64>,
-    /// Particles that touch it stay rigidly attached and move with it. Default false.
+    /// particles that touch it stay attached and move with it
     #[serde(default)]
+    #[field(unit = "bool", default = "false", range = Rule("true | false; not with absorbing"))]
     pub sticky: bool,
-    /// Particles that touch it are removed and counted. Default false.
+    /// particles that touch it are removed and counted
     #[serde(default)]
+    #[field(unit = "bool", default = "false", range = Rule("true | false"))]
     pub absorbing: bool,
 }
 
@@ -358,16 +426,16 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             format!("must be \"{KIND}\" here, got {:?}", file.scene.kind),
         ));
     }
-    let t_end = v.field(&fields::T_END, file.scene.t_end)?;
+    let t_end = v.field(&HardSceneSection::T_END, file.scene.t_end)?;
     crate::io::run_budget::validate(&v, &file.run)?;
     let dt = v.step("stepping.dt", file.stepping.dt, t_end)?;
-    let collapse_speed = v.field(&fields::COLLAPSE_SPEED, file.stepping.collapse_speed)?;
-    let skin_steps = v.field(&fields::SKIN_STEPS, file.stepping.skin_steps)?;
+    let collapse_speed = v.field(&SteppingSection::COLLAPSE_SPEED, file.stepping.collapse_speed)?;
+    let skin_steps = v.field(&SteppingSection::SKIN_STEPS, file.stepping.skin_steps)?;
     let max_events = file.stepping.max_events_per_step;
     // A count above 2^53 rounds as an f64, but every such count is far beyond the range's upper end (1e9).
-    if !fields::MAX_EVENTS.range.contains(max_events as f64) {
+    if !SteppingSection::MAX_EVENTS_PER_STEP.range.contains(max_events as f64) {
         return Err(v.invalid(
-            fields::MAX_EVENTS.key,
+            SteppingSection::MAX_EVENTS_PER_STEP.key,
             format!("must be in [1, {MAX_EVENTS_PER_STEP}] (MAX_EVENTS_PER_STEP), got {max_events}"),
         ));
     }
@@ -375,8 +443,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
         Some(g) => Some(v.vec("gravity.uniform", g.uniform)?),
         None => None,
     };
-    let eps_n = v.field(&fields::MATERIAL_EPS_N, file.material.eps_n)?;
-    let eps_t = v.field(&fields::MATERIAL_EPS_T, file.material.eps_t)?;
+    let eps_n = v.field(&MaterialSection::EPS_N, file.material.eps_n)?;
+    let eps_t = v.field(&MaterialSection::EPS_T, file.material.eps_t)?;
     let every = v.cadence("output.every", file.output.every, t_end)?;
     let times = v.output_times(file.output.times.as_deref(), file.output.snapshot_every, t_end)?;
 
@@ -416,8 +484,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             v.count("particle", file.particles.len(), MAX_BODIES, "particles (MAX_BODIES)")?;
             for (k, p) in file.particles.iter().enumerate() {
                 let f = |x: &str| format!("particle[{k}].{x}");
-                let mass = v.within(&fields::PARTICLE_MASS, &f("mass"), p.mass)?;
-                let radius = v.within(&fields::PARTICLE_RADIUS, &f("radius"), p.radius)?;
+                let mass = v.within(&ParticleSpec::MASS, &f("mass"), p.mass)?;
+                let radius = v.within(&ParticleSpec::RADIUS, &f("radius"), p.radius)?;
                 moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
@@ -427,8 +495,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
                     v.vec(&f("velocity"), p.velocity)?,
                     v.vec(&f("spin"), p.spin)?,
                 );
-                q.eps_n = v.within(&fields::PARTICLE_EPS_N, &f("eps_n"), p.eps_n.unwrap_or(eps_n))?;
-                q.eps_t = v.within(&fields::PARTICLE_EPS_T, &f("eps_t"), p.eps_t.unwrap_or(eps_t))?;
+                q.eps_n = v.within(&ParticleSpec::EPS_N, &f("eps_n"), p.eps_n.unwrap_or(eps_n))?;
+                q.eps_t = v.within(&ParticleSpec::EPS_T, &f("eps_t"), p.eps_t.unwrap_or(eps_t))?;
                 q.stuck = attach(f("stuck_to"), p.stuck_to, &q)?;
                 particles.push(q);
             }
@@ -443,8 +511,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             for (k, row) in rows.iter().enumerate() {
                 let r = &row.values;
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
-                let mass = v.within(&fields::PARTICLE_MASS, &f("mass"), r[2])?;
-                let radius = v.within(&fields::PARTICLE_RADIUS, &f("radius"), r[3])?;
+                let mass = v.within(&ParticleSpec::MASS, &f("mass"), r[2])?;
+                let radius = v.within(&ParticleSpec::RADIUS, &f("radius"), r[3])?;
                 moment_of_inertia(&v, &f, mass, radius)?;
                 let mut q = Particle::new(
                     k,
@@ -573,8 +641,7 @@ fn reject_wall_overlaps(v: &V, particles: &[Particle], walls: &[Wall]) -> Result
 /// round-off overlaps are resolved at once by the event loop; a sphere placed deep inside another would bounce in
 /// place forever and stall it, so such a start is refused.
 pub const MAX_START_OVERLAP: f64 = 1e-3;
-// The field reference writes this number into a rule (`scene_fields`, "overlaps <= 1e-3 of the radius"); held here,
-// where the reference is read, so that the reference need not name this file.
+// The `particle.position` row writes this number into its rule ("overlaps <= 1e-3 of the radius").
 const _: () = assert!(MAX_START_OVERLAP == 1e-3);
 
 /// Refuses a start where two spheres, not both stuck to walls, overlap by more than [`MAX_START_OVERLAP`].
@@ -693,11 +760,11 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         spin: w.spin,
     };
     wall.eps_n = match w.eps_n {
-        Some(e) => Some(v.within(&fields::WALL_EPS_N, &f("eps_n"), e)?),
+        Some(e) => Some(v.within(&WallSpec::EPS_N, &f("eps_n"), e)?),
         None => None,
     };
     wall.eps_t = match w.eps_t {
-        Some(e) => Some(v.within(&fields::WALL_EPS_T, &f("eps_t"), e)?),
+        Some(e) => Some(v.within(&WallSpec::EPS_T, &f("eps_t"), e)?),
         None => None,
     };
     if w.sticky && w.absorbing {

@@ -23,7 +23,6 @@ pub mod particle;
 pub mod respa;
 pub mod run;
 pub mod scene;
-pub mod scene_fields;
 pub mod spinup;
 pub mod spinup_diagnostics;
 pub mod spring_frame;

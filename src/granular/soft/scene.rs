@@ -71,6 +71,7 @@
 
 use std::path::{Path, PathBuf};
 
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::geometry::neighbours::sphere_pairs;
@@ -79,7 +80,6 @@ use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, ad
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
-use crate::granular::soft::scene_fields as fields;
 use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::{
@@ -92,57 +92,76 @@ use crate::math::Vec3;
 pub const KIND: &str = crate::granular::vocabulary::SOFT_KIND;
 
 /// A whole soft-sphere scene file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[serde(deny_unknown_fields)]
 pub struct SoftSceneFile {
-    /// `[scene]`.
+    /// what is simulated and for how long (required)
+    #[field(table)]
     pub scene: SoftSceneSection,
-    /// `[stepping]`.
+    /// the fixed leapfrog step (required)
+    #[field(table)]
     pub stepping: SoftSteppingSection,
-    /// `[material]`.
+    /// the contact law's material, Zhang17 Eqs. 1-12 (required for k_n; the rest default to Zhang17's nominal set)
+    #[field(table)]
     pub material: MaterialSection,
-    /// `[gravity]`, optional.
+    /// uniform field and self-gravity (optional; absent = no gravity)
     #[serde(default)]
+    #[field(table)]
     pub gravity: GravitySection,
-    /// `[output]`.
+    /// time-series cadence and snapshot times (required)
+    #[field(table)]
     pub output: SoftOutputSection,
-    /// `[[wall]]` tables.
+    /// one wall each: a plane (point, normal), the inside of a sphere (centre, radius) or a cylinder (centre, axis,
+    /// radius, length)
     #[serde(default, rename = "wall")]
+    #[field(table)]
     pub walls: Vec<WallSpec>,
-    /// `[[particle]]` tables (or `scene.particles_file`).
+    /// one sphere each (or scene.particles_file)
     #[serde(default, rename = "particle")]
+    #[field(table)]
     pub particles: Vec<ParticleSpec>,
-    /// `[spinup]`, optional: spin-up forcing and diagnostics ([`crate::granular::soft::spinup`]).
+    /// spin-up forcing along a period path T(t) and its diagnostics (optional; Zhang17 §2.3.4)
     #[serde(default)]
+    #[field(table)]
     pub spinup: Option<crate::granular::soft::spinup::SpinupSection>,
-    /// `[run]`: the run's budget (most steps, most wall-clock seconds; [`crate::io::run_budget`]). Optional.
+    /// the run's budget: most steps and wall-clock seconds (optional)
     #[serde(default, skip_serializing_if = "crate::io::run_budget::RunSection::is_empty")]
+    #[field(table)]
     pub run: crate::io::run_budget::RunSection,
 }
 
 /// `[scene]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "scene")]
 #[serde(deny_unknown_fields)]
 pub struct SoftSceneSection {
-    /// Must be `"soft-spheres"`.
+    /// which engine reads the scene
+    #[field(unit = "text", default = "required", range = Rule("\"soft-spheres\""))]
     pub kind: String,
-    /// End time (s, > 0).
+    /// end time; the run takes round(t_end/dt) steps
+    #[field(unit = "s", default = "required", range = Positive)]
     pub t_end: f64,
-    /// Seed, recorded in the summary (default 0).
+    /// recorded in the summary; the engine draws no random numbers
     #[serde(default)]
+    #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub seed: u64,
     /// CSV of the initial particles (relative to the scene's directory), columns
     /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (`t`, `id` optional and ignored): a snapshot works.
     #[serde(default)]
+    #[field(unit = "path", default = "none", range = Rule("readable CSV, <= 1e7 rows"))]
+    #[field(meaning = "initial particles (t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz) instead of [[particle]]")]
     pub particles_file: Option<String>,
 }
 
 /// `[stepping]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "stepping")]
 #[serde(deny_unknown_fields)]
 pub struct SoftSteppingSection {
     /// Fixed leapfrog step (s, at most the stability limit `2 √(μ_min/k_N)` and `t_end`, at least `t_end × 1e-12`).
     /// More than 1e9 steps are run with a warning.
+    #[field(unit = "s", default = "required", range = Rule("<= 2 sqrt(m_min/2 / k_n) and t_end, >= t_end x 1e-12"))]
+    #[field(meaning = "fixed leapfrog step (see `rubblepile ssdem advise`)")]
     pub dt: f64,
 }
 
@@ -166,131 +185,172 @@ fn d005() -> f64 {
 }
 
 /// `[material]`: the contact law's material (defaults: Zhang17's nominal set, §2.3.3).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "material")]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
-    /// Normal spring constant (N/m, > 0). Required.
+    /// normal spring constant (k_S = 2/7 k_N); see `rubblepile ssdem advise`
+    #[field(unit = "N/m", default = "required", range = Positive)]
     pub k_n: f64,
-    /// Normal restitution ε_n, in (0, 1]. Default 0.55.
+    /// normal coefficient of restitution
     #[serde(default = "d055")]
+    #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
     pub eps_n: f64,
-    /// Tangential restitution ε_t, in (0, 1]. Default 0.55.
+    /// tangential coefficient of restitution
     #[serde(default = "d055")]
+    #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
     pub eps_t: f64,
-    /// Sliding friction μ_S (≥ 0). Default 1.0.
+    /// sliding friction coefficient
     #[serde(default = "d1")]
+    #[field(unit = "-", default = "1.0", range = NonNegative)]
     pub mu_s: f64,
-    /// Twisting friction μ_T (≥ 0). Default 1.3.
+    /// twisting friction coefficient
     #[serde(default = "d13")]
+    #[field(unit = "-", default = "1.3", range = NonNegative)]
     pub mu_t: f64,
-    /// Rolling friction μ_R (≥ 0). Default 1.05.
+    /// rolling friction coefficient
     #[serde(default = "d105")]
+    #[field(unit = "-", default = "1.05", range = NonNegative)]
     pub mu_r: f64,
-    /// Shape parameter β (≥ 0). Default 0.5.
+    /// shape parameter (0 = no twisting or rolling resistance)
     #[serde(default = "d05")]
+    #[field(unit = "-", default = "0.5", range = NonNegative)]
     pub beta: f64,
-    /// Largest initial overlap accepted, as a fraction of the smaller radius (≥ 0). Default 0.05.
+    /// largest initial overlap accepted, as a fraction of the smaller radius
     #[serde(default = "d005")]
+    #[field(unit = "-", default = "0.05", range = NonNegative)]
     pub max_start_overlap: f64,
 }
 
 /// `[gravity]`.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, SceneFields)]
+#[scene(table = "gravity")]
 #[serde(deny_unknown_fields)]
 pub struct GravitySection {
-    /// Uniform acceleration `[gx, gy, gz]` (m/s², finite). Default none.
+    /// uniform acceleration
     #[serde(default, deserialize_with = "exact::option")]
+    #[field(unit = "m/s^2", default = "none", range = Rule("3 finite numbers"))]
     pub uniform: Option<[f64; 3]>,
-    /// Self-gravity: `"tree"` (octree, quadrupole) or `"direct"` (exact). Default none.
+    /// self-gravity by octree (quadrupole) or exact pair sum; absent = none
     #[serde(default, rename = "self")]
+    #[field(unit = "text", default = "none", range = Rule("\"tree\" | \"direct\""))]
     pub self_gravity: Option<String>,
-    /// Tree opening angle θ (in (0, 1]). Default 0.5.
+    /// tree opening angle; only with self = "tree"
     #[serde(default)]
+    #[field(unit = "-", default = "0.5", range = open_closed(0.0, 1.0))]
     pub theta: Option<f64>,
     /// Steps (an integer ≥ 1) between self-gravity evaluations: self-gravity is applied as kicks of `k dt/2` at
     /// both ends of each block of `k` steps (r-RESPA, [`crate::granular::soft::respa`]). Default 1 (every step).
     #[serde(default)]
+    #[field(unit = "steps", default = "1", range = Rule("integer >= 1; > 1 needs self"))]
+    #[field(meaning = "steps between self-gravity evaluations (r-RESPA kicks)")]
     pub interval_steps: Option<i64>,
-    /// Gravitational constant (m³ kg⁻¹ s⁻², > 0). Default 6.674e-11.
+    /// gravitational constant of the self-gravity
     #[serde(default, rename = "G")]
+    #[field(unit = "m^3 kg^-1 s^-2", default = "6.674e-11", range = Positive)]
     pub g: Option<f64>,
 }
 
 /// `[output]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "output")]
 #[serde(deny_unknown_fields)]
 pub struct SoftOutputSection {
     /// Time-series cadence (s, at least `t_end / 1e8`: at most 1e8 rows), rounded to a whole number of steps (at
     /// least one).
+    #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
+    #[field(meaning = "time-series cadence, rounded to whole steps (at least one)")]
     pub every: f64,
     /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step, at most 1e5. Default
     /// `[0, t_end]`.
     #[serde(default)]
+    #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], >= 1 step apart, <= 1e5"))]
+    #[field(meaning = "snapshot times, each at the nearest step; not with snapshot_every")]
     pub times: Option<Vec<f64>>,
     /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
     /// `t_end`, each at the nearest step and at least one step apart, at most 1e5. Give `times` or this, not both.
     /// Default: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "s", default = "none", range = Rule(">= 1 step, <= 1e5 snapshots"))]
+    #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
     pub snapshot_every: Option<f64>,
     /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
     /// `--format vtk` does. Default false.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    #[field(unit = "bool", default = "false", range = Rule("true | false"))]
+    #[field(meaning = "also write every snapshot as VTK (vtk/*.vtp, vtk/run.pvd)")]
     pub vtk: bool,
 }
 
 /// `[[wall]]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "wall")]
 #[serde(deny_unknown_fields)]
 pub struct WallSpec {
-    /// `"plane"`, `"sphere"` or `"cylinder"`.
+    /// a half-space, the inside of a sphere, or a cylinder (touched from inside or outside)
+    #[field(unit = "text", default = "required", range = Rule("\"plane\" | \"sphere\" | \"cylinder\""))]
     pub kind: String,
-    /// Plane: a point on it (m).
+    /// a point of the plane
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "required by \"plane\"", range = Rule("3 finite numbers"))]
     pub point: Option<[f64; 3]>,
-    /// Plane: normal towards the particles (any length > 0; normalised).
+    /// plane normal towards the particles (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "required by \"plane\"", range = Rule("3 finite numbers, non-zero"))]
     pub normal: Option<[f64; 3]>,
-    /// Sphere: centre; cylinder: the middle of its axis segment (m).
+    /// centre of a sphere wall, middle of a cylinder's axis
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "required by \"sphere\", \"cylinder\"", range = Rule("3 finite numbers"))]
     pub centre: Option<[f64; 3]>,
-    /// Cylinder: axis (any length > 0; normalised).
+    /// cylinder axis (normalised)
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
+    #[field(unit = "-", default = "required by \"cylinder\"", range = Rule("3 finite numbers, non-zero"))]
     pub axis: Option<[f64; 3]>,
-    /// Sphere: inner radius; cylinder: radius (m, ≥ 1e-300).
+    /// inner radius of a sphere wall, radius of a cylinder
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "required by \"sphere\", \"cylinder\"", range = Positive)]
     pub radius: Option<f64>,
-    /// Cylinder: length along the axis, centred on `centre` (m, ≥ 1e-300). Default infinite.
+    /// length of a cylinder along its axis, centred on its centre
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "m", default = "infinite", range = Positive)]
     pub length: Option<f64>,
-    /// Optional sinusoidal translation (`granular::vocabulary`): amplitude (m), angular frequency (rad/s), phase
-    /// (rad), direction (default the plane's normal or the cylinder's axis; required for a sphere).
+    /// sinusoidal translation A (sin(omega t + phi) - sin phi) along direction (optional)
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(table)]
     pub oscillation: Option<OscillationSpec>,
-    /// Cylinder: spin about the axis (rad/s, right-handed, finite). Default 0.
+    /// spin about the axis (right-handed): moves the surface tangentially
     #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[field(unit = "rad/s", default = "0", range = Rule("finite; \"cylinder\" only"))]
     pub spin: Option<f64>,
 }
 
 /// `[[particle]]`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "particle")]
 #[serde(deny_unknown_fields)]
 pub struct ParticleSpec {
-    /// Radius (m, finite, ≥ 1e-300).
+    /// sphere radius
+    #[field(unit = "m", default = "required", range = Positive)]
     pub radius: f64,
-    /// Mass (kg, finite, ≥ 1e-300); exactly one of `mass` and `density`.
+    /// mass; exactly one of mass, density
     #[serde(default)]
+    #[field(unit = "kg", default = "(mass or density)", range = Positive)]
     pub mass: Option<f64>,
-    /// Grain density (kg/m³, finite, ≥ 1e-300); then `mass = 4/3 π r³ density` (finite, ≥ 1e-300).
+    /// grain density: mass = 4/3 pi r^3 density
     #[serde(default)]
+    #[field(unit = "kg/m^3", default = "(mass or density)", range = Positive)]
     pub density: Option<f64>,
-    /// Centre position (m, finite).
+    /// centre
     #[serde(deserialize_with = "exact::array")]
+    #[field(unit = "m", default = "required", range = Rule("3 finite numbers; overlaps <= contact.max_start_overlap"))]
     pub position: [f64; 3],
-    /// Velocity (m/s, finite, with a finite kinetic energy). Default 0.
+    /// velocity
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "m/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub velocity: [f64; 3],
-    /// Spin (rad/s, finite, with a finite rotational energy). Default 0.
+    /// spin
     #[serde(default, deserialize_with = "exact::array")]
+    #[field(unit = "rad/s", default = "[0, 0, 0]", range = Rule("3 finite numbers"))]
     pub spin: [f64; 3],
 }
 
@@ -388,14 +448,14 @@ impl V<'_> {
     }
 
     fn particle(&self, label: &str, s: &ParticleSpec) -> Result<Particle, SceneError> {
-        let radius = self.within(&fields::PARTICLE_RADIUS, &format!("{label}.radius"), s.radius)?;
+        let radius = self.within(&ParticleSpec::RADIUS, &format!("{label}.radius"), s.radius)?;
         // r² and r³ enter the moment of inertia and the mass from the density: they must stay normal numbers.
         let r3 = radius * radius * radius;
         let radius_fault = !(r3.is_finite() && radius * radius >= f64::MIN_POSITIVE && r3 >= f64::MIN_POSITIVE);
         let mass = match (s.mass, s.density) {
-            (Some(m), None) => self.within(&fields::PARTICLE_MASS, &format!("{label}.mass"), m)?,
+            (Some(m), None) => self.within(&ParticleSpec::MASS, &format!("{label}.mass"), m)?,
             (None, Some(rho)) => {
-                let m = self.within(&fields::PARTICLE_DENSITY, &format!("{label}.density"), rho)? * 4.0 / 3.0
+                let m = self.within(&ParticleSpec::DENSITY, &format!("{label}.density"), rho)? * 4.0 / 3.0
                     * std::f64::consts::PI
                     * r3;
                 if !(m.is_finite() && m >= MIN_MEANINGFUL) {
@@ -566,7 +626,7 @@ impl V<'_> {
             }
             "sphere" => Ok(Wall::Sphere(SphereContainer {
                 centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
-                radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
+                radius: self.within(&WallSpec::RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
                 oscillation: shaking(None)?,
             })),
             _ => {
@@ -578,10 +638,10 @@ impl V<'_> {
                 Ok(Wall::Cylinder(Cylinder {
                     centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
                     axis,
-                    radius: self.within(&fields::WALL_RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
+                    radius: self.within(&WallSpec::RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
                     length: w
                         .length
-                        .map(|l| self.within(&fields::WALL_LENGTH, &field("length"), l))
+                        .map(|l| self.within(&WallSpec::LENGTH, &field("length"), l))
                         .transpose()?,
                     oscillation: shaking(Some(axis))?,
                     spin,
@@ -594,7 +654,7 @@ impl V<'_> {
         if file.scene.kind != KIND {
             return Err(self.invalid("scene.kind", format!("must be \"{KIND}\", got {:?}", file.scene.kind)));
         }
-        let t_end = self.field(&fields::T_END, file.scene.t_end)?;
+        let t_end = self.field(&SoftSceneSection::T_END, file.scene.t_end)?;
         crate::io::run_budget::validate(self, &file.run)?;
         let dt = self.step("stepping.dt", file.stepping.dt, t_end)?;
         let steps = (t_end / dt).round();
@@ -608,19 +668,19 @@ impl V<'_> {
 
         let c = &file.material;
         let material = Material {
-            k_n: self.field(&fields::K_N, c.k_n)?,
-            eps_n: self.field(&fields::EPS_N, c.eps_n)?,
-            eps_t: self.field(&fields::EPS_T, c.eps_t)?,
-            mu_s: self.field(&fields::MU_S, c.mu_s)?,
-            mu_t: self.field(&fields::MU_T, c.mu_t)?,
-            mu_r: self.field(&fields::MU_R, c.mu_r)?,
-            beta: self.field(&fields::BETA, c.beta)?,
+            k_n: self.field(&MaterialSection::K_N, c.k_n)?,
+            eps_n: self.field(&MaterialSection::EPS_N, c.eps_n)?,
+            eps_t: self.field(&MaterialSection::EPS_T, c.eps_t)?,
+            mu_s: self.field(&MaterialSection::MU_S, c.mu_s)?,
+            mu_t: self.field(&MaterialSection::MU_T, c.mu_t)?,
+            mu_r: self.field(&MaterialSection::MU_R, c.mu_r)?,
+            beta: self.field(&MaterialSection::BETA, c.beta)?,
         };
-        let max_start = self.field(&fields::MAX_START_OVERLAP, c.max_start_overlap)?;
+        let max_start = self.field(&MaterialSection::MAX_START_OVERLAP, c.max_start_overlap)?;
 
         let gs = &file.gravity;
         let g = match gs.g {
-            Some(g) => self.field(&fields::GRAVITY_G, g)?,
+            Some(g) => self.field(&GravitySection::G, g)?,
             None => SI_G,
         };
         let self_gravity = match gs.self_gravity.as_deref() {
@@ -637,7 +697,7 @@ impl V<'_> {
                 Some(SelfGravity::Direct)
             }
             Some("tree") => {
-                let theta = self.field(&fields::GRAVITY_THETA, gs.theta.unwrap_or(0.5))?;
+                let theta = self.field(&GravitySection::THETA, gs.theta.unwrap_or(0.5))?;
                 Some(SelfGravity::Tree { theta })
             }
             Some(other) => {

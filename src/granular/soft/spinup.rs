@@ -12,6 +12,7 @@
 //! Release (§2.3.4 footnote 6): when b/a, c/a or η_B moves from its value at `t_start` by more than
 //! `release_axis_ratio` / `release_packing` at `release_samples` consecutive outputs, the forcing stops for good.
 
+use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::granular::soft::ordered_sum::{SUM_CHUNK, ordered_reduce, ordered_sum};
@@ -35,57 +36,78 @@ fn d_rve() -> usize {
 }
 
 /// The `[spinup]` table as written (periods in hours, times in seconds).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
+#[scene(table = "spinup")]
 #[serde(deny_unknown_fields)]
 pub struct SpinupSection {
-    /// Period held while the body settles (h, > 0).
+    /// spin period held while the body settles
     #[serde(rename = "T_start")]
+    #[field(unit = "h", default = "required", range = Positive)]
     pub period_start_h: f64,
-    /// Period at `t_inter` (h, > 0, ≤ `T_start`).
+    /// spin period at t_inter (<= T_start)
     #[serde(rename = "T_inter")]
+    #[field(unit = "h", default = "required", range = Positive)]
     pub period_inter_h: f64,
-    /// Final period, held after `t_final` (h, > 0, ≤ `T_inter`).
+    /// final spin period, held after t_final (<= T_inter)
     #[serde(rename = "T_final")]
+    #[field(unit = "h", default = "required", range = Positive)]
     pub period_final_h: f64,
-    /// End of the settling phase (s, ≥ 0).
+    /// end of the settling phase
+    #[field(unit = "s", default = "required", range = NonNegative)]
     pub t_start: f64,
-    /// End of the fast linear spin-up (s, ≥ `t_start`).
+    /// end of the fast linear spin-up (>= t_start)
+    #[field(unit = "s", default = "required", range = NonNegative)]
     pub t_inter: f64,
-    /// End of the slow spin-up (s, ≥ `t_inter`).
+    /// end of the slow spin-up (>= t_inter)
+    #[field(unit = "s", default = "required", range = NonNegative)]
     pub t_final: f64,
-    /// Rest stages in the slow phase (default 0).
+    /// rest stages in the slow phase
     #[serde(default)]
+    #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub rests: u32,
-    /// Length of each rest (s, ≥ 0; default 0); all rests together shorter than `t_final − t_inter`.
+    /// length of each rest; all rests together shorter than t_final - t_inter
     #[serde(default)]
+    #[field(unit = "s", default = "0", range = NonNegative)]
     pub rest_length: f64,
-    /// Spin axis, fixed in space (three finite numbers, non-zero; default `[0, 0, 1]`).
+    /// spin axis, fixed in space
     #[serde(default, deserialize_with = "crate::io::scene_file::exact::option")]
+    #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero"))]
     pub axis: Option<[f64; 3]>,
     /// What the forcing holds on the path: `"period"` (default; the body's rotation period `2π I/L` equals `T(t)`
     /// after every step, Zhang17 §2.3.4: "strictly constrained to the spin-up path") or `"angular_momentum"`
     /// (`L = I_ref 2π/T(t)` with `I_ref` the members' inertia as placed at t = 0, so an expanding body slows).
     #[serde(default)]
+    #[field(unit = "text", default = "\"period\"", range = Rule("\"period\" | \"angular_momentum\""))]
+    #[field(meaning = "what the forcing holds on the path: the rotation period, or L = I_ref 2 pi/T(t)")]
     pub target: Option<String>,
-    /// Release threshold on b/a and c/a (> 0; default 0.1).
+    /// disruption when |d(b/a)| or |d(c/a)| exceeds this
     #[serde(default = "d_release_axis")]
+    #[field(unit = "-", default = "0.1", range = Positive)]
     pub release_axis_ratio: f64,
-    /// Release threshold on η_B (> 0; default 0.01).
+    /// disruption when the interior packing fraction changes by more than this
     #[serde(default = "d_release_packing")]
+    #[field(unit = "-", default = "0.01", range = Positive)]
     pub release_packing: f64,
-    /// Consecutive samples beyond a release threshold that confirm disruption (≥ 1; default 2).
+    /// consecutive samples beyond a release threshold that confirm disruption
     #[serde(default = "d_release_samples")]
+    #[field(unit = "count", default = "2", range = Rule("integer >= 1"))]
     pub release_samples: u32,
-    /// Target particles per RVE (≥ 8; default 300).
+    /// target particles per representative volume element (stress diagnostics)
     #[serde(default = "d_rve")]
+    #[field(unit = "count", default = "300", range = Rule("integer >= 8"))]
     pub rve_particles: usize,
     /// Which particles η_B is taken over ([`InteriorRule`]): unset, the layer rule (default); set, the depth (m,
     /// ≥ 0) below the surface layer from which a particle counts, with weight rising linearly to 1 over
     /// `interior_ramp` (m, > 0; default `interior_depth`). Meant for piles of unequal spheres (PP1).
     #[serde(default)]
+    #[field(unit = "m", default = "none (layer rule)", range = NonNegative)]
+    #[field(
+        meaning = "depth below the surface layer from which a particle counts in eta_B (piles of unequal spheres)"
+    )]
     pub interior_depth: Option<f64>,
-    /// See `interior_depth` (m, > 0).
+    /// depth span over which a particle's eta_B weight rises from 0 to 1; needs interior_depth
     #[serde(default)]
+    #[field(unit = "m", default = "interior_depth", range = Positive)]
     pub interior_ramp: Option<f64>,
 }
 
@@ -195,26 +217,25 @@ pub struct SpinupSettings {
 impl crate::io::scene_file::Validator<'_> {
     /// Checks a `[spinup]` table; errors name the field (`spinup.T_final`, …) and the expected value.
     pub(crate) fn spinup(&self, s: &SpinupSection) -> Result<SpinupSettings, SceneError> {
-        use crate::granular::soft::scene_fields as fields;
-        let ts = self.field(&fields::SPINUP_T_START, s.period_start_h)?;
-        let ti = self.field(&fields::SPINUP_T_INTER, s.period_inter_h)?;
-        let tf = self.field(&fields::SPINUP_T_FINAL, s.period_final_h)?;
+        let ts = self.field(&SpinupSection::PERIOD_START_H, s.period_start_h)?;
+        let ti = self.field(&SpinupSection::PERIOD_INTER_H, s.period_inter_h)?;
+        let tf = self.field(&SpinupSection::PERIOD_FINAL_H, s.period_final_h)?;
         if ti > ts {
             return Err(self.invalid("spinup.T_inter", format!("must be <= T_start = {ts} h, got {ti}")));
         }
         if tf > ti {
             return Err(self.invalid("spinup.T_final", format!("must be <= T_inter = {ti} h, got {tf}")));
         }
-        let t0 = self.field(&fields::SPINUP_TIME_START, s.t_start)?;
-        let t1 = self.field(&fields::SPINUP_TIME_INTER, s.t_inter)?;
-        let t2 = self.field(&fields::SPINUP_TIME_FINAL, s.t_final)?;
+        let t0 = self.field(&SpinupSection::T_START, s.t_start)?;
+        let t1 = self.field(&SpinupSection::T_INTER, s.t_inter)?;
+        let t2 = self.field(&SpinupSection::T_FINAL, s.t_final)?;
         if t1 < t0 {
             return Err(self.invalid("spinup.t_inter", format!("must be >= t_start = {t0} s, got {t1}")));
         }
         if t2 < t1 {
             return Err(self.invalid("spinup.t_final", format!("must be >= t_inter = {t1} s, got {t2}")));
         }
-        let rest = self.field(&fields::SPINUP_REST_LENGTH, s.rest_length)?;
+        let rest = self.field(&SpinupSection::REST_LENGTH, s.rest_length)?;
         if s.rests as f64 * rest >= t2 - t1 && s.rests > 0 {
             return Err(self.invalid(
                 "spinup.rest_length",
@@ -251,9 +272,9 @@ impl crate::io::scene_file::Validator<'_> {
                 return Err(self.invalid("spinup.interior_ramp", "needs spinup.interior_depth (m, >= 0)"));
             }
             (Some(d), ramp) => {
-                let depth = self.field(&fields::SPINUP_INTERIOR_DEPTH, d)?;
+                let depth = self.field(&SpinupSection::INTERIOR_DEPTH, d)?;
                 let ramp = match ramp {
-                    Some(w) => self.field(&fields::SPINUP_INTERIOR_RAMP, w)?,
+                    Some(w) => self.field(&SpinupSection::INTERIOR_RAMP, w)?,
                     None if depth > 0.0 => depth,
                     None => {
                         return Err(self.invalid(
@@ -281,8 +302,8 @@ impl crate::io::scene_file::Validator<'_> {
             },
             axis: axis.normalize(),
             target,
-            release_axis_ratio: self.field(&fields::SPINUP_RELEASE_AXIS_RATIO, s.release_axis_ratio)?,
-            release_packing: self.field(&fields::SPINUP_RELEASE_PACKING, s.release_packing)?,
+            release_axis_ratio: self.field(&SpinupSection::RELEASE_AXIS_RATIO, s.release_axis_ratio)?,
+            release_packing: self.field(&SpinupSection::RELEASE_PACKING, s.release_packing)?,
             release_samples: s.release_samples,
             rve_particles: s.rve_particles,
             interior,
