@@ -471,7 +471,16 @@ fn impact_command_still_works() {
     // the run directory's scene is an ordinary scene
     let scene = std::fs::read_to_string(out_dir.join("scene.toml")).unwrap();
     assert!(scene.contains("bodies_file = \"initial_bodies.csv\""));
-    assert!(scene.contains("calibrate = { beta = 10.0, v = 20.0, reading = \"printed\" }"));
+    let calibrate = rubblepile::ellipsoid::scene::parse_toml(&scene, "scene.toml")
+        .unwrap()
+        .model
+        .calibrate
+        .unwrap();
+    assert_eq!((calibrate.beta, calibrate.v), (10.0, 20.0));
+    assert_eq!(
+        calibrate.reading,
+        rubblepile::ellipsoid::calibration::KappaReading::Printed
+    );
     // existing directory without --force; bad angle: one line naming the flag
     let out = run(&args("30"));
     assert_eq!(out.status.code(), Some(2));

@@ -98,6 +98,14 @@ pub(crate) fn fmt_list(v: &[f64]) -> String {
     format!("[{}]", parts.join(", "))
 }
 
+/// A scene value (an engine's scene-file struct) as the text of a scene file: each of `comments` on a `# ` line, then
+/// the value in TOML, which parses back to the same value. Panics only for a value TOML cannot hold (an integer
+/// above `i64::MAX`), which the scenes' checks refuse first.
+pub fn scene_text<T: serde::Serialize>(comments: &[&str], scene: &T) -> String {
+    let body = toml::to_string(scene).expect("a checked scene value is TOML");
+    comments.iter().map(|c| format!("# {c}\n")).collect::<String>() + &body
+}
+
 /// A scene file as every engine's loader needs it: its name for messages (the path as given), its text, and the
 /// directory relative paths in it are resolved against (`.` for a bare file name).
 pub struct SceneText {

@@ -63,17 +63,12 @@ pub enum Action {
     Conflict(String),
 }
 
-/// Whether `dir` holds the run `plan` describes: its `scene.toml` (comment lines aside) and its
-/// `initial_bodies.csv` (bit for bit) are those this campaign would write.
+/// Whether `dir` holds the run `plan` describes: its `scene.toml` parses to the scene this campaign would write
+/// (compared as values: comments and layout aside, as an older build wrote it) and its `initial_bodies.csv` (bit
+/// for bit) is the one it would write.
 fn same_run(dir: &Path, plan: &ImpactPlan) -> Result<(), String> {
-    let strip = |s: &str| -> Vec<String> {
-        s.lines()
-            .filter(|l| !l.trim_start().starts_with('#'))
-            .map(|l| l.trim_end().to_string())
-            .collect()
-    };
     let scene = std::fs::read_to_string(dir.join("scene.toml")).map_err(|e| format!("scene.toml: {e}"))?;
-    if strip(&scene) != strip(&plan.scene_toml) {
+    if crate::ellipsoid::scene::parse_toml(&scene, "scene.toml").ok().as_ref() != Some(&plan.scene) {
         return Err("its scene.toml differs from this campaign's (changed [impact] settings?)".into());
     }
     let records = read_bodies_csv(&dir.join("initial_bodies.csv")).map_err(|e| e.to_string())?;
