@@ -648,3 +648,65 @@ fn bench_critical_times_both_settings_on_one_prepared_base() {
     assert_eq!(settings, ["1,2", "1,1", "2,1"], "{csv}");
     assert!(dir.join("b/searches/parallel1_threads1/critical.csv").is_file());
 }
+
+/// `spinup critical --branch` resumed over a base run whose `scene.toml` an older build wrote (the base scene's
+/// TOML table edited and printed whole, another layout than the scene value's): the same values are accepted and
+/// the missing hold is branched again; other values (another range of T_final) are refused.
+#[test]
+fn a_resumed_search_accepts_a_base_scene_of_the_old_layout_with_the_same_values() {
+    let dir = temp_dir("spinup-old-base");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
+    let args = [
+        "spinup",
+        "critical",
+        "--scene",
+        "s.toml",
+        "--from",
+        "6",
+        "--to",
+        "6.5",
+        "--step",
+        "0.5",
+        "--branch",
+        "--hold",
+        "600",
+        "--out",
+        "crit",
+        "--prepare-only",
+    ];
+    let c = rubblepile(&dir, &args);
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let base = dir.join("crit/base/scene.toml");
+    // the base scene as the text path of earlier builds wrote it: the scene file's table with an absolute
+    // particles_file, the base run's t_end and output times, printed by `toml::to_string`
+    let written: toml::Table = read(&base).parse().unwrap();
+    let old_layout = |t_end: &toml::Value| -> String {
+        let mut table: toml::Table = read(&dir.join("s.toml")).parse().unwrap();
+        let abs = std::path::absolute(dir.join("ball.csv")).unwrap().display().to_string();
+        table["scene"]["particles_file"] = toml::Value::String(abs);
+        table["scene"]["t_end"] = t_end.clone();
+        table["output"]["times"] = written["output"]["times"].clone();
+        toml::to_string(&table).unwrap()
+    };
+    let old = old_layout(&written["scene"]["t_end"]);
+    assert_ne!(old, read(&base), "the layouts differ");
+    std::fs::write(&base, &old).unwrap();
+    // the later hold (T = 6.0 h) is branched again from the base run's checkpoint
+    let hold = read(&dir.join("crit/T6.00/scene.toml"));
+    std::fs::remove_dir_all(dir.join("crit/T6.00")).unwrap();
+    let again = rubblepile(&dir, &args);
+    assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
+    assert_eq!(read(&dir.join("crit/T6.00/scene.toml")), hold);
+    // a base run made for another span is refused as before
+    let t_end = written["scene"]["t_end"].as_float().unwrap();
+    std::fs::write(&base, old_layout(&toml::Value::Float(t_end + 120.0))).unwrap();
+    std::fs::remove_dir_all(dir.join("crit/T6.00")).unwrap();
+    let refused = rubblepile(&dir, &args);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&refused.stderr).contains("the base run was made for another range of T_final"),
+        "{}",
+        String::from_utf8_lossy(&refused.stderr)
+    );
+}

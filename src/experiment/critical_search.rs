@@ -13,8 +13,10 @@ use crate::analysis::creep::{CreepCriterion, CreepCriterionKind};
 use crate::analysis::critical::*;
 use crate::analysis::spinup_diagnostics::read_spinup_csv;
 use crate::driver::RunOptions;
+use crate::granular::soft::scene::SoftSceneFile;
 use crate::impact::campaign::Shard;
 use crate::io::messages::{Channel, emit};
+use crate::io::scene_file::{parse_toml_as, scene_text};
 
 /// The options of a T_c,3 search (those of `rubblepile spinup critical`).
 #[derive(Debug, Clone, PartialEq)]
@@ -143,12 +145,14 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             base.t_end
         )));
     }
-    let mut table: toml::Table = toml::from_str(&text).map_err(|e| SearchError::usage(e.to_string()))?;
+    // the scene as a value, which each hold's scene changes and is written from
+    let mut file: SoftSceneFile =
+        parse_toml_as(&text, &args.scene.display().to_string()).map_err(|e| SearchError::usage(e.to_string()))?;
     // a particles_file is resolved against the base scene's directory
     let scene_dir = args.scene.parent().map(Path::to_path_buf).unwrap_or_default();
-    if let Some(toml::Value::String(f)) = table.get("scene").and_then(|s| s.get("particles_file")).cloned() {
-        let abs = std::path::absolute(scene_dir.join(&f)).map_err(|e| SearchError::usage(e.to_string()))?;
-        table["scene"]["particles_file"] = toml::Value::String(abs.display().to_string());
+    if let Some(f) = &file.scene.particles_file {
+        let abs = std::path::absolute(scene_dir.join(f)).map_err(|e| SearchError::usage(e.to_string()))?;
+        file.scene.particles_file = Some(abs.display().to_string());
     }
     std::fs::create_dir_all(&args.out).map_err(|e| SearchError::usage(format!("{}: {e}", args.out.display())))?;
     let criteria = criteria(args.significance, args.coordination_tolerance)?;
@@ -178,7 +182,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         }
     }
     let branches = if args.branch {
-        Some(prepare_branches(args, &table, &base, &settings.path, &grid)?)
+        Some(prepare_branches(args, &file, &base, &settings.path, &grid)?)
     } else {
         None
     };
@@ -189,10 +193,12 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         let scene = match branches {
             Some(_) => None,
             None => {
-                table["spinup"]["T_final"] = toml::Value::Float(tf);
-                let scene_text = toml::to_string(&table).map_err(|e| SearchError::usage(e.to_string()))?;
+                let mut hold = file.clone();
+                if let Some(spinup) = hold.spinup.as_mut() {
+                    spinup.period_final_h = tf;
+                }
                 let path = args.out.join(format!("T{tf:.2}.toml"));
-                crate::io::safe_write::write_atomic(&path, &scene_text)
+                crate::io::safe_write::write_atomic(&path, scene_text(&[], &hold))
                     .map_err(|e| SearchError::failed(format!("{}: {e}", path.display())))?;
                 Some(crate::granular::soft::scene::load_soft_scene(&path).map_err(SearchError::usage)?)
             }
@@ -472,6 +478,12 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
     requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
+/// Whether the scene text `text` (a base run's `scene.toml`) holds the scene `file`: compared as values, so that a
+/// base run whose scene an older build wrote in another layout (or with defaults left out) is still recognised.
+fn same_scene(text: &str, file: &SoftSceneFile) -> bool {
+    parse_toml_as::<SoftSceneFile>(text, "scene.toml").is_ok_and(|f| f == *file)
+}
+
 /// How many checkpointed legs the base run of `--branch` is cut into over its whole span (a stopped search loses
 /// at most one leg of the path: about 15 min of a full-size base run on two cores).
 const BASE_LEGS: u64 = 8;
@@ -503,7 +515,7 @@ fn base_legs(samples: &[u64], from: u64, to: u64, leg_steps: u64) -> Vec<u64> {
 /// the hold length. Branches already written are kept. Returns `t_X` (s) per grid entry.
 fn prepare_branches(
     args: &CriticalOptions,
-    table: &toml::Table,
+    file: &SoftSceneFile,
     base: &crate::granular::soft::scene::SoftScene,
     path: &crate::granular::soft::spinup::SpinupPath,
     grid: &[f64],
@@ -534,31 +546,14 @@ fn prepare_branches(
     }
     let dt = base.dt;
     let every = base.every_steps as f64 * dt;
-    let times: Vec<f64> = table
-        .get("output")
-        .and_then(|o| o.get("times"))
-        .and_then(|t| t.as_array())
-        .map(|a| a.iter().filter_map(|v| v.as_float()).collect())
-        .unwrap_or_else(|| vec![0.0]);
+    let times: Vec<f64> = file.output.times.clone().unwrap_or_else(|| vec![0.0]);
     // the base scene: the path run to just past the earliest hold's start
     let t_base_end = starts.iter().cloned().fold(0.0, f64::max) + 2.0 * every;
-    let mut table = table.clone();
-    table
-        .entry("output")
-        .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-    let mut base_table = table.clone();
-    base_table["scene"]["t_end"] = toml::Value::Float(t_base_end);
-    let keep = |limit: f64| -> toml::Value {
-        toml::Value::Array(
-            times
-                .iter()
-                .filter(|&&t| t <= limit + 1e-9)
-                .map(|&t| toml::Value::Float(t))
-                .collect(),
-        )
-    };
-    base_table["output"]["times"] = keep(t_base_end);
-    let base_text = toml::to_string(&base_table).map_err(|e| SearchError::usage(e.to_string()))?;
+    let keep = |limit: f64| -> Vec<f64> { times.iter().copied().filter(|&t| t <= limit + 1e-9).collect() };
+    let mut base_file = file.clone();
+    base_file.scene.t_end = t_base_end;
+    base_file.output.times = Some(keep(t_base_end));
+    let base_text = scene_text(&[], &base_file);
     let parent = args
         .scene
         .parent()
@@ -572,7 +567,7 @@ fn prepare_branches(
     let base_dir = args.out.join("base");
     // a base run from an earlier search over a shorter span cannot be extended (its scene is fixed)
     if let Ok(text) = std::fs::read_to_string(base_dir.join("scene.toml"))
-        && text != base_text
+        && !same_scene(&text, &base_file)
         && grid.iter().any(|tf| {
             let dir = args.out.join(format!("T{tf:.2}"));
             !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())
@@ -660,25 +655,20 @@ fn prepare_branches(
             }
             here = Some(s_leg);
         }
-        let mut hold_table = table.clone();
-        hold_table["spinup"]["T_final"] = toml::Value::Float(tf);
-        hold_table["spinup"]["t_final"] = toml::Value::Float(starts[k]);
-        hold_table["scene"]["t_end"] = toml::Value::Float(starts[k] + hold);
-        let mut snaps = match keep(t_ck) {
-            toml::Value::Array(a) => a,
-            _ => Vec::new(),
-        };
+        let mut hold_file = file.clone();
+        if let Some(spinup) = hold_file.spinup.as_mut() {
+            spinup.period_final_h = tf;
+            spinup.t_final = starts[k];
+        }
+        hold_file.scene.t_end = starts[k] + hold;
+        let mut snaps = keep(t_ck);
         for t in [starts[k], starts[k] + hold] {
-            if snaps
-                .last()
-                .and_then(|v| v.as_float())
-                .is_none_or(|last| t >= last + dt)
-            {
-                snaps.push(toml::Value::Float(t));
+            if snaps.last().is_none_or(|&last| t >= last + dt) {
+                snaps.push(t);
             }
         }
-        hold_table["output"]["times"] = toml::Value::Array(snaps);
-        let hold_text = toml::to_string(&hold_table).map_err(|e| SearchError::usage(e.to_string()))?;
+        hold_file.output.times = Some(snaps);
+        let hold_text = scene_text(&[], &hold_file);
         if dir.exists() {
             std::fs::remove_dir_all(&dir).map_err(|e| SearchError::failed(format!("{}: {e}", dir.display())))?;
         }
