@@ -140,20 +140,39 @@ impl ImpactArgs {
     }
 }
 
-/// The command-line flag of an [`ImpactConfig`] field named in an error.
+/// The command-line flag of each [`ImpactConfig`] field (and of the pile's file) that an error can name; the
+/// custom projectile's fields are all given through its radius.
+const FIELD_FLAGS: [(&str, &str); 19] = [
+    ("target", "--target"),
+    ("projectile", "--projectile-radius-km"),
+    ("projectile.equivalent_radius", "--projectile-radius-km"),
+    ("projectile.density", "--projectile-radius-km"),
+    ("projectile.axis_ratios", "--projectile-radius-km"),
+    ("projectile.speed", "--projectile-speed-km-s"),
+    ("projectile_pile", "--projectile-pile"),
+    ("angle_deg", "--angle"),
+    ("seed", "--seed"),
+    ("contact_time", "--contact-time"),
+    ("t_end", "--t-end"),
+    ("method", "--method"),
+    ("rtol", "--rtol"),
+    ("f0", "--f0"),
+    ("beta", "--beta"),
+    ("kappa_reading", "--kappa-reading"),
+    ("snapshots", "--snapshots"),
+    ("every", "--every"),
+    ("inertia", "--inertia"),
+];
+
+/// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`]), its index kept
+/// (`snapshots[2]` is `--snapshots[2]`); a field not in the table is named as it is.
 fn flag(field: &str) -> String {
-    let (head, rest) = match field.find('[') {
-        Some(i) => field.split_at(i),
-        None => (field, ""),
-    };
-    let name = match head {
-        "angle_deg" => "angle",
-        "projectile.speed" => "projectile-speed-km-s",
-        "projectile_pile" => "projectile-pile",
-        f if f.starts_with("projectile") => "projectile-radius-km",
-        f => f,
-    };
-    format!("--{}{rest}", name.replace('_', "-"))
+    let (head, index) = field.split_at(field.find('[').unwrap_or(field.len()));
+    let flag = FIELD_FLAGS
+        .iter()
+        .find(|(f, _)| *f == head)
+        .map_or(head, |(_, flag)| flag);
+    format!("{flag}{index}")
 }
 
 /// An impact error as the command line reports it (flags instead of field names).
@@ -199,5 +218,26 @@ impl PileArgs {
             .as_ref()
             .map(|file| ProjectilePile::read(file, !self.pile_fixed_attitude).map_err(as_field("projectile_pile")))
             .transpose()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every flag of the table is one of `rubblepile impact`'s, and an index follows its field.
+    #[test]
+    fn field_flags_are_the_command_s_flags() {
+        let command = <ImpactArgs as clap::Args>::augment_args(clap::Command::new("impact"));
+        for (field, flag) in FIELD_FLAGS {
+            let long = flag.trim_start_matches("--");
+            assert!(
+                command.get_arguments().any(|a| a.get_long() == Some(long)),
+                "{field}: {flag} is no flag of `impact`"
+            );
+        }
+        assert_eq!(flag("angle_deg"), "--angle");
+        assert_eq!(flag("snapshots[2]"), "--snapshots[2]");
+        assert_eq!(flag("projectile.speed"), "--projectile-speed-km-s");
     }
 }
