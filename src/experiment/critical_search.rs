@@ -478,12 +478,6 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
     requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
-/// Whether the scene text `text` (a base run's `scene.toml`) holds the scene `file`: compared as values, so that a
-/// base run whose scene an older build wrote in another layout (or with defaults left out) is still recognised.
-fn same_scene(text: &str, file: &SoftSceneFile) -> bool {
-    parse_toml_as::<SoftSceneFile>(text, "scene.toml").is_ok_and(|f| f == *file)
-}
-
 /// How many checkpointed legs the base run of `--branch` is cut into over its whole span (a stopped search loses
 /// at most one leg of the path: about 15 min of a full-size base run on two cores).
 const BASE_LEGS: u64 = 8;
@@ -565,9 +559,10 @@ fn prepare_branches(
         .map_err(SearchError::usage)?;
     let plan = sample_steps(&base_scene);
     let base_dir = args.out.join("base");
-    // a base run from an earlier search over a shorter span cannot be extended (its scene is fixed)
+    // a base run from an earlier search over a shorter span cannot be extended (its scene is fixed); its scene is
+    // compared as a value, so that one an older build wrote in another layout (defaults left out) is recognised
     if let Ok(text) = std::fs::read_to_string(base_dir.join("scene.toml"))
-        && !same_scene(&text, &base_file)
+        && parse_toml_as::<SoftSceneFile>(&text, "scene.toml").ok().as_ref() != Some(&base_file)
         && grid.iter().any(|tf| {
             let dir = args.out.join(format!("T{tf:.2}"));
             !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())

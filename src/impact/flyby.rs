@@ -24,13 +24,10 @@ use crate::ellipsoid::body::Body;
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::output::write_snapshot;
 use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::ellipsoid::scene::{
-    ContactSpec, DissipationSpec, GravitySpec, IntegratorSection, LoadedScene, ModelSection, OutputSection,
-    PhysicsSection, SceneFile, SceneSection, parse_scene,
-};
+use crate::ellipsoid::scene::{LoadedScene, ModelSection, parse_scene};
 use crate::ellipsoid::tide::FlybySpec;
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
-use crate::impact::run::{ImpactError, read_target};
+use crate::impact::run::{ImpactError, pile_scene, read_target};
 use crate::impact::settle::{SETTLE_MAX_FREE_FALLS, SettleReport, free_fall_time, set_principal_axis_rotation, settle};
 use crate::io::run_lock::DirLock;
 use crate::io::scene_file::scene_text;
@@ -406,48 +403,26 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         args.q_m / args.planet_radius_m,
         args.v_inf_km_s
     );
-    let scene_file = |planet_mass: f64| SceneFile {
-        scene: SceneSection {
-            kind: "ellipsoids".into(),
-            t_end,
-            seed: 0,
-            bodies_file: Some("initial_bodies.csv".into()),
-        },
-        model: ModelSection {
+    let times = output_times(t_end, args.snapshots);
+    let scene_file = |planet_mass: f64| {
+        let model = ModelSection {
             kappa: Some(kappa),
             calibrate: None,
             inertia: Default::default(),
-        },
-        physics: PhysicsSection {
-            gravity: Some(GravitySpec::default()),
-            contact: Some(ContactSpec::default()),
-            dissipation: Some(DissipationSpec { f0 }),
-            flyby: Some(FlybySpec {
-                mass: planet_mass,
-                radius: Some(args.planet_radius_m),
-                q: args.q_m,
-                v_inf: Some(v_inf),
-                eccentricity: None,
-                t_perigee,
-                orientation_deg: [orientation[0], orientation[1], orientation[2]],
-                j2: args.planet_j2,
-                pole,
-            }),
-        },
-        integrator: IntegratorSection {
-            rtol: Some(args.rtol),
-            atol: Some(args.rtol),
-            ..IntegratorSection::default()
-        },
-        output: OutputSection {
-            times: Some(output_times(t_end, args.snapshots)),
-            snapshot_every: None,
-            every: t_end / 400.0,
-            track: None,
-            vtk: false,
-        },
-        bodies: Vec::new(),
-        run: Default::default(),
+        };
+        let mut scene = pile_scene(t_end, model, f0, args.rtol, times.clone(), t_end / 400.0);
+        scene.physics.flyby = Some(FlybySpec {
+            mass: planet_mass,
+            radius: Some(args.planet_radius_m),
+            q: args.q_m,
+            v_inf: Some(v_inf),
+            eccentricity: None,
+            t_perigee,
+            orientation_deg: [orientation[0], orientation[1], orientation[2]],
+            j2: args.planet_j2,
+            pole,
+        });
+        scene
     };
     let scene_toml = scene_text(&[&title, GENERATED_BY_FLYBY], &scene_file(args.planet_mass));
     let out = &args.out;

@@ -90,6 +90,43 @@ pub fn snapshot_times(t_end: f64, list: Option<&[f64]>, every: Option<f64>) -> R
     }
 }
 
+/// The scene of an impact's or a flyby's run: the bodies of `initial_bodies.csv` beside it under gravity, contact
+/// and dissipation `f0`, Bulirsch–Stoer at `rtol` (also `atol`), snapshots at `times` and a time-series row every
+/// `every` seconds (s); the seed, method, tracks and tide are the caller's to set.
+pub fn pile_scene(t_end: f64, model: ModelSection, f0: f64, rtol: f64, times: Vec<f64>, every: f64) -> SceneFile {
+    let bodies_file = Some("initial_bodies.csv".into());
+    let (gravity, contact) = (Some(GravitySpec::default()), Some(ContactSpec::default()));
+    SceneFile {
+        scene: SceneSection {
+            kind: "ellipsoids".into(),
+            t_end,
+            seed: 0,
+            bodies_file,
+        },
+        model,
+        physics: PhysicsSection {
+            gravity,
+            contact,
+            dissipation: Some(DissipationSpec { f0 }),
+            flyby: None,
+        },
+        integrator: IntegratorSection {
+            rtol: Some(rtol),
+            atol: Some(rtol),
+            ..IntegratorSection::default()
+        },
+        output: OutputSection {
+            times: Some(times),
+            snapshot_every: None,
+            every,
+            track: None,
+            vtk: false,
+        },
+        bodies: Vec::new(),
+        run: Default::default(),
+    }
+}
+
 /// Everything that defines one impact run. SI units unless the name says otherwise; the defaults (of
 /// [`ImpactConfig::new`]) are those of `rubblepile impact`.
 #[derive(Debug, Clone, PartialEq)]
@@ -190,10 +227,7 @@ impl ImpactConfig {
             );
         }
         if i64::try_from(self.seed).is_err() {
-            return invalid(
-                "seed",
-                format!("must be at most {} (a TOML integer), got {}", i64::MAX, self.seed),
-            );
+            return invalid("seed", format!("must be <= {}, got {}", i64::MAX, self.seed));
         }
         if !(self.contact_time >= 0.0 && self.contact_time.is_finite()) {
             return invalid("contact_time", format!("must be >= 0 s, got {}", self.contact_time));
@@ -259,44 +293,20 @@ impl ImpactConfig {
 
     /// The scene of this impact (bodies in `initial_bodies.csv` beside it; `projectile_index` tracked).
     pub fn scene(&self, projectile_index: usize) -> SceneFile {
-        SceneFile {
-            scene: SceneSection {
-                kind: "ellipsoids".into(),
-                t_end: self.t_end,
-                seed: self.seed,
-                bodies_file: Some("initial_bodies.csv".into()),
-            },
-            model: ModelSection {
-                kappa: None,
-                calibrate: Some(CalibrateSpec {
-                    beta: self.beta,
-                    v: self.projectile.speed,
-                    reading: self.kappa_reading,
-                }),
-                inertia: self.inertia,
-            },
-            physics: PhysicsSection {
-                gravity: Some(GravitySpec::default()),
-                contact: Some(ContactSpec::default()),
-                dissipation: Some(DissipationSpec { f0: self.f0 }),
-                flyby: None,
-            },
-            integrator: IntegratorSection {
-                method: self.method,
-                rtol: Some(self.rtol),
-                atol: Some(self.rtol),
-                ..IntegratorSection::default()
-            },
-            output: OutputSection {
-                times: Some(self.snapshots.clone()),
-                snapshot_every: None,
-                every: self.every,
-                track: Some(vec![projectile_index]),
-                vtk: false,
-            },
-            bodies: Vec::new(),
-            run: Default::default(),
-        }
+        let (beta, v, reading) = (self.beta, self.projectile.speed, self.kappa_reading);
+        let model = ModelSection {
+            kappa: None,
+            calibrate: Some(CalibrateSpec { beta, v, reading }),
+            inertia: self.inertia,
+        };
+        let &ImpactConfig {
+            t_end, f0, rtol, every, ..
+        } = self;
+        let mut scene = pile_scene(t_end, model, f0, rtol, self.snapshots.clone(), every);
+        scene.scene.seed = self.seed;
+        scene.integrator.method = self.method;
+        scene.output.track = Some(vec![projectile_index]);
+        scene
     }
 
     /// The scene file of this impact, [`Self::scene`] serialised once; `title` becomes its first, comment, line.
@@ -365,8 +375,10 @@ impl ImpactConfig {
             self.angle_deg,
             setup.q_erg_per_g
         );
-        let scene = self.scene(setup.projectile_index);
-        let scene_toml = scene_text(&[&title, GENERATED_BY_IMPACT], &scene);
+        let (scene, scene_toml) = (
+            self.scene(setup.projectile_index),
+            self.scene_toml(&title, setup.projectile_index),
+        );
         ImpactPlan {
             bodies,
             setup,
@@ -479,7 +491,6 @@ mod tests {
         cfg.rtol = 1e-6;
         cfg.inertia = InertiaModel::Uniform;
         let text = cfg.scene_toml("a title", 30);
-        println!("{text}");
         let file = crate::ellipsoid::scene::parse_toml(&text, "scene.toml").unwrap();
         assert_eq!(file, cfg.scene(30));
         assert!(text.starts_with("# a title\n# Generated by `rubblepile impact`"));
