@@ -357,6 +357,16 @@ fn flyby_command_writes_the_planet_j2() {
         scene.contains("j2 = 0.0010826") && scene.contains("pole = [1.0, 0.0, 0.0]"),
         "{scene}"
     );
+    // the scene values: the control's scene is the run's without the planet's mass
+    let parse = |p: &str| rubblepile::ellipsoid::scene::parse_toml(&std::fs::read_to_string(dir.join(p)).unwrap(), p);
+    let (run, mut control) = (parse("j2/scene.toml").unwrap(), parse("j2/control/scene.toml").unwrap());
+    let tide = run.physics.flyby.unwrap();
+    assert_eq!(
+        (tide.j2, tide.pole, tide.radius),
+        (Some(1.0826e-3), Some([1.0, 0.0, 0.0]), Some(6378137.0))
+    );
+    control.physics.flyby.as_mut().unwrap().mass = tide.mass;
+    assert_eq!(control, run);
     let setup = std::fs::read_to_string(dir.join("j2/flyby.json")).unwrap();
     assert!(setup.contains("\"j2\": 0.0010826"), "{setup}");
     // the point-mass default writes no J2
