@@ -13,6 +13,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::SystemTime;
 
 use rubblepile::driver::RunOptions;
+use rubblepile::ellipsoid::body::InertiaModel;
 use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::impact::campaign::{
     Action, CAMPAIGN_COLUMNS, CampaignOptions, RunStatus, Shard, load_campaign, merge_campaign, parse_campaign,
@@ -20,6 +21,7 @@ use rubblepile::impact::campaign::{
 };
 use rubblepile::impact::run::run_impact;
 use rubblepile::impact::target::{TargetSpec, build_target};
+use rubblepile::integrate::Method;
 use std::f64::consts::PI;
 
 fn temp_dir(tag: &str) -> PathBuf {
@@ -324,13 +326,13 @@ fn bad_campaign_files_give_one_line_errors() {
         uniform
             .points
             .iter()
-            .all(|p| p.plan.scene_toml.contains("inertia = \"uniform\""))
+            .all(|p| p.plan.scene.model.inertia == InertiaModel::Uniform)
     );
     assert!(
         ok.unwrap()
             .points
             .iter()
-            .all(|p| p.plan.scene_toml.contains("inertia = \"gaussian\""))
+            .all(|p| p.plan.scene.model.inertia == InertiaModel::Gaussian)
     );
     // impact.method reaches every run's scene; without rtol, Dop853 takes its per-step default 1e-8
     let dop =
@@ -338,7 +340,7 @@ fn bad_campaign_files_give_one_line_errors() {
     assert!(
         dop.points
             .iter()
-            .all(|p| p.plan.scene_toml.contains("method = \"dop853\"") && p.config.rtol == 1e-8)
+            .all(|p| p.plan.scene.integrator.method == Method::Dop853 && p.config.rtol == 1e-8)
     );
     let cases: [(String, &str); 12] = [
         (
@@ -513,7 +515,7 @@ fn roig2003_campaign_files_are_valid() {
                 assert_eq!(c.points.len(), runs, "{file}");
                 assert!(c.points.iter().all(|p| p.config.rtol == 1e-6), "{file}");
                 assert!(c.points.iter().all(|p| p.config.kappa_reading == reading), "{file}");
-                let scene = c.points[0].config.scene_toml("t", 0);
+                let scene = c.points[0].plan.scene_toml();
                 assert!(scene.contains(&format!("reading = \"{reading}\"")), "{file}: {scene}");
                 let seeds = if runs == 162 { vec![1, 2, 3] } else { vec![1] };
                 assert!(c.points.iter().all(|p| seeds.contains(&p.seed)), "{file}");

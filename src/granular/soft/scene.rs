@@ -113,11 +113,11 @@ pub struct SoftSceneFile {
     pub output: SoftOutputSection,
     /// one wall each: a plane (point, normal), the inside of a sphere (centre, radius) or a cylinder (centre, axis,
     /// radius, length)
-    #[serde(default, rename = "wall")]
+    #[serde(default, rename = "wall", skip_serializing_if = "Vec::is_empty")]
     #[field(table)]
     pub walls: Vec<WallSpec>,
     /// one sphere each (or scene.particles_file)
-    #[serde(default, rename = "particle")]
+    #[serde(default, rename = "particle", skip_serializing_if = "Vec::is_empty")]
     #[field(table)]
     pub particles: Vec<ParticleSpec>,
     /// spin-up forcing along a period path T(t) and its diagnostics (optional; Zhang17 §2.3.4)
