@@ -223,6 +223,18 @@ fn grid_runs_then_everything_is_skipped() {
     assert_eq!(runs_only(&tree(&dir.join("out"))), runs_only(&before));
     let rows = read_csv(&dir.join("out/campaign.csv"));
     assert!(rows[0][6].starts_with("failed: "), "{:?}", rows[0]);
+    // the campaign as it was: a run whose scene.toml holds the same values in another layout (as older builds
+    // wrote it) is still this run, skipped
+    std::fs::write(&file, GRID).unwrap();
+    let scene = dir.join("out/tiny_S1_z0_s7/scene.toml");
+    let table: toml::Table = std::fs::read_to_string(&scene).unwrap().parse().unwrap();
+    std::fs::write(
+        &scene,
+        format!("# another layout\n{}", toml::to_string(&table).unwrap()),
+    )
+    .unwrap();
+    let relaid = run_campaign(&load_campaign(&file).unwrap(), &quiet()).unwrap();
+    assert_eq!(relaid.skipped(), 4, "{}", relaid.one_line());
     let _ = std::fs::remove_dir_all(&dir);
 }
 
