@@ -470,6 +470,37 @@ fn array3(rows: impl Iterator<Item = [f64; 3]>) -> Array2<f64> {
     Array2::from_shape_vec((n, 3), flat).expect("three columns")
 }
 
+/// Sets positions, velocities and world-frame spins (`angular_velocities`) of a soft-sphere run from `arrays` (one
+/// row per sphere; the arrays not given keep their values).
+fn set_soft_state(s: &mut Session<SoftEngine>, arrays: &[(String, Array2<f64>)]) -> Result<(), Failure> {
+    use rubblepile::math::Vec3;
+    const WRITABLE: [&str; 3] = ["positions", "velocities", "angular_velocities"];
+    let now = s.engine().particles();
+    let n = now.len();
+    let mut columns: [Vec<Vec3>; 3] = [
+        now.iter().map(|p| p.position).collect(),
+        now.iter().map(|p| p.velocity).collect(),
+        now.iter().map(|p| p.spin_world).collect(),
+    ];
+    for (name, a) in arrays {
+        let Some(k) = WRITABLE.iter().position(|w| w == name) else {
+            return Err(Failure::scene(format!(
+                "{name}: not a writable state array of a soft-sphere run ({})",
+                WRITABLE.join(", ")
+            )));
+        };
+        if a.dim() != (n, 3) {
+            return Err(Failure::scene(format!(
+                "{name}: expected shape ({n}, 3), got {:?}",
+                a.dim()
+            )));
+        }
+        columns[k] = a.rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect();
+    }
+    let [x, v, w] = &columns;
+    s.engine_mut().set_particles(x, v, w).map_err(Failure::from)
+}
+
 #[pymethods]
 impl Simulation {
     /// See `rubblepile.Simulation.from_scene`.
@@ -704,9 +735,12 @@ impl Simulation {
             arrays.push((name, a.as_array().to_owned()));
         }
         self.read(py, |any| {
+            if let Any::SoftSpheres(s) = any {
+                return set_soft_state(s, &arrays);
+            }
             let Any::Ellipsoids(s) = any else {
                 return Err(Failure::scene(format!(
-                    "the state of a {} run cannot be set (only that of an ellipsoid run)",
+                    "the state of a {} run cannot be set (only that of an ellipsoid or soft-sphere run)",
                     any.kind()
                 )));
             };
