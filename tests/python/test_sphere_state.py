@@ -1,5 +1,6 @@
-"""The state of a soft-sphere run written between integrations: set, saved, read back bit for bit, and integrated on
-from it (free flight over the expected distance; a resumed copy ends as the run held in memory)."""
+"""The state of a sphere run (soft and hard spheres) written between integrations: set, saved, read back bit for
+bit, and integrated on from it (free flight over the expected distance; a resumed copy ends as the run held in
+memory)."""
 
 import numpy as np
 import pytest
@@ -37,8 +38,40 @@ velocity = [0.0, 0.1, 0.0]
 """
 
 
-def test_soft_state_set_saved_and_read_back(tmp_path):
-    sim = rubblepile.Simulation.from_scene(FREE, tmp_path / "run")
+# The same two spheres as hard spheres (elastic, no gravity).
+HARD = """
+[scene]
+kind = "hard-spheres"
+t_end = 2.0
+seed = 0
+
+[stepping]
+dt = 1e-3
+
+[material]
+eps_n = 1.0
+eps_t = 1.0
+
+[output]
+every = 0.5
+times = [0.0, 1.0, 2.0]
+
+[[particle]]
+mass = 1.0
+radius = 0.5
+position = [0.0, 0.0, 0.0]
+
+[[particle]]
+mass = 1.0
+radius = 0.5
+position = [10.0, 0.0, 0.0]
+velocity = [0.0, 0.1, 0.0]
+"""
+
+
+@pytest.mark.parametrize("scene", [FREE, HARD], ids=["soft-spheres", "hard-spheres"])
+def test_sphere_state_set_saved_and_read_back(scene, tmp_path):
+    sim = rubblepile.Simulation.from_scene(scene, tmp_path / "run")
     sim.integrate(1.0)
     assert sim.t == pytest.approx(1.0)
     t1 = sim.t
@@ -74,6 +107,19 @@ def test_soft_state_set_saved_and_read_back(tmp_path):
     back.close()
 
 
+def test_hard_state_predicts_collisions_again():
+    # Two spheres sent at each other by the state set: they collide (the predictions were made from the new
+    # state) and, elastic and equal, exchange their velocities.
+    sim = rubblepile.Simulation.from_scene(HARD)
+    sim.integrate(1.0)
+    sim.set_state(positions=np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0]]),
+                  velocities=np.array([[1.0, 0.0, 0.0], [-1.0, 0.0, 0.0]]))
+    sim.integrate()
+    np.testing.assert_allclose(sim.velocities, [[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]], atol=1e-12)
+    # they met at x = +-0.5 at t = 1.5 s and flew apart for the remaining 0.5 s
+    np.testing.assert_allclose(sim.positions[:, 0], [0.5 - 0.5, 1.5 + 0.5], atol=1e-9)
+
+
 def test_soft_state_sets_the_forces_again():
     # Two spheres pushed into contact by the state set: the first step after it repels them (the forces were
     # evaluated at the new positions, not kept from the old ones).
@@ -86,8 +132,9 @@ def test_soft_state_sets_the_forces_again():
     np.testing.assert_allclose(v[0] * sim.masses[0] + v[1] * sim.masses[1], 0.0, atol=1e-12)
 
 
-def test_soft_state_writes_are_checked():
-    sim = rubblepile.Simulation.from_scene(FREE)
+@pytest.mark.parametrize("scene", [FREE, HARD], ids=["soft-spheres", "hard-spheres"])
+def test_sphere_state_writes_are_checked(scene):
+    sim = rubblepile.Simulation.from_scene(scene)
     sim.step()
     with pytest.raises(rubblepile.SceneError, match=r"positions: expected shape \(2, 3\)"):
         sim.set_state(positions=np.zeros((3, 3)))

@@ -470,12 +470,14 @@ fn array3(rows: impl Iterator<Item = [f64; 3]>) -> Array2<f64> {
     Array2::from_shape_vec((n, 3), flat).expect("three columns")
 }
 
-/// Sets positions, velocities and world-frame spins (`angular_velocities`) of a soft-sphere run from `arrays` (one
-/// row per sphere; the arrays not given keep their values).
-fn set_soft_state(s: &mut Session<SoftEngine>, arrays: &[(String, Array2<f64>)]) -> Result<(), Failure> {
+/// Positions, velocities and world-frame spins (`angular_velocities`) of a sphere run: those of `now` with the
+/// arrays given (one row per sphere) in their place.
+fn sphere_state(
+    now: &[ParticleView],
+    arrays: &[(String, Array2<f64>)],
+) -> Result<[Vec<rubblepile::math::Vec3>; 3], Failure> {
     use rubblepile::math::Vec3;
     const WRITABLE: [&str; 3] = ["positions", "velocities", "angular_velocities"];
-    let now = s.engine().particles();
     let n = now.len();
     let mut columns: [Vec<Vec3>; 3] = [
         now.iter().map(|p| p.position).collect(),
@@ -485,7 +487,7 @@ fn set_soft_state(s: &mut Session<SoftEngine>, arrays: &[(String, Array2<f64>)])
     for (name, a) in arrays {
         let Some(k) = WRITABLE.iter().position(|w| w == name) else {
             return Err(Failure::scene(format!(
-                "{name}: not a writable state array of a soft-sphere run ({})",
+                "{name}: not a writable state array of a sphere run ({})",
                 WRITABLE.join(", ")
             )));
         };
@@ -497,8 +499,7 @@ fn set_soft_state(s: &mut Session<SoftEngine>, arrays: &[(String, Array2<f64>)])
         }
         columns[k] = a.rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect();
     }
-    let [x, v, w] = &columns;
-    s.engine_mut().set_particles(x, v, w).map_err(Failure::from)
+    Ok(columns)
 }
 
 #[pymethods]
@@ -735,14 +736,16 @@ impl Simulation {
             arrays.push((name, a.as_array().to_owned()));
         }
         self.read(py, |any| {
-            if let Any::SoftSpheres(s) = any {
-                return set_soft_state(s, &arrays);
-            }
-            let Any::Ellipsoids(s) = any else {
-                return Err(Failure::scene(format!(
-                    "the state of a {} run cannot be set (only that of an ellipsoid or soft-sphere run)",
-                    any.kind()
-                )));
+            let s = match any {
+                Any::SoftSpheres(s) => {
+                    let [x, v, w] = sphere_state(&s.engine().particles(), &arrays)?;
+                    return s.engine_mut().set_particles(&x, &v, &w).map_err(Failure::from);
+                }
+                Any::HardSpheres(s) => {
+                    let [x, v, w] = sphere_state(&s.engine().particles(), &arrays)?;
+                    return s.engine_mut().set_particles(&x, &v, &w).map_err(Failure::from);
+                }
+                Any::Ellipsoids(s) => s,
             };
             let mut bodies = s.engine().bodies();
             let n = bodies.len();

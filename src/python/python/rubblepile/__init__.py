@@ -267,22 +267,24 @@ class Simulation:
         return dict(self._inner._state())
 
     def set_state(self, **arrays: Any) -> None:
-        """Sets the state of an ellipsoid or soft-sphere run between two samples; the run continues from it.
+        """Sets the state of a run (any engine) between two samples; the run continues from it.
         Keywords, each an array of one row per particle in scene order (those not given keep their values):
 
         - ellipsoids: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s), ``quaternions`` (n, 4; scalar last,
           normalised here), and one of ``angular_velocities`` (n, 3; rad/s, world frame) or ``spins_body`` (n, 3;
           rad/s, principal axes). Masses and semi-axes are the scene's.
-        - soft spheres: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s), ``angular_velocities`` (n, 3; rad/s,
-          world frame). Masses and radii are the scene's. The forces and torques the next step starts from are
-          evaluated again at the new state (the springs of contacts that still touch are kept, the neighbour list
-          rebuilt); with ``[gravity] interval_steps > 1`` the state can be set only on a self-gravity block
-          boundary.
+        - spheres: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s), ``angular_velocities`` (n, 3; rad/s,
+          world frame). Masses and radii are the scene's. Soft spheres: the forces and torques the next step starts
+          from are evaluated again at the new state (the springs of contacts that still touch are kept, the
+          neighbour list rebuilt); with ``[gravity] interval_steps > 1`` the state can be set only on a self-gravity
+          block boundary. Hard spheres: the rows are the particles still in the run (as :meth:`state`); the
+          neighbour list, the pair certificates and the predicted collisions are rebuilt from the new state; a
+          particle stuck to a wall keeps its state; new positions must not overlap.
 
         The conserved quantities are still measured against t = 0, so a change of energy counts in
         :attr:`energy_error`. :meth:`save` (or a checkpoint) then holds the new state. Raises :class:`SceneError`
-        for a hard-sphere run (not writable yet), a wrong shape, a non-finite value, or attitudes of a run that does
-        not integrate them.
+        for a wrong shape, a non-finite value, attitudes of a run that does not integrate them, or a changed state of
+        a hard sphere stuck to a wall.
         """
         state = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
         self._inner._set_state(state)
