@@ -635,6 +635,59 @@ impl Engine for HardEngine {
 }
 
 impl HardEngine {
+    /// Sets the positions (m), velocities (m/s) and spins (rad/s, world frame) of the particles still in the run
+    /// (those [`Engine::particles`] lists, in that order) between two output samples; the run continues from them.
+    /// What the stepper keeps from the last step is dropped: the neighbour list, the certificates of the pairs
+    /// that cannot meet for a while and the predicted collisions are rebuilt from the new state at the next step,
+    /// as after a fresh start. Masses and radii are the scene's; a particle stuck to a wall keeps its state (giving
+    /// it another is refused). The conserved quantities are still measured against t = 0. New positions must not
+    /// overlap (the run's maximum-overlap diagnostic would report it).
+    ///
+    /// Errors ([`EngineError::State`], one line, nothing changed): another number of particles, a non-finite
+    /// value, a changed state of a particle stuck to a wall.
+    pub fn set_particles(
+        &mut self,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        spins: &[Vec3],
+    ) -> Result<(), EngineError> {
+        let alive: Vec<usize> = (0..self.system.particles.len())
+            .filter(|&k| self.system.particles[k].alive)
+            .collect();
+        let n = alive.len();
+        for (name, v) in [("positions", positions), ("velocities", velocities), ("spins", spins)] {
+            if v.len() != n {
+                return Err(EngineError::State(format!(
+                    "{name}: {} given, the run has {n} particles",
+                    v.len()
+                )));
+            }
+            if let Some(i) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+                return Err(EngineError::State(format!("{name}[{i}]: a non-finite value")));
+            }
+        }
+        for (i, &k) in alive.iter().enumerate() {
+            let p = &self.system.particles[k];
+            let same = p.position == positions[i] && p.velocity == velocities[i] && p.spin == spins[i];
+            if p.stuck.is_some() && !same {
+                return Err(EngineError::State(format!(
+                    "particle {i}: stuck to a wall, its state cannot change"
+                )));
+            }
+        }
+        let t = self.system.t;
+        for (i, &k) in alive.iter().enumerate() {
+            let p = &mut self.system.particles[k];
+            p.position = positions[i];
+            p.velocity = velocities[i];
+            p.spin = spins[i];
+            p.t_local = t;
+        }
+        self.system.restore_neighbours(None).map_err(EngineError::State)?;
+        self.good = self.system.clone();
+        Ok(())
+    }
+
     /// [`Engine::restore`] with one-line `String` errors (made [`EngineError::State`] there).
     fn restore_from(&mut self, ck: HardState, _dir: &Path, at: Resumed) -> Result<(), String> {
         let system = &mut self.system;

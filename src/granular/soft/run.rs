@@ -820,6 +820,58 @@ impl Engine for SoftEngine {
 }
 
 impl SoftEngine {
+    /// Sets the spheres' positions (m), velocities (m/s) and spins (rad/s, world frame), one entry per sphere in
+    /// scene order, between two output samples; the run continues from them. What the stepper keeps from the last
+    /// step is made to match: the Verlet list is rebuilt, and the forces and torques (which the next step's first
+    /// kick uses) are evaluated again at the new state without advancing the contacts' springs (the springs of
+    /// pairs still touching are kept; the others are dropped by that evaluation). Masses and radii are the
+    /// scene's. The conserved quantities are still measured against t = 0, so a change of energy counts in the
+    /// energy error; a `[spinup]` forcing goes on from the new spin.
+    ///
+    /// Errors ([`EngineError::State`], one line, nothing changed): another number of spheres, a non-finite value,
+    /// a run inside a self-gravity block (`[gravity] interval_steps > 1` and the step not on a block boundary:
+    /// the block's opening kick used the old positions).
+    pub fn set_particles(
+        &mut self,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        spins: &[Vec3],
+    ) -> Result<(), EngineError> {
+        let n = self.sys.particles.len();
+        for (name, v) in [("positions", positions), ("velocities", velocities), ("spins", spins)] {
+            if v.len() != n {
+                return Err(EngineError::State(format!(
+                    "{name}: {} given, the run has {n} spheres",
+                    v.len()
+                )));
+            }
+            if let Some(i) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
+                return Err(EngineError::State(format!("{name}[{i}]: a non-finite value")));
+            }
+        }
+        if self.sys.split_gravity() && self.sys.gravity_phase != 0 {
+            return Err(EngineError::State(format!(
+                "the run is inside a self-gravity block (step {} of {}); set the state at a block boundary",
+                self.sys.gravity_phase, self.sys.gravity_interval
+            )));
+        }
+        for (k, p) in self.sys.particles.iter_mut().enumerate() {
+            p.position = positions[k];
+            p.velocity = velocities[k];
+            p.spin = spins[k];
+        }
+        // the same springs, for a Verlet list rebuilt at the new positions
+        let springs = self.sys.pair_springs();
+        self.sys.set_pair_springs(springs);
+        if self.sys.split_gravity() {
+            self.sys.update_slow_gravity();
+        }
+        let t = self.time();
+        self.sys.compute_forces(t, 0.0);
+        self.before.clone_from(&self.sys.particles);
+        Ok(())
+    }
+
     /// [`Engine::restore`] with one-line `String` errors (made [`EngineError::State`] there).
     fn restore_from(&mut self, ck: SoftState, dir: &Path, _at: Resumed) -> Result<(), String> {
         let scene = &self.scene;

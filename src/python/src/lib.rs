@@ -470,6 +470,38 @@ fn array3(rows: impl Iterator<Item = [f64; 3]>) -> Array2<f64> {
     Array2::from_shape_vec((n, 3), flat).expect("three columns")
 }
 
+/// Positions, velocities and world-frame spins (`angular_velocities`) of a sphere run: those of `now` with the
+/// arrays given (one row per sphere) in their place.
+fn sphere_state(
+    now: &[ParticleView],
+    arrays: &[(String, Array2<f64>)],
+) -> Result<[Vec<rubblepile::math::Vec3>; 3], Failure> {
+    use rubblepile::math::Vec3;
+    const WRITABLE: [&str; 3] = ["positions", "velocities", "angular_velocities"];
+    let n = now.len();
+    let mut columns: [Vec<Vec3>; 3] = [
+        now.iter().map(|p| p.position).collect(),
+        now.iter().map(|p| p.velocity).collect(),
+        now.iter().map(|p| p.spin_world).collect(),
+    ];
+    for (name, a) in arrays {
+        let Some(k) = WRITABLE.iter().position(|w| w == name) else {
+            return Err(Failure::scene(format!(
+                "{name}: not a writable state array of a sphere run ({})",
+                WRITABLE.join(", ")
+            )));
+        };
+        if a.dim() != (n, 3) {
+            return Err(Failure::scene(format!(
+                "{name}: expected shape ({n}, 3), got {:?}",
+                a.dim()
+            )));
+        }
+        columns[k] = a.rows().into_iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect();
+    }
+    Ok(columns)
+}
+
 #[pymethods]
 impl Simulation {
     /// See `rubblepile.Simulation.from_scene`.
@@ -704,11 +736,16 @@ impl Simulation {
             arrays.push((name, a.as_array().to_owned()));
         }
         self.read(py, |any| {
-            let Any::Ellipsoids(s) = any else {
-                return Err(Failure::scene(format!(
-                    "the state of a {} run cannot be set (only that of an ellipsoid run)",
-                    any.kind()
-                )));
+            let s = match any {
+                Any::SoftSpheres(s) => {
+                    let [x, v, w] = sphere_state(&s.engine().particles(), &arrays)?;
+                    return s.engine_mut().set_particles(&x, &v, &w).map_err(Failure::from);
+                }
+                Any::HardSpheres(s) => {
+                    let [x, v, w] = sphere_state(&s.engine().particles(), &arrays)?;
+                    return s.engine_mut().set_particles(&x, &v, &w).map_err(Failure::from);
+                }
+                Any::Ellipsoids(s) => s,
             };
             let mut bodies = s.engine().bodies();
             let n = bodies.len();
@@ -1099,6 +1136,175 @@ fn flyby(
     result.map_err(|e| e.into_py(py))
 }
 
+/// One grid point of a campaign as Python gets it: `campaign.csv`'s row, the run's directory and what the campaign
+/// did with it.
+fn campaign_row<'py>(
+    py: Python<'py>,
+    out: &Path,
+    point: &rubblepile::impact::campaign::GridPoint,
+    record: &rubblepile::impact::campaign::RunRecord,
+) -> PyResult<Bound<'py, PyDict>> {
+    use rubblepile::impact::campaign::{Action, RunStatus};
+    let d = PyDict::new(py);
+    let n = record.numbers.unwrap_or_default();
+    d.set_item("run", &point.name)?;
+    d.set_item("target", &point.target)?;
+    d.set_item("projectile", &point.projectile)?;
+    d.set_item("angle_deg", point.angle_deg)?;
+    d.set_item("seed", point.seed)?;
+    d.set_item("q_erg_per_g", point.plan.setup.q_erg_per_g)?;
+    d.set_item("status", record.status.to_string())?;
+    d.set_item("wall_seconds", n.wall_seconds)?;
+    d.set_item("final_time", n.final_time)?;
+    d.set_item("steps_accepted", n.steps_accepted)?;
+    d.set_item("rhs_evaluations", n.rhs_evaluations)?;
+    d.set_item("energy_error", n.energy_error)?;
+    d.set_item("linear_momentum_error", n.linear_momentum_error)?;
+    d.set_item("angular_momentum_error", n.angular_momentum_error)?;
+    let action = match record.action {
+        Action::Skip => "skipped",
+        Action::Resume => "resumed",
+        Action::Start => "started",
+        Action::Conflict(_) => "conflict",
+    };
+    d.set_item("action", action)?;
+    d.set_item("completed", record.status == RunStatus::Completed)?;
+    d.set_item("stopped", record.stopped)?;
+    d.set_item("dir", out.join(&point.name).display().to_string())?;
+    Ok(d)
+}
+
+/// What [`campaign`] returns: the closing line, the problem (message, exit code), the campaign directory, the rows.
+type CampaignOut<'py> = (String, Option<(String, u8)>, String, Vec<Bound<'py, PyDict>>);
+
+/// `rubblepile.campaign`: `rubblepile campaign FILE` (see the Python docstring): runs the grid on this process's
+/// threads and returns the campaign's one-line summary, its problem (message, exit code) if any, and one dict per
+/// grid point in grid order.
+#[pyfunction]
+#[pyo3(signature = (file, out=None, *, parallel=None, threads_per_run=None, checkpoint_every=None, checkpoint_every_sim=None, max_steps=None, max_wall_seconds=None))]
+#[allow(clippy::too_many_arguments)]
+fn campaign<'py>(
+    py: Python<'py>,
+    file: PathBuf,
+    out: Option<PathBuf>,
+    parallel: Option<usize>,
+    threads_per_run: Option<usize>,
+    checkpoint_every: Option<f64>,
+    checkpoint_every_sim: Option<f64>,
+    max_steps: Option<u64>,
+    max_wall_seconds: Option<f64>,
+) -> PyResult<CampaignOut<'py>> {
+    use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignError, CampaignOptions, load_campaign, run_campaign};
+    let failure = |e: CampaignError| {
+        let mut f = Failure::scene(e.to_string());
+        if e.exit_code() != 2 {
+            f.class = Class::Other;
+        }
+        f
+    };
+    if parallel == Some(0) {
+        return Err(Failure::scene("parallel: must be at least 1, got 0".into()).into_py(py));
+    }
+    if threads_per_run == Some(0) {
+        return Err(Failure::scene("threads_per_run: must be at least 1, got 0".into()).into_py(py));
+    }
+    let result = py.detach(|| {
+        let mut c = load_campaign(&file).map_err(failure)?;
+        if let Some(out) = &out {
+            c.out = out.clone();
+        }
+        let o = CampaignOptions {
+            run: options(
+                false,
+                checkpoint_every,
+                checkpoint_every_sim,
+                max_steps,
+                max_wall_seconds,
+            ),
+            parallel,
+            threads_per_run,
+            verbose: false,
+            shard: None,
+        };
+        let report = run_campaign(&c, &o).map_err(failure)?;
+        Ok::<_, Failure>((c, report))
+    });
+    let (c, report) = result.map_err(|e| e.into_py(py))?;
+    let problem = report.problem(&c.out.join(CAMPAIGN_CSV));
+    let rows = c
+        .points
+        .iter()
+        .zip(&report.runs)
+        .map(|(p, r)| campaign_row(py, &c.out, p, r))
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok((report.one_line(), problem, c.out.display().to_string(), rows))
+}
+
+/// `rubblepile.critical_search`: `rubblepile spinup critical` (see the Python docstring); returns the lines the
+/// command line prints (the search writes `critical.json` and `critical.csv` in `out`).
+#[pyfunction]
+#[pyo3(signature = (scene, out, *, from_hours, to_hours, step_hours=0.01, force=false, branch=false, criterion="paper", significance=None, coordination_tolerance=None, hold=None, judge_window=None, all_holds=false, parallel=1, threads_per_hold=None, finish_released=false))]
+#[allow(clippy::too_many_arguments)]
+fn critical_search(
+    py: Python<'_>,
+    scene: PathBuf,
+    out: PathBuf,
+    from_hours: f64,
+    to_hours: f64,
+    step_hours: f64,
+    force: bool,
+    branch: bool,
+    criterion: &str,
+    significance: Option<f64>,
+    coordination_tolerance: Option<f64>,
+    hold: Option<f64>,
+    judge_window: Option<f64>,
+    all_holds: bool,
+    parallel: usize,
+    threads_per_hold: Option<usize>,
+    finish_released: bool,
+) -> PyResult<Vec<String>> {
+    use rubblepile::analysis::critical::SearchError;
+    use rubblepile::experiment::critical_search::{CriticalOptions, critical};
+    use rubblepile::io::messages::{Channel, default_sink, reset_sink, set_sink};
+    let criterion = criterion
+        .parse()
+        .map_err(|e: String| Failure::scene(format!("criterion: {e}")).into_py(py))?;
+    let options = CriticalOptions {
+        force,
+        branch,
+        criterion,
+        coordination_tolerance,
+        significance,
+        hold,
+        judge_window,
+        all_holds,
+        parallel,
+        threads_per_hold,
+        finish_released,
+        ..CriticalOptions::new(scene, from_hours, to_hours, step_hours, out)
+    };
+    // The search's result lines (the command line's stdout) are collected; progress and warnings go where they
+    // always go.
+    let lines = std::sync::Arc::new(Mutex::new(Vec::<String>::new()));
+    let sink_lines = lines.clone();
+    set_sink(move |channel, line| match channel {
+        Channel::Out => sink_lines
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(line.to_string()),
+        other => default_sink(other, line),
+    });
+    let result = py.detach(|| critical(&options));
+    reset_sink();
+    result.map_err(|e| match e {
+        SearchError::Usage(m) => Failure::scene(m).into_py(py),
+        SearchError::Failed(m) => RubblepileError::new_err(m),
+    })?;
+    let lines = lines.lock().unwrap_or_else(|e| e.into_inner()).clone();
+    Ok(lines)
+}
+
 /// The extension module.
 #[pymodule]
 fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -1113,5 +1319,7 @@ fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyze, m)?)?;
     m.add_function(wrap_pyfunction!(build_target, m)?)?;
     m.add_function(wrap_pyfunction!(flyby, m)?)?;
+    m.add_function(wrap_pyfunction!(campaign, m)?)?;
+    m.add_function(wrap_pyfunction!(critical_search, m)?)?;
     Ok(())
 }

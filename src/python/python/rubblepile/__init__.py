@@ -36,10 +36,13 @@ __all__ = [
     "RunStopped",
     "analyze",
     "build_target",
+    "campaign",
+    "critical_search",
     "flyby",
     "impact",
     "read_run",
     "read_snapshot",
+    "spinup",
     "__version__",
 ]
 
@@ -264,15 +267,24 @@ class Simulation:
         return dict(self._inner._state())
 
     def set_state(self, **arrays: Any) -> None:
-        """Sets the state of an ellipsoid run between two samples; the run continues from it. Keywords, each an
-        array of one row per body in scene order: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s),
-        ``quaternions`` (n, 4; scalar last, normalised here), and one of ``angular_velocities`` (n, 3; rad/s,
-        world frame) or ``spins_body`` (n, 3; rad/s, principal axes). Masses and semi-axes are the scene's.
+        """Sets the state of a run (any engine) between two samples; the run continues from it.
+        Keywords, each an array of one row per particle in scene order (those not given keep their values):
+
+        - ellipsoids: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s), ``quaternions`` (n, 4; scalar last,
+          normalised here), and one of ``angular_velocities`` (n, 3; rad/s, world frame) or ``spins_body`` (n, 3;
+          rad/s, principal axes). Masses and semi-axes are the scene's.
+        - spheres: ``positions`` (n, 3; m), ``velocities`` (n, 3; m/s), ``angular_velocities`` (n, 3; rad/s,
+          world frame). Masses and radii are the scene's. Soft spheres: the forces and torques the next step starts
+          from are evaluated again at the new state (the springs of contacts that still touch are kept, the
+          neighbour list rebuilt); with ``[gravity] interval_steps > 1`` the state can be set only on a self-gravity
+          block boundary. Hard spheres: the rows are the particles still in the run (as :meth:`state`); the
+          neighbour list, the pair certificates and the predicted collisions are rebuilt from the new state; a
+          particle stuck to a wall keeps its state; new positions must not overlap.
 
         The conserved quantities are still measured against t = 0, so a change of energy counts in
         :attr:`energy_error`. :meth:`save` (or a checkpoint) then holds the new state. Raises :class:`SceneError`
-        for a sphere run (not writable yet), a wrong shape, a non-finite value, or attitudes of a run that does not
-        integrate them.
+        for a wrong shape, a non-finite value, attitudes of a run that does not integrate them, or a changed state of
+        a hard sphere stuck to a wall.
         """
         state = {k: np.ascontiguousarray(v, dtype=np.float64) for k, v in arrays.items()}
         self._inner._set_state(state)
@@ -495,3 +507,170 @@ def flyby(
         with open(path) as f:
             analysis = json.load(f)
     return {"lines": list(lines), "analysis": analysis}
+
+
+# The columns of campaign.csv, in its order (the per-run results :func:`campaign` returns).
+_CAMPAIGN_COLUMNS = ("run", "target", "projectile", "angle_deg", "seed", "q_erg_per_g", "status", "wall_seconds",
+                     "final_time", "steps_accepted", "rhs_evaluations", "energy_error", "linear_momentum_error",
+                     "angular_momentum_error")
+
+
+def campaign(
+    file: PathLike,
+    out: Optional[PathLike] = None,
+    *,
+    parallel: Optional[int] = None,
+    threads_per_run: Optional[int] = None,
+    checkpoint_every: Optional[float] = None,
+    checkpoint_every_sim: Optional[float] = None,
+    max_steps: Optional[int] = None,
+    max_wall_seconds: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Runs an impact campaign as ``rubblepile campaign FILE [--out OUT]`` does: the grid of the campaign file
+    (targets x projectiles x angles x seeds, Roig03 Sec. 3), ``parallel`` runs at once (default the file's
+    ``campaign.parallel``) on this process's threads, one run directory per grid point under the campaign
+    directory ``out`` (default the file's ``campaign.out``), and ``campaign.csv``. As the command line, completed
+    runs are skipped and checkpointed ones resumed. ``threads_per_run``: threads of each run's pool (default this
+    process's cores shared among the runs at once); ``checkpoint_every`` (wall-clock s), ``checkpoint_every_sim``
+    (simulated s), ``max_steps``, ``max_wall_seconds`` (s): every run's options, as the command line's flags.
+
+    Returns a dict:
+
+    - ``runs``: the per-run results, one entry per grid point in grid order (``campaign.csv``'s rows), as column
+      name -> NumPy array: ``run`` (name), ``target`` (file stem), ``projectile``, ``angle_deg`` (degrees),
+      ``seed``, ``q_erg_per_g`` (specific impact energy, erg/g), ``status`` (``completed``, ``failed: <cause>``,
+      ``pending``), ``wall_seconds`` (s), ``final_time`` (s), ``steps_accepted``, ``rhs_evaluations``,
+      ``energy_error``, ``linear_momentum_error``, ``angular_momentum_error`` (relative; NaN where the run has no
+      summary), plus ``action`` (``started``, ``resumed``, ``skipped``, ``conflict``), ``completed`` (bool),
+      ``stopped`` (bool) and ``dir`` (each run directory, readable with :func:`read_run` and :func:`analyze`);
+    - ``line``: the command line's closing line; ``out``: the campaign directory;
+    - ``problem``: ``None``, or the command line's error message when runs failed or stopped (the command line
+      exits 1 or 3 then; here the results are returned all the same).
+
+    Raises :class:`SceneError` naming the field for a bad campaign file (the command line's exit code 2).
+    """
+    line, problem, out_dir, rows = _rubblepile.campaign(
+        os.fspath(file), None if out is None else os.fspath(out), parallel=parallel,
+        threads_per_run=threads_per_run, checkpoint_every=checkpoint_every,
+        checkpoint_every_sim=checkpoint_every_sim, max_steps=max_steps, max_wall_seconds=max_wall_seconds)
+    columns = _CAMPAIGN_COLUMNS + ("action", "completed", "stopped", "dir")
+    runs: Dict[str, np.ndarray] = {}
+    for name in columns:
+        cells = [r[name] for r in rows]
+        if name in ("seed", "steps_accepted", "rhs_evaluations"):
+            runs[name] = np.array([-1 if c is None else c for c in cells], dtype=np.int64)
+        elif name in ("completed", "stopped"):
+            runs[name] = np.array(cells, dtype=bool)
+        elif name in ("run", "target", "projectile", "status", "action", "dir"):
+            runs[name] = np.array(cells, dtype=object)
+        else:
+            runs[name] = np.array([np.nan if c is None else c for c in cells], dtype=np.float64)
+    return {"runs": runs, "line": line, "out": out_dir,
+            "problem": None if problem is None else problem[0]}
+
+
+def spinup(
+    scene: Union[PathLike, Dict[str, Any], str],
+    out: Optional[PathLike] = None,
+    *,
+    force: bool = False,
+    checkpoint_every: Optional[float] = None,
+    checkpoint_every_sim: Optional[float] = None,
+    max_steps: Optional[int] = None,
+    max_wall_seconds: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Runs a spin-up (Zhang17 Sec. 2.3.4) as ``rubblepile run SCENE --out OUT`` does: a soft-sphere ``scene``
+    (path, dict or TOML text, as :meth:`Simulation.from_scene`) with a ``[spinup]`` table, whose central body is
+    spun along the period path T_start -> T_inter -> T_final (h) and then held, integrated to its ``t_end``. The run
+    directory ``out`` (``None``: a temporary one, removed when the returned simulation is collected) gets the
+    command line's files, ``spinup.csv`` among them.
+
+    Returns a dict: ``spinup``: ``spinup.csv`` as column name -> NumPy array, one row per output sample: ``t``
+    (s), ``path_period_h`` and ``period_h`` (the path's and the body's spin period, h), ``forcing`` (1 while
+    forced), ``body_particles``, ``body_mass_fraction``, the body's semi-axes ``a``, ``b``, ``c`` (m) and their
+    ratios, ``packing_fraction``, ``coordination_number``, ``theta_max_deg`` (the largest mobilised friction
+    angle of its RVEs, degrees), ...; ``summary``: ``summary.json`` as a dict; ``dir``: the run directory;
+    ``simulation``: the finished :class:`Simulation`.
+
+    Raises :class:`SceneError` when the scene is not a soft-sphere scene with a ``[spinup]`` table, and as
+    :meth:`Simulation.integrate`.
+    """
+    sim = Simulation.from_scene(scene, out, force=force, checkpoint_every=checkpoint_every,
+                                checkpoint_every_sim=checkpoint_every_sim, max_steps=max_steps,
+                                max_wall_seconds=max_wall_seconds)
+    path = os.path.join(sim.out_dir, "spinup.csv")
+    kind = sim.kind
+    if kind != "soft-spheres" or not os.path.isfile(path):
+        sim.close()
+        raise SceneError(f"spinup: the scene is a {kind} scene without a [spinup] table (need a soft-spheres "
+                         "scene with one)")
+    sim.integrate()
+    from .runs import _read_csv
+
+    return {"spinup": _read_csv(path), "summary": sim.summary(), "dir": sim.out_dir, "simulation": sim}
+
+
+def critical_search(
+    scene: PathLike,
+    out: PathLike,
+    *,
+    from_hours: float,
+    to_hours: float,
+    step_hours: float = 0.01,
+    force: bool = False,
+    branch: bool = False,
+    criterion: str = "paper",
+    significance: Optional[float] = None,
+    coordination_tolerance: Optional[float] = None,
+    hold: Optional[float] = None,
+    judge_window: Optional[float] = None,
+    all_holds: bool = False,
+    parallel: int = 1,
+    threads_per_hold: Optional[int] = None,
+    finish_released: bool = False,
+) -> Dict[str, Any]:
+    """Searches the third critical spin limit T_c,3 (Zhang17 Sec. 3.3.3) as ``rubblepile spinup critical`` does:
+    for T_final = ``from_hours``, ``from_hours + step_hours``, ... up to ``to_hours`` (h) a hold run ``out/T<X>``
+    spins the soft-sphere ``scene`` (with a ``[spinup]`` table whose ``t_end`` leaves a hold after ``t_final``) up
+    to T_final and holds it; each hold is judged by the three creep criteria, and T_c,3 under a criterion is its
+    first stable T_final. ``branch``: the holds branch off one run of the path (``out/base``), each ``hold``
+    seconds long (s; default the scene's ``t_end - t_final``); ``criterion``: ``paper``, ``paper-tolerance`` or
+    ``ours``, the one behind the top-level ``t_c3_hours``; ``significance`` (standard errors),
+    ``coordination_tolerance`` (contacts per particle), ``judge_window`` (s), ``all_holds``, ``parallel`` (holds at
+    once), ``threads_per_hold``, ``finish_released``: as the command line's flags. Writes ``out/critical.json``
+    and ``out/critical.csv`` (refused when ``critical.json`` exists, unless ``force``).
+
+    Returns a dict: ``t_c3_hours`` and ``friction_angle_deg`` (h, degrees; ``None`` where no hold is stable) of the
+    selected criterion, ``criterion`` (its name); ``by_criterion``: for each of ``paper``, ``paper-tolerance``,
+    ``ours`` a dict of ``t_c3_hours``, ``friction_angle_deg`` and ``set_aside_hours``; ``holds``: the holds as rows
+    (``critical.csv``: column name -> NumPy array, one entry per hold by increasing T_final: ``t_final_h`` (h),
+    ``hold_s`` (s), ``released``, ``theta_max_deg`` (degrees), the drifts, the rates and their standard errors
+    per 1000 s, and ``<criterion>_stable`` / ``<criterion>_drifting`` per criterion); ``runs``: the holds as
+    ``critical.json`` holds them (dicts, with each run's ``dir``); ``lines``: the command line's lines.
+
+    Raises :class:`SceneError` for bad options or a scene without a usable ``[spinup]`` table,
+    :class:`RubblepileError` when a hold fails.
+    """
+    lines = _rubblepile.critical_search(
+        os.fspath(scene), os.fspath(out), from_hours=from_hours, to_hours=to_hours, step_hours=step_hours,
+        force=force, branch=branch, criterion=criterion, significance=significance,
+        coordination_tolerance=coordination_tolerance, hold=hold, judge_window=judge_window, all_holds=all_holds,
+        parallel=parallel, threads_per_hold=threads_per_hold, finish_released=finish_released)
+    from .runs import _read_csv
+
+    with open(os.path.join(os.fspath(out), "critical.json")) as f:
+        result = json.load(f)
+    by_criterion = {}
+    for key, name in (("paper", "paper"), ("paper_tolerance", "paper-tolerance"), ("ours", "ours")):
+        r = result[key]
+        by_criterion[name] = {"t_c3_hours": r.get("t_c3_hours"), "friction_angle_deg": r.get("friction_angle_deg"),
+                              "set_aside_hours": list(r.get("set_aside_hours", []))}
+    return {
+        "t_c3_hours": result.get("t_c3_hours"),
+        "friction_angle_deg": result.get("friction_angle_deg"),
+        "criterion": criterion,
+        "by_criterion": by_criterion,
+        "holds": _read_csv(os.path.join(os.fspath(out), "critical.csv")),
+        "runs": result["runs"],
+        "lines": list(lines),
+    }

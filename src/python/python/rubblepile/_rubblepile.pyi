@@ -76,7 +76,9 @@ class Simulation:
         """Wall-clock seconds of the run (s)."""
     def _summary_json(self) -> str: ...
     def _state(self) -> Dict[str, np.ndarray]: ...
-    def _set_state(self, state: Dict[str, np.ndarray]) -> None: ...
+    def _set_state(self, state: Dict[str, np.ndarray]) -> None:
+        """Sets positions (m), velocities (m/s), angular_velocities (rad/s, world frame) of a run of any engine,
+        and quaternions or spins_body (rad/s) of an ellipsoid run; float64 arrays, one row per particle."""
     def __enter__(self) -> "Simulation": ...
     def __exit__(self, *args: Any) -> None: ...
 
@@ -144,3 +146,38 @@ def flyby(
     settle_to_principal: bool = False,
     settle_max_hours: Optional[float] = None,
 ) -> List[str]: ...
+def campaign(
+    file: str,
+    out: Optional[str] = None,
+    *,
+    parallel: Optional[int] = None,
+    threads_per_run: Optional[int] = None,
+    checkpoint_every: Optional[float] = None,
+    checkpoint_every_sim: Optional[float] = None,
+    max_steps: Optional[int] = None,
+    max_wall_seconds: Optional[float] = None,
+) -> Tuple[str, Optional[Tuple[str, int]], str, List[Dict[str, Any]]]:
+    """`rubblepile campaign FILE`: (closing line, (problem, exit code) or None, campaign directory, one dict per grid
+    point: campaign.csv's columns (angle_deg in degrees, q_erg_per_g in erg/g, wall_seconds and final_time in s) and
+    action, completed, stopped, dir)."""
+def critical_search(
+    scene: str,
+    out: str,
+    *,
+    from_hours: float,
+    to_hours: float,
+    step_hours: float = 0.01,
+    force: bool = False,
+    branch: bool = False,
+    criterion: str = "paper",
+    significance: Optional[float] = None,
+    coordination_tolerance: Optional[float] = None,
+    hold: Optional[float] = None,
+    judge_window: Optional[float] = None,
+    all_holds: bool = False,
+    parallel: int = 1,
+    threads_per_hold: Optional[int] = None,
+    finish_released: bool = False,
+) -> List[str]:
+    """`rubblepile spinup critical` (periods in h, hold and judge_window in s): writes out/critical.json and
+    out/critical.csv; returns the command line's lines."""
