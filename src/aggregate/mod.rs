@@ -152,7 +152,7 @@ pub enum AggregateError {
     Failed(String),
 }
 
-fn input(field: &str, message: impl Into<String>) -> AggregateError {
+pub(crate) fn input(field: &str, message: impl Into<String>) -> AggregateError {
     AggregateError::Input {
         field: field.into(),
         message: message.into(),

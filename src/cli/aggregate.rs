@@ -135,26 +135,7 @@ pub fn build_cmd(args: &BuildArgs) -> Result<(), CliError> {
     })?;
     check_outputs(&args.out, args.force).map_err(cli_error)?;
     let shape = Shape::parse(&args.shape, args.obj_scale).map_err(CliError::usage)?;
-    let mut recipe = Recipe::default();
-    if let Some(p) = args.shake_periods {
-        if !(p.is_finite() && p >= 0.0) {
-            return Err(CliError::usage(format!(
-                "--shake-periods: a number of periods >= 0, got {p}"
-            )));
-        }
-        recipe.shake_periods = p;
-    }
-    if let Some(k) = args.gravity_interval {
-        let most = (recipe.steps_per_contact / 5.0).floor() as u64;
-        if !(1..=most).contains(&k) {
-            return Err(CliError::usage(format!(
-                "--gravity-interval: steps between self-gravity evaluations, 1 to {most} \
-                 (steps per contact {} / 5), got {k}",
-                recipe.steps_per_contact
-            )));
-        }
-        recipe.gravity_interval = k;
-    }
+    let recipe = Recipe::with_overrides(args.shake_periods, args.gravity_interval).map_err(cli_error)?;
     let spec = BuildSpec {
         model,
         shape,

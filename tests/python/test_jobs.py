@@ -82,6 +82,27 @@ def test_build_target_is_the_command_lines(tmp_path):
         rubblepile.build_target(30, 4.0, tmp_path / "x.csv", rigidity=2.0)
 
 
+def test_build_aggregate_is_the_command_lines(tmp_path):
+    # A small HCP ball (Zhang17's lattice model, carved; no packing recipe to run).
+    args = ["--model", "hcp", "--shape", "sphere:60", "--radius", "6", "--lattice-orientation", "tilt:54.7"]
+    r = run_cli("aggregate", "build", *args, "--out", str(tmp_path / "cli.csv"))
+    assert r.returncode == 0, r.stderr
+    report = rubblepile.build_aggregate("hcp", "sphere:60", tmp_path / "py.csv", radius=6.0,
+                                        lattice_orientation="tilt:54.7")
+    assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
+    cli = json.loads((tmp_path / "cli.json").read_text())
+    for side in (report, cli):
+        side.pop("build_seconds")  # wall time
+    assert report == cli
+    assert report["n"] > 100
+    with pytest.raises(rubblepile.SceneError, match="exists"):
+        rubblepile.build_aggregate("hcp", "sphere:60", tmp_path / "py.csv", radius=6.0)
+    with pytest.raises(rubblepile.SceneError, match="model"):
+        rubblepile.build_aggregate("hex", "sphere:60", tmp_path / "x.csv", radius=6.0)
+    with pytest.raises(rubblepile.SceneError, match="shake-periods"):
+        rubblepile.build_aggregate("rcp", "sphere:60", tmp_path / "y.csv", radius=6.0, shake_periods=-1.0)
+
+
 def test_flyby_is_the_command_lines(tmp_path):
     # The control flyby of tests/flyby.rs (planet mass 0, a rescaled and re-spun N30 pile, no control run).
     args = ["--target", str(TARGET), "--radius-m", "170", "--period-hours", "30.5", "--q-m", "3.8e7",

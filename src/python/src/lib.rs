@@ -1056,6 +1056,73 @@ fn build_target(
     result.map_err(|e| e.into_py(py))
 }
 
+/// `rubblepile.build_aggregate`: `rubblepile aggregate build` (see the Python docstring); returns the report JSON text.
+#[pyfunction]
+#[pyo3(signature = (model, shape, out, *, particles=None, radius=None, radius_range=None, bulk_density=2100.0, core_radius=None, seed=1, lattice_orientation="perpendicular", shake_periods=None, gravity_interval=None, obj_scale=1.0, force=false))]
+#[allow(clippy::too_many_arguments)]
+fn build_aggregate(
+    py: Python<'_>,
+    model: &str,
+    shape: &str,
+    out: PathBuf,
+    particles: Option<usize>,
+    radius: Option<f64>,
+    radius_range: Option<(f64, f64)>,
+    bulk_density: f64,
+    core_radius: Option<f64>,
+    seed: u64,
+    lattice_orientation: &str,
+    shake_periods: Option<f64>,
+    gravity_interval: Option<u64>,
+    obj_scale: f64,
+    force: bool,
+) -> PyResult<String> {
+    use rubblepile::aggregate::{
+        AggregateError, BuildSpec, Grains, Model, build_with_progress, files, random_packing::Recipe, shape::Shape,
+    };
+    let from_aggregate = |e: AggregateError| match e {
+        AggregateError::Input { .. } => Failure::scene(e.to_string()),
+        AggregateError::Failed(_) => Failure {
+            class: Class::Other,
+            ..Failure::scene(e.to_string())
+        },
+    };
+    let result = py.detach(|| {
+        let model = Model::parse(model).ok_or_else(|| {
+            Failure::scene(format!(
+                "model: unknown model `{model}`; expected hcp, rcp, rcpc, pp1, pp2 or ppc"
+            ))
+        })?;
+        let grains = match (particles, radius, radius_range) {
+            (Some(n), None, None) => Grains::Count(n),
+            (None, Some(r), None) => Grains::Radius(r),
+            (None, None, Some((lo, hi))) => Grains::Range(lo, hi),
+            _ => {
+                return Err(Failure::scene(
+                    "give one of particles (a count), radius (m) or radius_range ((rmin, rmax), m)".into(),
+                ));
+            }
+        };
+        files::check_outputs(&out, force).map_err(from_aggregate)?;
+        let spec = BuildSpec {
+            model,
+            shape: Shape::parse(shape, obj_scale).map_err(|e| Failure::scene(format!("shape: {e}")))?,
+            grains,
+            bulk_density,
+            seed,
+            core_radius,
+            recipe: Recipe::with_overrides(shake_periods, gravity_interval).map_err(from_aggregate)?,
+            orientation: lattice_orientation
+                .parse()
+                .map_err(|e: String| Failure::scene(format!("lattice_orientation: {e}")))?,
+        };
+        let agg = build_with_progress(&spec, &mut |_| {}).map_err(from_aggregate)?;
+        files::write_aggregate(&out, &agg.particles, &agg.report).map_err(from_aggregate)?;
+        serde_json::to_string(&agg.report).map_err(|e| Failure::scene(e.to_string()))
+    });
+    result.map_err(|e| e.into_py(py))
+}
+
 /// `rubblepile.flyby`: `rubblepile flyby` (see the Python docstring): prepares, runs (and its control) and
 /// analyses a flyby; returns the command line's lines.
 #[pyfunction]
@@ -1318,6 +1385,7 @@ fn _rubblepile(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(impact, m)?)?;
     m.add_function(wrap_pyfunction!(analyze, m)?)?;
     m.add_function(wrap_pyfunction!(build_target, m)?)?;
+    m.add_function(wrap_pyfunction!(build_aggregate, m)?)?;
     m.add_function(wrap_pyfunction!(flyby, m)?)?;
     m.add_function(wrap_pyfunction!(campaign, m)?)?;
     m.add_function(wrap_pyfunction!(critical_search, m)?)?;

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Dict, Optional, Union
+from typing import Any, Dict, Optional, Tuple, Union
 
 import numpy as np
 
@@ -36,6 +36,7 @@ __all__ = [
     "RunStopped",
     "analyze",
     "build_target",
+    "build_aggregate",
     "campaign",
     "critical_search",
     "flyby",
@@ -458,6 +459,39 @@ def build_target(
         fragments, period_hours, os.fspath(out), seed=seed, r_largest_km=r_largest_km, r_smallest_km=r_smallest_km,
         total_mass=total_mass, f0=f0, rigidity=rigidity, drop_detached=drop_detached, kappa_reading=kappa_reading,
         force=force)
+    return json.loads(text)
+
+
+def build_aggregate(
+    model: str,
+    shape: str,
+    out: PathLike,
+    *,
+    particles: Optional[int] = None,
+    radius: Optional[float] = None,
+    radius_range: Optional[Tuple[float, float]] = None,
+    bulk_density: float = 2100.0,
+    core_radius: Optional[float] = None,
+    seed: int = 1,
+    lattice_orientation: str = "perpendicular",
+    shake_periods: Optional[float] = None,
+    gravity_interval: Optional[int] = None,
+    obj_scale: float = 1.0,
+    force: bool = False,
+) -> Dict[str, Any]:
+    """Builds a soft-sphere aggregate for spin-up studies as ``rubblepile aggregate build`` does (Zhang17 Table 2):
+    ``model`` hcp, rcp, rcpc, pp1, pp2 or ppc, carved to ``shape`` (``sphere:R``, ``ellipsoid:A,B,C``, ``top[:D_EQ]``,
+    ``didymos[:LX,LY,LZ,D_EQ]``, ``obj:PATH``; m). Exactly one of ``particles`` (about this many grains), ``radius``
+    (m, monodisperse) or ``radius_range`` ((rmin, rmax), m, dN/dr ~ r^-3). ``bulk_density`` (kg/m^3),
+    ``core_radius`` (m, rcpc and ppc), ``lattice_orientation`` (perpendicular, parallel, tilt:DEG or random[:SEED]).
+    Writes the particle file ``out`` (``.csv``) and its report beside it (``.json``), which it returns as a dict.
+
+    Raises :class:`SceneError` naming the argument for a bad value, or when ``out`` exists (unless ``force``).
+    """
+    text = _rubblepile.build_aggregate(
+        model, shape, os.fspath(out), particles=particles, radius=radius, radius_range=radius_range,
+        bulk_density=bulk_density, core_radius=core_radius, seed=seed, lattice_orientation=lattice_orientation,
+        shake_periods=shake_periods, gravity_interval=gravity_interval, obj_scale=obj_scale, force=force)
     return json.loads(text)
 
 

@@ -107,6 +107,25 @@ def impact(
     checkpoint_every_sim: Optional[float] = None,
 ) -> Simulation: ...
 def analyze(dir: str, at: Optional[float] = None, *, force: bool = False) -> Tuple[str, List[str]]: ...
+def build_aggregate(
+    model: str,
+    shape: str,
+    out: str,
+    *,
+    particles: Optional[int] = None,
+    radius: Optional[float] = None,
+    radius_range: Optional[Tuple[float, float]] = None,
+    bulk_density: float = 2100.0,
+    core_radius: Optional[float] = None,
+    seed: int = 1,
+    lattice_orientation: str = "perpendicular",
+    shake_periods: Optional[float] = None,
+    gravity_interval: Optional[int] = None,
+    obj_scale: float = 1.0,
+    force: bool = False,
+) -> str:
+    """``rubblepile aggregate build``; returns the report as JSON text (m, kg/m^3)."""
+
 def build_target(
     fragments: int,
     period_hours: float,
