@@ -135,3 +135,18 @@ fn build_progress_follows_the_stages_and_changes_nothing() {
         assert_eq!(total, st.steps, "stage {}", st.stage);
     }
 }
+
+/// The user's recipe choices are checked once, in the library, with the flag named (the CLI and Python share it).
+#[test]
+fn recipe_overrides_are_checked_and_name_the_flag() {
+    let r = Recipe::with_overrides(Some(4.0), Some(2)).unwrap();
+    assert_eq!((r.shake_periods, r.gravity_interval), (4.0, 2));
+    assert_eq!(Recipe::with_overrides(None, None).unwrap(), Recipe::default());
+    let e = Recipe::with_overrides(Some(-1.0), None).unwrap_err().to_string();
+    assert!(e.starts_with("--shake-periods: "), "{e}");
+    let e = Recipe::with_overrides(None, Some(0)).unwrap_err().to_string();
+    assert!(e.starts_with("--gravity-interval: "), "{e}");
+    let most = (Recipe::default().steps_per_contact / 5.0).floor() as u64;
+    assert!(Recipe::with_overrides(None, Some(most)).is_ok());
+    assert!(Recipe::with_overrides(None, Some(most + 1)).is_err());
+}
