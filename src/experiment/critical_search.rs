@@ -515,6 +515,7 @@ fn prepare_branches(
     grid: &[f64],
 ) -> Result<Vec<f64>, SearchError> {
     use crate::driver::branch::{branch_soft, checkpoint_time};
+    use crate::driver::progress::fmt_time;
     use crate::driver::{resume_soft, run_soft};
     use crate::granular::soft::run::sample_steps;
     if path.rests > 0 {
@@ -636,8 +637,10 @@ fn prepare_branches(
             emit(
                 Channel::Progress,
                 &format!(
-                    "spinup critical: base run to t = {t_leg} s of {t_ck} s (T_final = {tf} h starts at {} s)",
-                    starts[k]
+                    "spinup critical: base run to t = {} s of {} s (T_final = {tf} h starts at {} s)",
+                    fmt_time(t_leg),
+                    fmt_time(t_ck),
+                    fmt_time(starts[k])
                 ),
             );
             let result = match here {
