@@ -114,14 +114,33 @@ fn analyze_reproduces_the_golden_analysis() {
             .success()
     );
     // no snapshot at the requested time: one line naming the available times
-    let bad = rubblepile(&dir, &["analyze", ".", "--at", "400", "--force"]);
+    let bad = rubblepile(&dir, &["analyze", ".", "--at", "100", "--force"]);
     assert_eq!(bad.status.code(), Some(2));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(
-        err.contains("no snapshot at t = 400") && err.contains("[0.0, 200.0]"),
+        err.contains("no snapshot at t = 100") && err.contains("[0.0, 200.0]"),
         "{err}"
     );
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
+}
+
+/// Issue 57: `analyze --at T` past the run's end is one line naming `--at` and the run's end time, not an
+/// analysis of nothing (a bound mass fraction of -0.000).
+#[test]
+fn analyze_at_past_the_runs_end_is_an_error_naming_at_and_the_end() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/n30_p1_z45");
+    let dir = temp_dir("analyze-past-end").join("run");
+    copy_dir(&golden_dir, &dir);
+    let bad = rubblepile(&dir, &["analyze", ".", "--at", "400"]);
+    assert_eq!(bad.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--at 400 s is past the run's end (t_end = 200 s)"),
+        "{err}"
+    );
+    assert!(!dir.join("analysis/analysis.json").exists());
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
 

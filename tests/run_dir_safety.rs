@@ -366,3 +366,24 @@ fn readers_refuse_a_damaged_or_non_finite_snapshot_with_one_line() {
         "{e}"
     );
 }
+
+/// Issue 57: `run --force` (and `impact --force`, through the same preparation) over a previous run removes that
+/// run's derived `analysis/` and `frames/` too: nothing left describes the old snapshots, and `analyze` of the new
+/// run is not refused for an existing analysis.
+#[test]
+fn force_leaves_no_stale_analysis_or_frames() {
+    let base = temp_dir("force-derived");
+    let sc = scene(&base, "ellipsoids", &[]);
+    let run = finished(&base, "ellipsoids", &[], "run", &[]);
+    let a = rubblepile(&base, &["analyze", s(&run)]);
+    assert!(a.status.success(), "{}", describe(&a));
+    assert!(run.join("analysis").is_dir());
+    std::fs::create_dir_all(run.join("frames")).unwrap();
+    std::fs::write(run.join("frames/0000.png"), b"old").unwrap();
+    let again = rubblepile(&base, &["run", s(&sc), "--out", s(&run), "--no-progress", "--force"]);
+    assert!(again.status.success(), "{}", describe(&again));
+    assert!(!run.join("analysis").exists(), "stale analysis/ kept");
+    assert!(!run.join("frames").exists(), "stale frames/ kept");
+    let a = rubblepile(&base, &["analyze", s(&run)]);
+    assert!(a.status.success(), "{}", describe(&a));
+}

@@ -710,3 +710,28 @@ fn a_resumed_search_accepts_a_base_scene_of_the_old_layout_with_the_same_values(
         String::from_utf8_lossy(&refused.stderr)
     );
 }
+
+/// Issue 57: `spinup critical --branch` on a scene whose snapshots are given by `[output] snapshot_every` (not
+/// `times`) branches its hold (it used to fail on the missing `times` list); the hold scene lists the base
+/// run's cadence samples up to the branch point and the hold's own start and end.
+#[test]
+fn branch_accepts_a_scene_with_snapshot_every() {
+    let dir = temp_dir("spinup-branch-every");
+    let path = PATH.replace("T_final = 6.0", "T_final = 5.0");
+    let text = scene(&dir, &path).replace("times = [0.0, 1200.0, 2400.0]", "snapshot_every = 1200.0");
+    std::fs::write(dir.join("s.toml"), text).unwrap();
+    let c = rubblepile(
+        &dir,
+        &[
+            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "600",
+            "--out", "crit",
+        ],
+    );
+    assert!(c.status.success(), "{}", String::from_utf8_lossy(&c.stderr));
+    let hold = dir.join("crit/T6.00");
+    let scene_text = read(&hold.join("scene.toml"));
+    assert!(!scene_text.contains("snapshot_every"), "{scene_text}");
+    assert!(scene_text.contains("t_final = 1600.0"), "{scene_text}");
+    assert!(hold.join("summary.json").is_file());
+    assert!(dir.join("crit/critical.json").is_file());
+}

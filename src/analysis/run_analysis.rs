@@ -37,6 +37,16 @@ pub enum AnalysisError {
         /// What is wrong, naming the file.
         reason: String,
     },
+    /// The requested time is past the run's end (issue 57).
+    #[error("{dir}: --at {t} s is past the run's end (t_end = {t_end} s)")]
+    PastEnd {
+        /// The run directory.
+        dir: PathBuf,
+        /// Requested time (s).
+        t: f64,
+        /// The run's end time (s).
+        t_end: f64,
+    },
     /// No snapshot at the requested time.
     #[error("{dir}: no snapshot at t = {t} s (snapshots at {available:?} s)")]
     NoSnapshot {
@@ -253,6 +263,13 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
             reason: e.to_string(),
         }
     })?;
+    if t_at > scene.scene.t_end * (1.0 + 1e-9) {
+        return Err(AnalysisError::PastEnd {
+            dir: dir.to_path_buf(),
+            t: t_at,
+            t_end: scene.scene.t_end,
+        });
+    }
     let g = scene.physics.gravity.and_then(|g| g.g).unwrap_or(G_SI);
     let times = snapshot_times(dir)?;
     let find = |t: f64| {

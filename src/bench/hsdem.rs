@@ -77,11 +77,9 @@ impl HsdemTiming {
     }
 }
 
-/// CPU time (s) of the calling thread, where the kernel reports it.
+/// CPU time (s) of the calling thread, where the kernel reports it (not where it reads 0: issue 57).
 fn thread_cpu_seconds() -> Option<f64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
+    crate::bench::work_precision::thread_cpu_seconds()
 }
 
 /// Steps `system` to `t` with steps of `dt`, the last one shortened to land on `t` (as the run driver lands on an

@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 use super::BenchError as CliError;
-use crate::bench::work_precision::{Setting, median, run_once, thread_cpu_seconds};
+use crate::bench::work_precision::{Setting, fmt_cpu, median, run_once, thread_cpu_seconds};
 use crate::bench::work_precision_sweep::prepare_outputs;
 use rubblepile::impact::problems::{NBodyProblem, PointMassGravity, ProblemSetup};
 use rubblepile::integrate::{IntegrateError, Method, OdeSystem, Stats, Tolerances, make_integrator};
@@ -195,13 +195,13 @@ pub fn nbody(args: &NBodyArgs) -> Result<(), CliError> {
                 .install(|| measure_nbody(&problem, &setting, args.repeats as usize))
                 .map_err(|e| CliError::failed(format!("{}: {e}", setting.label())))?;
             println!(
-                "  {:<28} {:.4e} s (median of {}; min {:.4e} s; cpu {:.4e} s)  {} RHS, {} steps  energy {:.2e}  \
+                "  {:<28} {:.4e} s (median of {}; min {:.4e} s; cpu {})  {} RHS, {} steps  energy {:.2e}  \
                  RHS share {:.0}%  bare RHS {:.4e} s",
                 setting.label(),
                 row.wall,
                 row.timed_runs,
                 row.wall_min,
-                row.cpu,
+                fmt_cpu(row.cpu),
                 row.stats.rhs_evaluations,
                 row.stats.steps_accepted,
                 row.energy_error,

@@ -98,11 +98,35 @@ pub struct RunOutcome {
 }
 
 /// CPU time the calling thread has run so far (s), from `/proc/thread-self/schedstat` (Linux, ns resolution);
-/// `None` where that file is not available.
+/// `None` where that file is not available or accounts no CPU time (reads 0).
 pub fn thread_cpu_seconds() -> Option<f64> {
     let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     let ns: u64 = text.split_whitespace().next()?.parse().ok()?;
-    Some(ns as f64 * 1e-9)
+    // The calling thread is running: a kernel that accounts its CPU time says more than 0. Some (containers,
+    // kernels without schedstats) always say 0: then the CPU time is unknown, not zero (issue 57).
+    (ns > 0).then_some(ns as f64 * 1e-9)
+}
+
+/// A CPU time for a printed line: `1.2345e-2 s`, or `n/a` when it could not be measured (NaN,
+/// [`thread_cpu_seconds`]).
+pub fn fmt_cpu(seconds: f64) -> String {
+    if seconds.is_finite() {
+        format!("{seconds:.4e} s")
+    } else {
+        "n/a".to_string()
+    }
+}
+
+/// How a row's time was taken, for a printed line: `median of 5`, and why the number of timed runs differs from
+/// `--repeats` when it does (a short run is repeated more, a long one at most [`LONG_RUN_REPEATS`] times).
+pub fn timed_runs_note(statistic: &str, timed_runs: usize, repeats: usize) -> String {
+    let mut note = format!("{statistic} of {timed_runs}");
+    if timed_runs > repeats {
+        note += &format!("; --repeats {repeats} raised for a run under {SHORT_RUN_SECONDS} s");
+    } else if timed_runs < repeats {
+        note += &format!("; --repeats {repeats} capped for a run over {LONG_RUN_SECONDS} s");
+    }
+    note
 }
 
 /// Integrates `problem` from 0 to `t_end` with `setting`, landing on the energy checks; only the
@@ -430,14 +454,13 @@ pub fn sweep(
             match measure(problem, setting, config.repeats, &error_of) {
                 Ok(row) => {
                     progress(&format!(
-                        "{:<28} error {:.3e}  energy {:.3e}  wall {:.4e} s, cpu {:.4e} s ({} of {})  {} RHS, {} steps",
+                        "{:<28} error {:.3e}  energy {:.3e}  wall {:.4e} s, cpu {} ({})  {} RHS, {} steps",
                         setting.label(),
                         row.error,
                         row.energy_error,
                         row.wall_seconds,
-                        row.cpu_seconds,
-                        row.statistic,
-                        row.timed_runs,
+                        fmt_cpu(row.cpu_seconds),
+                        timed_runs_note(row.statistic, row.timed_runs, config.repeats),
                         row.rhs_evaluations,
                         row.steps
                     ));
@@ -501,6 +524,27 @@ pub fn csv_line(row: &SweepRow) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 57: a CPU time that could not be measured prints as `n/a`, not `0.0000e0 s`, and a row timed more
+    /// (or fewer) times than `--repeats` says why.
+    #[test]
+    fn printed_timing_says_what_was_measured() {
+        assert_eq!(fmt_cpu(0.0123), "1.2300e-2 s");
+        assert_eq!(fmt_cpu(f64::NAN), "n/a");
+        assert_eq!(timed_runs_note("median", 5, 5), "median of 5");
+        assert_eq!(
+            timed_runs_note("median", 25, 1),
+            "median of 25; --repeats 1 raised for a run under 0.05 s"
+        );
+        assert_eq!(
+            timed_runs_note("min", 2, 5),
+            "min of 2; --repeats 5 capped for a run over 2 s"
+        );
+        if let Some(t) = thread_cpu_seconds() {
+            assert!(t > 0.0, "{t}");
+        }
+    }
+
     use rubblepile::impact::problems::WorkPrecisionProblem;
 
     #[test]

@@ -123,15 +123,27 @@ pub fn progress_line(t: f64, t_end: f64, t_start: f64, wall: Duration, error: Op
         "unknown".to_string()
     };
     let mut line = format!(
-        "progress: t = {} of {t_end} s ({done:.1} %), wall {}, ETA {eta}",
+        "progress: t = {} of {} s ({done:.1} %), wall {}, ETA {eta}",
         // Four decimals are plenty for a log; an adaptive step's time has sixteen.
-        (t * 1e4).round() / 1e4,
+        fmt_time(t),
+        fmt_time(t_end),
         clock(w)
     );
     if let Some((name, value)) = error {
         line.push_str(&format!(", {name} {value:.1e}"));
     }
     line
+}
+
+/// A simulated time (s) for a progress or status line: rounded to four decimals, so that a time made of steps
+/// (`3 × 1.1` = 3.3000000000000003) prints as `3.3`; a whole time prints without decimals (`120`).
+pub fn fmt_time(t: f64) -> String {
+    let r = (t * 1e4).round() / 1e4;
+    if r.is_finite() {
+        format!("{}", r + 0.0)
+    } else {
+        format!("{t}")
+    }
 }
 
 /// Seconds as `2h 5m 3s`, `5m 3s` or `3s` (whole seconds).
@@ -155,7 +167,7 @@ pub fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::Prog
     pb.set_style(style);
     pb.set_position((t / t_end * 1e6) as u64);
     pb.reset_eta();
-    pb.set_message(format!("t = {t}/{t_end} s"));
+    pb.set_message(format!("t = {}/{} s", fmt_time(t), fmt_time(t_end)));
     pb.enable_steady_tick(Duration::from_millis(250));
     Some(pb)
 }
@@ -163,7 +175,7 @@ pub fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::Prog
 /// Moves `pb` to simulated time `t` of `t_end` (s).
 pub fn show_progress(pb: &indicatif::ProgressBar, t: f64, t_end: f64) {
     pb.set_position((t / t_end * 1e6) as u64);
-    pb.set_message(format!("t = {t:.4}/{t_end} s"));
+    pb.set_message(format!("t = {}/{} s", fmt_time(t), fmt_time(t_end)));
 }
 
 #[cfg(test)]
@@ -192,5 +204,20 @@ mod tests {
         );
         let line = progress_line(0.0, 600.0, 0.0, Duration::from_secs(5), None);
         assert!(line.ends_with("ETA unknown"), "{line}");
+    }
+
+    /// Issue 57: times made of steps print rounded, not with their round-off digits.
+    #[test]
+    fn fmt_time_rounds_step_times_to_four_decimals() {
+        assert_eq!(format!("{}", 3.0 * 1.1), "3.3000000000000003");
+        assert_eq!(fmt_time(3.0 * 1.1), "3.3");
+        assert_eq!(fmt_time(3931.2 + 4.6e-13), "3931.2");
+        assert_eq!(fmt_time(120.0), "120");
+        assert_eq!(fmt_time(0.1 + 0.2), "0.3");
+        assert_eq!(fmt_time(1.23456789), "1.2346");
+        assert_eq!(fmt_time(-0.0), "0");
+        assert_eq!(fmt_time(f64::INFINITY), "inf");
+        let line = progress_line(3.0 * 1.1, 6.0 * 1.1, 0.0, Duration::from_secs(60), None);
+        assert!(line.starts_with("progress: t = 3.3 of 6.6 s (50.0 %)"), "{line}");
     }
 }

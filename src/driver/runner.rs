@@ -270,7 +270,8 @@ fn holds_outputs<S>(dir: &Path) -> Result<bool, RunError<S>> {
 
 /// Checks `dir` is usable, creates it, locks it for this process ([`lock_output_dir`]) and creates `snapshots/`; the
 /// lock is held until the returned guard is dropped (keep it for as long as the directory is written). With `force`,
-/// a previous run's files are removed first (only those: other files are left alone, the lock file too).
+/// a previous run's files are removed first, with its derived `analysis/` and `frames/` (only those: other files
+/// are left alone, the lock file too).
 ///
 /// Errors: [`RunError::NotADirectory`]; [`RunError::Locked`] at once when another rubblepile process writes `dir`
 /// (before anything in it is removed, `--force` or not); [`RunError::OutputExists`] when `dir` holds anything but
@@ -286,6 +287,15 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
             let p = dir.join(name);
             if p.is_file() && *name != "impact.json" {
                 std::fs::remove_file(&p).map_err(io_err(&p))?;
+            }
+        }
+        // The previous run's derived outputs (`analysis/`, `frames/`) describe its snapshots, not the new run's:
+        // they go too (issue 57); a link there is refused (nothing is removed through a link).
+        for name in crate::io::manifest::NOT_RECORDED {
+            let p = dir.join(name);
+            safe_write::refuse_symlink(&p).map_err(io_err(&p))?;
+            if p.is_dir() {
+                std::fs::remove_dir_all(&p).map_err(io_err(&p))?;
             }
         }
         let snaps = dir.join("snapshots");

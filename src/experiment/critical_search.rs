@@ -515,6 +515,7 @@ fn prepare_branches(
     grid: &[f64],
 ) -> Result<Vec<f64>, SearchError> {
     use crate::driver::branch::{branch_soft, checkpoint_time};
+    use crate::driver::progress::fmt_time;
     use crate::driver::{resume_soft, run_soft};
     use crate::granular::soft::run::sample_steps;
     if path.rests > 0 {
@@ -540,13 +541,19 @@ fn prepare_branches(
     }
     let dt = base.dt;
     let every = base.every_steps as f64 * dt;
-    let times: Vec<f64> = file.output.times.clone().unwrap_or_else(|| vec![0.0]);
+    // the scene's snapshot times, from its list or its cadence: the base and hold scenes list theirs (issue 57)
+    let times: Vec<f64> = match (&file.output.times, file.output.snapshot_every) {
+        (Some(times), _) => times.clone(),
+        (None, Some(every)) => crate::io::output_times::cadence_times(file.scene.t_end, every),
+        (None, None) => vec![0.0],
+    };
     // the base scene: the path run to just past the earliest hold's start
     let t_base_end = starts.iter().cloned().fold(0.0, f64::max) + 2.0 * every;
     let keep = |limit: f64| -> Vec<f64> { times.iter().copied().filter(|&t| t <= limit + 1e-9).collect() };
     let mut base_file = file.clone();
     base_file.scene.t_end = t_base_end;
     base_file.output.times = Some(keep(t_base_end));
+    base_file.output.snapshot_every = None;
     let base_text = scene_text(&[], &base_file);
     let parent = args
         .scene
@@ -630,8 +637,10 @@ fn prepare_branches(
             emit(
                 Channel::Progress,
                 &format!(
-                    "spinup critical: base run to t = {t_leg} s of {t_ck} s (T_final = {tf} h starts at {} s)",
-                    starts[k]
+                    "spinup critical: base run to t = {} s of {} s (T_final = {tf} h starts at {} s)",
+                    fmt_time(t_leg),
+                    fmt_time(t_ck),
+                    fmt_time(starts[k])
                 ),
             );
             let result = match here {
@@ -663,6 +672,7 @@ fn prepare_branches(
             }
         }
         hold_file.output.times = Some(snaps);
+        hold_file.output.snapshot_every = None;
         let hold_text = scene_text(&[], &hold_file);
         if dir.exists() {
             std::fs::remove_dir_all(&dir).map_err(|e| SearchError::failed(format!("{}: {e}", dir.display())))?;
