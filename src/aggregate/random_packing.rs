@@ -75,40 +75,6 @@ fn one() -> u64 {
     1
 }
 
-impl Recipe {
-    /// The default recipe with a user's choices: `shake_periods` (≥ 0) and `gravity_interval` (self-gravity every K
-    /// steps, 1 ≤ K ≤ a fifth of the steps per contact). Bad values are an input error naming the flag.
-    pub fn with_overrides(
-        shake_periods: Option<f64>,
-        gravity_interval: Option<u64>,
-    ) -> Result<Recipe, crate::aggregate::AggregateError> {
-        let mut recipe = Recipe::default();
-        if let Some(p) = shake_periods {
-            if !(p.is_finite() && p >= 0.0) {
-                return Err(crate::aggregate::input(
-                    "--shake-periods",
-                    format!("a number of periods >= 0, got {p}"),
-                ));
-            }
-            recipe.shake_periods = p;
-        }
-        if let Some(k) = gravity_interval {
-            let most = (recipe.steps_per_contact / 5.0).floor() as u64;
-            if !(1..=most).contains(&k) {
-                return Err(crate::aggregate::input(
-                    "--gravity-interval",
-                    format!(
-                        "steps between self-gravity evaluations, 1 to {most} (steps per contact {} / 5), got {k}",
-                        recipe.steps_per_contact
-                    ),
-                ));
-            }
-            recipe.gravity_interval = k;
-        }
-        Ok(recipe)
-    }
-}
-
 impl Default for Recipe {
     fn default() -> Self {
         Recipe {
