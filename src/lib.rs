@@ -35,11 +35,12 @@
 //! uses the library as `rubblepile::…` and its own modules as `crate::…`, again only downwards (`tests/layers.rs`
 //! reads this list too, and checks that no library file names a program):
 //!
-//! - **P0**: `studies`, `choice` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
+//! - **P0**: `test_dirs` — the unit tests' temporary directories (test builds only);
+//! - **P1**: `studies`, `choice` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
 //!   `analysis`;
-//! - **P1**: `bench` — benchmarks and timed systems on the canonical test problems (they plot with `analysis`'
+//! - **P2**: `bench` — benchmarks and timed systems on the canonical test problems (they plot with `analysis`'
 //!   figures);
-//! - **P2**: `cli` — argument parsing and dispatch.
+//! - **P3**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;
 pub mod analysis;

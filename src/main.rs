@@ -5,6 +5,8 @@ mod bench;
 mod choice;
 mod cli;
 mod studies;
+#[cfg(test)]
+mod test_dirs;
 
 fn main() -> std::process::ExitCode {
     cli::main()

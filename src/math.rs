@@ -36,6 +36,21 @@ pub fn median(values: &[f64]) -> f64 {
     }
 }
 
+/// Arithmetic mean (NaN for no values).
+pub fn mean(values: &[f64]) -> f64 {
+    values.iter().sum::<f64>() / values.len() as f64
+}
+
+/// Mean and sample standard deviation (0 for one value).
+pub fn mean_std(values: &[f64]) -> (f64, f64) {
+    let m = mean(values);
+    if values.len() < 2 {
+        return (m, 0.0);
+    }
+    let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (values.len() - 1) as f64;
+    (m, var.sqrt())
+}
+
 /// Interpolates, in log–log, the wall time at which a method's (time, error) curve reaches `error`
 /// (`points` in any order; the curve is taken as the sequence sorted by time). `None` when `error` is
 /// outside the curve's range.

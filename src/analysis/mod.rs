@@ -2,29 +2,20 @@
 //! spin-up diagnostics, the verdicts of T_c,3 searches, creep, the model atmosphere and tumbler measurements,
 //! figures). The three papers' reports are in the binary, in `src/studies/` (nothing here names them).
 
-pub mod atmosphere;
 pub mod campaign_analysis;
 pub mod clumps;
 pub mod composition;
 pub mod creep;
-pub mod creep_extrapolation;
 pub mod critical;
-pub mod csv_rows;
-pub mod ejection_fits;
 pub mod figures;
 pub mod fits;
 pub mod flyby;
 pub mod fragments;
-pub mod pile_equilibrium;
 pub use crate::ellipsoid::rigid_rotation;
-pub mod rotational_split;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;
-pub mod spin_limit;
 pub mod spinup;
-pub mod surface_slopes;
 pub use crate::granular::soft::spinup_diagnostics;
-pub mod tumbler;
 
 /// Why an analysis could not be made: a run directory or file to read is missing or malformed, or a figure or
 /// report could not be written. Messages are one line naming the file.

@@ -41,11 +41,6 @@ pub struct RunDirReport {
 }
 
 impl RunDirReport {
-    /// Whether nothing is missing or inconsistent.
-    pub fn is_whole(&self) -> bool {
-        self.findings.iter().all(|f| !f.problem)
-    }
-
     /// The findings that make the directory not whole.
     pub fn problems(&self) -> impl Iterator<Item = &Finding> {
         self.findings.iter().filter(|f| f.problem)

@@ -108,11 +108,6 @@ impl TideTerm {
         -self.orbit.state(t).0
     }
 
-    /// The frame origin's velocity `V₀ = ṡ(t)` (m/s) relative to the planet at time `t` (s).
-    pub fn frame_velocity(&self, t: f64) -> Vec3 {
-        self.orbit.state(t).1
-    }
-
     /// Tidal acceleration (m/s²) at `r` (m) with the planet at `planet` (m):
     /// `−GM (r − R)/|r − R|³ − GM R/|R|³`, in the cancellation-free form
     /// `GM [R (|R|³ − |d|³)/(|d|³ |R|³) − r/|d|³]`, `d = r − R`; plus `g_J2(d)` with J2.
@@ -135,14 +130,6 @@ impl TideTerm {
         let cube_diff = diff * (big * big + big * d + d * d);
         let (d3, big3) = (d * d * d, big * big * big);
         self.gm * (planet * (cube_diff / (d3 * big3)) - r / d3)
-    }
-
-    /// Adds `m_i a_i` (N) to `forces` for bodies at `positions` (m) with `masses` (kg), at time `t` (s).
-    pub fn add_forces(&self, t: f64, positions: &[Vec3], masses: &[f64], forces: &mut [Vec3]) {
-        let planet = self.planet_position(t);
-        for ((f, r), m) in forces.iter_mut().zip(positions).zip(masses) {
-            *f += self.acceleration(r, &planet) * *m;
-        }
     }
 
     /// Tidal energy `E_tide = P·V₀ + Σ GM m_i (1/|R| − 1/|r_i − R|)` (+ `Σ m_i Φ_J2(r_i − R)` with J2) (J) of

@@ -8,6 +8,7 @@
 //!   `richardson2011-tumbler`;
 //! - [`report_notes`]: the hand-written `NOTES.md` the Zhang17 and Richardson11 reports append.
 
+pub mod csv_rows;
 pub mod report_notes;
 pub mod richardson2011;
 pub mod roig2003;

@@ -1,7 +1,6 @@
 //! Figures of the Roig03 §4 post-processing (Figs. 2–9) and of Zhang17 runs, each as SVG and PNG with titled,
 //! unit-labelled axes: [`run_figures`] (one run: Figs. 2, 3, 4, 6, 8, 9 and `sfd`), [`campaign_figures`] (Fig. 5
-//! `bound_fraction_vs_q`, Fig. 7 `spin_distributions`), [`sfd`] (clump mass distribution), [`spinup_figures`]
-//! (Zhang17 Fig. 5-style time series), [`stacked`] (Zhang17 Fig. 22 panels), [`energy`] (Fig. 2's data), [`style`]
+//! `bound_fraction_vs_q`, Fig. 7 `spin_distributions`), [`sfd`] (clump mass distribution), [`stacked`] (Zhang17 Fig. 22 panels), [`energy`] (Fig. 2's data), [`style`]
 //! (font, look, [`style::write_figure`] renders each figure once per backend so SVG and PNG agree). A figure that
 //! cannot be drawn is a one-line warning, the others are still written; nothing panics on bad data.
 
@@ -10,7 +9,6 @@ pub mod energy;
 pub mod lines;
 pub mod run_figures;
 pub mod sfd;
-pub mod spinup_figures;
 pub mod stacked;
 pub mod style;
 

@@ -4,24 +4,15 @@
 //! `H − H0 − 2∫F` below 1e-6; κ = 1.6 and κ = 50 complete; no quick case fails. `tests/stability.rs` runs the
 //! command-line side.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::cases::{QUATERNION_HARD, RTOL, all_cases};
 use super::suite::{CaseResult, Verdict, run_case};
+use crate::test_dirs::temp_dir;
 use rubblepile::driver::{RunError, RunOptions, resume_run, run_scene};
 use rubblepile::ellipsoid::barrier::OVERRUN_FILE;
 use rubblepile::ellipsoid::scene::parse_scene;
 use rubblepile::integrate::Method;
-
-/// A fresh, empty directory under the system temp dir, unique per process and call.
-fn temp_dir(tag: &str) -> PathBuf {
-    static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-    let dir = std::env::temp_dir().join(format!("rubblepile-bin-test-{tag}-{}-{n}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 /// Whether case `id` is named by `prefix`: the id itself, or its part before a `-`.
 fn named(id: &str, prefix: &str) -> bool {

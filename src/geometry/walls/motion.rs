@@ -59,11 +59,6 @@ impl WallMotion {
         d
     }
 
-    /// Whether the wall never moves (no translation, oscillation or spin).
-    pub fn is_static(&self) -> bool {
-        self.velocity == Vec3::zeros() && self.oscillation.is_none() && self.spin == 0.0
-    }
-
     /// The secant velocity over `[t0, t1]` (m/s), used for the whole step.
     pub fn step_velocity(&self, t0: f64, t1: f64) -> Vec3 {
         if t1 > t0 {

@@ -401,11 +401,6 @@ pub fn scene_kind(text: &str) -> Option<String> {
     value.get("scene")?.get("kind")?.as_str().map(str::to_string)
 }
 
-/// Whether the file at `path` is a soft-sphere scene.
-pub fn is_soft_scene_file(path: &Path) -> bool {
-    crate::io::scene_file::read_text_bounded(path).is_ok_and(|t| scene_kind(&t).as_deref() == Some(KIND))
-}
-
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }

@@ -12,26 +12,26 @@
 //!    (and `.png`): the rotational share and f_KE against F0 with the paper's ranges.
 //!
 //! The fragment quantities are those of [`rubblepile::analysis::fragments`] (the same call `rubblepile analyze`
-//! makes); the new ones come from [`rubblepile::analysis::ejection_fits`], [`rubblepile::analysis::rotational_split`]
-//! and [`rubblepile::analysis::pile_equilibrium`].
+//! makes); the new ones come from [`super::ejection_fits`], [`super::rotational_split`]
+//! and [`super::pile_equilibrium`].
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
 
+use super::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor};
+use super::pile_equilibrium::pile_drift;
+use super::rotational_split::rotational_split;
+use crate::studies::csv_rows::{read_rows, write_rows};
 use rubblepile::analysis::AnalysisError;
-use rubblepile::analysis::atmosphere::mean_std;
-use rubblepile::analysis::csv_rows::{read_rows, write_rows};
-use rubblepile::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor};
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
 use rubblepile::analysis::fits::{PowerLawFit, fit_power_law};
 use rubblepile::analysis::fragments::{FragmentParams, analyse_fragments, pearson, read_snapshot_bodies};
-use rubblepile::analysis::pile_equilibrium::pile_drift;
-use rubblepile::analysis::rotational_split::rotational_split;
 use rubblepile::analysis::run_analysis::snapshot_path;
 use rubblepile::ellipsoid::body::Body;
 use rubblepile::ellipsoid::equations::G_SI;
+use rubblepile::math::mean_std;
 
 /// The Δv floor of the Fig. 4 fits (m/s): above the largest ejection speed a fragment of a 4 h pile gets from
 /// the pile's turning alone over 400 s, `2 sin(Ω t/2) Ω R ≈ 8.5 m/s` at the apparent radius 110 km.
@@ -128,7 +128,7 @@ pub struct RefereeRun {
     pub energy_error: f64,
 }
 
-/// One snapshot of a target run alone ([`rubblepile::analysis::pile_equilibrium`]).
+/// One snapshot of a target run alone ([`super::pile_equilibrium`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EquilibriumRow {
     /// Target name.

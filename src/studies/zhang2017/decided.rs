@@ -15,16 +15,16 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+use super::creep_extrapolation::{ZeroRate, weakening_zeros};
+use super::spin_limit::{critical_kappa, least_friction_angle};
 use rubblepile::aggregate::report::AggregateReport;
 use rubblepile::aggregate::triaxial_top::{NAIDU2020_EQUIVALENT_DIAMETER_M, NAIDU2020_EXTENTS_M};
 use rubblepile::analysis::creep::CreepCriterionKind;
-use rubblepile::analysis::creep_extrapolation::{ZeroRate, weakening_zeros};
 use rubblepile::analysis::critical::{
     Criteria, HoldSeries, HoldVerdict, critical_from_verdicts, read_critical_csv, read_holds_csv, rejudge,
 };
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
-use rubblepile::analysis::spin_limit::{critical_kappa, least_friction_angle};
 use rubblepile::analysis::spinup::{omega_of_hours, paper_bulk_density};
 use rubblepile::io::scene_file::SI_G;
 
@@ -324,7 +324,7 @@ pub fn naidu_ellipsoid() -> [f64; 3] {
 }
 
 /// The table "Where creep stops": for each search, read at the longest hold length it has, the period at which
-/// the weakening rates of its held (not released) holds reach zero ([`rubblepile::analysis::creep_extrapolation::zero_rate_period`]).
+/// the weakening rates of its held (not released) holds reach zero ([`super::creep_extrapolation::zero_rate_period`]).
 fn write_zero_rates(md: &mut String, searches: &[DecidedSearch]) {
     let _ = writeln!(md, "\n### Where creep stops: the weakening rates' zero\n");
     let _ = writeln!(
@@ -332,7 +332,7 @@ fn write_zero_rates(md: &mut String, searches: &[DecidedSearch]) {
         "With zero tolerance a hold creeps whenever a rate is significant, however small. Here the weakening rates \
          (coordination number and η_B falling, θ_max rising, over each hold's second half) of the holds that kept \
          their forcing are fitted by a line against T_final, read at the longest length every such hold has; its \
-         zero is the period from which no hold would weaken (`analysis::creep_extrapolation`; the error from the \
+         zero is the period from which no hold would weaken (`studies/zhang2017/creep_extrapolation.rs`; the error from the \
          rates' scatter about the line). \"largest\" is the slowest of the three: the period from which the paper's \
          test would call every hold stable.\n"
     );
@@ -560,7 +560,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     };
     let _ = writeln!(
         md,
-        "\n### The equilibrium bound on φ (Holsapple 2001; `analysis::spin_limit`)\n"
+        "\n### The equilibrium bound on φ (Holsapple 2001; `studies/zhang2017/spin_limit.rs`)\n"
     );
     let _ = writeln!(
         md,
@@ -601,11 +601,11 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
 }
 
 /// Zhang17 Fig. 2's analogue: the surface slopes of the decided shape (and of the top of the earlier runs)
-/// as homogeneous bodies of the decided density spinning at the Didymos period ([`rubblepile::analysis::surface_slopes`]);
+/// as homogeneous bodies of the decided density spinning at the Didymos period ([`super::surface_slopes`]);
 /// writes `decided_slopes.{svg,png}` (slope against latitude, every longitude).
 fn write_slopes(md: &mut String, rho: f64, out: &Path) -> Result<(), String> {
+    use super::surface_slopes::slope_map;
     use rubblepile::aggregate::shape::Shape;
-    use rubblepile::analysis::surface_slopes::slope_map;
     let _ = writeln!(md, "\n### Fig. 2: surface slopes at the Didymos period\n");
     let _ = writeln!(
         md,
@@ -685,7 +685,7 @@ pub fn kappa_of(t_c3_hours: f64, rho: f64) -> f64 {
 }
 
 /// Zhang17 Fig. 23's analogue: κ₃ against φ, the paper's six models and ours (decided protocol) beside the continuum
-/// upper spin limit (the volume-averaged bound of [`rubblepile::analysis::spin_limit`]) of a sphere and of the Naidu
+/// upper spin limit (the volume-averaged bound of [`super::spin_limit`]) of a sphere and of the Naidu
 /// ellipsoid; a table says which points lie above the limit. Writes `decided_fig23.{svg,png}`.
 fn write_fig23(md: &mut String, searches: &[DecidedSearch], hold: f64, rho: f64, out: &Path) -> Result<(), String> {
     let body = naidu_ellipsoid();

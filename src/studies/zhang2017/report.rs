@@ -26,7 +26,7 @@ use rubblepile::io::table::{Cells, read_table};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use rubblepile::analysis::figures::spinup_figures::SpinupTimeSeries;
+use super::spinup_figures::SpinupTimeSeries;
 use rubblepile::analysis::figures::style::write_figure;
 use rubblepile::analysis::spinup::{DensityFit, fit_density};
 use rubblepile::analysis::spinup_diagnostics::SpinupSample;

@@ -1,14 +1,13 @@
-//! Centrifuging measures of the tumbler analysis (Richardson11 §3.2, `src/analysis/tumbler.rs`) on synthetic
+//! Centrifuging measures of the tumbler analysis (Richardson11 §3.2, [`super::tumbler`]) on synthetic
 //! states whose answers are known exactly: a ring turning rigidly with the drum, a pile at rest, a half-full bed in
 //! solid-body rotation, rings slipping by known amounts; the circular-segment fill and the threshold `R / r_in`
 //! against their closed forms; and a synthetic run directory for the per-window means.
 
-mod common;
-use common::temp_dir;
-use rubblepile::analysis::tumbler::{
+use super::tumbler::{
     Centrifuging, DrumParticle, analyse_tumbler_run, centrifuging, centrifuging_threshold, co_rotates,
-    disc_fraction_below, initial_fill, mean_centrifuging,
+    disc_fraction_below, initial_fill, mean_centrifuging, repose_fit,
 };
+use crate::test_dirs::temp_dir;
 use rubblepile::math::Vec3;
 use std::fmt::Write as _;
 
@@ -217,4 +216,21 @@ fn a_run_is_averaged_over_its_second_half_and_each_quarter_of_it() {
     ));
     assert_eq!((run.free, run.stuck), (ring(40, 0.027, OMEGA).len(), 1));
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_fit_error_of_an_angle_is_the_slope_standard_error_carried_through_atan() {
+    // (0, 0), (1, 1), (2, 0): slope 0, residuals −1/3, 2/3, −1/3, s² = rss / (N − 2) = 2/3, Sxx = 2, so
+    // σ_slope = √(1/3) and, at slope 0, σ_θ = σ_slope rad.
+    let (a, e) = repose_fit(&[(0.0, 0.0), (1.0, 1.0), (2.0, 0.0)], -1.0, 3.0).unwrap();
+    assert!(a.abs() < 1e-12, "angle {a}");
+    assert!((e - (1.0f64 / 3.0).sqrt().to_degrees()).abs() < 1e-9, "error {e}");
+    // The same residuals about the line z = −x: 45°, and σ_θ = σ_slope / (1 + 1).
+    let (a, e) = repose_fit(&[(0.0, 0.0), (1.0, 0.0), (2.0, -2.0)], -1.0, 3.0).unwrap();
+    assert!((a - 45.0).abs() < 1e-9, "angle {a}");
+    assert!((e - (1.0f64 / 3.0).sqrt().to_degrees() / 2.0).abs() < 1e-9, "error {e}");
+    // Points on an exact line have no fit error; fewer than three points give no fit.
+    let (a, e) = repose_fit(&[(-3.0, 3.0), (-2.0, 2.0), (-1.0, 1.0)], -4.0, 0.0).unwrap();
+    assert!((a - 45.0).abs() < 1e-9 && e.abs() < 1e-9, "{a} {e}");
+    assert!(repose_fit(&[(0.0, 0.0), (1.0, 1.0)], -1.0, 3.0).is_none());
 }

@@ -7,9 +7,9 @@
 //! antipode) is measured by [`ejected_sites`]: the correlation of `ln size` with the impact-site cosine and the
 //! median sizes from each hemisphere.
 
-use crate::analysis::fits::{FitError, PowerLawFit, fit_power_law};
-use crate::analysis::fragments::{EjectionSites, FragmentAnalysis, pearson};
-use crate::math::median;
+use rubblepile::analysis::fits::{FitError, PowerLawFit, fit_power_law};
+use rubblepile::analysis::fragments::{EjectionSites, FragmentAnalysis, pearson};
+use rubblepile::math::median;
 
 /// The three Fig. 4 fits of one run.
 #[derive(Debug, Clone, PartialEq)]
@@ -71,7 +71,7 @@ pub fn ejection_fits(fragments: &[FragmentAnalysis], floor: f64) -> EjectionFits
 }
 
 /// §4.2's "small fragments from the impact point, large ones from the antipode", measured on the target
-/// fragments thrown above `floor` (m/s) instead of the faster half of [`crate::analysis::fragments::ejection_sites`]:
+/// fragments thrown above `floor` (m/s) instead of the faster half of [`rubblepile::analysis::fragments::ejection_sites`]:
 /// the same fields, `fast_fragments` counting those above the floor.
 pub fn ejected_sites(fragments: &[FragmentAnalysis], floor: f64) -> EjectionSites {
     let ejected: Vec<&FragmentAnalysis> = fragments

@@ -2,15 +2,15 @@
 //! primary: "slopes greater than 50° are well above any angle of repose"): the angle between the inward surface
 //! normal and the effective acceleration, self-gravity plus the centrifugal pull of the spin about z.
 //!
-//! The body is any closed shape given by `contains` (here the [`crate::aggregate::shape::Shape`]s). Its surface
+//! The body is any closed shape given by `contains` (here the [`rubblepile::aggregate::shape::Shape`]s). Its surface
 //! along a direction from the origin is found by bisection (the shapes are star-shaped about their centre); the
 //! normal from the cross product of the surface's derivatives along latitude and longitude (finite differences,
 //! so that a sharp ridge gets the slope of either flank, not an average); the gravity of the homogeneous body from
 //! a cubic grid of equal point masses filling it (cells of side `body / 2 n`; the error of the sum at the surface
 //! is 1.6 % at n = 24, tested against a sphere's `GM/R²`; the slopes come out within a degree at n = 40).
 
-use crate::io::scene_file::SI_G;
-use crate::math::Vec3;
+use rubblepile::io::scene_file::SI_G;
+use rubblepile::math::Vec3;
 
 /// The homogeneous body as point masses at the centres of the cubic cells inside it.
 #[derive(Debug, Clone)]

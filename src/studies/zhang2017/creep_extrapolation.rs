@@ -2,13 +2,13 @@
 //! periods reach zero, from a straight line through them (Zhang17 §3.3.3's creep test read as a trend across the
 //! holds rather than hold by hold).
 //!
-//! Judged with zero tolerance ([`crate::analysis::creep`]), a long hold of a lattice well above its failure period
+//! Judged with zero tolerance ([`rubblepile::analysis::creep`]), a long hold of a lattice well above its failure period
 //! still loses contacts slowly: each rate lies many standard errors from zero, so no hold is called stable, yet the
 //! rates fall steadily with the period. The zero of the fitted line is the period from which no hold would weaken.
 //! Its standard error comes from the scatter of the rates about the line (first-order error propagation of
 //! −a/b); the scatter, not the rates' own errors, measures how well a line describes them.
 
-use crate::analysis::critical::HoldVerdict;
+use rubblepile::analysis::critical::HoldVerdict;
 
 /// The period at which a fitted weakening rate reaches zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,7 +69,7 @@ pub fn weakening_zeros(verdicts: &[HoldVerdict]) -> [Option<ZeroRate>; 3] {
         .filter(|v| !v.released)
         .filter_map(|v| v.rates.map(|r| (v.t_final_hours, r)))
         .collect();
-    let zero = |weakening: &dyn Fn(&crate::analysis::creep::HoldRates) -> f64| {
+    let zero = |weakening: &dyn Fn(&rubblepile::analysis::creep::HoldRates) -> f64| {
         let points: Vec<(f64, f64)> = held.iter().map(|(t, r)| (*t, weakening(r))).collect();
         zero_rate_period(&points)
     };

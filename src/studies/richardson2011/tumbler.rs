@@ -6,7 +6,7 @@
 //! moves towards `−x` and the material rises on the `x < 0` side (the paper's "left of centre" in its clockwise
 //! view). Surface points: the free particles are binned in columns of width `2r` along x; each column's highest
 //! particle that touches another free particle (centres within 2.5 r, so flying particles do not count) is a surface
-//! point. The fit ([`crate::analysis::fits::fit_line`]) uses the columns with `−0.8 R < x < 0`; the angle is
+//! point. The fit ([`rubblepile::analysis::fits::fit_line`]) uses the columns with `−0.8 R < x < 0`; the angle is
 //! `atan(−slope)`.
 //!
 //! Centrifuging ([`centrifuging`]): the fraction of free particles moving with the drum's wall speed at their
@@ -16,12 +16,13 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::analysis::AnalysisError;
-use crate::analysis::atmosphere::{RunFiles, mean, mean_std, read_run_files};
-use crate::analysis::csv_rows::{read_rows, write_rows};
-use crate::analysis::fits::fit_line;
-use crate::granular::hard::scene::{ParticleRow, read_particles_csv};
-use crate::math::Vec3;
+use super::atmosphere::{RunFiles, read_run_files};
+use crate::studies::csv_rows::{read_rows, write_rows};
+use rubblepile::analysis::AnalysisError;
+use rubblepile::analysis::fits::fit_line;
+use rubblepile::granular::hard::scene::{ParticleRow, read_particles_csv};
+use rubblepile::math::Vec3;
+use rubblepile::math::{mean, mean_std};
 
 /// Surface points `(x, z)` of a pile of free particles (centres `(x, z)` projected along the axis, radius `r`):
 /// per column of width `2r`, the highest particle with another within 2.5 r.
@@ -46,13 +47,8 @@ pub fn surface_points(centres: &[(f64, f64)], r: f64) -> Vec<(f64, f64)> {
     tops.into_values().collect()
 }
 
-/// Dynamic angle of repose (degrees) from surface points with `x_lo < x < x_hi`: `atan(−slope)` of the
-/// least-squares line. `None` with fewer than 3 points.
-pub fn repose_angle(surface: &[(f64, f64)], x_lo: f64, x_hi: f64) -> Option<f64> {
-    repose_fit(surface, x_lo, x_hi).map(|a| a.0)
-}
-
-/// [`repose_angle`] and its fit error (degrees): the slope's standard error `σ_s` carried through `atan`,
+/// Dynamic angle of repose (degrees) from surface points with `x_lo < x < x_hi`, `atan(−slope)` of the
+/// least-squares line, and its fit error (degrees): the slope's standard error `σ_s` carried through `atan`,
 /// `σ_θ = σ_s / (1 + s²)`. `None` with fewer than 3 points.
 pub fn repose_fit(surface: &[(f64, f64)], x_lo: f64, x_hi: f64) -> Option<(f64, f64)> {
     let (x, z): (Vec<f64>, Vec<f64>) = surface.iter().filter(|p| p.0 > x_lo && p.0 < x_hi).copied().unzip();
@@ -176,7 +172,8 @@ fn drum_particles(rows: &[ParticleRow]) -> Vec<DrumParticle> {
 /// measures of its snapshots.
 #[derive(Debug, Clone)]
 pub struct TumblerRun {
-    /// Run directory.
+    /// Run directory (the tests compare runs read from two places with it).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub dir: PathBuf,
     /// The run-level facts.
     pub facts: TumblerFacts,
@@ -191,7 +188,8 @@ pub struct TumblerRun {
     pub angle_history: Vec<(f64, f64, f64)>,
     /// [`centrifuging_threshold`] for the fill.
     pub threshold: f64,
-    /// `(t, measures)` per snapshot.
+    /// `(t, measures)` per snapshot (the report reads the means below; the tests read these).
+    #[cfg_attr(not(test), allow(dead_code))]
     pub centrifuging: Vec<(f64, Centrifuging)>,
     /// Mean measures over the snapshots of the second half of the run (t ≥ half the time reached).
     pub late: Centrifuging,
@@ -457,14 +455,14 @@ mod tests {
         }
         // A flying particle above the pile is ignored.
         c.push((-10.0, 25.0));
-        let a = repose_angle(&surface_points(&c, r), -24.0, 0.0).unwrap();
+        let a = repose_fit(&surface_points(&c, r), -24.0, 0.0).unwrap().0;
         assert!((a - 30.0).abs() < 3.0, "angle {a}");
         // A flat pile gives 0.
         let flat: Vec<(f64, f64)> = (-20..20)
             .flat_map(|i| [(2.0 * i as f64, 0.0), (2.0 * i as f64, -2.0)])
             .collect();
-        let a0 = repose_angle(&surface_points(&flat, r), -24.0, 0.0).unwrap();
+        let a0 = repose_fit(&surface_points(&flat, r), -24.0, 0.0).unwrap().0;
         assert!(a0.abs() < 1e-9, "flat angle {a0}");
-        assert!(repose_angle(&[(0.0, 0.0)], -1.0, 1.0).is_none());
+        assert!(repose_fit(&[(0.0, 0.0)], -1.0, 1.0).is_none());
     }
 }

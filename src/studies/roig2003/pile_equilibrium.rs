@@ -12,9 +12,9 @@
 //!   centre of mass at `t = 0`, turned by `Ω₀ t` about the axis of `Ω₀`, against its offset at `t` (rms and
 //!   largest, m).
 
-use crate::ellipsoid::body::Body;
-use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
-use crate::math::Vec3;
+use rubblepile::ellipsoid::body::Body;
+use rubblepile::ellipsoid::rigid_rotation::fit_rigid_rotation;
+use rubblepile::math::Vec3;
 
 /// The drift of a pile between `t = 0` and `t`.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]

@@ -13,14 +13,15 @@
 //! ([`ks_exponential`]), once with the measured mean height and once with the equipartition value. The paper's
 //! caveat applies: with the scale fitted from the same data the formal KS probability is biased high.
 
-use crate::analysis::AnalysisError;
+use rubblepile::analysis::AnalysisError;
+use rubblepile::math::{mean, mean_std};
 use std::path::{Path, PathBuf};
 
 use statrs::distribution::Exp;
 use statrs::stats_tests::NaNPolicy;
 use statrs::stats_tests::ks_test::{KSOneSampleAlternativeMethod, ks_onesample};
 
-use crate::granular::hard::scene::{ParticleRow, read_particles_csv};
+use rubblepile::granular::hard::scene::{ParticleRow, read_particles_csv};
 
 /// The snapshot fractions of the run at which KS probabilities are averaged (Richardson11 §3.1).
 pub const KS_FRACTIONS: [f64; 6] = [0.5, 0.6, 0.7, 0.8, 0.9, 1.0];
@@ -78,21 +79,6 @@ pub fn scale_height(kt: f64, mass: f64, g: f64) -> f64 {
     kt / (mass * g)
 }
 
-/// Arithmetic mean (NaN for no values).
-pub fn mean(values: &[f64]) -> f64 {
-    values.iter().sum::<f64>() / values.len() as f64
-}
-
-/// Mean and sample standard deviation (0 for one value).
-pub fn mean_std(values: &[f64]) -> (f64, f64) {
-    let m = mean(values);
-    if values.len() < 2 {
-        return (m, 0.0);
-    }
-    let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (values.len() - 1) as f64;
-    (m, var.sqrt())
-}
-
 /// Kolmogorov–Smirnov test of `heights` against the exponential law `1 − exp(−z/h)`: the statistic D and the
 /// two-sided probability (asymptotic Kolmogorov distribution, `statrs`). Errors: fewer than 2 heights, a scale
 /// height that is not positive and finite.
@@ -139,8 +125,6 @@ pub struct AtmosphereRun {
     pub dir: PathBuf,
     /// Cylinder radius (m), from the run's `scene.toml`.
     pub cylinder_radius: f64,
-    /// Gravity magnitude (m/s²).
-    pub g: f64,
     /// Species masses (kg), lightest first.
     pub masses: Vec<f64>,
     /// Particles per species.
@@ -235,7 +219,7 @@ pub fn read_run_files(dir: &Path) -> Result<RunFiles, AnalysisError> {
     let sp = dir.join("scene.toml");
     let text = std::fs::read_to_string(&sp).map_err(|e| format!("{}: {e}", sp.display()))?;
     // A scene copy of an older run may use the old names: read it as its migrated text.
-    let text = crate::granular::migrate::migrate(&text).text;
+    let text = rubblepile::granular::migrate::migrate(&text).text;
     let scene: toml::Value = toml::from_str(&text).map_err(|e| format!("{}: {e}", sp.display()))?;
     let g = scene
         .get("gravity")
@@ -354,7 +338,6 @@ pub fn analyse_atmosphere_run(dir: &Path) -> Result<AtmosphereRun, AnalysisError
     Ok(AtmosphereRun {
         dir: dir.to_path_buf(),
         cylinder_radius,
-        g,
         masses,
         counts,
         energy0,
@@ -397,7 +380,7 @@ pub fn read_energy_series(path: &Path) -> Result<Vec<(f64, f64)>, AnalysisError>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::random::{generator, uniform};
+    use rubblepile::random::{generator, uniform};
 
     /// Exponential samples of scale `h` by inversion from a seeded PCG stream.
     fn exponential_samples(n: usize, h: f64, seed: u64) -> Vec<f64> {

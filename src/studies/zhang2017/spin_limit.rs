@@ -11,18 +11,11 @@
 //! averaged over the whole body, no smaller friction angle can carry the spin. A sphere gives
 //! `sin φ = q / (2 − q)`, `q = 3ω² / (4πGρ)`.
 
-use crate::io::scene_file::SI_G;
+use rubblepile::io::scene_file::SI_G;
 
 /// Carlson's symmetric integral of the second kind `R_D(x, y, z) = (3/2) ∫₀^∞ dt / ((t + z) √((t+x)(t+y)(t+z)))`
 /// for `x, y ≥ 0` (not both 0) and `z > 0`, by the duplication theorem (B. C. Carlson, Numer. Algorithms 10
 /// (1995) 13–26, Eq. 2.29 and its series), to about 1e-15 relative.
-///
-/// ```
-/// use rubblepile::analysis::spin_limit::carlson_rd;
-/// // Carlson (1995) §3's check values
-/// assert!((carlson_rd(0.0, 2.0, 1.0) - 1.797_210_352_103_4).abs() < 1e-12);
-/// assert!((carlson_rd(2.0, 3.0, 4.0) - 0.165_105_272_942_61).abs() < 1e-12);
-/// ```
 pub fn carlson_rd(x: f64, y: f64, z: f64) -> f64 {
     let (mut x, mut y, mut z) = (x, y, z);
     let (mut sum, mut weight) = (0.0, 1.0);
@@ -82,14 +75,6 @@ pub fn averaged_stress(axes: [f64; 3], rho: f64, period_s: f64) -> [f64; 3] {
 /// The least friction angle (degrees) with which a cohesionless body of this shape, density (kg/m³) and spin
 /// period (s) is in equilibrium on volume average; `None` when a principal stress is tensile (no friction angle
 /// holds it without cohesion).
-///
-/// ```
-/// use rubblepile::analysis::spin_limit::least_friction_angle;
-/// // a sphere of 2100 kg/m³ at Zhang17's HCP and RCP T_c3 (2.40 h, 2.83 h)
-/// let sphere = [390.0; 3];
-/// assert!((least_friction_angle(sphere, 2100.0, 2.40 * 3600.0).unwrap() - 55.0).abs() < 0.1);
-/// assert!((least_friction_angle(sphere, 2100.0, 2.83 * 3600.0).unwrap() - 28.6).abs() < 0.1);
-/// ```
 pub fn least_friction_angle(axes: [f64; 3], rho: f64, period_s: f64) -> Option<f64> {
     let s = averaged_stress(axes, rho, period_s);
     let (max, min) = (
@@ -105,12 +90,6 @@ pub fn least_friction_angle(axes: [f64; 3], rho: f64, period_s: f64) -> Option<f
 /// The spin at which the least friction angle reaches `phi_deg` (the continuum upper spin limit of Zhang17 Fig. 23)
 /// as κ of Zhang17 Eq. 22, `Ω / √(4πGρ/3)`, for a body of the shape of `axes` (any scale; κ depends on neither the
 /// size nor the density). A sphere gives `κ² = 2 sin φ / (1 + sin φ)`.
-///
-/// ```
-/// use rubblepile::analysis::spin_limit::critical_kappa;
-/// let phi = 30f64.to_radians();
-/// assert!((critical_kappa([1.0; 3], 30.0) - (2.0 * phi.sin() / (1.0 + phi.sin())).sqrt()).abs() < 1e-9);
-/// ```
 pub fn critical_kappa(axes: [f64; 3], phi_deg: f64) -> f64 {
     // at ρ = 1000 kg/m³; the angle grows with the spin until the stress turns tensile
     let rho = 1000.0;
@@ -157,5 +136,18 @@ mod tests {
         }
         // spun past the point where the equator's averaged stress turns tensile: no cohesionless equilibrium
         assert_eq!(least_friction_angle([390.0; 3], 2100.0, 2.0 * 3600.0), None);
+    }
+
+    /// Guards the examples the docs quote: Carlson (1995) §3's check values of R_D, Zhang17's sphere at its HCP and
+    /// RCP T_c3, and κ of a sphere in closed form.
+    #[test]
+    fn carlson_values_and_the_sphere_limits() {
+        assert!((carlson_rd(0.0, 2.0, 1.0) - 1.797_210_352_103_4).abs() < 1e-12);
+        assert!((carlson_rd(2.0, 3.0, 4.0) - 0.165_105_272_942_61).abs() < 1e-12);
+        let sphere = [390.0; 3];
+        assert!((least_friction_angle(sphere, 2100.0, 2.40 * 3600.0).unwrap() - 55.0).abs() < 0.1);
+        assert!((least_friction_angle(sphere, 2100.0, 2.83 * 3600.0).unwrap() - 28.6).abs() < 0.1);
+        let phi = 30f64.to_radians();
+        assert!((critical_kappa([1.0; 3], 30.0) - (2.0 * phi.sin() / (1.0 + phi.sin())).sqrt()).abs() < 1e-9);
     }
 }

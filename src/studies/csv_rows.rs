@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use crate::analysis::AnalysisError;
+use rubblepile::analysis::AnalysisError;
 
 /// Every row of the CSV file at `path` as a `T` (header row first, columns by name).
 pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>, AnalysisError> {

@@ -4,13 +4,13 @@
 //! in the frame of the initial spin, `K_R,add = Σ ½ (wᵢ − Ω₀)ᵀ Tᵢ (wᵢ − Ω₀)` (world-frame spin and inertia at the
 //! analysis time, `Ω₀` the best-fit rigid rotation at t = 0, [`fit_rigid_rotation`]); per fragment, with each
 //! fragment's own spin at t = 0 in place of `Ω₀`. `K_R − K_R,add` is the pre-existing part. The translational energy
-//! compared with it is taken in the system's barycentric frame (as [`crate::analysis::fragments`]) and, as a
+//! compared with it is taken in the system's barycentric frame (as [`rubblepile::analysis::fragments`]) and, as a
 //! variant, in the target fragments' barycentre (Fig. 3's frame), which removes the target's recoil.
 
-use crate::ellipsoid::body::Body;
-use crate::ellipsoid::quaternion::rotation_matrix;
-use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
-use crate::math::{Mat3, Vec3};
+use rubblepile::ellipsoid::body::Body;
+use rubblepile::ellipsoid::quaternion::rotation_matrix;
+use rubblepile::ellipsoid::rigid_rotation::fit_rigid_rotation;
+use rubblepile::math::{Mat3, Vec3};
 
 /// The energies of the target fragments (projectile excluded), all in J.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]

@@ -1,13 +1,12 @@
-//! Exact answers for the issue 42 post-processing of Roig03: the Fig. 4 fits above a Δv floor and on the
-//! escaping fragments (`analysis::ejection_fits`), the split of K_R into the targets' own spin and the impact's
-//! (`analysis::rotational_split`), a pile's drift from its rigid rotation (`analysis::pile_equilibrium`). The
-//! run-name parser and the merge of `studies::roig2003::referee` are the binary's, tested beside them.
+//! Exact answers for the referee post-processing of Roig03: the Fig. 4 fits above a Δv floor and on the
+//! escaping fragments ([`super::ejection_fits`]), the split of K_R into the targets' own spin and the impact's
+//! ([`super::rotational_split`]), a pile's drift from its rigid rotation ([`super::pile_equilibrium`]).
 
-use rubblepile::analysis::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor, fit_selected};
+use super::ejection_fits::{ejected_sites, ejection_fits, fit_above_floor, fit_selected};
+use super::pile_equilibrium::pile_drift;
+use super::rotational_split::rotational_split;
 use rubblepile::analysis::fits::FitError;
 use rubblepile::analysis::fragments::{FragmentAnalysis, RotationMode};
-use rubblepile::analysis::pile_equilibrium::pile_drift;
-use rubblepile::analysis::rotational_split::rotational_split;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::math::{Vec3, Vec4};
 

@@ -5,11 +5,11 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::analysis::figures::style::{
+use rubblepile::analysis::figures::style::{
     Figure, PlotResult, SERIES_COLOURS, draw_err, draw_legend, finite_extent, label_style, padded, small_style,
     title_style,
 };
-use crate::analysis::spinup_diagnostics::SpinupSample;
+use rubblepile::analysis::spinup_diagnostics::SpinupSample;
 
 /// The four stacked panels of one run.
 pub struct SpinupTimeSeries {
