@@ -83,8 +83,8 @@ fn shape_keeps_integers_and_names_and_hides_floats_and_timings() {
         "rendered 61 frames in # s (median # ms per frame)"
     );
     assert_eq!(
-        shape("look at it: runs/demo/frames/impact.gif"),
-        "look at it: runs/demo/frames/impact.gif"
+        shape("look at it: runs/demo/frames/run.gif"),
+        "look at it: runs/demo/frames/run.gif"
     );
     assert_eq!(shape("max||q|-1| 1.2e-12, N30_T4"), "max||q|-1| #, N30_T4");
 }

@@ -42,10 +42,10 @@ fn the_first_readme_command_runs_the_impact_and_leaves_an_animation_and_a_paravi
         lines[n - 3].contains("energy error"),
         "the error beside the run time: {text}"
     );
-    assert!(lines[n - 2].ends_with("frames/impact.gif"), "{text}");
+    assert!(lines[n - 2].ends_with("frames/run.gif"), "{text}");
     assert!(lines[n - 1].contains("vtk/run.pvd"), "{text}");
     // 61 snapshots (every 10 s to 600 s): 61 PNG frames, a 61-frame GIF, 61 times in the collection.
-    assert_eq!(gif_frames(&out.join("frames/impact.gif")), (61, 800, 800));
+    assert_eq!(gif_frames(&out.join("frames/run.gif")), (61, 800, 800));
     assert!(out.join("frames/0060.png").exists());
     let pvd = std::fs::read_to_string(out.join("vtk/run.pvd")).unwrap();
     assert_eq!(pvd.matches("<DataSet").count(), 61);
@@ -92,6 +92,7 @@ fn render_draws_every_snapshot_and_refuses_bad_options_by_name() {
     assert!(err(&["render", "two", "--force", "--color", "mass"]).contains("--color"));
     assert!(err(&["render", "two", "--force", "--size", "8x8"]).contains("--size"));
     assert!(err(&["render", "two", "--force", "--size", "big"]).contains("--size"));
+    assert!(err(&["render", "two", "--force", "--centre-m", "0,0"]).contains("--centre-m"));
     assert!(err(&["render", "two", "--force", "--color", "bound"]).contains("rubblepile analyze"));
     assert!(err(&["render", "nowhere"]).contains("scene.toml"));
     assert!(err(&["export", "vtu", "two"]).contains("vtk"));

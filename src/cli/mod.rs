@@ -175,7 +175,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub no_progress: bool,
     /// Render the run afterwards (DIR/frames: PNGs and run.gif, as `rubblepile render`); always done for the
-    /// built-in default scene (its animation is DIR/frames/impact.gif).
+    /// built-in default scene.
     #[arg(long)]
     pub render: bool,
     /// Checkpoint options.
@@ -264,8 +264,8 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             if result.is_err() || !(args.render || args.scene.is_none()) {
                 return report(result);
             }
-            let (before, after) = rubblepile::render::run::after_run(&args.out, args.scene.is_none(), args.force)
-                .map_err(CliError::failed)?;
+            let (before, after) =
+                rubblepile::render::run::after_run(&args.out, args.force).map_err(CliError::failed)?;
             println!("{before}");
             report(result)?;
             after.iter().for_each(|l| println!("{l}"));

@@ -29,6 +29,9 @@ pub struct RenderArgs {
     /// growing to hold 98 % of them and never shrinking].
     #[arg(long, value_name = "METRES")]
     pub extent: Option<f64>,
+    /// Fixed centre X,Y,Z of every frame (m), e.g. a drum's axis [default: each snapshot's centre of mass].
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "X,Y,Z")]
+    pub centre_m: Option<Vec<f64>>,
     /// File name of the animation in the frames directory.
     #[arg(long, default_value = "run.gif")]
     pub gif: String,
@@ -60,6 +63,15 @@ impl RenderArgs {
                 rubblepile::io::scene_file::fmt_num(e)
             ));
         }
+        let centre = match self.centre_m.as_deref() {
+            None => None,
+            Some([x, y, z]) if [x, y, z].iter().all(|v| v.is_finite()) => Some(rubblepile::math::Vec3::new(*x, *y, *z)),
+            Some(v) => {
+                return Err(format!(
+                    "--centre-m: expected three finite coordinates X,Y,Z in metres, got {v:?}"
+                ));
+            }
+        };
         let colour: ColourBy = self.color.parse()?;
         let bad_size = || format!("--size: expected WIDTHxHEIGHT in pixels, got {:?}", self.size);
         let (w, h) = self.size.split_once('x').ok_or_else(bad_size)?;
@@ -84,6 +96,7 @@ impl RenderArgs {
             height,
             colour,
             extent: self.extent,
+            centre,
             gif_name: self.gif.clone(),
             out: self.out.clone(),
             force: self.force,

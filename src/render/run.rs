@@ -65,6 +65,9 @@ pub struct RenderRunOptions {
     /// Half-width of the picture (m) about each snapshot's centre of mass; `None`: following the bodies
     /// ([`following_framings`]).
     pub extent: Option<f64>,
+    /// Fixed centre of every frame (m); `None`: each snapshot's centre of mass. A drum or a box is framed whole
+    /// about its axis this way, where its grains' centre of mass would cut it off.
+    pub centre: Option<crate::math::Vec3>,
     /// File name of the animation in the frames directory.
     pub gif_name: String,
     /// Time each GIF frame is shown (1/100 s).
@@ -85,6 +88,7 @@ impl Default for RenderRunOptions {
             height: 800,
             colour: ColourBy::Speed,
             extent: None,
+            centre: None,
             gif_name: "run.gif".into(),
             gif_delay_centiseconds: 10,
             out: None,
@@ -186,6 +190,15 @@ pub fn reach_98(particles: &[ParticleView]) -> (crate::math::Vec3, f64) {
 pub fn following_framings(reaches: &[(crate::math::Vec3, f64)], extent: Option<f64>) -> Vec<Framing> {
     let mut follower = Follower::default();
     reaches.iter().map(|r| follower.frame(*r, extent)).collect()
+}
+
+/// A [`reach_98`] `(centre, reach)` moved to a fixed `centre`: the reach grows by the distance moved, so the frame
+/// still holds what it held.
+fn about((com, reach): (crate::math::Vec3, f64), centre: Option<crate::math::Vec3>) -> (crate::math::Vec3, f64) {
+    match centre {
+        Some(c) => (c, reach + (com - c).norm()),
+        None => (com, reach),
+    }
 }
 
 /// The camera of [`following_framings`], one frame at a time (a run still being written may gain snapshots while
@@ -297,7 +310,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     let mut fail: Option<RenderError> = None;
     visit_snapshots(dir, &mut |k, view| {
         let vals = values(&view, opts.colour, fields.as_ref());
-        let framing = follower.frame(reach_98(&view.particles), opts.extent);
+        let framing = follower.frame(about(reach_98(&view.particles), opts.centre), opts.extent);
         let camera = Camera::new(opts.view, opts.projection, framing, opts.width, opts.height);
         let t0 = Instant::now();
         let drawn = render_frame_with_walls(
@@ -355,11 +368,11 @@ fn caption(t: f64) -> String {
     }
 }
 
-/// Renders a run just finished by `rubblepile run` (`--render`, or always for the built-in default scene, whose
-/// animation is `impact.gif`): the line to print before the run's summary, and those after it (what to open).
-pub fn after_run(out: &Path, default_scene: bool, force: bool) -> Result<(String, Vec<String>), RenderRunError> {
+/// Renders a run just finished by `rubblepile run` (`--render`, or always for the built-in default scene) into
+/// `frames/run.gif`, the name `rubblepile render` uses: the line to print before the run's summary, and those after it (what to open).
+pub fn after_run(out: &Path, force: bool) -> Result<(String, Vec<String>), RenderRunError> {
     let opts = RenderRunOptions {
-        gif_name: if default_scene { "impact.gif" } else { "run.gif" }.into(),
+        gif_name: "run.gif".into(),
         force,
         ..Default::default()
     };
@@ -377,4 +390,22 @@ pub fn after_run(out: &Path, default_scene: bool, force: bool) -> Result<(String
         ));
     }
     Ok((before, after))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    /// Guards `--centre-m` (a drum framed about its axis): every frame is centred there, and its half-width grows by
+    /// the distance from the bodies' centre so that it still holds them.
+    #[test]
+    fn a_fixed_centre_frames_the_bodies_about_it() {
+        let mut follower = Follower::default();
+        let f = follower.frame(about((Vec3::new(3.0, 0.0, 4.0), 1.0), Some(Vec3::zeros())), None);
+        assert_eq!(f.centre, Vec3::zeros());
+        assert!((f.half_extent - 6.0 * (1.0 + Framing::MARGIN)).abs() < 1e-12, "{f:?}");
+        let g = Follower::default().frame(about((Vec3::new(3.0, 0.0, 4.0), 1.0), None), None);
+        assert_eq!(g.centre, Vec3::new(3.0, 0.0, 4.0));
+    }
 }
