@@ -520,8 +520,9 @@ fn tidal_torque_impulse_is_reported_apart_from_the_angular_momentum_residual() {
     assert_eq!(plain.tidal_torque_impulse, None);
 }
 
-/// The settling's cap is kept and said (a warning line, `settling.capped` in `flyby.json`), and `--no-control`
-/// runs no control: no `control/`, and the outcome says its changes are the run's own.
+/// The settling's cap is kept and said (a warning line, `settling.capped` in `flyby.json`), `--no-control`
+/// runs no control: no `control/`, and the outcome says its changes are the run's own; `--format` and
+/// `--progress-every` reach the run.
 #[test]
 fn capped_settling_is_reported_and_no_control_skips_the_control() {
     let dir = temp_dir("flyby-capped");
@@ -545,12 +546,19 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
             "--no-control",
             "--snapshots",
             "2",
+            "--format",
+            "xyz",
+            "--progress-every",
+            "0.1",
             "--out",
             "run",
         ],
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // `--format` and `--progress-every` as for `run`: an XYZ beside each CSV snapshot, progress lines in the log.
+    assert!(dir.join("run/snapshots/1.xyz").exists());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("progress: t = "));
     assert!(
         stdout.contains("warning: settling stopped at its cap of 0.50 h"),
         "{stdout}"

@@ -391,8 +391,8 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
 
 /// `rubblepile flyby`: prepares and runs the flyby of `args` ([`run_flyby`]), then analyses it ([`analyze_flyby`]);
 /// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request).
-pub fn flyby_command(args: &FlybyConfig) -> Result<Vec<String>, (String, u8)> {
-    let runs = run_flyby(args, &crate::driver::RunOptions::default()).map_err(|e| (e.to_string(), e.exit_code()))?;
+pub fn flyby_command(args: &FlybyConfig, options: &crate::driver::RunOptions) -> Result<Vec<String>, (String, u8)> {
+    let runs = run_flyby(args, options).map_err(|e| (e.to_string(), e.exit_code()))?;
     let Some(runs) = runs else {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use super::common::CheckpointArgs;
 use rubblepile::impact::flyby::{DEFAULT_START_Q, EARTH_MASS_KG, EARTH_RADIUS_M, FlybyConfig};
 
 /// `rubblepile flyby`: a rubble pile (a target file) past a planet on a hyperbolic orbit.
@@ -75,10 +76,19 @@ pub struct FlybyArgs {
     /// Cap on the settling time (hours) [default: 100 free-fall times √(3π/(32 G ρ)) of the pile].
     #[arg(long)]
     pub settle_max_hours: Option<f64>,
+    /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
+    #[arg(long)]
+    pub no_progress: bool,
+    /// Checkpoints, extra snapshot formats (`--format xyz`), progress lines in a batch log (`--progress-every`)
+    /// and budgets, as for `rubblepile run`; the control run takes the same.
+    #[command(flatten)]
+    pub checkpoints: CheckpointArgs,
 }
 
-impl From<FlybyArgs> for FlybyConfig {
-    fn from(a: FlybyArgs) -> Self {
+impl FlybyArgs {
+    /// The library's configuration of these flags.
+    pub fn config(&self) -> FlybyConfig {
+        let a = self.clone();
         FlybyConfig {
             target: a.target,
             radius_m: a.radius_m,

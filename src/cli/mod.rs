@@ -302,9 +302,11 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
-        Command::Flyby(args) => rubblepile::analysis::flyby::flyby_command(&(*args).into())
-            .map(|lines| lines.iter().for_each(|l| println!("{l}")))
-            .map_err(|(message, code)| CliError { message, code }),
+        Command::Flyby(args) => {
+            rubblepile::analysis::flyby::flyby_command(&args.config(), &args.checkpoints.options(!args.no_progress)?)
+                .map(|lines| lines.iter().for_each(|l| println!("{l}")))
+                .map_err(|(message, code)| CliError { message, code })
+        }
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
