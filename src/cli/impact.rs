@@ -34,6 +34,9 @@ pub struct ImpactArgs {
     /// Seed of the projectile's attitude.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Where the trajectory is aimed and the projectile's spin and attitude.
+    #[command(flatten)]
+    pub geometry: GeometryArgs,
     /// Time at which the surfaces first touch (s).
     #[arg(long, default_value_t = 90.0)]
     pub contact_time: f64,
@@ -134,6 +137,7 @@ impl ImpactArgs {
                 rubblepile::ellipsoid::body::InertiaModel::Gaussian
             },
             pile,
+            geometry: self.geometry.geometry()?,
         };
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)
@@ -142,7 +146,7 @@ impl ImpactArgs {
 
 /// The command-line flag of each [`ImpactConfig`] field (and of the pile's file) that an [`ImpactError::Invalid`] can
 /// name; the custom projectile's fields are all given through its radius.
-const FIELD_FLAGS: [(&str, &str); 16] = [
+const FIELD_FLAGS: [(&str, &str); 22] = [
     ("projectile", "--projectile-radius-km"),
     ("projectile.equivalent_radius", "--projectile-radius-km"),
     ("projectile.density", "--projectile-radius-km"),
@@ -159,6 +163,12 @@ const FIELD_FLAGS: [(&str, &str); 16] = [
     ("beta", "--beta"),
     ("snapshots", "--snapshots"),
     ("every", "--every"),
+    ("impact_parameter_m", "--impact-parameter-m"),
+    ("impact_parameter_frac", "--impact-parameter-frac"),
+    ("impact_angle_deg", "--impact-angle-deg"),
+    ("aim_azimuth_deg", "--aim-azimuth-deg"),
+    ("projectile_spin_rad_s", "--projectile-spin-rad-s"),
+    ("projectile_attitude", "--projectile-attitude"),
 ];
 
 /// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`]), its index kept
@@ -190,6 +200,69 @@ pub fn impact(args: &ImpactArgs) -> Result<(), CliError> {
     let prepared = prepare_impact(&cfg, &args.out, args.force).map_err(cli_error)?;
     println!("{}", prepared.plan.title);
     report(run_scene(&prepared.scene, &args.out, &options))
+}
+
+/// The impact geometry flags of `rubblepile impact` ([`rubblepile::impact::geometry`]).
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct GeometryArgs {
+    /// Impact parameter b (m): the trajectory's offset from the target's centre of mass [default: 0].
+    #[arg(long, value_name = "M", conflicts_with_all = ["impact_parameter_frac", "impact_angle_deg"])]
+    pub impact_parameter_m: Option<f64>,
+    /// Impact parameter b as a fraction of the target's radius R (volume-equivalent radius of its surface
+    /// ellipsoid), in [0, 1).
+    #[arg(long, value_name = "F", conflicts_with = "impact_angle_deg")]
+    pub impact_parameter_frac: Option<f64>,
+    /// Impact angle θ between the trajectory and the target's surface normal at the aim point (degrees, [0, 90);
+    /// 0 = head-on), on the target's surface ellipsoid. Not --angle (ζ, to the spin axis).
+    #[arg(long, value_name = "DEG")]
+    pub impact_angle_deg: Option<f64>,
+    /// Azimuth ψ of the aim point around the approach direction (degrees, [0, 360)): 0 along x, 90 along
+    /// (0, cos ζ, −sin ζ).
+    #[arg(long, value_name = "DEG", default_value_t = 0.0)]
+    pub aim_azimuth_deg: f64,
+    /// Spin of the projectile (rad/s, world frame) [default: 0,0,0].
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',')]
+    pub projectile_spin_rad_s: Option<Vec<f64>>,
+    /// Attitude of the projectile: a quaternion (scalar last, world → body, as in the bodies files) [default: a
+    /// random one drawn from --seed].
+    #[arg(long, value_name = "X,Y,Z,W", value_delimiter = ',')]
+    pub projectile_attitude: Option<Vec<f64>>,
+}
+
+impl GeometryArgs {
+    /// The geometry these flags ask for (its values checked by [`ImpactConfig::validate`]; a vector of the wrong
+    /// length is a usage error naming its flag).
+    pub fn geometry(&self) -> Result<rubblepile::impact::geometry::ImpactGeometry, CliError> {
+        use rubblepile::impact::geometry::Aim;
+        let aim = match (
+            self.impact_parameter_m,
+            self.impact_parameter_frac,
+            self.impact_angle_deg,
+        ) {
+            (Some(b), _, _) => Aim::ParameterM(b),
+            (_, Some(f), _) => Aim::ParameterFrac(f),
+            (_, _, Some(t)) => Aim::AngleDeg(t),
+            _ => Aim::Centre,
+        };
+        let length = |flag: &str, values: &Option<Vec<f64>>, n: usize| match values {
+            Some(v) if v.len() != n => Err(CliError::usage(format!(
+                "{flag}: expected {n} comma-separated numbers, got {v:?}"
+            ))),
+            _ => Ok(()),
+        };
+        length("--projectile-spin-rad-s", &self.projectile_spin_rad_s, 3)?;
+        length("--projectile-attitude", &self.projectile_attitude, 4)?;
+        let spin = self.projectile_spin_rad_s.as_deref().unwrap_or(&[0.0; 3]);
+        Ok(rubblepile::impact::geometry::ImpactGeometry {
+            aim,
+            azimuth_deg: self.aim_azimuth_deg,
+            spin_rad_s: rubblepile::math::Vec3::from_column_slice(spin),
+            attitude: self
+                .projectile_attitude
+                .as_deref()
+                .map(rubblepile::math::Vec4::from_column_slice),
+        })
+    }
 }
 
 /// `--projectile-pile FILE [--pile-fixed-attitude]` of `rubblepile impact`.

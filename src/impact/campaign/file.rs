@@ -78,6 +78,53 @@ pub struct ImpactSection {
     pub speed_km_s: Option<f64>,
     /// Inertia model of the ellipsoids: `"gaussian"` (Roig03 Eq. 4, default) or `"uniform"`.
     pub inertia: Option<crate::ellipsoid::body::InertiaModel>,
+    /// Impact parameter `b` (m, ≥ 0): the trajectory's offset from the target's centre of mass (default 0). At most
+    /// one of `impact_parameter_m`, `impact_parameter_frac`, `impact_angle_deg` ([`crate::impact::geometry`]).
+    pub impact_parameter_m: Option<f64>,
+    /// `b` as a fraction of the target's radius R (in [0, 1)).
+    pub impact_parameter_frac: Option<f64>,
+    /// Impact angle θ between the trajectory and the target's surface normal at the aim point (degrees, [0, 90)).
+    pub impact_angle_deg: Option<f64>,
+    /// Azimuth ψ of the aim point around the approach direction (degrees, [0, 360); default 0).
+    pub aim_azimuth_deg: Option<f64>,
+    /// Spin of a single-ellipsoid projectile (rad/s, world frame `[x, y, z]`; default none).
+    pub projectile_spin_rad_s: Option<[f64; 3]>,
+    /// Attitude of a single-ellipsoid projectile: a quaternion `[x, y, z, w]` (scalar last, world → body, as the
+    /// bodies files'; default a random one drawn from the seed).
+    pub projectile_attitude: Option<[f64; 4]>,
+}
+
+impl ImpactSection {
+    /// The geometry these keys ask for; the error names the two keys given together.
+    pub fn geometry(&self) -> Result<crate::impact::geometry::ImpactGeometry, (String, String)> {
+        use crate::impact::geometry::{Aim, ImpactGeometry};
+        let aims = [
+            ("impact_parameter_m", self.impact_parameter_m.map(Aim::ParameterM)),
+            (
+                "impact_parameter_frac",
+                self.impact_parameter_frac.map(Aim::ParameterFrac),
+            ),
+            ("impact_angle_deg", self.impact_angle_deg.map(Aim::AngleDeg)),
+        ];
+        let given: Vec<_> = aims.iter().filter(|(_, a)| a.is_some()).collect();
+        if let [(first, _), (second, _), ..] = given[..] {
+            return Err((
+                format!("impact.{second}"),
+                format!(
+                    "give at most one of `impact_parameter_m`, `impact_parameter_frac` and `impact_angle_deg` (each \
+                     sets the aim), got `{first}` and `{second}`"
+                ),
+            ));
+        }
+        Ok(ImpactGeometry {
+            aim: given.first().and_then(|(_, a)| *a).unwrap_or_default(),
+            azimuth_deg: self.aim_azimuth_deg.unwrap_or(0.0),
+            spin_rad_s: self
+                .projectile_spin_rad_s
+                .map_or(crate::math::Vec3::zeros(), Into::into),
+            attitude: self.projectile_attitude.map(Into::into),
+        })
+    }
 }
 
 /// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5), or a rubble-pile
