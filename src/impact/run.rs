@@ -443,8 +443,8 @@ pub struct PreparedImpact {
 pub fn prepare_impact(cfg: &ImpactConfig, out: &Path, force: bool) -> Result<PreparedImpact, ImpactError> {
     cfg.validate()?;
     let target = read_target(&cfg.target)?;
-    let lock = prepare_output_dir(out, force)?;
     let plan = cfg.plan(&target)?;
+    let lock = prepare_output_dir(out, force)?;
     let io = |p: &Path| {
         let path = p.to_path_buf();
         move |source| ImpactError::Io { path, source }
