@@ -3,7 +3,8 @@
 //! A projectile is one ellipsoid with the fragments' density and axis ratios (1 : 0.7 : 0.5), a random
 //! (seeded) attitude and no spin. It moves in the y–z plane toward the target's centre of mass, at angle ζ to
 //! the target's spin axis z, and is placed so that its surface first touches a fragment at `contact_time`
-//! (≈ 90 s). The whole system is then moved to its centre-of-mass frame.
+//! (≈ 90 s); [`crate::impact::geometry`] aims it off the centre, spins and turns it. The whole system is then moved
+//! to its centre-of-mass frame.
 //! `Q = ½ m_p v² / M` is the specific impact energy (J/kg; ×10⁴ for erg/g).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
@@ -146,9 +147,10 @@ pub fn set_up_aimed_impact(
         None => random_quaternion(&mut generator(seed)),
     };
     // Zero stays the exact zero of the default set-up (no rounded −0).
-    let spin_body = match geometry.spin_rad_s == Vec3::zeros() {
-        true => Vec3::zeros(),
-        false => rotation_matrix(&quaternion) * geometry.spin_rad_s,
+    let spin_body = if geometry.spin_rad_s == Vec3::zeros() {
+        Vec3::zeros()
+    } else {
+        rotation_matrix(&quaternion) * geometry.spin_rad_s
     };
     let aiming = geometry.aiming(&bodies, &n);
     let incoming = [Body {
