@@ -9,9 +9,8 @@ use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError, report};
 use rubblepile::driver::{RunOptions, run_scene};
-use rubblepile::impact::pile::{ProjectilePile, as_field};
-use rubblepile::impact::projectile::ProjectileSpec;
 use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact, snapshot_times};
+use rubblepile::impact::{geometry::ImpactGeometry, pile::ProjectilePile, pile::as_field, projectile::ProjectileSpec};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]
@@ -34,9 +33,24 @@ pub struct ImpactArgs {
     /// Seed of the projectile's attitude.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Where the trajectory is aimed and the projectile's spin and attitude.
-    #[command(flatten)]
-    pub geometry: GeometryArgs,
+    /// Impact parameter b (m): the trajectory's offset from the target's centre of mass [default: 0].
+    #[arg(long, value_name = "M", conflicts_with_all = ["impact_parameter_frac", "impact_angle_deg"])]
+    pub impact_parameter_m: Option<f64>,
+    /// b as a fraction (in [0, 1)) of the target's radius R (of its surface ellipsoid's volume).
+    #[arg(long, value_name = "F", conflicts_with = "impact_angle_deg")]
+    pub impact_parameter_frac: Option<f64>,
+    /// Impact angle θ to the surface normal at the aim point (degrees, [0, 90); 0 = head-on); not ζ (--angle).
+    #[arg(long, value_name = "DEG")]
+    pub impact_angle_deg: Option<f64>,
+    /// Azimuth ψ of the aim point around the approach direction n (degrees, [0, 360); 0 along x, 90 along n × x).
+    #[arg(long, value_name = "DEG")]
+    pub aim_azimuth_deg: Option<f64>,
+    /// Spin of the projectile (rad/s, world frame) [default: none].
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',')]
+    pub projectile_spin_rad_s: Option<Vec<f64>>,
+    /// Attitude of the projectile: a quaternion, scalar last, world → body [default: random from --seed].
+    #[arg(long, value_name = "X,Y,Z,W", value_delimiter = ',')]
+    pub projectile_attitude: Option<Vec<f64>>,
     /// Time at which the surfaces first touch (s).
     #[arg(long, default_value_t = 90.0)]
     pub contact_time: f64,
@@ -116,6 +130,10 @@ impl ImpactArgs {
         }
         let pile = self.pile.read().map_err(cli_error)?;
         let projectile = pile.as_ref().map_or(projectile, |p| p.equivalent_spec(p.id(), speed));
+        let a = self;
+        let aims = [a.impact_parameter_m, a.impact_parameter_frac, a.impact_angle_deg];
+        let (spin, attitude) = (a.projectile_spin_rad_s.as_deref(), a.projectile_attitude.as_deref());
+        let geometry = ImpactGeometry::from_options(aims, a.aim_azimuth_deg, spin, attitude).map_err(cli_error)?;
         let cfg = ImpactConfig {
             target: self.target.clone(),
             projectile,
@@ -137,7 +155,7 @@ impl ImpactArgs {
                 rubblepile::ellipsoid::body::InertiaModel::Gaussian
             },
             pile,
-            geometry: self.geometry.geometry()?,
+            geometry,
         };
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)
@@ -146,7 +164,7 @@ impl ImpactArgs {
 
 /// The command-line flag of each [`ImpactConfig`] field (and of the pile's file) that an [`ImpactError::Invalid`] can
 /// name; the custom projectile's fields are all given through its radius.
-const FIELD_FLAGS: [(&str, &str); 22] = [
+const FIELD_FLAGS: [(&str, &str); 16] = [
     ("projectile", "--projectile-radius-km"),
     ("projectile.equivalent_radius", "--projectile-radius-km"),
     ("projectile.density", "--projectile-radius-km"),
@@ -163,19 +181,17 @@ const FIELD_FLAGS: [(&str, &str); 22] = [
     ("beta", "--beta"),
     ("snapshots", "--snapshots"),
     ("every", "--every"),
-    ("impact_parameter_m", "--impact-parameter-m"),
-    ("impact_parameter_frac", "--impact-parameter-frac"),
-    ("impact_angle_deg", "--impact-angle-deg"),
-    ("aim_azimuth_deg", "--aim-azimuth-deg"),
-    ("projectile_spin_rad_s", "--projectile-spin-rad-s"),
-    ("projectile_attitude", "--projectile-attitude"),
 ];
 
-/// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`]), its index kept
-/// (`snapshots[2]` is `--snapshots[2]`); a field not in the table is named as it is.
+/// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`], else the field with dashes:
+/// `impact_angle_deg` is `--impact-angle-deg`), its index kept (`snapshots[2]` is `--snapshots[2]`).
 fn flag(field: &str) -> String {
     let (head, index) = field.split_at(field.find('[').unwrap_or(field.len()));
-    let flag = FIELD_FLAGS.iter().find(|(f, _)| *f == head).map_or(head, |p| p.1);
+    let dashed = || format!("--{}", head.replace('_', "-"));
+    let flag = FIELD_FLAGS
+        .iter()
+        .find(|(f, _)| *f == head)
+        .map_or_else(dashed, |p| p.1.into());
     format!("{flag}{index}")
 }
 
@@ -200,69 +216,6 @@ pub fn impact(args: &ImpactArgs) -> Result<(), CliError> {
     let prepared = prepare_impact(&cfg, &args.out, args.force).map_err(cli_error)?;
     println!("{}", prepared.plan.title);
     report(run_scene(&prepared.scene, &args.out, &options))
-}
-
-/// The impact geometry flags of `rubblepile impact` ([`rubblepile::impact::geometry`]).
-#[derive(Debug, Clone, Default, clap::Args)]
-pub struct GeometryArgs {
-    /// Impact parameter b (m): the trajectory's offset from the target's centre of mass [default: 0].
-    #[arg(long, value_name = "M", conflicts_with_all = ["impact_parameter_frac", "impact_angle_deg"])]
-    pub impact_parameter_m: Option<f64>,
-    /// Impact parameter b as a fraction of the target's radius R (volume-equivalent radius of its surface
-    /// ellipsoid), in [0, 1).
-    #[arg(long, value_name = "F", conflicts_with = "impact_angle_deg")]
-    pub impact_parameter_frac: Option<f64>,
-    /// Impact angle θ between the trajectory and the target's surface normal at the aim point (degrees, [0, 90);
-    /// 0 = head-on), on the target's surface ellipsoid. Not --angle (ζ, to the spin axis).
-    #[arg(long, value_name = "DEG")]
-    pub impact_angle_deg: Option<f64>,
-    /// Azimuth ψ of the aim point around the approach direction (degrees, [0, 360)): 0 along x, 90 along
-    /// (0, cos ζ, −sin ζ).
-    #[arg(long, value_name = "DEG", default_value_t = 0.0)]
-    pub aim_azimuth_deg: f64,
-    /// Spin of the projectile (rad/s, world frame) [default: 0,0,0].
-    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',')]
-    pub projectile_spin_rad_s: Option<Vec<f64>>,
-    /// Attitude of the projectile: a quaternion (scalar last, world → body, as in the bodies files) [default: a
-    /// random one drawn from --seed].
-    #[arg(long, value_name = "X,Y,Z,W", value_delimiter = ',')]
-    pub projectile_attitude: Option<Vec<f64>>,
-}
-
-impl GeometryArgs {
-    /// The geometry these flags ask for (its values checked by [`ImpactConfig::validate`]; a vector of the wrong
-    /// length is a usage error naming its flag).
-    pub fn geometry(&self) -> Result<rubblepile::impact::geometry::ImpactGeometry, CliError> {
-        use rubblepile::impact::geometry::Aim;
-        let aim = match (
-            self.impact_parameter_m,
-            self.impact_parameter_frac,
-            self.impact_angle_deg,
-        ) {
-            (Some(b), _, _) => Aim::ParameterM(b),
-            (_, Some(f), _) => Aim::ParameterFrac(f),
-            (_, _, Some(t)) => Aim::AngleDeg(t),
-            _ => Aim::Centre,
-        };
-        let length = |flag: &str, values: &Option<Vec<f64>>, n: usize| match values {
-            Some(v) if v.len() != n => Err(CliError::usage(format!(
-                "{flag}: expected {n} comma-separated numbers, got {v:?}"
-            ))),
-            _ => Ok(()),
-        };
-        length("--projectile-spin-rad-s", &self.projectile_spin_rad_s, 3)?;
-        length("--projectile-attitude", &self.projectile_attitude, 4)?;
-        let spin = self.projectile_spin_rad_s.as_deref().unwrap_or(&[0.0; 3]);
-        Ok(rubblepile::impact::geometry::ImpactGeometry {
-            aim,
-            azimuth_deg: self.aim_azimuth_deg,
-            spin_rad_s: rubblepile::math::Vec3::from_column_slice(spin),
-            attitude: self
-                .projectile_attitude
-                .as_deref()
-                .map(rubblepile::math::Vec4::from_column_slice),
-        })
-    }
 }
 
 /// `--projectile-pile FILE [--pile-fixed-attitude]` of `rubblepile impact`.

@@ -13,6 +13,7 @@
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::rotation_matrix;
+use crate::impact::error::ImpactError;
 use crate::math::{Mat3, Vec3, Vec4};
 
 /// Where the projectile's trajectory (a line along the approach direction `n`) is aimed.
@@ -45,16 +46,58 @@ pub struct ImpactGeometry {
     pub attitude: Option<Vec4>,
 }
 
-/// The field of [`crate::impact::run::ImpactConfig`] (and of the campaign's `[impact]`) that `aim` is given by.
+/// The keys (fields of the impact's configuration and of the campaign's `[impact]`) that set the aim.
+pub const AIM_KEYS: [&str; 3] = ["impact_parameter_m", "impact_parameter_frac", "impact_angle_deg"];
+
+/// The key of [`AIM_KEYS`] that `aim` is given by.
 pub fn aim_field(aim: &Aim) -> &'static str {
     match aim {
-        Aim::Centre | Aim::ParameterM(_) => "impact_parameter_m",
-        Aim::ParameterFrac(_) => "impact_parameter_frac",
-        Aim::AngleDeg(_) => "impact_angle_deg",
+        Aim::Centre | Aim::ParameterM(_) => AIM_KEYS[0],
+        Aim::ParameterFrac(_) => AIM_KEYS[1],
+        Aim::AngleDeg(_) => AIM_KEYS[2],
     }
 }
 
 impl ImpactGeometry {
+    /// The geometry given as options, each absent one the default: `aims` are the values of [`AIM_KEYS`] (at most
+    /// one), ψ (degrees), the spin (3 numbers, rad/s) and the attitude (4). Errors name the key (the message names
+    /// the two aim keys given together); the values are checked by [`Self::validate`].
+    pub fn from_options(
+        aims: [Option<f64>; 3],
+        azimuth_deg: Option<f64>,
+        spin_rad_s: Option<&[f64]>,
+        attitude: Option<&[f64]>,
+    ) -> Result<Self, ImpactError> {
+        let invalid = |field: &str, message: String| ImpactError::Invalid {
+            field: field.into(),
+            message,
+        };
+        let given: Vec<usize> = (0..3).filter(|&k| aims[k].is_some()).collect();
+        if let [first, second, ..] = given[..] {
+            let (first, second) = (AIM_KEYS[first], AIM_KEYS[second]);
+            let message = format!("give at most one of {AIM_KEYS:?} (each sets the aim), got {first} and {second}");
+            return Err(invalid(second, message));
+        }
+        let aim = match (given.first(), aims) {
+            (Some(0), [Some(b), ..]) => Aim::ParameterM(b),
+            (Some(1), [_, Some(f), _]) => Aim::ParameterFrac(f),
+            (Some(2), [.., Some(t)]) => Aim::AngleDeg(t),
+            _ => Aim::Centre,
+        };
+        let length = |field: &str, v: Option<&[f64]>, n: usize| match v {
+            Some(v) if v.len() != n => Err(invalid(field, format!("expected {n} numbers, got {v:?}"))),
+            _ => Ok(()),
+        };
+        length("projectile_spin_rad_s", spin_rad_s, 3)?;
+        length("projectile_attitude", attitude, 4)?;
+        Ok(ImpactGeometry {
+            aim,
+            azimuth_deg: azimuth_deg.unwrap_or(0.0),
+            spin_rad_s: spin_rad_s.map_or(Vec3::zeros(), Vec3::from_column_slice),
+            attitude: attitude.map(Vec4::from_column_slice),
+        })
+    }
+
     /// Checks every value is in range: `Err((field, message))`; `pile` says the projectile is a rubble pile
     /// (which keeps its own spin and attitude).
     pub fn validate(&self, pile: bool) -> Result<(), (&'static str, String)> {

@@ -95,35 +95,18 @@ pub struct ImpactSection {
 }
 
 impl ImpactSection {
-    /// The geometry these keys ask for; the error names the two keys given together.
-    pub fn geometry(&self) -> Result<crate::impact::geometry::ImpactGeometry, (String, String)> {
-        use crate::impact::geometry::{Aim, ImpactGeometry};
-        let aims = [
-            ("impact_parameter_m", self.impact_parameter_m.map(Aim::ParameterM)),
-            (
-                "impact_parameter_frac",
-                self.impact_parameter_frac.map(Aim::ParameterFrac),
-            ),
-            ("impact_angle_deg", self.impact_angle_deg.map(Aim::AngleDeg)),
-        ];
-        let given: Vec<_> = aims.iter().filter(|(_, a)| a.is_some()).collect();
-        if let [(first, _), (second, _), ..] = given[..] {
-            return Err((
-                format!("impact.{second}"),
-                format!(
-                    "give at most one of `impact_parameter_m`, `impact_parameter_frac` and `impact_angle_deg` (each \
-                     sets the aim), got `{first}` and `{second}`"
-                ),
-            ));
-        }
-        Ok(ImpactGeometry {
-            aim: given.first().and_then(|(_, a)| *a).unwrap_or_default(),
-            azimuth_deg: self.aim_azimuth_deg.unwrap_or(0.0),
-            spin_rad_s: self
-                .projectile_spin_rad_s
-                .map_or(crate::math::Vec3::zeros(), Into::into),
-            attitude: self.projectile_attitude.map(Into::into),
-        })
+    /// The geometry these keys ask for ([`crate::impact::geometry::ImpactGeometry::from_options`]).
+    pub fn geometry(&self) -> Result<crate::impact::geometry::ImpactGeometry, crate::impact::run::ImpactError> {
+        crate::impact::geometry::ImpactGeometry::from_options(
+            [
+                self.impact_parameter_m,
+                self.impact_parameter_frac,
+                self.impact_angle_deg,
+            ],
+            self.aim_azimuth_deg,
+            self.projectile_spin_rad_s.as_ref().map(|v| &v[..]),
+            self.projectile_attitude.as_ref().map(|v| &v[..]),
+        )
     }
 }
 

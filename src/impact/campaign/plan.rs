@@ -325,7 +325,10 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();
             base.snapshots = snapshots.clone();
-            base.geometry = imp.geometry().map_err(|(field, message)| invalid(field, message))?;
+            base.geometry = imp.geometry().map_err(|e| match e {
+                ImpactError::Invalid { field, message } => invalid(format!("impact.{field}"), message),
+                other => invalid("impact".into(), other.to_string()),
+            })?;
             base.pile = piles
                 .iter()
                 .find(|(id, _)| *id == projectile.id)
