@@ -17,7 +17,7 @@ fn the_default_scene_is_the_n30_p2_impact_of_its_header() {
     cfg.t_end = 600.0;
     cfg.snapshots = (0..=60).map(|k| 10.0 * k as f64).collect();
     cfg.every = 10.0;
-    let plan = cfg.plan(&target);
+    let plan = cfg.plan(&target).unwrap();
     let scene = default_scene().unwrap();
     assert_eq!(scene.bodies.len(), 31);
     assert_eq!(scene.bodies.len(), plan.bodies.len());

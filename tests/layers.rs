@@ -295,7 +295,8 @@ fn the_library_does_not_use_clap() {
 /// The command line parses and dispatches; science and timed systems live in `analysis` and `bench`. Its size is a
 /// cheap guard against logic creeping back in. The bound was 2000 lines until the flag structs of `flyby`, `render`,
 /// `export`, `convert`, `campaign merge|slurm` and `--projectile-pile` (about 350 lines of flags and their help) moved
-/// here from the library, which no longer knows clap.
+/// here from the library, which no longer knows clap; 2400 until `impact`'s six geometry flags (issue 57: b, θ, ψ,
+/// spin, attitude; about 25 lines of flags and their help, read by the library's `ImpactGeometry::from_options`).
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -305,8 +306,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2400,
-        "src/cli/ has {lines} lines (at most 2400: move logic to analysis/ or bench/)"
+        lines <= 2430,
+        "src/cli/ has {lines} lines (at most 2430: move logic to analysis/ or bench/)"
     );
 }
 

@@ -9,9 +9,8 @@ use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError, report};
 use rubblepile::driver::{RunOptions, run_scene};
-use rubblepile::impact::pile::{ProjectilePile, as_field};
-use rubblepile::impact::projectile::ProjectileSpec;
 use rubblepile::impact::run::{ImpactConfig, ImpactError, prepare_impact, snapshot_times};
+use rubblepile::impact::{geometry::ImpactGeometry, pile::ProjectilePile, pile::as_field, projectile::ProjectileSpec};
 
 /// `rubblepile impact`.
 #[derive(Debug, clap::Args)]
@@ -34,6 +33,24 @@ pub struct ImpactArgs {
     /// Seed of the projectile's attitude.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Impact parameter b (m): the trajectory's offset from the target's centre of mass [default: 0].
+    #[arg(long, value_name = "M", conflicts_with_all = ["impact_parameter_frac", "impact_angle_deg"])]
+    pub impact_parameter_m: Option<f64>,
+    /// b as a fraction (in [0, 1)) of the target's radius R (of its surface ellipsoid's volume).
+    #[arg(long, value_name = "F", conflicts_with = "impact_angle_deg")]
+    pub impact_parameter_frac: Option<f64>,
+    /// Impact angle θ to the surface normal at the aim point (degrees, [0, 90); 0 = head-on); not ζ (--angle).
+    #[arg(long, value_name = "DEG")]
+    pub impact_angle_deg: Option<f64>,
+    /// Azimuth ψ of the aim point around the approach direction n (degrees, [0, 360); 0 along x, 90 along n × x).
+    #[arg(long, value_name = "DEG")]
+    pub aim_azimuth_deg: Option<f64>,
+    /// Spin of the projectile (rad/s, world frame) [default: none].
+    #[arg(long, value_name = "X,Y,Z", value_delimiter = ',')]
+    pub projectile_spin_rad_s: Option<Vec<f64>>,
+    /// Attitude of the projectile: a quaternion, scalar last, world → body [default: random from --seed].
+    #[arg(long, value_name = "X,Y,Z,W", value_delimiter = ',')]
+    pub projectile_attitude: Option<Vec<f64>>,
     /// Time at which the surfaces first touch (s).
     #[arg(long, default_value_t = 90.0)]
     pub contact_time: f64,
@@ -113,6 +130,10 @@ impl ImpactArgs {
         }
         let pile = self.pile.read().map_err(cli_error)?;
         let projectile = pile.as_ref().map_or(projectile, |p| p.equivalent_spec(p.id(), speed));
+        let a = self;
+        let aims = [a.impact_parameter_m, a.impact_parameter_frac, a.impact_angle_deg];
+        let (spin, attitude) = (a.projectile_spin_rad_s.as_deref(), a.projectile_attitude.as_deref());
+        let geometry = ImpactGeometry::from_options(aims, a.aim_azimuth_deg, spin, attitude).map_err(cli_error)?;
         let cfg = ImpactConfig {
             target: self.target.clone(),
             projectile,
@@ -134,6 +155,7 @@ impl ImpactArgs {
                 rubblepile::ellipsoid::body::InertiaModel::Gaussian
             },
             pile,
+            geometry,
         };
         cfg.validate().map_err(cli_error)?;
         Ok(cfg)
@@ -161,11 +183,15 @@ const FIELD_FLAGS: [(&str, &str); 16] = [
     ("every", "--every"),
 ];
 
-/// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`]), its index kept
-/// (`snapshots[2]` is `--snapshots[2]`); a field not in the table is named as it is.
+/// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`], else the field with dashes:
+/// `impact_angle_deg` is `--impact-angle-deg`), its index kept (`snapshots[2]` is `--snapshots[2]`).
 fn flag(field: &str) -> String {
     let (head, index) = field.split_at(field.find('[').unwrap_or(field.len()));
-    let flag = FIELD_FLAGS.iter().find(|(f, _)| *f == head).map_or(head, |p| p.1);
+    let dashed = || format!("--{}", head.replace('_', "-"));
+    let flag = FIELD_FLAGS
+        .iter()
+        .find(|(f, _)| *f == head)
+        .map_or_else(dashed, |p| p.1.into());
     format!("{flag}{index}")
 }
 

@@ -2,6 +2,7 @@
 //!
 //! - [`target`]: the Monte-Carlo rubble-pile builder and its relaxation to a rigidly rotating pile;
 //! - [`projectile`]: the projectiles P1–P3 and the impact geometry;
+//! - [`geometry`]: aiming off the centre (impact parameter, impact angle to the surface normal), projectile spin and attitude;
 //! - [`pile`]: rubble-pile projectiles (a whole pile thrown at the target);
 //! - [`run`]: one impact run (target + projectile → run directory → [`crate::driver::run_scene`]);
 //! - [`campaign`]: a grid of impact runs (targets × projectiles × angles × seeds) from a campaign file, run
@@ -13,6 +14,7 @@
 pub mod campaign;
 pub mod error;
 pub mod flyby;
+pub mod geometry;
 pub mod pile;
 pub mod problems;
 pub mod projectile;

@@ -6,7 +6,7 @@
 //! attitude (the same draw, [`random_quaternion`] of the run's seed, as the single ellipsoid's), then
 //! translated rigidly along the impact direction `n = (0, sin ζ, cos ζ)` and given the velocity `−v n`, so that
 //! the closest surfaces of the two piles first touch at `contact_time` (the ellipsoids' overlap test of
-//! [`first_contact_distance`], as for a single projectile). The whole system is then moved to its
+//! [`crate::impact::projectile::first_contact_distance`], as for a single projectile). The whole system is then moved to its
 //! centre-of-mass frame. Bodies `0..N_t` are the target's, `N_t..N_t + N_p` the projectile's.
 //! `Q = ½ M_p v² / M_t` uses the pile's total mass `M_p`.
 
@@ -15,9 +15,10 @@ use std::path::{Path, PathBuf};
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::{from_unit_quaternion, rotation_matrix, to_unit_quaternion};
 use crate::impact::error::{ImpactError, read_target};
+use crate::impact::geometry::{Aim, ImpactGeometry};
 pub use crate::impact::projectile::PileRecord;
 use crate::impact::projectile::{
-    ERG_PER_G_PER_J_PER_KG, ImpactSetup, ProjectileSpec, first_contact_distance, target_and_direction,
+    ERG_PER_G_PER_J_PER_KG, ImpactSetup, ProjectileSpec, contact_walk, target_and_direction,
 };
 use crate::impact::target::to_centre_of_mass_frame;
 use crate::random::{generator, random_quaternion};
@@ -108,10 +109,31 @@ pub fn set_up_pile_impact(
     contact_time: f64,
     seed: u64,
 ) -> (Vec<Body>, ImpactSetup) {
+    let geometry = ImpactGeometry::default();
+    let (bodies, setup, _) =
+        set_up_aimed_pile_impact(target, pile, projectile, &geometry, angle_deg, contact_time, seed);
+    (bodies, setup)
+}
+
+/// [`set_up_pile_impact`] aimed by `geometry` (its aim only: a pile keeps its own spin and attitude) and whether
+/// the pile meets the target, as for [`crate::impact::projectile::set_up_aimed_impact`].
+pub fn set_up_aimed_pile_impact(
+    target: &[Body],
+    pile: &ProjectilePile,
+    projectile: &ProjectileSpec,
+    geometry: &ImpactGeometry,
+    angle_deg: f64,
+    contact_time: f64,
+    seed: u64,
+) -> (Vec<Body>, ImpactSetup, bool) {
     let (mut bodies, target_mass, n) = target_and_direction(target, angle_deg);
     let n_t = bodies.len();
-    let incoming = pile.oriented_bodies(seed);
-    let touch = first_contact_distance(&bodies, &incoming, &n);
+    let mut incoming = pile.oriented_bodies(seed);
+    let aiming = geometry.aiming(&bodies, &n);
+    if geometry.aim != Aim::Centre {
+        incoming.iter_mut().for_each(|b| b.position += aiming.offset);
+    }
+    let (touch, touched) = contact_walk(&bodies, &incoming, &n);
     let start = touch + projectile.speed * contact_time;
     bodies.extend(incoming.into_iter().map(|mut b| {
         b.position += n * start;
@@ -140,8 +162,10 @@ pub fn set_up_pile_impact(
         seed,
         projectile_index: n_t,
         projectile_pile: Some(record),
+        geometry: (*geometry != ImpactGeometry::default()).then(|| aiming.record(geometry, &n)),
     };
-    (bodies, setup)
+    let hits = geometry.aim == Aim::Centre || (touched && aiming.aim_point.is_some());
+    (bodies, setup, hits)
 }
 
 /// Whether any projectile body overlaps any target body (the ellipsoids' overlap test): the check that a

@@ -3,12 +3,14 @@
 //! A projectile is one ellipsoid with the fragments' density and axis ratios (1 : 0.7 : 0.5), a random
 //! (seeded) attitude and no spin. It moves in the y–z plane toward the target's centre of mass, at angle ζ to
 //! the target's spin axis z, and is placed so that its surface first touches a fragment at `contact_time`
-//! (≈ 90 s). The whole system is then moved to its centre-of-mass frame.
+//! (≈ 90 s); [`crate::impact::geometry`] aims it off the centre, spins and turns it. The whole system is then moved
+//! to its centre-of-mass frame.
 //! `Q = ½ m_p v² / M` is the specific impact energy (J/kg; ×10⁴ for erg/g).
 
 use crate::ellipsoid::body::{Body, Ellipsoid};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::geometry::ellipsoid_overlap::are_apart;
+use crate::impact::geometry::{Aim, GeometryRecord, ImpactGeometry};
 use crate::impact::target::to_centre_of_mass_frame;
 use crate::math::{Mat3, Vec3};
 use crate::random::{generator, random_quaternion};
@@ -90,6 +92,10 @@ pub struct ImpactSetup {
     /// (`pile.rs`); absent for a single ellipsoid.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub projectile_pile: Option<PileRecord>,
+    /// The impact geometry ([`crate::impact::geometry`]), when it is not the default (aimed at the centre of mass,
+    /// seeded random attitude, no spin).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<GeometryRecord>,
 }
 
 /// The target's bodies in their centre-of-mass frame, their total mass (kg) and the unit vector `n` from the
@@ -111,24 +117,59 @@ pub fn set_up_impact(
     contact_time: f64,
     seed: u64,
 ) -> (Vec<Body>, ImpactSetup) {
+    let (bodies, setup, _) = set_up_aimed_impact(
+        target,
+        projectile,
+        &ImpactGeometry::default(),
+        angle_deg,
+        contact_time,
+        seed,
+    );
+    (bodies, setup)
+}
+
+/// [`set_up_impact`] with the projectile's `geometry` (aim, spin, attitude): its trajectory is displaced by the
+/// aim's offset (⊥ `n`), its velocity stays `−v n`. The flag says whether the projectile meets the target (its
+/// trajectory enters the surface ellipsoid and its surface touches a fragment before its centre passes the
+/// target's); always true when aimed at the centre.
+pub fn set_up_aimed_impact(
+    target: &[Body],
+    projectile: &ProjectileSpec,
+    geometry: &ImpactGeometry,
+    angle_deg: f64,
+    contact_time: f64,
+    seed: u64,
+) -> (Vec<Body>, ImpactSetup, bool) {
     let (mut bodies, target_mass, n) = target_and_direction(target, angle_deg);
     let shape = projectile.shape();
-    let quaternion = random_quaternion(&mut generator(seed));
+    let quaternion = match geometry.attitude {
+        Some(q) => q.normalize(),
+        None => random_quaternion(&mut generator(seed)),
+    };
+    // Zero stays the exact zero of the default set-up (no rounded −0).
+    let spin_body = if geometry.spin_rad_s == Vec3::zeros() {
+        Vec3::zeros()
+    } else {
+        rotation_matrix(&quaternion) * geometry.spin_rad_s
+    };
+    let aiming = geometry.aiming(&bodies, &n);
     let incoming = [Body {
         shape,
-        position: Vec3::zeros(),
+        position: aiming.offset,
         velocity: Vec3::zeros(),
         quaternion,
-        spin_body: Vec3::zeros(),
+        spin_body,
     }];
-    let hi = first_contact_distance(&bodies, &incoming, &n);
+    let (hi, touched) = contact_walk(&bodies, &incoming, &n);
     let start = hi + projectile.speed * contact_time;
+    let mut position = n * start;
+    if geometry.aim != Aim::Centre {
+        position += aiming.offset;
+    }
     bodies.push(Body {
-        shape,
-        position: n * start,
+        position,
         velocity: -n * projectile.speed,
-        quaternion,
-        spin_body: Vec3::zeros(),
+        ..incoming[0].clone()
     });
     to_centre_of_mass_frame(&mut bodies);
     let q = 0.5 * shape.mass * projectile.speed.powi(2) / target_mass;
@@ -143,8 +184,10 @@ pub fn set_up_impact(
         seed,
         projectile_index: bodies.len() - 1,
         projectile_pile: None,
+        geometry: (*geometry != ImpactGeometry::default()).then(|| aiming.record(geometry, &n)),
     };
-    (bodies, setup)
+    let hits = geometry.aim == Aim::Centre || (touched && aiming.aim_point.is_some());
+    (bodies, setup, hits)
 }
 
 /// Distance `s` (m) along the unit vector `n` at which `projectile` (bodies in its own frame, moved rigidly by
@@ -152,6 +195,12 @@ pub fn set_up_impact(
 /// pair of ellipsoids overlaps, to bisection precision (60 halvings of a step of 2 % of the smallest semi-axis
 /// of the projectile). The walk starts beyond every bounding sphere and moves in by that step.
 pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) -> f64 {
+    contact_walk(target, projectile, n).0
+}
+
+/// [`first_contact_distance`] and whether the bodies touch at all before the projectile's frame passes the
+/// target's centre (`s > 0`).
+pub(crate) fn contact_walk(target: &[Body], projectile: &[Body], n: &Vec3) -> (f64, bool) {
     let sigma = |b: &Body| {
         let r = rotation_matrix(&b.quaternion);
         r.transpose() * Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
@@ -185,7 +234,7 @@ pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) ->
         let mid = 0.5 * (lo + hi);
         if touching(mid) { lo = mid } else { hi = mid }
     }
-    hi
+    (hi, s > 0.0)
 }
 
 /// Where the bodies of an impact with a rubble-pile projectile come from (in `impact.json` as

@@ -23,8 +23,9 @@ use crate::ellipsoid::scene::{
     OutputSection, PhysicsSection, SceneFile, SceneSection, parse_scene,
 };
 pub use crate::impact::error::{ImpactError, read_target};
-use crate::impact::pile::{ProjectilePile, set_up_pile_impact};
-use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_impact};
+use crate::impact::geometry::{ImpactGeometry, aim_field};
+use crate::impact::pile::{ProjectilePile, set_up_aimed_pile_impact};
+use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_aimed_impact};
 use crate::integrate::Method;
 use crate::io::run_lock::DirLock;
 use crate::io::scene_file::{MAX_TIMESERIES_ROWS, scene_text};
@@ -166,6 +167,9 @@ pub struct ImpactConfig {
     /// the single ellipsoid, at `projectile.speed` (`projectile` then describes the same-mass ellipsoid, see
     /// [`ProjectilePile::equivalent_spec`]).
     pub pile: Option<ProjectilePile>,
+    /// Aim (impact parameter or impact angle θ, azimuth ψ), spin and attitude of the projectile
+    /// ([`crate::impact::geometry`]; default: at the centre of mass, seeded random attitude, no spin).
+    pub geometry: ImpactGeometry,
 }
 
 impl ImpactConfig {
@@ -187,6 +191,7 @@ impl ImpactConfig {
             every: DEFAULT_EVERY,
             inertia: InertiaModel::Gaussian,
             pile: None,
+            geometry: ImpactGeometry::default(),
         }
     }
 
@@ -225,6 +230,9 @@ impl ImpactConfig {
                 "angle_deg",
                 format!("expected 0 to 180 degrees, got {}", self.angle_deg),
             );
+        }
+        if let Err((field, message)) = self.geometry.validate(self.pile.is_some()) {
+            return invalid(field, message);
         }
         if i64::try_from(self.seed).is_err() {
             return invalid("seed", format!("must be <= {}, got {}", i64::MAX, self.seed));
@@ -344,39 +352,56 @@ impl ImpactConfig {
         Ok(kappa)
     }
 
-    /// The impact in memory: bodies, setup, title and scene text (nothing is written).
-    pub fn plan(&self, target: &[Body]) -> ImpactPlan {
-        let (bodies, setup) = match &self.pile {
-            Some(pile) => set_up_pile_impact(
-                target,
-                pile,
-                &self.projectile,
-                self.angle_deg,
-                self.contact_time,
-                self.seed,
-            ),
-            None => set_up_impact(target, &self.projectile, self.angle_deg, self.contact_time, self.seed),
+    /// The impact in memory: bodies, setup, title and scene text (nothing is written). An error
+    /// ([`ImpactError::Invalid`] naming the aim's field) when an off-centre aim misses the target.
+    pub fn plan(&self, target: &[Body]) -> Result<ImpactPlan, ImpactError> {
+        let (geometry, angle, time, seed) = (&self.geometry, self.angle_deg, self.contact_time, self.seed);
+        let (bodies, setup, hits) = match &self.pile {
+            Some(pile) => set_up_aimed_pile_impact(target, pile, &self.projectile, geometry, angle, time, seed),
+            None => set_up_aimed_impact(target, &self.projectile, geometry, angle, time, seed),
         };
+        let aim = setup
+            .geometry
+            .as_ref()
+            .map(|g| (g.impact_parameter_m, g.target_radius_m));
+        if let (false, Some((b, r))) = (hits, aim) {
+            return Err(ImpactError::Invalid {
+                field: aim_field(&geometry.aim).into(),
+                message: format!(
+                    "the trajectory at b = {b:.6e} m ({:.4} of the target's radius R = {r:.6e} m) misses the \
+                     target; need a smaller b or impact angle",
+                    b / r
+                ),
+            });
+        }
         let what = match &self.pile {
             Some(pile) => format!("the rubble pile {} (N = {})", pile.file.display(), pile.bodies.len()),
             None => self.projectile.id.clone(),
         };
-        let title = format!(
-            "Impact of {} ({:.2} km, {:.1} km/s) on {} at zeta = {} deg; Q = {:.3e} erg/g",
+        let mut title = format!(
+            "Impact of {} ({:.2} km, {:.1} km/s) on {} at zeta = {} deg",
             what,
             self.projectile.equivalent_radius / 1e3,
             self.projectile.speed / 1e3,
             self.target.display(),
             self.angle_deg,
-            setup.q_erg_per_g
         );
+        if let Some((b, r)) = aim {
+            title += &format!(
+                ", b = {:.3} km = {:.3} R, psi = {} deg",
+                b / 1e3,
+                b / r,
+                geometry.azimuth_deg
+            );
+        }
+        title += &format!("; Q = {:.3e} erg/g", setup.q_erg_per_g);
         let scene = self.scene(setup.projectile_index);
-        ImpactPlan {
+        Ok(ImpactPlan {
             bodies,
             setup,
             title,
             scene,
-        }
+        })
     }
 }
 
@@ -418,8 +443,8 @@ pub struct PreparedImpact {
 pub fn prepare_impact(cfg: &ImpactConfig, out: &Path, force: bool) -> Result<PreparedImpact, ImpactError> {
     cfg.validate()?;
     let target = read_target(&cfg.target)?;
+    let plan = cfg.plan(&target)?;
     let lock = prepare_output_dir(out, force)?;
-    let plan = cfg.plan(&target);
     let io = |p: &Path| {
         let path = p.to_path_buf();
         move |source| ImpactError::Io { path, source }

@@ -78,6 +78,36 @@ pub struct ImpactSection {
     pub speed_km_s: Option<f64>,
     /// Inertia model of the ellipsoids: `"gaussian"` (Roig03 Eq. 4, default) or `"uniform"`.
     pub inertia: Option<crate::ellipsoid::body::InertiaModel>,
+    /// Impact parameter `b` (m, ≥ 0): the trajectory's offset from the target's centre of mass (default 0). At most
+    /// one of `impact_parameter_m`, `impact_parameter_frac`, `impact_angle_deg` ([`crate::impact::geometry`]).
+    pub impact_parameter_m: Option<f64>,
+    /// `b` as a fraction of the target's radius R (in [0, 1)).
+    pub impact_parameter_frac: Option<f64>,
+    /// Impact angle θ between the trajectory and the target's surface normal at the aim point (degrees, [0, 90)).
+    pub impact_angle_deg: Option<f64>,
+    /// Azimuth ψ of the aim point around the approach direction (degrees, [0, 360); default 0).
+    pub aim_azimuth_deg: Option<f64>,
+    /// Spin of a single-ellipsoid projectile (rad/s, world frame `[x, y, z]`; default none).
+    pub projectile_spin_rad_s: Option<[f64; 3]>,
+    /// Attitude of a single-ellipsoid projectile: a quaternion `[x, y, z, w]` (scalar last, world → body, as the
+    /// bodies files'; default a random one drawn from the seed).
+    pub projectile_attitude: Option<[f64; 4]>,
+}
+
+impl ImpactSection {
+    /// The geometry these keys ask for ([`crate::impact::geometry::ImpactGeometry::from_options`]).
+    pub fn geometry(&self) -> Result<crate::impact::geometry::ImpactGeometry, crate::impact::run::ImpactError> {
+        crate::impact::geometry::ImpactGeometry::from_options(
+            [
+                self.impact_parameter_m,
+                self.impact_parameter_frac,
+                self.impact_angle_deg,
+            ],
+            self.aim_azimuth_deg,
+            self.projectile_spin_rad_s.as_ref().map(|v| &v[..]),
+            self.projectile_attitude.as_ref().map(|v| &v[..]),
+        )
+    }
 }
 
 /// `[[projectile]]`: a custom projectile (density 3000 kg m⁻³, axis ratios 1 : 0.7 : 0.5), or a rubble-pile

@@ -26,6 +26,12 @@
 //! # snapshot_every = 100.0          # or their cadence (s): 0, 100, 200, ... and t_end; not both
 //! speed_km_s = 5.0                 # impact speed of P1-P3 and of custom projectiles without one (km/s; default 5)
 //! inertia = "gaussian"             # "gaussian" (Roig03 Eq. 4, default) or "uniform" (homogeneous ellipsoids)
+//! impact_parameter_frac = 0.7      # aim off the centre (crate::impact::geometry): b as a fraction of R, in [0, 1);
+//!                                  # or impact_parameter_m (b in m, >= 0), or impact_angle_deg (theta to the
+//!                                  # surface normal, [0, 90)): at most one (default: at the centre of mass)
+//! aim_azimuth_deg = 0.0            # psi of the aim point around the approach direction (degrees, [0, 360); default 0)
+//! projectile_spin_rad_s = [0.0, 0.0, 1e-3]   # spin of the projectile (rad/s, world frame; default none)
+//! projectile_attitude = [0.0, 0.0, 0.0, 1.0] # quaternion x, y, z, w (world -> body; default random from the seed)
 //!
 //! [[projectile]]                   # optional custom projectiles (density 3000 kg/m^3, axes 1 : 0.7 : 0.5)
 //! id = "S1"                        # name in campaign.projectiles and in run names ([A-Za-z0-9_-], not P1-P3)

@@ -325,6 +325,10 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
             base.every = imp.every.unwrap_or(DEFAULT_EVERY);
             base.inertia = imp.inertia.unwrap_or_default();
             base.snapshots = snapshots.clone();
+            base.geometry = imp.geometry().map_err(|e| match e {
+                ImpactError::Invalid { field, message } => invalid(format!("impact.{field}"), message),
+                other => invalid("impact".into(), other.to_string()),
+            })?;
             base.pile = piles
                 .iter()
                 .find(|(id, _)| *id == projectile.id)
@@ -334,7 +338,9 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 None => format!("campaign.projectiles[{pk}]"),
             };
             base.validate().map_err(|e| match e {
-                ImpactError::Invalid { field, message } if field.starts_with("projectile") => {
+                ImpactError::Invalid { field, message }
+                    if field.starts_with("projectile") && !field.starts_with("projectile_") =>
+                {
                     invalid(projectile_field(), format!("{field}: {message}"))
                 }
                 ImpactError::Invalid { field, message } => invalid(format!("impact.{field}"), message),
@@ -354,7 +360,12 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                         seed,
                         ..base.clone()
                     };
-                    let plan = config.plan(bodies);
+                    let plan = config.plan(bodies).map_err(|e| match e {
+                        ImpactError::Invalid { field, message } => {
+                            invalid(format!("impact.{field}"), format!("on target `{stem}`: {message}"))
+                        }
+                        other => invalid("impact".into(), other.to_string()),
+                    })?;
                     points.push(GridPoint {
                         name: format!("{stem}_{}_z{angle}_s{seed}", projectile.id),
                         target: stem.clone(),
