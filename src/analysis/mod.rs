@@ -4,6 +4,7 @@
 
 pub mod atmosphere;
 pub mod campaign_analysis;
+pub mod campaign_by;
 pub mod clumps;
 pub mod composition;
 pub mod creep;
@@ -16,6 +17,7 @@ pub mod fits;
 pub mod flyby;
 pub mod fragments;
 pub mod pile_equilibrium;
+pub mod q_star_bootstrap;
 pub use crate::ellipsoid::rigid_rotation;
 pub mod rotational_split;
 pub mod run_analysis;
