@@ -145,8 +145,8 @@ fn choose(header: &[String], rows: &[Vec<String>], requested: Option<&str>) -> R
     }
 }
 
-/// The table of `analysis`'s runs against `field` (see [`choose`] for `None`), from `dir/campaign.csv`.
-pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&str>) -> Result<ByTable, AnalysisError> {
+/// `dir/campaign.csv`: its header and rows.
+fn read_index(dir: &Path) -> Result<(Vec<String>, Vec<Vec<String>>), AnalysisError> {
     let index = dir.join(CAMPAIGN_CSV);
     let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
         path: index.clone(),
@@ -159,6 +159,23 @@ pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&st
         .map(|r| r.map(|r| r.iter().map(String::from).collect()))
         .collect::<Result<_, _>>()
         .map_err(|e| err(&e))?;
+    Ok((header, rows))
+}
+
+/// The column of `dir/campaign.csv` that `requested` names, or the default field for `None` (see [`choose`]);
+/// an error naming `--by` and the valid fields when there is none (check it before a long analysis).
+pub fn by_field_name(dir: &Path, requested: Option<&str>) -> Result<String, AnalysisError> {
+    let (header, rows) = read_index(dir)?;
+    choose(&header, &rows, requested)
+}
+
+/// The table of `analysis`'s runs against `field` (see [`choose`] for `None`), from `dir/campaign.csv`.
+pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&str>) -> Result<ByTable, AnalysisError> {
+    let (header, rows) = read_index(dir)?;
+    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
+        path: dir.join(CAMPAIGN_CSV),
+        reason: e.to_string(),
+    };
     let field = choose(&header, &rows, field)?;
     let col = |c: &str| header.iter().position(|h| h == c);
     let (c_run, c_by) = (col("run").ok_or_else(|| err(&"no `run` column"))?, col(&field).unwrap_or(0));

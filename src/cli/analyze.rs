@@ -130,6 +130,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     if !(at.is_finite() && at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {at}")));
     }
+    let field = rubblepile::analysis::campaign_by::by_field_name(&args.dir, args.by.as_deref()).map_err(CliError::usage)?;
     let selection = rubblepile::analysis::run_analysis::SpinSelection {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
@@ -163,7 +164,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
             eprintln!("note: spin distribution of {}: {}", d.projectile, d.selection);
         }
     }
-    let by = rubblepile::analysis::campaign_by::by_field_table(&args.dir, &a, args.by.as_deref())
+    let by = rubblepile::analysis::campaign_by::by_field_table(&args.dir, &a, Some(&field))
         .map_err(CliError::usage)?;
     let csv = by.write_csv(&args.dir).map_err(CliError::failed)?;
     let figure = rubblepile::analysis::figures::by_field::OutcomesByField { table: &by, t_at: at };
