@@ -79,6 +79,6 @@ impl Figure for OutcomesByField<'_> {
                 .label(format!("{label}: runs, mean ± standard error"))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
     }
 }
