@@ -116,7 +116,14 @@ fn the_plan_is_the_product_in_order_and_a_swept_value_is_the_written_one() {
     let names: Vec<&str> = c.points.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(
         names,
-        ["tiny_S1_z0_s3", "tiny_S1_z0_s5", "tiny_S1_z0_s7", "tiny_S1_z90_s3", "tiny_S1_z90_s5", "tiny_S1_z90_s7"]
+        [
+            "tiny_S1_z0_s3",
+            "tiny_S1_z0_s5",
+            "tiny_S1_z0_s7",
+            "tiny_S1_z90_s3",
+            "tiny_S1_z90_s5",
+            "tiny_S1_z90_s7"
+        ]
     );
     // without [sweep], no override is recorded (campaign.csv keeps its columns)
     let plain = parse_campaign(BASE, "c.toml", &dir).unwrap();
@@ -131,17 +138,41 @@ fn wrong_sweep_paths_and_grids_are_refused_naming_them() {
     let with = |sweep: &str| format!("{BASE}\n[sweep]\n{sweep}\n");
     for (sweep, wanted) in [
         // a mistyped field: named, with the valid ones of its table
-        ("\"impact.speed\" = [1.0]", &["sweep.\"impact.speed\"", "unknown field `speed`", "speed_km_s", "f0"][..]),
-        ("\"impakt.f0\" = [1.0]", &["sweep.\"impakt.f0\"", "unknown field `impakt`", "impact"]),
+        (
+            "\"impact.speed\" = [1.0]",
+            &["sweep.\"impact.speed\"", "unknown field `speed`", "speed_km_s", "f0"][..],
+        ),
+        (
+            "\"impakt.f0\" = [1.0]",
+            &["sweep.\"impakt.f0\"", "unknown field `impakt`", "impact"],
+        ),
         ("\"impact.f0\" = [\"x\"]", &["sweep.\"impact.f0\"", "invalid type"]),
-        ("\"projectile[3].radius_km\" = [1.0]", &["sweep.\"projectile[3].radius_km\"", "has 1 entries, so no [3]"]),
-        ("\"impact.f0\" = { from = 1.0, to = 2.0 }", &["sweep.\"impact.f0\"", "one of `step` and `count`"]),
-        ("\"impact.f0\" = { from = 1.0, to = 2.0, step = -1.0 }", &["sweep.\"impact.f0\"", "step"]),
+        (
+            "\"projectile[3].radius_km\" = [1.0]",
+            &["sweep.\"projectile[3].radius_km\"", "has 1 entries, so no [3]"],
+        ),
+        (
+            "\"impact.f0\" = { from = 1.0, to = 2.0 }",
+            &["sweep.\"impact.f0\"", "one of `step` and `count`"],
+        ),
+        (
+            "\"impact.f0\" = { from = 1.0, to = 2.0, step = -1.0 }",
+            &["sweep.\"impact.f0\"", "step"],
+        ),
         ("\"impact.f0\" = []", &["sweep.\"impact.f0\"", "at least one value"]),
-        ("\"impact.f0\" = 3.0", &["sweep.\"impact.f0\"", "expected a list of values or a grid"]),
-        ("\"campaign.out\" = [\"a\"]", &["sweep.\"campaign.out\"", "not a field of a run"]),
+        (
+            "\"impact.f0\" = 3.0",
+            &["sweep.\"impact.f0\"", "expected a list of values or a grid"],
+        ),
+        (
+            "\"campaign.out\" = [\"a\"]",
+            &["sweep.\"campaign.out\"", "not a field of a run"],
+        ),
         // a value the impact refuses: the field, and which swept values gave it
-        ("\"impact.t_end\" = [40.0, -1.0]", &["impact.t_end", "with the sweep's impact.t_end = -1"]),
+        (
+            "\"impact.t_end\" = [40.0, -1.0]",
+            &["impact.t_end", "with the sweep's impact.t_end = -1"],
+        ),
     ] {
         let e = plan_error(&with(sweep), &dir);
         assert_eq!(e.lines().count(), 1, "{e}");
@@ -155,7 +186,10 @@ fn wrong_sweep_paths_and_grids_are_refused_naming_them() {
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let header = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r.records().map(|x| x.unwrap().iter().map(String::from).collect()).collect();
+    let rows = r
+        .records()
+        .map(|x| x.unwrap().iter().map(String::from).collect())
+        .collect();
     (header, rows)
 }
 
@@ -186,7 +220,10 @@ fn a_swept_campaign_runs_and_is_tabulated_against_its_field() {
     assert!(stdout.contains("outcomes against projectile[0].speed_km_s"), "{stdout}");
     // two Q values: Q*_D (if any) comes with the warning
     if stdout.contains("bootstrap 95 % interval") {
-        assert!(stderr.contains("warning: Q*_D") && stderr.contains("fewer than three"), "{stderr}");
+        assert!(
+            stderr.contains("warning: Q*_D") && stderr.contains("fewer than three"),
+            "{stderr}"
+        );
     }
     let table = dir.join("out/analysis/campaign_by_projectile_0__speed_km_s.csv");
     let (th, trows) = read_csv(&table);
@@ -219,7 +256,10 @@ fn a_swept_campaign_runs_and_is_tabulated_against_its_field() {
             // s/√n for two values is |a − b| / 2
             let se: f64 = row[tc(&format!("{metric}_se"))].parse().unwrap();
             let want = (expected[1] - expected[0]).abs() / 2.0;
-            assert!((se - want).abs() <= 1e-12 * want.max(1e-300) + 1e-15, "{metric}: {se} vs {want}");
+            assert!(
+                (se - want).abs() <= 1e-12 * want.max(1e-300) + 1e-15,
+                "{metric}: {se} vs {want}"
+            );
         }
     }
     let svg = std::fs::read_to_string(dir.join("out/analysis/campaign_by_projectile_0__speed_km_s.svg")).unwrap();
@@ -232,7 +272,10 @@ fn a_swept_campaign_runs_and_is_tabulated_against_its_field() {
     assert_eq!(qrows.len(), 2);
     // a field the campaign lacks, a target it lacks: one line naming the flag and the valid names
     for (args, wanted) in [
-        (&["--by", "speed"][..], &["--by", "`speed`", "projectile[0].speed_km_s", "angle_deg"][..]),
+        (
+            &["--by", "speed"][..],
+            &["--by", "`speed`", "projectile[0].speed_km_s", "angle_deg"][..],
+        ),
         (&["--spin-target", "N200_T12"], &["--spin-target", "N200_T12", "tiny"]),
     ] {
         let mut all = vec!["analyze-campaign", "out", "--force"];
@@ -260,7 +303,10 @@ fn runs_ending_at_different_times_need_at() {
     let bad = rubblepile(&dir, &["analyze-campaign", "out"]);
     assert_eq!(bad.status.code(), Some(2));
     let e = String::from_utf8_lossy(&bad.stderr);
-    assert!(e.contains("--at: the runs end at different times ([20.0, 40.0] s)"), "{e}");
+    assert!(
+        e.contains("--at: the runs end at different times ([20.0, 40.0] s)"),
+        "{e}"
+    );
     // at a time both have a snapshot (t_end of each, and the default snapshots cut at t_end: 0, 20; 0, 40) —
     // t = 20 s is the shorter run's end but not a snapshot of the longer: named
     let bad = rubblepile(&dir, &["analyze-campaign", "out", "--at", "20"]);

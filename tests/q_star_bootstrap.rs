@@ -40,12 +40,18 @@ fn the_interval_contains_the_true_q_star_and_is_reproducible() {
     }
     // a 95 % interval misses the truth about once in 20 data sets; at least 16 of 20 (binomial p ≈ 0.016 of fewer
     // for a true coverage of 0.95; the percentile bootstrap under-covers a little with 8 runs per level)
-    assert!(contained >= 16, "the interval held Q*_D = {truth} in {contained} of 20 data sets");
+    assert!(
+        contained >= 16,
+        "the interval held Q*_D = {truth} in {contained} of 20 data sets"
+    );
 
     // noiseless data: every resample is the line itself, the interval shrinks to Q*_D
     let (q, b) = synthetic(truth, 4, 3, 0.0, 1);
     let a = q_star_bootstrap(&q, &b, 200, 1).unwrap();
-    assert!((a.low / truth - 1.0).abs() < 1e-9 && (a.high / truth - 1.0).abs() < 1e-9, "{a:?}");
+    assert!(
+        (a.low / truth - 1.0).abs() < 1e-9 && (a.high / truth - 1.0).abs() < 1e-9,
+        "{a:?}"
+    );
 
     // four times the runs: the interval about halves (1/√4), within a generous 0.3 to 0.75
     let (q, b) = synthetic(truth, 5, 8, 0.1, 3);

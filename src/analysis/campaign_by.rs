@@ -178,7 +178,10 @@ pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&st
     };
     let field = choose(&header, &rows, field)?;
     let col = |c: &str| header.iter().position(|h| h == c);
-    let (c_run, c_by) = (col("run").ok_or_else(|| err(&"no `run` column"))?, col(&field).unwrap_or(0));
+    let (c_run, c_by) = (
+        col("run").ok_or_else(|| err(&"no `run` column"))?,
+        col(&field).unwrap_or(0),
+    );
     let analysed: Vec<(&Vec<String>, &CampaignRun)> = analysis
         .runs
         .iter()

@@ -41,7 +41,11 @@ impl QStarBootstrap {
                  trustworthy; add projectiles or speeds around it",
                 self.q_star,
                 self.q_levels,
-                if self.q_levels >= 3 { ", and lies outside them" } else { "" }
+                if self.q_levels >= 3 {
+                    ", and lies outside them"
+                } else {
+                    ""
+                }
             )
         })
     }

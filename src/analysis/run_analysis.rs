@@ -648,6 +648,33 @@ pub struct CampaignAnalysis {
     pub spin_distributions: Vec<SpinDistribution>,
 }
 
+impl CampaignAnalysis {
+    /// Q*_D for a summary line: `Q ± σ erg/g (bootstrap 95 % interval low to high, seed s)`, or why there is none.
+    pub fn q_star_text(&self) -> String {
+        match (&self.q_star_d, &self.q_star_d_bootstrap) {
+            (Fit::Ok(c), Fit::Ok(b)) => format!(
+                "{:.3e} ± {:.1e} erg/g (bootstrap 95 % interval {:.3e} to {:.3e}, seed {})",
+                c.x, c.sigma_x, b.low, b.high, b.seed
+            ),
+            (Fit::Ok(c), Fit::Failed(why)) => format!("{:.3e} ± {:.1e} erg/g (no bootstrap: {why})", c.x, c.sigma_x),
+            (Fit::Failed(why), _) => format!("n/a ({why})"),
+        }
+    }
+
+    /// What a reader must be told: Q*_D resting on fewer than three Q values, spin distributions pooled over every
+    /// angle for want of runs at the requested one.
+    pub fn warnings(&self) -> Vec<String> {
+        let q = self.q_star_d_bootstrap.ok().and_then(|b| b.warning());
+        let spins = self
+            .spin_distributions
+            .iter()
+            .filter(|d| !d.selection.contains(" at zeta "));
+        q.into_iter()
+            .chain(spins.map(|d| format!("spin distribution of {}: {}", d.projectile, d.selection)))
+            .collect()
+    }
+}
+
 /// Which runs make each projectile's spin distribution (Fig. 7): those on `target` at ζ = `angle_deg`, when the
 /// campaign has them (the paper uses N200_T12 at 45°); otherwise the projectile's runs on `target` at every angle.
 /// Runs on different targets are never pooled.
@@ -711,7 +738,11 @@ pub fn spin_distributions(
             let of_p: Vec<usize> = (0..runs.len())
                 .filter(|&k| runs[k].projectile == p && runs[k].target == target)
                 .collect();
-            let case: Vec<usize> = of_p.iter().copied().filter(|&k| runs[k].angle_deg == angle_deg).collect();
+            let case: Vec<usize> = of_p
+                .iter()
+                .copied()
+                .filter(|&k| runs[k].angle_deg == angle_deg)
+                .collect();
             let (chosen, how) = if case.is_empty() {
                 (of_p, format!("target {target}, every angle (none at zeta {angle_deg})"))
             } else {

@@ -122,60 +122,35 @@ pub struct AnalyzeCampaignArgs {
 
 /// Runs `analyze-campaign`.
 pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
-    use rubblepile::analysis::campaign_analysis::campaign_end_time;
-    let at = match args.at {
-        Some(at) => at,
-        None => campaign_end_time(&args.dir).map_err(CliError::usage)?,
-    };
+    use rubblepile::analysis::{campaign_analysis as ca, campaign_by, figures::by_field, run_analysis::SpinSelection};
+    let at = args
+        .at
+        .map_or_else(|| ca::campaign_end_time(&args.dir), Ok)
+        .map_err(CliError::usage)?;
     if !(at.is_finite() && at > 0.0) {
         return Err(CliError::usage(format!("--at: must be a time > 0 s, got {at}")));
     }
-    let field = rubblepile::analysis::campaign_by::by_field_name(&args.dir, args.by.as_deref()).map_err(CliError::usage)?;
-    let selection = rubblepile::analysis::run_analysis::SpinSelection {
+    let field = campaign_by::by_field_name(&args.dir, args.by.as_deref()).map_err(CliError::usage)?;
+    let selection = SpinSelection {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
     };
-    let a = rubblepile::analysis::campaign_analysis::analyze_campaign(
-        &args.dir,
-        at,
-        args.force,
-        &selection,
-        args.bootstrap_seed,
-    )
-    .map_err(|e| match e {
+    let a = ca::analyze_campaign(&args.dir, at, args.force, &selection, args.bootstrap_seed).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
-    let q_star = match (&a.q_star_d, &a.q_star_d_bootstrap) {
-        (Fit::Ok(c), Fit::Ok(b)) => format!(
-            "{:.3e} ± {:.1e} erg/g (bootstrap 95 % interval {:.3e} to {:.3e}, seed {})",
-            c.x, c.sigma_x, b.low, b.high, b.seed
-        ),
-        (Fit::Ok(c), Fit::Failed(why)) => format!("{:.3e} ± {:.1e} erg/g (no bootstrap: {why})", c.x, c.sigma_x),
-        (Fit::Failed(why), _) => format!("n/a ({why})"),
-    };
-    if let Fit::Ok(b) = &a.q_star_d_bootstrap
-        && let Some(w) = b.warning()
-    {
-        eprintln!("warning: {w}");
-    }
-    for d in &a.spin_distributions {
-        if !d.selection.contains(" at zeta ") {
-            eprintln!("note: spin distribution of {}: {}", d.projectile, d.selection);
-        }
-    }
-    let by = rubblepile::analysis::campaign_by::by_field_table(&args.dir, &a, Some(&field))
-        .map_err(CliError::usage)?;
-    let csv = by.write_csv(&args.dir).map_err(CliError::failed)?;
-    let figure = rubblepile::analysis::figures::by_field::OutcomesByField { table: &by, t_at: at };
-    if let Err(why) = rubblepile::analysis::figures::style::write_figure(&args.dir.join("analysis"), &by.stem(), &figure)
-    {
-        eprintln!("warning: figure not drawn: {}: {why}", by.stem());
-    }
-    println!("outcomes against {} ({}):", by.field, csv.display());
-    for line in by.lines() {
-        println!("  {line}");
-    }
+    a.warnings().iter().for_each(|w| eprintln!("warning: {w}"));
+    let by = campaign_by::by_field_table(&args.dir, &a, Some(&field)).map_err(CliError::usage)?;
+    let (csv, not_drawn) = by_field::write_by_field(&args.dir, &by, at).map_err(CliError::failed)?;
+    not_drawn
+        .iter()
+        .for_each(|why| eprintln!("warning: figure not drawn: {}: {why}", by.stem()));
+    println!(
+        "outcomes against {} ({}):\n  {}",
+        by.field,
+        csv.display(),
+        by.lines().join("\n  ")
+    );
     println!(
         "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {} \
          (campaign_analysis.json, campaign_runs.csv, {}.csv, Figs. 5 and 7 as SVG and PNG; each run's figures in its \
@@ -183,7 +158,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
         a.t_at,
         a.runs.len(),
         a.skipped.len(),
-        q_star,
+        a.q_star_text(),
         args.dir.join("analysis").display(),
         by.stem(),
     );

@@ -33,9 +33,13 @@ impl Figure for OutcomesByField<'_> {
             return Err("no run to plot".into());
         };
         let xr = padded(x0, x1, 0.08);
-        let mut chart = figure_chart(root, &format!("Outcomes vs {} at t = {} s", self.table.field, self.t_at), 64)
-            .build_cartesian_2d(xr.0..xr.1, 0.0..1.1)
-            .map_err(draw_err)?;
+        let mut chart = figure_chart(
+            root,
+            &format!("Outcomes vs {} at t = {} s", self.table.field, self.t_at),
+            64,
+        )
+        .build_cartesian_2d(xr.0..xr.1, 0.0..1.1)
+        .map_err(draw_err)?;
         chart
             .configure_mesh()
             .x_desc(self.table.field.as_str())
@@ -68,7 +72,14 @@ impl Figure for OutcomesByField<'_> {
             chart
                 .draw_series(means.iter().filter(|p| p.2.is_finite()).map(|&(x, y, se)| {
                     PathElement::new(
-                        vec![(x - cap, y - se), (x + cap, y - se), (x, y - se), (x, y + se), (x - cap, y + se), (x + cap, y + se)],
+                        vec![
+                            (x - cap, y - se),
+                            (x + cap, y - se),
+                            (x, y - se),
+                            (x, y + se),
+                            (x - cap, y + se),
+                            (x + cap, y + se),
+                        ],
                         colour.stroke_width(2),
                     )
                 }))
@@ -81,4 +92,17 @@ impl Figure for OutcomesByField<'_> {
         }
         draw_legend(&mut chart, SeriesLabelPosition::LowerLeft)
     }
+}
+
+/// Writes `table` as `campaign_dir/analysis/<stem>.csv` ([`ByTable::write_csv`]) and its figure (`t_at`: the
+/// snapshots' time, s): the CSV's path, and why the figure was not drawn, if it was not.
+pub fn write_by_field(
+    campaign_dir: &std::path::Path,
+    table: &ByTable,
+    t_at: f64,
+) -> Result<(std::path::PathBuf, Option<String>), crate::analysis::run_analysis::AnalysisError> {
+    let csv = table.write_csv(campaign_dir)?;
+    let figure = OutcomesByField { table, t_at };
+    let drawn = super::style::write_figure(&campaign_dir.join("analysis"), &table.stem(), &figure);
+    Ok((csv, drawn.err().map(String::from)))
 }

@@ -106,7 +106,11 @@ fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Camp
             .collect();
         let text: Vec<(String, String)> = overrides.iter().map(|(p, v)| (p.clone(), value_text(v))).collect();
         let with = with_overrides(&file, &overrides).map_err(invalid)?;
-        let described = text.iter().map(|(p, v)| format!("{p} = {v}")).collect::<Vec<_>>().join(", ");
+        let described = text
+            .iter()
+            .map(|(p, v)| format!("{p} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ");
         let mut c = resolve(with, name, base_dir).map_err(|e| match e {
             CampaignError::File(crate::io::scene_file::SceneError::Invalid { file, field, message }) => {
                 CampaignError::File(crate::io::scene_file::SceneError::Invalid {
@@ -124,7 +128,13 @@ fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Camp
                 let leaf = p.rsplit('.').next().unwrap_or(p);
                 let clean = |s: &str| -> String {
                     s.chars()
-                        .map(|ch| if ch.is_ascii_alphanumeric() || "_.-".contains(ch) { ch } else { '-' })
+                        .map(|ch| {
+                            if ch.is_ascii_alphanumeric() || "_.-".contains(ch) {
+                                ch
+                            } else {
+                                '-'
+                            }
+                        })
                         .collect()
                 };
                 format!("_{}{}", clean(leaf), clean(v))
@@ -136,7 +146,10 @@ fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Camp
             if !names.insert(p.name.clone()) {
                 return Err(invalid((
                     "sweep".into(),
-                    format!("two runs would be named `{}`: make the swept values differ in their names", p.name),
+                    format!(
+                        "two runs would be named `{}`: make the swept values differ in their names",
+                        p.name
+                    ),
                 )));
             }
         }

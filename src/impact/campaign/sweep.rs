@@ -73,7 +73,9 @@ fn flatten(table: &toml::Table, prefix: &str, axes: &mut Vec<SweepAxis>) -> Resu
             other => {
                 return Err((
                     field,
-                    format!("expected a list of values or a grid {{ from, to, step }} / {{ from, to, count }}, got {other}"),
+                    format!(
+                        "expected a list of values or a grid {{ from, to, step }} / {{ from, to, count }}, got {other}"
+                    ),
                 ));
             }
         };
@@ -85,7 +87,10 @@ fn flatten(table: &toml::Table, prefix: &str, axes: &mut Vec<SweepAxis>) -> Resu
         }
         let path = canonical(&path).to_string();
         if path == "campaign.out" || path == "campaign.parallel" {
-            return Err((field, "not a field of a run: the campaign has one directory and one pool".into()));
+            return Err((
+                field,
+                "not a field of a run: the campaign has one directory and one pool".into(),
+            ));
         }
         axes.push(SweepAxis { path, values });
     }
@@ -95,8 +100,13 @@ fn flatten(table: &toml::Table, prefix: &str, axes: &mut Vec<SweepAxis>) -> Resu
 /// The values of a grid table: `from`, `from + step`, … up to `to` (inclusive, within 1e-9 of a step), or `count`
 /// values evenly from `from` to `to`; integers when `from`, `to` and `step` are.
 fn grid(t: &toml::Table) -> Result<Vec<Value>, String> {
-    if let Some(k) = t.keys().find(|k| !["from", "to", "step", "count"].contains(&k.as_str())) {
-        return Err(format!("unknown key `{k}` in a grid: expected from, to and one of step, count"));
+    if let Some(k) = t
+        .keys()
+        .find(|k| !["from", "to", "step", "count"].contains(&k.as_str()))
+    {
+        return Err(format!(
+            "unknown key `{k}` in a grid: expected from, to and one of step, count"
+        ));
     }
     let num = |k: &str| match t.get(k) {
         Some(Value::Integer(i)) => Ok(*i as f64),
@@ -113,10 +123,14 @@ fn grid(t: &toml::Table) -> Result<Vec<Value>, String> {
             let step = num("step")?;
             let n = (to - from) / step;
             if step == 0.0 || n < -1e-9 || !n.is_finite() {
-                return Err(format!("step: must be non-zero and lead from {from} to {to}, got {step}"));
+                return Err(format!(
+                    "step: must be non-zero and lead from {from} to {to}, got {step}"
+                ));
             }
             if n + 1.0 > MAX_GRID as f64 {
-                return Err(format!("step: at most {MAX_GRID} values, got {step} from {from} to {to}"));
+                return Err(format!(
+                    "step: at most {MAX_GRID} values, got {step} from {from} to {to}"
+                ));
             }
             let n = (n + 1e-9).floor() as usize + 1;
             let xs = (0..n).map(|k| round(from + k as f64 * step)).collect();
@@ -139,7 +153,13 @@ fn grid(t: &toml::Table) -> Result<Vec<Value>, String> {
     };
     Ok(xs
         .into_iter()
-        .map(|x| if integers { Value::Integer(x as i64) } else { Value::Float(x) })
+        .map(|x| {
+            if integers {
+                Value::Integer(x as i64)
+            } else {
+                Value::Float(x)
+            }
+        })
         .collect())
 }
 
@@ -153,10 +173,12 @@ pub fn with_overrides(file: &CampaignFile, overrides: &[(String, Value)]) -> Res
     for (path, value) in overrides {
         let field = format!("sweep.\"{path}\"");
         set(&mut root, path, value.clone()).map_err(|m| (field.clone(), m))?;
-        out = root
-            .clone()
-            .try_into::<CampaignFile>()
-            .map_err(|e| (field.clone(), format!("not a valid field or value: {}", super::one_line(e.message()))))?;
+        out = root.clone().try_into::<CampaignFile>().map_err(|e| {
+            (
+                field.clone(),
+                format!("not a valid field or value: {}", super::one_line(e.message())),
+            )
+        })?;
     }
     Ok(out)
 }
@@ -192,13 +214,13 @@ fn set(root: &mut Value, path: &str, value: Value) -> Result<(), String> {
             table.insert(name.to_string(), value);
             return Ok(());
         }
-        let entry = table.entry(name.to_string()).or_insert_with(|| Value::Table(Default::default()));
+        let entry = table
+            .entry(name.to_string())
+            .or_insert_with(|| Value::Table(Default::default()));
         at = match index {
             None => entry,
             Some(i) => {
-                let list = entry
-                    .as_array_mut()
-                    .ok_or_else(|| format!("`{name}` is not a list"))?;
+                let list = entry.as_array_mut().ok_or_else(|| format!("`{name}` is not a list"))?;
                 let len = list.len();
                 list.get_mut(i)
                     .ok_or_else(|| format!("`{name}` has {len} entries, so no [{i}]"))?

@@ -296,7 +296,10 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             b.high,
             b.seed,
             if b.underdetermined {
-                format!(" — **warning**: only {} Q value(s), fewer than three bracket it", b.q_levels)
+                format!(
+                    " — **warning**: only {} Q value(s), fewer than three bracket it",
+                    b.q_levels
+                )
             } else {
                 String::new()
             }
