@@ -7,8 +7,11 @@ use std::path::{Path, PathBuf};
 use crate::analysis::run_analysis::{AnalysisError, CampaignAnalysis, CampaignRun};
 use crate::impact::campaign::{CAMPAIGN_COLUMNS, CAMPAIGN_CSV};
 
+/// How an outcome is read from a run.
+pub type Outcome = fn(&CampaignRun) -> Option<f64>;
+
 /// The outcomes tabulated, with how each is read from a run.
-pub const BY_METRICS: [(&str, fn(&CampaignRun) -> Option<f64>); 7] = [
+pub const BY_METRICS: [(&str, Outcome); 7] = [
     ("largest_remnant_fraction", |r| r.largest_remnant_fraction),
     ("bound_mass_fraction", |r| Some(r.bound_mass_fraction)),
     ("fragments", |r| Some(r.fragments as f64)),
