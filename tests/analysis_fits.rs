@@ -465,9 +465,9 @@ fn campaign_run(
     }
 }
 
-/// Roig03 Fig. 7: per projectile, the requested case (target, ζ) is pooled when it exists, else all runs; spins
-/// drawn from n = 0.5 come out best fitted by n = 0.5 with b near the truth, and the Eq. 45-normalised curve
-/// integrates to 1.
+/// Roig03 Fig. 7: per projectile, the requested case (target, ζ) is pooled when it exists, else the target's runs
+/// at every angle, never another target's; spins drawn from n = 0.5 come out best fitted by n = 0.5 with b near the
+/// truth, and the Eq. 45-normalised curve integrates to 1. The default target is the campaign's own.
 #[test]
 fn spin_distributions_pool_the_requested_case_and_normalise() {
     use rubblepile::analysis::run_analysis::{SpinSelection, spin_distributions};
@@ -483,17 +483,40 @@ fn spin_distributions_pool_the_requested_case_and_normalise() {
         spin_samples(12, 2000, N_TRUE, B_TRUE),
         spin_samples(13, 2000, N_TRUE, B_TRUE),
     ];
-    let d = spin_distributions(&runs, &spins, &SpinSelection::default());
-    assert_eq!(d.len(), 2);
+    let on_n200 = spin_distributions(&runs, &spins, "N200_T12", 45.0);
     assert_eq!(
-        (d[0].projectile.as_str(), d[0].runs.clone()),
+        on_n200.len(),
+        1,
+        "P2 has no run on N200_T12: left out, not pooled from N30_T4"
+    );
+    assert_eq!(
+        (on_n200[0].projectile.as_str(), on_n200[0].runs.clone()),
         ("P1", vec!["a".to_string()])
     );
-    assert_eq!(d[0].selection, "target N200_T12 at zeta 45");
+    assert_eq!(on_n200[0].selection, "target N200_T12 at zeta 45");
+    let on_n30 = spin_distributions(&runs, &spins, "N30_T4", 0.0);
+    assert_eq!(on_n30.len(), 1);
     assert_eq!(
-        (d[1].runs.len(), d[1].selection.as_str(), d[1].fragments),
-        (2, "all runs", 4000)
+        (on_n30[0].runs.len(), on_n30[0].selection.as_str(), on_n30[0].fragments),
+        (2, "target N30_T4, every angle (none at zeta 0)", 4000)
     );
+    let d = [on_n200, on_n30].concat();
+    // the default target: the only one, else N200_T12 among several, else an error naming them
+    let targets = |t: &[&str]| t.iter().map(|s| s.to_string()).collect::<Vec<_>>();
+    let default = SpinSelection::default();
+    assert_eq!(default.resolve(&targets(&["N30_T4"])).unwrap(), "N30_T4");
+    assert_eq!(default.resolve(&targets(&["N30_T4", "N200_T12"])).unwrap(), "N200_T12");
+    let e = default
+        .resolve(&targets(&["N30_T4", "N100_T4"]))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--spin-target") && e.contains("N30_T4, N100_T4"), "{e}");
+    let asked = SpinSelection {
+        target: Some("N1".into()),
+        angle_deg: 45.0,
+    };
+    let e = asked.resolve(&targets(&["N30_T4"])).unwrap_err().to_string();
+    assert!(e.contains("no target `N1`") && e.contains("N30_T4"), "{e}");
     for dist in &d {
         let best = dist.best().expect("a fit");
         assert_eq!(best.n, 0.5, "{}: best n", dist.projectile);

@@ -15,12 +15,14 @@ use crate::io::messages::{Channel, emit};
 /// `analysis/` is written or, with `force`, rewritten, figures included) and writes
 /// `CAMPAIGN_DIR/analysis/campaign_analysis.json`, `campaign_runs.csv` and the campaign figures (Roig03 Figs. 5
 /// and 7, [`crate::analysis::figures::write_campaign_figures`]; a figure that cannot be drawn is a warning on
-/// stderr).
+/// stderr). The spin distributions are of one target ([`SpinSelection::resolve`], checked before any run is
+/// analysed); Q*_D's bootstrap draws from `bootstrap_seed`.
 pub fn analyze_campaign(
     dir: &Path,
     t_at: f64,
     force: bool,
     selection: &SpinSelection,
+    bootstrap_seed: u64,
 ) -> Result<CampaignAnalysis, AnalysisError> {
     let _lock = lock_analysis(dir, "campaign.csv")?;
     let out_dir = dir.join("analysis");
@@ -36,11 +38,21 @@ pub fn analyze_campaign(
     let names = ["run", "target", "projectile", "angle_deg", "q_erg_per_g", "status"];
     let (mut rdr, [c_run, c_target, c_proj, c_angle, c_q, c_status]) =
         crate::io::table::open_columns(&index, names).map_err(|e| err(&e))?;
+    let records: Vec<csv::StringRecord> = rdr.records().collect::<Result<_, _>>().map_err(|e| err(&e))?;
+    let mut targets: Vec<String> = Vec::new();
+    for rec in records.iter().filter(|r| &r[c_status] == "completed") {
+        if !targets.iter().any(|t| t == &rec[c_target]) {
+            targets.push(rec[c_target].to_string());
+        }
+    }
+    let spin_target = match targets.is_empty() {
+        true => String::new(),
+        false => selection.resolve(&targets)?,
+    };
     let mut runs = Vec::new();
     let mut spins: Vec<Vec<f64>> = Vec::new();
     let mut skipped = Vec::new();
-    for rec in rdr.records() {
-        let rec = rec.map_err(|e| err(&e))?;
+    for rec in records {
         let run = rec[c_run].to_string();
         if &rec[c_status] != "completed" {
             skipped.push(run);
@@ -115,13 +127,20 @@ pub fn analyze_campaign(
         Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
         Err(e) => Fit::Failed(e.to_string()),
     };
-    let spin_distributions = spin_distributions(&runs, &spins, selection);
+    let spin_distributions = spin_distributions(&runs, &spins, &spin_target, selection.angle_deg);
+    let q_star_d_bootstrap = Fit::from(crate::analysis::q_star_bootstrap::q_star_bootstrap(
+        &q,
+        &bound,
+        crate::analysis::q_star_bootstrap::DEFAULT_RESAMPLES,
+        bootstrap_seed,
+    ));
     let analysis = CampaignAnalysis {
         t_at,
         runs,
         skipped,
         bound_fraction_vs_q: Fit::from(line),
         q_star_d,
+        q_star_d_bootstrap,
         spin_distributions,
     };
     crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
@@ -148,4 +167,37 @@ pub fn analyze_campaign(
         emit(Channel::Warning, &format!("warning: figure not drawn: {why}"));
     }
     Ok(analysis)
+}
+
+/// The end time shared by the completed runs of `dir/campaign.csv` (their `final_time`, s): `analyze-campaign`'s
+/// default `--at`. Errors ([`AnalysisError::Request`]) when no run completed or the runs end at different times.
+pub fn campaign_end_time(dir: &Path) -> Result<f64, AnalysisError> {
+    let index = dir.join("campaign.csv");
+    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
+        path: index.clone(),
+        reason: e.to_string(),
+    };
+    let (mut rdr, [c_status, c_end]) =
+        crate::io::table::open_columns(&index, ["status", "final_time"]).map_err(|e| err(&e))?;
+    let mut ends: Vec<f64> = Vec::new();
+    for rec in rdr.records() {
+        let rec = rec.map_err(|e| err(&e))?;
+        if &rec[c_status] == "completed"
+            && let Ok(t) = rec[c_end].parse::<f64>()
+            && !ends.contains(&t)
+        {
+            ends.push(t);
+        }
+    }
+    ends.sort_by(f64::total_cmp);
+    match ends[..] {
+        [t] => Ok(t),
+        [] => Err(AnalysisError::Request(format!(
+            "--at: no completed run in {} to take the end time from; give --at",
+            index.display()
+        ))),
+        _ => Err(AnalysisError::Request(format!(
+            "--at: the runs end at different times ({ends:?} s); give --at, a time with a snapshot in every run"
+        ))),
+    }
 }

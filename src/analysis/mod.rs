@@ -1,8 +1,8 @@
 //! Post-processing of states and runs: what any run needs (fragments, fits, clumps, composition, flyby outcome,
-//! spin-up diagnostics, the verdicts of T_c,3 searches, creep, the model atmosphere and tumbler measurements,
-//! figures). The three papers' reports are in the binary, in `src/studies/` (nothing here names them).
+//! spin-up diagnostics, the verdicts of T_c,3 searches, creep, campaigns against any field, figures). The three papers' reports are in the binary, in `src/studies/` (nothing here names them).
 
 pub mod campaign_analysis;
+pub mod campaign_by;
 pub mod clumps;
 pub mod composition;
 pub mod creep;
@@ -11,6 +11,7 @@ pub mod figures;
 pub mod fits;
 pub mod flyby;
 pub mod fragments;
+pub mod q_star_bootstrap;
 pub use crate::ellipsoid::rigid_rotation;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;

@@ -63,6 +63,9 @@ pub enum AnalysisError {
     /// The fragment analysis refused its input.
     #[error("{0}")]
     Fragments(String),
+    /// A request that does not fit the campaign (an option naming a field or target it lacks).
+    #[error("{0}")]
+    Request(String),
     /// A report or its directory could not be written.
     #[error("{path}: {reason}")]
     Write {
@@ -607,7 +610,8 @@ pub struct SpinDistribution {
     pub q_erg_per_g: f64,
     /// The runs pooled.
     pub runs: Vec<String>,
-    /// How they were chosen: `"target T at zeta Z"` when the requested case exists, else `"all runs"`.
+    /// How they were chosen: `"target T at zeta Z"` when the requested case exists, else
+    /// `"target T, every angle (none at zeta Z)"`.
     pub selection: String,
     /// Number of spin rates pooled.
     pub fragments: usize,
@@ -638,38 +642,92 @@ pub struct CampaignAnalysis {
     pub bound_fraction_vs_q: Fit<crate::analysis::fits::LineFit>,
     /// Q*_D: the Q at which that line gives a bound fraction of 0.5 (erg/g), with its propagated error.
     pub q_star_d: Fit<crate::analysis::fits::LineCrossing>,
+    /// Q*_D with its bootstrap 95 % interval and the warning flag ([`crate::analysis::q_star_bootstrap`]).
+    pub q_star_d_bootstrap: Fit<crate::analysis::q_star_bootstrap::QStarBootstrap>,
     /// Spin distributions per projectile, in the order the projectiles first appear (Fig. 7).
     pub spin_distributions: Vec<SpinDistribution>,
 }
 
+impl CampaignAnalysis {
+    /// Q*_D for a summary line: `Q ± σ erg/g (bootstrap 95 % interval low to high, seed s)`, or why there is none.
+    pub fn q_star_text(&self) -> String {
+        match (&self.q_star_d, &self.q_star_d_bootstrap) {
+            (Fit::Ok(c), Fit::Ok(b)) => format!(
+                "{:.3e} ± {:.1e} erg/g (bootstrap 95 % interval {:.3e} to {:.3e}, seed {})",
+                c.x, c.sigma_x, b.low, b.high, b.seed
+            ),
+            (Fit::Ok(c), Fit::Failed(why)) => format!("{:.3e} ± {:.1e} erg/g (no bootstrap: {why})", c.x, c.sigma_x),
+            (Fit::Failed(why), _) => format!("n/a ({why})"),
+        }
+    }
+
+    /// What a reader must be told: Q*_D resting on fewer than three Q values, spin distributions pooled over every
+    /// angle for want of runs at the requested one.
+    pub fn warnings(&self) -> Vec<String> {
+        let q = self.q_star_d_bootstrap.ok().and_then(|b| b.warning());
+        let spins = self
+            .spin_distributions
+            .iter()
+            .filter(|d| !d.selection.contains(" at zeta "));
+        q.into_iter()
+            .chain(spins.map(|d| format!("spin distribution of {}: {}", d.projectile, d.selection)))
+            .collect()
+    }
+}
+
 /// Which runs make each projectile's spin distribution (Fig. 7): those on `target` at ζ = `angle_deg`, when the
-/// campaign has them (the paper uses N200_T12 at 45°); otherwise all the projectile's runs.
+/// campaign has them (the paper uses N200_T12 at 45°); otherwise the projectile's runs on `target` at every angle.
+/// Runs on different targets are never pooled.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpinSelection {
-    /// Target file stem.
-    pub target: String,
+    /// Target file stem; `None`: the campaign's own ([`SpinSelection::resolve`]).
+    pub target: Option<String>,
     /// ζ (degrees).
     pub angle_deg: f64,
 }
 
 impl Default for SpinSelection {
+    /// The campaign's own target at 45°.
     fn default() -> Self {
         SpinSelection {
-            target: "N200_T12".into(),
+            target: None,
             angle_deg: 45.0,
         }
     }
 }
 
-/// One [`SpinDistribution`] per projectile (in order of first appearance) from the runs and their target
-/// fragments' corrected spin rates (`spins[k]` belongs to `runs[k]`).
+impl SpinSelection {
+    /// The target stem for a campaign on `targets`: the one asked for, which must be among them; else the only one,
+    /// or N200_T12 (Roig03's case) when it is among several; else an error naming them.
+    pub fn resolve(&self, targets: &[String]) -> Result<String, AnalysisError> {
+        let list = || targets.join(", ");
+        match &self.target {
+            Some(t) if targets.contains(t) => Ok(t.clone()),
+            Some(t) => Err(AnalysisError::Request(format!(
+                "--spin-target: the campaign has no target `{t}`; its targets are {}",
+                list()
+            ))),
+            None if targets.len() == 1 => Ok(targets[0].clone()),
+            None if targets.iter().any(|t| t == "N200_T12") => Ok("N200_T12".into()),
+            None => Err(AnalysisError::Request(format!(
+                "--spin-target: the campaign has several targets ({}); name the one whose spin distributions to draw                  (runs on different targets are not pooled)",
+                list()
+            ))),
+        }
+    }
+}
+
+/// One [`SpinDistribution`] per projectile with runs on `target` (in order of first appearance), of those runs at ζ =
+/// `angle_deg` (degrees), or at every angle when there are none, from their target fragments' corrected spin rates
+/// (`spins[k]` belongs to `runs[k]`).
 pub fn spin_distributions(
     runs: &[CampaignRun],
     spins: &[Vec<f64>],
-    selection: &SpinSelection,
+    target: &str,
+    angle_deg: f64,
 ) -> Vec<SpinDistribution> {
     let mut projectiles: Vec<&str> = Vec::new();
-    for r in runs {
+    for r in runs.iter().filter(|r| r.target == target) {
         if !projectiles.contains(&r.projectile.as_str()) {
             projectiles.push(&r.projectile);
         }
@@ -677,19 +735,18 @@ pub fn spin_distributions(
     projectiles
         .into_iter()
         .map(|p| {
-            let of_p: Vec<usize> = (0..runs.len()).filter(|&k| runs[k].projectile == p).collect();
+            let of_p: Vec<usize> = (0..runs.len())
+                .filter(|&k| runs[k].projectile == p && runs[k].target == target)
+                .collect();
             let case: Vec<usize> = of_p
                 .iter()
                 .copied()
-                .filter(|&k| runs[k].target == selection.target && runs[k].angle_deg == selection.angle_deg)
+                .filter(|&k| runs[k].angle_deg == angle_deg)
                 .collect();
             let (chosen, how) = if case.is_empty() {
-                (of_p, "all runs".to_string())
+                (of_p, format!("target {target}, every angle (none at zeta {angle_deg})"))
             } else {
-                (
-                    case,
-                    format!("target {} at zeta {}", selection.target, selection.angle_deg),
-                )
+                (case, format!("target {target} at zeta {angle_deg}"))
             };
             let pooled: Vec<f64> = chosen.iter().flat_map(|&k| spins[k].iter().copied()).collect();
             let bins = ((pooled.len() as f64).sqrt().round() as usize).clamp(5, 40);

@@ -97,47 +97,70 @@ fn analyze_clumps_of_run(args: &AnalyzeArgs) -> Result<(), CliError> {
 pub struct AnalyzeCampaignArgs {
     /// A campaign directory (holding campaign.csv).
     pub dir: PathBuf,
-    /// Time of the post-impact snapshots to analyse (s).
-    #[arg(long, default_value_t = 400.0)]
-    pub at: f64,
+    /// Time of the post-impact snapshots to analyse (s) [default: the campaign's end time, shared by its completed
+    /// runs].
+    #[arg(long)]
+    pub at: Option<f64>,
     /// Rewrite earlier analyses.
     #[arg(long)]
     pub force: bool,
-    /// Spin distributions (Roig03 Fig. 7): pool the runs on this target (file stem) ...
-    #[arg(long, default_value = "N200_T12")]
-    pub spin_target: String,
-    /// ... at this impact angle ζ (degrees); a projectile without such a run pools all its runs.
+    /// Tabulate and plot the outcomes against this field of campaign.csv (e.g. impact.speed_km_s, angle_deg, q,
+    /// target), runs differing only in their seed grouped [default: the one swept field, else q].
+    #[arg(long, value_name = "FIELD")]
+    pub by: Option<String>,
+    /// Spin distributions (Roig03 Fig. 7) of the runs on this target (file stem) [default: the campaign's only
+    /// target, or N200_T12 among several; runs on different targets are never pooled] ...
+    #[arg(long)]
+    pub spin_target: Option<String>,
+    /// ... at this impact angle ζ (degrees); a projectile without such a run pools its runs at every angle.
     #[arg(long, default_value_t = 45.0)]
     pub spin_angle: f64,
+    /// Seed of Q*_D's bootstrap interval (resampling the runs within each Q value).
+    #[arg(long, default_value_t = 1)]
+    pub bootstrap_seed: u64,
 }
 
 /// Runs `analyze-campaign`.
 pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
-    if !(args.at.is_finite() && args.at > 0.0) {
-        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+    use rubblepile::analysis::{campaign_analysis as ca, campaign_by, figures::by_field, run_analysis::SpinSelection};
+    let at = args
+        .at
+        .map_or_else(|| ca::campaign_end_time(&args.dir), Ok)
+        .map_err(CliError::usage)?;
+    if !(at.is_finite() && at > 0.0) {
+        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {at}")));
     }
-    let selection = rubblepile::analysis::run_analysis::SpinSelection {
+    let field = campaign_by::by_field_name(&args.dir, args.by.as_deref()).map_err(CliError::usage)?;
+    let selection = SpinSelection {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
     };
-    let a = rubblepile::analysis::campaign_analysis::analyze_campaign(&args.dir, args.at, args.force, &selection)
-        .map_err(|e| match e {
-            AnalysisError::Fragments(_) => CliError::failed(e),
-            _ => CliError::usage(e),
-        })?;
-    let q_star = match &a.q_star_d {
-        Fit::Ok(c) => format!("{:.3e} ± {:.1e} erg/g", c.x, c.sigma_x),
-        Fit::Failed(why) => format!("n/a ({why})"),
-    };
+    let a = ca::analyze_campaign(&args.dir, at, args.force, &selection, args.bootstrap_seed).map_err(|e| match e {
+        AnalysisError::Fragments(_) => CliError::failed(e),
+        _ => CliError::usage(e),
+    })?;
+    a.warnings().iter().for_each(|w| eprintln!("warning: {w}"));
+    let by = campaign_by::by_field_table(&args.dir, &a, Some(&field)).map_err(CliError::usage)?;
+    let (csv, not_drawn) = by_field::write_by_field(&args.dir, &by, at).map_err(CliError::failed)?;
+    not_drawn
+        .iter()
+        .for_each(|why| eprintln!("warning: figure not drawn: {}: {why}", by.stem()));
+    println!(
+        "outcomes against {} ({}):\n  {}",
+        by.field,
+        csv.display(),
+        by.lines().join("\n  ")
+    );
     println!(
         "campaign analysis at t = {} s: {} runs analysed, {} skipped (not completed); Q*_D {}; wrote {} \
-         (campaign_analysis.json, campaign_runs.csv, Figs. 5 and 7 as SVG and PNG; each run's figures in its \
+         (campaign_analysis.json, campaign_runs.csv, {}.csv, Figs. 5 and 7 as SVG and PNG; each run's figures in its \
          analysis/)",
         a.t_at,
         a.runs.len(),
         a.skipped.len(),
-        q_star,
+        a.q_star_text(),
         args.dir.join("analysis").display(),
+        by.stem(),
     );
     Ok(())
 }

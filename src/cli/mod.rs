@@ -15,7 +15,8 @@
 //! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`rubblepile::impact::campaign`]);
 //! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
-//! - `rubblepile analyze-campaign DIR [--at 400]`: all completed runs of a campaign, bound fraction vs Q, Q*_D;
+//! - `rubblepile analyze-campaign DIR [--at T] [--by FIELD]`: all completed runs of a campaign, bound fraction vs Q,
+//!   Q*_D;
 //! - `rubblepile report richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
 //!   (`analysis/richardson2011/REPORT.md` and figures);
 //! - `rubblepile bench rhs --bodies N[,N…] [--repeats R] [--out DIR] [--force]`: times one right-hand-side

@@ -4,6 +4,7 @@
 //! (font, look, [`style::write_figure`] renders each figure once per backend so SVG and PNG agree). A figure that
 //! cannot be drawn is a one-line warning, the others are still written; nothing panics on bad data.
 
+pub mod by_field;
 pub mod campaign_figures;
 pub mod energy;
 pub mod lines;

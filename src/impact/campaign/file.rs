@@ -22,6 +22,9 @@ pub struct CampaignFile {
     /// `[[projectile]]`: custom projectiles.
     #[serde(default, rename = "projectile")]
     pub projectiles: Vec<CustomProjectile>,
+    /// `[sweep]`: field path → list of values or grid ([`super::sweep`]); the runs are the product.
+    #[serde(default, skip_serializing_if = "toml::Table::is_empty")]
+    pub sweep: toml::Table,
 }
 
 /// `[campaign]`.

@@ -210,27 +210,37 @@ pub(crate) fn write_campaign_csv(
         path: path.clone(),
         source: std::io::Error::other(e.to_string()),
     };
-    w.write_record(CAMPAIGN_COLUMNS).map_err(to_io)?;
+    // one column per swept path after the fixed ones (none without a sweep)
+    let swept = points.first().map_or(&[][..], |p| &p.overrides[..]);
+    let header = CAMPAIGN_COLUMNS
+        .iter()
+        .copied()
+        .chain(swept.iter().map(|(path, _)| path.as_str()));
+    w.write_record(header).map_err(to_io)?;
     for (p, r) in points.iter().zip(runs) {
         let n = r.numbers.unwrap_or_default();
         let f = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
         let u = |x: Option<u64>| x.map(|x| x.to_string()).unwrap_or_default();
-        w.write_record([
-            p.name.clone(),
-            p.target.clone(),
-            p.projectile.clone(),
-            format!("{}", p.angle_deg),
-            p.seed.to_string(),
-            fmt_num(p.plan.setup.q_erg_per_g),
-            r.status.to_string(),
-            f(n.wall_seconds),
-            f(n.final_time),
-            u(n.steps_accepted),
-            u(n.rhs_evaluations),
-            f(n.energy_error),
-            f(n.linear_momentum_error),
-            f(n.angular_momentum_error),
-        ])
+        w.write_record(
+            [
+                p.name.clone(),
+                p.target.clone(),
+                p.projectile.clone(),
+                format!("{}", p.angle_deg),
+                p.seed.to_string(),
+                fmt_num(p.plan.setup.q_erg_per_g),
+                r.status.to_string(),
+                f(n.wall_seconds),
+                f(n.final_time),
+                u(n.steps_accepted),
+                u(n.rhs_evaluations),
+                f(n.energy_error),
+                f(n.linear_momentum_error),
+                f(n.angular_momentum_error),
+            ]
+            .into_iter()
+            .chain(p.overrides.iter().map(|(_, v)| v.clone())),
+        )
         .map_err(to_io)?;
     }
     let bytes = w.into_inner().map_err(|e| CampaignError::Io {

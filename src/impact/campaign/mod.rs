@@ -42,7 +42,17 @@
 //! id = "pile30"                    # a bodies file thrown whole (relative to the campaign file)
 //! projectile_pile = "../../targets/N30_T4.csv"
 //! random_attitude = true           # turn it by a random attitude drawn from the seed (default true)
+//!
+//! [sweep]                          # optional: any field of this file over values; the runs are the product
+//! "impact.speed_km_s" = [0.02, 0.05]          # a list (a bare `impact.f0 = [...]` works too)
+//! "impact.f0" = { from = 1e-6, to = 1e-4, count = 3 }  # or a grid: { from, to, step } / { from, to, count }
+//! seed = { from = 1, to = 4, step = 1 }       # short names: target, projectile, angle, seed (the lists above)
 //! ```
+//!
+//! The sweep's paths (sorted; the first outermost, then targets, projectiles, angles, seeds) are set in the
+//! file's TOML value and read back through its schema, so any field is covered and a wrong path is refused naming
+//! it and the valid names. A swept run's name ends with `_<last path name><value>` per swept field outside
+//! `[campaign]` (e.g. `tiny_S1_z0_s7_speed_km_s0.02`), and `campaign.csv` gains one column per swept path.
 //!
 //! Unknown keys are refused; every error is one line naming the field (`campaign.angles[2]: …`). Relative
 //! paths are joined to the campaign file's directory and cleaned lexically (`a/b/../../t.csv` → `t.csv`).
@@ -88,6 +98,7 @@ pub mod mpi;
 pub mod plan;
 pub mod shard;
 pub mod slurm;
+pub mod sweep;
 
 pub use distributed::*;
 pub use execute::*;
@@ -96,6 +107,7 @@ pub use index::*;
 pub use plan::*;
 pub use shard::*;
 pub use slurm::*;
+pub use sweep::*;
 
 use std::path::PathBuf;
 

@@ -30,6 +30,8 @@ pub struct GridPoint {
     pub config: ImpactConfig,
     /// The impact set up in memory (what the run directory must hold).
     pub plan: ImpactPlan,
+    /// The `[sweep]` values of this run: `(path, value as text)`, in the sweep's order (empty without a sweep).
+    pub overrides: Vec<(String, String)>,
 }
 
 /// A validated campaign.
@@ -69,7 +71,96 @@ pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
 /// Parses and validates campaign text; `name` is used in messages, `base_dir` resolves relative paths.
 pub fn parse_campaign(text: &str, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
     let file = parse_toml(text, name)?;
-    resolve(file, name, base_dir)
+    if file.sweep.is_empty() {
+        return resolve(file, name, base_dir);
+    }
+    resolve_sweep(file, name, base_dir)
+}
+
+/// The campaign of a file with a `[sweep]`: one resolved grid per combination of the swept values (the first path
+/// outermost), concatenated, each run's name suffixed and its overrides recorded.
+fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
+    let invalid = |(field, message): (String, String)| {
+        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
+            file: name.to_string(),
+            field,
+            message,
+        })
+    };
+    let axes = sweep_axes(&file.sweep).map_err(invalid)?;
+    let total: usize = axes.iter().map(|a| a.values.len()).product();
+    let mut all: Option<Campaign> = None;
+    let mut names = HashSet::new();
+    for combo in 0..total {
+        // odometer: the last axis varies fastest
+        let mut rest = combo;
+        let mut chosen = vec![0; axes.len()];
+        for (k, a) in axes.iter().enumerate().rev() {
+            chosen[k] = rest % a.values.len();
+            rest /= a.values.len();
+        }
+        let overrides: Vec<(String, toml::Value)> = axes
+            .iter()
+            .zip(&chosen)
+            .map(|(a, &i)| (a.path.clone(), a.values[i].clone()))
+            .collect();
+        let text: Vec<(String, String)> = overrides.iter().map(|(p, v)| (p.clone(), value_text(v))).collect();
+        let with = with_overrides(&file, &overrides).map_err(invalid)?;
+        let described = text
+            .iter()
+            .map(|(p, v)| format!("{p} = {v}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let mut c = resolve(with, name, base_dir).map_err(|e| match e {
+            CampaignError::File(crate::io::scene_file::SceneError::Invalid { file, field, message }) => {
+                CampaignError::File(crate::io::scene_file::SceneError::Invalid {
+                    file,
+                    field,
+                    message: format!("{message} (with the sweep's {described})"),
+                })
+            }
+            other => other,
+        })?;
+        let suffix: String = text
+            .iter()
+            .filter(|(p, _)| !p.starts_with("campaign."))
+            .map(|(p, v)| {
+                let leaf = p.rsplit('.').next().unwrap_or(p);
+                let clean = |s: &str| -> String {
+                    s.chars()
+                        .map(|ch| {
+                            if ch.is_ascii_alphanumeric() || "_.-".contains(ch) {
+                                ch
+                            } else {
+                                '-'
+                            }
+                        })
+                        .collect()
+                };
+                format!("_{}{}", clean(leaf), clean(v))
+            })
+            .collect();
+        for p in &mut c.points {
+            p.name.push_str(&suffix);
+            p.overrides = text.clone();
+            if !names.insert(p.name.clone()) {
+                return Err(invalid((
+                    "sweep".into(),
+                    format!(
+                        "two runs would be named `{}`: make the swept values differ in their names",
+                        p.name
+                    ),
+                )));
+            }
+        }
+        match &mut all {
+            None => all = Some(c),
+            Some(a) => a.points.append(&mut c.points),
+        }
+    }
+    let mut campaign = all.ok_or_else(|| invalid(("sweep".into(), "sweeps no value".into())))?;
+    campaign.file = file;
+    Ok(campaign)
 }
 
 /// `base.join(rel)` with `.` and `dir/..` removed lexically (for readable paths in messages and files).
@@ -374,6 +465,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                         seed,
                         config,
                         plan,
+                        overrides: Vec::new(),
                     });
                 }
             }

@@ -43,6 +43,9 @@ pub const SPIN_EXPONENT: Published = Published { low: -1.4, high: -1.0 };
 pub const MAXWELLIAN_RATIO: Published = Published { low: 2.0, high: 3.0 };
 /// Roig03 §4.2: typical ejection speeds, 0.01–0.05 % of the projectile speed (as printed).
 pub const EJECTION_RELATIVE: Published = Published { low: 1e-4, high: 5e-4 };
+/// Seed of Q*_D's bootstrap interval in the report.
+const BOOTSTRAP_SEED: u64 = 1;
+
 /// Roig03 §4.2 (Fig. 5): Q*_D ≈ 2.6e9 erg/g.
 pub const Q_STAR_D: f64 = 2.6e9;
 /// What the report needs besides the campaign analysis.
@@ -94,7 +97,7 @@ impl CampaignDirs<'_> {
 /// Re-analyses every campaign of `dirs` at `at` seconds (rewriting their `analysis/`) and writes `out/REPORT.md`;
 /// returns its path and the main campaign's analysis.
 pub fn regenerate(dirs: &CampaignDirs<'_>, at: f64, out: &Path) -> Result<(PathBuf, CampaignAnalysis), AnalysisError> {
-    let analyse = |dir: &Path| analyze_campaign(dir, at, true, &SpinSelection::default());
+    let analyse = |dir: &Path| analyze_campaign(dir, at, true, &SpinSelection::default(), BOOTSTRAP_SEED);
     let campaign = analyse(dirs.campaign)?;
     let uniform = dirs.uniform.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
     let other_kappa = dirs.other_kappa.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
@@ -286,9 +289,26 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             &|x| format!("{:.3} %", 100.0 * x),
         ),
     );
+    let interval = match &c.q_star_d_bootstrap {
+        Fit::Ok(b) => format!(
+            "; bootstrap 95 % interval {:.2e}–{:.2e} erg/g (seed {}){}",
+            b.low,
+            b.high,
+            b.seed,
+            if b.underdetermined {
+                format!(
+                    " — **warning**: only {} Q value(s), fewer than three bracket it",
+                    b.q_levels
+                )
+            } else {
+                String::new()
+            }
+        ),
+        Fit::Failed(_) => String::new(),
+    };
     let q_star = match &c.q_star_d {
         Fit::Ok(x) => format!(
-            "{:.2e} ± {:.1e} erg/g ({:.2} × the paper's)",
+            "{:.2e} ± {:.1e} erg/g ({:.2} × the paper's){interval}",
             x.x,
             x.sigma_x,
             x.x / Q_STAR_D
