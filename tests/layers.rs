@@ -296,7 +296,9 @@ fn the_library_does_not_use_clap() {
 /// cheap guard against logic creeping back in. The bound was 2000 lines until the flag structs of `flyby`, `render`,
 /// `export`, `convert`, `campaign merge|slurm` and `--projectile-pile` (about 350 lines of flags and their help) moved
 /// here from the library, which no longer knows clap; 2400 until `impact`'s six geometry flags (issue 57: b, θ, ψ,
-/// spin, attitude; about 25 lines of flags and their help, read by the library's `ImpactGeometry::from_options`).
+/// spin, attitude; about 25 lines of flags and their help, read by the library's `ImpactGeometry::from_options`);
+/// 2430 until `flyby` took `run`'s checkpoint, format and progress flags, `render` `--centre-m` and `analyze-campaign`
+/// `--by` and `--bootstrap-seed` (flags and their help).
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -306,8 +308,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2430,
-        "src/cli/ has {lines} lines (at most 2430: move logic to analysis/ or bench/)"
+        lines <= 2460,
+        "src/cli/ has {lines} lines (at most 2460: move logic to analysis/ or bench/)"
     );
 }
 
