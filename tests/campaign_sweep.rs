@@ -313,3 +313,36 @@ fn runs_ending_at_different_times_need_at() {
     assert_eq!(bad.status.code(), Some(2), "{}", String::from_utf8_lossy(&bad.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The oblique-impact keys of `[impact]` are swept like any other field (no code of their own): θ = 0° and 30°
+/// become two runs aimed at the centre and at θ (45° misses this lumpy six-fragment pile: the plan refuses it,
+/// naming the field), and a sweep of `impact_parameter_frac` beside a fixed
+/// `impact_angle_deg` is refused as two aims, naming both.
+#[test]
+fn oblique_impact_fields_are_swept_without_code_of_their_own() {
+    use rubblepile::impact::geometry::Aim;
+    let dir = temp_dir("sweep-oblique");
+    tiny_target(&dir);
+    let text = format!("{BASE}\n[sweep]\nimpact.impact_angle_deg = [0.0, 30.0]\n");
+    let c = parse_campaign(&text, "c.toml", &dir).unwrap();
+    assert_eq!(c.points.len(), 4);
+    assert_eq!(c.points[0].config.geometry.aim, Aim::AngleDeg(0.0));
+    assert_eq!(c.points[2].config.geometry.aim, Aim::AngleDeg(30.0));
+    assert!(
+        c.points[2].name.ends_with("_impact_angle_deg30"),
+        "{}",
+        c.points[2].name
+    );
+    let miss = plan_error(&format!("{BASE}\n[sweep]\nimpact.impact_angle_deg = [45.0]\n"), &dir);
+    assert!(
+        miss.contains("impact.impact_angle_deg") && miss.contains("misses the target"),
+        "{miss}"
+    );
+    let both = BASE.replace("[impact]\n", "[impact]\nimpact_angle_deg = 30.0\n")
+        + "\n[sweep]\nimpact.impact_parameter_frac = [0.5]\n";
+    let e = plan_error(&both, &dir);
+    assert!(
+        e.contains("impact_angle_deg") && e.contains("impact_parameter_frac"),
+        "{e}"
+    );
+}
