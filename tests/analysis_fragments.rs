@@ -193,6 +193,13 @@ fn binding_energy_and_escape_by_hand() {
         assert_eq!(r.summary.n_escaping, usize::from(c_escapes));
         assert!(close(r.summary.largest_fragment_fraction, 1.0 / 1.5, 1e-15));
     }
+    // Every fragment escaping: a bound fraction of +0, which prints "0.000" (an empty sum is −0.0: "-0.000").
+    let mut at = three_bodies(speed_for(4.0));
+    at[1].velocity.y = -1e3;
+    let r = analyse_fragments(&three_bodies(0.0), &at, &params(0)).unwrap();
+    assert_eq!(r.summary.n_escaping, 2);
+    assert!(r.summary.bound_mass_fraction == 0.0 && r.summary.bound_mass_fraction.is_sign_positive());
+    assert_eq!(format!("{:.3}", r.summary.bound_mass_fraction), "0.000");
 }
 
 #[test]

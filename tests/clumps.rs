@@ -258,7 +258,7 @@ fn analyze_finds_the_clumps_of_a_sphere_run() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
-        stdout.contains("largest remnant: 0.8182 of the mass (3 bodies"),
+        stdout.contains("largest remnant: 0.8182 of all bodies' mass (3 bodies"),
         "{stdout}"
     );
     let table = std::fs::read_to_string(dir.join("analysis/clumps.csv")).unwrap();

@@ -52,7 +52,7 @@ fn the_first_readme_command_runs_the_impact_and_leaves_an_animation_and_a_paravi
     assert!(pvd.contains("timestep=\"6e2\""), "{pvd}");
     // It is an impact run like any other: `analyze` reads it, and `render --color bound` then colours by fate.
     let a = stdout(&rubblepile(&root(), &["analyze", out.to_str().unwrap(), "--at", "400"]));
-    assert!(a.contains("bound mass fraction"), "{a}");
+    assert!(a.contains("of the target mass bound"), "{a}");
     let r = stdout(&rubblepile(
         &root(),
         &["render", out.to_str().unwrap(), "--color", "bound", "--force"],

@@ -334,11 +334,11 @@ impl ClumpReport {
             })
         };
         let second = self.second().map_or("none".into(), |s| {
-            format!("{:.4} of the mass ({} bodies)", s.mass_fraction, s.n_members)
+            format!("{:.4} ({} bodies)", s.mass_fraction, s.n_members)
         });
         format!(
-            "largest remnant: {:.4} of the mass ({} bodies, {:.4e} kg), spin period {}, b/a {:.3}, c/a {:.3}; \
-             second remnant {second}; {} clumps, {} escaping",
+            "largest remnant: {:.4} of all bodies' mass ({} bodies, {:.4e} kg), spin period {}, b/a {:.3}, c/a {:.3}; \
+             second remnant {second}; {} clumps, {} escaping the largest remnant",
             lr.mass_fraction,
             lr.n_members,
             lr.mass_kg,

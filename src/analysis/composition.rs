@@ -103,7 +103,7 @@ impl Composition {
     pub fn summary_line(&self) -> String {
         let lr = &self.largest_remnant;
         format!(
-            "composition: {} clumps ({} bound, {:.3} of the mass); largest remnant {} bodies, {:.4e} kg ({:.3} of \
+            "composition: {} clumps ({} bound to the system, {:.3} of all bodies' mass); largest remnant {} bodies, {:.4e} kg ({:.3} of \
              the system, {}), spin period {}, projectile fraction {:.3}; other bound clumps {} ({:.4e} kg, projectile \
              fraction {}, {} mixed)",
             self.n_clumps,

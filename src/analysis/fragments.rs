@@ -472,7 +472,8 @@ pub fn analyse_fragments(
     let fragment_kinetic = fragment_kinetic_translational + fragment_kinetic_rotational;
     let projectile_speed = (projectile_velocity0 - v_target0).norm();
     let projectile_kinetic_energy = 0.5 * projectile_mass * projectile_speed.powi(2);
-    let bound_mass: f64 = targets.iter().filter(|f| !f.escaping).map(|f| f.mass).sum();
+    // + 0.0: an empty sum is −0.0, which prints as "-0.000" when every fragment escapes
+    let bound_mass: f64 = targets.iter().filter(|f| !f.escaping).map(|f| f.mass).sum::<f64>() + 0.0;
     let largest = targets.iter().map(|f| f.mass).fold(0.0, f64::max);
     let speeds: Vec<f64> = targets.iter().map(|f| f.ejection_speed).collect();
     let ejection_speed_median = median(&speeds);

@@ -59,7 +59,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         Fit::Failed(why) => format!("n/a ({why})"),
     };
     println!(
-        "analysis at t = {} s: f_KE {:.3} %, rotational share {:.1} %, bound mass fraction {:.3}, {} escaping, \
+        "analysis at t = {} s: f_KE {:.3} %, rotational share {:.1} %; fragments (Roig03): {:.3} of the target mass \
+         bound, {} escaping; \
          median ejection {:.3} m/s ({:.4} % of v_p), v_esc {:.1} m/s; ejection-size exponent {}, spin-size exponent {}, \
          best spin-histogram n {}; wrote {} (fragments.csv, analysis.json, {})",
         a.t_at,
