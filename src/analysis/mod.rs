@@ -20,6 +20,7 @@ pub use crate::ellipsoid::rigid_rotation;
 pub mod rotational_split;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;
+pub mod spin_likelihood;
 pub mod spin_limit;
 pub mod spinup;
 pub mod surface_slopes;
