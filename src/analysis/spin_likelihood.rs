@@ -8,8 +8,9 @@
 //! fit is a bracketed bisection with one root (none when all rates are equal).
 //!
 //! Weights (by number: 1 each; by mass) enter the log-likelihood as `Σ wᵢ ln f(ωᵢ)` with the weights rescaled to
-//! sum to the number of rates; the tests then use Kish's effective size `(Σw)²/Σw²`. Rates ≤ 0 have no density
-//! for `n > 0` and are left out (counted in `skipped`).
+//! sum to Kish's effective size `N_eff = (Σw)²/Σw²` (= N for equal weights), so that unequal weights widen the
+//! intervals; the tests use `N_eff` as their sample size (rounded for the exact KS law). Rates ≤ 0 have no
+//! density for `n > 0` and are left out (counted in `skipped`).
 //!
 //! p-values are for a fully specified distribution. Here its parameters were fitted to the same data, so they
 //! are optimistic (too large; Lilliefors): a small p rejects, a large one proves little.
@@ -59,7 +60,7 @@ pub struct LikelihoodFit {
     pub sigma_interval: [f64; 2],
     /// Eq. 44's width `b = √2 σ` (rad/s).
     pub b: f64,
-    /// Weighted log-likelihood at the fit (with `ω` in rad/s).
+    /// Weighted log-likelihood at the fit (weights summing to the effective size; `ω` in rad/s).
     pub log_likelihood: f64,
     /// Tests against the fitted distribution.
     pub goodness: GoodnessOfFit,
@@ -100,12 +101,17 @@ impl SpinLikelihood {
         let (f, m) = (&self.free, &self.maxwellian);
         let [nl, nh] = f.n_interval.unwrap_or([f64::NAN; 2]);
         format!(
-            "spin rates by unbinned likelihood ({} rates, weighted by {}): free n = {:.3} [{:.3}, {:.3}], \
+            "spin rates by unbinned likelihood ({} rates, weighted by {}{}): free n = {:.3} [{:.3}, {:.3}], \
              σ = {:.3e} rad/s [{:.3e}, {:.3e}], KS p = {:.3}, AD p = {:.3}; Maxwellian n = 2: σ = {:.3e} rad/s \
              [{:.3e}, {:.3e}], KS p = {:.3}, AD p = {:.3} (95 % profile-likelihood intervals; p-values with fitted \
              parameters are optimistic)",
             self.samples,
             self.weighting,
+            if self.weighting == "number" {
+                String::new()
+            } else {
+                format!(", effective size {:.1}", self.effective_samples)
+            },
             f.n,
             nl,
             nh,
@@ -140,11 +146,11 @@ pub fn chi_cdf(x: f64, k: f64, sigma: f64) -> f64 {
     gamma_lr(0.5 * k, 0.5 * (x / sigma).powi(2))
 }
 
-/// The weighted sample: rates > 0, weights summing to the number of rates.
+/// The weighted sample: rates > 0, weights summing to the effective size.
 struct Sample {
     x: Vec<f64>,
     w: Vec<f64>,
-    /// Σw (= N).
+    /// Σw (= N_eff).
     total: f64,
     /// ⟨ω²⟩ (weighted).
     m2: f64,
@@ -273,16 +279,15 @@ pub fn fit_spin_likelihood(omega: &[f64], weights: Weights<'_>) -> Result<SpinLi
             needed: 2,
         });
     }
-    let n = x.len() as f64;
     let sum_w: f64 = w.iter().sum();
-    w.iter_mut().for_each(|v| *v *= n / sum_w);
-    let effective_samples = n * n / w.iter().map(|v| v * v).sum::<f64>();
-    let m2 = x.iter().zip(&w).map(|(o, v)| v * o * o).sum::<f64>() / n;
-    let mean_ln = x.iter().zip(&w).map(|(o, v)| v * o.ln()).sum::<f64>() / n;
+    let effective_samples = sum_w * sum_w / w.iter().map(|v| v * v).sum::<f64>();
+    w.iter_mut().for_each(|v| *v *= effective_samples / sum_w);
+    let m2 = x.iter().zip(&w).map(|(o, v)| v * o * o).sum::<f64>() / effective_samples;
+    let mean_ln = x.iter().zip(&w).map(|(o, v)| v * o.ln()).sum::<f64>() / effective_samples;
     let s = Sample {
         x,
         w,
-        total: n,
+        total: effective_samples,
         m2,
         mean_ln,
     };
@@ -348,7 +353,7 @@ fn sorted_order(x: &[f64]) -> Vec<usize> {
     order
 }
 
-/// KS and AD of the weighted sample (weights summing to N) against the chi(k, σ) CDF.
+/// KS and AD of the weighted sample against the chi(k, σ) CDF.
 fn goodness_of_fit(x: &[f64], w: &[f64], order: &[usize], n_eff: f64, k: f64, sigma: f64) -> GoodnessOfFit {
     let total: f64 = w.iter().sum();
     let (mut d, mut a2, mut before, mut u_prev, mut sf_prev) = (0.0f64, 0.0, 0.0, 0.0, 1.0);
