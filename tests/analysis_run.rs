@@ -281,6 +281,17 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
         "same runs on both sides"
     );
     assert!(dir.join("rep/figures").is_dir());
+    // the likelihood fits beside the binned ones (issue 57): a summary row, the appendix columns, per projectile
+    for text in [
+        "by unbinned maximum likelihood, n free",
+        "| likelihood n [95 %] | Maxwellian KS p / AD p |",
+        "(least squares below): spin rates by unbinned likelihood (",
+    ] {
+        assert!(report.contains(text), "the report lacks {text:?}");
+    }
+    if std::env::var_os("RUBBLEPILE_KEEP_REPORT").is_some() {
+        std::fs::copy(dir.join("rep/REPORT.md"), std::env::temp_dir().join("i57_REPORT.md")).unwrap();
+    }
     // a second report only with --force
     let again = rubblepile(&dir, &["report", "roig2003", "c", "--out", "rep", "--at", "110"]);
     assert_eq!(again.status.code(), Some(2));

@@ -37,12 +37,11 @@ pub enum Weights<'a> {
 pub struct GoodnessOfFit {
     /// KS statistic `D = sup |F_N − F|` (weighted empirical CDF).
     pub ks_d: f64,
-    /// Two-sided KS p-value: exact for `N` (Marsaglia–Tsang–Wang 2003) while `⌊N D⌋ ≤ 200`, else Kolmogorov's
-    /// asymptotic law.
+    /// Two-sided KS p-value ([`ks_p_value`]).
     pub ks_p: f64,
     /// Anderson–Darling `A² = N ∫ (F_N − F)² / (F (1 − F)) dF`.
     pub ad_a2: f64,
-    /// AD p-value from the asymptotic distribution of `A²` (Marsaglia & Marsaglia 2004).
+    /// AD p-value from the asymptotic distribution of `A²` ([`ad_p_value`]).
     pub ad_p: f64,
 }
 
@@ -102,8 +101,8 @@ impl SpinLikelihood {
         let [nl, nh] = f.n_interval.unwrap_or([f64::NAN; 2]);
         format!(
             "spin rates by unbinned likelihood ({} rates, weighted by {}{}): free n = {:.3} [{:.3}, {:.3}], \
-             σ = {:.3e} rad/s [{:.3e}, {:.3e}], KS p = {:.3}, AD p = {:.3}; Maxwellian n = 2: σ = {:.3e} rad/s \
-             [{:.3e}, {:.3e}], KS p = {:.3}, AD p = {:.3} (95 % profile-likelihood intervals; p-values with fitted \
+             σ = {:.3e} rad/s [{:.3e}, {:.3e}], KS p = {}, AD p = {}; Maxwellian n = 2: σ = {:.3e} rad/s \
+             [{:.3e}, {:.3e}], KS p = {}, AD p = {} (95 % profile-likelihood intervals; p-values with fitted \
              parameters are optimistic)",
             self.samples,
             self.weighting,
@@ -118,14 +117,23 @@ impl SpinLikelihood {
             f.sigma,
             f.sigma_interval[0],
             f.sigma_interval[1],
-            f.goodness.ks_p,
-            f.goodness.ad_p,
+            format_p(f.goodness.ks_p),
+            format_p(f.goodness.ad_p),
             m.sigma,
             m.sigma_interval[0],
             m.sigma_interval[1],
-            m.goodness.ks_p,
-            m.goodness.ad_p,
+            format_p(m.goodness.ks_p),
+            format_p(m.goodness.ad_p),
         )
+    }
+}
+
+/// A p-value for reading: three decimals, or two significant digits below 0.001.
+pub fn format_p(p: f64) -> String {
+    if p < 1e-3 {
+        format!("{p:.1e}")
+    } else {
+        format!("{p:.3}")
     }
 }
 
@@ -374,7 +382,7 @@ fn goodness_of_fit(x: &[f64], w: &[f64], order: &[usize], n_eff: f64, k: f64, si
         ks_d: d,
         ks_p: ks_p_value(d, m),
         ad_a2: a2,
-        ad_p: 1.0 - ad_asymptotic_cdf(a2),
+        ad_p: ad_p_value(a2),
     }
 }
 
@@ -391,8 +399,9 @@ fn ad_piece(c: f64, u1: f64, s1: f64, u2: f64, s2: f64) -> f64 {
     v
 }
 
-/// Two-sided one-sample KS p-value `P(D_N ≥ d)`: exact by the Durbin matrix of Marsaglia, Tsang & Wang (2003)
-/// while `⌊N d⌋ ≤ 200`, else Kolmogorov's limit `2 Σ (−1)^{j−1} exp(−2 j² N d²)`.
+/// Two-sided one-sample KS p-value `P(D_N ≥ d)` (as SciPy's `kstest` by default, `kstwo.sf`): exact by the Durbin
+/// matrix of Marsaglia, Tsang & Wang (2003) while `⌊N d⌋ ≤ 200`, else Kolmogorov's limit
+/// `2 Σ (−1)^{j−1} exp(−2 j² N d²)`; below 10⁻⁵ twice the exact one-sided tail (relative error ≲ 10⁻⁵).
 pub fn ks_p_value(d: f64, n: usize) -> f64 {
     let nf = n as f64;
     if !(d > 0.0) || n == 0 || d <= 0.5 / nf {
@@ -400,6 +409,11 @@ pub fn ks_p_value(d: f64, n: usize) -> f64 {
     }
     if d >= 1.0 {
         return 0.0;
+    }
+    // In the far tail 1 − P(D < d) cancels; there P(D ≥ d) = 2 P(D⁺ ≥ d) − P(both), the last of order p².
+    let one_sided = smirnov_sf(d, n);
+    if 2.0 * one_sided < 1e-5 {
+        return 2.0 * one_sided;
     }
     let k = (nf * d).floor() as usize + 1;
     if k > 201 {
@@ -468,8 +482,46 @@ pub fn ks_p_value(d: f64, n: usize) -> f64 {
     (1.0 - ln_cdf.exp()).clamp(0.0, 1.0)
 }
 
+/// Asymptotic AD p-value `1 − ADinf(A²)` ([`ad_asymptotic_cdf`]; for `2 ≤ A² < 8` as `−expm1(−eᵉ)`, kept
+/// accurate in the tail). Beyond `A² = 8` (p ≈ 10⁻⁴), where that polynomial fails, the leading tail of the limit
+/// `A² = Σ Y_j²/(j (j+1))`: `√3 erfc(√A²)` (1.4 % below the polynomial at 8).
+pub fn ad_p_value(a2: f64) -> f64 {
+    if a2 >= 8.0 {
+        3f64.sqrt() * statrs::function::erf::erfc(a2.sqrt())
+    } else if a2 >= 2.0 {
+        -(-ad_tail_exponent(a2).exp()).exp_m1()
+    } else {
+        1.0 - ad_asymptotic_cdf(a2)
+    }
+}
+
+/// The exponent `e` of `ADinf(z) = exp(−eᵉ)` for `z ≥ 2` (Marsaglia & Marsaglia 2004).
+fn ad_tail_exponent(z: f64) -> f64 {
+    1.0776 - (2.30695 - (0.43424 - (0.082433 - (0.008056 - 0.0003146 * z) * z) * z) * z) * z
+}
+
+/// One-sided `P(D⁺_N ≥ d)`, exact (Birnbaum & Tingey 1951):
+/// `d Σ_{j=0}^{⌊N(1−d)⌋} C(N, j) (1 − d − j/N)^{N−j} (d + j/N)^{j−1}`, summed in logs.
+fn smirnov_sf(d: f64, n: usize) -> f64 {
+    let nf = n as f64;
+    let ln_n_fact = ln_gamma(nf + 1.0);
+    let last = (nf * (1.0 - d)).floor() as usize;
+    (0..=last.min(n))
+        .map(|j| {
+            let jf = j as f64;
+            let a = 1.0 - d - jf / nf;
+            if a <= 0.0 {
+                return 0.0;
+            }
+            let ln_c = ln_n_fact - ln_gamma(jf + 1.0) - ln_gamma(nf - jf + 1.0);
+            (ln_c + (nf - jf) * a.ln() + (jf - 1.0) * (d + jf / nf).ln()).exp()
+        })
+        .sum::<f64>()
+        * d
+}
+
 /// CDF of the asymptotic Anderson–Darling distribution, `lim P(A² < z)`, by the approximation of Marsaglia &
-/// Marsaglia (2004, J. Stat. Softw. 9(2), their `ADinf`; |error| < 2·10⁻⁶).
+/// Marsaglia (2004, J. Stat. Softw. 9(2), their `ADinf`; |error| < 2·10⁻⁶ for `z < 8`; 1 beyond).
 pub fn ad_asymptotic_cdf(z: f64) -> f64 {
     if !(z > 0.0) {
         return 0.0;
@@ -480,8 +532,9 @@ pub fn ad_asymptotic_cdf(z: f64) -> f64 {
     if z < 2.0 {
         let poly = 2.00012 + (0.247105 - (0.0649821 - (0.0347962 - (0.011672 - 0.00168691 * z) * z) * z) * z) * z;
         (-1.2337141 / z).exp() / z.sqrt() * poly
+    } else if z < 8.0 {
+        (-ad_tail_exponent(z).exp()).exp()
     } else {
-        let inner = 1.0776 - (2.30695 - (0.43424 - (0.082433 - (0.008056 - 0.0003146 * z) * z) * z) * z) * z;
-        (-inner.exp()).exp()
+        1.0 - ad_p_value(z)
     }
 }

@@ -25,7 +25,7 @@ use crate::analysis::figures::style::{
 use crate::analysis::fits::{PowerLawFit, SpinFit};
 use crate::analysis::fragments::FragmentReport;
 use crate::analysis::run_analysis::{Fit, RunAnalysis};
-use crate::analysis::spin_likelihood::{LikelihoodFit, SpinLikelihood};
+use crate::analysis::spin_likelihood::{LikelihoodFit, SpinLikelihood, format_p};
 
 /// X-axis label of the size plots (Figs. 4, 8, 9).
 pub const SIZE_LABEL: &str = "fragment size / parent-body effective radius (dimensionless)";
@@ -157,7 +157,7 @@ impl SpinHistogram {
             return Vec::new();
         };
         let [lo, hi] = l.free.n_interval.unwrap_or([f64::NAN; 2]);
-        let p = |f: &LikelihoodFit| format!("KS p {:.3}, AD p {:.3}", f.goodness.ks_p, f.goodness.ad_p);
+        let p = |f: &LikelihoodFit| format!("KS p {}, AD p {}", format_p(f.goodness.ks_p), format_p(f.goodness.ad_p));
         vec![
             (
                 format!(
