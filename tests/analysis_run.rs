@@ -72,6 +72,30 @@ fn analyze_reproduces_the_golden_analysis() {
     let ours = read(&dir.join("analysis/analysis.json"));
     let golden = read(&golden_dir.join("golden_analysis.json"));
     assert_json_close(&ours, &golden, "analysis");
+    // Issue 57: the console reports the fitted exponents (binned least squares with n free, unbinned likelihood
+    // with its interval and p-values), and the best of the fixed n ∈ {0.5, 1, 1.5, 2} only as such.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let ls_n = ours["spin_fits"]["ok"]["free"]["n"].as_f64().unwrap();
+    let ml = &ours["spin_likelihood"]["ok"]["free"];
+    let ml_n = ml["n"].as_f64().unwrap();
+    assert!(
+        (ml_n - ls_n).abs() > 0.5,
+        "the golden run's two fits differ: {ml_n} vs {ls_n}"
+    );
+    for text in [
+        format!("free n {ls_n:.2} ± "),
+        "least residual among fixed n ∈ {0.5, 1, 1.5, 2}: 1;".to_string(),
+        format!(
+            "free n = {ml_n:.3} [{:.3}, {:.3}]",
+            ml["n_interval"][0].as_f64().unwrap(),
+            ml["n_interval"][1].as_f64().unwrap()
+        ),
+        "weighted by number".into(),
+        "weighted by mass".into(),
+    ] {
+        assert!(stdout.contains(&text), "stdout lacks {text:?}: {stdout}");
+    }
+    assert!(!stdout.contains("best spin-histogram n"), "{stdout}");
     // the run hit: the projectile was stopped and its energy mostly dissipated
     let f_ke = ours["summary"]["f_ke"].as_f64().unwrap();
     assert!(f_ke > 0.0 && f_ke < 0.2, "f_KE {f_ke}");
@@ -257,6 +281,17 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
         "same runs on both sides"
     );
     assert!(dir.join("rep/figures").is_dir());
+    // the likelihood fits beside the binned ones (issue 57): a summary row, the appendix columns, per projectile
+    for text in [
+        "by unbinned maximum likelihood, n free",
+        "| likelihood n [95 %] | Maxwellian KS p / AD p |",
+        "(least squares below): spin rates by unbinned likelihood (",
+    ] {
+        assert!(report.contains(text), "the report lacks {text:?}");
+    }
+    if std::env::var_os("RUBBLEPILE_KEEP_REPORT").is_some() {
+        std::fs::copy(dir.join("rep/REPORT.md"), std::env::temp_dir().join("i57_REPORT.md")).unwrap();
+    }
     // a second report only with --force
     let again = rubblepile(&dir, &["report", "roig2003", "c", "--out", "rep", "--at", "110"]);
     assert_eq!(again.status.code(), Some(2));

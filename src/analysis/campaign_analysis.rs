@@ -92,6 +92,7 @@ pub fn analyze_campaign(
             }
             Fit::Failed(_) => (None, None),
         };
+        let ml = a.spin_likelihood.ok();
         let s = &a.summary;
         runs.push(CampaignRun {
             target: rec[c_target].to_string(),
@@ -112,6 +113,12 @@ pub fn analyze_campaign(
             spin_exponent_sigma: sp.map(|f| f.sigma_alpha),
             best_n,
             maxwellian_residual_ratio: maxwell,
+            likelihood_n: ml.map(|l| l.free.n),
+            likelihood_n_low: ml.and_then(|l| Some(l.free.n_interval?[0])),
+            likelihood_n_high: ml.and_then(|l| Some(l.free.n_interval?[1])),
+            likelihood_ks_p: ml.map(|l| l.free.goodness.ks_p),
+            maxwellian_ks_p: ml.map(|l| l.maxwellian.goodness.ks_p),
+            maxwellian_ad_p: ml.map(|l| l.maxwellian.goodness.ad_p),
             size_site_correlation: s.ejection_sites.size_cosine_correlation,
             impact_side_median_size: s.ejection_sites.impact_side_median_size,
             antipodal_side_median_size: s.ejection_sites.antipodal_side_median_size,

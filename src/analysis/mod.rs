@@ -15,6 +15,7 @@ pub mod q_star_bootstrap;
 pub use crate::ellipsoid::rigid_rotation;
 pub mod run_analysis;
 pub use crate::geometry::shape_metrics;
+pub mod spin_likelihood;
 pub mod spinup;
 pub use crate::granular::soft::spinup_diagnostics;
 

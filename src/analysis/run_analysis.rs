@@ -14,6 +14,7 @@ use crate::analysis::clumps::{ClumpReport, ClumpSummary, DEFAULT_GAP_FRACTION, a
 use crate::analysis::composition::{Composition, Origin, composition};
 use crate::analysis::fits::{ExponentComparison, PowerLawFit, SpinFit, compare_exponents, fit_power_law, histogram};
 use crate::analysis::fragments::{FragmentParams, FragmentReport, analyse_fragments, read_snapshot_bodies};
+use crate::analysis::spin_likelihood::{SpinLikelihood, Weights, fit_spin_likelihood};
 use crate::ellipsoid::equations::G_SI;
 use crate::io::run_lock::{DirLock, LockError};
 
@@ -121,6 +122,11 @@ pub struct RunAnalysis {
     pub spin_histogram: (Vec<f64>, Vec<f64>),
     /// Fits of `a xⁿ exp(−x²/b²)` to that histogram for n ∈ {0.5, 1, 1.5, 2} and free n (Eqs. 44–45).
     pub spin_fits: Fit<ExponentComparison>,
+    /// Unbinned maximum-likelihood fits (Maxwellian and free n) of the same spin rates, each fragment counting once
+    /// ([`crate::analysis::spin_likelihood`]).
+    pub spin_likelihood: Fit<SpinLikelihood>,
+    /// The same, each fragment weighted by its mass.
+    pub spin_likelihood_by_mass: Fit<SpinLikelihood>,
     /// For a rubble-pile projectile only: clumps, largest remnant (mass, spin, composition) and mixing
     /// ([`crate::analysis::composition`]); its per-body table is `analysis/composition.csv`.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -317,6 +323,7 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
     let spins: Vec<f64> = target.iter().map(|f| f.spin_rate_corrected).collect();
     let bins = ((target.len() as f64).sqrt().round() as usize).clamp(5, 40);
     let spin_histogram = histogram(&spins, bins, None).unwrap_or_default();
+    let masses: Vec<f64> = target.iter().map(|f| f.mass).collect();
     let analysis = RunAnalysis {
         t_at,
         kappa,
@@ -329,6 +336,8 @@ pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, F
             &[0.5, 1.0, 1.5, 2.0],
         )),
         spin_histogram,
+        spin_likelihood: Fit::from(fit_spin_likelihood(&spins, Weights::Number)),
+        spin_likelihood_by_mass: Fit::from(fit_spin_likelihood(&spins, Weights::Mass(&masses))),
         composition: pile_range.and_then(|r| {
             let kappa_i = scene.model.inertia.inertia_kappa(kappa);
             composition(&at, r, g, |b| b.shape.principal_moments(kappa_i))
@@ -586,6 +595,18 @@ pub struct CampaignRun {
     pub best_n: Option<f64>,
     /// Residual of the Maxwellian-like n = 2 fit over that of the best n (≥ 1).
     pub maxwellian_residual_ratio: Option<f64>,
+    /// Free exponent n of the unbinned likelihood fit (by number; [`RunAnalysis::spin_likelihood`]).
+    pub likelihood_n: Option<f64>,
+    /// Lower end of its 95 % profile-likelihood interval.
+    pub likelihood_n_low: Option<f64>,
+    /// Upper end of that interval.
+    pub likelihood_n_high: Option<f64>,
+    /// KS p-value of the free-n likelihood fit.
+    pub likelihood_ks_p: Option<f64>,
+    /// KS p-value of the Maxwellian likelihood fit.
+    pub maxwellian_ks_p: Option<f64>,
+    /// AD p-value of the Maxwellian likelihood fit.
+    pub maxwellian_ad_p: Option<f64>,
     /// Correlation of ln(size) with the impact-site cosine over the fast fragments (§4.2; < 0: small ones from
     /// the impact side).
     pub size_site_correlation: Option<f64>,
@@ -601,7 +622,8 @@ pub struct CampaignRun {
 
 /// The spin distribution of one projectile's runs (Roig03 Fig. 7): the corrected spin rates of the target
 /// fragments of the selected runs, pooled into one histogram and fitted with Eq. 44 for n ∈ {0.5, 1, 1.5, 2} and
-/// free n. The curve of Fig. 7 is the best fixed-n fit normalised by Eq. 45 ([`SpinFit::density`]).
+/// free n, and by unbinned likelihood. The curve of Fig. 7 is the best fixed-n fit normalised by Eq. 45
+/// ([`SpinFit::density`]).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct SpinDistribution {
     /// Projectile id.
@@ -619,6 +641,8 @@ pub struct SpinDistribution {
     pub histogram: (Vec<f64>, Vec<f64>),
     /// Fits of Eq. 44 to it.
     pub fits: Fit<ExponentComparison>,
+    /// Unbinned likelihood fits of the pooled rates (by number; [`crate::analysis::spin_likelihood`]).
+    pub likelihood: Fit<SpinLikelihood>,
 }
 
 impl SpinDistribution {
@@ -760,6 +784,7 @@ pub fn spin_distributions(
                 fragments: pooled.len(),
                 histogram: hist,
                 fits,
+                likelihood: Fit::from(fit_spin_likelihood(&pooled, Weights::Number)),
             }
         })
         .collect()

@@ -54,15 +54,26 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         Fit::Ok(p) => format!("{:.2} ± {:.2}", p.alpha, p.sigma_alpha),
         Fit::Failed(why) => format!("n/a ({why})"),
     };
-    let best_n = match &a.spin_fits {
-        Fit::Ok(c) => format!("{}", c.best_n),
+    // The best of the fixed exponents is only a choice among {0.5, 1, 1.5, 2}: shown as such, after the free fit
+    // (issue 57: it was printed as if it were the fitted n).
+    let binned = match &a.spin_fits {
+        Fit::Ok(c) => {
+            let free = c.free.as_ref().map_or_else(
+                || "free n n/a".to_string(),
+                |f| format!("free n {:.2} ± {:.2}", f.n, f.sigma_n),
+            );
+            format!(
+                "{free}, least residual among fixed n ∈ {{0.5, 1, 1.5, 2}}: {}",
+                c.best_n
+            )
+        }
         Fit::Failed(why) => format!("n/a ({why})"),
     };
     println!(
         "analysis at t = {} s: f_KE {:.3} %, rotational share {:.1} %; fragments (Roig03): {:.3} of the target mass \
          bound, {} escaping; \
          median ejection {:.3} m/s ({:.4} % of v_p), v_esc {:.1} m/s; ejection-size exponent {}, spin-size exponent {}, \
-         best spin-histogram n {}; wrote {} (fragments.csv, analysis.json, {})",
+         spin-histogram least squares ({} bins): {}; wrote {} (fragments.csv, analysis.json, {})",
         a.t_at,
         100.0 * s.f_ke,
         100.0 * s.rotational_share,
@@ -73,10 +84,17 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         s.escape_velocity,
         alpha(&a.ejection_speed_vs_size),
         alpha(&a.spin_vs_size),
-        best_n,
+        a.spin_histogram.0.len(),
+        binned,
         args.dir.join("analysis").display(),
         figures.join(", ")
     );
+    for (fit, by) in [(&a.spin_likelihood, "number"), (&a.spin_likelihood_by_mass, "mass")] {
+        match fit {
+            Fit::Ok(l) => println!("{}", l.summary_line()),
+            Fit::Failed(why) => println!("spin rates by unbinned likelihood (weighted by {by}): n/a ({why})"),
+        }
+    }
     println!("{}", a.clump_report.summary_line());
     if let Some(c) = &a.composition {
         println!("{}", c.summary_line());

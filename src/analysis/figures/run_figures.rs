@@ -1,7 +1,7 @@
 //! Figures of one impact run (Roig03 Figs. 2, 3, 4, 6, 8, 9), written by `rubblepile analyze RUN_DIR` into
 //! `RUN_DIR/analysis/` as SVG and PNG: `energy_partition` (Fig. 2), `velocity_field` (Fig. 3, with the escape
-//! circle), `ejection_vs_size` (Fig. 4, power-law fit, −3/2 reference), `spin_histogram` (Fig. 6, the n = 0.5 and
-//! n = 2 fits of Eq. 44), `spin_vs_size` (Fig. 8, −5/2 reference), `rotation_mode_vs_size` (Fig. 9, SAM/LAM) and
+//! circle), `ejection_vs_size` (Fig. 4, power-law fit, −3/2 reference), `spin_histogram` (Fig. 6, histogram and
+//! empirical CDF with the least-squares and likelihood fits of Eq. 44), `spin_vs_size` (Fig. 8, −5/2 reference), `rotation_mode_vs_size` (Fig. 9, SAM/LAM) and
 //! `sfd` (clump mass distribution, [`super::sfd`]).
 //!
 //! Only target fragments are plotted ([`crate::analysis::fragments`]); sizes over the parent's effective radius,
@@ -25,6 +25,7 @@ use crate::analysis::figures::style::{
 use crate::analysis::fits::{PowerLawFit, SpinFit};
 use crate::analysis::fragments::FragmentReport;
 use crate::analysis::run_analysis::{Fit, RunAnalysis};
+use crate::analysis::spin_likelihood::{LikelihoodFit, SpinLikelihood, format_p};
 
 /// X-axis label of the size plots (Figs. 4, 8, 9).
 pub const SIZE_LABEL: &str = "fragment size / parent-body effective radius (dimensionless)";
@@ -127,8 +128,9 @@ impl Figure for SizeScatter {
     }
 }
 
-/// Roig03 Fig. 6: histogram of the corrected spin rates with fits of Eq. 44 (solid: n = 0.5, the paper's best;
-/// dashed: n = 2, "Maxwellian").
+/// Roig03 Fig. 6: (a) histogram of the corrected spin rates with the binned least-squares fit of Eq. 44 and the
+/// unbinned likelihood fits (free n, Maxwellian) scaled to counts per bin, every curve inside the y range;
+/// (b) the empirical CDF with the likelihood fits' CDFs (drawn when the rates are given).
 #[derive(Debug, Clone)]
 pub struct SpinHistogram {
     /// Figure title.
@@ -137,19 +139,79 @@ pub struct SpinHistogram {
     pub centres: Vec<f64>,
     /// Fragments per bin.
     pub counts: Vec<f64>,
-    /// The fits to draw (at most a few).
+    /// Least-squares fits of Eq. 44 to the bins (counts per bin) to draw.
     pub fits: Vec<SpinFit>,
+    /// The spin rates themselves (rad/s), for the empirical CDF; empty: histogram only.
+    pub rates: Vec<f64>,
+    /// The unbinned likelihood fits ([`crate::analysis::spin_likelihood`]).
+    pub likelihood: Option<SpinLikelihood>,
 }
 
-impl Figure for SpinHistogram {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> PlotResult {
-        if self.centres.len() < 2 || self.centres.len() != self.counts.len() {
-            return Err("histogram has fewer than 2 bins".into());
-        }
+/// A curve of [`SpinHistogram`]: legend, points, colour, dashed.
+type Curve = (String, Vec<(f64, f64)>, RGBColor, bool);
+
+impl SpinHistogram {
+    /// The likelihood fits as curves of `value(fit, x)` at `xs`.
+    fn likelihood_curves(&self, xs: &[f64], value: impl Fn(&LikelihoodFit, f64) -> f64) -> Vec<Curve> {
+        let Some(l) = &self.likelihood else {
+            return Vec::new();
+        };
+        let [lo, hi] = l.free.n_interval.unwrap_or([f64::NAN; 2]);
+        let p = |f: &LikelihoodFit| format!("KS p {}, AD p {}", format_p(f.goodness.ks_p), format_p(f.goodness.ad_p));
+        vec![
+            (
+                format!(
+                    "likelihood, n free: n = {:.2} [{lo:.2}, {hi:.2}], {}",
+                    l.free.n,
+                    p(&l.free)
+                ),
+                xs.iter().map(|&x| (x, value(&l.free, x))).collect(),
+                FIT_COLOUR,
+                false,
+            ),
+            (
+                format!("likelihood, Maxwellian n = 2: {}", p(&l.maxwellian)),
+                xs.iter().map(|&x| (x, value(&l.maxwellian, x))).collect(),
+                SERIES_COLOURS[2],
+                true,
+            ),
+        ]
+    }
+
+    fn histogram_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>, caption: &str) -> PlotResult {
         let width = self.centres[1] - self.centres[0];
         let x1 = self.centres[self.centres.len() - 1] + width;
-        let y1 = self.counts.iter().cloned().fold(1.0, f64::max) * 1.35;
-        let mut chart = figure_chart(root, &self.title, 64)
+        let scale = self.counts.iter().sum::<f64>() * width;
+        // from one step above 0: a density with n < 0 is infinite at 0
+        let xs: Vec<f64> = linear_samples(0.0, x1, 400).into_iter().skip(1).collect();
+        let mut curves: Vec<Curve> = self
+            .fits
+            .iter()
+            .enumerate()
+            .map(|(k, f)| {
+                let how = if f.n_free { "free" } else { "fixed" };
+                (
+                    format!(
+                        "least squares on the bins, n {how} = {:.2}: residual {:.3e}",
+                        f.n, f.rss
+                    ),
+                    xs.iter().map(|&x| (x, f.evaluate(x))).collect(),
+                    SERIES_COLOURS[(k + 3) % 4],
+                    true,
+                )
+            })
+            .collect();
+        curves.extend(self.likelihood_curves(&xs, |f, x| scale * f.density(x)));
+        let top = finite_extent(
+            curves
+                .iter()
+                .flat_map(|c| c.1.iter().map(|p| p.1))
+                .chain(self.counts.clone()),
+        )
+        .map_or(1.0, |e| e.1.max(1.0));
+        // headroom for the legend; every curve's maximum inside
+        let y1 = top * 1.45;
+        let mut chart = figure_chart(area, caption, 64)
             .build_cartesian_2d(0.0..x1, 0.0..y1)
             .map_err(draw_err)?;
         chart
@@ -171,35 +233,86 @@ impl Figure for SpinHistogram {
             .map_err(draw_err)?
             .label(format!("histogram ({:.0} fragments)", self.counts.iter().sum::<f64>()))
             .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], DATA_COLOUR.mix(0.35).filled()));
-        let xs = linear_samples(0.0, x1, 200);
-        for (k, f) in self.fits.iter().enumerate() {
-            let colour = if k == 0 {
-                FIT_COLOUR
-            } else {
-                SERIES_COLOURS[(k + 1) % 4]
-            };
-            let style = colour.stroke_width(2);
-            let line: Vec<(f64, f64)> = xs.iter().map(|&x| (x, f.evaluate(x))).collect();
-            let name = if f.n == 2.0 {
-                format!("Eq. 44 fit, n = 2 (Maxwellian): residual {:.3e}", f.rss)
-            } else {
-                format!("Eq. 44 fit a xⁿ exp(−x²/b²), n = {}: residual {:.3e}", f.n, f.rss)
-            };
-            for (j, run) in inside_runs(&line, (0.0, x1), (0.0, y1)).into_iter().enumerate() {
-                let s = if k == 0 {
-                    chart.draw_series(LineSeries::new(run, style))
-                } else {
-                    chart.draw_series(DashedLineSeries::new(run, 8, 5, style))
-                }
+        draw_curves(&mut chart, curves, (0.0, x1), (0.0, y1))?;
+        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+
+    fn ecdf_panel<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> PlotResult {
+        let mut sorted: Vec<f64> = self.rates.iter().copied().filter(|v| v.is_finite()).collect();
+        sorted.sort_by(f64::total_cmp);
+        let width = self.centres[1] - self.centres[0];
+        let x1 = (self.centres[self.centres.len() - 1] + width).max(sorted.last().copied().unwrap_or(0.0));
+        let mut chart = figure_chart(area, "(b) empirical CDF and the likelihood fits", 64)
+            .build_cartesian_2d(0.0..x1, 0.0..1.05)
+            .map_err(draw_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("spin rate ω, corrected (rad/s)")
+            .y_desc("fraction ≤ ω (dimensionless)")
+            .axis_desc_style(label_style())
+            .label_style(small_style())
+            .x_label_formatter(&|v| format!("{v:.1e}"))
+            .draw()
+            .map_err(draw_err)?;
+        let n = sorted.len() as f64;
+        let mut steps = vec![(0.0, 0.0)];
+        for (i, &v) in sorted.iter().enumerate() {
+            steps.push((v, i as f64 / n));
+            steps.push((v, (i + 1) as f64 / n));
+        }
+        steps.push((x1, 1.0));
+        let style = DATA_COLOUR.stroke_width(2);
+        chart
+            .draw_series(LineSeries::new(steps, style))
+            .map_err(draw_err)?
+            .label(format!("empirical CDF ({} rates)", sorted.len()))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+        let xs = linear_samples(0.0, x1, 400);
+        draw_curves(
+            &mut chart,
+            self.likelihood_curves(&xs, |f, x| f.cdf(x)),
+            (0.0, x1),
+            (0.0, 1.05),
+        )?;
+        draw_legend(&mut chart, SeriesLabelPosition::LowerRight)
+    }
+}
+
+/// Draws `curves` (solid or dashed, each with its legend entry) inside the axis ranges.
+fn draw_curves<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    curves: Vec<Curve>,
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> PlotResult {
+    for (name, line, colour, dashed) in curves {
+        let style = colour.stroke_width(2);
+        let (on, off) = if dashed { (8, 5) } else { (1000, 0) };
+        for (j, run) in inside_runs(&line, xr, yr).into_iter().enumerate() {
+            let s = chart
+                .draw_series(DashedLineSeries::new(run, on, off, style))
                 .map_err(draw_err)?;
-                if j == 0 {
-                    s.label(name.clone()).legend(move |(x, y)| {
-                        DashedPathElement::new(vec![(x, y), (x + 20, y)], if k == 0 { 20 } else { 6 }, 3, style)
-                    });
-                }
+            if j == 0 {
+                s.label(name.clone())
+                    .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], on.min(20), off, style));
             }
         }
-        draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
+    }
+    Ok(())
+}
+
+impl Figure for SpinHistogram {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> PlotResult {
+        if self.centres.len() < 2 || self.centres.len() != self.counts.len() {
+            return Err("histogram has fewer than 2 bins".into());
+        }
+        if self.rates.is_empty() {
+            return self.histogram_panel(root, &self.title);
+        }
+        let body = root.titled(&self.title, title_style()).map_err(draw_err)?;
+        let panels = body.split_evenly((2, 1));
+        self.histogram_panel(&panels[0], "(a) histogram and fits")?;
+        self.ecdf_panel(&panels[1])
     }
 }
 
@@ -646,13 +759,18 @@ pub fn write_run_figures(
         title: format!("Spin rates of the target fragments at t = {t_at} s"),
         centres: analysis.spin_histogram.0.clone(),
         counts: analysis.spin_histogram.1.clone(),
+        // the free-n least-squares fit (the best fixed n when the free one failed)
         fits: match &analysis.spin_fits {
-            Fit::Ok(c) => {
-                let pick = |n: f64| c.fixed.iter().find(|f| f.n == n).cloned();
-                [pick(0.5), pick(2.0)].into_iter().flatten().collect()
-            }
+            Fit::Ok(c) => c
+                .free
+                .clone()
+                .or_else(|| c.fixed.iter().find(|f| f.n == c.best_n).cloned())
+                .into_iter()
+                .collect(),
             Fit::Failed(_) => Vec::new(),
         },
+        rates: target.iter().map(|f| f.spin_rate_corrected).collect(),
+        likelihood: analysis.spin_likelihood.ok().cloned(),
     };
     log.write(&dir, "spin_histogram", &fig6);
 
@@ -729,12 +847,37 @@ mod tests {
             centres: vec![0.5e-3, 1.5e-3, 2.5e-3, 3.5e-3],
             counts: vec![3.0, 6.0, 4.0, 1.0],
             fits: Vec::new(),
+            rates: Vec::new(),
+            likelihood: None,
         };
         assert_writes(
             "spin_histogram",
             &fig,
             &["spin rate ω, corrected (rad/s)", "fragments per bin"],
         );
+        // with the rates: the likelihood fits in both panels, the ECDF below
+        let rates = [
+            0.4e-3, 0.7e-3, 1.1e-3, 1.3e-3, 1.6e-3, 2.2e-3, 2.4e-3, 2.9e-3, 3.3e-3, 3.9e-3,
+        ];
+        let fig = SpinHistogram {
+            likelihood: crate::analysis::spin_likelihood::fit_spin_likelihood(
+                &rates,
+                crate::analysis::spin_likelihood::Weights::Number,
+            )
+            .ok(),
+            rates: rates.to_vec(),
+            ..fig
+        };
+        let svg = assert_writes(
+            "spin_histogram",
+            &fig,
+            &[
+                "fraction ≤ ω (dimensionless)",
+                "empirical CDF (10 rates)",
+                "likelihood, n free: n = ",
+            ],
+        );
+        assert!(svg.contains("likelihood, Maxwellian n = 2: KS p"));
     }
 
     #[test]

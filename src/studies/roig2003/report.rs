@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use super::kappa::{FIG4_EXPONENTS, FIG8_EXPONENTS, overrun_pairs};
 use rubblepile::analysis::campaign_analysis::analyze_campaign;
 use rubblepile::analysis::run_analysis::{AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection};
+use rubblepile::analysis::spin_likelihood::format_p;
 
 /// A published outcome of Roig03 as a closed interval (with the paper's words).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -277,6 +278,26 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             &values(runs, |r| r.maxwellian_residual_ratio),
             Some(MAXWELLIAN_RATIO),
             &num2,
+        ),
+    );
+    row(
+        w,
+        "n of f(ω) ∝ ωⁿ exp(−ω²/b²) by unbinned maximum likelihood, n free (not in the paper)",
+        "–",
+        summary_cell(&values(runs, |r| r.likelihood_n), None, &num2),
+    );
+    let rejected = |p: fn(&CampaignRun) -> Option<f64>| {
+        let v = values(runs, p);
+        format!("{} of {}", v.iter().filter(|x| x.0 < 0.05).count(), v.len())
+    };
+    row(
+        w,
+        "runs whose likelihood-fitted Maxwellian (n = 2) is rejected at 5 % (p-values optimistic: fitted σ)",
+        "–",
+        format!(
+            "KS: {}; AD: {}",
+            rejected(|r| r.maxwellian_ks_p),
+            rejected(|r| r.maxwellian_ad_p)
         ),
     );
     row(
@@ -607,6 +628,9 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         );
     }
     for d in &c.spin_distributions {
+        if let Fit::Ok(l) = &d.likelihood {
+            let _ = writeln!(w, "- {} (least squares below): {}", d.projectile, l.summary_line());
+        }
         if let Some(b) = d.best() {
             let _ = writeln!(
                 w,
@@ -624,7 +648,7 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     let _ = writeln!(w);
     fig(
         w,
-        "Fig. 6 — spin histogram with the n = 0.5 and n = 2 fits, N200_T4 + P2, ζ = 0°",
+        "Fig. 6 — spin histogram and empirical CDF with the least-squares (n free) and likelihood fits, N200_T4 + P2, ζ = 0°",
         "N200_T4",
         "P2",
         0.0,
@@ -662,9 +686,12 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
     let _ = writeln!(w, "## Appendix: every run\n");
     let _ = writeln!(
         w,
-        "| run | Q (erg/g) | bound | largest remnant | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | energy error | barrier overruns | wall (s) |"
+        "| run | Q (erg/g) | bound | largest remnant | escaping / fragments | f_KE | rot. share | median Δv (m/s) | ejection α | spin α | best n | n=2 / best | likelihood n [95 %] | Maxwellian KS p / AD p | energy error | barrier overruns | wall (s) |"
     );
-    let _ = writeln!(w, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        w,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     let mut overrun_runs = (0, 0);
     for r in runs {
         let overruns = overrun_pairs(&inputs.campaign_dir.join(&r.run));
@@ -674,7 +701,7 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
         }
         let _ = writeln!(
             w,
-            "| `{}` | {:.3e} | {:.3} | {} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} |",
+            "| `{}` | {:.3e} | {:.3} | {} | {} / {} | {} | {} | {:.1} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.run,
             r.q_erg_per_g,
             r.bound_mass_fraction,
@@ -688,6 +715,14 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             opt(r.spin_exponent, &num2),
             opt(r.best_n, &|x| format!("{x}")),
             opt(r.maxwellian_residual_ratio, &num2),
+            match (r.likelihood_n, r.likelihood_n_low, r.likelihood_n_high) {
+                (Some(n), Some(lo), Some(hi)) => format!("{n:.2} [{lo:.2}, {hi:.2}]"),
+                _ => "–".into(),
+            },
+            match (r.maxwellian_ks_p, r.maxwellian_ad_p) {
+                (Some(k), Some(a)) => format!("{} / {}", format_p(k), format_p(a)),
+                _ => "–".into(),
+            },
             opt(r.energy_error, &|x| format!("{x:.1e}")),
             overruns.map_or_else(|| "–".to_string(), |k| k.to_string()),
             opt(r.wall_seconds, &|x| format!("{x:.1}")),
@@ -797,7 +832,7 @@ fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
         return;
     }
     type Outcome = (&'static str, fn(&CampaignRun) -> Option<f64>, fn(f64) -> String);
-    let outcomes: [Outcome; 7] = [
+    let outcomes: [Outcome; 8] = [
         ("bound", |r| Some(r.bound_mass_fraction), |x| format!("{x:.3}")),
         ("f_KE (%)", |r| Some(100.0 * r.f_ke), |x| format!("{x:.2}")),
         (
@@ -813,6 +848,7 @@ fn seed_scatter(w: &mut String, runs: &[CampaignRun]) {
         ("ejection α", |r| r.ejection_exponent, |x| format!("{x:.2}")),
         ("spin α", |r| r.spin_exponent, |x| format!("{x:.2}")),
         ("best n", |r| r.best_n, |x| format!("{x:.2}")),
+        ("likelihood n", |r| r.likelihood_n, |x| format!("{x:.2}")),
     ];
     let _ = writeln!(w, "### Seed scatter\n");
     let _ = writeln!(
@@ -897,6 +933,12 @@ mod tests {
             spin_exponent_sigma: Some(0.2),
             best_n: Some(0.5),
             maxwellian_residual_ratio: Some(2.0),
+            likelihood_n: Some(0.4),
+            likelihood_n_low: Some(0.1),
+            likelihood_n_high: Some(0.7),
+            likelihood_ks_p: Some(0.5),
+            maxwellian_ks_p: Some(0.01),
+            maxwellian_ad_p: Some(0.005),
             size_site_correlation: None,
             impact_side_median_size: None,
             antipodal_side_median_size: None,
