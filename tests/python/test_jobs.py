@@ -70,6 +70,16 @@ def test_impact_errors_name_the_argument(tmp_path):
         rubblepile.impact(tmp_path / "nope.csv", tmp_path / "c", run=False)
 
 
+def test_impact_aims_off_centre_as_the_command_line(tmp_path):
+    sim = rubblepile.impact(TARGET, tmp_path / "b", impact_parameter_frac=0.7, aim_azimuth_deg=30.0, run=False)
+    geometry = json.loads((tmp_path / "b" / "impact.json").read_text())["geometry"]
+    text = json.dumps(geometry)
+    assert "0.7" in text and "30" in text, text
+    del sim
+    with pytest.raises(rubblepile.SceneError, match="impact_angle_deg"):
+        rubblepile.impact(TARGET, tmp_path / "c", impact_parameter_frac=0.5, impact_angle_deg=30.0, run=False)
+
+
 def test_build_target_is_the_command_lines(tmp_path):
     r = run_cli("target", "build", "--fragments", "30", "--period-hours", "4", "--out", str(tmp_path / "cli.csv"))
     assert r.returncode == 0, r.stderr

@@ -852,7 +852,7 @@ fn impact_failure(e: rubblepile::impact::error::ImpactError) -> Failure {
 /// `rubblepile.impact`: prepares the impact's run directory as `rubblepile impact` does and returns its
 /// simulation, not yet advanced (see the Python docstring).
 #[pyfunction]
-#[pyo3(signature = (target, out=None, *, projectile="P2", projectile_radius=None, speed=5000.0, angle=45.0, seed=1, contact_time=90.0, t_end=10000.0, rtol=None, method="bulirsch-stoer", f0=rubblepile::impact::run::DEFAULT_F0, beta=10.0, inertia="gaussian", kappa_reading="printed", snapshots=None, snapshot_every=None, every=10.0, force=false, checkpoint_every=None, checkpoint_every_sim=None))]
+#[pyo3(signature = (target, out=None, *, projectile="P2", projectile_radius=None, speed=5000.0, angle=45.0, seed=1, contact_time=90.0, t_end=10000.0, rtol=None, method="bulirsch-stoer", f0=rubblepile::impact::run::DEFAULT_F0, beta=10.0, inertia="gaussian", kappa_reading="printed", snapshots=None, snapshot_every=None, every=10.0, force=false, checkpoint_every=None, checkpoint_every_sim=None, impact_parameter_m=None, impact_parameter_frac=None, impact_angle_deg=None, aim_azimuth_deg=None, projectile_spin_rad_s=None, projectile_attitude=None))]
 #[allow(clippy::too_many_arguments)]
 fn impact(
     py: Python<'_>,
@@ -877,6 +877,12 @@ fn impact(
     force: bool,
     checkpoint_every: Option<f64>,
     checkpoint_every_sim: Option<f64>,
+    impact_parameter_m: Option<f64>,
+    impact_parameter_frac: Option<f64>,
+    impact_angle_deg: Option<f64>,
+    aim_azimuth_deg: Option<f64>,
+    projectile_spin_rad_s: Option<Vec<f64>>,
+    projectile_attitude: Option<Vec<f64>>,
 ) -> PyResult<Simulation> {
     use rubblepile::impact::projectile::ProjectileSpec;
     use rubblepile::impact::run::{ImpactConfig, default_rtol, prepare_impact, snapshot_times};
@@ -912,7 +918,15 @@ fn impact(
         .map_err(|e: String| usage(format!("kappa_reading: {e}")))?;
     let snapshots =
         snapshot_times(t_end, snapshots.as_deref(), snapshot_every).map_err(|m| usage(format!("snapshots: {m}")))?;
+    let geometry = rubblepile::impact::geometry::ImpactGeometry::from_options(
+        [impact_parameter_m, impact_parameter_frac, impact_angle_deg],
+        aim_azimuth_deg,
+        projectile_spin_rad_s.as_deref(),
+        projectile_attitude.as_deref(),
+    )
+    .map_err(|e| impact_failure(e).into_py(py))?;
     let cfg = ImpactConfig {
+        geometry,
         angle_deg: angle,
         seed,
         contact_time,

@@ -382,6 +382,12 @@ def impact(
     force: bool = False,
     checkpoint_every: Optional[float] = None,
     checkpoint_every_sim: Optional[float] = None,
+    impact_parameter_m: Optional[float] = None,
+    impact_parameter_frac: Optional[float] = None,
+    impact_angle_deg: Optional[float] = None,
+    aim_azimuth_deg: Optional[float] = None,
+    projectile_spin_rad_s: Optional[list] = None,
+    projectile_attitude: Optional[list] = None,
     run: bool = True,
 ) -> Simulation:
     """An impact of a projectile on a rubble-pile target (Roig03), as ``rubblepile impact`` sets it up: the run
@@ -396,7 +402,10 @@ def impact(
     (default 1e-6 for Bulirsch-Stoer, 1e-8 for dop853/dopri5); ``method``: ``bulirsch-stoer``, ``dop853`` or
     ``dopri5``; ``f0``: dissipation coefficient F0 (s m^-2); ``beta``: Roig03 Eq. 14; ``inertia``: ``gaussian``
     or ``uniform``; ``kappa_reading``: ``printed``, ``impactor`` or ``reduced``; ``snapshots`` (s) or
-    ``snapshot_every`` (s); ``every``: time-series cadence (s).
+    ``snapshot_every`` (s); ``every``: time-series cadence (s). Off-centre aim (at most one): ``impact_parameter_m``
+    (b, m), ``impact_parameter_frac`` (b over the target's radius) or ``impact_angle_deg`` (θ to the surface normal
+    at the aim point), with ``aim_azimuth_deg`` (ψ); ``projectile_spin_rad_s`` ([x, y, z], rad/s) and
+    ``projectile_attitude`` (quaternion, scalar last), as ``rubblepile impact`` (README, *Impact experiments*).
 
     Raises :class:`SceneError` naming the argument (e.g. ``angle_deg: ...``) for a value out of range.
     """
@@ -405,7 +414,10 @@ def impact(
         projectile_radius=projectile_radius, speed=speed, angle=angle, seed=seed, contact_time=contact_time,
         t_end=t_end, rtol=rtol, method=method, f0=f0, beta=beta, inertia=inertia, kappa_reading=kappa_reading,
         snapshots=snapshots, snapshot_every=snapshot_every, every=every, force=force,
-        checkpoint_every=checkpoint_every, checkpoint_every_sim=checkpoint_every_sim)
+        checkpoint_every=checkpoint_every, checkpoint_every_sim=checkpoint_every_sim,
+        impact_parameter_m=impact_parameter_m, impact_parameter_frac=impact_parameter_frac,
+        impact_angle_deg=impact_angle_deg, aim_azimuth_deg=aim_azimuth_deg,
+        projectile_spin_rad_s=projectile_spin_rad_s, projectile_attitude=projectile_attitude)
     sim = Simulation(inner)
     if run:
         sim.integrate()

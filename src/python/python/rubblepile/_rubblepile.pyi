@@ -105,6 +105,12 @@ def impact(
     force: bool = False,
     checkpoint_every: Optional[float] = None,
     checkpoint_every_sim: Optional[float] = None,
+    impact_parameter_m: Optional[float] = None,
+    impact_parameter_frac: Optional[float] = None,
+    impact_angle_deg: Optional[float] = None,
+    aim_azimuth_deg: Optional[float] = None,
+    projectile_spin_rad_s: Optional[List[float]] = None,
+    projectile_attitude: Optional[List[float]] = None,
 ) -> Simulation: ...
 def analyze(dir: str, at: Optional[float] = None, *, force: bool = False) -> Tuple[str, List[str]]: ...
 def build_aggregate(
