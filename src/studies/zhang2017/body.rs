@@ -5,8 +5,9 @@
 //! Two sources, best first: the aggregate's record `NAME.json` beside the scene's `particles_file` (written by
 //! `rubblepile aggregate`: `shape_equivalent_diameter_m`, `bulk_density_kg_m3`), used when its `total_mass_kg`
 //! is the run's mass; else the grains over the packing, `V = Σ (4/3)π r³ / η_B` with η_B at t_start, the
-//! estimate by which [`rubblepile::analysis::spinup::paper_bulk_density`] derives the paper's own bodies (it counts
-//! the looser surface layer at the interior's packing, so it makes V a little small: +0.5 % on D for our HCP).
+//! estimate by which [`rubblepile::analysis::spinup::paper_bulk_density`] derives the paper's own bodies (it takes
+//! the interior's packing for the whole body's filling: for our settled HCP, D 783 m and ρ_B 2072 kg/m³ against
+//! the carved 780 m and 2100 kg/m³).
 
 use std::path::Path;
 
