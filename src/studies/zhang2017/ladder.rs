@@ -16,7 +16,9 @@ use rubblepile::analysis::critical::read_critical;
 use rubblepile::analysis::figures::lines::{LineChart, Mark, Series};
 use rubblepile::analysis::figures::style::write_figure;
 
-use super::rows::{ModelRow, PaperRow, TABLE3, base_model, mode, model_dirs, model_row, opt, search_subdirs};
+use super::rows::{
+    ModelRow, PaperRow, TABLE3, base_model, flagged, mode, model_dirs, model_row, opt, search_subdirs, warn_settling,
+};
 
 /// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
 /// and its directory name.
@@ -97,6 +99,7 @@ fn rungs(ladder: &Path) -> Result<Vec<Rung>, String> {
     let mut out = Vec::new();
     for dir in model_dirs(ladder)? {
         let (row, _) = model_row(&dir).map_err(|e| e.to_string())?;
+        warn_settling(&row);
         let subdirs = search_subdirs(&dir);
         let searches = subdirs.iter().filter_map(|d| read_search(d)).collect();
         out.push(Rung {
@@ -185,8 +188,8 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
                 r.row.n,
                 r.row.radius_range.1,
                 r.row.packing,
-                opt(r.row.limits.t_c1_hours, 3),
-                opt(r.row.limits.t_c2_hours, 3),
+                flagged(&r.row, "T_c1", opt(r.row.limits.t_c1_hours, 3)),
+                flagged(&r.row, "T_c2", opt(r.row.limits.t_c2_hours, 3)),
                 opt(r.row.limits_smoothed.t_c1_hours, 3),
                 opt(r.row.limits_smoothed.t_c2_hours, 3),
                 mode(r.row.limits.failure_mode),

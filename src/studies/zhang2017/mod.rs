@@ -6,6 +6,7 @@
 //! of [`rows`]. The searches that make its runs are generic and live in
 //! [`rubblepile::analysis::critical`].
 
+pub mod body;
 pub mod creep_extrapolation;
 pub mod decided;
 pub mod holds;
@@ -17,6 +18,7 @@ pub mod report;
 #[cfg(test)]
 mod report_tests;
 pub mod rows;
+pub mod settling;
 pub mod spin_limit;
 pub mod spinup_figures;
 pub mod surface_slopes;

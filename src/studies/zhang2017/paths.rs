@@ -10,7 +10,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use crate::studies::zhang2017::rows::{TABLE3, mode, opt, path_row, t_end_of};
+use crate::studies::zhang2017::rows::{TABLE3, flagged, mode, opt, path_row, t_end_of, warn_settling};
 
 /// The spin-up paths, by the run directory's name.
 pub const PATHS: [&str; 3] = ["path1", "path2", "path3"];
@@ -91,13 +91,14 @@ pub fn write_paths_section(md: &mut String, runs: &Path, paths: &Path) -> Result
                 continue;
             }
             let (r, _) = path_row(&dir, path).map_err(|e| e.to_string())?;
+            warn_settling(&r);
             let _ = writeln!(
                 md,
                 "| {} | {} | {} | {} | {}/{} | {} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
                 name.to_uppercase(),
                 k + 1,
-                opt(r.limits.t_c1_hours, 3),
-                opt(r.limits.t_c2_hours, 3),
+                flagged(&r, "T_c1", opt(r.limits.t_c1_hours, 3)),
+                flagged(&r, "T_c2", opt(r.limits.t_c2_hours, 3)),
                 opt(r.limits_smoothed.t_c1_hours, 3),
                 opt(r.limits_smoothed.t_c2_hours, 3),
                 match r.t_c3_by_criterion {

@@ -4,8 +4,14 @@
 //!
 //! Layout read: `RUNS/<model>/path2/` (a soft-sphere run with `[spinup]`: `spinup.csv`, `summary.json`,
 //! `snapshots/0.csv`) and, optionally, `RUNS/<model>/critical/critical.json` (from `rubblepile spinup
-//! critical`, giving T_c,3 and φ). Models: any directory under RUNS with a `path2` run; the paper's Table 3 row is
-//! printed beside ours for HCP, RCP, RCPC, PP1, PP2 and PPC.
+//! critical`, giving T_c,3 and φ). Also read: a run directory `RUNS/<run>/` with `spinup.csv` directly in it (a
+//! user's `rubblepile run` of a spin-up scene), or RUNS being one such run directory ([`model_dirs`]); the report
+//! says which layout it read. Models: every such directory; the paper's Table 3 row is printed beside ours for HCP,
+//! RCP, RCPC, PP1, PP2 and PPC, "–" for any other name.
+//!
+//! The body's size and bulk density in the text are read from each run ([`crate::studies::zhang2017::body`]); a
+//! T_c,1 or T_c,2 read within one dynamical time of t_start is marked as the settling's, in its cell, in a warning
+//! line and on stderr ([`crate::studies::zhang2017::settling`]).
 //!
 //! Per model: N and the particle radii (the radius scaling against the paper's sizes), T_c,1 and T_c,2 from the
 //! forced part after `t_start` ([`rubblepile::analysis::spinup::critical_limits`]), the failure mode, T_c,3 and φ, κ₃
@@ -32,6 +38,7 @@ use rubblepile::analysis::spinup::{DensityFit, fit_density};
 use rubblepile::analysis::spinup_diagnostics::SpinupSample;
 use rubblepile::io::scene_file::SI_G;
 
+use super::body::BodySource;
 use super::rows::*;
 
 /// The full-size section: one row per model under `full` (`<model>/path2`), finished or not, with its wall
@@ -57,7 +64,7 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
     let mut figures = Vec::new();
     for m in &models {
         let (r, samples) = model_row(m)?;
-        let ts = timeseries_worst(&m.join("path2"));
+        let ts = timeseries_worst(&run_dir(m, "path2"));
         let _ = writeln!(
             md,
             "| {} | {} | {:.2} | {:.4} | {} | {} | {} | {} | {:.0} / {} | {:.0} | {} | {} |",
@@ -65,12 +72,12 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
             r.n,
             r.radius_range.1,
             r.packing,
-            opt(r.limits.t_c1_hours, 3),
-            opt(r.limits.t_c2_hours, 3),
+            flagged(&r, "T_c1", opt(r.limits.t_c1_hours, 3)),
+            flagged(&r, "T_c2", opt(r.limits.t_c2_hours, 3)),
             mode(r.limits.failure_mode),
             r.status,
             r.final_time,
-            opt(t_end_of(&m.join("path2")), 0),
+            opt(t_end_of(&run_dir(m, "path2")), 0),
             r.wall_seconds,
             if r.max_overlap.is_finite() {
                 format!("{:.2e}", r.max_overlap)
@@ -82,6 +89,7 @@ fn write_full_section(md: &mut String, full: &Path, out: &Path) -> Result<(), St
                 .or(ts.map(|t| format!("{:.1e} / {:.1e} (so far)", t.1, t.2)))
                 .unwrap_or_else(|| "–".into()),
         );
+        warn_settling(&r);
         let title = format!("{} (N = {}), full size, spin-up path 2", r.model.to_uppercase(), r.n);
         figures.extend(fig5(out, format!("fig5_{}_full", r.model), title, samples));
     }
@@ -175,7 +183,11 @@ pub fn write_report(
     }
     let models = model_dirs(runs)?;
     if models.is_empty() {
-        return Err(format!("{}: no <model>/path2/spinup.csv found", runs.display()).into());
+        return Err(format!(
+            "{}: no spin-up run found (expected <model>/path2/spinup.csv, <run>/spinup.csv, or a spinup.csv in it)",
+            runs.display()
+        )
+        .into());
     }
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let mut rows = Vec::new();
@@ -213,6 +225,7 @@ pub fn write_report(
         out.display(),
         runs.display()
     );
+    let _ = writeln!(md, "{}\n", layout_sentence(runs, &models));
     let _ = writeln!(
         md,
         "Ours: T_c1/T_c2 from `spinup.csv` by the paper's rule as written: the first sample, after t_start and \
@@ -276,9 +289,9 @@ pub fn write_report(
             r.model.to_uppercase(),
             r.n,
             r.packing,
-            opt(r.limits.t_c1_hours, 3),
+            flagged(r, "T_c1", opt(r.limits.t_c1_hours, 3)),
             if r.t_c2_resolved {
-                opt(r.limits.t_c2_hours, 3)
+                flagged(r, "T_c2", opt(r.limits.t_c2_hours, 3))
             } else {
                 format!(
                     "unresolved ({}; η_B scatter {:.1e})",
@@ -299,11 +312,20 @@ pub fn write_report(
             mode(r.limits_smoothed.failure_mode),
         );
     }
+    let warnings: Vec<String> = nominal
+        .iter()
+        .flat_map(|r| r.settling.iter().map(|w| w.describe(&r.model.to_uppercase())))
+        .collect();
+    for w in &warnings {
+        let _ = writeln!(md, "\n**Warning** (settling, Zhang17 §2.3.4): {w}.");
+        eprintln!("warning: {w}");
+    }
     let _ = writeln!(
         md,
         "\nRadius scaling: the paper's HCP/RCP spheres are ≈ 10 m (42 062 and 36 523 particles in \
-         the 780 m body) and PP1's 4–32 m; ours keep the body (D = 780 m, ρ_B = 2100 kg/m³) and use fewer, larger \
-         particles (radius column), i.e. lengths scaled by (N_paper/N)^(1/3).\n"
+         the 780 m body) and PP1's 4–32 m; ours keep the body ({}) and use fewer, larger \
+         particles (radius column), i.e. lengths scaled by (N_paper/N)^(1/3).\n",
+        bodies_sentence(&nominal)
     );
     write_criterion_section(&mut md, &nominal);
     let _ = writeln!(md, "## Runs\n");
@@ -357,6 +379,76 @@ pub fn write_report(
     crate::studies::report_notes::append_notes(&mut md, out);
     std::fs::write(&report, md).map_err(|e| format!("{}: {e}", report.display()))?;
     Ok(report)
+}
+
+/// Which layout of run directories was read: `<model>/path2/` ones, run directories with `spinup.csv` in them,
+/// or `runs` itself as one run.
+fn layout_sentence(runs: &Path, models: &[std::path::PathBuf]) -> String {
+    if models.len() == 1 && models[0] == runs {
+        return format!(
+            "Layout read: `{}` is one run directory (`spinup.csv` directly in it), its row named after it.",
+            runs.display()
+        );
+    }
+    let (nested, direct): (Vec<_>, Vec<_>) = models.iter().partition(|m| m.join("path2/spinup.csv").is_file());
+    let names = |v: &[&std::path::PathBuf]| v.iter().map(|m| dir_name(m)).collect::<Vec<_>>().join(", ");
+    let mut parts = Vec::new();
+    if !nested.is_empty() {
+        parts.push(format!("`<model>/path2/spinup.csv` for {} models", nested.len()));
+    }
+    if !direct.is_empty() {
+        parts.push(format!(
+            "run directories with `spinup.csv` directly in them for {}",
+            names(&direct)
+        ));
+    }
+    let unknown: Vec<&std::path::PathBuf> = models
+        .iter()
+        .filter(|m| {
+            let n = dir_name(m);
+            !TABLE3.iter().any(|p| p.0 == base_model(&n))
+        })
+        .collect();
+    let mut s = format!("Layout read under `{}`: {}.", runs.display(), parts.join("; "));
+    if !unknown.is_empty() {
+        let _ = write!(
+            s,
+            " Not models of the paper's Table 3 (hcp, rcp, rcpc, pp1, pp2, ppc), so – in its columns: {}.",
+            names(&unknown)
+        );
+    }
+    s
+}
+
+/// The bodies of `rows` as read from the runs: one "D = …, ρ_B = …" when all agree at the printed precision,
+/// else each value with the models that have it; where each was read from.
+fn bodies_sentence(rows: &[&ModelRow]) -> String {
+    let mut groups: Vec<(String, Vec<String>)> = Vec::new();
+    for r in rows {
+        let key = match &r.body {
+            Some(b) => format!(
+                "{} ({})",
+                b.describe(),
+                match b.source {
+                    BodySource::Aggregate => "the aggregate's record",
+                    BodySource::GrainsOverPacking => "the grains' volume over η_B at t_start",
+                }
+            ),
+            None => "size not found in the run".to_string(),
+        };
+        match groups.iter_mut().find(|g| g.0 == key) {
+            Some(g) => g.1.push(r.model.to_uppercase()),
+            None => groups.push((key, vec![r.model.to_uppercase()])),
+        }
+    }
+    if groups.len() == 1 {
+        return groups.remove(0).0;
+    }
+    groups
+        .iter()
+        .map(|(k, m)| format!("{k} for {}", m.join(", ")))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 /// The searches whose holds the Fig. 22 analogue may show: PP2's T_c,3 searches under `runs` (the paper's model, at
@@ -609,6 +701,8 @@ mod tests {
             max_overlap: 0.0,
             max_overlap_before_failure: None,
             residuals: None,
+            body: None,
+            settling: Vec::new(),
             wall_seconds: 0.0,
             final_time: 0.0,
             status: "completed".into(),

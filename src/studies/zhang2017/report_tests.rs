@@ -717,3 +717,125 @@ fn holds_section_shows_pp2_at_each_density_run() {
     assert!(!holds_md.contains("### runs hcp"), "{holds_md}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// A user's run directory (`rubblepile run` of a spin-up scene: `spinup.csv` directly in it, a name not in Table 3)
+/// is read beside this project's `<model>/path2` layout, gets its row with "–" in the paper's column, and the
+/// report says which layout it read; RUNS may also be that run directory itself.
+#[test]
+fn a_users_run_directory_gets_its_row() {
+    let root = fresh_root("user_layout");
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    fake_run_at(
+        &root.join("runs"),
+        "myrun",
+        40,
+        38300.0,
+        38300.0,
+        600.0,
+        true,
+        Some(2.6),
+    );
+    let md = report_of_runs(&root);
+    let row = line_starting(&md, "| MYRUN |");
+    assert!(row.contains("| 40 |"), "N: {row}");
+    assert!(row.ends_with("| – |"), "the paper's column: {row}");
+    assert!(line_starting(&md, "| HCP |").contains("2.38/2.36/2.40 h"));
+    assert!(
+        md.contains("`<model>/path2/spinup.csv` for 1 models"),
+        "{}",
+        &md[..1200]
+    );
+    assert!(
+        md.contains("`spinup.csv` directly in them for myrun"),
+        "{}",
+        &md[..1200]
+    );
+    assert!(md.contains("– in its columns: myrun."), "{}", &md[..1200]);
+    // RUNS is the run directory itself
+    let one = root.join("runs/myrun");
+    let path = write_report(&ReportSources::new(&one), &root.join("out_one"), false).unwrap();
+    let md = std::fs::read_to_string(path).unwrap();
+    assert!(line_starting(&md, "| MYRUN |").contains("| 40 |"));
+    assert!(md.contains("is one run directory"), "{}", &md[..1200]);
+    // a directory with no spin-up run is refused with a message naming the layouts
+    let err = write_report(&ReportSources::new(&root.join("out")), &root.join("out_none"), false).unwrap_err();
+    assert!(err.to_string().contains("<run>/spinup.csv"), "{err}");
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// The body's size and bulk density in the text are the runs', not the paper's D = 780 m: for the fake runs' n
+/// grains of 10 m radius and 1e7 kg at η_B = 0.74, V = n (4/3)π 10³ / 0.74, so D = 20 (n/0.74)^(1/3) m and
+/// ρ_B = 0.74 × 1e7 / ((4/3)π 10³) kg/m³; and the aggregate's record beside the scene's particles file, when it
+/// is of the run's mass, gives its own values instead.
+#[test]
+fn the_body_in_the_text_is_the_runs() {
+    let root = fresh_root("body");
+    fake_run(&root.join("runs/hcp"), 30, 38300.0, 38300.0, 600.0, true);
+    let md = report_of_runs(&root);
+    let d = 20.0 * (30.0f64 / 0.74).cbrt();
+    let rho = 0.74 * 1e7 / (4.0 / 3.0 * std::f64::consts::PI * 1e3);
+    let expected = format!("ours keep the body (D ≈ {d:.0} m, ρ_B ≈ {rho:.0} kg/m³ (the grains' volume over η_B");
+    assert!(md.contains(&expected), "{expected}: {md}");
+    assert!(!md.contains("D = 780 m"));
+    // with the aggregate's record of a 1234 m body of the run's mass (30 × 1e7 kg)
+    let run = root.join("runs/hcp/path2");
+    let scene = std::fs::read_to_string(run.join("scene.toml")).unwrap();
+    let scene = scene.replace("[scene]\n", "[scene]\nparticles_file = \"agg.csv\"\n");
+    std::fs::write(run.join("scene.toml"), scene).unwrap();
+    std::fs::write(
+        run.join("agg.json"),
+        r#"{"total_mass_kg": 3e8, "shape_equivalent_diameter_m": 1234.0, "bulk_density_kg_m3": 1500.0}"#,
+    )
+    .unwrap();
+    let path = write_report(&ReportSources::new(&root.join("runs")), &root.join("out"), true).unwrap();
+    let md = std::fs::read_to_string(path).unwrap();
+    assert!(
+        md.contains("ours keep the body (D = 1234 m, ρ_B = 1500 kg/m³ (the aggregate's record))"),
+        "{md}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// A shape that departs at the second forced sample (200 s after t_start's, within the dynamical time
+/// 1/√(Gρ_B) ≈ 2900 s of the fake body) marks T_c1 as read in the settling, in its cell and in a warning line;
+/// one that departs 18 000 s later is quoted plainly.
+#[test]
+fn a_departure_at_t_start_is_flagged_as_settling() {
+    let root = fresh_root("settling");
+    // period 5 − 2t/38300 h: below 4.95 h from t = 957 s, the sample at 1000 s (the first forced one is at 800 s)
+    fake_run_at(
+        &root.join("runs/hcp"),
+        "path2",
+        30,
+        38300.0,
+        38300.0,
+        600.0,
+        true,
+        Some(4.95),
+    );
+    let md = report_of_runs(&root);
+    let row = line_starting(&md, "| HCP |");
+    assert!(row.contains("| 4.948 ⚠ settling |"), "{row}");
+    assert!(
+        md.contains("**Warning** (settling, Zhang17 §2.3.4): HCP: T_c1 is read 200 s after t_start"),
+        "{md}"
+    );
+    // below 4.0 h from t = 19 150 s: outside the settling
+    let root = fresh_root("settled");
+    fake_run_at(
+        &root.join("runs/hcp"),
+        "path2",
+        30,
+        38300.0,
+        38300.0,
+        600.0,
+        true,
+        Some(4.0),
+    );
+    let md = report_of_runs(&root);
+    let row = line_starting(&md, "| HCP |");
+    assert!(row.contains("| 3.997 |"), "{row}");
+    assert!(!md.contains("⚠ settling") && !md.contains("**Warning**"), "{md}");
+    let _ = std::fs::remove_dir_all(&root);
+    let _ = std::fs::remove_dir_all(fresh_root("settling"));
+}

@@ -8,11 +8,14 @@ use std::path::Path;
 
 use rubblepile::analysis::critical::read_critical;
 use rubblepile::analysis::spinup::{
-    AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, critical_limits, dynamical_time,
-    first_departure, fit_density, smoothed_critical_limits,
+    AXIS_RATIO_THRESHOLD, CriticalLimits, DIDYMOS_MASS, DensityFit, FailureMode, PACKING_THRESHOLD, critical_limits,
+    dynamical_time, first_departure, fit_density, smoothed_critical_limits,
 };
 use rubblepile::analysis::spinup_diagnostics::{SpinupSample, read_spinup_csv};
 use rubblepile::io::scene_file::SI_G;
+
+use super::body::{Body, body_of};
+use super::settling::{SettlingWarning, settling_warnings};
 
 /// T_c,3 (h) and φ (°) under one creep criterion, either missing when that criterion found no stable hold.
 pub type LimitAndAngle = (Option<f64>, Option<f64>);
@@ -191,6 +194,10 @@ pub struct ModelRow {
     /// Largest energy and angular-momentum residuals of the run (`summary.json`), forcing work and torque
     /// booked; `None` for runs made before the forcing was booked (their residuals include the forcing).
     pub residuals: Option<(f64, f64)>,
+    /// The body's size and bulk density read from the run ([`crate::studies::zhang2017::body`]), if found.
+    pub body: Option<Body>,
+    /// T_c,1 / T_c,2 read within the body's settling ([`crate::studies::zhang2017::settling`]).
+    pub settling: Vec<SettlingWarning>,
     /// Wall time (s), simulated time (s), status.
     pub wall_seconds: f64,
     /// See `wall_seconds`.
@@ -208,33 +215,33 @@ fn t_start_of(dir: &Path) -> f64 {
 }
 
 /// The file of a compact run directory (no snapshots; `analysis/zhang2017/compact.py`) that keeps what
-/// [`radii_and_mass`] reads from the first snapshot: `n`, `radius_min_m`, `radius_max_m`, `mass_kg`.
+/// [`radii_mass_and_volume`] reads from the first snapshot: `n`, `radius_min_m`, `radius_max_m`, `mass_kg`.
 pub const PARTICLES_SUMMARY: &str = "particles.json";
 
-/// Smallest and largest radius (m), total mass (kg) and count of the particles at t = 0: from the first snapshot,
-/// or from [`PARTICLES_SUMMARY`] in a compact run directory that keeps no snapshots.
-fn radii_and_mass(dir: &Path) -> Option<(f64, f64, f64, usize)> {
+/// Smallest and largest radius (m), total mass (kg), count and volume Σ (4/3)π r³ (m³) of the particles at t = 0:
+/// from the first snapshot, or from [`PARTICLES_SUMMARY`] in a compact run directory that keeps no snapshots (the
+/// volume there only when the grains are all of one radius).
+fn radii_mass_and_volume(dir: &Path) -> Option<(f64, f64, f64, usize, Option<f64>)> {
+    let ball = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
     if !dir.join("snapshots/0.csv").is_file() {
         let text = std::fs::read_to_string(dir.join(PARTICLES_SUMMARY)).ok()?;
         let v: serde_json::Value = serde_json::from_str(&text).ok()?;
         let n = usize::try_from(v["n"].as_u64()?).ok()?;
-        return Some((
-            v["radius_min_m"].as_f64()?,
-            v["radius_max_m"].as_f64()?,
-            v["mass_kg"].as_f64()?,
-            n,
-        ));
+        let (lo, hi) = (v["radius_min_m"].as_f64()?, v["radius_max_m"].as_f64()?);
+        let volume = (lo == hi).then(|| n as f64 * ball(lo));
+        return Some((lo, hi, v["mass_kg"].as_f64()?, n, volume));
     }
     let table = read_table(&dir.join("snapshots/0.csv"), Cells::Lenient).ok()?;
     let (km, kr) = (table.column("mass")?, table.column("radius")?);
-    let (mut lo, mut hi, mut m, mut n) = (f64::INFINITY, 0.0f64, 0.0, 0);
+    let (mut lo, mut hi, mut m, mut n, mut volume) = (f64::INFINITY, 0.0f64, 0.0, 0, 0.0);
     for v in table.rows.iter().filter(|v| v.len() > km.max(kr)) {
         m += v[km];
+        volume += ball(v[kr]);
         lo = lo.min(v[kr]);
         hi = hi.max(v[kr]);
         n += 1;
     }
-    (m > 0.0).then_some((lo, hi, m, n))
+    (m > 0.0).then_some((lo, hi, m, n, Some(volume)))
 }
 
 /// The `wall_seconds` of the last row of the run's `timeseries.csv` (cumulative over resumes): the wall time
@@ -285,11 +292,8 @@ pub fn path_row(
     model_dir: &Path,
     path: &str,
 ) -> Result<(ModelRow, Vec<SpinupSample>), rubblepile::analysis::AnalysisError> {
-    let model = model_dir
-        .file_name()
-        .map(|s| s.to_string_lossy().to_string())
-        .unwrap_or_default();
-    let run = model_dir.join(path);
+    let model = dir_name(model_dir);
+    let run = run_dir(model_dir, path);
     let samples = read_spinup_csv(&run.join("spinup.csv")).map_err(|e| e.to_string())?;
     let summary: serde_json::Value = std::fs::read_to_string(run.join("summary.json"))
         .ok()
@@ -304,8 +308,10 @@ pub fn path_row(
         &col(|s| s.c_over_a),
         &col(|s| s.packing_fraction),
     );
-    let (lo, hi, mass, n) = radii_and_mass(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0));
+    let (lo, hi, mass, n, grains) = radii_mass_and_volume(&run).unwrap_or((f64::NAN, f64::NAN, f64::NAN, 0, None));
     let rho_b = 2100.0 * mass / DIDYMOS_MASS;
+    let packing = forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN);
+    let body = body_of(&run, mass, grains, packing);
     // the smoothing window of the check on the limits
     let window = dynamical_time(SI_G, rho_b);
     let limits_smoothed = smoothed_critical_limits(
@@ -351,6 +357,14 @@ pub fn path_row(
     .flatten()
     .min()
     .unwrap_or(forced.len());
+    let settling = settling_warnings(
+        &col(|s| s.t),
+        [
+            (shape_change < forced.len()).then_some(shape_change),
+            first_departure(&col(|s| s.packing_fraction), PACKING_THRESHOLD),
+        ],
+        dynamical_time(SI_G, body.map_or(rho_b, |b| b.bulk_density)),
+    );
     let before: Vec<f64> = forced[..shape_change].iter().map(|s| s.packing_fraction).collect();
     let packing_noise = successive_scatter(&before);
     let spacing = match (forced.first(), forced.get(1)) {
@@ -380,7 +394,9 @@ pub fn path_row(
         n,
         radius_range: (lo, hi),
         mass,
-        packing: forced.first().map(|s| s.packing_fraction).unwrap_or(f64::NAN),
+        packing,
+        body,
+        settling,
         limits,
         limits_smoothed,
         packing_noise,
@@ -412,6 +428,22 @@ pub fn path_row(
     Ok((row, samples))
 }
 
+/// The T_c1 or T_c2 cell `value` of `r`, marked when that limit was read within the body's settling.
+pub(crate) fn flagged(r: &ModelRow, limit: &str, value: String) -> String {
+    if r.settling.iter().any(|w| w.limit == limit) {
+        format!("{value} ⚠ settling")
+    } else {
+        value
+    }
+}
+
+/// One line on stderr per limit of `r` read within the body's settling (the report marks its cell).
+pub(crate) fn warn_settling(r: &ModelRow) {
+    for w in &r.settling {
+        eprintln!("warning: {}", w.describe(&r.model.to_uppercase()));
+    }
+}
+
 pub(crate) fn opt(x: Option<f64>, digits: usize) -> String {
     x.map(|v| format!("{v:.digits$}")).unwrap_or_else(|| "–".into())
 }
@@ -424,16 +456,41 @@ pub(crate) fn mode(m: Option<FailureMode>) -> &'static str {
     }
 }
 
-/// The model directories under `runs`: those with a `path2/spinup.csv`, sorted by name.
+/// The model directories under `runs`, sorted by name: those with a `path2/spinup.csv` (this project's layout)
+/// or with a `spinup.csv` directly in them (a user's `rubblepile run` of a spin-up scene); `runs` alone when it
+/// is such a run directory itself.
 pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
+    if runs.join("spinup.csv").is_file() {
+        return Ok(vec![runs.to_path_buf()]);
+    }
     let mut models: Vec<_> = std::fs::read_dir(runs)
         .map_err(|e| format!("{}: {e}", runs.display()))?
         .filter_map(|e| e.ok())
         .map(|e| e.path())
-        .filter(|p| p.join("path2/spinup.csv").is_file())
+        .filter(|p| p.join("path2/spinup.csv").is_file() || p.join("spinup.csv").is_file())
         .collect();
     models.sort();
     Ok(models)
+}
+
+/// The run directory of `model_dir`'s spin-up path `path`: `model_dir/path`, or for path 2 `model_dir` itself
+/// when it holds the `spinup.csv` directly (see [`model_dirs`]).
+pub fn run_dir(model_dir: &Path, path: &str) -> std::path::PathBuf {
+    let nested = model_dir.join(path);
+    if path == "path2" && !nested.join("spinup.csv").is_file() && model_dir.join("spinup.csv").is_file() {
+        model_dir.to_path_buf()
+    } else {
+        nested
+    }
+}
+
+/// A directory's name (`.` and paths ending in `..` by their canonical name), the model's name of its row.
+pub fn dir_name(dir: &Path) -> String {
+    dir.file_name()
+        .map(|s| s.to_os_string())
+        .or_else(|| dir.canonicalize().ok()?.file_name().map(|s| s.to_os_string()))
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default()
 }
 
 /// The `critical*` subdirectories of `dir` (the T_c,3 searches of a run or variant: a coarse one, a finer one, …),
