@@ -166,7 +166,7 @@ fn help_of(path: &[String]) -> (Vec<String>, Vec<String>) {
         if section == "Options" && indent <= 6 {
             let t = t.split_once(", ").filter(|(s, _)| s.len() == 2).map_or(t, |(_, l)| l);
             if let Some(l) = t.strip_prefix("--") {
-                flags.push(l.split(|c: char| c == ' ' || c == '=').next().unwrap().to_string());
+                flags.push(l.split([' ', '=']).next().unwrap().to_string());
             }
         }
     }
@@ -190,7 +190,15 @@ fn every_flag_names_its_unit_or_is_dimensionless() {
         }
     }
     assert!(seen.len() > 250, "only {} flags found: is the help parsed?", seen.len());
-    for f in ["t-end-s", "angle-deg", "q-m", "hold-s", "bulk-density-kg-m3", "checkpoint-every-sim-s", "kappa"] {
+    for f in [
+        "t-end-s",
+        "angle-deg",
+        "q-m",
+        "hold-s",
+        "bulk-density-kg-m3",
+        "checkpoint-every-sim-s",
+        "kappa",
+    ] {
         assert!(seen.iter().any(|s| s == f), "--{f} not found in any help");
     }
     assert!(

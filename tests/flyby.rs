@@ -544,7 +544,7 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
             "--settle-max-h",
             "0.5",
             "--no-control",
-            "--snapshots-s",
+            "--snapshots",
             "2",
             "--format",
             "xyz",

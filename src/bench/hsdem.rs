@@ -4,7 +4,7 @@
 //!
 //! The canonical case is Richardson11 §3.1's model atmosphere (`analysis/richardson2011/atmosphere.toml`: 991
 //! elastic spheres in a cylinder on a plane under uniform gravity). Its first seconds (a blob falling and
-//! splashing) are not what a long run spends its time on, so the timing can start after a warm-up (`--from-h`, e.g.
+//! splashing) are not what a long run spends its time on, so the timing can start after a warm-up (`--from-s`, e.g.
 //! t = 50, when the atmosphere has equilibrated); the warm-up is stepped exactly as the timed part and not timed.
 
 use std::io::Write;
@@ -114,7 +114,7 @@ pub fn time_scene(
     let t_end = t_end.unwrap_or(sc.t_end);
     if !(t_from.is_finite() && t_from >= 0.0 && t_end.is_finite() && t_end > t_from) {
         return Err(BenchError::usage(format!(
-            "need 0 <= --from-h < --t-end-s, got {t_from} and {t_end}"
+            "need 0 <= --from-s < --t-end-s, got {t_from} and {t_end}"
         )));
     }
     if threads == 0 {

@@ -235,7 +235,7 @@ pub enum BenchCommand {
     /// Timed point-mass N-body runs (Pythagorean three-body, outer Solar System) with final states (CSV).
     Nbody(crate::bench::nbody::NBodyArgs),
     /// Wall-clock time of whole impact runs (default N200_T4 + P2, ζ = 45°, 10 000 s, the impact default rtol) per
-    /// integrator, tolerance, F0 and thread count, with each run's energy error and a goal line (60 s unless `--goal-s`).
+    /// integrator, tolerance, F0 and thread count, with each run's energy error and a goal line (60 s, or `--goal-s`).
     Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(crate::bench::ssdem::BenchSsdemArgs),

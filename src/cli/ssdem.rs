@@ -71,12 +71,12 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
         }
         a
     } else {
-        let r = positive("radius", args.radius)?.unwrap_or(1.0);
-        let rho = positive("density", args.density)?.unwrap_or(1.0);
-        let body = positive("body-radius", args.body_radius)?;
-        let bulk = positive("bulk-density", args.bulk_density)?.unwrap_or(0.64 * rho);
+        let r = positive("radius-m", args.radius)?.unwrap_or(1.0);
+        let rho = positive("density-kg-m3", args.density)?.unwrap_or(1.0);
+        let body = positive("body-radius-m", args.body_radius)?;
+        let bulk = positive("bulk-density-kg-m3", args.bulk_density)?.unwrap_or(0.64 * rho);
         let period = positive("spin-period-h", args.spin_period_h)?.map(|h| h * 3600.0);
-        let speed = positive("speed", args.speed)?.unwrap_or(0.0);
+        let speed = positive("speed-m-s", args.speed)?.unwrap_or(0.0);
         if body.is_none() && speed == 0.0 {
             return Err(CliError::usage(
                 "give --speed-m-s or --body-radius-m (and optionally --spin-period-h)",
