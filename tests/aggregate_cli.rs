@@ -48,7 +48,7 @@ fn aggregate_cli_builds_refuses_overwrite_and_names_bad_fields() {
         "density",
         "--input",
         o,
-        "--bulk-density",
+        "--bulk-density-kg-m3",
         "2500",
         "--out",
         dense.to_str().unwrap(),
@@ -70,14 +70,17 @@ fn aggregate_cli_builds_refuses_overwrite_and_names_bad_fields() {
         assert!(err.starts_with("error: ") && err.contains(field), "{extra:?}: {err}");
         assert!(!path.exists());
     };
-    bad(&["--model", "fcc", "--shape", "sphere:100", "--radius", "5"], "--model");
-    bad(&["--model", "hcp", "--shape", "cube:100", "--radius", "5"], "--shape");
     bad(
-        &["--model", "hcp", "--shape", "sphere:100", "--radius", "-5"],
-        "--radius",
+        &["--model", "fcc", "--shape", "sphere:100", "--radius-m", "5"],
+        "--model",
+    );
+    bad(&["--model", "hcp", "--shape", "cube:100", "--radius-m", "5"], "--shape");
+    bad(
+        &["--model", "hcp", "--shape", "sphere:100", "--radius-m", "-5"],
+        "--radius-m",
     );
     bad(
-        &["--model", "hcp", "--shape", "obj:/nonexistent.obj", "--radius", "5"],
+        &["--model", "hcp", "--shape", "obj:/nonexistent.obj", "--radius-m", "5"],
         "/nonexistent.obj",
     );
     bad(
@@ -85,8 +88,8 @@ fn aggregate_cli_builds_refuses_overwrite_and_names_bad_fields() {
         "--particles",
     );
     bad(
-        &["--model", "pp1", "--shape", "sphere:100", "--radius-range", "8,4"],
-        "--radius-range",
+        &["--model", "pp1", "--shape", "sphere:100", "--radius-range-m", "8,4"],
+        "--radius-range-m",
     );
     bad(
         &[
@@ -94,12 +97,12 @@ fn aggregate_cli_builds_refuses_overwrite_and_names_bad_fields() {
             "hcp",
             "--shape",
             "sphere:100",
-            "--radius",
+            "--radius-m",
             "5",
-            "--bulk-density",
+            "--bulk-density-kg-m3",
             "0",
         ],
-        "--bulk-density",
+        "--bulk-density-kg-m3",
     );
     std::fs::remove_dir_all(&dir).ok();
 }
@@ -144,7 +147,13 @@ fn density_variant_of_a_snapshot_takes_the_report_named_by_report() {
         if let Some(r) = report {
             a.extend(["--report", r]);
         }
-        a.extend(["--bulk-density", "2500", "--out", out.to_str().unwrap(), "--force"]);
+        a.extend([
+            "--bulk-density-kg-m3",
+            "2500",
+            "--out",
+            out.to_str().unwrap(),
+            "--force",
+        ]);
         run(&a)
     };
     let (code, err) = density(None);

@@ -66,7 +66,7 @@ fn analyze_reproduces_the_golden_analysis() {
     let dir = temp_dir("analyze").join("run");
     copy_dir(&golden_dir, &dir);
     std::fs::remove_file(dir.join("golden_analysis.json")).unwrap();
-    let out = rubblepile(&dir, &["analyze", ".", "--at", "200"]);
+    let out = rubblepile(&dir, &["analyze", ".", "--at-s", "200"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
     let ours = read(&dir.join("analysis/analysis.json"));
@@ -129,16 +129,16 @@ fn analyze_reproduces_the_golden_analysis() {
     assert!(!dir.join("analysis/energy_partition.png").exists());
     // a second analysis refuses to overwrite, --force allows it
     assert_eq!(
-        rubblepile(&dir, &["analyze", ".", "--at", "200"]).status.code(),
+        rubblepile(&dir, &["analyze", ".", "--at-s", "200"]).status.code(),
         Some(2)
     );
     assert!(
-        rubblepile(&dir, &["analyze", ".", "--at", "200", "--force"])
+        rubblepile(&dir, &["analyze", ".", "--at-s", "200", "--force"])
             .status
             .success()
     );
     // no snapshot at the requested time: one line naming the available times
-    let bad = rubblepile(&dir, &["analyze", ".", "--at", "100", "--force"]);
+    let bad = rubblepile(&dir, &["analyze", ".", "--at-s", "100", "--force"]);
     assert_eq!(bad.status.code(), Some(2));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
@@ -149,19 +149,19 @@ fn analyze_reproduces_the_golden_analysis() {
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
 
-/// Issue 57: `analyze --at T` past the run's end is one line naming `--at` and the run's end time, not an
+/// Issue 57: `analyze --at-s T` past the run's end is one line naming `--at-s` and the run's end time, not an
 /// analysis of nothing (a bound mass fraction of -0.000).
 #[test]
 fn analyze_at_past_the_runs_end_is_an_error_naming_at_and_the_end() {
     let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/n30_p1_z45");
     let dir = temp_dir("analyze-past-end").join("run");
     copy_dir(&golden_dir, &dir);
-    let bad = rubblepile(&dir, &["analyze", ".", "--at", "400"]);
+    let bad = rubblepile(&dir, &["analyze", ".", "--at-s", "400"]);
     assert_eq!(bad.status.code(), Some(2));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(
-        err.contains("--at 400 s is past the run's end (t_end = 200 s)"),
+        err.contains("--at-s 400 s is past the run's end (t_end = 200 s)"),
         "{err}"
     );
     assert!(!dir.join("analysis/analysis.json").exists());
@@ -182,7 +182,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     std::fs::write(dir.join("c.toml"), campaign).unwrap();
     let run = rubblepile(&dir, &["campaign", "c.toml", "--no-progress"]);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
-    let out = rubblepile(&dir, &["analyze-campaign", "c", "--at", "110"]);
+    let out = rubblepile(&dir, &["analyze-campaign", "c", "--at-s", "110"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let a: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("c/analysis/campaign_analysis.json")).unwrap()).unwrap();
@@ -237,7 +237,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
     );
     // not again without --force
     assert_eq!(
-        rubblepile(&dir, &["analyze-campaign", "c", "--at", "110"])
+        rubblepile(&dir, &["analyze-campaign", "c", "--at-s", "110"])
             .status
             .code(),
         Some(2)
@@ -255,7 +255,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
             "c",
             "--out",
             "rep",
-            "--at",
+            "--at-s",
             "110",
         ],
     );
@@ -293,7 +293,7 @@ fn analyze_campaign_collects_runs_and_fits_q_star() {
         std::fs::copy(dir.join("rep/REPORT.md"), std::env::temp_dir().join("i57_REPORT.md")).unwrap();
     }
     // a second report only with --force
-    let again = rubblepile(&dir, &["report", "roig2003", "c", "--out", "rep", "--at", "110"]);
+    let again = rubblepile(&dir, &["report", "roig2003", "c", "--out", "rep", "--at-s", "110"]);
     assert_eq!(again.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&again.stderr).contains("use --force"));
     let _ = std::fs::remove_dir_all(&dir);
@@ -309,13 +309,13 @@ fn a_run_still_going_is_analysed_with_the_kappa_its_scene_resolves() {
     std::fs::remove_file(dir.join("golden_analysis.json")).unwrap();
     std::fs::remove_file(dir.join("summary.json")).unwrap();
     // without the scene's bodies κ cannot be resolved: one line naming the scene and the reason
-    let missing = rubblepile(&dir, &["analyze", ".", "--at", "200"]);
+    let missing = rubblepile(&dir, &["analyze", ".", "--at-s", "200"]);
     assert_eq!(missing.status.code(), Some(2));
     let err = String::from_utf8_lossy(&missing.stderr);
     assert!(err.contains("scene.toml") && err.contains("no summary.json"), "{err}");
     // the impact's initial bodies are its t = 0 snapshot
     std::fs::copy(dir.join("snapshots/0.csv"), dir.join("initial_bodies.csv")).unwrap();
-    let out = rubblepile(&dir, &["analyze", ".", "--at", "200"]);
+    let out = rubblepile(&dir, &["analyze", ".", "--at-s", "200"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
     let (mut ours, mut golden) = (

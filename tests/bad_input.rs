@@ -107,7 +107,7 @@ fn prepare(case: &Case, dir: &Path, out: &Path) -> Result<(), String> {
             "--out",
             &out_s,
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "0",
             "--stop-after-checkpoints",
             "1",

@@ -16,7 +16,7 @@ fn bench_impact_rows_are_thread_independent_and_flags_checked() {
         target,
         "--projectile",
         "P1",
-        "--t-end",
+        "--t-end-s",
         "100",
         "--f0",
         "1e-6,1e-4",
@@ -52,9 +52,9 @@ fn bench_impact_rows_are_thread_independent_and_flags_checked() {
     let bad = rubblepile(&dir, &["bench", "impact", "--rtol", "1e-6,2", "--out", "c"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--rtol: each must be in (0, 1), got 2"));
-    let bad = rubblepile(&dir, &["bench", "impact", "--goal", "0", "--out", "c"]);
+    let bad = rubblepile(&dir, &["bench", "impact", "--goal-s", "0", "--out", "c"]);
     assert_eq!(bad.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("--goal: must be > 0 s"));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--goal-s: must be > 0 s"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -69,13 +69,13 @@ fn bench_impact_times_each_tolerance_and_draws_the_goal_it_is_given() {
         target.to_str().unwrap(),
         "--projectile",
         "P1",
-        "--t-end",
+        "--t-end-s",
         "100",
         "--rtol",
         "1e-6,1e-4",
         "--threads",
         "1",
-        "--goal",
+        "--goal-s",
         "600",
         "--out",
         "b",
@@ -96,7 +96,7 @@ fn bench_impact_times_each_tolerance_and_draws_the_goal_it_is_given() {
     let svg = std::fs::read_to_string(dir.join("b/bench_impact.svg")).unwrap();
     assert!(
         svg.contains("goal: 600 s on 2 cores"),
-        "the goal line is not labelled with --goal"
+        "the goal line is not labelled with --goal-s"
     );
     assert!(
         svg.contains("rtol 1e-4") && svg.contains("rtol 1e-6") && svg.matches("F0 1e-6, 1 thr").count() == 2,
@@ -118,7 +118,7 @@ fn bench_impact_times_each_method_and_names_it_in_the_csv_and_on_the_bars() {
         target,
         "--projectile",
         "P1",
-        "--t-end",
+        "--t-end-s",
         "100",
     ];
     let args = [
@@ -150,7 +150,7 @@ fn bench_impact_times_each_method_and_names_it_in_the_csv_and_on_the_bars() {
         .unwrap()
         .modified()
         .unwrap();
-    let replot = rubblepile(&dir, &["bench", "impact", "--replot", "--goal", "250", "--out", "b"]);
+    let replot = rubblepile(&dir, &["bench", "impact", "--replot", "--goal-s", "250", "--out", "b"]);
     assert!(replot.status.success(), "{}", String::from_utf8_lossy(&replot.stderr));
     let again = std::fs::read_to_string(dir.join("b/bench_impact.svg")).unwrap();
     assert!(

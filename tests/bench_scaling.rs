@@ -22,13 +22,13 @@ fn bench_scaling_writes_every_case_at_every_thread_count() {
         "1,2",
         "--repeats",
         "2",
-        "--n200-t-end",
+        "--n200-t-end-s",
         "150",
         "--ssdem-steps",
         "2",
         "--campaign-runs",
         "3",
-        "--campaign-t-end",
+        "--campaign-t-end-s",
         "200",
         "--root",
         root,
@@ -111,7 +111,7 @@ fn bench_scaling_refuses_unknown_cases_and_bad_times() {
     let dir = temp_dir("bench-scaling-bad");
     for (args, expect) in [
         (vec!["--cases", "rhs-n2"], "--cases: unknown case \"rhs-n2\""),
-        (vec!["--window", "0"], "--window: must be a time > 0 s"),
+        (vec!["--window-s", "0"], "--window-s: must be a time > 0 s"),
         (vec!["--threads", "0"], "--threads"),
     ] {
         let mut all = vec!["bench", "scaling", "--out", "s"];

@@ -189,7 +189,7 @@ fn the_wall_clock_budget_stops_between_samples_and_inside_a_long_interval() {
             "run" => vec!["run".into(), s(&hard).into(), "--out".into(), target.into()],
             _ => vec!["resume".into(), target.into()],
         };
-        a.extend(["--no-progress", "--max-steps", "3e7", "--max-wall-seconds", "1"].map(String::from));
+        a.extend(["--no-progress", "--max-steps", "3e7", "--max-wall-s", "1"].map(String::from));
         a
     };
     let run = |a: Vec<String>| {
@@ -232,7 +232,7 @@ fn the_wall_clock_budget_stops_between_samples_and_inside_a_long_interval() {
             "--no-progress",
             "--max-steps",
             "1e8",
-            "--max-wall-seconds",
+            "--max-wall-s",
             "1",
         ],
     );

@@ -251,7 +251,7 @@ fn stopped_runs_are_resumed_bit_for_bit() {
     let out = bin(&[
         "campaign",
         f,
-        "--checkpoint-every-sim",
+        "--checkpoint-every-sim-s",
         "10",
         "--stop-after-checkpoints",
         "1",
@@ -438,15 +438,15 @@ fn impact_command_still_works() {
             "1",
             "--projectile-speed-km-s",
             "0.02",
-            "--angle",
+            "--angle-deg",
             angle,
-            "--contact-time",
+            "--contact-time-s",
             "5",
-            "--t-end",
+            "--t-end-s",
             "20",
-            "--snapshots",
+            "--snapshots-s",
             "0,20",
-            "--every",
+            "--every-s",
             "5",
             "--out",
             out_dir.to_str().unwrap(),
@@ -503,7 +503,7 @@ fn impact_command_still_works() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(
         stderr(&out).trim(),
-        "error: --angle: expected 0 to 180 degrees, got 200"
+        "error: --angle-deg: expected 0 to 180 degrees, got 200"
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -761,7 +761,7 @@ fn a_rank_killed_mid_campaign_loses_nothing() {
         mpi_out.to_str().unwrap(),
         "--no-progress",
     ];
-    let mut child = mpirun(3, &[&args[..], &["--checkpoint-every-sim", "0"]].concat())
+    let mut child = mpirun(3, &[&args[..], &["--checkpoint-every-sim-s", "0"]].concat())
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn()

@@ -1,7 +1,7 @@
 //! `[sweep]` in campaign files (any field over a list or a grid; the runs are the product) and `analyze-campaign
 //! --by FIELD`: the plan's product and order, a swept value equal to the same value written in the file, wrong paths
 //! refused naming them, and a tiny swept campaign run and tabulated against its swept field (one row per value, the
-//! seeds grouped), with `--at` defaulting to the campaign's end.
+//! seeds grouped), with `--at-s` defaulting to the campaign's end.
 
 mod common;
 use common::{rubblepile, temp_dir};
@@ -209,7 +209,7 @@ fn a_swept_campaign_runs_and_is_tabulated_against_its_field() {
     let speeds: Vec<&str> = rows.iter().map(|r| r[header.len() - 1].as_str()).collect();
     assert_eq!(speeds, ["0.02", "0.02", "0.03", "0.03"]);
 
-    // no --at: the campaign's end (40 s); no --by: its one swept field
+    // no --at-s: the campaign's end (40 s); no --by: its one swept field
     let out = rubblepile(&dir, &["analyze-campaign", "out"]);
     let (stdout, stderr) = (
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -291,7 +291,7 @@ fn a_swept_campaign_runs_and_is_tabulated_against_its_field() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Runs ending at different times: no default `--at`, and the error says so.
+/// Runs ending at different times: no default `--at-s`, and the error says so.
 #[test]
 fn runs_ending_at_different_times_need_at() {
     let dir = temp_dir("sweep-ends");
@@ -304,12 +304,12 @@ fn runs_ending_at_different_times_need_at() {
     assert_eq!(bad.status.code(), Some(2));
     let e = String::from_utf8_lossy(&bad.stderr);
     assert!(
-        e.contains("--at: the runs end at different times ([20.0, 40.0] s)"),
+        e.contains("--at-s: the runs end at different times ([20.0, 40.0] s)"),
         "{e}"
     );
     // at a time both have a snapshot (t_end of each, and the default snapshots cut at t_end: 0, 20; 0, 40) —
     // t = 20 s is the shorter run's end but not a snapshot of the longer: named
-    let bad = rubblepile(&dir, &["analyze-campaign", "out", "--at", "20"]);
+    let bad = rubblepile(&dir, &["analyze-campaign", "out", "--at-s", "20"]);
     assert_eq!(bad.status.code(), Some(2), "{}", String::from_utf8_lossy(&bad.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -219,7 +219,7 @@ fn kill_and_resume(method: &str, bodies_file: bool, stops: &[u64], resume_cwd: &
             "--out",
             b_s,
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "0",
             "--stop-after-checkpoints",
             &stop,
@@ -264,7 +264,7 @@ fn kill_and_resume(method: &str, bodies_file: bool, stops: &[u64], resume_cwd: &
                 "resume",
                 b_s,
                 "--no-progress",
-                "--checkpoint-every-sim",
+                "--checkpoint-every-sim-s",
                 "0",
                 "--stop-after-checkpoints",
                 &more,
@@ -324,7 +324,7 @@ fn checkpoint_of_the_crates_dop853_is_refused_with_one_line() {
             "--out",
             "x",
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "5",
             "--stop-after-checkpoints",
             "2",
@@ -365,7 +365,7 @@ fn completed_and_missing_and_corrupt_checkpoints_give_one_line_errors() {
             "--out",
             "done",
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "0",
         ],
     );
@@ -401,7 +401,7 @@ fn completed_and_missing_and_corrupt_checkpoints_give_one_line_errors() {
             "--out",
             "cut",
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "5",
             "--stop-after-checkpoints",
             "2",
@@ -447,7 +447,7 @@ fn moved_bodies_file_is_detected_on_resume() {
             "--out",
             "out",
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "0",
             "--stop-after-checkpoints",
             "3",
@@ -469,8 +469,8 @@ fn bad_checkpoint_flags_are_refused() {
     let dir = temp_dir("flags");
     std::fs::write(dir.join("scene.toml"), scene("bulirsch-stoer", false)).unwrap();
     for (flag, value) in [
-        ("--checkpoint-every", "-1"),
-        ("--checkpoint-every-sim", "nan"),
+        ("--checkpoint-every-s", "-1"),
+        ("--checkpoint-every-sim-s", "nan"),
         ("--stop-after-checkpoints", "0"),
     ] {
         let out = rubblepile(&dir, &["run", "scene.toml", "--out", "x", flag, value]);

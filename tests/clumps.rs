@@ -250,7 +250,7 @@ fn analyze_finds_the_clumps_of_a_sphere_run() {
         csv += &format!("5,{id},{mass},{radius},{},{},{},0,0,0,0,0,0\n", x[0], x[1], x[2]);
     }
     std::fs::write(dir.join("snapshots/0.csv"), csv).unwrap();
-    let bad = rubblepile(&dir, &["analyze", ".", "--at", "7"]);
+    let bad = rubblepile(&dir, &["analyze", ".", "--at-s", "7"]);
     assert_eq!(bad.status.code(), Some(2));
     let err = String::from_utf8_lossy(&bad.stderr);
     assert!(err.contains("no snapshot at t = 7") && err.contains("[5.0]"), "{err}");
@@ -301,11 +301,11 @@ fn a_gentle_impact_leaves_a_largest_remnant_far_above_its_largest_fragment() {
             target.to_str().unwrap(),
             "--projectile",
             "P1",
-            "--angle",
+            "--angle-deg",
             "45",
-            "--t-end",
+            "--t-end-s",
             "400",
-            "--snapshots",
+            "--snapshots-s",
             "0,400",
             "--no-progress",
             "--out",

@@ -446,11 +446,11 @@ fn control_flyby_is_classed_unaffected() {
             target.to_str().unwrap(),
             "--radius-m",
             "170",
-            "--period-hours",
+            "--period-h",
             "30.5",
             "--q-m",
             "3.8e7",
-            "--planet-mass",
+            "--planet-mass-kg",
             "0",
             "--out",
             "run",
@@ -522,7 +522,7 @@ fn tidal_torque_impulse_is_reported_apart_from_the_angular_momentum_residual() {
 
 /// The settling's cap is kept and said (a warning line, `settling.capped` in `flyby.json`), `--no-control`
 /// runs no control: no `control/`, and the outcome says its changes are the run's own; `--format` and
-/// `--progress-every` reach the run.
+/// `--progress-every-s` reach the run.
 #[test]
 fn capped_settling_is_reported_and_no_control_skips_the_control() {
     let dir = temp_dir("flyby-capped");
@@ -535,20 +535,20 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
             target.to_str().unwrap(),
             "--radius-m",
             "170",
-            "--period-hours",
+            "--period-h",
             "30.5",
             "--q-m",
             "3.8e7",
             "--v-inf-km-s",
             "12",
-            "--settle-max-hours",
+            "--settle-max-h",
             "0.5",
             "--no-control",
             "--snapshots",
             "2",
             "--format",
             "xyz",
-            "--progress-every",
+            "--progress-every-s",
             "0.1",
             "--out",
             "run",
@@ -556,7 +556,7 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    // `--format` and `--progress-every` as for `run`: an XYZ beside each CSV snapshot, progress lines in the log.
+    // `--format` and `--progress-every-s` as for `run`: an XYZ beside each CSV snapshot, progress lines in the log.
     assert!(dir.join("run/snapshots/1.xyz").exists());
     assert!(String::from_utf8_lossy(&out.stderr).contains("progress: t = "));
     assert!(
@@ -582,7 +582,7 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
             target.to_str().unwrap(),
             "--q-m",
             "3.8e7",
-            "--settle-max-hours",
+            "--settle-max-h",
             "0",
             "--no-run",
             "--out",

@@ -191,7 +191,7 @@ fn golden_ellipsoids_four_fragments() {
             "--out",
             "OUT",
             "--no-progress",
-            "--checkpoint-every",
+            "--checkpoint-every-s",
             "0",
         ],
     );
@@ -206,14 +206,14 @@ fn golden_impact_n30() {
             "impact",
             "--target",
             "targets/N30_T4.csv",
-            "--t-end",
+            "--t-end-s",
             "300",
-            "--every",
+            "--every-s",
             "20",
             "--out",
             "OUT",
             "--no-progress",
-            "--checkpoint-every",
+            "--checkpoint-every-s",
             "0",
         ],
     );
@@ -273,7 +273,7 @@ fn golden_impact_n30_scene_copy_reruns_bit_identically() {
             "--out",
             "out",
             "--no-progress",
-            "--checkpoint-every",
+            "--checkpoint-every-s",
             "0",
         ];
         let o = rubblepile(&dir, &args);
@@ -305,7 +305,7 @@ fn check_scene_case(name: &str) {
             "--out",
             "OUT",
             "--no-progress",
-            "--checkpoint-every",
+            "--checkpoint-every-s",
             "0",
         ],
     );

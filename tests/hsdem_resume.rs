@@ -1,4 +1,4 @@
-//! Hard-sphere runs checkpoint and resume bit for bit (`rubblepile run … --checkpoint-every-sim`, `rubblepile
+//! Hard-sphere runs checkpoint and resume bit for bit (`rubblepile run … --checkpoint-every-sim-s`, `rubblepile
 //! resume`), here on a small tumbler (Richardson11 §3.2): a spinning drum lined with particles attached from t = 0
 //! (`stuck_to` column of the particles file), free rough spheres, gravity, frictionless end planes.
 
@@ -94,9 +94,9 @@ fn interrupted_run_resumes_bit_for_bit() {
     std::fs::write(dir.join("s.toml"), SCENE).unwrap();
     std::fs::write(dir.join("p.csv"), particles_csv()).unwrap();
     let ck = [
-        "--checkpoint-every",
+        "--checkpoint-every-s",
         "0",
-        "--checkpoint-every-sim",
+        "--checkpoint-every-sim-s",
         "0.05",
         "--no-progress",
     ];

@@ -39,11 +39,11 @@ fn short_impact_conserves_and_decelerates_the_projectile() {
         .args([
             "--projectile",
             "P1",
-            "--angle",
+            "--angle-deg",
             "45",
-            "--t-end",
+            "--t-end-s",
             "200",
-            "--snapshots",
+            "--snapshots-s",
             "0,60,200",
             "--out",
         ])
@@ -104,9 +104,9 @@ fn impact_with_dop853_writes_its_method_and_conserves() {
         t,
         "--projectile",
         "P1",
-        "--t-end",
+        "--t-end-s",
         "200",
-        "--snapshots",
+        "--snapshots-s",
         "0,200",
     ];
     let dir = out.join("run");
@@ -150,7 +150,7 @@ fn committed_targets_reproduce_table1() {
             let json_path = csv_path.with_extension("json");
             if !json_path.exists() {
                 panic!(
-                    "{} missing: build it with `rubblepile target build --fragments {n} --period-hours {period} --seed 1 --out targets/N{n}_T{period}.csv`",
+                    "{} missing: build it with `rubblepile target build --fragments {n} --period-h {period} --seed 1 --out targets/N{n}_T{period}.csv`",
                     json_path.display()
                 );
             }
@@ -202,11 +202,11 @@ fn target_build_is_deterministic() {
             "1.5",
         ];
         args.extend([
-            "--total-mass",
+            "--total-mass-kg",
             "8.1e14",
             "--f0",
             "0.3",
-            "--period-hours",
+            "--period-h",
             "8",
             "--seed",
             seed,

@@ -76,7 +76,7 @@ fn stopped_after_two_snapshots(dir: &Path, name: &str) -> PathBuf {
     let (out, o) = run(
         dir,
         name,
-        &["--checkpoint-every-sim", "25", "--stop-after-checkpoints", "1"],
+        &["--checkpoint-every-sim-s", "25", "--stop-after-checkpoints", "1"],
     );
     assert_eq!(o.status.code(), Some(3), "{}", describe(&o));
     assert!(out.join("snapshots/1.csv").is_file() && !out.join("snapshots/2.csv").exists());
@@ -179,7 +179,7 @@ fn check_says_whether_a_run_directory_is_whole() {
         let (going, o) = run(
             &edir,
             "going",
-            &["--checkpoint-every-sim", "0", "--stop-after-checkpoints", "1"],
+            &["--checkpoint-every-sim-s", "0", "--stop-after-checkpoints", "1"],
         );
         assert_eq!(o.status.code(), Some(3), "{engine}: {}", describe(&o));
         let o = check(&going);

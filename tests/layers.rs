@@ -298,7 +298,9 @@ fn the_library_does_not_use_clap() {
 /// here from the library, which no longer knows clap; 2400 until `impact`'s six geometry flags (issue 57: b, θ, ψ,
 /// spin, attitude; about 25 lines of flags and their help, read by the library's `ImpactGeometry::from_options`);
 /// 2430 until `flyby` took `run`'s checkpoint, format and progress flags, `render` `--centre-m` and `analyze-campaign`
-/// `--by` and `--bootstrap-seed` (flags and their help).
+/// `--by` and `--bootstrap-seed` (flags and their help); 2460 until the units rule (issue 57 item 5): `units.rs`, the
+/// table of renamed flags (old → new, per subcommand) and the argument rewrite that keeps the old spellings working
+/// (99 lines), and the renamed flags' longer attributes, messages and wiring (14 lines).
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -308,8 +310,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2460,
-        "src/cli/ has {lines} lines (at most 2460: move logic to analysis/ or bench/)"
+        lines <= 2573,
+        "src/cli/ has {lines} lines (at most 2573: move logic to analysis/ or bench/)"
     );
 }
 

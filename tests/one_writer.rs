@@ -140,7 +140,7 @@ fn stopped_run(cwd: &Path, name: &str) -> PathBuf {
             "--out",
             s(&out),
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "0",
             "--stop-after-checkpoints",
             "1",
@@ -283,7 +283,7 @@ fn impact_and_flyby_into_a_directory_being_written_are_refused() {
                 "impact",
                 "--target",
                 s(&target),
-                "--t-end",
+                "--t-end-s",
                 "10",
                 "--force",
                 "--no-progress",
@@ -410,7 +410,7 @@ fn render_export_and_analyze_are_refused_while_their_output_is_written() {
     drop(whole);
 
     let analysis = acquire_soon(|| DirLock::acquire_part(&run, "analysis"));
-    let o = rubblepile(cwd, &["analyze", s(&run), "--at", "200"]);
+    let o = rubblepile(cwd, &["analyze", s(&run), "--at-s", "200"]);
     assert_eq!(assert_refused(&o, &run.join("analysis"), "analyze"), std::process::id());
     assert!(!run.join("analysis").exists(), "analyze wrote nothing");
     drop(analysis);
@@ -428,7 +428,7 @@ fn readers_and_part_writers_work_on_a_run_being_written() {
     let o = rubblepile(cwd, &["check", s(&run)]);
     let stdout = String::from_utf8_lossy(&o.stdout);
     assert!(stdout.contains("status: completed"), "check: {}", describe(&o));
-    let o = rubblepile(cwd, &["analyze", s(&run), "--at", "200"]);
+    let o = rubblepile(cwd, &["analyze", s(&run), "--at-s", "200"]);
     assert!(o.status.success(), "analyze: {}", describe(&o));
     assert!(run.join("analysis/analysis.json").is_file());
     let o = rubblepile(cwd, &["render", s(&run), "--size", "64x64", "--color", "bound"]);

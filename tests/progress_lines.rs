@@ -1,5 +1,5 @@
 //! Progress on a non-terminal (issue 41): with stderr piped, as in a batch job, a run prints a plain progress line
-//! (simulated time, per cent, ETA, the engine's error) every `--progress-every` seconds of wall clock, none with
+//! (simulated time, per cent, ETA, the engine's error) every `--progress-every-s` seconds of wall clock, none with
 //! the default 60 s in a run that takes less, and refuses a bad cadence by name: below the floor of 0.1 s (a
 //! cadence of 1e-320 once printed 125 801 lines) or above the ceiling of 1e7 s (1e308 once panicked) (issue 53).
 
@@ -46,7 +46,10 @@ fn a_piped_run_prints_progress_lines_at_the_wall_clock_cadence() {
     std::fs::write(dir.join("s.toml"), SCENE).unwrap();
     std::fs::write(dir.join("slow.toml"), slow_scene()).unwrap();
     // The floor's cadence over a run of a second or so: several lines, in order of simulated time.
-    let o = rubblepile(&dir, &["run", "slow.toml", "--out", "fast", "--progress-every", "0.1"]);
+    let o = rubblepile(
+        &dir,
+        &["run", "slow.toml", "--out", "fast", "--progress-every-s", "0.1"],
+    );
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{stderr}");
     let lines = progress_lines(&stderr);
@@ -82,7 +85,7 @@ fn a_piped_run_prints_progress_lines_at_the_wall_clock_cadence() {
             "--out",
             "quiet",
             "--no-progress",
-            "--progress-every",
+            "--progress-every-s",
             "0.1",
         ],
     );
@@ -123,12 +126,18 @@ fn the_environment_sets_the_cadence_and_bad_values_are_refused() {
     for bad in ["-1", "1e308", "1e-320", "1e-9", "NaN"] {
         let o = rubblepile(
             &dir,
-            &["run", "s.toml", "--out", "bad-flag", &format!("--progress-every={bad}")],
+            &[
+                "run",
+                "s.toml",
+                "--out",
+                "bad-flag",
+                &format!("--progress-every-s={bad}"),
+            ],
         );
         assert_eq!(o.status.code(), Some(2), "{bad}");
         let stderr = String::from_utf8_lossy(&o.stderr);
         assert!(
-            stderr.contains("--progress-every must be 0 (no lines) or a number of seconds from 0.1 to 1e7"),
+            stderr.contains("--progress-every-s must be 0 (no lines) or a number of seconds from 0.1 to 1e7"),
             "{stderr}"
         );
     }

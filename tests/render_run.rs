@@ -51,7 +51,10 @@ fn the_first_readme_command_runs_the_impact_and_leaves_an_animation_and_a_paravi
     assert_eq!(pvd.matches("<DataSet").count(), 61);
     assert!(pvd.contains("timestep=\"6e2\""), "{pvd}");
     // It is an impact run like any other: `analyze` reads it, and `render --color bound` then colours by fate.
-    let a = stdout(&rubblepile(&root(), &["analyze", out.to_str().unwrap(), "--at", "400"]));
+    let a = stdout(&rubblepile(
+        &root(),
+        &["analyze", out.to_str().unwrap(), "--at-s", "400"],
+    ));
     assert!(a.contains("of the target mass bound"), "{a}");
     let r = stdout(&rubblepile(
         &root(),
@@ -109,14 +112,14 @@ fn export_after_analyze_adds_each_bodys_fate_and_ejection_speed() {
             "impact",
             "--target",
             t.to_str().unwrap(),
-            "--t-end",
+            "--t-end-s",
             "400",
             "--out",
             "imp",
             "--no-progress",
         ],
     ));
-    stdout(&rubblepile(&dir, &["analyze", "imp", "--at", "400"]));
+    stdout(&rubblepile(&dir, &["analyze", "imp", "--at-s", "400"]));
     let text = stdout(&rubblepile(&dir, &["export", "vtk", "imp"]));
     assert!(text.contains("bound and ejection_speed"), "{text}");
     let piece = std::fs::read_to_string(dir.join("imp/vtk/particles_0.vtp")).unwrap();

@@ -494,7 +494,16 @@ position = [0.0, 0.0, 0.0]
     ok(&rubblepile(
         &dir,
         &[
-            "render", "run", "--view", "z", "--size", "400x400", "--extent", "3", "--out", "views",
+            "render",
+            "run",
+            "--view",
+            "z",
+            "--size",
+            "400x400",
+            "--extent-m",
+            "3",
+            "--out",
+            "views",
         ],
     ));
     let ppm = 200.0 / 3.0;

@@ -105,7 +105,7 @@ fn run_into(base: &Path, engine: &str, replace: &[(&str, &str)], name: &str, ext
         "--out",
         s(&out),
         "--no-progress",
-        "--checkpoint-every-sim",
+        "--checkpoint-every-sim-s",
         every,
     ];
     args.extend(extra);

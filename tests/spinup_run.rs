@@ -98,7 +98,7 @@ fn forced_body_follows_the_path_and_resumes_bit_identically() {
             "--out",
             "c",
             "--no-progress",
-            "--checkpoint-every-sim",
+            "--checkpoint-every-sim-s",
             "500",
             "--stop-after-checkpoints",
             "2",
@@ -201,14 +201,14 @@ fn all_holds_runs_the_whole_grid() {
             "critical",
             "--scene",
             "s.toml",
-            "--from",
+            "--from-h",
             "5.8",
-            "--to",
+            "--to-h",
             "6.0",
-            "--step",
+            "--step-h",
             "0.1",
             "--branch",
-            "--hold",
+            "--hold-s",
             "600",
             "--all-holds",
             "--out",
@@ -306,7 +306,7 @@ fn branched_hold_equals_the_hold_run_from_the_start() {
     let c = rubblepile(
         &dir,
         &[
-            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "600",
+            "spinup", "critical", "--scene", "s.toml", "--from-h", "6", "--to-h", "6", "--branch", "--hold-s", "600",
             "--out", "crit",
         ],
     );
@@ -388,9 +388,9 @@ fn creep_criterion_option_names_the_expected_values() {
             "critical",
             "--scene",
             "s.toml",
-            "--from",
+            "--from-h",
             "6",
-            "--to",
+            "--to-h",
             "6",
             "--creep-criterion",
             "Paper",
@@ -419,7 +419,7 @@ fn branch_refuses_a_path_with_rests() {
     let c = rubblepile(
         &dir,
         &[
-            "spinup", "critical", "--scene", "s.toml", "--from", "6.5", "--to", "6.5", "--branch", "--out", "crit",
+            "spinup", "critical", "--scene", "s.toml", "--from-h", "6.5", "--to-h", "6.5", "--branch", "--out", "crit",
         ],
     );
     assert!(!c.status.success());
@@ -470,14 +470,14 @@ fn parallel_and_sharded_searches_equal_the_sequential_one() {
             "critical",
             "--scene",
             "s.toml",
-            "--from",
+            "--from-h",
             "5.7",
-            "--to",
+            "--to-h",
             "6.0",
-            "--step",
+            "--step-h",
             "0.1",
             "--branch",
-            "--hold",
+            "--hold-s",
             "600",
             "--all-holds",
             "--out",
@@ -554,7 +554,7 @@ fn a_released_hold_stops_early_unless_asked_to_finish() {
     std::fs::write(dir.join("s.toml"), scene(&dir, &path)).unwrap();
     let search = |out: &str, extra: &[&str]| {
         let mut args = vec![
-            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "6000",
+            "spinup", "critical", "--scene", "s.toml", "--from-h", "6", "--to-h", "6", "--branch", "--hold-s", "6000",
             "--out", out,
         ];
         args.extend_from_slice(extra);
@@ -606,8 +606,8 @@ fn bench_critical_times_both_settings_on_one_prepared_base() {
     let bench = |extra: &[&str]| {
         let c = std::process::Command::new(env!("CARGO_BIN_EXE_rubblepile"))
             .args([
-                "bench", "critical", "--scene", "s.toml", "--from", "5.8", "--to", "6.0", "--step", "0.1", "--hold",
-                "600", "--out", "b", "--force",
+                "bench", "critical", "--scene", "s.toml", "--from-h", "5.8", "--to-h", "6.0", "--step-h", "0.1",
+                "--hold-s", "600", "--out", "b", "--force",
             ])
             .args(extra)
             .env("RAYON_NUM_THREADS", "2")
@@ -662,14 +662,14 @@ fn a_resumed_search_accepts_a_base_scene_of_the_old_layout_with_the_same_values(
         "critical",
         "--scene",
         "s.toml",
-        "--from",
+        "--from-h",
         "6",
-        "--to",
+        "--to-h",
         "6.5",
-        "--step",
+        "--step-h",
         "0.5",
         "--branch",
-        "--hold",
+        "--hold-s",
         "600",
         "--out",
         "crit",
@@ -723,7 +723,7 @@ fn branch_accepts_a_scene_with_snapshot_every() {
     let c = rubblepile(
         &dir,
         &[
-            "spinup", "critical", "--scene", "s.toml", "--from", "6", "--to", "6", "--branch", "--hold", "600",
+            "spinup", "critical", "--scene", "s.toml", "--from-h", "6", "--to-h", "6", "--branch", "--hold-s", "600",
             "--out", "crit",
         ],
     );

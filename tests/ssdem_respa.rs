@@ -193,7 +193,7 @@ fn run_cut_by_a_checkpoint_inside_a_gravity_block_resumes_bit_for_bit() {
     let c = run(
         &dir,
         "c",
-        &["--checkpoint-every-sim", "0.1", "--stop-after-checkpoints", "1"],
+        &["--checkpoint-every-sim-s", "0.1", "--stop-after-checkpoints", "1"],
     );
     assert_eq!(c.status.code(), Some(3), "{}", String::from_utf8_lossy(&c.stderr));
     let ck: serde_json::Value = serde_json::from_str(&read(&dir.join("c/checkpoint.json"))).unwrap();

@@ -121,7 +121,7 @@ fn run_outputs_determinism_and_bit_identical_resume() {
         &dir,
         "s.toml",
         "c",
-        &["--checkpoint-every-sim", "0.1", "--stop-after-checkpoints", "2"],
+        &["--checkpoint-every-sim-s", "0.1", "--stop-after-checkpoints", "2"],
         "2",
     );
     assert_eq!(c.status.code(), Some(3), "{}", String::from_utf8_lossy(&c.stderr));
@@ -216,11 +216,11 @@ fn advise_suggests_k_n_and_dt() {
         &[
             "ssdem",
             "advise",
-            "--radius",
+            "--radius-m",
             "10",
-            "--density",
+            "--density-kg-m3",
             "2000",
-            "--body-radius",
+            "--body-radius-m",
             "390",
             "--spin-period-h",
             "2.26",
@@ -231,8 +231,16 @@ fn advise_suggests_k_n_and_dt() {
     assert!(text.contains("k_n = ") && text.contains("dt = "), "{text}");
     let out = rubblepile(
         &dir,
-        &["ssdem", "advise", "--radius=-1", "--density", "2000", "--speed", "1"],
+        &[
+            "ssdem",
+            "advise",
+            "--radius-m=-1",
+            "--density-kg-m3",
+            "2000",
+            "--speed-m-s",
+            "1",
+        ],
     );
     assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("--radius must be > 0"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--radius-m must be > 0"));
 }

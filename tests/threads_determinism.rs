@@ -112,7 +112,7 @@ fn ellipsoid_impact_is_bit_identical_on_one_to_four_threads() {
                 &target,
                 "--projectile",
                 "P2",
-                "--t-end",
+                "--t-end-s",
                 "110",
                 "--out",
                 out,

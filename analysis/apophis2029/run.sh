@@ -12,8 +12,8 @@ mkdir -p "$OUT"
 # 170 m at its bulk density 1959 kg/m^3; max extent 205 m), set into rigid rotation at P = 30.56 h and relaxed for
 # 36 h without tide (a flyby with the planet's mass 0); its last snapshot is the pile of every run below.
 if [ ! -f "$OUT/relax/analysis/flyby.json" ]; then
-  $BIN flyby --target targets/N100_T12.csv --radius-m 205 --period-hours 30.56 --q-m 3.8e7 --v-inf-km-s 5.8 \
-    --planet-mass 0 --out "$OUT/relax" --force > "$OUT/relax.log" 2>&1
+  $BIN flyby --target targets/N100_T12.csv --radius-m 205 --period-h 30.56 --q-m 3.8e7 --v-inf-km-s 5.8 \
+    --planet-mass-kg 0 --out "$OUT/relax" --force > "$OUT/relax.log" 2>&1
 fi
 COMMON=(--target "$OUT/relax/snapshots/8.csv" --kappa 14.982288520067549 --force)
 one() { # name, extra args...
@@ -24,7 +24,7 @@ one() { # name, extra args...
 # Apophis on 13 April 2029: perigee 38 000 km from Earth's centre, v_inf 5.8 km/s.
 one apophis --q-m 3.8e7 --v-inf-km-s 5.8
 # Control: the same pile and duration scale with the planet's mass set to 0 (no tide): the drift of the pile alone.
-one control --q-m 3.8e7 --v-inf-km-s 5.8 --planet-mass 0
+one control --q-m 3.8e7 --v-inf-km-s 5.8 --planet-mass-kg 0
 for v in 5.8 12; do
   for qr in 1.2 1.5 2 2.5 3 4 6; do
     q=$(python3 -c "print($qr*$RE)")

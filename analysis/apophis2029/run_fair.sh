@@ -9,7 +9,7 @@ set -u
 BIN=./target/release/rubblepile
 OUT=runs/apophis2029_fair
 mkdir -p "$OUT"
-PILE=(--target targets/N100_T12.csv --radius-m 205 --period-hours 30.56 --kappa 14.982288520067549)
+PILE=(--target targets/N100_T12.csv --radius-m 205 --period-h 30.56 --kappa 14.982288520067549)
 APOPHIS=(--q-m 3.8e7 --v-inf-km-s 5.8)
 one() { # name, extra args...
   local name=$1; shift

@@ -17,6 +17,6 @@ for v in 3 6 12; do
     if [ -f "$OUT/$name/analysis/flyby.json" ]; then continue; fi
     q=$(python3 -c "print($qr*$RE)")
     /usr/bin/time -f "%e" -o "$OUT/$name.time" $BIN flyby --target targets/N30_T4.csv --radius-m 170 \
-      --period-hours 6 --q-m "$q" --v-inf-km-s "$v" --out "$OUT/$name" --force > "$OUT/$name.log" 2>&1
+      --period-h 6 --q-m "$q" --v-inf-km-s "$v" --out "$OUT/$name" --force > "$OUT/$name.log" 2>&1
   done
 done

@@ -22,10 +22,10 @@ impact() {
     shift 5
     if [ ! -f "$dir/analysis/analysis.json" ]; then
         rm -rf "$dir"
-        nice "$BIN" impact --target "$target" --projectile "$projectile" --angle 45 --seed "$seed" --t-end 400 \
-            --snapshots 0,400 --f0 "$f0" --beta 10 --kappa-reading reduced --rtol 1e-6 --no-progress \
+        nice "$BIN" impact --target "$target" --projectile "$projectile" --angle-deg 45 --seed "$seed" --t-end-s 400 \
+            --snapshots-s 0,400 --f0 "$f0" --beta 10 --kappa-reading reduced --rtol 1e-6 --no-progress \
             --out "$dir" "$@" | tail -1
-        nice "$BIN" analyze "$dir" --at 400 >"$dir/analyze.log"
+        nice "$BIN" analyze "$dir" --at-s 400 >"$dir/analyze.log"
         head -1 "$dir/analyze.log"
     fi
 }
@@ -37,7 +37,7 @@ target() { # target NAME SEED [extra build options...]; N200 unless --fragments 
         fragments=$2
         shift 2
     fi
-    [ -f "$OUT/targets/$name.csv" ] || nice "$BIN" target build --fragments "$fragments" --period-hours 4 \
+    [ -f "$OUT/targets/$name.csv" ] || nice "$BIN" target build --fragments "$fragments" --period-h 4 \
         --seed "$seed" --out "$OUT/targets/$name.csv" "$@" | tail -1
 }
 

@@ -29,6 +29,6 @@ if [ "$PART" != scaling ] && [ -x "$BASE" ]; then
     step base_ssdem 60 "$BASE" bench ssdem --particles 40000 --threads 1,2,4,8,16 --steps 30 --out "$OUT/base_ssdem" --force
     step base_impact_n200 60 "$BASE" bench impact --target targets/N200_T4.csv --threads 1,8,16 --out "$OUT/base_impact_n200" --force
 fi
-[ "$PART" != scaling ] && step impact_n2000 290 "$B" bench impact --target targets/N2000_T4.csv --method dop853:1e-8 --threads 16 --goal 90 \
+[ "$PART" != scaling ] && step impact_n2000 290 "$B" bench impact --target targets/N2000_T4.csv --method dop853:1e-8 --threads 16 --goal-s 90 \
     --out "$OUT/impact_n2000" --force
 tail -n 100 "$OUT"/*.log > "$OUT/all_logs_tail.txt" 2>&1

@@ -79,7 +79,7 @@ pub fn density_variant(
 ) -> Result<(Vec<Particle>, AggregateReport, f64), AggregateError> {
     if !(bulk_density.is_finite() && bulk_density > 0.0) {
         return Err(input(
-            "--bulk-density",
+            "--bulk-density-kg-m3",
             format!("a positive density in kg/m³, got {bulk_density}"),
         ));
     }

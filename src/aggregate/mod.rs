@@ -9,7 +9,7 @@
 //! - [`core`]: RCPC's HCP core and PPC's denser core; [`density`]: masses from a bulk density and its variants;
 //! - [`report`]: the JSON report.
 //!
-//! Grain radii: `--radius` / `--radius-range` directly, or from a requested count `N` via the shape's volume and
+//! Grain radii: `--radius-m` / `--radius-range-m` directly, or from a requested count `N` via the shape's volume and
 //! an assumed packing fraction ([`expected_packing`]); the count actually carved is reported.
 
 pub mod core;
@@ -230,19 +230,22 @@ fn grain_sizes(spec: &BuildSpec) -> Result<(Option<f64>, Option<PowerLawRadii>, 
         }
         (Grains::Radius(r), false) => {
             if !(r.is_finite() && r > 0.0) {
-                return Err(input("--radius", format!("a positive radius in m, got {r}")));
+                return Err(input("--radius-m", format!("a positive radius in m, got {r}")));
             }
             Ok((Some(r), None, format!("radius given: {r} m")))
         }
         (Grains::Radius(_), true) => Err(input(
-            "--radius",
-            "polydisperse models take --radius-range RMIN,RMAX (m)",
+            "--radius-m",
+            "polydisperse models take --radius-range-m RMIN,RMAX (m)",
         )),
         (Grains::Range(lo, hi), true) => match PowerLawRadii::inverse_cube(lo, hi) {
             Some(law) => Ok((None, Some(law), format!("radius range given: {lo}–{hi} m"))),
-            None => Err(input("--radius-range", format!("0 < RMIN < RMAX in m, got {lo},{hi}"))),
+            None => Err(input(
+                "--radius-range-m",
+                format!("0 < RMIN < RMAX in m, got {lo},{hi}"),
+            )),
         },
-        (Grains::Range(..), false) => Err(input("--radius-range", "monodisperse models take --radius R (m)")),
+        (Grains::Range(..), false) => Err(input("--radius-range-m", "monodisperse models take --radius-m R (m)")),
     }
 }
 
@@ -259,7 +262,7 @@ pub fn build_with_progress(
     let started = std::time::Instant::now();
     if !(spec.bulk_density.is_finite() && spec.bulk_density > 0.0) {
         return Err(input(
-            "--bulk-density",
+            "--bulk-density-kg-m3",
             format!("a positive density in kg/m³, got {}", spec.bulk_density),
         ));
     }
@@ -268,7 +271,7 @@ pub fn build_with_progress(
     let bounding = spec.shape.bounding_radius();
     if r_max > 0.25 * bounding {
         return Err(input(
-            "--particles/--radius",
+            "--particles/--radius-m",
             format!(
                 "grains of radius {r_max:.4e} m are too large for a shape of bounding radius {bounding:.4e} m (at most a quarter)"
             ),
@@ -281,7 +284,7 @@ pub fn build_with_progress(
                 .unwrap_or_else(|| core::default_core_radius(spec.shape.equivalent_diameter()));
             if !(c.is_finite() && c > 0.0 && c < bounding) {
                 return Err(input(
-                    "--core-radius",
+                    "--core-radius-m",
                     format!("a radius in m between 0 and {bounding:.4e}, got {c}"),
                 ));
             }
@@ -342,7 +345,7 @@ pub fn build_with_progress(
     };
     if centres.len() < MIN_PARTICLES {
         return Err(input(
-            "--particles/--radius",
+            "--particles/--radius-m",
             format!(
                 "only {} grains fit in the shape; at least {MIN_PARTICLES} are needed (smaller grains)",
                 centres.len()

@@ -177,7 +177,7 @@ pub fn analyze_campaign(
 }
 
 /// The end time shared by the completed runs of `dir/campaign.csv` (their `final_time`, s): `analyze-campaign`'s
-/// default `--at`. Errors ([`AnalysisError::Request`]) when no run completed or the runs end at different times.
+/// default `--at-s`. Errors ([`AnalysisError::Request`]) when no run completed or the runs end at different times.
 pub fn campaign_end_time(dir: &Path) -> Result<f64, AnalysisError> {
     let index = dir.join("campaign.csv");
     let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
@@ -200,11 +200,11 @@ pub fn campaign_end_time(dir: &Path) -> Result<f64, AnalysisError> {
     match ends[..] {
         [t] => Ok(t),
         [] => Err(AnalysisError::Request(format!(
-            "--at: no completed run in {} to take the end time from; give --at",
+            "--at-s: no completed run in {} to take the end time from; give --at-s",
             index.display()
         ))),
         _ => Err(AnalysisError::Request(format!(
-            "--at: the runs end at different times ({ends:?} s); give --at, a time with a snapshot in every run"
+            "--at-s: the runs end at different times ({ends:?} s); give --at-s, a time with a snapshot in every run"
         ))),
     }
 }

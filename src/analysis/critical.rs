@@ -675,7 +675,7 @@ pub fn judge_dir(
     if let Some(w) = window
         && !(w.is_finite() && w > 0.0)
     {
-        return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
+        return Err(SearchError::usage(format!("--judge-window-s must be > 0 s, got {w}")));
     }
     let criteria = criteria(significance, None)?;
     let judged = match read_holds_csv(&dir.join("holds.csv")) {
@@ -798,7 +798,7 @@ pub fn density_fit(points: &[String], period: f64) -> Result<(), SearchError> {
     }
     if !(period.is_finite() && period > 0.0) {
         return Err(SearchError::usage(format!(
-            "--period must be > 0 hours, got {}",
+            "--period-h must be > 0 hours, got {}",
             period
         )));
     }

@@ -39,7 +39,7 @@ pub enum AnalysisError {
         reason: String,
     },
     /// The requested time is past the run's end (issue 57).
-    #[error("{dir}: --at {t} s is past the run's end (t_end = {t_end} s)")]
+    #[error("{dir}: --at-s {t} s is past the run's end (t_end = {t_end} s)")]
     PastEnd {
         /// The run directory.
         dir: PathBuf,

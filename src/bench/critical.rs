@@ -19,16 +19,16 @@ pub struct BenchCriticalArgs {
     #[arg(long, value_name = "SCENE.toml")]
     pub scene: PathBuf,
     /// First T_final (hours).
-    #[arg(long)]
+    #[arg(long = "from-h")]
     pub from: f64,
     /// Last T_final (hours).
-    #[arg(long)]
+    #[arg(long = "to-h")]
     pub to: f64,
     /// Step of T_final (hours).
-    #[arg(long, default_value_t = 0.05)]
+    #[arg(long = "step-h", default_value_t = 0.05)]
     pub step: f64,
     /// Length of each hold (simulated seconds).
-    #[arg(long, default_value_t = 4000.0)]
+    #[arg(long = "hold-s", default_value_t = 4000.0)]
     pub hold: f64,
     /// Holds at once to compare with one at a time (comma-separated; 1 is always timed first).
     #[arg(long, default_value = "2", value_delimiter = ',')]

@@ -4,7 +4,7 @@
 //!
 //! The canonical case is Richardson11 §3.1's model atmosphere (`analysis/richardson2011/atmosphere.toml`: 991
 //! elastic spheres in a cylinder on a plane under uniform gravity). Its first seconds (a blob falling and
-//! splashing) are not what a long run spends its time on, so the timing can start after a warm-up (`--from`, e.g.
+//! splashing) are not what a long run spends its time on, so the timing can start after a warm-up (`--from-s`, e.g.
 //! t = 50, when the atmosphere has equilibrated); the warm-up is stepped exactly as the timed part and not timed.
 
 use std::io::Write;
@@ -23,10 +23,10 @@ pub struct BenchHsdemArgs {
     #[arg(long, value_name = "FILE")]
     pub scene: PathBuf,
     /// Time the steps from this simulated time on (s); the steps before it are taken untimed (warm-up).
-    #[arg(long, default_value_t = 0.0, value_name = "T")]
+    #[arg(long = "from-s", default_value_t = 0.0, value_name = "T")]
     pub from: f64,
     /// Simulated end time (s); default the scene's `t_end`.
-    #[arg(long, value_name = "T")]
+    #[arg(long = "t-end-s", value_name = "T")]
     pub t_end: Option<f64>,
     /// Threads of the pool the engine runs in (the stepper is serial; only full neighbour-list builds fork).
     #[arg(long, default_value_t = 1)]
@@ -114,7 +114,7 @@ pub fn time_scene(
     let t_end = t_end.unwrap_or(sc.t_end);
     if !(t_from.is_finite() && t_from >= 0.0 && t_end.is_finite() && t_end > t_from) {
         return Err(BenchError::usage(format!(
-            "need 0 <= --from < --t-end, got {t_from} and {t_end}"
+            "need 0 <= --from-s < --t-end-s, got {t_from} and {t_end}"
         )));
     }
     if threads == 0 {

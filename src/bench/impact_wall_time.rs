@@ -24,10 +24,10 @@ pub struct ImpactBenchArgs {
     #[arg(long, default_value = "P2")]
     pub projectile: String,
     /// Impact angle ζ (degrees).
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long = "angle-deg", default_value_t = 45.0)]
     pub angle: f64,
     /// End time of each run (s).
-    #[arg(long, default_value_t = 10_000.0)]
+    #[arg(long = "t-end-s", default_value_t = 10_000.0)]
     pub t_end: f64,
     /// Integrators, comma-separated: bulirsch-stoer (the impact default), dop853, dopri5, bulirsch-stoer-implicit. `METHOD:RTOL` runs that
     /// method at that tolerance only (e.g. `bulirsch-stoer:1e-4,dop853:1e-8`); a bare METHOD runs every --rtol.
@@ -44,7 +44,7 @@ pub struct ImpactBenchArgs {
     #[arg(long, value_delimiter = ',', default_value = "1,2", value_parser = clap::value_parser!(u64).range(1..=4096))]
     pub threads: Vec<u64>,
     /// The wall-time goal drawn as a line on the plot (s): 60 for the N200 impact, 600 for the N2000 one.
-    #[arg(long, default_value_t = 60.0)]
+    #[arg(long = "goal-s", default_value_t = 60.0)]
     pub goal: f64,
     /// Repeats of each configuration (the median and the minimum are reported).
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u64).range(1..=100))]
@@ -56,7 +56,7 @@ pub struct ImpactBenchArgs {
     #[arg(long)]
     pub force: bool,
     /// Run nothing: redraw `bench_impact.svg` and `.png` from OUT/bench_impact.csv (its target, projectile, angle
-    /// and end time; `--goal` as given), overwriting the plot only.
+    /// and end time; `--goal-s` as given), overwriting the plot only.
     #[arg(long)]
     pub replot: bool,
     /// Keep the run directories (`OUT/runs/<METHOD>_rtol_<RTOL>_f0_<F0>_threads_<T>_<k>`).
@@ -133,7 +133,7 @@ pub fn impact(args: &ImpactBenchArgs) -> Result<(), CliError> {
         return Err(CliError::usage(format!("--rtol: each must be in (0, 1), got {bad}")));
     }
     if !(args.goal.is_finite() && args.goal > 0.0) {
-        return Err(CliError::usage(format!("--goal: must be > 0 s, got {}", args.goal)));
+        return Err(CliError::usage(format!("--goal-s: must be > 0 s, got {}", args.goal)));
     }
     if args.replot {
         return replot(args);

@@ -10,9 +10,9 @@
 //!   `targets/N200_T4`, `N2000_T4` and `N10000_T4` (exact gravity; the octree with a step's frozen lists), contact
 //!   and dissipation, the median of `--repeats` evaluations, on every thread of the pool (a run would use at most
 //!   one per 25 bodies: `rhs-n200` shows why);
-//! - `impact-n2000`: a window of the N2000 impact (P2, ζ = 45°, Dop853 at rtol 1e-8) from first contact, `--window`
+//! - `impact-n2000`: a window of the N2000 impact (P2, ζ = 45°, Dop853 at rtol 1e-8) from first contact, `--window-s`
 //!   simulated seconds long;
-//! - `impact-n200`: the N200 impact (P2, ζ = 45°, Bulirsch–Stoer at rtol 1e-6 of the run) to `--n200-t-end`;
+//! - `impact-n200`: the N200 impact (P2, ζ = 45°, Bulirsch–Stoer at rtol 1e-6 of the run) to `--n200-t-end-s`;
 //! - `ssdem-40k` / `ssdem-40k-tree10`: soft-sphere steps on the 40 000-sphere FCC ball ([`crate::bench::ssdem`]),
 //!   contacts only and with the tree every 10 steps; `ssdem-2k`: the same on 2000 spheres (a small run);
 //! - `campaign-n30`: a campaign of `--campaign-runs` N30 impacts run `p` at a time on one thread each;
@@ -65,10 +65,10 @@ pub struct ScalingArgs {
     #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u64).range(1..=100_000))]
     pub repeats: u64,
     /// Simulated seconds of the N2000 impact window, from first contact (s).
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long = "window-s", default_value_t = 20.0)]
     pub window: f64,
     /// End time of the N200 impact (s).
-    #[arg(long, default_value_t = 10_000.0)]
+    #[arg(long = "n200-t-end-s", default_value_t = 10_000.0)]
     pub n200_t_end: f64,
     /// Timed soft-sphere steps per thread count.
     #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u64).range(1..=1_000_000))]
@@ -77,7 +77,7 @@ pub struct ScalingArgs {
     #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u64).range(1..=10_000))]
     pub campaign_runs: u64,
     /// End time of each campaign run (s).
-    #[arg(long, default_value_t = 2_000.0)]
+    #[arg(long = "campaign-t-end-s", default_value_t = 2_000.0)]
     pub campaign_t_end: f64,
     /// Time from which the hard-sphere atmosphere is timed (system units; the gas has settled by t = 20).
     #[arg(long, default_value_t = 20.0)]
@@ -643,9 +643,9 @@ pub fn scaling(args: &ScalingArgs) -> Result<(), BenchError> {
         )));
     }
     for (name, v) in [
-        ("--window", args.window),
-        ("--n200-t-end", args.n200_t_end),
-        ("--campaign-t-end", args.campaign_t_end),
+        ("--window-s", args.window),
+        ("--n200-t-end-s", args.n200_t_end),
+        ("--campaign-t-end-s", args.campaign_t_end),
         ("--hsdem-window", args.hsdem_window),
     ] {
         if !(v.is_finite() && v > 0.0) {

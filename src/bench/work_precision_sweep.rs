@@ -60,7 +60,7 @@ pub struct WorkPrecisionArgs {
     #[arg(long, value_delimiter = ',', value_name = "H")]
     pub rk4_steps: Option<Vec<f64>>,
     /// A method's sweep stops after its first setting whose timed run exceeds this many seconds.
-    #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+    #[arg(long = "max-run-s", default_value_t = 60.0, value_name = "SECONDS")]
     pub max_run_seconds: f64,
     /// rtol = atol of the reference runs (problems without an analytic reference).
     #[arg(long, default_value = "1e-13", value_name = "TOL")]
@@ -233,7 +233,7 @@ pub fn work_precision(args: &WorkPrecisionArgs) -> Result<(), CliError> {
     }
     if args.max_run_seconds.is_nan() || args.max_run_seconds <= 0.0 {
         return Err(CliError::usage(format!(
-            "--max-run-seconds: must be > 0, got {}",
+            "--max-run-s: must be > 0, got {}",
             args.max_run_seconds
         )));
     }

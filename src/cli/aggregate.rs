@@ -37,17 +37,17 @@ pub struct BuildArgs {
     #[arg(long, conflicts_with_all = ["radius", "radius_range"])]
     pub particles: Option<usize>,
     /// Grain radius (m), monodisperse models.
-    #[arg(long, conflicts_with = "radius_range", allow_negative_numbers = true)]
+    #[arg(long = "radius-m", conflicts_with = "radius_range", allow_negative_numbers = true)]
     pub radius: Option<f64>,
     /// Radius range RMIN,RMAX (m), polydisperse models (dN/dr ∝ r⁻³).
-    #[arg(long, value_name = "RMIN,RMAX")]
+    #[arg(long = "radius-range-m", value_name = "RMIN,RMAX")]
     pub radius_range: Option<String>,
     /// Bulk density (kg/m³): total mass / shape volume.
-    #[arg(long, default_value_t = 2100.0, allow_negative_numbers = true)]
+    #[arg(long = "bulk-density-kg-m3", default_value_t = 2100.0, allow_negative_numbers = true)]
     pub bulk_density: f64,
     /// Core radius (m) for rcpc and ppc (default: Zhang17's 200 m scaled to the shape, 200/390 of its
     /// volume-equivalent radius).
-    #[arg(long)]
+    #[arg(long = "core-radius-m")]
     pub core_radius: Option<f64>,
     /// Seed of every random choice.
     #[arg(long, default_value_t = 1)]
@@ -84,7 +84,7 @@ pub struct DensityArgs {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// New bulk density (kg/m³).
-    #[arg(long)]
+    #[arg(long = "bulk-density-kg-m3")]
     pub bulk_density: f64,
     /// The particle file to write; NAME.json goes beside it.
     #[arg(long, value_name = "FILE.csv")]
@@ -111,16 +111,16 @@ fn grains(args: &BuildArgs) -> Result<Grains, CliError> {
                 .split(',')
                 .map(|x| x.trim().parse::<f64>())
                 .collect::<Result<_, _>>()
-                .map_err(|_| CliError::usage(format!("--radius-range: expected RMIN,RMAX in m, got `{s}`")))?;
+                .map_err(|_| CliError::usage(format!("--radius-range-m: expected RMIN,RMAX in m, got `{s}`")))?;
             match v[..] {
                 [lo, hi] => Ok(Grains::Range(lo, hi)),
                 _ => Err(CliError::usage(format!(
-                    "--radius-range: expected RMIN,RMAX in m, got `{s}`"
+                    "--radius-range-m: expected RMIN,RMAX in m, got `{s}`"
                 ))),
             }
         }
         _ => Err(CliError::usage(
-            "give one of --particles N, --radius R (m) or --radius-range RMIN,RMAX (m)",
+            "give one of --particles N, --radius-m R (m) or --radius-range-m RMIN,RMAX (m)",
         )),
     }
 }

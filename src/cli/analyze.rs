@@ -1,4 +1,4 @@
-//! `rubblepile analyze RUN_DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4); of a
+//! `rubblepile analyze RUN_DIR [--at-s 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4); of a
 //! flyby run, the largest remnant before and after (`analysis/flyby.json`).
 
 use std::path::PathBuf;
@@ -14,7 +14,7 @@ pub struct AnalyzeArgs {
     pub dir: PathBuf,
     /// Time of the snapshot to analyse (s); there must be a snapshot at that time. Default: 400 s for an impact
     /// run, the last snapshot for any other run.
-    #[arg(long)]
+    #[arg(long = "at-s")]
     pub at: Option<f64>,
     /// Overwrite an earlier analysis in DIR/analysis.
     #[arg(long)]
@@ -31,14 +31,14 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
     if let Some(at) = args.at
         && !(at.is_finite() && at >= 0.0)
     {
-        return Err(CliError::usage(format!("--at: must be a time >= 0 s, got {at}")));
+        return Err(CliError::usage(format!("--at-s: must be a time >= 0 s, got {at}")));
     }
     if !rubblepile::analysis::run_analysis::is_impact_run(&args.dir) {
         return analyze_clumps_of_run(args);
     }
     if args.at == Some(0.0) {
         return Err(CliError::usage(
-            "--at: an impact run is analysed after the impact: must be a time > 0 s, got 0",
+            "--at-s: an impact run is analysed after the impact: must be a time > 0 s, got 0",
         ));
     }
     let (a, report) = analyze_run(&args.dir, args.at.unwrap_or(400.0), args.force).map_err(|e| match e {
@@ -118,7 +118,7 @@ pub struct AnalyzeCampaignArgs {
     pub dir: PathBuf,
     /// Time of the post-impact snapshots to analyse (s) [default: the campaign's end time, shared by its completed
     /// runs].
-    #[arg(long)]
+    #[arg(long = "at-s")]
     pub at: Option<f64>,
     /// Rewrite earlier analyses.
     #[arg(long)]
@@ -132,7 +132,7 @@ pub struct AnalyzeCampaignArgs {
     #[arg(long)]
     pub spin_target: Option<String>,
     /// ... at this impact angle ζ (degrees); a projectile without such a run pools its runs at every angle.
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long = "spin-angle-deg", default_value_t = 45.0)]
     pub spin_angle: f64,
     /// Seed of Q*_D's bootstrap interval (resampling the runs within each Q value).
     #[arg(long, default_value_t = 1)]
@@ -147,7 +147,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
         .map_or_else(|| ca::campaign_end_time(&args.dir), Ok)
         .map_err(CliError::usage)?;
     if !(at.is_finite() && at > 0.0) {
-        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {at}")));
+        return Err(CliError::usage(format!("--at-s: must be a time > 0 s, got {at}")));
     }
     let field = campaign_by::by_field_name(&args.dir, args.by.as_deref()).map_err(CliError::usage)?;
     let selection = SpinSelection {
@@ -200,7 +200,7 @@ pub struct ReportRoig2003Args {
     #[arg(long)]
     pub out: PathBuf,
     /// Time of the post-impact snapshots to analyse (s).
-    #[arg(long, default_value_t = 400.0)]
+    #[arg(long = "at-s", default_value_t = 400.0)]
     pub at: f64,
     /// Replace an existing OUT/REPORT.md.
     #[arg(long)]
@@ -210,7 +210,10 @@ pub struct ReportRoig2003Args {
 /// Runs `report roig2003`: re-analyses the campaign(s) (rewriting their `analysis/`), then writes the report.
 pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
     if !(args.at.is_finite() && args.at > 0.0) {
-        return Err(CliError::usage(format!("--at: must be a time > 0 s, got {}", args.at)));
+        return Err(CliError::usage(format!(
+            "--at-s: must be a time > 0 s, got {}",
+            args.at
+        )));
     }
     let report = args.out.join("REPORT.md");
     if report.exists() && !args.force {
@@ -239,7 +242,7 @@ pub fn report_roig2003(args: &ReportRoig2003Args) -> Result<(), CliError> {
 }
 
 /// `analyze` of a flyby run (from `rubblepile flyby` or any scene with `[physics.flyby]`): the first and last
-/// snapshots' largest remnant into `DIR/analysis/flyby.json` (`--at` does not apply).
+/// snapshots' largest remnant into `DIR/analysis/flyby.json` (`--at-s` does not apply).
 fn analyze_flyby_run(args: &AnalyzeArgs) -> Result<(), CliError> {
     let out = args.dir.join("analysis/flyby.json");
     if out.exists() && !args.force {

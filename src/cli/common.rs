@@ -36,11 +36,11 @@ impl CliError {
 pub struct CheckpointArgs {
     /// Checkpoint at the first output sample after every SECONDS of wall-clock time (0 = never; else 0.001 to
     /// 1e7).
-    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
+    #[arg(long = "checkpoint-every-s", value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
     /// Also checkpoint at the first output sample SECONDS of simulated time after the last
     /// checkpoint (0 = at every output sample; at most 1e18).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "checkpoint-every-sim-s", value_name = "SECONDS")]
     pub checkpoint_every_sim: Option<f64>,
     /// Extra snapshot format(s) beside the CSV snapshots, e.g. `--format xyz` (extended XYZ for OVITO/VMD/ASE);
     /// repeat for several.
@@ -49,7 +49,7 @@ pub struct CheckpointArgs {
     /// When stderr is not a terminal (a batch log): a progress line (t, %, ETA, the energy error) every SECONDS
     /// of wall-clock time (0.1 to 1e7), 0 = none [default: $RUBBLEPILE_PROGRESS_EVERY, else 60]. On a terminal the
     /// bar is shown.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "progress-every-s", value_name = "SECONDS")]
     pub progress_every: Option<f64>,
     /// Most steps the run may take, over the scene's `[run] max_steps` [default: the scene's, else 1e9]: a scene
     /// estimated to need more is refused; a run reaching it stops with a checkpoint (exit code 3).
@@ -57,7 +57,7 @@ pub struct CheckpointArgs {
     pub max_steps: Option<f64>,
     /// Most wall-clock seconds this process may run, over the scene's `[run] max_wall_seconds` [default: none]:
     /// the run stops with a checkpoint at the output sample before it would overrun (exit code 3).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "max-wall-s", value_name = "SECONDS")]
     pub max_wall_seconds: Option<f64>,
     /// Testing: exit with code 3 right after the N-th checkpoint this process writes.
     #[arg(long, value_name = "N", hide = true)]

@@ -17,10 +17,10 @@ pub struct FlybyArgs {
     pub radius_m: Option<f64>,
     /// Set the pile into rigid rotation about its z axis with this period (hours); a re-spun pile is settled before
     /// the run [default: the target's spins].
-    #[arg(long)]
+    #[arg(long = "period-h")]
     pub period_hours: Option<f64>,
     /// Planet mass (kg; 0 for a control run without tide, the frame then moves straight at v∞) [default: Earth].
-    #[arg(long, default_value_t = EARTH_MASS_KG)]
+    #[arg(long = "planet-mass-kg", default_value_t = EARTH_MASS_KG)]
     pub planet_mass: f64,
     /// Planet radius (m) [default: Earth's mean radius].
     #[arg(long, default_value_t = EARTH_RADIUS_M)]
@@ -74,12 +74,12 @@ pub struct FlybyArgs {
     #[arg(long)]
     pub settle_to_principal: bool,
     /// Cap on the settling time (hours) [default: 100 free-fall times √(3π/(32 G ρ)) of the pile].
-    #[arg(long)]
+    #[arg(long = "settle-max-h")]
     pub settle_max_hours: Option<f64>,
     /// Never show the progress bar (it is shown only when stderr is a terminal anyway).
     #[arg(long)]
     pub no_progress: bool,
-    /// Checkpoints, extra snapshot formats (`--format xyz`), progress lines in a batch log (`--progress-every`)
+    /// Checkpoints, extra snapshot formats (`--format xyz`), progress lines in a batch log (`--progress-every-s`)
     /// and budgets, as for `rubblepile run`; the control run takes the same.
     #[command(flatten)]
     pub checkpoints: CheckpointArgs,

@@ -21,14 +21,14 @@ pub struct ImpactArgs {
     /// Projectile preset P1, P2 or P3 (Roig03 Table 2); or give --projectile-radius-km.
     #[arg(long, default_value = "P2")]
     pub projectile: String,
-    /// Equivalent radius of a custom projectile (km); overrides the preset. Alias `--projectile-radius` (km).
-    #[arg(long, visible_alias = "projectile-radius")]
+    /// Equivalent radius of a custom projectile (km); overrides the preset.
+    #[arg(long)]
     pub projectile_radius_km: Option<f64>,
-    /// Impact speed (km/s). Alias `--projectile-speed` (km/s).
-    #[arg(long, default_value_t = 5.0, visible_alias = "projectile-speed")]
+    /// Impact speed (km/s).
+    #[arg(long, default_value_t = 5.0)]
     pub projectile_speed_km_s: f64,
     /// Angle ζ between the trajectory and the target's spin axis z (degrees, 0–180).
-    #[arg(long, default_value_t = 45.0)]
+    #[arg(long = "angle-deg", default_value_t = 45.0)]
     pub angle: f64,
     /// Seed of the projectile's attitude.
     #[arg(long, default_value_t = 1)]
@@ -39,7 +39,7 @@ pub struct ImpactArgs {
     /// b as a fraction (in [0, 1)) of the target's radius R (of its surface ellipsoid's volume).
     #[arg(long, value_name = "F", conflicts_with = "impact_angle_deg")]
     pub impact_parameter_frac: Option<f64>,
-    /// Impact angle θ to the surface normal at the aim point (degrees, [0, 90); 0 = head-on); not ζ (--angle).
+    /// Impact angle θ to the surface normal at the aim point (degrees, [0, 90); 0 = head-on); not ζ (--angle-deg).
     #[arg(long, value_name = "DEG")]
     pub impact_angle_deg: Option<f64>,
     /// Azimuth ψ of the aim point around the approach direction n (degrees, [0, 360); 0 along x, 90 along n × x).
@@ -52,10 +52,10 @@ pub struct ImpactArgs {
     #[arg(long, value_name = "X,Y,Z,W", value_delimiter = ',')]
     pub projectile_attitude: Option<Vec<f64>>,
     /// Time at which the surfaces first touch (s).
-    #[arg(long, default_value_t = 90.0)]
+    #[arg(long = "contact-time-s", default_value_t = 90.0)]
     pub contact_time: f64,
     /// End time (s).
-    #[arg(long, default_value_t = 10_000.0)]
+    #[arg(long = "t-end-s", default_value_t = 10_000.0)]
     pub t_end: f64,
     /// Relative (and absolute) tolerance: of the whole run for Bulirsch–Stoer (default 1e-6), of each step for
     /// Dop853/Dopri5 (default 1e-8).
@@ -81,14 +81,14 @@ pub struct ImpactArgs {
     /// κ ≈ 10). See analysis/roig2003/DISCUSSION.md.
     #[arg(long, default_value_t = rubblepile::ellipsoid::calibration::KappaReading::Printed)]
     pub kappa_reading: rubblepile::ellipsoid::calibration::KappaReading,
-    /// Snapshot times (s), comma-separated [default: 0,100,400,1000,10000, cut at --t-end, plus --t-end].
-    #[arg(long, value_delimiter = ',')]
+    /// Snapshot times (s), comma-separated [default: 0,100,400,1000,10000, cut at --t-end-s, plus --t-end-s].
+    #[arg(long = "snapshots-s", value_delimiter = ',')]
     pub snapshots: Option<Vec<f64>>,
-    /// Snapshot cadence (s), instead of --snapshots: snapshots at 0, S, 2S, … and at --t-end (at most 1e5).
-    #[arg(long, value_name = "S", conflicts_with = "snapshots")]
+    /// Snapshot cadence (s), instead of --snapshots-s: snapshots at 0, S, 2S, … and at --t-end-s (at most 1e5).
+    #[arg(long = "snapshot-every-s", value_name = "S", conflicts_with = "snapshots")]
     pub snapshot_every: Option<f64>,
     /// Time-series cadence (s).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long = "every-s", default_value_t = 10.0)]
     pub every: f64,
     /// Output directory (must be empty or absent unless --force).
     #[arg(long)]
@@ -171,20 +171,20 @@ const FIELD_FLAGS: [(&str, &str); 16] = [
     ("projectile.axis_ratios", "--projectile-radius-km"),
     ("projectile.speed", "--projectile-speed-km-s"),
     ("projectile_pile", "--projectile-pile"),
-    ("angle_deg", "--angle"),
+    ("angle_deg", "--angle-deg"),
     ("seed", "--seed"),
-    ("contact_time", "--contact-time"),
-    ("t_end", "--t-end"),
+    ("contact_time", "--contact-time-s"),
+    ("t_end", "--t-end-s"),
     ("method", "--method"),
     ("rtol", "--rtol"),
     ("f0", "--f0"),
     ("beta", "--beta"),
-    ("snapshots", "--snapshots"),
-    ("every", "--every"),
+    ("snapshots", "--snapshots-s"),
+    ("every", "--every-s"),
 ];
 
 /// The command-line flag of an [`ImpactConfig`] field named in an error ([`FIELD_FLAGS`], else the field with dashes:
-/// `impact_angle_deg` is `--impact-angle-deg`), its index kept (`snapshots[2]` is `--snapshots[2]`).
+/// `impact_angle_deg` is `--impact-angle-deg`), its index kept (`snapshots[2]` is `--snapshots-s[2]`).
 fn flag(field: &str) -> String {
     let (head, index) = field.split_at(field.find('[').unwrap_or(field.len()));
     let dashed = || format!("--{}", head.replace('_', "-"));
@@ -252,6 +252,6 @@ mod tests {
             super::FIELD_FLAGS.iter().all(|(_, f)| longs.contains(&&f[2..])),
             "{longs:?}"
         );
-        assert_eq!(super::flag("snapshots[2]"), "--snapshots[2]");
+        assert_eq!(super::flag("snapshots[2]"), "--snapshots-s[2]");
     }
 }

@@ -1,21 +1,21 @@
 //! The `rubblepile` command line.
 //!
-//! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress] [--checkpoint-every S]
-//!   [--checkpoint-every-sim S]`: runs a scene (the built-in default scene without SCENE) and writes
+//! - `rubblepile run [SCENE.toml] --out DIR [--force] [--no-progress] [--checkpoint-every-s S]
+//!   [--checkpoint-every-sim-s S]`: runs a scene (the built-in default scene without SCENE) and writes
 //!   its outputs into DIR, with checkpoints as asked;
-//! - `rubblepile resume DIR [--no-progress] [--checkpoint-every S] [--checkpoint-every-sim S]`:
+//! - `rubblepile resume DIR [--no-progress] [--checkpoint-every-s S] [--checkpoint-every-sim-s S]`:
 //!   continues an interrupted run from `DIR/checkpoint.json` (see [`rubblepile::driver`]);
 //! - `rubblepile check [SCENE.toml]`: validates a scene and prints what it resolved to; `rubblepile check DIR` (a
 //!   directory): whether a run directory is whole ([`rubblepile::driver::inspect`]), one line per finding, exit code 2
 //!   when it is not; `rubblepile check --explain [KIND]`: every key of a scene file with its unit, default and
 //!   allowed range ([`rubblepile::driver::explain`]);
-//! - `rubblepile target build --fragments N --period-hours T --seed S --out targets/NAME.csv`: a relaxed
+//! - `rubblepile target build --fragments N --period-h T --seed S --out targets/NAME.csv`: a relaxed
 //!   rubble-pile target (Roig03 §3) and its Table 1 quantities in `NAME.json`;
-//! - `rubblepile impact --target FILE.csv --projectile P2 --angle 45 --out DIR`: an impact run (Roig03 §3);
-//! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every S]`: a resumable grid of impact runs
+//! - `rubblepile impact --target FILE.csv --projectile P2 --angle-deg 45 --out DIR`: an impact run (Roig03 §3);
+//! - `rubblepile campaign FILE.toml [--parallel N] [--checkpoint-every-s S]`: a resumable grid of impact runs
 //!   (targets × projectiles × angles × seeds) with `campaign.csv` (see [`rubblepile::impact::campaign`]);
-//! - `rubblepile analyze DIR [--at 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
-//! - `rubblepile analyze-campaign DIR [--at T] [--by FIELD]`: all completed runs of a campaign, bound fraction vs Q,
+//! - `rubblepile analyze DIR [--at-s 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4);
+//! - `rubblepile analyze-campaign DIR [--at-s T] [--by FIELD]`: all completed runs of a campaign, bound fraction vs Q,
 //!   Q*_D;
 //! - `rubblepile report richardson2011 --atmosphere DIR [--half DIR] [--tumbler DIR…]`: the Richardson11 §3 report
 //!   (`analysis/richardson2011/REPORT.md` and figures);
@@ -26,11 +26,11 @@
 //! - `rubblepile bench nbody --problem {pythagorean,outer-solar} --rtol TOL[,TOL…] --out DIR [--force]`:
 //!   timed point-mass runs with their final states, for the comparison with REBOUND
 //!   (`analysis/rebound_compare`);
-//! - `rubblepile ssdem advise --radius R --density RHO [--body-radius B] [--spin-period-h T | --speed V]
+//! - `rubblepile ssdem advise --radius-m R --density-kg-m3 RHO [--body-radius-m B] [--spin-period-h T | --speed-m-s V]
 //!   [--max-overlap 0.01]` or `--scene FILE`: k_N and dt for soft spheres (see [`rubblepile::granular::soft::advise`]);
 //! - `rubblepile bench ssdem --particles N --gravity {off,tree,direct}`: soft-sphere particle-steps per second;
-//! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius R
-//!   --bulk-density RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
+//! - `rubblepile aggregate build --model {hcp,rcp,rcpc,pp1,pp2,ppc} --shape SHAPE --particles N|--radius-m R
+//!   --bulk-density-kg-m3 RHO --seed S --out targets/NAME.csv` and `aggregate density`: see [`aggregate`].
 //! - `rubblepile spinup critical …` / `rubblepile spinup density-fit …`: the T_c,3 search and the Eq. 22 fit
 //!   ([`spinup`]); `rubblepile report zhang2017 RUNS --out analysis/zhang2017 [--force]`: the Table 3 report.
 //!
@@ -41,6 +41,10 @@
 //! `run`, `resume` and `check` dispatch on `scene.kind`: `"soft-spheres"` scenes go to [`ssdem`].
 //! - `rubblepile bench stability --out DIR [--force] [--quick] [--only ID,…]`: the stability suite
 //!   ([`crate::bench::stability`]): `stability.csv`, `stability.md` and one run directory per case.
+//!
+//! Units: every flag that carries a dimensional quantity names its unit as a suffix, spelled the same everywhere
+//! (`-s`, `-h`, `-m`, `-km`, `-m-s`, `-km-s`, `-deg`, `-kg`, `-kg-m3`, `-rad-s`); dimensionless flags (κ, β, rtol,
+//! counts, fractions) keep bare names. Old spellings still parse, with one warning line each ([`units`]).
 //!
 //! Errors are printed as one line, `error: …`, on stderr; the exit code is 2 for bad input (bad
 //! scene, bad arguments, existing output directory, nothing to resume, a run directory that is not whole, a
@@ -69,6 +73,7 @@ pub mod spinup;
 pub mod ssdem;
 pub mod stability;
 pub mod target;
+pub mod units;
 pub mod visual;
 
 use std::path::PathBuf;
@@ -230,7 +235,7 @@ pub enum BenchCommand {
     /// Timed point-mass N-body runs (Pythagorean three-body, outer Solar System) with final states (CSV).
     Nbody(crate::bench::nbody::NBodyArgs),
     /// Wall-clock time of whole impact runs (default N200_T4 + P2, ζ = 45°, 10 000 s, the impact default rtol) per
-    /// integrator, tolerance, F0 and thread count, with each run's energy error and a goal line (60 s unless `--goal`).
+    /// integrator, tolerance, F0 and thread count, with each run's energy error and a goal line (60 s, or `--goal-s`).
     Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(crate::bench::ssdem::BenchSsdemArgs),
@@ -395,7 +400,9 @@ fn one_line_clap_error(e: &clap::Error) -> String {
 
 /// The binary's entry point: parses `std::env::args`, runs, prints `error: …` on failure.
 pub fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let (args, warnings) = units::rewrite(std::env::args().collect());
+    warnings.iter().for_each(|w| eprintln!("{w}"));
+    let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) if !e.use_stderr() => {
             // --help / --version: print and exit 0.

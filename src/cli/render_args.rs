@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use rubblepile::render::run::{ColourBy, RenderRunOptions};
 use rubblepile::render::{Projection, RenderError, View};
 
-/// Largest `--extent` accepted (m): 1e300, beyond it the camera's scale underflows.
+/// Largest `--extent-m` accepted (m): 1e300, beyond it the camera's scale underflows.
 pub const MAX_EXTENT_M: f64 = 1e300;
 
 /// `rubblepile render`.
@@ -23,11 +23,11 @@ pub struct RenderArgs {
     #[arg(long, default_value = "800x800")]
     pub size: String,
     /// Perspective camera with this field of view (degrees) instead of the orthographic one.
-    #[arg(long, value_name = "DEGREES")]
+    #[arg(long = "perspective-deg", value_name = "DEGREES")]
     pub perspective: Option<f64>,
     /// Fixed half-width of the picture (m) about each snapshot's centre of mass [default: follows the bodies,
     /// growing to hold 98 % of them and never shrinking].
-    #[arg(long, value_name = "METRES")]
+    #[arg(long = "extent-m", value_name = "METRES")]
     pub extent: Option<f64>,
     /// Fixed centre X,Y,Z of every frame (m), e.g. a drum's axis [default: each snapshot's centre of mass].
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true, value_name = "X,Y,Z")]
@@ -58,7 +58,7 @@ impl RenderArgs {
             && !(rubblepile::io::limits::MIN_MEANINGFUL..=MAX_EXTENT_M).contains(&e)
         {
             return Err(format!(
-                "--extent: expected a half-width in metres from {:e} to {MAX_EXTENT_M:e}, got {}",
+                "--extent-m: expected a half-width in metres from {:e} to {MAX_EXTENT_M:e}, got {}",
                 rubblepile::io::limits::MIN_MEANINGFUL,
                 rubblepile::io::scene_file::fmt_num(e)
             ));
@@ -80,7 +80,7 @@ impl RenderArgs {
             None => Projection::Orthographic,
             Some(f) if f.is_finite() && f > 1.0 && f < 170.0 => Projection::Perspective { fov_deg: f },
             Some(f) => {
-                return Err(format!("--perspective: expected 1 to 170 degrees, got {f}"));
+                return Err(format!("--perspective-deg: expected 1 to 170 degrees, got {f}"));
             }
         };
         if self.gif.contains(['/', '\\']) || !self.gif.ends_with(".gif") {

@@ -16,7 +16,7 @@ pub enum SpinupCommand {
     /// Fit κ of Eq. 22 over bulk densities and give the critical bulk density.
     DensityFit(DensityFitArgs),
     /// Judge the holds of a search again (its directory, or a compact copy with critical.csv and holds.csv) by
-    /// every creep criterion over their first --judge-window seconds; prints (and writes --csv).
+    /// every creep criterion over their first --judge-window-s seconds; prints (and writes --csv).
     Judge(JudgeArgs),
 }
 
@@ -27,7 +27,7 @@ pub struct JudgeArgs {
     #[arg(value_name = "DIR")]
     pub dir: PathBuf,
     /// Judge only the first SECONDS of each hold.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "judge-window-s", value_name = "SECONDS")]
     pub judge_window: Option<f64>,
     /// Standard errors by which a weakening rate must exceed zero for the paper's criterion (default 2).
     #[arg(long, value_name = "Z")]
@@ -50,13 +50,13 @@ pub struct CriticalArgs {
     #[arg(long, value_name = "SCENE.toml")]
     pub scene: PathBuf,
     /// First T_final (hours).
-    #[arg(long)]
+    #[arg(long = "from-h")]
     pub from: f64,
     /// Last T_final (hours).
-    #[arg(long)]
+    #[arg(long = "to-h")]
     pub to: f64,
     /// Step of T_final (hours).
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long = "step-h", default_value_t = 0.01)]
     pub step: f64,
     /// Directory of the hold runs and `critical.json`.
     #[arg(long, value_name = "DIR")]
@@ -84,14 +84,14 @@ pub struct CriticalArgs {
     #[arg(long, value_name = "CHANGE")]
     pub coordination_tolerance: Option<f64>,
     /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "hold-s", value_name = "SECONDS")]
     pub hold: Option<f64>,
-    /// Run every hold from --from to --to, also after both criteria have found a stable one (by default the
+    /// Run every hold from --from-h to --to-h, also after both criteria have found a stable one (by default the
     /// search stops one hold after that): shows whether the verdicts stay stable at slower spins.
     #[arg(long)]
     pub all_holds: bool,
     /// Judge only the first SECONDS of each hold (T_c,3 against the hold length from one set of long holds).
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long = "judge-window-s", value_name = "SECONDS")]
     pub judge_window: Option<f64>,
     /// Holds run at once (the base run of --branch is shared and runs first); outputs are those of --parallel 1.
     #[arg(long, value_name = "N", default_value_t = 1)]
@@ -120,7 +120,7 @@ pub struct DensityFitArgs {
     #[arg(long, value_delimiter = ',')]
     pub points: Vec<String>,
     /// Period (h) at which to give the critical bulk density.
-    #[arg(long, default_value_t = 2.26)]
+    #[arg(long = "period-h", default_value_t = 2.26)]
     pub period: f64,
 }
 

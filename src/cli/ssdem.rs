@@ -21,22 +21,22 @@ pub struct AdviseArgs {
     #[arg(long, value_name = "SCENE.toml", conflicts_with_all = ["radius", "density", "body_radius", "spin_period_h", "speed"])]
     pub scene: Option<PathBuf>,
     /// Smallest particle radius (m).
-    #[arg(long, required_unless_present = "scene")]
+    #[arg(long = "radius-m", required_unless_present = "scene")]
     pub radius: Option<f64>,
     /// Grain density (kg/m³).
-    #[arg(long, required_unless_present = "scene")]
+    #[arg(long = "density-kg-m3", required_unless_present = "scene")]
     pub density: Option<f64>,
     /// Radius of the self-gravitating body (m): adds its escape speed and central pressure.
-    #[arg(long)]
+    #[arg(long = "body-radius-m")]
     pub body_radius: Option<f64>,
     /// Bulk density of the body (kg/m³); default 0.64 × the grain density (random close packing).
-    #[arg(long)]
+    #[arg(long = "bulk-density-kg-m3")]
     pub bulk_density: Option<f64>,
     /// Spin period of the body (hours): adds its equatorial speed.
     #[arg(long)]
     pub spin_period_h: Option<f64>,
     /// Largest expected impact speed (m/s).
-    #[arg(long)]
+    #[arg(long = "speed-m-s")]
     pub speed: Option<f64>,
     /// Largest overlap as a fraction of the smallest radius.
     #[arg(long, default_value_t = DEFAULT_MAX_OVERLAP)]
@@ -71,15 +71,15 @@ pub fn advise(args: &AdviseArgs) -> Result<(), CliError> {
         }
         a
     } else {
-        let r = positive("radius", args.radius)?.unwrap_or(1.0);
-        let rho = positive("density", args.density)?.unwrap_or(1.0);
-        let body = positive("body-radius", args.body_radius)?;
-        let bulk = positive("bulk-density", args.bulk_density)?.unwrap_or(0.64 * rho);
+        let r = positive("radius-m", args.radius)?.unwrap_or(1.0);
+        let rho = positive("density-kg-m3", args.density)?.unwrap_or(1.0);
+        let body = positive("body-radius-m", args.body_radius)?;
+        let bulk = positive("bulk-density-kg-m3", args.bulk_density)?.unwrap_or(0.64 * rho);
         let period = positive("spin-period-h", args.spin_period_h)?.map(|h| h * 3600.0);
-        let speed = positive("speed", args.speed)?.unwrap_or(0.0);
+        let speed = positive("speed-m-s", args.speed)?.unwrap_or(0.0);
         if body.is_none() && speed == 0.0 {
             return Err(CliError::usage(
-                "give --speed or --body-radius (and optionally --spin-period-h)",
+                "give --speed-m-s or --body-radius-m (and optionally --spin-period-h)",
             ));
         }
         advise_for_grains(r, rho, body.map(|b| (b, bulk)), period, speed, args.max_overlap)

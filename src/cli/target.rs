@@ -104,7 +104,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub fragments: usize,
     /// Spin period of the pile (hours).
-    #[arg(long)]
+    #[arg(long = "period-h")]
     pub period_hours: f64,
     /// Seed of every random choice (sizes, positions, attitudes).
     #[arg(long, default_value_t = 1)]
@@ -119,7 +119,7 @@ pub struct BuildArgs {
     #[arg(long)]
     pub r_smallest_km: Option<f64>,
     /// Total mass (kg).
-    #[arg(long)]
+    #[arg(long = "total-mass-kg")]
     pub total_mass: Option<f64>,
     /// Dissipation coefficient F0 while relaxing (s m⁻²).
     #[arg(long)]
@@ -143,7 +143,7 @@ pub struct BuildArgs {
     pub resume: bool,
     /// Write `FILE.checkpoint.json` at the first relaxation check after this many wall-clock seconds (s; 0 = at
     /// every check, else 0.001 to 1e7).
-    #[arg(long, value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
+    #[arg(long = "checkpoint-every-s", value_name = "SECONDS", default_value_t = DEFAULT_CHECKPOINT_EVERY)]
     pub checkpoint_every: f64,
 }
 
@@ -190,8 +190,12 @@ pub fn build(args: &BuildArgs) -> Result<(), CliError> {
             args.out.display()
         )));
     }
-    check_wall_seconds("--checkpoint-every", args.checkpoint_every, "at every relaxation check")
-        .map_err(CliError::usage)?;
+    check_wall_seconds(
+        "--checkpoint-every-s",
+        args.checkpoint_every,
+        "at every relaxation check",
+    )
+    .map_err(CliError::usage)?;
     let checkpoint_file = checkpoint_path(&args.out);
     let resume = if args.resume {
         Some(read_checkpoint(&checkpoint_file).map_err(CliError::usage)?)

@@ -11,7 +11,7 @@ use crate::io::messages::{Channel, emit};
 /// Default wall-clock seconds between progress lines on a non-terminal (the runner's `RunOptions::progress_every`).
 pub const DEFAULT_PROGRESS_EVERY: f64 = 60.0;
 
-/// The environment variable that sets the seconds between progress lines when `--progress-every` is not given.
+/// The environment variable that sets the seconds between progress lines when `--progress-every-s` is not given.
 pub const PROGRESS_EVERY_ENV: &str = "RUBBLEPILE_PROGRESS_EVERY";
 
 /// The cadence [`PROGRESS_EVERY_ENV`] sets (its text `text`): 0 (no lines) or 0.1 to 1e7 s

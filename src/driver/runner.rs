@@ -59,7 +59,7 @@ pub struct RunOptions {
     /// Most steps the run may take (`--max-steps`), over the scene's `[run] max_steps`; `None`: the scene's, else
     /// [`crate::io::run_budget::DEFAULT_MAX_STEPS`] ([`crate::io::run_budget`]).
     pub max_steps: Option<u64>,
-    /// Most wall-clock seconds this process may run the run (`--max-wall-seconds`), over the scene's
+    /// Most wall-clock seconds this process may run the run (`--max-wall-s`), over the scene's
     /// `[run] max_wall_seconds`; `None`: the scene's, else no limit.
     pub max_wall_seconds: Option<f64>,
 }
@@ -121,7 +121,7 @@ pub enum RunError<S> {
         summary: Box<S>,
     },
     /// [`resume`]: the directory holds no checkpoint.
-    #[error("nothing to resume: {} does not exist (checkpoints are written only when due, see --checkpoint-every)", .dir.join(CHECKPOINT_FILE).display())]
+    #[error("nothing to resume: {} does not exist (checkpoints are written only when due, see --checkpoint-every-s)", .dir.join(CHECKPOINT_FILE).display())]
     NoCheckpoint {
         /// The run directory.
         dir: PathBuf,

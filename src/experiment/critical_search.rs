@@ -101,13 +101,13 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     let ok = |x: f64| x.is_finite() && x > 0.0;
     if !ok(args.from) || !ok(args.to) || args.to < args.from {
         return Err(SearchError::usage(format!(
-            "--from and --to must be periods in hours with 0 < from <= to, got {} and {}",
+            "--from-h and --to-h must be periods in hours with 0 < from <= to, got {} and {}",
             args.from, args.to
         )));
     }
     if !ok(args.step) {
         return Err(SearchError::usage(format!(
-            "--step must be > 0 hours, got {}",
+            "--step-h must be > 0 hours, got {}",
             args.step
         )));
     }
@@ -119,7 +119,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     if let Some(w) = args.judge_window
         && !ok(w)
     {
-        return Err(SearchError::usage(format!("--judge-window must be > 0 s, got {w}")));
+        return Err(SearchError::usage(format!("--judge-window-s must be > 0 s, got {w}")));
     }
     let json = args.out.join("critical.json");
     if json.exists() && !args.force && args.shard.is_none() && !args.prepare_only {
@@ -324,7 +324,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
                 Channel::Out,
                 &format!(
                     "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
-                 monotone there: refine with a finer --step from {first:.2} h to the next creeping hold above {last:.2} h)",
+                 monotone there: refine with a finer --step-h from {first:.2} h to the next creeping hold above {last:.2} h)",
                     r.criterion.kind.name(),
                     r.set_aside_hours
                 ),
@@ -527,7 +527,7 @@ fn prepare_branches(
     }
     let hold = args.hold.unwrap_or(base.t_end - path.t_final);
     if !(hold.is_finite() && hold > 0.0) {
-        return Err(SearchError::usage(format!("--hold must be > 0 s, got {hold}")));
+        return Err(SearchError::usage(format!("--hold-s must be > 0 s, got {hold}")));
     }
     let mut starts = Vec::with_capacity(grid.len());
     for &tf in grid {

@@ -363,8 +363,8 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
                 "period_hours",
                 format!(
                     "a spin period of {} h asks for about {steps:.1e} steps to settle the pile over {settle_max_time:.3e} \
-                     s, more than the step ceiling {:e}; give a longer --period-hours (or a shorter \
-                     --settle-max-hours)",
+                     s, more than the step ceiling {:e}; give a longer --period-h (or a shorter \
+                     --settle-max-h)",
                     crate::io::scene_file::fmt_num(p),
                     crate::io::run_budget::DEFAULT_MAX_STEPS as f64
                 ),

@@ -79,13 +79,13 @@ pub fn default_snapshots(t_end: f64) -> Vec<f64> {
 }
 
 /// The snapshot times of an impact to `t_end` (s): the `list` when given, else those of a cadence `every` (s,
-/// checked: [`crate::io::output_times::checked_cadence_times`], errors naming `--snapshot-every` and `--t-end`),
+/// checked: [`crate::io::output_times::checked_cadence_times`], errors naming `--snapshot-every-s` and `--t-end-s`),
 /// else [`default_snapshots`].
 pub fn snapshot_times(t_end: f64, list: Option<&[f64]>, every: Option<f64>) -> Result<Vec<f64>, String> {
     match (list, every) {
         (Some(times), _) => Ok(times.to_vec()),
         (None, Some(every)) => {
-            crate::io::output_times::checked_cadence_times(t_end, every, "--snapshot-every", "--t-end")
+            crate::io::output_times::checked_cadence_times(t_end, every, "--snapshot-every-s", "--t-end-s")
         }
         (None, None) => Ok(default_snapshots(t_end)),
     }

@@ -486,7 +486,7 @@ fn validate(spec: &TargetSpec) -> Result<(), TargetError> {
         return bad("fragments", "need at least 2", spec.fragments.to_string());
     }
     if !(spec.period_hours.is_finite() && spec.period_hours > 0.0) {
-        return bad("period-hours", "must be > 0 and finite", spec.period_hours.to_string());
+        return bad("period-h", "must be > 0 and finite", spec.period_hours.to_string());
     }
     if !(spec.r_smallest > 0.0 && spec.r_smallest <= spec.r_largest && spec.r_largest.is_finite()) {
         return bad(
@@ -496,7 +496,7 @@ fn validate(spec: &TargetSpec) -> Result<(), TargetError> {
         );
     }
     for (field, v) in [
-        ("total-mass", spec.total_mass),
+        ("total-mass-kg", spec.total_mass),
         ("density", spec.density),
         ("f0", spec.f0),
         ("rtol", spec.rtol),

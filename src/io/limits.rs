@@ -58,11 +58,11 @@ pub const MAX_LINE_BYTES: usize = 16 << 20;
 /// Most threads a command-line option may ask for (`--threads`, `--threads-per-rank`): the benches' bound.
 pub const MAX_THREADS: usize = 4096;
 
-/// Shortest wall-clock interval (s) of a time option other than "off" (`--checkpoint-every`): a millisecond. Below
+/// Shortest wall-clock interval (s) of a time option other than "off" (`--checkpoint-every-s`): a millisecond. Below
 /// it a value is a typo or a subnormal (1e-320), never a cadence anyone wants.
 pub const MIN_WALL_INTERVAL: f64 = 1e-3;
 
-/// Shortest interval between progress lines (s; `--progress-every`, `RUBBLEPILE_PROGRESS_EVERY`): a tenth of a
+/// Shortest interval between progress lines (s; `--progress-every-s`, `RUBBLEPILE_PROGRESS_EVERY`): a tenth of a
 /// second, so a batch log gets at most ten lines a second (a cadence of 1e-320 once wrote 125 801 lines).
 pub const MIN_PROGRESS_EVERY: f64 = 0.1;
 
@@ -70,6 +70,6 @@ pub const MIN_PROGRESS_EVERY: f64 = 0.1;
 /// limit; a larger value is a typo (and 1e308 overflowed the conversion to a `Duration`).
 pub const MAX_WALL_INTERVAL: f64 = 1e7;
 
-/// Longest simulated-time interval (s) a time option accepts (`--checkpoint-every-sim`): 1e18 s, longer than any
+/// Longest simulated-time interval (s) a time option accepts (`--checkpoint-every-sim-s`): 1e18 s, longer than any
 /// scene's `t_end` worth running; it must be finite.
 pub const MAX_SIM_INTERVAL: f64 = 1e18;

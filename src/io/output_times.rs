@@ -1,5 +1,5 @@
 //! Snapshot times computed from a cadence or a count, shared by the three engines' `[output] snapshot_every` and
-//! the commands that write scenes (`impact --snapshot-every`, the flyby's evenly spaced snapshots). Each time is
+//! the commands that write scenes (`impact --snapshot-every-s`, the flyby's evenly spaced snapshots). Each time is
 //! `k × step` computed from its index (not by adding steps, which drifts), and the last is `t_end` itself: a product
 //! that rounds one ulp above `t_end` would be refused by the scene check (computed as
 //! `t_end·k/(N−1)`, the last of `flyby --snapshots N` did so for 147 of N = 2…1201).
@@ -47,7 +47,7 @@ pub fn evenly_spaced(t_end: f64, n: usize) -> Vec<f64> {
 }
 
 /// The snapshot times of a cadence `every` (s) for a run of `t_end` (s), [`cadence_times`], after checking both:
-/// the error names `every_field` or `t_end_field` (e.g. `--snapshot-every`, `--t-end`) and the expected value.
+/// the error names `every_field` or `t_end_field` (e.g. `--snapshot-every-s`, `--t-end-s`) and the expected value.
 pub fn checked_cadence_times(t_end: f64, every: f64, every_field: &str, t_end_field: &str) -> Result<Vec<f64>, String> {
     use crate::io::limits::{MAX_SNAPSHOTS, MIN_MEANINGFUL};
     if !(every.is_finite() && every >= MIN_MEANINGFUL) {

@@ -7,7 +7,7 @@
 //!   at the next output sample with a checkpoint, naming the budget (and an ellipsoid integrator is never let take
 //!   more steps than are left within one sample interval).
 //! - `max_wall_seconds`: the most wall-clock seconds this process may run a run (`[run] max_wall_seconds`,
-//!   `--max-wall-seconds`); none by default. The run stops with a checkpoint at the output sample after which the
+//!   `--max-wall-s`); none by default. The run stops with a checkpoint at the output sample after which the
 //!   next interval would overrun it (judged by the last one), or at the first sample past it.
 //!
 //! [`check_interval`] checks the time options of the command line (cadences, budgets) against their floors and
@@ -57,8 +57,8 @@ pub fn check_wall_seconds(name: &str, value: f64, off: &str) -> Result<f64, Stri
     check_interval(name, value, MIN_WALL_INTERVAL, MAX_WALL_INTERVAL, "seconds", Some(off))
 }
 
-/// The time options and the budget of a run as the command line gives them (`--checkpoint-every`,
-/// `--checkpoint-every-sim`, `--progress-every`, `--max-steps`, `--max-wall-seconds`), before they are checked.
+/// The time options and the budget of a run as the command line gives them (`--checkpoint-every-s`,
+/// `--checkpoint-every-sim-s`, `--progress-every-s`, `--max-steps`, `--max-wall-s`), before they are checked.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimeOptions {
     /// Wall-clock checkpoint cadence (s; 0 = never).
@@ -78,10 +78,10 @@ impl TimeOptions {
     /// outside them refused in one line naming it; `checkpoint_every` 0 becomes `None` (never).
     pub fn check(&self) -> Result<TimeOptions, String> {
         use crate::io::limits::{MAX_SIM_INTERVAL, MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY};
-        let every = check_wall_seconds("--checkpoint-every", self.checkpoint_every, "never")?;
+        let every = check_wall_seconds("--checkpoint-every-s", self.checkpoint_every, "never")?;
         let sim = |s| {
             check_interval(
-                "--checkpoint-every-sim",
+                "--checkpoint-every-sim-s",
                 s,
                 0.0,
                 MAX_SIM_INTERVAL,
@@ -91,7 +91,7 @@ impl TimeOptions {
         };
         let progress = |s| {
             check_interval(
-                "--progress-every",
+                "--progress-every-s",
                 s,
                 MIN_PROGRESS_EVERY,
                 MAX_WALL_INTERVAL,
@@ -99,16 +99,7 @@ impl TimeOptions {
                 Some("no lines"),
             )
         };
-        let wall = |s| {
-            check_interval(
-                "--max-wall-seconds",
-                s,
-                MIN_WALL_BUDGET,
-                MAX_WALL_BUDGET,
-                "seconds",
-                None,
-            )
-        };
+        let wall = |s| check_interval("--max-wall-s", s, MIN_WALL_BUDGET, MAX_WALL_BUDGET, "seconds", None);
         Ok(TimeOptions {
             checkpoint_every: every,
             checkpoint_every_sim: self.checkpoint_every_sim.map(sim).transpose()?,
@@ -152,7 +143,7 @@ pub struct RunSection {
     #[field(unit = "s", default = "none", range = closed(MIN_WALL_BUDGET, MAX_WALL_BUDGET))]
     #[field(
         meaning = "most wall-clock seconds a process may run it; it stops with a checkpoint before overrunning (also \
-                   --max-wall-seconds)"
+                   --max-wall-s)"
     )]
     pub max_wall_seconds: Option<f64>,
 }

@@ -234,7 +234,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
     if let Some(e) = opts.extent
         && !(e.is_finite() && e > 0.0)
     {
-        return Err(RenderRunError::Option(format!("--extent: must be > 0 m, got {e}")));
+        return Err(RenderRunError::Option(format!("--extent-m: must be > 0 m, got {e}")));
     }
     let fields = match opts.colour {
         ColourBy::Bound => Some(

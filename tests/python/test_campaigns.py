@@ -136,7 +136,7 @@ def test_critical_search_is_the_command_lines(tmp_path):
     scene = tmp_path / "s.toml"
     scene.write_text(text)
     cli, py = tmp_path / "cli", tmp_path / "py"
-    args = ["--from", "5.9", "--to", "6.0", "--step", "0.1", "--branch", "--hold", "600", "--all-holds"]
+    args = ["--from-h", "5.9", "--to-h", "6.0", "--step-h", "0.1", "--branch", "--hold-s", "600", "--all-holds"]
     r = run_cli("spinup", "critical", "--scene", str(scene), *args, "--out", str(cli))
     assert r.returncode == 0, r.stderr
     result = rubblepile.critical_search(scene, py, from_hours=5.9, to_hours=6.0, step_hours=0.1, branch=True,

@@ -16,7 +16,7 @@ def impacts(tmp_path_factory):
     """The same impact from the command line and from Python (the golden test's impact_n30)."""
     base = tmp_path_factory.mktemp("impact")
     cli, py = base / "cli", base / "py"
-    r = run_cli("impact", "--target", str(TARGET), "--t-end", "300", "--every", "20", "--out", str(cli),
+    r = run_cli("impact", "--target", str(TARGET), "--t-end-s", "300", "--every-s", "20", "--out", str(cli),
                 "--no-progress")
     assert r.returncode == 0, r.stderr
     sim = rubblepile.impact(TARGET, py, t_end=300.0, every=20.0)
@@ -38,7 +38,7 @@ def test_impact_writes_the_command_lines_files(impacts):
 
 def test_analyze_is_the_command_lines(impacts, tmp_path):
     cli, py, _ = impacts
-    r = run_cli("analyze", str(cli), "--at", "300")
+    r = run_cli("analyze", str(cli), "--at-s", "300")
     assert r.returncode == 0, r.stderr
     a = rubblepile.analyze(py, at=300.0)
     expected = json.loads((cli / "analysis" / "analysis.json").read_text())
@@ -81,7 +81,7 @@ def test_impact_aims_off_centre_as_the_command_line(tmp_path):
 
 
 def test_build_target_is_the_command_lines(tmp_path):
-    r = run_cli("target", "build", "--fragments", "30", "--period-hours", "4", "--out", str(tmp_path / "cli.csv"))
+    r = run_cli("target", "build", "--fragments", "30", "--period-h", "4", "--out", str(tmp_path / "cli.csv"))
     assert r.returncode == 0, r.stderr
     report = rubblepile.build_target(30, 4.0, tmp_path / "py.csv")
     assert (tmp_path / "py.csv").read_bytes() == (tmp_path / "cli.csv").read_bytes()
@@ -94,7 +94,7 @@ def test_build_target_is_the_command_lines(tmp_path):
 
 def test_build_aggregate_is_the_command_lines(tmp_path):
     # A small HCP ball (Zhang17's lattice model, carved; no packing recipe to run).
-    args = ["--model", "hcp", "--shape", "sphere:60", "--radius", "6", "--lattice-orientation", "tilt:54.7"]
+    args = ["--model", "hcp", "--shape", "sphere:60", "--radius-m", "6", "--lattice-orientation", "tilt:54.7"]
     r = run_cli("aggregate", "build", *args, "--out", str(tmp_path / "cli.csv"))
     assert r.returncode == 0, r.stderr
     report = rubblepile.build_aggregate("hcp", "sphere:60", tmp_path / "py.csv", radius=6.0,
@@ -115,8 +115,8 @@ def test_build_aggregate_is_the_command_lines(tmp_path):
 
 def test_flyby_is_the_command_lines(tmp_path):
     # The control flyby of tests/flyby.rs (planet mass 0, a rescaled and re-spun N30 pile, no control run).
-    args = ["--target", str(TARGET), "--radius-m", "170", "--period-hours", "30.5", "--q-m", "3.8e7",
-            "--planet-mass", "0", "--no-control"]
+    args = ["--target", str(TARGET), "--radius-m", "170", "--period-h", "30.5", "--q-m", "3.8e7",
+            "--planet-mass-kg", "0", "--no-control"]
     r = run_cli("flyby", *args, "--out", str(tmp_path / "cli"))
     assert r.returncode == 0, r.stderr
     out = rubblepile.flyby(TARGET, tmp_path / "py", radius_m=170.0, period_hours=30.5, q_m=3.8e7,

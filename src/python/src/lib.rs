@@ -255,7 +255,7 @@ impl Any {
     }
 }
 
-/// Run options of the Python calls, as the command line's `--checkpoint-every`, `--max-steps`, ….
+/// Run options of the Python calls, as the command line's `--checkpoint-every-s`, `--max-steps`, ….
 fn options(
     force: bool,
     checkpoint_every: Option<f64>,
@@ -960,7 +960,7 @@ fn impact(
     Simulation::new(py, any, out, temporary)
 }
 
-/// `rubblepile.analyze`: what `rubblepile analyze DIR [--at T]` computes and writes (`DIR/analysis/`), as JSON
+/// `rubblepile.analyze`: what `rubblepile analyze DIR [--at-s T]` computes and writes (`DIR/analysis/`), as JSON
 /// text of `analysis.json` with the CLI's summary lines (see the Python docstring).
 #[pyfunction]
 #[pyo3(signature = (dir, at=None, *, force=false))]

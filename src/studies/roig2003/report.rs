@@ -89,7 +89,7 @@ impl CampaignDirs<'_> {
             }
         }
         if at != 400.0 {
-            command += &format!(" --at {at}");
+            command += &format!(" --at-s {at}");
         }
         command + " --force"
     }

@@ -499,7 +499,7 @@ pub fn write_decided_section(md: &mut String, dir: &Path, out: &Path) -> Result<
     let _ = writeln!(
         md,
         "T_c3 (paper's criterion) of every search whose holds are long enough, each hold read over its first L \
-         seconds (`spinup critical --judge-window`): T_c3 stops moving at **{hold:.0} s**.\n"
+         seconds (`spinup critical --judge-window-s`): T_c3 stops moving at **{hold:.0} s**.\n"
     );
     let _ = writeln!(
         md,

@@ -425,7 +425,7 @@ def impact(
 
 
 def analyze(dir: PathLike, at: Optional[float] = None, *, force: bool = False) -> Dict[str, Any]:
-    """Analyses a finished run as ``rubblepile analyze DIR [--at T]`` does, writing ``DIR/analysis/``.
+    """Analyses a finished run as ``rubblepile analyze DIR [--at-s T]`` does, writing ``DIR/analysis/``.
 
     An impact run (one with ``impact.json``) is analysed at ``at`` (s; default 400): fragments, energy partition,
     ejection and spin fits (Roig03 Sec. 4), clumps. Any other run: the clumps of the snapshot at ``at`` (default the
