@@ -300,7 +300,8 @@ fn the_library_does_not_use_clap() {
 /// 2430 until `flyby` took `run`'s checkpoint, format and progress flags, `render` `--centre-m` and `analyze-campaign`
 /// `--by` and `--bootstrap-seed` (flags and their help); 2460 until the units rule (issue 57 item 5): `units.rs`, the
 /// table of renamed flags (old → new, per subcommand) and the argument rewrite that keeps the old spellings working
-/// (99 lines), and the renamed flags' longer attributes, messages and wiring (14 lines).
+/// (99 lines), and the renamed flags' longer attributes, messages and wiring (14 lines); 2573 until `analyze` printed
+/// the unbinned likelihood fits beside the binned one (8 lines of printing).
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -310,8 +311,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2573,
-        "src/cli/ has {lines} lines (at most 2573: move logic to analysis/ or bench/)"
+        lines <= 2581,
+        "src/cli/ has {lines} lines (at most 2581: move logic to analysis/ or bench/)"
     );
 }
 
