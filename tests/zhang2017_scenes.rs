@@ -327,7 +327,7 @@ fn decided_scenes_load_and_their_headers_build_what_their_names_say() {
             Some("didymos"),
             "{name}: {flags:?}"
         );
-        let header_rho: f64 = flags["bulk-density"].parse().unwrap();
+        let header_rho: f64 = flags["bulk-density-kg-m3"].parse().unwrap();
         assert!((header_rho - rho).abs() < 0.05, "{name}: {header_rho} vs {rho}");
         assert!(
             file.ends_with(&format!("{}.csv", name.trim_end_matches("_path2.toml"))),
