@@ -168,6 +168,39 @@ fn analyze_at_past_the_runs_end_is_an_error_naming_at_and_the_end() {
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
 
+/// Issue 57: `analyze --out OUT` writes the analysis (JSON, CSV, figures) into OUT and only reads the run: no
+/// `analysis/` and no lock file appear in it; a second analysis into OUT is refused without `--force`.
+#[test]
+fn analyze_out_writes_elsewhere_and_leaves_the_run_untouched() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/n30_p1_z45");
+    let root = temp_dir("analyze-out");
+    let dir = root.join("run");
+    copy_dir(&golden_dir, &dir);
+    let before: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    let ok = rubblepile(&root, &["analyze", "run", "--at-s", "200", "--out", "elsewhere"]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    for f in ["analysis.json", "fragments.csv", "clumps.csv"] {
+        assert!(root.join("elsewhere").join(f).is_file(), "{f}");
+    }
+    assert!(String::from_utf8_lossy(&ok.stdout).contains("elsewhere"));
+    let after: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(before, after, "the run directory changed");
+    let again = rubblepile(&root, &["analyze", "run", "--at-s", "200", "--out", "elsewhere"]);
+    assert_eq!(again.status.code(), Some(2));
+    let forced = rubblepile(
+        &root,
+        &["analyze", "run", "--at-s", "200", "--out", "elsewhere", "--force"],
+    );
+    assert!(forced.status.success());
+    let _ = std::fs::remove_dir_all(&root);
+}
+
 /// A two-run campaign (P1 and P3 on N30_T4) analysed as a whole: one row per run with its Q, and a
 /// bound-fraction line through two Q values gives a Q*_D (or says why not) without failing.
 #[test]

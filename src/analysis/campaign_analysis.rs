@@ -61,11 +61,11 @@ pub fn analyze_campaign(
         let run_dir = dir.join(&run);
         // The run's analysis and its figures under one lock.
         let _run_lock = lock_analysis(&run_dir, "scene.toml")?;
-        let (a, report) = match analyze_run(&run_dir, t_at, force) {
-            Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, t_at, true)?,
+        let (a, report) = match analyze_run(&run_dir, None, t_at, force) {
+            Err(AnalysisError::Exists(_)) => analyze_run(&run_dir, None, t_at, true)?,
             other => other?,
         };
-        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, &a, &report);
+        let (_, not_drawn) = crate::analysis::figures::write_run_figures(&run_dir, None, &a, &report);
         for why in &not_drawn {
             emit(Channel::Warning, &format!("warning: {run}: figure not drawn: {why}"));
         }

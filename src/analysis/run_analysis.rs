@@ -241,12 +241,24 @@ pub fn lock_analysis(dir: &Path, marker: &str) -> Result<Option<DirLock>, Analys
     Ok(Some(DirLock::acquire_part(dir, "analysis")?))
 }
 
-/// Analyses the run in `dir` at `t_at` (s); writes `dir/analysis/{fragments.csv, analysis.json}` unless they exist
-/// (or `force`), holding the lock of `dir/analysis/` ([`lock_analysis`]). Returns the per-run results and the
-/// per-fragment report.
-pub fn analyze_run(dir: &Path, t_at: f64, force: bool) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
-    let _lock = lock_analysis(dir, "scene.toml")?;
-    let out_dir = dir.join("analysis");
+/// Where an analysis of the run in `dir` goes: `out`, else `dir/analysis/`; and the lock of `dir/analysis/`
+/// ([`lock_analysis`]) when it goes there (a run read elsewhere is only read).
+fn analysis_out(dir: &Path, out: Option<&Path>) -> Result<(PathBuf, Option<DirLock>), AnalysisError> {
+    match out {
+        Some(o) => Ok((o.to_path_buf(), None)),
+        None => Ok((dir.join("analysis"), lock_analysis(dir, "scene.toml")?)),
+    }
+}
+
+/// Analyses the run in `dir` at `t_at` (s); writes `{fragments.csv, analysis.json}` into `out` (default
+/// `dir/analysis/`) unless they exist (or `force`). Returns the per-run results and the per-fragment report.
+pub fn analyze_run(
+    dir: &Path,
+    out: Option<&Path>,
+    t_at: f64,
+    force: bool,
+) -> Result<(RunAnalysis, FragmentReport), AnalysisError> {
+    let (out_dir, _lock) = analysis_out(dir, out)?;
     let (json_path, csv_path) = (out_dir.join("analysis.json"), out_dir.join("fragments.csv"));
     if !force && (json_path.exists() || csv_path.exists()) {
         return Err(AnalysisError::Exists(out_dir));
@@ -433,12 +445,16 @@ fn run_snapshot_bodies(
 }
 
 /// Analyses the clumps of the run in `dir` (any engine; [`crate::analysis::clumps`]) at its snapshot at `t_at`
-/// (s; `None`: its last snapshot): writes `dir/analysis/{clumps.csv, analysis.json}` unless `analysis.json`
-/// exists (or `force`), holding the lock of `dir/analysis/` ([`lock_analysis`]). The size–frequency figure is
-/// left to the caller (`ClumpRunAnalysis::write_figure_and_describe`, in `analysis::figures::sfd`).
-pub fn analyze_clumps_run(dir: &Path, t_at: Option<f64>, force: bool) -> Result<ClumpRunAnalysis, AnalysisError> {
-    let _lock = lock_analysis(dir, "scene.toml")?;
-    let out_dir = dir.join("analysis");
+/// (s; `None`: its last snapshot): writes `{clumps.csv, analysis.json}` into `out` (default `dir/analysis/`)
+/// unless `analysis.json` exists (or `force`). The size–frequency figure is left to the caller
+/// (`ClumpRunAnalysis::write_figure_and_describe`, in `analysis::figures::sfd`).
+pub fn analyze_clumps_run(
+    dir: &Path,
+    out: Option<&Path>,
+    t_at: Option<f64>,
+    force: bool,
+) -> Result<ClumpRunAnalysis, AnalysisError> {
+    let (out_dir, _lock) = analysis_out(dir, out)?;
     let json_path = out_dir.join("analysis.json");
     if !force && json_path.exists() {
         return Err(AnalysisError::Exists(out_dir));

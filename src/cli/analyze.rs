@@ -16,16 +16,33 @@ pub struct AnalyzeArgs {
     /// run, the last snapshot for any other run.
     #[arg(long = "at-s")]
     pub at: Option<f64>,
-    /// Overwrite an earlier analysis in DIR/analysis.
+    /// Overwrite an earlier analysis in DIR/analysis (or in --out).
     #[arg(long)]
     pub force: bool,
+    /// Write the analysis here instead of DIR/analysis, e.g. for a run one may not write to (the run is only read);
+    /// an analysis already there is kept unless --force. Not for flyby runs.
+    #[arg(long, value_name = "OUT_DIR")]
+    pub out: Option<PathBuf>,
+}
+
+impl AnalyzeArgs {
+    /// Where the analysis goes.
+    fn analysis_dir(&self) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| self.dir.join("analysis"))
+    }
 }
 
 /// Runs `analyze`, holding the lock of `DIR/analysis/` from the first check to the last figure (so a second
 /// `analyze` of the run is refused at once, while the run itself may still be writing `DIR`).
 pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
-    let _lock = rubblepile::analysis::run_analysis::lock_analysis(&args.dir, "scene.toml").map_err(CliError::usage)?;
+    let _lock = match args.out {
+        Some(_) => None,
+        None => rubblepile::analysis::run_analysis::lock_analysis(&args.dir, "scene.toml").map_err(CliError::usage)?,
+    };
     if rubblepile::analysis::flyby::is_flyby_run(&args.dir) {
+        if args.out.is_some() {
+            return Err(CliError::usage("--out: a flyby run is analysed into DIR/analysis only"));
+        }
         return analyze_flyby_run(args);
     }
     if let Some(at) = args.at
@@ -41,11 +58,12 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
             "--at-s: an impact run is analysed after the impact: must be a time > 0 s, got 0",
         ));
     }
-    let (a, report) = analyze_run(&args.dir, args.at.unwrap_or(400.0), args.force).map_err(|e| match e {
+    let out = args.out.as_deref();
+    let (a, report) = analyze_run(&args.dir, out, args.at.unwrap_or(400.0), args.force).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
-    let (figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&args.dir, &a, &report);
+    let (figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&args.dir, out, &a, &report);
     for why in &not_drawn {
         eprintln!("warning: figure not drawn: {why}");
     }
@@ -86,7 +104,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         alpha(&a.spin_vs_size),
         a.spin_histogram.0.len(),
         binned,
-        args.dir.join("analysis").display(),
+        args.analysis_dir().display(),
         figures.join(", ")
     );
     for (fit, by) in [(&a.spin_likelihood, "number"), (&a.spin_likelihood_by_mass, "mass")] {
@@ -105,9 +123,9 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
 /// `analyze` of a run that is not an impact (no `impact.json`): the clumps of one snapshot
 /// (`analysis/clumps.csv`, `analysis.json`, the size–frequency figure `analysis/sfd.svg`).
 fn analyze_clumps_of_run(args: &AnalyzeArgs) -> Result<(), CliError> {
-    let a = rubblepile::analysis::run_analysis::analyze_clumps_run(&args.dir, args.at, args.force)
+    let a = rubblepile::analysis::run_analysis::analyze_clumps_run(&args.dir, args.out.as_deref(), args.at, args.force)
         .map_err(CliError::usage)?;
-    println!("{}", a.write_figure_and_describe(&args.dir));
+    println!("{}", a.write_figure_and_describe(&args.analysis_dir()));
     Ok(())
 }
 

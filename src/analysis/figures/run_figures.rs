@@ -707,14 +707,15 @@ pub fn energy_inputs(run_dir: &Path, report: &FragmentReport) -> Option<(EnergyI
     ))
 }
 
-/// Writes the run figures (module docs) into `run_dir/analysis/`; returns the files written and, for each
-/// figure that could not be drawn, why (one line each; the other figures are still written).
+/// Writes the run figures (module docs) into `out` (default `run_dir/analysis/`); returns the files written and,
+/// for each figure that could not be drawn, why (one line each; the other figures are still written).
 pub fn write_run_figures(
     run_dir: &Path,
+    out: Option<&Path>,
     analysis: &RunAnalysis,
     report: &FragmentReport,
 ) -> (Vec<String>, Vec<String>) {
-    let dir = run_dir.join("analysis");
+    let dir = out.map_or_else(|| run_dir.join("analysis"), Path::to_path_buf);
     let target: Vec<_> = report.fragments.iter().filter(|f| !f.is_projectile).collect();
     let t_at = analysis.t_at;
     let mut log = FigureLog::default();

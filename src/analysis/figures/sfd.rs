@@ -92,9 +92,9 @@ impl Figure for SizeFrequency {
 impl crate::analysis::run_analysis::ClumpRunAnalysis {
     /// Draws the size–frequency figure into `dir/analysis` (`sfd.svg`, `sfd.png`) and returns the line `analyze`
     /// prints; a figure that cannot be drawn is a warning on stderr, not an error (the tables are written).
-    pub fn write_figure_and_describe(&self, dir: &std::path::Path) -> String {
+    pub fn write_figure_and_describe(&self, analysis_dir: &std::path::Path) -> String {
         let figure = SizeFrequency::of(&self.clump_report, self.t_at);
-        let drawn = crate::analysis::figures::style::write_figure(&dir.join("analysis"), "sfd", &figure);
+        let drawn = crate::analysis::figures::style::write_figure(analysis_dir, "sfd", &figure);
         if let Err(why) = &drawn {
             crate::io::messages::emit(
                 crate::io::messages::Channel::Warning,
@@ -105,7 +105,7 @@ impl crate::analysis::run_analysis::ClumpRunAnalysis {
             "clumps at t = {} s: {}; wrote {} (clumps.csv, analysis.json{})",
             self.t_at,
             self.clump_report.summary_line(),
-            dir.join("analysis").display(),
+            analysis_dir.display(),
             if drawn.is_ok() { ", sfd.svg, sfd.png" } else { "" }
         )
     }

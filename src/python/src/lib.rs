@@ -975,8 +975,8 @@ fn analyze(py: Python<'_>, dir: PathBuf, at: Option<f64>, force: bool) -> PyResu
             return Err(usage(format!("at: must be a time >= 0 s, got {at}")));
         }
         if !is_impact_run(&dir) {
-            let a = analyze_clumps_run(&dir, at, force).map_err(|e| usage(e.to_string()))?;
-            let line = a.write_figure_and_describe(&dir);
+            let a = analyze_clumps_run(&dir, None, at, force).map_err(|e| usage(e.to_string()))?;
+            let line = a.write_figure_and_describe(&dir.join("analysis"));
             let json = serde_json::to_string(&a).map_err(|e| usage(e.to_string()))?;
             return Ok((json, vec![line]));
         }
@@ -985,8 +985,8 @@ fn analyze(py: Python<'_>, dir: PathBuf, at: Option<f64>, force: bool) -> PyResu
                 "at: an impact run is analysed after the impact: must be a time > 0 s, got 0".into(),
             ));
         }
-        let (a, report) = analyze_run(&dir, at.unwrap_or(400.0), force).map_err(|e| usage(e.to_string()))?;
-        let (_figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&dir, &a, &report);
+        let (a, report) = analyze_run(&dir, None, at.unwrap_or(400.0), force).map_err(|e| usage(e.to_string()))?;
+        let (_figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&dir, None, &a, &report);
         let mut lines = vec![a.clump_report.summary_line()];
         if let Some(c) = &a.composition {
             lines.push(c.summary_line());
