@@ -21,20 +21,15 @@ pub const BY_METRICS: [(&str, Outcome); 7] = [
     ("q_erg_per_g", |r| Some(r.q_erg_per_g)),
 ];
 
-/// Columns of the index that are not a run's inputs, or that group runs differing in their seed.
-const NOT_KEYS: [&str; 11] = [
-    "run",
-    "seed",
-    "campaign.seeds",
-    "q_erg_per_g",
-    "status",
-    "wall_seconds",
-    "final_time",
-    "steps_accepted",
-    "rhs_evaluations",
-    "energy_error",
-    "linear_momentum_error",
-];
+/// Whether a column of the index is not one of a run's inputs (its name, and the outcome columns of
+/// [`CAMPAIGN_COLUMNS`] from `status` on), or groups runs that differ only in their seed (`seed`, `q_erg_per_g`).
+fn is_not_key(h: &str) -> bool {
+    let outcomes = CAMPAIGN_COLUMNS
+        .iter()
+        .position(|c| *c == "status")
+        .unwrap_or(CAMPAIGN_COLUMNS.len());
+    matches!(h, "run" | "seed" | "campaign.seeds" | "q_erg_per_g") || CAMPAIGN_COLUMNS[outcomes..].contains(&h)
+}
 
 /// One outcome over one row's runs.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
@@ -137,7 +132,7 @@ fn choose(header: &[String], rows: &[Vec<String>], requested: Option<&str>) -> R
             let valid: Vec<&str> = header
                 .iter()
                 .map(String::as_str)
-                .filter(|h| !NOT_KEYS.contains(h) || ["seed", "q_erg_per_g"].contains(h))
+                .filter(|h| !is_not_key(h) || ["seed", "q_erg_per_g"].contains(h))
                 .filter(|h| !h.ends_with("_error") && !h.starts_with("campaign."))
                 .collect();
             Err(AnalysisError::Request(format!(
@@ -192,7 +187,7 @@ pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&st
         .collect();
     // the other inputs that vary among the analysed runs split the rows
     let key_cols: Vec<usize> = (0..header.len())
-        .filter(|&c| c != c_by && !NOT_KEYS.contains(&header[c].as_str()) && !header[c].ends_with("_error"))
+        .filter(|&c| c != c_by && !is_not_key(&header[c]) && !header[c].ends_with("_error"))
         .filter(|&c| !(field == "angle_deg" && header[c] == "campaign.angles"))
         .filter(|&c| analysed.iter().any(|(row, _)| row[c] != analysed[0].0[c]))
         .collect();

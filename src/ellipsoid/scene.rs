@@ -1,44 +1,9 @@
-//! Scene files: the TOML a user writes to describe a run, its validation, and its conversion into
-//! the model's types ([`Body`], [`ModelConfig`], [`Physics`]).
-//!
-//! A scene file looks like this (every key is documented on the struct that holds it, starting at
-//! [`SceneFile`]):
-//!
-//! ```toml
-//! [scene]
-//! kind = "ellipsoids"
-//! t_end = 200.0                 # s
-//! seed = 1
-//!
-//! [model]
-//! kappa = 10.0                  # or: calibrate = { beta = 10.0, v = 20.0 }
-//! inertia = "gaussian"          # or "uniform"
-//!
-//! [physics]                     # every term optional: absent = left out
-//! gravity = { G = 6.674e-11 }     # method = "auto" | "direct" | "tree", theta = 0.5
-//! contact = {}
-//! dissipation = { F0 = 1.0 }
-//!
-//! [integrator]
-//! method = "bulirsch-stoer"
-//! rtol = 1e-10
-//! atol = 1e-10
-//!
-//! [output]
-//! times = [0.0, 100.0, 200.0]
-//! every = 1.0
-//!
-//! [[body]]
-//! axes = [3.0, 2.0, 1.0]
-//! mass = 1000.0
-//! position = [0.0, 0.0, 0.0]
-//! velocity = [0.0, 0.0, 0.0]
-//! spin_body = [0.01, 0.5, 0.02]
-//! ```
-//!
-//! Bad input never panics: [`parse_scene`] and [`load_scene`] return a [`SceneError`] whose message
-//! is one line naming the file, the field and what was expected, e.g.
-//! `scene.toml: body[3].axes: need A >= B >= C > 0, got [1, 2, 3]`.
+//! The `kind = "ellipsoids"` scene file (Roig03 §2): its validation and its conversion into the model's types
+//! ([`Body`], [`ModelConfig`], [`Physics`]). Every key is documented once, on the struct that holds it (from
+//! [`SceneFile`]), and listed by `rubblepile check --explain ellipsoids`; `rubblepile check --print-default` prints
+//! the default scene and `targets/examples/` holds others. Bad input never panics: [`parse_scene`] and
+//! [`load_scene`] return a [`SceneError`] whose message is one line naming the file, the field and what was
+//! expected, e.g. `scene.toml: body[3].axes: need A >= B >= C > 0, got [1, 2, 3]`.
 
 use std::path::{Path, PathBuf};
 

@@ -1,61 +1,11 @@
-//! The `kind = "hard-spheres"` scene file (Richardson11 §2; walls "from a text file", here `[[wall]]` tables).
-//!
-//! ```toml
-//! [scene]
-//! kind = "hard-spheres"
-//! t_end = 2.0                      # s
-//! seed = 0                         # recorded; the engine draws no random numbers
-//! # particles_file = "p.csv"       # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
-//! #                                # and optionally stuck_to (index of the wall a particle is attached to, -1 free)
-//!
-//! [stepping]
-//! dt = 1e-3                        # s
-//! collapse_speed = 1e-4            # m/s: slower normal approaches bounce elastically (inelastic-collapse guard)
-//! max_events_per_step = 10000000   # the run stops as stalled beyond this
-//! skin_steps = 16.0                # neighbour-list skin in steps (0 = a fresh list every step)
-//!
-//! [gravity]                        # optional: uniform field
-//! uniform = [0.0, 0.0, -9.81]      # m/s², uniform acceleration
-//!
-//! [material]                       # defaults for every particle
-//! eps_n = 1.0
-//! eps_t = 1.0
-//!
-//! [output]
-//! times = [0.0, 1.0, 2.0]          # s: snapshots/<k>.csv
-//! every = 0.01                     # s: timeseries.csv rows
-//!
-//! [[particle]]
-//! mass = 1.0                       # kg
-//! radius = 0.05                    # m
-//! position = [0.0, 0.0, 0.5]       # m
-//! velocity = [0.0, 0.0, 0.0]       # m/s
-//! spin = [0.0, 0.0, 0.0]           # rad/s, world frame
-//! # stuck_to = 0                   # attached to wall 0 from t = 0 (moves rigidly with it: a rough lining)
-//!
-//! [[wall]]
-//! kind = "plane"                   # plane | disk | cylinder | ring | point | line
-//! point = [0.0, 0.0, 0.0]          # m, a point of the plane at t = 0 (the others: centre)
-//! normal = [0.0, 0.0, 1.0]         # plane normal (the others: axis)
-//! oscillation = { amplitude = 0.01, angular_frequency = 60.0, phase = 0.0, direction = [0.0, 0.0, 1.0] }   # m, rad/s, rad
-//!
-//! [[wall]]
-//! kind = "cylinder"                # a drum (both faces are walls)
-//! centre = [0.0, 0.0, 0.5]         # m, the middle of the axis segment at t = 0
-//! axis = [0.0, 1.0, 0.0]
-//! radius = 0.4                     # m
-//! length = 0.2                     # m; absent = infinite
-//! spin = 1.0                       # rad/s about the axis (right-handed)
-//! ```
-//!
-//! The names are those of the soft-sphere scene wherever the concept is the same (`granular::vocabulary`):
-//! `[stepping] dt` (s), `[material]`, `[gravity] uniform` (m/s²), and for walls `kind`, `point` and `normal` of a
-//! plane, `centre` and `axis` of the others, `radius`, `length` (m), `velocity` (m/s), `oscillation = { amplitude
-//! (m), angular_frequency (rad/s), phase (rad), direction }` and `spin` (rad/s). The old names (`gravity.g`, a
-//! wall's `type`, `origin`, a plane's `axis`, an oscillation's `omega`) are still read, each with a warning
-//! (`granular::migrate`; `rubblepile check --migrate` rewrites a file).
-//!
-//! Bad input never panics: every error is one line naming the field and what was expected.
+//! The `kind = "hard-spheres"` scene file (Richardson11 §2; its walls "from a text file" are `[[wall]]` tables):
+//! `[scene]`, `[stepping]`, `[gravity]`, `[material]`, `[output]`, `[[particle]]` (optionally `stuck_to` a wall)
+//! and `[[wall]]` (plane, disk, cylinder, ring, point, line). Every field's unit, default, range and meaning is
+//! written once, on the structs below, and listed by `rubblepile check --explain hard-spheres`;
+//! `targets/examples/hard_spheres.toml` is a complete scene. The names are the soft-sphere scene's wherever the
+//! concept is the same ([`crate::granular::vocabulary`]); old names are read with a warning
+//! ([`crate::granular::migrate`]). Bad input never panics: every error is one line naming the field and what was
+//! expected.
 
 use std::path::{Path, PathBuf};
 

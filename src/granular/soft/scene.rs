@@ -1,73 +1,11 @@
-//! The `kind = "soft-spheres"` scene file (Zhang17 §2; parameters of §2.3.3), run by `rubblepile run`.
-//!
-//! ```toml
-//! [scene]
-//! kind = "soft-spheres"
-//! t_end = 10.0                 # s; the run takes round(t_end/dt) steps
-//! seed = 1                     # recorded; the engine draws no random numbers
-//! # particles_file = "p.csv"   # instead of [[particle]]: columns t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz
-//!
-//! [stepping]
-//! dt = 1e-4                    # s, fixed leapfrog step (see `rubblepile ssdem advise`)
-//!
-//! [material]                   # Zhang17 Eqs. 1–12; defaults: the paper's nominal material
-//! k_n = 1e6                    # N/m, required; k_S = 2/7 k_N
-//! eps_n = 0.55                 # normal restitution, (0, 1]
-//! eps_t = 0.55                 # tangential restitution, (0, 1]
-//! mu_s = 1.0                   # sliding friction
-//! mu_t = 1.3                   # twisting friction
-//! mu_r = 1.05                  # rolling friction
-//! beta = 0.5                   # shape parameter (0 = no twisting/rolling resistance)
-//! max_start_overlap = 0.05     # largest initial overlap / smaller radius accepted
-//!
-//! [gravity]                    # optional; absent = no gravity
-//! uniform = [0.0, 0.0, -9.81]  # m/s², uniform acceleration
-//! self = "tree"                # or "direct"; absent = no self-gravity
-//! theta = 0.5                  # tree opening angle
-//! interval_steps = 1           # steps (integer >= 1): self-gravity every k steps (r-RESPA); see `ssdem advise`
-//! G = 6.674e-11                # m³ kg⁻¹ s⁻²
-//!
-//! [output]
-//! every = 0.1                  # s, time-series cadence (rounded to whole steps)
-//! times = [0.0, 10.0]          # s, snapshots (each at the nearest step); default [0, t_end]
-//!
-//! [[wall]]
-//! kind = "plane"               # a half-space: point + normal (towards the particles)
-//! point = [0.0, 0.0, 0.0]      # m
-//! normal = [0.0, 0.0, 1.0]
-//! oscillation = { amplitude = 0.01, angular_frequency = 31.4, phase = 0.0, direction = [0.0, 0.0, 1.0] }   # m, rad/s, rad
-//!
-//! [[wall]]
-//! kind = "sphere"              # the inside of a sphere: centre + radius
-//! centre = [0.0, 0.0, 0.0]     # m
-//! radius = 5.0                 # m
-//!
-//! [[wall]]
-//! kind = "cylinder"            # a drum (both faces): centre + axis + radius, length (absent = infinite)
-//! centre = [0.0, 0.0, 0.0]     # m, the middle of the axis segment
-//! axis = [0.0, 1.0, 0.0]
-//! radius = 5.0                 # m
-//! length = 20.0                # m
-//! spin = 0.0                   # rad/s about the axis (right-handed)
-//!
-//! [[particle]]
-//! radius = 0.5                 # m
-//! density = 2000.0             # kg/m³ (grain density), or mass = … (kg)
-//! position = [0.0, 0.0, 0.6]   # m
-//! velocity = [1.0, 0.0, 0.0]   # m/s, default 0
-//! spin = [0.0, 0.0, 0.0]       # rad/s, default 0
-//! ```
-//!
-//! The names are those of the hard-sphere scene wherever the concept is the same (`granular::vocabulary`):
-//! `[stepping] dt` (s), `[material]`, `[gravity] uniform` (m/s²), and for walls `kind`, `point` and `normal` of a
-//! plane, `centre`, `axis`, `radius`, `length` (m), `oscillation = { amplitude (m), angular_frequency (rad/s),
-//! phase (rad), direction }` and `spin` (rad/s). The old names (`[integrator]`, `[contact]`, an oscillation's
-//! vector `amplitude` and `frequency` in Hz) are still read, each with a warning (`granular::migrate`; `rubblepile
-//! check --migrate` rewrites a file).
-//!
-//! Errors are one line naming the file, the dotted field and what was expected (the crate's [`SceneError`]).
-//! Warnings (returned with the scene, printed by the command line) flag an old name, a step more than ten times the
-//! advised one and a `k_N` far below the advised one.
+//! The `kind = "soft-spheres"` scene file (Zhang17 §2; parameters of §2.3.3), run by `rubblepile run`: `[scene]`,
+//! `[stepping]`, `[material]`, `[gravity]`, `[output]`, `[[wall]]` (plane, sphere, cylinder) and `[[particle]]`.
+//! Every field's unit, default, range and meaning is written once, on the structs below, and listed by `rubblepile
+//! check --explain soft-spheres`; `targets/examples/soft_spheres.toml` and `soft_drum.toml` are complete scenes.
+//! The names are the hard-sphere scene's wherever the concept is the same ([`crate::granular::vocabulary`]); old
+//! names are read with a warning ([`crate::granular::migrate`]). Errors are one line naming the file, the dotted
+//! field and what was expected ([`SceneError`]); warnings flag an old name, a step more than ten times the advised
+//! one and a `k_N` far below the advised one.
 
 use std::path::{Path, PathBuf};
 
