@@ -304,3 +304,38 @@ fn the_readme_uses_no_deprecated_flag() {
     }
     assert!(bad.is_empty(), "the README uses deprecated flags: {bad:#?}");
 }
+
+/// Guards the joining of a negative value to its flag: `--angle-deg -5` reaches the flag's own range check (which
+/// names the flag and the range) instead of clap's "unexpected argument '-5'".
+#[test]
+fn a_negative_value_after_a_space_reaches_the_flags_own_check() {
+    let target = "targets/N30_T4.csv";
+    let spaced = rubblepile(&[
+        "impact",
+        "--target",
+        target,
+        "--angle-deg",
+        "-5",
+        "--out",
+        "/nonexistent/never-written",
+    ]);
+    let joined = rubblepile(&[
+        "impact",
+        "--target",
+        target,
+        "--angle-deg=-5",
+        "--out",
+        "/nonexistent/never-written",
+    ]);
+    let (spaced_err, joined_err) = (
+        String::from_utf8_lossy(&spaced.stderr).to_string(),
+        String::from_utf8_lossy(&joined.stderr).to_string(),
+    );
+    assert!(!spaced.status.success(), "{spaced_err}");
+    assert!(!spaced_err.contains("unexpected argument"), "{spaced_err}");
+    assert_eq!(spaced_err, joined_err);
+    assert!(
+        spaced_err.contains("--angle-deg: expected 0 to 180 degrees, got -5"),
+        "{spaced_err}"
+    );
+}

@@ -61,7 +61,7 @@ pub const RENAMED: &[(&str, &str, &str, &str)] = &[
 ];
 
 /// `args` with every renamed flag of its subcommand in its new spelling (`--old V` and `--old=V`; nothing after a bare
-/// `--`), and one warning line per old flag used.
+/// `--`), a negative value joined to its flag (`--x -5` → `--x=-5`), and one warning line per old flag used.
 pub fn rewrite(args: Vec<String>) -> (Vec<String>, Vec<String>) {
     let words: Vec<String> = args
         .iter()
@@ -92,8 +92,25 @@ pub fn rewrite(args: Vec<String>) -> (Vec<String>, Vec<String>) {
                 }
                 out.push(value.map_or_else(|| format!("--{new}"), |v| format!("--{new}={v}")));
             }
+            None if !rest && is_negative_value(&a) && out.last().is_some_and(|f: &String| takes_value_next(f)) => {
+                // clap reads `--x -5` as two flags; `--x=-5` reaches the flag's own check.
+                let flag = out.pop().unwrap_or_default();
+                out.push(format!("{flag}={a}"));
+            }
             None => out.push(a),
         }
     }
     (out, warnings)
+}
+
+/// A negative number or list (`-5`, `-1e-3`, `-.5`, `-1,0,0`): never a flag of ours.
+fn is_negative_value(a: &str) -> bool {
+    a.strip_prefix('-')
+        .and_then(|r| r.chars().find(|c| *c != '.'))
+        .is_some_and(|c| c.is_ascii_digit())
+}
+
+/// A long flag written without `=` (`--x`), which may take the next word as its value.
+fn takes_value_next(a: &str) -> bool {
+    a.len() > 2 && a.starts_with("--") && !a.contains('=')
 }
