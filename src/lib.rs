@@ -38,8 +38,8 @@
 //! - **P0**: `test_dirs` — the unit tests' temporary directories (test builds only);
 //! - **P1**: `studies`, `choice` — the three papers' reports (Roig03, Zhang17, Richardson11), one room per paper, on top of
 //!   `analysis`;
-//! - **P2**: `bench` — benchmarks and timed systems on the canonical test problems (they plot with `analysis`'
-//!   figures);
+//! - **P2**: `bench`, `cluster` — benchmarks and timed systems on the canonical test problems (they plot with
+//!   `analysis`' figures); campaigns launched on clusters (Slurm job-array scripts, MPI ranks);
 //! - **P3**: `cli` — argument parsing and dispatch.
 
 pub mod aggregate;

@@ -4,10 +4,9 @@
 use std::path::PathBuf;
 
 use crate::cli::common::{CheckpointArgs, CliError};
-use rubblepile::impact::campaign::{
-    CAMPAIGN_CSV, CampaignError, CampaignOptions, SlurmJob, load_campaign, merge_campaign, run_campaign_anywhere,
-    write_slurm,
-};
+use crate::cluster::launch::{run_campaign_anywhere, threads_per_rank};
+use crate::cluster::slurm::{SlurmJob, write_slurm};
+use rubblepile::impact::campaign::{CAMPAIGN_CSV, CampaignError, CampaignOptions, load_campaign, merge_campaign};
 
 /// `rubblepile campaign`.
 #[derive(Debug, clap::Args)]
@@ -73,7 +72,7 @@ pub fn campaign(args: &CampaignArgs) -> Result<(), CliError> {
     if let Some(out) = &args.out {
         campaign.out = out.clone();
     }
-    let threads = rubblepile::impact::campaign::threads_per_rank(args.threads_per_rank);
+    let threads = threads_per_rank(args.threads_per_rank);
     rayon::ThreadPoolBuilder::new().num_threads(threads).build_global().ok();
     let Some(report) = run_campaign_anywhere(&campaign, &options).map_err(to_cli)? else {
         return Ok(()); // an MPI worker rank: rank 0 reports

@@ -117,12 +117,46 @@ pub fn decide(dir: &Path, plan: &ImpactPlan) -> (Action, Option<RunNumbers>) {
     (Action::Start, None)
 }
 
+/// The record of every grid point of `campaign` as it starts, from what its run directory holds ([`decide`]:
+/// completed runs skipped, directories of another run failed, the rest pending), and the indices of the points to
+/// run (to resume or start; only those of `shard` when given), in the grid's order.
+pub fn plan_runs(campaign: &Campaign, shard: Option<Shard>) -> (Vec<RunRecord>, Vec<usize>) {
+    let runs: Vec<RunRecord> = campaign
+        .points
+        .iter()
+        .map(|p| {
+            let (action, numbers) = decide(&campaign.out.join(&p.name), &p.plan);
+            let status = match &action {
+                Action::Skip => RunStatus::Completed,
+                Action::Conflict(why) => RunStatus::Failed(why.clone()),
+                Action::Resume | Action::Start => RunStatus::Pending,
+            };
+            RunRecord {
+                name: p.name.clone(),
+                action,
+                status,
+                stopped: false,
+                numbers,
+            }
+        })
+        .collect();
+    let todo = (0..runs.len())
+        .filter(|&i| matches!(runs[i].action, Action::Resume | Action::Start))
+        .filter(|&i| shard.is_none_or(|s| s.contains(i)))
+        .collect();
+    (runs, todo)
+}
+
 pub(crate) fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Runs one grid point: its new status, whether it stopped on request, its numbers.
-pub(crate) fn execute(
+/// Runs the grid point `point` in its run directory `dir` as `action` says ([`Action::Resume`] from its
+/// checkpoint, else afresh; [`decide`] chooses), with `options` but never forced nor with a progress bar: its new
+/// status, whether it stopped on request (then pending, to resume), its numbers. A failed run or a panic is a
+/// [`RunStatus::Failed`], not an error. Every campaign runner runs its points through this, so a run directory
+/// holds the same bytes whichever runner ran it.
+pub fn run_point(
     point: &GridPoint,
     dir: &Path,
     action: &Action,
@@ -262,27 +296,8 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
     let index_file = options.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());
     let index_file = index_file.as_str();
     let points = &campaign.points;
-    let mut runs = Vec::with_capacity(points.len());
-    for p in points {
-        let (action, numbers) = decide(&out.join(&p.name), &p.plan);
-        let status = match &action {
-            Action::Skip => RunStatus::Completed,
-            Action::Conflict(why) => RunStatus::Failed(why.clone()),
-            Action::Resume | Action::Start => RunStatus::Pending,
-        };
-        runs.push(RunRecord {
-            name: p.name.clone(),
-            action,
-            status,
-            stopped: false,
-            numbers,
-        });
-    }
+    let (runs, todo) = plan_runs(campaign, options.shard);
     write_campaign_csv(out, index_file, points, &runs)?;
-    let todo: Vec<usize> = (0..runs.len())
-        .filter(|&i| matches!(runs[i].action, Action::Resume | Action::Start))
-        .filter(|&i| options.shard.is_none_or(|s| s.contains(i)))
-        .collect();
     let finished_before = (runs.len() - todo.len()) as u64;
     let display = (options.run.progress && std::io::stderr().is_terminal() && !todo.is_empty())
         .then(|| Display::new(runs.len() as u64, finished_before));
@@ -351,7 +366,7 @@ pub fn run_campaign(campaign: &Campaign, options: &CampaignOptions) -> Result<Ca
                             d.start(i, &point.name);
                         }
                         let (status, stopped, numbers) =
-                            pool.install(|| execute(point, &out.join(&point.name), &action, &options.run));
+                            pool.install(|| run_point(point, &out.join(&point.name), &action, &options.run));
                         let n = done_count.fetch_add(1, Ordering::SeqCst) + 1;
                         let line = match (&status, &numbers) {
                             (RunStatus::Completed, Some(x)) => format!(

@@ -69,7 +69,7 @@ impl From<&RunSummary> for RunNumbers {
 impl RunNumbers {
     /// From the text of a `summary.json`, exactly (the numbers are parsed as Rust parses them; `null` and
     /// absent keys give `None`).
-    pub(crate) fn from_summary_text(text: &str) -> Self {
+    pub fn from_summary_text(text: &str) -> Self {
         // `"key": value` at the top level of the summary (its keys are unique in the file).
         let raw = |key: &str| -> Option<&str> {
             let start = text.find(&format!("\"{key}\":"))? + key.len() + 3;
@@ -197,8 +197,10 @@ pub(crate) fn fmt_num(x: f64) -> String {
     }
 }
 
-/// Writes `campaign.csv` atomically and durably, never through a link ([`crate::io::safe_write`]).
-pub(crate) fn write_campaign_csv(
+/// Writes the index `out/file` ([`CAMPAIGN_CSV`] or a shard's [`Shard::index_file`]): [`CAMPAIGN_COLUMNS`] and one
+/// column per swept path, one row per grid point of `points` with its record of `runs` (in the same order);
+/// atomically and durably, never through a link ([`crate::io::safe_write`]).
+pub fn write_campaign_csv(
     out: &Path,
     file: &str,
     points: &[GridPoint],

@@ -13,27 +13,24 @@
 //!
 //! # Layout
 //!
-//! [`file`] is the campaign file format, [`plan`] expands it into the grid of runs, [`execute`] runs the grid
-//! (in parallel, resumable), and [`index`] keeps `campaign.csv`.
+//! [`file`] is the campaign file format, [`sweep`] its `[sweep]` table, [`plan`] expands it into the grid of runs,
+//! [`execute`] runs the grid on this machine's threads (in parallel, resumable; [`run_point`] runs one point),
+//! [`index`] keeps `campaign.csv`, and [`shard`] splits the grid into deterministic parts and merges what they ran.
+//! Launching a campaign on a cluster (Slurm job-array scripts, MPI ranks) is the `rubblepile` binary's business:
+//! it builds on [`Shard`], [`plan_runs`], [`run_point`] and [`write_campaign_csv`].
 
-pub mod distributed;
 pub mod execute;
 pub mod file;
 pub mod index;
-#[cfg(feature = "mpi")]
-pub mod mpi;
 pub mod plan;
 pub mod shard;
-pub mod slurm;
 pub mod sweep;
 
-pub use distributed::*;
 pub use execute::*;
 pub use file::*;
 pub use index::*;
 pub use plan::*;
 pub use shard::*;
-pub use slurm::*;
 pub use sweep::*;
 
 use std::path::PathBuf;

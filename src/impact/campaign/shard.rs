@@ -1,6 +1,6 @@
 //! Campaigns past one machine without a distributed system of our own: deterministic shards of the grid for any
-//! scheduler's job array (Slurm, PBS, GNU parallel), the merge of their run directories into one `campaign.csv`,
-//! and a ready Slurm job-array script.
+//! scheduler's job array (Slurm, PBS, GNU parallel) and the merge of their run directories into one `campaign.csv`.
+//! (The job scripts themselves, and the runs over MPI ranks, are the `rubblepile` binary's, not the library's.)
 //!
 //! Shard `I/N` (0 ≤ I < N) runs the grid points whose index k (in the grid's order: targets, projectiles, angles,
 //! seeds) has k mod N = I, so N shards cover the grid exactly once and interleave long and short runs. A sharded
@@ -8,7 +8,7 @@
 //! campaign merge DIR` rebuilds `campaign.csv` from the run directories themselves, so it is right whatever
 //! shards ran, died or ran twice.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::str::FromStr;
 use std::time::Instant;
 
@@ -116,35 +116,4 @@ pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
         runs,
         wall_seconds: started.elapsed().as_secs_f64(),
     })
-}
-
-/// Writes the Slurm job array of the campaign file `file` (its directory `out` when given, else `campaign.out`) as
-/// `DIR/campaign.slurm` (not submitted): returns the script's path, the number of runs and the campaign directory.
-pub fn write_slurm(
-    file: &Path,
-    out: Option<&Path>,
-    job: &SlurmJob,
-) -> Result<(PathBuf, usize, PathBuf), CampaignError> {
-    let invalid = |(field, message)| crate::io::scene_file::SceneError::Invalid {
-        file: file.display().to_string(),
-        field,
-        message,
-    };
-    job.check().map_err(invalid)?;
-    let mut campaign = load_campaign(file)?;
-    if let Some(o) = out {
-        campaign.out = o.to_path_buf();
-    }
-    let abs_file = campaign.source.clone().unwrap_or_else(|| file.to_path_buf());
-    let paths = SlurmPaths::resolve(&job.binary, &abs_file, &campaign.out).map_err(invalid)?;
-    campaign.out = paths.out.clone();
-    let text = slurm_script(campaign.points.len(), &paths, job);
-    let path = slurm_script_path(&campaign);
-    let io = |source| CampaignError::Io {
-        path: path.clone(),
-        source,
-    };
-    std::fs::create_dir_all(&campaign.out).map_err(io)?;
-    crate::io::safe_write::write_atomic(&path, text).map_err(io)?;
-    Ok((path, campaign.points.len(), campaign.out))
 }

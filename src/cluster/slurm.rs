@@ -1,5 +1,5 @@
-//! `rubblepile campaign slurm`: a Slurm job-array script running a campaign as shards ([`super::shard`]), written
-//! so that it runs only what it says.
+//! `rubblepile campaign slurm`: a Slurm job-array script running a campaign as shards
+//! ([`rubblepile::impact::campaign::shard`]), written so that it runs only what it says.
 //!
 //! - Every value put into the script is quoted for the reader that reads it: shell words in single quotes
 //!   ([`sh_quote`]; a path holding `;`, `$(…)`, a backtick or a quote stays one word and is never run), `#SBATCH`
@@ -15,7 +15,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::*;
+use rubblepile::impact::campaign::{Campaign, CampaignError, load_campaign};
 
 /// Longest `--time` accepted: 365 days (no cluster grants more; a larger value is a typo).
 pub const MAX_TIME_DAYS: u64 = 365;
@@ -317,6 +317,37 @@ pub fn slurm_script(runs: usize, paths: &SlurmPaths, job: &SlurmJob) -> String {
 /// Where `campaign slurm` writes its script.
 pub fn slurm_script_path(campaign: &Campaign) -> PathBuf {
     campaign.out.join("campaign.slurm")
+}
+
+/// Writes the Slurm job array of the campaign file `file` (its directory `out` when given, else `campaign.out`) as
+/// `DIR/campaign.slurm` (not submitted): returns the script's path, the number of runs and the campaign directory.
+pub fn write_slurm(
+    file: &Path,
+    out: Option<&Path>,
+    job: &SlurmJob,
+) -> Result<(PathBuf, usize, PathBuf), CampaignError> {
+    let invalid = |(field, message)| rubblepile::io::scene_file::SceneError::Invalid {
+        file: file.display().to_string(),
+        field,
+        message,
+    };
+    job.check().map_err(invalid)?;
+    let mut campaign = load_campaign(file)?;
+    if let Some(o) = out {
+        campaign.out = o.to_path_buf();
+    }
+    let abs_file = campaign.source.clone().unwrap_or_else(|| file.to_path_buf());
+    let paths = SlurmPaths::resolve(&job.binary, &abs_file, &campaign.out).map_err(invalid)?;
+    campaign.out = paths.out.clone();
+    let text = slurm_script(campaign.points.len(), &paths, job);
+    let path = slurm_script_path(&campaign);
+    let io = |source| CampaignError::Io {
+        path: path.clone(),
+        source,
+    };
+    std::fs::create_dir_all(&campaign.out).map_err(io)?;
+    rubblepile::io::safe_write::write_atomic(&path, text).map_err(io)?;
+    Ok((path, campaign.points.len(), campaign.out))
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 //! does: skip, resume, start), hands the runs out one at a time to whichever rank asks (dynamic, so long runs do not
 //! hold short ones back), and is the only writer of `campaign.csv` (atomically, after every event), holding the
 //! campaign directory's lock ([`lock_campaign_dir`]) while it coordinates. Ranks 1…K−1 run
-//! the runs they are given through the same [`execute`] as the threaded runner, so every run directory holds the
+//! the runs they are given through the same [`run_point`] as the threaded runner, so every run directory holds the
 //! same bytes whichever rank ran it. While waiting, rank 0 polls with short sleeps instead of MPI's busy-waiting
 //! receive, so it costs no core.
 //!
@@ -19,11 +19,12 @@
 
 use std::time::{Duration, Instant};
 
-use crate::io::messages::{Channel, emit};
-
 use ::mpi::traits::*;
-
-use super::*;
+use rubblepile::impact::campaign::{
+    CAMPAIGN_CSV, Campaign, CampaignError, CampaignOptions, CampaignReport, RunNumbers, RunStatus, decide,
+    lock_campaign_dir, plan_runs, run_point, write_campaign_csv,
+};
+use rubblepile::io::messages::{Channel, emit};
 
 const TAG: i32 = 7;
 
@@ -50,7 +51,7 @@ pub fn run_campaign_mpi(
     campaign: &Campaign,
     options: &CampaignOptions,
 ) -> Result<Option<CampaignReport>, CampaignError> {
-    let universe = ::mpi::initialize().ok_or_else(|| crate::io::scene_file::SceneError::Invalid {
+    let universe = ::mpi::initialize().ok_or_else(|| rubblepile::io::scene_file::SceneError::Invalid {
         file: campaign.name.clone(),
         field: "mpirun".into(),
         message: "MPI could not be initialised".into(),
@@ -99,7 +100,7 @@ fn work(world: &::mpi::topology::SimpleCommunicator, campaign: &Campaign, option
         let point = &campaign.points[k];
         let dir = campaign.out.join(&point.name);
         let action = decide(&dir, &point.plan).0;
-        let (status, stopped, _) = execute(point, &dir, &action, &options.run);
+        let (status, stopped, _) = run_point(point, &dir, &action, &options.run);
         send(world, 0, &format!("done {k} {stopped} {status}"));
     }
 }
@@ -112,30 +113,9 @@ fn coordinate(
     let started = Instant::now();
     let out = &campaign.out;
     let points = &campaign.points;
-    let mut runs: Vec<RunRecord> = points
-        .iter()
-        .map(|p| {
-            let (action, numbers) = decide(&out.join(&p.name), &p.plan);
-            let status = match &action {
-                Action::Skip => RunStatus::Completed,
-                Action::Conflict(why) => RunStatus::Failed(why.clone()),
-                Action::Resume | Action::Start => RunStatus::Pending,
-            };
-            RunRecord {
-                name: p.name.clone(),
-                action,
-                status,
-                stopped: false,
-                numbers,
-            }
-        })
-        .collect();
+    let (mut runs, todo) = plan_runs(campaign, options.shard);
     let index_file = options.shard.map_or(CAMPAIGN_CSV.to_string(), |s| s.index_file());
-    index::write_campaign_csv(out, &index_file, points, &runs)?;
-    let todo: Vec<usize> = (0..runs.len())
-        .filter(|&i| matches!(runs[i].action, Action::Resume | Action::Start))
-        .filter(|&i| options.shard.is_none_or(|s| s.contains(i)))
-        .collect();
+    write_campaign_csv(out, &index_file, points, &runs)?;
     let workers = world.size() - 1;
     if options.verbose {
         emit(
@@ -187,11 +167,11 @@ fn coordinate(
             }
         }
         if points.len() <= EVERY_EVENT_UP_TO || last_write.elapsed() >= Duration::from_secs(1) {
-            index::write_campaign_csv(out, &index_file, points, &runs)?;
+            write_campaign_csv(out, &index_file, points, &runs)?;
             last_write = Instant::now();
         }
     }
-    index::write_campaign_csv(out, &index_file, points, &runs)?;
+    write_campaign_csv(out, &index_file, points, &runs)?;
     Ok(CampaignReport {
         runs,
         wall_seconds: started.elapsed().as_secs_f64(),

@@ -1,10 +1,10 @@
 //! Where a campaign runs: on this machine's threads ([`run_campaign`]), or, when the process was started by
-//! `mpirun` and rubblepile was built with the `mpi` cargo feature, over MPI ranks (`campaign::mpi`, feature `mpi`): rank 0 hands
-//! runs out one at a time and keeps `campaign.csv`, the other ranks run them. The default build needs no MPI; a
-//! default build started by `mpirun` with several ranks refuses to run (every rank would run the whole grid into
-//! the same directories) and says how to build with MPI.
+//! `mpirun` and rubblepile was built with the `mpi` cargo feature, over MPI ranks (`cluster::mpi`, feature `mpi`):
+//! rank 0 hands runs out one at a time and keeps `campaign.csv`, the other ranks run them. The default build needs
+//! no MPI; a default build started by `mpirun` with several ranks refuses to run (every rank would run the whole
+//! grid into the same directories) and says how to build with MPI.
 
-use super::*;
+use rubblepile::impact::campaign::{Campaign, CampaignError, CampaignOptions, CampaignReport, run_campaign};
 
 /// The number of ranks `mpirun` (Open MPI, MPICH, PMIx launchers) says this process belongs to, if any.
 pub fn launcher_world_size() -> Option<usize> {
@@ -41,7 +41,7 @@ pub fn run_campaign_anywhere(
     }
     #[cfg(not(feature = "mpi"))]
     if ranks > 1 {
-        return Err(crate::io::scene_file::SceneError::Invalid {
+        return Err(rubblepile::io::scene_file::SceneError::Invalid {
             file: campaign.name.clone(),
             field: "mpirun".into(),
             message: format!(
