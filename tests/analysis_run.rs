@@ -168,6 +168,37 @@ fn analyze_at_past_the_runs_end_is_an_error_naming_at_and_the_end() {
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
 
+/// `analyze` without `--at-s` follows the run: this committed run ends at 200 s (before the 400 s default), so it is
+/// analysed at its end, the same analysis as `--at-s 200`, instead of an error about 400 s.
+#[test]
+fn analyze_defaults_to_the_runs_end_when_it_ends_before_400_s() {
+    let golden_dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/n30_p1_z45");
+    let dir = temp_dir("analyze-default-at").join("run");
+    copy_dir(&golden_dir, &dir);
+    let end = rubblepile::analysis::run_analysis::analysis_time(&dir, None).unwrap();
+    assert_eq!(end, 200.0);
+    assert_eq!(
+        rubblepile::analysis::run_analysis::analysis_time(&dir, Some(50.0)).unwrap(),
+        50.0
+    );
+    let out = rubblepile(&dir, &["analyze", "."]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = |p: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap() };
+    let ours = read(&dir.join("analysis/analysis.json"));
+    assert_eq!(ours["t_at"], 200.0);
+    assert_json_close(&ours, &read(&golden_dir.join("golden_analysis.json")), "analysis");
+    // a run going past 400 s keeps Roig03's 400 s
+    let scene = std::fs::read_to_string(dir.join("scene.toml")).unwrap();
+    let longer = scene.replacen("t_end = 200.0", "t_end = 1000.0", 1);
+    assert_ne!(longer, scene, "the scene's t_end line moved");
+    std::fs::write(dir.join("scene.toml"), longer).unwrap();
+    assert_eq!(
+        rubblepile::analysis::run_analysis::analysis_time(&dir, None).unwrap(),
+        400.0
+    );
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
+}
+
 /// Issue 57: `analyze --out OUT` writes the analysis (JSON, CSV, figures) into OUT and only reads the run: no
 /// `analysis/` and no lock file appear in it; a second analysis into OUT is refused without `--force`.
 #[test]
@@ -374,4 +405,79 @@ fn drop_key(v: &mut serde_json::Value, key: &str) {
         serde_json::Value::Array(a) => a.iter_mut().for_each(|x| drop_key(x, key)),
         _ => {}
     }
+}
+
+/// Q*_D is of one target at one angle, never pooled: a campaign on two targets (N30_T4, N30_T12) at two angles (0°,
+/// 45°) over four speeds, analysed for N30_T12, fits only that target's four runs at 45° (the default angle), and
+/// its Q*_D is the crossing of the line an independent fit draws through those four runs of `campaign_runs`; asked
+/// for an angle the campaign lacks, Q*_D is refused, naming `--spin-angle-deg`.
+#[test]
+fn q_star_is_fitted_over_one_target_at_one_angle() {
+    use rubblepile::analysis::fits::{fit_line, line_crossing};
+    let dir = temp_dir("campaign-two-targets");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let target = |stem: &str| format!("{:?}", root.join(format!("targets/{stem}.csv")).display().to_string());
+    let campaign = format!(
+        "[campaign]\nout = \"c\"\ntargets = [{}, {}]\nprojectiles = [\"P2\"]\nangles = [0.0, 45.0]\nparallel = 2\n\n\
+         [impact]\nt_end = 110.0\n\n[sweep]\n\"impact.speed_km_s\" = [3.0, 6.0, 12.0, 24.0]\n",
+        target("N30_T4"),
+        target("N30_T12")
+    );
+    std::fs::write(dir.join("c.toml"), campaign).unwrap();
+    let run = rubblepile(&dir, &["campaign", "c.toml", "--no-progress"]);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    let out = rubblepile(&dir, &["analyze-campaign", "c", "--spin-target", "N30_T12"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = || -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(dir.join("c/analysis/campaign_analysis.json")).unwrap()).unwrap()
+    };
+    let a = read();
+    let runs = a["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 16);
+    let chosen: Vec<&serde_json::Value> = runs
+        .iter()
+        .filter(|r| r["target"] == "N30_T12" && r["angle_deg"] == 45.0)
+        .collect();
+    assert_eq!(chosen.len(), 4);
+    assert_eq!(a["q_star_runs"]["target"], "N30_T12");
+    assert_eq!(a["q_star_runs"]["angle_deg"], 45.0);
+    assert_eq!(a["q_star_runs"]["runs"], 4);
+    assert_eq!(a["bound_fraction_vs_q"]["ok"]["points"], 4);
+    let q: Vec<f64> = chosen.iter().map(|r| r["q_erg_per_g"].as_f64().unwrap()).collect();
+    let b: Vec<f64> = chosen
+        .iter()
+        .map(|r| r["bound_mass_fraction"].as_f64().unwrap())
+        .collect();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("N30_T12 at zeta = 45 deg, 4 runs"), "{stdout}");
+    match line_crossing(&fit_line(&q, &b).unwrap(), 0.5) {
+        Ok(c) => {
+            let ours = a["q_star_d"]["ok"]["x"].as_f64().unwrap();
+            assert!((ours / c.x - 1.0).abs() < 1e-12, "{ours} vs {}", c.x);
+        }
+        Err(_) => assert!(a["q_star_d"].get("failed").is_some(), "{}", a["q_star_d"]),
+    }
+    // an angle the campaign lacks: refused with a warning naming the flag
+    let out = rubblepile(
+        &dir,
+        &[
+            "analyze-campaign",
+            "c",
+            "--spin-target",
+            "N30_T12",
+            "--spin-angle-deg",
+            "30",
+            "--force",
+        ],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let a = read();
+    let why = a["q_star_d"]["failed"].as_str().unwrap_or_default().to_string();
+    assert!(
+        why.contains("--spin-angle-deg") && why.contains("[0.0, 45.0]"),
+        "{}",
+        a["q_star_d"]
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--spin-angle-deg"));
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -247,10 +247,18 @@ fn the_default_is_the_zeta_only_set_up() {
         let zero = cfg.plan(&target).unwrap();
         assert_eq!(bits(&zero.bodies), bits(&bodies));
         assert_eq!(zero.setup.geometry.unwrap().impact_parameter_m, 0.0);
-        assert_eq!(
-            zero.title.replace(", b = 0.000 km = 0.000 R, psi = 0 deg", ""),
-            plan.title
+        // the aimed title only adds the aim: b, which R, ψ
+        let (from, to) = (
+            zero.title.find(", b = 0.000 km = 0.000 R (R = "),
+            zero.title.find("psi = 0 deg"),
         );
+        let (from, to) = (from.expect(&zero.title), to.expect(&zero.title) + "psi = 0 deg".len());
+        assert!(
+            zero.title[from..to].contains("of the target's surface ellipsoid"),
+            "{}",
+            zero.title
+        );
+        assert_eq!(format!("{}{}", &zero.title[..from], &zero.title[to..]), plan.title);
     }
 }
 
@@ -425,4 +433,85 @@ fn bad_geometry_names_the_flag_or_the_field() {
     let e = campaign("projectile_spin_rad_s = [1.0, 0.0]");
     assert!(e.contains("projectile_spin_rad_s"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// ψ means the same for a θ aim as for a b aim: on a rotated triaxial ellipsoid (its own surface ellipsoid), θ aims
+/// at ψ = 0 and 60° put the trajectory's offset at azimuth ψ about the approach direction (ψ = 0 along x̂, 90°
+/// along n × x̂) to 1e-9 rad, the normal where the line meets the body makes θ with it to 1e-9 rad, and the record
+/// says that ψ and θ. The committed N30_T4 target aimed at θ = 45° prints θ and says which R; an angle below the
+/// smallest the azimuth offers is refused, naming the field.
+#[test]
+fn an_angle_aim_goes_in_at_the_recorded_azimuth() {
+    let attitude = Vec4::new(0.3, -0.5, 0.2, 0.9).normalize();
+    let target = vec![body([12e3, 8e3, 6e3], [0.0; 3], attitude)];
+    for zeta in [30.0, 75.0] {
+        for psi in [0.0, 60.0] {
+            for theta in [30.0, 45.0, 70.0] {
+                let (bodies, setup, hits) =
+                    set_up_aimed_impact(&target, &projectile(), &aimed(Aim::AngleDeg(theta), psi), zeta, 90.0, 1);
+                assert!(hits);
+                let (t, p) = (&bodies[0], &bodies[1]);
+                let n = -(p.velocity - t.velocity).normalize();
+                let r = p.position - t.position;
+                let offset = r - n * r.dot(&n);
+                let x = Vec3::x();
+                let azimuth = offset.dot(&n.cross(&x)).atan2(offset.dot(&x));
+                let want = psi.to_radians();
+                let gap =
+                    (azimuth - want + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+                assert!(
+                    gap.abs() < 1e-9,
+                    "ζ {zeta}, ψ {psi}, θ {theta}: offset azimuth {} deg",
+                    azimuth.to_degrees()
+                );
+                let (_, angle) = line_meets_body(&bodies, 0);
+                assert!(
+                    (angle - theta.to_radians()).abs() < 1e-9,
+                    "ζ {zeta}, ψ {psi}: normal at {} deg",
+                    angle.to_degrees()
+                );
+                let g = setup.geometry.unwrap();
+                assert_eq!(g.aim_azimuth_deg, psi);
+                assert!((g.impact_angle_deg.unwrap() - theta).abs() < 1e-7);
+                assert!((g.impact_parameter_m - offset.norm()).abs() < 1e-6 * offset.norm());
+            }
+        }
+    }
+    // the committed target from the configuration: θ echoed, R named; θ = 0 off the point whose normal is n is refused
+    let file = root().join("targets/N30_T4.csv");
+    let rubble = rubblepile::impact::run::read_target(&file).unwrap();
+    let mut cfg = ImpactConfig::new(file, ProjectileSpec::preset("P2").unwrap());
+    cfg.geometry = aimed(Aim::AngleDeg(45.0), 0.0);
+    let plan = cfg.plan(&rubble).unwrap();
+    for part in [
+        ", theta = 45 deg, b = ",
+        " R (R = ",
+        " km, of the target's surface ellipsoid), psi = 0 deg",
+    ] {
+        assert!(plan.title.contains(part), "{part:?} not in {}", plan.title);
+    }
+    // θ = 0 is the head-on point (normal n), recorded at its own azimuth
+    cfg.geometry = aimed(Aim::AngleDeg(0.0), 90.0);
+    let head_on = cfg.plan(&rubble).unwrap();
+    let g = head_on.setup.geometry.unwrap();
+    assert!(g.impact_angle_deg.unwrap().abs() < 1e-6, "{g:?}");
+    let p = head_on.bodies.last().unwrap();
+    let n = -p.velocity.normalize();
+    let com: Vec3 = head_on.bodies[..30]
+        .iter()
+        .map(|b| b.position * b.shape.mass)
+        .sum::<Vec3>()
+        / head_on.bodies[..30].iter().map(|b| b.shape.mass).sum::<f64>();
+    let r = p.position - com;
+    let offset = r - n * r.dot(&n);
+    let azimuth = offset
+        .dot(&n.cross(&Vec3::x()))
+        .atan2(offset.dot(&Vec3::x()))
+        .to_degrees()
+        .rem_euclid(360.0);
+    assert!((azimuth - g.aim_azimuth_deg).abs() < 1e-6, "{azimuth} vs {g:?}");
+    // a θ just above 0 off the head-on point's azimuth is out of reach there
+    cfg.geometry = aimed(Aim::AngleDeg(1e-3), (g.aim_azimuth_deg + 90.0).rem_euclid(360.0));
+    let e = cfg.plan(&rubble).map(|_| ()).unwrap_err().to_string();
+    assert!(e.contains("impact_angle_deg") && e.contains("smallest there"), "{e}");
 }

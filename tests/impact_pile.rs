@@ -6,8 +6,8 @@ mod common;
 use common::temp_dir;
 use std::path::{Path, PathBuf};
 
-use rubblepile::analysis::clumps::clump_spin;
-use rubblepile::analysis::composition::{CLUMP_MARGIN, Origin, composition};
+use rubblepile::analysis::clumps::{DEFAULT_GAP_FRACTION, analyse_clumps, clump_spin};
+use rubblepile::analysis::composition::{Origin, composition};
 use rubblepile::driver::RunOptions;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
@@ -161,8 +161,19 @@ fn random_attitude_is_a_rigid_turn_of_the_pile() {
     }
 }
 
+/// The clumps of `bodies` as `analyze`'s `largest remnant:` line finds them (default gap, self-gravity `g`).
+fn clumps_of(bodies: &[Body], g: f64) -> Vec<Vec<usize>> {
+    analyse_clumps(bodies, DEFAULT_GAP_FRACTION, Some(g), |b| {
+        b.shape.principal_moments(2.5)
+    })
+    .clumps
+    .into_iter()
+    .map(|c| c.members)
+    .collect()
+}
+
 /// Spheres of radius 1 (G = 100): clump A = {T0, T1, P2} (masses 2, 2, 1; in contact), clump B = {P3, T4}
-/// (1, 3; 0.1 apart, inside the contact margin), both at rest 50 apart; P5 (0.01) alone and fast. Known answers:
+/// (1, 3; 0.05 apart, inside the clump finder's gap), both at rest 50 apart; P5 (0.01) alone and fast. Known answers:
 /// A is the largest remnant (mass 5, projectile fraction 0.2, bound), B the other bound clump (projectile
 /// fraction 0.25, mixed), P5 escapes.
 #[test]
@@ -177,20 +188,26 @@ fn composition_of_a_constructed_outcome() {
         quaternion: Vec4::new(0.0, 0.0, 0.0, 1.0),
         spin_body: Vec3::zeros(),
     };
-    const { assert!(CLUMP_MARGIN >= 0.05, "B's 0.1 gap must fall inside the margin") };
+    const {
+        assert!(
+            DEFAULT_GAP_FRACTION > 0.05,
+            "B's 0.05 gap must fall inside the finder's gap"
+        )
+    };
     let bodies = [
         sphere(2.0, 0.0, 0.0, 0.0),    // T0
         sphere(2.0, 1.9, 0.0, 0.0),    // T1
         sphere(1.0, 0.0, 1.9, 0.0),    // P2
         sphere(1.0, 50.0, 0.0, 0.0),   // P3
-        sphere(3.0, 52.1, 0.0, 0.0),   // T4
+        sphere(3.0, 52.05, 0.0, 0.0),  // T4
         sphere(0.01, -50.0, 0.0, 1e3), // P5
     ];
     let projectile = [2usize, 3, 5];
     // Reorder so the projectile bodies are the contiguous range 3..6: T0 T1 T4 | P2 P3 P5.
     let order = [0usize, 1, 4, 2, 3, 5];
     let bodies: Vec<Body> = order.iter().map(|&i| bodies[i].clone()).collect();
-    let c = composition(&bodies, 3..6, 100.0, |b| b.shape.principal_moments(2.5)).unwrap();
+    let clumps = clumps_of(&bodies, 100.0);
+    let c = composition(&bodies, 3..6, &clumps, 100.0, |b| b.shape.principal_moments(2.5)).unwrap();
     for (k, &i) in order.iter().enumerate() {
         let expected = if projectile.contains(&i) {
             Origin::Projectile
@@ -219,8 +236,8 @@ fn composition_of_a_constructed_outcome() {
     assert!((c.projectile_in_largest_remnant - 1.0 / 2.01).abs() < 1e-14);
     assert_eq!(c.clump_of, vec![0, 0, 1, 0, 1, 2]);
     // Everything a target: no composition.
-    assert!(composition(&bodies, 0..6, 100.0, |b| b.shape.principal_moments(2.5)).is_none());
-    assert!(composition(&bodies, 3..3, 100.0, |b| b.shape.principal_moments(2.5)).is_none());
+    assert!(composition(&bodies, 0..6, &clumps, 100.0, |b| b.shape.principal_moments(2.5)).is_none());
+    assert!(composition(&bodies, 3..3, &clumps, 100.0, |b| b.shape.principal_moments(2.5)).is_none());
 }
 
 /// Two touching spheres in rigid rotation ω about z through their barycentre (velocities ω × r, body spins ω):
@@ -243,7 +260,7 @@ fn clump_spin_of_a_rigid_rotation_is_its_rate() {
     let moments = |b: &Body| b.shape.principal_moments(2.5);
     let spin = clump_spin(&bodies, &[0, 1], moments);
     assert!((spin - omega).norm() < 1e-12 * omega.norm(), "spin {spin:?}");
-    let c = composition(&bodies, 1..2, 1e-3, moments).unwrap();
+    let c = composition(&bodies, 1..2, &clumps_of(&bodies, 1e-3), 1e-3, moments).unwrap();
     let period = c.largest_remnant.spin_period_h.unwrap();
     let expected = 2.0 * std::f64::consts::PI / 3e-4 / 3600.0;
     assert!(
@@ -310,4 +327,64 @@ speed_km_s = 3.0
         "radius_km = 2.0\nrandom_attitude = true",
     ));
     assert!(e.contains("projectile[0].random_attitude"), "{e}");
+}
+
+/// A pile-projectile run's `analyze` names one largest remnant: the `composition:` line and `analysis.json`'s
+/// `composition.largest_remnant` are the clump of the `largest remnant:` line (same member count, same mass), and
+/// counts of one print with a singular noun ("(1 body)", never "(1 bodies)").
+#[test]
+fn composition_and_largest_remnant_line_name_the_same_clump() {
+    let dir = temp_dir("pile-one-lr");
+    let target = root().join("targets/N30_T4.csv");
+    let pile = root().join("targets/N30_T12.csv");
+    let (target, pile) = (target.to_str().unwrap(), pile.to_str().unwrap());
+    let o = common::rubblepile(
+        &dir,
+        &[
+            "impact",
+            "--target",
+            target,
+            "--projectile-pile",
+            pile,
+            "--projectile-speed-km-s",
+            "0.3",
+            "--t-end-s",
+            "400",
+            "--out",
+            "run",
+            "--no-progress",
+        ],
+    );
+    assert!(o.status.success(), "{}", common::describe(&o));
+    let o = common::rubblepile(&dir, &["analyze", "run"]);
+    assert!(o.status.success(), "{}", common::describe(&o));
+    let a = json(&dir.join("run/analysis/analysis.json"));
+    let (lr, c) = (&a["largest_remnant"], &a["composition"]["largest_remnant"]);
+    assert!(
+        lr["n_members"].as_u64().unwrap() > 1,
+        "a merger must leave a clump of several bodies: {lr}"
+    );
+    assert_eq!(lr["n_members"], c["n_bodies"], "{lr} vs {c}");
+    assert_eq!(lr["mass_kg"], c["mass_kg"], "{lr} vs {c}");
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let members = lr["n_members"].as_u64().unwrap();
+    let line = |start: &str| {
+        stdout
+            .lines()
+            .find(|l| l.starts_with(start))
+            .unwrap_or_else(|| panic!("{stdout}"))
+    };
+    assert!(
+        line("largest remnant:").contains(&format!("({members} bodies,")),
+        "{stdout}"
+    );
+    assert!(
+        line("composition:").contains(&format!("largest remnant {members} bodies,")),
+        "{stdout}"
+    );
+    assert!(
+        !stdout.contains("(1 bodies)") && !stdout.contains(" 1 clumps"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -73,9 +73,41 @@ fn two_q_values_raise_the_warning() {
     assert_eq!(a.q_levels, 2);
     assert!(a.underdetermined);
     let w = a.warning().unwrap();
-    assert!(w.contains("2 Q value(s)") && w.contains("fewer than three"), "{w}");
+    assert!(
+        w.contains("underdetermined") && w.contains("fewer than two on each side"),
+        "{w}"
+    );
     // three levels that all lie below Q*_D: it is extrapolated, also flagged
     let (q, b) = synthetic(20.0e9, 3, 4, 0.01, 1);
     let a = q_star_bootstrap(&q, &b, 500, 1).unwrap();
     assert!(a.q_star > 3.5e9 && a.underdetermined, "{a:?}");
+}
+
+/// Fewer than two Q values on a side of the crossing is underdetermined, however many lie on the other: a step-like
+/// campaign (bound 1 at the lowest Q, 0 at the two above, as a real one gave) has one Q below Q*_D, and its
+/// bootstrap interval, inside the gap between the two Q values around Q*_D, is named as set by the line, not the
+/// data. Two on each side is not flagged. Counts are checked against the levels written out here.
+#[test]
+fn fewer_than_two_q_values_on_a_side_is_underdetermined() {
+    let q = [1.49e9, 1.49e9, 2.39e10, 2.39e10, 1.49e11, 1.49e11];
+    let b = [0.98, 1.0, 0.003, 0.0, 0.0, 0.0];
+    let a = q_star_bootstrap(&q, &b, 500, 1).unwrap();
+    let below = [1.49e9, 2.39e10, 1.49e11].iter().filter(|&&x| x < a.q_star).count();
+    assert_eq!((a.levels_below, a.levels_above), (below, 3 - below), "{a:?}");
+    assert!(a.underdetermined, "{a:?}");
+    let w = a.warning().unwrap();
+    assert!(w.contains("underdetermined"), "{w}");
+    if let Some([lo, hi]) = a.bracket
+        && lo <= a.low
+        && a.high <= hi
+    {
+        assert!(w.contains("inside the gap"), "{w}");
+    }
+    // two levels on each side: not underdetermined
+    let q = [1e9, 2e9, 3e9, 4e9];
+    let b = [0.9, 0.7, 0.3, 0.1];
+    let a = q_star_bootstrap(&q, &b, 200, 1).unwrap();
+    assert_eq!((a.levels_below, a.levels_above), (2, 2), "{a:?}");
+    assert!(!a.underdetermined && a.warning().is_none(), "{a:?}");
+    assert_eq!(a.bracket, Some([2e9, 3e9]));
 }

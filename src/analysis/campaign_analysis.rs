@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use crate::analysis::run_analysis::{
-    AnalysisError, CampaignAnalysis, CampaignRun, Fit, SpinSelection, analyze_run, lock_analysis, read_json,
+    AnalysisError, CampaignAnalysis, CampaignRun, Fit, QStarRuns, SpinSelection, analyze_run, lock_analysis, read_json,
     spin_distributions,
 };
 use crate::io::messages::{Channel, emit};
@@ -127,25 +127,38 @@ pub fn analyze_campaign(
             run,
         });
     }
-    let q: Vec<f64> = runs.iter().map(|r| r.q_erg_per_g).collect();
-    let bound: Vec<f64> = runs.iter().map(|r| r.bound_mass_fraction).collect();
-    let line = crate::analysis::fits::fit_line(&q, &bound);
-    let q_star_d = match &line {
-        Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
-        Err(e) => Fit::Failed(e.to_string()),
+    let q_star_runs = q_star_selection(&runs, &spin_target, selection.angle_deg);
+    let (bound_fraction_vs_q, q_star_d, q_star_d_bootstrap) = match &q_star_runs.refused {
+        Some(why) => (
+            Fit::Failed(why.clone()),
+            Fit::Failed(why.clone()),
+            Fit::Failed(why.clone()),
+        ),
+        None => {
+            let chosen: Vec<&CampaignRun> = runs.iter().filter(|r| q_star_runs.holds(r)).collect();
+            let q: Vec<f64> = chosen.iter().map(|r| r.q_erg_per_g).collect();
+            let bound: Vec<f64> = chosen.iter().map(|r| r.bound_mass_fraction).collect();
+            let line = crate::analysis::fits::fit_line(&q, &bound);
+            let q_star_d = match &line {
+                Ok(l) => Fit::from(crate::analysis::fits::line_crossing(l, 0.5)),
+                Err(e) => Fit::Failed(e.to_string()),
+            };
+            let bootstrap = Fit::from(crate::analysis::q_star_bootstrap::q_star_bootstrap(
+                &q,
+                &bound,
+                crate::analysis::q_star_bootstrap::DEFAULT_RESAMPLES,
+                bootstrap_seed,
+            ));
+            (Fit::from(line), q_star_d, bootstrap)
+        }
     };
     let spin_distributions = spin_distributions(&runs, &spins, &spin_target, selection.angle_deg);
-    let q_star_d_bootstrap = Fit::from(crate::analysis::q_star_bootstrap::q_star_bootstrap(
-        &q,
-        &bound,
-        crate::analysis::q_star_bootstrap::DEFAULT_RESAMPLES,
-        bootstrap_seed,
-    ));
     let analysis = CampaignAnalysis {
         t_at,
         runs,
         skipped,
-        bound_fraction_vs_q: Fit::from(line),
+        q_star_runs,
+        bound_fraction_vs_q,
         q_star_d,
         q_star_d_bootstrap,
         spin_distributions,
@@ -174,6 +187,39 @@ pub fn analyze_campaign(
         emit(Channel::Warning, &format!("warning: figure not drawn: {why}"));
     }
     Ok(analysis)
+}
+
+/// Which runs Q*_D is fitted over: those on `target` at one impact angle, never pooled across targets or angles
+/// (each has its own Q*_D). The angle is the runs' only one on `target`, else `angle_deg` when they have it; with
+/// several angles and none at `angle_deg` the fit is refused, naming `--spin-angle-deg` and the angles.
+pub fn q_star_selection(runs: &[CampaignRun], target: &str, angle_deg: f64) -> QStarRuns {
+    let mut angles: Vec<f64> = Vec::new();
+    for r in runs.iter().filter(|r| r.target == target) {
+        if !angles.contains(&r.angle_deg) {
+            angles.push(r.angle_deg);
+        }
+    }
+    angles.sort_by(f64::total_cmp);
+    let angle = match angles[..] {
+        [one] => Some(one),
+        _ => angles.iter().copied().find(|&a| a == angle_deg),
+    };
+    let refused = match (angle, angles.is_empty()) {
+        (_, true) => Some(format!("no analysed run on the target `{target}`")),
+        (None, false) => Some(format!(
+            "the runs on {target} are at several impact angles ({angles:?} deg) and none at {angle_deg} deg; Q*_D is \
+             of one target at one angle: pick one with --spin-angle-deg (and the target with --spin-target)"
+        )),
+        (Some(_), false) => None,
+    };
+    let mut selection = QStarRuns {
+        target: target.to_string(),
+        angle_deg: angle,
+        runs: 0,
+        refused,
+    };
+    selection.runs = runs.iter().filter(|r| selection.holds(r)).count();
+    selection
 }
 
 /// The end time shared by the completed runs of `dir/campaign.csv` (their `final_time`, s): `analyze-campaign`'s

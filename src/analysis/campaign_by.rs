@@ -80,14 +80,15 @@ pub struct ByTable {
     pub field: String,
     /// The other fields that vary among the runs (seed aside), which also split the rows.
     pub key_fields: Vec<String>,
-    /// Rows sorted by key, then by value.
+    /// Rows sorted by the field's value, then by the key fields in turn ([`sort_rows`]).
     pub rows: Vec<ByRow>,
 }
 
 /// The column `requested` names (a column, `q`, `angle`, a swept path's short name or last segment), or, when
-/// `None`, the campaign's one swept field (a `[sweep]` column, or `angle_deg` when several angles ran) if it has
-/// exactly one, else `q_erg_per_g`.
-fn choose(header: &[String], rows: &[Vec<String>], requested: Option<&str>) -> Result<String, AnalysisError> {
+/// `None`, the campaign's one swept field if it has exactly one, else `q_erg_per_g`. Swept means a field of the
+/// campaign file's `[sweep]` table (a column of `campaign.csv` after [`CAMPAIGN_COLUMNS`]), seeds aside; the
+/// `[campaign]` lists (targets, projectiles, angles) are the grid, not a sweep.
+fn choose(header: &[String], requested: Option<&str>) -> Result<String, AnalysisError> {
     let has = |c: &str| header.iter().any(|h| h == c);
     fn alias(c: &str) -> &str {
         match c {
@@ -105,15 +106,7 @@ fn choose(header: &[String], rows: &[Vec<String>], requested: Option<&str>) -> R
         .filter(|h| *h != "seed")
         .collect();
     let Some(req) = requested else {
-        let angle = header.iter().position(|h| h == "angle_deg");
-        let mut candidates = swept.clone();
-        if let Some(a) = angle
-            && rows.iter().any(|r| r[a] != rows[0][a])
-            && !candidates.contains(&"angle_deg")
-        {
-            candidates.push("angle_deg");
-        }
-        return Ok(match candidates[..] {
+        return Ok(match swept[..] {
             [one] => one.to_string(),
             _ => "q_erg_per_g".to_string(),
         });
@@ -143,6 +136,29 @@ fn choose(header: &[String], rows: &[Vec<String>], requested: Option<&str>) -> R
     }
 }
 
+/// Orders two cells: numerically when both parse as numbers, else as text (numbers first).
+fn cell_order(a: &str, b: &str) -> std::cmp::Ordering {
+    let number = |s: &str| s.parse::<f64>().ok().filter(|x| !x.is_nan());
+    match (number(a), number(b)) {
+        (Some(x), Some(y)) => x.total_cmp(&y),
+        (Some(_), None) => std::cmp::Ordering::Less,
+        (None, Some(_)) => std::cmp::Ordering::Greater,
+        (None, None) => a.cmp(b),
+    }
+}
+
+/// Sorts `rows` by the field's value, then by each key field in turn, each numerically where both cells are
+/// numbers (5 before 20 before 50), else as text.
+pub fn sort_rows(rows: &mut [ByRow]) {
+    rows.sort_by(|a, b| {
+        let keys = a.key.iter().zip(&b.key).map(|(x, y)| cell_order(x, y));
+        std::iter::once(cell_order(&a.value, &b.value))
+            .chain(keys)
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+}
+
 /// `dir/campaign.csv`: its header and rows.
 fn read_index(dir: &Path) -> Result<(Vec<String>, Vec<Vec<String>>), AnalysisError> {
     let index = dir.join(CAMPAIGN_CSV);
@@ -163,8 +179,8 @@ fn read_index(dir: &Path) -> Result<(Vec<String>, Vec<Vec<String>>), AnalysisErr
 /// The column of `dir/campaign.csv` that `requested` names, or the default field for `None` (see [`choose`]);
 /// an error naming `--by` and the valid fields when there is none (check it before a long analysis).
 pub fn by_field_name(dir: &Path, requested: Option<&str>) -> Result<String, AnalysisError> {
-    let (header, rows) = read_index(dir)?;
-    choose(&header, &rows, requested)
+    let (header, _) = read_index(dir)?;
+    choose(&header, requested)
 }
 
 /// The table of `analysis`'s runs against `field` (see [`choose`] for `None`), from `dir/campaign.csv`.
@@ -174,7 +190,7 @@ pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&st
         path: dir.join(CAMPAIGN_CSV),
         reason: e.to_string(),
     };
-    let field = choose(&header, &rows, field)?;
+    let field = choose(&header, field)?;
     let col = |c: &str| header.iter().position(|h| h == c);
     let (c_run, c_by) = (
         col("run").ok_or_else(|| err(&"no `run` column"))?,
@@ -213,12 +229,7 @@ pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&st
             key,
         })
         .collect();
-    table_rows.sort_by(|a, b| {
-        a.key.cmp(&b.key).then(match (a.x, b.x) {
-            (Some(x), Some(y)) => x.total_cmp(&y),
-            _ => a.value.cmp(&b.value),
-        })
-    });
+    sort_rows(&mut table_rows);
     Ok(ByTable {
         key_fields: key_cols.iter().map(|&c| header[c].clone()).collect(),
         field,
@@ -271,7 +282,8 @@ impl ByTable {
     }
 
     /// The table for a console: one line per row, `mean ± standard error (n runs)` of the largest remnant fraction,
-    /// bound mass fraction and number of fragments.
+    /// bound mass fraction and number of fragments (a count as its integer when the runs agree); Q to 4
+    /// significant digits.
     pub fn lines(&self) -> Vec<String> {
         let mut head = vec![self.field.clone()];
         head.extend(self.key_fields.iter().cloned());
@@ -280,14 +292,22 @@ impl ByTable {
             head.join(" | ")
         )];
         let pm = |s: &ByStat| {
-            if s.standard_error.is_finite() {
-                format!("{:.4} ± {:.4}", s.mean, s.standard_error)
-            } else {
-                format!("{:.4}", s.mean)
+            let counts = ["fragments", "escaping"].contains(&s.metric.as_str()) && !s.values.is_empty();
+            match (counts, s.standard_error.is_finite()) {
+                // a count: the integer when every run agrees, else mean ± se to a hundredth
+                (true, _) if s.values.iter().all(|v| *v == s.values[0]) => format!("{}", s.values[0]),
+                (true, true) => format!("{:.2} ± {:.2}", s.mean, s.standard_error),
+                (false, true) => format!("{:.4} ± {:.4}", s.mean, s.standard_error),
+                (_, false) => format!("{:.4}", s.mean),
             }
         };
+        // Q to 4 significant digits (the CSV keeps every digit)
+        let value = |field: &str, v: &str| match v.parse::<f64>() {
+            Ok(x) if field == "q_erg_per_g" => format!("{x:.3e}"),
+            _ => v.to_string(),
+        };
         for r in &self.rows {
-            let mut cells = vec![r.value.clone()];
+            let mut cells = vec![value(&self.field, &r.value)];
             cells.extend(r.key.iter().cloned());
             out.push(format!(
                 "{} | {} | {} | {} | {}",
@@ -299,5 +319,127 @@ impl ByTable {
             ));
         }
         out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header(swept: &[&str]) -> Vec<String> {
+        CAMPAIGN_COLUMNS.iter().chain(swept).map(|s| s.to_string()).collect()
+    }
+
+    /// The default `--by` is the one field of `[sweep]` (seeds aside), whatever the `[campaign]` grid varies
+    /// (several angles too), else Q.
+    #[test]
+    fn the_default_by_is_the_one_sweep_field() {
+        assert_eq!(
+            choose(&header(&["impact.speed_km_s"]), None).unwrap(),
+            "impact.speed_km_s"
+        );
+        assert_eq!(
+            choose(&header(&["campaign.seeds", "impact.speed_km_s"]), None).unwrap(),
+            "impact.speed_km_s"
+        );
+        assert_eq!(choose(&header(&["campaign.angles"]), None).unwrap(), "angle_deg");
+        assert_eq!(choose(&header(&[]), None).unwrap(), "q_erg_per_g");
+        let two = header(&["impact.speed_km_s", "impact.t_end"]);
+        assert_eq!(choose(&two, None).unwrap(), "q_erg_per_g");
+    }
+
+    fn row(value: &str, key: &[&str], fragments: &[f64]) -> ByRow {
+        ByRow {
+            value: value.into(),
+            x: value.parse().ok(),
+            key: key.iter().map(|k| k.to_string()).collect(),
+            runs: fragments.iter().map(|f| format!("r{f}")).collect(),
+            stats: BY_METRICS
+                .iter()
+                .map(|(m, _)| {
+                    ByStat::of(
+                        m,
+                        if *m == "fragments" {
+                            fragments.to_vec()
+                        } else {
+                            vec![0.5, 0.25]
+                        },
+                    )
+                })
+                .collect(),
+        }
+    }
+
+    /// Rows go by the field's value, then by each key, numerically where the cells are numbers (text sorts 20
+    /// before 5 before 50; numbers 5, 20, 50).
+    #[test]
+    fn rows_sort_numerically_by_value_then_keys() {
+        let mut rows: Vec<ByRow> = [
+            ("45", "50"),
+            ("0", "20"),
+            ("45", "5"),
+            ("0", "5"),
+            ("0", "50"),
+            ("45", "20"),
+        ]
+        .iter()
+        .map(|(a, s)| row(a, &[s, "N30_T4"], &[30.0]))
+        .collect();
+        sort_rows(&mut rows);
+        let order: Vec<(&str, &str)> = rows.iter().map(|r| (r.value.as_str(), r.key[0].as_str())).collect();
+        let mut want = order.clone();
+        want.sort_by(|a, b| {
+            let n = |s: &str| s.parse::<f64>().unwrap();
+            n(a.0).total_cmp(&n(b.0)).then(n(a.1).total_cmp(&n(b.1)))
+        });
+        assert_eq!(order, want);
+        assert_eq!(order[..3], [("0", "5"), ("0", "20"), ("0", "50")]);
+        // text after numbers, text among itself as text
+        let mut mixed = vec![
+            row("b", &[], &[1.0]),
+            row("10", &[], &[1.0]),
+            row("a", &[], &[1.0]),
+            row("9", &[], &[1.0]),
+        ];
+        sort_rows(&mut mixed);
+        let values: Vec<&str> = mixed.iter().map(|r| r.value.as_str()).collect();
+        assert_eq!(values, ["9", "10", "a", "b"]);
+    }
+
+    /// The console table prints Q to 4 significant digits and a count on which the runs agree as its integer (no
+    /// "30.0000 ± 0.0000"); a count that differs keeps its mean ± standard error.
+    #[test]
+    fn console_rows_print_q_to_four_digits_and_counts_as_integers() {
+        let q = 23912243924.102383_f64;
+        let table = ByTable {
+            field: "q_erg_per_g".into(),
+            key_fields: vec![],
+            rows: vec![
+                row(&q.to_string(), &[], &[30.0, 30.0]),
+                row("1494515245.256399", &[], &[29.0, 30.0]),
+            ],
+        };
+        let lines = table.lines();
+        let cells = |k: usize| lines[k].split(" | ").map(String::from).collect::<Vec<_>>();
+        let first = cells(1);
+        assert_eq!(first[0], "2.391e10");
+        assert!((first[0].parse::<f64>().unwrap() / q - 1.0).abs() < 5e-4);
+        assert_eq!(first[4], "30", "{}", lines[1]);
+        assert_eq!(cells(2)[4], "29.50 ± 0.50", "{}", lines[2]);
+        assert_eq!(first[3], "0.3750 ± 0.1250", "{}", lines[1]);
+        // a fraction that is 1 in every run stays a fraction
+        let mut whole = row("5", &[], &[30.0]);
+        whole.stats[1] = ByStat::of("bound_mass_fraction", vec![1.0, 1.0]);
+        let table = ByTable {
+            field: "impact.speed_km_s".into(),
+            key_fields: vec![],
+            rows: vec![whole],
+        };
+        assert_eq!(
+            table.lines()[1].split(" | ").nth(3),
+            Some("1.0000 ± 0.0000"),
+            "{:?}",
+            table.lines()
+        );
     }
 }

@@ -114,6 +114,11 @@ pub fn clump_spin(bodies: &[Body], members: &[usize], moments: impl Fn(&Body) ->
     inertia.try_inverse().map_or_else(Vec3::zeros, |inv| inv * l)
 }
 
+/// `n` with its noun for a printed line: `counted(1, "body", "bodies")` is `1 body`, with 2 `2 bodies`.
+pub fn counted(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 /// Where a clump goes (module docs, item 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -334,18 +339,18 @@ impl ClumpReport {
             })
         };
         let second = self.second().map_or("none".into(), |s| {
-            format!("{:.4} ({} bodies)", s.mass_fraction, s.n_members)
+            format!("{:.4} ({})", s.mass_fraction, counted(s.n_members, "body", "bodies"))
         });
         format!(
-            "largest remnant: {:.4} of all bodies' mass ({} bodies, {:.4e} kg), spin period {}, b/a {:.3}, c/a {:.3}; \
-             second remnant {second}; {} clumps, {} escaping the largest remnant",
+            "largest remnant: {:.4} of all bodies' mass ({}, {:.4e} kg), spin period {}, b/a {:.3}, c/a {:.3}; \
+             second remnant {second}; {}, {} escaping the largest remnant",
             lr.mass_fraction,
-            lr.n_members,
+            counted(lr.n_members, "body", "bodies"),
             lr.mass_kg,
             period(lr.period_h),
             lr.b_over_a,
             lr.c_over_a,
-            self.clumps.len(),
+            counted(self.clumps.len(), "clump", "clumps"),
             self.n_escaping(),
         )
     }
@@ -432,5 +437,16 @@ mod tests {
         assert_eq!(members, vec![&[0, 1, 2][..], &[3]]);
         assert_eq!(report.clumps[1].fate, Fate::Escaping);
         assert_eq!(report.n_escaping(), 1);
+    }
+
+    /// A count of one prints with the singular noun: the chain's dropped body is "(1 body)", never "(1 bodies)".
+    #[test]
+    fn a_count_of_one_prints_a_singular_noun() {
+        let bodies = [sphere(0.0, 0.0, 1.0), sphere(2.0, 0.0, 1.0), sphere(6.0, 5.0, 1.0)];
+        let line = analyse_clumps(&bodies, 0.1, Some(1.0), |b| b.shape.principal_moments(2.5)).summary_line();
+        assert!(line.contains("(2 bodies,") && line.contains("(1 body)"), "{line}");
+        assert!(!line.contains("1 bodies") && !line.contains(" 1 clumps"), "{line}");
+        let one = analyse_clumps(&bodies[..1], 0.1, Some(1.0), |b| b.shape.principal_moments(2.5)).summary_line();
+        assert!(one.contains("(1 body,") && one.contains("; 1 clump,"), "{one}");
     }
 }

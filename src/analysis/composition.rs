@@ -1,7 +1,7 @@
 //! Composition of the outcome of a collision between two rubble piles (the paper has a single-ellipsoid projectile;
-//! these are our definitions): bodies are `target` or `projectile` by index (`impact.json`); clumps link bodies whose
-//! ellipsoids, each semi-axis enlarged by [`CLUMP_MARGIN`], overlap ([`crate::geometry::ellipsoid_overlap::are_apart`]
-//! via [`crate::ellipsoid::clumps`]). A clump is bound by Roig03 Eq. 43 with the clump as one body:
+//! these are our definitions): bodies are `target` or `projectile` by index (`impact.json`); the clumps are the
+//! caller's, those of [`crate::analysis::clumps`] (so the largest remnant here is the one of `analyze`'s
+//! `largest remnant:` line). A clump is bound to the system by Roig03 Eq. 43 with the clump as one body:
 //! `½ M_c |V_c − V_sys|² < Σ_{i∈c} Σ_{j∉c} G m_i m_j / r_ij`. The largest remnant is the heaviest clump, its spin
 //! `ω = I⁻¹ L` with `I = Σ (Rᵢᵀ Iᵢ Rᵢ + mᵢ(|dᵢ|² 1 − dᵢ dᵢᵀ))`, `L = Σ (mᵢ dᵢ × uᵢ + Rᵢᵀ Iᵢ ω_bᵢ)` (barycentric),
 //! period `2π/|ω|` (no §4.3 correction: parallel-axis terms dominate). Mixing of the other bound clumps: their
@@ -9,11 +9,7 @@
 
 use crate::analysis::clumps::clump_spin;
 use crate::ellipsoid::body::Body;
-use crate::ellipsoid::clumps::{Linking, find_clumps};
 use crate::math::Vec3;
-
-/// Relative enlargement of every semi-axis in the contact test that defines clumps (0.1 = 10 %).
-pub const CLUMP_MARGIN: f64 = 0.1;
 
 /// Where a body came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -38,7 +34,7 @@ pub struct Clump {
     pub bound: bool,
 }
 
-/// The largest remnant (most massive clump).
+/// The largest remnant (most massive clump): the same clump as [`crate::analysis::clumps::ClumpReport::largest`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct LargestRemnant {
     /// Number of bodies.
@@ -62,8 +58,6 @@ pub struct LargestRemnant {
 /// Composition of a two-pile collision outcome (`analysis.json`'s `composition`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Composition {
-    /// The contact margin used ([`CLUMP_MARGIN`]).
-    pub clump_margin: f64,
     /// Target mass (kg).
     pub target_mass_kg: f64,
     /// Projectile mass (kg).
@@ -103,16 +97,20 @@ impl Composition {
     pub fn summary_line(&self) -> String {
         let lr = &self.largest_remnant;
         format!(
-            "composition: {} clumps ({} bound to the system, {:.3} of all bodies' mass); largest remnant {} bodies, {:.4e} kg ({:.3} of \
+            "composition: {} ({} bound to the system, {:.3} of all bodies' mass); largest remnant {}, {:.4e} kg ({:.3} of \
              the system, {}), spin period {}, projectile fraction {:.3}; other bound clumps {} ({:.4e} kg, projectile \
              fraction {}, {} mixed)",
-            self.n_clumps,
+            crate::analysis::clumps::counted(self.n_clumps, "clump", "clumps"),
             self.n_bound_clumps,
             self.bound_mass_fraction,
-            lr.n_bodies,
+            crate::analysis::clumps::counted(lr.n_bodies, "body", "bodies"),
             lr.mass_kg,
             lr.mass_fraction_of_system,
-            if lr.bound { "bound" } else { "unbound" },
+            if lr.bound {
+                "bound to the system"
+            } else {
+                "not bound to the system"
+            },
             lr.spin_period_h.map_or("none".into(), |p| format!("{p:.3} h")),
             lr.projectile_fraction,
             self.n_other_bound,
@@ -124,17 +122,20 @@ impl Composition {
     }
 }
 
-/// The composition of `bodies` (one snapshot) whose projectile bodies are `projectile` (a range of indices);
-/// `moments` gives each body's principal moments (kg m²), `g` the gravitational constant (SI). `None` when the
-/// range is empty, out of bounds or covers every body.
+/// The composition of `bodies` (one snapshot) whose projectile bodies are `projectile` (a range of indices), over
+/// the clumps `clumps` (lists of body indices, each ascending, covering every body once: those of
+/// [`crate::analysis::clumps::ClumpReport`], so both name the same largest remnant); `moments` gives each body's
+/// principal moments (kg m²), `g` the gravitational constant (SI). `None` when the range is empty, out of bounds or
+/// covers every body, or when `clumps` is empty.
 pub fn composition(
     bodies: &[Body],
     projectile: std::ops::Range<usize>,
+    clumps: &[Vec<usize>],
     g: f64,
     moments: impl Fn(&Body) -> Vec3,
 ) -> Option<Composition> {
     let n = bodies.len();
-    if projectile.is_empty() || projectile.end > n || projectile.len() == n {
+    if projectile.is_empty() || projectile.end > n || projectile.len() == n || clumps.is_empty() {
         return None;
     }
     let origins: Vec<Origin> = (0..n)
@@ -157,8 +158,9 @@ pub fn composition(
     let projectile_mass = mass_of(&mut (0..n), Some(Origin::Projectile));
     let v_sys = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / total;
 
-    let mut clumps: Vec<Clump> = find_clumps(bodies, Linking::ScaledAxes(CLUMP_MARGIN))
-        .into_iter()
+    let mut clumps: Vec<Clump> = clumps
+        .iter()
+        .cloned()
         .map(|ids| {
             let mass = mass_of(&mut ids.iter().copied(), None);
             let from_projectile = mass_of(&mut ids.iter().copied(), Some(Origin::Projectile));
@@ -210,7 +212,6 @@ pub fn composition(
     let other_mass: f64 = others.iter().map(|c| c.mass_kg).sum::<f64>() + 0.0; // -0 → 0 when empty
     let other_projectile: f64 = others.iter().map(|c| c.mass_kg * c.projectile_fraction).sum();
     Some(Composition {
-        clump_margin: CLUMP_MARGIN,
         target_mass_kg: target_mass,
         projectile_mass_kg: projectile_mass,
         n_clumps: clumps.len(),

@@ -27,25 +27,34 @@ pub struct QStarBootstrap {
     pub seed: u64,
     /// Distinct Q values (levels) among the runs.
     pub q_levels: usize,
-    /// Whether fewer than three Q levels bracket Q*_D (fewer than three levels, or Q*_D outside their range): the line
-    /// and its interval then rest on too few energies to be trusted.
+    /// Q levels below Q*_D.
+    pub levels_below: usize,
+    /// Q levels above Q*_D.
+    pub levels_above: usize,
+    /// The two adjacent Q levels Q*_D falls between (erg/g); `None` when it lies outside them all.
+    pub bracket: Option<[f64; 2]>,
+    /// Whether fewer than two Q levels lie on either side of Q*_D: the line's crossing, and its interval, then rest
+    /// on too few energies to be trusted.
     pub underdetermined: bool,
 }
 
 impl QStarBootstrap {
-    /// The warning to print when [`Self::underdetermined`].
+    /// The warning to print when [`Self::underdetermined`]; it adds when the interval lies inside the gap between
+    /// the two Q values Q*_D falls between (no run there: the straight line, not the data, places it).
     pub fn warning(&self) -> Option<String> {
         self.underdetermined.then(|| {
+            let gap = match self.bracket {
+                Some([a, b]) if a <= self.low && self.high <= b => format!(
+                    "; its bootstrap interval ({:.3e} to {:.3e}) lies inside the gap between the runs' Q = {a:.3e} \
+                     and {b:.3e}, so it reflects the straight line, not the data",
+                    self.low, self.high
+                ),
+                _ => String::new(),
+            };
             format!(
-                "Q*_D = {:.3e} erg/g rests on {} Q value(s){}: fewer than three bracket it, so its interval is not \
-                 trustworthy; add projectiles or speeds around it",
-                self.q_star,
-                self.q_levels,
-                if self.q_levels >= 3 {
-                    ", and lies outside them"
-                } else {
-                    ""
-                }
+                "Q*_D = {:.3e} erg/g is underdetermined: {} Q value(s) below it and {} above (of {}), fewer than two \
+                 on each side{gap}; add projectiles or speeds around it",
+                self.q_star, self.levels_below, self.levels_above, self.q_levels
             )
         })
     }
@@ -101,7 +110,10 @@ pub fn q_star_bootstrap(q: &[f64], bound: &[f64], resamples: usize, seed: u64) -
         return Err(FitError::TooFewPoints { points: 0, needed: 1 });
     }
     found.sort_by(f64::total_cmp);
-    let (q_min, q_max) = (q[groups[0][0]], q[groups[groups.len() - 1][0]]);
+    let level_q: Vec<f64> = groups.iter().map(|g| q[g[0]]).collect();
+    let below = level_q.iter().filter(|&&x| x < q_star).count();
+    let above = level_q.iter().filter(|&&x| x > q_star).count();
+    let bracket = (below > 0 && above > 0).then(|| [level_q[below - 1], level_q[level_q.len() - above]]);
     Ok(QStarBootstrap {
         q_star,
         low: quantile(&found, 0.025),
@@ -110,6 +122,9 @@ pub fn q_star_bootstrap(q: &[f64], bound: &[f64], resamples: usize, seed: u64) -
         crossings: found.len(),
         seed,
         q_levels: groups.len(),
-        underdetermined: groups.len() < 3 || !(q_min..=q_max).contains(&q_star),
+        levels_below: below,
+        levels_above: above,
+        bracket,
+        underdetermined: below < 2 || above < 2,
     })
 }

@@ -2,8 +2,8 @@
 //!
 //! Reads `summary.json` (κ; from `scene.toml` while the run is still going), `scene.toml` (inertia model, G),
 //! `impact.json` (projectile) and the snapshots at t = 0 and at `t_at` (default 400 s, "a few minutes after the
-//! impact"); writes `analysis/fragments.csv` and `analysis/analysis.json` inside the run directory. Fits that
-//! cannot be made (too few fragments, say) are recorded with their reason instead of stopping the analysis.
+//! impact", or the run's end when sooner); writes `analysis/fragments.csv` and `analysis/analysis.json` inside the
+//! run directory. Fits that cannot be made (too few fragments, say) are recorded with their reason instead of stopping the analysis.
 //!
 //! The analysis locks what it writes, `analysis/` ([`lock_analysis`]), not the run directory, so a run still going
 //! can be analysed while it writes.
@@ -250,6 +250,26 @@ fn analysis_out(dir: &Path, out: Option<&Path>) -> Result<(PathBuf, Option<DirLo
     }
 }
 
+/// The default analysis time of an impact run (s): Roig03's "a few minutes after the impact".
+pub const DEFAULT_AT_S: f64 = 400.0;
+
+/// The time `analyze` takes for the impact run in `dir` (s): `at` when given, else [`DEFAULT_AT_S`], or the run's
+/// end (`scene.toml`'s `t_end`) when it ends sooner.
+pub fn analysis_time(dir: &Path, at: Option<f64>) -> Result<f64, AnalysisError> {
+    if let Some(at) = at {
+        return Ok(at);
+    }
+    let scene_path = dir.join("scene.toml");
+    let read = |reason: String| AnalysisError::Read {
+        path: scene_path.clone(),
+        reason,
+    };
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| read(e.to_string()))?;
+    let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
+        .map_err(|e| read(e.to_string()))?;
+    Ok(DEFAULT_AT_S.min(scene.scene.t_end))
+}
+
 /// Analyses the run in `dir` at `t_at` (s); writes `{fragments.csv, analysis.json}` into `out` (default
 /// `dir/analysis/`) unless they exist (or `force`). Returns the per-run results and the per-fragment report.
 pub fn analyze_run(
@@ -352,7 +372,8 @@ pub fn analyze_run(
         spin_likelihood_by_mass: Fit::from(fit_spin_likelihood(&spins, Weights::Mass(&masses))),
         composition: pile_range.and_then(|r| {
             let kappa_i = scene.model.inertia.inertia_kappa(kappa);
-            composition(&at, r, g, |b| b.shape.principal_moments(kappa_i))
+            let members: Vec<Vec<usize>> = clump_report.clumps.iter().map(|c| c.members.clone()).collect();
+            composition(&at, r, &members, g, |b| b.shape.principal_moments(kappa_i))
         }),
         clumps: clump_report.summary(),
         clump_report,
@@ -678,7 +699,9 @@ pub struct CampaignAnalysis {
     pub runs: Vec<CampaignRun>,
     /// Runs listed in `campaign.csv` but not completed, skipped.
     pub skipped: Vec<String>,
-    /// Bound mass fraction against Q (erg/g), least squares (Fig. 5).
+    /// The runs Q*_D and its line are fitted over: one target at one angle (`campaign_analysis::q_star_selection`).
+    pub q_star_runs: QStarRuns,
+    /// Bound mass fraction against Q (erg/g), least squares over [`Self::q_star_runs`] (Fig. 5).
     pub bound_fraction_vs_q: Fit<crate::analysis::fits::LineFit>,
     /// Q*_D: the Q at which that line gives a bound fraction of 0.5 (erg/g), with its propagated error.
     pub q_star_d: Fit<crate::analysis::fits::LineCrossing>,
@@ -688,23 +711,59 @@ pub struct CampaignAnalysis {
     pub spin_distributions: Vec<SpinDistribution>,
 }
 
+/// The runs of a campaign that Q*_D is fitted over (`campaign_analysis.json`'s `q_star_runs`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct QStarRuns {
+    /// The target (file stem).
+    pub target: String,
+    /// The impact angle ζ (degrees); `None` when none could be chosen.
+    pub angle_deg: Option<f64>,
+    /// How many runs.
+    pub runs: usize,
+    /// Why no fit is made (several angles and none chosen, no run on the target); `None`: fitted.
+    pub refused: Option<String>,
+}
+
+impl QStarRuns {
+    /// Whether `run` is one of them.
+    pub fn holds(&self, run: &CampaignRun) -> bool {
+        run.target == self.target && Some(run.angle_deg) == self.angle_deg
+    }
+
+    /// `N30_T4 at zeta = 45 deg, 6 runs` (what the fit is of).
+    pub fn label(&self) -> String {
+        match self.angle_deg {
+            Some(a) => format!("{} at zeta = {a} deg, {} runs", self.target, self.runs),
+            None => self.target.clone(),
+        }
+    }
+}
+
 impl CampaignAnalysis {
-    /// Q*_D for a summary line: `Q ± σ erg/g (bootstrap 95 % interval low to high, seed s)`, or why there is none.
+    /// Q*_D for a summary line: `Q ± σ erg/g (bootstrap 95 % interval low to high, seed s; TARGET at zeta = A deg,
+    /// N runs)`, or why there is none.
     pub fn q_star_text(&self) -> String {
+        let of = self.q_star_runs.label();
         match (&self.q_star_d, &self.q_star_d_bootstrap) {
             (Fit::Ok(c), Fit::Ok(b)) => format!(
-                "{:.3e} ± {:.1e} erg/g (bootstrap 95 % interval {:.3e} to {:.3e}, seed {})",
+                "{:.3e} ± {:.1e} erg/g (bootstrap 95 % interval {:.3e} to {:.3e}, seed {}; {of})",
                 c.x, c.sigma_x, b.low, b.high, b.seed
             ),
-            (Fit::Ok(c), Fit::Failed(why)) => format!("{:.3e} ± {:.1e} erg/g (no bootstrap: {why})", c.x, c.sigma_x),
-            (Fit::Failed(why), _) => format!("n/a ({why})"),
+            (Fit::Ok(c), Fit::Failed(why)) => {
+                format!("{:.3e} ± {:.1e} erg/g (no bootstrap: {why}; {of})", c.x, c.sigma_x)
+            }
+            (Fit::Failed(why), _) => format!("n/a ({why}; {of})"),
         }
     }
 
-    /// What a reader must be told: Q*_D resting on fewer than three Q values, spin distributions pooled over every
-    /// angle for want of runs at the requested one.
+    /// What a reader must be told: Q*_D underdetermined (fewer than two Q values on a side of it) or refused
+    /// (several angles, none chosen), spin distributions pooled over every angle for want of runs at the requested
+    /// one.
     pub fn warnings(&self) -> Vec<String> {
-        let q = self.q_star_d_bootstrap.ok().and_then(|b| b.warning());
+        let q = match &self.q_star_runs.refused {
+            Some(why) => Some(format!("Q*_D not fitted: {why}")),
+            None => self.q_star_d_bootstrap.ok().and_then(|b| b.warning()),
+        };
         let spins = self
             .spin_distributions
             .iter()
@@ -750,7 +809,8 @@ impl SpinSelection {
             None if targets.len() == 1 => Ok(targets[0].clone()),
             None if targets.iter().any(|t| t == "N200_T12") => Ok("N200_T12".into()),
             None => Err(AnalysisError::Request(format!(
-                "--spin-target: the campaign has several targets ({}); name the one whose spin distributions to draw                  (runs on different targets are not pooled)",
+                "--spin-target: the campaign has several targets ({}); name the one whose Q*_D and spin distributions to draw \
+                 (runs on different targets are not pooled)",
                 list()
             ))),
         }

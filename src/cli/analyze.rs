@@ -1,10 +1,10 @@
-//! `rubblepile analyze RUN_DIR [--at-s 400]`: per-fragment and per-run analysis of an impact run (Roig03 §4); of a
+//! `rubblepile analyze RUN_DIR [--at-s T]`: per-fragment and per-run analysis of an impact run (Roig03 §4); of a
 //! flyby run, the largest remnant before and after (`analysis/flyby.json`).
 
 use std::path::PathBuf;
 
 use crate::cli::common::CliError;
-use rubblepile::analysis::run_analysis::{AnalysisError, Fit, analyze_run};
+use rubblepile::analysis::run_analysis::{AnalysisError, Fit, analysis_time, analyze_run};
 
 /// `rubblepile analyze`.
 #[derive(Debug, clap::Args)]
@@ -12,8 +12,7 @@ pub struct AnalyzeArgs {
     /// An impact run directory (from `rubblepile impact` or a campaign), or a flyby run (`rubblepile flyby`, or any
     /// scene with `[physics.flyby]`), or any other run (ellipsoids, soft or hard spheres: its clumps only).
     pub dir: PathBuf,
-    /// Time of the snapshot to analyse (s); there must be a snapshot at that time. Default: 400 s for an impact
-    /// run, the last snapshot for any other run.
+    /// Time of a snapshot to analyse (s) [default: 400 s for an impact, its t_end if sooner; else the last one].
     #[arg(long = "at-s")]
     pub at: Option<f64>,
     /// Overwrite an earlier analysis in DIR/analysis (or in --out).
@@ -59,7 +58,8 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
         ));
     }
     let out = args.out.as_deref();
-    let (a, report) = analyze_run(&args.dir, out, args.at.unwrap_or(400.0), args.force).map_err(|e| match e {
+    let at = analysis_time(&args.dir, args.at).map_err(CliError::usage)?;
+    let (a, report) = analyze_run(&args.dir, out, at, args.force).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),
         _ => CliError::usage(e),
     })?;
@@ -142,14 +142,14 @@ pub struct AnalyzeCampaignArgs {
     #[arg(long)]
     pub force: bool,
     /// Tabulate and plot the outcomes against this field of campaign.csv (e.g. impact.speed_km_s, angle_deg, q,
-    /// target), runs differing only in their seed grouped [default: the one swept field, else q].
+    /// target), seed-only differences grouped, rows sorted numerically [default: the one [sweep] field, else q].
     #[arg(long, value_name = "FIELD")]
     pub by: Option<String>,
-    /// Spin distributions (Roig03 Fig. 7) of the runs on this target (file stem) [default: the campaign's only
-    /// target, or N200_T12 among several; runs on different targets are never pooled] ...
+    /// Q*_D and the spin distributions (Roig03 Figs. 5 and 7) of the runs on this target (file stem) [default: the
+    /// campaign's only target, or N200_T12 among several; runs on different targets are never pooled] ...
     #[arg(long)]
     pub spin_target: Option<String>,
-    /// ... at this impact angle ζ (degrees); a projectile without such a run pools its runs at every angle.
+    /// ... at this impact angle ζ (degrees; Q*_D: the target's only angle if one); else spins pool every angle.
     #[arg(long = "spin-angle-deg", default_value_t = 45.0)]
     pub spin_angle: f64,
     /// Seed of Q*_D's bootstrap interval (resampling the runs within each Q value).

@@ -6,10 +6,13 @@
 //! θ is measured on the target's *surface ellipsoid* ([`SurfaceEllipsoid`]): centred at its centre of mass,
 //! with the axes and axis ratios of its second moments, scaled to enclose every fragment. It stands for the
 //! macroscopic surface that θ means; the union of the fragments would give a normal that changes at the
-//! fragments' scale, and a θ(b) that is neither monotonic nor unique. The aim point is the one point of that
-//! ellipsoid whose outward normal is `N = cos θ n + sin θ e(ψ)` (for a convex surface the point where a ray
-//! along `−n` enters it), and the offset `b` is its distance from the line through the centre of mass along `n`;
-//! for a sphere of radius `R`, `b = R sin θ`.
+//! fragments' scale, and a θ(b) that is neither monotonic nor unique. ψ means the same for every aim: the azimuth
+//! of the trajectory's offset (and so of the aim point) about `n`. Aimed by θ, the aim point is the point of that
+//! ellipsoid on the half-plane spanned by `n` and `e(ψ)`, on the side facing the projectile, whose outward normal
+//! makes θ with `n`: a root in the polar angle φ from `n` (bisection between φ = 0 and the silhouette, where the
+//! normal is ⊥ `n`); the offset `b` is its distance from the line through the centre of mass along `n`. For a
+//! sphere of radius `R`, `φ = θ` and `b = R sin θ`. θ = 0 is the one point whose normal is `n`, at its own azimuth
+//! (recorded as ψ), whatever ψ was given.
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::quaternion::rotation_matrix;
@@ -36,8 +39,8 @@ pub enum Aim {
 pub struct ImpactGeometry {
     /// Where the trajectory is aimed.
     pub aim: Aim,
-    /// Azimuth ψ (degrees, in [0, 360)) of the aim point around `n`: of the offset for `b`, of the normal's tilt
-    /// for θ (the same on a sphere). ψ = 0 is along `x̂`, ψ = 90° along `n × x̂ = (0, cos ζ, −sin ζ)`.
+    /// Azimuth ψ (degrees, in [0, 360)) of the aim point around `n`: of the trajectory's offset, for every aim.
+    /// ψ = 0 is along `x̂`, ψ = 90° along `n × x̂ = (0, cos ζ, −sin ζ)`.
     pub azimuth_deg: f64,
     /// Spin of the projectile (rad/s, world frame).
     pub spin_rad_s: Vec3,
@@ -170,9 +173,13 @@ impl ImpactGeometry {
             Aim::Centre => Vec3::zeros(),
             Aim::ParameterM(b) => e * b,
             Aim::ParameterFrac(f) => e * (f * surface.radius()),
+            // θ = 0: the one point whose normal is n, wherever ψ points (recorded at its own azimuth)
+            Aim::AngleDeg(0.0) => {
+                let p = surface.point_with_normal(n);
+                p - n * p.dot(n)
+            }
             Aim::AngleDeg(t) => {
-                let t = t.to_radians();
-                let p = surface.point_with_normal(&(n * t.cos() + e * t.sin()));
+                let p = surface.point_at_angle(n, &e, t.to_radians());
                 p - n * p.dot(n)
             }
         };
@@ -205,7 +212,15 @@ impl Aiming {
         GeometryRecord {
             impact_parameter_m: self.offset.norm(),
             target_radius_m: self.surface.radius(),
-            aim_azimuth_deg: geometry.azimuth_deg,
+            aim_azimuth_deg: match geometry.aim {
+                // the head-on point's own azimuth (ψ = 0 along x̂, 90° along n × x̂), 0 on the axis
+                Aim::AngleDeg(0.0) if self.offset.norm() > 0.0 => {
+                    let x = Vec3::x();
+                    let psi = self.offset.dot(&n.cross(&x)).atan2(self.offset.dot(&x)).to_degrees();
+                    psi.rem_euclid(360.0)
+                }
+                _ => geometry.azimuth_deg,
+            },
             impact_angle_deg: theta,
             aim_point_m: self.aim_point.map(|p| p.into()),
             projectile_spin_rad_s: geometry.spin_rad_s.into(),
@@ -293,6 +308,53 @@ impl SurfaceEllipsoid {
     pub fn point_with_normal(&self, normal: &Vec3) -> Vec3 {
         let inverse = self.q(2);
         inverse * normal / normal.dot(&(inverse * normal)).sqrt()
+    }
+
+    /// The point `p(φ) = d/√(dᵀ Q d)`, `d = cos φ n + sin φ e`, of the ellipsoid on the half-plane of the unit
+    /// vectors `n` and `e ⊥ n` (`φ ∈ [0, φ_s]` from `n` to the silhouette, where the normal is ⊥ `n`) whose outward
+    /// normal makes the angle `theta` (rad, in [0, π/2)) with `n` (module docs). The first sign change of the
+    /// angle's excess over a scan of 64 steps is bisected to the last bit of φ; when no point of the arc makes
+    /// `theta` (an angle below the smallest there, which is above 0 unless `n` is a principal direction or the
+    /// azimuth holds the point whose normal is `n`), the point of the smallest angle the scan found.
+    pub fn point_at_angle(&self, n: &Vec3, e: &Vec3, theta: f64) -> Vec3 {
+        let q = self.q(-2);
+        let point = |phi: f64| {
+            let d = n * phi.cos() + e * phi.sin();
+            d / d.dot(&(q * d)).sqrt()
+        };
+        let excess = |phi: f64| (q * point(phi)).normalize().dot(n).clamp(-1.0, 1.0).acos() - theta;
+        // The silhouette of the plane's ellipse u² M₀₀ + 2uv M₀₁ + v² M₁₁ = 1 (p = u n + v e): largest v.
+        let silhouette = n.dot(&(q * n)).atan2(-n.dot(&(q * e)));
+        const STEPS: usize = 64;
+        let phis: Vec<f64> = (0..=STEPS).map(|k| silhouette * k as f64 / STEPS as f64).collect();
+        let values: Vec<f64> = phis.iter().map(|&phi| excess(phi)).collect();
+        if values[0] == 0.0 {
+            return point(0.0);
+        }
+        let Some(k) = (1..=STEPS).find(|&k| values[k - 1] < 0.0 && values[k] >= 0.0) else {
+            let lowest = (0..=STEPS)
+                .min_by(|&a, &b| values[a].total_cmp(&values[b]))
+                .unwrap_or(0);
+            return point(phis[lowest]);
+        };
+        let (mut lo, mut hi) = (phis[k - 1], phis[k]);
+        loop {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            if excess(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        // the end whose angle is nearer θ
+        if excess(lo).abs() <= excess(hi).abs() {
+            point(lo)
+        } else {
+            point(hi)
+        }
     }
 
     /// Where the line `offset + s n` coming from `s = +∞` enters the ellipsoid, or `None` if it misses (or only

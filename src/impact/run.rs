@@ -23,7 +23,7 @@ use crate::ellipsoid::scene::{
     OutputSection, PhysicsSection, SceneFile, SceneSection, parse_scene,
 };
 pub use crate::impact::error::{ImpactError, read_target};
-use crate::impact::geometry::{ImpactGeometry, aim_field};
+use crate::impact::geometry::{Aim, ImpactGeometry, aim_field};
 use crate::impact::pile::{ProjectilePile, set_up_aimed_pile_impact};
 use crate::impact::projectile::{ImpactSetup, ProjectileSpec, set_up_aimed_impact};
 use crate::integrate::Method;
@@ -353,7 +353,8 @@ impl ImpactConfig {
     }
 
     /// The impact in memory: bodies, setup, title and scene text (nothing is written). An error
-    /// ([`ImpactError::Invalid`] naming the aim's field) when an off-centre aim misses the target.
+    /// ([`ImpactError::Invalid`] naming the aim's field) when an off-centre aim misses the target, or when no point
+    /// of the target's surface ellipsoid at the azimuth ψ makes the impact angle θ asked for.
     pub fn plan(&self, target: &[Body]) -> Result<ImpactPlan, ImpactError> {
         let (geometry, angle, time, seed) = (&self.geometry, self.angle_deg, self.contact_time, self.seed);
         let (bodies, setup, hits) = match &self.pile {
@@ -364,6 +365,21 @@ impl ImpactConfig {
             .geometry
             .as_ref()
             .map(|g| (g.impact_parameter_m, g.target_radius_m));
+        // Aimed by θ: the aim point found must make θ (else θ is out of reach at this ψ; geometry::point_at_angle).
+        if let (Aim::AngleDeg(theta), Some(got)) =
+            (geometry.aim, setup.geometry.as_ref().and_then(|g| g.impact_angle_deg))
+            && (got - theta).abs() > 1e-6
+        {
+            return Err(ImpactError::Invalid {
+                field: aim_field(&geometry.aim).into(),
+                message: format!(
+                    "no point of the target's surface ellipsoid at aim_azimuth_deg = {} makes an impact angle of \
+                     {theta} deg with the approach (the smallest there is about {got:.3} deg); give a larger angle, \
+                     0 (the head-on point) or another azimuth",
+                    geometry.azimuth_deg
+                ),
+            });
+        }
         if let (false, Some((b, r))) = (hits, aim) {
             return Err(ImpactError::Invalid {
                 field: aim_field(&geometry.aim).into(),
@@ -387,10 +403,14 @@ impl ImpactConfig {
             self.angle_deg,
         );
         if let Some((b, r)) = aim {
+            if let Aim::AngleDeg(theta) = geometry.aim {
+                title += &format!(", theta = {theta} deg");
+            }
             title += &format!(
-                ", b = {:.3} km = {:.3} R, psi = {} deg",
+                ", b = {:.3} km = {:.3} R (R = {:.3} km, of the target's surface ellipsoid), psi = {} deg",
                 b / 1e3,
                 b / r,
+                r / 1e3,
                 geometry.azimuth_deg
             );
         }

@@ -92,8 +92,7 @@ fn is_zero_mass(m: &f64) -> bool {
     *m == 0.0
 }
 
-/// Relative enlargement of the semi-axes in the contact test of [`drop_detached`] (as the impact analysis's
-/// clumps, `analysis::composition::CLUMP_MARGIN`).
+/// Relative enlargement of the semi-axes in the contact test of [`drop_detached`].
 pub const DETACHED_MARGIN: f64 = 0.1;
 
 /// Removes from `bodies` every fragment outside their most massive clump (bodies in contact, semi-axes enlarged

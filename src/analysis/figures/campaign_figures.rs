@@ -346,19 +346,24 @@ pub fn spin_distribution_curves(analysis: &CampaignAnalysis) -> (Vec<(String, f6
 pub fn write_campaign_figures(campaign_dir: &Path, analysis: &CampaignAnalysis) -> (Vec<String>, Vec<String>) {
     let dir = campaign_dir.join("analysis");
     let mut log = FigureLog::default();
+    // the runs of Q*_D's fit (one target at one angle; all the target's runs when no angle could be chosen)
+    let selection = &analysis.q_star_runs;
+    let fitted = || {
+        analysis
+            .runs
+            .iter()
+            .filter(|r| selection.holds(r) || (selection.angle_deg.is_none() && r.target == selection.target))
+    };
     let fig5 = BoundFractionVsQ {
         title: format!(
-            "Bound mass fraction vs specific impact energy at t = {} s",
+            "Bound mass fraction vs specific impact energy, {}, at t = {} s",
+            analysis.q_star_runs.label(),
             analysis.t_at
         ),
-        runs: analysis
-            .runs
-            .iter()
+        runs: fitted()
             .map(|r| (r.projectile.clone(), r.q_erg_per_g, r.bound_mass_fraction))
             .collect(),
-        largest_remnant: analysis
-            .runs
-            .iter()
+        largest_remnant: fitted()
             .filter_map(|r| Some((r.q_erg_per_g, r.largest_remnant_fraction?)))
             .collect(),
         fit: analysis.bound_fraction_vs_q.ok().copied(),

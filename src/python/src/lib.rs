@@ -985,7 +985,8 @@ fn analyze(py: Python<'_>, dir: PathBuf, at: Option<f64>, force: bool) -> PyResu
                 "at: an impact run is analysed after the impact: must be a time > 0 s, got 0".into(),
             ));
         }
-        let (a, report) = analyze_run(&dir, None, at.unwrap_or(400.0), force).map_err(|e| usage(e.to_string()))?;
+        let at = rubblepile::analysis::run_analysis::analysis_time(&dir, at).map_err(|e| usage(e.to_string()))?;
+        let (a, report) = analyze_run(&dir, None, at, force).map_err(|e| usage(e.to_string()))?;
         let (_figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&dir, None, &a, &report);
         let mut lines = vec![a.clump_report.summary_line()];
         if let Some(c) = &a.composition {

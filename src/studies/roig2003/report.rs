@@ -316,14 +316,7 @@ pub fn write_report(inputs: &ReportInputs<'_>, out_dir: &Path) -> std::io::Resul
             b.low,
             b.high,
             b.seed,
-            if b.underdetermined {
-                format!(
-                    " — **warning**: only {} Q value(s), fewer than three bracket it",
-                    b.q_levels
-                )
-            } else {
-                String::new()
-            }
+            b.warning().map_or(String::new(), |w| format!(" — **warning**: {w}"))
         ),
         Fit::Failed(_) => String::new(),
     };

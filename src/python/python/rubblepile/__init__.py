@@ -427,7 +427,7 @@ def impact(
 def analyze(dir: PathLike, at: Optional[float] = None, *, force: bool = False) -> Dict[str, Any]:
     """Analyses a finished run as ``rubblepile analyze DIR [--at-s T]`` does, writing ``DIR/analysis/``.
 
-    An impact run (one with ``impact.json``) is analysed at ``at`` (s; default 400): fragments, energy partition,
+    An impact run (one with ``impact.json``) is analysed at ``at`` (s; default 400, or the run's end when sooner): fragments, energy partition,
     ejection and spin fits (Roig03 Sec. 4), clumps. Any other run: the clumps of the snapshot at ``at`` (default the
     last). Returns ``analysis.json`` as a dict (e.g. ``largest_remnant`` with its ``mass_kg``, ``mass_fraction``, ``n_members``, ``period_h``), plus ``lines``
     (the command line's summary lines) and, for an impact run, ``fragments`` (``analysis/fragments.csv``, column
