@@ -378,7 +378,7 @@ fn flyby_command_writes_the_planet_j2() {
     );
     let refused = flyby(&["--planet-pole", "0,0,1"], "pole-alone");
     assert!(!refused.status.success());
-    assert!(String::from_utf8_lossy(&refused.stderr).contains("planet_pole"));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("error: --planet-pole: "));
 }
 
 /// `rubblepile analyze DIR` recognises a flyby run (a scene with `[physics.flyby]`) and writes its remnant analysis;
@@ -558,7 +558,9 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // `--format` and `--progress-every-s` as for `run`: an XYZ beside each CSV snapshot, progress lines in the log.
     assert!(dir.join("run/snapshots/1.xyz").exists());
-    assert!(String::from_utf8_lossy(&out.stderr).contains("progress: t = "));
+    // the progress lines name the run (a flyby runs its control after it, from 0 to 100 % again)
+    assert!(String::from_utf8_lossy(&out.stderr).contains("progress: run: t = "));
+    flyby_printout_names_each_quantity_once(&stdout);
     assert!(
         stdout.contains("warning: settling stopped at its cap of 0.50 h"),
         "{stdout}"
@@ -590,7 +592,34 @@ fn capped_settling_is_reported_and_no_control_skips_the_control() {
         ],
     );
     assert_eq!(bad.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("settle_max_hours"));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("error: --settle-max-h: "));
+    // flyby errors name the flag, not the field (`q_m:` once)
+    for (flag, value, said) in [
+        ("--q-m", "5e6", "error: --q-m: must exceed the planet radius"),
+        ("--v-inf-km-s", "0", "error: --v-inf-km-s: must be > 0"),
+        ("--period-h", "0", "error: --period-h: must be > 0"),
+        ("--planet-mass-kg=-1", "", "error: --planet-mass-kg: must be >= 0"),
+    ] {
+        let mut args = vec![
+            "flyby",
+            "--target",
+            target.to_str().unwrap(),
+            "--no-run",
+            "--out",
+            "bad_flag",
+        ];
+        if value.is_empty() {
+            args.extend(["--q-m", "3.8e7", flag]);
+        } else {
+            args.extend([flag, value]);
+            if flag != "--q-m" {
+                args.extend(["--q-m", "3.8e7"]);
+            }
+        }
+        let bad = rubblepile(&dir, &args);
+        let stderr = String::from_utf8_lossy(&bad.stderr);
+        assert!(stderr.contains(said), "{flag}: {stderr}");
+    }
 }
 
 /// Spheres under gravity alone take the packed right-hand side; with a planet the state also carries the tide's six
@@ -642,4 +671,31 @@ velocity = [0.0, 0.02, 0.0]
         "{:?}",
         s.tidal_impulse
     );
+}
+
+/// The flyby printout: "dP" is the momentum error only (the period change is `d(period)`), the tide's impulses carry
+/// N s and N m s, mass lost says of what, and the end time has at most six significant digits (an adaptive step's
+/// end once printed as `t = 48234.652155108546 s`).
+fn flyby_printout_names_each_quantity_once(stdout: &str) {
+    let words = |line: &str| line.split([' ', ',', '(', ')']).filter(|w| *w == "dP").count();
+    for line in stdout.lines() {
+        assert!(words(line) == 0, "dP as a word: {line}");
+    }
+    assert!(stdout.contains("|dP| "), "{stdout}");
+    let flyby = stdout
+        .lines()
+        .find(|l| l.starts_with("flyby: "))
+        .expect("the flyby line");
+    assert!(
+        flyby.contains(" d(period) ") && flyby.contains(" of the target's, "),
+        "{flyby}"
+    );
+    let done = stdout
+        .lines()
+        .find(|l| l.starts_with("run: done: t = "))
+        .expect("the run's done line");
+    assert!(done.contains(" N s (") && done.contains(" N m s ("), "{done}");
+    let t = done["run: done: t = ".len()..].split(' ').next().unwrap();
+    let digits = t.chars().filter(char::is_ascii_digit).collect::<String>();
+    assert!(digits.trim_start_matches('0').len() <= 6 || !t.contains('.'), "{done}");
 }

@@ -45,6 +45,14 @@ pub struct CriterionVerdict {
     pub stable: bool,
 }
 
+impl CriterionVerdict {
+    /// Whether the hold's record was too short to judge ([`TOO_SHORT`]): neither stable nor creeping. `critical.csv`
+    /// keeps its vocabulary (`stable` false, drifting `record_too_short`); T_c,3 counts such a hold as not stable.
+    pub fn undecided(&self) -> bool {
+        self.drifting == [TOO_SHORT]
+    }
+}
+
 /// One hold run judged by the creep criteria (Zhang17 §3.3.3; [`crate::analysis::creep`]).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct HoldVerdict {
@@ -75,6 +83,10 @@ pub struct HoldVerdict {
     pub drifting: Vec<&'static str>,
     /// The selected criterion's verdict.
     pub stable: bool,
+    /// For a record too short to judge ([`TOO_SHORT`]): the judged length (s) that would give enough samples, where
+    /// the record tells (`None` otherwise, and for holds read back from a `critical.csv`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub record_needed_s: Option<f64>,
 }
 
 impl HoldVerdict {
@@ -221,6 +233,19 @@ pub fn judge_series(
     let theta_max_deg = theta.iter().cloned().fold(f64::NAN, f64::max);
     // a record with too few samples in its second half to fit a trend cannot show that the hold settled
     let too_short = !released && n / 2 < MIN_SECOND_HALF_SAMPLES;
+    // the hold time of the sample that would make the second half long enough: read off the record when it runs
+    // past the window, else extrapolated at its sample spacing
+    let needed = 2 * MIN_SECOND_HALF_SAMPLES - 1;
+    let record_needed_s = too_short
+        .then(|| match series.t_s.get(needed) {
+            Some(&t) => Some(t),
+            None if series.t_s.len() >= 2 => {
+                let (first, last) = (series.t_s[0], series.t_s[series.t_s.len() - 1]);
+                Some(first + needed as f64 * (last - first) / (series.t_s.len() - 1) as f64)
+            }
+            None => None,
+        })
+        .flatten();
     let verdict = |c: &CreepCriterion| {
         let drifting = if too_short {
             vec![TOO_SHORT]
@@ -257,6 +282,7 @@ pub fn judge_series(
         ours,
         drifting: chosen.drifting,
         stable: chosen.stable,
+        record_needed_s,
     }
 }
 
@@ -381,7 +407,10 @@ pub fn critical_from_verdicts(runs: &[HoldVerdict], kind: CreepCriterionKind) ->
 /// not monotone in the spin. [`critical_from_verdicts`] sets them aside; a finer search between them and the next
 /// creeping hold says whether they were luck.
 pub fn set_aside(runs: &[HoldVerdict], kind: CreepCriterionKind) -> Vec<f64> {
-    let last_unstable = runs.iter().rposition(|r| !r.stable_by(kind));
+    // an undecided hold (record too short) is not a creeping one
+    let last_unstable = runs
+        .iter()
+        .rposition(|r| !r.stable_by(kind) && !r.verdict(kind).is_some_and(CriterionVerdict::undecided));
     runs.iter()
         .enumerate()
         .filter(|(i, r)| last_unstable.is_some_and(|u| *i < u) && r.stable_by(kind))
@@ -417,9 +446,21 @@ pub fn verdict_line(r: &HoldVerdict) -> String {
         None => "not judged".to_string(),
         Some(v) if v.stable => "stable".to_string(),
         Some(_) if r.released => "disrupted".to_string(),
+        Some(v) if v.undecided() => format!(
+            "undecided (record too short: {:.0} s judged, need {})",
+            r.hold_s,
+            r.record_needed_s
+                .map_or(format!("{} samples", 2 * MIN_SECOND_HALF_SAMPLES), |s| format!(
+                    "{s:.0} s"
+                ))
+        ),
         Some(v) => format!("creeps ({})", v.drifting.join(", ")),
     };
-    let rates = r.rates.map_or(String::new(), |q| {
+    let too_short = CreepCriterionKind::ALL
+        .iter()
+        .all(|&k| r.verdict(k).is_none_or(CriterionVerdict::undecided));
+    // the rates of too few samples are meaningless (standard errors of inf)
+    let rates = r.rates.filter(|_| !too_short).map_or(String::new(), |q| {
         format!(
             "; rates per 1000 s: theta_max {:+.3} +- {:.3} deg, eta_B {:+.2e} +- {:.1e}, coordination {:+.4} +- {:.4}",
             q.theta_max_deg.rate_per_ks,
@@ -442,6 +483,21 @@ pub fn verdict_line(r: &HoldVerdict) -> String {
         r.drift.packing,
         r.drift.coordination
     )
+}
+
+/// `" (undecided, record too short: 2.50, 2.60 h)"` when holds of `runs` are undecided under `kind`, else empty: why a
+/// search may have no T_c,3 that is not creep.
+pub fn undecided_note(runs: &[HoldVerdict], kind: CreepCriterionKind) -> String {
+    let t: Vec<String> = runs
+        .iter()
+        .filter(|r| r.verdict(kind).is_some_and(CriterionVerdict::undecided))
+        .map(|r| format!("{:.2}", r.t_final_hours))
+        .collect();
+    if t.is_empty() {
+        String::new()
+    } else {
+        format!(" (undecided, record too short: {} h)", t.join(", "))
+    }
 }
 
 /// The `critical.csv` header written before Dec 2026 (one-sided tolerance verdicts in `paper_*`, no rates); still
@@ -625,6 +681,7 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
             ours: verdict("ours")?,
             drifting: selected.drifting,
             stable: selected.stable,
+            record_needed_s: None,
         });
     }
     Ok(out)
@@ -746,7 +803,11 @@ pub fn judge_dir(
             ),
             _ => emit(
                 Channel::Out,
-                &format!("{} criterion: no T_c3 among these holds", kind.name()),
+                &format!(
+                    "{} criterion: no T_c3 among these holds{}",
+                    kind.name(),
+                    undecided_note(&judged, kind)
+                ),
             ),
         }
     }
@@ -1117,5 +1178,71 @@ mod tests {
             "{}",
             e.to_string()
         );
+    }
+
+    /// A hold whose judged record has too few samples is undecided, not creeping: its line says how long a record it
+    /// needs and prints no rates of ± inf, a stable hold below it is not set aside as non-monotone, and the search
+    /// says why it has no T_c,3. `critical.csv` keeps its vocabulary (`false`, `record_too_short`).
+    #[test]
+    fn a_record_too_short_is_undecided_not_creeping() {
+        let series = |n: usize| HoldSeries {
+            t_s: (0..n).map(|k| 108.0 + 200.0 * k as f64).collect(),
+            theta_max_deg: vec![30.0; n],
+            packing: vec![0.65; n],
+            coordination: vec![5.0; n],
+            release_s: None,
+        };
+        let criteria = Criteria::default();
+        let short = judge_series(
+            &series(5),
+            None,
+            &criteria,
+            CreepCriterionKind::Paper,
+            2.70,
+            PathBuf::new(),
+        );
+        let line = verdict_line(&short);
+        assert!(
+            line.contains("paper undecided (record too short: 908 s judged, need 1508 s)"),
+            "{line}"
+        );
+        assert!(!line.contains("creeps") && !line.contains("inf"), "{line}");
+        assert!(
+            CreepCriterionKind::ALL
+                .iter()
+                .all(|&k| short.verdict(k).unwrap().undecided())
+        );
+        // a window that cuts a longer record: the needed length is read off the record
+        let cut = judge_series(
+            &series(20),
+            Some(1000.0),
+            &criteria,
+            CreepCriterionKind::Paper,
+            2.70,
+            PathBuf::new(),
+        );
+        assert_eq!(cut.record_needed_s, Some(1508.0));
+        let long = judge_series(
+            &series(20),
+            None,
+            &criteria,
+            CreepCriterionKind::Paper,
+            2.60,
+            PathBuf::new(),
+        );
+        assert!(long.stable && long.record_needed_s.is_none(), "{}", verdict_line(&long));
+        let runs = [long, short];
+        for kind in CreepCriterionKind::ALL {
+            assert!(set_aside(&runs, kind).is_empty());
+            assert_eq!(critical_from_verdicts(&runs, kind), (None, None));
+            assert_eq!(undecided_note(&runs, kind), " (undecided, record too short: 2.70 h)");
+        }
+        let csv = critical_csv(&runs);
+        assert!(
+            csv.lines().nth(2).unwrap().ends_with(",false,record_too_short"),
+            "{csv}"
+        );
+        let back = read_critical_csv(&csv).unwrap();
+        assert!(back[1].paper.as_ref().unwrap().undecided() && back[1].ours.undecided());
     }
 }

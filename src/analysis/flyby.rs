@@ -390,9 +390,18 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
 }
 
 /// `rubblepile flyby`: prepares and runs the flyby of `args` ([`run_flyby`]), then analyses it ([`analyze_flyby`]);
-/// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request).
+/// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request). A
+/// bad value is named by its flag ([`crate::impact::flyby::flag`]).
 pub fn flyby_command(args: &FlybyConfig, options: &crate::driver::RunOptions) -> Result<Vec<String>, (String, u8)> {
-    let runs = run_flyby(args, options).map_err(|e| (e.to_string(), e.exit_code()))?;
+    let runs = run_flyby(args, options).map_err(|e| {
+        let message = match &e {
+            crate::impact::run::ImpactError::Invalid { field, message } => {
+                format!("{}: {message}", crate::impact::flyby::flag(field))
+            }
+            other => other.to_string(),
+        };
+        (message, e.exit_code())
+    })?;
     let Some(runs) = runs else {
         return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
     };
@@ -444,7 +453,7 @@ impl FlybyOutcome {
     pub fn one_line(&self) -> String {
         let t = &self.tide;
         format!(
-            "flyby: {} (RBL98 {}), tide ({}): mass lost {:.4}, dP {:+.3} h (pi|L|/E {:+.3} h), d(b/a) {:+.4}, d(c/a) {:+.4}; run: P {:.3} h -> {:.3} h, b/a {:.3} -> {:.3}, c/a {:.3} -> {:.3}",
+            "flyby: {} (RBL98 {}), tide ({}): mass lost {:.4} of the target's, d(period) {:+.3} h (d(pi|L|/E) {:+.3} h), d(b/a) {:+.4}, d(c/a) {:+.4}; run: P {:.3} h -> {:.3} h, b/a {:.3} -> {:.3}, c/a {:.3} -> {:.3}",
             self.class,
             self.rbl98_class,
             if t.from_control {

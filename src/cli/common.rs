@@ -87,7 +87,6 @@ impl CheckpointArgs {
             (None, Err(_)) => DEFAULT_PROGRESS_EVERY,
         };
         Ok(RunOptions {
-            force: false,
             progress,
             checkpoint_every: (t.checkpoint_every > 0.0).then_some(t.checkpoint_every),
             checkpoint_every_sim: t.checkpoint_every_sim,
@@ -96,6 +95,7 @@ impl CheckpointArgs {
             stop_after_checkpoints: self.stop_after_checkpoints,
             max_steps: t.max_steps.map(|n| n as u64),
             max_wall_seconds: t.max_wall_seconds,
+            ..RunOptions::default()
         })
     }
 }

@@ -83,7 +83,7 @@ pub struct CriticalArgs {
     /// paper-tolerance criterion lets pass (default 0.05).
     #[arg(long, value_name = "CHANGE")]
     pub coordination_tolerance: Option<f64>,
-    /// Length of each hold (s) with `--branch`; default: the scene's `t_end − t_final`.
+    /// Length of each hold (s); needs `--branch` (refused without it); default: the scene's `t_end − t_final`.
     #[arg(long = "hold-s", value_name = "SECONDS")]
     pub hold: Option<f64>,
     /// Run every hold from --from-h to --to-h, also after both criteria have found a stable one (by default the

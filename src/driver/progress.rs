@@ -53,16 +53,23 @@ pub struct Lines {
     // A cell: the run's failure path and its progress callback both hold the display.
     last: Cell<Instant>,
     t_start: f64,
+    label: Option<&'static str>,
 }
 
 impl Progress {
     /// The bar when `enabled` and stderr is a terminal; lines every `every` wall-clock seconds when `enabled`,
-    /// stderr is not a terminal and `every > 0`; otherwise nothing.
-    pub fn new(enabled: bool, every: f64, t_end: f64, t: f64) -> Progress {
+    /// stderr is not a terminal and `every > 0`; otherwise nothing. `label` names the run in each line and in the
+    /// bar's message (a flyby's `run` and `control`, which run one after the other).
+    pub fn new(enabled: bool, every: f64, t_end: f64, t: f64, label: Option<&'static str>) -> Progress {
         if !enabled {
             Progress::Off
         } else if std::io::stderr().is_terminal() {
-            progress_bar(true, t_end, t).map_or(Progress::Off, Progress::Bar)
+            progress_bar(true, t_end, t).map_or(Progress::Off, |pb| {
+                if let Some(l) = label {
+                    pb.set_prefix(l);
+                }
+                Progress::Bar(pb)
+            })
         } else if every.is_finite() && every > 0.0 {
             let now = Instant::now();
             Progress::Lines(Lines {
@@ -71,6 +78,7 @@ impl Progress {
                 started: now,
                 last: Cell::new(now),
                 t_start: t,
+                label,
             })
         } else {
             Progress::Off
@@ -88,7 +96,10 @@ impl Progress {
                     lines.last.set(Instant::now());
                     emit(
                         Channel::Progress,
-                        &progress_line(t, t_end, lines.t_start, lines.started.elapsed(), error),
+                        &labelled(
+                            lines.label,
+                            progress_line(t, t_end, lines.t_start, lines.started.elapsed(), error),
+                        ),
                     );
                 }
             }
@@ -135,16 +146,15 @@ pub fn progress_line(t: f64, t_end: f64, t_start: f64, wall: Duration, error: Op
     line
 }
 
-/// A simulated time (s) for a progress or status line: rounded to four decimals, so that a time made of steps
-/// (`3 × 1.1` = 3.3000000000000003) prints as `3.3`; a whole time prints without decimals (`120`).
-pub fn fmt_time(t: f64) -> String {
-    let r = (t * 1e4).round() / 1e4;
-    if r.is_finite() {
-        format!("{}", r + 0.0)
-    } else {
-        format!("{t}")
+/// A progress line of the run named `label`: `progress: control: t = …` (unchanged without a label).
+pub fn labelled(label: Option<&str>, line: String) -> String {
+    match label {
+        Some(l) => line.replacen("progress: ", &format!("progress: {l}: "), 1),
+        None => line,
     }
 }
+
+pub use crate::io::messages::fmt_time;
 
 /// Seconds as `2h 5m 3s`, `5m 3s` or `3s` (whole seconds).
 fn clock(s: f64) -> String {
@@ -162,8 +172,9 @@ pub fn progress_bar(enabled: bool, t_end: f64, t: f64) -> Option<indicatif::Prog
         return None;
     }
     let pb = indicatif::ProgressBar::with_draw_target(Some(1_000_000), indicatif::ProgressDrawTarget::stderr());
-    let style = indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg} ETA {eta}")
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    let style =
+        indicatif::ProgressStyle::with_template("{spinner} {prefix} [{elapsed_precise}] {wide_bar} {msg} ETA {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
     pb.set_style(style);
     pb.set_position((t / t_end * 1e6) as u64);
     pb.reset_eta();
@@ -207,14 +218,28 @@ mod tests {
     }
 
     /// Issue 57: times made of steps print rounded, not with their round-off digits.
+    /// A flyby's run and control each go from 0 to 100 %: their lines say which is which; an unnamed run's are as
+    /// before.
     #[test]
-    fn fmt_time_rounds_step_times_to_four_decimals() {
+    fn progress_lines_of_a_named_run_say_its_name() {
+        let line = progress_line(3.0, 6.0, 0.0, Duration::from_secs(1), None);
+        assert!(labelled(Some("control"), line.clone()).starts_with("progress: control: t = 3 of 6 s"));
+        assert_eq!(labelled(None, line.clone()), line);
+    }
+
+    #[test]
+    fn fmt_time_prints_six_significant_digits() {
         assert_eq!(format!("{}", 3.0 * 1.1), "3.3000000000000003");
         assert_eq!(fmt_time(3.0 * 1.1), "3.3");
         assert_eq!(fmt_time(3931.2 + 4.6e-13), "3931.2");
         assert_eq!(fmt_time(120.0), "120");
         assert_eq!(fmt_time(0.1 + 0.2), "0.3");
-        assert_eq!(fmt_time(1.23456789), "1.2346");
+        assert_eq!(fmt_time(1.23456789), "1.23457");
+        // a flyby's adaptive end time and its progress total once printed 17 and 10 digits
+        assert_eq!(fmt_time(48234.652155108546), "48234.7");
+        assert_eq!(fmt_time(122782.7643), "122783");
+        assert_eq!(fmt_time(0.999996), "0.999996");
+        assert_eq!(fmt_time(1234567.0), "1234567");
         assert_eq!(fmt_time(-0.0), "0");
         assert_eq!(fmt_time(f64::INFINITY), "inf");
         let line = progress_line(3.0 * 1.1, 6.0 * 1.1, 0.0, Duration::from_secs(60), None);

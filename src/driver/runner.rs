@@ -62,6 +62,9 @@ pub struct RunOptions {
     /// Most wall-clock seconds this process may run the run (`--max-wall-s`), over the scene's
     /// `[run] max_wall_seconds`; `None`: the scene's, else no limit.
     pub max_wall_seconds: Option<f64>,
+    /// The name of this run in its progress lines and bar (`None`: unnamed), for a command that runs several one
+    /// after another (a flyby's `run` and `control`).
+    pub progress_label: Option<&'static str>,
 }
 
 impl Default for RunOptions {
@@ -78,6 +81,7 @@ impl Default for RunOptions {
             stop_after_checkpoints: None,
             max_steps: None,
             max_wall_seconds: None,
+            progress_label: None,
         }
     }
 }
@@ -797,7 +801,13 @@ impl<E: Engine> Session<E> {
     ) -> Self {
         let ts_path = out_dir.join("timeseries.csv");
         let started = Instant::now();
-        let shown = progress::Progress::new(options.progress, options.progress_every, engine.t_end(), engine.time());
+        let shown = progress::Progress::new(
+            options.progress,
+            options.progress_every,
+            engine.t_end(),
+            engine.time(),
+            options.progress_label,
+        );
         // The wall-clock budget holds inside a sample interval too: past the deadline an advance stops, and the run
         // stops with a checkpoint of the state saved at the sample before (kept only when there is a budget).
         let deadline = budget

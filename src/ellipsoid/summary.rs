@@ -171,16 +171,24 @@ impl RunSummary {
     }
 
     /// The one-line report printed after a run, e.g.
-    /// `done: t = 200 s, wall 1.23 s, steps 456 (12 rejected), RHS 7890, energy error 3.1e-11, |dP| 1e-16, |dL| 2e-15, max||q|-1| 1e-12`.
+    /// `done: t = 200 s, wall 1.23 s, steps 456 (12 rejected), RHS 7890, energy error 3.1e-11, |dP| 1e-16, |dL| 2e-15, max||q|-1| 1e-12`:
+    /// the time to six significant digits ([`crate::io::messages::fmt_time`]), the errors relative to their
+    /// [`Scales`]. A flyby adds the tide's impulse and torque impulse in N s and N m s, each also as a fraction of
+    /// its scale, beside the momentum errors they are not.
     pub fn one_line(&self) -> String {
         let head = if self.completed() { "done" } else { "stopped" };
         let tide = match (self.tidal_impulse, self.tidal_torque_impulse) {
-            (Some(p), Some(l)) => format!(" (tide's impulse, not errors: |int F dt| {p:.1e}, |int tau dt| {l:.1e})"),
+            (Some(p), Some(l)) => format!(
+                " (tide's impulse, not errors: |int F dt| {:.1e} N s ({p:.1e} of the momentum scale), |int tau dt| \
+                 {:.1e} N m s ({l:.1e} of the angular-momentum scale))",
+                p * self.scales.momentum,
+                l * self.scales.angular_momentum
+            ),
             _ => String::new(),
         };
         format!(
             "{head}: t = {} s, wall {:.2} s, steps {} ({} rejected), RHS {}, energy error {:.1e}, |dP| {:.1e}, |dL| {:.1e}, max||q|-1| {:.1e}{tide}",
-            self.final_time,
+            crate::io::messages::fmt_time(self.final_time),
             self.wall_seconds,
             self.steps_accepted,
             self.steps_rejected,

@@ -121,6 +121,15 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     {
         return Err(SearchError::usage(format!("--judge-window-s must be > 0 s, got {w}")));
     }
+    // without --branch every hold runs the scene from t = 0 to its own t_end, so a hold length has no meaning
+    if let Some(hold) = args.hold
+        && !args.branch
+    {
+        return Err(SearchError::usage(format!(
+            "--hold-s {hold} needs --branch (without it each hold runs the scene from t = 0 to its t_end: set the \
+             hold's length there)"
+        )));
+    }
     let json = args.out.join("critical.json");
     if json.exists() && !args.force && args.shard.is_none() && !args.prepare_only {
         return Err(SearchError::usage(format!(
@@ -341,9 +350,10 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             _ => emit(
                 Channel::Out,
                 &format!(
-                    "{} criterion: no stable T_final up to {} h",
+                    "{} criterion: no stable T_final up to {} h{}",
                     r.criterion.kind.name(),
-                    args.to
+                    args.to,
+                    undecided_note(&out.runs, r.criterion.kind)
                 ),
             ),
         }
@@ -697,5 +707,31 @@ mod tests {
         // legs shorter than the sample spacing still advance, one sample at a time
         assert_eq!(base_legs(&samples, 0, 30, 3), [10, 20, 30]);
         assert!(base_legs(&samples, 200, 200, 45).is_empty());
+    }
+
+    /// `--hold-s` sets the hold of a branched search only: without `--branch` it is refused by name, whatever its
+    /// value, before any scene is read or hold run (it was once silently ignored and 21 full runs began).
+    #[test]
+    fn hold_s_without_branch_is_refused_naming_both_flags() {
+        for hold in [-5.0, 2000.0] {
+            let args = CriticalOptions {
+                hold: Some(hold),
+                ..CriticalOptions::new(
+                    PathBuf::from("/nonexistent/scene.toml"),
+                    2.5,
+                    2.7,
+                    0.1,
+                    PathBuf::from("/nonexistent/out"),
+                )
+            };
+            let e = match critical(&args) {
+                Err(SearchError::Usage(m)) => m,
+                other => panic!("expected a usage error, got {other:?}"),
+            };
+            assert!(
+                e.contains("--hold-s") && e.contains("needs --branch") && !e.contains('\n'),
+                "{e}"
+            );
+        }
     }
 }

@@ -177,6 +177,17 @@ pub fn output_times(t_end: f64, n: usize) -> Vec<f64> {
     crate::io::output_times::evenly_spaced(t_end, n)
 }
 
+/// The `rubblepile flyby` flag of a [`FlybyConfig`] field named in an error: the field with dashes (`q_m` is
+/// `--q-m`), except those whose flag spells its unit otherwise.
+pub fn flag(field: &str) -> String {
+    match field {
+        "period_hours" => "--period-h".into(),
+        "planet_mass" => "--planet-mass-kg".into(),
+        "settle_max_hours" => "--settle-max-h".into(),
+        other => format!("--{}", other.replace('_', "-")),
+    }
+}
+
 fn invalid(field: &str, message: String) -> ImpactError {
     ImpactError::Invalid {
         field: field.into(),
@@ -500,8 +511,10 @@ pub fn run_flyby(args: &FlybyConfig, options: &RunOptions) -> Result<Option<Flyb
     if args.no_run {
         return Ok(None);
     }
+    // the run and its control show the same 0 to 100 %: their progress lines say which is which
     let options = RunOptions {
         force: true,
+        progress_label: Some("run"),
         ..*options
     };
     let run = crate::driver::run_scene(&scene, &args.out, &options)?;
@@ -510,7 +523,10 @@ pub fn run_flyby(args: &FlybyConfig, options: &RunOptions) -> Result<Option<Flyb
         Some(crate::driver::run_scene(
             &control,
             &args.out.join(CONTROL_DIR),
-            &options,
+            &RunOptions {
+                progress_label: Some(CONTROL_DIR),
+                ..options
+            },
         )?)
     } else {
         None

@@ -60,6 +60,21 @@ pub fn default_sink(channel: Channel, line: &str) {
     }
 }
 
+/// A simulated time (s) for a line a person reads (progress, `done:`): six significant digits, so that an adaptive
+/// step's time (`48234.652155108546`) prints as `48234.7` and a time made of steps (`3 × 1.1` = 3.3000000000000003)
+/// as `3.3`; a whole time prints whole, without decimals (`120`, `1234567`). The files keep every digit.
+pub fn fmt_time(t: f64) -> String {
+    if !t.is_finite() {
+        return format!("{t}");
+    }
+    let whole = t.round();
+    if (t - whole).abs() <= 1e-9 * whole.abs().max(1.0) {
+        return format!("{}", whole + 0.0);
+    }
+    let r: f64 = format!("{t:.5e}").parse().unwrap_or(t);
+    format!("{}", r + 0.0)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

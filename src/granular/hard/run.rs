@@ -265,7 +265,7 @@ impl HardRunSummary {
         format!(
             "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy error {:.2e} (change {:.2e}: restitution {:.2e} J, walls {:.2e} J, removed {:.2e} J), momentum error {:.2e} kg m/s (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
             self.status,
-            self.t_reached,
+            crate::io::messages::fmt_time(self.t_reached),
             self.steps,
             self.collisions,
             self.events_per_second,

@@ -136,7 +136,7 @@ impl SoftSummary {
         format!(
             "{}: t = {} s, {} steps, {} particles, energy error {:.3e}, max overlap {:.3e} of radius, {:.2} s",
             self.status,
-            self.final_time,
+            crate::io::messages::fmt_time(self.final_time),
             self.steps,
             self.n_particles,
             self.energy_error,

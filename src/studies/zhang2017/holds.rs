@@ -165,7 +165,7 @@ pub fn write_holds_section(md: &mut String, searches: &[(String, PathBuf, f64)],
         let _ = writeln!(md, "### {label}\n");
         let _ = writeln!(
             md,
-            "| T_final (h) | ρ_B at 2.26 h (kg/m³) | released | Δθ_max (°) | Δη_B | Δ contacts per particle | ours | paper's |"
+            "| T_final (h) | ρ_B at 2.26 h (kg/m³) | released | Δθ_max (°) | Δη_B | Δ contacts per particle | ours | paper-tolerance |"
         );
         let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- |");
         for v in &verdicts {

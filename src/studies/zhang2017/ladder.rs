@@ -20,7 +20,7 @@ use super::rows::{
     ModelRow, PaperRow, TABLE3, base_model, flagged, mode, model_dirs, model_row, opt, search_subdirs, warn_settling,
 };
 
-/// The search of a rung: its T_c,3 (h) and φ (°) by the paper's criterion and by ours, its step of T_final (h),
+/// The search of a rung: its T_c,3 (h) and φ (°) by the paper-tolerance criterion and by ours, its step of T_final (h),
 /// and its directory name.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RungSearch {
@@ -28,7 +28,7 @@ pub struct RungSearch {
     pub name: String,
     /// Smallest difference between two holds' T_final (h).
     pub step_hours: f64,
-    /// T_c,3 (h) and φ (°) by the paper's criterion.
+    /// T_c,3 (h) and φ (°) by the paper's criterion with tolerances (`paper-tolerance`).
     pub paper: (Option<f64>, Option<f64>),
     /// T_c,3 (h) and φ (°) by ours.
     pub ours: (Option<f64>, Option<f64>),
@@ -62,7 +62,7 @@ pub fn read_search(dir: &Path) -> Option<RungSearch> {
     })
 }
 
-/// The search a rung's row shows: of those that found a T_c,3 by the paper's criterion the finest; else the
+/// The search a rung's row shows: of those that found a T_c,3 by the paper-tolerance criterion the finest; else the
 /// finest of all.
 pub fn chosen_search(searches: &[RungSearch]) -> Option<&RungSearch> {
     let by_step = |a: &&RungSearch, b: &&RungSearch| a.step_hours.total_cmp(&b.step_hours);
@@ -162,15 +162,15 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
         md,
         "Rungs under `{}`: the same body, material and path 2 at several grain counts (lengths scaled with the grain \
          radius). T_c,1/T_c,2 by the rule of Table 3 above (sampled, then smoothed); T_c,3 and φ from the rung's finest \
-         search that found one (`critical*/critical.json`), by the paper's criterion and by ours. The paper's row is \
+         search that found one (`critical*/critical.json`), by the paper's criterion with tolerances (`paper-tolerance`) and by ours. The paper's row is \
          Table 3 (path 1; its T_c,3 does not depend on the path, §4.3) at the grain count of its Table 2. In the figures \
          each model has its colours, the paper's value is the dashed line, and the points of our criterion sit 4 % to \
-         the right of the rung's grain count so that they do not hide the paper's criterion's.\n",
+         the right of the rung's grain count so that they do not hide the paper-tolerance criterion's.\n",
         ladder.display()
     );
     let _ = writeln!(
         md,
-        "| rung | grains | radius (m) | η_B | T_c1 / T_c2 (h) | smoothed T_c1 / T_c2 (h) | mode | T_c3, φ: paper's criterion | T_c3, φ: ours | search (step, holds) | largest overlap / r | wall (s) |"
+        "| rung | grains | radius (m) | η_B | T_c1 / T_c2 (h) | smoothed T_c1 / T_c2 (h) | mode | T_c3, φ: paper-tolerance | T_c3, φ: ours | search (step, holds) | largest overlap / r | wall (s) |"
     );
     let _ = writeln!(
         md,
@@ -259,14 +259,14 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
         };
         write_figure(out, name, &chart).map_err(|e| e.to_string())
     };
-    // the paper's value is drawn once per model: beside the paper's criterion (Table 3 gives one T_c,3 and φ)
+    // the paper's value is drawn once per model: beside the paper-tolerance criterion (Table 3 gives one T_c,3 and φ)
     figure(
         "ladder",
         "T_c3 against the grain count (path 2)",
         "T_c3 (h)",
         &[
             (
-                "T_c3 (paper's criterion)",
+                "T_c3 (paper-tolerance criterion)",
                 &|r| r.chosen().and_then(|s| s.paper.0),
                 Some(|p| p.5),
             ),
@@ -279,7 +279,7 @@ pub fn write_ladder_section(md: &mut String, ladder: &Path, out: &Path) -> Resul
         "phi (deg)",
         &[
             (
-                "phi (paper's criterion)",
+                "phi (paper-tolerance criterion)",
                 &|r| r.chosen().and_then(|s| s.paper.1),
                 Some(|p| p.2),
             ),

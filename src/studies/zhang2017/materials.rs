@@ -66,7 +66,7 @@ pub fn write_materials_section(md: &mut String, runs: &Path, rows: &[ModelRow]) 
         md,
         "The model spun up along path 2 with the weaker and the stronger material of §4.4, each from a pile settled \
          with that material (runs `<model>_beta<β>_mus<μ_s>`, scenes `analysis/zhang2017/<model>_beta<β>_mus<μ_s>_path2.toml`); \
-         the nominal row is Table 3's. T_c3 by the paper's creep criterion and by ours, and where the pile stops \
+         the nominal row is Table 3's. T_c3 by the paper's creep criterion with tolerances (`paper-tolerance`) and by ours, and where the pile stops \
          failing (the shortest period held above every released hold; holds of 16 000 s). φ is the θ_max of that \
          hold, and κ₃ and ρ_B^{{c,3}} (the bulk density whose T_c3 is the Didymos period, {DIDYMOS_PERIOD_HOURS} h) \
          follow from its period by Eq. 22 at the one density run: where it stops failing is defined for every \
@@ -75,7 +75,7 @@ pub fn write_materials_section(md: &mut String, runs: &Path, rows: &[ModelRow]) 
     );
     let _ = writeln!(
         md,
-        "| model | β, μ_s | spun up from | T_c1 / T_c2 (h) | T_c3 (h): paper's / ours | stops failing (h) | φ (°) there | κ₃, ρ_B^{{c,3}} (kg/m³) there | paper: κ₃, ρ_B^{{c,3}}, φ |"
+        "| model | β, μ_s | spun up from | T_c1 / T_c2 (h) | T_c3 (h): paper-tolerance / ours | stops failing (h) | φ (°) there | κ₃, ρ_B^{{c,3}} (kg/m³) there | paper: κ₃, ρ_B^{{c,3}}, φ |"
     );
     let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for &(model, beta, mu_s, rho_c, kappa, phi) in TABLE7.iter().filter(|t| models.contains(&t.0)) {

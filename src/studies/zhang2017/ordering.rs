@@ -171,7 +171,7 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
          scaled HCP (3033 grains) and RCP (2083 grains) searched with the twisting and rolling resistance of Eqs. \
          11–12 changed, everything else as in Table 3 above (searches under `{}`, the nominal ones under `{}`; \
          holds of 16 000 s branched off one path-2 run each). T_c3 by our creep criterion (θ_max and η_B) and by \
-         the paper's (also the coordination number), each where the trailing run of stable holds begins; \"> X\" \
+         the paper's with tolerances (`paper-tolerance`, also the coordination number), each where the trailing run of stable holds begins; \"> X\" \
          when the slowest hold, X h, is not stable. 'Stops failing' is the shortest period held above every \
          released hold, whatever the creep criteria say (they differ from it where slow holds relax, θ_max falling \
          by more than 0.5°, or lose contacts); '≤' when no hold was released. Holds: R released, S stable, C creeping, by ours. The last column is RCP's 'stops failing' minus \
@@ -181,7 +181,7 @@ pub fn write_ordering_section(md: &mut String, runs: &Path, ordering: &Path) {
     );
     let _ = writeln!(
         md,
-        "| contact law | HCP: ours | HCP: paper's criterion | HCP: stops failing | HCP holds | RCP: ours | RCP: paper's criterion | RCP: stops failing | RCP holds | RCP − HCP (h) |"
+        "| contact law | HCP: ours | HCP: paper-tolerance | HCP: stops failing | HCP holds | RCP: ours | RCP: paper-tolerance | RCP: stops failing | RCP holds | RCP − HCP (h) |"
     );
     let _ = writeln!(md, "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     let stops = |s: &Option<VariantSearch>| {

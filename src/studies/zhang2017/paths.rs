@@ -74,7 +74,7 @@ pub fn write_paths_section(md: &mut String, runs: &Path, paths: &Path) -> Result
     );
     let _ = writeln!(
         md,
-        "| model | path | T_c1 (h) | T_c2 (h) | smoothed T_c1/T_c2 | T_c3 (h), paper's / our creep criterion | failure mode | status | simulated / t_end (s) | wall (s) | largest overlap / radius | paper T_c1 / T_c2 / T_c3 (h) |"
+        "| model | path | T_c1 (h) | T_c2 (h) | smoothed T_c1/T_c2 | T_c3 (h), paper-tolerance / our creep criterion | failure mode | status | simulated / t_end (s) | wall (s) | largest overlap / radius | paper T_c1 / T_c2 / T_c3 (h) |"
     );
     let _ = writeln!(
         md,

@@ -76,7 +76,7 @@ pub const DENSITY_LIMITS: usize = 4;
 pub struct DensitySeries {
     /// Model name.
     pub model: String,
-    /// (ρ_B, [T_c1, T_c2, T_c3 paper's criterion, T_c3 ours]) by increasing density.
+    /// (ρ_B, [T_c1, T_c2, T_c3 paper-tolerance, T_c3 ours]) by increasing density.
     pub points: Vec<(f64, [Option<f64>; DENSITY_LIMITS])>,
     /// Fit of limit i (κ_i ± σ, critical bulk density at [`DIDYMOS_PERIOD_HOURS`]) over at least 2 densities.
     pub fits: [Option<DensityFit>; DENSITY_LIMITS],
@@ -169,11 +169,12 @@ pub struct ModelRow {
     /// Whether that scatter of single samples is below half the T_c,2 threshold, so that T_c,2 measures the
     /// packing and not the scatter ([`t_c2_resolved`] with a window of one sample).
     pub t_c2_resolved: bool,
-    /// T_c,3 (h) and φ (°) from `critical.json`.
+    /// T_c,3 (h) and φ (°) from `critical.json` by the paper's creep criterion with tolerances (`paper-tolerance`),
+    /// the rule of the searches made before Dec 2026 that the report's tables keep.
     pub t_c3: Option<f64>,
     /// See `t_c3`.
     pub phi: Option<f64>,
-    /// T_c,3 (h) and φ (°) by the paper's creep criterion and by ours, from a `critical.json` that records both
+    /// T_c,3 (h) and φ (°) by the paper-tolerance creep criterion and by ours, from a `critical.json` that records both
     /// (searches made after the paper's criterion came in; [`rubblepile::analysis::creep`]); `None` for older ones.
     pub t_c3_by_criterion: Option<[LimitAndAngle; 2]>,
     /// κ₃ of Eq. 22.
@@ -458,10 +459,25 @@ pub(crate) fn mode(m: Option<FailureMode>) -> &'static str {
 
 /// The model directories under `runs`, sorted by name: those with a `path2/spinup.csv` (this project's layout)
 /// or with a `spinup.csv` directly in them (a user's `rubblepile run` of a spin-up scene); `runs` alone when it
-/// is such a run directory itself.
+/// is such a run directory itself. A T_c,3 search directory ([`is_search_dir`]) is refused with the layout expected:
+/// its holds are not models.
 pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
     if runs.join("spinup.csv").is_file() {
         return Ok(vec![runs.to_path_buf()]);
+    }
+    if is_search_dir(runs) {
+        let base = if runs.join("base/spinup.csv").is_file() {
+            format!("{}/base", runs.display())
+        } else {
+            "PATH2_RUN".to_string()
+        };
+        return Err(format!(
+            "{0}: a `spinup critical` search directory (critical.json or hold runs T<period>/), not a directory of \
+             models; the report reads RUNS/<model>/path2/ (the path-2 spin-up run) and RUNS/<model>/critical/ (its \
+             search), e.g. mkdir -p R/rcp && ln -s \"$PWD/{base}\" R/rcp/path2 && ln -s \"$PWD/{0}\" R/rcp/critical, \
+             then report zhang2017 R",
+            runs.display()
+        ));
     }
     let mut models: Vec<_> = std::fs::read_dir(runs)
         .map_err(|e| format!("{}: {e}", runs.display()))?
@@ -471,6 +487,25 @@ pub fn model_dirs(runs: &Path) -> Result<Vec<std::path::PathBuf>, String> {
         .collect();
     models.sort();
     Ok(models)
+}
+
+/// Whether `dir` is the output of `rubblepile spinup critical` (its `critical.json` or `critical.csv`, or its
+/// `--branch` base run `base/` beside hold runs `T<period>/`) rather than a directory of models.
+pub fn is_search_dir(dir: &Path) -> bool {
+    let hold = |p: &Path| {
+        p.join("spinup.csv").is_file()
+            && p.file_name()
+                .and_then(|n| n.to_str()?.strip_prefix('T')?.parse::<f64>().ok())
+                .is_some()
+    };
+    dir.join("critical.json").is_file()
+        || dir.join("critical.csv").is_file()
+        || (dir.join("base/spinup.csv").is_file()
+            && std::fs::read_dir(dir)
+                .into_iter()
+                .flatten()
+                .filter_map(|e| e.ok())
+                .any(|e| hold(&e.path())))
 }
 
 /// The run directory of `model_dir`'s spin-up path `path`: `model_dir/path`, or for path 2 `model_dir` itself
