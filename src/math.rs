@@ -70,3 +70,9 @@ pub fn time_at_error(points: &[(f64, f64)], error: f64) -> Option<f64> {
     }
     None
 }
+
+/// The bytes a vector's buffer holds: its capacity times the element size (heap memory the elements own
+/// themselves is not counted).
+pub fn vec_bytes<T>(v: &Vec<T>) -> usize {
+    v.capacity() * std::mem::size_of::<T>()
+}

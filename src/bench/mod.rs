@@ -15,6 +15,7 @@ pub mod ab;
 pub mod critical;
 pub mod hsdem;
 pub mod impact_wall_time;
+pub mod memory;
 pub mod nbody;
 pub mod render;
 pub mod rhs;

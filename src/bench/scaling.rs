@@ -192,7 +192,7 @@ fn fingerprint_f64(values: &[f64]) -> String {
 }
 
 /// A relaxed pile with its κ (from `FILE.json`), under gravity by `method`, contact and dissipation.
-fn pile_system(path: &Path, method: GravityMethod) -> Result<EllipsoidSystem, BenchError> {
+pub(crate) fn pile_system(path: &Path, method: GravityMethod) -> Result<EllipsoidSystem, BenchError> {
     let bodies = read_target(path).map_err(|e| BenchError::usage(format!("{}: {e}", path.display())))?;
     let json = path.with_extension("json");
     let text = std::fs::read_to_string(&json).map_err(|e| BenchError::usage(format!("{}: {e}", json.display())))?;

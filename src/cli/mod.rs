@@ -239,6 +239,8 @@ pub enum BenchCommand {
     Impact(crate::bench::impact_wall_time::ImpactBenchArgs),
     /// Soft-sphere engine throughput (particle-steps per second) on 1 and 2 threads (CSV + SVG).
     Ssdem(crate::bench::ssdem::BenchSsdemArgs),
+    /// Bytes per grain or body: peak resident set and the engine's own count, each case in a process of its own.
+    Memory(crate::bench::memory::BenchMemoryArgs),
     /// Strong scaling of every engine at 1, 2, 4, … threads: speed-up, efficiency, Karp–Flatt serial fraction,
     /// where the time goes (CSV + plot).
     Scaling(crate::bench::scaling::ScalingArgs),
@@ -340,6 +342,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             crate::bench::impact_wall_time::impact(&args).map_err(CliError::from)
         }
         Command::Bench(BenchCommand::Ssdem(args)) => Ok(crate::bench::ssdem::bench(&args)?),
+        Command::Bench(BenchCommand::Memory(args)) => Ok(crate::bench::memory::bench(&args)?),
         Command::Bench(BenchCommand::Critical(args)) => Ok(crate::bench::critical::bench(&args)?),
         Command::Bench(BenchCommand::Ab(args)) => Ok(crate::bench::ab::bench(&args)?),
         Command::Bench(BenchCommand::Scaling(args)) => Ok(crate::bench::scaling::scaling(&args)?),

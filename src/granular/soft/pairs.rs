@@ -351,6 +351,19 @@ pub struct PairList {
 }
 
 impl PairList {
+    /// The bytes its buffers hold (capacity, not length): the list's part of [`super::forces::SoftSystem::heap_bytes`].
+    pub fn heap_bytes(&self) -> usize {
+        use crate::math::vec_bytes;
+        vec_bytes(&self.row_start)
+            + vec_bytes(&self.cols)
+            + vec_bytes(&self.slots)
+            + vec_bytes(&self.cross_start)
+            + vec_bytes(&self.cross)
+            + vec_bytes(&self.shares)
+            + vec_bytes(&self.load)
+            + vec_bytes(&self.origin)
+    }
+
     /// An empty list with skin `skin` (m).
     pub fn new(skin: f64) -> Self {
         PairList {

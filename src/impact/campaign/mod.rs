@@ -1,7 +1,7 @@
 //! Impact campaigns: a grid of impact runs (targets × projectiles × angles × seeds, Roig03 §3) from one
 //! TOML file, run in parallel, resumable, summarised in `campaign.csv`.
 //!
-//! The file's keys are documented once, on the structs of [`file`] (units, defaults, ranges); the README's
+//! The file's keys are documented once, on the structs of [`file`](mod@file) (units, defaults, ranges); the README's
 //! "Impact campaigns" gives a complete example. [`sweep`] sets any field over a list or a grid. Each grid point runs
 //! as `rubblepile impact` would in `<out>/<target stem>_<projectile>_z<angle>_s<seed>/`, and `<out>/campaign.csv`
 //! ([`CAMPAIGN_COLUMNS`]) is rewritten atomically whenever a run starts or ends. What happens to each point is
@@ -13,7 +13,7 @@
 //!
 //! # Layout
 //!
-//! [`file`] is the campaign file format, [`sweep`] its `[sweep]` table, [`plan`] expands it into the grid of runs,
+//! [`file`](mod@file) is the campaign file format, [`sweep`] its `[sweep]` table, [`plan`] expands it into the grid of runs,
 //! [`execute`] runs the grid on this machine's threads (in parallel, resumable; [`run_point`] runs one point),
 //! [`index`] keeps `campaign.csv`, and [`shard`] splits the grid into deterministic parts and merges what they ran.
 //! Launching a campaign on a cluster (Slurm job-array scripts, MPI ranks) is the `rubblepile` binary's business:
