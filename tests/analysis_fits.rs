@@ -519,7 +519,7 @@ fn spin_distributions_pool_the_requested_case_and_normalise() {
     assert!(e.contains("--spin-target") && e.contains("N30_T4, N100_T4"), "{e}");
     let asked = SpinSelection {
         target: Some("N1".into()),
-        angle_deg: 45.0,
+        ..SpinSelection::default()
     };
     let e = asked.resolve(&targets(&["N30_T4"])).unwrap_err().to_string();
     assert!(e.contains("no target `N1`") && e.contains("N30_T4"), "{e}");

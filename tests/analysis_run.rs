@@ -479,5 +479,20 @@ fn q_star_is_fitted_over_one_target_at_one_angle() {
         a["q_star_d"]
     );
     assert!(String::from_utf8_lossy(&out.stderr).contains("--spin-angle-deg"));
+    // pooled (the Roig03 reproduction's Fig. 5): every run in one line
+    let pooled = rubblepile::analysis::run_analysis::SpinSelection {
+        target: Some("N30_T12".into()),
+        pool_q_star: true,
+        ..Default::default()
+    };
+    let p = rubblepile::analysis::campaign_analysis::analyze_campaign(&dir.join("c"), 110.0, true, &pooled, 1).unwrap();
+    assert!(p.q_star_runs.pooled && p.q_star_runs.runs == 16, "{:?}", p.q_star_runs);
+    let all_q: Vec<f64> = p.runs.iter().map(|r| r.q_erg_per_g).collect();
+    let all_b: Vec<f64> = p.runs.iter().map(|r| r.bound_mass_fraction).collect();
+    let line = fit_line(&all_q, &all_b).unwrap();
+    match (&p.bound_fraction_vs_q, line_crossing(&line, 0.5)) {
+        (rubblepile::analysis::run_analysis::Fit::Ok(l), _) => assert!((l.slope / line.slope - 1.0).abs() < 1e-12),
+        (f, _) => panic!("pooled fit failed: {f:?}"),
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -127,7 +127,7 @@ pub fn analyze_campaign(
             run,
         });
     }
-    let q_star_runs = q_star_selection(&runs, &spin_target, selection.angle_deg);
+    let q_star_runs = q_star_selection(&runs, &spin_target, selection.angle_deg, selection.pool_q_star);
     let (bound_fraction_vs_q, q_star_d, q_star_d_bootstrap) = match &q_star_runs.refused {
         Some(why) => (
             Fit::Failed(why.clone()),
@@ -191,8 +191,18 @@ pub fn analyze_campaign(
 
 /// Which runs Q*_D is fitted over: those on `target` at one impact angle, never pooled across targets or angles
 /// (each has its own Q*_D). The angle is the runs' only one on `target`, else `angle_deg` when they have it; with
-/// several angles and none at `angle_deg` the fit is refused, naming `--spin-angle-deg` and the angles.
-pub fn q_star_selection(runs: &[CampaignRun], target: &str, angle_deg: f64) -> QStarRuns {
+/// several angles and none at `angle_deg` the fit is refused, naming `--spin-angle-deg` and the angles. `pooled`:
+/// every run instead ([`SpinSelection::pool_q_star`]).
+pub fn q_star_selection(runs: &[CampaignRun], target: &str, angle_deg: f64, pooled: bool) -> QStarRuns {
+    if pooled {
+        return QStarRuns {
+            target: "all".into(),
+            angle_deg: None,
+            runs: runs.len(),
+            refused: runs.is_empty().then(|| "no analysed run".to_string()),
+            pooled: true,
+        };
+    }
     let mut angles: Vec<f64> = Vec::new();
     for r in runs.iter().filter(|r| r.target == target) {
         if !angles.contains(&r.angle_deg) {
@@ -217,6 +227,7 @@ pub fn q_star_selection(runs: &[CampaignRun], target: &str, angle_deg: f64) -> Q
         angle_deg: angle,
         runs: 0,
         refused,
+        pooled: false,
     };
     selection.runs = runs.iter().filter(|r| selection.holds(r)).count();
     selection

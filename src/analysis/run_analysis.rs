@@ -722,16 +722,22 @@ pub struct QStarRuns {
     pub runs: usize,
     /// Why no fit is made (several angles and none chosen, no run on the target); `None`: fitted.
     pub refused: Option<String>,
+    /// Every run, pooled over targets and angles ([`SpinSelection::pool_q_star`]; Roig03 Fig. 5 fits its whole
+    /// campaign at once); `target` and `angle_deg` are then not a restriction.
+    pub pooled: bool,
 }
 
 impl QStarRuns {
     /// Whether `run` is one of them.
     pub fn holds(&self, run: &CampaignRun) -> bool {
-        run.target == self.target && Some(run.angle_deg) == self.angle_deg
+        self.pooled || (run.target == self.target && Some(run.angle_deg) == self.angle_deg)
     }
 
     /// `N30_T4 at zeta = 45 deg, 6 runs` (what the fit is of).
     pub fn label(&self) -> String {
+        if self.pooled {
+            return format!("every run pooled over targets and angles, {} runs", self.runs);
+        }
         match self.angle_deg {
             Some(a) => format!("{} at zeta = {a} deg, {} runs", self.target, self.runs),
             None => self.target.clone(),
@@ -783,14 +789,18 @@ pub struct SpinSelection {
     pub target: Option<String>,
     /// ζ (degrees).
     pub angle_deg: f64,
+    /// Fit Q*_D over every run at once, pooled over targets and angles, as Roig03 Fig. 5 does (its reproduction
+    /// compares that line); `false` (default): over the target and angle above only, since each has its own Q*_D.
+    pub pool_q_star: bool,
 }
 
 impl Default for SpinSelection {
-    /// The campaign's own target at 45°.
+    /// The campaign's own target at 45°; Q*_D not pooled.
     fn default() -> Self {
         SpinSelection {
             target: None,
             angle_deg: 45.0,
+            pool_q_star: false,
         }
     }
 }

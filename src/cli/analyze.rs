@@ -171,6 +171,7 @@ pub fn analyze_campaign(args: &AnalyzeCampaignArgs) -> Result<(), CliError> {
     let selection = SpinSelection {
         target: args.spin_target.clone(),
         angle_deg: args.spin_angle,
+        ..SpinSelection::default()
     };
     let a = ca::analyze_campaign(&args.dir, at, args.force, &selection, args.bootstrap_seed).map_err(|e| match e {
         AnalysisError::Fragments(_) => CliError::failed(e),

@@ -351,7 +351,7 @@ pub struct PairList {
 }
 
 impl PairList {
-    /// The bytes its buffers hold (capacity, not length): the list's part of [`super::forces::SoftSystem::heap_bytes`].
+    /// The bytes its buffers hold (capacity, not length): the list's part of `SoftSystem::heap_bytes`.
     pub fn heap_bytes(&self) -> usize {
         use crate::math::vec_bytes;
         vec_bytes(&self.row_start)

@@ -98,7 +98,12 @@ impl CampaignDirs<'_> {
 /// Re-analyses every campaign of `dirs` at `at` seconds (rewriting their `analysis/`) and writes `out/REPORT.md`;
 /// returns its path and the main campaign's analysis.
 pub fn regenerate(dirs: &CampaignDirs<'_>, at: f64, out: &Path) -> Result<(PathBuf, CampaignAnalysis), AnalysisError> {
-    let analyse = |dir: &Path| analyze_campaign(dir, at, true, &SpinSelection::default(), BOOTSTRAP_SEED);
+    // Roig03 Fig. 5 fits its whole campaign at once: the reproduction pools Q*_D the same way.
+    let pooled = SpinSelection {
+        pool_q_star: true,
+        ..SpinSelection::default()
+    };
+    let analyse = |dir: &Path| analyze_campaign(dir, at, true, &pooled, BOOTSTRAP_SEED);
     let campaign = analyse(dirs.campaign)?;
     let uniform = dirs.uniform.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
     let other_kappa = dirs.other_kappa.map(|d| analyse(d).map(|a| (a, d))).transpose()?;
