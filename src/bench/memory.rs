@@ -23,8 +23,9 @@ pub struct BenchMemoryArgs {
     /// Self-gravity of the soft-sphere cases: `off` or `tree` (θ = 0.5; its octree is rebuilt at every evaluation).
     #[arg(long, default_value = "tree", value_parser = ["off", "tree"])]
     pub gravity: String,
-    /// Ellipsoid targets (comma-separated bodies files with their `.json` beside them giving κ; empty for none).
-    #[arg(long, default_value = "targets/N10000_T4.csv", value_delimiter = ',')]
+    /// Ellipsoid targets (comma-separated bodies files with their `.json` beside them giving κ; `--targets` with
+    /// no value for none).
+    #[arg(long, default_value = "targets/N10000_T4.csv", value_delimiter = ',', num_args = 0..)]
     pub targets: Vec<PathBuf>,
     /// Leapfrog steps per soft-sphere case (an ellipsoid case advances 0.01 s under Bulirsch–Stoer).
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..=1000))]
