@@ -274,6 +274,17 @@ fn example_soft_drum_runs() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
     assert_eq!(summary["status"], "completed", "{summary}");
     assert_eq!(summary["n_walls"], 3, "{summary}");
+    // Its energy residual is above 1 % with a k_N and a step off the advice: the done line says so, with the
+    // summary's own ratios.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let f = |k: &str| summary[k].as_f64().unwrap();
+    assert!(f("energy_error") > 1e-2, "{summary}");
+    let k_ratio = format!("k_N is {:.1}x below", f("advised_k_n") / f("k_n"));
+    let dt_ratio = format!("dt is {:.1}x the step advised", f("dt") / f("advised_dt"));
+    assert!(
+        stdout.contains(&k_ratio) && stdout.contains(&dt_ratio) && stdout.contains("rubblepile ssdem advise"),
+        "{stdout}"
+    );
     // The drum turns about +y, its bottom moving towards -x: the bed is carried up the -x side.
     let last = std::fs::read_to_string(dir.join("run/snapshots/2.csv")).unwrap();
     let rows: Vec<Vec<f64>> = last
@@ -287,5 +298,24 @@ fn example_soft_drum_runs() {
     assert!(
         x < -0.01 && z > -0.02,
         "the bed was not carried up the rising side: x = {x}, z = {z}"
+    );
+}
+
+/// Guards the accuracy hint's threshold: the example soft-sphere scene (energy residual below 1 %) ends on the plain
+/// done line, without a hint.
+#[test]
+fn a_resolved_soft_scene_prints_no_accuracy_hint() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("targets/examples/soft_spheres.toml");
+    let dir = common::temp_dir("soft-no-hint");
+    let out = common::rubblepile(&dir, &["run", scene.to_str().unwrap(), "--out", "run", "--no-progress"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run/summary.json")).unwrap()).unwrap();
+    assert!(summary["energy_error"].as_f64().unwrap() <= 1e-2, "{summary}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("completed: ") && !stdout.contains("energy residual above"),
+        "{stdout}"
     );
 }

@@ -142,9 +142,45 @@ impl SoftSummary {
             self.energy_error,
             self.max_overlap_fraction,
             self.wall_seconds
-        )
+        ) + &self.accuracy_hint().map_or(String::new(), |h| format!("; {h}"))
+    }
+
+    /// When the energy residual is above [`ENERGY_HINT_ABOVE`], what in the scene explains it: a step longer than the
+    /// advised one, or a `k_N` below the advised one (`rubblepile ssdem advise`), or neither.
+    pub fn accuracy_hint(&self) -> Option<String> {
+        if self.energy_error.is_nan() || self.energy_error <= ENERGY_HINT_ABOVE {
+            return None;
+        }
+        let mut causes = Vec::new();
+        if self.k_n < 0.5 * self.advised_k_n {
+            causes.push(format!(
+                "k_N is {:.1}x below the advised {:.2e} N/m",
+                self.advised_k_n / self.k_n,
+                self.advised_k_n
+            ));
+        }
+        if self.dt > 2.0 * self.advised_dt {
+            causes.push(format!(
+                "dt is {:.1}x the step advised with that k_N ({:.2e} s)",
+                self.dt / self.advised_dt,
+                self.advised_dt
+            ));
+        }
+        Some(if causes.is_empty() {
+            format!(
+                "energy residual above {ENERGY_HINT_ABOVE:.0e} of the energy scale, with dt and k_N as advised: shorten dt to check convergence"
+            )
+        } else {
+            format!(
+                "energy residual above {ENERGY_HINT_ABOVE:.0e}: {} (see `rubblepile ssdem advise`)",
+                causes.join(", ")
+            )
+        })
     }
 }
+
+/// The energy residual above which the done line says what in the scene explains it ([`SoftSummary::accuracy_hint`]).
+pub const ENERGY_HINT_ABOVE: f64 = 1e-2;
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct SpringRecord {
