@@ -140,6 +140,24 @@ pub struct RunAnalysis {
     pub clump_report: ClumpReport,
 }
 
+impl RunAnalysis {
+    /// The largest-remnant line ([`ClumpReport::summary_line`]) and, when the largest remnant holds more of the mass
+    /// than the bound mass fraction, why: a clump bound to itself can move off faster than the system's escape speed,
+    /// and Roig03's "bound" (README, "one meaning") is bound to the whole system's centre of mass.
+    pub fn clump_lines(&self) -> String {
+        let line = self.clump_report.summary_line();
+        match self.clump_report.largest() {
+            Some(lr) if lr.mass_fraction > self.summary.bound_mass_fraction + 0.05 => format!(
+                "{line}\nnote: the largest remnant ({:.3} of all bodies' mass) is bound to itself, while only {:.3} of \
+                 the target mass is bound to the system as a whole: the remnant moves off faster than the system's \
+                 escape speed",
+                lr.mass_fraction, self.summary.bound_mass_fraction
+            ),
+            _ => line,
+        }
+    }
+}
+
 /// `analysis.json` of a run that is not an impact (any ellipsoid run, soft or hard spheres): the clumps of one
 /// snapshot.
 #[derive(Debug, Clone, serde::Serialize)]

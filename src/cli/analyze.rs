@@ -113,7 +113,7 @@ pub fn analyze(args: &AnalyzeArgs) -> Result<(), CliError> {
             Fit::Failed(why) => println!("spin rates by unbinned likelihood (weighted by {by}): n/a ({why})"),
         }
     }
-    println!("{}", a.clump_report.summary_line());
+    println!("{}", a.clump_lines());
     if let Some(c) = &a.composition {
         println!("{}", c.summary_line());
     }

@@ -988,7 +988,7 @@ fn analyze(py: Python<'_>, dir: PathBuf, at: Option<f64>, force: bool) -> PyResu
         let at = rubblepile::analysis::run_analysis::analysis_time(&dir, at).map_err(|e| usage(e.to_string()))?;
         let (a, report) = analyze_run(&dir, None, at, force).map_err(|e| usage(e.to_string()))?;
         let (_figures, not_drawn) = rubblepile::analysis::figures::write_run_figures(&dir, None, &a, &report);
-        let mut lines = vec![a.clump_report.summary_line()];
+        let mut lines = vec![a.clump_lines()];
         if let Some(c) = &a.composition {
             lines.push(c.summary_line());
         }
