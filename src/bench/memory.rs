@@ -41,6 +41,20 @@ pub struct BenchMemoryArgs {
     pub child: Option<String>,
 }
 
+/// The columns of `bench_memory.csv`.
+const CSV_COLUMNS: [&str; 10] = [
+    "engine",
+    "bodies",
+    "baseline_rss_bytes",
+    "peak_rss_bytes",
+    "peak_bytes_per_body",
+    "engine_bytes",
+    "engine_bytes_per_body",
+    "contacts",
+    "steps",
+    "step_seconds",
+];
+
 /// One case's figures.
 #[derive(Debug, Clone, PartialEq)]
 struct Case {
@@ -214,26 +228,27 @@ pub fn bench(args: &BenchMemoryArgs) -> Result<(), BenchError> {
     }
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| BenchError::failed(format!("{}: {e}", dir.display())))?;
-        let mut text = String::from(
-            "engine,bodies,baseline_rss_bytes,peak_rss_bytes,peak_bytes_per_body,engine_bytes,engine_bytes_per_body,contacts,steps,step_seconds\n",
-        );
-        for r in &rows {
-            text += &format!(
-                "{},{},{},{},{:.1},{},{},{},{},{:.3}\n",
-                r.engine,
-                r.bodies,
-                r.baseline,
-                r.peak,
-                r.per_body_peak(),
-                r.engine_bytes.map_or(String::new(), |b| b.to_string()),
-                r.per_body_engine().map_or(String::new(), |b| format!("{b:.1}")),
-                r.contacts.map_or(String::new(), |c| c.to_string()),
-                args.steps,
-                r.seconds
-            );
-        }
         let csv = dir.join("bench_memory.csv");
-        std::fs::write(&csv, text).map_err(|e| BenchError::failed(format!("{}: {e}", csv.display())))?;
+        let fail = |e: &dyn std::fmt::Display| BenchError::failed(format!("{}: {e}", csv.display()));
+        let mut w = csv::Writer::from_path(&csv).map_err(|e| fail(&e))?;
+        w.write_record(CSV_COLUMNS).map_err(|e| fail(&e))?;
+        for r in &rows {
+            let blank = |x: Option<String>| x.unwrap_or_default();
+            w.write_record([
+                r.engine.clone(),
+                r.bodies.to_string(),
+                r.baseline.to_string(),
+                r.peak.to_string(),
+                format!("{:.1}", r.per_body_peak()),
+                blank(r.engine_bytes.map(|b| b.to_string())),
+                blank(r.per_body_engine().map(|b| format!("{b:.1}"))),
+                blank(r.contacts.map(|c| c.to_string())),
+                args.steps.to_string(),
+                format!("{:.3}", r.seconds),
+            ])
+            .map_err(|e| fail(&e))?;
+        }
+        w.flush().map_err(|e| fail(&e))?;
         plot(&dir.join("bench_memory.svg"), &rows).map_err(BenchError::failed)?;
         println!("wrote {} and bench_memory.svg", csv.display());
     }
