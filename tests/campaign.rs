@@ -6,6 +6,8 @@
 //! Everything runs on a tiny target (6 fragments, 3 → 1.5 km) built here, hit by 1 km projectiles at a few
 //! tens of m/s, for a few tens of simulated seconds.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::OnceLock;
@@ -20,9 +22,8 @@ use rubblepile::impact::campaign::{
     run_campaign,
 };
 use rubblepile::impact::run::run_impact;
-use rubblepile::impact::target::{TargetSpec, build_target};
+use rubblepile::impact::target::build_target;
 use rubblepile::integrate::Method;
-use std::f64::consts::PI;
 
 fn temp_dir(tag: &str) -> PathBuf {
     static N: AtomicUsize = AtomicUsize::new(0);
@@ -41,20 +42,7 @@ fn temp_dir(tag: &str) -> PathBuf {
 fn tiny_target_csv() -> &'static [u8] {
     static CSV: OnceLock<Vec<u8>> = OnceLock::new();
     CSV.get_or_init(|| {
-        let mut spec = TargetSpec::table1(30, 6.0, 1).unwrap();
-        spec.fragments = 6;
-        spec.r_largest = 3e3;
-        spec.r_smallest = 1.5e3;
-        spec.total_mass = {
-            // the expected mass of such a draw, so that a draw within 10 % comes quickly
-            let (a, b) = (spec.r_largest.powf(-2.5), spec.r_smallest.powf(-2.5));
-            let mean_r3 = (0..1000)
-                .map(|k| (a + (k as f64 + 0.5) / 1000.0 * (b - a)).powf(-1.2))
-                .sum::<f64>()
-                / 1000.0;
-            3000.0 * 4.0 / 3.0 * PI * (3e3f64.powi(3) + 1.5e3f64.powi(3) + 4.0 * mean_r3)
-        };
-        spec.mass_tolerance = 0.1;
+        let mut spec = common::small_pile_spec(1, 6, 3e3, 1.5e3, 0.1);
         spec.f0 = 1e-3; // damps this small pile to rigid rotation quickly
         let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
         let (bodies, _) = build_target(&spec, &mut quiet).unwrap();

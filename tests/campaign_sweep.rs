@@ -5,28 +5,15 @@
 
 mod common;
 use common::{rubblepile, temp_dir};
-use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 use rubblepile::ellipsoid::output::write_snapshot;
 use rubblepile::impact::campaign::parse_campaign;
-use rubblepile::impact::target::{TargetSpec, build_target};
+use rubblepile::impact::target::build_target;
 
 /// A tiny target (6 fragments, 3 → 1.5 km) as in `tests/campaign.rs`, written to `dir/targets/tiny.csv`.
 fn tiny_target(dir: &Path) -> PathBuf {
-    let mut spec = TargetSpec::table1(30, 6.0, 1).unwrap();
-    spec.fragments = 6;
-    spec.r_largest = 3e3;
-    spec.r_smallest = 1.5e3;
-    spec.total_mass = {
-        let (a, b) = (spec.r_largest.powf(-2.5), spec.r_smallest.powf(-2.5));
-        let mean_r3 = (0..1000)
-            .map(|k| (a + (k as f64 + 0.5) / 1000.0 * (b - a)).powf(-1.2))
-            .sum::<f64>()
-            / 1000.0;
-        3000.0 * 4.0 / 3.0 * PI * (3e3f64.powi(3) + 1.5e3f64.powi(3) + 4.0 * mean_r3)
-    };
-    spec.mass_tolerance = 0.1;
+    let mut spec = common::small_pile_spec(1, 6, 3e3, 1.5e3, 0.1);
     spec.f0 = 1e-3;
     let mut quiet = |_: usize, _: f64, _: f64, _: f64| {};
     let (bodies, _) = build_target(&spec, &mut quiet).unwrap();

@@ -116,21 +116,7 @@ fn rigid_rotation_fit_recovers_omega_and_zero_relative_energy() {
 /// in the centre-of-mass frame, and the same seed gives the same bodies and report bit for bit.
 /// The 12-fragment pile (6→3 km) of the small-target tests.
 fn small_spec() -> TargetSpec {
-    let mut spec = TargetSpec::table1(30, 6.0, 11).unwrap();
-    spec.fragments = 12;
-    spec.r_largest = 6e3;
-    spec.r_smallest = 3e3;
-    spec.total_mass = {
-        // the expected mass of such a draw, so that a draw within 5 % comes quickly
-        let (a, b) = (spec.r_largest.powf(-2.5), spec.r_smallest.powf(-2.5));
-        let mean_r3 = (0..1000)
-            .map(|k| (a + (k as f64 + 0.5) / 1000.0 * (b - a)).powf(-1.2))
-            .sum::<f64>()
-            / 1000.0;
-        3000.0 * 4.0 / 3.0 * PI * (6e3f64.powi(3) + 3e3f64.powi(3) + 10.0 * mean_r3)
-    };
-    spec.mass_tolerance = 0.05;
-    spec
+    common::small_pile_spec(11, 12, 6e3, 3e3, 0.05)
 }
 
 #[test]

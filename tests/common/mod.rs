@@ -255,3 +255,29 @@ pub fn describe(o: &std::process::Output) -> String {
         String::from_utf8_lossy(&o.stderr)
     )
 }
+
+/// A small Table-1-style pile spec for the impact tests: `fragments` of 3000 kg/m³ between `r_largest` and
+/// `r_smallest` (m), seed `seed`, its total mass the expected mass of such a draw (the two end radii plus the mean
+/// r³ of the Roig03 size law for the others), so that a draw within `mass_tolerance` comes quickly.
+pub fn small_pile_spec(
+    seed: u64,
+    fragments: usize,
+    r_largest: f64,
+    r_smallest: f64,
+    mass_tolerance: f64,
+) -> rubblepile::impact::target::TargetSpec {
+    let mut spec = rubblepile::impact::target::TargetSpec::table1(30, 6.0, seed).unwrap();
+    spec.fragments = fragments;
+    spec.r_largest = r_largest;
+    spec.r_smallest = r_smallest;
+    let (a, b) = (r_largest.powf(-2.5), r_smallest.powf(-2.5));
+    let mean_r3 = (0..1000)
+        .map(|k| (a + (k as f64 + 0.5) / 1000.0 * (b - a)).powf(-1.2))
+        .sum::<f64>()
+        / 1000.0;
+    spec.total_mass = 3000.0 * 4.0 / 3.0
+        * std::f64::consts::PI
+        * (r_largest.powi(3) + r_smallest.powi(3) + (fragments - 2) as f64 * mean_r3);
+    spec.mass_tolerance = mass_tolerance;
+    spec
+}
