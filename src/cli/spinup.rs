@@ -1,10 +1,11 @@
-//! `rubblepile spinup …`: the options, and the calls into [`rubblepile::analysis::critical`] and [`rubblepile::experiment::critical_search`].
+//! `rubblepile spinup …`: the options, and the calls into [`crate::studies::zhang2017::spinup_tools`] and the search.
 
 use std::path::PathBuf;
 
 use crate::cli::common::CliError;
+use crate::studies::zhang2017::spinup_tools::{density_fit as fit, judge_dir};
 use rubblepile::analysis::creep::CreepCriterionKind;
-use rubblepile::analysis::critical::{SearchError, density_fit as fit};
+use rubblepile::analysis::critical::SearchError;
 use rubblepile::experiment::critical_search::{CriticalOptions, critical as run_critical};
 
 /// `rubblepile spinup …`.
@@ -39,8 +40,7 @@ pub struct JudgeArgs {
 
 /// `rubblepile spinup judge`.
 pub fn judge(args: &JudgeArgs) -> Result<(), CliError> {
-    rubblepile::analysis::critical::judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref())
-        .map_err(cli_error)
+    judge_dir(&args.dir, args.judge_window, args.significance, args.csv.as_deref()).map_err(cli_error)
 }
 
 /// `rubblepile spinup critical`.
