@@ -38,10 +38,7 @@ pub struct ProjectilePile {
 /// Turns an error reading a pile file into [`ImpactError::Invalid`] naming `field` (the file and the reason in
 /// the message).
 pub fn as_field(field: &str) -> impl Fn(ImpactError) -> ImpactError + '_ {
-    move |e| ImpactError::Invalid {
-        field: field.to_string(),
-        message: e.to_string(),
-    }
+    move |e| ImpactError::invalid(field, e.to_string())
 }
 
 impl ProjectilePile {
