@@ -12,7 +12,7 @@ use rubblepile::driver::RunOptions;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::impact::campaign::parse_campaign;
-use rubblepile::impact::pile::{ProjectilePile, piles_overlap, set_up_pile_impact};
+use rubblepile::impact::pile::{ProjectilePile, set_up_pile_impact};
 use rubblepile::impact::run::{ImpactConfig, read_target, run_impact};
 use rubblepile::math::{Mat3, Vec3, Vec4};
 
@@ -23,6 +23,23 @@ fn root() -> PathBuf {
 fn json(path: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     serde_json::from_str(&text).unwrap()
+}
+
+/// Whether any projectile body overlaps any target body (the ellipsoids' overlap test): the check that a
+/// set-up starts with the piles apart.
+fn piles_overlap(bodies: &[Body], n_target: usize) -> bool {
+    let sigma = |b: &Body| {
+        let r = rotation_matrix(&b.quaternion);
+        r.transpose() * Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
+    };
+    let (target, projectile) = bodies.split_at(n_target);
+    projectile.iter().any(|p| {
+        target.iter().any(|t| {
+            let d = p.position - t.position;
+            d.norm() < p.shape.axes.x + t.shape.axes.x
+                && !rubblepile::geometry::ellipsoid_overlap::are_apart(&d, &sigma(p), &sigma(t))
+        })
+    })
 }
 
 fn pile(file: &str, random_attitude: bool) -> ProjectilePile {

@@ -31,10 +31,7 @@ pub fn analyze_campaign(
         return Err(AnalysisError::Exists(out_dir));
     }
     let index = dir.join("campaign.csv");
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: index.clone(),
-        reason: e.to_string(),
-    };
+    let err = |e: &dyn std::fmt::Display| AnalysisError::read(&index, e);
     let names = ["run", "target", "projectile", "angle_deg", "q_erg_per_g", "status"];
     let (mut rdr, [c_run, c_target, c_proj, c_angle, c_q, c_status]) =
         crate::io::table::open_columns(&index, names).map_err(|e| err(&e))?;
@@ -163,15 +160,9 @@ pub fn analyze_campaign(
         q_star_d_bootstrap,
         spin_distributions,
     };
-    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
-        path: out_dir.clone(),
-        reason: crate::io::safe_write::reason(&e),
-    })?;
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::write(&out_dir, &e))?;
     let csv_path = out_dir.join("campaign_runs.csv");
-    let werr = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: csv_path.clone(),
-        reason: e.to_string(),
-    };
+    let werr = |e: &dyn std::fmt::Display| AnalysisError::read(&csv_path, e);
     let file =
         crate::io::safe_write::AtomicFile::create(&csv_path).map_err(|e| werr(&crate::io::safe_write::reason(&e)))?;
     let mut w = csv::Writer::from_writer(file);
@@ -237,10 +228,7 @@ pub fn q_star_selection(runs: &[CampaignRun], target: &str, angle_deg: f64, pool
 /// default `--at-s`. Errors ([`AnalysisError::Request`]) when no run completed or the runs end at different times.
 pub fn campaign_end_time(dir: &Path) -> Result<f64, AnalysisError> {
     let index = dir.join("campaign.csv");
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: index.clone(),
-        reason: e.to_string(),
-    };
+    let err = |e: &dyn std::fmt::Display| AnalysisError::read(&index, e);
     let (mut rdr, [c_status, c_end]) =
         crate::io::table::open_columns(&index, ["status", "final_time"]).map_err(|e| err(&e))?;
     let mut ends: Vec<f64> = Vec::new();

@@ -162,10 +162,7 @@ pub fn sort_rows(rows: &mut [ByRow]) {
 /// `dir/campaign.csv`: its header and rows.
 fn read_index(dir: &Path) -> Result<(Vec<String>, Vec<Vec<String>>), AnalysisError> {
     let index = dir.join(CAMPAIGN_CSV);
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: index.clone(),
-        reason: e.to_string(),
-    };
+    let err = |e: &dyn std::fmt::Display| AnalysisError::read(&index, e);
     let mut rdr = csv::Reader::from_path(&index).map_err(|e| err(&e))?;
     let header: Vec<String> = rdr.headers().map_err(|e| err(&e))?.iter().map(String::from).collect();
     let rows: Vec<Vec<String>> = rdr
@@ -186,10 +183,7 @@ pub fn by_field_name(dir: &Path, requested: Option<&str>) -> Result<String, Anal
 /// The table of `analysis`'s runs against `field` (see [`choose`] for `None`), from `dir/campaign.csv`.
 pub fn by_field_table(dir: &Path, analysis: &CampaignAnalysis, field: Option<&str>) -> Result<ByTable, AnalysisError> {
     let (header, rows) = read_index(dir)?;
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: dir.join(CAMPAIGN_CSV),
-        reason: e.to_string(),
-    };
+    let err = |e: &dyn std::fmt::Display| AnalysisError::read(&dir.join(CAMPAIGN_CSV), e);
     let field = choose(&header, field)?;
     let col = |c: &str| header.iter().position(|h| h == c);
     let (c_run, c_by) = (

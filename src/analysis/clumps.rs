@@ -20,14 +20,15 @@ use crate::ellipsoid::clumps::{Linking, find_clumps_among};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::math::{Mat3, Vec3};
 
+/// The mass-weighted mean of `f(body)` over the bodies `ids`, whose mass is `mass` (kg).
+pub(crate) fn mass_mean(bodies: &[Body], ids: &[usize], mass: f64, f: impl Fn(&Body) -> Vec3) -> Vec3 {
+    ids.iter().map(|&i| f(&bodies[i]) * bodies[i].shape.mass).sum::<Vec3>() / mass
+}
+
 /// The energy `Eᵢ` of each member of `ids` against the rest of the set (module docs, item 2), with `g` (SI).
 fn member_energies(bodies: &[Body], ids: &[usize], g: f64) -> Vec<f64> {
     let mass: f64 = ids.iter().map(|&i| bodies[i].shape.mass).sum();
-    let v = ids
-        .iter()
-        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / mass;
+    let v = mass_mean(bodies, ids, mass, |b| b.velocity);
     ids.par_iter()
         .map(|&i| {
             let b = &bodies[i];
@@ -84,16 +85,8 @@ pub fn bound_clumps(bodies: &[Body], linking: Linking, g: Option<f64>) -> Vec<Ve
 /// `members` (module docs, item 3), with `moments(body)` each body's principal moments (kg m²).
 fn mass_properties(bodies: &[Body], members: &[usize], moments: &dyn Fn(&Body) -> Vec3) -> (Vec3, Vec3, Mat3, Vec3) {
     let mass: f64 = members.iter().map(|&i| bodies[i].shape.mass).sum();
-    let centre = members
-        .iter()
-        .map(|&i| bodies[i].position * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / mass;
-    let velocity = members
-        .iter()
-        .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / mass;
+    let centre = mass_mean(bodies, members, mass, |b| b.position);
+    let velocity = mass_mean(bodies, members, mass, |b| b.velocity);
     let (mut inertia, mut l) = (Mat3::zeros(), Vec3::zeros());
     for &i in members {
         let b = &bodies[i];

@@ -7,7 +7,7 @@
 //! period `2π/|ω|` (no §4.3 correction: parallel-axis terms dominate). Mixing of the other bound clumps: their
 //! mass-weighted projectile fraction and how many hold bodies of both origins.
 
-use crate::analysis::clumps::clump_spin;
+use crate::analysis::clumps::{clump_spin, mass_mean};
 use crate::ellipsoid::body::Body;
 use crate::math::Vec3;
 
@@ -164,11 +164,7 @@ pub fn composition(
         .map(|ids| {
             let mass = mass_of(&mut ids.iter().copied(), None);
             let from_projectile = mass_of(&mut ids.iter().copied(), Some(Origin::Projectile));
-            let v = ids
-                .iter()
-                .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-                .sum::<Vec3>()
-                / mass;
+            let v = mass_mean(bodies, &ids, mass, |b| b.velocity);
             let kinetic = 0.5 * mass * (v - v_sys).norm_squared();
             let mut binding = 0.0;
             for &i in &ids {

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::analysis::clumps::mass_mean;
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
@@ -135,16 +136,8 @@ pub fn largest_remnant(g: f64, bodies: &[Body]) -> Vec<usize> {
     let mut set: Vec<usize> = (0..bodies.len()).collect();
     loop {
         let m: f64 = set.iter().map(|&i| bodies[i].shape.mass).sum();
-        let r = set
-            .iter()
-            .map(|&i| bodies[i].position * bodies[i].shape.mass)
-            .sum::<Vec3>()
-            / m;
-        let v = set
-            .iter()
-            .map(|&i| bodies[i].velocity * bodies[i].shape.mass)
-            .sum::<Vec3>()
-            / m;
+        let r = mass_mean(bodies, &set, m, |b| b.position);
+        let v = mass_mean(bodies, &set, m, |b| b.velocity);
         let kept: Vec<usize> = set
             .iter()
             .copied()
@@ -187,11 +180,7 @@ pub fn remnant(t: f64, g: f64, bodies: &[Body], kappa_i: f64) -> Remnant {
     let ids = largest_remnant(g, bodies);
     let total: f64 = bodies.iter().map(|b| b.shape.mass).sum();
     let m: f64 = ids.iter().map(|&i| bodies[i].shape.mass).sum();
-    let r = ids
-        .iter()
-        .map(|&i| bodies[i].position * bodies[i].shape.mass)
-        .sum::<Vec3>()
-        / m;
+    let r = mass_mean(bodies, &ids, m, |b| b.position);
     let members: Vec<Body> = ids.iter().map(|&i| bodies[i].clone()).collect();
     let moments: Vec<Vec3> = members.iter().map(|b| b.shape.principal_moments(kappa_i)).collect();
     let fit = fit_rigid_rotation(&members, &moments);

@@ -77,6 +77,24 @@ pub enum AnalysisError {
     },
 }
 
+impl AnalysisError {
+    /// An [`AnalysisError::Read`] of `path` saying `reason`.
+    pub(crate) fn read(path: &Path, reason: impl std::fmt::Display) -> Self {
+        AnalysisError::Read {
+            path: path.to_path_buf(),
+            reason: reason.to_string(),
+        }
+    }
+
+    /// An [`AnalysisError::Write`] of `path` for the I/O error `e` ([`crate::io::safe_write::reason`]).
+    pub(crate) fn write(path: &Path, e: &std::io::Error) -> Self {
+        AnalysisError::Write {
+            path: path.to_path_buf(),
+            reason: crate::io::safe_write::reason(e),
+        }
+    }
+}
+
 /// A fit, or why it could not be made.
 #[derive(Debug, Clone, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -173,12 +191,8 @@ pub struct ClumpRunAnalysis {
 }
 
 pub(crate) fn read_json(path: &Path) -> Result<serde_json::Value, AnalysisError> {
-    let err = |reason: String| AnalysisError::Read {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| err(e.to_string()))?;
-    serde_json::from_str(&text).map_err(|e| err(e.to_string()))
+    let text = std::fs::read_to_string(path).map_err(|e| AnalysisError::read(path, e))?;
+    serde_json::from_str(&text).map_err(|e| AnalysisError::read(path, e))
 }
 
 /// Refuses a snapshot of the run in `dir` that its manifest says is damaged, or that is cut short or holds a
@@ -190,10 +204,7 @@ fn verified(dir: &Path, snapshot: &Path) -> Result<(), AnalysisError> {
 /// Snapshot times of a run directory, from the first line of each `snapshots/<k>.csv`.
 fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     let snaps = dir.join("snapshots");
-    let entries = std::fs::read_dir(&snaps).map_err(|e| AnalysisError::Read {
-        path: snaps.clone(),
-        reason: e.to_string(),
-    })?;
+    let entries = std::fs::read_dir(&snaps).map_err(|e| AnalysisError::read(&snaps, e))?;
     let mut out = Vec::new();
     for entry in entries.flatten() {
         let path = entry.path();
@@ -204,10 +215,7 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
         // Each is checked whole before its time is believed: a damaged or non-finite one is refused by name,
         // never passed over for another.
         verified(dir, &path)?;
-        let mut rdr = csv::Reader::from_path(&path).map_err(|e| AnalysisError::Read {
-            path: path.clone(),
-            reason: e.to_string(),
-        })?;
+        let mut rdr = csv::Reader::from_path(&path).map_err(|e| AnalysisError::read(&path, e))?;
         if let Some(Ok(rec)) = rdr.records().next()
             && let Some(t) = rec.get(0).and_then(|s| s.parse::<f64>().ok())
         {
@@ -218,13 +226,14 @@ fn snapshot_times(dir: &Path) -> Result<Vec<(f64, PathBuf)>, AnalysisError> {
     Ok(out)
 }
 
+/// The snapshot of `times` ([`snapshot_times`]) at time `t` (s, to 1e-9 relative), if there is one.
+fn snapshot_at(times: &[(f64, PathBuf)], t: f64) -> Option<&(f64, PathBuf)> {
+    times.iter().find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
+}
+
 /// The snapshot of the run in `dir` at time `t` (s, to 1e-9 relative), if there is one.
 pub fn snapshot_path(dir: &Path, t: f64) -> Option<PathBuf> {
-    snapshot_times(dir)
-        .ok()?
-        .into_iter()
-        .find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
-        .map(|(_, p)| p)
+    Some(snapshot_at(&snapshot_times(dir).ok()?, t)?.1.clone())
 }
 
 /// The κ the run in `dir` used: from its `summary.json`, or, while the run is still going (no summary yet, so that
@@ -234,15 +243,14 @@ fn run_kappa(dir: &Path) -> Result<f64, AnalysisError> {
     let summary_path = dir.join("summary.json");
     if summary_path.exists() {
         let summary = read_json(&summary_path)?;
-        return summary["kappa"].as_f64().ok_or_else(|| AnalysisError::Read {
-            path: summary_path,
-            reason: "no numeric `kappa`".into(),
-        });
+        return summary["kappa"]
+            .as_f64()
+            .ok_or_else(|| AnalysisError::read(&summary_path, "no numeric `kappa`"));
     }
     let scene_path = dir.join("scene.toml");
-    let scene = crate::ellipsoid::scene::load_scene(&scene_path).map_err(|e| AnalysisError::Read {
-        path: scene_path,
-        reason: format!("no summary.json (run not finished), and κ could not be resolved from the scene: {e}"),
+    let scene = crate::ellipsoid::scene::load_scene(&scene_path).map_err(|e| {
+        let why = format!("no summary.json (run not finished), and κ could not be resolved from the scene: {e}");
+        AnalysisError::read(&scene_path, why)
     })?;
     Ok(scene.model.kappa)
 }
@@ -277,15 +285,15 @@ pub fn analysis_time(dir: &Path, at: Option<f64>) -> Result<f64, AnalysisError> 
     if let Some(at) = at {
         return Ok(at);
     }
+    Ok(DEFAULT_AT_S.min(read_scene(dir)?.scene.t_end))
+}
+
+/// The ellipsoid scene of the run in `dir` (its `scene.toml`).
+fn read_scene(dir: &Path) -> Result<crate::ellipsoid::scene::SceneFile, AnalysisError> {
     let scene_path = dir.join("scene.toml");
-    let read = |reason: String| AnalysisError::Read {
-        path: scene_path.clone(),
-        reason,
-    };
-    let text = std::fs::read_to_string(&scene_path).map_err(|e| read(e.to_string()))?;
-    let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
-        .map_err(|e| read(e.to_string()))?;
-    Ok(DEFAULT_AT_S.min(scene.scene.t_end))
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| AnalysisError::read(&scene_path, e))?;
+    crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
+        .map_err(|e| AnalysisError::read(&scene_path, e))
 }
 
 /// Analyses the run in `dir` at `t_at` (s); writes `{fragments.csv, analysis.json}` into `out` (default
@@ -303,25 +311,15 @@ pub fn analyze_run(
     }
     let kappa = run_kappa(dir)?;
     let impact = read_json(&dir.join("impact.json"))?;
-    let projectile = impact["projectile_index"].as_u64().ok_or_else(|| AnalysisError::Read {
-        path: dir.join("impact.json"),
-        reason: "no `projectile_index`".into(),
-    })? as usize;
+    let projectile = impact["projectile_index"]
+        .as_u64()
+        .ok_or_else(|| AnalysisError::read(&dir.join("impact.json"), "no `projectile_index`"))?
+        as usize;
     // A rubble-pile projectile: bodies `start..end` (crate::impact::pile::PileRecord).
     let pile_range = impact["projectile_pile"]["projectile_bodies"]
         .as_array()
         .and_then(|r| Some(r.first()?.as_u64()? as usize..r.get(1)?.as_u64()? as usize));
-    let scene_path = dir.join("scene.toml");
-    let text = std::fs::read_to_string(&scene_path).map_err(|e| AnalysisError::Read {
-        path: scene_path.clone(),
-        reason: e.to_string(),
-    })?;
-    let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string()).map_err(|e| {
-        AnalysisError::Read {
-            path: scene_path.clone(),
-            reason: e.to_string(),
-        }
-    })?;
+    let scene = read_scene(dir)?;
     if t_at > scene.scene.t_end * (1.0 + 1e-9) {
         return Err(AnalysisError::PastEnd {
             dir: dir.to_path_buf(),
@@ -331,12 +329,7 @@ pub fn analyze_run(
     }
     let g = scene.physics.gravity.and_then(|g| g.g).unwrap_or(G_SI);
     let times = snapshot_times(dir)?;
-    let find = |t: f64| {
-        times
-            .iter()
-            .find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0))
-            .map(|(_, p)| p.clone())
-    };
+    let find = |t: f64| snapshot_at(&times, t).map(|(_, p)| p.clone());
     let missing = |t: f64| AnalysisError::NoSnapshot {
         dir: dir.to_path_buf(),
         t,
@@ -348,10 +341,7 @@ pub fn analyze_run(
     );
     let read = |p: &Path| {
         verified(dir, p)?;
-        read_snapshot_bodies(p).map_err(|e| AnalysisError::Read {
-            path: p.to_path_buf(),
-            reason: e.to_string(),
-        })
+        read_snapshot_bodies(p).map_err(|e| AnalysisError::read(p, e))
     };
     let (initial, at) = (read(&p0)?, read(&pat)?);
     let kappa_i = scene.model.inertia.inertia_kappa(kappa);
@@ -396,10 +386,7 @@ pub fn analyze_run(
         clumps: clump_report.summary(),
         clump_report,
     };
-    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
-        path: out_dir.clone(),
-        reason: crate::io::safe_write::reason(&e),
-    })?;
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::write(&out_dir, &e))?;
     write_fragments_csv(&csv_path, &report)?;
     if let Some(c) = &analysis.composition {
         write_composition_csv(&out_dir.join("composition.csv"), c)?;
@@ -412,10 +399,7 @@ pub fn analyze_run(
 
 /// Writes `text` to `path` atomically, never through a link ([`crate::io::safe_write`]).
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
-    crate::io::safe_write::write_atomic(path, text).map_err(|e| AnalysisError::Write {
-        path: path.to_path_buf(),
-        reason: crate::io::safe_write::reason(&e),
-    })
+    crate::io::safe_write::write_atomic(path, text).map_err(|e| AnalysisError::write(path, &e))
 }
 
 /// Whether `dir` holds an impact run (its `impact.json`, from `rubblepile impact`, a campaign or `run` of the
@@ -435,23 +419,19 @@ fn run_snapshot_bodies(
 ) -> Result<(Vec<crate::ellipsoid::body::Body>, Option<f64>, f64), AnalysisError> {
     use crate::driver::kind::SceneKind;
     let scene_path = dir.join("scene.toml");
-    let read_err = |path: &Path, reason: String| AnalysisError::Read {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let text = std::fs::read_to_string(&scene_path).map_err(|e| read_err(&scene_path, e.to_string()))?;
+    let text = std::fs::read_to_string(&scene_path).map_err(|e| AnalysisError::read(&scene_path, e))?;
     verified(dir, snapshot)?;
     match SceneKind::of_text(&text) {
         SceneKind::Ellipsoids => {
             let scene = crate::ellipsoid::scene::parse_toml(&text, &scene_path.display().to_string())
-                .map_err(|e| read_err(&scene_path, e.to_string()))?;
+                .map_err(|e| AnalysisError::read(&scene_path, e))?;
             let kappa_i = scene.model.inertia.inertia_kappa(run_kappa(dir)?);
             let g = scene.physics.gravity.as_ref().map(|s| s.g.unwrap_or(G_SI));
-            let bodies = read_snapshot_bodies(snapshot).map_err(|e| read_err(snapshot, e.to_string()))?;
+            let bodies = read_snapshot_bodies(snapshot).map_err(|e| AnalysisError::read(snapshot, e))?;
             Ok((bodies, g, kappa_i))
         }
         kind => {
-            let table: toml::Table = text.parse().map_err(|e| read_err(&scene_path, format!("{e}")))?;
+            let table: toml::Table = text.parse().map_err(|e| AnalysisError::read(&scene_path, e))?;
             let gravity = table.get("gravity");
             let g = (kind == SceneKind::SoftSpheres && gravity.and_then(|g| g.get("self")).is_some()).then(|| {
                 gravity
@@ -461,7 +441,7 @@ fn run_snapshot_bodies(
             });
             let columns = ["mass", "radius", "x", "y", "z", "vx", "vy", "vz", "wx", "wy", "wz"];
             let rows = crate::io::particles::read_particles(snapshot, &columns, &[])
-                .map_err(|e| read_err(snapshot, e.to_string()))?;
+                .map_err(|e| AnalysisError::read(snapshot, e))?;
             let bodies = rows
                 .iter()
                 .map(|r| {
@@ -500,7 +480,7 @@ pub fn analyze_clumps_run(
     }
     let times = snapshot_times(dir)?;
     let found = match t_at {
-        Some(t) => times.iter().find(|(s, _)| (s - t).abs() <= 1e-9 * t.abs().max(1.0)),
+        Some(t) => snapshot_at(&times, t),
         None => times.last(),
     };
     let Some((t, snapshot)) = found.cloned() else {
@@ -517,10 +497,7 @@ pub fn analyze_clumps_run(
         clumps: report.summary(),
         clump_report: report,
     };
-    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::Write {
-        path: out_dir.clone(),
-        reason: crate::io::safe_write::reason(&e),
-    })?;
+    crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::write(&out_dir, &e))?;
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
     write_text(
         &json_path,
@@ -546,10 +523,7 @@ fn write_composition_csv(path: &Path, c: &Composition) -> Result<(), AnalysisErr
 
 /// `fragments.csv`: one row per body.
 fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), AnalysisError> {
-    let err = |e: &dyn std::fmt::Display| AnalysisError::Read {
-        path: path.to_path_buf(),
-        reason: e.to_string(),
-    };
+    let err = |e: &dyn std::fmt::Display| AnalysisError::read(path, e);
     let file = crate::io::safe_write::AtomicFile::create(path).map_err(|e| err(&crate::io::safe_write::reason(&e)))?;
     let mut w = csv::Writer::from_writer(file);
     w.write_record([
@@ -910,10 +884,7 @@ impl FragmentFields {
         if !path.exists() {
             return Ok(None);
         }
-        let err = |reason: String| AnalysisError::Read {
-            path: path.clone(),
-            reason,
-        };
+        let err = |reason: String| AnalysisError::read(&path, reason);
         let mut rdr = csv::Reader::from_path(&path).map_err(|e| err(e.to_string()))?;
         let headers = rdr.headers().map_err(|e| err(e.to_string()))?.clone();
         let col = |name: &str| {

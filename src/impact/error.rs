@@ -46,6 +46,14 @@ pub enum ImpactError {
 }
 
 impl ImpactError {
+    /// An [`ImpactError::Invalid`] naming `field`.
+    pub fn invalid(field: &str, message: String) -> Self {
+        ImpactError::Invalid {
+            field: field.to_string(),
+            message,
+        }
+    }
+
     /// The command line's exit code: 2 for bad input, 1 for a failed run, 3 for a run stopped on request.
     pub fn exit_code(&self) -> u8 {
         match self {

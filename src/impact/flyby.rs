@@ -160,10 +160,11 @@ pub struct FlybySetup {
 /// `v_inf` (m/s), and the time (s) from `start_q · q` on the way in to perigee: half the run's duration.
 pub fn flyby_orbit(gm: f64, q: f64, v_inf: f64, start_q: f64) -> Result<(KeplerOrbit, f64), ImpactError> {
     let rot = orientation_matrix(0.0, 0.0, 0.0);
-    let orbit = KeplerOrbit::hyperbolic(gm, q, v_inf, 0.0, rot).map_err(|e| invalid("q_m", e.to_string()))?;
+    let orbit =
+        KeplerOrbit::hyperbolic(gm, q, v_inf, 0.0, rot).map_err(|e| ImpactError::invalid("q_m", e.to_string()))?;
     let t_perigee = orbit
         .time_from_perigee_at_distance(start_q * q)
-        .ok_or_else(|| invalid("start_q", "the orbit never reaches that distance".into()))?;
+        .ok_or_else(|| ImpactError::invalid("start_q", "the orbit never reaches that distance".into()))?;
     Ok((orbit, t_perigee))
 }
 
@@ -185,13 +186,6 @@ pub fn flag(field: &str) -> String {
         "planet_mass" => "--planet-mass-kg".into(),
         "settle_max_hours" => "--settle-max-h".into(),
         other => format!("--{}", other.replace('_', "-")),
-    }
-}
-
-fn invalid(field: &str, message: String) -> ImpactError {
-    ImpactError::Invalid {
-        field: field.into(),
-        message,
     }
 }
 
@@ -252,11 +246,11 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         ("settle_max_hours", args.settle_max_hours.unwrap_or(1.0)),
     ] {
         if !positive(x) {
-            return Err(invalid(field, format!("must be > 0 and finite, got {x}")));
+            return Err(ImpactError::invalid(field, format!("must be > 0 and finite, got {x}")));
         }
     }
     if !(args.planet_mass.is_finite() && args.planet_mass >= 0.0) {
-        return Err(invalid(
+        return Err(ImpactError::invalid(
             "planet_mass",
             format!(
                 "must be >= 0 kg (0: a control run without tide), got {}",
@@ -265,13 +259,13 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         ));
     }
     if !(args.start_q.is_finite() && args.start_q > 1.0) {
-        return Err(invalid(
+        return Err(ImpactError::invalid(
             "start_q",
             format!("must be > 1 (in units of q), got {}", args.start_q),
         ));
     }
     if args.q_m <= args.planet_radius_m {
-        return Err(invalid(
+        return Err(ImpactError::invalid(
             "q_m",
             format!(
                 "must exceed the planet radius {} m, got {}",
@@ -281,7 +275,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     }
     let max_snapshots = crate::io::scene_file::MAX_SNAPSHOTS;
     if !(2..=max_snapshots).contains(&args.snapshots) {
-        return Err(invalid(
+        return Err(ImpactError::invalid(
             "snapshots",
             format!("need 2 to {max_snapshots} (MAX_SNAPSHOTS), got {}", args.snapshots),
         ));
@@ -294,7 +288,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         if let Some(v) = values
             && v.len() != 3
         {
-            return Err(invalid(
+            return Err(ImpactError::invalid(
                 field,
                 format!("needs three comma-separated numbers, got {v:?}"),
             ));
@@ -303,11 +297,11 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     if let Some(j2) = args.planet_j2
         && !j2.is_finite()
     {
-        return Err(invalid("planet_j2", format!("must be finite, got {j2}")));
+        return Err(ImpactError::invalid("planet_j2", format!("must be finite, got {j2}")));
     }
     let pole = match (&args.planet_pole, args.planet_j2) {
         (Some(_), None) => {
-            return Err(invalid(
+            return Err(ImpactError::invalid(
                 "planet_pole",
                 "is the planet's spin axis for --planet-j2; give --planet-j2 too".to_string(),
             ));
@@ -315,7 +309,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         (Some(p), Some(_)) => {
             let p = [p[0], p[1], p[2]];
             if !(p.iter().all(|x| x.is_finite()) && p.iter().any(|x| *x != 0.0)) {
-                return Err(invalid(
+                return Err(ImpactError::invalid(
                     "planet_pole",
                     format!("must be a finite non-zero vector, got {p:?}"),
                 ));
@@ -328,9 +322,9 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     let target = read_target(&args.target)?;
     let kappa = match args.kappa.or_else(|| target_kappa(&args.target)) {
         Some(k) if k > 1.5 => k,
-        Some(k) => return Err(invalid("kappa", format!("must be > 1.5, got {k}"))),
+        Some(k) => return Err(ImpactError::invalid("kappa", format!("must be > 1.5, got {k}"))),
         None => {
-            return Err(invalid(
+            return Err(ImpactError::invalid(
                 "kappa",
                 format!(
                     "no --kappa and no \"kappa\" in {}",
@@ -350,7 +344,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     // unbounded), which is the speed's fault, not the perigee's.
     let excess = args.q_m * v_inf * v_inf / gm;
     if gm > 0.0 && (excess.is_nan() || excess < MIN_HYPERBOLIC_EXCESS) {
-        return Err(invalid(
+        return Err(ImpactError::invalid(
             "v_inf_km_s",
             format!(
                 "must be at least {:.3e} km/s for q_m = {} m and this planet (slower, the orbit is parabolic to \
@@ -370,7 +364,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     if let Some(p) = args.period_hours {
         let steps = crate::ellipsoid::scene::STEPS_PER_TIME_SCALE * settle_max_time / (p * 3600.0);
         if steps.is_nan() || steps > crate::io::run_budget::DEFAULT_MAX_STEPS as f64 {
-            return Err(invalid(
+            return Err(ImpactError::invalid(
                 "period_hours",
                 format!(
                     "a spin period of {} h asks for about {steps:.1e} steps to settle the pile over {settle_max_time:.3e} \

@@ -71,10 +71,7 @@ impl ImpactGeometry {
         spin_rad_s: Option<&[f64]>,
         attitude: Option<&[f64]>,
     ) -> Result<Self, ImpactError> {
-        let invalid = |field: &str, message: String| ImpactError::Invalid {
-            field: field.into(),
-            message,
-        };
+        let invalid = ImpactError::invalid;
         let given: Vec<usize> = (0..3).filter(|&k| aims[k].is_some()).collect();
         if let [first, second, ..] = given[..] {
             let (first, second) = (AIM_KEYS[first], AIM_KEYS[second]);

@@ -13,7 +13,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::ellipsoid::body::Body;
-use crate::ellipsoid::quaternion::{from_unit_quaternion, rotation_matrix, to_unit_quaternion};
+use crate::ellipsoid::quaternion::{from_unit_quaternion, to_unit_quaternion};
 use crate::impact::error::{ImpactError, read_target};
 use crate::impact::geometry::{Aim, ImpactGeometry};
 pub use crate::impact::projectile::PileRecord;
@@ -38,10 +38,7 @@ pub struct ProjectilePile {
 /// Turns an error reading a pile file into [`ImpactError::Invalid`] naming `field` (the file and the reason in
 /// the message).
 pub fn as_field(field: &str) -> impl Fn(ImpactError) -> ImpactError + '_ {
-    move |e| ImpactError::Invalid {
-        field: field.to_string(),
-        message: e.to_string(),
-    }
+    move |e| ImpactError::invalid(field, e.to_string())
 }
 
 impl ProjectilePile {
@@ -166,21 +163,4 @@ pub fn set_up_aimed_pile_impact(
     };
     let hits = geometry.aim == Aim::Centre || (touched && aiming.aim_point.is_some());
     (bodies, setup, hits)
-}
-
-/// Whether any projectile body overlaps any target body (the ellipsoids' overlap test): the check that a
-/// set-up starts with the piles apart.
-pub fn piles_overlap(bodies: &[Body], n_target: usize) -> bool {
-    let sigma = |b: &Body| {
-        let r = rotation_matrix(&b.quaternion);
-        r.transpose() * crate::math::Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r
-    };
-    let (target, projectile) = bodies.split_at(n_target);
-    projectile.iter().any(|p| {
-        target.iter().any(|t| {
-            let d = p.position - t.position;
-            d.norm() < p.shape.axes.x + t.shape.axes.x
-                && !crate::geometry::ellipsoid_overlap::are_apart(&d, &sigma(p), &sigma(t))
-        })
-    })
 }

@@ -14,6 +14,7 @@ use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
 };
+use crate::ellipsoid::output::{BodyRecord, read_bodies};
 use crate::impact::projectile::{ProjectileSpec, set_up_impact};
 use crate::impact::target::to_centre_of_mass_frame;
 use crate::integrate::OdeSystem;
@@ -442,11 +443,7 @@ pub const PILE_T_END: f64 = 100.0;
 /// fastest time scale of the deepest contacts, at 1e-2 of every contact (overdamped: the pile creeps apart).
 /// 30 bodies, 420 state components (431 with the dissipation integral).
 pub fn squeezed_pile(f0: f64) -> ProblemSetup {
-    let mut bodies: Vec<Body> = crate::ellipsoid::output::read_bodies(N30_T4_CSV.as_bytes())
-        .expect("the embedded target parses")
-        .iter()
-        .map(crate::ellipsoid::output::BodyRecord::to_body)
-        .collect();
+    let mut bodies = embedded_bodies(N30_T4_CSV);
     let projectile = ProjectileSpec::preset("P1").expect("a preset projectile");
     let cfg = crate::impact::run::ImpactConfig::new("targets/N30_T4.csv".into(), projectile);
     let kappa = cfg.kappa(&bodies).expect("the target and projectile calibrate");
@@ -493,6 +490,12 @@ pub fn n200_impact() -> ProblemSetup {
     setup.build()
 }
 
+/// The bodies of an embedded target file ([`N30_T4_CSV`], [`N200_T4_CSV`]).
+fn embedded_bodies(csv: &str) -> Vec<Body> {
+    let records = read_bodies(csv.as_bytes()).expect("the embedded target parses");
+    records.iter().map(BodyRecord::to_body).collect()
+}
+
 /// An impact of a committed target as `rubblepile impact` sets it up (ζ = 45°, κ calibrated with β = 10, SI
 /// gravity + contact + dissipation), with the campaign defaults unless overridden.
 struct ImpactProblem {
@@ -511,11 +514,7 @@ struct ImpactProblem {
 
 impl ImpactProblem {
     fn build(self) -> ProblemSetup {
-        let target: Vec<Body> = crate::ellipsoid::output::read_bodies(self.target_csv.as_bytes())
-            .expect("the embedded target parses")
-            .iter()
-            .map(crate::ellipsoid::output::BodyRecord::to_body)
-            .collect();
+        let target = embedded_bodies(self.target_csv);
         let projectile = ProjectileSpec::preset(self.projectile).expect("a preset projectile");
         let mut cfg = crate::impact::run::ImpactConfig::new(self.target_path.into(), projectile.clone());
         if let Some(t) = self.contact_time {

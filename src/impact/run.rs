@@ -198,12 +198,7 @@ impl ImpactConfig {
     /// Checks every value is in range. Errors are [`ImpactError::Invalid`], naming the field as in this
     /// struct (`angle_deg`, `projectile.speed`, `snapshots[2]`, …).
     pub fn validate(&self) -> Result<(), ImpactError> {
-        let invalid = |field: &str, message: String| {
-            Err(ImpactError::Invalid {
-                field: field.to_string(),
-                message,
-            })
-        };
+        let invalid = |field: &str, message: String| Err(ImpactError::invalid(field, message));
         let positive = |x: f64| x.is_finite() && x > 0.0;
         let p = &self.projectile;
         if !positive(p.equivalent_radius) {
@@ -339,15 +334,15 @@ impl ImpactConfig {
             (large.equivalent_radius(), large.mass),
             G_SI,
         )
-        .map_err(|e| ImpactError::Invalid {
-            field: "projectile".into(),
-            message: format!("kappa calibration over target + projectile fails: {e}"),
+        .map_err(|e| {
+            ImpactError::invalid(
+                "projectile",
+                format!("kappa calibration over target + projectile fails: {e}"),
+            )
         })?;
         if !(kappa.is_finite() && kappa > 1.5) {
-            return Err(ImpactError::Invalid {
-                field: "projectile".into(),
-                message: format!("kappa calibration over target + projectile gave {kappa}, need > 1.5"),
-            });
+            let why = format!("kappa calibration over target + projectile gave {kappa}, need > 1.5");
+            return Err(ImpactError::invalid("projectile", why));
         }
         Ok(kappa)
     }
@@ -370,25 +365,25 @@ impl ImpactConfig {
             (geometry.aim, setup.geometry.as_ref().and_then(|g| g.impact_angle_deg))
             && (got - theta).abs() > 1e-6
         {
-            return Err(ImpactError::Invalid {
-                field: aim_field(&geometry.aim).into(),
-                message: format!(
+            return Err(ImpactError::invalid(
+                aim_field(&geometry.aim),
+                format!(
                     "no point of the target's surface ellipsoid at aim_azimuth_deg = {} makes an impact angle of \
                      {theta} deg with the approach (the smallest there is about {got:.3} deg); give a larger angle, \
                      0 (the head-on point) or another azimuth",
                     geometry.azimuth_deg
                 ),
-            });
+            ));
         }
         if let (false, Some((b, r))) = (hits, aim) {
-            return Err(ImpactError::Invalid {
-                field: aim_field(&geometry.aim).into(),
-                message: format!(
+            return Err(ImpactError::invalid(
+                aim_field(&geometry.aim),
+                format!(
                     "the trajectory at b = {b:.6e} m ({:.4} of the target's radius R = {r:.6e} m) misses the \
                      target; need a smaller b or impact angle",
                     b / r
                 ),
-            });
+            ));
         }
         let what = match &self.pile {
             Some(pile) => format!("the rubble pile {} (N = {})", pile.file.display(), pile.bodies.len()),
