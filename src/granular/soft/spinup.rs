@@ -344,8 +344,7 @@ impl DisjointSets {
 
     /// The root of `i`'s set. Links are followed without compressing them while unions may run: only roots are
     /// ever linked, to a root of lower index, so with the contacts in key order the paths stay short, and plain
-    /// loads cost far less than the atomic writes of path halving (on a 42 000-sphere pile this is as fast as the
-    /// serial union–find on one thread; with halving it took twice as long).
+    /// loads cost far less than the atomic writes of path halving (`analysis/ssdem_perf/NOTES.md`).
     fn find(&self, mut i: u32) -> u32 {
         loop {
             let p = self.parent[i as usize].load(Ordering::Acquire);
