@@ -377,10 +377,10 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             format!("must be in [1, {MAX_EVENTS_PER_STEP}] (MAX_EVENTS_PER_STEP), got {max_events}"),
         ));
     }
-    let gravity = match &file.gravity {
-        Some(g) => Some(vector(&v, "gravity.uniform", g.uniform)?),
-        None => None,
-    };
+    let gravity = file
+        .gravity
+        .map(|g| vector(&v, "gravity.uniform", g.uniform))
+        .transpose()?;
     let eps_n = v.field(&MaterialSection::EPS_N, file.material.eps_n)?;
     let eps_t = v.field(&MaterialSection::EPS_T, file.material.eps_t)?;
     let every = v.cadence("output.every", file.output.every, t_end)?;
@@ -574,10 +574,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
             None => Err(v.invalid(f("radius"), format!("required for a {}, got nothing", w.kind))),
         }
     };
-    let length = match w.length {
-        Some(l) => Some(v.size_or_zero(&f("length"), l)?),
-        None => None,
-    };
+    let length = w.length.map(|l| v.size_or_zero(&f("length"), l)).transpose()?;
     let no = |field: &str, given: bool| -> Result<(), SceneError> {
         if given {
             Err(v.invalid(f(field), format!("not used by a {}; remove it", w.kind)))
@@ -658,14 +655,14 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         oscillation,
         spin: w.spin,
     };
-    wall.eps_n = match w.eps_n {
-        Some(e) => Some(v.within(&WallSpec::EPS_N, &f("eps_n"), e)?),
-        None => None,
-    };
-    wall.eps_t = match w.eps_t {
-        Some(e) => Some(v.within(&WallSpec::EPS_T, &f("eps_t"), e)?),
-        None => None,
-    };
+    wall.eps_n = w
+        .eps_n
+        .map(|e| v.within(&WallSpec::EPS_N, &f("eps_n"), e))
+        .transpose()?;
+    wall.eps_t = w
+        .eps_t
+        .map(|e| v.within(&WallSpec::EPS_T, &f("eps_t"), e))
+        .transpose()?;
     if w.sticky && w.absorbing {
         return Err(v.invalid(f("sticky"), "a wall cannot be both sticky and absorbing, got both true"));
     }

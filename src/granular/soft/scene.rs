@@ -560,10 +560,10 @@ impl V<'_> {
         let max_start = self.field(&MaterialSection::MAX_START_OVERLAP, c.max_start_overlap)?;
 
         let gs = &file.gravity;
-        let g = match gs.g {
-            Some(g) => self.field(&GravitySection::G, g)?,
-            None => SI_G,
-        };
+        let g =
+            gs.g.map(|g| self.field(&GravitySection::G, g))
+                .transpose()?
+                .unwrap_or(SI_G);
         let self_gravity = match gs.self_gravity.as_deref() {
             None => {
                 if gs.theta.is_some() {
@@ -601,10 +601,8 @@ impl V<'_> {
             }
             Some(k) => k as u64,
         };
-        let uniform = match gs.uniform {
-            Some(u) => vector(self, "gravity.uniform", u)?,
-            None => Vec3::zeros(),
-        };
+        let uniform = gs.uniform.map(|u| vector(self, "gravity.uniform", u)).transpose()?;
+        let uniform = uniform.unwrap_or_else(Vec3::zeros);
         let gravity = Gravity {
             uniform,
             self_gravity,
