@@ -94,16 +94,125 @@ pub(crate) fn oscillation(
     })
 }
 
+/// The field `field`'s vector `x`: three finite numbers.
+pub(crate) fn vector(v: &Validator, field: &str, x: [f64; 3]) -> Result<Vec3, SceneError> {
+    if x.iter().all(|c| c.is_finite()) {
+        Ok(Vec3::from(x))
+    } else {
+        Err(v.invalid(field, format!("must be finite, got {x:?}")))
+    }
+}
+
 /// The field `field`'s vector `x` normalised: three finite numbers, not all zero (a wall's normal, axis or
 /// direction).
 pub(crate) fn unit(v: &Validator, field: &str, x: [f64; 3]) -> Result<Vec3, SceneError> {
-    if !x.iter().all(|c| c.is_finite()) {
-        return Err(v.invalid(field, format!("must be finite, got {x:?}")));
-    }
-    let y = Vec3::from(x);
+    let y = vector(v, field, x)?;
     if y.norm() > 0.0 {
         Ok(y.normalize())
     } else {
         Err(v.invalid(field, format!("must be a non-zero vector, got {x:?}")))
+    }
+}
+
+/// `N / 100` as the serde default of a scene field: correctly rounded, so the same `f64` as the literal.
+pub(crate) fn hundredths<const N: u32>() -> f64 {
+    f64::from(N) / 100.0
+}
+
+/// Refuses a sphere whose moment of inertia `2/5 m r²` is not a normal number (the collisions divide by it): a
+/// radius (`radius_fault`, its powers underflow) or a mass so small that it underflows. `f` names a key of the sphere.
+pub(crate) fn check_inertia(
+    v: &Validator,
+    f: &dyn Fn(&str) -> String,
+    mass: f64,
+    radius: f64,
+    radius_fault: bool,
+) -> Result<(), SceneError> {
+    let inertia = 0.4 * mass * radius * radius;
+    if !(inertia.is_finite() && inertia >= f64::MIN_POSITIVE) {
+        return Err(v.invalid(
+            f(if radius_fault { "radius" } else { "mass" }),
+            format!(
+                "gives a moment of inertia 2/5 m r^2 = {inertia:e} kg m^2, not a finite normal number (mass {mass:e} \
+                 kg, radius {radius:e} m)"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a uniform field of size `g` (m/s²) that gives a sphere `(mass, position)` a non-finite potential energy
+/// `m |g| |x|` or kick `|g| dt` at t = 0, naming the largest factor.
+pub(crate) fn check_uniform_gravity(
+    v: &Validator,
+    g: f64,
+    spheres: impl Iterator<Item = (f64, Vec3)>,
+    dt: f64,
+) -> Result<(), SceneError> {
+    for (k, (m, position)) in spheres.enumerate() {
+        let x = position.norm();
+        if !(m * g * x).is_finite() || !(g * dt).is_finite() {
+            let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", g), ("x", x)]) {
+                "m" => format!("particle[{k}].mass"),
+                "x" => format!("particle[{k}].position"),
+                _ => "gravity.uniform".to_string(),
+            };
+            return Err(v.invalid(
+                field,
+                format!(
+                    "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at t = 0 \
+                     (m = {m:e} kg, |g| = {g:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a start where two spheres (`skip` excepted) overlap by more than `max` of the smaller radius; `limit`
+/// ends the message with the rule broken.
+pub(crate) fn check_start_overlaps(
+    v: &Validator,
+    centres: &[Vec3],
+    radii: &[f64],
+    max: f64,
+    skip: impl Fn(usize, usize) -> bool,
+    limit: &str,
+) -> Result<(), SceneError> {
+    for (i, j) in crate::geometry::neighbours::sphere_pairs(centres, radii) {
+        if skip(i, j) {
+            continue;
+        }
+        let overlap = radii[i] + radii[j] - (centres[j] - centres[i]).norm();
+        let fraction = overlap / radii[i].min(radii[j]);
+        if fraction > max {
+            return Err(v.invalid(
+                format!("particle[{i}].position"),
+                format!(
+                    "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start{limit}"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn hundredths_are_the_literals() {
+        use super::hundredths;
+        let got = [
+            hundredths::<1>(),
+            hundredths::<5>(),
+            hundredths::<10>(),
+            hundredths::<50>(),
+            hundredths::<55>(),
+        ];
+        assert_eq!(got, [0.01, 0.05, 0.1, 0.5, 0.55]);
+        assert_eq!(
+            [hundredths::<100>(), hundredths::<105>(), hundredths::<130>()],
+            [1.0, 1.05, 1.3]
+        );
     }
 }

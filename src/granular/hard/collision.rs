@@ -4,8 +4,9 @@
 //! `u·n̂ < 0`. With `μ = m₁m₂/M` and `β = 1/(1 + μ(R₁²/I₁ + R₂²/I₂))` (2/7 for uniform spheres) the impulses are
 //! `p = (1+ε_n) u_n + β(1−ε_t) u_t`, `q = μβ(1−ε_t)(n̂ × u)`: `v₁ += (m₂/M) p`, `v₂ −= (m₁/M) p`, `ω₁ += (R₁/I₁) q`,
 //! `ω₂ += (R₂/I₂) q`; ε_n ∈ [0, 1], ε_t ∈ [−1, 1] (1 smooth, −1 reversed). Both momenta are conserved exactly; the
-//! energy change is [`pair_energy_change`]. Against a wall (infinite mass): `v −= (1 + ε_n) u_n + (2/7)(1 − ε_t) u_t`,
-//! `ω −= (5/7)(1 − ε_t)(R × u)/s²`; a wall's ε override the particle's, sticky walls hold, absorbing ones remove.
+//! energy changes by `−½ μ (1−ε_n²) u_n² − ½ μβ (1−ε_t²) |u_t|²` (`tests/hsdem_collisions.rs`). Against a wall
+//! (infinite mass): `v −= (1 + ε_n) u_n + (2/7)(1 − ε_t) u_t`, `ω −= (5/7)(1 − ε_t)(R × u)/s²`; a wall's ε override
+//! the particle's, sticky walls hold, absorbing ones remove.
 //!
 //! Inelastic-collapse guard: a collision approaching slower than `collapse_speed` is made elastic, so a pile at rest
 //! under gravity bounces at speeds of order g·dt instead of making infinitely many ever smaller bounces in finite
@@ -73,19 +74,6 @@ pub fn contact_velocity(b1: &Body, b2: &Body) -> (Vec3, Vec3) {
     let n = (b2.position - b1.position).normalize();
     let u = (b2.velocity + b2.spin.cross(&(-n * b2.radius))) - (b1.velocity + b1.spin.cross(&(n * b1.radius)));
     (u, n)
-}
-
-/// The closed-form energy change (J, ≤ 0) of a pair collision: `−½ μ (1−ε_n²) u_n² − ½ μβ (1−ε_t²) |u_t|²`.
-pub fn pair_energy_change(b1: &Body, b2: &Body, r: Restitution) -> f64 {
-    let (u, n) = contact_velocity(b1, b2);
-    let un = u.dot(&n);
-    if un >= 0.0 {
-        return 0.0;
-    }
-    let ut = u - n * un;
-    let mu = b1.mass * b2.mass / (b1.mass + b2.mass);
-    let beta = 1.0 / (1.0 + mu * (b1.radius * b1.radius / b1.inertia + b2.radius * b2.radius / b2.inertia));
-    -0.5 * mu * (1.0 - r.eps_n * r.eps_n) * un * un - 0.5 * mu * beta * (1.0 - r.eps_t * r.eps_t) * ut.norm_squared()
 }
 
 /// The restitution a contact with normal relative velocity `un` (m/s, negative when approaching) gets: `None`

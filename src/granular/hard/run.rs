@@ -123,14 +123,8 @@ pub struct HardRunSummary {
 
 /// The walls at time `t` (s), unbounded ones cut to a piece reaching past every particle.
 fn wall_surfaces(walls: &[crate::geometry::walls::Wall], t: f64, particles: &[ParticleView]) -> Vec<NamedSurface> {
-    walls
-        .iter()
-        .enumerate()
-        .map(|(k, w)| NamedSurface {
-            name: format!("wall{k}"),
-            mesh: w.surface_at(t, crate::engine::reach(particles, &w.origin_at(t))),
-        })
-        .collect()
+    let reach = |w: &crate::geometry::walls::Wall| crate::engine::reach(particles, &w.origin_at(t));
+    crate::granular::wall_surfaces(walls.iter().map(|w| w.surface_at(t, reach(w))))
 }
 
 /// Writes the alive particles in the particles-file columns.
@@ -259,9 +253,8 @@ fn unpack_particles(system: &mut System, v: &[f64]) -> Result<(), String> {
     Ok(())
 }
 
-impl HardRunSummary {
-    /// One line for the terminal.
-    pub fn one_line(&self) -> String {
+impl RunReport for HardRunSummary {
+    fn one_line(&self) -> String {
         format!(
             "{}: t = {} s, {} steps, {} collisions ({:.3e} events/s), energy error {:.2e} (change {:.2e}: restitution {:.2e} J, walls {:.2e} J, removed {:.2e} J), momentum error {:.2e} kg m/s (change {:.2e}), max overlap {:.2e}, {} absorbed, {:.2} s",
             self.status,
@@ -280,12 +273,6 @@ impl HardRunSummary {
             self.absorbed,
             self.wall_seconds
         )
-    }
-}
-
-impl RunReport for HardRunSummary {
-    fn one_line(&self) -> String {
-        HardRunSummary::one_line(self)
     }
 }
 
@@ -654,18 +641,8 @@ impl HardEngine {
         let alive: Vec<usize> = (0..self.system.particles.len())
             .filter(|&k| self.system.particles[k].alive)
             .collect();
-        let n = alive.len();
-        for (name, v) in [("positions", positions), ("velocities", velocities), ("spins", spins)] {
-            if v.len() != n {
-                return Err(EngineError::State(format!(
-                    "{name}: {} given, the run has {n} particles",
-                    v.len()
-                )));
-            }
-            if let Some(i) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
-                return Err(EngineError::State(format!("{name}[{i}]: a non-finite value")));
-            }
-        }
+        let arrays = [("positions", positions), ("velocities", velocities), ("spins", spins)];
+        crate::granular::check_particle_arrays(alive.len(), "particles", arrays)?;
         for (i, &k) in alive.iter().enumerate() {
             let p = &self.system.particles[k];
             let same = p.position == positions[i] && p.velocity == velocities[i] && p.spin == spins[i];

@@ -15,7 +15,9 @@ use serde::{Deserialize, Serialize};
 use super::particle::{Attachment, Particle};
 use super::stepper::{DEFAULT_SKIN_STEPS, StepperSettings};
 use crate::geometry::walls::{Shape, Wall, WallMotion};
-use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
+use crate::granular::vocabulary::{
+    OscillationSpec, check_inertia, check_start_overlaps, check_uniform_gravity, hundredths, oscillation, unit, vector,
+};
 use crate::io::scene_file::{MAX_BODIES, MAX_EVENTS_PER_STEP, SceneError, WORK_WARNING_STEPS, exact, parse_toml_as};
 use crate::math::Vec3;
 
@@ -158,17 +160,13 @@ pub struct GravitySection {
 #[serde(deny_unknown_fields)]
 pub struct MaterialSection {
     /// normal coefficient of restitution of every particle
-    #[serde(default = "one")]
+    #[serde(default = "hundredths::<100>")]
     #[field(unit = "-", default = "1 (elastic)", range = closed(0.0, 1.0))]
     pub eps_n: f64,
     /// tangential coefficient of restitution of every particle
-    #[serde(default = "one")]
+    #[serde(default = "hundredths::<100>")]
     #[field(unit = "-", default = "1 (smooth)", range = closed(-1.0, 1.0))]
     pub eps_t: f64,
-}
-
-fn one() -> f64 {
-    1.0
 }
 
 impl Default for MaterialSection {
@@ -348,16 +346,6 @@ pub struct HardScene {
 
 use crate::io::scene_file::Validator as V;
 
-impl V<'_> {
-    fn vec(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
-        if v.iter().all(|x| x.is_finite()) {
-            Ok(Vec3::from(v))
-        } else {
-            Err(self.invalid(field, format!("must be finite, got {v:?}")))
-        }
-    }
-}
-
 /// Reads and validates a hard-sphere scene file.
 pub fn load_hard_scene(path: &Path) -> Result<HardScene, SceneError> {
     let s = crate::io::scene_file::read_scene_text(path)?;
@@ -389,10 +377,10 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             format!("must be in [1, {MAX_EVENTS_PER_STEP}] (MAX_EVENTS_PER_STEP), got {max_events}"),
         ));
     }
-    let gravity = match &file.gravity {
-        Some(g) => Some(v.vec("gravity.uniform", g.uniform)?),
-        None => None,
-    };
+    let gravity = file
+        .gravity
+        .map(|g| vector(&v, "gravity.uniform", g.uniform))
+        .transpose()?;
     let eps_n = v.field(&MaterialSection::EPS_N, file.material.eps_n)?;
     let eps_t = v.field(&MaterialSection::EPS_T, file.material.eps_t)?;
     let every = v.cadence("output.every", file.output.every, t_end)?;
@@ -434,17 +422,8 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             v.count("particle", file.particles.len(), MAX_BODIES, "particles (MAX_BODIES)")?;
             for (k, p) in file.particles.iter().enumerate() {
                 let f = |x: &str| format!("particle[{k}].{x}");
-                let mass = v.within(&ParticleSpec::MASS, &f("mass"), p.mass)?;
-                let radius = v.within(&ParticleSpec::RADIUS, &f("radius"), p.radius)?;
-                moment_of_inertia(&v, &f, mass, radius)?;
-                let mut q = Particle::new(
-                    k,
-                    mass,
-                    radius,
-                    v.vec(&f("position"), p.position)?,
-                    v.vec(&f("velocity"), p.velocity)?,
-                    v.vec(&f("spin"), p.spin)?,
-                );
+                let motion = [("position", p.position), ("velocity", p.velocity), ("spin", p.spin)];
+                let mut q = sphere(&v, k, &f, p.mass, p.radius, motion)?;
                 q.eps_n = v.within(&ParticleSpec::EPS_N, &f("eps_n"), p.eps_n.unwrap_or(eps_n))?;
                 q.eps_t = v.within(&ParticleSpec::EPS_T, &f("eps_t"), p.eps_t.unwrap_or(eps_t))?;
                 q.stuck = attach(f("stuck_to"), p.stuck_to, &q)?;
@@ -461,17 +440,12 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
             for (k, row) in rows.iter().enumerate() {
                 let r = &row.values;
                 let f = |x: &str| format!("scene.particles_file row {}: {x}", k + 1);
-                let mass = v.within(&ParticleSpec::MASS, &f("mass"), r[2])?;
-                let radius = v.within(&ParticleSpec::RADIUS, &f("radius"), r[3])?;
-                moment_of_inertia(&v, &f, mass, radius)?;
-                let mut q = Particle::new(
-                    k,
-                    mass,
-                    radius,
-                    v.vec(&f("x,y,z"), [r[4], r[5], r[6]])?,
-                    v.vec(&f("vx,vy,vz"), [r[7], r[8], r[9]])?,
-                    v.vec(&f("wx,wy,wz"), [r[10], r[11], r[12]])?,
-                );
+                let motion = [
+                    ("x,y,z", [r[4], r[5], r[6]]),
+                    ("vx,vy,vz", [r[7], r[8], r[9]]),
+                    ("wx,wy,wz", [r[10], r[11], r[12]]),
+                ];
+                let mut q = sphere(&v, k, &f, r[2], r[3], motion)?;
                 q.eps_n = eps_n;
                 q.eps_t = eps_t;
                 q.stuck = attach(f(STUCK_COLUMN), row.stuck_to, &q)?;
@@ -489,23 +463,7 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     .map_err(|(field, message)| v.invalid(field, message))?;
     if let Some(g) = gravity {
         // The potential energy m g·x of every particle enters the energy book.
-        for (k, p) in particles.iter().enumerate() {
-            let (m, gn, x) = (p.mass, g.norm(), p.position.norm());
-            if !(m * gn * x).is_finite() || !(gn * dt).is_finite() {
-                let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", gn), ("x", x)]) {
-                    "m" => format!("particle[{k}].mass"),
-                    "x" => format!("particle[{k}].position"),
-                    _ => "gravity.uniform".to_string(),
-                };
-                return Err(v.invalid(
-                    field,
-                    format!(
-                        "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at t = 0 \
-                         (m = {m:e} kg, |g| = {gn:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
-                    ),
-                ));
-            }
-        }
+        check_uniform_gravity(&v, g.norm(), particles.iter().map(|p| (p.mass, p.position)), dt)?;
     }
     let steps = t_end / dt;
     let mut warnings = migration.warnings(name);
@@ -538,25 +496,22 @@ pub fn parse_hard_scene(text: &str, name: &str, base_dir: &Path) -> Result<HardS
     })
 }
 
-/// Refuses a sphere whose moment of inertia `2/5 m r²` is not a normal number (the collisions divide by it): a
-/// radius (or mass) so small that it underflows.
-fn moment_of_inertia(v: &V, f: &dyn Fn(&str) -> String, mass: f64, radius: f64) -> Result<(), SceneError> {
-    let inertia = 0.4 * mass * radius * radius;
-    if !(inertia.is_finite() && inertia >= f64::MIN_POSITIVE) {
-        let field = if !(radius * radius).is_finite() || radius * radius < f64::MIN_POSITIVE {
-            "radius"
-        } else {
-            "mass"
-        };
-        return Err(v.invalid(
-            f(field),
-            format!(
-                "gives a moment of inertia 2/5 m r^2 = {inertia:e} kg m^2, not a finite normal number (mass {mass:e} \
-                 kg, radius {radius:e} m)"
-            ),
-        ));
-    }
-    Ok(())
+/// Particle `k` from its mass (kg), radius (m) and `(key, vector)` of its position, velocity and spin, checked
+/// ([`check_inertia`]); `f` names its keys.
+fn sphere(
+    v: &V,
+    k: usize,
+    f: &dyn Fn(&str) -> String,
+    mass: f64,
+    radius: f64,
+    [x, u, w]: [(&str, [f64; 3]); 3],
+) -> Result<Particle, SceneError> {
+    let mass = v.within(&ParticleSpec::MASS, &f("mass"), mass)?;
+    let radius = v.within(&ParticleSpec::RADIUS, &f("radius"), radius)?;
+    let r2 = radius * radius;
+    check_inertia(v, f, mass, radius, !r2.is_finite() || r2 < f64::MIN_POSITIVE)?;
+    let [x, u, w] = [x, u, w].map(|(key, value)| vector(v, &f(key), value));
+    Ok(Particle::new(k, mass, radius, x?, u?, w?))
 }
 
 /// Refuses a start where a sphere overlaps a wall by more than [`MAX_START_OVERLAP`] of its radius (as the
@@ -598,22 +553,16 @@ const _: () = assert!(MAX_START_OVERLAP == 1e-3);
 fn reject_deep_overlaps(v: &V, particles: &[Particle]) -> Result<(), SceneError> {
     let centres: Vec<Vec3> = particles.iter().map(|p| p.position).collect();
     let radii: Vec<f64> = particles.iter().map(|p| p.radius).collect();
-    for (i, j) in crate::geometry::neighbours::sphere_pairs(&centres, &radii) {
-        if particles[i].stuck.is_some() && particles[j].stuck.is_some() {
-            continue;
-        }
-        let overlap = radii[i] + radii[j] - (centres[j] - centres[i]).norm();
-        let fraction = overlap / radii[i].min(radii[j]);
-        if fraction > MAX_START_OVERLAP {
-            return Err(v.invalid(
-                format!("particle[{i}].position"),
-                format!(
-                    "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start; hard spheres may overlap by at most {MAX_START_OVERLAP} of it"
-                ),
-            ));
-        }
-    }
-    Ok(())
+    let stuck = |i: usize| particles[i].stuck.is_some();
+    let limit = format!("; hard spheres may overlap by at most {MAX_START_OVERLAP} of it");
+    check_start_overlaps(
+        v,
+        &centres,
+        &radii,
+        MAX_START_OVERLAP,
+        |i, j| stuck(i) && stuck(j),
+        &limit,
+    )
 }
 
 fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
@@ -625,10 +574,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
             None => Err(v.invalid(f("radius"), format!("required for a {}, got nothing", w.kind))),
         }
     };
-    let length = match w.length {
-        Some(l) => Some(v.size_or_zero(&f("length"), l)?),
-        None => None,
-    };
+    let length = w.length.map(|l| v.size_or_zero(&f("length"), l)).transpose()?;
     let no = |field: &str, given: bool| -> Result<(), SceneError> {
         if given {
             Err(v.invalid(f(field), format!("not used by a {}; remove it", w.kind)))
@@ -695,7 +641,7 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         (("centre", w.centre), ("axis", w.axis))
     };
     let axis = unit(v, &f(facing.0), facing.1.unwrap_or([0.0, 0.0, 1.0]))?;
-    let mut wall = Wall::new(shape, v.vec(&f(at.0), at.1.unwrap_or_default())?, axis);
+    let mut wall = Wall::new(shape, vector(v, &f(at.0), at.1.unwrap_or_default())?, axis);
     let oscillation = w
         .oscillation
         .as_ref()
@@ -705,18 +651,18 @@ fn wall(v: &V, k: usize, w: &WallSpec) -> Result<Wall, SceneError> {
         return Err(v.invalid(f("spin"), format!("must be finite, got {}", w.spin)));
     }
     wall.motion = WallMotion {
-        velocity: v.vec(&f("velocity"), w.velocity)?,
+        velocity: vector(v, &f("velocity"), w.velocity)?,
         oscillation,
         spin: w.spin,
     };
-    wall.eps_n = match w.eps_n {
-        Some(e) => Some(v.within(&WallSpec::EPS_N, &f("eps_n"), e)?),
-        None => None,
-    };
-    wall.eps_t = match w.eps_t {
-        Some(e) => Some(v.within(&WallSpec::EPS_T, &f("eps_t"), e)?),
-        None => None,
-    };
+    wall.eps_n = w
+        .eps_n
+        .map(|e| v.within(&WallSpec::EPS_N, &f("eps_n"), e))
+        .transpose()?;
+    wall.eps_t = w
+        .eps_t
+        .map(|e| v.within(&WallSpec::EPS_T, &f("eps_t"), e))
+        .transpose()?;
     if w.sticky && w.absorbing {
         return Err(v.invalid(f("sticky"), "a wall cannot be both sticky and absorbing, got both true"));
     }

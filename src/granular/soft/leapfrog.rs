@@ -6,12 +6,10 @@
 //! conserves total linear and angular momentum up to rounding. With `gravity_interval = k > 1` self-gravity
 //! is kicked separately once per block of `k` steps ([`crate::granular::soft::respa`]).
 //!
-//! Every kick and drift is a loop over the spheres, each sphere on its own, so they run in parallel with the
-//! same bits on any number of threads. The passes of a step are fused (each sphere gets the same operations in
-//! the same order as in separate passes): one pass for the opening slow kick, the kick, the drift and the Verlet
-//! list's staleness check (and, for a run, the copy of the state before the step); the force evaluation; one
-//! pass for the closing kick and slow kick. Fewer passes mean fewer fork–joins per step on many threads and less
-//! memory traffic on one.
+//! Every kick and drift treats each sphere on its own, so they run in parallel with the same bits on any number of
+//! threads. A step's passes are fused (the same operations per sphere, in the same order): the opening slow kick,
+//! kick, drift, Verlet-list staleness check and (for a run) the copy of the state before the step in one pass; the
+//! force evaluation; the closing kick and slow kick in one pass (fewer fork–joins and less memory traffic).
 
 use crate::granular::soft::forces::SoftSystem;
 use crate::granular::soft::particle::Particle;

@@ -130,9 +130,8 @@ pub struct SoftSummary {
     pub warnings: Vec<String>,
 }
 
-impl SoftSummary {
-    /// One line for the terminal.
-    pub fn one_line(&self) -> String {
+impl RunReport for SoftSummary {
+    fn one_line(&self) -> String {
         format!(
             "{}: t = {} s, {} steps, {} particles, energy error {:.3e}, max overlap {:.3e} of radius, {:.2} s",
             self.status,
@@ -144,7 +143,9 @@ impl SoftSummary {
             self.wall_seconds
         ) + &self.accuracy_hint().map_or(String::new(), |h| format!("; {h}"))
     }
+}
 
+impl SoftSummary {
     /// When the energy residual is above [`ENERGY_HINT_ABOVE`], what in the scene explains it: a step longer than the
     /// advised one, or a `k_N` below the advised one (`rubblepile ssdem advise`), or neither.
     pub fn accuracy_hint(&self) -> Option<String> {
@@ -405,17 +406,8 @@ fn wall_surfaces(
     t: f64,
     particles: &[ParticleView],
 ) -> Vec<NamedSurface> {
-    walls
-        .iter()
-        .enumerate()
-        .map(|(k, w)| {
-            let anchor = w.anchor();
-            NamedSurface {
-                name: format!("wall{k}"),
-                mesh: w.surface_at(t, crate::engine::reach(particles, &anchor)),
-            }
-        })
-        .collect()
+    let reach = |w: &crate::geometry::walls::soft::Wall| crate::engine::reach(particles, &w.anchor());
+    crate::granular::wall_surfaces(walls.iter().map(|w| w.surface_at(t, reach(w))))
 }
 
 fn gravity_name(scene: &SoftScene) -> String {
@@ -608,12 +600,6 @@ impl SoftEngine {
                 s.material.k_n, s.advice.k_n, s.advice.dt
             ),
         ]
-    }
-}
-
-impl RunReport for SoftSummary {
-    fn one_line(&self) -> String {
-        SoftSummary::one_line(self)
     }
 }
 
@@ -873,18 +859,8 @@ impl SoftEngine {
         velocities: &[Vec3],
         spins: &[Vec3],
     ) -> Result<(), EngineError> {
-        let n = self.sys.particles.len();
-        for (name, v) in [("positions", positions), ("velocities", velocities), ("spins", spins)] {
-            if v.len() != n {
-                return Err(EngineError::State(format!(
-                    "{name}: {} given, the run has {n} spheres",
-                    v.len()
-                )));
-            }
-            if let Some(i) = v.iter().position(|x| !x.iter().all(|c| c.is_finite())) {
-                return Err(EngineError::State(format!("{name}[{i}]: a non-finite value")));
-            }
-        }
+        let arrays = [("positions", positions), ("velocities", velocities), ("spins", spins)];
+        crate::granular::check_particle_arrays(self.sys.particles.len(), "spheres", arrays)?;
         if self.sys.split_gravity() && self.sys.gravity_phase != 0 {
             return Err(EngineError::State(format!(
                 "the run is inside a self-gravity block (step {} of {}); set the state at a block boundary",

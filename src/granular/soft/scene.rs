@@ -12,13 +12,14 @@ use std::path::{Path, PathBuf};
 use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
-use crate::geometry::neighbours::sphere_pairs;
 use crate::geometry::walls::soft::{Cylinder, Plane, SphereContainer, Wall};
 use crate::granular::soft::advise::{Advice, AdviceInput, DEFAULT_MAX_OVERLAP, advise};
 use crate::granular::soft::contact::Material;
 use crate::granular::soft::forces::Gravity;
 use crate::granular::soft::particle::Particle;
-use crate::granular::vocabulary::{OscillationSpec, oscillation, unit};
+use crate::granular::vocabulary::{
+    OscillationSpec, check_inertia, check_start_overlaps, check_uniform_gravity, hundredths, oscillation, unit, vector,
+};
 use crate::gravity::SelfGravity;
 use crate::io::scene_file::{
     MAX_BODIES, MIN_MEANINGFUL, MIN_STEP_FRACTION, SI_G, SceneError, WORK_WARNING_STEPS, exact,
@@ -103,25 +104,6 @@ pub struct SoftSteppingSection {
     pub dt: f64,
 }
 
-fn d055() -> f64 {
-    0.55
-}
-fn d1() -> f64 {
-    1.0
-}
-fn d13() -> f64 {
-    1.3
-}
-fn d105() -> f64 {
-    1.05
-}
-fn d05() -> f64 {
-    0.5
-}
-fn d005() -> f64 {
-    0.05
-}
-
 /// `[material]`: the contact law's material (defaults: Zhang17's nominal set, §2.3.3).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
 #[scene(table = "material")]
@@ -131,31 +113,31 @@ pub struct MaterialSection {
     #[field(unit = "N/m", default = "required", range = Positive)]
     pub k_n: f64,
     /// normal coefficient of restitution
-    #[serde(default = "d055")]
+    #[serde(default = "hundredths::<55>")]
     #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
     pub eps_n: f64,
     /// tangential coefficient of restitution
-    #[serde(default = "d055")]
+    #[serde(default = "hundredths::<55>")]
     #[field(unit = "-", default = "0.55", range = open_closed(0.0, 1.0))]
     pub eps_t: f64,
     /// sliding friction coefficient
-    #[serde(default = "d1")]
+    #[serde(default = "hundredths::<100>")]
     #[field(unit = "-", default = "1.0", range = NonNegative)]
     pub mu_s: f64,
     /// twisting friction coefficient
-    #[serde(default = "d13")]
+    #[serde(default = "hundredths::<130>")]
     #[field(unit = "-", default = "1.3", range = NonNegative)]
     pub mu_t: f64,
     /// rolling friction coefficient
-    #[serde(default = "d105")]
+    #[serde(default = "hundredths::<105>")]
     #[field(unit = "-", default = "1.05", range = NonNegative)]
     pub mu_r: f64,
     /// shape parameter (0 = no twisting or rolling resistance)
-    #[serde(default = "d05")]
+    #[serde(default = "hundredths::<50>")]
     #[field(unit = "-", default = "0.5", range = NonNegative)]
     pub beta: f64,
     /// largest initial overlap accepted, as a fraction of the smaller radius
-    #[serde(default = "d005")]
+    #[serde(default = "hundredths::<5>")]
     #[field(unit = "-", default = "0.05", range = NonNegative)]
     pub max_start_overlap: f64,
 }
@@ -372,14 +354,6 @@ pub fn parse_soft_scene(text: &str, name: &str, base_dir: Option<&Path>) -> Resu
 use crate::io::scene_file::Validator as V;
 
 impl V<'_> {
-    fn vector(&self, field: &str, v: [f64; 3]) -> Result<Vec3, SceneError> {
-        if v.iter().all(|x| x.is_finite()) {
-            Ok(Vec3::from(v))
-        } else {
-            Err(self.invalid(field, format!("must be finite, got {v:?}")))
-        }
-    }
-
     fn particle(&self, label: &str, s: &ParticleSpec) -> Result<Particle, SceneError> {
         let radius = self.within(&ParticleSpec::RADIUS, &format!("{label}.radius"), s.radius)?;
         // r² and r³ enter the moment of inertia and the mass from the density: they must stay normal numbers.
@@ -405,23 +379,13 @@ impl V<'_> {
             }
             _ => return Err(self.invalid(label, "give exactly one of `mass` (kg) and `density` (kg/m^3)")),
         };
-        let inertia = 0.4 * mass * radius * radius;
-        if !(inertia.is_finite() && inertia >= f64::MIN_POSITIVE) {
-            let field = if radius_fault { "radius" } else { "mass" };
-            return Err(self.invalid(
-                format!("{label}.{field}"),
-                format!(
-                    "gives a moment of inertia 2/5 m r^2 = {inertia:e} kg m^2, not a finite normal number (mass {mass:e} \
-                     kg, radius {radius:e} m)"
-                ),
-            ));
-        }
+        check_inertia(self, &|key| format!("{label}.{key}"), mass, radius, radius_fault)?;
         Ok(Particle {
             mass,
             radius,
-            position: self.vector(&format!("{label}.position"), s.position)?,
-            velocity: self.vector(&format!("{label}.velocity"), s.velocity)?,
-            spin: self.vector(&format!("{label}.spin"), s.spin)?,
+            position: vector(self, &format!("{label}.position"), s.position)?,
+            velocity: vector(self, &format!("{label}.velocity"), s.velocity)?,
+            spin: vector(self, &format!("{label}.spin"), s.spin)?,
         })
     }
 
@@ -447,23 +411,7 @@ impl V<'_> {
         }
         let g = gravity.uniform.norm();
         if g > 0.0 {
-            for (k, p) in particles.iter().enumerate() {
-                let (m, x) = (p.mass, p.position.norm());
-                if !(m * g * x).is_finite() || !(g * dt).is_finite() {
-                    let field = match crate::io::scene_file::largest_factor(&[("m", m), ("g", g), ("x", x)]) {
-                        "m" => format!("particle[{k}].mass"),
-                        "x" => format!("particle[{k}].position"),
-                        _ => "gravity.uniform".to_string(),
-                    };
-                    return Err(self.invalid(
-                        field,
-                        format!(
-                            "gives particle[{k}] a non-finite potential energy m |g| |x| or velocity kick |g| dt at \
-                             t = 0 (m = {m:e} kg, |g| = {g:e} m/s^2, |x| = {x:e} m, dt = {dt:e} s)"
-                        ),
-                    ));
-                }
-            }
+            check_uniform_gravity(self, g, particles.iter().map(|p| (p.mass, p.position)), dt)?;
         }
         Ok(())
     }
@@ -549,7 +497,7 @@ impl V<'_> {
         };
         match w.kind.as_str() {
             "plane" => {
-                let point = self.vector(&field("point"), w.point.unwrap_or_default())?;
+                let point = vector(self, &field("point"), w.point.unwrap_or_default())?;
                 let normal = unit(self, &field("normal"), w.normal.unwrap_or_default())?;
                 Ok(Wall::Plane(Plane {
                     point,
@@ -558,7 +506,7 @@ impl V<'_> {
                 }))
             }
             "sphere" => Ok(Wall::Sphere(SphereContainer {
-                centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
+                centre: vector(self, &field("centre"), w.centre.unwrap_or_default())?,
                 radius: self.within(&WallSpec::RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
                 oscillation: shaking(None)?,
             })),
@@ -569,7 +517,7 @@ impl V<'_> {
                     return Err(self.invalid(field("spin"), format!("must be finite (rad/s), got {spin}")));
                 }
                 Ok(Wall::Cylinder(Cylinder {
-                    centre: self.vector(&field("centre"), w.centre.unwrap_or_default())?,
+                    centre: vector(self, &field("centre"), w.centre.unwrap_or_default())?,
                     axis,
                     radius: self.within(&WallSpec::RADIUS, &field("radius"), w.radius.unwrap_or_default())?,
                     length: w
@@ -612,10 +560,10 @@ impl V<'_> {
         let max_start = self.field(&MaterialSection::MAX_START_OVERLAP, c.max_start_overlap)?;
 
         let gs = &file.gravity;
-        let g = match gs.g {
-            Some(g) => self.field(&GravitySection::G, g)?,
-            None => SI_G,
-        };
+        let g =
+            gs.g.map(|g| self.field(&GravitySection::G, g))
+                .transpose()?
+                .unwrap_or(SI_G);
         let self_gravity = match gs.self_gravity.as_deref() {
             None => {
                 if gs.theta.is_some() {
@@ -653,10 +601,8 @@ impl V<'_> {
             }
             Some(k) => k as u64,
         };
-        let uniform = match gs.uniform {
-            Some(u) => self.vector("gravity.uniform", u)?,
-            None => Vec3::zeros(),
-        };
+        let uniform = gs.uniform.map(|u| vector(self, "gravity.uniform", u)).transpose()?;
+        let uniform = uniform.unwrap_or_else(Vec3::zeros);
         let gravity = Gravity {
             uniform,
             self_gravity,
@@ -718,18 +664,8 @@ impl V<'_> {
         // Initial overlaps.
         let centres: Vec<Vec3> = particles.iter().map(|p| p.position).collect();
         let radii: Vec<f64> = particles.iter().map(|p| p.radius).collect();
-        for (i, j) in sphere_pairs(&centres, &radii) {
-            let overlap = radii[i] + radii[j] - (centres[j] - centres[i]).norm();
-            let fraction = overlap / radii[i].min(radii[j]);
-            if fraction > max_start {
-                return Err(self.invalid(
-                    format!("particle[{i}].position"),
-                    format!(
-                        "overlaps particle[{j}] by {overlap} m = {fraction:.4} of the smaller radius at the start, more than material.max_start_overlap = {max_start}"
-                    ),
-                ));
-            }
-        }
+        let limit = format!(", more than material.max_start_overlap = {max_start}");
+        check_start_overlaps(self, &centres, &radii, max_start, |_, _| false, &limit)?;
         for (k, w) in walls.iter().enumerate() {
             for (i, p) in particles.iter().enumerate() {
                 if let Some(touch) = w.touch(&p.position, p.radius, 0.0)

@@ -22,12 +22,6 @@ use crate::math::Vec3;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
-fn d_release_axis() -> f64 {
-    0.1
-}
-fn d_release_packing() -> f64 {
-    0.01
-}
 fn d_release_samples() -> u32 {
     2
 }
@@ -81,11 +75,11 @@ pub struct SpinupSection {
     #[field(meaning = "what the forcing holds on the path: the rotation period, or L = I_ref 2 pi/T(t)")]
     pub target: Option<String>,
     /// disruption when |d(b/a)| or |d(c/a)| exceeds this
-    #[serde(default = "d_release_axis")]
+    #[serde(default = "crate::granular::vocabulary::hundredths::<10>")]
     #[field(unit = "-", default = "0.1", range = Positive)]
     pub release_axis_ratio: f64,
     /// disruption when the interior packing fraction changes by more than this
-    #[serde(default = "d_release_packing")]
+    #[serde(default = "crate::granular::vocabulary::hundredths::<1>")]
     #[field(unit = "-", default = "0.01", range = Positive)]
     pub release_packing: f64,
     /// consecutive samples beyond a release threshold that confirm disruption
@@ -350,8 +344,7 @@ impl DisjointSets {
 
     /// The root of `i`'s set. Links are followed without compressing them while unions may run: only roots are
     /// ever linked, to a root of lower index, so with the contacts in key order the paths stay short, and plain
-    /// loads cost far less than the atomic writes of path halving (on a 42 000-sphere pile this is as fast as the
-    /// serial union–find on one thread; with halving it took twice as long).
+    /// loads cost far less than the atomic writes of path halving (`analysis/ssdem_perf/NOTES.md`).
     fn find(&self, mut i: u32) -> u32 {
         loop {
             let p = self.parent[i as usize].load(Ordering::Acquire);

@@ -295,7 +295,7 @@ pub fn depth_weights(
 /// Contacts per particle from a force evaluation's contact list: `records` holds each touching pair once (and each
 /// sphere–wall contact once, with the wall's `j ≥ n`), so a pair adds one contact to both spheres and a wall
 /// contact one to its sphere. `n` is the number of spheres.
-pub fn contact_counts(records: &[ContactRecord], n: usize) -> Vec<u32> {
+pub fn contact_counts<'a>(records: impl IntoIterator<Item = &'a ContactRecord>, n: usize) -> Vec<u32> {
     let mut count = vec![0u32; n];
     for r in records {
         count[r.i] += 1;
@@ -322,14 +322,7 @@ pub fn loaded_contact_counts(records: &[ContactRecord], n: usize, floor: f64) ->
     let pairs = records.iter().filter(|r| r.j < n);
     let (sum, k) = pairs.fold((0.0, 0usize), |(s, k), r| (s + r.output.normal_force, k + 1));
     let threshold = if k > 0 { floor * sum / k as f64 } else { 0.0 };
-    let mut count = vec![0u32; n];
-    for r in records.iter().filter(|r| r.output.normal_force >= threshold) {
-        count[r.i] += 1;
-        if r.j < n {
-            count[r.j] += 1;
-        }
-    }
-    count
+    contact_counts(records.iter().filter(|r| r.output.normal_force >= threshold), n)
 }
 
 /// The coordination number of Zhang17 §4.1.1 (Fig. 5, bottom frame; the creep test of §3.3.3): the mean number
