@@ -205,12 +205,10 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         .has_headers(true)
         .trim(::csv::Trim::All)
         .from_reader(reader);
+    let bad_header = |message: String| BodiesFileError::Format { line: 1, message };
     let headers = r
         .headers()
-        .map_err(|e| BodiesFileError::Format {
-            line: 1,
-            message: format!("bad header: {}", one_line_csv(&e)),
-        })?
+        .map_err(|e| bad_header(format!("bad header: {}", one_line_csv(&e))))?
         .clone();
     let required = &SNAPSHOT_COLUMNS[2..];
     let mut index = [usize::MAX; 17];
@@ -220,29 +218,19 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         }
         match required.iter().position(|&c| c == name) {
             Some(k) if index[k] == usize::MAX => index[k] = pos,
-            Some(_) => {
-                return Err(BodiesFileError::Format {
-                    line: 1,
-                    message: format!("column `{name}` appears twice"),
-                });
-            }
+            Some(_) => return Err(bad_header(format!("column `{name}` appears twice"))),
             None => {
-                return Err(BodiesFileError::Format {
-                    line: 1,
-                    message: format!("unknown column `{name}`; expected {}", SNAPSHOT_COLUMNS.join(",")),
-                });
+                let expected = SNAPSHOT_COLUMNS.join(",");
+                return Err(bad_header(format!("unknown column `{name}`; expected {expected}")));
             }
         }
     }
     if let Some(k) = index.iter().position(|&i| i == usize::MAX) {
-        return Err(BodiesFileError::Format {
-            line: 1,
-            message: format!(
-                "missing column `{}`; expected {}",
-                required[k],
-                SNAPSHOT_COLUMNS.join(",")
-            ),
-        });
+        let expected = SNAPSHOT_COLUMNS.join(",");
+        return Err(bad_header(format!(
+            "missing column `{}`; expected {expected}",
+            required[k]
+        )));
     }
     let mut out = Vec::new();
     for rec in r.records() {

@@ -424,7 +424,7 @@ impl EllipsoidEngine {
     /// velocities (m/s), attitude quaternions (normalised here) and body-frame spins (rad/s). For a run between
     /// two samples (e.g. from Python); the run continues from the new state, its conserved quantities measured
     /// against those at t = 0 as before (so a change of energy counts in the energy error). Attitudes and spins
-    /// cannot change where they are not integrated ([`EllipsoidSystem::integrates_attitudes`]).
+    /// cannot change where they are not integrated ([`EllipsoidSystem::rotation_integrated`]).
     ///
     /// Errors ([`EngineError::State`], one line, nothing changed): another number of bodies, another shape or
     /// mass, a non-finite value, a changed attitude or spin that is not integrated.
@@ -453,7 +453,7 @@ impl EllipsoidEngine {
                     "body[{i}]: a non-finite value (or a zero quaternion)"
                 )));
             }
-            if !self.system.integrates_attitudes() && (b.quaternion != old.quaternion || b.spin_body != old.spin_body) {
+            if !self.system.rotation_integrated() && (b.quaternion != old.quaternion || b.spin_body != old.spin_body) {
                 return Err(EngineError::State(format!(
                     "body[{i}]: attitudes and spins are not integrated in this run (spheres without dissipation); \
                      only positions and velocities can change"
