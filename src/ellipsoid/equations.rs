@@ -240,8 +240,7 @@ const PAIR_BLOCK: usize = 64;
 /// The slot of a culled candidate (see `RhsScratch::slots`).
 const NO_TERMS: u32 = u32::MAX;
 
-/// Buffers of the right-hand side kept between evaluations, so that an evaluation allocates nothing once they
-/// have grown (fresh buffers of ~100 kB per evaluation cost page faults worth ~10 % of it).
+/// Buffers of the right-hand side kept between evaluations: once grown, an evaluation allocates nothing.
 #[derive(Default)]
 struct RhsScratch {
     kin: Vec<Kinematics>,
@@ -450,8 +449,7 @@ fn sum_pair_terms(
     dissipation
 }
 
-/// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential, and a
-/// rebuild of the N2000 pile's ~10⁵ candidates took milliseconds on one thread).
+/// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential).
 fn candidates_of(
     pairs: Vec<(usize, usize)>,
     candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send,

@@ -59,15 +59,6 @@ pub fn snapshot_records(t: f64, bodies: &[Body]) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// The snapshot rows of the bodies `ids` (indices into `bodies`, in that order) at time `t`, without the header.
-///
-/// # Panics
-/// If an index is out of range (scene validation guarantees it is not).
-pub fn tracked_records(t: f64, bodies: &[Body], ids: &[usize]) -> Vec<Vec<String>> {
-    let all = snapshot_records(t, bodies);
-    ids.iter().map(|&id| all[id].clone()).collect()
-}
-
 /// Writes `tracks.csv` (the snapshot columns, one row per tracked body per time-series sample), flushing after
 /// each sample so a crash loses nothing written.
 pub struct TracksWriter {
@@ -106,10 +97,12 @@ impl TracksWriter {
         })
     }
 
-    /// Appends the rows of the tracked bodies `ids` at time `t` and flushes them to the OS.
+    /// Appends the rows of the tracked bodies `ids` (indices into `bodies`, in that order; scene validation keeps
+    /// them in range) at time `t` and flushes them to the OS.
     pub fn write_sample(&mut self, t: f64, bodies: &[Body], ids: &[usize]) -> std::io::Result<()> {
-        for row in tracked_records(t, bodies, ids) {
-            self.w.write_record(&row).map_err(csv_to_io)?;
+        let rows = snapshot_records(t, bodies);
+        for &id in ids {
+            self.w.write_record(&rows[id]).map_err(csv_to_io)?;
         }
         self.w.flush()
     }

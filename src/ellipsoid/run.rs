@@ -203,43 +203,19 @@ fn check_initial_state(scene: &LoadedScene, initial: &Diagnostics, y: &[f64]) ->
         KappaSource::Given => "model.kappa",
         KappaSource::Calibrated { .. } => "model.calibrate",
     };
+    // Each term on its own: a system with only that term (or only the tide) enabled.
+    let (mut gravity, mut contact, mut dissipation) = (none, none, none);
+    (gravity.gravity, contact.contact, dissipation.dissipation) = (p.gravity, p.contact, p.dissipation);
     let terms = [
-        (
-            "gravity",
-            "physics.gravity.G",
-            p.gravity.is_some(),
-            Physics {
-                gravity: p.gravity,
-                ..none
-            },
-            None,
-        ),
-        (
-            "contact",
-            kappa_field,
-            p.contact.is_some(),
-            Physics {
-                contact: p.contact,
-                ..none
-            },
-            None,
-        ),
-        (
-            "dissipation",
-            "physics.dissipation.F0",
-            p.dissipation.is_some(),
-            Physics {
-                dissipation: p.dissipation,
-                ..none
-            },
-            None,
-        ),
-        ("flyby tide", "physics.flyby", scene.tide.is_some(), none, scene.tide),
+        ("gravity", "physics.gravity.G", gravity, None),
+        ("contact", kappa_field, contact, None),
+        ("dissipation", "physics.dissipation.F0", dissipation, None),
+        ("flyby tide", "physics.flyby", none, scene.tide),
     ];
     let (term, field, body, energy) = terms
         .iter()
-        .filter(|t| t.2)
-        .find_map(|(term, field, _, physics, tide)| {
+        .filter(|t| t.2 != none || t.3.is_some())
+        .find_map(|(term, field, physics, tide)| {
             let system = EllipsoidSystem::new(&scene.bodies, scene.model, *physics).with_tide(*tide);
             let d = system.diagnostics_at(0.0, y);
             let body = rates_finite(&system);

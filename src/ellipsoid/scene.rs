@@ -246,7 +246,7 @@ pub struct DissipationSpec {
 }
 
 /// `[integrator]`. The whole table is optional.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, SceneFields)]
 #[scene(table = "integrator")]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
@@ -263,7 +263,7 @@ pub struct IntegratorSection {
     /// the implicit method's steps follow the motion instead; below it (soft contacts, Roig03's F0 = 1e-6 s m⁻²)
     /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
     /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
-    #[serde(default = "default_method")]
+    #[serde(default)]
     #[field(unit = "text", default = "\"bulirsch-stoer\"")]
     #[field(range = Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""))]
     #[field(
@@ -309,24 +309,8 @@ pub struct IntegratorSection {
     pub project_attitudes: Option<bool>,
 }
 
-fn default_method() -> Method {
-    Method::BulirschStoer
-}
-
 fn default_tolerance() -> f64 {
     1e-10
-}
-
-impl Default for IntegratorSection {
-    fn default() -> Self {
-        IntegratorSection {
-            method: default_method(),
-            rtol: None,
-            atol: None,
-            step: None,
-            project_attitudes: None,
-        }
-    }
 }
 
 /// `[output]`.

@@ -131,7 +131,7 @@ pub struct Strategy {
 
 /// The base rule an [`Extrapolation`] extrapolates — Gragg's modified midpoint rule ([`Midpoint`]) or the linearly
 /// implicit Euler method (`linearly_implicit.rs`) — with the checkpoint layout of its method.
-pub trait BaseRule {
+pub trait BaseRule: Default {
     /// What the rule takes from the system at the start of each step ([`StepMethod::Frozen`]).
     type Frozen<'s>;
     /// The method's name.
@@ -182,7 +182,7 @@ pub type Unpacked<'a> = Result<(usize, usize, &'a ColumnControlState, &'a [f64])
 
 /// An extrapolation step: the base rule `R` in columns `j = 1, 2, …` extrapolated by Aitken–Neville, with the
 /// column (order) and step control of ODEX or SEULEX ([`BaseRule::STRATEGY`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Extrapolation<R> {
     tol: Tolerances,
     /// Maximum number of columns `km`.
@@ -220,18 +220,8 @@ impl<R: BaseRule> Extrapolation<R> {
         let mut e = Extrapolation {
             tol,
             km,
-            k: 2,
-            reject: false,
-            started: false,
-            span: None,
-            nj: Vec::new(),
-            a: Vec::new(),
-            hh: Vec::new(),
-            w: Vec::new(),
-            n: 0,
-            scal: Vec::new(),
-            tab: Vec::new(),
             rule,
+            ..Extrapolation::default()
         };
         e.setup_sequence();
         e.k = e.initial_columns();

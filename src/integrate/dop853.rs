@@ -378,13 +378,7 @@ impl Dop853 {
         let method = Dop853Step {
             tol: tolerances,
             parallel_from: DEFAULT_PARALLEL_FROM,
-            evals: 0,
-            n: 0,
-            k: Vec::new(),
-            y: Vec::new(),
-            y_new: Vec::new(),
-            y_stage: Vec::new(),
-            partials: Vec::new(),
+            ..Dop853Step::default()
         };
         Adaptive::with_method(method, step)
     }
@@ -397,7 +391,7 @@ impl Dop853 {
 }
 
 /// One DOP853 step and its work arrays.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Dop853Step {
     tol: Tolerances,
     parallel_from: usize,

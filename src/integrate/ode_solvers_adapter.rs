@@ -169,11 +169,6 @@ impl OdeSolversAdapter {
         })
     }
 
-    /// Sets the maximum number of steps in one call to [`Integrator::advance`] (default 10⁸).
-    pub fn set_max_steps(&mut self, max_steps: u64) {
-        self.budget.max_steps = max_steps;
-    }
-
     /// Sets the number of steps per `ode_solvers` run (see the module docs); `None` = automatic
     /// (about 64 MiB of stored states).
     pub fn set_chunk_steps(&mut self, chunk: Option<usize>) {
