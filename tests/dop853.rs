@@ -1,6 +1,6 @@
-//! Our DOP853 (`src/integrate/dop853.rs`): its tableau's order conditions, order 8 at a fixed step, accuracy on
-//! problems with known solutions, agreement with the `ode_solvers` crate's Dop853 on the N30 impact, exact landing
-//! and continuation, bits independent of the thread count, exact checkpoint/resume, the step hooks, and failures
+//! Our DOP853 (`src/integrate/dop853.rs`, whose unit tests check its tableau's order conditions): order 8 at a
+//! fixed step, accuracy on problems with known solutions, agreement with the `ode_solvers` crate's Dop853 on the N30
+//! impact, exact landing and continuation, bits independent of the thread count, exact checkpoint/resume, the step hooks, and failures
 //! that leave the last good state.
 //!
 //! Run with `--nocapture` to see the measured errors and statistics.
@@ -28,54 +28,6 @@ fn bits(v: &[f64]) -> Vec<u64> {
 
 // ---------------------------------------------------------------------------------------------
 // The method
-
-#[test]
-fn tableau_satisfies_its_order_conditions() {
-    let (c, a, b, b5, b3) = dop853::tableau();
-    let close = |x: f64, y: f64, what: &str| assert!((x - y).abs() <= 1e-14 * (1.0 + y.abs()), "{what}: {x} vs {y}");
-    // Row sums: each stage's time is its node.
-    for i in 0..12 {
-        close(a[i].iter().sum::<f64>(), c[i], &format!("row {i}"));
-        assert!(a[i][i..].iter().all(|&v| v == 0.0), "row {i} is explicit");
-    }
-    assert_eq!(c[11], 1.0, "the 12th stage is at t + h");
-    // Quadrature conditions Σ b_i c_i^(q−1) = 1/q: order 8 for b, 5 for the 5th-order weights, 3 for the 3rd.
-    let quad = |w: &[f64; 12], q: i32| (0..12).map(|i| w[i] * c[i].powi(q - 1)).sum::<f64>();
-    for q in 1..=8 {
-        close(quad(&b, q), 1.0 / q as f64, &format!("b, c^{}", q - 1));
-    }
-    for q in 1..=5 {
-        close(quad(&b5, q), 1.0 / q as f64, &format!("b5, c^{}", q - 1));
-    }
-    for q in 1..=3 {
-        close(quad(&b3, q), 1.0 / q as f64, &format!("b3, c^{}", q - 1));
-    }
-    // Σ b_i a_ij c_j^(q−1) = 1/(q (q+1)) (the trees [τ^q]): order 8 needs q ≤ 7.
-    let ac = |q: i32| -> Vec<f64> {
-        (0..12)
-            .map(|i| (0..12).map(|j| a[i][j] * c[j].powi(q - 1)).sum())
-            .collect()
-    };
-    for q in 1..=7 {
-        let v = ac(q);
-        close(
-            (0..12).map(|i| b[i] * v[i]).sum(),
-            1.0 / (q * (q + 1)) as f64,
-            &format!("b a c^{}", q - 1),
-        );
-    }
-    // The simplifying assumption behind DOP853's stages 4 on: Σ_j a_ij c_j = c_i²/2.
-    let v = ac(2);
-    for i in 3..12 {
-        close(v[i], c[i] * c[i] / 2.0, &format!("stage {i}: a c = c²/2"));
-    }
-    // An order-8 tree with a branch: Σ_i b_i c_i⁵ Σ_j a_ij c_j = 1/16.
-    close(
-        (0..12).map(|i| b[i] * c[i].powi(5) * v[i]).sum(),
-        1.0 / 16.0,
-        "b c^5 a c",
-    );
-}
 
 /// Kepler e = 0.3 over one orbit at a fixed step `T/steps` (a tolerance too loose to reject, `h_max` = the step).
 fn kepler_fixed_step_error(steps: u32) -> f64 {

@@ -5,18 +5,73 @@ use common::{Random, rel_err};
 use rubblepile::ellipsoid::body::Ellipsoid;
 use rubblepile::ellipsoid::calibration::{calibrate_kappa, lambda, pair_prefactor};
 use rubblepile::ellipsoid::dissipation::{BodyVelocity, pair_dissipation};
-use rubblepile::ellipsoid::equations::{
-    constrained_momentum_rate, constrained_momentum_rate_closed_form, constraint_rhs,
-};
+use rubblepile::ellipsoid::equations::{constrained_momentum_rate_closed_form, constraint_rhs};
 use rubblepile::ellipsoid::gravity::{add_gravity_forces, gravity_forces};
 use rubblepile::ellipsoid::potential::{
-    BodyGeometry, Taper, contact_gradient, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
-    overlap,
+    BodyGeometry, Overlap, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
 use rubblepile::ellipsoid::quaternion::*;
-use rubblepile::math::{Vec3, Vec4, skew};
+use rubblepile::math::{Mat4, Vec3, Vec4, skew};
 
 const G: f64 = 6.674e-11;
+
+/// `M(q)⁻¹ = Wᵀ Ĩ⁻¹ W / (4 |q|⁴)` formed in full (the library applies it to vectors only).
+fn inverse_mass_matrix(q: &Vec4, inertia_ext: &Vec4) -> Mat4 {
+    let w = w_matrix(q);
+    let inv = inertia_ext.map(|x| 1.0 / x);
+    w.transpose() * Mat4::from_diagonal(&inv) * w / (4.0 * q.norm_squared().powi(2))
+}
+
+/// `ṗ` from Roig03 Eq. 36 as printed: three rows of the projector `|q|² 1 − q qᵀ` (the row of the largest `|q_k|`
+/// deleted) applied to `ṗ = g` plus the constraint row `qᵀ M⁻¹ ṗ = c`, solved by LU.
+fn constrained_momentum_rate(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Vec4 {
+    let q2 = q.norm_squared();
+    let kmax = q.iamax();
+    let qg = q.dot(g);
+    let mq = m_inv * q;
+    let mut a = Mat4::zeros();
+    let mut b = Vec4::zeros();
+    for (row, k) in (0..4).filter(|&k| k != kmax).enumerate() {
+        for l in 0..4 {
+            a[(row, l)] = if l == k { q2 } else { 0.0 } - q[k] * q[l];
+        }
+        b[row] = q2 * g[k] - q[k] * qg;
+    }
+    for l in 0..4 {
+        a[(3, l)] = mq[l];
+    }
+    b[3] = c;
+    a.lu().solve(&b).unwrap_or_else(|| Vec4::from_element(f64::NAN))
+}
+
+/// Gradients of `U_C` with respect to the positions and quaternions of a pair.
+struct ContactGradient {
+    /// `∂U_C/∂r_i` (N).
+    d_ri: Vec3,
+    /// `∂U_C/∂q_i` (J).
+    d_qi: Vec4,
+    /// `∂U_C/∂q_j` (J).
+    d_qj: Vec4,
+}
+
+/// The contact gradient in quaternion form (`ellipsoid::potential`'s module doc): `∂U_C/∂r_i = −2κ U (T − T′) y`
+/// and `∂U_C/∂q_k = 2 U_raw ⟨D R S, ∂R/∂q_k⟩_F`, `S = −½ T G⁻¹ + κ (T − T′) y yᵀ`; the library computes the
+/// attitude part as spin gradients ([`contact_spin_gradient`]).
+fn contact_gradient(ov: &Overlap, kappa: f64, gi: &BodyGeometry, gj: &BodyGeometry) -> ContactGradient {
+    let (t, dt) = (ov.taper, ov.taper_slope);
+    let s = -0.5 * t * ov.g_inv + kappa * (t - dt) * ov.y * ov.y.transpose();
+    let d_q = |body: &BodyGeometry| {
+        let x = body.axes_rot * s;
+        let d_rot = rotation_matrix_derivatives(&body.q);
+        Vec4::from_fn(|k, _| 2.0 * ov.potential_raw * x.dot(&d_rot[k]))
+    };
+    ContactGradient {
+        d_ri: -2.0 * kappa * ov.potential_raw * (t - dt) * ov.y,
+        d_qi: d_q(gi),
+        d_qj: d_q(gj),
+    }
+}
+
 /// The default relative cutoff.
 const CUTOFF: f64 = 1e-16;
 
@@ -567,7 +622,11 @@ fn uniform_inertia_is_the_uniform_ellipsoid() {
 /// The cheap form of the pair prefactor equals Eq. 11's `U0` times `m_i m_j (κ/π)^{3/2}`.
 #[test]
 fn pair_prefactor_equals_eq11_form() {
-    use rubblepile::ellipsoid::calibration::contact_amplitude_u0;
+    // U0_ij = G π^{3/2}/2 (R_i+R_j)² exp(κλ)/(κλ)^{5/2} (Roig03 Eq. 11), as printed.
+    let contact_amplitude_u0 = |g: f64, kappa: f64, r_i: f64, r_j: f64| {
+        let x = kappa * lambda(r_i, r_j);
+        0.5 * g * std::f64::consts::PI.powf(1.5) * (r_i + r_j).powi(2) * x.exp() / x.powf(2.5)
+    };
     let mut rng = Random::new(31);
     for _ in 0..100 {
         let (ri, rj, k) = (rng.range(1e2, 1e5), rng.range(1e2, 1e5), rng.range(1.6, 40.0));

@@ -1,7 +1,8 @@
 //! Tests of the linearly implicit extrapolation integrator (`method = "bulirsch-stoer-implicit"`,
 //! `rubblepile::integrate::linearly_implicit`): error proportional to the tolerance on a stiff problem with an
-//! exact solution, the dissipation's analytic Jacobian against finite differences, momentum conservation over a
-//! stiff pile's settling, and bit-identical resume.
+//! exact solution, momentum conservation over a stiff pile's settling, and bit-identical resume (the
+//! dissipation's analytic Jacobian is checked against finite differences by `ellipsoid::equations`'s unit
+//! tests).
 
 use rubblepile::integrate::linearly_implicit::LinearlyImplicit;
 use rubblepile::integrate::problems::{StiffDampedOscillator, TestProblem};
@@ -39,10 +40,7 @@ fn stiff_oscillator_error_follows_the_tolerance() {
 mod common;
 use common::{Random, rock};
 use rubblepile::ellipsoid::body::Body;
-use rubblepile::ellipsoid::dissipation_jacobian::apply_dense;
 use rubblepile::ellipsoid::equations::{EllipsoidSystem, ModelConfig, Physics};
-use rubblepile::integrate::OdeSystem;
-use rubblepile::integrate::linearly_implicit::StiffSolve;
 
 /// Four ellipsoids of 400–1000 m, random attitudes, spins and velocities, their centres 800–1100 m apart so that
 /// every neighbouring pair overlaps.
@@ -69,106 +67,6 @@ fn overlapping_four(seed: u64) -> Vec<Body> {
             )
         })
         .collect()
-}
-
-/// The analytic `J = −C D B` against central differences of the right-hand side's dissipation part (the RHS at F0
-/// minus the RHS at F0 = 0) in every momentum component; and the solve of `(I − h J) x = b` against the dense `J`.
-#[test]
-fn dissipation_jacobian_matches_finite_differences() {
-    let bodies = overlapping_four(7);
-    let model = ModelConfig::gaussian_si(6.0);
-    let f0 = 100.0;
-    let sys = EllipsoidSystem::new(&bodies, model, Physics::impact(f0));
-    let free = EllipsoidSystem::new(&bodies, model, Physics::impact(0.0));
-    let y = sys.initial_state();
-    let n = sys.dim();
-    let jac = sys.dissipation_jacobian(&y).expect("dissipation is on");
-    assert!(jac.pairs() >= 4, "only {} dissipating pairs", jac.pairs());
-    let dense = jac.dense(n);
-    let units = sys.state_units().unwrap();
-    let diss = |y: &[f64]| {
-        let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
-        sys.rhs(0.0, y, &mut a);
-        free.rhs(0.0, y, &mut b);
-        a.iter().zip(&b).map(|(x, z)| x - z).collect::<Vec<f64>>()
-    };
-    let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
-    for body in 0..bodies.len() {
-        for c in 7..14 {
-            let k = body * 14 + c;
-            // The dissipation is linear in the momenta: central differences are exact up to rounding, so the step
-            // can be large (1e-3 of the component's user unit: 1 mm/s or 1 mrad/s).
-            let d = 1e-3 * units[k];
-            let (mut yp, mut ym) = (y.clone(), y.clone());
-            yp[k] += d;
-            ym[k] -= d;
-            let (fp, fm) = (diss(&yp), diss(&ym));
-            for row in 0..bodies.len() * 14 {
-                // Columns scaled by the user unit, rows by theirs: entries in s⁻¹.
-                let fd = (fp[row] - fm[row]) / (2.0 * d) * units[k] / units[row];
-                let an = dense[(row, k)] * units[k] / units[row];
-                worst = worst.max((fd - an).abs());
-                scale = scale.max(an.abs());
-            }
-        }
-    }
-    eprintln!("largest |J| entry {scale:e} 1/s, largest |J - J_fd| {worst:e}");
-    assert!(
-        scale > 1e-3,
-        "the dissipation is not stiff enough to test ({scale:e} 1/s)"
-    );
-    assert!(
-        worst <= 1e-8 * scale,
-        "J differs from finite differences by {:e} relative",
-        worst / scale
-    );
-
-    // The solve: (I − h J') x = b with the dense J' = [[0, T], [0, J]] (J and the kinematic rows), and total
-    // momentum unchanged.
-    let solved = jac.dense_with_kinematics(n);
-    let mut solver = sys.dissipation_jacobian(&y).unwrap();
-    let mut rng = Random::new(3);
-    let b: Vec<f64> = (0..n).map(|k| units[k] * rng.range(-1.0, 1.0)).collect();
-    for h in [1e-3, 1.0, 1e3] {
-        let mut x = b.clone();
-        solver.solve(h, &mut x);
-        // Against dense LU of the same matrix: both are limited by its condition, about 1 + h |J| (the pile's
-        // stiffness), so they agree to ε (1 + h |J|) of |x|.
-        let a = nalgebra::DMatrix::<f64>::identity(n, n) - &solved * h;
-        let x_lu = a.lu().solve(&nalgebra::DVector::from_column_slice(&b)).unwrap();
-        let diff = x_lu
-            .iter()
-            .zip(&x)
-            .zip(&units)
-            .map(|((p, q), u)| ((p - q) / u).abs())
-            .fold(0.0, f64::max);
-        let size = x.iter().zip(&units).map(|(p, u)| (p / u).abs()).fold(0.0, f64::max);
-        let bound = 1e-14 * (1.0 + h * scale) * size;
-        eprintln!("h = {h:e}: |x_cg - x_lu| {diff:e}, bound {bound:e} (user units)");
-        assert!(diff <= bound, "CG and LU differ by {diff:e} > {bound:e} at h = {h}");
-        // The residual of (I − h J) x = b itself, where h J is small.
-        if h * scale < 1e3 {
-            let back = apply_dense(&solved, h, &x);
-            let resid = back
-                .iter()
-                .zip(&b)
-                .zip(&units)
-                .map(|((p, q), u)| ((p - q) / u).abs())
-                .fold(0.0, f64::max);
-            assert!(
-                resid <= 1e-13 * (1.0 + h * scale) * size,
-                "residual {resid:e} at h = {h}"
-            );
-        }
-        let sum = |v: &[f64], c: usize| (0..bodies.len()).map(|i| v[i * 14 + 7 + c]).sum::<f64>();
-        let p_scale: f64 = (0..bodies.len()).map(|i| units[i * 14 + 7]).sum();
-        for c in 0..3 {
-            assert!(
-                (sum(&x, c) - sum(&b, c)).abs() <= 1e-14 * p_scale,
-                "momentum changed by the solve"
-            );
-        }
-    }
 }
 
 /// A stiff pile settling: four overlapping ellipsoids (gravity, contact, F0 = 100 s m⁻², damping rates up to

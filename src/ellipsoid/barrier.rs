@@ -22,10 +22,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::Body;
 use crate::ellipsoid::calibration::{KappaReading, lambda, pair_prefactor};
+use crate::ellipsoid::clumps::shape_matrix;
 use crate::ellipsoid::equations::{EllipsoidSystem, ModelConfig};
-use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::KappaSource;
-use crate::math::Mat3;
 
 /// β used when κ is given rather than calibrated (Roig03 after Eq. 13: "β ~ 10").
 pub const DEFAULT_BETA: f64 = 10.0;
@@ -70,19 +69,15 @@ pub struct BarrierSettings {
 impl BarrierSettings {
     /// β of the scene's calibration, or [`DEFAULT_BETA`] for a given κ; margin [`SPEED_MARGIN`].
     pub fn for_kappa_source(source: &KappaSource) -> Self {
-        match *source {
-            KappaSource::Calibrated { beta, reading, .. } => BarrierSettings {
-                beta,
-                reading,
-                beta_source: "model.calibrate",
-                speed_margin: SPEED_MARGIN,
-            },
-            KappaSource::Given => BarrierSettings {
-                beta: DEFAULT_BETA,
-                reading: KappaReading::Printed,
-                beta_source: "default",
-                speed_margin: SPEED_MARGIN,
-            },
+        let (beta, reading, beta_source) = match *source {
+            KappaSource::Calibrated { beta, reading, .. } => (beta, reading, "model.calibrate"),
+            KappaSource::Given => (DEFAULT_BETA, KappaReading::Printed, "default"),
+        };
+        BarrierSettings {
+            beta,
+            reading,
+            beta_source,
+            speed_margin: SPEED_MARGIN,
         }
     }
 }
@@ -168,13 +163,6 @@ pub fn calibrated_speed(g: f64, kappa: f64, beta: f64, r_i: f64, r_j: f64, m_ref
     (g * m_ref / (beta * (r_i + r_j))).sqrt() * (0.5 * (x - x.ln())).exp()
 }
 
-/// World-frame shape matrix `Σ = Rᵀ diag(A², B², C²) R` of a body (m²), as the contact potential uses it.
-fn sigma(b: &Body) -> Mat3 {
-    let r = rotation_matrix(&b.quaternion);
-    let d = Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes));
-    r.transpose() * d * r
-}
-
 /// Radius (m) beyond which no partner can be in contact: `x < κλ ≤ 2κ` needs `|Δ|² < 2 λ_max(G)`, and
 /// `λ_max(Σ) ≤ A² (|q|² + ||q|² − 1|)²`, so `|Δ| < √2 (ρ_i + ρ_j)` with `ρ = A (|q|² + ||q|² − 1|)`.
 fn reach(b: &Body) -> f64 {
@@ -195,7 +183,8 @@ pub fn pair_contact(
     let (ri, rj) = (bi.shape.equivalent_radius(), bj.shape.equivalent_radius());
     let (mi, mj) = (bi.shape.mass, bj.shape.mass);
     let contact_exponent = kappa * lambda(ri, rj);
-    let g = sigma(bi) + sigma(bj);
+    // Σ = Rᵀ diag(A², B², C²) R of each body, as the contact potential uses it.
+    let g = shape_matrix(bi, 1.0) + shape_matrix(bj, 1.0);
     let g_inv = g.try_inverse()?;
     let delta = bi.position - bj.position;
     let exponent = kappa * delta.dot(&(g_inv * delta));
@@ -429,11 +418,6 @@ impl BarrierMonitor {
             std::fs::remove_file(log)?;
         }
         Ok(m)
-    }
-
-    /// The settings.
-    pub fn settings(&self) -> &BarrierSettings {
-        &self.settings
     }
 
     /// Adds one overrun sample to the per-pair record (no file output).

@@ -4,8 +4,6 @@
 //! `|r_i − r_j| = R_i + R_j` when `U0_ij` is Eq. 11; there `U_C/|U_G| = 1/(2κλ_ij)` with `λ_ij` of Eq. 12.
 //! Ellipsoids use their equivalent radius `(ABC)^{1/3}` (the paper's rule).
 
-use std::f64::consts::PI;
-
 use serde::{Deserialize, Serialize};
 
 /// Why κ could not be calibrated.
@@ -38,14 +36,8 @@ pub fn lambda(r_i: f64, r_j: f64) -> f64 {
     (r_i + r_j).powi(2) / (r_i * r_i + r_j * r_j)
 }
 
-/// `U0_ij = G π^{3/2}/2 (R_i+R_j)² exp(κλ)/(κλ)^{5/2}` (Roig03 Eq. 11), in m⁵ kg⁻¹ s⁻² … such that
-/// `U_C = U0 ∫ρ_iρ_j d³r` is an energy.
-pub fn contact_amplitude_u0(g: f64, kappa: f64, r_i: f64, r_j: f64) -> f64 {
-    let x = kappa * lambda(r_i, r_j);
-    0.5 * g * PI.powf(1.5) * (r_i + r_j).powi(2) * x.exp() / x.powf(2.5)
-}
-
-/// The pair prefactor `U0_ij m_i m_j (κ/π)^{3/2}` (J m³) so that
+/// The pair prefactor `U0_ij m_i m_j (κ/π)^{3/2}` (J m³), with `U0_ij = G π^{3/2}/2 (R_i+R_j)² exp(κλ)/(κλ)^{5/2}`
+/// (Roig03 Eq. 11, such that `U_C = U0 ∫ρ_iρ_j d³r` is an energy), so that
 /// `U_C = prefactor · det(G)^{−1/2} · exp(−κ Δᵀ G⁻¹ Δ)` (the note's cheaper form of Eq. 10).
 ///
 /// Evaluated without `powf` (it runs for every interacting pair at every RHS evaluation):

@@ -55,11 +55,8 @@ pub fn random_cloud(n: usize, seed: u64, p: &CloudParams) -> Vec<Body> {
     for k in 0..n {
         let (ix, iy, iz) = (k % side, (k / side) % side, k / (side * side));
         let lattice = Vec3::new(ix as f64, iy as f64, iz as f64) * spacing - Vec3::repeat(offset);
-        let jitter = Vec3::new(
-            symmetric(&mut rng, 0.5 * p.jitter * spacing),
-            symmetric(&mut rng, 0.5 * p.jitter * spacing),
-            symmetric(&mut rng, 0.5 * p.jitter * spacing),
-        );
+        // Components drawn in order x, y, z.
+        let jitter = Vec3::from_fn(|_, _| symmetric(&mut rng, 0.5 * p.jitter * spacing));
         let r = p.r_min + (p.r_max - p.r_min) * uniform(&mut rng);
         let ba = p.min_axis_ratio + (1.0 - p.min_axis_ratio) * uniform(&mut rng);
         let cb = p.min_axis_ratio + (1.0 - p.min_axis_ratio) * uniform(&mut rng);
@@ -71,17 +68,9 @@ pub fn random_cloud(n: usize, seed: u64, p: &CloudParams) -> Vec<Body> {
         bodies.push(Body {
             shape: Ellipsoid { axes, mass },
             position: lattice + jitter,
-            velocity: Vec3::new(
-                symmetric(&mut rng, p.speed),
-                symmetric(&mut rng, p.speed),
-                symmetric(&mut rng, p.speed),
-            ),
+            velocity: Vec3::from_fn(|_, _| symmetric(&mut rng, p.speed)),
             quaternion: random_quaternion(&mut rng),
-            spin_body: Vec3::new(
-                symmetric(&mut rng, p.spin),
-                symmetric(&mut rng, p.spin),
-                symmetric(&mut rng, p.spin),
-            ),
+            spin_body: Vec3::from_fn(|_, _| symmetric(&mut rng, p.spin)),
         });
     }
     bodies

@@ -48,7 +48,7 @@ impl Linking {
 }
 
 /// World-frame shape matrix `Rᵀ diag(a², b², c²) R` with every semi-axis times `scale`.
-fn shape_matrix(b: &Body, scale: f64) -> Mat3 {
+pub(crate) fn shape_matrix(b: &Body, scale: f64) -> Mat3 {
     let r = rotation_matrix(&b.quaternion);
     let axes = b.shape.axes * scale;
     r.transpose() * Mat3::from_diagonal(&axes.component_mul(&axes)) * r

@@ -15,7 +15,7 @@
 
 use std::ops::{AddAssign, SubAssign};
 
-use nalgebra::{DVector, SMatrix, SVector};
+use nalgebra::{SMatrix, SVector};
 
 use crate::ellipsoid::potential::{BodyGeometry, Overlap};
 use crate::ellipsoid::quaternion::{inverse_mass_apply, w_matrix};
@@ -197,62 +197,6 @@ impl DissipationJacobian {
             *o = Vec6::new(t.x, t.y, t.z, r.x, r.y, r.z);
         }
     }
-
-    /// The momentum-space Jacobian `J = −C D B` as a dense `dim × dim` matrix over the whole state (`dim` the
-    /// system's dimension; rows and columns other than the momenta are zero). For tests on small systems.
-    pub fn dense(&self, dim: usize) -> nalgebra::DMatrix<f64> {
-        let n = self.bodies.len();
-        let s = self.stride;
-        let mut jac = nalgebra::DMatrix::zeros(dim, dim);
-        let mut v = vec![Vec6::zeros(); n];
-        let mut f = vec![Vec6::zeros(); n];
-        for col_body in 0..n {
-            for c in 0..7 {
-                v.fill(Vec6::zeros());
-                let b = &self.bodies[col_body];
-                if c < 3 {
-                    v[col_body][c] = 1.0 / b.mass;
-                } else {
-                    let mut p = Vec4::zeros();
-                    p[c - 3] = 1.0;
-                    let w = b.spin_of(&p);
-                    v[col_body].fixed_rows_mut::<3>(3).copy_from(&w);
-                }
-                self.apply_d(&v, &mut f);
-                for (row_body, (fi, bi)) in f.iter().zip(&self.bodies).enumerate() {
-                    let rate_p = bi.momentum_rate_of(&Vec3::new(fi[3], fi[4], fi[5]));
-                    for k in 0..3 {
-                        jac[(row_body * s + 7 + k, col_body * s + 7 + c)] = -fi[k];
-                    }
-                    for k in 0..4 {
-                        jac[(row_body * s + 10 + k, col_body * s + 7 + c)] = -rate_p[k];
-                    }
-                }
-            }
-        }
-        jac
-    }
-
-    /// The whole stiff part the solve inverts, `[[0, T], [0, J]]`: [`Self::dense`] plus the kinematic rows
-    /// `T = ∂(ṙ, q̇)/∂(u, p) = diag(1/m, M(q)⁻¹)` at the linearisation point. For tests on small systems.
-    pub fn dense_with_kinematics(&self, dim: usize) -> nalgebra::DMatrix<f64> {
-        let s = self.stride;
-        let mut jac = self.dense(dim);
-        for (i, b) in self.bodies.iter().enumerate() {
-            for k in 0..3 {
-                jac[(i * s + k, i * s + 7 + k)] = 1.0 / b.mass;
-            }
-            for c in 0..4 {
-                let mut e = Vec4::zeros();
-                e[c] = 1.0;
-                let col = inverse_mass_apply(&b.q, &b.inertia_ext, &e);
-                for k in 0..4 {
-                    jac[(i * s + 3 + k, i * s + 10 + c)] = col[k];
-                }
-            }
-        }
-        jac
-    }
 }
 
 impl StiffSolve for DissipationJacobian {
@@ -379,8 +323,62 @@ impl StiffSolve for DissipationJacobian {
     }
 }
 
-/// `(I − h J) x` for the dense `J` of [`DissipationJacobian::dense`] (for tests of the solve).
-pub fn apply_dense(jacobian: &nalgebra::DMatrix<f64>, h: f64, x: &[f64]) -> Vec<f64> {
-    let xv = DVector::from_column_slice(x);
-    (&xv - jacobian * &xv * h).as_slice().to_vec()
+/// Dense forms of the Jacobian, for the unit tests of `ellipsoid::equations`.
+#[cfg(test)]
+impl DissipationJacobian {
+    /// The momentum-space Jacobian `J = −C D B` as a dense `dim × dim` matrix over the whole state (`dim` the
+    /// system's dimension; rows and columns other than the momenta are zero). For tests on small systems.
+    pub(crate) fn dense(&self, dim: usize) -> nalgebra::DMatrix<f64> {
+        let n = self.bodies.len();
+        let s = self.stride;
+        let mut jac = nalgebra::DMatrix::zeros(dim, dim);
+        let mut v = vec![Vec6::zeros(); n];
+        let mut f = vec![Vec6::zeros(); n];
+        for col_body in 0..n {
+            for c in 0..7 {
+                v.fill(Vec6::zeros());
+                let b = &self.bodies[col_body];
+                if c < 3 {
+                    v[col_body][c] = 1.0 / b.mass;
+                } else {
+                    let mut p = Vec4::zeros();
+                    p[c - 3] = 1.0;
+                    let w = b.spin_of(&p);
+                    v[col_body].fixed_rows_mut::<3>(3).copy_from(&w);
+                }
+                self.apply_d(&v, &mut f);
+                for (row_body, (fi, bi)) in f.iter().zip(&self.bodies).enumerate() {
+                    let rate_p = bi.momentum_rate_of(&Vec3::new(fi[3], fi[4], fi[5]));
+                    for k in 0..3 {
+                        jac[(row_body * s + 7 + k, col_body * s + 7 + c)] = -fi[k];
+                    }
+                    for k in 0..4 {
+                        jac[(row_body * s + 10 + k, col_body * s + 7 + c)] = -rate_p[k];
+                    }
+                }
+            }
+        }
+        jac
+    }
+
+    /// The whole stiff part the solve inverts, `[[0, T], [0, J]]`: [`Self::dense`] plus the kinematic rows
+    /// `T = ∂(ṙ, q̇)/∂(u, p) = diag(1/m, M(q)⁻¹)` at the linearisation point. For tests on small systems.
+    pub(crate) fn dense_with_kinematics(&self, dim: usize) -> nalgebra::DMatrix<f64> {
+        let s = self.stride;
+        let mut jac = self.dense(dim);
+        for (i, b) in self.bodies.iter().enumerate() {
+            for k in 0..3 {
+                jac[(i * s + k, i * s + 7 + k)] = 1.0 / b.mass;
+            }
+            for c in 0..4 {
+                let mut e = Vec4::zeros();
+                e[c] = 1.0;
+                let col = inverse_mass_apply(&b.q, &b.inertia_ext, &e);
+                for k in 0..4 {
+                    jac[(i * s + 3 + k, i * s + 10 + c)] = col[k];
+                }
+            }
+        }
+        jac
+    }
 }

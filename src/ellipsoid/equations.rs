@@ -8,7 +8,7 @@
 //! `u̇ = ∂L/∂r + ∂F/∂ṙ`; `ṗ = ∂L/∂q + ∂F/∂q̇ − λ q` with λ fixed by differentiating `q·q̇ = 0` twice:
 //! `qᵀ M⁻¹ ṗ = qᵀ M⁻¹ Ṁ M⁻¹ p − pᵀ M⁻² p` (Roig03 Eq. 35 as corrected in the notes). The right-hand side
 //! solves it per body in the closed form [`constrained_momentum_rate_closed_form`] (`ṗ = g − λ q`); the paper's
-//! 4×4 system of Eq. 36 solved by LU ([`constrained_momentum_rate`]) is its test oracle.
+//! 4×4 system of Eq. 36 solved by LU is its test oracle.
 //!
 //! The attitude parts of the pair forces are summed per body as torques conjugate to the world spin
 //! ([`contact_spin_gradient`], the dissipation's `∂F/∂ω`) and mapped to the quaternion once per body: that is the
@@ -36,7 +36,7 @@ use crate::geometry::neighbours::sphere_pairs;
 use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::integrate::OdeSystem;
 use crate::integrate::linearly_implicit::StiffSolve;
-use crate::math::{Mat4, Vec3, Vec4};
+use crate::math::{Vec3, Vec4};
 use crate::phase::{Kind, Phase};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -240,8 +240,7 @@ const PAIR_BLOCK: usize = 64;
 /// The slot of a culled candidate (see `RhsScratch::slots`).
 const NO_TERMS: u32 = u32::MAX;
 
-/// Buffers of the right-hand side kept between evaluations, so that an evaluation allocates nothing once they
-/// have grown (fresh buffers of ~100 kB per evaluation cost page faults worth ~10 % of it).
+/// Buffers of the right-hand side kept between evaluations: once grown, an evaluation allocates nothing.
 #[derive(Default)]
 struct RhsScratch {
     kin: Vec<Kinematics>,
@@ -450,8 +449,7 @@ fn sum_pair_terms(
     dissipation
 }
 
-/// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential, and a
-/// rebuild of the N2000 pile's ~10⁵ candidates took milliseconds on one thread).
+/// The pairs' constants, in the pairs' order; in parallel for many pairs (each costs an exponential).
 fn candidates_of(
     pairs: Vec<(usize, usize)>,
     candidate: impl Fn((usize, usize)) -> CandidatePair + Sync + Send,
@@ -501,11 +499,6 @@ impl EllipsoidSystem {
         self
     }
 
-    /// The flyby tide, if any.
-    pub fn tide(&self) -> Option<&TideTerm> {
-        self.tide.as_ref()
-    }
-
     /// The packed initial state (quaternions normalised, `q̇ ⊥ q`).
     pub fn initial_state(&self) -> Vec<f64> {
         let mut y = vec![0.0; self.dim()];
@@ -513,13 +506,7 @@ impl EllipsoidSystem {
         y
     }
 
-    /// Whether attitudes are integrated (false for a system of spheres without dissipation, whose spins are
-    /// constant and whose attitudes follow from them).
-    pub fn integrates_attitudes(&self) -> bool {
-        self.rotation
-    }
-
-    /// Writes the positions, velocities and (when integrated, [`EllipsoidSystem::integrates_attitudes`]) attitudes
+    /// Writes the positions, velocities and (when integrated, [`EllipsoidSystem::rotation_integrated`]) attitudes
     /// and body-frame spins of `bodies` (one per body of the system, in order; their shapes are not read) into the
     /// packed state `y`, as [`EllipsoidSystem::initial_state`] packs the initial bodies (quaternions normalised,
     /// `q̇ ⊥ q`). Components past the bodies' are left as they are.
@@ -588,7 +575,8 @@ impl EllipsoidSystem {
         drift
     }
 
-    /// Whether attitudes are integrated (false for all-sphere scenes without dissipation).
+    /// Whether attitudes are integrated (false for a system of spheres without dissipation, whose spins are
+    /// constant and whose attitudes follow from them).
     pub fn rotation_integrated(&self) -> bool {
         self.rotation
     }
@@ -611,11 +599,6 @@ impl EllipsoidSystem {
     /// Number of bodies.
     pub fn n_bodies(&self) -> usize {
         self.shapes.len()
-    }
-
-    /// The enabled physics.
-    pub fn physics(&self) -> &Physics {
-        &self.physics
     }
 
     /// The model constants.
@@ -694,6 +677,16 @@ impl EllipsoidSystem {
         }
         rates[0..3].copy_from_slice(force.as_slice());
         rates[3..6].copy_from_slice(torque.as_slice());
+    }
+
+    /// Body `i`'s position in the packed state `y` (m).
+    fn position(&self, y: &[f64], i: usize) -> Vec3 {
+        Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])
+    }
+
+    /// Every body's position in `y` (m).
+    fn positions(&self, y: &[f64]) -> Vec<Vec3> {
+        (0..self.n_bodies()).map(|i| self.position(y, i)).collect()
     }
 
     fn kinematics(&self, i: usize, y: &[f64], with_geometry: bool) -> Kinematics {
@@ -1052,10 +1045,7 @@ impl EllipsoidSystem {
     pub fn diagnostics_at(&self, t: f64, y: &[f64]) -> Diagnostics {
         let mut d = self.diagnostics(y);
         if let Some(tide) = &self.tide {
-            let positions: Vec<Vec3> = (0..self.n_bodies())
-                .map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]))
-                .collect();
-            d.potential_tidal = tide.energy(t, &positions, &self.masses, &d.momentum);
+            d.potential_tidal = tide.energy(t, &self.positions(y), &self.masses, &d.momentum);
             d.energy_scale += d.potential_tidal.abs();
         }
         d
@@ -1079,33 +1069,10 @@ pub fn constraint_rhs(q: &Vec4, q_dot: &Vec4, m_inv_q: &Vec4, inertia_ext: &Vec4
     m_inv_q.dot(&m_dot_q_dot) - q_dot.norm_squared()
 }
 
-/// `ṗ` from Roig03 Eq. 36: three rows of the projector `|q|² 1 − q qᵀ` (the row of the largest `|q_k|`
-/// deleted) applied to `ṗ = g` plus the constraint row `qᵀ M⁻¹ ṗ = c`, solved by LU.
-/// `g = ∂L/∂q + ∂F/∂q̇` (J).
-pub fn constrained_momentum_rate(q: &Vec4, g: &Vec4, m_inv: &Mat4, c: f64) -> Vec4 {
-    let q2 = q.norm_squared();
-    let kmax = q.iamax();
-    let qg = q.dot(g);
-    let mq = m_inv * q;
-    let mut a = Mat4::zeros();
-    let mut b = Vec4::zeros();
-    for (row, k) in (0..4).filter(|&k| k != kmax).enumerate() {
-        for l in 0..4 {
-            a[(row, l)] = if l == k { q2 } else { 0.0 } - q[k] * q[l];
-        }
-        b[row] = q2 * g[k] - q[k] * qg;
-    }
-    for l in 0..4 {
-        a[(3, l)] = mq[l];
-    }
-    b[3] = c;
-    a.lu().solve(&b).unwrap_or_else(|| Vec4::from_element(f64::NAN))
-}
-
-/// Closed form equivalent to [`constrained_momentum_rate`]: `ṗ = g − λ q`, `λ = (qᵀM⁻¹g − c)/(qᵀM⁻¹q)` (the
-/// projector rows of Eq. 36 hold because they remove `q`, the constraint row by the choice of λ). The right-hand
-/// side's form: about a tenth of the LU solve's cost.
-/// `m_inv_q` is `M⁻¹ q`.
+/// `ṗ` of Roig03 Eq. 36 (three rows of the projector `|q|² 1 − q qᵀ` applied to `ṗ = g`, `g = ∂L/∂q + ∂F/∂q̇`
+/// in J, plus the constraint row `qᵀ M⁻¹ ṗ = c`) in closed form: `ṗ = g − λ q`, `λ = (qᵀM⁻¹g − c)/(qᵀM⁻¹q)` (the
+/// projector rows hold because they remove `q`, the constraint row by the choice of λ); `tests/ellipsoid_gradients.rs`
+/// checks it against the LU solution of the paper's 4×4 system. `m_inv_q` is `M⁻¹ q`.
 pub fn constrained_momentum_rate_closed_form(q: &Vec4, g: &Vec4, m_inv_q: &Vec4, c: f64) -> Vec4 {
     let mq = m_inv_q;
     let lambda = (mq.dot(g) - c) / mq.dot(q);
@@ -1164,12 +1131,7 @@ impl OdeSystem for EllipsoidSystem {
         let Some(theta) = self.physics.gravity.and_then(|gr| gr.method.tree_theta(n)) else {
             return;
         };
-        let positions: Vec<Vec3> = y
-            .chunks_exact(self.stride)
-            .take(n)
-            .map(|b| Vec3::new(b[0], b[1], b[2]))
-            .collect();
-        let frozen = Octree::build(&positions, &self.masses).freeze(theta);
+        let frozen = Octree::build(&self.positions(y), &self.masses).freeze(theta);
         *self.gravity_lists.lock().unwrap_or_else(|e| e.into_inner()) = Some(Arc::new(frozen));
     }
 
@@ -1203,18 +1165,14 @@ impl OdeSystem for EllipsoidSystem {
             }
             if let Some((tide, planet)) = &tide {
                 for (i, out) in dydt[..n * self.stride].chunks_exact_mut(self.stride).enumerate() {
-                    let r = Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]);
-                    let f = tide.acceleration(&r, planet) * self.masses[i];
+                    let f = tide.acceleration(&self.position(y, i), planet) * self.masses[i];
                     for (o, fk) in out[3..6].iter_mut().zip(f.iter()) {
                         *o += fk;
                     }
                 }
             }
             if let Some(idx) = self.tide_impulse_index() {
-                let positions: Vec<Vec3> = (0..n)
-                    .map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2]))
-                    .collect();
-                self.add_tide_impulse_rates(t, &positions, &mut dydt[idx..idx + 6]);
+                self.add_tide_impulse_rates(t, &self.positions(y), &mut dydt[idx..idx + 6]);
             }
             return;
         }
@@ -1241,8 +1199,7 @@ impl OdeSystem for EllipsoidSystem {
         // worker sums gravity while this one computes the kinematics.
         PHASE_GATHER.time(|| {
             positions.clear();
-            positions
-                .extend((0..n).map(|i| Vec3::new(y[i * self.stride], y[i * self.stride + 1], y[i * self.stride + 2])));
+            positions.extend((0..n).map(|i| self.position(y, i)));
         });
         let mut dissipation_rate = 0.0;
         let mut pairs = || {
@@ -1351,6 +1308,164 @@ impl OdeSystem for EllipsoidSystem {
         if let Some(idx) = self.tide_impulse_index() {
             let at = idx - n * stride;
             self.add_tide_impulse_rates(t, positions, &mut rest[at..at + 6]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::random::{Generator, generator, uniform};
+
+    /// `(I − h J) x` for a dense `J`.
+    fn apply_dense(jacobian: &nalgebra::DMatrix<f64>, h: f64, x: &[f64]) -> Vec<f64> {
+        let xv = nalgebra::DVector::from_column_slice(x);
+        (&xv - jacobian * &xv * h).as_slice().to_vec()
+    }
+
+    /// Uniform in `[lo, hi)`.
+    fn range(rng: &mut Generator, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * uniform(rng)
+    }
+
+    /// A random unit quaternion (by rejection from the cube).
+    fn unit_quaternion(rng: &mut Generator) -> Vec4 {
+        loop {
+            let q = Vec4::from_fn(|_, _| range(rng, -1.0, 1.0));
+            let n = q.norm();
+            if n > 0.2 && n < 1.0 {
+                return q / n;
+            }
+        }
+    }
+
+    /// Four ellipsoids of 400–1000 m (density 3000 kg/m³), random attitudes, spins and velocities, their centres
+    /// 800–1100 m apart so that every neighbouring pair overlaps.
+    fn overlapping_four(seed: u64) -> Vec<Body> {
+        let mut rng = generator(seed);
+        let centres = [
+            [0.0, 0.0, 0.0],
+            [1000.0, 100.0, 0.0],
+            [400.0, 900.0, 100.0],
+            [500.0, 400.0, 850.0],
+        ];
+        centres
+            .iter()
+            .map(|&c| {
+                let a = range(&mut rng, 700.0, 1000.0);
+                let velocity = Vec3::from_fn(|_, _| range(&mut rng, -0.1, 0.1));
+                let spin_body = Vec3::from_fn(|_, _| range(&mut rng, -1e-4, 1e-4));
+                let axes = Vec3::new(a, a * range(&mut rng, 0.6, 0.9), a * range(&mut rng, 0.4, 0.6));
+                let quaternion = unit_quaternion(&mut rng);
+                let mass = 3000.0 * 4.0 / 3.0 * std::f64::consts::PI * axes.x * axes.y * axes.z;
+                Body {
+                    shape: Ellipsoid { axes, mass },
+                    position: Vec3::from(c),
+                    velocity,
+                    quaternion,
+                    spin_body,
+                }
+            })
+            .collect()
+    }
+
+    /// The analytic `J = −C D B` against central differences of the right-hand side's dissipation part (the RHS at F0
+    /// minus the RHS at F0 = 0) in every momentum component; and the solve of `(I − h J) x = b` against the dense `J`.
+    #[test]
+    fn dissipation_jacobian_matches_finite_differences() {
+        let bodies = overlapping_four(7);
+        let model = ModelConfig::gaussian_si(6.0);
+        let f0 = 100.0;
+        let sys = EllipsoidSystem::new(&bodies, model, Physics::impact(f0));
+        let free = EllipsoidSystem::new(&bodies, model, Physics::impact(0.0));
+        let y = sys.initial_state();
+        let n = sys.dim();
+        let jac = sys.dissipation_jacobian(&y).expect("dissipation is on");
+        assert!(jac.pairs() >= 4, "only {} dissipating pairs", jac.pairs());
+        let dense = jac.dense(n);
+        let units = sys.state_units().unwrap();
+        let diss = |y: &[f64]| {
+            let (mut a, mut b) = (vec![0.0; n], vec![0.0; n]);
+            sys.rhs(0.0, y, &mut a);
+            free.rhs(0.0, y, &mut b);
+            a.iter().zip(&b).map(|(x, z)| x - z).collect::<Vec<f64>>()
+        };
+        let (mut worst, mut scale) = (0.0_f64, 0.0_f64);
+        for body in 0..bodies.len() {
+            for c in 7..14 {
+                let k = body * 14 + c;
+                // The dissipation is linear in the momenta: central differences are exact up to rounding, so the step
+                // can be large (1e-3 of the component's user unit: 1 mm/s or 1 mrad/s).
+                let d = 1e-3 * units[k];
+                let (mut yp, mut ym) = (y.clone(), y.clone());
+                yp[k] += d;
+                ym[k] -= d;
+                let (fp, fm) = (diss(&yp), diss(&ym));
+                for row in 0..bodies.len() * 14 {
+                    // Columns scaled by the user unit, rows by theirs: entries in s⁻¹.
+                    let fd = (fp[row] - fm[row]) / (2.0 * d) * units[k] / units[row];
+                    let an = dense[(row, k)] * units[k] / units[row];
+                    worst = worst.max((fd - an).abs());
+                    scale = scale.max(an.abs());
+                }
+            }
+        }
+        eprintln!("largest |J| entry {scale:e} 1/s, largest |J - J_fd| {worst:e}");
+        assert!(
+            scale > 1e-3,
+            "the dissipation is not stiff enough to test ({scale:e} 1/s)"
+        );
+        assert!(
+            worst <= 1e-8 * scale,
+            "J differs from finite differences by {:e} relative",
+            worst / scale
+        );
+
+        // The solve: (I − h J') x = b with the dense J' = [[0, T], [0, J]] (J and the kinematic rows), and total
+        // momentum unchanged.
+        let solved = jac.dense_with_kinematics(n);
+        let mut solver = sys.dissipation_jacobian(&y).unwrap();
+        let mut rng = generator(3);
+        let b: Vec<f64> = (0..n).map(|k| units[k] * range(&mut rng, -1.0, 1.0)).collect();
+        for h in [1e-3, 1.0, 1e3] {
+            let mut x = b.clone();
+            solver.solve(h, &mut x);
+            // Against dense LU of the same matrix: both are limited by its condition, about 1 + h |J| (the pile's
+            // stiffness), so they agree to ε (1 + h |J|) of |x|.
+            let a = nalgebra::DMatrix::<f64>::identity(n, n) - &solved * h;
+            let x_lu = a.lu().solve(&nalgebra::DVector::from_column_slice(&b)).unwrap();
+            let diff = x_lu
+                .iter()
+                .zip(&x)
+                .zip(&units)
+                .map(|((p, q), u)| ((p - q) / u).abs())
+                .fold(0.0, f64::max);
+            let size = x.iter().zip(&units).map(|(p, u)| (p / u).abs()).fold(0.0, f64::max);
+            let bound = 1e-14 * (1.0 + h * scale) * size;
+            eprintln!("h = {h:e}: |x_cg - x_lu| {diff:e}, bound {bound:e} (user units)");
+            assert!(diff <= bound, "CG and LU differ by {diff:e} > {bound:e} at h = {h}");
+            // The residual of (I − h J) x = b itself, where h J is small.
+            if h * scale < 1e3 {
+                let back = apply_dense(&solved, h, &x);
+                let resid = back
+                    .iter()
+                    .zip(&b)
+                    .zip(&units)
+                    .map(|((p, q), u)| ((p - q) / u).abs())
+                    .fold(0.0, f64::max);
+                assert!(
+                    resid <= 1e-13 * (1.0 + h * scale) * size,
+                    "residual {resid:e} at h = {h}"
+                );
+            }
+            let sum = |v: &[f64], c: usize| (0..bodies.len()).map(|i| v[i * 14 + 7 + c]).sum::<f64>();
+            let p_scale: f64 = (0..bodies.len()).map(|i| units[i * 14 + 7]).sum();
+            for c in 0..3 {
+                assert!(
+                    (sum(&x, c) - sum(&b, c)).abs() <= 1e-14 * p_scale,
+                    "momentum changed by the solve"
+                );
+            }
         }
     }
 }

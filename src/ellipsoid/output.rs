@@ -59,15 +59,6 @@ pub fn snapshot_records(t: f64, bodies: &[Body]) -> Vec<Vec<String>> {
         .collect()
 }
 
-/// The snapshot rows of the bodies `ids` (indices into `bodies`, in that order) at time `t`, without the header.
-///
-/// # Panics
-/// If an index is out of range (scene validation guarantees it is not).
-pub fn tracked_records(t: f64, bodies: &[Body], ids: &[usize]) -> Vec<Vec<String>> {
-    let all = snapshot_records(t, bodies);
-    ids.iter().map(|&id| all[id].clone()).collect()
-}
-
 /// Writes `tracks.csv` (the snapshot columns, one row per tracked body per time-series sample), flushing after
 /// each sample so a crash loses nothing written.
 pub struct TracksWriter {
@@ -106,10 +97,12 @@ impl TracksWriter {
         })
     }
 
-    /// Appends the rows of the tracked bodies `ids` at time `t` and flushes them to the OS.
+    /// Appends the rows of the tracked bodies `ids` (indices into `bodies`, in that order; scene validation keeps
+    /// them in range) at time `t` and flushes them to the OS.
     pub fn write_sample(&mut self, t: f64, bodies: &[Body], ids: &[usize]) -> std::io::Result<()> {
-        for row in tracked_records(t, bodies, ids) {
-            self.w.write_record(&row).map_err(csv_to_io)?;
+        let rows = snapshot_records(t, bodies);
+        for &id in ids {
+            self.w.write_record(&rows[id]).map_err(csv_to_io)?;
         }
         self.w.flush()
     }
@@ -205,12 +198,10 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         .has_headers(true)
         .trim(::csv::Trim::All)
         .from_reader(reader);
+    let bad_header = |message: String| BodiesFileError::Format { line: 1, message };
     let headers = r
         .headers()
-        .map_err(|e| BodiesFileError::Format {
-            line: 1,
-            message: format!("bad header: {}", one_line_csv(&e)),
-        })?
+        .map_err(|e| bad_header(format!("bad header: {}", one_line_csv(&e))))?
         .clone();
     let required = &SNAPSHOT_COLUMNS[2..];
     let mut index = [usize::MAX; 17];
@@ -220,29 +211,19 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         }
         match required.iter().position(|&c| c == name) {
             Some(k) if index[k] == usize::MAX => index[k] = pos,
-            Some(_) => {
-                return Err(BodiesFileError::Format {
-                    line: 1,
-                    message: format!("column `{name}` appears twice"),
-                });
-            }
+            Some(_) => return Err(bad_header(format!("column `{name}` appears twice"))),
             None => {
-                return Err(BodiesFileError::Format {
-                    line: 1,
-                    message: format!("unknown column `{name}`; expected {}", SNAPSHOT_COLUMNS.join(",")),
-                });
+                let expected = SNAPSHOT_COLUMNS.join(",");
+                return Err(bad_header(format!("unknown column `{name}`; expected {expected}")));
             }
         }
     }
     if let Some(k) = index.iter().position(|&i| i == usize::MAX) {
-        return Err(BodiesFileError::Format {
-            line: 1,
-            message: format!(
-                "missing column `{}`; expected {}",
-                required[k],
-                SNAPSHOT_COLUMNS.join(",")
-            ),
-        });
+        let expected = SNAPSHOT_COLUMNS.join(",");
+        return Err(bad_header(format!(
+            "missing column `{}`; expected {expected}",
+            required[k]
+        )));
     }
     let mut out = Vec::new();
     for rec in r.records() {

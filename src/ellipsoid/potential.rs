@@ -20,7 +20,7 @@ pub struct BodyGeometry {
     pub rot: Mat3,
     /// `Σ = Rᵀ diag(A², B², C²) R` (m²), the world-frame covariance shape of the body.
     pub sigma: Mat3,
-    /// The attitude `q` (its `∂R/∂q_k` are linear in it, see [`quaternion_gradient`]).
+    /// The attitude `q`.
     pub q: Vec4,
     /// `diag(A², B², C²) R` (m²), shared by `Σ` and every pair's quaternion gradient.
     pub axes_rot: Mat3,
@@ -201,104 +201,12 @@ fn determinant_and_inverse(m: &Mat3) -> (f64, Mat3) {
     (det, inv)
 }
 
-/// Gradients of `U_C` with respect to the positions and quaternions of a pair.
-#[derive(Debug, Clone, Copy)]
-pub struct ContactGradient {
-    /// `∂U_C/∂r_i` (N); `∂U_C/∂r_j` is its negative.
-    pub d_ri: Vec3,
-    /// `∂U_C/∂q_i` (J).
-    pub d_qi: Vec4,
-    /// `∂U_C/∂q_j` (J).
-    pub d_qj: Vec4,
-}
-
-/// `∂U_C/∂q` of one body of the pair, `2 U_C ⟨D R S, ∂R/∂q_k⟩_F`.
-///
-/// `∂R/∂q_k` ([`crate::ellipsoid::quaternion::rotation_matrix_derivatives`]) is linear in `q` with a few zero
-/// entries; each Frobenius product is written out over its non-zero entries, in the column-major order (and
-/// from the `0.0` start) of nalgebra's `dot`, so the bits are those of `x.dot(&d_rot[k])`: a skipped term is
-/// `x·0 = ±0`, which leaves a sum that started at +0 unchanged. The factors `2·(2a)`, `2·(−d)` … are the exact
-/// entries of `2 M_k`.
-fn quaternion_gradient(u: f64, s: &Mat3, body: &BodyGeometry) -> Vec4 {
-    let x = body.axes_rot * s;
-    let (a, b, g, d) = (body.q.x, body.q.y, body.q.z, body.q.w);
-    let (a2, b2, g2, d2) = (2.0 * a, 2.0 * b, 2.0 * g, 2.0 * d);
-    let (a4, b4, g4, d4) = (2.0 * a2, 2.0 * b2, 2.0 * g2, 2.0 * d2);
-    // Σ over (row, col, entry) in column-major order, starting from +0 as nalgebra's dot does.
-    let frobenius = |terms: &[(usize, usize, f64)]| {
-        let mut sum = 0.0;
-        for &(r, c, m) in terms {
-            sum += x[(r, c)] * m;
-        }
-        sum
-    };
-    let dots = [
-        // 2 [2a b g; b 0 d; g −d 0]
-        frobenius(&[
-            (0, 0, a4),
-            (1, 0, b2),
-            (2, 0, g2),
-            (0, 1, b2),
-            (2, 1, -d2),
-            (0, 2, g2),
-            (1, 2, d2),
-        ]),
-        // 2 [0 a −d; a 2b g; d g 0]
-        frobenius(&[
-            (1, 0, a2),
-            (2, 0, d2),
-            (0, 1, a2),
-            (1, 1, b4),
-            (2, 1, g2),
-            (0, 2, -d2),
-            (1, 2, g2),
-        ]),
-        // 2 [0 d a; −d 0 b; a b 2g]
-        frobenius(&[
-            (1, 0, -d2),
-            (2, 0, a2),
-            (0, 1, d2),
-            (2, 1, b2),
-            (0, 2, a2),
-            (1, 2, b2),
-            (2, 2, g4),
-        ]),
-        // 2 [2d g −b; −g 2d a; b −a 2d]
-        frobenius(&[
-            (0, 0, d4),
-            (1, 0, -g2),
-            (2, 0, b2),
-            (0, 1, g2),
-            (1, 1, d4),
-            (2, 1, -a2),
-            (0, 2, -b2),
-            (1, 2, a2),
-            (2, 2, d4),
-        ]),
-    ];
-    let mut out = Vec4::zeros();
-    for k in 0..4 {
-        out[k] = 2.0 * u * dots[k];
-    }
-    out
-}
-
 /// `∂U_C/∂r_i` and the matrix `S` with `dU_C = U_raw ⟨S, dΣ⟩_F` for a change `dΣ` of either body's `Σ` (taper
 /// included, see the module doc).
 fn position_gradient_and_shape_matrix(ov: &Overlap, kappa: f64) -> (Vec3, Mat3) {
     let (t, dt) = (ov.taper, ov.taper_slope);
     let s = -0.5 * t * ov.g_inv + kappa * (t - dt) * ov.y * ov.y.transpose();
     (-2.0 * kappa * ov.potential_raw * (t - dt) * ov.y, s)
-}
-
-/// Analytic gradients of the contact potential of a pair (see the module doc).
-pub fn contact_gradient(ov: &Overlap, kappa: f64, gi: &BodyGeometry, gj: &BodyGeometry) -> ContactGradient {
-    let (d_ri, s) = position_gradient_and_shape_matrix(ov, kappa);
-    ContactGradient {
-        d_ri,
-        d_qi: quaternion_gradient(ov.potential_raw, &s, gi),
-        d_qj: quaternion_gradient(ov.potential_raw, &s, gj),
-    }
 }
 
 /// Gradients of the contact potential of a pair with respect to the positions and the world-frame spins.
@@ -313,7 +221,7 @@ pub struct ContactSpinGradient {
     pub d_wj: Vec3,
 }
 
-/// [`contact_gradient`] with the attitude derivatives as spin gradients: while a body turns at world spin `ω`,
+/// The contact gradient of the module doc with the attitude derivatives as spin gradients: while a body turns at world spin `ω`,
 /// `Σ̇ = [ω]× Σ − Σ [ω]×`, so `U̇_C = U_raw tr((Σ S − S Σ) [ω]×)` and `∂U_C/∂ω = −2 U_raw axial(Σ S − S Σ)`
 /// (`tr([m]× [ω]×) = −2 m·ω`). Through `ω = Rᵀ 2 W₃(q) q̇`, `2 W₃ᵀ R ∂U_C/∂ω` is the part of `∂U_C/∂q` tangent
 /// to `|q| = 1`, the only part the constrained equations of motion see (Roig03 Eq. 36 removes the radial one),
@@ -360,7 +268,6 @@ pub fn interaction_radius(kappa: f64, gi: &BodyGeometry, cull_exp: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ellipsoid::quaternion::rotation_matrix_derivatives;
 
     /// A xorshift stream of numbers in [−1, 1) (no dependency for a few hundred test draws).
     fn uniform_in_minus_one_one(mut seed: u64) -> impl FnMut() -> f64 {
@@ -387,25 +294,6 @@ mod tests {
             let (det_ref, inv_ref) = (g.determinant(), g.try_inverse().unwrap());
             assert!((det - det_ref).abs() <= 1e-12 * det_ref.abs(), "{det} vs {det_ref}");
             assert!((inv - inv_ref).norm() <= 1e-12 * inv_ref.norm(), "{inv} vs {inv_ref}");
-        }
-    }
-
-    /// The written-out quaternion gradient has the bits of the Frobenius products with `∂R/∂q_k`.
-    #[test]
-    fn quaternion_gradient_matches_frobenius_products_bitwise() {
-        let mut rand = uniform_in_minus_one_one(0x2545_f491_4f6c_dd1d);
-        for _ in 0..200 {
-            let q = Vec4::new(rand(), rand(), rand(), rand()) * 1.1;
-            let axes = Vec3::new(1.0 + rand().abs(), 0.7, 0.5 + 0.1 * rand());
-            let body = BodyGeometry::new(&axes, &q);
-            let s = Mat3::from_fn(|_, _| rand());
-            let u = rand() * 1e3;
-            let got = quaternion_gradient(u, &s, &body);
-            let x = Mat3::from_diagonal(&body.axes_sq) * body.rot * s;
-            let d_rot = rotation_matrix_derivatives(&q);
-            for k in 0..4 {
-                assert_eq!(got[k].to_bits(), (2.0 * u * x.dot(&d_rot[k])).to_bits(), "k = {k}");
-            }
         }
     }
 }

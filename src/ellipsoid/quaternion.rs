@@ -81,15 +81,8 @@ pub fn mass_matrix(q: &Vec4, inertia_ext: &Vec4) -> Mat4 {
     4.0 * w.transpose() * Mat4::from_diagonal(inertia_ext) * w
 }
 
-/// `M(q)⁻¹ = Wᵀ Ĩ⁻¹ W / (4 |q|⁴)` — no general 4×4 inverse needed since `W` is orthogonal times `|q|`.
-pub fn inverse_mass_matrix(q: &Vec4, inertia_ext: &Vec4) -> Mat4 {
-    let w = w_matrix(q);
-    let inv = inertia_ext.map(|x| 1.0 / x);
-    w.transpose() * Mat4::from_diagonal(&inv) * w / (4.0 * q.norm_squared().powi(2))
-}
-
-/// `M(q)⁻¹ v` without forming `M⁻¹`: `Wᵀ (Ĩ⁻¹ ∘ (W v)) / (4 |q|⁴)` (two 4×4 products with a vector instead of
-/// two with a matrix). The right-hand side needs only `M⁻¹ p = q̇` and `M⁻¹ q`.
+/// `M(q)⁻¹ v = Wᵀ (Ĩ⁻¹ ∘ (W v)) / (4 |q|⁴)`, since `M(q)⁻¹ = Wᵀ Ĩ⁻¹ W / (4 |q|⁴)` (`W` is orthogonal times `|q|`),
+/// without forming `M⁻¹`. The right-hand side needs only `M⁻¹ p = q̇` and `M⁻¹ q`.
 pub fn inverse_mass_apply(q: &Vec4, inertia_ext: &Vec4, v: &Vec4) -> Vec4 {
     let w = w_matrix(q);
     w.transpose() * (w * v).component_div(inertia_ext) / (4.0 * q.norm_squared().powi(2))

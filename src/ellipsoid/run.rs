@@ -203,43 +203,19 @@ fn check_initial_state(scene: &LoadedScene, initial: &Diagnostics, y: &[f64]) ->
         KappaSource::Given => "model.kappa",
         KappaSource::Calibrated { .. } => "model.calibrate",
     };
+    // Each term on its own: a system with only that term (or only the tide) enabled.
+    let (mut gravity, mut contact, mut dissipation) = (none, none, none);
+    (gravity.gravity, contact.contact, dissipation.dissipation) = (p.gravity, p.contact, p.dissipation);
     let terms = [
-        (
-            "gravity",
-            "physics.gravity.G",
-            p.gravity.is_some(),
-            Physics {
-                gravity: p.gravity,
-                ..none
-            },
-            None,
-        ),
-        (
-            "contact",
-            kappa_field,
-            p.contact.is_some(),
-            Physics {
-                contact: p.contact,
-                ..none
-            },
-            None,
-        ),
-        (
-            "dissipation",
-            "physics.dissipation.F0",
-            p.dissipation.is_some(),
-            Physics {
-                dissipation: p.dissipation,
-                ..none
-            },
-            None,
-        ),
-        ("flyby tide", "physics.flyby", scene.tide.is_some(), none, scene.tide),
+        ("gravity", "physics.gravity.G", gravity, None),
+        ("contact", kappa_field, contact, None),
+        ("dissipation", "physics.dissipation.F0", dissipation, None),
+        ("flyby tide", "physics.flyby", none, scene.tide),
     ];
     let (term, field, body, energy) = terms
         .iter()
-        .filter(|t| t.2)
-        .find_map(|(term, field, _, physics, tide)| {
+        .filter(|t| t.2 != none || t.3.is_some())
+        .find_map(|(term, field, physics, tide)| {
             let system = EllipsoidSystem::new(&scene.bodies, scene.model, *physics).with_tide(*tide);
             let d = system.diagnostics_at(0.0, y);
             let body = rates_finite(&system);
@@ -424,7 +400,7 @@ impl EllipsoidEngine {
     /// velocities (m/s), attitude quaternions (normalised here) and body-frame spins (rad/s). For a run between
     /// two samples (e.g. from Python); the run continues from the new state, its conserved quantities measured
     /// against those at t = 0 as before (so a change of energy counts in the energy error). Attitudes and spins
-    /// cannot change where they are not integrated ([`EllipsoidSystem::integrates_attitudes`]).
+    /// cannot change where they are not integrated ([`EllipsoidSystem::rotation_integrated`]).
     ///
     /// Errors ([`EngineError::State`], one line, nothing changed): another number of bodies, another shape or
     /// mass, a non-finite value, a changed attitude or spin that is not integrated.
@@ -453,7 +429,7 @@ impl EllipsoidEngine {
                     "body[{i}]: a non-finite value (or a zero quaternion)"
                 )));
             }
-            if !self.system.integrates_attitudes() && (b.quaternion != old.quaternion || b.spin_body != old.spin_body) {
+            if !self.system.rotation_integrated() && (b.quaternion != old.quaternion || b.spin_body != old.spin_body) {
                 return Err(EngineError::State(format!(
                     "body[{i}]: attitudes and spins are not integrated in this run (spheres without dissipation); \
                      only positions and velocities can change"

@@ -39,9 +39,7 @@ pub const DEFAULT_IMPACT_JSON: &str = include_str!("../../targets/default_impact
 /// Name used for the built-in scene in messages.
 pub const DEFAULT_SCENE_NAME: &str = "<built-in default scene>";
 
-// ---------------------------------------------------------------------------------------------
 // The file model (what serde reads). Every struct rejects unknown keys.
-// ---------------------------------------------------------------------------------------------
 
 /// A whole scene file. Tables: `[scene]`, `[model]`, `[physics]`, `[integrator]`, `[output]` and
 /// one `[[body]]` table per body (or `scene.bodies_file` instead of the `[[body]]` tables).
@@ -248,7 +246,7 @@ pub struct DissipationSpec {
 }
 
 /// `[integrator]`. The whole table is optional.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, SceneFields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize, SceneFields)]
 #[scene(table = "integrator")]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
@@ -265,7 +263,7 @@ pub struct IntegratorSection {
     /// the implicit method's steps follow the motion instead; below it (soft contacts, Roig03's F0 = 1e-6 s m⁻²)
     /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
     /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
-    #[serde(default = "default_method")]
+    #[serde(default)]
     #[field(unit = "text", default = "\"bulirsch-stoer\"")]
     #[field(range = Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""))]
     #[field(
@@ -311,24 +309,8 @@ pub struct IntegratorSection {
     pub project_attitudes: Option<bool>,
 }
 
-fn default_method() -> Method {
-    Method::BulirschStoer
-}
-
 fn default_tolerance() -> f64 {
     1e-10
-}
-
-impl Default for IntegratorSection {
-    fn default() -> Self {
-        IntegratorSection {
-            method: default_method(),
-            rtol: None,
-            atol: None,
-            step: None,
-            project_attitudes: None,
-        }
-    }
 }
 
 /// `[output]`.
@@ -421,13 +403,7 @@ pub struct BodySpec {
     pub spin_world: Option<[f64; 3]>,
 }
 
-// ---------------------------------------------------------------------------------------------
-// Errors.
-// ---------------------------------------------------------------------------------------------
-
-// ---------------------------------------------------------------------------------------------
 // The resolved scene.
-// ---------------------------------------------------------------------------------------------
 
 /// How κ was obtained.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -513,9 +489,7 @@ pub struct LoadedScene {
     pub work_steps: Option<f64>,
 }
 
-// ---------------------------------------------------------------------------------------------
 // Entry points.
-// ---------------------------------------------------------------------------------------------
 
 /// Reads and validates a scene file. Errors name the file as given by `path`.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
@@ -541,9 +515,7 @@ pub fn parse_toml(text: &str, name: &str) -> Result<SceneFile, SceneError> {
     parse_toml_as(text, name)
 }
 
-// ---------------------------------------------------------------------------------------------
 // Validation.
-// ---------------------------------------------------------------------------------------------
 
 /// A body before conversion, from either a `[[body]]` table or a bodies-file row.
 struct RawBody {
@@ -692,9 +664,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let t_end = self.field(&SceneSection::T_END, file.scene.t_end)?;
-
-        Ok(t_end)
+        self.field(&SceneSection::T_END, file.scene.t_end)
     }
 
     /// `[model]`: exactly one of `kappa` (in (1.5, [`MAX_KAPPA`]]) or `calibrate` (β, v > 0); κ itself is computed
@@ -713,7 +683,6 @@ impl Validator<'_> {
                 self.field(&CalibrateSpec::V, c.v)?;
             }
         }
-
         Ok(())
     }
 
@@ -745,45 +714,37 @@ impl Validator<'_> {
 
     /// `[physics]`: each term optional (absent = not computed).
     fn physics_section(&self, p: &PhysicsSection) -> Result<Physics, SceneError> {
-        let gravity = match p.gravity {
-            Some(g) => {
-                use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
-                let theta = self.field(&GravitySpec::THETA, g.theta.unwrap_or(DEFAULT_THETA))?;
-                Some(GravityTerm {
-                    g: self.field(&GravitySpec::G, g.g.unwrap_or(SI_G))?,
-                    method: match g.method.unwrap_or_default() {
-                        GravityMethodSpec::Direct => GravityMethod::Direct,
-                        GravityMethodSpec::Tree => GravityMethod::Tree { theta },
-                        GravityMethodSpec::Auto => GravityMethod::Auto { theta },
-                    },
-                })
+        use crate::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod};
+        let gravity = p.gravity.map(|g| {
+            let theta = self.field(&GravitySpec::THETA, g.theta.unwrap_or(DEFAULT_THETA))?;
+            Ok(GravityTerm {
+                g: self.field(&GravitySpec::G, g.g.unwrap_or(SI_G))?,
+                method: match g.method.unwrap_or_default() {
+                    GravityMethodSpec::Direct => GravityMethod::Direct,
+                    GravityMethodSpec::Tree => GravityMethod::Tree { theta },
+                    GravityMethodSpec::Auto => GravityMethod::Auto { theta },
+                },
+            })
+        });
+        let contact = p.contact.map(|c| {
+            let cutoff = self.field(&ContactSpec::CUTOFF, c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF))?;
+            if cutoff < MIN_MEANINGFUL {
+                return Err(self.invalid(
+                    "physics.contact.cutoff",
+                    format!("is below the smallest meaningful value ({MIN_MEANINGFUL:e}), got {cutoff:e}"),
+                ));
             }
-            None => None,
-        };
-        let contact = match p.contact {
-            Some(c) => {
-                let cutoff = c.cutoff.unwrap_or(DEFAULT_CONTACT_CUTOFF);
-                let cutoff = self.field(&ContactSpec::CUTOFF, cutoff)?;
-                if cutoff < MIN_MEANINGFUL {
-                    return Err(self.invalid(
-                        "physics.contact.cutoff",
-                        format!("is below the smallest meaningful value ({MIN_MEANINGFUL:e}), got {cutoff:e}"),
-                    ));
-                }
-                Some(ContactTerm { cutoff })
-            }
-            None => None,
-        };
-        let dissipation = match p.dissipation {
-            Some(d) => Some(DissipationTerm {
+            Ok(ContactTerm { cutoff })
+        });
+        let dissipation = p.dissipation.map(|d| {
+            Ok(DissipationTerm {
                 f0: self.field(&DissipationSpec::F0, d.f0)?,
-            }),
-            None => None,
-        };
+            })
+        });
         Ok(Physics {
-            gravity,
-            contact,
-            dissipation,
+            gravity: gravity.transpose()?,
+            contact: contact.transpose()?,
+            dissipation: dissipation.transpose()?,
         })
     }
 
@@ -802,10 +763,7 @@ impl Validator<'_> {
             ));
         }
         let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
-        let step = match i.step {
-            Some(h) => Some(self.step("integrator.step", h, t_end)?),
-            None => None,
-        };
+        let step = i.step.map(|h| self.step("integrator.step", h, t_end)).transpose()?;
         if i.method == Method::Rk4 {
             if step.is_none() {
                 return Err(self.invalid("integrator.step", "method \"rk4\" needs a fixed step: step = <s> (> 0)"));
@@ -849,7 +807,6 @@ impl Validator<'_> {
         let every = self.cadence("output.every", o.every, t_end)?;
         let times = self.output_times(o.times.as_deref(), o.snapshot_every, t_end)?;
         let track = o.track.clone().unwrap_or_default();
-
         Ok(OutputSettings { times, every, track })
     }
 

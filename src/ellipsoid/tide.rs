@@ -166,10 +166,7 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
     let mass = v.field(&FlybySpec::MASS, spec.mass)?;
     let gm = g * mass;
     let q = v.field(&FlybySpec::Q, spec.q)?;
-    let radius = match spec.radius {
-        Some(r) => Some(v.field(&FlybySpec::RADIUS, r)?),
-        None => None,
-    };
+    let radius = spec.radius.map(|r| v.field(&FlybySpec::RADIUS, r)).transpose()?;
     if let Some(r) = radius
         && q <= r
     {

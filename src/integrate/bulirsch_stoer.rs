@@ -49,20 +49,11 @@ pub const RUN_BUDGET: f64 = 0.25;
 /// Default maximum number of columns (ODEX `km`).
 pub const DEFAULT_MAX_COLUMNS: usize = 9;
 
-/// Adaptive Gragg–Bulirsch–Stoer extrapolation integrator (ODEX strategy), see the
-/// [module documentation](self): the step loop [`Adaptive`] around [`Extrapolation`] of Gragg's rule.
-///
-/// The step size and column count are carried from one [`Integrator::advance`] call to the next,
-/// so a sequence of output times does not restart the step control; when a step is shortened to
-/// land exactly on an output time, the un-shortened proposal is kept for the next call. Call
-/// [`Adaptive::reset`] after a discontinuity of the state or of the equations.
-///
-/// Statistics ([`Integrator::stats`]) count every RHS call (including the initial-step guess and
-/// the derivative at the start of each `advance`); `smallest_step` leaves out steps shortened
-/// only to land on an output time. [`Adaptive::rejections`] splits the rejected steps by cause.
-///
-/// All work arrays are allocated once (at the first call and whenever the dimension changes);
-/// a step allocates nothing.
+/// Adaptive Gragg–Bulirsch–Stoer extrapolation integrator (ODEX strategy), see the [module documentation](self):
+/// the step loop [`Adaptive`] (which carries the step size, and here the column count, from one call to the next
+/// and counts every RHS call, the initial-step guess included) around [`Extrapolation`] of Gragg's rule.
+/// [`Adaptive::rejections`] splits the rejected steps by cause. The work arrays are allocated at the first call and
+/// whenever the dimension changes; a step allocates nothing.
 ///
 /// ```
 /// use rubblepile::integrate::{Integrator, Tolerances, bulirsch_stoer::BulirschStoer};
@@ -81,14 +72,10 @@ pub const DEFAULT_MAX_COLUMNS: usize = 9;
 pub type BulirschStoer = Adaptive<Extrapolation<Midpoint>>;
 
 impl BulirschStoer {
-    /// A new integrator with per-component `tolerances` and an optional initial step `step`
-    /// (|step| is used for the very first step only, and again after [`Adaptive::reset`];
-    /// `None` = automatic guess from `f(t0, y0)` and one more evaluation, Hairer's `hinit`).
-    ///
-    /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or
-    /// contain negative or non-finite values, if some component has `rtol = atol = 0`, or if
-    /// `step` is not positive and finite. The vectors' length must equal the dimension of the
-    /// systems later passed to [`Integrator::advance`].
+    /// A new integrator with per-component `tolerances` (of the dimension of the systems later passed to
+    /// [`Integrator::advance`]) and an optional initial step `step` (|step| for the very first step, and again after
+    /// [`Adaptive::reset`]; `None`: Hairer's `hinit` from `f(t0, y0)` and one more evaluation). Errors with
+    /// [`IntegrateError::Config`] for tolerances [`validate_tolerances`] refuses or a `step` not non-zero and finite.
     pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
         validate_tolerances(&tolerances)?;
         Adaptive::with_method(
@@ -144,7 +131,7 @@ pub struct Strategy {
 
 /// The base rule an [`Extrapolation`] extrapolates — Gragg's modified midpoint rule ([`Midpoint`]) or the linearly
 /// implicit Euler method (`linearly_implicit.rs`) — with the checkpoint layout of its method.
-pub trait BaseRule {
+pub trait BaseRule: Default {
     /// What the rule takes from the system at the start of each step ([`StepMethod::Frozen`]).
     type Frozen<'s>;
     /// The method's name.
@@ -195,7 +182,7 @@ pub type Unpacked<'a> = Result<(usize, usize, &'a ColumnControlState, &'a [f64])
 
 /// An extrapolation step: the base rule `R` in columns `j = 1, 2, …` extrapolated by Aitken–Neville, with the
 /// column (order) and step control of ODEX or SEULEX ([`BaseRule::STRATEGY`]).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Extrapolation<R> {
     tol: Tolerances,
     /// Maximum number of columns `km`.
@@ -233,18 +220,8 @@ impl<R: BaseRule> Extrapolation<R> {
         let mut e = Extrapolation {
             tol,
             km,
-            k: 2,
-            reject: false,
-            started: false,
-            span: None,
-            nj: Vec::new(),
-            a: Vec::new(),
-            hh: Vec::new(),
-            w: Vec::new(),
-            n: 0,
-            scal: Vec::new(),
-            tab: Vec::new(),
             rule,
+            ..Extrapolation::default()
         };
         e.setup_sequence();
         e.k = e.initial_columns();

@@ -44,10 +44,11 @@ pub trait OdeSystem: Sync {
 }
 
 /// Which integrator runs a system (the scene's `[integrator] method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Method {
-    /// Adaptive Bulirsch–Stoer (ours), `"bulirsch-stoer"`.
+    /// Adaptive Bulirsch–Stoer (ours), `"bulirsch-stoer"`: the default.
+    #[default]
     BulirschStoer,
     /// Dormand–Prince 8(5,3) (ours, `dop853::Dop853`), `"dop853"`.
     Dop853,
@@ -106,7 +107,7 @@ impl fmt::Display for Method {
 /// [`OdeSystem::state_units`]. Dividing numerator and denominator by `unit_i` shows that this is the same norm
 /// applied to the state expressed in user units (`e_i / unit_i` against `atol + rtol |y_i / unit_i|`): the
 /// relative part is unit-free anyway, and the absolute part then reads in m, m/s, rad/s, … whatever the masses.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Tolerances {
     /// Relative tolerance per component (dimensionless, > 0).
     pub rtol: Vec<f64>,
@@ -213,7 +214,9 @@ impl From<SavedStats> for Stats {
 /// Everything an integrator carries from one [`Integrator::advance`] call to the next (step-size
 /// and order control, counters, settings), as saved by [`Integrator::save_state`] into a checkpoint.
 /// Serialisable with exact floats: restoring it into a fresh integrator of the same method and
-/// tolerances continues bit for bit like the original.
+/// tolerances continues bit for bit like the original. The tolerances are not saved (the `ode_solvers`
+/// adapter's scalar ones only to check them): that integrator must be built with the same ones, and
+/// only their length is checked.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "kebab-case")]
 pub enum IntegratorState {
@@ -359,8 +362,7 @@ pub struct ColumnControlState {
 /// Everything a `BulirschStoer` carries between [`Integrator::advance`] calls
 /// ([`Integrator::save_state`]): the step-size and column control, the per-column proposals and
 /// work of the last attempt, the counters and the settings. The work arrays are not saved: every
-/// call recomputes them before reading them. The tolerances are not saved either: the integrator
-/// the state is restored into must be built with the same ones (only their length is checked).
+/// call recomputes them before reading them.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct BulirschStoerState {
     /// Length of the tolerance vectors (the system's dimension).
@@ -398,10 +400,8 @@ pub struct Rejections {
 }
 
 /// Everything a `Dop853` carries between [`Integrator::advance`] calls ([`Integrator::save_state`]): the
-/// proposed step, the settings and the counters. The tolerances are not saved: the integrator the state is
-/// restored into must be built with the same ones (only their length is checked). The derivative at the start of
-/// a call is recomputed by every call, so it is not part of the state; nor is the parallel threshold, on which no
-/// bit of the results depends.
+/// proposed step, the settings and the counters. The derivative at the start of a call is recomputed by every call,
+/// so it is not part of the state; nor is the parallel threshold, on which no bit of the results depends.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Dop853State {
     /// Length of the tolerance vectors (the system's dimension).
@@ -428,8 +428,7 @@ pub trait StiffSolve {
     fn solve(&mut self, h: f64, b: &mut [f64]);
 }
 
-/// Everything a `LinearlyImplicit` carries between [`Integrator::advance`] calls, for checkpoints (the tolerances
-/// are not saved: the integrator it is restored into must be built with the same ones).
+/// Everything a `LinearlyImplicit` carries between [`Integrator::advance`] calls ([`Integrator::save_state`]).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct LinearlyImplicitState {
     /// The system's dimension.

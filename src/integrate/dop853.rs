@@ -250,35 +250,6 @@ const _: () = {
     }
 };
 
-/// The published DOP853 tableau as full arrays, for tests of its order conditions: `(c, a, b, bhat5, bhat3)`
-/// with `c` and `b` of length 12, `a` 12 × 12 (strictly lower triangular), `bhat5 = b − e5` (the 5th-order
-/// embedded weights) and `bhat3` the 3rd-order weights on stages 1, 9 and 12.
-#[allow(clippy::type_complexity)]
-pub fn tableau() -> ([f64; 12], [[f64; 12]; 12], [f64; 12], [f64; 12], [f64; 12]) {
-    let mut c = [0.0; 12];
-    let mut a = [[0.0; 12]; 12];
-    for (s, row) in STAGES.iter().enumerate() {
-        c[s + 1] = row.c;
-        for &(j, v) in row.a {
-            a[s + 1][j] = v;
-        }
-    }
-    let mut b = [0.0; 12];
-    let mut b5 = [0.0; 12];
-    for &(j, v) in &WEIGHTS {
-        b[j] = v;
-        b5[j] = v;
-    }
-    for &(j, v) in &ERROR5 {
-        b5[j] -= v;
-    }
-    let mut b3 = [0.0; 12];
-    b3[0] = BHH1;
-    b3[8] = BHH2;
-    b3[11] = BHH3;
-    (c, a, b, b5, b3)
-}
-
 /// Runs `f(lo, chunk)` on every [`CHUNK`] of `out` (`lo`: the chunk's first index), on rayon's pool if `parallel`.
 fn each_chunk(parallel: bool, out: &mut [f64], f: impl Fn(usize, &mut [f64]) + Sync + Send) {
     if parallel {
@@ -398,24 +369,16 @@ fn stage_row_chunk(out: &mut [f64], y: &[f64], h: f64, k: &[Vec<f64>], lo: usize
 pub type Dop853 = Adaptive<Dop853Step>;
 
 impl Dop853 {
-    /// A new integrator with per-component `tolerances` and an optional initial step `step` (|step| is used for
-    /// the very first step only; `None` = Hairer's automatic guess from `f(t0, y0)` and one more evaluation).
-    ///
-    /// Errors with [`IntegrateError::Config`] if the `rtol`/`atol` vectors differ in length or contain negative
-    /// or non-finite values, if some component has `rtol = atol = 0`, or if `step` is not non-zero and finite.
-    /// The vectors' length must equal the dimension of the systems later passed to [`Integrator::advance`].
+    /// A new integrator with per-component `tolerances` (of the dimension of the systems later passed to
+    /// [`Integrator::advance`]) and an optional initial step `step` (|step| for the very first step; `None`: Hairer's
+    /// `hinit` from `f(t0, y0)` and one more evaluation). Errors with [`IntegrateError::Config`] for tolerances
+    /// [`validate_tolerances`] refuses or a `step` not non-zero and finite.
     pub fn new(tolerances: Tolerances, step: Option<f64>) -> Result<Self, IntegrateError> {
         validate_tolerances(&tolerances)?;
         let method = Dop853Step {
             tol: tolerances,
             parallel_from: DEFAULT_PARALLEL_FROM,
-            evals: 0,
-            n: 0,
-            k: Vec::new(),
-            y: Vec::new(),
-            y_new: Vec::new(),
-            y_stage: Vec::new(),
-            partials: Vec::new(),
+            ..Dop853Step::default()
         };
         Adaptive::with_method(method, step)
     }
@@ -428,7 +391,7 @@ impl Dop853 {
 }
 
 /// One DOP853 step and its work arrays.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct Dop853Step {
     tol: Tolerances,
     parallel_from: usize,
@@ -719,5 +682,88 @@ impl StepMethod for Dop853Step {
         carried.h = s.h;
         carried.stats = s.stats;
         carried.check(Method::Dop853, self.tol.rtol.len())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The published DOP853 tableau as full arrays, for tests of its order conditions: `(c, a, b, bhat5, bhat3)`
+    /// with `c` and `b` of length 12, `a` 12 × 12 (strictly lower triangular), `bhat5 = b − e5` (the 5th-order
+    /// embedded weights) and `bhat3` the 3rd-order weights on stages 1, 9 and 12.
+    #[allow(clippy::type_complexity)]
+    fn tableau() -> ([f64; 12], [[f64; 12]; 12], [f64; 12], [f64; 12], [f64; 12]) {
+        let mut c = [0.0; 12];
+        let mut a = [[0.0; 12]; 12];
+        for (s, row) in STAGES.iter().enumerate() {
+            c[s + 1] = row.c;
+            for &(j, v) in row.a {
+                a[s + 1][j] = v;
+            }
+        }
+        let mut b = [0.0; 12];
+        let mut b5 = [0.0; 12];
+        for &(j, v) in &WEIGHTS {
+            b[j] = v;
+            b5[j] = v;
+        }
+        for &(j, v) in &ERROR5 {
+            b5[j] -= v;
+        }
+        let mut b3 = [0.0; 12];
+        b3[0] = BHH1;
+        b3[8] = BHH2;
+        b3[11] = BHH3;
+        (c, a, b, b5, b3)
+    }
+
+    #[test]
+    fn tableau_satisfies_its_order_conditions() {
+        let (c, a, b, b5, b3) = tableau();
+        let close =
+            |x: f64, y: f64, what: &str| assert!((x - y).abs() <= 1e-14 * (1.0 + y.abs()), "{what}: {x} vs {y}");
+        // Row sums: each stage's time is its node.
+        for i in 0..12 {
+            close(a[i].iter().sum::<f64>(), c[i], &format!("row {i}"));
+            assert!(a[i][i..].iter().all(|&v| v == 0.0), "row {i} is explicit");
+        }
+        assert_eq!(c[11], 1.0, "the 12th stage is at t + h");
+        // Quadrature conditions Σ b_i c_i^(q−1) = 1/q: order 8 for b, 5 for the 5th-order weights, 3 for the 3rd.
+        let quad = |w: &[f64; 12], q: i32| (0..12).map(|i| w[i] * c[i].powi(q - 1)).sum::<f64>();
+        for q in 1..=8 {
+            close(quad(&b, q), 1.0 / q as f64, &format!("b, c^{}", q - 1));
+        }
+        for q in 1..=5 {
+            close(quad(&b5, q), 1.0 / q as f64, &format!("b5, c^{}", q - 1));
+        }
+        for q in 1..=3 {
+            close(quad(&b3, q), 1.0 / q as f64, &format!("b3, c^{}", q - 1));
+        }
+        // Σ b_i a_ij c_j^(q−1) = 1/(q (q+1)) (the trees [τ^q]): order 8 needs q ≤ 7.
+        let ac = |q: i32| -> Vec<f64> {
+            (0..12)
+                .map(|i| (0..12).map(|j| a[i][j] * c[j].powi(q - 1)).sum())
+                .collect()
+        };
+        for q in 1..=7 {
+            let v = ac(q);
+            close(
+                (0..12).map(|i| b[i] * v[i]).sum(),
+                1.0 / (q * (q + 1)) as f64,
+                &format!("b a c^{}", q - 1),
+            );
+        }
+        // The simplifying assumption behind DOP853's stages 4 on: Σ_j a_ij c_j = c_i²/2.
+        let v = ac(2);
+        for i in 3..12 {
+            close(v[i], c[i] * c[i] / 2.0, &format!("stage {i}: a c = c²/2"));
+        }
+        // An order-8 tree with a branch: Σ_i b_i c_i⁵ Σ_j a_ij c_j = 1/16.
+        close(
+            (0..12).map(|i| b[i] * c[i].powi(5) * v[i]).sum(),
+            1.0 / 16.0,
+            "b c^5 a c",
+        );
     }
 }

@@ -169,11 +169,6 @@ impl OdeSolversAdapter {
         })
     }
 
-    /// Sets the maximum number of steps in one call to [`Integrator::advance`] (default 10⁸).
-    pub fn set_max_steps(&mut self, max_steps: u64) {
-        self.budget.max_steps = max_steps;
-    }
-
     /// Sets the number of steps per `ode_solvers` run (see the module docs); `None` = automatic
     /// (about 64 MiB of stored states).
     pub fn set_chunk_steps(&mut self, chunk: Option<usize>) {
@@ -379,17 +374,13 @@ impl OdeSolversAdapter {
             // Rk4::integrate never fails.
             let _ = s.integrate();
             // ys[0] is the segment's start; keep the states before the first non-finite one.
-            let ys = s.y_out();
-            let last = match ys.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
-                Some(bad) => bad - 1,
-                None => ys.len() - 1,
-            };
+            let (last, last_state) = last_finite(s.y_out());
             let is_final = done >= n_full;
             self.stats.steps_accepted += last as u64;
             if last > 0 {
                 self.stats.smallest_step = self.stats.smallest_step.min(scale.abs());
             }
-            state = ys[last].clone();
+            state = last_state;
             done += last as u64;
             if last as u64 != m {
                 x = if is_final { x } else { t_start + dir * h * done as f64 };

@@ -29,8 +29,6 @@ pub trait TestProblem: OdeSystem {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-
 /// Harmonic oscillator `x'' = −ω² x`, state `[x, v]`, started at `x = 1, v = 0`.
 ///
 /// Exact solution `x = cos ωt`, `v = −ω sin ωt`; invariant `E = ½ v² + ½ ω² x²` (= ½ ω² initially).
@@ -81,8 +79,6 @@ impl TestProblem for HarmonicOscillator {
         Some(vec![c, -self.omega * s])
     }
 }
-
-// ---------------------------------------------------------------------------------------------
 
 /// Planar Kepler two-body problem `r'' = −r/|r|³` (G M = 1) with eccentricity `e`, semi-major
 /// axis 1 and period 2π, state `[x, y, vx, vy]`.
@@ -181,8 +177,6 @@ impl TestProblem for Kepler {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-
 /// The Arenstorf orbit: a periodic solution of the planar restricted three-body problem
 /// (Earth–Moon mass ratio), the classic step-size-control test of Hairer, Nørsett & Wanner
 /// (*Solving ODEs I*, §II.0). State `[x, y, vx, vy]` in the rotating frame.
@@ -241,8 +235,6 @@ impl TestProblem for Arenstorf {
     }
 }
 
-// ---------------------------------------------------------------------------------------------
-
 /// Exponential decay `y' = −λ y`, `y(0) = 1`, exact `y = e^{−λt}`; mildly stiff for large λ
 /// (explicit methods are limited by stability to `h ≲ c/λ` once the transient has decayed).
 /// The natural end time is 1.
@@ -282,8 +274,6 @@ impl TestProblem for ExponentialDecay {
         Some(vec![(-self.lambda * t).exp()])
     }
 }
-
-// ---------------------------------------------------------------------------------------------
 
 /// The overdamped oscillator `x'' + 2 ζ ω x' + ω² x = 0` (ζ > 1), state `[x, v]`, started at `x = 1, v = 0`: the
 /// contact of two bodies under strong linear damping, reduced to one coordinate.
@@ -351,8 +341,6 @@ impl TestProblem for StiffDampedOscillator {
         Some(vec![a * es + b * ef, a * slow * es + b * fast * ef])
     }
 }
-
-// ---------------------------------------------------------------------------------------------
 
 /// Free rigid body, Euler's equations in the body frame `I ω̇ = (I ω) × ω` with principal
 /// moments `I = diag(I₁, I₂, I₃)`; state `ω = [ω₁, ω₂, ω₃]`.
