@@ -11,11 +11,6 @@ pub type Mat3 = nalgebra::Matrix3<f64>;
 /// A 4×4 matrix (the quaternion mass matrix `M`, `W(q)` of Roig03 Eq. 24 …).
 pub type Mat4 = nalgebra::Matrix4<f64>;
 
-/// The skew-symmetric cross-product matrix `[v]×`, so that `[v]× x = v × x`.
-pub fn skew(v: &Vec3) -> Mat3 {
-    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
-}
-
 /// Median of `values` (the mean of the two middle values for an even count); NaN for an empty slice.
 ///
 /// ```
@@ -49,26 +44,6 @@ pub fn mean_std(values: &[f64]) -> (f64, f64) {
     }
     let var = values.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (values.len() - 1) as f64;
     (m, var.sqrt())
-}
-
-/// Interpolates, in log–log, the wall time at which a method's (time, error) curve reaches `error`
-/// (`points` in any order; the curve is taken as the sequence sorted by time). `None` when `error` is
-/// outside the curve's range.
-pub fn time_at_error(points: &[(f64, f64)], error: f64) -> Option<f64> {
-    let mut p: Vec<(f64, f64)> = points
-        .iter()
-        .copied()
-        .filter(|(t, e)| *t > 0.0 && *e > 0.0 && e.is_finite())
-        .collect();
-    p.sort_by(|a, b| a.0.total_cmp(&b.0));
-    for w in p.windows(2) {
-        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
-        if (e0 - error) * (e1 - error) <= 0.0 && e0 != e1 {
-            let s = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
-            return Some((t0.ln() + s * (t1.ln() - t0.ln())).exp());
-        }
-    }
-    None
 }
 
 /// The bytes a vector's buffer holds: its capacity times the element size (heap memory the elements own

@@ -136,12 +136,8 @@ pub fn reset() {
 /// parallel sums (s).
 pub fn split(prefix: &str) -> (Vec<Total>, f64, f64) {
     let mine: Vec<Total> = totals().into_iter().filter(|t| t.name.starts_with(prefix)).collect();
-    let serial = mine.iter().filter(|t| t.kind == Kind::Serial).map(|t| t.seconds).sum();
-    let parallel = mine
-        .iter()
-        .filter(|t| t.kind == Kind::Parallel)
-        .map(|t| t.seconds)
-        .sum();
+    let sum = |kind: Kind| mine.iter().filter(|t| t.kind == kind).map(|t| t.seconds).sum();
+    let (serial, parallel) = (sum(Kind::Serial), sum(Kind::Parallel));
     (mine, serial, parallel)
 }
 

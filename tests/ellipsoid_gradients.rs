@@ -11,9 +11,14 @@ use rubblepile::ellipsoid::potential::{
     BodyGeometry, Overlap, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
 };
 use rubblepile::ellipsoid::quaternion::*;
-use rubblepile::math::{Mat4, Vec3, Vec4, skew};
+use rubblepile::math::{Mat3, Mat4, Vec3, Vec4};
 
 const G: f64 = 6.674e-11;
+
+/// The skew-symmetric cross-product matrix `[v]×`, so that `[v]× x = v × x`.
+fn skew(v: &Vec3) -> Mat3 {
+    Mat3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
 
 /// `M(q)⁻¹ = Wᵀ Ĩ⁻¹ W / (4 |q|⁴)` formed in full (the library applies it to vectors only).
 fn inverse_mass_matrix(q: &Vec4, inertia_ext: &Vec4) -> Mat4 {

@@ -67,7 +67,7 @@ fn ellipsoid_projects_to_its_analytic_ellipse_along_each_axis() {
     ];
     for (view, a, b, (cx, cy)) in cases {
         let camera = ortho(view);
-        assert_eq!(camera.pixels_per_metre(), Some(ppm));
+        assert_eq!(camera.pixels_per_metre_at_centre(), ppm);
         let image = render_bodies(&[body(centre, Mat3::identity(), axes, [200, 180, 160])], &camera, BG);
         let (n, (mx, my), (x0, x1, y0, y1)) = coverage(&image);
         let area = std::f64::consts::PI * a * b * ppm * ppm;

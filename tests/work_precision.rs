@@ -9,7 +9,6 @@ use common::{rubblepile, temp_dir};
 use rubblepile::impact::problems::{NBodyProblem, PointMassGravity, WorkPrecisionProblem};
 use rubblepile::integrate::bulirsch_stoer::BulirschStoer;
 use rubblepile::integrate::{Integrator, OdeSystem, Tolerances};
-use rubblepile::math::time_at_error;
 use std::path::Path;
 
 /// `work_precision_<problem>.csv`'s header, as `rubblepile bench work-precision` writes it.
@@ -69,14 +68,6 @@ fn block_norm_and_point_mass_rhs() {
         .sum::<rubblepile::math::Vec3>()
         / m;
     assert!(com.norm() < 1e-15 && vcom.norm() < 1e-17);
-}
-
-#[test]
-fn time_at_error_interpolates_in_log_log() {
-    let pts = [(1.0, 1e-4), (10.0, 1e-8), (100.0, 1e-12)];
-    assert!((time_at_error(&pts, 1e-6).unwrap() - 10f64.sqrt()).abs() < 1e-12);
-    assert!((time_at_error(&pts, 1e-8).unwrap() - 10.0).abs() < 1e-12);
-    assert!(time_at_error(&pts, 1e-14).is_none());
 }
 
 /// Regression: with rtol = 1e-13 and 20 output times the columns of a step converge to round-off noise; the old

@@ -17,9 +17,10 @@ use crate::math::{Mat3, Vec3};
 use crate::random::{generator, random_quaternion};
 
 /// How a lattice is turned before it is carved (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum LatticeOrientation {
-    /// Close-packed layers perpendicular to the spin axis (identity).
+    /// Close-packed layers perpendicular to the spin axis (identity); the default, for a build that names none.
+    #[default]
     Perpendicular,
     /// Layers containing the spin axis: 90° about x.
     Parallel,
@@ -33,13 +34,6 @@ pub enum LatticeOrientation {
         /// Seed of the draw.
         seed: Option<u64>,
     },
-}
-
-impl Default for LatticeOrientation {
-    /// [`LatticeOrientation::Perpendicular`]: the lattice of a build that names no orientation.
-    fn default() -> Self {
-        LatticeOrientation::Perpendicular
-    }
 }
 
 impl std::str::FromStr for LatticeOrientation {

@@ -53,15 +53,8 @@ pub enum Model {
 impl Model {
     /// Parses a model name (`hcp`, `rcp`, `rcpc`, `pp1`, `pp2`, `ppc`).
     pub fn parse(s: &str) -> Option<Model> {
-        Some(match s {
-            "hcp" => Model::Hcp,
-            "rcp" => Model::Rcp,
-            "rcpc" => Model::Rcpc,
-            "pp1" => Model::Pp1,
-            "pp2" => Model::Pp2,
-            "ppc" => Model::Ppc,
-            _ => return None,
-        })
+        let all = [Model::Hcp, Model::Rcp, Model::Rcpc, Model::Pp1, Model::Pp2, Model::Ppc];
+        all.into_iter().find(|m| m.name() == s)
     }
 
     /// The model's name.
@@ -356,17 +349,8 @@ pub fn build_with_progress(
         (Model::Ppc, Some(c)) => core::core_weights(&centres, c, core::PPC_CORE_DENSITY_RATIO),
         _ => vec![1.0; centres.len()],
     };
-    let mut particles: Vec<Particle> = centres
-        .iter()
-        .zip(&radii)
-        .map(|(&position, &radius)| Particle {
-            mass: 0.0,
-            radius,
-            position,
-            velocity: Vec3::zeros(),
-            spin: Vec3::zeros(),
-        })
-        .collect();
+    // Massless until the bulk density sets the masses.
+    let mut particles = random_packing::particles(&centres, &radii, 0.0);
     let rho_g = density::assign_masses(&mut particles, &weights, spec.shape.volume(), spec.bulk_density);
     let mut report = measure(&particles, &spec.shape);
     report.model = spec.model.name().into();

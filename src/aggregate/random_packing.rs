@@ -208,7 +208,8 @@ fn random_cloud(radii: &[f64], cloud_radius: f64, rng: &mut Generator) -> Option
     Some(centres)
 }
 
-fn particles(centres: &[Vec3], radii: &[f64], rho: f64) -> Vec<Particle> {
+/// Grains at rest with these centres (m), radii (m) and grain density `rho` (kg/m³).
+pub(crate) fn particles(centres: &[Vec3], radii: &[f64], rho: f64) -> Vec<Particle> {
     centres
         .iter()
         .zip(radii)
@@ -271,6 +272,19 @@ fn run(sys: &mut SoftSystem, dt: f64, steps: u64, stage: &str, progress: &mut dy
 /// `steps` rounded up to a whole number of self-gravity blocks of `k` steps.
 fn whole_blocks(steps: u64, k: u64) -> u64 {
     steps.div_ceil(k.max(1)) * k.max(1)
+}
+
+/// Runs one stage of `steps` steps of `dt` ([`run`]) and logs it.
+fn stage(
+    sys: &mut SoftSystem,
+    dt: f64,
+    steps: u64,
+    name: &str,
+    notes: String,
+    progress: &mut dyn FnMut(BuildProgress<'_>),
+) -> StageLog {
+    let worst = run(sys, dt, steps, name, progress);
+    log(name, sys, dt, steps, worst, notes)
 }
 
 fn log(stage: &str, sys: &SoftSystem, dt: f64, steps: u64, worst: f64, notes: String) -> StageLog {
@@ -342,15 +356,8 @@ pub fn random_heap(
     );
     sys.gravity_interval = recipe.gravity_interval.max(1);
     let steps = whole_blocks(steps, sys.gravity_interval);
-    let worst = run(&mut sys, dt, steps, "collapse", progress);
-    stages.push(log(
-        "collapse",
-        &sys,
-        dt,
-        steps,
-        worst,
-        format!("cloud radius {cloud_radius:.4e} m, t_ff {t_ff:.4e} s"),
-    ));
+    let notes = format!("cloud radius {cloud_radius:.4e} m, t_ff {t_ff:.4e} s");
+    stages.push(stage(&mut sys, dt, steps, "collapse", notes, progress));
 
     // 3. shaking in a spherical container under a uniform field
     let mut ps = sys.particles;
@@ -404,34 +411,19 @@ pub fn random_heap(
     );
     let mut sys = SoftSystem::new(ps, vec![wall(Some(osc))], material, field);
     let steps = (recipe.shake_periods * period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps, "shake", progress);
-    stages.push(log("shake", &sys, dt, steps, worst, notes));
+    stages.push(stage(&mut sys, dt, steps, "shake", notes, progress));
     let mut sys = SoftSystem::new(sys.particles, vec![wall(None)], material, field);
     let steps = (recipe.calm_periods * period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps, "calm", progress);
-    stages.push(log(
-        "calm",
-        &sys,
-        dt,
-        steps,
-        worst,
-        "field on, container at rest".into(),
-    ));
+    let notes = "field on, container at rest".into();
+    stages.push(stage(&mut sys, dt, steps, "calm", notes, progress));
     let no_field = Gravity {
         uniform: Vec3::zeros(),
         ..field
     };
     let mut sys = SoftSystem::new(sys.particles, vec![wall(None)], material, no_field);
     let steps = (period / dt).ceil() as u64;
-    let worst = run(&mut sys, dt, steps, "unload", progress);
-    stages.push(log(
-        "unload",
-        &sys,
-        dt,
-        steps,
-        worst,
-        "field off, container at rest".into(),
-    ));
+    let notes = "field off, container at rest".into();
+    stages.push(stage(&mut sys, dt, steps, "unload", notes, progress));
 
     // optional insert (the HCP core of RCPC)
     let mut ps = sys.particles;

@@ -60,19 +60,18 @@ impl Shape {
     pub fn parse(spec: &str, obj_scale: f64) -> Result<Shape, ShapeSpecError> {
         let (kind, arg) = spec.split_once(':').unwrap_or((spec, ""));
         let numbers = |n: usize, what: &str| -> Result<Vec<f64>, ShapeSpecError> {
+            let bad = || {
+                ShapeSpecError(format!(
+                    "`{spec}`: expected {kind}:{what} with {n} positive number(s) in m"
+                ))
+            };
             let v: Vec<f64> = arg
                 .split(',')
                 .map(|s| s.trim().parse::<f64>())
                 .collect::<Result<_, _>>()
-                .map_err(|_| {
-                    ShapeSpecError(format!(
-                        "`{spec}`: expected {kind}:{what} with {n} positive number(s) in m"
-                    ))
-                })?;
+                .map_err(|_| bad())?;
             if v.len() != n || v.iter().any(|x| !(x.is_finite() && *x > 0.0)) {
-                return Err(ShapeSpecError(format!(
-                    "`{spec}`: expected {kind}:{what} with {n} positive number(s) in m"
-                )));
+                return Err(bad());
             }
             Ok(v)
         };

@@ -46,13 +46,11 @@ impl FromStr for View {
 
     /// Parses the `--view` names `x`, `y`, `z`, `iso` (case-insensitive).
     fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "x" => Ok(View::X),
-            "y" => Ok(View::Y),
-            "z" => Ok(View::Z),
-            "iso" => Ok(View::Iso),
-            _ => Err(RenderError::UnknownView(s.to_string())),
-        }
+        let name = s.trim().to_ascii_lowercase();
+        let all = [View::X, View::Y, View::Z, View::Iso];
+        all.into_iter()
+            .find(|v| v.to_string() == name)
+            .ok_or_else(|| RenderError::UnknownView(s.to_string()))
     }
 }
 
@@ -253,14 +251,6 @@ impl Camera {
         self.up
     }
 
-    /// Orthographic scale (pixels per metre); `None` for a perspective camera, whose scale varies with depth.
-    pub fn pixels_per_metre(&self) -> Option<f64> {
-        match self.projection {
-            Projection::Orthographic => Some(self.half_short_px / self.scale),
-            Projection::Perspective { .. } => None,
-        }
-    }
-
     /// Pixels per metre at the depth of the framing centre: the orthographic scale, or for a perspective camera the
     /// scale of the plane through the framing centre facing the camera (nearer things look bigger, farther smaller).
     pub fn pixels_per_metre_at_centre(&self) -> f64 {
@@ -327,29 +317,6 @@ impl Camera {
         }
     }
 
-    /// Converts a fractional screen coordinate range to inclusive pixel bounds, with one pixel of slack so that
-    /// rounding never drops a covered pixel; `None` when it misses the image.
-    fn pixel_range(&self, s_lo: f64, s_hi: f64, along_x: bool) -> Option<(u32, u32)> {
-        let (lo, hi, n) = if along_x {
-            let c = 0.5 * f64::from(self.width);
-            (c + s_lo * self.half_short_px, c + s_hi * self.half_short_px, self.width)
-        } else {
-            // Screen y is up, pixel y is down: the range flips.
-            let c = 0.5 * f64::from(self.height);
-            (
-                c - s_hi * self.half_short_px,
-                c - s_lo * self.half_short_px,
-                self.height,
-            )
-        };
-        let lo = (lo - 1.0).floor();
-        let hi = (hi + 1.0).ceil();
-        if !(lo.is_finite() && hi.is_finite()) || hi < 0.0 || lo > f64::from(n - 1) {
-            return None;
-        }
-        Some((lo.max(0.0) as u32, hi.min(f64::from(n - 1)) as u32))
-    }
-
     /// The pixel rectangle that holds the projection of the convex polygon through `points` (m), with one pixel of
     /// slack; `None` when it is wholly off screen or behind a perspective eye. A perspective camera sees only the
     /// part in front of its eye: the polygon is clipped to depths of at least a billionth of the framing's
@@ -394,16 +361,8 @@ impl Camera {
         if points.is_empty() {
             return None;
         }
-        let range = |lo: f64, hi: f64, n: u32| -> Option<(u32, u32)> {
-            // Pixel k covers [k, k + 1): the pixels whose centres may be covered, plus one of slack.
-            let (a, b) = ((lo - 1.0).floor(), (hi + 1.0).ceil());
-            if a.is_nan() || b.is_nan() || b < 0.0 || a > f64::from(n - 1) {
-                return None;
-            }
-            Some((a.max(0.0) as u32, b.min(f64::from(n - 1)) as u32))
-        };
-        let (x0, x1) = range(lo.0, hi.0, self.width)?;
-        let (y0, y1) = range(lo.1, hi.1, self.height)?;
+        let (x0, x1) = pixel_span(lo.0, hi.0, self.width, false)?;
+        let (y0, y1) = pixel_span(lo.1, hi.1, self.height, false)?;
         Some(ScreenBox { x0, x1, y0, y1 })
     }
 
@@ -449,8 +408,30 @@ impl Camera {
                 }
             }
         };
-        let (x0, x1) = self.pixel_range(x_lo, x_hi, true)?;
-        let (y0, y1) = self.pixel_range(y_lo, y_hi, false)?;
+        // Screen y is up, pixel y is down: the y range flips.
+        let (cx, cy, k) = (
+            0.5 * f64::from(self.width),
+            0.5 * f64::from(self.height),
+            self.half_short_px,
+        );
+        let (x0, x1) = pixel_span(cx + x_lo * k, cx + x_hi * k, self.width, true)?;
+        let (y0, y1) = pixel_span(cy - y_hi * k, cy - y_lo * k, self.height, true)?;
         Some(ScreenBox { x0, x1, y0, y1 })
     }
+}
+
+/// Inclusive bounds of the pixels (pixel k covers [k, k + 1)) of a side of `n` whose centres the fractional pixel
+/// range [`lo`, `hi`] may cover, with one pixel of slack so that rounding never drops a covered pixel; `None` when
+/// it misses the image, is NaN, or (`finite`) reaches infinity.
+fn pixel_span(lo: f64, hi: f64, n: u32, finite: bool) -> Option<(u32, u32)> {
+    let (a, b) = ((lo - 1.0).floor(), (hi + 1.0).ceil());
+    let bad = if finite {
+        !(a.is_finite() && b.is_finite())
+    } else {
+        a.is_nan() || b.is_nan()
+    };
+    if bad || b < 0.0 || a > f64::from(n - 1) {
+        return None;
+    }
+    Some((a.max(0.0) as u32, b.min(f64::from(n - 1)) as u32))
 }

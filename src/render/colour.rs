@@ -134,34 +134,16 @@ impl ColourScale {
         }
     }
 
-    /// Continuous: `value` mapped linearly to [0, 1] (clamped; a scale with `max == min` maps everything to 0.5;
-    /// NaN stays NaN). Categorical: the index of the nearest category divided by (count − 1), for ordering only.
-    pub fn normalise(&self, value: f64) -> f64 {
-        match &self.kind {
-            ScaleKind::Continuous { min, max, .. } => {
-                if value.is_nan() {
-                    f64::NAN
-                } else if max > min {
-                    ((value - min) / (max - min)).clamp(0.0, 1.0)
-                } else {
-                    0.5
-                }
-            }
-            ScaleKind::Categorical(categories) => match nearest(categories, value) {
-                Some(i) if categories.len() > 1 => i as f64 / (categories.len() - 1) as f64,
-                Some(_) => 0.5,
-                None => f64::NAN,
-            },
-        }
-    }
-
-    /// The colour of `value`; NaN (or an empty categorical scale) gives [`MISSING_COLOUR`].
+    /// The colour of `value`: continuous, the map's colour at `value` mapped linearly from [min, max] to [0, 1]
+    /// (clamped; the middle when `max == min`); categorical, the nearest category's. NaN (or an empty categorical
+    /// scale) gives [`MISSING_COLOUR`].
     pub fn colour(&self, value: f64) -> [u8; 3] {
         match &self.kind {
-            ScaleKind::Continuous { map, .. } => {
-                let t = self.normalise(value);
-                if t.is_nan() { MISSING_COLOUR } else { map.colour(t) }
+            ScaleKind::Continuous { .. } if value.is_nan() => MISSING_COLOUR,
+            ScaleKind::Continuous { min, max, map } if max > min => {
+                map.colour(((value - min) / (max - min)).clamp(0.0, 1.0))
             }
+            ScaleKind::Continuous { map, .. } => map.colour(0.5),
             ScaleKind::Categorical(categories) => {
                 nearest(categories, value).map_or(MISSING_COLOUR, |i| categories[i].colour)
             }

@@ -81,15 +81,10 @@ pub fn render_frame_with_walls(
         let (dx, dy) = (a.tip.0 - triad.origin.0, a.tip.1 - triad.origin.1);
         let len = dx.hypot(dy);
         // Beyond the tip, or beside the ring of an axis seen end-on.
-        let (ux, uy) = if len < 0.25 * triad.length {
-            (0.7, -0.7)
+        let ((ux, uy), reach) = if len < 0.25 * triad.length {
+            ((0.7, -0.7), 0.45 * triad.length)
         } else {
-            (dx / len, dy / len)
-        };
-        let reach = if len < 0.25 * triad.length {
-            0.45 * triad.length
-        } else {
-            len + 0.6 * f64::from(layout.font)
+            ((dx / len, dy / len), len + 0.6 * f64::from(layout.font))
         };
         let at = (triad.origin.0 + reach * ux, triad.origin.1 + reach * uy);
         labels.push((a.label.to_string(), (at.0 as i32, at.1 as i32), a.colour, VPos::Center));
@@ -145,21 +140,21 @@ impl Layout {
         }
     }
 
-    /// Length of the triad's arrows (pixels).
-    fn triad_length(&self) -> f64 {
-        f64::from(self.font) * 2.5
+    /// Length of the triad's arrows and the distance of its foot from the left and bottom edges (pixels).
+    fn triad_length_and_pad(&self) -> (f64, f64) {
+        let len = f64::from(self.font) * 2.5;
+        (len, f64::from(self.margin) + len + 1.2 * f64::from(self.font))
     }
 
     /// The triad in the bottom-left corner, room left for its labels.
     fn triad(&self, camera: &Camera) -> Triad {
-        let len = self.triad_length();
-        let pad = f64::from(self.margin) + len + 1.2 * f64::from(self.font);
+        let (len, pad) = self.triad_length_and_pad();
         Triad::new(camera, (pad, f64::from(camera.height()) - pad), len)
     }
 
     /// Left end and top row of the scale bar: right of the triad, level with its foot.
     fn scale_bar_at(&self) -> (u32, u32) {
-        let pad = f64::from(self.margin) + self.triad_length() + 1.2 * f64::from(self.font);
+        let pad = self.triad_length_and_pad().1;
         (
             (2.0 * pad).round() as u32,
             (f64::from(self.height) - pad).round() as u32,
@@ -221,31 +216,24 @@ fn draw_text(
         ))
         .map_err(text_err)?;
     }
-    let tick_x = l.bar_x0 - l.margin / 2;
-    match &scale.kind {
+    let ticks: Vec<(String, i32)> = match &scale.kind {
         ScaleKind::Continuous { min, max, .. } => {
-            for (value, y) in [(*max, l.bar_y0), (*min, l.bar_y1 - 1)] {
-                root.draw(&Text::new(
-                    format_value(value),
-                    (tick_x, y),
-                    style(HPos::Right, VPos::Center),
-                ))
-                .map_err(text_err)?;
-            }
+            vec![(format_value(*max), l.bar_y0), (format_value(*min), l.bar_y1 - 1)]
         }
         ScaleKind::Categorical(categories) => {
-            let n = categories.len().max(1) as i32;
-            let block = (l.bar_y1 - l.bar_y0) / n;
-            for (k, category) in categories.iter().enumerate() {
-                let y = l.bar_y0 + block * k as i32 + block / 2;
-                root.draw(&Text::new(
-                    category.name.as_str(),
-                    (tick_x, y),
-                    style(HPos::Right, VPos::Center),
-                ))
-                .map_err(text_err)?;
-            }
+            let block = (l.bar_y1 - l.bar_y0) / categories.len().max(1) as i32;
+            let y = |k: usize| l.bar_y0 + block * k as i32 + block / 2;
+            categories
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (c.name.clone(), y(k)))
+                .collect()
         }
+    };
+    for (text, y) in ticks {
+        let at = (l.bar_x0 - l.margin / 2, y);
+        root.draw(&Text::new(text, at, style(HPos::Right, VPos::Center)))
+            .map_err(text_err)?;
     }
     for (text, at, colour, v_pos) in labels {
         let rgb = RGBColor(colour[0], colour[1], colour[2]);

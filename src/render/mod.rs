@@ -26,7 +26,7 @@ pub use encode::{GifOptions, GifWriter, write_png};
 pub use frame::{BACKGROUND, FrameBody, render_frame, render_frame_with_walls};
 pub use image::RgbImage;
 pub use overlay::{ScaleBar, Triad};
-pub use raycast::{Hit, RenderBody, intersect_ellipsoid, render_bodies, render_scene};
+pub use raycast::{RenderBody, render_bodies, render_scene};
 pub use walls::{WALL_ALPHA, WALL_COLOUR, WallPolygon, wall_polygons};
 
 pub use error::RenderError;

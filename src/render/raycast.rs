@@ -1,5 +1,5 @@
-//! Exact ray casting of ellipsoids: the ray–ellipsoid intersection ([`intersect_ellipsoid`]) and the renderer
-//! ([`render_bodies`]) that shades every pixel by its nearest hit.
+//! Exact ray casting of ellipsoids: the renderer ([`render_bodies`]) that shades every pixel by its nearest
+//! ray–ellipsoid intersection.
 //!
 //! Cost: each body's bounding sphere is projected to a pixel rectangle first, and the bodies are bucketed by the
 //! row bands their rectangles cover; a band (rendered in parallel with rayon) then tests only its own bodies, and
@@ -33,17 +33,6 @@ impl BoundingSphere for RenderBody {
     fn bounding_sphere(&self) -> (Vec3, f64) {
         (self.centre, self.axes.max())
     }
-}
-
-/// Where a ray meets an ellipsoid.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Hit {
-    /// Ray parameter of the hit (m along the unit direction).
-    pub t: f64,
-    /// Hit point (m, world frame).
-    pub point: Vec3,
-    /// Unit outward normal at the hit (world frame).
-    pub normal: Vec3,
 }
 
 /// An ellipsoid prepared for many rays: `to_unit = diag(1/axes)·Rᵀ` takes world offsets from the centre into the
@@ -89,19 +78,6 @@ impl Prepared {
     fn normal(&self, u: &Vec3) -> Vec3 {
         (self.rotation * u.component_mul(&self.inv_axes)).normalize()
     }
-}
-
-/// The nearest intersection with parameter `t > t_min` of `ray` (unit direction) with the ellipsoid of `centre`,
-/// `rotation` (body → world) and semi-axes `axes` (m); `None` when it misses. Use `t_min = 0` for a half-line
-/// and `f64::NEG_INFINITY` for a whole line.
-pub fn intersect_ellipsoid(ray: &Ray, centre: &Vec3, rotation: &Mat3, axes: &Vec3, t_min: f64) -> Option<Hit> {
-    let body = Prepared::new(centre, rotation, axes);
-    let (t, u) = body.hit_t(ray, t_min)?;
-    Some(Hit {
-        t,
-        point: ray.origin + t * ray.direction,
-        normal: body.normal(&u),
-    })
 }
 
 /// Rows per band: bands are the unit of parallel work and of body bucketing. Small enough for load balance

@@ -15,8 +15,8 @@ use std::str::FromStr;
 use std::time::Instant;
 
 use super::{
-    Camera, ColourScale, FrameBody, Framing, GifOptions, GifWriter, Projection, RenderError, View,
-    render_frame_with_walls, wall_polygons, write_png,
+    Camera, ColourScale, FrameBody, Framing, GifWriter, Projection, RenderError, View, render_frame_with_walls,
+    wall_polygons, write_png,
 };
 use crate::analysis::run_analysis::FragmentFields;
 use crate::driver::export::{ExportError, visit_snapshots};
@@ -300,11 +300,7 @@ pub fn render_run(dir: &Path, opts: &RenderRunOptions) -> Result<RenderReport, R
         source,
     })?;
     let gif_path = frames_dir.join(&opts.gif_name);
-    let options = GifOptions {
-        speed: 10,
-        halve: false,
-    };
-    let mut gif = GifWriter::create_with(&gif_path, opts.width, opts.height, opts.gif_delay_centiseconds, options)?;
+    let mut gif = GifWriter::create(&gif_path, opts.width, opts.height, opts.gif_delay_centiseconds)?;
     let mut frame_ms = Vec::new();
     let mut follower = Follower::default();
     let mut fail: Option<RenderError> = None;
@@ -372,7 +368,6 @@ fn caption(t: f64) -> String {
 /// `frames/run.gif`, the name `rubblepile render` uses: the line to print before the run's summary, and those after it (what to open).
 pub fn after_run(out: &Path, force: bool) -> Result<(String, Vec<String>), RenderRunError> {
     let opts = RenderRunOptions {
-        gif_name: "run.gif".into(),
         force,
         ..Default::default()
     };
