@@ -69,8 +69,7 @@ fn write_particles(path: &Path, t: f64, ps: &[SsParticle]) -> std::io::Result<()
 /// Converts `input` to `output`, by their extensions (`.ss` ↔ `.csv`); `spheres` picks the particles-file
 /// columns for `.ss` → CSV. Refuses to overwrite `output` unless `force`.
 pub fn convert(input: &Path, output: &Path, spheres: bool, force: bool) -> Result<Converted, ConvertError> {
-    // What the output is must be said by its name: a directory or a name without `.csv` or `.ss` is refused before
-    // anything is read (a name like `o` once got CSV, and a directory failed only after --force).
+    // The output's format is read from its name: a directory or a name without `.csv` or `.ss` is refused first.
     let by_slash = output
         .as_os_str()
         .to_string_lossy()

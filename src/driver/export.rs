@@ -81,11 +81,12 @@ pub fn visit_snapshots(
         source,
     };
     fn each<E: Engine>(
-        engine: &E,
+        (text, name, base): (&str, &str, &Path),
         files: &[(usize, PathBuf)],
         visit: &mut dyn FnMut(usize, SnapshotView) -> Result<(), ExportError>,
         engine_err: &dyn Fn(EngineError) -> ExportError,
     ) -> Result<(), ExportError> {
+        let engine = E::from_scene_text(text, name, Some(base)).map_err(engine_err)?;
         // A long run's snapshots take a while to read and draw: a bar on a terminal, nothing otherwise.
         let pb = std::io::IsTerminal::is_terminal(&std::io::stderr()).then(|| {
             let pb = indicatif::ProgressBar::with_draw_target(
@@ -114,19 +115,11 @@ pub fn visit_snapshots(
         }
         Ok(())
     }
+    let scene = (text.as_str(), name.as_str(), base.as_path());
     match SceneKind::of_text(&text) {
-        SceneKind::Ellipsoids => {
-            let e = EllipsoidEngine::from_scene_text(&text, &name, Some(&base)).map_err(engine_err)?;
-            each(&e, &files, visit, &engine_err)
-        }
-        SceneKind::SoftSpheres => {
-            let e = SoftEngine::from_scene_text(&text, &name, Some(&base)).map_err(engine_err)?;
-            each(&e, &files, visit, &engine_err)
-        }
-        SceneKind::HardSpheres => {
-            let e = HardEngine::from_scene_text(&text, &name, Some(&base)).map_err(engine_err)?;
-            each(&e, &files, visit, &engine_err)
-        }
+        SceneKind::Ellipsoids => each::<EllipsoidEngine>(scene, &files, visit, &engine_err),
+        SceneKind::SoftSpheres => each::<SoftEngine>(scene, &files, visit, &engine_err),
+        SceneKind::HardSpheres => each::<HardEngine>(scene, &files, visit, &engine_err),
     }
 }
 

@@ -293,8 +293,8 @@ pub fn prepare_output_dir<S>(dir: &Path, force: bool) -> Result<DirLock, RunErro
                 std::fs::remove_file(&p).map_err(io_err(&p))?;
             }
         }
-        // The previous run's derived outputs (`analysis/`, `frames/`) describe its snapshots, not the new run's:
-        // they go too (issue 57); a link there is refused (nothing is removed through a link).
+        // The previous run's derived outputs (`analysis/`, `frames/`) describe its snapshots: they go too; a link
+        // there is refused (nothing is removed through a link).
         for name in crate::io::manifest::NOT_RECORDED {
             let p = dir.join(name);
             safe_write::refuse_symlink(&p).map_err(io_err(&p))?;
@@ -390,14 +390,11 @@ struct Identity {
 }
 
 fn absolute_base<S>(engine: &impl Engine) -> Result<Option<PathBuf>, RunError<S>> {
-    match engine.scene_base_dir() {
-        Some(d) => Ok(Some(
-            std::fs::canonicalize(d)
-                .or_else(|_| std::path::absolute(d))
-                .map_err(io_err(d))?,
-        )),
-        None => Ok(None),
-    }
+    let absolute = |d: &Path| std::fs::canonicalize(d).or_else(|_| std::path::absolute(d));
+    engine
+        .scene_base_dir()
+        .map(|d| absolute(d).map_err(io_err(d)))
+        .transpose()
 }
 
 /// The scene text a run keeps as `out_dir/scene.toml`: the engine's own, with its relative input files written by
@@ -526,13 +523,6 @@ pub(super) fn read_checkpoint<E: Engine>(dir: &Path) -> Result<Checkpoint<E::Sta
     Ok(c)
 }
 
-/// Cuts the output file `path` back to `bytes` (its length at the checkpoint) and opens it for appending.
-///
-/// Errors: [`RunError::BadCheckpoint`] when the file is missing or shorter than `bytes`.
-pub fn reopen_truncated<S>(path: &Path, bytes: u64) -> Result<File, RunError<S>> {
-    crate::engine::reopen_truncated(path, bytes).map_err(|e| RunError::BadCheckpoint(e.to_string()))
-}
-
 /// Continues the run in `dir` from its `checkpoint.json` (see the module docs), as if it had never stopped: same
 /// snapshots, time-series rows (after cutting those written after the checkpoint) and summary. `options.force` is
 /// ignored; the checkpoint options apply to the continued run.
@@ -549,119 +539,6 @@ pub fn resume<E: Engine>(dir: &Path, options: &RunOptions) -> Result<E::Summary,
     Session::<E>::resume(dir, options)?.run_to_end()
 }
 
-/// The setup of [`resume`], up to the first sample to advance.
-fn resume_session<E: Engine>(dir: &Path, options: &RunOptions) -> Result<Session<E>, RunError<E::Summary>> {
-    // A directory that does not exist is left to the checks below to name.
-    let lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
-    // Nothing through a link: refused before anything is read or changed.
-    if dir.is_dir() {
-        refuse_links(dir)?;
-    }
-    if let Some(t) = completed_run(dir) {
-        return Err(RunError::AlreadyCompleted {
-            dir: dir.to_path_buf(),
-            t,
-        });
-    }
-    let ckpt = read_checkpoint::<E>(dir)?;
-    let bad = RunError::BadCheckpoint;
-    let scene_path = dir.join("scene.toml");
-    let text = std::fs::read_to_string(&scene_path).map_err(|e| bad(format!("{}: {e}", scene_path.display())))?;
-    if fnv1a_hex(text.as_bytes()) != ckpt.scene_hash {
-        return Err(bad(format!(
-            "{} changed since the checkpoint was written",
-            scene_path.display()
-        )));
-    }
-    let mut engine = E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
-        .map_err(|e| bad(e.to_string()))?;
-
-    // The checkpoint must sit right after one of the run's samples.
-    let samples = engine.samples();
-    let prev = ckpt.next_sample.checked_sub(1).and_then(|i| samples.get(i as usize));
-    if ckpt.next_sample as usize >= samples.len() || prev.is_none_or(|p| p.t.to_bits() != ckpt.t.to_bits()) {
-        return Err(bad(format!(
-            "the checkpoint (t = {} s, next sample {}) does not match the scene's output samples",
-            ckpt.t, ckpt.next_sample
-        )));
-    }
-    if ckpt.timeseries_rows != ckpt.next_sample {
-        return Err(bad(format!(
-            "the checkpoint counts {} time-series rows for {} samples",
-            ckpt.timeseries_rows, ckpt.next_sample
-        )));
-    }
-    // What the run wrote before the checkpoint must all be there: a resumed run never writes it again.
-    let missing = inspect::missing_snapshots(dir, &samples[..ckpt.next_sample as usize]);
-    if !missing.is_empty() {
-        return Err(bad(format!(
-            "{}; re-run the scene from the start",
-            inspect::describe_missing(dir, &missing, &format!("the checkpoint at t = {} s", ckpt.t))
-        )));
-    }
-    let ts_path = dir.join("timeseries.csv");
-    match std::fs::metadata(&ts_path) {
-        Err(e) => return Err(bad(format!("{}: {e}", ts_path.display()))),
-        Ok(m) if m.len() < ckpt.timeseries_bytes => {
-            return Err(bad(format!(
-                "{}: holds {} bytes, fewer than the {} written before the checkpoint; re-run the scene from the start",
-                ts_path.display(),
-                m.len(),
-                ckpt.timeseries_bytes
-            )));
-        }
-        Ok(_) => {}
-    }
-    // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
-    // by row), before anything is continued from them.
-    match crate::io::manifest::verify_all(dir) {
-        Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
-        Ok(Some(_)) => {}
-        Ok(None) => {
-            for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
-                let p = dir.join("snapshots").join(format!("{k}.csv"));
-                crate::io::manifest::check_rows(&p, true)
-                    .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
-            }
-        }
-    }
-    engine
-        .restore(
-            ckpt.engine,
-            dir,
-            Resumed {
-                t: ckpt.t,
-                samples_done: ckpt.next_sample,
-            },
-        )
-        .map_err(|e| bad(e.to_string()))?;
-
-    // Stale files of the interrupted process (a failure summary, a half-written checkpoint).
-    for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
-        let p = dir.join(name);
-        if p.is_file() {
-            std::fs::remove_file(&p).map_err(io_err(&p))?;
-        }
-    }
-    let snaps = dir.join("snapshots");
-    safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
-    let timeseries = reopen_truncated(&ts_path, ckpt.timeseries_bytes)?;
-    let identity = Identity {
-        scene_base_dir: ckpt.scene_base_dir.clone(),
-        scene_hash: ckpt.scene_hash.clone(),
-    };
-    let start = Start {
-        next_sample: ckpt.next_sample,
-        rows: ckpt.timeseries_rows,
-        bytes: ckpt.timeseries_bytes,
-        wall_before: ckpt.wall_seconds,
-        checkpoints: ckpt.checkpoints,
-        timeseries,
-    };
-    let budget = budget_of(&engine, options);
-    Ok(Session::new(engine, dir, options, start, identity, budget, lock))
-}
-
 /// The bytes of `dir/checkpoint.json` for `checkpoint`.
 fn checkpoint_bytes<S: Serialize>(checkpoint: &Checkpoint<S>) -> std::io::Result<Vec<u8>> {
     let mut bytes = serde_json::to_vec_pretty(checkpoint).map_err(std::io::Error::other)?;
@@ -676,8 +553,7 @@ fn write_summary<S: Serialize>(path: &Path, summary: &S) -> std::io::Result<()> 
 
 /// Runs `op` on a worker thread of rayon's global pool while the caller waits (in place when already on a pool's
 /// worker). An engine's parallel passes are then forked from inside the pool; forked from outside it, every pass
-/// is injected into the pool and the caller sleeps until it ends, a cost of tens of µs per right-hand side
-/// (`analysis/speed/NOTES.md`). The pool's other workers stay awake for the run
+/// is injected into the pool and the caller sleeps until it ends. The pool's other workers stay awake for the run
 /// ([`warm_pool::with_warm_workers`]).
 ///
 /// With `useful` threads fewer than the pool has (see [`Engine::useful_threads`]), `op` runs on a pool of its own
@@ -787,7 +663,116 @@ impl<E: Engine> Session<E> {
     /// Continues the run in `dir` from its checkpoint, as [`resume`] does before its first sample. Errors: as
     /// [`resume`].
     pub fn resume(dir: &Path, options: &RunOptions) -> Result<Self, RunError<E::Summary>> {
-        resume_session(dir, options)
+        // A directory that does not exist is left to the checks below to name.
+        let lock = dir.is_dir().then(|| DirLock::acquire(dir)).transpose()?;
+        // Nothing through a link: refused before anything is read or changed.
+        if dir.is_dir() {
+            refuse_links(dir)?;
+        }
+        if let Some(t) = completed_run(dir) {
+            return Err(RunError::AlreadyCompleted {
+                dir: dir.to_path_buf(),
+                t,
+            });
+        }
+        let ckpt = read_checkpoint::<E>(dir)?;
+        let bad = RunError::BadCheckpoint;
+        let scene_path = dir.join("scene.toml");
+        let text = std::fs::read_to_string(&scene_path).map_err(|e| bad(format!("{}: {e}", scene_path.display())))?;
+        if fnv1a_hex(text.as_bytes()) != ckpt.scene_hash {
+            return Err(bad(format!(
+                "{} changed since the checkpoint was written",
+                scene_path.display()
+            )));
+        }
+        let mut engine = E::from_scene_text(&text, &scene_path.display().to_string(), ckpt.scene_base_dir.as_deref())
+            .map_err(|e| bad(e.to_string()))?;
+
+        // The checkpoint must sit right after one of the run's samples.
+        let samples = engine.samples();
+        let prev = ckpt.next_sample.checked_sub(1).and_then(|i| samples.get(i as usize));
+        if ckpt.next_sample as usize >= samples.len() || prev.is_none_or(|p| p.t.to_bits() != ckpt.t.to_bits()) {
+            return Err(bad(format!(
+                "the checkpoint (t = {} s, next sample {}) does not match the scene's output samples",
+                ckpt.t, ckpt.next_sample
+            )));
+        }
+        if ckpt.timeseries_rows != ckpt.next_sample {
+            return Err(bad(format!(
+                "the checkpoint counts {} time-series rows for {} samples",
+                ckpt.timeseries_rows, ckpt.next_sample
+            )));
+        }
+        // What the run wrote before the checkpoint must all be there: a resumed run never writes it again.
+        let missing = inspect::missing_snapshots(dir, &samples[..ckpt.next_sample as usize]);
+        if !missing.is_empty() {
+            return Err(bad(format!(
+                "{}; re-run the scene from the start",
+                inspect::describe_missing(dir, &missing, &format!("the checkpoint at t = {} s", ckpt.t))
+            )));
+        }
+        let ts_path = dir.join("timeseries.csv");
+        match std::fs::metadata(&ts_path) {
+            Err(e) => return Err(bad(format!("{}: {e}", ts_path.display()))),
+            Ok(m) if m.len() < ckpt.timeseries_bytes => {
+                return Err(bad(format!(
+                    "{}: holds {} bytes, fewer than the {} written before the checkpoint; re-run the scene from the start",
+                    ts_path.display(),
+                    m.len(),
+                    ckpt.timeseries_bytes
+                )));
+            }
+            Ok(_) => {}
+        }
+        // Every finished file as the manifest records it (a directory written before the manifest: the snapshots row
+        // by row), before anything is continued from them.
+        match crate::io::manifest::verify_all(dir) {
+            Err(e) => return Err(bad(format!("{e}; re-run the scene from the start"))),
+            Ok(Some(_)) => {}
+            Ok(None) => {
+                for k in samples[..ckpt.next_sample as usize].iter().filter_map(|s| s.snapshot) {
+                    let p = dir.join("snapshots").join(format!("{k}.csv"));
+                    crate::io::manifest::check_rows(&p, true)
+                        .map_err(|e| bad(format!("{e}; re-run the scene from the start")))?;
+                }
+            }
+        }
+        engine
+            .restore(
+                ckpt.engine,
+                dir,
+                Resumed {
+                    t: ckpt.t,
+                    samples_done: ckpt.next_sample,
+                },
+            )
+            .map_err(|e| bad(e.to_string()))?;
+
+        // Stale files of the interrupted process (a failure summary, a half-written checkpoint).
+        for name in ["summary.json", "last_good_state.csv", CHECKPOINT_TMP_FILE] {
+            let p = dir.join(name);
+            if p.is_file() {
+                std::fs::remove_file(&p).map_err(io_err(&p))?;
+            }
+        }
+        let snaps = dir.join("snapshots");
+        safe_write::ensure_dir(&snaps).map_err(io_err(&snaps))?;
+        let timeseries =
+            crate::engine::reopen_truncated(&ts_path, ckpt.timeseries_bytes).map_err(|e| bad(e.to_string()))?;
+        let identity = Identity {
+            scene_base_dir: ckpt.scene_base_dir.clone(),
+            scene_hash: ckpt.scene_hash.clone(),
+        };
+        let start = Start {
+            next_sample: ckpt.next_sample,
+            rows: ckpt.timeseries_rows,
+            bytes: ckpt.timeseries_bytes,
+            wall_before: ckpt.wall_seconds,
+            checkpoints: ckpt.checkpoints,
+            timeseries,
+        };
+        let budget = budget_of(&engine, options);
+        Ok(Session::new(engine, dir, options, start, identity, budget, lock))
     }
 
     fn new(
@@ -903,36 +888,30 @@ impl<E: Engine> Session<E> {
 
     /// On failure: the rows so far, the last good state and the summary, then the error.
     fn fail(&mut self, failure: &crate::engine::Failure) -> RunError<E::Summary> {
-        self.done = true;
         self.shown.abandon();
-        if let Err((path, source)) = self.files.flush() {
-            return RunError::Io { path, source };
-        }
-        let lgs = self.out_dir.join("last_good_state.csv");
-        let t_good = match self.engine.write_last_good_state(&lgs) {
-            Ok(t) => t,
-            Err(e) => return RunError::Io { path: lgs, source: e },
-        };
-        let summary = self
-            .engine
-            .summary(Outcome::Failed(failure), self.rows, self.wall_seconds());
-        let sp = self.out_dir.join("summary.json");
-        if let Err(e) = write_summary(&sp, &summary) {
-            return RunError::Io { path: sp, source: e };
-        }
-        let mp = self.out_dir.join(MANIFEST_FILE);
-        if let Err(e) = self.files.sync().and_then(|()| {
+        let mut write = || -> Result<RunError<E::Summary>, RunError<E::Summary>> {
+            self.files.flush().map_err(file_error)?;
+            let lgs = self.out_dir.join("last_good_state.csv");
+            let t_good = self.engine.write_last_good_state(&lgs).map_err(io_err(&lgs))?;
+            let summary = self
+                .engine
+                .summary(Outcome::Failed(failure), self.rows, self.wall_seconds());
+            let sp = self.out_dir.join("summary.json");
+            write_summary(&sp, &summary).map_err(io_err(&sp))?;
+            let mp = self.out_dir.join(MANIFEST_FILE);
+            self.files.sync().map_err(file_error)?;
             self.manifest
                 .write(&self.out_dir, "failed", true)
-                .map_err(|e| (mp.clone(), e))
-        }) {
-            return RunError::Io { path: e.0, source: e.1 };
-        }
-        RunError::Failed {
-            t: t_good,
-            cause: failure.cause.clone(),
-            last_good_state: lgs,
-            summary: Box::new(summary),
+                .map_err(io_err(&mp))?;
+            Ok(RunError::Failed {
+                t: t_good,
+                cause: failure.cause.clone(),
+                last_good_state: lgs,
+                summary: Box::new(summary),
+            })
+        };
+        match write() {
+            Ok(e) | Err(e) => e,
         }
     }
 
@@ -1008,8 +987,7 @@ impl<E: Engine> Session<E> {
         )
     }
 
-    fn budget_stop(&mut self, t: f64, reason: String) -> RunError<E::Summary> {
-        self.done = true;
+    fn budget_stop(&self, t: f64, reason: String) -> RunError<E::Summary> {
         RunError::Budget {
             dir: self.out_dir.to_path_buf(),
             t,
@@ -1091,10 +1069,7 @@ impl<E: Engine> Session<E> {
         let row = match self.engine.sample(&sample, self.wall_seconds()) {
             Ok(row) => row,
             Err(SampleError::Failed(failure)) => return Err(self.fail(&failure)),
-            Err(SampleError::Io { path, source }) => {
-                self.done = true;
-                return Err(RunError::Io { path, source });
-            }
+            Err(SampleError::Io { path, source }) => return Err(RunError::Io { path, source }),
         };
         self.files.write_row(&row).map_err(file_error)?;
         self.rows += 1;
@@ -1166,7 +1141,6 @@ impl<E: Engine> Session<E> {
                 .is_some_and(|n| self.checkpoints_here >= n)
             {
                 self.shown.abandon();
-                self.done = true;
                 return Err(RunError::Stopped {
                     dir: self.out_dir.to_path_buf(),
                     t,

@@ -63,34 +63,27 @@ pub struct ParticleView {
     /// Mass (kg).
     pub mass: f64,
     /// Centre (m).
-    pub position: crate::math::Vec3,
+    pub position: Vec3,
     /// Velocity of the centre (m/s).
-    pub velocity: crate::math::Vec3,
+    pub velocity: Vec3,
     /// Spin in the world frame (rad/s).
-    pub spin_world: crate::math::Vec3,
+    pub spin_world: Vec3,
     /// Semi-axes A ≥ B ≥ C (m); a sphere's radius three times.
-    pub axes: crate::math::Vec3,
+    pub axes: Vec3,
     /// Rotation from the body frame to the world frame (the identity for spheres).
     pub rotation: crate::math::Mat3,
 }
 
 impl ParticleView {
     /// A sphere of `radius` (m): axes all equal to it, no rotation.
-    pub fn sphere(
-        id: usize,
-        mass: f64,
-        radius: f64,
-        position: crate::math::Vec3,
-        velocity: crate::math::Vec3,
-        spin_world: crate::math::Vec3,
-    ) -> Self {
+    pub fn sphere(id: usize, mass: f64, radius: f64, position: Vec3, velocity: Vec3, spin_world: Vec3) -> Self {
         ParticleView {
             id,
             mass,
             position,
             velocity,
             spin_world,
-            axes: crate::math::Vec3::repeat(radius),
+            axes: Vec3::repeat(radius),
             rotation: crate::math::Mat3::identity(),
         }
     }
@@ -136,7 +129,7 @@ pub struct SnapshotView {
 
 /// How far the particles reach from `from` (m): the largest distance to a particle's centre plus its largest
 /// semi-axis; 1 m without particles. Unbounded walls are drawn this far.
-pub fn reach(particles: &[ParticleView], from: &crate::math::Vec3) -> f64 {
+pub fn reach(particles: &[ParticleView], from: &Vec3) -> f64 {
     let r = particles
         .iter()
         .map(|p| (p.position - from).norm() + p.axes.max())
@@ -159,7 +152,7 @@ pub fn read_sphere_snapshot(path: &Path) -> Result<(f64, Vec<ParticleView>), Eng
         .iter()
         .map(|r| {
             let v = &r.values;
-            let vec3 = |k: usize| crate::math::Vec3::new(v[k], v[k + 1], v[k + 2]);
+            let vec3 = |k: usize| Vec3::new(v[k], v[k + 1], v[k + 2]);
             ParticleView::sphere(v[1] as usize, v[2], v[3], vec3(4), vec3(7), vec3(10))
         })
         .collect();
@@ -408,18 +401,18 @@ pub trait Engine: Sized + Send {
 /// Cuts an output file back to `bytes` (its length at a checkpoint) and opens it for appending, so that a resumed
 /// run continues it exactly. Errors are one line naming the file (missing, or shorter than at the checkpoint).
 pub fn reopen_truncated(path: &Path, bytes: u64) -> Result<std::fs::File, EngineError> {
-    let err = |e: std::io::Error| EngineError::File {
+    let file_err = |reason: String| EngineError::File {
         path: path.to_path_buf(),
-        reason: crate::io::safe_write::reason(&e),
+        reason,
     };
+    let err = |e: std::io::Error| file_err(crate::io::safe_write::reason(&e));
     // Never through a link (crate::io::safe_write): the file opened is the regular file at `path`.
     let mut file = crate::io::safe_write::open_nofollow(path, false).map_err(err)?;
     let len = file.metadata().map_err(err)?.len();
     if len < bytes {
-        return Err(EngineError::File {
-            path: path.to_path_buf(),
-            reason: format!("holds {len} bytes, fewer than the {bytes} written before the checkpoint"),
-        });
+        return Err(file_err(format!(
+            "holds {len} bytes, fewer than the {bytes} written before the checkpoint"
+        )));
     }
     file.set_len(bytes).map_err(err)?;
     std::io::Seek::seek(&mut file, std::io::SeekFrom::End(0)).map_err(err)?;

@@ -74,46 +74,29 @@ impl Iterator for Schedule {
 
     fn next(&mut self) -> Option<Sample> {
         let grid = self.peek_grid();
-        let snap = self.snapshots.get(self.next_snapshot).copied();
-        match (grid, snap) {
-            (None, None) => None,
-            (Some(g), None) => {
-                self.pop_grid();
-                Some(Sample { t: g, snapshot: None })
-            }
-            (None, Some(s)) => {
-                let k = self.next_snapshot;
-                self.next_snapshot += 1;
-                Some(Sample {
-                    t: s,
-                    snapshot: Some(k),
-                })
-            }
-            (Some(g), Some(s)) => {
-                // Interior grid times within tol of a snapshot time are replaced by it; 0 and t_end
-                // are always sampled exactly.
-                let interior = g != 0.0 && g != self.t_end;
-                if g == s || (interior && (g - s).abs() <= self.tol) {
-                    self.pop_grid();
-                    let k = self.next_snapshot;
-                    self.next_snapshot += 1;
-                    Some(Sample {
-                        t: s,
-                        snapshot: Some(k),
-                    })
-                } else if g < s {
-                    self.pop_grid();
-                    Some(Sample { t: g, snapshot: None })
-                } else {
-                    let k = self.next_snapshot;
-                    self.next_snapshot += 1;
-                    Some(Sample {
-                        t: s,
-                        snapshot: Some(k),
-                    })
-                }
-            }
+        // Interior grid times within tol of a snapshot time are replaced by it; 0 and t_end are always sampled
+        // exactly.
+        let merged = |g: f64, s: f64| g == s || (g != 0.0 && g != self.t_end && (g - s).abs() <= self.tol);
+        let (take_grid, snapshot_t) = match (grid, self.snapshots.get(self.next_snapshot).copied()) {
+            (None, None) => return None,
+            (Some(g), Some(s)) if merged(g, s) => (true, Some(s)),
+            (Some(g), s) if s.is_none_or(|s| g < s) => (true, None),
+            (_, s) => (false, s),
+        };
+        if take_grid {
+            self.pop_grid();
         }
+        let Some(t) = snapshot_t else {
+            return Some(Sample {
+                t: grid?,
+                snapshot: None,
+            });
+        };
+        self.next_snapshot += 1;
+        Some(Sample {
+            t,
+            snapshot: Some(self.next_snapshot - 1),
+        })
     }
 }
 

@@ -179,10 +179,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     }
     if args.shard.is_some() && args.branch {
         // shards started together must not all run the base: it is the job of --prepare-only
-        if let Some(tf) = grid.iter().find(|tf| {
-            let dir = args.out.join(format!("T{tf:.2}"));
-            !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())
-        }) {
+        if let Some(tf) = grid.iter().find(|tf| !written(&args.out.join(format!("T{tf:.2}")))) {
             return Err(SearchError::usage(format!(
                 "--shard: the branch of T_final = {tf:.2} h is not in {}; run the same command with --prepare-only \
                  (instead of --shard) first",
@@ -379,6 +376,11 @@ struct HoldJob {
     scene: Option<crate::granular::soft::scene::SoftScene>,
 }
 
+/// Whether the hold (or base) run in `dir` was started or branched there: it holds a checkpoint or a summary.
+fn written(dir: &Path) -> bool {
+    dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file()
+}
+
 /// Whether the forcing of the run in `dir` has been released (its `spinup.csv` says so).
 fn released_in(dir: &Path) -> bool {
     read_spinup_csv(&dir.join("spinup.csv")).is_ok_and(|s| s.iter().any(|x| !x.forcing))
@@ -404,9 +406,7 @@ fn run_hold(job: &HoldJob, finish_released: bool) -> Result<(), SearchError> {
         let options = RunOptions {
             force: true,
             progress: false,
-            checkpoint_every: Some(crate::driver::DEFAULT_CHECKPOINT_EVERY),
             checkpoint_every_sim: Some(RELEASE_CHECK_S),
-            formats: crate::driver::formats::Formats::NONE,
             stop_after_checkpoints: Some(1),
             ..RunOptions::default()
         };
@@ -488,8 +488,7 @@ pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
     requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
-/// How many checkpointed legs the base run of `--branch` is cut into over its whole span (a stopped search loses
-/// at most one leg of the path: about 15 min of a full-size base run on two cores).
+/// Checkpointed legs the base run of `--branch` is cut into over its span (a stopped search loses one at most).
 const BASE_LEGS: u64 = 8;
 
 /// The output-sample steps at which the base run stops and checkpoints on its way from step `from` to `to` (an
@@ -580,10 +579,7 @@ fn prepare_branches(
     // compared as a value, so that one an older build wrote in another layout (defaults left out) is recognised
     if let Ok(text) = std::fs::read_to_string(base_dir.join("scene.toml"))
         && parse_toml_as::<SoftSceneFile>(&text, "scene.toml").ok().as_ref() != Some(&base_file)
-        && grid.iter().any(|tf| {
-            let dir = args.out.join(format!("T{tf:.2}"));
-            !(dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file())
-        })
+        && grid.iter().any(|tf| !written(&args.out.join(format!("T{tf:.2}"))))
     {
         return Err(SearchError::usage(format!(
             "{}: the base run was made for another range of T_final; remove that directory to start it again \
@@ -601,7 +597,7 @@ fn prepare_branches(
     for k in order {
         let tf = grid[k];
         let dir = args.out.join(format!("T{tf:.2}"));
-        if dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file() {
+        if written(&dir) {
             continue;
         }
         let s_x = (starts[k] / dt + 1e-9).floor() as u64;
@@ -640,7 +636,6 @@ fn prepare_branches(
                 progress: false,
                 checkpoint_every: None,
                 checkpoint_every_sim: Some(t_leg - t_here - 0.5 * dt),
-                formats: crate::driver::formats::Formats::NONE,
                 stop_after_checkpoints: Some(1),
                 ..RunOptions::default()
             };
