@@ -98,7 +98,11 @@ pub fn push_f64(out: &mut String, x: f64) {
     if exp10 < 0 {
         out.push('-');
     }
-    out.extend(decimal(exp10.unsigned_abs().into(), &mut text).iter().map(|&d| d as char));
+    out.extend(
+        decimal(exp10.unsigned_abs().into(), &mut text)
+            .iter()
+            .map(|&d| d as char),
+    );
 }
 
 /// The decimal digits of `n`, most significant first, written at the end of `buffer`.

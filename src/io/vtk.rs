@@ -70,7 +70,11 @@ pub struct DataArray {
 impl DataArray {
     fn new(name: &str, components: usize, values: Values) -> Self {
         let name = name.into();
-        DataArray { name, components, values }
+        DataArray {
+            name,
+            components,
+            values,
+        }
     }
 
     /// Scalars (one float per tuple).
@@ -91,7 +95,9 @@ impl DataArray {
     /// 3×3 tensors given as matrices `m[row][col]`, stored column by column as VTK's tensor glyphs read them
     /// (component `i + 3 j` is row `i`, column `j`).
     pub fn tensors(name: &str, values: impl IntoIterator<Item = [[f64; 3]; 3]>) -> Self {
-        let columns = values.into_iter().flat_map(|m| (0..3).flat_map(move |j| m.map(|row| row[j])));
+        let columns = values
+            .into_iter()
+            .flat_map(|m| (0..3).flat_map(move |j| m.map(|row| row[j])));
         DataArray::new(name, 9, Values::Float64(columns.collect()))
     }
 
