@@ -78,8 +78,9 @@ fn kepler_orbits_keep_energy_and_angular_momentum() {
         KeplerOrbit::hyperbolic(GM_EARTH, q, 12_000.0, -50.0, rotation()).unwrap(),
         KeplerOrbit::new(GM_EARTH, q, 0.6, 0.0, rotation()).unwrap(),
     ] {
-        let energy = orbit.specific_energy();
-        let h = orbit.specific_angular_momentum();
+        // Specific orbital energy −GM/(2a) (J/kg) and angular momentum |s × ṡ| = sqrt(GM q (1 + e)) (m²/s).
+        let energy = -orbit.gm / (2.0 * orbit.semi_major_axis());
+        let h = (orbit.gm * orbit.q * (1.0 + orbit.e)).sqrt();
         let normal = rotation().column(2).into_owned();
         for t in [-2e5, -1e4, -10.0, 0.0, 3.0, 5e3, 8e4, 1e6] {
             let (r, v) = orbit.state(orbit.t_perigee + t);

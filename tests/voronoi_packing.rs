@@ -2,9 +2,28 @@
 //! simple cubic one π/6 within ±0.002, boundary cells are excluded, and the closed cells tile the interior; for
 //! unequal spheres the radical cells give each sphere type its exact share (a CsCl crystal).
 
-use rubblepile::geometry::lattice::{hcp_centres, simple_cubic_centres};
+use rubblepile::geometry::lattice::hcp_centres;
 use rubblepile::geometry::voronoi::{packing_fraction, radical_cells, voronoi_cells};
 use rubblepile::math::Vec3;
+
+/// Centres of equal spheres of radius `r` (m) on a simple cubic lattice of spacing 2r within `extent` (m) of the
+/// origin.
+fn simple_cubic_centres(r: f64, extent: f64) -> Vec<Vec3> {
+    let d = 2.0 * r;
+    let n = (extent / d).ceil() as i64;
+    let mut out = Vec::new();
+    for i in -n..=n {
+        for j in -n..=n {
+            for k in -n..=n {
+                let p = Vec3::new(i as f64, j as f64, k as f64) * d;
+                if p.norm() <= extent {
+                    out.push(p);
+                }
+            }
+        }
+    }
+    out
+}
 
 fn interior_fraction(centres: &[Vec3], r: f64, depth: f64, extent: f64) -> (f64, usize, usize) {
     let cells = voronoi_cells(centres, 4.0 * r);

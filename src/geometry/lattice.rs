@@ -1,5 +1,5 @@
-//! Regular sphere packings: hexagonal close packing (HCP, packing fraction π/(3√2) ≈ 0.7405, Zhang17's HCP
-//! aggregates) and simple cubic (π/6), as point sets filling a sphere.
+//! Regular sphere packing: hexagonal close packing (HCP, packing fraction π/(3√2) ≈ 0.7405, Zhang17's HCP
+//! aggregates), as a point set filling a sphere.
 
 use crate::math::Vec3;
 
@@ -24,25 +24,6 @@ pub fn hcp_centres(r: f64, extent: f64) -> Vec<Vec3> {
                 let x = i as f64 * d + 0.5 * d * j.rem_euclid(2) as f64 + sx;
                 let y = j as f64 * row + sy;
                 let p = Vec3::new(x, y, z);
-                if p.norm() <= extent {
-                    out.push(p);
-                }
-            }
-        }
-    }
-    out
-}
-
-/// Centres of equal spheres of radius `r` (m) on a simple cubic lattice of spacing 2r within `extent` (m) of the
-/// origin.
-pub fn simple_cubic_centres(r: f64, extent: f64) -> Vec<Vec3> {
-    let d = 2.0 * r;
-    let n = (extent / d).ceil() as i64;
-    let mut out = Vec::new();
-    for i in -n..=n {
-        for j in -n..=n {
-            for k in -n..=n {
-                let p = Vec3::new(i as f64, j as f64, k as f64) * d;
                 if p.norm() <= extent {
                     out.push(p);
                 }

@@ -106,16 +106,6 @@ impl KeplerOrbit {
         (self.gm / (a * a * a)).sqrt()
     }
 
-    /// Specific orbital energy `v²/2 − GM/r = −GM/(2a)` (J/kg), constant along the orbit.
-    pub fn specific_energy(&self) -> f64 {
-        -self.gm / (2.0 * self.semi_major_axis())
-    }
-
-    /// Specific angular momentum `|s × ṡ| = sqrt(GM q (1 + e))` (m²/s).
-    pub fn specific_angular_momentum(&self) -> f64 {
-        (self.gm * self.q * (1.0 + self.e)).sqrt()
-    }
-
     /// Position (m) and velocity (m/s) at time `t` (s) of the orbiting point relative to the central mass.
     pub fn state(&self, t: f64) -> (Vec3, Vec3) {
         if self.gm == 0.0 {

@@ -581,43 +581,6 @@ impl Octree {
         }
     }
 
-    /// Field at point `p`: acceleration (m/s²) and potential (J/kg), skipping particle `skip` (its input index
-    /// when `p` is a particle) and any particle at `p` itself, with opening angle `theta` and gravitational
-    /// constant `g`.
-    pub fn field_at(&self, p: &Vec3, skip: Option<usize>, theta: f64, g: f64) -> (Vec3, f64) {
-        if self.next.is_empty() {
-            return (Vec3::zeros(), 0.0);
-        }
-        let mut lists = Lists::default();
-        self.walk(&self.reach2(theta), *p, *p, &mut lists);
-        // a length unit of 1/128 of the root side: the point's list spans a few leaves around it
-        let frame = self.frame(*p, self.side[0] / (1u64 << (KEY_BITS / 3)) as f64);
-        let point = [[p.x, p.y, p.z, 0.0]];
-        let mut out = [[0.0; 4]];
-        if self.single_precision() {
-            let mut local = Local::<f32>::default();
-            self.gather(&lists, &frame, &mut local);
-            Self::block::<f32, 1>(&local, &frame, &point, &mut out, 1.0);
-        } else {
-            let mut local = Local::<f64>::default();
-            self.gather(&lists, &frame, &mut local);
-            Self::block::<f64, 1>(&local, &frame, &point, &mut out, 1.0);
-        }
-        let (mut a, mut phi) = (Vec3::new(out[0][0], out[0][1], out[0][2]), out[0][3]);
-        // A particle at `p` itself was skipped by the sums; `skip` elsewhere was included: remove its direct
-        // term (exact when its leaf was summed directly, as it is whenever `p` lies near it).
-        if let Some(sorted) = skip.filter(|&i| i < self.rank.len()).map(|i| self.rank[i] as usize) {
-            let [xj, yj, zj, mj] = self.particles[sorted];
-            let d = Vec3::new(xj, yj, zj) - p;
-            let r = d.norm();
-            if r > 0.0 {
-                a -= d * (mj / (r * r * r));
-                phi += mj / r;
-            }
-        }
-        (a * g, phi * g)
-    }
-
     /// Accelerations (m/s²) and potentials (J/kg) of every particle, in input order.
     ///
     /// ```
@@ -875,6 +838,65 @@ mod tests {
             jumpy > 1e-5,
             "fresh walks never changed a list here ({jumpy:e}): nothing is tested"
         );
+    }
+
+    impl Octree {
+        /// Field at point `p`: acceleration (m/s²) and potential (J/kg), skipping any particle at `p` itself,
+        /// with opening angle `theta` and gravitational constant `g`.
+        fn field_at(&self, p: &Vec3, theta: f64, g: f64) -> (Vec3, f64) {
+            let mut lists = Lists::default();
+            self.walk(&self.reach2(theta), *p, *p, &mut lists);
+            // a length unit of 1/128 of the root side: the point's list spans a few leaves around it
+            let frame = self.frame(*p, self.side[0] / (1u64 << (KEY_BITS / 3)) as f64);
+            let mut out = [[0.0; 4]];
+            if self.single_precision() {
+                let mut local = Local::<f32>::default();
+                self.gather(&lists, &frame, &mut local);
+                Self::block::<f32, 1>(&local, &frame, &[[p.x, p.y, p.z, 0.0]], &mut out, g);
+            } else {
+                let mut local = Local::<f64>::default();
+                self.gather(&lists, &frame, &mut local);
+                Self::block::<f64, 1>(&local, &frame, &[[p.x, p.y, p.z, 0.0]], &mut out, g);
+            }
+            (Vec3::new(out[0][0], out[0][1], out[0][2]), out[0][3])
+        }
+    }
+
+    /// A cubic lattice (spacing h, mass 1) inside radius 16 h: density 1/h³. Its interior field at points at
+    /// cell centres, where the nearest lattice sites cancel by symmetry, is `g = 4/3 π G ρ r` within 1 %.
+    #[test]
+    fn interior_field_of_a_uniform_ball() {
+        let h = 1.0;
+        let big = 16.0;
+        let mut x = Vec::new();
+        let n = big as i64 + 1;
+        for i in -n..=n {
+            for j in -n..=n {
+                for k in -n..=n {
+                    let p = Vec3::new(i as f64, j as f64, k as f64) * h;
+                    if p.norm() < big * h {
+                        x.push(p);
+                    }
+                }
+            }
+        }
+        let m = vec![1.0; x.len()];
+        let tree = Octree::build(&x, &m);
+        let rho = 1.0 / h.powi(3);
+        let mut worst: f64 = 0.0;
+        for (a, b, c) in [(2, 1, 0), (4, -3, 2), (-6, 5, 3), (8, 2, -5), (-9, -6, 4), (3, 10, -2)] {
+            let p = Vec3::new(a as f64 + 0.5, b as f64 + 0.5, c as f64 + 0.5) * h;
+            let (g, _) = tree.field_at(&p, 0.3, 1.0);
+            let expect = 4.0 / 3.0 * std::f64::consts::PI * rho * p.norm();
+            let radial = -g.dot(&p.normalize());
+            let err = (radial - expect).abs() / expect;
+            worst = worst.max(err);
+        }
+        println!(
+            "interior field of a uniform ball ({} points): worst relative error {worst:.2e}",
+            x.len()
+        );
+        assert!(worst < 0.01, "interior field off by {worst}");
     }
 
     /// The frame's rescaling is by powers of two, so it is exact.

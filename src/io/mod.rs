@@ -88,37 +88,33 @@ pub fn push_f64(out: &mut String, x: f64) {
         }
     }
     let mut text = [0u8; 20];
-    let mut k = text.len();
-    let mut rest = digits;
-    while rest > 0 {
-        k -= 1;
-        text[k] = b'0' + (rest % 10) as u8;
-        rest /= 10;
-    }
-    let significant = &text[k..];
+    let significant = decimal(digits, &mut text);
     out.push(significant[0] as char);
     if significant.len() > 1 {
         out.push('.');
-        for &d in &significant[1..] {
-            out.push(d as char);
-        }
+        out.extend(significant[1..].iter().map(|&d| d as char));
     }
     out.push('e');
     if exp10 < 0 {
         out.push('-');
     }
-    let mut e = exp10.unsigned_abs();
-    let mut k = text.len();
+    out.extend(
+        decimal(exp10.unsigned_abs().into(), &mut text)
+            .iter()
+            .map(|&d| d as char),
+    );
+}
+
+/// The decimal digits of `n`, most significant first, written at the end of `buffer`.
+fn decimal(mut n: u64, buffer: &mut [u8; 20]) -> &[u8] {
+    let mut k = buffer.len();
     loop {
         k -= 1;
-        text[k] = b'0' + (e % 10) as u8;
-        e /= 10;
-        if e == 0 {
-            break;
+        buffer[k] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            return &buffer[k..];
         }
-    }
-    for &d in &text[k..] {
-        out.push(d as char);
     }
 }
 

@@ -315,21 +315,18 @@ fn fmt_path(segments: &[serde_path_to_error::Segment]) -> String {
     use serde_path_to_error::Segment;
     let mut s = String::new();
     for seg in segments {
-        match seg {
-            Segment::Seq { index } => s.push_str(&format!("[{index}]")),
-            Segment::Map { key } | Segment::Enum { variant: key } => {
-                if !s.is_empty() {
-                    s.push('.');
-                }
-                s.push_str(key);
+        let key = match seg {
+            Segment::Seq { index } => {
+                s.push_str(&format!("[{index}]"));
+                continue;
             }
-            Segment::Unknown => {
-                if !s.is_empty() {
-                    s.push('.');
-                }
-                s.push('?');
-            }
+            Segment::Map { key } | Segment::Enum { variant: key } => key.as_str(),
+            Segment::Unknown => "?",
+        };
+        if !s.is_empty() {
+            s.push('.');
         }
+        s.push_str(key);
     }
     s
 }

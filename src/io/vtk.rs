@@ -11,6 +11,8 @@
 
 use std::path::Path;
 
+use crate::io::safe_write::write_atomic;
+
 use quick_xml::Writer;
 use quick_xml::events::{BytesEnd, BytesStart, BytesText, Event};
 
@@ -66,49 +68,37 @@ pub struct DataArray {
 }
 
 impl DataArray {
+    fn new(name: &str, components: usize, values: Values) -> Self {
+        let name = name.into();
+        DataArray {
+            name,
+            components,
+            values,
+        }
+    }
+
     /// Scalars (one float per tuple).
     pub fn scalars(name: &str, values: Vec<f64>) -> Self {
-        DataArray {
-            name: name.into(),
-            components: 1,
-            values: Values::Float64(values),
-        }
+        DataArray::new(name, 1, Values::Float64(values))
     }
 
     /// Integer ids (one per tuple).
     pub fn ids(name: &str, values: Vec<i64>) -> Self {
-        DataArray {
-            name: name.into(),
-            components: 1,
-            values: Values::Int64(values),
-        }
+        DataArray::new(name, 1, Values::Int64(values))
     }
 
     /// Vectors (three floats per tuple).
     pub fn vectors(name: &str, values: impl IntoIterator<Item = [f64; 3]>) -> Self {
-        DataArray {
-            name: name.into(),
-            components: 3,
-            values: Values::Float64(values.into_iter().flatten().collect()),
-        }
+        DataArray::new(name, 3, Values::Float64(values.into_iter().flatten().collect()))
     }
 
     /// 3×3 tensors given as matrices `m[row][col]`, stored column by column as VTK's tensor glyphs read them
     /// (component `i + 3 j` is row `i`, column `j`).
     pub fn tensors(name: &str, values: impl IntoIterator<Item = [[f64; 3]; 3]>) -> Self {
-        let mut flat = Vec::new();
-        for m in values {
-            for j in 0..3 {
-                for row in &m {
-                    flat.push(row[j]);
-                }
-            }
-        }
-        DataArray {
-            name: name.into(),
-            components: 9,
-            values: Values::Float64(flat),
-        }
+        let columns = values
+            .into_iter()
+            .flat_map(|m| (0..3).flat_map(move |j| m.map(|row| row[j])));
+        DataArray::new(name, 9, Values::Float64(columns.collect()))
     }
 
     fn tuples(&self) -> usize {
@@ -263,7 +253,7 @@ impl PolyData {
 
     /// Writes the piece to `path` (through a temporary file renamed into place, so a reader never sees half a file).
     pub fn write(&self, path: &Path) -> std::io::Result<()> {
-        write_atomically(path, &self.to_bytes()?)
+        write_atomic(path, &self.to_bytes()?)
     }
 }
 
@@ -310,11 +300,7 @@ pub fn write_collection(path: &Path, entries: &[CollectionEntry]) -> std::io::Re
         })?;
     let mut out = w.into_inner();
     out.push(b'\n');
-    write_atomically(path, &out)
-}
-
-fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    crate::io::safe_write::write_atomic(path, bytes)
+    write_atomic(path, &out)
 }
 
 #[cfg(test)]
