@@ -304,7 +304,9 @@ fn the_library_does_not_use_clap() {
 /// the unbinned likelihood fits beside the binned one (8 lines of printing); 2581 until `analyze --out` (the flag,
 /// where the analysis goes, and the refusal for flyby runs: 18 lines); 2599 until `--x -5` was read as `--x=-5`
 /// (17 lines in the argument rewrite, so a negative value reaches the flag's own check); 2616 until `bench memory`
-/// (its subcommand and dispatch, 3 lines); 2618 until `SpinSelection` gained Q*_D's pooling (1 line).
+/// (its subcommand and dispatch, 3 lines); 2618 until `SpinSelection` gained Q*_D's pooling (1 line); 2619 until the
+/// printing of `run --render` and of `flyby` left the library for the command line (44 lines here, 57 out of the
+/// library).
 #[test]
 fn the_command_line_stays_small() {
     let mut files = Vec::new();
@@ -314,8 +316,8 @@ fn the_command_line_stays_small() {
         .map(|f| std::fs::read_to_string(f).unwrap().lines().count())
         .sum();
     assert!(
-        lines <= 2619,
-        "src/cli/ has {lines} lines (at most 2619: move logic to analysis/ or bench/)"
+        lines <= 2663,
+        "src/cli/ has {lines} lines (at most 2663: move logic to analysis/ or bench/)"
     );
 }
 

@@ -20,7 +20,7 @@ use crate::ellipsoid::equations::G_SI;
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
 use crate::ellipsoid::spin_state::{SpinState, spin_state_of_fit};
-use crate::impact::flyby::{CONTROL_DIR, FlybyConfig, run_flyby};
+use crate::impact::flyby::CONTROL_DIR;
 use crate::impact::run::read_target;
 use crate::impact::settle::SettleReport;
 use crate::math::{Mat3, Vec3};
@@ -376,40 +376,6 @@ pub fn analyze_flyby(dir: &Path) -> Result<FlybyOutcome, FlybyAnalysisError> {
             message: crate::io::safe_write::reason(&e),
         })?;
     Ok(outcome)
-}
-
-/// `rubblepile flyby`: prepares and runs the flyby of `args` ([`run_flyby`]), then analyses it ([`analyze_flyby`]);
-/// returns the lines to print, or the message and exit code (2 bad input, 1 failed run, 3 stopped on request). A
-/// bad value is named by its flag ([`crate::impact::flyby::flag`]).
-pub fn flyby_command(args: &FlybyConfig, options: &crate::driver::RunOptions) -> Result<Vec<String>, (String, u8)> {
-    let runs = run_flyby(args, options).map_err(|e| {
-        let message = match &e {
-            crate::impact::run::ImpactError::Invalid { field, message } => {
-                format!("{}: {message}", crate::impact::flyby::flag(field))
-            }
-            other => other.to_string(),
-        };
-        (message, e.exit_code())
-    })?;
-    let Some(runs) = runs else {
-        return Ok(vec![format!("wrote {}", args.out.join("scene.toml").display())]);
-    };
-    let o = analyze_flyby(&args.out).map_err(|e| {
-        let code = if matches!(e, FlybyAnalysisError::Locked(_)) {
-            2
-        } else {
-            1
-        };
-        (e.to_string(), code)
-    })?;
-    let mut lines = Vec::new();
-    lines.extend(runs.setup.settling.as_ref().map(settling_line));
-    lines.push(format!("run: {}", runs.run.one_line()));
-    if let Some(c) = &runs.control {
-        lines.push(format!("control ({}): {}", CONTROL_DIR, c.one_line()));
-    }
-    lines.extend(o.lines());
-    Ok(lines)
 }
 
 /// One line on the settling: its time, `K_rel/K`, the period, and a warning when the cap was reached.

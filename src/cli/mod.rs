@@ -272,11 +272,25 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
             if result.is_err() || !(args.render || args.scene.is_none()) {
                 return report(result);
             }
-            let (before, after) =
-                rubblepile::render::run::after_run(&args.out, args.force).map_err(CliError::failed)?;
-            println!("{before}");
+            // the built-in default scene (or --render) is drawn into frames/run.gif, the name `render` uses
+            let opts = rubblepile::render::run::RenderRunOptions {
+                force: args.force,
+                ..Default::default()
+            };
+            let r = rubblepile::render::run::render_run(&args.out, &opts).map_err(CliError::failed)?;
+            println!(
+                "rendered {} frames in {:.1} s (median {:.0} ms per frame)",
+                r.frames, r.seconds, r.median_frame_ms
+            );
             report(result)?;
-            after.iter().for_each(|l| println!("{l}"));
+            println!("look at it: {}", r.gif.display());
+            let pvd = args
+                .out
+                .join("vtk")
+                .join(rubblepile::driver::formats::vtk::COLLECTION_FILE);
+            if pvd.exists() {
+                println!("in ParaView: open {} (see README, \"Looking at a run\")", pvd.display());
+            }
             Ok(())
         }
         Command::Resume(args) => {
@@ -310,11 +324,7 @@ pub fn execute(cli: Cli) -> Result<(), CliError> {
         Command::Target(target::TargetCommand::Build(args)) => target::build(&args),
         Command::Target(target::TargetCommand::Table(args)) => target::table(&args),
         Command::Impact(args) => impact::impact(&args),
-        Command::Flyby(args) => {
-            rubblepile::analysis::flyby::flyby_command(&args.config(), &args.checkpoints.options(!args.no_progress)?)
-                .map(|lines| lines.iter().for_each(|l| println!("{l}")))
-                .map_err(|(message, code)| CliError { message, code })
-        }
+        Command::Flyby(args) => flyby(&args.config(), &args.checkpoints.options(!args.no_progress)?),
         Command::Campaign(args) => campaign::campaign(&args),
         Command::Analyze(args) => analyze::analyze(&args),
         Command::AnalyzeCampaign(args) => analyze::analyze_campaign(&args),
@@ -425,4 +435,38 @@ pub fn main() -> ExitCode {
             ExitCode::from(e.code)
         }
     }
+}
+
+/// `rubblepile flyby`: prepares and runs the flyby, then analyses it; a bad value is named by its flag.
+fn flyby(config: &rubblepile::impact::flyby::FlybyConfig, options: &RunOptions) -> Result<(), CliError> {
+    use rubblepile::analysis::flyby::{FlybyAnalysisError, analyze_flyby, settling_line};
+    use rubblepile::impact::{flyby, run::ImpactError};
+    let runs = flyby::run_flyby(config, options).map_err(|e| CliError {
+        message: match &e {
+            ImpactError::Invalid { field, message } => format!("{}: {message}", flyby::flag(field)),
+            other => other.to_string(),
+        },
+        code: e.exit_code(),
+    })?;
+    let Some(runs) = runs else {
+        println!("wrote {}", config.out.join("scene.toml").display());
+        return Ok(());
+    };
+    let o = analyze_flyby(&config.out).map_err(|e| CliError {
+        code: if matches!(e, FlybyAnalysisError::Locked(_)) {
+            2
+        } else {
+            1
+        },
+        message: e.to_string(),
+    })?;
+    if let Some(s) = &runs.setup.settling {
+        println!("{}", settling_line(s));
+    }
+    println!("run: {}", runs.run.one_line());
+    if let Some(c) = &runs.control {
+        println!("control ({}): {}", flyby::CONTROL_DIR, c.one_line());
+    }
+    o.lines().iter().for_each(|l| println!("{l}"));
+    Ok(())
 }

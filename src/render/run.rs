@@ -364,29 +364,6 @@ fn caption(t: f64) -> String {
     }
 }
 
-/// Renders a run just finished by `rubblepile run` (`--render`, or always for the built-in default scene) into
-/// `frames/run.gif`, the name `rubblepile render` uses: the line to print before the run's summary, and those after it (what to open).
-pub fn after_run(out: &Path, force: bool) -> Result<(String, Vec<String>), RenderRunError> {
-    let opts = RenderRunOptions {
-        force,
-        ..Default::default()
-    };
-    let r = render_run(out, &opts)?;
-    let before = format!(
-        "rendered {} frames in {:.1} s (median {:.0} ms per frame)",
-        r.frames, r.seconds, r.median_frame_ms
-    );
-    let mut after = vec![format!("look at it: {}", r.gif.display())];
-    let pvd = out.join("vtk").join(crate::driver::formats::vtk::COLLECTION_FILE);
-    if pvd.exists() {
-        after.push(format!(
-            "in ParaView: open {} (see README, \"Looking at a run\")",
-            pvd.display()
-        ));
-    }
-    Ok((before, after))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
