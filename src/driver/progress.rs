@@ -20,20 +20,13 @@ pub const PROGRESS_EVERY_ENV: &str = "RUBBLEPILE_PROGRESS_EVERY";
 pub fn every_from_env(text: &str) -> Result<f64, String> {
     use crate::io::limits::{MAX_WALL_INTERVAL, MIN_PROGRESS_EVERY};
     let value = text.trim().parse::<f64>().unwrap_or(f64::NAN);
-    crate::io::run_budget::check_interval(
-        PROGRESS_EVERY_ENV,
-        value,
-        MIN_PROGRESS_EVERY,
-        MAX_WALL_INTERVAL,
-        "",
-        Some(""),
-    )
-    .map_err(|_| {
-        format!(
-            "{PROGRESS_EVERY_ENV} must be 0 (no lines) or a number of seconds from {MIN_PROGRESS_EVERY} to \
-                 {MAX_WALL_INTERVAL:e}, got {text:?}"
-        )
-    })
+    if value == 0.0 || (MIN_PROGRESS_EVERY..=MAX_WALL_INTERVAL).contains(&value) {
+        return Ok(value);
+    }
+    Err(format!(
+        "{PROGRESS_EVERY_ENV} must be 0 (no lines) or a number of seconds from {MIN_PROGRESS_EVERY} to \
+         {MAX_WALL_INTERVAL:e}, got {text:?}"
+    ))
 }
 
 /// A progress display for a run from `t` to `t_end` (s).

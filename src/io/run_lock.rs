@@ -20,11 +20,6 @@ use std::thread::ThreadId;
 /// The lock file of a directory as a whole (`DIR/.rubblepile.lock`).
 pub const LOCK_FILE: &str = ".rubblepile.lock";
 
-/// The name of the lock file guarding `part` of a directory (`.rubblepile-<part>.lock`).
-pub fn part_lock_file(part: &str) -> String {
-    format!(".rubblepile-{part}.lock")
-}
-
 /// Whether a directory entry named `name` is one of rubblepile's lock files ([`LOCK_FILE`] or a part's), which are
 /// no output and never make a directory "not empty".
 pub fn is_lock_file(name: &std::ffi::OsStr) -> bool {
@@ -116,7 +111,7 @@ impl DirLock {
     /// exclusively, through `dir/.rubblepile-<part>.lock`; `dir` must exist, `dir/<part>` need not. Errors as
     /// [`DirLock::acquire`], naming `dir/<part>`.
     pub fn acquire_part(dir: &Path, part: &str) -> Result<DirLock, LockError> {
-        lock(dir, &part_lock_file(part), dir.join(part), false)
+        lock(dir, &format!(".rubblepile-{part}.lock"), dir.join(part), false)
     }
 
     /// Locks the existing directory `dir` shared: other shared holders are let in, exclusive ones are refused (and
@@ -314,7 +309,7 @@ mod tests {
         assert!(ex.unwrap_err().to_string().contains("pid unknown"));
         drop(s1);
         assert!(is_lock_file(LOCK_FILE.as_ref()));
-        assert!(is_lock_file(part_lock_file("frames").as_ref()));
+        assert!(is_lock_file(".rubblepile-frames.lock".as_ref()));
         assert!(!is_lock_file("summary.json".as_ref()));
         let _ = std::fs::remove_dir_all(&d);
     }

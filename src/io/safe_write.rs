@@ -201,11 +201,7 @@ impl AtomicFile {
         self.complete(false)
     }
 
-    /// [`AtomicFile::finish`], made durable: the file is synced before the rename and the directory after it.
-    pub fn finish_durable(self) -> std::io::Result<()> {
-        self.complete(true)
-    }
-
+    /// Renames into place; `durable`: the file is synced before the rename and the directory after it.
     fn complete(mut self, durable: bool) -> std::io::Result<()> {
         let w = self.w.take().ok_or_else(|| std::io::Error::other("finished twice"))?;
         let file = w.into_inner().map_err(|e| e.into_error())?;
@@ -254,17 +250,19 @@ impl Drop for AtomicFile {
 
 /// Writes `bytes` to `path` atomically ([`AtomicFile`]); refuses a link at `path`.
 pub fn write_atomic(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
-    let mut f = AtomicFile::create(path)?;
-    f.write_all(bytes.as_ref())?;
-    f.finish()
+    write_whole(path, bytes.as_ref(), false)
 }
 
 /// [`write_atomic`], made durable (the file synced before the rename, the directory after it): for the files a
 /// resumed run relies on (the checkpoint, the manifest).
 pub fn write_atomic_durable(path: &Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
+    write_whole(path, bytes.as_ref(), true)
+}
+
+fn write_whole(path: &Path, bytes: &[u8], durable: bool) -> std::io::Result<()> {
     let mut f = AtomicFile::create(path)?;
-    f.write_all(bytes.as_ref())?;
-    f.finish_durable()
+    f.write_all(bytes)?;
+    f.complete(durable)
 }
 
 /// Copies the file `from` to `to` atomically (read whole, then [`write_atomic`]); refuses a link at `to`.
