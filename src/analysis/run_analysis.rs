@@ -386,14 +386,18 @@ pub fn analyze_run(
         write_composition_csv(&out_dir.join("composition.csv"), c)?;
     }
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
-    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    write_text(&json_path, &text)?;
+    write_json(&json_path, &analysis)?;
     Ok((analysis, report))
 }
 
 /// Writes `text` to `path` atomically, never through a link ([`crate::io::safe_write`]).
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
     crate::io::safe_write::write_atomic(path, text).map_err(|e| AnalysisError::write(path, &e))
+}
+
+/// Writes `value` to `path` as pretty-printed JSON with a final newline ([`write_text`]).
+pub(crate) fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), AnalysisError> {
+    write_text(path, &(serde_json::to_string_pretty(value).unwrap_or_default() + "\n"))
 }
 
 /// Whether `dir` holds an impact run (its `impact.json`, from `rubblepile impact`, a campaign or `run` of the
@@ -493,10 +497,7 @@ pub fn analyze_clumps_run(
     };
     crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::write(&out_dir, &e))?;
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
-    write_text(
-        &json_path,
-        &(serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n"),
-    )?;
+    write_json(&json_path, &analysis)?;
     Ok(analysis)
 }
 

@@ -476,11 +476,7 @@ impl Figure for VelocityField {
             .flat_map(|f| f.0)
             .filter(|x| x.is_finite())
             .fold(0.0, |m: f64, x| m.max(x.abs()));
-        let v = if self.escape_velocity.is_finite() {
-            self.escape_velocity
-        } else {
-            0.0
-        };
+        let v = Some(self.escape_velocity).filter(|v| v.is_finite()).unwrap_or(0.0);
         let r = 1.1 * biggest.max(v);
         if self.fragments.is_empty() || r <= 0.0 {
             return Err("no fragment velocities to plot".into());
