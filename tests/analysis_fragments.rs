@@ -218,7 +218,7 @@ fn rigid_translation_gives_zero_ejection() {
             ..b.clone()
         })
         .collect();
-    for dv in ejection_velocities(&initial, &at, 3) {
+    for dv in ejection_velocities(&initial, &at, |i| i != 3) {
         assert!(dv.norm() < 1e-12, "{dv:?}");
     }
 }
@@ -239,7 +239,7 @@ fn single_kick_minus_barycentre_shift() {
     at[1].velocity += kick;
     at[3].velocity += w; // the projectile's change must not move the target barycentre
     let shift = kick * masses[1] / m_t;
-    let dv = ejection_velocities(&initial, &at, 3);
+    let dv = ejection_velocities(&initial, &at, |i| i != 3);
     let expected = [-shift, kick - shift, -shift, w - shift];
     for (got, want) in dv.iter().zip(expected) {
         assert!((got - want).norm() < 1e-12, "{got:?} vs {want:?}");

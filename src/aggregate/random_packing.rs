@@ -134,15 +134,13 @@ pub struct Insert {
     pub clear_radius: f64,
 }
 
-/// The settled heap: centres about its centre of mass (m), radii (m), and which grains came from the insert.
+/// The settled heap: centres about its centre of mass (m) and radii (m).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Heap {
     /// Centres (m).
     pub centres: Vec<Vec3>,
     /// Radii (m).
     pub radii: Vec<f64>,
-    /// Whether each grain came from the [`Insert`].
-    pub inserted: Vec<bool>,
     /// The stages.
     pub stages: Vec<StageLog>,
 }
@@ -221,6 +219,12 @@ pub(crate) fn particles(centres: &[Vec3], radii: &[f64], rho: f64) -> Vec<Partic
             spin: Vec3::zeros(),
         })
         .collect()
+}
+
+fn at_rest(ps: &mut [Particle]) {
+    for p in ps.iter_mut() {
+        (p.velocity, p.spin) = (Vec3::zeros(), Vec3::zeros());
+    }
 }
 
 fn recentre(ps: &mut [Particle]) {
@@ -371,10 +375,7 @@ pub fn random_heap(
     let before = ps.len();
     ps.retain(|p| p.position.norm() + p.radius <= container);
     let dropped = before - ps.len();
-    for p in ps.iter_mut() {
-        p.velocity = Vec3::zeros();
-        p.spin = Vec3::zeros();
-    }
+    at_rest(&mut ps);
     let amplitude = recipe.shake_amplitude * r_mean;
     let omega = (recipe.shake_gamma * recipe.shake_g / amplitude).sqrt();
     let period = std::f64::consts::TAU / omega;
@@ -428,7 +429,6 @@ pub fn random_heap(
     // optional insert (the HCP core of RCPC)
     let mut ps = sys.particles;
     recentre(&mut ps);
-    let mut inserted = vec![false; ps.len()];
     if let Some(ins) = insert {
         let keep = |p: &Particle| {
             p.position.norm() >= ins.clear_radius
@@ -439,17 +439,12 @@ pub fn random_heap(
                     .all(|(c, r)| (p.position - c).norm() >= p.radius + r)
         };
         ps.retain(keep);
-        inserted = vec![false; ps.len()];
         ps.extend(particles(&ins.centres, &ins.radii, rho));
-        inserted.extend(std::iter::repeat_n(true, ins.centres.len()));
     }
 
     // 4. settle under self-gravity alone, from rest
     let n = ps.len();
-    for p in ps.iter_mut() {
-        p.velocity = Vec3::zeros();
-        p.spin = Vec3::zeros();
-    }
+    at_rest(&mut ps);
     let k_settle = 10.0 * loads.k_n(0.0, p_c, recipe.settle_overlap);
     let dt = loads.dt(k_settle, recipe.steps_per_contact);
     let t_ff_pile = (3.0 * PI / (32.0 * SI_G * rho_packed)).sqrt();
@@ -481,7 +476,6 @@ pub fn random_heap(
     Some(Heap {
         centres: ps.iter().map(|p| p.position).collect(),
         radii: ps.iter().map(|p| p.radius).collect(),
-        inserted,
         stages,
     })
 }

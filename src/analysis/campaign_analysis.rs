@@ -170,8 +170,7 @@ pub fn analyze_campaign(
         w.serialize(r).map_err(|e| werr(&e))?;
     }
     w.into_inner().map_err(|e| werr(&e))?.finish().map_err(|e| werr(&e))?;
-    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    crate::analysis::run_analysis::write_text(&json_path, &text)?;
+    crate::analysis::run_analysis::write_json(&json_path, &analysis)?;
     // here rather than in the CLI, so every caller (analyze-campaign, report roig2003) gets them
     let (_, not_drawn) = crate::analysis::figures::write_campaign_figures(dir, &analysis);
     for why in &not_drawn {

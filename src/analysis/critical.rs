@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::analysis::creep::{CreepCriterion, CreepCriterionKind, HoldDrift, HoldRates};
+use crate::analysis::creep::{CreepCriterion, CreepCriterionKind, HoldDrift, HoldRates, RateFit};
 use crate::analysis::spinup_diagnostics::SpinupSample;
 
 /// Why a search or a fit could not be made: bad options or inputs (the caller's), or a run or file that failed.
@@ -252,18 +252,7 @@ pub fn judge_series(
             drifting,
         }
     };
-    let (paper, paper_tolerance, ours) = (
-        verdict(&criteria.paper),
-        verdict(&criteria.paper_tolerance),
-        verdict(&criteria.ours),
-    );
-    let chosen = match selected {
-        CreepCriterionKind::Paper => &paper,
-        CreepCriterionKind::PaperTolerance => &paper_tolerance,
-        CreepCriterionKind::Ours => &ours,
-    }
-    .clone();
-    HoldVerdict {
+    let mut judged = HoldVerdict {
         t_final_hours,
         dir,
         hold_s: t.last().copied().unwrap_or(0.0).min(end),
@@ -272,13 +261,16 @@ pub fn judge_series(
         drift,
         rates: Some(rates),
         theta_max_deg,
-        paper: Some(paper),
-        paper_tolerance,
-        ours,
-        drifting: chosen.drifting,
-        stable: chosen.stable,
+        paper: Some(verdict(&criteria.paper)),
+        paper_tolerance: verdict(&criteria.paper_tolerance),
+        ours: verdict(&criteria.ours),
+        drifting: Vec::new(),
+        stable: false,
         record_needed_s,
-    }
+    };
+    let chosen = judged.verdict(selected).expect("every criterion judged").clone();
+    (judged.drifting, judged.stable) = (chosen.drifting, chosen.stable);
+    judged
 }
 
 /// Reads the `holds.csv` of a search's compact copy (`analysis/zhang2017/compact.py --search`: `t_final_h`,
@@ -507,37 +499,26 @@ pub const CRITICAL_CSV_HEADER: &str = "t_final_h,hold_s,released,release_s,theta
 /// value is empty).
 pub fn critical_csv(runs: &[HoldVerdict]) -> String {
     let mut out = CRITICAL_CSV_HEADER.to_string();
-    let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or(String::new(), f);
     for r in runs {
-        let q = r.rates;
-        let rate = |f: fn(&HoldRates) -> crate::analysis::creep::RateFit, se: bool| {
-            opt(
-                q.map(|q| {
-                    let x = f(&q);
-                    if se { x.se_per_ks } else { x.rate_per_ks }
-                }),
-                &|v| format!("{v:.6e}"),
-            )
-        };
+        // the rate and its standard error of each diagnostic (six empty cells without rates)
+        let rates = r.rates.map_or(",,,,,".to_string(), |q| {
+            let cells = [q.theta_max_deg, q.packing, q.coordination]
+                .map(|x| format!("{:.6e},{:.6e}", x.rate_per_ks, x.se_per_ks));
+            cells.join(",")
+        });
         let verdict = |v: Option<&CriterionVerdict>| {
             v.map_or(",".to_string(), |v| format!("{},{}", v.stable, v.drifting.join(";")))
         };
         out += &format!(
-            "{:.2},{:.1},{},{},{:.3},{:.4},{:.6},{:.4},{},{},{},{},{},{},{},{},{}\n",
+            "{:.2},{:.1},{},{},{:.3},{:.4},{:.6},{:.4},{rates},{},{},{}\n",
             r.t_final_hours,
             r.hold_s,
             r.released,
-            opt(r.release_s, &|v| format!("{v:.1}")),
+            r.release_s.map_or(String::new(), |v| format!("{v:.1}")),
             r.theta_max_deg,
             r.drift.theta_max_deg,
             r.drift.packing,
             r.drift.coordination,
-            rate(|q| q.theta_max_deg, false),
-            rate(|q| q.theta_max_deg, true),
-            rate(|q| q.packing, false),
-            rate(|q| q.packing, true),
-            rate(|q| q.coordination, false),
-            rate(|q| q.coordination, true),
             verdict(r.paper.as_ref()),
             verdict(Some(&r.paper_tolerance)),
             verdict(Some(&r.ours)),
@@ -562,14 +543,7 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
             CRITICAL_CSV_HEADER.trim()
         ));
     }
-    let columns: Vec<&str> = if v1 {
-        CRITICAL_CSV_HEADER_V1
-    } else {
-        CRITICAL_CSV_HEADER
-    }
-    .trim()
-    .split(',')
-    .collect();
+    let columns: Vec<&str> = header.unwrap_or_default().split(',').collect();
     let mut out = Vec::new();
     for (k, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
         let at = |col: &str| format!("line {}: column {col}", k + 2);
@@ -588,13 +562,7 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
                 .parse::<f64>()
                 .map_err(|_| format!("{}: not a number", at(col)))
         };
-        let opt_num = |col: &str| -> Result<Option<f64>, String> {
-            if cell(col).is_empty() {
-                Ok(None)
-            } else {
-                num(col).map(Some)
-            }
-        };
+        let opt_num = |col: &str| (!cell(col).is_empty()).then(|| num(col)).transpose();
         let flag = |col: &str| {
             cell(col)
                 .parse::<bool>()
@@ -621,20 +589,15 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
         let (paper, paper_tolerance, rates, hold_s, release_s) = if v1 {
             (None, verdict("paper")?, None, f64::NAN, None)
         } else {
-            let fit = |name: &str| -> Result<Option<crate::analysis::creep::RateFit>, String> {
-                Ok(
-                    match (
-                        opt_num(&format!("rate_{name}_per_ks"))?,
-                        opt_num(&format!("se_{name}_per_ks"))?,
-                    ) {
-                        (Some(rate_per_ks), Some(se_per_ks)) => Some(crate::analysis::creep::RateFit {
-                            rate_per_ks,
-                            se_per_ks,
-                            samples: 0,
-                        }),
-                        _ => None,
-                    },
-                )
+            let fit = |name: &str| -> Result<Option<RateFit>, String> {
+                let rate = opt_num(&format!("rate_{name}_per_ks"))?;
+                let se = opt_num(&format!("se_{name}_per_ks"))?;
+                let fit = |(rate_per_ks, se_per_ks)| RateFit {
+                    rate_per_ks,
+                    se_per_ks,
+                    samples: 0,
+                };
+                Ok(rate.zip(se).map(fit))
             };
             let rates = match (fit("theta_max_deg")?, fit("packing")?, fit("coordination")?) {
                 (Some(theta_max_deg), Some(packing), Some(coordination)) => Some(HoldRates {
@@ -644,11 +607,9 @@ pub fn read_critical_csv(text: &str) -> Result<Vec<HoldVerdict>, String> {
                 }),
                 _ => None,
             };
-            let paper = if cell("paper_stable").is_empty() {
-                None
-            } else {
-                Some(verdict("paper")?)
-            };
+            let paper = (!cell("paper_stable").is_empty())
+                .then(|| verdict("paper"))
+                .transpose()?;
             (
                 paper,
                 verdict("paper_tolerance")?,

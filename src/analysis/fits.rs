@@ -384,14 +384,9 @@ pub fn fit_spin_histogram(centres: &[f64], counts: &[f64], n: Option<f64>) -> Re
     if mean <= 0.0 {
         return Err(FitError::InvalidInput("histogram mean must be > 0".into()));
     }
-    let options = LmOptions::default();
-    let (n0, fixed_fit) = match n {
-        Some(v) => (v, None),
-        None => (1.0, Some(fit_spin_histogram(centres, counts, Some(1.0))?)),
-    };
-    let (a0, b0) = match &fixed_fit {
-        Some(f) => (f.a, f.b),
-        None => {
+    // parameters (a, b) with n fixed, (a, b, n) with n free
+    let p0 = match n {
+        Some(n0) => {
             let b0 = mean * gamma(0.5 * (n0 + 1.0)) / gamma(0.5 * (n0 + 2.0));
             let (mut num, mut den) = (0.0, 0.0);
             for (&x, &c) in centres.iter().zip(counts) {
@@ -399,31 +394,24 @@ pub fn fit_spin_histogram(centres: &[f64], counts: &[f64], n: Option<f64>) -> Re
                 num += c * g;
                 den += g * g;
             }
-            (if den > 0.0 { num / den } else { total }, b0)
-        }
-    };
-
-    let lm = match n {
-        Some(nf) => {
-            let model = move |x: f64, p: &[f64]| spin_model(x, p[0], p[1], nf);
-            let jac = move |x: f64, p: &[f64], d: &mut [f64]| {
-                let g = spin_model(x, 1.0, p[1], nf);
-                d[0] = g;
-                d[1] = p[0] * g * 2.0 * x * x / (p[1] * p[1] * p[1]);
-            };
-            levenberg_marquardt(centres, counts, None, &[a0, b0], &model, Some(&jac), &options)?
+            vec![if den > 0.0 { num / den } else { total }, b0]
         }
         None => {
-            let model = |x: f64, p: &[f64]| spin_model(x, p[0], p[1], p[2]);
-            let jac = |x: f64, p: &[f64], d: &mut [f64]| {
-                let g = spin_model(x, 1.0, p[1], p[2]);
-                d[0] = g;
-                d[1] = p[0] * g * 2.0 * x * x / (p[1] * p[1] * p[1]);
-                d[2] = if x > 0.0 { p[0] * g * x.ln() } else { 0.0 };
-            };
-            levenberg_marquardt(centres, counts, None, &[a0, b0, n0], &model, Some(&jac), &options)?
+            let fixed = fit_spin_histogram(centres, counts, Some(1.0))?;
+            vec![fixed.a, fixed.b, 1.0]
         }
     };
+    let n_of = |p: &[f64]| n.unwrap_or_else(|| p[2]);
+    let model = |x: f64, p: &[f64]| spin_model(x, p[0], p[1], n_of(p));
+    let jac = |x: f64, p: &[f64], d: &mut [f64]| {
+        let g = spin_model(x, 1.0, p[1], n_of(p));
+        d[0] = g;
+        d[1] = p[0] * g * 2.0 * x * x / (p[1] * p[1] * p[1]);
+        if n.is_none() {
+            d[2] = if x > 0.0 { p[0] * g * x.ln() } else { 0.0 };
+        }
+    };
+    let lm = levenberg_marquardt(centres, counts, None, &p0, &model, Some(&jac), &LmOptions::default())?;
     let p = &lm.parameters;
     let (a, b) = (p[0], p[1].abs());
     let (n_fit, sigma_n) = match n {

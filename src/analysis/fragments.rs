@@ -312,33 +312,24 @@ pub fn binding_energies(g: f64, bodies: &[Body]) -> Vec<f64> {
     u
 }
 
-/// Mass-weighted mean velocity of the bodies for which `include(index)` holds.
-fn mean_position(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
-    let (mut r, mut m) = (Vec3::zeros(), 0.0);
+/// Mass-weighted mean of `f(body)` over the bodies for which `include(index)` holds.
+fn mass_mean(bodies: &[Body], include: impl Fn(usize) -> bool, f: impl Fn(&Body) -> Vec3) -> Vec3 {
+    let (mut sum, mut m) = (Vec3::zeros(), 0.0);
     for (_, b) in bodies.iter().enumerate().filter(|(i, _)| include(*i)) {
-        r += b.position * b.shape.mass;
+        sum += f(b) * b.shape.mass;
         m += b.shape.mass;
     }
-    r / m
+    sum / m
 }
 
 fn mean_velocity(bodies: &[Body], include: impl Fn(usize) -> bool) -> Vec3 {
-    let (mut p, mut m) = (Vec3::zeros(), 0.0);
-    for (_, b) in bodies.iter().enumerate().filter(|(i, _)| include(*i)) {
-        p += b.velocity * b.shape.mass;
-        m += b.shape.mass;
-    }
-    p / m
+    mass_mean(bodies, include, |b| b.velocity)
 }
 
-/// Ejection velocities `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]` of all bodies, `V_T` the target
-/// barycentre velocity (projectile excluded). Panics if the snapshots differ in length; NaN without a target body.
-pub fn ejection_velocities(initial: &[Body], at: &[Body], projectile: usize) -> Vec<Vec3> {
-    ejection_velocities_of(initial, at, |i| i != projectile)
-}
-
-/// [`ejection_velocities`] with the target bodies those for which `is_target(index)` holds.
-fn ejection_velocities_of(initial: &[Body], at: &[Body], is_target: impl Fn(usize) -> bool + Copy) -> Vec<Vec3> {
+/// Ejection velocities `Δv_i = [v_i(t_at) − V_T(t_at)] − [v_i(0) − V_T(0)]` of all bodies, `V_T` the barycentre
+/// velocity of the target bodies, those for which `is_target(index)` holds. Panics if the snapshots differ in
+/// length; NaN without a target body.
+pub fn ejection_velocities(initial: &[Body], at: &[Body], is_target: impl Fn(usize) -> bool + Copy) -> Vec<Vec3> {
     assert_eq!(initial.len(), at.len(), "snapshots differ in size");
     let v0 = mean_velocity(initial, is_target);
     let v1 = mean_velocity(at, is_target);
@@ -379,33 +370,26 @@ pub fn analyse_fragments(
     let is_projectile = |i: usize| (p..p + pc).contains(&i);
     let is_target = |i: usize| !is_projectile(i);
 
-    let target_mass: f64 = at
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| is_target(*i))
-        .map(|(_, b)| b.shape.mass)
-        .sum();
-    let target_volume: f64 = at
-        .iter()
-        .enumerate()
-        .filter(|(i, _)| is_target(*i))
-        .map(|(_, b)| b.shape.volume())
-        .sum();
+    let target_sum = |f: fn(&Body) -> f64| -> f64 {
+        let targets = at.iter().enumerate().filter(|(i, _)| is_target(*i));
+        targets.map(|(_, b)| f(b)).sum()
+    };
+    let (target_mass, target_volume) = (target_sum(|b| b.shape.mass), target_sum(|b| b.shape.volume()));
     let target_radius = (3.0 * target_volume / (4.0 * std::f64::consts::PI)).cbrt();
 
     let v_sys0 = mean_velocity(initial, |_| true);
     let v_sys = mean_velocity(at, |_| true);
     let v_target0 = mean_velocity(initial, is_target);
-    let dv = ejection_velocities_of(initial, at, is_target);
+    let dv = ejection_velocities(initial, at, is_target);
     let binding = binding_energies(params.g, at);
-    let centre0 = mean_position(initial, is_target);
+    let centre0 = mass_mean(initial, is_target, |b| b.position);
     // A single projectile's own position and velocity (bit for bit as before); a pile's barycentre.
     let (projectile_position0, projectile_velocity0, projectile_mass) = if pc == 1 {
         (initial[p].position, initial[p].velocity, initial[p].shape.mass)
     } else {
         let mass = initial[p..p + pc].iter().map(|b| b.shape.mass).sum();
         (
-            mean_position(initial, is_projectile),
+            mass_mean(initial, is_projectile, |b| b.position),
             mean_velocity(initial, is_projectile),
             mass,
         )

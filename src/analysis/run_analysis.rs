@@ -361,8 +361,7 @@ pub fn analyze_run(
     let sizes: Vec<f64> = target.iter().map(|f| f.size).collect();
     let speeds: Vec<f64> = target.iter().map(|f| f.ejection_speed).collect();
     let spins: Vec<f64> = target.iter().map(|f| f.spin_rate_corrected).collect();
-    let bins = ((target.len() as f64).sqrt().round() as usize).clamp(5, 40);
-    let spin_histogram = histogram(&spins, bins, None).unwrap_or_default();
+    let (spin_histogram, spin_fits) = spin_histogram_fits(&spins);
     let masses: Vec<f64> = target.iter().map(|f| f.mass).collect();
     let analysis = RunAnalysis {
         t_at,
@@ -370,16 +369,11 @@ pub fn analyze_run(
         summary: report.summary.clone(),
         ejection_speed_vs_size: Fit::from(fit_power_law(&sizes, &speeds)),
         spin_vs_size: Fit::from(fit_power_law(&sizes, &spins)),
-        spin_fits: Fit::from(compare_exponents(
-            &spin_histogram.0,
-            &spin_histogram.1,
-            &[0.5, 1.0, 1.5, 2.0],
-        )),
+        spin_fits,
         spin_histogram,
         spin_likelihood: Fit::from(fit_spin_likelihood(&spins, Weights::Number)),
         spin_likelihood_by_mass: Fit::from(fit_spin_likelihood(&spins, Weights::Mass(&masses))),
         composition: pile_range.and_then(|r| {
-            let kappa_i = scene.model.inertia.inertia_kappa(kappa);
             let members: Vec<Vec<usize>> = clump_report.clumps.iter().map(|c| c.members.clone()).collect();
             composition(&at, r, &members, g, |b| b.shape.principal_moments(kappa_i))
         }),
@@ -392,14 +386,18 @@ pub fn analyze_run(
         write_composition_csv(&out_dir.join("composition.csv"), c)?;
     }
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
-    let text = serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n";
-    write_text(&json_path, &text)?;
+    write_json(&json_path, &analysis)?;
     Ok((analysis, report))
 }
 
 /// Writes `text` to `path` atomically, never through a link ([`crate::io::safe_write`]).
 pub(crate) fn write_text(path: &Path, text: &str) -> Result<(), AnalysisError> {
     crate::io::safe_write::write_atomic(path, text).map_err(|e| AnalysisError::write(path, &e))
+}
+
+/// Writes `value` to `path` as pretty-printed JSON with a final newline ([`write_text`]).
+pub(crate) fn write_json(path: &Path, value: &impl serde::Serialize) -> Result<(), AnalysisError> {
+    write_text(path, &(serde_json::to_string_pretty(value).unwrap_or_default() + "\n"))
 }
 
 /// Whether `dir` holds an impact run (its `impact.json`, from `rubblepile impact`, a campaign or `run` of the
@@ -499,10 +497,7 @@ pub fn analyze_clumps_run(
     };
     crate::io::safe_write::ensure_dir(&out_dir).map_err(|e| AnalysisError::write(&out_dir, &e))?;
     write_text(&out_dir.join("clumps.csv"), &analysis.clump_report.csv())?;
-    write_text(
-        &json_path,
-        &(serde_json::to_string_pretty(&analysis).unwrap_or_default() + "\n"),
-    )?;
+    write_json(&json_path, &analysis)?;
     Ok(analysis)
 }
 
@@ -523,62 +518,38 @@ fn write_composition_csv(path: &Path, c: &Composition) -> Result<(), AnalysisErr
 
 /// `fragments.csv`: one row per body.
 fn write_fragments_csv(path: &Path, report: &FragmentReport) -> Result<(), AnalysisError> {
-    let err = |e: &dyn std::fmt::Display| AnalysisError::read(path, e);
-    let file = crate::io::safe_write::AtomicFile::create(path).map_err(|e| err(&crate::io::safe_write::reason(&e)))?;
-    let mut w = csv::Writer::from_writer(file);
-    w.write_record([
-        "index",
-        "is_projectile",
-        "mass",
-        "equivalent_radius",
-        "size",
-        "dvx",
-        "dvy",
-        "dvz",
-        "ejection_speed",
-        "kinetic_energy",
-        "rotational_energy",
-        "binding_energy",
-        "escaping",
-        "spin_rate",
-        "spin_rate_corrected",
-        "effective_inertia",
-        "rotation_mode_measure",
-        "rotation_mode",
-        "impact_site_cosine",
-    ])
-    .map_err(|e| err(&e))?;
-    let num = |x: f64| format!("{x:e}");
-    let opt = |x: Option<f64>| x.map_or_else(String::new, num);
+    let mut text = String::from(
+        "index,is_projectile,mass,equivalent_radius,size,dvx,dvy,dvz,ejection_speed,kinetic_energy,rotational_energy,\
+         binding_energy,escaping,spin_rate,spin_rate_corrected,effective_inertia,rotation_mode_measure,rotation_mode,\
+         impact_site_cosine\n",
+    );
+    let opt = |x: Option<f64>| x.map_or_else(String::new, |x| format!("{x:e}"));
     for f in &report.fragments {
         let mode = serde_json::to_value(f.rotation_mode)
             .ok()
             .and_then(|v| v.as_str().map(str::to_string))
             .unwrap_or_default();
-        w.write_record([
-            f.index.to_string(),
-            f.is_projectile.to_string(),
-            num(f.mass),
-            num(f.equivalent_radius),
-            num(f.size),
-            num(f.ejection_velocity[0]),
-            num(f.ejection_velocity[1]),
-            num(f.ejection_velocity[2]),
-            num(f.ejection_speed),
-            num(f.kinetic_energy),
-            num(f.rotational_energy),
-            num(f.binding_energy),
-            f.escaping.to_string(),
-            num(f.spin_rate),
-            num(f.spin_rate_corrected),
+        let [dvx, dvy, dvz] = f.ejection_velocity;
+        text += &format!(
+            "{},{},{:e},{:e},{:e},{dvx:e},{dvy:e},{dvz:e},{:e},{:e},{:e},{:e},{},{:e},{:e},{},{},{mode},{:e}\n",
+            f.index,
+            f.is_projectile,
+            f.mass,
+            f.equivalent_radius,
+            f.size,
+            f.ejection_speed,
+            f.kinetic_energy,
+            f.rotational_energy,
+            f.binding_energy,
+            f.escaping,
+            f.spin_rate,
+            f.spin_rate_corrected,
             opt(f.effective_inertia),
             opt(f.rotation_mode_measure),
-            mode,
-            num(f.impact_site_cosine),
-        ])
-        .map_err(|e| err(&e))?;
+            f.impact_site_cosine,
+        );
     }
-    w.into_inner().map_err(|e| err(&e))?.finish().map_err(|e| err(&e))
+    write_text(path, &text)
 }
 
 /// One analysed run of a campaign (a row of `campaign_runs.csv`). Exponents and fit results are empty when the
@@ -819,6 +790,14 @@ impl SpinSelection {
     }
 }
 
+/// The histogram of the spin rates `spins` (√N bins, 5 to 40) and its fits of Eq. 44 for n ∈ {0.5, 1, 1.5, 2}.
+fn spin_histogram_fits(spins: &[f64]) -> ((Vec<f64>, Vec<f64>), Fit<ExponentComparison>) {
+    let bins = ((spins.len() as f64).sqrt().round() as usize).clamp(5, 40);
+    let hist = histogram(spins, bins, None).unwrap_or_default();
+    let fits = Fit::from(compare_exponents(&hist.0, &hist.1, &[0.5, 1.0, 1.5, 2.0]));
+    (hist, fits)
+}
+
 /// One [`SpinDistribution`] per projectile with runs on `target` (in order of first appearance), of those runs at ζ =
 /// `angle_deg` (degrees), or at every angle when there are none, from their target fragments' corrected spin rates
 /// (`spins[k]` belongs to `runs[k]`).
@@ -851,9 +830,7 @@ pub fn spin_distributions(
                 (case, format!("target {target} at zeta {angle_deg}"))
             };
             let pooled: Vec<f64> = chosen.iter().flat_map(|&k| spins[k].iter().copied()).collect();
-            let bins = ((pooled.len() as f64).sqrt().round() as usize).clamp(5, 40);
-            let hist = histogram(&pooled, bins, None).unwrap_or_default();
-            let fits = Fit::from(compare_exponents(&hist.0, &hist.1, &[0.5, 1.0, 1.5, 2.0]));
+            let (hist, fits) = spin_histogram_fits(&pooled);
             SpinDistribution {
                 projectile: p.to_string(),
                 q_erg_per_g: chosen.iter().map(|&k| runs[k].q_erg_per_g).sum::<f64>() / chosen.len() as f64,

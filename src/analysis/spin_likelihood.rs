@@ -314,29 +314,24 @@ pub fn fit_spin_likelihood(omega: &[f64], weights: Weights<'_>) -> Result<SpinLi
         let sigma = s.sigma_at(k);
         let log_l = s.log_l(k, sigma);
         let target = log_l - DELTA_LOG_L_95;
-        let (n_interval, sigma_interval) = if free {
-            let prof_k = |kk: f64| s.log_l(kk, s.sigma_at(kk));
-            let prof_s = |ss: f64| s.log_l(s.k_at(ss), ss);
-            let kl = crossing(prof_k, k, target, true, 1e-300);
-            let kh = crossing(prof_k, k, target, false, 1e12);
-            let sl = crossing(prof_s, sigma, target, true, sigma * 1e-12);
-            let sh = crossing(prof_s, sigma, target, false, sigma * 1e12);
-            (Some([kl - 1.0, kh - 1.0]), [sl, sh])
-        } else {
-            let prof = |ss: f64| s.log_l(k, ss);
-            (
-                None,
-                [
-                    crossing(prof, sigma, target, true, sigma * 1e-12),
-                    crossing(prof, sigma, target, false, sigma * 1e12),
-                ],
-            )
-        };
+        // the profiles: over k with σ at its best; over σ with k at its best (n free) or fixed
+        let prof_k = |kk: f64| s.log_l(kk, s.sigma_at(kk));
+        let prof_s = |ss: f64| s.log_l(if free { s.k_at(ss) } else { k }, ss);
+        let n_interval = free.then(|| {
+            [
+                crossing(prof_k, k, target, true, 1e-300),
+                crossing(prof_k, k, target, false, 1e12),
+            ]
+            .map(|kk| kk - 1.0)
+        });
         LikelihoodFit {
             n: k - 1.0,
             n_interval,
             sigma,
-            sigma_interval,
+            sigma_interval: [
+                crossing(prof_s, sigma, target, true, sigma * 1e-12),
+                crossing(prof_s, sigma, target, false, sigma * 1e12),
+            ],
             b: std::f64::consts::SQRT_2 * sigma,
             log_likelihood: log_l,
             goodness: goodness_of_fit(&s.x, &s.w, &order, effective_samples, k, sigma),

@@ -17,8 +17,9 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::analysis::figures::style::{
-    DATA_COLOUR, FIT_COLOUR, Figure, FigureLog, GUIDE_COLOUR, PlotResult, REFERENCE_COLOUR, SERIES_COLOURS, draw_err,
-    draw_legend, figure_chart, finite_extent, inside_runs, label_style, linear_samples, small_style, write_figure,
+    DATA_COLOUR, FIT_COLOUR, Figure, FigureLog, GUIDE_COLOUR, PlotResult, REFERENCE_COLOUR, SERIES_COLOURS,
+    draw_dashed, draw_err, draw_legend, figure_chart, finite_extent, inside_runs, label_style, linear_samples,
+    small_style, write_figure,
 };
 use crate::analysis::fits::{LineCrossing, LineFit, spin_integral};
 use crate::analysis::run_analysis::{CampaignAnalysis, Fit};
@@ -117,16 +118,11 @@ impl Figure for BoundFractionVsQ {
             .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 2, 3, guide));
         let (a, b) = PAPER_BOUND_FRACTION;
         let paper: Vec<(f64, f64)> = qs.iter().map(|&q| (q, a + b * q)).collect();
-        let reference = REFERENCE_COLOUR.stroke_width(2);
-        for (k, run) in inside_runs(&paper, xr, yr).into_iter().enumerate() {
-            let s = chart
-                .draw_series(DashedLineSeries::new(run, 8, 5, reference))
-                .map_err(draw_err)?;
-            if k == 0 {
-                s.label("Roig et al. (2003): 1.04 − 0.2×10⁻⁹ Q")
-                    .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 3, reference));
-            }
-        }
+        let (reference, name) = (
+            (REFERENCE_COLOUR.stroke_width(2), 8, 5),
+            "Roig et al. (2003): 1.04 − 0.2×10⁻⁹ Q",
+        );
+        draw_dashed(&mut chart, &paper, (xr, yr), reference, name, (20, 6, 3))?;
         if let Some(f) = &self.fit {
             let line: Vec<(f64, f64)> = qs.iter().map(|&q| (q, f.intercept + f.slope * q)).collect();
             for (k, run) in inside_runs(&line, xr, yr).into_iter().enumerate() {
@@ -283,18 +279,9 @@ impl Figure for SpinDistributions {
                 1 => (8, 5),
                 _ => (3, 3),
             };
-            let style = SERIES_COLOURS[k % SERIES_COLOURS.len()].stroke_width(2);
-            for (j, run) in inside_runs(&curve, (0.0, x1), yr).into_iter().enumerate() {
-                let s = chart
-                    .draw_series(DashedLineSeries::new(run, on, off, style))
-                    .map_err(draw_err)?;
-                if j == 0 {
-                    s.label(format!("{}: n = {}, b = {:.3e} {}", f.0, f.1, f.2, self.x_unit))
-                        .legend(move |(x, y)| {
-                            DashedPathElement::new(vec![(x, y), (x + 24, y)], on.min(24), off, style)
-                        });
-                }
-            }
+            let style = (SERIES_COLOURS[k % SERIES_COLOURS.len()].stroke_width(2), on, off);
+            let name = format!("{}: n = {}, b = {:.3e} {}", f.0, f.1, f.2, self.x_unit);
+            draw_dashed(&mut chart, &curve, ((0.0, x1), yr), style, &name, (24, on.min(24), off))?;
         }
         draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }

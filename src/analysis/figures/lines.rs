@@ -136,15 +136,9 @@ where
                     .map_err(draw_err)?
             }
         };
-        let dashed = s.mark == Mark::Dashed;
-        anno.label(&s.label).legend(move |(x, y)| {
-            let style = if dashed {
-                colour.stroke_width(1)
-            } else {
-                colour.stroke_width(2)
-            };
-            PathElement::new(vec![(x, y), (x + 20, y)], style)
-        });
+        let style = colour.stroke_width(if s.mark == Mark::Dashed { 1 } else { 2 });
+        anno.label(&s.label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
     }
     Ok(())
 }

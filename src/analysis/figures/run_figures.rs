@@ -19,8 +19,9 @@ use plotters::prelude::*;
 use crate::analysis::figures::energy::{EnergyInputs, EnergySeries, momentum_scales, read_energy_series};
 use crate::analysis::figures::style::{
     DATA_COLOUR, FIT_COLOUR, Figure, FigureLog, GUIDE_COLOUR, HIGHLIGHT_COLOUR, PlotResult, REFERENCE_COLOUR,
-    SERIES_COLOURS, draw_err, draw_legend, figure_chart, finite_extent, inside_runs, label_style, linear_samples,
-    log_log_chart, log_samples, log_tick, padded, padded_log, small_style, square_margins, title_style, write_figure,
+    SERIES_COLOURS, draw_dashed, draw_err, draw_legend, figure_chart, finite_extent, inside_runs, label_style,
+    linear_samples, log_log_chart, log_samples, log_tick, padded, padded_log, small_style, square_margins, title_style,
+    write_figure,
 };
 use crate::analysis::fits::{PowerLawFit, SpinFit};
 use crate::analysis::fragments::FragmentReport;
@@ -103,16 +104,8 @@ impl Figure for SizeScatter {
             && let Some(c) = self.reference_coefficient(*e, &pts)
         {
             let line: Vec<(f64, f64)> = xs.iter().map(|&x| (x, c * x.powf(*e))).collect();
-            for (k, run) in inside_runs(&line, xr, yr).into_iter().enumerate() {
-                let style = REFERENCE_COLOUR.stroke_width(2);
-                let s = chart
-                    .draw_series(DashedLineSeries::new(run, 8, 5, style))
-                    .map_err(draw_err)?;
-                if k == 0 {
-                    s.label(name.clone())
-                        .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 3, style));
-                }
-            }
+            let style = (REFERENCE_COLOUR.stroke_width(2), 8, 5);
+            draw_dashed(&mut chart, &line, (xr, yr), style, name, (20, 6, 3))?;
         }
         if let Some((h, name)) = &self.horizontal
             && *h > 0.0
@@ -279,24 +272,16 @@ impl SpinHistogram {
 }
 
 /// Draws `curves` (solid or dashed, each with its legend entry) inside the axis ranges.
-fn draw_curves<DB: DrawingBackend>(
-    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+fn draw_curves<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     curves: Vec<Curve>,
     xr: (f64, f64),
     yr: (f64, f64),
 ) -> PlotResult {
     for (name, line, colour, dashed) in curves {
-        let style = colour.stroke_width(2);
         let (on, off) = if dashed { (8, 5) } else { (1000, 0) };
-        for (j, run) in inside_runs(&line, xr, yr).into_iter().enumerate() {
-            let s = chart
-                .draw_series(DashedLineSeries::new(run, on, off, style))
-                .map_err(draw_err)?;
-            if j == 0 {
-                s.label(name.clone())
-                    .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], on.min(20), off, style));
-            }
-        }
+        let style = (colour.stroke_width(2), on, off);
+        draw_dashed(chart, &line, (xr, yr), style, &name, (20, on.min(20), off))?;
     }
     Ok(())
 }
@@ -491,11 +476,7 @@ impl Figure for VelocityField {
             .flat_map(|f| f.0)
             .filter(|x| x.is_finite())
             .fold(0.0, |m: f64, x| m.max(x.abs()));
-        let v = if self.escape_velocity.is_finite() {
-            self.escape_velocity
-        } else {
-            0.0
-        };
+        let v = Some(self.escape_velocity).filter(|v| v.is_finite()).unwrap_or(0.0);
         let r = 1.1 * biggest.max(v);
         if self.fragments.is_empty() || r <= 0.0 {
             return Err("no fragment velocities to plot".into());
@@ -553,19 +534,10 @@ impl EnergyPartition {
         let mut chart = time_log_panel(area, "(a) energy partition", (tr, yr), y_desc, &log_tick)?;
         for (name, values, dash, colour) in curves {
             let pts: Vec<(f64, f64)> = s.t.iter().copied().zip(values.iter().copied()).collect();
-            let style = colour.stroke_width(2);
             // solid, dashed, dash-dotted-like short dashes: the paper's line styles, plus colour
             let (on, off) = [(1000, 0), (8, 5), (3, 3)][dash];
-            for (k, run) in inside_runs(&pts, tr, yr).into_iter().enumerate() {
-                let series = chart
-                    .draw_series(DashedLineSeries::new(run, on, off, style))
-                    .map_err(draw_err)?;
-                if k == 0 {
-                    series.label(name.clone()).legend(move |(x, y)| {
-                        DashedPathElement::new(vec![(x, y), (x + 24, y)], on.min(24), off, style)
-                    });
-                }
-            }
+            let style = (colour.stroke_width(2), on, off);
+            draw_dashed(&mut chart, &pts, (tr, yr), style, &name, (24, on.min(24), off))?;
         }
         draw_legend(&mut chart, SeriesLabelPosition::UpperRight)
     }

@@ -230,6 +230,29 @@ pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .map_err(|e| crate::analysis::AnalysisError::Output(draw_err(e)))
 }
 
+/// Draws the sampled `line` inside the axis ranges ([`inside_runs`]) in `style`, dashed `on` px on and `off` off
+/// (`(1000, 0)`: solid); the first run puts `name` in the legend beside a dashed sample `(length, on, off)` px.
+pub fn draw_dashed<'a, DB: DrawingBackend + 'a, CT: CoordTranslate<From = (f64, f64)>>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    line: &[(f64, f64)],
+    (xr, yr): ((f64, f64), (f64, f64)),
+    (style, on, off): (ShapeStyle, i32, i32),
+    name: &str,
+    (length, sample_on, sample_off): (i32, i32, i32),
+) -> PlotResult {
+    for (k, run) in inside_runs(line, xr, yr).into_iter().enumerate() {
+        let s = chart
+            .draw_series(DashedLineSeries::new(run, on, off, style))
+            .map_err(draw_err)?;
+        if k == 0 {
+            s.label(name).legend(move |(x, y)| {
+                plotters::element::DashedPathElement::new(vec![(x, y), (x + length, y)], sample_on, sample_off, style)
+            });
+        }
+    }
+    Ok(())
+}
+
 /// The smallest and largest of the finite values (`None` without any).
 pub fn finite_extent(values: impl IntoIterator<Item = f64>) -> Option<(f64, f64)> {
     values
