@@ -28,8 +28,8 @@ use crate::ellipsoid::potential::{
     overlap, overlap_within_taper,
 };
 use crate::ellipsoid::quaternion::{
-    extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin, rotation_matrix,
-    rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
+    body_spin, extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin,
+    rotation_matrix, rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
 };
 use crate::ellipsoid::tide::TideTerm;
 use crate::geometry::neighbours::sphere_pairs;
@@ -698,8 +698,7 @@ impl EllipsoidSystem {
             let p = Vec4::new(s[10], s[11], s[12], s[13]);
             let q_dot = inverse_mass_apply(&q, &self.inertia_ext[i], &p);
             let m_inv_q = inverse_mass_apply(&q, &self.inertia_ext[i], &q);
-            let wq = w_matrix(&q) * q_dot;
-            let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
+            let spin_body = body_spin(&q, &q_dot);
             let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
             let rot = geometry.map_or_else(|| rotation_matrix(&q), |g| g.rot);
             Kinematics {
