@@ -21,11 +21,10 @@ use crate::ellipsoid::dissipation_jacobian::{BodyLinear, DissipationJacobian, Pa
 use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
-pub use crate::ellipsoid::gravity_tree::{GravityMethod, TREE_FROM};
-use crate::ellipsoid::gravity_tree::{frozen_tree_gravity_forces, tree_gravity_forces};
+use crate::ellipsoid::gravity_tree::{GravityMethod, frozen_tree_gravity_forces, tree_gravity_forces};
 use crate::ellipsoid::potential::{
-    BodyGeometry, TAPER_WIDTH, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
-    overlap, overlap_within_taper,
+    BodyGeometry, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
+    overlap_within_taper,
 };
 use crate::ellipsoid::quaternion::{
     body_spin, extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin,
@@ -49,7 +48,7 @@ pub const G_SI: f64 = 6.674e-11;
 pub struct GravityTerm {
     /// Gravitational constant G (m³ kg⁻¹ s⁻²); SI default [`G_SI`].
     pub g: f64,
-    /// Exact pair sum or octree ([`GravityMethod`]; default: exact below [`TREE_FROM`] bodies).
+    /// Exact pair sum or octree ([`GravityMethod`]; default [`GravityMethod::Auto`]: the tree from 5000 bodies).
     pub method: GravityMethod,
 }
 
@@ -230,7 +229,7 @@ struct CandidatePair {
     j: usize,
     /// `U0_ij m_i m_j (κ/π)^{3/2}` (J m³), see [`pair_prefactor`].
     prefactor: f64,
-    /// The far-pair taper ([`EllipsoidSystem::pair_taper`]).
+    /// The far-pair taper ([`Taper::for_pair`]).
     taper: Taper,
 }
 
@@ -298,8 +297,8 @@ pub struct EllipsoidSystem {
     physics: Physics,
     rotation: bool,
     stride: usize,
-    /// `−ln(cutoff)`, where each pair's taper starts above its contact exponent κλ.
-    neg_ln_cutoff: f64,
+    /// The contact term's relative cutoff: each pair's taper starts `−ln(cutoff)` above its contact exponent κλ.
+    cutoff: f64,
     cull_exp: f64,
     /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
     /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
@@ -483,7 +482,7 @@ impl EllipsoidSystem {
             physics,
             rotation,
             stride: if rotation { 14 } else { 6 },
-            neg_ln_cutoff: -cutoff.ln(),
+            cutoff,
             cull_exp: max_cull_exponent(model.kappa, cutoff),
             pair_cache: std::sync::Mutex::new(None),
             scratch: std::sync::Mutex::new(RhsScratch::default()),
@@ -845,16 +844,7 @@ impl EllipsoidSystem {
                 self.radii[j],
                 self.shapes[j].mass,
             ),
-            taper: self.pair_taper(i, j),
-        }
-    }
-
-    /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
-    fn pair_taper(&self, i: usize, j: usize) -> Taper {
-        let start = self.model.kappa * lambda(self.radii[i], self.radii[j]) + self.neg_ln_cutoff;
-        Taper {
-            start,
-            end: start + TAPER_WIDTH,
+            taper: Taper::for_pair(self.cutoff, self.model.kappa * lambda(self.radii[i], self.radii[j])),
         }
     }
 
@@ -958,7 +948,7 @@ impl EllipsoidSystem {
             census.exponent_evaluated += 1;
             if let Some(ov) = overlap_within_taper(c.prefactor, kappa, &delta, gi, gj, &c.taper) {
                 census.interacting += 1;
-                if ov.exponent <= c.taper.start - self.neg_ln_cutoff {
+                if ov.exponent <= c.taper.start + self.cutoff.ln() {
                     census.touching += 1;
                 }
             }

@@ -19,7 +19,7 @@ use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
 use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem, Physics};
-use crate::ellipsoid::output::{TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
+use crate::ellipsoid::output::{TIMESERIES_COLUMNS, TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
@@ -35,10 +35,8 @@ use crate::phase::{Kind, Phase};
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
 
-pub use crate::ellipsoid::output::TIMESERIES_COLUMNS;
-
 /// Running maxima of the conservation errors (absolute; made relative at the end), as stored in checkpoints.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ErrorTracker {
     #[serde(with = "exact_f64")]
     h0: f64,
@@ -78,13 +76,7 @@ impl ErrorTracker {
             l0: [d0.angular_momentum.x, d0.angular_momentum.y, d0.angular_momentum.z],
             scales0: s,
             scales_max: s,
-            energy: 0.0,
-            momentum: 0.0,
-            angular: 0.0,
-            quaternion: 0.0,
-            samples: 0,
-            tidal_impulse: 0.0,
-            tidal_torque_impulse: 0.0,
+            ..ErrorTracker::default()
         }
     }
 

@@ -14,12 +14,11 @@ use serde::{Deserialize, Serialize};
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
-pub use crate::ellipsoid::tide::FlybySpec;
-use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
+use crate::ellipsoid::tide::{FlybySpec, TideTerm, resolve_flyby};
 use crate::integrate::Method;
-use crate::io::scene_file::{MAX_BODIES, MIN_MEANINGFUL, Validator, WORK_WARNING_STEPS, exact, fmt_list, fmt_num};
-pub use crate::io::scene_file::{
-    MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
+use crate::io::scene_file::{
+    MAX_BODIES, MIN_MEANINGFUL, MIN_RTOL, SI_G, SceneError, Validator, WORK_WARNING_STEPS, exact, fmt_list, fmt_num,
+    parse_toml_as, read_scene_text,
 };
 use crate::math::{Vec3, Vec4};
 
@@ -671,19 +670,20 @@ impl Validator<'_> {
     /// after the bodies ([`Validator::kappa_section`]), since calibration needs them.
     fn model_section(&self, m: &ModelSection) -> Result<(), SceneError> {
         match (m.kappa, m.calibrate) {
-            (Some(_), Some(_)) => {
-                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got both"));
-            }
-            (None, None) => {
-                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got neither"));
-            }
             (Some(k), None) => self.kappa_value("model.kappa", k)?,
             (None, Some(c)) => {
                 self.field(&CalibrateSpec::BETA, c.beta)?;
                 self.field(&CalibrateSpec::V, c.v)?;
             }
+            (k, _) => return Err(self.exactly_one("model", "kappa", "calibrate", k.is_some())),
         }
         Ok(())
+    }
+
+    /// The error of `field`, which needs exactly one of the keys `a` and `b`, when it got `both` or neither.
+    pub(crate) fn exactly_one(&self, field: impl Into<String>, a: &str, b: &str, both: bool) -> SceneError {
+        let got = if both { "both" } else { "neither" };
+        self.invalid(field, format!("give exactly one of `{a}` or `{b}`, got {got}"))
     }
 
     /// κ in (1.5, [`MAX_KAPPA`]].
@@ -1204,12 +1204,7 @@ impl Validator<'_> {
                 }
                 m
             }
-            (Some(_), Some(_)) => {
-                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got both"));
-            }
-            (None, None) => {
-                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got neither"));
-            }
+            (m, _) => return Err(self.exactly_one(b.label.clone(), "mass", "density", m.is_some())),
         };
         // Moments of inertia m/(2κ) (B²+C², C²+A², A²+B²) (Roig03 Eq. 4): the smallest is at least
         // m (B²+C²)/(2 MAX_KAPPA), the largest at most m (A²+B²)/3. Both must be normal numbers: the equations of
