@@ -272,7 +272,7 @@ const CANDIDATES_PER_TASK: usize = 64;
 const PARALLEL_BODIES: usize = 64;
 
 /// Bodies per thread at least ([`EllipsoidSystem::useful_threads`]): with fewer, joining a parallel pass costs more
-/// than the thread's share of it (the N200 impact runs faster on 8 threads than on 16; `analysis/scaling/NOTES.md`).
+/// than the thread's share of it.
 pub const BODIES_PER_THREAD: usize = 25;
 
 // Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).

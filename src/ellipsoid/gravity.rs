@@ -10,16 +10,14 @@ use rayon::prelude::*;
 /// Above this many bodies the parallel row-wise sum is used.
 pub const PARALLEL_THRESHOLD: usize = 256;
 
-/// Rows of the half loop are cut into [`blocks`] blocks of about equal work, each summed into its own buffer
-/// and reduced in block order: the bits do not depend on the number of threads (they depend on N only).
-/// Fewest blocks: what systems below 512 bodies always used (their bits are those of every earlier run).
+/// Fewest blocks of the half loop (rows cut into [`blocks`] blocks of about equal work, each summed into its own
+/// buffer and reduced in block order, so the bits depend on N only, not on the number of threads).
 const MIN_BLOCKS: usize = 8;
 
 /// Most blocks: each costs a force buffer of N entries, and the per-body sum adds them all.
 const MAX_BLOCKS: usize = 64;
 
-/// Bodies per block: 2000 bodies make 31 blocks, about two per thread on 16 threads, so that no thread idles in the
-/// gravity pass (`analysis/scaling/NOTES.md`).
+/// Bodies per block: about two blocks per thread on 16 threads at 2000 bodies, so that no thread idles.
 const BODIES_PER_BLOCK: usize = 64;
 
 /// The number of blocks of the half loop over `n` bodies: `n / 64`, between 8 and 64.

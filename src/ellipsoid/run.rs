@@ -330,11 +330,10 @@ impl EllipsoidEngine {
         let mut integrator = make_integrator(settings.method, tolerances, settings.step)
             .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         // The error budget is the run's: rtol bounds the accumulated error, not each step's. Not with tree
-        // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`;
-        // Bulirsch-Stoer and Dop853 do; Dop853 controls each step's error anyway): freshly walked forces jump (by about the multipole error, 1e-4) wherever a
-        // body's interaction list changes, a step's share h/T of rtol falls below those jumps on long runs, and
-        // Bulirsch-Stoer without frozen lists accepted no 1 s step in a minute (N2000 impact,
-        // analysis/n2000/REPORT.md). There each step's error is bounded by rtol (ODEX's rule).
+        // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`):
+        // freshly walked forces jump (by about the multipole error) wherever a body's interaction list changes,
+        // and a step's share h/T of rtol falls below those jumps on long runs. There each step's error is bounded
+        // by rtol (ODEX's rule).
         if system.forces_are_smooth()
             || matches!(settings.method, Method::BulirschStoer | Method::BulirschStoerImplicit)
         {

@@ -197,8 +197,7 @@ pub struct GravitySpec {
     #[field(meaning = "exact O(N^2) sum, Barnes-Hut tree, or exact below 5000 bodies and tree from there")]
     pub method: Option<GravityMethodSpec>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]): a node is used whole beyond `side/θ` from a
-    /// body. Default 0.5 (RMS relative force error 2.6e-4 against the exact sum on 2000 ellipsoids). Ignored by
-    /// `"direct"`.
+    /// body. Default 0.5. Ignored by `"direct"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "0.5", range = open_closed(0.0, crate::ellipsoid::gravity_tree::MAX_THETA))]
     #[field(meaning = "tree opening angle: a node is used whole beyond side/theta; ignored by \"direct\"")]
@@ -249,19 +248,13 @@ pub struct DissipationSpec {
 #[scene(table = "integrator")]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
-    /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
-    /// (adaptive Dormand–Prince), `"rk4"` (fixed step; needs `step`, and takes no `rtol` or `atol`) or
+    /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice; the default), `"dop853"`, `"dopri5"`
+    /// (adaptive Dormand–Prince), `"rk4"` (fixed step; needs `step`, takes no `rtol` or `atol`) or
     /// `"bulirsch-stoer-implicit"` (linearly implicit Euler extrapolation, [`crate::integrate::linearly_implicit`],
-    /// with the dissipation's analytic Jacobian, [`crate::ellipsoid::dissipation_jacobian`]). Default
-    /// `"bulirsch-stoer"`.
-    ///
-    /// **When to use the implicit method.** The dissipation damps a touching pair at the rate
-    /// `2 F0 U_C / μ` (s⁻¹; `μ` the reduced mass, `U_C` the pair's contact energy, about
-    /// `G m_i m_j / (2κλ (R_i + R_j))` at contact by Roig03 Eq. 11), and an explicit method must resolve that time
-    /// scale. Once it exceeds the contact's own frequency (the pair is overdamped: sticking regimes, large `F0`)
-    /// the implicit method's steps follow the motion instead; below it (soft contacts, Roig03's F0 = 1e-6 s m⁻²)
-    /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
-    /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
+    /// with the dissipation's analytic Jacobian, [`crate::ellipsoid::dissipation_jacobian`]). The implicit method
+    /// pays when the dissipation damps a touching pair (at the rate `2 F0 U_C / μ`, μ the reduced mass) faster than
+    /// its contact oscillates (overdamped, sticking regimes): an explicit method must resolve the damping time.
+    /// Below that (Roig03's F0 = 1e-6 s m⁻²) `"bulirsch-stoer"` is cheaper per unit of accuracy.
     #[serde(default)]
     #[field(unit = "text", default = "\"bulirsch-stoer\"")]
     #[field(range = Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""))]
@@ -271,13 +264,11 @@ pub struct IntegratorSection {
                    advises it)"
     )]
     pub method: Method,
-    /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
-    /// is judged in the units a user thinks in (position in m, velocity in m/s, spin in rad/s, attitude as a
-    /// unit quaternion, dissipated energy relative to the initial energy scale), whatever its mass. With
-    /// `"bulirsch-stoer"` and `"bulirsch-stoer-implicit"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
-    /// quarter of it (error per unit step), so the final error follows `rtol`; the other methods apply it to each
-    /// step. In `[1e-15, 1)` ([`MIN_RTOL`]); only for the adaptive methods (refused with `"rk4"`, which has no
-    /// error control).
+    /// Relative tolerance (dimensionless, in `[1e-15, 1)`, [`MIN_RTOL`]). Default 1e-10. The error norm is
+    /// scale-free: every state is judged in the units a user thinks in (m, m/s, rad/s, a unit quaternion, the
+    /// dissipated energy relative to the initial energy scale), whatever the body's mass. With the two
+    /// Bulirsch–Stoer methods it bounds the whole run's error (the local errors to `t_end` add up to about a
+    /// quarter of it); the other methods apply it to each step. Refused with `"rk4"`, which has no error control.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "1e-10", range = closed_open(MIN_RTOL, 1.0))]
     #[field(meaning = "relative tolerance of the adaptive methods (refused with \"rk4\")")]
@@ -297,11 +288,9 @@ pub struct IntegratorSection {
     pub step: Option<f64>,
     /// Whether to pull the attitudes back onto `|q| = 1` at every output sample (`true`/`false`; see
     /// [`crate::ellipsoid::equations::EllipsoidSystem::project_attitudes`]). Default: `true` for `"dop853"`,
-    /// `"dopri5"` and `"rk4"`, whose error norm lets one fast-spinning body's `|q|` drift by 1e-3 within a few
-    /// hundred turns (the N2000 impact, `analysis/n2000/REPORT.md`); `false` for `"bulirsch-stoer"`, which keeps
-    /// the constraint without it (1.3e-6 over that impact) and whose runs stay as they were, and for
-    /// `"bulirsch-stoer-implicit"`, which controls the error in the same run-wide norm. The run's
-    /// `quaternion_norm_error` is the largest `||q| − 1|` before projection, and above 1e-3 it still stops the run.
+    /// `"dopri5"` and `"rk4"`, whose per-step error norm lets a fast-spinning body's `|q|` drift; `false` for the
+    /// two Bulirsch–Stoer methods, whose run-wide error norm keeps the constraint. The run's
+    /// `quaternion_norm_error` is the largest `||q| − 1|` before projection; above 1e-3 it still stops the run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "bool", default = "true (false for bulirsch-stoer)", range = Rule("true | false"))]
     #[field(meaning = "pull the attitudes back onto |q| = 1 at every output sample")]
@@ -533,13 +522,12 @@ struct RawBody {
 
 /// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
 /// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
-/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
+/// half is left for `G m_i m_j (R_i + R_j)²`.
 pub const MAX_KAPPA: f64 = 175.0;
 
 /// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
 /// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
-/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
-/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
+/// monopole gravity near its singularity); relaxed piles touch and overlap only slightly.
 pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
 
 // The numbers written into the rows' words, held to the constants they restate.
@@ -552,9 +540,8 @@ const _: () = assert!(crate::ellipsoid::gravity_tree::DEFAULT_THETA == 0.5);
 pub const STEPS_PER_TIME_SCALE: f64 = 10.0;
 
 /// The ratio of contact period to damping time above which `rubblepile check` advises
-/// `integrator.method = "bulirsch-stoer-implicit"` ([`contact_stiffness`]). At 10 an explicit method spends at least
-/// ten times the steps the contact needs; the stiff work–precision diagrams (`analysis/work_precision/REPORT.md`)
-/// show the implicit method ahead at the pile's F0 = 1e-2 and not at 1e-6.
+/// `integrator.method = "bulirsch-stoer-implicit"` ([`contact_stiffness`]): at 10 an explicit method spends at least
+/// ten times the steps the contact needs.
 pub const STIFF_ADVICE_RATIO: f64 = 10.0;
 
 /// The stiffest body of a scene's contacts ([`contact_stiffness`]).
@@ -1102,7 +1089,7 @@ impl Validator<'_> {
     /// damping time `τ = 4κR / (F0 G m)` (`targets/README.md`, "Choosing κ and F0"); when `T/τ` exceeds
     /// [`STIFF_ADVICE_RATIO`] for some body and the method is an explicit one, one line naming the body, both times
     /// and the ratio. Deeper overlaps (impacts) raise the contact weight `U_C` and with it the ratio, so a scene
-    /// below the threshold at rest may still be stiff during an impact (the N200 impact at F0 = 1e-4 s m⁻²).
+    /// below the threshold at rest may still be stiff during an impact.
     fn stiffness_advice(
         &self,
         bodies: &[Body],
