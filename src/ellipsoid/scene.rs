@@ -7,13 +7,13 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{Quaternion, UnitQuaternion};
 use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
+use crate::ellipsoid::quaternion::to_unit_quaternion;
 use crate::ellipsoid::tide::{FlybySpec, TideTerm, resolve_flyby};
 use crate::integrate::Method;
 use crate::io::scene_file::{
@@ -297,9 +297,8 @@ pub struct IntegratorSection {
     pub project_attitudes: Option<bool>,
 }
 
-fn default_tolerance() -> f64 {
-    1e-10
-}
+/// Default `rtol` and `atol`.
+const DEFAULT_TOLERANCE: f64 = 1e-10;
 
 /// `[output]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
@@ -738,7 +737,7 @@ impl Validator<'_> {
     /// `[integrator]`: method, tolerances (`rtol` in [[`MIN_RTOL`], 1), `atol` finite and ≥ 0; adaptive methods
     /// only), the fixed step of `"rk4"` (≥ `t_end ×` [`crate::io::scene_file::MIN_STEP_FRACTION`]; `"rk4"` only).
     fn integrator_section(&self, i: &IntegratorSection, t_end: f64) -> Result<IntegratorSettings, SceneError> {
-        let rtol = i.rtol.unwrap_or_else(default_tolerance);
+        let rtol = i.rtol.unwrap_or(DEFAULT_TOLERANCE);
         if !IntegratorSection::RTOL.range.contains(rtol) {
             return Err(self.invalid(
                 IntegratorSection::RTOL.key,
@@ -749,7 +748,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
+        let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or(DEFAULT_TOLERANCE))?;
         let step = i.step.map(|h| self.step("integrator.step", h, t_end)).transpose()?;
         if i.method == Method::Rk4 {
             if step.is_none() {
@@ -1310,8 +1309,7 @@ impl Validator<'_> {
 ///
 /// R(q) is the transpose of nalgebra's rotation matrix of the unit quaternion `δ + α i + β j + γ k`.
 pub fn world_to_body(q: &Vec4, v: &Vec3) -> Vec3 {
-    let uq = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    uq.to_rotation_matrix().matrix().transpose() * v
+    to_unit_quaternion(q).to_rotation_matrix().matrix().transpose() * v
 }
 
 #[cfg(test)]
