@@ -364,13 +364,6 @@ impl Candidates {
     }
 }
 
-impl std::ops::Deref for Candidates {
-    type Target = [CandidatePair];
-    fn deref(&self) -> &[CandidatePair] {
-        &self.pairs
-    }
-}
-
 impl PairCache {
     fn build(
         centres: &[Vec3],
@@ -627,6 +620,7 @@ impl EllipsoidSystem {
         let kin = self.all_kinematics(y, true);
         let candidates = self.candidate_pairs(&kin);
         let pairs = candidates
+            .pairs
             .iter()
             .filter_map(|c| {
                 let (gi, gj) = (kin[c.i].geometry.as_ref()?, kin[c.j].geometry.as_ref()?);
@@ -915,14 +909,15 @@ impl EllipsoidSystem {
         let terms = |c: &CandidatePair| self.pair_terms(c, kin, with_forces);
         // The exact cull runs in the same parallel pass as the pair terms (one fork-join, not two); rayon's
         // collect keeps the candidates' order.
-        if candidates.len() >= PARALLEL_CANDIDATES {
+        if candidates.pairs.len() >= PARALLEL_CANDIDATES {
             candidates
+                .pairs
                 .par_iter()
                 .with_min_len(CANDIDATES_PER_TASK)
                 .filter_map(terms)
                 .collect()
         } else {
-            candidates.iter().filter_map(terms).collect()
+            candidates.pairs.iter().filter_map(terms).collect()
         }
     }
 
@@ -935,11 +930,11 @@ impl EllipsoidSystem {
         let kin = self.all_kinematics(y, true);
         let candidates = self.candidate_pairs(&kin);
         let mut census = PairCensus {
-            candidates: candidates.len(),
+            candidates: candidates.pairs.len(),
             ..PairCensus::default()
         };
         let kappa = self.model.kappa;
-        for c in candidates.iter() {
+        for c in &candidates.pairs {
             let (gi, gj) = (kin[c.i].geometry.as_ref().unwrap(), kin[c.j].geometry.as_ref().unwrap());
             let delta = kin[c.i].r - kin[c.j].r;
             if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
@@ -1202,7 +1197,7 @@ impl OdeSystem for EllipsoidSystem {
                 return;
             }
             let candidates = PHASE_CANDIDATES.time(|| self.candidate_pairs(kin));
-            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates, kin, blocks, slots));
+            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates.pairs, kin, blocks, slots));
             dissipation_rate = if n >= PARALLEL_BODIES && rayon::current_num_threads() > 1 {
                 PHASE_PAIR_SUM_PARALLEL.time(|| sum_pair_terms(&candidates, blocks, slots, force, torque))
             } else {
