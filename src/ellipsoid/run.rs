@@ -722,6 +722,10 @@ impl Engine for EllipsoidEngine {
         let settings = scene.integrator;
         let stats = self.integrator.stats();
         let scales = self.tracker.scales();
+        let calibration = match scene.kappa_source {
+            KappaSource::Given => None,
+            KappaSource::Calibrated { beta, v, reading } => Some(CalibrationSummary { beta, v, reading }),
+        };
         let (status, final_time) = match outcome {
             Outcome::Completed => ("completed".to_string(), self.t),
             Outcome::Failed(f) => (f.cause.clone(), self.last_good.0),
@@ -755,14 +759,8 @@ impl Engine for EllipsoidEngine {
             scales,
             samples: self.tracker.samples,
             kappa: scene.model.kappa,
-            kappa_source: match scene.kappa_source {
-                KappaSource::Given => "given".into(),
-                KappaSource::Calibrated { .. } => "calibrated".into(),
-            },
-            calibration: match scene.kappa_source {
-                KappaSource::Given => None,
-                KappaSource::Calibrated { beta, v, reading } => Some(CalibrationSummary { beta, v, reading }),
-            },
+            kappa_source: if calibration.is_some() { "calibrated" } else { "given" }.into(),
+            calibration,
             inertia: match scene.model.inertia {
                 InertiaModel::Gaussian => "gaussian".into(),
                 InertiaModel::Uniform => "uniform".into(),

@@ -867,25 +867,18 @@ impl Validator<'_> {
         let (kappa, kappa_source) = match (m.kappa, m.calibrate) {
             (Some(k), _) => (k, KappaSource::Given),
             (None, Some(c)) => {
-                let small = bodies
-                    .iter()
-                    .min_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
-                    .expect("at least one body (checked above)");
-                let large = bodies
-                    .iter()
-                    .max_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
-                    .expect("at least one body (checked above)");
-                let k = calibrate_kappa_read(
-                    c.reading,
-                    c.beta,
-                    c.v,
-                    (small.shape.equivalent_radius(), small.shape.mass),
-                    (large.shape.equivalent_radius(), large.shape.mass),
-                    contact_g,
-                )
-                .map_err(|source| SceneError::Calibration {
-                    file: self.file.to_string(),
-                    message: source.to_string(),
+                let by_mass = |a: &&Body, b: &&Body| a.shape.mass.total_cmp(&b.shape.mass);
+                let radius_mass = |b: Option<&Body>| {
+                    let b = b.expect("at least one body (checked above)");
+                    (b.shape.equivalent_radius(), b.shape.mass)
+                };
+                let small = radius_mass(bodies.iter().min_by(by_mass));
+                let large = radius_mass(bodies.iter().max_by(by_mass));
+                let k = calibrate_kappa_read(c.reading, c.beta, c.v, small, large, contact_g).map_err(|source| {
+                    SceneError::Calibration {
+                        file: self.file.to_string(),
+                        message: source.to_string(),
+                    }
                 })?;
                 if !(k.is_finite() && k > 1.5) {
                     return Err(self.invalid("model.calibrate", format!("calibration gave kappa = {k}, need > 1.5")));
