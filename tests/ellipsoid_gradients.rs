@@ -640,3 +640,14 @@ fn pair_prefactor_equals_eq11_form() {
         assert!((pair_prefactor(G, k, ri, mi, rj, mj) / direct - 1.0).abs() < 1e-12);
     }
 }
+
+/// `∂R/∂q_k` for k = α, β, γ, δ (each linear in q).
+fn rotation_matrix_derivatives(q: &Vec4) -> [Mat3; 4] {
+    let (a, b, g, d) = (q.x, q.y, q.z, q.w);
+    [
+        2.0 * Mat3::new(2.0 * a, b, g, b, 0.0, d, g, -d, 0.0),
+        2.0 * Mat3::new(0.0, a, -d, a, 2.0 * b, g, d, g, 0.0),
+        2.0 * Mat3::new(0.0, d, a, -d, 0.0, b, a, b, 2.0 * g),
+        2.0 * Mat3::new(2.0 * d, g, -b, -g, 2.0 * d, a, b, -a, 2.0 * d),
+    ]
+}

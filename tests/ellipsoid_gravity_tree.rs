@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use rubblepile::ellipsoid::equations::{EllipsoidSystem, GravityMethod};
+use rubblepile::ellipsoid::equations::EllipsoidSystem;
 use rubblepile::ellipsoid::gravity::gravity_forces;
-use rubblepile::ellipsoid::gravity_tree::{DEFAULT_THETA, tree_gravity_forces};
+use rubblepile::ellipsoid::gravity_tree::{DEFAULT_THETA, GravityMethod, tree_gravity_forces};
 use rubblepile::ellipsoid::output::read_bodies_csv;
 use rubblepile::ellipsoid::scene::parse_scene;
 use rubblepile::integrate::{Method, OdeSystem, Tolerances, make_integrator};

@@ -90,15 +90,6 @@ impl KappaReading {
         }
     }
 
-    /// The mass `M_K` (kg) of `K = ½ M_K v²` for a pair of masses `m_small ≤ m_large` (kg).
-    pub fn kinetic_mass(self, m_small: f64, m_large: f64) -> f64 {
-        match self {
-            KappaReading::Printed => m_large,
-            KappaReading::Impactor => m_small,
-            KappaReading::Reduced => m_small * m_large / (m_small + m_large),
-        }
-    }
-
     /// `"printed"`, `"impactor"` or `"reduced"` (the scene and command-line spelling).
     pub fn as_str(self) -> &'static str {
         match self {
@@ -200,6 +191,18 @@ pub fn calibrate_kappa(
         Ok(kappa)
     } else {
         Err(unreachable())
+    }
+}
+
+#[cfg(test)]
+impl KappaReading {
+    /// The mass `M_K` (kg) of `K = ½ M_K v²` for a pair of masses `m_small ≤ m_large` (kg).
+    pub(crate) fn kinetic_mass(self, m_small: f64, m_large: f64) -> f64 {
+        match self {
+            KappaReading::Printed => m_large,
+            KappaReading::Impactor => m_small,
+            KappaReading::Reduced => m_small * m_large / (m_small + m_large),
+        }
     }
 }
 

@@ -18,7 +18,7 @@ use std::ops::{AddAssign, SubAssign};
 use nalgebra::{SMatrix, SVector};
 
 use crate::ellipsoid::potential::{BodyGeometry, Overlap};
-use crate::ellipsoid::quaternion::{inverse_mass_apply, w_matrix};
+use crate::ellipsoid::quaternion::{body_spin, inverse_mass_apply, w_matrix};
 use crate::integrate::linearly_implicit::StiffSolve;
 use crate::math::{Mat3, Vec3, Vec4};
 
@@ -64,8 +64,7 @@ impl BodyLinear {
 
     /// `B`: the world spin `Rᵀ 2 W₃ M⁻¹ p` of the quaternion momentum `p` (rad/s).
     fn spin_of(&self, p: &Vec4) -> Vec3 {
-        let wq = w_matrix(&self.q) * inverse_mass_apply(&self.q, &self.inertia_ext, p);
-        self.rot.transpose() * (2.0 * Vec3::new(wq.x, wq.y, wq.z))
+        self.rot.transpose() * body_spin(&self.q, &inverse_mass_apply(&self.q, &self.inertia_ext, p))
     }
 
     /// `C`: the quaternion momentum rate `Π 2 W₃ᵀ R τ` of a torque `τ` conjugate to the world spin.
@@ -145,8 +144,6 @@ pub struct DissipationJacobian {
     pairs: Vec<PairLinear>,
     /// `Σ` of the pairs' diagonal 6 × 6 blocks of `D` per body (for the preconditioner).
     diagonal: Vec<Mat6>,
-    /// Conjugate-gradient iterations over all solves (for benchmarks).
-    iterations: u64,
 }
 
 impl DissipationJacobian {
@@ -164,18 +161,7 @@ impl DissipationJacobian {
             bodies,
             pairs,
             diagonal,
-            iterations: 0,
         }
-    }
-
-    /// Number of dissipating pairs (the 12 × 12 blocks of `D`).
-    pub fn pairs(&self) -> usize {
-        self.pairs.len()
-    }
-
-    /// Conjugate-gradient iterations over all solves so far.
-    pub fn iterations(&self) -> u64 {
-        self.iterations
     }
 
     /// `D v` (forces and torques conjugate to `V`, 6 per body), summed over the pairs in their order.
@@ -300,7 +286,6 @@ impl StiffSolve for DissipationJacobian {
             }
             it += 1;
         }
-        self.iterations += it as u64;
         // x_P = b_P − h C D v, then the kinematic rows x_r = b_r + h x_u/m, x_q = b_q + h M⁻¹ x_p.
         self.apply_d(&x, &mut scratch);
         for (i, (f, body)) in scratch.iter().zip(&self.bodies).enumerate() {
@@ -326,6 +311,11 @@ impl StiffSolve for DissipationJacobian {
 /// Dense forms of the Jacobian, for the unit tests of `ellipsoid::equations`.
 #[cfg(test)]
 impl DissipationJacobian {
+    /// Number of dissipating pairs (the 12 × 12 blocks of `D`).
+    pub(crate) fn pairs(&self) -> usize {
+        self.pairs.len()
+    }
+
     /// The momentum-space Jacobian `J = −C D B` as a dense `dim × dim` matrix over the whole state (`dim` the
     /// system's dimension; rows and columns other than the momenta are zero). For tests on small systems.
     pub(crate) fn dense(&self, dim: usize) -> nalgebra::DMatrix<f64> {

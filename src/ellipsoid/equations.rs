@@ -21,15 +21,14 @@ use crate::ellipsoid::dissipation_jacobian::{BodyLinear, DissipationJacobian, Pa
 use crate::ellipsoid::gravity::{
     BLOCKED_FROM, add_gravity_forces, add_gravity_forces_packed, gravity_blocks, gravity_forces,
 };
-pub use crate::ellipsoid::gravity_tree::{GravityMethod, TREE_FROM};
-use crate::ellipsoid::gravity_tree::{frozen_tree_gravity_forces, tree_gravity_forces};
+use crate::ellipsoid::gravity_tree::{GravityMethod, frozen_tree_gravity_forces, tree_gravity_forces};
 use crate::ellipsoid::potential::{
-    BodyGeometry, TAPER_WIDTH, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent,
-    overlap, overlap_within_taper,
+    BodyGeometry, Taper, contact_spin_gradient, interaction_radius, is_negligible, max_cull_exponent, overlap,
+    overlap_within_taper,
 };
 use crate::ellipsoid::quaternion::{
-    extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin, rotation_matrix,
-    rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
+    body_spin, extended_inertia, from_unit_quaternion, inverse_mass_apply, mass_matrix, q_dot_from_body_spin,
+    rotation_matrix, rotational_kinetic_gradient, to_unit_quaternion, w_matrix,
 };
 use crate::ellipsoid::tide::TideTerm;
 use crate::geometry::neighbours::sphere_pairs;
@@ -49,7 +48,7 @@ pub const G_SI: f64 = 6.674e-11;
 pub struct GravityTerm {
     /// Gravitational constant G (m³ kg⁻¹ s⁻²); SI default [`G_SI`].
     pub g: f64,
-    /// Exact pair sum or octree ([`GravityMethod`]; default: exact below [`TREE_FROM`] bodies).
+    /// Exact pair sum or octree ([`GravityMethod`]; default [`GravityMethod::Auto`]: the tree from 5000 bodies).
     pub method: GravityMethod,
 }
 
@@ -230,7 +229,7 @@ struct CandidatePair {
     j: usize,
     /// `U0_ij m_i m_j (κ/π)^{3/2}` (J m³), see [`pair_prefactor`].
     prefactor: f64,
-    /// The far-pair taper ([`EllipsoidSystem::pair_taper`]).
+    /// The far-pair taper ([`Taper::for_pair`]).
     taper: Taper,
 }
 
@@ -273,7 +272,7 @@ const CANDIDATES_PER_TASK: usize = 64;
 const PARALLEL_BODIES: usize = 64;
 
 /// Bodies per thread at least ([`EllipsoidSystem::useful_threads`]): with fewer, joining a parallel pass costs more
-/// than the thread's share of it (the N200 impact runs faster on 8 threads than on 16; `analysis/scaling/NOTES.md`).
+/// than the thread's share of it.
 pub const BODIES_PER_THREAD: usize = 25;
 
 // Where an evaluation's time goes (`rubblepile bench scaling`; see [`crate::phase`]).
@@ -298,8 +297,8 @@ pub struct EllipsoidSystem {
     physics: Physics,
     rotation: bool,
     stride: usize,
-    /// `−ln(cutoff)`, where each pair's taper starts above its contact exponent κλ.
-    neg_ln_cutoff: f64,
+    /// The contact term's relative cutoff: each pair's taper starts `−ln(cutoff)` above its contact exponent κλ.
+    cutoff: f64,
     cull_exp: f64,
     /// Verlet list of candidate pairs, reused while no body has moved more than its skin (see
     /// [`PairCache`]); a cache only: the pairs used at a state never depend on it.
@@ -362,13 +361,6 @@ impl Candidates {
             }
         }
         Candidates { pairs, start, members }
-    }
-}
-
-impl std::ops::Deref for Candidates {
-    type Target = [CandidatePair];
-    fn deref(&self) -> &[CandidatePair] {
-        &self.pairs
     }
 }
 
@@ -483,7 +475,7 @@ impl EllipsoidSystem {
             physics,
             rotation,
             stride: if rotation { 14 } else { 6 },
-            neg_ln_cutoff: -cutoff.ln(),
+            cutoff,
             cull_exp: max_cull_exponent(model.kappa, cutoff),
             pair_cache: std::sync::Mutex::new(None),
             scratch: std::sync::Mutex::new(RhsScratch::default()),
@@ -628,6 +620,7 @@ impl EllipsoidSystem {
         let kin = self.all_kinematics(y, true);
         let candidates = self.candidate_pairs(&kin);
         let pairs = candidates
+            .pairs
             .iter()
             .filter_map(|c| {
                 let (gi, gj) = (kin[c.i].geometry.as_ref()?, kin[c.j].geometry.as_ref()?);
@@ -698,8 +691,7 @@ impl EllipsoidSystem {
             let p = Vec4::new(s[10], s[11], s[12], s[13]);
             let q_dot = inverse_mass_apply(&q, &self.inertia_ext[i], &p);
             let m_inv_q = inverse_mass_apply(&q, &self.inertia_ext[i], &q);
-            let wq = w_matrix(&q) * q_dot;
-            let spin_body = 2.0 * Vec3::new(wq.x, wq.y, wq.z);
+            let spin_body = body_spin(&q, &q_dot);
             let geometry = with_geometry.then(|| BodyGeometry::new(&self.shapes[i].axes, &q));
             let rot = geometry.map_or_else(|| rotation_matrix(&q), |g| g.rot);
             Kinematics {
@@ -846,16 +838,7 @@ impl EllipsoidSystem {
                 self.radii[j],
                 self.shapes[j].mass,
             ),
-            taper: self.pair_taper(i, j),
-        }
-    }
-
-    /// The far-pair taper of a pair (see [`crate::ellipsoid::potential`]).
-    fn pair_taper(&self, i: usize, j: usize) -> Taper {
-        let start = self.model.kappa * lambda(self.radii[i], self.radii[j]) + self.neg_ln_cutoff;
-        Taper {
-            start,
-            end: start + TAPER_WIDTH,
+            taper: Taper::for_pair(self.cutoff, self.model.kappa * lambda(self.radii[i], self.radii[j])),
         }
     }
 
@@ -926,14 +909,15 @@ impl EllipsoidSystem {
         let terms = |c: &CandidatePair| self.pair_terms(c, kin, with_forces);
         // The exact cull runs in the same parallel pass as the pair terms (one fork-join, not two); rayon's
         // collect keeps the candidates' order.
-        if candidates.len() >= PARALLEL_CANDIDATES {
+        if candidates.pairs.len() >= PARALLEL_CANDIDATES {
             candidates
+                .pairs
                 .par_iter()
                 .with_min_len(CANDIDATES_PER_TASK)
                 .filter_map(terms)
                 .collect()
         } else {
-            candidates.iter().filter_map(terms).collect()
+            candidates.pairs.iter().filter_map(terms).collect()
         }
     }
 
@@ -946,11 +930,11 @@ impl EllipsoidSystem {
         let kin = self.all_kinematics(y, true);
         let candidates = self.candidate_pairs(&kin);
         let mut census = PairCensus {
-            candidates: candidates.len(),
+            candidates: candidates.pairs.len(),
             ..PairCensus::default()
         };
         let kappa = self.model.kappa;
-        for c in candidates.iter() {
+        for c in &candidates.pairs {
             let (gi, gj) = (kin[c.i].geometry.as_ref().unwrap(), kin[c.j].geometry.as_ref().unwrap());
             let delta = kin[c.i].r - kin[c.j].r;
             if is_negligible(kappa, &delta, gi, gj, c.taper.end) {
@@ -959,7 +943,7 @@ impl EllipsoidSystem {
             census.exponent_evaluated += 1;
             if let Some(ov) = overlap_within_taper(c.prefactor, kappa, &delta, gi, gj, &c.taper) {
                 census.interacting += 1;
-                if ov.exponent <= c.taper.start - self.neg_ln_cutoff {
+                if ov.exponent <= c.taper.start + self.cutoff.ln() {
                     census.touching += 1;
                 }
             }
@@ -1213,7 +1197,7 @@ impl OdeSystem for EllipsoidSystem {
                 return;
             }
             let candidates = PHASE_CANDIDATES.time(|| self.candidate_pairs(kin));
-            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates, kin, blocks, slots));
+            PHASE_PAIR_FORCES.time(|| self.pair_forces_into(&candidates.pairs, kin, blocks, slots));
             dissipation_rate = if n >= PARALLEL_BODIES && rayon::current_num_threads() > 1 {
                 PHASE_PAIR_SUM_PARALLEL.time(|| sum_pair_terms(&candidates, blocks, slots, force, torque))
             } else {

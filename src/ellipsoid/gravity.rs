@@ -10,16 +10,14 @@ use rayon::prelude::*;
 /// Above this many bodies the parallel row-wise sum is used.
 pub const PARALLEL_THRESHOLD: usize = 256;
 
-/// Rows of the half loop are cut into [`blocks`] blocks of about equal work, each summed into its own buffer
-/// and reduced in block order: the bits do not depend on the number of threads (they depend on N only).
-/// Fewest blocks: what systems below 512 bodies always used (their bits are those of every earlier run).
+/// Fewest blocks of the half loop (rows cut into [`blocks`] blocks of about equal work, each summed into its own
+/// buffer and reduced in block order, so the bits depend on N only, not on the number of threads).
 const MIN_BLOCKS: usize = 8;
 
 /// Most blocks: each costs a force buffer of N entries, and the per-body sum adds them all.
 const MAX_BLOCKS: usize = 64;
 
-/// Bodies per block: 2000 bodies make 31 blocks, about two per thread on 16 threads, so that no thread idles in the
-/// gravity pass (`analysis/scaling/NOTES.md`).
+/// Bodies per block: about two blocks per thread on 16 threads at 2000 bodies, so that no thread idles.
 const BODIES_PER_BLOCK: usize = 64;
 
 /// The number of blocks of the half loop over `n` bodies: `n / 64`, between 8 and 64.
@@ -143,13 +141,16 @@ pub fn add_gravity_forces(g: f64, positions: &[Vec3], masses: &[f64], forces: &m
     }
     let mut blocks = Vec::new();
     gravity_blocks(g, positions, masses, &mut blocks);
-    add_gravity_blocks(&blocks, forces);
+    for block in blocks {
+        for (f, p) in forces.iter_mut().zip(block) {
+            *f += p;
+        }
+    }
 }
 
 /// The blocked half loop of [`add_gravity_forces`] (for [`BLOCKED_FROM`] bodies or more) without the final
-/// sum, into `blocks` (its buffers reused): one force buffer per block, computed in parallel. Adding the
-/// buffers to the other forces in block order ([`add_gravity_blocks`], or per body) gives the bits of
-/// [`add_gravity_forces`]; split so that a caller can compute the blocks while it computes the other forces.
+/// sum, into `blocks` (its buffers reused): one force buffer per block, computed in parallel. Adding them to the
+/// other forces in block order gives the bits of [`add_gravity_forces`], while the caller computes those forces.
 pub fn gravity_blocks(g: f64, positions: &[Vec3], masses: &[f64], blocks: &mut Vec<Vec<Vec3>>) {
     let n = positions.len();
     let bounds = block_bounds(n);
@@ -160,15 +161,6 @@ pub fn gravity_blocks(g: f64, positions: &[Vec3], masses: &[f64], blocks: &mut V
         out.resize(n, Vec3::zeros());
         half_loop(g, &columns, masses, bounds[b]..bounds[b + 1], out);
     });
-}
-
-/// Adds the buffers of [`gravity_blocks`] to `forces`, in block order.
-pub fn add_gravity_blocks(blocks: &[Vec<Vec3>], forces: &mut [Vec3]) {
-    for block in blocks {
-        for (f, p) in forces.iter_mut().zip(block) {
-            *f += p;
-        }
-    }
 }
 
 /// Gravitational forces `−∂U_G/∂r_i` (N) on each body, and the total potential `U_G` (J).

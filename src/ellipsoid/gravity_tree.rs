@@ -4,25 +4,18 @@
 //!
 //! The tree treats each ellipsoid as a point mass at its centre, exactly as Eq. 6 does, so the only error is
 //! the multipole truncation of far groups, set by the opening angle θ. Its sums are done per body in a fixed
-//! order (the octree's buckets are independent), so the forces do not depend on the number of threads. Tree
-//! forces are not exactly pairwise: momentum and energy are conserved only to the force error (measured in
-//! `analysis/n2000/REPORT.md`).
-//!
-//! [`GravityMethod::Auto`] (the default) uses the exact sum below [`TREE_FROM`] bodies and the tree from
-//! there on: the threshold and [`DEFAULT_THETA`] are measured (`rubblepile bench rhs --gravity direct,tree`,
-//! and the RMS error test `tests/ellipsoid_gravity_tree.rs`).
+//! order, so the forces do not depend on the number of threads. Tree forces are not exactly pairwise: momentum
+//! and energy are conserved only to the force error. [`GravityMethod::Auto`] (the default) uses the exact sum
+//! below [`TREE_FROM`] bodies and the tree from there on.
 
 use crate::gravity::octree::{FrozenOctree, Octree};
 use crate::math::Vec3;
 
-/// Default opening angle θ (dimensionless): `tests/ellipsoid_gravity_tree.rs` bounds the RMS relative force error
-/// against the exact sum by 1e-3 and the potential's by 1e-4 (the errors found: `analysis/n2000/NOTES.md`).
+/// Default opening angle θ (dimensionless; `tests/ellipsoid_gravity_tree.rs` bounds its RMS force error by 1e-3).
 pub const DEFAULT_THETA: f64 = 0.5;
 
-/// Bodies from which [`GravityMethod::Auto`] uses the tree. Below it the exact blocked pair sum costs at most
-/// about what the tree saves, and it is exactly pairwise; under Bulirsch–Stoer the tree's lists are fixed per step
-/// ([`crate::gravity::octree::FrozenOctree`]), but at 2000 bodies that was both slower than the exact sum and less
-/// accurate in energy (`analysis/n2000/REPORT.md`, `analysis/n2000/NOTES.md`).
+/// Bodies from which [`GravityMethod::Auto`] uses the tree: below it the exact blocked pair sum costs at most
+/// about what the tree saves, and it is exactly pairwise.
 pub const TREE_FROM: usize = 5000;
 
 /// Largest opening angle accepted (dimensionless): above `2/√3` a node could be used whole for a point inside

@@ -7,6 +7,7 @@ use std::path::Path;
 use crate::ellipsoid::body::Body;
 use crate::engine::{MOMENTUM_COLUMNS, column_names};
 use crate::io::fmt_f64;
+use crate::io::scene_file::one_line;
 
 /// Columns of a snapshot (and of a bodies file): time (s), body index, mass (kg), semi-axes A, B, C
 /// (m), position (m), velocity (m/s), quaternion `(α, β, γ, δ)` (scalar last), body-frame spin (rad/s).
@@ -201,9 +202,10 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
     let bad_header = |message: String| BodiesFileError::Format { line: 1, message };
     let headers = r
         .headers()
-        .map_err(|e| bad_header(format!("bad header: {}", one_line_csv(&e))))?
+        .map_err(|e| bad_header(format!("bad header: {}", one_line(&e.to_string()))))?
         .clone();
     let required = &SNAPSHOT_COLUMNS[2..];
+    let expected = SNAPSHOT_COLUMNS.join(",");
     let mut index = [usize::MAX; 17];
     for (pos, name) in headers.iter().enumerate() {
         if name == "t" || name == "id" {
@@ -212,14 +214,10 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         match required.iter().position(|&c| c == name) {
             Some(k) if index[k] == usize::MAX => index[k] = pos,
             Some(_) => return Err(bad_header(format!("column `{name}` appears twice"))),
-            None => {
-                let expected = SNAPSHOT_COLUMNS.join(",");
-                return Err(bad_header(format!("unknown column `{name}`; expected {expected}")));
-            }
+            None => return Err(bad_header(format!("unknown column `{name}`; expected {expected}"))),
         }
     }
     if let Some(k) = index.iter().position(|&i| i == usize::MAX) {
-        let expected = SNAPSHOT_COLUMNS.join(",");
         return Err(bad_header(format!(
             "missing column `{}`; expected {expected}",
             required[k]
@@ -229,7 +227,7 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
     for rec in r.records() {
         let rec = rec.map_err(|e| BodiesFileError::Format {
             line: e.position().map(|p| p.line()).unwrap_or(0),
-            message: one_line_csv(&e),
+            message: one_line(&e.to_string()),
         })?;
         let line = rec.position().map(|p| p.line()).unwrap_or(0);
         if out.len() >= crate::io::scene_file::MAX_BODIES {
@@ -260,10 +258,6 @@ pub fn read_bodies<R: std::io::Read>(reader: R) -> Result<Vec<BodyRecord>, Bodie
         });
     }
     Ok(out)
-}
-
-fn one_line_csv(e: &::csv::Error) -> String {
-    e.to_string().split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// The sidecar of a `.ss` file: `<stem>.bodies.csv` beside it, where `rubblepile convert` keeps the exact

@@ -19,7 +19,7 @@ use crate::bits::{exact_f64, exact_f64_array, exact_f64_vec, fnv1a_hex};
 use crate::ellipsoid::barrier::{BarrierMonitor, BarrierSettings, OVERRUN_FILE};
 use crate::ellipsoid::body::InertiaModel;
 use crate::ellipsoid::equations::{Diagnostics, EllipsoidSystem, Physics};
-use crate::ellipsoid::output::{TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
+use crate::ellipsoid::output::{TIMESERIES_COLUMNS, TracksWriter, read_bodies_csv, snapshot_records, write_snapshot};
 use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::scene::{KappaSource, LoadedScene, default_scene, load_scene, parse_scene};
 use crate::ellipsoid::summary::{CalibrationSummary, PhysicsSummary, RunSummary, Scales};
@@ -35,10 +35,8 @@ use crate::phase::{Kind, Phase};
 /// Quaternion norm errors above this mean the unit-norm constraint broke; the run stops.
 pub const QUATERNION_NORM_LIMIT: f64 = 1e-3;
 
-pub use crate::ellipsoid::output::TIMESERIES_COLUMNS;
-
 /// Running maxima of the conservation errors (absolute; made relative at the end), as stored in checkpoints.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ErrorTracker {
     #[serde(with = "exact_f64")]
     h0: f64,
@@ -78,13 +76,7 @@ impl ErrorTracker {
             l0: [d0.angular_momentum.x, d0.angular_momentum.y, d0.angular_momentum.z],
             scales0: s,
             scales_max: s,
-            energy: 0.0,
-            momentum: 0.0,
-            angular: 0.0,
-            quaternion: 0.0,
-            samples: 0,
-            tidal_impulse: 0.0,
-            tidal_torque_impulse: 0.0,
+            ..ErrorTracker::default()
         }
     }
 
@@ -338,11 +330,10 @@ impl EllipsoidEngine {
         let mut integrator = make_integrator(settings.method, tolerances, settings.step)
             .map_err(|e| EngineError::Setup(format!("integrator setup: {e}")))?;
         // The error budget is the run's: rtol bounds the accumulated error, not each step's. Not with tree
-        // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`;
-        // Bulirsch-Stoer and Dop853 do; Dop853 controls each step's error anyway): freshly walked forces jump (by about the multipole error, 1e-4) wherever a
-        // body's interaction list changes, a step's share h/T of rtol falls below those jumps on long runs, and
-        // Bulirsch-Stoer without frozen lists accepted no 1 s step in a minute (N2000 impact,
-        // analysis/n2000/REPORT.md). There each step's error is bounded by rtol (ODEX's rule).
+        // gravity under an integrator that does not fix the tree's lists per step (`OdeSystem::begin_step`):
+        // freshly walked forces jump (by about the multipole error) wherever a body's interaction list changes,
+        // and a step's share h/T of rtol falls below those jumps on long runs. There each step's error is bounded
+        // by rtol (ODEX's rule).
         if system.forces_are_smooth()
             || matches!(settings.method, Method::BulirschStoer | Method::BulirschStoerImplicit)
         {
@@ -731,6 +722,10 @@ impl Engine for EllipsoidEngine {
         let settings = scene.integrator;
         let stats = self.integrator.stats();
         let scales = self.tracker.scales();
+        let calibration = match scene.kappa_source {
+            KappaSource::Given => None,
+            KappaSource::Calibrated { beta, v, reading } => Some(CalibrationSummary { beta, v, reading }),
+        };
         let (status, final_time) = match outcome {
             Outcome::Completed => ("completed".to_string(), self.t),
             Outcome::Failed(f) => (f.cause.clone(), self.last_good.0),
@@ -764,14 +759,8 @@ impl Engine for EllipsoidEngine {
             scales,
             samples: self.tracker.samples,
             kappa: scene.model.kappa,
-            kappa_source: match scene.kappa_source {
-                KappaSource::Given => "given".into(),
-                KappaSource::Calibrated { .. } => "calibrated".into(),
-            },
-            calibration: match scene.kappa_source {
-                KappaSource::Given => None,
-                KappaSource::Calibrated { beta, v, reading } => Some(CalibrationSummary { beta, v, reading }),
-            },
+            kappa_source: if calibration.is_some() { "calibrated" } else { "given" }.into(),
+            calibration,
             inertia: match scene.model.inertia {
                 InertiaModel::Gaussian => "gaussian".into(),
                 InertiaModel::Uniform => "uniform".into(),

@@ -7,19 +7,18 @@
 
 use std::path::{Path, PathBuf};
 
-use nalgebra::{Quaternion, UnitQuaternion};
 use scene_derive::SceneFields;
 use serde::{Deserialize, Serialize};
 
 use crate::ellipsoid::body::{Body, Ellipsoid, InertiaModel};
 use crate::ellipsoid::calibration::{KappaReading, calibrate_kappa_read};
 use crate::ellipsoid::equations::{ContactTerm, DissipationTerm, GravityTerm, ModelConfig, Physics};
-pub use crate::ellipsoid::tide::FlybySpec;
-use crate::ellipsoid::tide::{TideTerm, resolve_flyby};
+use crate::ellipsoid::quaternion::to_unit_quaternion;
+use crate::ellipsoid::tide::{FlybySpec, TideTerm, resolve_flyby};
 use crate::integrate::Method;
-use crate::io::scene_file::{MAX_BODIES, MIN_MEANINGFUL, Validator, WORK_WARNING_STEPS, exact, fmt_list, fmt_num};
-pub use crate::io::scene_file::{
-    MAX_TIMESERIES_ROWS, MIN_RTOL, SCENE_KINDS, SI_G, SceneError, SceneText, parse_toml_as, peek_kind, read_scene_text,
+use crate::io::scene_file::{
+    MAX_BODIES, MIN_MEANINGFUL, MIN_RTOL, SI_G, SceneError, Validator, WORK_WARNING_STEPS, exact, fmt_list, fmt_num,
+    parse_toml_as, read_scene_text,
 };
 use crate::math::{Vec3, Vec4};
 
@@ -198,8 +197,7 @@ pub struct GravitySpec {
     #[field(meaning = "exact O(N^2) sum, Barnes-Hut tree, or exact below 5000 bodies and tree from there")]
     pub method: Option<GravityMethodSpec>,
     /// Opening angle θ of the tree (dimensionless, in (0, 1]): a node is used whole beyond `side/θ` from a
-    /// body. Default 0.5 (RMS relative force error 2.6e-4 against the exact sum on 2000 ellipsoids). Ignored by
-    /// `"direct"`.
+    /// body. Default 0.5. Ignored by `"direct"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "0.5", range = open_closed(0.0, crate::ellipsoid::gravity_tree::MAX_THETA))]
     #[field(meaning = "tree opening angle: a node is used whole beyond side/theta; ignored by \"direct\"")]
@@ -250,19 +248,13 @@ pub struct DissipationSpec {
 #[scene(table = "integrator")]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSection {
-    /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice), `"dop853"`, `"dopri5"`
-    /// (adaptive Dormand–Prince), `"rk4"` (fixed step; needs `step`, and takes no `rtol` or `atol`) or
+    /// `"bulirsch-stoer"` (adaptive Gragg–Bulirsch–Stoer, Roig03's choice; the default), `"dop853"`, `"dopri5"`
+    /// (adaptive Dormand–Prince), `"rk4"` (fixed step; needs `step`, takes no `rtol` or `atol`) or
     /// `"bulirsch-stoer-implicit"` (linearly implicit Euler extrapolation, [`crate::integrate::linearly_implicit`],
-    /// with the dissipation's analytic Jacobian, [`crate::ellipsoid::dissipation_jacobian`]). Default
-    /// `"bulirsch-stoer"`.
-    ///
-    /// **When to use the implicit method.** The dissipation damps a touching pair at the rate
-    /// `2 F0 U_C / μ` (s⁻¹; `μ` the reduced mass, `U_C` the pair's contact energy, about
-    /// `G m_i m_j / (2κλ (R_i + R_j))` at contact by Roig03 Eq. 11), and an explicit method must resolve that time
-    /// scale. Once it exceeds the contact's own frequency (the pair is overdamped: sticking regimes, large `F0`)
-    /// the implicit method's steps follow the motion instead; below it (soft contacts, Roig03's F0 = 1e-6 s m⁻²)
-    /// `"bulirsch-stoer"` is cheaper per unit of accuracy (order `2k` against `k` for the same substeps).
-    /// Its `rtol` and `atol` mean what they mean for `"bulirsch-stoer"` (the whole run's error, in user units).
+    /// with the dissipation's analytic Jacobian, [`crate::ellipsoid::dissipation_jacobian`]). The implicit method
+    /// pays when the dissipation damps a touching pair (at the rate `2 F0 U_C / μ`, μ the reduced mass) faster than
+    /// its contact oscillates (overdamped, sticking regimes): an explicit method must resolve the damping time.
+    /// Below that (Roig03's F0 = 1e-6 s m⁻²) `"bulirsch-stoer"` is cheaper per unit of accuracy.
     #[serde(default)]
     #[field(unit = "text", default = "\"bulirsch-stoer\"")]
     #[field(range = Rule("\"bulirsch-stoer\" | \"dop853\" | \"dopri5\" | \"rk4\" | \"bulirsch-stoer-implicit\""))]
@@ -272,13 +264,11 @@ pub struct IntegratorSection {
                    advises it)"
     )]
     pub method: Method,
-    /// Relative tolerance (dimensionless, > 0). Default 1e-10. The error norm is scale-free: every body's state
-    /// is judged in the units a user thinks in (position in m, velocity in m/s, spin in rad/s, attitude as a
-    /// unit quaternion, dissipated energy relative to the initial energy scale), whatever its mass. With
-    /// `"bulirsch-stoer"` and `"bulirsch-stoer-implicit"` the tolerance is the run's: the local errors of all steps to `t_end` add up to about a
-    /// quarter of it (error per unit step), so the final error follows `rtol`; the other methods apply it to each
-    /// step. In `[1e-15, 1)` ([`MIN_RTOL`]); only for the adaptive methods (refused with `"rk4"`, which has no
-    /// error control).
+    /// Relative tolerance (dimensionless, in `[1e-15, 1)`, [`MIN_RTOL`]). Default 1e-10. The error norm is
+    /// scale-free: every state is judged in the units a user thinks in (m, m/s, rad/s, a unit quaternion, the
+    /// dissipated energy relative to the initial energy scale), whatever the body's mass. With the two
+    /// Bulirsch–Stoer methods it bounds the whole run's error (the local errors to `t_end` add up to about a
+    /// quarter of it); the other methods apply it to each step. Refused with `"rk4"`, which has no error control.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "1e-10", range = closed_open(MIN_RTOL, 1.0))]
     #[field(meaning = "relative tolerance of the adaptive methods (refused with \"rk4\")")]
@@ -298,20 +288,17 @@ pub struct IntegratorSection {
     pub step: Option<f64>,
     /// Whether to pull the attitudes back onto `|q| = 1` at every output sample (`true`/`false`; see
     /// [`crate::ellipsoid::equations::EllipsoidSystem::project_attitudes`]). Default: `true` for `"dop853"`,
-    /// `"dopri5"` and `"rk4"`, whose error norm lets one fast-spinning body's `|q|` drift by 1e-3 within a few
-    /// hundred turns (the N2000 impact, `analysis/n2000/REPORT.md`); `false` for `"bulirsch-stoer"`, which keeps
-    /// the constraint without it (1.3e-6 over that impact) and whose runs stay as they were, and for
-    /// `"bulirsch-stoer-implicit"`, which controls the error in the same run-wide norm. The run's
-    /// `quaternion_norm_error` is the largest `||q| − 1|` before projection, and above 1e-3 it still stops the run.
+    /// `"dopri5"` and `"rk4"`, whose per-step error norm lets a fast-spinning body's `|q|` drift; `false` for the
+    /// two Bulirsch–Stoer methods, whose run-wide error norm keeps the constraint. The run's
+    /// `quaternion_norm_error` is the largest `||q| − 1|` before projection; above 1e-3 it still stops the run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "bool", default = "true (false for bulirsch-stoer)", range = Rule("true | false"))]
     #[field(meaning = "pull the attitudes back onto |q| = 1 at every output sample")]
     pub project_attitudes: Option<bool>,
 }
 
-fn default_tolerance() -> f64 {
-    1e-10
-}
+/// Default `rtol` and `atol`.
+const DEFAULT_TOLERANCE: f64 = 1e-10;
 
 /// `[output]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, SceneFields)]
@@ -534,13 +521,12 @@ struct RawBody {
 
 /// Largest κ accepted (`model.kappa`, or the one `model.calibrate` gives): every pair's contact amplitude holds
 /// `e^{κλ}` with `λ ≤ 2` (Roig03 Eq. 12), and at κ = 175 that factor is 1e152, half the range of an `f64`; the other
-/// half is left for `G m_i m_j (R_i + R_j)²`. The committed scenes and benches use κ ≤ 50, Roig03 κ ≈ 10–30.
+/// half is left for `G m_i m_j (R_i + R_j)²`.
 pub const MAX_KAPPA: f64 = 175.0;
 
 /// Two bodies whose centres lie closer than this fraction of the smaller of their smallest semi-axes are refused
 /// at t = 0 as coincident or deeply overlapping (their contact energy is near its full-overlap maximum and their
-/// monopole gravity near its singularity). Relaxed piles touch and overlap slightly: the committed targets keep
-/// their centres at least 1.87 smallest semi-axes apart (N10000_T4), so 0.5 refuses none of them.
+/// monopole gravity near its singularity); relaxed piles touch and overlap only slightly.
 pub const MIN_CENTRE_SEPARATION: f64 = 0.5;
 
 // The numbers written into the rows' words, held to the constants they restate.
@@ -553,9 +539,8 @@ const _: () = assert!(crate::ellipsoid::gravity_tree::DEFAULT_THETA == 0.5);
 pub const STEPS_PER_TIME_SCALE: f64 = 10.0;
 
 /// The ratio of contact period to damping time above which `rubblepile check` advises
-/// `integrator.method = "bulirsch-stoer-implicit"` ([`contact_stiffness`]). At 10 an explicit method spends at least
-/// ten times the steps the contact needs; the stiff work–precision diagrams (`analysis/work_precision/REPORT.md`)
-/// show the implicit method ahead at the pile's F0 = 1e-2 and not at 1e-6.
+/// `integrator.method = "bulirsch-stoer-implicit"` ([`contact_stiffness`]): at 10 an explicit method spends at least
+/// ten times the steps the contact needs.
 pub const STIFF_ADVICE_RATIO: f64 = 10.0;
 
 /// The stiffest body of a scene's contacts ([`contact_stiffness`]).
@@ -671,19 +656,20 @@ impl Validator<'_> {
     /// after the bodies ([`Validator::kappa_section`]), since calibration needs them.
     fn model_section(&self, m: &ModelSection) -> Result<(), SceneError> {
         match (m.kappa, m.calibrate) {
-            (Some(_), Some(_)) => {
-                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got both"));
-            }
-            (None, None) => {
-                return Err(self.invalid("model", "give exactly one of `kappa` or `calibrate`, got neither"));
-            }
             (Some(k), None) => self.kappa_value("model.kappa", k)?,
             (None, Some(c)) => {
                 self.field(&CalibrateSpec::BETA, c.beta)?;
                 self.field(&CalibrateSpec::V, c.v)?;
             }
+            (k, _) => return Err(self.exactly_one("model", "kappa", "calibrate", k.is_some())),
         }
         Ok(())
+    }
+
+    /// The error of `field`, which needs exactly one of the keys `a` and `b`, when it got `both` or neither.
+    pub(crate) fn exactly_one(&self, field: impl Into<String>, a: &str, b: &str, both: bool) -> SceneError {
+        let got = if both { "both" } else { "neither" };
+        self.invalid(field, format!("give exactly one of `{a}` or `{b}`, got {got}"))
     }
 
     /// κ in (1.5, [`MAX_KAPPA`]].
@@ -751,7 +737,7 @@ impl Validator<'_> {
     /// `[integrator]`: method, tolerances (`rtol` in [[`MIN_RTOL`], 1), `atol` finite and ≥ 0; adaptive methods
     /// only), the fixed step of `"rk4"` (≥ `t_end ×` [`crate::io::scene_file::MIN_STEP_FRACTION`]; `"rk4"` only).
     fn integrator_section(&self, i: &IntegratorSection, t_end: f64) -> Result<IntegratorSettings, SceneError> {
-        let rtol = i.rtol.unwrap_or_else(default_tolerance);
+        let rtol = i.rtol.unwrap_or(DEFAULT_TOLERANCE);
         if !IntegratorSection::RTOL.range.contains(rtol) {
             return Err(self.invalid(
                 IntegratorSection::RTOL.key,
@@ -762,7 +748,7 @@ impl Validator<'_> {
                 ),
             ));
         }
-        let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or_else(default_tolerance))?;
+        let atol = self.field(&IntegratorSection::ATOL, i.atol.unwrap_or(DEFAULT_TOLERANCE))?;
         let step = i.step.map(|h| self.step("integrator.step", h, t_end)).transpose()?;
         if i.method == Method::Rk4 {
             if step.is_none() {
@@ -881,25 +867,18 @@ impl Validator<'_> {
         let (kappa, kappa_source) = match (m.kappa, m.calibrate) {
             (Some(k), _) => (k, KappaSource::Given),
             (None, Some(c)) => {
-                let small = bodies
-                    .iter()
-                    .min_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
-                    .expect("at least one body (checked above)");
-                let large = bodies
-                    .iter()
-                    .max_by(|a, b| a.shape.mass.total_cmp(&b.shape.mass))
-                    .expect("at least one body (checked above)");
-                let k = calibrate_kappa_read(
-                    c.reading,
-                    c.beta,
-                    c.v,
-                    (small.shape.equivalent_radius(), small.shape.mass),
-                    (large.shape.equivalent_radius(), large.shape.mass),
-                    contact_g,
-                )
-                .map_err(|source| SceneError::Calibration {
-                    file: self.file.to_string(),
-                    message: source.to_string(),
+                let by_mass = |a: &&Body, b: &&Body| a.shape.mass.total_cmp(&b.shape.mass);
+                let radius_mass = |b: Option<&Body>| {
+                    let b = b.expect("at least one body (checked above)");
+                    (b.shape.equivalent_radius(), b.shape.mass)
+                };
+                let small = radius_mass(bodies.iter().min_by(by_mass));
+                let large = radius_mass(bodies.iter().max_by(by_mass));
+                let k = calibrate_kappa_read(c.reading, c.beta, c.v, small, large, contact_g).map_err(|source| {
+                    SceneError::Calibration {
+                        file: self.file.to_string(),
+                        message: source.to_string(),
+                    }
                 })?;
                 if !(k.is_finite() && k > 1.5) {
                     return Err(self.invalid("model.calibrate", format!("calibration gave kappa = {k}, need > 1.5")));
@@ -1102,7 +1081,7 @@ impl Validator<'_> {
     /// damping time `τ = 4κR / (F0 G m)` (`targets/README.md`, "Choosing κ and F0"); when `T/τ` exceeds
     /// [`STIFF_ADVICE_RATIO`] for some body and the method is an explicit one, one line naming the body, both times
     /// and the ratio. Deeper overlaps (impacts) raise the contact weight `U_C` and with it the ratio, so a scene
-    /// below the threshold at rest may still be stiff during an impact (the N200 impact at F0 = 1e-4 s m⁻²).
+    /// below the threshold at rest may still be stiff during an impact.
     fn stiffness_advice(
         &self,
         bodies: &[Body],
@@ -1204,12 +1183,7 @@ impl Validator<'_> {
                 }
                 m
             }
-            (Some(_), Some(_)) => {
-                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got both"));
-            }
-            (None, None) => {
-                return Err(self.invalid(b.label.clone(), "give exactly one of `mass` or `density`, got neither"));
-            }
+            (m, _) => return Err(self.exactly_one(b.label.clone(), "mass", "density", m.is_some())),
         };
         // Moments of inertia m/(2κ) (B²+C², C²+A², A²+B²) (Roig03 Eq. 4): the smallest is at least
         // m (B²+C²)/(2 MAX_KAPPA), the largest at most m (A²+B²)/3. Both must be normal numbers: the equations of
@@ -1328,8 +1302,7 @@ impl Validator<'_> {
 ///
 /// R(q) is the transpose of nalgebra's rotation matrix of the unit quaternion `δ + α i + β j + γ k`.
 pub fn world_to_body(q: &Vec4, v: &Vec3) -> Vec3 {
-    let uq = UnitQuaternion::from_quaternion(Quaternion::new(q[3], q[0], q[1], q[2]));
-    uq.to_rotation_matrix().matrix().transpose() * v
+    to_unit_quaternion(q).to_rotation_matrix().matrix().transpose() * v
 }
 
 #[cfg(test)]

@@ -18,8 +18,7 @@ use crate::integrate::elliptic::{complete_k, jacobi_sn_cn_dn};
 use crate::math::{Mat3, Vec3};
 
 /// Angle between `L` and `ω` (degrees) below which the rotation counts as principal-axis: the period `2π/|ω|`
-/// of such a rotation varies over its cycle by well under 0.1 % (the settled Apophis pile of
-/// `analysis/apophis2029/`, at 2.55°, varies by 1.4 %).
+/// of such a rotation varies over its cycle by well under 0.1 %.
 pub const PRINCIPAL_AXIS_ANGLE_DEG: f64 = 0.2;
 
 /// Points of the trapezoidal rule over one period `P_ψ` for `⟨φ̇⟩` and the range of `|ω|`.

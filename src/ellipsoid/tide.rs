@@ -185,18 +185,6 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
     let [node, inc, peri] = spec.orientation_deg.map(f64::to_radians);
     let rotation = orientation_matrix(node, inc, peri);
     let orbit = match (spec.v_inf, spec.eccentricity) {
-        (Some(_), Some(_)) => {
-            return Err(v.invalid(
-                "physics.flyby",
-                "give exactly one of `v_inf` or `eccentricity`, got both",
-            ));
-        }
-        (None, None) => {
-            return Err(v.invalid(
-                "physics.flyby",
-                "give exactly one of `v_inf` or `eccentricity`, got neither",
-            ));
-        }
         (Some(vi), None) => {
             let vi = v.field(&FlybySpec::V_INF, vi)?;
             KeplerOrbit::hyperbolic(gm, q, vi, spec.t_perigee, rotation)
@@ -218,6 +206,7 @@ pub(crate) fn resolve_flyby(v: &Validator, spec: &FlybySpec, g: f64) -> Result<T
             KeplerOrbit::new(gm, q, e, spec.t_perigee, rotation)
                 .map_err(|e| v.invalid("physics.flyby", e.to_string()))?
         }
+        (vi, _) => return Err(v.exactly_one("physics.flyby", "v_inf", "eccentricity", vi.is_some())),
     };
     let j2 = match spec.j2 {
         None => None,

@@ -60,6 +60,7 @@ trait Real:
     + SubAssign
     + Send
     + Sync
+    + Default
 {
     const ZERO: Self;
     fn of(x: f64) -> Self;
@@ -126,7 +127,7 @@ pub struct Octree {
     leaf: Vec<bool>,
     /// Bucket node indices, in order (they cover the sorted particles in order).
     buckets: Vec<u32>,
-    /// Whether leaves may be used whole (at least [`FAR_LEAVES_FROM`] particles).
+    /// Whether leaves may be used whole and lists are summed in f32 (at least [`FAR_LEAVES_FROM`] particles).
     far_leaves: bool,
 }
 
@@ -151,7 +152,7 @@ struct Lists {
 }
 
 /// A bucket's interaction lists gathered for summing: relative to the bucket's centre, in its scales.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 struct Local<T> {
     /// Moments of the nodes used whole.
     cells: Vec<Moments<T>>,
@@ -212,15 +213,6 @@ struct Frame {
     origin: Vec3,
     length: f64,
     mass: f64,
-}
-
-impl<T> Default for Local<T> {
-    fn default() -> Self {
-        Local {
-            cells: Vec::new(),
-            sources: Vec::new(),
-        }
-    }
 }
 
 impl Frame {
@@ -416,13 +408,7 @@ impl Octree {
             };
             (tree, nodes.cubes)
         });
-        tree.moments = PHASE_MOMENTS.time(|| {
-            (0..cubes.len())
-                .into_par_iter()
-                .with_min_len(32)
-                .map(|k| tree.node_moments(tree.start[k] as usize, tree.end[k] as usize, cubes[k].0))
-                .collect()
-        });
+        tree.moments = PHASE_MOMENTS.time(|| tree.node_moments(|k| cubes[k].0));
         PHASE_MOMENTS.time(|| {
             tree.side = cubes.par_iter().with_min_len(1024).map(|c| c.1).collect();
             tree.delta = tree
@@ -436,8 +422,17 @@ impl Octree {
         tree
     }
 
+    /// Moments of every node (`fallback(k)` as node `k`'s centre if it is massless).
+    fn node_moments(&self, fallback: impl Fn(usize) -> Vec3 + Sync) -> Vec<Moments> {
+        (0..self.start.len())
+            .into_par_iter()
+            .with_min_len(32)
+            .map(|k| self.moments_of(self.start[k] as usize, self.end[k] as usize, fallback(k)))
+            .collect()
+    }
+
     /// Moments of sorted particles `s..e` (`fallback` as centre if massless).
-    fn node_moments(&self, s: usize, e: usize, fallback: Vec3) -> Moments {
+    fn moments_of(&self, s: usize, e: usize, fallback: Vec3) -> Moments {
         let (mut m, mut wx, mut wy, mut wz) = (0.0, 0.0, 0.0, 0.0);
         for &[x, y, z, mj] in &self.particles[s..e] {
             m += mj;
@@ -566,12 +561,6 @@ impl Octree {
         }
     }
 
-    /// Whether lists are summed in single precision ([`FAR_LEAVES_FROM`] particles or more: see the module
-    /// header).
-    fn single_precision(&self) -> bool {
-        self.far_leaves
-    }
-
     /// The frame of points around `origin` spanning about `side` (m).
     fn frame(&self, origin: Vec3, side: f64) -> Frame {
         Frame {
@@ -598,7 +587,7 @@ impl Octree {
         let mut sorted = vec![[0.0; 4]; n];
         let open = Walk::Open(self.reach2(theta));
         PHASE_WALK.time(|| {
-            if self.single_precision() {
+            if self.far_leaves {
                 self.sum_buckets::<f32, 8, 4>(&open, g, &mut sorted);
             } else {
                 self.sum_buckets::<f64, 4, 2>(&open, g, &mut sorted);
@@ -738,16 +727,7 @@ impl FrozenOctree {
         // A node without mass keeps the centre it had when the tree was built (the moments are otherwise
         // those of the particles alone).
         let built = &self.tree.moments;
-        let current = &tree;
-        let moments: Vec<Moments> = (0..current.start.len())
-            .into_par_iter()
-            .with_min_len(32)
-            .map(|k| {
-                let fallback = Vec3::new(built[k][0], built[k][1], built[k][2]);
-                current.node_moments(current.start[k] as usize, current.end[k] as usize, fallback)
-            })
-            .collect();
-        tree.moments = moments;
+        tree.moments = tree.node_moments(|k| Vec3::new(built[k][0], built[k][1], built[k][2]));
         let mut sorted = vec![[0.0; 4]; self.len()];
         tree.sum_buckets::<f64, 4, 2>(&Walk::Frozen(&self.lists), g, &mut sorted);
         tree.unsort(&sorted)
@@ -775,7 +755,7 @@ mod tests {
         let x: Vec<Vec3> = (0..5000).map(|_| point_in_ball(&mut rng, 1000.0)).collect();
         let m = vec![1e12; x.len()];
         let tree = Octree::build(&x, &m);
-        assert!(tree.single_precision());
+        assert!(tree.far_leaves);
         let (single, double) = (sums::<f32, 8, 4>(&tree, 0.5), sums::<f64, 4, 2>(&tree, 0.5));
         let (mut sq, mut worst, mut worst_phi) = (0.0, 0.0f64, 0.0f64);
         for (s, d) in single.iter().zip(&double) {
@@ -849,7 +829,7 @@ mod tests {
             // a length unit of 1/128 of the root side: the point's list spans a few leaves around it
             let frame = self.frame(*p, self.side[0] / (1u64 << (KEY_BITS / 3)) as f64);
             let mut out = [[0.0; 4]];
-            if self.single_precision() {
+            if self.far_leaves {
                 let mut local = Local::<f32>::default();
                 self.gather(&lists, &frame, &mut local);
                 Self::block::<f32, 1>(&local, &frame, &[[p.x, p.y, p.z, 0.0]], &mut out, g);
