@@ -338,7 +338,7 @@ impl SpinRun {
     }
     /// The diagnostics row at an output sample (time `t`, s), then the release check.
     fn sample(&mut self, sys: &SoftSystem, t: f64) -> std::io::Result<()> {
-        let d = diagnose_run(sys, &self.driver, t).sample;
+        let d = diagnose_run(sys, &self.driver, t);
         let line = if self.legacy { d.csv_row_legacy() } else { d.csv_row() };
         self.csv.write_all(line.as_bytes())?;
         self.csv.flush()?;
