@@ -193,11 +193,7 @@ pub struct RveStress {
     pub centre: Vec3,
     /// Particles.
     pub particles: usize,
-    /// Volume, Σ V_i (m³).
-    pub volume: f64,
-    /// Average stress tensor (Eq. 16, Pa).
-    pub sigma: Mat3,
-    /// Principal stresses and Mohr–Coulomb measures.
+    /// Principal stresses and Mohr–Coulomb measures of the average stress tensor (Eq. 16).
     pub state: StressState,
 }
 
@@ -232,13 +228,10 @@ pub fn rve_stresses(
                 .iter()
                 .map(|&i| (volumes[i], particle_stress(volumes[i], &contacts[i])))
                 .collect();
-            let sigma = rve_stress(&parts);
             RveStress {
                 centre: set.iter().map(|&i| centres[i]).sum::<Vec3>() / set.len() as f64,
                 particles: set.len(),
-                volume: parts.iter().map(|p| p.0).sum(),
-                sigma,
-                state: stress_state(&sigma),
+                state: stress_state(&rve_stress(&parts)),
             }
         })
         .collect()
