@@ -79,12 +79,8 @@ fn central_rve_pressure_of_a_settled_ball_matches_the_uniform_sphere() {
     );
     // the run-time reduction over the tree's RVEs (~60 particles each): none exceeds the central pressure much
     let d = diagnose(&sys, &Vec3::z(), 1.0, false, 60, InteriorRule::Layers, 0.0);
-    assert!(
-        d.sample.p_max > 0.5 * p_c && d.sample.p_max < 1.15 * p_c,
-        "{:?}",
-        d.sample
-    );
-    assert!(d.sample.rves >= 15, "{} RVEs", d.sample.rves);
+    assert!(d.p_max > 0.5 * p_c && d.p_max < 1.15 * p_c, "{:?}", d);
+    assert!(d.rves >= 15, "{} RVEs", d.rves);
 }
 
 /// An ellipsoid carved from an HCP lattice whose semi-axes end on lattice sites (so the extents are exact): the
@@ -112,7 +108,7 @@ fn carved_ellipsoid_gives_its_axis_ratios_and_hcp_packing() {
         .collect();
     assert!(particles.len() > 500, "{}", particles.len());
     let sys = system(particles, 6.674e-11, 1e6);
-    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, InteriorRule::Layers, 0.0).sample;
+    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, InteriorRule::Layers, 0.0);
     for (got, want, name) in [(s.b_over_a, b / a, "b/a"), (s.c_over_a, c / a, "c/a")] {
         assert!((got / want - 1.0).abs() < 0.01, "{name}: {got} vs the shape's {want}");
     }
@@ -129,7 +125,7 @@ fn carved_ellipsoid_gives_its_axis_ratios_and_hcp_packing() {
         depth: 1.5 * d,
         ramp: d,
     };
-    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, rule, 0.0).sample;
+    let s = diagnose(&sys, &Vec3::z(), 1.0, false, 300, rule, 0.0);
     assert!(
         (s.packing_fraction - hcp).abs() < 0.002 && s.interior_particles > 40,
         "depth rule: η_B = {} over {} effective interior particles, HCP {hcp}",
@@ -257,9 +253,7 @@ fn layer_rule_packing_does_not_turn_with_the_starting_cube() {
                 })
                 .collect();
             let sys = system(particles, 6.674e-11, 1e6);
-            diagnose(&sys, &Vec3::z(), 1.0, false, 300, InteriorRule::Layers, 0.0)
-                .sample
-                .packing_fraction
+            diagnose(&sys, &Vec3::z(), 1.0, false, 300, InteriorRule::Layers, 0.0).packing_fraction
         })
         .collect();
     let spread = etas.iter().cloned().fold(0.0, f64::max) - etas.iter().cloned().fold(f64::INFINITY, f64::min);
@@ -312,9 +306,9 @@ fn coordination_number_counts_the_contact_list_twelve_inside_an_hcp_ball() {
     let expected = 2.0 * pairs as f64 / n as f64;
     assert!((mean_coordination(&counts) - expected).abs() < 1e-12);
     let d = diagnose(&sys, &Vec3::z(), 5.0 * 3600.0, true, 300, InteriorRule::Layers, 0.0);
-    assert!((d.sample.coordination_number - expected).abs() < 1e-12);
+    assert!((d.coordination_number - expected).abs() < 1e-12);
     assert!(expected > 6.0 && expected < 12.0, "mean coordination {expected}");
     // the fractions of spheres with 0 and 1 contacts come from the same counts (none in a touching lattice)
-    assert_eq!(d.sample.fraction_0_contacts, 0.0);
-    assert_eq!(d.sample.fraction_1_contact, 0.0);
+    assert_eq!(d.fraction_0_contacts, 0.0);
+    assert_eq!(d.fraction_1_contact, 0.0);
 }

@@ -1,6 +1,6 @@
 //! The old names of the granular scene files, rewritten to the one vocabulary (`granular::vocabulary`): both parsers
 //! read a scene through [`migrate`] (one warning per old name), `rubblepile check --migrate` writes the migrated text
-//! ([`migrate_file`]). Old → new: soft `[integrator]` → `[stepping]`, `[contact]` → `[material]`,
+//! ([`command`]). Old → new: soft `[integrator]` → `[stepping]`, `[contact]` → `[material]`,
 //! `wall.oscillation.frequency = f` (Hz) → `angular_frequency = 2π f` (rad/s), `amplitude = [ax, ay, az]` (m) →
 //! `amplitude = |A|`, `direction = A/|A|`; hard `gravity.g` → `gravity.uniform` (m/s²), `wall.type` → `wall.kind`,
 //! `wall.origin` → `wall.point` (plane) or `wall.centre`, a plane's `wall.axis` → `wall.normal`,
@@ -117,83 +117,41 @@ pub fn migrate(text: &str) -> Migration {
     edits.finish()
 }
 
-/// Where `migrate_file` sends the migrated text.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Destination {
-    /// Returned to the caller (the command line prints it).
-    Text,
-    /// Written over the scene file itself.
-    InPlace,
-    /// Written to this file.
-    File(PathBuf),
-}
-
-/// What [`migrate_file`] did: the migration, and the file it wrote (`None` for [`Destination::Text`]).
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct MigrateReport {
-    /// The migrated text and the old names found.
-    pub migration: Migration,
-    /// The file written, if any.
-    pub written: Option<PathBuf>,
-}
-
-/// Migrates the scene file at `path` ([`migrate`]) to `destination`. A file is never overwritten silently: the scene
-/// itself only with [`Destination::InPlace`] (the command line's `--force`), another existing file only when
-/// `force`. Files are written atomically. Errors are one line naming the file.
-pub fn migrate_file(path: &Path, destination: &Destination, force: bool) -> Result<MigrateReport, String> {
-    let text = crate::io::scene_file::read_text_bounded(path)
-        .map_err(|e| format!("{}: cannot read: {}", path.display(), crate::io::safe_write::reason(&e)))?;
+/// `rubblepile check --migrate SCENE [--out FILE] [--force]`: the scene migrated ([`migrate`]) to FILE (an existing
+/// one only with `force`), to SCENE itself with `force` and no FILE, else to the output channel (`io::messages`);
+/// files are written atomically, and each old name found is a `migrated: old -> new` warning line. Errors are one
+/// line naming the file.
+pub fn command(scene: &Path, out: Option<PathBuf>, force: bool) -> Result<(), String> {
+    use crate::io::messages::{Channel, emit};
+    use crate::io::safe_write::{describe, reason, write_atomic};
+    let text = crate::io::scene_file::read_text_bounded(scene)
+        .map_err(|e| format!("{}: cannot read: {}", scene.display(), reason(&e)))?;
     if DeTable::parse(&text).is_err() {
         return Err(format!(
             "{}: not TOML, nothing migrated (`rubblepile check` names the error)",
-            path.display()
+            scene.display()
         ));
     }
     let migration = migrate(&text);
-    let target = match destination {
-        Destination::Text => None,
-        Destination::InPlace => Some(path.to_path_buf()),
-        Destination::File(out) => {
-            if !force && std::fs::symlink_metadata(out).is_ok() {
-                return Err(format!("{}: exists; give --force to overwrite it", out.display()));
-            }
-            Some(out.clone())
-        }
-    };
-    if let Some(target) = &target {
-        crate::io::safe_write::write_atomic(target, &migration.text)
-            .map_err(|e| crate::io::safe_write::describe(target, &e))?;
+    if let Some(file) = &out
+        && !force
+        && std::fs::symlink_metadata(file).is_ok()
+    {
+        return Err(format!("{}: exists; give --force to overwrite it", file.display()));
     }
-    Ok(MigrateReport {
-        migration,
-        written: target,
-    })
-}
-
-/// `rubblepile check --migrate SCENE [--out FILE] [--force]`: [`migrate_file`] to FILE, to SCENE itself with
-/// `force` and no FILE, else to the output channel (`io::messages`); each old name found as a `migrated: old -> new`
-/// warning line.
-pub fn command(scene: &Path, out: Option<PathBuf>, force: bool) -> Result<(), String> {
-    use crate::io::messages::{Channel, emit};
-    let destination = match (out, force) {
-        (Some(file), _) => Destination::File(file),
-        (None, true) => Destination::InPlace,
-        (None, false) => Destination::Text,
-    };
-    let report = migrate_file(scene, &destination, force)?;
-    for r in &report.migration.renames {
+    let target = out.or_else(|| force.then(|| scene.to_path_buf()));
+    if let Some(target) = &target {
+        write_atomic(target, &migration.text).map_err(|e| describe(target, &e))?;
+    }
+    for r in &migration.renames {
         emit(Channel::Warning, &format!("migrated: {} -> {}", r.old, r.new));
     }
-    match report.written {
+    match target {
         Some(path) => emit(
             Channel::Out,
-            &format!(
-                "wrote {} ({} old names)",
-                path.display(),
-                report.migration.renames.len()
-            ),
+            &format!("wrote {} ({} old names)", path.display(), migration.renames.len()),
         ),
-        None => report.migration.text.lines().for_each(|l| emit(Channel::Out, l)),
+        None => migration.text.lines().for_each(|l| emit(Channel::Out, l)),
     }
     Ok(())
 }

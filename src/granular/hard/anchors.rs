@@ -48,7 +48,7 @@ enum Slot {
 
 /// `⌊q⌋` as an integer (saturating like `as`), without the library call that `f64::floor` costs on the baseline
 /// x86-64 target.
-fn floor_i64(q: f64) -> i64 {
+pub(crate) fn floor_i64(q: f64) -> i64 {
     let i = q as i64;
     if (i as f64) > q { i - 1 } else { i }
 }

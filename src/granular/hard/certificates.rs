@@ -93,11 +93,7 @@ impl Default for Calendar {
 impl Calendar {
     /// The absolute bucket index of time `t`, never before the earliest bucket.
     fn index(&self, t: f64) -> i64 {
-        let q = t / self.width;
-        // ⌊q⌋ (saturating), without the library call of `f64::floor`.
-        let i = q as i64;
-        let i = if (i as f64) > q { i - 1 } else { i };
-        i.max(self.base)
+        super::anchors::floor_i64(t / self.width).max(self.base)
     }
 
     /// Files a certificate (one due beyond the ring goes in its last bucket and is filed again when that comes

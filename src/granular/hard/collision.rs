@@ -41,39 +41,12 @@ pub struct Body {
 }
 
 /// What a collision did.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Outcome {
     /// Whether the bodies were approaching (otherwise nothing changed).
     pub applied: bool,
-    /// Normal approach speed |u·n̂| (m/s).
-    pub approach_speed: f64,
     /// Whether the collapse guard made it elastic.
     pub guarded: bool,
-}
-
-impl Outcome {
-    /// Nothing changed: the bodies were not approaching.
-    const NONE: Outcome = Outcome {
-        applied: false,
-        approach_speed: 0.0,
-        guarded: false,
-    };
-
-    /// Applied at the normal relative speed `un` (m/s, negative: approaching).
-    fn applied(un: f64, guarded: bool) -> Outcome {
-        Outcome {
-            applied: true,
-            approach_speed: -un,
-            guarded,
-        }
-    }
-}
-
-/// The relative contact velocity `u` of body 2 with respect to body 1 and the unit normal from 1 to 2.
-pub fn contact_velocity(b1: &Body, b2: &Body) -> (Vec3, Vec3) {
-    let n = (b2.position - b1.position).normalize();
-    let u = (b2.velocity + b2.spin.cross(&(-n * b2.radius))) - (b1.velocity + b1.spin.cross(&(n * b1.radius)));
-    (u, n)
 }
 
 /// The restitution a contact with normal relative velocity `un` (m/s, negative when approaching) gets: `None`
@@ -96,10 +69,12 @@ fn effective_restitution(un: f64, r: Restitution, collapse_speed: f64) -> Option
 
 /// Resolves a collision between two free spheres in contact (velocities and spins updated in place).
 pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed: f64) -> Outcome {
-    let (u, n) = contact_velocity(b1, b2);
+    let n = (b2.position - b1.position).normalize();
+    // The contact-point velocity of body 2 relative to body 1.
+    let u = (b2.velocity + b2.spin.cross(&(-n * b2.radius))) - (b1.velocity + b1.spin.cross(&(n * b1.radius)));
     let un = u.dot(&n);
     let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
-        return Outcome::NONE;
+        return Outcome::default();
     };
     let u_n = n * un;
     let u_t = u - u_n;
@@ -112,7 +87,7 @@ pub fn resolve_pair(b1: &mut Body, b2: &mut Body, r: Restitution, collapse_speed
     b2.velocity -= p * (b1.mass / m);
     b1.spin += q * (b1.radius / b1.inertia);
     b2.spin += q * (b2.radius / b2.inertia);
-    Outcome::applied(un, guarded)
+    Outcome { applied: true, guarded }
 }
 
 /// Resolves a collision of a sphere with an infinitely massive surface (a wall, or a particle stuck to one):
@@ -125,12 +100,12 @@ pub fn resolve_wall(b: &mut Body, n: &Vec3, surface_velocity: &Vec3, r: Restitut
     let u = b.velocity + b.spin.cross(&arm) - surface_velocity;
     let un = u.dot(n);
     let Some((r, guarded)) = effective_restitution(un, r, collapse_speed) else {
-        return Outcome::NONE;
+        return Outcome::default();
     };
     let u_n = n * un;
     let u_t = u - u_n;
     let beta = 1.0 / (1.0 + b.mass * b.radius * b.radius / b.inertia);
     b.velocity -= u_n * (1.0 + r.eps_n) + u_t * (beta * (1.0 - r.eps_t));
     b.spin -= arm.cross(&u) * (b.mass * beta * (1.0 - r.eps_t) / b.inertia);
-    Outcome::applied(un, guarded)
+    Outcome { applied: true, guarded }
 }

@@ -51,38 +51,8 @@ impl PartialOrd for Event {
     }
 }
 
-/// Earliest-first queue of [`Event`]s.
-#[derive(Debug, Default)]
-pub struct EventQueue {
-    heap: BinaryHeap<Event>,
-}
-
-impl EventQueue {
-    /// An empty queue.
-    pub fn new() -> Self {
-        EventQueue::default()
-    }
-    /// Adds an event.
-    pub fn push(&mut self, e: Event) {
-        self.heap.push(e);
-    }
-    /// Removes and returns the earliest event.
-    pub fn pop(&mut self) -> Option<Event> {
-        self.heap.pop()
-    }
-    /// Drops every event.
-    pub fn clear(&mut self) {
-        self.heap.clear();
-    }
-    /// Number of queued events (valid or stale).
-    pub fn len(&self) -> usize {
-        self.heap.len()
-    }
-    /// Whether the queue is empty.
-    pub fn is_empty(&self) -> bool {
-        self.heap.is_empty()
-    }
-}
+/// Earliest-first queue of [`Event`]s (the heap's greatest is the earliest by their reversed order).
+pub type EventQueue = BinaryHeap<Event>;
 
 #[cfg(test)]
 mod tests {

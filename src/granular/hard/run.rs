@@ -327,11 +327,8 @@ impl HardEngine {
         let book = Book {
             e0: d0.energy(),
             scale: d0.energy().abs().max(d0.kinetic + d0.rotational).max(f64::MIN_POSITIVE),
-            energy_change: 0.0,
-            energy_residual: 0.0,
-            momentum_error: 0.0,
-            momentum_change: 0.0,
             p0: d0.momentum,
+            ..Book::default()
         };
         HardEngine {
             scene,

@@ -95,9 +95,8 @@ pub struct HardSceneSection {
     #[serde(default)]
     #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub seed: u64,
-    /// CSV with the initial particles instead of `[[particle]]` tables, relative to the scene file's directory;
-    /// columns `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (kg, m, m/s, rad/s; `t` and `id` ignored), so a snapshot
-    /// can be used directly. Restitution comes from `[material]`.
+    /// CSV of the initial particles, relative to the scene file's directory (a snapshot works; restitution from
+    /// `[material]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "path", default = "none", range = Rule("readable CSV, <= 1e7 rows"))]
     #[field(meaning = "initial particles (t,id,mass,radius,x,...,wz[,stuck_to]) instead of [[particle]]")]
@@ -109,26 +108,22 @@ pub struct HardSceneSection {
 #[scene(table = "stepping")]
 #[serde(deny_unknown_fields)]
 pub struct SteppingSection {
-    /// Kick–drift–kick step (s), at least `t_end × 1e-12` (at most 1e12 steps) and 1e-300. Required. Steps are
-    /// shortened to land on output times. More than 1e9 steps (`t_end/dt`) are run with a warning.
+    /// Kick–drift–kick step (s), at least 1e-300; more than 1e9 steps are run with a warning.
     #[field(unit = "s", default = "required", range = Rule(">= t_end x 1e-12"))]
     #[field(meaning = "kick-drift-kick step, shortened to land on output times")]
     pub dt: f64,
-    /// Inelastic-collapse guard (m/s, ≥ 0): a collision whose normal approach speed is below this is elastic.
-    /// Default 0 (off).
+    /// Inelastic-collapse guard (m/s): a collision whose normal approach speed is below this is elastic.
     #[serde(default)]
     #[field(unit = "m/s", default = "0 (off)", range = NonNegative)]
     #[field(meaning = "inelastic-collapse guard: slower normal approaches bounce elastically")]
     pub collapse_speed: f64,
-    /// Most events one step may process (in [1, 1e9], [`MAX_EVENTS_PER_STEP`]); beyond it the run stops as stalled.
-    /// Default 1e7.
+    /// Most events one step may process (at most [`MAX_EVENTS_PER_STEP`]); beyond it the run stops as stalled.
     #[serde(default = "default_max_events")]
     #[field(unit = "count", default = "1e7", range = closed(1.0, MAX_EVENTS_PER_STEP as f64))]
     #[field(meaning = "most events one step may process; beyond it the run stops as stalled")]
     pub max_events_per_step: u64,
-    /// Neighbour-list skin in steps (dimensionless, ≥ 0): a particle's travel allowance is about
-    /// `skin_steps · |v| · dt` and the list is kept across steps, re-listing a particle when it could leave its
-    /// allowance; 0 = a fresh list for all at every step. Default 16.
+    /// Neighbour-list skin in steps: the list is kept across steps, re-listing a particle that could leave its
+    /// allowance.
     #[serde(default = "default_skin_steps")]
     #[field(unit = "steps", default = "16", range = NonNegative)]
     #[field(meaning = "neighbour-list skin, about skin_steps |v| dt per particle; 0 = a fresh list every step")]
@@ -185,8 +180,7 @@ pub struct HardOutputSection {
     #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], <= 1e5"))]
     #[field(meaning = "snapshot times (snapshots/<k>.csv); not with snapshot_every")]
     pub times: Option<Vec<f64>>,
-    /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
-    /// `t_end` (the last exactly `t_end`), at most 1e5. Give `times` or this, not both. Default: none.
+    /// Snapshot cadence (s), instead of `times`; the last snapshot is exactly at `t_end`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "s", default = "none", range = Rule(">= 1e-300, <= 1e5 snapshots"))]
     #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
@@ -194,8 +188,7 @@ pub struct HardOutputSection {
     /// time-series cadence (timeseries.csv rows)
     #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
     pub every: f64,
-    /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
-    /// `--format vtk` does. Default false.
+    /// Also write every snapshot as VTK for ParaView, as `--format vtk` does.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     #[field(unit = "bool", default = "false", range = Rule("true | false"))]
     #[field(meaning = "also write every snapshot as VTK (vtk/*.vtp, vtk/run.pvd)")]
@@ -213,8 +206,7 @@ pub struct ParticleSpec {
     /// radius
     #[field(unit = "m", default = "required", range = Positive)]
     pub radius: f64,
-    /// Centre `[x, y, z]` (m, finite). At t = 0 it may overlap another sphere or a wall by at most
-    /// [`MAX_START_OVERLAP`] of its radius.
+    /// Centre; at t = 0 it may overlap a sphere or a wall by at most [`MAX_START_OVERLAP`] of its radius.
     #[serde(deserialize_with = "exact::array")]
     #[field(unit = "m", default = "required", range = Rule("3 finite numbers; overlaps <= 1e-3 of the radius"))]
     #[field(meaning = "centre")]
@@ -235,8 +227,7 @@ pub struct ParticleSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "material.eps_t", range = closed(-1.0, 1.0))]
     pub eps_t: Option<f64>,
-    /// Index of the wall this particle is attached to from t = 0 (it then moves rigidly with the wall, as an
-    /// infinite mass: a rough lining). Default: free.
+    /// The wall this particle is attached to from t = 0, moving with it as an infinite mass (a rough lining).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "count", default = "free", range = Rule("a wall index"))]
     #[field(meaning = "wall this particle is attached to from t = 0 (moves rigidly with it)")]
@@ -259,8 +250,7 @@ pub struct WallSpec {
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; plane only"))]
     pub normal: Option<[f64; 3]>,
-    /// The others: the centre at t = 0 (m) of the disk, ring or point, the middle of the cylinder's or line's axis
-    /// segment. Default the origin.
+    /// The centre at t = 0 of a wall that is not a plane.
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "[0, 0, 0]", range = Rule("3 finite numbers; not a plane"))]
     #[field(meaning = "centre at t = 0 of a disk, ring or point; middle of a cylinder's or line's axis")]
@@ -269,8 +259,7 @@ pub struct WallSpec {
     #[serde(default, deserialize_with = "exact::option", skip_serializing_if = "Option::is_none")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero; not a plane"))]
     pub axis: Option<[f64; 3]>,
-    /// Radius (m) of a disk (≥ 1e-300), ring (0 or ≥ 1e-300; 0 is a point) or cylinder (0 or ≥ 1e-300; 0 is a
-    /// line).
+    /// Radius of a disk, ring or cylinder.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "m", default = "required by disk, ring, cylinder")]
     #[field(range = Rule(">= 1e-300 (disk); 0 or >= 1e-300 (ring, cylinder)"))]

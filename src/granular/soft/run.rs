@@ -338,7 +338,7 @@ impl SpinRun {
     }
     /// The diagnostics row at an output sample (time `t`, s), then the release check.
     fn sample(&mut self, sys: &SoftSystem, t: f64) -> std::io::Result<()> {
-        let d = diagnose_run(sys, &self.driver, t).sample;
+        let d = diagnose_run(sys, &self.driver, t);
         let line = if self.legacy { d.csv_row_legacy() } else { d.csv_row() };
         self.csv.write_all(line.as_bytes())?;
         self.csv.flush()?;
@@ -422,55 +422,6 @@ fn gravity_name(scene: &SoftScene) -> String {
     }
 }
 
-fn summary(
-    scene: &SoftScene,
-    sys: &SoftSystem,
-    book: &Book,
-    status: String,
-    step: u64,
-    rows: u64,
-    wall: f64,
-) -> SoftSummary {
-    SoftSummary {
-        status,
-        kind: crate::granular::soft::scene::KIND.into(),
-        wall_seconds: wall,
-        energy_error: book.max_energy,
-        final_energy_residual: book.last_energy,
-        momentum_error: book.max_p,
-        angular_momentum_error: book.max_l,
-        max_overlap_fraction: book.max_overlap,
-        final_time: step as f64 * scene.dt,
-        t_end: scene.t_end,
-        steps: step,
-        dt: scene.dt,
-        samples: rows,
-        n_particles: sys.particles.len(),
-        n_walls: sys.walls.len(),
-        contacts: sys.stats.pair_contacts + sys.stats.wall_contacts,
-        coordination_number: sys.coordination_number(),
-        k_n: scene.material.k_n,
-        advised_k_n: scene.advice.k_n,
-        advised_dt: scene.advice.dt,
-        self_gravity: gravity_name(scene),
-        seed: scene.seed,
-        warnings: scene.warnings.clone(),
-    }
-}
-
-/// A fresh system for the scene, forces evaluated at t = 0.
-pub fn initial_system(scene: &SoftScene) -> SoftSystem {
-    let mut sys = SoftSystem::new(
-        scene.particles.clone(),
-        scene.walls.clone(),
-        scene.material,
-        scene.gravity,
-    );
-    sys.gravity_interval = scene.gravity_interval;
-    sys.compute_forces(0.0, 0.0);
-    sys
-}
-
 fn row(scene: &SoftScene, sys: &SoftSystem, book: &mut Book, step: u64, wall: f64) -> String {
     let ke = sys.kinetic_energy();
     let s = &sys.stats;
@@ -522,17 +473,6 @@ pub struct SoftState {
     spinup: Option<SpinupCheckpoint>,
 }
 
-impl SoftState {
-    /// The step of the checkpoint.
-    pub fn step(&self) -> u64 {
-        self.step
-    }
-    /// Particles whose state the checkpoint holds.
-    pub fn particles(&self) -> usize {
-        self.state.len() / 15
-    }
-}
-
 /// A soft-sphere run (Zhang17): leapfrog steps of a fixed `dt`, with the spin-up forcing after every step when the
 /// scene has a `[spinup]` table.
 pub struct SoftEngine {
@@ -551,7 +491,14 @@ pub struct SoftEngine {
 impl SoftEngine {
     /// The engine for a validated scene, forces evaluated at t = 0.
     pub fn new(scene: SoftScene) -> Self {
-        let sys = initial_system(&scene);
+        let mut sys = SoftSystem::new(
+            scene.particles.clone(),
+            scene.walls.clone(),
+            scene.material,
+            scene.gravity,
+        );
+        sys.gravity_interval = scene.gravity_interval;
+        sys.compute_forces(0.0, 0.0);
         let book = Book::new(&sys);
         let plan = sample_steps(&scene);
         let before = sys.particles.clone();
@@ -575,11 +522,6 @@ impl SoftEngine {
     /// The scene's warnings (e.g. a step longer than advised).
     pub fn scene_warnings(&self) -> &[String] {
         &self.scene.warnings
-    }
-
-    /// The scene being run.
-    pub fn scene(&self) -> &SoftScene {
-        &self.scene
     }
 
     /// What the scene resolves to, for `rubblepile check`.
@@ -788,15 +730,32 @@ impl Engine for SoftEngine {
             Outcome::Completed => "completed".to_string(),
             Outcome::Failed(f) => format!("failed: {} at t = {} s", f.cause, self.time() + self.scene.dt),
         };
-        summary(
-            &self.scene,
-            &self.sys,
-            &self.book,
+        let (scene, sys, book) = (&self.scene, &self.sys, &self.book);
+        SoftSummary {
             status,
-            self.step,
-            samples,
+            kind: crate::granular::soft::scene::KIND.into(),
             wall_seconds,
-        )
+            energy_error: book.max_energy,
+            final_energy_residual: book.last_energy,
+            momentum_error: book.max_p,
+            angular_momentum_error: book.max_l,
+            max_overlap_fraction: book.max_overlap,
+            final_time: self.time(),
+            t_end: scene.t_end,
+            steps: self.step,
+            dt: scene.dt,
+            samples,
+            n_particles: sys.particles.len(),
+            n_walls: sys.walls.len(),
+            contacts: sys.stats.pair_contacts + sys.stats.wall_contacts,
+            coordination_number: sys.coordination_number(),
+            k_n: scene.material.k_n,
+            advised_k_n: scene.advice.k_n,
+            advised_dt: scene.advice.dt,
+            self_gravity: gravity_name(scene),
+            seed: scene.seed,
+            warnings: scene.warnings.clone(),
+        }
     }
 
     fn save(&mut self) -> std::io::Result<SoftState> {

@@ -84,8 +84,7 @@ pub struct SoftSceneSection {
     #[serde(default)]
     #[field(unit = "count", default = "0", range = Rule("integer >= 0"))]
     pub seed: u64,
-    /// CSV of the initial particles (relative to the scene's directory), columns
-    /// `t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz` (`t`, `id` optional and ignored): a snapshot works.
+    /// CSV of the initial particles, relative to the scene's directory (`t`, `id` optional; a snapshot works).
     #[serde(default)]
     #[field(unit = "path", default = "none", range = Rule("readable CSV, <= 1e7 rows"))]
     #[field(meaning = "initial particles (t,id,mass,radius,x,y,z,vx,vy,vz,wx,wy,wz) instead of [[particle]]")]
@@ -97,8 +96,7 @@ pub struct SoftSceneSection {
 #[scene(table = "stepping")]
 #[serde(deny_unknown_fields)]
 pub struct SoftSteppingSection {
-    /// Fixed leapfrog step (s, at most the stability limit `2 √(μ_min/k_N)` and `t_end`, at least `t_end × 1e-12`).
-    /// More than 1e9 steps are run with a warning.
+    /// Fixed leapfrog step (s); more than 1e9 steps are run with a warning.
     #[field(unit = "s", default = "required", range = Rule("<= 2 sqrt(m_min/2 / k_n) and t_end, >= t_end x 1e-12"))]
     #[field(meaning = "fixed leapfrog step (see `rubblepile ssdem advise`)")]
     pub dt: f64,
@@ -159,8 +157,8 @@ pub struct GravitySection {
     #[serde(default)]
     #[field(unit = "-", default = "0.5", range = open_closed(0.0, 1.0))]
     pub theta: Option<f64>,
-    /// Steps (an integer ≥ 1) between self-gravity evaluations: self-gravity is applied as kicks of `k dt/2` at
-    /// both ends of each block of `k` steps (r-RESPA, [`crate::granular::soft::respa`]). Default 1 (every step).
+    /// Steps `k` between self-gravity evaluations: kicks of `k dt/2` at both ends of each block of `k` steps
+    /// (r-RESPA, [`crate::granular::soft::respa`]).
     #[serde(default)]
     #[field(unit = "steps", default = "1", range = Rule("integer >= 1; > 1 needs self"))]
     #[field(meaning = "steps between self-gravity evaluations (r-RESPA kicks)")]
@@ -176,26 +174,21 @@ pub struct GravitySection {
 #[scene(table = "output")]
 #[serde(deny_unknown_fields)]
 pub struct SoftOutputSection {
-    /// Time-series cadence (s, at least `t_end / 1e8`: at most 1e8 rows), rounded to a whole number of steps (at
-    /// least one).
+    /// Time-series cadence (s), rounded to a whole number of steps.
     #[field(unit = "s", default = "required", range = Rule(">= t_end / 1e8"))]
     #[field(meaning = "time-series cadence, rounded to whole steps (at least one)")]
     pub every: f64,
-    /// Snapshot times (s), increasing, in `[0, t_end]`, each taken at the nearest step, at most 1e5. Default
-    /// `[0, t_end]`.
+    /// Snapshot times (s), each taken at the nearest step.
     #[serde(default)]
     #[field(unit = "s", default = "[0, t_end]", range = Rule("increasing, in [0, t_end], >= 1 step apart, <= 1e5"))]
     #[field(meaning = "snapshot times, each at the nearest step; not with snapshot_every")]
     pub times: Option<Vec<f64>>,
-    /// Snapshot cadence (s, > 0), instead of `times`: snapshots at `0, snapshot_every, 2·snapshot_every, …` and at
-    /// `t_end`, each at the nearest step and at least one step apart, at most 1e5. Give `times` or this, not both.
-    /// Default: none.
+    /// Snapshot cadence (s), instead of `times`; each snapshot at the nearest step.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     #[field(unit = "s", default = "none", range = Rule(">= 1 step, <= 1e5 snapshots"))]
     #[field(meaning = "snapshot cadence instead of times: 0, every, 2 every, ... and t_end")]
     pub snapshot_every: Option<f64>,
-    /// Also write every snapshot as VTK for ParaView (`vtk/*.vtp` and the collection `vtk/run.pvd`), as
-    /// `--format vtk` does. Default false.
+    /// Also write every snapshot as VTK for ParaView, as `--format vtk` does.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     #[field(unit = "bool", default = "false", range = Rule("true | false"))]
     #[field(meaning = "also write every snapshot as VTK (vtk/*.vtp, vtk/run.pvd)")]

@@ -67,9 +67,7 @@ pub struct SpinupSection {
     #[serde(default, deserialize_with = "crate::io::scene_file::exact::option")]
     #[field(unit = "-", default = "[0, 0, 1]", range = Rule("3 finite numbers, non-zero"))]
     pub axis: Option<[f64; 3]>,
-    /// What the forcing holds on the path: `"period"` (default; the body's rotation period `2π I/L` equals `T(t)`
-    /// after every step, Zhang17 §2.3.4: "strictly constrained to the spin-up path") or `"angular_momentum"`
-    /// (`L = I_ref 2π/T(t)` with `I_ref` the members' inertia as placed at t = 0, so an expanding body slows).
+    /// What the forcing holds on the path ([`SpinupTarget`]; Zhang17 §2.3.4).
     #[serde(default)]
     #[field(unit = "text", default = "\"period\"", range = Rule("\"period\" | \"angular_momentum\""))]
     #[field(meaning = "what the forcing holds on the path: the rotation period, or L = I_ref 2 pi/T(t)")]
@@ -90,9 +88,7 @@ pub struct SpinupSection {
     #[serde(default = "d_rve")]
     #[field(unit = "count", default = "300", range = Rule("integer >= 8"))]
     pub rve_particles: usize,
-    /// Which particles η_B is taken over ([`InteriorRule`]): unset, the layer rule (default); set, the depth (m,
-    /// ≥ 0) below the surface layer from which a particle counts, with weight rising linearly to 1 over
-    /// `interior_ramp` (m, > 0; default `interior_depth`). Meant for piles of unequal spheres (PP1).
+    /// The depth of [`InteriorRule::Depth`], the rule for η_B meant for piles of unequal spheres (PP1).
     #[serde(default)]
     #[field(unit = "m", default = "none (layer rule)", range = NonNegative)]
     #[field(
@@ -309,11 +305,7 @@ impl crate::io::scene_file::Validator<'_> {
 /// (`(i, j)` keys, as `granular::soft::forces::SoftSystem::touching_pairs` after a force evaluation); ties go
 /// to the set holding the lowest index.
 pub fn central_body(particles: &[Particle], contacts: impl IntoIterator<Item = (usize, usize)>) -> Vec<bool> {
-    let sets = DisjointSets::new(particles.len());
-    for (i, j) in contacts {
-        sets.union(i, j);
-    }
-    sets.heaviest(particles)
+    central_body_par(particles, |union| contacts.into_iter().for_each(|(i, j)| union(i, j)))
 }
 
 /// [`central_body`] with the contacts handed over in parallel: `contacts` calls its argument once for every

@@ -193,11 +193,7 @@ pub struct RveStress {
     pub centre: Vec3,
     /// Particles.
     pub particles: usize,
-    /// Volume, Σ V_i (m³).
-    pub volume: f64,
-    /// Average stress tensor (Eq. 16, Pa).
-    pub sigma: Mat3,
-    /// Principal stresses and Mohr–Coulomb measures.
+    /// Principal stresses and Mohr–Coulomb measures of the average stress tensor (Eq. 16).
     pub state: StressState,
 }
 
@@ -232,25 +228,13 @@ pub fn rve_stresses(
                 .iter()
                 .map(|&i| (volumes[i], particle_stress(volumes[i], &contacts[i])))
                 .collect();
-            let sigma = rve_stress(&parts);
             RveStress {
                 centre: set.iter().map(|&i| centres[i]).sum::<Vec3>() / set.len() as f64,
                 particles: set.len(),
-                volume: parts.iter().map(|p| p.0).sum(),
-                sigma,
-                state: stress_state(&sigma),
+                state: stress_state(&rve_stress(&parts)),
             }
         })
         .collect()
-}
-
-/// Everything measured at one sample, with the per-RVE stresses (for tests and figures).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Diagnosis {
-    /// The row.
-    pub sample: SpinupSample,
-    /// Per-RVE stresses.
-    pub rves: Vec<RveStress>,
 }
 
 /// Weights of the particles in η_B by [`InteriorRule::Depth`]: a cell is open when it reaches `open_radius`
@@ -331,7 +315,7 @@ pub fn mean_coordination(counts: &[u32]) -> f64 {
     counts.iter().map(|&c| c as f64).sum::<f64>() / counts.len().max(1) as f64
 }
 
-/// Measures the system at time `t` (s). Needs the contact records of the last force evaluation
+/// The `spinup.csv` row of the system at time `t` (s). Needs the contact records of the last force evaluation
 /// (`sys.keep_records` on for it); `axis` is the spin axis, `path_period` the path's period (s), `interior` the
 /// rule for η_B's particles.
 pub fn diagnose(
@@ -342,7 +326,7 @@ pub fn diagnose(
     rve_target: usize,
     interior: InteriorRule,
     t: f64,
-) -> Diagnosis {
+) -> SpinupSample {
     let ps = &sys.particles;
     let n = ps.len();
     let member = central_body(ps, sys.touching_pairs());
@@ -406,7 +390,7 @@ pub fn diagnose(
         .iter()
         .filter_map(|r| r.state.friction_angle_deg)
         .fold(f64::NAN, f64::max);
-    let sample = SpinupSample {
+    SpinupSample {
         t,
         path_period_h: path_period / 3600.0,
         period_h: rot.period() / 3600.0,
@@ -428,12 +412,11 @@ pub fn diagnose(
         p_max,
         theta_max_deg: theta_max,
         coordination_loaded: mean_coordination(&loaded_contact_counts(&sys.records, n, CONTACT_FORCE_FLOOR)),
-    };
-    Diagnosis { sample, rves: stresses }
+    }
 }
 
 /// [`diagnose`] for a run with a spin-up driver at time `t` (s).
-pub fn diagnose_run(sys: &SoftSystem, driver: &SpinupDriver, t: f64) -> Diagnosis {
+pub fn diagnose_run(sys: &SoftSystem, driver: &SpinupDriver, t: f64) -> SpinupSample {
     let s = &driver.settings;
     diagnose(
         sys,
