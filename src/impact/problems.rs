@@ -15,8 +15,9 @@ use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
 };
 use crate::ellipsoid::output::{BodyRecord, read_bodies};
-use crate::impact::projectile::{ProjectileSpec, set_up_impact};
-use crate::impact::target::to_centre_of_mass_frame;
+use crate::impact::geometry::ImpactGeometry;
+use crate::impact::projectile::{ProjectileSpec, set_up_aimed_impact};
+use crate::impact::target::{centre_of_mass, to_centre_of_mass_frame};
 use crate::integrate::OdeSystem;
 use crate::integrate::problems::torque_free_spin;
 use crate::math::{Vec3, Vec4};
@@ -447,8 +448,7 @@ pub fn squeezed_pile(f0: f64) -> ProblemSetup {
     let projectile = ProjectileSpec::preset("P1").expect("a preset projectile");
     let cfg = crate::impact::run::ImpactConfig::new("targets/N30_T4.csv".into(), projectile);
     let kappa = cfg.kappa(&bodies).expect("the target and projectile calibrate");
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let centre = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let (centre, _) = centre_of_mass(&bodies);
     for b in &mut bodies {
         b.position = centre + (b.position - centre) * PILE_SQUEEZE;
     }
@@ -524,7 +524,15 @@ impl ImpactProblem {
             cfg.f0 = f0;
         }
         let kappa = cfg.kappa(&target).expect("the target and projectile calibrate");
-        let (bodies, _) = set_up_impact(&target, &projectile, cfg.angle_deg, cfg.contact_time, cfg.seed);
+        let geometry = ImpactGeometry::default();
+        let (bodies, ..) = set_up_aimed_impact(
+            &target,
+            &projectile,
+            &geometry,
+            cfg.angle_deg,
+            cfg.contact_time,
+            cfg.seed,
+        );
         let system = EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), Physics::impact(cfg.f0));
         ProblemSetup {
             name: self.name,

@@ -1,6 +1,6 @@
 //! One impact run (Roig03 §3) as a library call: a projectile on a rubble-pile target, run to `t_end`.
 //!
-//! [`run_impact`] reads the target bodies file, adds the projectile ([`set_up_impact`]), writes into the run
+//! [`run_impact`] reads the target bodies file, adds the projectile ([`set_up_aimed_impact`]), writes into the run
 //! directory
 //! - `initial_bodies.csv`: target + projectile in the centre-of-mass frame (snapshot columns),
 //! - `impact.json`: the [`ImpactSetup`] (Q, impact time, projectile, …) plus `"target"`, the target file,

@@ -203,11 +203,18 @@ pub fn place_fragments(spec: &TargetSpec, radii: &[f64], rng: &mut Generator) ->
     }
 }
 
+/// Centre-of-mass position (m) and velocity (m/s) of `bodies`.
+pub fn centre_of_mass(bodies: &[Body]) -> (Vec3, Vec3) {
+    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let r = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let v = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / mass;
+    (r, v)
+}
+
 /// Puts every body into the rigid rotation `ω` about the centre of mass (world frame, rad/s), with the
 /// centre of mass at rest at the origin.
 pub fn set_rigid_rotation(bodies: &mut [Body], omega: &Vec3) {
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let com = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let (com, _) = centre_of_mass(bodies);
     for b in bodies.iter_mut() {
         b.position -= com;
         b.velocity = omega.cross(&b.position);
@@ -217,9 +224,7 @@ pub fn set_rigid_rotation(bodies: &mut [Body], omega: &Vec3) {
 
 /// Shifts positions and velocities to the centre-of-mass frame.
 pub fn to_centre_of_mass_frame(bodies: &mut [Body]) {
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let com = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
-    let vcm = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / mass;
+    let (com, vcm) = centre_of_mass(bodies);
     for b in bodies.iter_mut() {
         b.position -= com;
         b.velocity -= vcm;
