@@ -15,6 +15,7 @@ use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
 use crate::impact::target_checkpoint::{BuildCheckpoint, RoundState};
+use crate::impact::target_spec::is_default;
 pub use crate::impact::target_spec::{TargetError, TargetSpec};
 use crate::integrate::{Method, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};
@@ -75,21 +76,13 @@ pub struct TargetReport {
     /// Size draws tried before the mass matched.
     pub size_draws: usize,
     /// Fragments removed as detached from the pile ([`TargetSpec::drop_detached`]); absent (0) otherwise.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub detached_fragments: usize,
     /// Their mass (kg), not counted in `total_mass_kg`.
-    #[serde(default, skip_serializing_if = "is_zero_mass")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub detached_mass_kg: f64,
     /// The inputs.
     pub spec: TargetSpec,
-}
-
-fn is_zero(n: &usize) -> bool {
-    *n == 0
-}
-
-fn is_zero_mass(m: &f64) -> bool {
-    *m == 0.0
 }
 
 /// Relative enlargement of the semi-axes in the contact test of [`drop_detached`].

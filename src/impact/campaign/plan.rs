@@ -194,6 +194,17 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
     };
     let c = &file.campaign;
     let imp = &file.impact;
+    let listed = |empty: bool, field: &str, what: &str| match empty {
+        true => Err(invalid(
+            format!("campaign.{field}"),
+            format!("must list at least one {what}, got []"),
+        )),
+        false => Ok(()),
+    };
+    let speed_ok = |field: String, v: f64| match v.is_finite() && v > 0.0 {
+        true => Ok(v),
+        false => Err(invalid(field, format!("must be > 0 km/s and finite, got {v}"))),
+    };
     if c.out.as_os_str().is_empty() {
         return Err(invalid("campaign.out".into(), "must name a directory, got \"\"".into()));
     }
@@ -205,13 +216,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
 
     // [impact]
     let t_end = imp.t_end.unwrap_or(DEFAULT_T_END);
-    let speed_km_s = imp.speed_km_s.unwrap_or(5.0);
-    if !(speed_km_s.is_finite() && speed_km_s > 0.0) {
-        return Err(invalid(
-            "impact.speed_km_s".into(),
-            format!("must be > 0 km/s and finite, got {speed_km_s}"),
-        ));
-    }
+    let speed_km_s = speed_ok("impact.speed_km_s".into(), imp.speed_km_s.unwrap_or(5.0))?;
 
     // [[projectile]]
     let mut custom: Vec<(String, ProjectileSpec)> = Vec::new();
@@ -240,13 +245,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 ),
             ));
         }
-        let speed = p.speed_km_s.unwrap_or(speed_km_s);
-        if !(speed.is_finite() && speed > 0.0) {
-            return Err(invalid(
-                field("speed_km_s"),
-                format!("must be > 0 km/s and finite, got {speed}"),
-            ));
-        }
+        let speed = speed_ok(field("speed_km_s"), p.speed_km_s.unwrap_or(speed_km_s))?;
         let spec = match (p.radius_km, &p.projectile_pile) {
             (Some(r), None) if r.is_finite() && r > 0.0 && p.random_attitude.is_none() => {
                 ProjectileSpec::custom(p.id.clone(), r * 1e3, speed * 1e3)
@@ -284,12 +283,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
     }
 
     // [campaign] lists
-    if c.targets.is_empty() {
-        return Err(invalid(
-            "campaign.targets".into(),
-            "must list at least one target bodies file, got []".into(),
-        ));
-    }
+    listed(c.targets.is_empty(), "targets", "target bodies file")?;
     let mut targets: Vec<(String, PathBuf, Vec<Body>)> = Vec::new();
     for (k, rel) in c.targets.iter().enumerate() {
         let field = format!("campaign.targets[{k}]");
@@ -313,12 +307,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         let bodies = read_target(&path).map_err(|e| invalid(field.clone(), one_line(&e.to_string())))?;
         targets.push((stem, path, bodies));
     }
-    if c.projectiles.is_empty() {
-        return Err(invalid(
-            "campaign.projectiles".into(),
-            "must list at least one projectile, got []".into(),
-        ));
-    }
+    listed(c.projectiles.is_empty(), "projectiles", "projectile")?;
     let mut projectiles: Vec<ProjectileSpec> = Vec::new();
     for (k, id) in c.projectiles.iter().enumerate() {
         let field = format!("campaign.projectiles[{k}]");
@@ -340,12 +329,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         }
         projectiles.push(p);
     }
-    if c.angles.is_empty() {
-        return Err(invalid(
-            "campaign.angles".into(),
-            "must list at least one angle (degrees), got []".into(),
-        ));
-    }
+    listed(c.angles.is_empty(), "angles", "angle (degrees)")?;
     let mut angles: Vec<f64> = Vec::new();
     for (k, &a) in c.angles.iter().enumerate() {
         let field = format!("campaign.angles[{k}]");
@@ -358,12 +342,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         }
         angles.push(a);
     }
-    if c.seeds.is_empty() {
-        return Err(invalid(
-            "campaign.seeds".into(),
-            "must list at least one seed, got []".into(),
-        ));
-    }
+    listed(c.seeds.is_empty(), "seeds", "seed")?;
     let mut seen = HashSet::new();
     for (k, s) in c.seeds.iter().enumerate() {
         if !seen.insert(*s) {
