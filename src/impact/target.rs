@@ -92,8 +92,7 @@ pub const DETACHED_MARGIN: f64 = 0.1;
 /// by [`DETACHED_MARGIN`]; [`crate::ellipsoid::clumps`]) and the same entries from `kept` (each body's index in
 /// the placement). The collapse of a large placement sphere throws a few small fragments onto wide orbits; the
 /// next round's rigid rotation would give those far out more than the local escape speed, and their growing
-/// distance would keep `K_rel/K` rising forever (N = 10 000: 18 fragments beyond 180 km, `analysis/n2000`).
-/// Returns how many were removed.
+/// distance would keep `K_rel/K` rising forever (`analysis/n2000/REPORT.md`). Returns how many were removed.
 pub fn drop_detached(bodies: &mut Vec<Body>, kept: &mut Vec<usize>) -> usize {
     let clumps =
         crate::ellipsoid::clumps::find_clumps(bodies, crate::ellipsoid::clumps::Linking::ScaledAxes(DETACHED_MARGIN));
@@ -307,9 +306,8 @@ fn relax_round(
 /// of the placement sphere (`ω² R_p³ > G M`: there the centrifugal acceleration exceeds the pile's gravity, and
 /// the outer fragments fly off during the collapse instead of settling). Then the first round spins at the
 /// rate where the centrifugal acceleration on that equator is half of gravity, `√(G M / (2 R_p³))`, and the
-/// later rounds reset the spin to `ω` as usual. Loose placements of many small fragments need this: the N = 2000
-/// pile of `analysis/n2000/` is placed in a sphere of 159 km, where a 4 h spin gives `ω² R_p³ / G M = 1.15`
-/// and K_rel/K rose for ever; Table 1's targets (at most 0.88) keep `ω`.
+/// later rounds reset the spin to `ω` as usual: loose placements of many small fragments need it (the N = 2000
+/// pile, `analysis/n2000/REPORT.md`); Table 1's targets keep `ω`.
 pub fn first_round_spin(omega: &Vec3, total_mass: f64, placement_radius: f64) -> Vec3 {
     let gm = G_SI * total_mass;
     let r3 = placement_radius.powi(3);
