@@ -89,11 +89,7 @@ impl DenseStarts {
 
 impl Grid {
     fn key(&self, p: &Vec3) -> [i64; 3] {
-        [
-            (p.z / self.cell).floor() as i64,
-            (p.y / self.cell).floor() as i64,
-            (p.x / self.cell).floor() as i64,
-        ]
+        [p.z, p.y, p.x].map(|v| (v / self.cell).floor() as i64)
     }
 
     /// Calls `visit(id)` for every binned body whose sphere overlaps the sphere (`c`, `r`), given the
