@@ -98,6 +98,7 @@ pub const RELEASE_CHECK_S: f64 = 2000.0;
 
 /// Runs the T_c,3 search (Zhang17 §3.3.3) and writes `critical.json` and `critical.csv` in `args.out`.
 pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
+    let say = |line: String| emit(Channel::Out, &line);
     let ok = |x: f64| x.is_finite() && x > 0.0;
     if !ok(args.from) || !ok(args.to) || args.to < args.from {
         return Err(SearchError::usage(format!(
@@ -230,14 +231,11 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         ))
     };
     if args.prepare_only {
-        emit(
-            Channel::Out,
-            &format!(
-                "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
-                jobs.len(),
-                args.out.display()
-            ),
-        );
+        say(format!(
+            "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
+            jobs.len(),
+            args.out.display()
+        ));
         return Ok(());
     }
     if let Some(shard) = args.shard {
@@ -248,16 +246,13 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             .map(|(_, j)| j)
             .collect();
         run_holds(&mine, args, &|_| false)?;
-        emit(
-            Channel::Out,
-            &format!(
-                "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
-                shard.index,
-                shard.count,
-                mine.len(),
-                jobs.len()
-            ),
-        );
+        say(format!(
+            "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
+            shard.index,
+            shard.count,
+            mine.len(),
+            jobs.len()
+        ));
         return Ok(());
     }
     let all: Vec<&HoldJob> = jobs.iter().collect();
@@ -287,7 +282,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     }
     runs.truncate(sequential_stop(&runs, args.all_holds));
     for r in &runs {
-        emit(Channel::Out, &verdict_line(r));
+        say(verdict_line(r));
     }
     let result = |criterion: CreepCriterion| {
         let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs, criterion.kind);
@@ -326,15 +321,12 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.paper_tolerance, &out.ours] {
         if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {
-            emit(
-                Channel::Out,
-                &format!(
-                    "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
+            say(format!(
+                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
                  monotone there: refine with a finer --step-h from {first:.2} h to the next creeping hold above {last:.2} h)",
-                    r.criterion.kind.name(),
-                    r.set_aside_hours
-                ),
-            );
+                r.criterion.kind.name(),
+                r.set_aside_hours
+            ));
         }
         let verdict = match (r.t_c3_hours, r.friction_angle_deg) {
             (Some(t), Some(p)) => format!("T_c3 = {t:.2} h, phi = {p:.1} deg"),
@@ -344,20 +336,14 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
                 undecided_note(&out.runs, r.criterion.kind)
             ),
         };
-        emit(
-            Channel::Out,
-            &format!("{} criterion: {verdict}", r.criterion.kind.name()),
-        );
+        say(format!("{} criterion: {verdict}", r.criterion.kind.name()));
     }
-    emit(
-        Channel::Out,
-        &format!(
-            "selected ({}): {} ({})",
-            args.criterion.name(),
-            t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
-            json.display()
-        ),
-    );
+    say(format!(
+        "selected ({}): {} ({})",
+        args.criterion.name(),
+        t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
+        json.display()
+    ));
     Ok(())
 }
 

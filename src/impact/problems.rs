@@ -88,12 +88,6 @@ impl crate::named::Named for WorkPrecisionProblem {
     }
 }
 
-impl std::fmt::Display for WorkPrecisionProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(crate::named::Named::name(*self))
-    }
-}
-
 impl WorkPrecisionProblem {
     /// Whether the problem has dissipation whose F0 `--f0` may set.
     pub fn takes_f0(self) -> bool {
@@ -147,12 +141,6 @@ impl crate::named::Named for NBodyProblem {
             NBodyProblem::Pythagorean => "Burrau's Pythagorean three-body problem, to t = 10",
             NBodyProblem::OuterSolar => "the Sun and the four giant planets, to t = 1000",
         }
-    }
-}
-
-impl std::fmt::Display for NBodyProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(crate::named::Named::name(*self))
     }
 }
 

@@ -12,6 +12,7 @@ use crate::impact::run::{
 };
 
 use super::*;
+use crate::io::scene_file::SceneError;
 
 /// One grid point.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,7 +56,7 @@ pub struct Campaign {
 /// Reads and validates a campaign file; relative paths in it are resolved against its directory.
 pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
     let name = path.display().to_string();
-    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| crate::io::scene_file::SceneError::Read {
+    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| SceneError::Read {
         file: name.clone(),
         reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
     })?;
@@ -80,13 +81,7 @@ pub fn parse_campaign(text: &str, name: &str, base_dir: &Path) -> Result<Campaig
 /// The campaign of a file with a `[sweep]`: one resolved grid per combination of the swept values (the first path
 /// outermost), concatenated, each run's name suffixed and its overrides recorded.
 fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
-    let invalid = |(field, message): (String, String)| {
-        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-            file: name.to_string(),
-            field,
-            message,
-        })
-    };
+    let invalid = |(field, message): (String, String)| invalid_in(name, field, message);
     let axes = sweep_axes(&file.sweep).map_err(invalid)?;
     let total: usize = axes.iter().map(|a| a.values.len()).product();
     let mut all: Option<Campaign> = None;
@@ -112,12 +107,8 @@ fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Camp
             .collect::<Vec<_>>()
             .join(", ");
         let mut c = resolve(with, name, base_dir).map_err(|e| match e {
-            CampaignError::File(crate::io::scene_file::SceneError::Invalid { file, field, message }) => {
-                CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-                    file,
-                    field,
-                    message: format!("{message} (with the sweep's {described})"),
-                })
+            CampaignError::File(SceneError::Invalid { file, field, message }) => {
+                invalid_in(&file, field, format!("{message} (with the sweep's {described})"))
             }
             other => other,
         })?;
@@ -184,14 +175,14 @@ fn join_clean(base: &Path, rel: &Path) -> PathBuf {
     }
 }
 
+/// The error of a value of the campaign file `file` out of range, naming its `field`.
+fn invalid_in(file: &str, field: String, message: String) -> CampaignError {
+    let file = file.to_string();
+    CampaignError::File(SceneError::Invalid { file, field, message })
+}
+
 fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
-    let invalid = |field: String, message: String| {
-        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-            file: name.to_string(),
-            field,
-            message,
-        })
-    };
+    let invalid = |field: String, message: String| invalid_in(name, field, message);
     let c = &file.campaign;
     let imp = &file.impact;
     let listed = |empty: bool, field: &str, what: &str| match empty {
