@@ -103,7 +103,6 @@ impl ImpactGeometry {
     pub fn validate(&self, pile: bool) -> Result<(), (&'static str, String)> {
         let field = aim_field(&self.aim);
         match self.aim {
-            Aim::Centre => {}
             Aim::ParameterM(b) if !(b.is_finite() && b >= 0.0) => {
                 return Err((field, format!("must be >= 0 m and finite, got {b}")));
             }
