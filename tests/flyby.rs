@@ -409,7 +409,8 @@ fn analyze_command_handles_flyby_runs() {
 /// case is one that catches the bug).
 #[test]
 fn flyby_output_times_never_pass_t_end() {
-    use rubblepile::impact::flyby::{DEFAULT_START_Q, EARTH_MASS_KG, EARTH_RADIUS_M, flyby_orbit, output_times};
+    use rubblepile::impact::flyby::{DEFAULT_START_Q, EARTH_MASS_KG, EARTH_RADIUS_M, flyby_orbit};
+    use rubblepile::io::output_times::evenly_spaced as output_times;
     let gm = rubblepile::ellipsoid::equations::G_SI * EARTH_MASS_KG;
     let (_, t_perigee) = flyby_orbit(gm, 6.0 * EARTH_RADIUS_M, 12_000.0, DEFAULT_START_Q).unwrap();
     let t_end = 2.0 * t_perigee;

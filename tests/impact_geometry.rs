@@ -17,9 +17,7 @@ use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::impact::campaign::parse_campaign;
 use rubblepile::impact::geometry::{Aim, ImpactGeometry, SurfaceEllipsoid};
-use rubblepile::impact::projectile::{
-    ProjectileSpec, first_contact_distance, set_up_aimed_impact, target_and_direction,
-};
+use rubblepile::impact::projectile::{ProjectileSpec, contact_walk, set_up_aimed_impact, target_and_direction};
 use rubblepile::impact::run::ImpactConfig;
 use rubblepile::impact::target::{set_rigid_rotation, to_centre_of_mass_frame};
 use rubblepile::math::{Mat3, Vec3, Vec4};
@@ -221,7 +219,7 @@ fn the_default_is_the_zeta_only_set_up() {
             quaternion,
             spin_body: Vec3::zeros(),
         }];
-        let start = first_contact_distance(&bodies, &incoming, &n) + cfg.projectile.speed * cfg.contact_time;
+        let start = contact_walk(&bodies, &incoming, &n).0 + cfg.projectile.speed * cfg.contact_time;
         bodies.push(Body {
             shape,
             position: n * start,

@@ -12,7 +12,8 @@ use rubblepile::driver::RunOptions;
 use rubblepile::ellipsoid::body::{Body, Ellipsoid};
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::impact::campaign::parse_campaign;
-use rubblepile::impact::pile::{ProjectilePile, set_up_pile_impact};
+use rubblepile::impact::geometry::ImpactGeometry;
+use rubblepile::impact::pile::{ProjectilePile, set_up_aimed_pile_impact};
 use rubblepile::impact::run::{ImpactConfig, read_target, run_impact};
 use rubblepile::math::{Mat3, Vec3, Vec4};
 
@@ -120,7 +121,8 @@ fn pile_set_up_touches_at_contact_time() {
     let p = pile("targets/N30_T12.csv", true);
     let spec = p.equivalent_spec(p.id(), 5000.0);
     for angle in [0.0, 45.0, 120.0] {
-        let (bodies, setup) = set_up_pile_impact(&target, &p, &spec, angle, 90.0, 3);
+        let geometry = ImpactGeometry::default();
+        let (bodies, setup, _) = set_up_aimed_pile_impact(&target, &p, &spec, &geometry, angle, 90.0, 3);
         assert_eq!(bodies.len(), 60);
         assert_eq!(setup.projectile_index, 30);
         assert!((total_mass(&bodies[30..]) - p.mass()).abs() <= 1e-12 * p.mass());

@@ -6,7 +6,8 @@ use rubblepile::analysis::rigid_rotation::fit_rigid_rotation;
 use rubblepile::ellipsoid::equations::G_SI;
 use rubblepile::ellipsoid::quaternion::rotation_matrix;
 use rubblepile::geometry::ellipsoid_overlap::are_apart;
-use rubblepile::impact::projectile::{ProjectileSpec, set_up_impact};
+use rubblepile::impact::geometry::ImpactGeometry;
+use rubblepile::impact::projectile::{ProjectileSpec, set_up_aimed_impact};
 use rubblepile::impact::target::{
     TargetSpec, build_target, build_target_resumable, draw_sizes, drop_detached, first_round_spin, place_fragments,
     set_rigid_rotation,
@@ -270,7 +271,7 @@ fn projectiles_have_table2_energies_and_impact_geometry() {
     for (id, q_paper) in [("P1", 0.44e9), ("P2", 1.49e9), ("P3", 3.54e9)] {
         let p = ProjectileSpec::preset(id).unwrap();
         for angle in [0.0, 45.0, 90.0] {
-            let (bodies, setup) = set_up_impact(&target, &p, angle, 90.0, 4);
+            let (bodies, setup, _) = set_up_aimed_impact(&target, &p, &ImpactGeometry::default(), angle, 90.0, 4);
             let q_1e19 = setup.q_erg_per_g * m_target / 1e19;
             assert!(
                 (q_1e19 / q_paper - 1.0).abs() < 0.01,

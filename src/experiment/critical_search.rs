@@ -98,6 +98,7 @@ pub const RELEASE_CHECK_S: f64 = 2000.0;
 
 /// Runs the T_c,3 search (Zhang17 §3.3.3) and writes `critical.json` and `critical.csv` in `args.out`.
 pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
+    let say = |line: String| emit(Channel::Out, &line);
     let ok = |x: f64| x.is_finite() && x > 0.0;
     if !ok(args.from) || !ok(args.to) || args.to < args.from {
         return Err(SearchError::usage(format!(
@@ -230,14 +231,11 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         ))
     };
     if args.prepare_only {
-        emit(
-            Channel::Out,
-            &format!(
-                "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
-                jobs.len(),
-                args.out.display()
-            ),
-        );
+        say(format!(
+            "spinup critical: {} holds prepared in {}; run them with --shard I/N or without it",
+            jobs.len(),
+            args.out.display()
+        ));
         return Ok(());
     }
     if let Some(shard) = args.shard {
@@ -248,16 +246,13 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
             .map(|(_, j)| j)
             .collect();
         run_holds(&mine, args, &|_| false)?;
-        emit(
-            Channel::Out,
-            &format!(
-                "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
-                shard.index,
-                shard.count,
-                mine.len(),
-                jobs.len()
-            ),
-        );
+        say(format!(
+            "spinup critical: shard {}/{} ran {} of {} holds; run the search again without --shard to judge them all",
+            shard.index,
+            shard.count,
+            mine.len(),
+            jobs.len()
+        ));
         return Ok(());
     }
     let all: Vec<&HoldJob> = jobs.iter().collect();
@@ -287,7 +282,7 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
     }
     runs.truncate(sequential_stop(&runs, args.all_holds));
     for r in &runs {
-        emit(Channel::Out, &verdict_line(r));
+        say(verdict_line(r));
     }
     let result = |criterion: CreepCriterion| {
         let (t_c3_hours, friction_angle_deg) = critical_from_verdicts(&runs, criterion.kind);
@@ -326,44 +321,29 @@ pub fn critical(args: &CriticalOptions) -> Result<(), SearchError> {
         .map_err(|e| SearchError::failed(format!("{}: {e}", json.display())))?;
     for r in [&out.paper, &out.paper_tolerance, &out.ours] {
         if let (Some(first), Some(last)) = (r.set_aside_hours.first(), r.set_aside_hours.last()) {
-            emit(
-                Channel::Out,
-                &format!(
-                    "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
+            say(format!(
+                "{} criterion: stable holds at {:?} h lie below creeping ones and are set aside (the verdict is not \
                  monotone there: refine with a finer --step-h from {first:.2} h to the next creeping hold above {last:.2} h)",
-                    r.criterion.kind.name(),
-                    r.set_aside_hours
-                ),
-            );
+                r.criterion.kind.name(),
+                r.set_aside_hours
+            ));
         }
-        match (r.t_c3_hours, r.friction_angle_deg) {
-            (Some(t), Some(p)) => emit(
-                Channel::Out,
-                &format!(
-                    "{} criterion: T_c3 = {t:.2} h, phi = {p:.1} deg",
-                    r.criterion.kind.name()
-                ),
+        let verdict = match (r.t_c3_hours, r.friction_angle_deg) {
+            (Some(t), Some(p)) => format!("T_c3 = {t:.2} h, phi = {p:.1} deg"),
+            _ => format!(
+                "no stable T_final up to {} h{}",
+                args.to,
+                undecided_note(&out.runs, r.criterion.kind)
             ),
-            _ => emit(
-                Channel::Out,
-                &format!(
-                    "{} criterion: no stable T_final up to {} h{}",
-                    r.criterion.kind.name(),
-                    args.to,
-                    undecided_note(&out.runs, r.criterion.kind)
-                ),
-            ),
-        }
+        };
+        say(format!("{} criterion: {verdict}", r.criterion.kind.name()));
     }
-    emit(
-        Channel::Out,
-        &format!(
-            "selected ({}): {} ({})",
-            args.criterion.name(),
-            t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
-            json.display()
-        ),
-    );
+    say(format!(
+        "selected ({}): {} ({})",
+        args.criterion.name(),
+        t_c3_hours.map_or("no T_c3".to_string(), |t| format!("T_c3 = {t:.2} h")),
+        json.display()
+    ));
     Ok(())
 }
 
@@ -381,15 +361,12 @@ fn written(dir: &Path) -> bool {
     dir.join("checkpoint.json").is_file() || dir.join("summary.json").is_file()
 }
 
-/// Whether the forcing of the run in `dir` has been released (its `spinup.csv` says so).
-fn released_in(dir: &Path) -> bool {
-    read_spinup_csv(&dir.join("spinup.csv")).is_ok_and(|s| s.iter().any(|x| !x.forcing))
-}
-
-/// Whether the hold in `dir` needs no more running: completed, or released (unless `finish_released`).
+/// Whether the hold in `dir` needs no more running: completed, or its forcing released (its `spinup.csv` says so)
+/// unless `finish_released`.
 fn hold_finished(dir: &Path, finish_released: bool) -> bool {
     let completed = std::fs::read_to_string(dir.join("summary.json")).is_ok_and(|s| s.contains("\"completed\""));
-    completed || (!finish_released && released_in(dir))
+    let released = || read_spinup_csv(&dir.join("spinup.csv")).is_ok_and(|s| s.iter().any(|x| !x.forcing));
+    completed || (!finish_released && released())
 }
 
 /// Runs one hold to its end, in legs of [`RELEASE_CHECK_S`] simulated seconds each ending in a checkpoint, and
@@ -421,7 +398,8 @@ fn run_hold(job: &HoldJob, finish_released: bool) -> Result<(), SearchError> {
     }
 }
 
-/// Runs `jobs` (in order), `args.parallel` at once, each on a rayon pool of its own threads ([`threads_per_hold`]);
+/// Runs `jobs` (in order), `args.parallel` at once, each on a rayon pool of its own threads (shared out as a
+/// campaign's, [`crate::impact::campaign::threads_per_run`]);
 /// `enough(k)` is asked after hold k finishes, and once it says so no further hold is started.
 fn run_holds(
     jobs: &[&HoldJob],
@@ -432,7 +410,7 @@ fn run_holds(
     let next = AtomicUsize::new(0);
     let stop = AtomicBool::new(false);
     let first_error = std::sync::Mutex::new(None);
-    let threads = threads_per_hold(args.threads_per_hold, args.parallel);
+    let threads = crate::impact::campaign::threads_per_run(args.parallel, args.threads_per_hold);
     let worker = || {
         let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
             Ok(p) => p,
@@ -480,12 +458,6 @@ fn run_holds(
         Some(e) => Err(e),
         None => Ok(()),
     }
-}
-
-/// Threads of each hold's rayon pool: `requested`, or the calling pool's threads shared among the `parallel` holds
-/// at once (at least one each), as campaigns share them among their runs.
-pub fn threads_per_hold(requested: Option<usize>, parallel: usize) -> usize {
-    requested.unwrap_or_else(|| (rayon::current_num_threads() / parallel.max(1)).max(1))
 }
 
 /// Checkpointed legs the base run of `--branch` is cut into over its span (a stopped search loses one at most).

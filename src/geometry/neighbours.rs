@@ -89,11 +89,7 @@ impl DenseStarts {
 
 impl Grid {
     fn key(&self, p: &Vec3) -> [i64; 3] {
-        [
-            (p.z / self.cell).floor() as i64,
-            (p.y / self.cell).floor() as i64,
-            (p.x / self.cell).floor() as i64,
-        ]
+        [p.z, p.y, p.x].map(|v| (v / self.cell).floor() as i64)
     }
 
     /// Calls `visit(id)` for every binned body whose sphere overlaps the sphere (`c`, `r`), given the
@@ -105,13 +101,14 @@ impl Grid {
         // A sphere far larger than the cells (a wild trial state of the integrator can give one) would walk more
         // cell rows than there are bodies: scanning the bodies is then cheaper, and finishes.
         let rows = (hi[0] as f64 - lo[0] as f64 + 1.0) * (hi[1] as f64 - lo[1] as f64 + 1.0);
-        if rows > self.keys.len() as f64 {
-            for m in 0..self.keys.len() {
-                let reach_ij = r + self.radii[m];
-                if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
-                    visit(self.ids[m]);
-                }
+        let mut check = |m: usize| {
+            let reach_ij = r + self.radii[m];
+            if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
+                visit(self.ids[m]);
             }
+        };
+        if rows > self.keys.len() as f64 {
+            (0..self.keys.len()).for_each(check);
             return;
         }
         for kz in lo[0]..=hi[0] {
@@ -124,12 +121,7 @@ impl Grid {
                         self.keys.partition_point(|k| *k < first)..self.keys.partition_point(|k| *k <= last)
                     }
                 };
-                for m in run {
-                    let reach_ij = r + self.radii[m];
-                    if (self.centres[m] - c).norm_squared() < reach_ij * reach_ij {
-                        visit(self.ids[m]);
-                    }
-                }
+                run.for_each(&mut check);
             }
         }
     }

@@ -256,23 +256,13 @@ impl XyGrid {
     }
 
     fn bin_of(&self, x: f64, y: f64) -> Option<usize> {
-        let i = (x - self.origin[0]) / self.cell[0];
-        let j = (y - self.origin[1]) / self.cell[1];
-        if !(i >= 0.0 && j >= 0.0) {
-            return None;
-        }
-        let (i, j) = (i.floor() as usize, j.floor() as usize);
-        // the upper boundary belongs to the last cell
-        let i = if i == self.dims[0] && x == self.origin[0] + self.cell[0] * self.dims[0] as f64 {
-            i - 1
-        } else {
-            i
+        let index = |v: f64, k: usize| {
+            let i = (v - self.origin[k]) / self.cell[k];
+            // the upper boundary belongs to the last cell
+            let top = i.floor() as usize == self.dims[k] && v == self.origin[k] + self.cell[k] * self.dims[k] as f64;
+            (i >= 0.0).then(|| i.floor() as usize - usize::from(top))
         };
-        let j = if j == self.dims[1] && y == self.origin[1] + self.cell[1] * self.dims[1] as f64 {
-            j - 1
-        } else {
-            j
-        };
+        let (i, j) = (index(x, 0)?, index(y, 1)?);
         (i < self.dims[0] && j < self.dims[1]).then_some(i * self.dims[1] + j)
     }
 }

@@ -186,13 +186,15 @@ fn tessellate(centres: &[Vec3], radii: Option<&[f64]>, half_size: f64) -> Vec<Vo
             let g = centres[i];
             let mut order: Vec<(f64, usize)> = neighbours[i].iter().map(|&j| ((centres[j] - g).norm(), j)).collect();
             order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let reach = |cell: &[Face]| {
+                cell.iter()
+                    .flat_map(|f| &f.polygon)
+                    .map(|p| (p - g).norm())
+                    .fold(0.0, f64::max)
+            };
             let mut cell = cube_around(&g, half_size);
             for (dist, j) in order {
-                let r_max = cell
-                    .iter()
-                    .flat_map(|f| f.polygon.iter())
-                    .map(|p| (p - g).norm())
-                    .fold(0.0, f64::max);
+                let r_max = reach(&cell);
                 if dist == 0.0 {
                     continue; // a duplicate point has no bisector
                 }
@@ -222,11 +224,7 @@ fn tessellate(centres: &[Vec3], radii: Option<&[f64]>, half_size: f64) -> Vec<Vo
             VoronoiCell {
                 volume,
                 boundary: cell.iter().any(|f| f.from_box),
-                reach: cell
-                    .iter()
-                    .flat_map(|f| f.polygon.iter())
-                    .map(|p| (p - g).norm())
-                    .fold(0.0, f64::max),
+                reach: reach(&cell),
             }
         })
         .collect()
@@ -235,14 +233,8 @@ fn tessellate(centres: &[Vec3], radii: Option<&[f64]>, half_size: f64) -> Vec<Vo
 /// Packing fraction Σ (4/3)π r³ / Σ V_cell over the particles with `interior[i]` whose cells are closed
 /// (not [`VoronoiCell::boundary`]); `None` when no particle qualifies.
 pub fn packing_fraction(cells: &[VoronoiCell], radii: &[f64], interior: &[bool]) -> Option<f64> {
-    let (mut solid, mut total) = (0.0, 0.0);
-    for ((c, &r), &keep) in cells.iter().zip(radii).zip(interior) {
-        if keep && !c.boundary {
-            solid += 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
-            total += c.volume;
-        }
-    }
-    (total > 0.0).then(|| solid / total)
+    let weights: Vec<f64> = interior.iter().map(|&keep| if keep { 1.0 } else { 0.0 }).collect();
+    weighted_packing_fraction(cells, radii, &weights)
 }
 
 /// Weighted packing fraction Σ wᵢ (4/3)π rᵢ³ / Σ wᵢ Vᵢ over the particles with closed cells (weights ≥ 0);

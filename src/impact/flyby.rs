@@ -28,7 +28,10 @@ use crate::ellipsoid::scene::{LoadedScene, ModelSection, parse_scene};
 use crate::ellipsoid::tide::FlybySpec;
 use crate::gravity::kepler::{KeplerOrbit, orientation_matrix};
 use crate::impact::run::{ImpactError, pile_scene, read_target};
-use crate::impact::settle::{SETTLE_MAX_FREE_FALLS, SettleReport, free_fall_time, set_principal_axis_rotation, settle};
+use crate::impact::settle::{
+    SETTLE_MAX_FREE_FALLS, SettleReport, apparent_radius, free_fall_time, set_principal_axis_rotation, settle,
+};
+use crate::impact::target::centre_of_mass;
 use crate::io::run_lock::DirLock;
 use crate::io::scene_file::scene_text;
 use crate::math::Vec3;
@@ -171,13 +174,6 @@ pub fn flyby_orbit(gm: f64, q: f64, v_inf: f64, start_q: f64) -> Result<(KeplerO
 /// Subfolder of a flyby run directory that holds its control run (the same pile and time, no planet).
 pub const CONTROL_DIR: &str = "control";
 
-/// `n ≥ 2` output times evenly spaced over `[0, t_end]` (s), the last exactly `t_end` and none above it
-/// ([`crate::io::output_times::evenly_spaced`]; `t_end·k/(n − 1)` can round one ulp above `t_end`, which the scene
-/// check refuses).
-pub fn output_times(t_end: f64, n: usize) -> Vec<f64> {
-    crate::io::output_times::evenly_spaced(t_end, n)
-}
-
 /// The `rubblepile flyby` flag of a [`FlybyConfig`] field named in an error: the field with dashes (`q_m` is
 /// `--q-m`), except those whose flag spells its unit otherwise.
 pub fn flag(field: &str) -> String {
@@ -187,17 +183,6 @@ pub fn flag(field: &str) -> String {
         "settle_max_hours" => "--settle-max-h".into(),
         other => format!("--{}", other.replace('_', "-")),
     }
-}
-
-/// Apparent radius (m) of a pile; it lives with the settling that reads it.
-pub use crate::impact::settle::apparent_radius;
-
-/// Centre-of-mass position (m) and velocity (m/s).
-fn centre_of_mass(bodies: &[Body]) -> (Vec3, Vec3) {
-    let m: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let r = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / m;
-    let v = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / m;
-    (r, v)
 }
 
 /// The pile of `args`: rescaled, spun and in its centre-of-mass frame; returns the bodies and the scale factor.
@@ -379,7 +364,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     let (orbit, t_perigee) = flyby_orbit(gm, args.q_m, v_inf, args.start_q)?;
     let start_distance = args.start_q * args.q_m;
     let t_end = 2.0 * t_perigee;
-    let setup = FlybySetup {
+    let mut setup = FlybySetup {
         target: args.target.display().to_string(),
         gm,
         planet_radius: args.planet_radius_m,
@@ -408,7 +393,7 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
         args.q_m / args.planet_radius_m,
         args.v_inf_km_s
     );
-    let times = output_times(t_end, args.snapshots);
+    let times = crate::io::output_times::evenly_spaced(t_end, args.snapshots);
     let scene_file = |planet_mass: f64| {
         let model = ModelSection {
             kappa: Some(kappa),
@@ -441,13 +426,12 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     let scene_path = out.join("scene.toml");
     crate::io::safe_write::write_atomic(&scene_path, &scene_toml).map_err(io(&scene_path))?;
     let mut scene = parse_scene(&scene_toml, &scene_path.display().to_string(), Some(out))?;
-    let mut setup = setup;
     if args.radius_m.is_some() || args.period_hours.is_some() || args.settle_to_principal {
         let prepared_path = out.join("prepared_bodies.csv");
         write_snapshot(&prepared_path, 0.0, &bodies).map_err(io(&prepared_path))?;
-        let max_time = settle_max_time;
-        let (mut settled, mut report) = settle(&scene.bodies, scene.model, scene.physics, args.rtol, max_time)
-            .map_err(|e| ImpactError::Run(crate::driver::RunError::Setup(format!("settling the pile: {e}"))))?;
+        let (mut settled, mut report) =
+            settle(&scene.bodies, scene.model, scene.physics, args.rtol, settle_max_time)
+                .map_err(|e| ImpactError::Run(crate::driver::RunError::Setup(format!("settling the pile: {e}"))))?;
         if args.settle_to_principal {
             let moments: Vec<Vec3> = settled
                 .iter()
@@ -481,13 +465,6 @@ pub fn prepare_flyby(args: &FlybyConfig) -> Result<(LoadedScene, FlybySetup, Dir
     Ok((scene, setup, lock))
 }
 
-/// The control run's scene of the flyby directory `dir` (written by [`prepare_flyby`]).
-pub fn control_scene(dir: &Path) -> Result<LoadedScene, ImpactError> {
-    Ok(crate::ellipsoid::scene::load_scene(
-        &dir.join(CONTROL_DIR).join("scene.toml"),
-    )?)
-}
-
 /// The summaries of a flyby run and of its control (when run).
 #[derive(Debug, Clone)]
 pub struct FlybyRuns {
@@ -513,7 +490,7 @@ pub fn run_flyby(args: &FlybyConfig, options: &RunOptions) -> Result<Option<Flyb
     };
     let run = crate::driver::run_scene(&scene, &args.out, &options)?;
     let control = if setup.control {
-        let control = control_scene(&args.out)?;
+        let control = crate::ellipsoid::scene::load_scene(&args.out.join(CONTROL_DIR).join("scene.toml"))?;
         Some(crate::driver::run_scene(
             &control,
             &args.out.join(CONTROL_DIR),

@@ -103,7 +103,6 @@ impl ImpactGeometry {
     pub fn validate(&self, pile: bool) -> Result<(), (&'static str, String)> {
         let field = aim_field(&self.aim);
         match self.aim {
-            Aim::Centre => {}
             Aim::ParameterM(b) if !(b.is_finite() && b >= 0.0) => {
                 return Err((field, format!("must be >= 0 m and finite, got {b}")));
             }
@@ -170,13 +169,12 @@ impl ImpactGeometry {
             Aim::Centre => Vec3::zeros(),
             Aim::ParameterM(b) => e * b,
             Aim::ParameterFrac(f) => e * (f * surface.radius()),
-            // θ = 0: the one point whose normal is n, wherever ψ points (recorded at its own azimuth)
-            Aim::AngleDeg(0.0) => {
-                let p = surface.point_with_normal(n);
-                p - n * p.dot(n)
-            }
             Aim::AngleDeg(t) => {
-                let p = surface.point_at_angle(n, &e, t.to_radians());
+                // θ = 0: the one point whose normal is n, wherever ψ points (recorded at its own azimuth)
+                let p = match t {
+                    0.0 => surface.point_with_normal(n),
+                    t => surface.point_at_angle(n, &e, t.to_radians()),
+                };
                 p - n * p.dot(n)
             }
         };

@@ -6,7 +6,7 @@
 //! attitude (the same draw, [`random_quaternion`] of the run's seed, as the single ellipsoid's), then
 //! translated rigidly along the impact direction `n = (0, sin ζ, cos ζ)` and given the velocity `−v n`, so that
 //! the closest surfaces of the two piles first touch at `contact_time` (the ellipsoids' overlap test of
-//! [`crate::impact::projectile::first_contact_distance`], as for a single projectile). The whole system is then moved to its
+//! [`crate::impact::projectile::contact_walk`], as for a single projectile). The whole system is then moved to its
 //! centre-of-mass frame. Bodies `0..N_t` are the target's, `N_t..N_t + N_p` the projectile's.
 //! `Q = ½ M_p v² / M_t` uses the pile's total mass `M_p`.
 
@@ -97,23 +97,9 @@ impl ProjectilePile {
 /// Adds the projectile pile to `target` (any frame) and returns the whole system in its centre-of-mass frame
 /// with the setup: the pile's bodies (`projectile.speed` is the impact speed, the rest of `projectile`
 /// is recorded as given) follow the target's, placed so that the closest surfaces first touch at
-/// `contact_time` (s), moving at `−speed n` relative to the target.
-pub fn set_up_pile_impact(
-    target: &[Body],
-    pile: &ProjectilePile,
-    projectile: &ProjectileSpec,
-    angle_deg: f64,
-    contact_time: f64,
-    seed: u64,
-) -> (Vec<Body>, ImpactSetup) {
-    let geometry = ImpactGeometry::default();
-    let (bodies, setup, _) =
-        set_up_aimed_pile_impact(target, pile, projectile, &geometry, angle_deg, contact_time, seed);
-    (bodies, setup)
-}
-
-/// [`set_up_pile_impact`] aimed by `geometry` (its aim only: a pile keeps its own spin and attitude) and whether
-/// the pile meets the target, as for [`crate::impact::projectile::set_up_aimed_impact`].
+/// `contact_time` (s), moving at `−speed n` relative to the target, aimed by `geometry` (its aim only: a pile keeps
+/// its own spin and attitude); and whether the pile meets the target, as for
+/// [`crate::impact::projectile::set_up_aimed_impact`].
 pub fn set_up_aimed_pile_impact(
     target: &[Body],
     pile: &ProjectilePile,

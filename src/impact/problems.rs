@@ -15,8 +15,9 @@ use crate::ellipsoid::equations::{
     ContactTerm, Diagnostics, DissipationTerm, EllipsoidSystem, G_SI, GravityTerm, ModelConfig, Physics,
 };
 use crate::ellipsoid::output::{BodyRecord, read_bodies};
-use crate::impact::projectile::{ProjectileSpec, set_up_impact};
-use crate::impact::target::to_centre_of_mass_frame;
+use crate::impact::geometry::ImpactGeometry;
+use crate::impact::projectile::{ProjectileSpec, set_up_aimed_impact};
+use crate::impact::target::{centre_of_mass, to_centre_of_mass_frame};
 use crate::integrate::OdeSystem;
 use crate::integrate::problems::torque_free_spin;
 use crate::math::{Vec3, Vec4};
@@ -87,12 +88,6 @@ impl crate::named::Named for WorkPrecisionProblem {
     }
 }
 
-impl std::fmt::Display for WorkPrecisionProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(crate::named::Named::name(*self))
-    }
-}
-
 impl WorkPrecisionProblem {
     /// Whether the problem has dissipation whose F0 `--f0` may set.
     pub fn takes_f0(self) -> bool {
@@ -102,24 +97,20 @@ impl WorkPrecisionProblem {
     /// Builds the problem with its F0 replaced by `f0` (s m⁻² in the problem's units; only where
     /// [`Self::takes_f0`], otherwise `None` is expected and the problem is built as it is).
     pub fn setup_with_f0(self, f0: Option<f64>) -> ProblemSetup {
-        match (self, f0) {
-            (WorkPrecisionProblem::StiffPair, f0) => stiff_pair(f0.unwrap_or(STIFF_PAIR_F0)),
-            (WorkPrecisionProblem::Pile, f0) => squeezed_pile(f0.unwrap_or(PILE_F0)),
-            (other, _) => other.setup(),
-        }
-    }
-
-    /// Builds the problem.
-    pub fn setup(self) -> ProblemSetup {
         match self {
-            WorkPrecisionProblem::StiffPair => stiff_pair(STIFF_PAIR_F0),
-            WorkPrecisionProblem::Pile => squeezed_pile(PILE_F0),
+            WorkPrecisionProblem::StiffPair => stiff_pair(f0.unwrap_or(STIFF_PAIR_F0)),
+            WorkPrecisionProblem::Pile => squeezed_pile(f0.unwrap_or(PILE_F0)),
             WorkPrecisionProblem::Top => free_top(),
             WorkPrecisionProblem::Pair => bouncing_pair(None),
             WorkPrecisionProblem::PairDissipative => bouncing_pair(Some(PAIR_F0)),
             WorkPrecisionProblem::N30 => n30_impact(),
             WorkPrecisionProblem::N200 => n200_impact(),
         }
+    }
+
+    /// Builds the problem.
+    pub fn setup(self) -> ProblemSetup {
+        self.setup_with_f0(None)
     }
 }
 
@@ -150,12 +141,6 @@ impl crate::named::Named for NBodyProblem {
             NBodyProblem::Pythagorean => "Burrau's Pythagorean three-body problem, to t = 10",
             NBodyProblem::OuterSolar => "the Sun and the four giant planets, to t = 1000",
         }
-    }
-}
-
-impl std::fmt::Display for NBodyProblem {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(crate::named::Named::name(*self))
     }
 }
 
@@ -391,8 +376,7 @@ pub fn n30_impact() -> ProblemSetup {
         projectile: "P1",
         // 5 s instead of the campaign's 90 s: the 60 s window is the impact itself.
         contact_time: Some(5.0),
-        // 1e-4 s m⁻², the impact default when the committed diagrams were measured (the default is now 1e-6):
-        // fixed here so that the problem, and analysis/work_precision/, stay what they were.
+        // fixed, not the impact default, so that the problem and analysis/work_precision/ stay what they were
         f0: Some(N30_F0),
         t_end: N30_T_END,
         energy_samples: 12,
@@ -447,8 +431,7 @@ pub fn squeezed_pile(f0: f64) -> ProblemSetup {
     let projectile = ProjectileSpec::preset("P1").expect("a preset projectile");
     let cfg = crate::impact::run::ImpactConfig::new("targets/N30_T4.csv".into(), projectile);
     let kappa = cfg.kappa(&bodies).expect("the target and projectile calibrate");
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let centre = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let (centre, _) = centre_of_mass(&bodies);
     for b in &mut bodies {
         b.position = centre + (b.position - centre) * PILE_SQUEEZE;
     }
@@ -517,14 +500,18 @@ impl ImpactProblem {
         let target = embedded_bodies(self.target_csv);
         let projectile = ProjectileSpec::preset(self.projectile).expect("a preset projectile");
         let mut cfg = crate::impact::run::ImpactConfig::new(self.target_path.into(), projectile.clone());
-        if let Some(t) = self.contact_time {
-            cfg.contact_time = t;
-        }
-        if let Some(f0) = self.f0 {
-            cfg.f0 = f0;
-        }
+        cfg.contact_time = self.contact_time.unwrap_or(cfg.contact_time);
+        cfg.f0 = self.f0.unwrap_or(cfg.f0);
         let kappa = cfg.kappa(&target).expect("the target and projectile calibrate");
-        let (bodies, _) = set_up_impact(&target, &projectile, cfg.angle_deg, cfg.contact_time, cfg.seed);
+        let geometry = ImpactGeometry::default();
+        let (bodies, ..) = set_up_aimed_impact(
+            &target,
+            &projectile,
+            &geometry,
+            cfg.angle_deg,
+            cfg.contact_time,
+            cfg.seed,
+        );
         let system = EllipsoidSystem::new(&bodies, ModelConfig::gaussian_si(kappa), Physics::impact(cfg.f0));
         ProblemSetup {
             name: self.name,

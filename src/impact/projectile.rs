@@ -109,27 +109,9 @@ pub fn target_and_direction(target: &[Body], angle_deg: f64) -> (Vec<Body>, f64,
 }
 
 /// Adds the projectile to `target` (bodies of the target, any frame) and returns the whole system in its
-/// centre-of-mass frame, with the setup. `contact_time` (s) is when the surfaces first touch.
-pub fn set_up_impact(
-    target: &[Body],
-    projectile: &ProjectileSpec,
-    angle_deg: f64,
-    contact_time: f64,
-    seed: u64,
-) -> (Vec<Body>, ImpactSetup) {
-    let (bodies, setup, _) = set_up_aimed_impact(
-        target,
-        projectile,
-        &ImpactGeometry::default(),
-        angle_deg,
-        contact_time,
-        seed,
-    );
-    (bodies, setup)
-}
-
-/// [`set_up_impact`] with the projectile's `geometry` (aim, spin, attitude): its trajectory is displaced by the
-/// aim's offset (⊥ `n`), its velocity stays `−v n`. The flag says whether the projectile meets the target (its
+/// centre-of-mass frame, with the setup; `contact_time` (s) is when the surfaces first touch. The projectile's
+/// `geometry` (aim, spin, attitude; [`ImpactGeometry::default`] for Roig03's) displaces its trajectory by the aim's
+/// offset (⊥ `n`), its velocity stays `−v n`. The flag says whether the projectile meets the target (its
 /// trajectory enters the surface ellipsoid and its surface touches a fragment before its centre passes the
 /// target's); always true when aimed at the centre.
 pub fn set_up_aimed_impact(
@@ -193,14 +175,9 @@ pub fn set_up_aimed_impact(
 /// Distance `s` (m) along the unit vector `n` at which `projectile` (bodies in its own frame, moved rigidly by
 /// `s n`) first touches `target` (centre-of-mass frame) when coming in from afar: the largest `s` at which some
 /// pair of ellipsoids overlaps, to bisection precision (60 halvings of a step of 2 % of the smallest semi-axis
-/// of the projectile). The walk starts beyond every bounding sphere and moves in by that step.
-pub fn first_contact_distance(target: &[Body], projectile: &[Body], n: &Vec3) -> f64 {
-    contact_walk(target, projectile, n).0
-}
-
-/// [`first_contact_distance`] and whether the bodies touch at all before the projectile's frame passes the
-/// target's centre (`s > 0`).
-pub(crate) fn contact_walk(target: &[Body], projectile: &[Body], n: &Vec3) -> (f64, bool) {
+/// of the projectile). The walk starts beyond every bounding sphere and moves in by that step. Also whether the
+/// bodies touch at all before the projectile's frame passes the target's centre (`s > 0`).
+pub fn contact_walk(target: &[Body], projectile: &[Body], n: &Vec3) -> (f64, bool) {
     let sigma = |b: &Body| {
         let r = rotation_matrix(&b.quaternion);
         r.transpose() * Mat3::from_diagonal(&b.shape.axes.component_mul(&b.shape.axes)) * r

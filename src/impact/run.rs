@@ -1,6 +1,6 @@
 //! One impact run (Roig03 §3) as a library call: a projectile on a rubble-pile target, run to `t_end`.
 //!
-//! [`run_impact`] reads the target bodies file, adds the projectile ([`set_up_impact`]), writes into the run
+//! [`run_impact`] reads the target bodies file, adds the projectile ([`set_up_aimed_impact`]), writes into the run
 //! directory
 //! - `initial_bodies.csv`: target + projectile in the centre-of-mass frame (snapshot columns),
 //! - `impact.json`: the [`ImpactSetup`] (Q, impact time, projectile, …) plus `"target"`, the target file,
@@ -36,13 +36,11 @@ const GENERATED_BY_IMPACT: &str =
 
 /// Default end time (s).
 pub const DEFAULT_T_END: f64 = 10_000.0;
-/// Default relative (and absolute, in m, m/s, rad/s) tolerance of Bulirsch–Stoer, over the whole run. 1e-6 costs the
-/// same RHS evaluations as the per-step 1e-9 of earlier builds on the N200 impact and conserves energy better
-/// (7e-12 against 4.6e-11; analysis/work_precision/REPORT.md).
+/// Default relative (and absolute, in m, m/s, rad/s) tolerance of Bulirsch–Stoer, over the whole run
+/// (analysis/work_precision/REPORT.md).
 pub const DEFAULT_RTOL: f64 = 1e-6;
 
-/// Default tolerance of the Dormand–Prince methods, which apply it to each step: at 1e-8, Dop853 runs the N2000 + P2
-/// impact to 10 000 s with an energy error of 1.6e-9 (analysis/n2000/REPORT.md).
+/// Default tolerance of the Dormand–Prince methods, which apply it to each step (analysis/n2000/REPORT.md).
 pub const DEFAULT_RTOL_PER_STEP: f64 = 1e-8;
 
 /// The impact's default tolerance for `method`: [`DEFAULT_RTOL`] for the Bulirsch–Stoer methods (of the whole run),
@@ -53,9 +51,8 @@ pub fn default_rtol(method: Method) -> f64 {
         _ => DEFAULT_RTOL_PER_STEP,
     }
 }
-/// Default dissipation coefficient F0 (s m⁻²): Roig03 §2.4's "F0 ≈ 1" in its kilometres and seconds (1 s km⁻²);
-/// a scan made before that reading found 1e-6 reproduces the bound fraction, f_KE, spin–size exponent and best
-/// spin-histogram n most closely (analysis/roig2003/F0_SCAN.md).
+/// Default dissipation coefficient F0 (s m⁻²): Roig03 §2.4's "F0 ≈ 1" in its kilometres and seconds (1 s km⁻²),
+/// which reproduces Roig03's outcomes most closely (analysis/roig2003/F0_SCAN.md).
 pub const DEFAULT_F0: f64 = 1e-6;
 /// Default β of Roig03 Eq. 14.
 pub const DEFAULT_BETA: f64 = 10.0;

@@ -14,7 +14,7 @@ use crate::ellipsoid::body::Body;
 use crate::ellipsoid::equations::{EllipsoidSystem, G_SI, ModelConfig, Physics};
 use crate::ellipsoid::rigid_rotation::fit_rigid_rotation;
 use crate::ellipsoid::spin_state::principal_axes;
-use crate::impact::target::{set_rigid_rotation, to_centre_of_mass_frame};
+use crate::impact::target::{centre_of_mass, set_rigid_rotation, to_centre_of_mass_frame};
 use crate::integrate::{IntegrateError, Method, Tolerances, make_integrator};
 use crate::math::Vec3;
 
@@ -145,8 +145,7 @@ pub fn set_principal_axis_rotation(bodies: &mut [Body], moments: &[Vec3]) -> Vec
 /// Apparent radius (m): max over bodies of `|r − r_cm| + A`, the size the free-fall time of the settling is taken
 /// at (and the flyby's reach of the pile).
 pub fn apparent_radius(bodies: &[Body]) -> f64 {
-    let m: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let cm = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / m;
+    let (cm, _) = centre_of_mass(bodies);
     bodies
         .iter()
         .map(|b| (b.position - cm).norm() + b.shape.axes.x)

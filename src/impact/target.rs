@@ -15,6 +15,7 @@ use crate::ellipsoid::quaternion::rotation_matrix;
 use crate::ellipsoid::rigid_rotation::{RigidFit, fit_rigid_rotation};
 use crate::geometry::ellipsoid_overlap::are_apart;
 use crate::impact::target_checkpoint::{BuildCheckpoint, RoundState};
+use crate::impact::target_spec::is_default;
 pub use crate::impact::target_spec::{TargetError, TargetSpec};
 use crate::integrate::{Method, Tolerances, make_integrator};
 use crate::math::{Mat3, Vec3};
@@ -75,21 +76,13 @@ pub struct TargetReport {
     /// Size draws tried before the mass matched.
     pub size_draws: usize,
     /// Fragments removed as detached from the pile ([`TargetSpec::drop_detached`]); absent (0) otherwise.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub detached_fragments: usize,
     /// Their mass (kg), not counted in `total_mass_kg`.
-    #[serde(default, skip_serializing_if = "is_zero_mass")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub detached_mass_kg: f64,
     /// The inputs.
     pub spec: TargetSpec,
-}
-
-fn is_zero(n: &usize) -> bool {
-    *n == 0
-}
-
-fn is_zero_mass(m: &f64) -> bool {
-    *m == 0.0
 }
 
 /// Relative enlargement of the semi-axes in the contact test of [`drop_detached`].
@@ -99,8 +92,7 @@ pub const DETACHED_MARGIN: f64 = 0.1;
 /// by [`DETACHED_MARGIN`]; [`crate::ellipsoid::clumps`]) and the same entries from `kept` (each body's index in
 /// the placement). The collapse of a large placement sphere throws a few small fragments onto wide orbits; the
 /// next round's rigid rotation would give those far out more than the local escape speed, and their growing
-/// distance would keep `K_rel/K` rising forever (N = 10 000: 18 fragments beyond 180 km, `analysis/n2000`).
-/// Returns how many were removed.
+/// distance would keep `K_rel/K` rising forever (`analysis/n2000/REPORT.md`). Returns how many were removed.
 pub fn drop_detached(bodies: &mut Vec<Body>, kept: &mut Vec<usize>) -> usize {
     let clumps =
         crate::ellipsoid::clumps::find_clumps(bodies, crate::ellipsoid::clumps::Linking::ScaledAxes(DETACHED_MARGIN));
@@ -203,11 +195,18 @@ pub fn place_fragments(spec: &TargetSpec, radii: &[f64], rng: &mut Generator) ->
     }
 }
 
+/// Centre-of-mass position (m) and velocity (m/s) of `bodies`.
+pub fn centre_of_mass(bodies: &[Body]) -> (Vec3, Vec3) {
+    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
+    let r = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let v = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / mass;
+    (r, v)
+}
+
 /// Puts every body into the rigid rotation `ω` about the centre of mass (world frame, rad/s), with the
 /// centre of mass at rest at the origin.
 pub fn set_rigid_rotation(bodies: &mut [Body], omega: &Vec3) {
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let com = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
+    let (com, _) = centre_of_mass(bodies);
     for b in bodies.iter_mut() {
         b.position -= com;
         b.velocity = omega.cross(&b.position);
@@ -217,9 +216,7 @@ pub fn set_rigid_rotation(bodies: &mut [Body], omega: &Vec3) {
 
 /// Shifts positions and velocities to the centre-of-mass frame.
 pub fn to_centre_of_mass_frame(bodies: &mut [Body]) {
-    let mass: f64 = bodies.iter().map(|b| b.shape.mass).sum();
-    let com = bodies.iter().map(|b| b.position * b.shape.mass).sum::<Vec3>() / mass;
-    let vcm = bodies.iter().map(|b| b.velocity * b.shape.mass).sum::<Vec3>() / mass;
+    let (com, vcm) = centre_of_mass(bodies);
     for b in bodies.iter_mut() {
         b.position -= com;
         b.velocity -= vcm;
@@ -309,9 +306,8 @@ fn relax_round(
 /// of the placement sphere (`ω² R_p³ > G M`: there the centrifugal acceleration exceeds the pile's gravity, and
 /// the outer fragments fly off during the collapse instead of settling). Then the first round spins at the
 /// rate where the centrifugal acceleration on that equator is half of gravity, `√(G M / (2 R_p³))`, and the
-/// later rounds reset the spin to `ω` as usual. Loose placements of many small fragments need this: the N = 2000
-/// pile of `analysis/n2000/` is placed in a sphere of 159 km, where a 4 h spin gives `ω² R_p³ / G M = 1.15`
-/// and K_rel/K rose for ever; Table 1's targets (at most 0.88) keep `ω`.
+/// later rounds reset the spin to `ω` as usual: loose placements of many small fragments need it (the N = 2000
+/// pile, `analysis/n2000/REPORT.md`); Table 1's targets keep `ω`.
 pub fn first_round_spin(omega: &Vec3, total_mass: f64, placement_radius: f64) -> Vec3 {
     let gm = G_SI * total_mass;
     let r3 = placement_radius.powi(3);

@@ -98,13 +98,13 @@ impl BuildCheckpoint {
         let round_start = round_start
             .iter()
             .flat_map(|b| {
-                b.position
-                    .iter()
-                    .chain(b.velocity.iter())
-                    .chain(b.quaternion.iter())
-                    .chain(b.spin_body.iter())
-                    .copied()
-                    .collect::<Vec<f64>>()
+                [
+                    b.position.as_slice(),
+                    b.velocity.as_slice(),
+                    b.quaternion.as_slice(),
+                    b.spin_body.as_slice(),
+                ]
+                .concat()
             })
             .collect();
         BuildCheckpoint {

@@ -46,12 +46,13 @@ pub struct TargetSpec {
     /// Which kinetic energy Roig03 Eq. 13's barrier is β times when κ is calibrated over the target's smallest
     /// and largest fragments ([`KappaReading`]). Printed (the default) for the committed targets, absent from
     /// their files; `reduced` relaxes the pile at the κ of the impacts (`analysis/roig2003/campaign.toml`).
-    #[serde(default, skip_serializing_if = "is_printed")]
+    #[serde(default, skip_serializing_if = "is_default")]
     pub kappa_reading: KappaReading,
 }
 
-fn is_printed(reading: &KappaReading) -> bool {
-    *reading == KappaReading::Printed
+/// Whether `x` is its type's default (a field `serde` leaves out of the files).
+pub(crate) fn is_default<T: Default + PartialEq>(x: &T) -> bool {
+    *x == T::default()
 }
 
 impl TargetSpec {

@@ -157,7 +157,6 @@ pub(crate) struct ScreenBox {
 /// A camera: image size, basis and projection; gives the primary ray of each pixel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Camera {
-    view: View,
     projection: Projection,
     framing: Framing,
     width: u32,
@@ -197,7 +196,6 @@ impl Camera {
             }
         };
         Camera {
-            view,
             projection,
             framing,
             width,
@@ -219,16 +217,6 @@ impl Camera {
     /// Image height (pixels).
     pub fn height(&self) -> u32 {
         self.height
-    }
-
-    /// The view this camera was built with.
-    pub fn view(&self) -> View {
-        self.view
-    }
-
-    /// The projection this camera was built with.
-    pub fn projection(&self) -> Projection {
-        self.projection
     }
 
     /// The framing this camera was built with.

@@ -1,8 +1,7 @@
 //! Writing frames: one PNG file per frame ([`write_png`]) and an animated, endlessly looping GIF of a run
 //! ([`GifWriter`]).
 //!
-//! GIF frames are quantised to 256 colours each with the `gif` crate's NeuQuant; its speed setting trades colour
-//! fidelity for time, and frames may be halved in size ([`GifOptions::halve`]) to keep large animations light.
+//! GIF frames are quantised to 256 colours each with the `gif` crate's NeuQuant at speed [`GIF_SPEED`].
 
 use std::path::{Path, PathBuf};
 
@@ -38,24 +37,9 @@ fn png_error(path: &Path, e: png::EncodingError) -> RenderError {
     }
 }
 
-/// How GIF frames are encoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct GifOptions {
-    /// NeuQuant speed, 1 (best colours, slowest) to 30 (fastest).
-    pub speed: i32,
-    /// Halve the frames in both directions (2×2 pixel averages) before encoding: a quarter of the pixels.
-    pub halve: bool,
-}
-
-impl Default for GifOptions {
-    /// Speed 10 and full size: a 800×800 frame encodes in well under a second.
-    fn default() -> Self {
-        GifOptions {
-            speed: 10,
-            halve: false,
-        }
-    }
-}
+/// NeuQuant speed of the GIF frames, from 1 (best colours, slowest) to 30 (fastest): an 800×800 frame encodes in
+/// well under a second.
+pub const GIF_SPEED: i32 = 10;
 
 /// An animated GIF being written, one frame at a time; loops forever.
 pub struct GifWriter {
@@ -64,43 +48,26 @@ pub struct GifWriter {
     width: u32,
     height: u32,
     delay: u16,
-    options: GifOptions,
 }
 
 impl GifWriter {
     /// Starts a GIF at `path` for frames of `width × height` pixels, each shown `frame_delay_centiseconds`
-    /// (1/100 s), with default [`GifOptions`].
+    /// (1/100 s).
     pub fn create(
         path: &Path,
         width: u32,
         height: u32,
         frame_delay_centiseconds: u16,
     ) -> Result<GifWriter, RenderError> {
-        GifWriter::create_with(path, width, height, frame_delay_centiseconds, GifOptions::default())
-    }
-
-    /// As [`GifWriter::create`], with explicit encoding options.
-    pub fn create_with(
-        path: &Path,
-        width: u32,
-        height: u32,
-        frame_delay_centiseconds: u16,
-        options: GifOptions,
-    ) -> Result<GifWriter, RenderError> {
-        let (out_w, out_h) = if options.halve {
-            ((width / 2).max(1), (height / 2).max(1))
-        } else {
-            (width, height)
-        };
         // GIF stores sizes in 16 bits.
         let too_big = || RenderError::Size {
             expected_width: u32::from(u16::MAX),
             expected_height: u32::from(u16::MAX),
-            got_width: out_w,
-            got_height: out_h,
+            got_width: width,
+            got_height: height,
         };
-        let w16 = u16::try_from(out_w).map_err(|_| too_big())?;
-        let h16 = u16::try_from(out_h).map_err(|_| too_big())?;
+        let w16 = u16::try_from(width).map_err(|_| too_big())?;
+        let h16 = u16::try_from(height).map_err(|_| too_big())?;
         let file = AtomicFile::create(path).map_err(|e| io_error(path, e))?;
         let mut encoder = gif::Encoder::new(file, w16, h16, &[]).map_err(|e| gif_error(path, e))?;
         encoder
@@ -112,7 +79,6 @@ impl GifWriter {
             width,
             height,
             delay: frame_delay_centiseconds,
-            options,
         })
     }
 
@@ -126,20 +92,8 @@ impl GifWriter {
                 got_height: image.height,
             });
         }
-        let halved;
-        let image = if self.options.halve {
-            halved = halve(image);
-            &halved
-        } else {
-            image
-        };
         // Sizes were checked to fit u16 at creation.
-        let mut frame = gif::Frame::from_rgb_speed(
-            image.width as u16,
-            image.height as u16,
-            &image.pixels,
-            self.options.speed.clamp(1, 30),
-        );
+        let mut frame = gif::Frame::from_rgb_speed(image.width as u16, image.height as u16, &image.pixels, GIF_SPEED);
         frame.delay = self.delay;
         self.encoder.write_frame(&frame).map_err(|e| gif_error(&self.path, e))
     }
@@ -157,25 +111,4 @@ fn gif_error(path: &Path, e: gif::EncodingError) -> RenderError {
         gif::EncodingError::Io(source) => io_error(path, source),
         other => RenderError::Encode(other.to_string()),
     }
-}
-
-/// The image at half size, each pixel the mean of a 2×2 block (an odd last row or column is dropped).
-fn halve(image: &RgbImage) -> RgbImage {
-    let (w, h) = ((image.width / 2).max(1), (image.height / 2).max(1));
-    let mut out = RgbImage::new(w, h, [0, 0, 0]);
-    for y in 0..h {
-        for x in 0..w {
-            let (x0, y0) = (2 * x, 2 * y);
-            let (x1, y1) = ((x0 + 1).min(image.width - 1), (y0 + 1).min(image.height - 1));
-            let p = [
-                image.get(x0, y0),
-                image.get(x1, y0),
-                image.get(x0, y1),
-                image.get(x1, y1),
-            ];
-            let mean = std::array::from_fn(|c| ((p.iter().map(|q| u32::from(q[c])).sum::<u32>() + 2) / 4) as u8);
-            out.set(x, y, mean);
-        }
-    }
-    out
 }

@@ -16,11 +16,7 @@ pub struct RgbImage {
 impl RgbImage {
     /// A `width × height` image filled with `fill`.
     pub fn new(width: u32, height: u32, fill: [u8; 3]) -> RgbImage {
-        let n = width as usize * height as usize;
-        let mut pixels = Vec::with_capacity(3 * n);
-        for _ in 0..n {
-            pixels.extend_from_slice(&fill);
-        }
+        let pixels = fill.repeat(width as usize * height as usize);
         RgbImage { width, height, pixels }
     }
 

@@ -22,7 +22,7 @@ pub mod walls;
 
 pub use camera::{BoundingSphere, Camera, Framing, Projection, Ray, View};
 pub use colour::{Category, ColourMap, ColourScale, ScaleKind};
-pub use encode::{GifOptions, GifWriter, write_png};
+pub use encode::{GifWriter, write_png};
 pub use frame::{BACKGROUND, FrameBody, render_frame, render_frame_with_walls};
 pub use image::RgbImage;
 pub use overlay::{ScaleBar, Triad};

@@ -13,10 +13,7 @@ use crate::math::Vec3;
 pub fn nearest(p: &Vec3, radius: f64, length: Option<f64>) -> (f64, Vec3) {
     let rho = (p.x * p.x + p.y * p.y).sqrt();
     let (ex, ey) = if rho > 0.0 { (p.x / rho, p.y / rho) } else { (1.0, 0.0) };
-    let z = match length {
-        Some(l) => p.z.clamp(-0.5 * l, 0.5 * l),
-        None => p.z,
-    };
+    let z = length.map_or(p.z, |l| p.z.clamp(-0.5 * l, 0.5 * l));
     let q = Vec3::new(radius * ex, radius * ey, z);
     let v = p - q;
     let r = v.norm();

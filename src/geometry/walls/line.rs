@@ -8,10 +8,7 @@ use crate::math::Vec3;
 
 /// Distance from `p` to the line (segment when `length` is given) and the unit normal towards `p`.
 pub fn nearest(p: &Vec3, length: Option<f64>) -> (f64, Vec3) {
-    let z = match length {
-        Some(l) => p.z.clamp(-0.5 * l, 0.5 * l),
-        None => p.z,
-    };
+    let z = length.map_or(p.z, |l| p.z.clamp(-0.5 * l, 0.5 * l));
     let v = p - Vec3::new(0.0, 0.0, z);
     let r = v.norm();
     if r > 0.0 { (r, v / r) } else { (0.0, Vec3::x()) }

@@ -211,12 +211,10 @@ impl Wall {
         let p = self.to_local(&(r - origin_now));
         let d = self.to_local(&(v - wall_velocity));
         let (dist, n) = self.shape.nearest(&p);
-        if dist - s <= TOUCH_TOLERANCE * s {
-            // Touching or overlapping: collide now if approaching; otherwise it is leaving this contact, and a
-            // later entry (e.g. the far side of a cylinder) is still found below.
-            if d.dot(&n) < 0.0 {
-                return Some(0.0);
-            }
+        // Touching or overlapping: collide now if approaching; otherwise it is leaving this contact, and a later
+        // entry (e.g. the far side of a cylinder) is still found below.
+        if dist - s <= TOUCH_TOLERANCE * s && d.dot(&n) < 0.0 {
+            return Some(0.0);
         }
         self.shape.toi(&p, &d, s, t_max)
     }

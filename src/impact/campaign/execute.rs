@@ -15,12 +15,8 @@ use crate::io::messages::{Channel, emit};
 
 use super::*;
 
-// ---------------------------------------------------------------------------------------------
-// Running.
-// ---------------------------------------------------------------------------------------------
-
-/// How a campaign runs (not what it runs).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// How a campaign runs (not what it runs); the default: [`RunOptions::default`], the file's `parallel`, quiet.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct CampaignOptions {
     /// Options of every run: the checkpoint cadence and the testing stop (`force` is ignored: a run is
     /// started afresh only as the module docs say); `progress` = the campaign's progress display on stderr
@@ -35,19 +31,6 @@ pub struct CampaignOptions {
     pub verbose: bool,
     /// Run only this shard of the grid ([`Shard`]); its index goes to its own file.
     pub shard: Option<Shard>,
-}
-
-impl Default for CampaignOptions {
-    /// [`RunOptions::default`], the file's `parallel`, quiet.
-    fn default() -> Self {
-        CampaignOptions {
-            run: RunOptions::default(),
-            parallel: None,
-            threads_per_run: None,
-            verbose: false,
-            shard: None,
-        }
-    }
 }
 
 /// What the campaign does with a grid point (decided when it starts; see the module docs).
@@ -102,19 +85,15 @@ pub fn decide(dir: &Path, plan: &ImpactPlan) -> (Action, Option<RunNumbers>) {
             dir.display()
         ))
     };
-    if completed {
-        return match same_run(dir, plan) {
-            Ok(()) => (Action::Skip, numbers),
-            Err(why) => (conflict(why), numbers),
-        };
+    if !completed && !dir.join(CHECKPOINT_FILE).is_file() {
+        return (Action::Start, None);
     }
-    if dir.join(CHECKPOINT_FILE).is_file() {
-        return match same_run(dir, plan) {
-            Ok(()) => (Action::Resume, None),
-            Err(why) => (conflict(why), None),
-        };
+    let action = if completed { Action::Skip } else { Action::Resume };
+    let numbers = numbers.filter(|_| completed);
+    match same_run(dir, plan) {
+        Ok(()) => (action, numbers),
+        Err(why) => (conflict(why), numbers),
     }
-    (Action::Start, None)
 }
 
 /// The record of every grid point of `campaign` as it starts, from what its run directory holds ([`decide`]:

@@ -208,9 +208,9 @@ pub fn write_campaign_csv(
 ) -> Result<(), CampaignError> {
     let path = out.join(file);
     let mut w = csv::Writer::from_writer(Vec::new());
-    let to_io = |e: csv::Error| CampaignError::Io {
+    let to_io = |e: String| CampaignError::Io {
         path: path.clone(),
-        source: std::io::Error::other(e.to_string()),
+        source: std::io::Error::other(e),
     };
     // one column per swept path after the fixed ones (none without a sweep)
     let swept = points.first().map_or(&[][..], |p| &p.overrides[..]);
@@ -218,7 +218,7 @@ pub fn write_campaign_csv(
         .iter()
         .copied()
         .chain(swept.iter().map(|(path, _)| path.as_str()));
-    w.write_record(header).map_err(to_io)?;
+    w.write_record(header).map_err(|e| to_io(e.to_string()))?;
     for (p, r) in points.iter().zip(runs) {
         let n = r.numbers.unwrap_or_default();
         let f = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
@@ -243,12 +243,9 @@ pub fn write_campaign_csv(
             .into_iter()
             .chain(p.overrides.iter().map(|(_, v)| v.clone())),
         )
-        .map_err(to_io)?;
+        .map_err(|e| to_io(e.to_string()))?;
     }
-    let bytes = w.into_inner().map_err(|e| CampaignError::Io {
-        path: path.clone(),
-        source: std::io::Error::other(e.to_string()),
-    })?;
+    let bytes = w.into_inner().map_err(|e| to_io(e.to_string()))?;
     crate::io::safe_write::write_atomic_durable(&path, bytes).map_err(|source| CampaignError::Io { path, source })
 }
 

@@ -87,7 +87,6 @@ impl CampaignError {
     pub fn exit_code(&self) -> u8 {
         match self {
             CampaignError::Io { .. } => 1,
-            CampaignError::Locked(_) => 2,
             _ => 2,
         }
     }

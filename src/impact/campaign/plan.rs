@@ -12,6 +12,7 @@ use crate::impact::run::{
 };
 
 use super::*;
+use crate::io::scene_file::SceneError;
 
 /// One grid point.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,7 +56,7 @@ pub struct Campaign {
 /// Reads and validates a campaign file; relative paths in it are resolved against its directory.
 pub fn load_campaign(path: &Path) -> Result<Campaign, CampaignError> {
     let name = path.display().to_string();
-    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| crate::io::scene_file::SceneError::Read {
+    let text = crate::io::scene_file::read_text_bounded(path).map_err(|e| SceneError::Read {
         file: name.clone(),
         reason: e.to_string().split_whitespace().collect::<Vec<_>>().join(" "),
     })?;
@@ -80,13 +81,7 @@ pub fn parse_campaign(text: &str, name: &str, base_dir: &Path) -> Result<Campaig
 /// The campaign of a file with a `[sweep]`: one resolved grid per combination of the swept values (the first path
 /// outermost), concatenated, each run's name suffixed and its overrides recorded.
 fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
-    let invalid = |(field, message): (String, String)| {
-        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-            file: name.to_string(),
-            field,
-            message,
-        })
-    };
+    let invalid = |(field, message): (String, String)| invalid_in(name, field, message);
     let axes = sweep_axes(&file.sweep).map_err(invalid)?;
     let total: usize = axes.iter().map(|a| a.values.len()).product();
     let mut all: Option<Campaign> = None;
@@ -112,12 +107,8 @@ fn resolve_sweep(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Camp
             .collect::<Vec<_>>()
             .join(", ");
         let mut c = resolve(with, name, base_dir).map_err(|e| match e {
-            CampaignError::File(crate::io::scene_file::SceneError::Invalid { file, field, message }) => {
-                CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-                    file,
-                    field,
-                    message: format!("{message} (with the sweep's {described})"),
-                })
+            CampaignError::File(SceneError::Invalid { file, field, message }) => {
+                invalid_in(&file, field, format!("{message} (with the sweep's {described})"))
             }
             other => other,
         })?;
@@ -184,16 +175,27 @@ fn join_clean(base: &Path, rel: &Path) -> PathBuf {
     }
 }
 
+/// The error of a value of the campaign file `file` out of range, naming its `field`.
+fn invalid_in(file: &str, field: String, message: String) -> CampaignError {
+    let file = file.to_string();
+    CampaignError::File(SceneError::Invalid { file, field, message })
+}
+
 fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, CampaignError> {
-    let invalid = |field: String, message: String| {
-        CampaignError::File(crate::io::scene_file::SceneError::Invalid {
-            file: name.to_string(),
-            field,
-            message,
-        })
-    };
+    let invalid = |field: String, message: String| invalid_in(name, field, message);
     let c = &file.campaign;
     let imp = &file.impact;
+    let listed = |empty: bool, field: &str, what: &str| match empty {
+        true => Err(invalid(
+            format!("campaign.{field}"),
+            format!("must list at least one {what}, got []"),
+        )),
+        false => Ok(()),
+    };
+    let speed_ok = |field: String, v: f64| match v.is_finite() && v > 0.0 {
+        true => Ok(v),
+        false => Err(invalid(field, format!("must be > 0 km/s and finite, got {v}"))),
+    };
     if c.out.as_os_str().is_empty() {
         return Err(invalid("campaign.out".into(), "must name a directory, got \"\"".into()));
     }
@@ -205,13 +207,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
 
     // [impact]
     let t_end = imp.t_end.unwrap_or(DEFAULT_T_END);
-    let speed_km_s = imp.speed_km_s.unwrap_or(5.0);
-    if !(speed_km_s.is_finite() && speed_km_s > 0.0) {
-        return Err(invalid(
-            "impact.speed_km_s".into(),
-            format!("must be > 0 km/s and finite, got {speed_km_s}"),
-        ));
-    }
+    let speed_km_s = speed_ok("impact.speed_km_s".into(), imp.speed_km_s.unwrap_or(5.0))?;
 
     // [[projectile]]
     let mut custom: Vec<(String, ProjectileSpec)> = Vec::new();
@@ -240,13 +236,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
                 ),
             ));
         }
-        let speed = p.speed_km_s.unwrap_or(speed_km_s);
-        if !(speed.is_finite() && speed > 0.0) {
-            return Err(invalid(
-                field("speed_km_s"),
-                format!("must be > 0 km/s and finite, got {speed}"),
-            ));
-        }
+        let speed = speed_ok(field("speed_km_s"), p.speed_km_s.unwrap_or(speed_km_s))?;
         let spec = match (p.radius_km, &p.projectile_pile) {
             (Some(r), None) if r.is_finite() && r > 0.0 && p.random_attitude.is_none() => {
                 ProjectileSpec::custom(p.id.clone(), r * 1e3, speed * 1e3)
@@ -284,12 +274,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
     }
 
     // [campaign] lists
-    if c.targets.is_empty() {
-        return Err(invalid(
-            "campaign.targets".into(),
-            "must list at least one target bodies file, got []".into(),
-        ));
-    }
+    listed(c.targets.is_empty(), "targets", "target bodies file")?;
     let mut targets: Vec<(String, PathBuf, Vec<Body>)> = Vec::new();
     for (k, rel) in c.targets.iter().enumerate() {
         let field = format!("campaign.targets[{k}]");
@@ -313,12 +298,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         let bodies = read_target(&path).map_err(|e| invalid(field.clone(), one_line(&e.to_string())))?;
         targets.push((stem, path, bodies));
     }
-    if c.projectiles.is_empty() {
-        return Err(invalid(
-            "campaign.projectiles".into(),
-            "must list at least one projectile, got []".into(),
-        ));
-    }
+    listed(c.projectiles.is_empty(), "projectiles", "projectile")?;
     let mut projectiles: Vec<ProjectileSpec> = Vec::new();
     for (k, id) in c.projectiles.iter().enumerate() {
         let field = format!("campaign.projectiles[{k}]");
@@ -340,12 +320,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         }
         projectiles.push(p);
     }
-    if c.angles.is_empty() {
-        return Err(invalid(
-            "campaign.angles".into(),
-            "must list at least one angle (degrees), got []".into(),
-        ));
-    }
+    listed(c.angles.is_empty(), "angles", "angle (degrees)")?;
     let mut angles: Vec<f64> = Vec::new();
     for (k, &a) in c.angles.iter().enumerate() {
         let field = format!("campaign.angles[{k}]");
@@ -358,12 +333,7 @@ fn resolve(file: CampaignFile, name: &str, base_dir: &Path) -> Result<Campaign, 
         }
         angles.push(a);
     }
-    if c.seeds.is_empty() {
-        return Err(invalid(
-            "campaign.seeds".into(),
-            "must list at least one seed, got []".into(),
-        ));
-    }
+    listed(c.seeds.is_empty(), "seeds", "seed")?;
     let mut seen = HashSet::new();
     for (k, s) in c.seeds.iter().enumerate() {
         if !seen.insert(*s) {

@@ -51,29 +51,16 @@ impl Shard {
     }
 }
 
-/// The status a run directory shows by itself: completed (with its numbers), failed (its summary says so and it
-/// has no checkpoint), a different run (conflict), or pending (not started, or checkpointed and unfinished).
-fn status_of(dir: &Path, point: &GridPoint) -> (RunStatus, Option<RunNumbers>) {
-    let (action, numbers) = decide(dir, &point.plan);
-    match action {
-        Action::Skip => (RunStatus::Completed, numbers),
-        Action::Conflict(why) => (RunStatus::Failed(why), numbers),
-        Action::Resume => (RunStatus::Pending, None),
-        Action::Start => {
-            let text = std::fs::read_to_string(dir.join("summary.json")).ok();
-            let status = text
-                .as_deref()
-                .and_then(|t| serde_json::from_str::<serde_json::Value>(t).ok())
-                .and_then(|v| v.get("status")?.as_str().map(str::to_string));
-            match status {
-                Some(s) if s.starts_with("failed") => (
-                    RunStatus::Failed(one_line(s.trim_start_matches("failed").trim_start_matches(':').trim())),
-                    text.as_deref().map(RunNumbers::from_summary_text),
-                ),
-                _ => (RunStatus::Pending, None),
-            }
-        }
-    }
+/// The cause and numbers of the run in `dir` when its summary says it failed (a directory [`decide`] would start
+/// afresh: it has no checkpoint).
+fn failed_run(dir: &Path) -> Option<(String, RunNumbers)> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let summary = serde_json::from_str::<serde_json::Value>(&text).ok()?;
+    let status = summary.get("status")?.as_str()?;
+    let cause = status.trim_start_matches("failed").trim_start_matches(':').trim();
+    status
+        .starts_with("failed")
+        .then(|| (one_line(cause), RunNumbers::from_summary_text(&text)))
 }
 
 /// The campaign whose directory is `dir` (from the campaign file recorded there, [`CAMPAIGN_SOURCE`]).
@@ -97,20 +84,16 @@ pub fn merge_campaign(dir: &Path) -> Result<CampaignReport, CampaignError> {
     let campaign = campaign_of_dir(dir)?;
     // The index is rewritten: not while a campaign or a shard writes the directory.
     let _lock = lock_campaign_dir(dir, None)?;
-    let runs: Vec<RunRecord> = campaign
-        .points
-        .iter()
-        .map(|p| {
-            let (status, numbers) = status_of(&dir.join(&p.name), p);
-            RunRecord {
-                name: p.name.clone(),
-                action: Action::Skip,
-                status,
-                stopped: false,
-                numbers,
-            }
-        })
-        .collect();
+    // What each run directory shows by itself: completed, failed, a different run (conflict), or pending.
+    let (mut runs, _) = plan_runs(&campaign, None);
+    for r in &mut runs {
+        if r.action == Action::Start
+            && let Some((cause, numbers)) = failed_run(&dir.join(&r.name))
+        {
+            (r.status, r.numbers) = (RunStatus::Failed(cause), Some(numbers));
+        }
+        r.action = Action::Skip;
+    }
     index::write_campaign_csv(dir, CAMPAIGN_CSV, &campaign.points, &runs)?;
     Ok(CampaignReport {
         runs,
