@@ -213,7 +213,8 @@ pub fn judge_series(
     t_final_hours: f64,
     dir: PathBuf,
 ) -> HoldVerdict {
-    let end = window.unwrap_or(f64::INFINITY) + 1e-6;
+    // within a second: a hold's last sample lands a step's rounding past its nominal length (16 000.1 s of 16 000)
+    let end = window.unwrap_or(f64::INFINITY) + 1.0;
     let n = series.t_s.iter().take_while(|&&t| t <= end).count();
     let (t, theta, eta, cn) = (
         &series.t_s[..n],
@@ -958,6 +959,39 @@ mod tests {
         assert_eq!(long.drifting, vec!["coordination_number"]);
         // 0.04 contacts per particle lost over the second half: under the old tolerance of 0.05, creep by rates
         assert!(long.paper_tolerance.stable, "{long:?}");
+    }
+
+    /// A hold of 16 000 s whose last sample lands at 16 000.1 s (the hold's start is off the output grid) is read
+    /// whole by a 16 000 s window: the judged length and the verdicts are those of the hold without a window.
+    #[test]
+    fn a_window_keeps_the_sample_a_rounding_past_its_end() {
+        let mut t_s: Vec<f64> = (0..80).map(|k| 200.0 * k as f64).collect();
+        t_s.push(16_000.1);
+        let n = t_s.len();
+        let series = HoldSeries {
+            // θ_max jumps by 5° in the last sample only (a fitted rise of 0.7°): the tolerance verdict turns on it
+            theta_max_deg: (0..n).map(|k| if k + 1 == n { 35.0 } else { 30.0 }).collect(),
+            t_s,
+            packing: vec![0.65; n],
+            coordination: vec![5.5; n],
+            release_s: None,
+        };
+        let c = Criteria::default();
+        let whole = judge_series(&series, None, &c, CreepCriterionKind::Paper, 2.75, PathBuf::new());
+        let read = judge_series(
+            &series,
+            Some(16_000.0),
+            &c,
+            CreepCriterionKind::Paper,
+            2.75,
+            PathBuf::new(),
+        );
+        assert_eq!(read.hold_s, 16_000.1);
+        assert!(
+            !whole.paper_tolerance.stable && !read.paper_tolerance.stable,
+            "{read:?}"
+        );
+        assert_eq!(read.drifting, whole.drifting);
     }
 
     /// A hold whose judged record has too few samples is undecided, not creeping: its line says how long a record it
